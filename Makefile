@@ -1,0 +1,59 @@
+# ninjemys — set-up, tests and demo. `make test` and `make demo` work from a fresh clone.
+PYTHON ?= python3
+VENV   := .venv
+PY     := $(VENV)/bin/python
+STAMP  := $(VENV)/.installed
+
+# Debian's real ROS 1 (Noetic-era 1.15), used as the reference in interop and comparison tests.
+ROS1_DEBS := ros-core python3-rospy python3-rosbag python3-genpy python3-rosmsg python3-roslaunch \
+	python3-rostopic python3-rosnode python3-rosparam python3-rosservice python3-rosmaster rosout \
+	python3-std-msgs python3-std-srvs python3-geometry-msgs python3-sensor-msgs python3-nav-msgs \
+	python3-rosgraph-msgs python3-actionlib-msgs python3-actionlib python3-tf2-msgs \
+	python3-diagnostic-msgs python3-visualization-msgs python3-trajectory-msgs python3-shape-msgs \
+	python3-stereo-msgs python3-roscpp-msg libroscpp-dev libstd-srvs-dev ros-std-srvs catkin g++
+BROWSER_DEBS := chromium chromium-driver fonts-dejavu-core
+SYSTEM_DEBS  := $(ROS1_DEBS) $(BROWSER_DEBS) tmux
+
+.PHONY: all venv system lint format test test-fast demo bench clean
+
+all: venv
+
+$(STAMP): pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install -q --upgrade pip
+	$(PY) -m pip install -q -e '.[test]'
+	touch $(STAMP)
+
+venv: $(STAMP)
+
+# Installs the Debian packages the tests compare against (root or sudo needed; skipped when present).
+system:
+	@missing=""; for p in $(SYSTEM_DEBS); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
+	if [ -n "$$missing" ]; then \
+		echo "installing Debian packages:$$missing"; \
+		SUDO=""; [ "$$(id -u)" = 0 ] || SUDO=sudo; \
+		$$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends $$missing >/dev/null; \
+	fi
+
+lint: venv
+	$(VENV)/bin/ruff format --check src tests bench examples
+	$(VENV)/bin/ruff check src tests bench examples
+
+format: venv
+	$(VENV)/bin/ruff format src tests bench examples
+	$(VENV)/bin/ruff check --fix src tests bench examples
+
+test: venv system lint
+	$(VENV)/bin/pytest -n 2 -q
+
+test-fast: venv
+	$(VENV)/bin/pytest -n 2 -q -m "not ros1 and not browser and not slow"
+
+demo: venv
+	$(PY) -m ninjemys.demo
+
+bench: venv system
+	$(PY) bench/run_all.py
+
+clean:
+	rm -rf $(VENV) build dist src/*.egg-info .pytest_cache .ruff_cache

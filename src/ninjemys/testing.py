@@ -1,0 +1,49 @@
+"""Public test helpers: free ports, and locating Debian's real ROS 1 for comparison tests.
+
+Kept dependency-free so user test suites (and ours) can import it without starting anything.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import socket
+import sys
+from pathlib import Path
+
+#: Debian's real ROS 1 runs under the system interpreter, never the project's venv.
+ROS1_PYTHON = "/usr/bin/python3"
+ROS1_BIN = Path("/usr/bin")
+
+
+def free_port(host: str = "127.0.0.1") -> int:
+    """A TCP port that was free a moment ago (bind to 0, read it back, release it)."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind((host, 0))
+        return s.getsockname()[1]
+
+
+def have_ros1() -> bool:
+    """True when Debian's ROS 1 (rospy + rosmaster under /usr/bin/python3) is installed."""
+    return Path(ROS1_PYTHON).exists() and Path("/usr/lib/python3/dist-packages/rospy").is_dir()
+
+
+def ros1_env(master_uri: str, **extra: str) -> dict[str, str]:
+    """An environment for running real ROS 1 programs: no venv, no ninjemys on the path."""
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV", "PYTHONHOME")}
+    env["PATH"] = "/usr/bin:/bin:/usr/sbin:/sbin"
+    env["ROS_MASTER_URI"] = master_uri
+    env.setdefault("ROS_HOSTNAME", "localhost")
+    env.update(extra)
+    return env
+
+
+def ninjemys_bin(command: str) -> str:
+    """Full path of one of our console scripts (the venv's bin/, next to the running interpreter)."""
+    candidate = Path(sys.executable).parent / command
+    if candidate.exists():
+        return str(candidate)
+    found = shutil.which(command)
+    if found is None:
+        raise FileNotFoundError(f"ninjemys command {command!r} is not installed next to {sys.executable}")
+    return found
