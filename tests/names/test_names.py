@@ -10,7 +10,9 @@ def test_resolution_matches_ros1_rules():
 
 
 def test_remapping_is_resolved_before_matching():
-    remaps = names.resolve_remappings(names.load_mappings(["chatter:=/news", "__name:=x", "_rate:=5"]), "/ns/talker")
+    remaps = names.resolve_remappings(
+        names.load_mappings(["chatter:=/news", "__name:=x", "_rate:=5"]), "/ns/talker"
+    )
     assert remaps == {"/ns/chatter": "/news"}
     assert names.resolve_name("chatter", "/ns/talker", remaps) == "/news"
     assert names.private_param_args(["_rate:=5", "__ns:=/a", "foo:=bar"]) == {"rate": "5"}

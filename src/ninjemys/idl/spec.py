@@ -98,7 +98,11 @@ class MsgSpec:
     @property
     def has_header(self) -> bool:
         """ROS 1 rule: the first field is ``Header header`` (std_msgs/Header)."""
-        return bool(self.fields) and self.fields[0].type == FieldType(HEADER_TYPE) and self.fields[0].name == "header"
+        return (
+            bool(self.fields)
+            and self.fields[0].type == FieldType(HEADER_TYPE)
+            and self.fields[0].name == "header"
+        )
 
     @property
     def dependencies(self) -> tuple[str, ...]:
