@@ -1,0 +1,5 @@
+"""The ROS interface package ``actionlib_tutorials``, shipped with ninjemys.
+
+Its definitions live in ``ninjemys/interfaces/actionlib_tutorials/``. ``actionlib_tutorials.msg`` are lazy modules: a class is
+generated from its definition the first time its name is looked up, so importing this package costs nothing.
+"""
