@@ -1,0 +1,175 @@
+"""ROS time for a node: the wall clock, or simulated time driven by /clock.
+
+When the parameter ``/use_sim_time`` is true at node start, ROS time is whatever the last
+``rosgraph_msgs/Clock`` message on ``/clock`` said, and 0 until the first one arrives (ROS 1 semantics,
+so ``rospy.get_time()`` reads 0.0 before ``rosbag play --clock`` starts). Otherwise ROS time is
+``time.time()``.
+
+Everything that waits on ROS time (``sleep``, ``Rate``, ``Timer``) waits here, on one condition
+variable that is notified by every /clock message, by :meth:`Clock.wake` and by
+:meth:`Clock.shutdown`. There is no polling loop: a waiter in simulated time sleeps until time
+advances; a waiter in wall time sleeps for exactly the remaining interval. Shutdown wakes every
+waiter at once, which is what makes Ctrl-C end a node promptly. A simulated clock that jumps
+backwards (``rosbag play --loop``) bumps an epoch counter, so waiters can tell a jump from progress.
+"""
+
+from __future__ import annotations
+
+import enum
+import threading
+import time
+from collections.abc import Callable
+from typing import Any
+
+USE_SIM_TIME = "/use_sim_time"
+CLOCK_TOPIC = "/clock"
+
+
+class Wake(enum.Enum):
+    """Why :meth:`Clock.wait_until` returned."""
+
+    REACHED = "reached"
+    SHUTDOWN = "shutdown"
+    MOVED_BACKWARDS = "moved_backwards"
+    CANCELLED = "cancelled"
+
+
+class Clock:
+    """The ROS clock of one node (wall time unless ``sim`` is true).
+
+    ``now()`` is in seconds as a float; ``now_ns()`` gives exact integer nanoseconds, which is what
+    ``Time.now()`` is built from so simulated stamps round-trip bit-exactly.
+    """
+
+    def __init__(self, sim: bool = False, wall: Callable[[], float] = time.time) -> None:
+        self.is_sim = sim
+        self._wall = wall
+        self._sim_ns = 0
+        self._epoch = 0
+        self._shutdown = False
+        self._cond = threading.Condition(threading.Lock())
+        self._subscription: Any = None
+
+    # -- reading ------------------------------------------------------------------------------------
+    def now(self) -> float:
+        """ROS time in seconds (0.0 in simulated time until the first /clock message)."""
+        if self.is_sim:
+            return self._sim_ns / 1e9
+        return self._wall()
+
+    def now_ns(self) -> int:
+        """ROS time in integer nanoseconds."""
+        if self.is_sim:
+            return self._sim_ns
+        return time.time_ns() if self._wall is time.time else int(self._wall() * 1e9)
+
+    @property
+    def is_wallclock(self) -> bool:
+        return not self.is_sim
+
+    @property
+    def epoch(self) -> int:
+        """Incremented each time simulated time jumps backwards."""
+        return self._epoch
+
+    @property
+    def is_shutdown(self) -> bool:
+        return self._shutdown
+
+    # -- driving (simulated time) ----------------------------------------------------------------------
+    def set_time_ns(self, ns: int) -> None:
+        """Set simulated time (the /clock callback); a backwards step starts a new epoch."""
+        with self._cond:
+            if ns < self._sim_ns:
+                self._epoch += 1
+            self._sim_ns = ns
+            self._cond.notify_all()
+
+    def set_time(self, secs: int, nsecs: int = 0) -> None:
+        self.set_time_ns(int(secs) * 1_000_000_000 + int(nsecs))
+
+    def on_clock_message(self, msg: Any) -> None:
+        """Subscriber callback for rosgraph_msgs/Clock."""
+        stamp = msg.clock
+        self.set_time(stamp.secs, stamp.nsecs)
+
+    # -- waiting ----------------------------------------------------------------------------------------
+    def wake(self) -> None:
+        """Wake every waiter so it re-checks its own cancel condition (Timer.shutdown uses this)."""
+        with self._cond:
+            self._cond.notify_all()
+
+    def shutdown(self) -> None:
+        """Wake every waiter for good: all current and future waits return SHUTDOWN."""
+        with self._cond:
+            self._shutdown = True
+            self._cond.notify_all()
+        sub, self._subscription = self._subscription, None
+        if sub is not None:
+            try:
+                sub.unregister()
+            except Exception:  # the node may already be gone; nothing left to release
+                pass
+
+    def wait_until(self, target: float, cancelled: Callable[[], bool] | None = None) -> Wake:
+        """Block until ROS time reaches ``target`` seconds, shutdown, a backwards jump, or ``cancelled()``."""
+        with self._cond:
+            epoch = self._epoch
+            while True:
+                if self._shutdown:
+                    return Wake.SHUTDOWN
+                if cancelled is not None and cancelled():
+                    return Wake.CANCELLED
+                if self._epoch != epoch:
+                    return Wake.MOVED_BACKWARDS
+                remaining = target - self.now()
+                if remaining <= 0:
+                    return Wake.REACHED
+                self._cond.wait(None if self.is_sim else remaining)
+
+    def wait_for(self, seconds: float, cancelled: Callable[[], bool] | None = None) -> Wake:
+        """Sleep ``seconds`` of ROS time (see :meth:`wait_until`)."""
+        return self.wait_until(self.now() + seconds, cancelled)
+
+    # -- wiring to a node -------------------------------------------------------------------------------
+    def subscribe(self, node: Any, clock_class: type) -> None:
+        """Follow ``/clock`` on ``node`` (queue 1: only the newest time matters)."""
+        self._subscription = node.subscriber(CLOCK_TOPIC, clock_class, self.on_clock_message, queue_size=1)
+
+    def install(self) -> None:
+        """Make ``ninjemys.rostime.Time.now()`` read this clock (the process's ROS time)."""
+        from ninjemys import rostime
+
+        rostime.set_clock(self.now_pair)
+
+    def now_pair(self) -> tuple[int, int]:
+        """ROS time as (secs, nsecs), the form ``ninjemys.rostime`` clock hooks return."""
+        return divmod(self.now_ns(), 1_000_000_000)
+
+
+class FakeClock(Clock):
+    """A simulated clock that tests drive by hand: ``clock.advance(0.1)`` wakes sleepers due by then."""
+
+    def __init__(self, start: float = 0.0) -> None:
+        super().__init__(sim=True)
+        self._sim_ns = int(round(start * 1e9))
+
+    def advance(self, seconds: float) -> None:
+        self.set_time_ns(self._sim_ns + int(round(seconds * 1e9)))
+
+    def set(self, seconds: float) -> None:
+        self.set_time_ns(int(round(seconds * 1e9)))
+
+
+def for_node(node: Any) -> Clock:
+    """The clock a node should use: simulated when ``/use_sim_time`` is true at start, else wall time."""
+    try:
+        sim = bool(node.get_param(USE_SIM_TIME, False))
+    except Exception:  # an unreachable parameter server means no sim time, as in rospy
+        sim = False
+    clock = Clock(sim=sim)
+    if sim:
+        from ninjemys.idl.loader import get_message_class
+
+        clock.subscribe(node, get_message_class("rosgraph_msgs/Clock"))
+    return clock
