@@ -47,3 +47,13 @@ def ninjemys_bin(command: str) -> str:
     if found is None:
         raise FileNotFoundError(f"ninjemys command {command!r} is not installed next to {sys.executable}")
     return found
+
+
+def FakeClock(start: float = 0.0):  # noqa: N802 - reads as a class at call sites
+    """A simulated ROS clock that a test drives by hand (``clock.advance(0.5)``, ``clock.set(3.0)``).
+
+    Returns a :class:`ninjemys.node.clock.FakeClock`; imported on call so this module stays light.
+    """
+    from ninjemys.node.clock import FakeClock as _FakeClock
+
+    return _FakeClock(start)
