@@ -1,0 +1,170 @@
+"""What a node has told the master, and re-telling it when the master forgets (a restart).
+
+ROS 1 nodes register once; a restarted master knows nothing and the graph stays broken until every
+node is restarted (the most cited ROS 1 complaint). Here the registrar keeps the node's
+registrations and a watchdog thread checks once a second, with one cheap ``lookupNode`` call, that
+the master still knows this node. When the master is back but has forgotten us (a new run), every
+publisher, subscriber, service and parameter subscription is registered again; subscribers get
+the current publisher list, publishers trigger ``publisherUpdate`` to their subscribers, so the
+graph heals with no user action. If the master reports another URI for our name, a newer node took
+it: we do not fight (the master shuts us down, as in ROS 1).
+
+Registration calls made while the master is down are not errors: they are remembered and sent when
+it comes back.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+from collections.abc import Callable
+from typing import TYPE_CHECKING
+
+from ninjemys.errors import MasterError, MasterUnreachable
+from ninjemys.master.client import MasterClient
+
+if TYPE_CHECKING:
+    from ninjemys.node.node import Node
+
+_log = logging.getLogger(__name__)
+
+#: Seconds between two checks that the master still knows us.
+WATCH_PERIOD = 1.0
+
+
+class Registrar:
+    """Registrations of one node, with a watchdog that restores them on a new master."""
+
+    def __init__(self, node: Node) -> None:
+        self.node = node
+        self.publications: dict[str, str] = {}
+        self.subscriptions: dict[str, str] = {}
+        self.services: dict[str, str] = {}
+        self.param_keys: set[str] = set()
+        self._lock = threading.RLock()
+        self._stop = threading.Event()
+        self._master_down = False
+        # the watchdog has its own client (short timeout) so it never waits behind a user call
+        self._probe = MasterClient(node.master_uri, node.name, timeout=2.0)
+        self._thread: threading.Thread | None = None
+
+    def start(self) -> None:
+        self._thread = threading.Thread(target=self._watch, name=f"reg:{self.node.name}", daemon=True)
+        self._thread.start()
+
+    # -- registrations (user threads) ------------------------------------------------------------
+
+    def _try(self, what: str, fn: Callable[[], object]) -> object | None:
+        try:
+            return fn()
+        except MasterUnreachable as exc:
+            if not self._master_down:
+                _log.warning("%s: master unreachable, will register when it is back (%s)", what, exc)
+            self._master_down = True
+            return None
+
+    def add_publisher(self, topic: str, type_name: str) -> None:
+        with self._lock:
+            self.publications[topic] = type_name
+        self._try(
+            f"publisher {topic}", lambda: self.node.master.register_publisher(topic, type_name, self.node.uri)
+        )
+
+    def add_subscriber(self, topic: str, type_name: str) -> list[str] | None:
+        with self._lock:
+            self.subscriptions[topic] = type_name
+        result = self._try(
+            f"subscriber {topic}",
+            lambda: self.node.master.register_subscriber(topic, type_name, self.node.uri),
+        )
+        return list(result) if isinstance(result, list) else None
+
+    def add_service(self, name: str, service_uri: str) -> None:
+        with self._lock:
+            self.services[name] = service_uri
+        self._try(
+            f"service {name}", lambda: self.node.master.register_service(name, service_uri, self.node.uri)
+        )
+
+    def add_param_subscription(self, key: str) -> object | None:
+        with self._lock:
+            self.param_keys.add(key)
+        return self._try(f"param {key}", lambda: self.node.master.subscribe_param(self.node.uri, key))
+
+    def remove_publisher(self, topic: str, client: MasterClient | None = None) -> None:
+        with self._lock:
+            self.publications.pop(topic, None)
+        self._quiet(lambda c: c.unregister_publisher(topic, self.node.uri), client)
+
+    def remove_subscriber(self, topic: str, client: MasterClient | None = None) -> None:
+        with self._lock:
+            self.subscriptions.pop(topic, None)
+        self._quiet(lambda c: c.unregister_subscriber(topic, self.node.uri), client)
+
+    def remove_service(self, name: str, client: MasterClient | None = None) -> None:
+        with self._lock:
+            uri = self.services.pop(name, None)
+        if uri is not None:
+            self._quiet(lambda c: c.unregister_service(name, uri), client)
+
+    def _quiet(self, fn: Callable[[MasterClient], object], client: MasterClient | None) -> None:
+        try:
+            fn(client or self.node.master)
+        except MasterError as exc:
+            _log.debug("unregister: %s", exc)
+
+    # -- watchdog --------------------------------------------------------------------------------
+
+    def _watch(self) -> None:
+        while not self._stop.wait(WATCH_PERIOD):
+            with self._lock:
+                empty = not (self.publications or self.subscriptions or self.services or self.param_keys)
+            if empty and not self._master_down:
+                continue
+            try:
+                known = self._probe.lookup_node(self.node.name)
+            except MasterUnreachable:
+                self._master_down = True
+                continue
+            except MasterError:
+                known = None  # "unknown node": a new master
+            if known == self.node.uri and not self._master_down:
+                continue
+            if known not in (None, self.node.uri):
+                continue  # another node took our name; the master shuts us down
+            if self._stop.is_set():
+                return
+            self._reregister()
+
+    def _reregister(self) -> None:
+        with self._lock:
+            pubs = dict(self.publications)
+            subs = dict(self.subscriptions)
+            srvs = dict(self.services)
+            keys = set(self.param_keys)
+        if pubs or subs or srvs or keys:
+            _log.info(
+                "master at %s does not know %s: registering again", self.node.master_uri, self.node.name
+            )
+        master, uri = self._probe, self.node.uri
+        try:
+            for topic, type_name in pubs.items():
+                master.register_publisher(topic, type_name, uri)
+            for topic, type_name in subs.items():
+                publishers = master.register_subscriber(topic, type_name, uri)
+                self.node._publisher_update(topic, list(publishers))
+            for name, service_uri in srvs.items():
+                master.register_service(name, service_uri, uri)
+            for key in keys:
+                master.subscribe_param(uri, key)
+        except MasterError as exc:
+            _log.info("re-registration interrupted: %s", exc)
+            self._master_down = True
+            return
+        self._master_down = False
+
+    def stop(self) -> None:
+        self._stop.set()
+        if self._thread is not None and self._thread is not threading.current_thread():
+            self._thread.join(3.0)
+        self._probe.close()

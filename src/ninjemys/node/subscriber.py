@@ -1,0 +1,333 @@
+"""Subscribing over TCPROS: connections read on the I/O loop, callbacks on one worker per Subscriber.
+
+The loop reads each publisher's stream with ``recv_into`` into a preallocated buffer and cuts it
+into frames (bytes, still serialized). Every Subscriber handle owns a bounded queue (``queue_size``,
+the oldest frame dropped first) and a worker thread that deserializes and calls back, so:
+
+* a dropped message is never deserialized;
+* callbacks never run on the I/O thread, and a slow callback delays only its own subscriber;
+* the loop reads everything the kernel has, so ``queue_size=1`` really means "the latest message",
+  whatever ``buff_size`` (rospy's ros_comm#536 does not apply).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+import socket
+import threading
+from collections import deque
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+from ninjemys.errors import NinjemysError, ProtocolError
+from ninjemys.net import xmlrpc_client
+from ninjemys.node import transport
+from ninjemys.node.topics import connection_ids
+from ninjemys.wire import headers
+from ninjemys.wire.tcpros import FrameReader
+
+if TYPE_CHECKING:
+    from ninjemys.node.node import Node
+
+_log = logging.getLogger(__name__)
+
+
+@dataclass(slots=True)
+class RawMessage:
+    """What a ``raw=True`` subscriber receives: the serialized bytes and the publisher's header."""
+
+    data: bytes | bytearray
+    connection_header: Mapping[str, str] = field(default_factory=dict)
+
+
+class SubConnection:
+    """One publisher's stream for one topic, read on the loop."""
+
+    def __init__(self, sub: Subscription, sock: socket.socket, uri: str, header: Mapping[str, str]) -> None:
+        self.sub = sub
+        self.sock = sock
+        self.fd = sock.fileno()
+        self.uri = uri
+        self.header = dict(header)
+        self.publisher = header.get("callerid", uri)
+        self.latching = header.get("latching", "0") == "1"
+        self.last: bytes | bytearray | None = None
+        self.id = next(connection_ids)
+        self.bytes_recv = 0
+        self.num_recv = 0
+        self.closed = False
+        self._reader = FrameReader()
+
+    def start(self) -> None:
+        self.sub.node.runtime.loop.add_reader(self.fd, self._on_readable)
+
+    def _on_readable(self) -> None:
+        reader = self._reader
+        try:
+            n = self.sock.recv_into(reader.buffer())
+        except (BlockingIOError, InterruptedError):
+            return
+        except OSError as exc:
+            self._lost(f"read failed: {exc}")
+            return
+        if n == 0:
+            if reader.pending:
+                self._lost(f"publisher disconnected mid-message ({reader.pending} bytes of a frame received)")
+            else:
+                self._lost("publisher closed the connection")
+            return
+        self.bytes_recv += n
+        try:
+            frames = reader.commit(n)
+        except ProtocolError as exc:
+            _log.warning("topic %s: dropped publisher %s: %s", self.sub.topic, self.publisher, exc)
+            self.close()
+            self.sub.connection_lost(self, retry=False)
+            return
+        if frames:
+            self.num_recv += len(frames)
+            if self.latching:
+                self.last = frames[-1]
+            for handle in self.sub.handles:
+                handle.enqueue(frames, self.header)
+
+    def _lost(self, why: str) -> None:
+        _log.info("topic %s: %s (%s)", self.sub.topic, why, self.publisher)
+        self.close()
+        self.sub.connection_lost(self, retry=True)
+
+    def close(self) -> None:
+        """Close on the loop thread (or before start)."""
+        if self.closed:
+            return
+        self.closed = True
+        try:
+            self.sub.node.runtime.loop.remove_reader(self.fd)
+        except (ValueError, OSError):
+            pass
+        transport.close_quietly(self.sock)
+
+
+class Subscription:
+    """A topic this node subscribes to: the publisher connections and the handles fed by them."""
+
+    def __init__(self, node: Node, topic: str, msg_class: Any, tcp_nodelay: bool) -> None:
+        self.node = node
+        self.topic = topic
+        self.msg_class = msg_class
+        self.type_name: str = getattr(msg_class, "_type", "*") if msg_class is not None else "*"
+        self.md5sum: str = getattr(msg_class, "_md5sum", "*") if msg_class is not None else "*"
+        self.definition: str = getattr(msg_class, "_full_text", "") if msg_class is not None else ""
+        self.tcp_nodelay = tcp_nodelay
+        self.handles: list[Subscriber] = []
+        self.connections: dict[str, SubConnection] = {}
+        self.publishers: list[str] = []
+        self._connecting: set[str] = set()
+        self.closed = False
+
+    # -- publisher set (on the loop) -------------------------------------------------------------
+
+    def update_publishers(self, uris: list[str]) -> None:
+        """publisherUpdate semantics: connect to new URIs, drop connections to missing ones."""
+        if self.closed:
+            return
+        self.publishers = list(uris)
+        wanted = set(uris)
+        for uri, conn in list(self.connections.items()):
+            if uri not in wanted:
+                conn.close()
+                del self.connections[uri]
+        loop = self.node.runtime.loop
+        for uri in uris:
+            if uri not in self.connections and uri not in self._connecting:
+                self._connecting.add(uri)
+                loop.create_task(self._connect(uri))
+
+    async def _connect(self, uri: str, attempt: int = 0) -> None:
+        sock: socket.socket | None = None
+        try:
+            reply = await xmlrpc_client.call(
+                uri, "requestTopic", (self.node.name, self.topic, [["TCPROS"]]), timeout=5.0
+            )
+            code, status, proto = reply
+            if code != 1 or not proto or proto[0] != "TCPROS":
+                _log.info("topic %s: publisher %s declined: %s", self.topic, uri, status)
+                return
+            host, port = proto[1], int(proto[2])
+            sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+            transport.tune(sock, self.tcp_nodelay)
+            async with asyncio.timeout(5.0):
+                await asyncio.get_running_loop().sock_connect(sock, (host, port))
+            await transport.write_all(sock, headers.encode_header(self._header()))
+            header = await transport.read_header(sock)
+            error = headers.check_publisher_header(header, self.type_name, self.md5sum)
+            if error is not None:
+                _log.warning("topic %s: cannot subscribe to %s: %s", self.topic, uri, error)
+                transport.close_quietly(sock)
+                return
+            if self.closed or uri not in self.publishers:
+                transport.close_quietly(sock)
+                return
+            conn = SubConnection(self, sock, uri, header)
+            old = self.connections.pop(uri, None)
+            if old is not None:
+                old.close()
+            self.connections[uri] = conn
+            conn.start()
+        except (OSError, TimeoutError, NinjemysError, ValueError, TypeError) as exc:
+            why = "timed out" if isinstance(exc, TimeoutError) else str(exc) or type(exc).__name__
+            _log.info("topic %s: could not connect to publisher %s: %s", self.topic, uri, why)
+            if sock is not None:
+                transport.close_quietly(sock)
+        except Exception as exc:  # an unexpected reply shape from a foreign peer
+            _log.warning("topic %s: bad answer from publisher %s: %s", self.topic, uri, exc)
+            if sock is not None:
+                transport.close_quietly(sock)
+        finally:
+            self._connecting.discard(uri)
+
+    def _header(self) -> dict[str, str]:
+        return {
+            "callerid": self.node.name,
+            "topic": self.topic,
+            "md5sum": self.md5sum,
+            "type": self.type_name,
+            "message_definition": self.definition,
+            "tcp_nodelay": "1" if self.tcp_nodelay else "0",
+        }
+
+    def connection_lost(self, conn: SubConnection, retry: bool) -> None:
+        """A stream ended (on the loop): forget it; if the publisher is still listed, try once more."""
+        if self.connections.get(conn.uri) is conn:
+            del self.connections[conn.uri]
+        if retry and not self.closed and conn.uri in self.publishers:
+            self.node.runtime.loop.call_later(0.5, self._retry, conn.uri)
+
+    def _retry(self, uri: str) -> None:
+        if self.closed or uri not in self.publishers or uri in self.connections or uri in self._connecting:
+            return
+        self._connecting.add(uri)
+        self.node.runtime.loop.create_task(self._connect(uri))
+
+    def latched_frames(self) -> list[tuple[bytes | bytearray, Mapping[str, str]]]:
+        return [(c.last, c.header) for c in self.connections.values() if c.last is not None]
+
+    def close(self) -> None:
+        """On the loop: close every stream."""
+        self.closed = True
+        for conn in self.connections.values():
+            conn.close()
+        self.connections.clear()
+
+
+class Subscriber:
+    """A callback subscription; see :meth:`ninjemys.node.Node.subscriber`."""
+
+    def __init__(
+        self,
+        subscription: Subscription,
+        callback: Callable[..., Any] | None,
+        callback_args: Any = None,
+        queue_size: int | None = None,
+        raw: bool = False,
+    ) -> None:
+        self._sub = subscription
+        self.name = subscription.topic
+        self.resolved_name = subscription.topic
+        self.data_class = subscription.msg_class
+        self.type = subscription.type_name
+        self.md5sum = subscription.md5sum
+        self.queue_size = queue_size
+        self.raw = raw
+        self.dropped = 0
+        self._callbacks: list[tuple[Callable[..., Any], Any]] = []
+        if callback is not None:
+            self._callbacks.append((callback, callback_args))
+        self._queue: deque[tuple[bytes | bytearray, Mapping[str, str]]] = deque(
+            maxlen=queue_size if queue_size and queue_size > 0 else None
+        )
+        self._wake = threading.Event()
+        self._closed = False
+        self._thread = subscription.node.runtime.start_thread(self._work, f"sub:{subscription.topic}")
+
+    # -- producer side (the loop) ----------------------------------------------------------------
+
+    def enqueue(self, frames: list[bytes | bytearray], header: Mapping[str, str]) -> None:
+        queue = self._queue
+        maxlen = queue.maxlen
+        if maxlen is not None:
+            overflow = len(queue) + len(frames) - maxlen
+            if overflow > 0:
+                self.dropped += overflow
+                if len(frames) > maxlen:
+                    frames = frames[-maxlen:]
+        queue.extend([(f, header) for f in frames])
+        self._wake.set()
+
+    # -- consumer side (the worker thread) -------------------------------------------------------
+
+    def _work(self) -> None:
+        queue, wake = self._queue, self._wake
+        while True:
+            try:
+                frame, header = queue.popleft()
+            except IndexError:
+                if self._closed:
+                    return
+                wake.clear()
+                if queue or self._closed:
+                    continue
+                wake.wait()
+                continue
+            if self._closed:
+                return
+            self._deliver(frame, header)
+
+    def _deliver(self, frame: bytes | bytearray, header: Mapping[str, str]) -> None:
+        if self.raw or self._sub.msg_class is None:
+            msg: Any = RawMessage(frame, header)
+        else:
+            try:
+                msg = self._sub.msg_class.deserialize_from(frame)
+            except Exception as exc:  # generated code raises DeserializationError, struct.error, ...
+                _log.warning(
+                    "topic %s: cannot deserialize a %d-byte %s from %s: %s",
+                    self.name,
+                    len(frame),
+                    self.type,
+                    header.get("callerid", "?"),
+                    exc,
+                )
+                return
+        for callback, args in list(self._callbacks):
+            try:
+                if args is None:
+                    callback(msg)
+                else:
+                    callback(msg, args)
+            except Exception:
+                _log.exception("topic %s: callback %r raised", self.name, callback)
+
+    # -- API -------------------------------------------------------------------------------------
+
+    def add_callback(self, callback: Callable[..., Any], callback_args: Any = None) -> None:
+        self._callbacks.append((callback, callback_args))
+
+    def get_num_connections(self) -> int:
+        return len(self._sub.connections)
+
+    def unregister(self) -> None:
+        """Stop receiving; the worker thread ends (joined unless called from a callback)."""
+        if self._closed:
+            return
+        self._closed = True
+        self._wake.set()
+        self._sub.node._drop_subscriber(self)
+        if threading.current_thread() is not self._thread:
+            self._thread.join(2.0)
+
+    @property
+    def closed(self) -> bool:
+        return self._closed

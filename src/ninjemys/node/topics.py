@@ -1,0 +1,307 @@
+"""Publishing over TCPROS: one Publication per topic per node, any number of Publisher handles.
+
+The publish path is built for latency and throughput:
+
+* the message is serialized once, in the caller's thread, whatever the number of subscribers (so
+  the caller may modify it afterwards, as in rospy);
+* for each connection whose queue is empty the frame is written straight to the (non-blocking)
+  socket from the caller's thread: no hand-off, no wake-up of another thread;
+* only when the kernel buffer is full does the frame wait in the connection's queue; the I/O loop
+  then drains the queue in batches (many frames joined into one ``send``).
+* ``queue_size=N`` bounds each connection's queue and drops the oldest frame; ``queue_size=None``
+  waits until the queue has drained (synchronous, lossless, as rospy).
+
+A slow subscriber therefore costs the publisher nothing but its own connection's queue.
+Latching is per Publisher handle: a new subscriber receives the last message of every latched
+handle of the topic right after the connection header (ROS 1 kept one per topic per process).
+"""
+
+from __future__ import annotations
+
+import itertools
+import logging
+import socket
+import threading
+from collections import deque
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any
+
+from ninjemys.errors import SerializationError, ShutdownError
+from ninjemys.node import transport
+from ninjemys.wire import headers
+from ninjemys.wire.tcpros import pack_len
+
+if TYPE_CHECKING:
+    from ninjemys.node.node import Node
+
+_log = logging.getLogger(__name__)
+
+#: Connection ids for getBusStats/getBusInfo, unique in the process.
+connection_ids = itertools.count(1)
+
+#: Most bytes joined into one send when the loop drains a queue.
+_BATCH_BYTES = 1 << 20
+
+
+class PubConnection:
+    """One subscriber of one topic: a non-blocking socket plus the frames the kernel did not take yet."""
+
+    def __init__(self, node: Node, sock: socket.socket, topic: str, subscriber: str, uri: str = "") -> None:
+        self.node = node
+        self.sock = sock
+        self.fd = sock.fileno()
+        self.topic = topic
+        self.subscriber = subscriber
+        self.uri = uri
+        self.id = next(connection_ids)
+        self.bytes_sent = 0
+        self.num_sent = 0
+        self.dropped = 0
+        self.closed = False
+        self._cond = threading.Condition(threading.Lock())
+        self._partial: memoryview | None = None  # the head frame, partly written
+        self._queue: deque[bytes] = deque()
+        self._armed = False  # the loop watches the socket for writability
+
+    @property
+    def idle(self) -> bool:
+        return self._partial is None and not self._queue
+
+    def send(self, data: bytes, queue_size: int | None) -> None:
+        """Queue ``data`` (one or more frames) for this subscriber; never blocks unless queue_size is None."""
+        with self._cond:
+            if self.closed:
+                return
+            if self._partial is None and not self._queue:
+                try:
+                    n = self.sock.send(data)
+                except (BlockingIOError, InterruptedError):
+                    n = 0
+                except OSError as exc:
+                    self._fail(f"write failed: {exc}")
+                    return
+                self.bytes_sent += n
+                if n == len(data):
+                    self.num_sent += 1
+                    return
+                self._partial = memoryview(data)[n:]
+            else:
+                self._queue.append(data)
+                if queue_size and len(self._queue) > queue_size:
+                    self._queue.popleft()
+                    self.dropped += 1
+            if not self._armed:
+                self._armed = True
+                self.node.runtime.call_soon(self._arm)
+            if queue_size is None:
+                while not self.closed and not (self._partial is None and not self._queue):
+                    self._cond.wait()
+
+    def _arm(self) -> None:
+        if self.closed:
+            return
+        try:
+            self.node.runtime.loop.add_writer(self.fd, self._drain)
+        except (ValueError, OSError) as exc:
+            with self._cond:
+                self._fail(f"cannot watch socket: {exc}")
+
+    def _drain(self) -> None:
+        """Writable: push the partial frame, then batches of queued frames (on the loop)."""
+        with self._cond:
+            if self.closed:
+                return
+            try:
+                while True:
+                    if self._partial is None:
+                        if not self._queue:
+                            break
+                        self._partial = memoryview(self._take_batch())
+                    n = self.sock.send(self._partial)
+                    self.bytes_sent += n
+                    if n < len(self._partial):
+                        self._partial = self._partial[n:]
+                        return
+                    self._partial = None
+            except (BlockingIOError, InterruptedError):
+                return
+            except OSError as exc:
+                self._fail(f"write failed: {exc}")
+                return
+            self._armed = False
+            self.node.runtime.loop.remove_writer(self.fd)
+            self._cond.notify_all()
+
+    def _take_batch(self) -> bytes:
+        queue = self._queue
+        if len(queue) == 1:
+            self.num_sent += 1
+            return queue.popleft()
+        parts, size = [], 0
+        while queue and size < _BATCH_BYTES:
+            item = queue.popleft()
+            parts.append(item)
+            size += len(item)
+        self.num_sent += len(parts)
+        return b"".join(parts)
+
+    def _fail(self, why: str) -> None:
+        """Called with the lock held: log once, close, wake blocked publishers."""
+        if not self.closed:
+            _log.info("topic %s: dropped subscriber %s: %s", self.topic, self.subscriber, why)
+        self._close_locked()
+
+    def _close_locked(self) -> None:
+        if self.closed:
+            return
+        self.closed = True
+        self._queue.clear()
+        self._partial = None
+        self._cond.notify_all()
+        self.node.runtime.call_soon(self._release_socket)
+        self.node.runtime.call_soon(self.node._topic_connection_closed, self)
+
+    def _release_socket(self) -> None:
+        try:
+            self.node.runtime.loop.remove_writer(self.fd)
+        except (ValueError, OSError):
+            pass
+        transport.close_quietly(self.sock)
+
+    def close(self) -> None:
+        with self._cond:
+            self._close_locked()
+
+
+class Publication:
+    """A topic this node publishes: type, connections, and the Publisher handles sharing them."""
+
+    def __init__(self, node: Node, topic: str, msg_class: Any) -> None:
+        self.node = node
+        self.topic = topic
+        self.msg_class = msg_class
+        self.type_name: str = msg_class._type
+        self.md5sum: str = msg_class._md5sum
+        self.definition: str = getattr(msg_class, "_full_text", "")
+        self.connections: tuple[PubConnection, ...] = ()
+        self.handles: list[Publisher] = []
+        self.lock = threading.Lock()
+        self.bytes_sent_closed = 0
+
+    def reply_header(self, extra: Mapping[str, str]) -> dict[str, str]:
+        latching = any(h.latch for h in self.handles)
+        fields = {
+            "callerid": self.node.name,
+            "topic": self.topic,
+            "type": self.type_name,
+            "md5sum": self.md5sum,
+            "message_definition": self.definition,
+            "latching": "1" if latching else "0",
+        }
+        for handle in self.handles:
+            fields.update(handle.headers)
+        fields.update(extra)
+        return fields
+
+    async def accept(self, sock: socket.socket, header: Mapping[str, str]) -> None:
+        """A subscriber connected (on the loop): check its header, answer, start streaming."""
+        error = headers.check_subscriber_header(header, self.topic, self.type_name, self.md5sum)
+        who = header.get("callerid", transport.peer_name(sock))
+        if error is not None:
+            _log.warning("topic %s: refused subscriber %s: %s", self.topic, who, error)
+            await transport.send_error_header(sock, error)
+            transport.close_quietly(sock)
+            return
+        nodelay = header.get("tcp_nodelay", "0") == "1"
+        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1 if nodelay else 0)
+        conn = PubConnection(self.node, sock, self.topic, who)
+        with self.lock:
+            reply = headers.encode_header(self.reply_header({}))
+            latched = b"".join(h.latched for h in self.handles if h.latch and h.latched is not None)
+            conn.send(reply + latched, queue_size=0)
+            conn.num_sent = 1 if latched else 0
+            self.connections = (*self.connections, conn)
+
+    def publish_frame(self, data: bytes, handle: Publisher) -> None:
+        with self.lock:
+            if handle.latch:
+                handle.latched = data
+            conns = self.connections
+        queue_size = handle.queue_size
+        for conn in conns:
+            conn.send(data, queue_size)
+
+    def remove_connection(self, conn: PubConnection) -> None:
+        with self.lock:
+            if conn in self.connections:
+                self.connections = tuple(c for c in self.connections if c is not conn)
+                self.bytes_sent_closed += conn.bytes_sent
+
+    def close(self) -> None:
+        with self.lock:
+            conns, self.connections = self.connections, ()
+        for conn in conns:
+            conn.close()
+
+
+class Publisher:
+    """A handle to publish on a topic; see :meth:`ninjemys.node.Node.publisher`."""
+
+    def __init__(
+        self,
+        publication: Publication,
+        queue_size: int | None,
+        latch: bool,
+        headers: Mapping[str, str] | None,
+    ) -> None:
+        self._pub = publication
+        self.name = publication.topic
+        self.resolved_name = publication.topic
+        self.data_class = publication.msg_class
+        self.type = publication.type_name
+        self.md5sum = publication.md5sum
+        self.queue_size = queue_size
+        self.latch = latch
+        self.headers = dict(headers or {})
+        self.latched: bytes | None = None
+        self._has_header = bool(getattr(publication.msg_class, "_has_header", False))
+        self._seq = 0
+        self._closed = False
+
+    def publish(self, msg: Any) -> None:
+        """Serialize ``msg`` once and send it to every subscriber (see the module docstring)."""
+        if self._closed:
+            raise ShutdownError(f"publisher of {self.name} is unregistered")
+        if self._has_header:
+            header = msg.header
+            header.seq = self._seq
+            self._seq += 1
+        try:
+            payload = msg.serialize_to_bytes()
+        except AttributeError:
+            if not hasattr(msg, "serialize_to_bytes"):
+                raise SerializationError(
+                    f"topic {self.name}: expected a {self.type} message, got {type(msg).__name__}"
+                ) from None
+            raise
+        self._pub.publish_frame(pack_len(len(payload)) + payload, self)
+
+    def publish_raw(self, payload: bytes | bytearray | memoryview) -> None:
+        """Send already-serialized bytes (relays, bag play, AnyMsg)."""
+        if self._closed:
+            raise ShutdownError(f"publisher of {self.name} is unregistered")
+        self._pub.publish_frame(pack_len(len(payload)) + bytes(payload), self)
+
+    def get_num_connections(self) -> int:
+        return len(self._pub.connections)
+
+    def unregister(self) -> None:
+        """Stop publishing; the last handle of a topic unregisters it from the master."""
+        if self._closed:
+            return
+        self._closed = True
+        self._pub.node._drop_publisher(self)
+
+    @property
+    def closed(self) -> bool:
+        return self._closed

@@ -1,0 +1,152 @@
+"""Socket plumbing shared by topics and services: header exchange and the node's TCPROS server.
+
+All coroutines here run on the runtime loop. Every read has a deadline and every length is checked
+before anything is allocated, so a silent, slow or lying peer costs one log line and one closed
+socket, never a hung or crashed node.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+import socket
+from collections.abc import Callable, Mapping
+
+from ninjemys.errors import ProtocolError
+from ninjemys.wire import headers
+
+_log = logging.getLogger(__name__)
+
+#: How long a peer may take to send its connection header.
+HEADER_TIMEOUT = 10.0
+
+
+def tune(sock: socket.socket, nodelay: bool = True) -> None:
+    """Non-blocking, TCP_NODELAY as asked, keepalive on (a vanished peer is eventually noticed)."""
+    sock.setblocking(False)
+    try:
+        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1 if nodelay else 0)
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_KEEPALIVE, 1)
+    except OSError:
+        pass
+
+
+def close_quietly(sock: socket.socket) -> None:
+    try:
+        sock.close()
+    except OSError:
+        pass
+
+
+async def read_exact(sock: socket.socket, n: int) -> bytearray:
+    """Exactly ``n`` bytes from a non-blocking socket; ProtocolError if the peer closes first."""
+    loop = asyncio.get_running_loop()
+    buf = bytearray(n)
+    view = memoryview(buf)
+    got = 0
+    while got < n:
+        k = await loop.sock_recv_into(sock, view[got:])
+        if k == 0:
+            raise ProtocolError(f"peer closed the connection after {got} of {n} bytes")
+        got += k
+    return buf
+
+
+async def read_header(sock: socket.socket, timeout: float = HEADER_TIMEOUT) -> dict[str, str]:
+    """Read and decode one connection header, with a deadline."""
+    async with asyncio.timeout(timeout):
+        length = headers.header_length(await read_exact(sock, 4))
+        return headers.decode_header(await read_exact(sock, length))
+
+
+async def write_all(sock: socket.socket, data: bytes) -> None:
+    await asyncio.get_running_loop().sock_sendall(sock, data)
+
+
+async def send_error_header(sock: socket.socket, text: str) -> None:
+    """Tell the peer why we refuse (``error=``), as roscpp/rospy do, then the caller closes."""
+    try:
+        async with asyncio.timeout(2.0):
+            await write_all(sock, headers.encode_header({"error": text}))
+    except (OSError, TimeoutError):
+        pass
+
+
+def peer_name(sock: socket.socket) -> str:
+    try:
+        host, port = sock.getpeername()[:2]
+        return f"{host}:{port}"
+    except OSError:
+        return "?"
+
+
+InboundHandler = Callable[[socket.socket, Mapping[str, str]], "asyncio.Future[None] | None"]
+
+
+class TcprosServer:
+    """The node's one TCPROS listening socket; routes each inbound connection by its header.
+
+    ``on_topic(sock, header)`` / ``on_service(sock, header)`` are coroutines that take ownership of
+    the socket. Headers with neither ``topic`` nor ``service`` get an error header and are closed.
+    """
+
+    def __init__(self, on_topic: Callable, on_service: Callable, host: str = "0.0.0.0") -> None:
+        self._on_topic = on_topic
+        self._on_service = on_service
+        self._sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        self._sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        self._sock.bind((host, 0))
+        self._sock.listen(128)
+        self._sock.setblocking(False)
+        self.port: int = self._sock.getsockname()[1]
+        self._task: asyncio.Task[None] | None = None
+        self._conns: set[asyncio.Task[None]] = set()
+
+    def start(self) -> None:
+        """Begin accepting (call on the loop)."""
+        self._task = asyncio.get_running_loop().create_task(self._accept_loop())
+
+    async def _accept_loop(self) -> None:
+        loop = asyncio.get_running_loop()
+        while True:
+            try:
+                conn, _ = await loop.sock_accept(self._sock)
+            except OSError as exc:
+                if self._sock.fileno() < 0:
+                    return
+                _log.warning("TCPROS accept failed: %s", exc)
+                await asyncio.sleep(0.05)
+                continue
+            tune(conn)
+            task = loop.create_task(self._route(conn))
+            self._conns.add(task)
+            task.add_done_callback(self._conns.discard)
+
+    async def _route(self, sock: socket.socket) -> None:
+        try:
+            header = await read_header(sock)
+        except (ProtocolError, OSError, TimeoutError) as exc:
+            why = "no connection header within the deadline" if isinstance(exc, TimeoutError) else exc
+            _log.warning("TCPROS: dropped inbound connection from %s: %s", peer_name(sock), why)
+            close_quietly(sock)
+            return
+        try:
+            if "topic" in header:
+                await self._on_topic(sock, header)
+            elif "service" in header:
+                await self._on_service(sock, header)
+            else:
+                _log.warning("TCPROS: connection from %s names no topic or service", peer_name(sock))
+                await send_error_header(sock, "no topic or service name detected")
+                close_quietly(sock)
+        except Exception as exc:  # a handler bug must not kill the accept loop
+            _log.error("TCPROS: error handling connection from %s: %s", peer_name(sock), exc)
+            close_quietly(sock)
+
+    def close(self) -> None:
+        """Stop accepting (call on the loop)."""
+        if self._task is not None:
+            self._task.cancel()
+        for task in list(self._conns):
+            task.cancel()
+        close_quietly(self._sock)
