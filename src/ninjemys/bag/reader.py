@@ -303,6 +303,35 @@ class BagReader:
             self._chunk_headers = {}
         self._chunk_headers[pos] = ChunkHeader(kind, dlen, size, dpos)
 
+    def chunk_extent(self, info: ChunkInfo) -> tuple[int, int | None]:
+        """(end of the chunk record, end of its INDEX_DATA records or None if they are not all intact)."""
+        fields, dpos, dlen, _ = self._record_at(info.pos, read_data=False)
+        chunk_end = dpos + dlen
+        pos = chunk_end
+        try:
+            for _ in range(len(info.counts)):
+                fields, dpos, dlen, _ = self._record_at(pos, read_data=False)
+                if field_op(fields, f"{self.path}:{pos}") != OP_INDEX_DATA or dpos + dlen > self.size:
+                    return chunk_end, None
+                pos = dpos + dlen
+        except BagError:
+            return chunk_end, None
+        return chunk_end, pos
+
+    def is_partial(self, info: ChunkInfo) -> bool:
+        """True for a chunk cut short in the file (its messages came from a partial decompression)."""
+        scanned = self._scanned.get(info.pos)
+        return scanned is not None and scanned.data is not None
+
+    def chunk_entries(self, info: ChunkInfo) -> list[tuple[int, int, int]]:
+        """(ns, conn, offset) of every message in one chunk, in time order."""
+        return self._chunk_data_and_entries(info, set(info.counts))[1]
+
+    def chunk_records(self, info: ChunkInfo) -> Iterator[RawMessage]:
+        """Every message of one chunk in time order (reindex rewrites a partial chunk from these)."""
+        data, entries = self._chunk_data_and_entries(info, set(info.counts))
+        yield from self._emit(data, entries, info, 0, 1 << 64)
+
     # -- queries ---------------------------------------------------------------------------------
 
     @property
@@ -348,6 +377,26 @@ class BagReader:
     def count(self, connections: Iterable[Connection]) -> int:
         ids = {c.id for c in connections}
         return sum(n for info in self.chunk_infos for conn, n in info.counts.items() if conn in ids)
+
+    def index_times(self, ids: set[int]) -> list[int]:
+        """Sorted times (ns) of every message on connections ``ids``, from the index records only."""
+        times: list[int] = []
+        for info in self.chunk_infos:
+            if not any(conn in ids for conn in info.counts):
+                continue
+            scanned = self._scanned.get(info.pos)
+            if scanned is not None:
+                times.extend(e[0] for e in scanned.entries if e[1] in ids)
+                continue
+            fields, dpos, dlen, _ = self._record_at(info.pos, read_data=False)
+            pos = dpos + dlen
+            for _ in range(len(info.counts)):
+                fields, dpos, dlen, raw = self._record_at(pos)
+                if field_u32(fields, "conn", f"{self.path}:{pos}") in ids:
+                    times.extend(s * NSEC + n for s, n, _o in INDEX_ENTRY.iter_unpack(raw or b""))
+                pos = dpos + dlen
+        times.sort()
+        return times
 
     # -- reading messages ------------------------------------------------------------------------
 
