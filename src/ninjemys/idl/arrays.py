@@ -1,0 +1,140 @@
+"""Zero-copy values for deserialized arrays.
+
+Representation choice (why): genpy turns a ``float32[]`` of 720 ranges into a tuple of 720 Python
+floats and copies a 6 MB image into a fresh ``bytes``; both cost time proportional to the data on
+every received message, even when the callback only looks at a few values or hands the buffer to numpy.
+ninjemys instead keeps views over the received buffer:
+
+* ``uint8[]`` / ``char[]`` (variable length) deserialize to a read-only ``memoryview`` (format ``B``)
+  over the received bytes: ``len``, indexing, slicing, iteration, ``bytes(x)``, ``x == b"..."``,
+  ``np.frombuffer(x, ...)`` and re-serialization all work without a copy. Fixed-size ``uint8[N]``
+  stays ``bytes``, as in genpy.
+* other variable-length numeric arrays deserialize to :class:`NumericArray`, an immutable sequence
+  over a typed memoryview: elements are converted to Python numbers only when read; it compares equal
+  to lists, tuples and other sequences with the same values; ``numpy.asarray(x)`` is a zero-copy view;
+  re-serializing it writes the original bytes back without touching the elements. Fixed-size numeric
+  arrays (covariances, ...) stay tuples, as in genpy.
+
+Both keep the received buffer alive; the caller of ``deserialize_from`` must not mutate that buffer
+afterwards (the node runtime hands over each received frame as immutable ``bytes``).
+"""
+
+from __future__ import annotations
+
+import struct
+import sys
+from collections.abc import Iterator, Sequence
+from typing import Any
+
+#: struct/memoryview format char -> numpy dtype string (little-endian wire layout)
+NUMPY_DTYPES = {
+    "b": "<i1",
+    "B": "<u1",
+    "h": "<i2",
+    "H": "<u2",
+    "i": "<i4",
+    "I": "<u4",
+    "q": "<i8",
+    "Q": "<u8",
+    "f": "<f4",
+    "d": "<f8",
+}
+LITTLE_ENDIAN_HOST = sys.byteorder == "little"
+
+
+class NumericArray(Sequence):
+    """An immutable, lazily converted view of a received numeric array (see the module docstring)."""
+
+    __slots__ = ("_view", "_fmt")
+
+    def __init__(self, raw: memoryview, fmt: str) -> None:
+        self._view = raw.cast("B").cast(fmt) if LITTLE_ENDIAN_HOST else None
+        self._fmt = fmt
+        if self._view is None:  # big-endian host: convert once, correctly
+            count = len(raw) // struct.calcsize(fmt)
+            self._view = struct.unpack(f"<{count}{fmt}", raw)
+
+    @property
+    def format(self) -> str:
+        """The struct format char of the elements (``f`` for float32, ...)."""
+        return self._fmt
+
+    def raw_bytes(self) -> memoryview | bytes:
+        """The elements in ROS wire layout (little-endian), without copying on little-endian hosts."""
+        view = self._view
+        if isinstance(view, memoryview):
+            return view.cast("B")
+        return struct.pack(f"<{len(view)}{self._fmt}", *view)
+
+    def __len__(self) -> int:
+        return len(self._view)
+
+    def __getitem__(self, index: Any) -> Any:
+        if isinstance(index, slice):
+            return tuple(self._view[index])
+        return self._view[index]
+
+    def __iter__(self) -> Iterator[Any]:
+        return iter(self._view)
+
+    def __reversed__(self) -> Iterator[Any]:
+        return reversed(self.tolist())
+
+    def __contains__(self, value: object) -> bool:
+        return value in self.tolist()
+
+    def tolist(self) -> list[Any]:
+        view = self._view
+        return view.tolist() if isinstance(view, memoryview) else list(view)
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, NumericArray):
+            return self.tolist() == other.tolist()
+        if isinstance(other, list):
+            return self.tolist() == other
+        if isinstance(other, tuple):
+            return tuple(self.tolist()) == other
+        if isinstance(other, Sequence) and not isinstance(other, str | bytes):
+            return self.tolist() == list(other)
+        if type(other).__module__ == "numpy" and hasattr(other, "tolist"):
+            return self.tolist() == other.tolist()
+        return NotImplemented
+
+    def __ne__(self, other: object) -> bool:
+        result = self.__eq__(other)
+        return result if result is NotImplemented else not result
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __add__(self, other: Any) -> Any:
+        if isinstance(other, list):
+            return self.tolist() + other
+        return tuple(self.tolist()) + tuple(other)
+
+    def __radd__(self, other: Any) -> Any:
+        if isinstance(other, list):
+            return other + self.tolist()
+        return tuple(other) + tuple(self.tolist())
+
+    def __repr__(self) -> str:
+        return repr(tuple(self.tolist()))
+
+    def __array__(self, dtype: Any = None, copy: Any = None) -> Any:
+        import numpy
+
+        view = self._view
+        arr = numpy.frombuffer(view, dtype=NUMPY_DTYPES[self._fmt]) if isinstance(view, memoryview) else None
+        if arr is None:
+            arr = numpy.array(view, dtype=NUMPY_DTYPES[self._fmt])
+        if dtype is not None:
+            arr = arr.astype(dtype)
+        return arr
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (tuple, (tuple(self.tolist()),))
+
+    def __copy__(self) -> NumericArray:
+        return self
+
+    def __deepcopy__(self, memo: dict) -> list[Any]:
+        return self.tolist()
