@@ -83,10 +83,17 @@ class Image:
     )
     _has_header = True
 
-    def __init__(self, height: int = 0, width: int = 0, encoding: str = "", step: int = 0, data: bytes = b"") -> None:
+    def __init__(
+        self, height: int = 0, width: int = 0, encoding: str = "", step: int = 0, data: bytes = b""
+    ) -> None:
         self.header = Header()
         self.height, self.width, self.encoding, self.is_bigendian, self.step, self.data = (
-            height, width, encoding, 0, step, data,
+            height,
+            width,
+            encoding,
+            0,
+            step,
+            data,
         )
 
     def serialize_to_bytes(self) -> bytes:

@@ -97,6 +97,26 @@ class PubConnection:
                 while not self.closed and not (self._partial is None and not self._queue):
                     self._cond.wait()
 
+    def watch(self) -> None:
+        """Notice a subscriber that goes away even while we have nothing to send (on the loop)."""
+        self.node.runtime.loop.add_reader(self.fd, self._on_readable)
+
+    def _on_readable(self) -> None:
+        try:
+            data = self.sock.recv(4096)
+        except (BlockingIOError, InterruptedError):
+            return
+        except OSError as exc:
+            data = b""
+            why = f"connection error: {exc}"
+        else:
+            why = "subscriber closed the connection"
+        if not data:
+            with self._cond:
+                if not self.closed:
+                    _log.debug("topic %s: %s (%s)", self.topic, why, self.subscriber)
+                self._close_locked()
+
     def _arm(self) -> None:
         if self.closed:
             return
@@ -162,8 +182,10 @@ class PubConnection:
         self.node.runtime.call_soon(self.node._topic_connection_closed, self)
 
     def _release_socket(self) -> None:
+        loop = self.node.runtime.loop
         try:
-            self.node.runtime.loop.remove_writer(self.fd)
+            loop.remove_writer(self.fd)
+            loop.remove_reader(self.fd)
         except (ValueError, OSError):
             pass
         transport.close_quietly(self.sock)
@@ -221,6 +243,7 @@ class Publication:
             conn.send(reply + latched, queue_size=0)
             conn.num_sent = 1 if latched else 0
             self.connections = (*self.connections, conn)
+        conn.watch()
 
     def publish_frame(self, data: bytes, handle: Publisher) -> None:
         with self.lock:
