@@ -5,10 +5,12 @@ Kept dependency-free so user test suites (and ours) can import it without starti
 
 from __future__ import annotations
 
+import contextlib
 import os
 import shutil
 import socket
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 #: Debian's real ROS 1 runs under the system interpreter, never the project's venv.
@@ -57,3 +59,46 @@ def FakeClock(start: float = 0.0):  # noqa: N802 - reads as a class at call site
     from ninjemys.node.clock import FakeClock as _FakeClock
 
     return _FakeClock(start)
+
+
+@contextlib.contextmanager
+def run_master(
+    port: int | None = None, env: dict[str, str] | None = None, timeout: float = 20.0
+) -> Iterator[str]:
+    """Start our ``roscore`` on a free port, yield its URI once it answers, kill it afterwards.
+
+    ``env`` replaces the child's environment (ROS_HOME and ROS_LOG_DIR are inherited by default,
+    so logs land in the test's own directory); its output is discarded.
+    """
+    import subprocess
+    import time
+    import xmlrpc.client
+
+    port = port or free_port()
+    uri = f"http://localhost:{port}/"
+    child_env = dict(os.environ if env is None else env)
+    child_env.setdefault("ROS_HOSTNAME", "localhost")
+    child_env["ROS_MASTER_URI"] = uri
+    proc = subprocess.Popen(
+        [ninjemys_bin("roscore"), "-p", str(port)],
+        env=child_env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        stdin=subprocess.DEVNULL,
+    )
+    try:
+        deadline = time.monotonic() + timeout
+        while True:
+            try:
+                xmlrpc.client.ServerProxy(uri).getPid("/run_master")
+                break
+            except OSError:
+                if proc.poll() is not None:
+                    raise RuntimeError(f"roscore -p {port} exited with {proc.returncode}") from None
+                if time.monotonic() > deadline:
+                    raise RuntimeError(f"roscore -p {port} did not answer within {timeout} s") from None
+                time.sleep(0.02)
+        yield uri
+    finally:
+        proc.kill()
+        proc.wait()
