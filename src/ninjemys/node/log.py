@@ -139,6 +139,7 @@ class NodeLog:
         level: threshold for console and /rosout (the file records every message).
         log_file: ``__log:=`` override for the file path.
         ros_time: seconds of ROS time when it is simulated (shown next to wall time, stamps /rosout).
+        write_file: False for console-only logging (rospy's messages before init_node).
     """
 
     def __init__(
@@ -150,6 +151,7 @@ class NodeLog:
         stdout: IO[str] | None = None,
         stderr: IO[str] | None = None,
         colorize: bool = True,
+        write_file: bool = True,
     ) -> None:
         self.node_name = node_name
         self.level = level
@@ -159,7 +161,7 @@ class NodeLog:
         self._stderr = stderr
         self._colorize = colorize
         self._file: IO[str] | None = None
-        self._file_failed = False
+        self._file_failed = not write_file
         self._lock = threading.Lock()
         self._filter = _CallSiteFilter()
         self._rosout: Any = None

@@ -1,0 +1,400 @@
+"""init_node and the module-level node API of rospy (names, parameters, spin, wait_for_message, ...).
+
+``init_node`` reads the command line with :mod:`ninjemys.node.cli_args`, creates the core
+:class:`~ninjemys.node.Node`, and hangs the process's logging, clock and signal handling off it. Every
+other function here forwards to that node and translates core errors into rospy's exceptions.
+"""
+
+from __future__ import annotations
+
+import atexit
+import os
+import signal
+import sys
+import threading
+from typing import Any
+
+from ninjemys.errors import MasterError, NameError_, NinjemysError, ParameterError
+from ninjemys.node.log import INFO, NodeLog
+from rospy.core import _process, is_shutdown, signal_shutdown
+from rospy.exceptions import ROSException, ROSInitException, ROSInterruptException, mapped, translate
+
+__all__ = [
+    "init_node",
+    "spin",
+    "myargv",
+    "get_name",
+    "get_namespace",
+    "get_caller_id",
+    "resolve_name",
+    "remap_name",
+    "get_param",
+    "get_param_cached",
+    "set_param",
+    "has_param",
+    "delete_param",
+    "search_param",
+    "get_param_names",
+    "wait_for_message",
+    "get_published_topics",
+    "get_master",
+]
+
+_UNSPECIFIED = object()
+_signals_installed = False
+
+
+# -- init ---------------------------------------------------------------------------------------------------
+
+
+def init_node(
+    name: str,
+    argv: list[str] | None = None,
+    anonymous: bool = False,
+    log_level: int | None = None,
+    disable_rostime: bool = False,
+    disable_rosout: bool = False,
+    disable_signals: bool = False,
+    xmlrpc_port: int = 0,
+    tcpros_port: int = 0,
+) -> None:
+    """Register this process as ROS node ``name`` (a base name) with the master.
+
+    ``anonymous=True`` appends ``_<pid>_<ms>`` so several copies can run; ``__name:=`` on the command
+    line overrides both. ``log_level`` (rospy.DEBUG ... rospy.FATAL) sets the console and /rosout
+    threshold. Unless ``disable_signals``, Ctrl-C (SIGINT) and SIGTERM shut the node down: sleeps
+    raise ROSInterruptException and spin() returns. Calling it again with the same arguments is a no-op.
+    """
+    key = (
+        name,
+        None if argv is None else tuple(argv),
+        anonymous,
+        log_level,
+        disable_rostime,
+        disable_signals,
+    )
+    with _process.lock:
+        if _process.init_args is not None:
+            if _process.init_args != key:
+                raise ROSException(
+                    f"rospy.init_node() has already been called with different arguments: {_process.init_args}"
+                )
+            return
+        if not name:
+            raise ValueError("name must not be empty")
+        if "/" in name:
+            raise ValueError("namespaces are not allowed in node names")
+        args = _parse(sys.argv if argv is None else argv)
+        try:
+            base = args.node_name(name, anonymous)
+        except NameError_ as exc:
+            raise ValueError(str(exc)) from None
+        from ninjemys.node.cli_args import network_env
+
+        os.environ.update(network_env(args))
+        if not disable_signals and threading.current_thread() is threading.main_thread():
+            _install_signal_handlers()
+        node = _start_node(base, args)
+        log = NodeLog(node.name, level=log_level or INFO, log_file=args.log_file)
+        _process.node = node
+        _process.log = log
+        _process.init_args = key
+        node.on_shutdown(_on_node_shutdown)
+        atexit.register(_at_exit)
+        if not disable_rostime:
+            _start_clock(node, log)
+        if not disable_rosout:
+            _start_rosout(node, log)
+        _start_logger_services(node, log)
+        pending, _process.pending = _process.pending, []
+    for handle in pending:
+        handle._bind(node)
+    if _process.shutdown_requested:
+        node.shutdown("signal before init_node completed")
+        raise ROSInitException("init_node interrupted before it could complete")
+
+
+def _parse(argv: list[str]) -> Any:
+    from ninjemys.node.cli_args import parse_args
+
+    try:
+        return parse_args(argv)
+    except ParameterError as exc:
+        raise ROSInitException(str(exc)) from None
+    except NameError_ as exc:
+        raise ValueError(str(exc)) from None
+
+
+def _start_node(base: str, args: Any) -> Any:
+    from ninjemys.node import Node
+
+    try:
+        return Node(
+            base,
+            namespace=args.namespace,
+            remappings=args.remappings,
+            master_uri=args.master_uri,
+            params=args.private_params,
+        )
+    except NameError_ as exc:
+        raise ValueError(str(exc)) from None
+    except NinjemysError as exc:
+        raise ROSInitException(f"init_node: {exc}") from None
+
+
+def _start_clock(node: Any, log: NodeLog) -> None:
+    """Switch the process clock to simulated time when /use_sim_time is set (read once, at init)."""
+    clock = _process.clock
+    try:
+        sim = bool(node.get_param("/use_sim_time", False))
+    except NinjemysError:
+        sim = False
+    if not sim:
+        return
+    from ninjemys.idl.loader import get_message_class
+
+    clock.is_sim = True
+    clock.subscribe(node, get_message_class("rosgraph_msgs/Clock"))
+    clock.install()
+    log.set_ros_time(clock.now)
+
+
+def _start_rosout(node: Any, log: NodeLog) -> None:
+    from ninjemys.idl.loader import get_message_class
+
+    log_class = get_message_class("rosgraph_msgs/Log")
+    pub = node.publisher("/rosout", log_class, queue_size=100, latch=True)
+    log.attach_rosout(pub, log_class, lambda: [t for t, _ in node.get_publications()])
+
+
+def _start_logger_services(node: Any, log: NodeLog) -> None:
+    from ninjemys.idl.loader import get_message_class, get_service_class
+
+    get_loggers = get_service_class("roscpp/GetLoggers")
+    set_level = get_service_class("roscpp/SetLoggerLevel")
+    logger_class = get_message_class("roscpp/Logger")
+    node.service(
+        "~get_loggers", get_loggers, log.get_loggers_handler(get_loggers._response_class, logger_class)
+    )
+    node.service("~set_logger_level", set_level, log.set_logger_level_handler(set_level._response_class))
+
+
+def _on_node_shutdown() -> None:
+    """The node is going down (for whatever reason): user hooks, then wake every sleeper."""
+    _process.shutdown_requested = True
+    _process.run_hooks()
+    _process.clock.shutdown()
+    with _process.lock:
+        waiters = list(_process.waiters)
+    for event in waiters:
+        event.set()
+
+
+def _at_exit() -> None:
+    node = _process.node
+    if node is not None and not node.is_shutdown:
+        signal_shutdown("atexit")
+    _process.log.close()
+
+
+# -- signals --------------------------------------------------------------------------------------------
+
+
+def _install_signal_handlers() -> None:
+    global _signals_installed
+    if _signals_installed:
+        return
+    _signals_installed = True
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        previous = signal.getsignal(signum)
+        signal.signal(signum, _make_handler(previous))
+
+
+def _make_handler(previous: Any) -> Any:
+    def handler(signum: int, frame: Any) -> None:
+        if _process.shutdown_requested and signum == signal.SIGINT:
+            # a second Ctrl-C while shutdown is under way: the user insists
+            raise KeyboardInterrupt
+        _process.shutdown_requested = True
+        # Shut down on a helper thread: the interrupted main thread may hold locks the shutdown needs.
+        threading.Thread(
+            target=signal_shutdown, args=(f"signal-{signum}",), name="rospy-signal", daemon=True
+        ).start()
+        if callable(previous) and previous not in (
+            signal.default_int_handler,
+            signal.SIG_DFL,
+            signal.SIG_IGN,
+        ):
+            previous(signum, frame)
+
+    return handler
+
+
+# -- spinning and args ----------------------------------------------------------------------------------
+
+
+def spin() -> None:
+    """Block until the node shuts down (Ctrl-C, rosnode kill, a name collision, signal_shutdown)."""
+    node = _process.require_node()
+    try:
+        node.wait_for_shutdown()
+    except KeyboardInterrupt:
+        signal_shutdown("keyboard interrupt")
+
+
+def myargv(argv: list[str] | None = None) -> list[str]:
+    """``argv`` (default sys.argv) without ROS remapping arguments (``x:=y``)."""
+    from ninjemys import names
+
+    return names.strip_remap_args(sys.argv if argv is None else argv)
+
+
+# -- names ----------------------------------------------------------------------------------------------
+
+
+def get_name() -> str:
+    """The node's fully resolved name (``/unnamed`` before init_node)."""
+    node = _process.node
+    return "/unnamed" if node is None else node.name
+
+
+get_caller_id = get_name
+
+
+def get_namespace() -> str:
+    """The node's namespace, always ending with ``/``."""
+    node = _process.node
+    if node is None:
+        from ninjemys import names
+
+        return names.get_ros_namespace(argv=sys.argv)
+    return node.namespace
+
+
+def resolve_name(name: str, caller_id: str | None = None) -> str:
+    """Resolve ``name`` as this node (or ``caller_id``) sees it, applying remappings."""
+    from ninjemys import names
+
+    node = _process.node
+    with mapped():
+        if caller_id is not None:
+            return names.resolve_name(name, caller_id, getattr(node, "remappings", None))
+        if node is None:
+            return names.resolve_name(name, get_namespace() + "unnamed")
+        return node.resolve_name(name)
+
+
+def remap_name(name: str, caller_id: str | None = None, resolved: bool = True) -> str:
+    """The remapped form of ``name`` (itself when no remapping applies)."""
+    return resolve_name(name, caller_id)
+
+
+# -- parameters -----------------------------------------------------------------------------------------
+
+
+def get_param(param_name: str, default: Any = _UNSPECIFIED) -> Any:
+    """A parameter's value (``~name`` is private to the node); KeyError when unset and no default."""
+    node = _process.require_node()
+    try:
+        if default is _UNSPECIFIED:
+            return node.get_param(param_name)
+        return node.get_param(param_name, default)
+    except ParameterError:
+        raise KeyError(param_name) from None
+    except NinjemysError as exc:
+        raise translate(exc) from None
+
+
+get_param_cached = get_param
+
+
+def set_param(param_name: str, param_value: Any) -> None:
+    """Set a parameter (dicts set a whole namespace)."""
+    node = _process.require_node()
+    with mapped():
+        node.set_param(param_name, param_value)
+
+
+def has_param(param_name: str) -> bool:
+    node = _process.require_node()
+    with mapped():
+        return node.has_param(param_name)
+
+
+def delete_param(param_name: str) -> None:
+    """Delete a parameter; KeyError when it is not set."""
+    node = _process.require_node()
+    try:
+        node.delete_param(param_name)
+    except ParameterError:
+        raise KeyError(param_name) from None
+    except NinjemysError as exc:
+        raise translate(exc) from None
+
+
+def search_param(param_name: str) -> str | None:
+    """The closest parameter named ``param_name`` up the namespace tree, or None."""
+    node = _process.require_node()
+    with mapped():
+        return node.search_param(param_name)
+
+
+def get_param_names() -> list[str]:
+    node = _process.require_node()
+    with mapped():
+        return node.get_param_names()
+
+
+# -- graph ----------------------------------------------------------------------------------------------
+
+
+def wait_for_message(topic: str, topic_type: Any, timeout: float | None = None) -> Any:
+    """Receive one message on ``topic``; ROSException after ``timeout`` seconds, ROSInterruptException on shutdown."""
+    from rospy.topics import Subscriber
+
+    node = _process.require_node()
+    box: list[Any] = []
+    got = threading.Event()
+
+    def take(msg: Any) -> None:
+        if not box:
+            box.append(msg)
+            got.set()
+
+    sub = Subscriber(topic, topic_type, take, queue_size=1)
+    with _process.lock:
+        _process.waiters.add(got)
+    if node.is_shutdown:
+        got.set()
+    try:
+        got.wait(timeout)
+    finally:
+        with _process.lock:
+            _process.waiters.discard(got)
+        sub.unregister()
+    if box:
+        return box[0]
+    if is_shutdown():
+        raise ROSInterruptException("rospy shutdown")
+    raise ROSException(f"timeout exceeded while waiting for message on topic {sub.resolved_name}")
+
+
+def get_published_topics(namespace: str = "/") -> list[list[str]]:
+    """[[topic, type], ...] of every published topic under ``namespace``."""
+    node = _process.require_node()
+    try:
+        return [list(x) for x in node.master.get_published_topics(namespace)]
+    except MasterError as exc:
+        raise ROSException(f"unable to get published topics: {exc}") from None
+
+
+def get_master(env: Any = None) -> Any:
+    """The master's XML-RPC API as this node (``get_master().getSystemState()`` -> [code, msg, value])."""
+    from rospy.msproxy import MasterProxy
+
+    node = _process.node
+    if node is None:
+        from ninjemys.node.cli_args import parse_args
+
+        return MasterProxy(parse_args(sys.argv, env).master_uri, "/unnamed")
+    return MasterProxy(node.master_uri, node.name, node.resolve_name)

@@ -1,0 +1,179 @@
+"""The one piece of global state of the rospy facade: the node of this process, and what hangs off it.
+
+rospy's API is module-level functions, so something must remember "the" node. Here that is a single
+:class:`_Process` instance holding the core :class:`~ninjemys.node.Node` (None until ``init_node``), its
+:class:`~ninjemys.node.log.NodeLog`, the process's :class:`~ninjemys.node.clock.Clock` (wall time until
+``init_node`` finds ``/use_sim_time``), the handles created before ``init_node`` (the seeds create
+their Publisher first), and the user's shutdown hooks. All behaviour lives in the core modules.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable
+from typing import Any
+
+from ninjemys.node.clock import Clock
+from ninjemys.node.log import DEBUG, ERROR, FATAL, INFO, WARN, NodeLog
+from rospy.exceptions import ROSException
+
+__all__ = [
+    "DEBUG",
+    "INFO",
+    "WARN",
+    "ERROR",
+    "FATAL",
+    "is_shutdown",
+    "signal_shutdown",
+    "on_shutdown",
+    "get_node_uri",
+    "is_initialized",
+]
+
+
+class _Process:
+    """State shared by the whole facade (one per process, like rospy's module globals)."""
+
+    def __init__(self) -> None:
+        self.node: Any = None
+        self.clock = Clock()
+        self.log = NodeLog("/unnamed", write_file=False)
+        self.lock = threading.RLock()
+        self.pending: list[Any] = []
+        self.waiters: set[threading.Event] = set()
+        self.hooks: list[Callable[[], Any]] = []
+        self.hooks_ran = False
+        self.shutdown_requested = False
+        self.init_args: tuple[Any, ...] | None = None
+
+    def require_node(self) -> Any:
+        node = self.node
+        if node is None:
+            raise ROSException("ROS node has not been initialized yet. Please call init_node() first")
+        return node
+
+    def attach(self, handle: Any) -> None:
+        """Bind a Publisher/Subscriber/Service to the node now, or at init_node if there is none yet."""
+        with self.lock:
+            if self.node is None:
+                self.pending.append(handle)
+                return
+        handle._bind(self.node)
+
+    def run_hooks(self) -> None:
+        """Run user shutdown hooks once, before the node tears down (rospy's order)."""
+        with self.lock:
+            if self.hooks_ran:
+                return
+            self.hooks_ran = True
+            hooks = list(self.hooks)
+        for hook in hooks:
+            try:
+                hook()
+            except Exception as exc:  # one bad hook must not stop the others or the teardown
+                self.log.error("on_shutdown hook %r raised: %s", hook, exc)
+
+
+_process = _Process()
+
+
+def is_initialized() -> bool:
+    """True once init_node has registered the node."""
+    return _process.node is not None
+
+
+def is_shutdown() -> bool:
+    """True once the node is shutting down (Ctrl-C, rosnode kill, a name collision, signal_shutdown)."""
+    node = _process.node
+    if node is not None:
+        return node.is_shutdown
+    return _process.shutdown_requested
+
+
+def signal_shutdown(reason: str) -> None:
+    """Initiate shutdown: user hooks first, then the node tears down; sleeps and spin() return at once."""
+    _process.shutdown_requested = True
+    node = _process.node
+    _process.run_hooks()
+    _process.clock.shutdown()
+    if node is not None:
+        node.shutdown(reason)
+
+
+def on_shutdown(hook: Callable[[], Any]) -> None:
+    """Call ``hook()`` (no arguments) when the node shuts down, before its connections close."""
+    with _process.lock:
+        if not _process.hooks_ran:
+            _process.hooks.append(hook)
+            return
+    hook()
+
+
+def get_node_uri() -> str | None:
+    """The node's slave XML-RPC URI (None before init_node)."""
+    node = _process.node
+    return None if node is None else node.uri
+
+
+# -- logging: the user-facing calls ---------------------------------------------------------------------
+
+
+def logdebug(msg: Any, *args: Any, **kwargs: Any) -> None:
+    _process.log.log(DEBUG, msg, *args, depth=2, exc_info=bool(kwargs.get("exc_info")))
+
+
+def loginfo(msg: Any, *args: Any, **kwargs: Any) -> None:
+    _process.log.log(INFO, msg, *args, depth=2, exc_info=bool(kwargs.get("exc_info")))
+
+
+def logwarn(msg: Any, *args: Any, **kwargs: Any) -> None:
+    _process.log.log(WARN, msg, *args, depth=2, exc_info=bool(kwargs.get("exc_info")))
+
+
+def logerr(msg: Any, *args: Any, **kwargs: Any) -> None:
+    _process.log.log(ERROR, msg, *args, depth=2, exc_info=bool(kwargs.get("exc_info")))
+
+
+def logfatal(msg: Any, *args: Any, **kwargs: Any) -> None:
+    _process.log.log(FATAL, msg, *args, depth=2, exc_info=bool(kwargs.get("exc_info")))
+
+
+logout = loginfo
+logerror = logerr
+logwarning = logwarn
+
+
+def _throttled(level: int) -> Callable[..., None]:
+    def log_throttle(period: float, msg: Any, *args: Any, **_kwargs: Any) -> None:
+        _process.log.log_throttle(period, level, msg, *args, depth=2)
+
+    return log_throttle
+
+
+def _once(level: int) -> Callable[..., None]:
+    def log_once(msg: Any, *args: Any, **_kwargs: Any) -> None:
+        _process.log.log_once(level, msg, *args, depth=2)
+
+    return log_once
+
+
+def _identical(level: int) -> Callable[..., None]:
+    def log_throttle_identical(period: float, msg: Any, *args: Any, **_kwargs: Any) -> None:
+        _process.log.log_throttle_identical(period, level, msg, *args, depth=2)
+
+    return log_throttle_identical
+
+
+logdebug_throttle, loginfo_throttle, logwarn_throttle, logerr_throttle, logfatal_throttle = (
+    _throttled(lvl) for lvl in (DEBUG, INFO, WARN, ERROR, FATAL)
+)
+logdebug_once, loginfo_once, logwarn_once, logerr_once, logfatal_once = (
+    _once(lvl) for lvl in (DEBUG, INFO, WARN, ERROR, FATAL)
+)
+(
+    logdebug_throttle_identical,
+    loginfo_throttle_identical,
+    logwarn_throttle_identical,
+    logerr_throttle_identical,
+    logfatal_throttle_identical,
+) = (_identical(lvl) for lvl in (DEBUG, INFO, WARN, ERROR, FATAL))

@@ -1,0 +1,60 @@
+"""AnyMsg (a message of any type, kept serialized) and rospy's implicit message construction."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from rospy.exceptions import ROSException, ROSSerializationException
+
+__all__ = ["AnyMsg", "args_kwds_to_message"]
+
+
+class AnyMsg:
+    """A message whose type is not known in advance: ``_buff`` holds its serialized bytes.
+
+    Subscribing with AnyMsg relays or records topics of any type; publishing one sends its bytes as is.
+    """
+
+    _md5sum = "*"
+    _type = "*"
+    _has_header = False
+    _full_text = ""
+    __slots__ = ["_buff", "_connection_header"]
+
+    def __init__(self, *args: Any) -> None:
+        if args:
+            raise ROSException("AnyMsg does not accept arguments")
+        self._buff: bytes | bytearray | None = None
+        self._connection_header: dict[str, str] = {}
+
+    def serialize(self, buff: Any) -> None:
+        if self._buff is None:
+            raise ROSSerializationException("AnyMsg is not initialized")
+        buff.write(self._buff)
+
+    def serialize_to_bytes(self) -> bytes:
+        if self._buff is None:
+            raise ROSSerializationException("AnyMsg is not initialized")
+        return bytes(self._buff)
+
+    def deserialize(self, data: bytes | bytearray) -> AnyMsg:
+        self._buff = data
+        return self
+
+    @classmethod
+    def deserialize_from(cls, data: bytes | bytearray | memoryview) -> AnyMsg:
+        msg = cls()
+        msg._buff = bytes(data)
+        return msg
+
+
+def args_kwds_to_message(data_class: Any, args: tuple[Any, ...], kwds: dict[str, Any]) -> Any:
+    """Build a ``data_class`` from publish()'s arguments: ``pub.publish("hi")`` makes ``String("hi")``."""
+    if args and kwds:
+        raise TypeError("publish() can be called with arguments or keywords, but not both.")
+    if len(args) == 1 and hasattr(args[0], "_type") and hasattr(args[0], "__slots__"):
+        other = args[0]
+        if other._type != data_class._type:
+            raise TypeError(f"expected [{data_class._type}] but got [{other._type}]")
+        return other
+    return data_class(*args, **kwds)

@@ -1,0 +1,208 @@
+"""rospy.Service, rospy.ServiceProxy and rospy.wait_for_service over the core's TCPROS services.
+
+As in rospy, a ServiceProxy and wait_for_service work without ``init_node`` (the rospy_tutorials
+add_two_ints client never calls it): they then talk to the master as ``/unnamed``.
+"""
+
+from __future__ import annotations
+
+import sys
+import threading
+from collections.abc import Callable, Mapping
+from typing import Any
+
+from ninjemys import names
+from ninjemys.errors import NinjemysError
+from ninjemys.node.log import ERROR
+from rospy.core import _process
+from rospy.exceptions import ServiceException, mapped, translate
+from rospy.msg import AnyMsg
+
+__all__ = ["Service", "ServiceProxy", "ServiceException", "wait_for_service"]
+
+
+def _check_service_class(service_class: Any, name: str) -> None:
+    if not all(hasattr(service_class, a) for a in ("_type", "_md5sum", "_request_class", "_response_class")):
+        raise ValueError(f"service [{name}]: [{service_class}] is not a service class")
+
+
+class _AnyService:
+    """Stands in for an unknown service type when only probing for a service's presence (md5 ``*``)."""
+
+    _type = "*"
+    _md5sum = "*"
+    _request_class = AnyMsg
+    _response_class = AnyMsg
+
+
+class _Unnamed:
+    """The surface a core ServiceProxy needs from a node, for calls made before init_node (as rospy's
+    ``/unnamed`` caller): a master client, a caller id, and interruptible waits."""
+
+    def __init__(self) -> None:
+        from ninjemys.master.client import MasterClient
+        from ninjemys.node.cli_args import parse_args
+
+        args = parse_args(sys.argv)
+        self.name = names.canonicalize_name(args.namespace + "unnamed")
+        self.remappings = args.resolved_remappings(self.name)
+        self.master = MasterClient(args.master_uri, self.name)
+        self._stop = threading.Event()
+
+    @property
+    def is_shutdown(self) -> bool:
+        return self._stop.is_set()
+
+    def wait_for_shutdown(self, timeout: float | None = None) -> bool:
+        return self._stop.wait(timeout)
+
+    def resolve_name(self, name: str) -> str:
+        return names.resolve_name(name, self.name, self.remappings)
+
+
+_unnamed: _Unnamed | None = None
+
+
+def _client_context() -> Any:
+    """The node to call services from: the initialized node, else the shared ``/unnamed`` context."""
+    global _unnamed
+    node = _process.node
+    if node is not None:
+        return node
+    if _unnamed is None:
+        _unnamed = _Unnamed()
+    return _unnamed
+
+
+def _core_proxy(name: str, service_class: Any, persistent: bool, headers: Mapping[str, str] | None) -> Any:
+    ctx = _client_context()
+    if ctx is _process.node:
+        return ctx.service_proxy(name, service_class, persistent=persistent, headers=headers)
+    from ninjemys.node.services import ServiceProxy as CoreProxy
+
+    return CoreProxy(ctx, ctx.resolve_name(name), service_class, persistent, headers)
+
+
+def wait_for_service(service: str, timeout: float | None = None) -> None:
+    """Block until ``service`` is available; ROSException after ``timeout`` seconds."""
+    with mapped():
+        _core_proxy(service, _AnyService, False, None).wait_for_service(timeout)
+
+
+class ServiceProxy:
+    """Call service ``name``: ``proxy(req)`` or ``proxy(a=1, b=2)``; ServiceException on failure."""
+
+    def __init__(
+        self,
+        name: str,
+        service_class: Any,
+        persistent: bool = False,
+        headers: Mapping[str, str] | None = None,
+    ) -> None:
+        _check_service_class(service_class, name)
+        self.service_class = service_class
+        self.request_class = service_class._request_class
+        self.response_class = service_class._response_class
+        self.persistent = persistent
+        self.headers = dict(headers or {})
+        self.name = name
+        self.resolved_name = _client_context().resolve_name(name)
+        self._impl: Any = None
+        self._lock = threading.Lock()
+
+    def _core(self) -> Any:
+        impl = self._impl
+        if impl is None:
+            with self._lock:
+                if self._impl is None:
+                    with mapped():
+                        self._impl = _core_proxy(self.name, self.service_class, self.persistent, self.headers)
+                impl = self._impl
+        return impl
+
+    def wait_for_service(self, timeout: float | None = None) -> None:
+        with mapped():
+            self._core().wait_for_service(timeout)
+
+    def __call__(self, *args: Any, **kwds: Any) -> Any:
+        return self.call(*args, **kwds)
+
+    def call(self, *args: Any, **kwds: Any) -> Any:
+        """Send a request (an instance, or its fields) and return the response."""
+        impl = self._core()
+        try:
+            return impl.call(*args, **kwds)
+        except NinjemysError as exc:
+            raise translate(exc) from None
+
+    def close(self) -> None:
+        """Close a persistent connection."""
+        impl, self._impl = self._impl, None
+        if impl is not None:
+            impl.close()
+
+
+class Service:
+    """Serve ``name`` with ``handler(request) -> response`` (or a dict, tuple or single value).
+
+    A handler raising ServiceException sends its message to the caller; any other exception is logged
+    with its traceback (or passed to ``error_handler``) and reported to the caller as an error.
+    """
+
+    def __init__(
+        self,
+        name: str,
+        service_class: Any,
+        handler: Callable[[Any], Any],
+        buff_size: int = 65536,
+        error_handler: Callable[..., Any] | None = None,
+    ) -> None:
+        _check_service_class(service_class, name)
+        self.service_class = service_class
+        self.request_class = service_class._request_class
+        self.response_class = service_class._response_class
+        self.handler = handler
+        self.error_handler = error_handler
+        self.buff_size = buff_size
+        self._requested = name
+        self.resolved_name = self.name = _client_context().resolve_name(name)
+        self._impl: Any = None
+        self._unregistered = False
+        _process.attach(self)
+
+    def _bind(self, node: Any) -> None:
+        if self._unregistered:
+            return
+        with mapped():
+            self._impl = node.service(self._requested, self.service_class, self._handle)
+        self.resolved_name = self.name = self._impl.resolved_name
+
+    def _handle(self, request: Any) -> Any:
+        try:
+            return self.handler(request)
+        except ServiceException:
+            raise
+        except Exception as exc:
+            if self.error_handler is not None:
+                self.error_handler(exc, *sys.exc_info())
+            else:
+                _process.log.log(ERROR, "Error processing request: %s", exc, exc_info=True)
+            raise
+
+    def shutdown(self, reason: str = "") -> None:
+        """Stop serving and unregister from the master."""
+        self._unregistered = True
+        impl, self._impl = self._impl, None
+        if impl is not None:
+            impl.shutdown()
+        with _process.lock:
+            if self in _process.pending:
+                _process.pending.remove(self)
+
+    unregister = shutdown
+
+    def spin(self) -> None:
+        """Block until the node shuts down (rospy.Service.spin)."""
+        from rospy.client import spin
+
+        spin()

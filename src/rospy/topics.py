@@ -1,0 +1,215 @@
+"""rospy.Publisher and rospy.Subscriber: handles that bind to the process's node.
+
+They may be created before ``init_node`` (the seeds' talker builds its Publisher first): the handle
+then waits in the facade's pending list and is created on the node during ``init_node``, with the
+node's final name, namespace and remappings. All transport behaviour is the core's.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from typing import Any
+
+from ninjemys.errors import NinjemysError, SerializationError, ShutdownError
+from rospy.core import _process
+from rospy.exceptions import (
+    ROSException,
+    ROSInterruptException,
+    ROSSerializationException,
+    translate,
+)
+from rospy.msg import AnyMsg, args_kwds_to_message
+
+__all__ = ["Publisher", "Subscriber", "SubscribeListener", "Topic"]
+
+
+def _check_class(data_class: Any, what: str) -> None:
+    if data_class is None:
+        raise ValueError(f"{what}: data_class must not be None")
+    if not hasattr(data_class, "_type") or not hasattr(data_class, "_md5sum"):
+        raise ValueError(f"{what}: data_class [{data_class}] is not a message class")
+
+
+def _resolved(name: str) -> str:
+    node = _process.node
+    if node is not None:
+        return node.resolve_name(name)
+    return name if name.startswith("/") else "/" + name.lstrip("~")
+
+
+class SubscribeListener:
+    """Accepted for API compatibility: rospy calls it on peer (un)subscription."""
+
+    def peer_subscribe(self, topic_name: str, topic_publish: Any, peer_publish: Any) -> None:
+        pass
+
+    def peer_unsubscribe(self, topic_name: str, num_peers: int) -> None:
+        pass
+
+
+class Topic:
+    """What Publisher and Subscriber share: the name, the message type and the core handle.
+
+    Subclasses provide ``_create(node)``, which makes the core handle.
+    """
+
+    def __init__(self, name: str, data_class: Any) -> None:
+        if not isinstance(name, str) or not name:
+            raise ValueError(f"topic name must be a non-empty string, not {name!r}")
+        _check_class(data_class, f"topic [{name}]")
+        self._requested = name
+        self.data_class = data_class
+        self.type = data_class._type
+        self.md5sum = data_class._md5sum
+        self.resolved_name = _resolved(name)
+        self.name = self.resolved_name
+        self._impl: Any = None
+        self._unregistered = False
+
+    def get_num_connections(self) -> int:
+        """Number of peers connected right now (0 before init_node)."""
+        impl = self._impl
+        return 0 if impl is None else impl.get_num_connections()
+
+    def unregister(self) -> None:
+        """Stop publishing/subscribing and tell the master."""
+        self._unregistered = True
+        impl, self._impl = self._impl, None
+        if impl is not None:
+            try:
+                impl.unregister()
+            except NinjemysError as exc:
+                raise translate(exc) from None
+        with _process.lock:
+            if self in _process.pending:
+                _process.pending.remove(self)
+
+    def _bind(self, node: Any) -> None:
+        if self._unregistered:
+            return
+        try:
+            self._impl = self._create(node)
+        except NinjemysError as exc:
+            raise translate(exc) from None
+        self.resolved_name = self.name = self._impl.resolved_name
+
+
+class Publisher(Topic):
+    """Publish messages of ``data_class`` on topic ``name``.
+
+    ``queue_size=None`` publishes synchronously (blocks, never drops); ``queue_size=N`` drops the oldest
+    per connection; ``latch=True`` resends the last message to late subscribers.
+    """
+
+    def __init__(
+        self,
+        name: str,
+        data_class: Any,
+        subscriber_listener: SubscribeListener | None = None,
+        tcp_nodelay: bool = False,
+        latch: bool = False,
+        headers: Mapping[str, str] | None = None,
+        queue_size: int | None = None,
+    ) -> None:
+        super().__init__(name, data_class)
+        self.subscriber_listener = subscriber_listener
+        self.tcp_nodelay = tcp_nodelay
+        self.latch = latch
+        self.headers = dict(headers or {})
+        self.queue_size = queue_size
+        self._raw = data_class is AnyMsg
+        _process.attach(self)
+
+    def _create(self, node: Any) -> Any:
+        return node.publisher(
+            self._requested,
+            self.data_class,
+            queue_size=self.queue_size,
+            latch=self.latch,
+            tcp_nodelay=self.tcp_nodelay,
+            headers=self.headers or None,
+        )
+
+    def publish(self, *args: Any, **kwds: Any) -> None:
+        """Publish a message, or build one from the arguments: ``pub.publish("hello")`` for a String."""
+        impl = self._impl
+        if impl is None:
+            self._not_ready()
+        if len(args) == 1 and not kwds and isinstance(args[0], self.data_class):
+            msg = args[0]
+        else:
+            try:
+                msg = args_kwds_to_message(self.data_class, args, kwds)
+            except (TypeError, ValueError) as exc:
+                raise ROSSerializationException(str(exc)) from None
+        try:
+            if self._raw:
+                impl.publish_raw(msg._buff)
+            else:
+                impl.publish(msg)
+        except ShutdownError:
+            raise ROSInterruptException(f"publish() to a closed topic [{self.resolved_name}]") from None
+        except SerializationError as exc:
+            raise ROSSerializationException(str(exc)) from None
+        except NinjemysError as exc:
+            raise translate(exc) from None
+
+    def _not_ready(self) -> None:
+        if self._unregistered:
+            raise ROSException(f"publish() to an unregistered() handle [{self.resolved_name}]")
+        if _process.node is None:
+            raise ROSException("ROS node has not been initialized yet. Please call init_node() first")
+        raise ROSInterruptException(f"publish() to a closed topic [{self.resolved_name}]")
+
+
+class Subscriber(Topic):
+    """Call ``callback(msg)`` (or ``callback(msg, callback_args)``) for each message on ``name``.
+
+    The callback runs on this subscription's own thread; ``queue_size`` bounds the messages waiting
+    for it (the oldest are dropped, never deserialized). ``buff_size`` and ``tcp_nodelay`` are accepted
+    for compatibility: the core reads whole messages and always sets TCP_NODELAY.
+    """
+
+    def __init__(
+        self,
+        name: str,
+        data_class: Any,
+        callback: Callable[..., Any] | None = None,
+        callback_args: Any = None,
+        queue_size: int | None = None,
+        buff_size: int = 65536,
+        tcp_nodelay: bool = False,
+    ) -> None:
+        super().__init__(name, data_class)
+        self.callback = callback
+        self.callback_args = callback_args
+        self.queue_size = queue_size
+        self.buff_size = buff_size
+        self.tcp_nodelay = tcp_nodelay
+        _process.attach(self)
+
+    def _create(self, node: Any) -> Any:
+        callback = self.callback
+        raw = self.data_class is AnyMsg
+        if raw and callback is not None:
+            callback = _any_msg_adapter(callback)
+        return node.subscriber(
+            self._requested,
+            None if raw else self.data_class,
+            callback,
+            callback_args=self.callback_args,
+            queue_size=self.queue_size,
+            raw=raw,
+        )
+
+
+def _any_msg_adapter(callback: Callable[..., Any]) -> Callable[..., Any]:
+    """Deliver AnyMsg instances (bytes in ``_buff``) instead of the core's RawMessage."""
+
+    def deliver(raw: Any, *args: Any) -> Any:
+        msg = AnyMsg()
+        msg._buff = raw.data
+        msg._connection_header = dict(raw.connection_header)
+        return callback(msg, *args)
+
+    return deliver
