@@ -30,19 +30,19 @@ def wait_until(predicate: Callable[[], object], timeout: float = 5.0, step: floa
 class MasterProcess:
     """A master in a child process on a fixed port, restartable (for master-restart tests)."""
 
-    def __init__(self, port: int) -> None:
+    def __init__(self, port: int, kind: str = "ninjemys") -> None:
         self.port = port
+        self.kind = kind
         self.uri = f"http://localhost:{port}/"
         self.proc: subprocess.Popen[bytes] | None = None
 
     def start(self) -> None:
-        run_master = getattr(testing, "master_command", None)
-        if run_master is not None:
-            cmd = run_master(self.port)
-            env = None
-        else:
+        if self.kind == "ros1":
             cmd = ["/usr/bin/rosmaster", "--core", "-p", str(self.port), "-w", "3"]
             env = testing.ros1_env(self.uri)
+        else:
+            cmd = [testing.ninjemys_bin("roscore"), "-p", str(self.port)]
+            env = None
         self.proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         client = MasterClient(self.uri, "/probe", timeout=1.0)
         try:
@@ -60,8 +60,6 @@ class MasterProcess:
 
 @pytest.fixture
 def master() -> Iterator[MasterProcess]:
-    if not testing.have_ros1() and getattr(testing, "master_command", None) is None:
-        pytest.skip("no master available")
     m = MasterProcess(testing.free_port())
     m.start()
     try:

@@ -160,3 +160,23 @@ def test_publish_after_modification_sends_the_original(make_node) -> None:
     msg.data = "after"
     assert wait_until(lambda: got)
     assert got == ["before"]
+
+
+def test_shutdown_leaves_no_thread_behind(master) -> None:
+    from ninjemys.node import Node
+
+    def ours() -> list[str]:
+        prefixes = ("ninjemys-io", "sub:", "srv:", "reg:", "param-update", "shutdown")
+        return [t.name for t in threading.enumerate() if t.name.startswith(prefixes)]
+
+    talker = Node("talker", master_uri=master.uri)
+    listener = Node("listener", master_uri=master.uri)
+    listener.subscriber("chatter", String, lambda m: None)
+    pub = talker.publisher("chatter", String)
+    assert _connected(pub)
+    assert ours()
+    started = time.monotonic()
+    talker.shutdown("done")
+    listener.shutdown("done")
+    assert time.monotonic() - started < 2
+    assert ours() == []
