@@ -9,8 +9,12 @@ from __future__ import annotations
 import os
 import sys
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
-from ninjemys.errors import NinjemysError
+from ninjemys.errors import MasterUnreachable, NinjemysError
+
+if TYPE_CHECKING:
+    from ninjemys.master.client import MasterClient
 
 
 def error(message: str) -> None:
@@ -31,9 +35,20 @@ def entry(main: Callable[[list[str] | None], int]) -> Callable[[], None]:
             devnull = os.open(os.devnull, os.O_WRONLY)
             os.dup2(devnull, sys.stdout.fileno())
             code = 1
+        except MasterUnreachable:
+            error("Unable to communicate with master!")
+            code = 1
         except NinjemysError as exc:
             error(str(exc))
             code = 1
         sys.exit(code)
 
     return console_main
+
+
+def master(caller_id: str = "/ninjemys_tool") -> MasterClient:
+    """A master client for a command-line tool (ROS_MASTER_URI), with a short timeout so a hung
+    master gives a clear error instead of a hang."""
+    from ninjemys.master.client import MasterClient
+
+    return MasterClient(caller_id=caller_id, timeout=10.0)
