@@ -63,7 +63,7 @@ def info_text(node: str, state: GraphState) -> str:
     subs = sorted(t for t, n in state.subscribers.items() if node in n)
     srvs = sorted(s for s, n in state.services.items() if node in n)
     buff = f"Node [{node}]"
-    for title, items, typed in (("Publications", pubs, True), ("Subscriptions", subs, True)):
+    for title, items in (("Publications", pubs), ("Subscriptions", subs)):
         if items:
             buff += f"\n{title}: \n" + "\n".join(f" * {t} [{_topic_type(t, state)}]" for t in items) + "\n"
         else:
