@@ -156,12 +156,12 @@ def build_workspace(
     new_cache: dict[str, list[float]] = {}
 
     for pkg in ordered:
-        for kind, files in _definitions(pkg).items():
+        for files in _definitions(pkg).values():
             for path in files:
                 stat = path.stat()
                 key = [stat.st_mtime, stat.st_size]
                 if cache.get(str(path)) != key:
-                    idl_check.validate(path, pkg.name, kind)
+                    idl_check.validate(path, pkg.name)
                     report.validated += 1
                 new_cache[str(path)] = key
 

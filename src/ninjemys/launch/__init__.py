@@ -1,0 +1,1 @@
+"""roslaunch: XML + substitutions -> a plain-data plan (``xml``, ``plan``) -> supervised processes (``runner``)."""

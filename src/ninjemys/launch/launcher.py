@@ -1,0 +1,206 @@
+"""One roslaunch session: plan -> master (found or auto-started) -> parameters -> supervised nodes.
+
+Everything that can fail because of user input (unknown package or executable, unknown machine,
+unreachable ssh host) is checked before the first process starts, so a bad launch file starts
+nothing.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import socket
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+from ninjemys.errors import LaunchError
+from ninjemys.launch import master_link
+from ninjemys.launch.plan import LaunchPlan, NodeSpec
+from ninjemys.launch.queries import node_command, node_environment
+from ninjemys.launch.runner import (
+    DEFAULT_SIGINT_TIMEOUT,
+    DEFAULT_SIGTERM_TIMEOUT,
+    ProcessSpec,
+    Supervisor,
+    node_process_name,
+    remote_command,
+)
+from ninjemys.master.client import MasterClient
+from ninjemys.packages.discovery import PackageIndex
+
+
+@dataclass
+class LaunchOptions:
+    screen: bool = False
+    log: bool = False
+    port: int | None = None
+    wait: bool = False
+    required: bool = False
+    local_only: bool = False
+    no_summary: bool = False
+    sigint_timeout: float = DEFAULT_SIGINT_TIMEOUT
+    sigterm_timeout: float = DEFAULT_SIGTERM_TIMEOUT
+    core_only: bool = False
+
+
+def _strip(value: object) -> str:
+    text = str(value)
+    if len(text) > 20:
+        text = text[:17] + "..."
+    return text if all(31 < ord(c) < 127 for c in text) else "<...>"
+
+
+def summary(plan: LaunchPlan, extra_params: dict[str, object]) -> str:
+    """ROS 1's SUMMARY block."""
+    out = ["", "SUMMARY", "========"]
+    if plan.clear_params:
+        out += ["", "CLEAR PARAMETERS", *sorted(f" * {p}" for p in plan.clear_params)]
+    params = {**extra_params, **plan.params}
+    if params:
+        out += ["", "PARAMETERS", *sorted(f" * {k}: {_strip(v)}" for k, v in params.items())]
+    machines = sorted(k for k in plan.machines if k)
+    if machines:
+        out += ["", "MACHINES", *(f" * {m}" for m in machines)]
+    out += ["", "NODES"]
+    by_ns: dict[str, list[NodeSpec]] = {}
+    for node in plan.nodes:
+        by_ns.setdefault(node.namespace, []).append(node)
+    for ns in sorted(by_ns):
+        out.append(f"  {ns}")
+        out += sorted(f"    {n.name} ({n.package}/{n.type})" for n in by_ns[ns])
+    return "\n".join(out) + "\n"
+
+
+def _process_specs(
+    plan: LaunchPlan, opts: LaunchOptions, master_uri: str, log_dir: Path, env: dict[str, str]
+) -> list[ProcessSpec]:
+    index = PackageIndex.from_environment(env)
+    specs = []
+    ros_home = env.get("ROS_HOME") or os.path.join(os.path.expanduser("~"), ".ros")
+    counter = 0
+    for node in plan.nodes:
+        machine = plan.machines.get(node.machine_name or "")
+        if machine is None:
+            raise LaunchError(
+                f"{node.filename}: node [{node.resolved_name}]: unknown machine [{node.machine_name}]"
+            )
+        if opts.local_only and not machine.is_local:
+            continue
+        counter += 1
+        name = node_process_name(node, counter)
+        proc_env = node_environment(node, master_uri, env)
+        proc_env["PYTHONUNBUFFERED"] = "1"
+        for key, value in machine.env_args:
+            proc_env[key] = value
+        argv = (
+            []
+            if not machine.is_local
+            else node_command(node, index) + [f"__log:={log_dir / (name + '.log')}"]
+        )
+        cwd = ros_home
+        if node.cwd == "node" and machine.is_local:
+            exe = next((a for a in argv[1:] if os.path.isfile(a)), argv[0] if argv else "")
+            cwd = os.path.dirname(exe) or ros_home
+        if not machine.is_local:
+            # the remote machine runs its own ninjemys: rosrun there finds the package and executable
+            argv = remote_command(machine, ["rosrun", node.package, node.type, *_user_args(node)], proc_env)
+            cwd = None
+        Path(ros_home).mkdir(parents=True, exist_ok=True)
+        output = "screen" if opts.screen else "log" if opts.log else (node.output or "log")
+        specs.append(
+            ProcessSpec(
+                name=name,
+                argv=argv,
+                env=proc_env,
+                cwd=cwd,
+                output=output,
+                respawn=node.respawn,
+                respawn_delay=node.respawn_delay,
+                required=node.required or opts.required,
+                sigint_timeout=node.sigint_timeout
+                if node.sigint_timeout is not None
+                else opts.sigint_timeout,
+                sigterm_timeout=opts.sigterm_timeout,
+                log_dir=log_dir,
+            )
+        )
+    return specs
+
+
+def _user_args(node: NodeSpec) -> list[str]:
+    import shlex
+
+    return shlex.split(node.args) + [f"{a}:={b}" for a, b in node.remap_args] + [f"__name:={node.name}"]
+
+
+class LaunchSession:
+    """Runs a plan; ``run()`` blocks until the launch ends and returns its exit status."""
+
+    def __init__(self, plan: LaunchPlan, opts: LaunchOptions, env: dict[str, str] | None = None) -> None:
+        self.plan = plan
+        self.opts = opts
+        self.env = dict(os.environ if env is None else env)
+        self.supervisor: Supervisor | None = None
+
+    def _say(self, text: str) -> None:
+        sys.stdout.write(text + "\n")
+        sys.stdout.flush()
+
+    def run(self) -> int:
+        for warning in self.plan.warnings:
+            print(f"WARNING: {warning}", file=sys.stderr)
+        uri = master_link.master_uri_for(self.opts.port, self.env)
+        self.env["ROS_MASTER_URI"] = uri
+        log_root = master_link.default_log_root(self.env)
+        # validate everything user-provided before starting anything
+        probe_specs = _process_specs(self.plan, self.opts, uri, log_root / "pending", self.env)
+        del probe_specs
+        core_proc = None
+        if not master_link.master_is_up(uri):
+            if self.opts.wait:
+                self._say(f"waiting for master at {uri} ...")
+                master_link.wait_for_master(uri, None)
+            elif not master_link.is_local_uri(uri):
+                raise LaunchError(
+                    f"unable to contact ROS master at [{uri}] (not this machine: cannot auto-start it)"
+                )
+            else:
+                self._say("auto-starting new master")
+                core_proc = master_link.start_core(uri, log_root / "latest-master.log", self.env)
+                self._say(f"process[master]: started with pid [{core_proc.pid}]")
+        self._say(f"ROS_MASTER_URI={uri}")
+        client = MasterClient(uri, master_link.CALLER_ID)
+        run_id = master_link.run_id(client)
+        log_dir = log_root / run_id
+        log_dir.mkdir(parents=True, exist_ok=True)
+        self._say(f"... logging to {log_dir / f'roslaunch-{socket.gethostname()}-{os.getpid()}.log'}")
+        if not self.opts.no_summary:
+            self._say(summary(self.plan, {}))
+        master_link.load_parameters(client, self.plan)
+        client.close()
+        specs = _process_specs(self.plan, self.opts, uri, log_dir, self.env)
+        if core_proc is not None:
+            specs.insert(
+                0,
+                ProcessSpec(
+                    name="master",
+                    argv=[str(a) for a in core_proc.args],
+                    env=self.env,
+                    popen=core_proc,
+                    is_core=True,
+                    sigint_timeout=self.opts.sigint_timeout,
+                ),
+            )
+        self.supervisor = Supervisor(specs)
+        previous = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
+        for sig in previous:
+            signal.signal(sig, lambda *_: self.supervisor.request_shutdown() if self.supervisor else None)
+        try:
+            if not specs and core_proc is None:
+                self._say("no nodes to launch")
+                return 0
+            return self.supervisor.run()
+        finally:
+            for sig, handler in previous.items():
+                signal.signal(sig, handler)
