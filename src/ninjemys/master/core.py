@@ -28,7 +28,7 @@ class Master:
         advertise: str | None = None,
         notify_timeout: float = 10.0,
     ) -> None:
-        self.handler = MasterHandler(on_shutdown=self.stop)
+        self.handler = MasterHandler(on_shutdown=self._stop_soon)
         self.handler.notifier = Notifier(
             timeout=notify_timeout, on_param_rejected=self.handler._param_rejected
         )
@@ -50,6 +50,10 @@ class Master:
     def set_param(self, key: str, value: Any) -> None:
         """Set a parameter directly (what roscore does for /run_id, /rosdistro, /rosversion)."""
         self.handler.params.set(key, value)
+
+    def _stop_soon(self, reason: str) -> None:
+        """``shutdown`` RPC: answer the caller first, then stop."""
+        asyncio.get_running_loop().call_soon(self.stop, reason)
 
     def stop(self, reason: str = "") -> None:
         """Stop serving (idempotent; must be called on the master's loop)."""

@@ -90,7 +90,7 @@ class XmlRpcServer:
         if self._server is not None:
             self._server.close()
         for conn in list(self._connections):
-            conn.abort()
+            conn.close_gracefully()
 
     async def wait_closed(self) -> None:
         if self._server is not None:
@@ -319,6 +319,14 @@ class _Connection(asyncio.Protocol):
             return
         log.debug("XML-RPC: closing %s (timeout)", self._peer())
         self.abort()
+
+    def close_gracefully(self) -> None:
+        """Flush what was already answered, then close; abort if the peer does not read within 1 s."""
+        self.closing = True
+        self._disarm()
+        if self.transport is not None:
+            self.transport.close()
+            asyncio.get_running_loop().call_later(1.0, self.transport.abort)
 
     def abort(self) -> None:
         self.closing = True
