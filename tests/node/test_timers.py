@@ -198,3 +198,14 @@ def test_wall_timer_runs_and_stops_promptly() -> None:
     timer.shutdown()
     timer.join(1)
     assert not timer.is_alive() and time.monotonic() - start < 1.0
+
+
+def test_sim_sleep_counts_from_first_clock_message() -> None:
+    clock = FakeClock(0.0)
+    t, box = _run(lambda: sleep(clock, 2.0))
+    _wait_blocked(t)
+    clock.set(100.0)
+    _wait_blocked(t)
+    clock.set(102.0)
+    t.join(2)
+    assert not t.is_alive() and "e" not in box

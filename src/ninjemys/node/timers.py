@@ -48,14 +48,19 @@ def _seconds(duration: Any) -> float:
 def sleep(clock: Clock, duration: Any) -> None:
     """Sleep ``duration`` seconds (or a Duration) of ROS time; a non-positive duration returns at once.
 
-    In simulated time a zero/negative sleep still yields to other threads, as rospy does.
+    In simulated time before the first /clock message, the duration counts from that first message
+    (rospy semantics: a node started before ``rosbag play --clock`` sleeps the full duration).
     """
     seconds = _seconds(duration)
-    start = clock.now()
     if clock.is_shutdown:
         raise ShutdownError("ROS shutdown request")
     if seconds <= 0:
         return
+    if clock.is_sim and clock.now_ns() == 0:
+        # simulated time has not started yet: count the duration from the first /clock, as rospy does
+        if clock.wait_until(1e-9) is Wake.SHUTDOWN:
+            raise ShutdownError("ROS shutdown request")
+    start = clock.now()
     wake = clock.wait_until(start + seconds)
     if wake is Wake.SHUTDOWN:
         raise ShutdownError("ROS shutdown request")
