@@ -370,13 +370,13 @@ def export_cmd(argv: list[str]) -> int:
 def record_cmd(argv: list[str]) -> int:
     from ninjemys.bag.record import record_main
 
-    return record_main(argv)
+    return record_main(argv, _Parser)
 
 
 def play_cmd(argv: list[str]) -> int:
     from ninjemys.bag.play import play_main
 
-    return play_main(argv)
+    return play_main(argv, _Parser)
 
 
 _HANDLERS: dict[str, Callable[[list[str]], int]] = {
