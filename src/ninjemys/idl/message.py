@@ -10,6 +10,7 @@ conversions of array values to wire bytes.
 from __future__ import annotations
 
 import struct
+from collections.abc import Callable, Iterable
 from typing import Any
 
 from ninjemys.errors import DeserializationError, SerializationError
@@ -356,8 +357,16 @@ def _yaml_string(value: str) -> str:
     return yaml.dump(value, default_style='"').rstrip("\n")
 
 
-def strify_message(val: Any, indent: str = "", time_offset: Time | None = None) -> str:
-    """Render a value the way genpy/rostopic echo do (YAML-ish, nested indentation by two spaces)."""
+def strify_message(
+    val: Any,
+    indent: str = "",
+    time_offset: Time | None = None,
+    field_filter: Callable[[Message], Iterable[str]] | None = None,
+) -> str:
+    """Render a value the way genpy/rostopic echo do (YAML-ish, nested indentation by two spaces).
+
+    ``field_filter(msg)`` yields the field names to print (rostopic echo --noarr / --nostr).
+    """
     t = type(val)
     if t in (int, float, bool):
         return str(val)
@@ -385,15 +394,18 @@ def strify_message(val: Any, indent: str = "", time_offset: Time | None = None) 
             return str(list(val))
         pref = indent + "- "
         sub = indent + "  "
-        return "\n" + "\n".join(pref + strify_message(v, sub, time_offset) for v in val)
+        return "\n" + "\n".join(pref + strify_message(v, sub, time_offset, field_filter) for v in val)
     if isinstance(val, Message):
         sub = "  " + indent
         lines = []
+        shown = set(field_filter(val)) if field_filter is not None else None
         for name, type_ in zip(val.__slots__, val._slot_types, strict=True):
+            if shown is not None and name not in shown:
+                continue
             value = getattr(val, name)
             if "uint8[" in type_ and isinstance(value, bytes | bytearray | memoryview):
                 value = list(value)
-            lines.append(f"{indent}{name}: {strify_message(value, sub, time_offset)}")
+            lines.append(f"{indent}{name}: {strify_message(value, sub, time_offset, field_filter)}")
         body = "\n".join(lines)
         return "\n" + body if indent else body
     if isinstance(val, memoryview):
