@@ -1,0 +1,200 @@
+"""The seeds' talker and listener, read verbatim from the course text, run unmodified on ninjemys.
+
+The programs are extracted from /work/shared/seeds at test time (never copied into the project), then
+run as separate processes: both on ninjemys over our roscore, both on ninjemys over Debian's real
+roscore, and mixed with Debian's real rospy in both directions.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).parents[1] / "rospy"))
+
+from nodeproc import NodeProc  # noqa: E402
+
+from ninjemys.testing import ROS1_PYTHON, free_port, ros1_env, run_master  # noqa: E402
+
+SEEDS = Path(os.environ.get("NINJEMYS_SEEDS", Path(__file__).resolve().parents[3] / "shared" / "seeds"))
+SEED = SEEDS / "000_7aec5b1f38a66cac.txt"
+pytestmark = pytest.mark.skipif(not SEED.exists(), reason=f"seed text {SEED} not available")
+
+INFO_LINE = r"^\[INFO\] \[\d+\.\d{6}\]: "
+
+
+def _blocks(text: str) -> list[str]:
+    return [b.strip("\n") + "\n" for b in re.findall(r"```\n(.*?)```", text, flags=re.S)]
+
+
+def _seed_program(*must: str, without: str | None = None) -> str:
+    """The first code block of the seed that contains every string in ``must`` (and not ``without``)."""
+    for block in _blocks(SEED.read_text()):
+        if all(m in block for m in must) and (without is None or without not in block):
+            compile(block, "seed", "exec")
+            return block
+    raise AssertionError(f"no code block with {must} in {SEED}")
+
+
+def talker_code() -> str:
+    return _seed_program(
+        "def talker():", "pub.publish(hello_str)", "ROSInterruptException", without="logfatal"
+    )
+
+
+def logging_talker_code() -> str:
+    return _seed_program("def talker():", "rospy.logfatal(hello_str)")
+
+
+def listener_code() -> str:
+    return _seed_program("def listener():", "rospy.spin()", "if __name__ == '__main__':")
+
+
+@pytest.fixture
+def procs() -> Iterator[list[NodeProc]]:
+    started: list[NodeProc] = []
+    try:
+        yield started
+    finally:
+        for p in started:
+            p.kill()
+
+
+def _run(
+    procs: list[NodeProc], tmp_path: Path, code: str, env: dict[str, str], python: str = sys.executable
+) -> NodeProc:
+    path = tmp_path / f"seed_{len(procs)}.py"
+    path.write_text(code)
+    proc = NodeProc([python, str(path)], env, tmp_path)
+    procs.append(proc)
+    return proc
+
+
+def _our_env(master: str, tmp_path: Path) -> dict[str, str]:
+    env = {
+        k: v for k, v in os.environ.items() if k not in ("ROS_NAMESPACE", "ROS_LOG_DIR", "ROSCONSOLE_FORMAT")
+    }
+    env.update(
+        ROS_MASTER_URI=master, ROS_HOME=str(tmp_path / "home"), ROS_HOSTNAME="localhost", PYTHONUNBUFFERED="1"
+    )
+    return env
+
+
+@pytest.fixture(scope="module")
+def our_master(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
+    env = dict(os.environ, ROS_HOME=str(tmp_path_factory.mktemp("seed_master")), ROS_HOSTNAME="localhost")
+    with run_master(env=env) as uri:
+        yield uri
+
+
+@pytest.fixture(scope="module")
+def real_master(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
+    """Debian's /usr/bin/roscore (rosmaster + rosout) on a free port, killed with its children."""
+    port = free_port()
+    uri = f"http://localhost:{port}/"
+    env = ros1_env(uri, ROS_HOME=str(tmp_path_factory.mktemp("real_roscore")))
+    proc = subprocess.Popen(
+        ["/usr/bin/roscore", "-p", str(port)],
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        stdin=subprocess.DEVNULL,
+        start_new_session=True,
+    )
+    try:
+        import xmlrpc.client
+
+        deadline = time.monotonic() + 30
+        while True:
+            try:
+                code, _, _ = xmlrpc.client.ServerProxy(uri).getSystemState("/seed_test")
+                state = xmlrpc.client.ServerProxy(uri).getSystemState("/seed_test")[2]
+                if code == 1 and any(t == "/rosout" for t, _ in state[1]):
+                    break
+            except OSError:
+                pass
+            if proc.poll() is not None or time.monotonic() > deadline:
+                raise RuntimeError("Debian's roscore did not come up")
+            time.sleep(0.1)
+        yield uri
+    finally:
+        try:
+            os.killpg(proc.pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+        proc.wait()
+
+
+def test_seed_blocks_are_found() -> None:
+    assert "rospy.init_node('talker', anonymous=True)" in talker_code()
+    assert 'rospy.Subscriber("chatter", String, callback)' in listener_code()
+
+
+def _check_pair(talker: NodeProc, listener: NodeProc) -> None:
+    sent = talker.wait_for(INFO_LINE + r"hello world (\d+\.\d+)$").group(1)
+    heard = listener.wait_for(INFO_LINE + r"(/listener_\d+_\d+)I heard hello world (\d+\.\d+)$")
+    assert float(heard.group(2)) >= float(sent) - 60
+    # every message the listener heard is one the talker logged
+    talked = {m.group(1) for line in talker.out if (m := re.search(r"hello world (\S+)$", line))}
+    heard_all = [m.group(1) for line in listener.out if (m := re.search(r"I heard hello world (\S+)$", line))]
+    assert heard_all and set(heard_all) <= talked | {heard_all[-1]}
+
+
+def test_seed_talker_and_listener_over_our_roscore(our_master: str, procs, tmp_path: Path) -> None:
+    env = _our_env(our_master, tmp_path)
+    listener = _run(procs, tmp_path, listener_code(), env)
+    talker = _run(procs, tmp_path, talker_code(), env)
+    _check_pair(talker, listener)
+    listener.interrupt()
+    talker.interrupt()
+    assert talker.wait(5) == 0 and listener.wait(5) == 0
+    assert not any("Traceback" in line for line in talker.err + listener.err)
+
+
+def test_seed_logging_talker_routes_levels(our_master: str, procs, tmp_path: Path) -> None:
+    env = _our_env(our_master, tmp_path)
+    talker = _run(procs, tmp_path, logging_talker_code(), env)
+    talker.wait_for(INFO_LINE + r"hello world \d+\.\d+$")
+    for level in ("WARN", "ERROR", "FATAL"):
+        talker.wait_for(rf"^\[{level}\] \[\d+\.\d{{6}}\]: hello world \d+\.\d+$", stream="err")
+    talker.interrupt()
+    assert talker.wait(5) == 0
+    assert all(line.startswith("[INFO]") for line in talker.out if line)
+    assert not any(line.startswith("[INFO]") or "DEBUG" in line for line in talker.err)
+    (log,) = (Path(env["ROS_HOME"]) / "log").glob("talker_*.log")
+    text = log.read_text()
+    assert "[rosout][DEBUG]" in text and "[rosout][CRITICAL]" in text
+
+
+@pytest.mark.ros1
+def test_seed_programs_over_real_roscore(real_master: str, procs, tmp_path: Path) -> None:
+    env = _our_env(real_master, tmp_path)
+    listener = _run(procs, tmp_path, listener_code(), env)
+    talker = _run(procs, tmp_path, talker_code(), env)
+    _check_pair(talker, listener)
+
+
+@pytest.mark.ros1
+def test_seed_talker_ours_listener_real_rospy(real_master: str, procs, tmp_path: Path) -> None:
+    listener = _run(
+        procs, tmp_path, listener_code(), ros1_env(real_master, ROS_HOME=str(tmp_path / "r")), ROS1_PYTHON
+    )
+    talker = _run(procs, tmp_path, talker_code(), _our_env(real_master, tmp_path))
+    _check_pair(talker, listener)
+
+
+@pytest.mark.ros1
+def test_seed_talker_real_rospy_listener_ours(our_master: str, procs, tmp_path: Path) -> None:
+    talker = _run(
+        procs, tmp_path, talker_code(), ros1_env(our_master, ROS_HOME=str(tmp_path / "r")), ROS1_PYTHON
+    )
+    listener = _run(procs, tmp_path, listener_code(), _our_env(our_master, tmp_path))
+    _check_pair(talker, listener)
