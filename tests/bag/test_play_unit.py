@@ -1,0 +1,183 @@
+"""Player and recorder logic with fake nodes and clocks: schedule, rate, latching, drops, naming."""
+
+from __future__ import annotations
+
+import io
+
+import pytest
+from bagtest_util import BASE, STRING_HEADER, string_bytes
+
+from ninjemys.bag.format import NSEC
+from ninjemys.bag.play import Player, PlayOptions
+from ninjemys.bag.record import BagNamer, ByteBoundedQueue, RecordOptions, parse_duration
+from ninjemys.bag.writer import BagWriter
+from ninjemys.errors import BagError
+
+
+class FakeTime:
+    """Monotonic clock that advances only when slept on (plus a fixed overshoot per sleep)."""
+
+    def __init__(self, overshoot: float = 0.0) -> None:
+        self.now = 100.0
+        self.overshoot = overshoot
+
+    def monotonic(self) -> float:
+        return self.now
+
+    def sleep(self, seconds: float) -> None:
+        self.now += max(seconds, 0.0) + self.overshoot
+
+
+class FakePub:
+    def __init__(self, log, topic, cls, latch):
+        self.log, self.topic, self.cls, self.latch = log, topic, cls, latch
+
+    def publish_raw(self, data):
+        self.log.append((self.topic, bytes(data)))
+
+    def get_num_connections(self):
+        return 1
+
+
+class FakeNode:
+    def __init__(self, clock: FakeTime) -> None:
+        self.clock = clock
+        self.sent: list = []
+        self.pubs: dict = {}
+
+    def publisher(self, topic, cls, queue_size=None, latch=False):
+        log = []
+        pub = FakePub(log, topic, cls, latch)
+
+        def publish_raw(data, topic=topic):
+            self.sent.append((self.clock.now, topic, bytes(data)))
+
+        pub.publish_raw = publish_raw
+        self.pubs[topic] = pub
+        return pub
+
+
+def make_bag(path, gaps_ms):
+    with BagWriter(path) as w:
+        c = w.connection("/a", STRING_HEADER)
+        lat = w.connection("/latched", dict(STRING_HEADER, latching=b"1"))
+        t = BASE
+        for i, gap in enumerate(gaps_ms):
+            t += gap * 1_000_000
+            w.write(c, t, string_bytes(str(i)))
+        w.write(lat, BASE, string_bytes("map"))
+    return path
+
+
+@pytest.mark.parametrize("rate", [1.0, 2.0, 0.5])
+def test_schedule_follows_recorded_gaps_without_drift(tmp_path, rate):
+    gaps = [0, 10, 250, 1, 1, 1, 500, 33, 33, 34] * 5
+    bag = make_bag(tmp_path / "a.bag", gaps)
+    clock = FakeTime(overshoot=0.0007)  # every sleep overshoots: errors must not accumulate
+    node = FakeNode(clock)
+    player = Player(
+        node,
+        PlayOptions(bags=[str(bag)], rate=rate, delay=0, quiet=True, topics=["/a"]),
+        sleep=clock.sleep,
+        monotonic=clock.monotonic,
+    )
+    player.run()
+    times = [t for t, topic, _ in node.sent if topic == "/a"]
+    assert len(times) == len(gaps)
+    start = times[0]
+    cumulative = 0
+    for i, t in enumerate(times):
+        cumulative += gaps[i] if i else 0
+        assert abs((t - start) - cumulative / 1000 / rate) <= 0.0008
+
+
+def test_latched_connections_are_relatched_and_types_kept(tmp_path):
+    bag = make_bag(tmp_path / "a.bag", [0, 10])
+    clock = FakeTime()
+    node = FakeNode(clock)
+    Player(
+        node, PlayOptions(bags=[str(bag)], delay=0, quiet=True), sleep=clock.sleep, monotonic=clock.monotonic
+    ).run()
+    assert node.pubs["/latched"].latch and not node.pubs["/a"].latch
+    assert node.pubs["/a"].cls._md5sum == "992ce8a1687cec8c8bd883ec73ca41d1"
+    assert node.pubs["/a"].cls._full_text == "string data\n"
+
+
+def test_clock_is_published_with_bag_time(tmp_path):
+    bag = make_bag(tmp_path / "a.bag", [0, 100, 100])
+    clock = FakeTime()
+    node = FakeNode(clock)
+    opts = PlayOptions(bags=[str(bag)], delay=0, quiet=True, clock=True, hz=100, topics=["/a"])
+    Player(node, opts, sleep=clock.sleep, monotonic=clock.monotonic).run()
+    import struct
+
+    stamps = [struct.unpack("<II", d) for _, topic, d in node.sent if topic == "/clock"]
+    ns = [s * NSEC + n for s, n in stamps]
+    assert len(ns) >= 20  # 200 ms of bag at 100 Hz
+    assert ns == sorted(ns) and ns[0] >= BASE and ns[-1] == BASE + 200_000_000
+
+
+def test_start_duration_and_immediate(tmp_path):
+    bag = make_bag(tmp_path / "a.bag", [0] + [100] * 9)
+    clock = FakeTime()
+    node = FakeNode(clock)
+    opts = PlayOptions(
+        bags=[str(bag)], delay=0, quiet=True, immediate=True, start=0.25, duration=0.3, topics=["/a"]
+    )
+    Player(node, opts, sleep=clock.sleep, monotonic=clock.monotonic).run()
+    assert [d for _, _, d in node.sent] == [string_bytes(str(i)) for i in (3, 4, 5)]
+    assert clock.now == 100.0  # immediate: never slept
+
+
+def test_pause_and_step_with_keys(tmp_path):
+    bag = make_bag(tmp_path / "a.bag", [0, 100, 100])
+    clock = FakeTime()
+    node = FakeNode(clock)
+
+    class Keys:
+        active = True
+        script = ["s", None, None, "s", None, " "]
+
+        def read(self):
+            return self.script.pop(0) if self.script else None
+
+    out = io.StringIO()
+    opts = PlayOptions(bags=[str(bag)], delay=0, pause=True, topics=["/a"])
+    Player(node, opts, out=out, keyboard=Keys(), sleep=clock.sleep, monotonic=clock.monotonic).run()
+    assert len(node.sent) == 3
+    assert "[PAUSED ]" in out.getvalue() and "Done." in out.getvalue()
+
+
+def test_status_line_layout(tmp_path):
+    bag = make_bag(tmp_path / "a.bag", [0, 300, 300])
+    clock = FakeTime()
+    out = io.StringIO()
+    Player(
+        FakeNode(clock),
+        PlayOptions(bags=[str(bag)], delay=0, topics=["/a"]),
+        out=out,
+        sleep=clock.sleep,
+        monotonic=clock.monotonic,
+    ).run()
+    assert " [RUNNING]  Bag Time: 1700000000.300000   Duration: 0.300000 / 0.600000" in out.getvalue()
+
+
+def test_byte_bounded_queue_drops_oldest_and_counts():
+    dropped = []
+    q = ByteBoundedQueue(1000, dropped.append)
+    for i in range(10):
+        q.put("/big", {}, bytes(300), i)
+    assert q.bytes <= 1000 and len(q) == 3
+    assert dropped == ["/big"] * 7
+    assert [q.get(0)[3] for _ in range(3)] == [7, 8, 9]
+    assert q.get(0) is None
+
+
+def test_names_and_durations():
+    assert BagNamer(RecordOptions(output_name="run")).next().name == "run.bag"
+    namer = BagNamer(RecordOptions(output_name="run.bag", split=True))
+    assert [namer.next().name for _ in range(2)] == ["run_0.bag", "run_1.bag"]
+    assert BagNamer(RecordOptions(output_prefix="pre")).next().name.startswith("pre_20")
+    assert parse_duration("30") == 30 and parse_duration("5m") == 300 and parse_duration("2h") == 7200
+    with pytest.raises(BagError):
+        parse_duration("soon")
