@@ -180,3 +180,41 @@ def test_shutdown_leaves_no_thread_behind(master) -> None:
     listener.shutdown("done")
     assert time.monotonic() - started < 2
     assert ours() == []
+
+
+def test_publisher_never_blocks_on_a_subscriber_that_stops_reading(make_node) -> None:
+    import socket
+
+    from ninjemys.wire import headers
+
+    talker = make_node("talker")
+    pub = talker.publisher("flood", String, queue_size=10)
+    sock = socket.create_connection(("127.0.0.1", talker.tcpros_port))
+    try:
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+        sock.sendall(
+            headers.encode_header({"callerid": "/stuck", "topic": "/flood", "md5sum": "*", "type": "*"})
+        )
+        assert _connected(pub)
+        payload = String("x" * 1024)
+        started = time.monotonic()
+        for _ in range(20000):  # 20 MB: far more than any socket buffer
+            pub.publish(payload)
+        assert time.monotonic() - started < 10
+        conn = pub._pub.connections[0]
+        assert len(conn._queue) <= 10
+        assert conn.dropped > 0
+    finally:
+        sock.close()
+
+
+def test_queue_size_none_is_lossless(make_node) -> None:
+    talker, listener = make_node("talker"), make_node("listener")
+    got: list[int] = []
+    listener.subscriber("n", Int64, lambda m: got.append(m.data))
+    pub = talker.publisher("n", Int64, queue_size=None)
+    assert _connected(pub)
+    for i in range(20000):
+        pub.publish(Int64(i))
+    assert wait_until(lambda: len(got) == 20000, timeout=20)
+    assert got == list(range(20000))
