@@ -90,6 +90,16 @@ from rospy.service import Service, ServiceProxy, wait_for_service
 from rospy.timer import Rate, Timer, TimerEvent, sleep
 from rospy.topics import Publisher, SubscribeListener, Subscriber
 
+
+def _install_import_hook() -> None:
+    """``from my_pkg.msg import MyMsg`` for packages on ROS_PACKAGE_PATH, without a build step."""
+    from ninjemys.idl.loader import install_import_hook
+
+    install_import_hook()
+
+
+_install_import_hook()
+
 __all__ = [
     "AnyMsg",
     "DEBUG",
