@@ -132,17 +132,24 @@ class Bag:
         self._reader: BagReader | None = None
         self._writer: BagWriter | None = None
         self._decoders = _Decoders()
+        self._unindexed = False
         try:
             if mode == "r":
                 self._reader = BagReader(f)
             else:
-                if mode == "a" and Path(f).exists() and not allow_unindexed:
+                unindexed = False
+                if mode == "a" and Path(f).exists():
                     with BagReader(f) as probe:
-                        if not probe.indexed:
-                            raise ROSBagUnindexedException()
-                self._writer = BagWriter(
-                    f, compression=compression, chunk_threshold=chunk_threshold, append=(mode == "a")
-                )
+                        unindexed = not probe.indexed
+                    if unindexed and not allow_unindexed:
+                        raise ROSBagUnindexedException()
+                if unindexed:
+                    # allow_unindexed: the caller will reindex() first; the writer opens after that
+                    self._unindexed = True
+                else:
+                    self._writer = BagWriter(
+                        f, compression=compression, chunk_threshold=chunk_threshold, append=(mode == "a")
+                    )
         except ROSBagException:
             raise
         except BagError as exc:
@@ -224,6 +231,8 @@ class Bag:
         """Write ``msg`` (a message, or with ``raw`` a (datatype, data, md5sum, pytype) tuple) at ``t``."""
         writer = self._writer
         if writer is None:
+            if self._unindexed:
+                raise ROSBagUnindexedException()
             if self._reader is None:
                 raise ValueError("I/O operation on closed bag")
             raise ROSBagException(f"{self._filename}: bag is open for reading, not writing")
@@ -391,7 +400,13 @@ class Bag:
             self._writer.abandon()
             self._writer = None
         self._reader = None
-        yield from reindex_in_place(self._filename)
+        try:
+            yield from reindex_in_place(self._filename)
+        except ROSBagException:
+            raise
+        except BagError as exc:
+            raise ROSBagFormatException(str(exc)) from None
+        self._unindexed = False
         self._writer = BagWriter(
             self._filename, compression=self._compression, chunk_threshold=self._chunk_threshold, append=True
         )
