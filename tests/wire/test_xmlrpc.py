@@ -44,7 +44,7 @@ def test_none_is_refused() -> None:
 
 
 def test_fault_response_raises_fault() -> None:
-    with pytest.raises(xmlrpc.client.Fault) as info:
+    with pytest.raises(wire.Fault) as info:
         wire.parse_response(wire.dump_fault(3, "bad"))
     assert (info.value.faultCode, info.value.faultString) == (3, "bad")
 
@@ -118,3 +118,79 @@ def test_response_parser_needs_content_length() -> None:
         wire.HttpResponseParser().feed(b"HTTP/1.1 200 OK\r\n\r\n")
     ok = wire.HttpResponseParser().feed(wire.http_response(b"abc"))[0]
     assert ok.start[1] == "200" and ok.body == b"abc"
+
+
+# --- cross-checks against the stdlib codec (what rospy and rosmaster use) ---------------------------
+
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+_xml_text = st.text(st.characters(blacklist_categories=("Cs", "Cc")), max_size=20)
+_scalars = (
+    st.integers(min_value=-(2**31), max_value=2**31 - 1)
+    | st.booleans()
+    | st.floats(allow_nan=False)
+    | _xml_text
+    | st.binary(max_size=20)
+)
+_values = st.recursive(
+    _scalars,
+    lambda inner: st.lists(inner, max_size=4) | st.dictionaries(_xml_text, inner, max_size=4),
+    max_leaves=20,
+)
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.lists(_values, max_size=4))
+def test_stdlib_reads_what_we_write(params: list[object]) -> None:
+    decoded, method = xmlrpc.client.loads(wire.dump_call("m", params), use_builtin_types=True)
+    assert method == "m" and list(decoded) == params
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.lists(_values, max_size=4))
+def test_we_read_what_stdlib_writes(params: list[object]) -> None:
+    body = xmlrpc.client.dumps(tuple(params), "m").encode()
+    assert wire.parse_call(body) == ("m", tuple(params))
+
+
+def test_untyped_values_nil_and_i8_from_other_peers() -> None:
+    body = (
+        b"<?xml version='1.0'?><methodCall><methodName>m</methodName><params>"
+        b"<param><value>bare text</value></param><param><value></value></param>"
+        b"<param><value><i8>-9000000000</i8></value></param><param><value><ex:nil/></value></param>"
+        b"<param><value><dateTime.iso8601>20240102T03:04:05</dateTime.iso8601></value></param>"
+        b"</params></methodCall>"
+    )
+    import datetime
+
+    assert wire.parse_call(body) == (
+        "m",
+        ("bare text", "", -9000000000, None, datetime.datetime(2024, 1, 2, 3, 4, 5)),
+    )
+
+
+def test_foreign_value_types_are_marshalled() -> None:
+    import datetime
+
+    params = (xmlrpc.client.Binary(b"\x01"), datetime.datetime(2024, 1, 2, 3, 4, 5), (1, 2))
+    decoded, _ = xmlrpc.client.loads(wire.dump_call("m", params), use_builtin_types=True)
+    assert decoded == (b"\x01", datetime.datetime(2024, 1, 2, 3, 4, 5), [1, 2])
+    with pytest.raises(ProtocolError, match="cannot marshal"):
+        wire.dump_call("m", (object(),))
+    with pytest.raises(ProtocolError, match="struct keys"):
+        wire.dump_call("m", ({1: 2},))
+
+
+def test_deep_nesting_is_parsed_without_recursion() -> None:
+    depth = 5000
+    body = (
+        b"<methodCall><methodName>m</methodName><params><param>"
+        + b"<value><array><data>" * depth
+        + b"</data></array></value>" * depth
+        + b"</param></params></methodCall>"
+    )
+    _, (value,) = wire.parse_call(body)
+    for _ in range(depth - 1):
+        value = value[0]
+    assert value == []

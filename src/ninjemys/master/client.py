@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import socket
 import threading
-import xmlrpc.client
 from typing import Any
 
 from ninjemys.errors import MasterError, MasterUnreachable, ProtocolError
@@ -65,7 +64,7 @@ class MasterClient:
             raise MasterError(f"{method}: master at {self.uri} answered HTTP {response.start[1]}")
         try:
             return wire.parse_response(response.body)
-        except xmlrpc.client.Fault as fault:
+        except wire.Fault as fault:
             raise MasterError(f"{method}: XML-RPC fault {fault.faultCode}: {fault.faultString}") from None
         except ProtocolError as exc:
             raise MasterError(f"{method}: {exc}") from None

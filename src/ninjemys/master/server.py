@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import logging
 import os
-import xmlrpc.client
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -26,6 +25,7 @@ from ninjemys.master.notify import Notifier
 from ninjemys.master.params import ParamTree, compute_updates, subscription_key
 from ninjemys.master.store import ANYTYPE, Bumped, RegistrationStore
 from ninjemys.names import resolve_name
+from ninjemys.wire import xmlrpc as wire
 
 log = logging.getLogger("ninjemys.master")
 
@@ -192,7 +192,7 @@ class MasterHandler:
     def _dispatch(self, method: str, params: tuple[Any, ...]) -> list[Any]:
         api = self._apis.get(method)
         if api is None:
-            raise xmlrpc.client.Fault(1, f"<class 'Exception'>:method \"{method}\" is not supported")
+            raise wire.Fault(1, f"<class 'Exception'>:method \"{method}\" is not supported")
         if not params:
             return [-1, "missing required caller_id parameter", api.error_value]
         if len(params) != len(api.validators) + 1:

@@ -22,7 +22,8 @@ async def call(uri: str, method: str, params: tuple[Any, ...] | list[Any], timeo
     """Call ``method`` at ``uri`` and return the response value.
 
     Raises ``TimeoutError_`` after ``timeout`` seconds, ``OSError`` if the peer cannot be reached,
-    ``ProtocolError`` if it answers with something that is not XML-RPC, and ``xmlrpc.client.Fault``.
+    ``ProtocolError`` if it answers with something that is not XML-RPC, and ``wire.Fault`` (a
+    ``ProtocolError``) for a fault response.
     """
     try:
         host, port = split_uri(uri)

@@ -20,7 +20,6 @@ from __future__ import annotations
 import asyncio
 import inspect
 import logging
-import xmlrpc.client
 from collections import deque
 from typing import Any
 
@@ -99,7 +98,7 @@ class XmlRpcServer:
     # ----------------------------------------------------------------------------------- dispatch
 
     def call(self, method: str, params: tuple[Any, ...]) -> Any:
-        """Run one RPC method (may return an awaitable). Raises ``xmlrpc.client.Fault``."""
+        """Run one RPC method (may return an awaitable). Raises ``wire.Fault``."""
         if method == "system.multicall":
             return self._multicall(params)
         if method == "system.listMethods":
@@ -108,7 +107,7 @@ class XmlRpcServer:
             return self._dispatch(method, params)
         fn = None if method.startswith("_") else getattr(self.handler, method, None)
         if fn is None or not callable(fn):
-            raise xmlrpc.client.Fault(FAULT_NO_METHOD, f'method "{method}" is not supported')
+            raise wire.Fault(FAULT_NO_METHOD, f'method "{method}" is not supported')
         return fn(*params)
 
     def _list_methods(self) -> list[str]:
@@ -117,20 +116,20 @@ class XmlRpcServer:
 
     def _multicall(self, params: tuple[Any, ...]) -> Any:
         if len(params) != 1 or not isinstance(params[0], list):
-            raise xmlrpc.client.Fault(FAULT_APPLICATION, "system.multicall expects one array of calls")
+            raise wire.Fault(FAULT_APPLICATION, "system.multicall expects one array of calls")
         results: list[Any] = []
         awaitables: list[tuple[int, Any]] = []
         for call in params[0]:
             try:
                 if not isinstance(call, dict) or not isinstance(call.get("methodName"), str):
-                    raise xmlrpc.client.Fault(FAULT_APPLICATION, "multicall entry needs methodName")
+                    raise wire.Fault(FAULT_APPLICATION, "multicall entry needs methodName")
                 if call["methodName"] == "system.multicall":
-                    raise xmlrpc.client.Fault(FAULT_APPLICATION, "recursive system.multicall forbidden")
+                    raise wire.Fault(FAULT_APPLICATION, "recursive system.multicall forbidden")
                 result = self.call(call["methodName"], tuple(call.get("params", ())))
                 if inspect.isawaitable(result):
                     awaitables.append((len(results), result))
                 results.append([result])
-            except xmlrpc.client.Fault as fault:
+            except wire.Fault as fault:
                 results.append({"faultCode": fault.faultCode, "faultString": fault.faultString})
             except Exception as exc:  # an application error becomes that entry's fault
                 results.append(_fault_dict(exc))
@@ -149,7 +148,7 @@ class XmlRpcServer:
 
 
 def _fault_dict(exc: Exception) -> dict[str, Any]:
-    if isinstance(exc, xmlrpc.client.Fault):
+    if isinstance(exc, wire.Fault):
         return {"faultCode": exc.faultCode, "faultString": exc.faultString}
     return {"faultCode": FAULT_APPLICATION, "faultString": f"{type(exc).__name__}: {exc}"}
 
@@ -255,7 +254,7 @@ class _Connection(asyncio.Protocol):
             return wire.dump_fault(FAULT_APPLICATION, f"{method}: {exc}")
 
     def _fault_body(self, method: str, exc: BaseException) -> bytes:
-        if isinstance(exc, xmlrpc.client.Fault):
+        if isinstance(exc, wire.Fault):
             return wire.dump_fault(exc.faultCode, exc.faultString)
         if not isinstance(exc, TypeError | ValueError | ProtocolError):
             log.exception("XML-RPC method %s failed", method, exc_info=exc)

@@ -1,0 +1,129 @@
+"""Shared helpers of the master benchmarks: start ninjemys' or Debian's roscore, poll it, stop it."""
+
+from __future__ import annotations
+
+import os
+import signal
+import socket
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
+
+from ninjemys.errors import MasterError  # noqa: E402
+from ninjemys.master.client import MasterClient  # noqa: E402
+from ninjemys.testing import free_port, have_ros1, ninjemys_bin, ros1_env  # noqa: E402
+
+OURS = "ninjemys"
+REAL = "ROS 1"
+
+
+@dataclass
+class Core:
+    """A running roscore (either implementation)."""
+
+    impl: str
+    proc: subprocess.Popen[bytes]
+    uri: str
+    started: float  # time.perf_counter() just before Popen
+
+    def stop(self) -> float:
+        """Send SIGINT (Ctrl-C) and return the seconds until the process has exited."""
+        t0 = time.perf_counter()
+        self.proc.send_signal(signal.SIGINT)
+        try:
+            self.proc.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            self.proc.wait()
+            return float("inf")
+        return time.perf_counter() - t0
+
+    def kill(self) -> None:
+        if self.proc.poll() is None:
+            self.proc.kill()
+            self.proc.wait()
+
+
+def start_core(impl: str, home: str | None = None) -> Core:
+    port = free_port()
+    uri = f"http://localhost:{port}/"
+    home = home or tempfile.mkdtemp(prefix="bench_ros_home_")
+    if impl == OURS:
+        env = dict(os.environ, ROS_HOME=home, ROS_MASTER_URI=uri, ROS_HOSTNAME="localhost")
+        cmd = [ninjemys_bin("roscore"), "-p", str(port)]
+    else:
+        env = ros1_env(uri, ROS_HOME=home)
+        cmd = ["/usr/bin/roscore", "-p", str(port)]
+    started = time.perf_counter()
+    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    return Core(impl, proc, uri, started)
+
+
+def wait_ready(core: Core, timeout: float = 60.0) -> float:
+    """Seconds from launch to the first successful getSystemState."""
+    client = MasterClient(core.uri, "/bench", timeout=5)
+    deadline = time.perf_counter() + timeout
+    while True:
+        try:
+            client.get_system_state()
+            return time.perf_counter() - core.started
+        except MasterError:
+            if time.perf_counter() > deadline or core.proc.poll() is not None:
+                raise RuntimeError(f"{core.impl} roscore never became ready") from None
+            time.sleep(0.001)
+
+
+def wait_rosout(core: Core, timeout: float = 60.0) -> float:
+    """Seconds from launch until the /rosout node subscribes /rosout and publishes /rosout_agg."""
+    client = MasterClient(core.uri, "/bench", timeout=5)
+    deadline = time.perf_counter() + timeout
+    while True:
+        try:
+            pubs, subs, _ = client.get_system_state()
+            if any(t == "/rosout" and "/rosout" in n for t, n in subs) and any(
+                t == "/rosout_agg" and "/rosout" in n for t, n in pubs
+            ):
+                return time.perf_counter() - core.started
+        except MasterError:
+            pass
+        if time.perf_counter() > deadline or core.proc.poll() is not None:
+            raise RuntimeError(f"{core.impl} rosout never came up")
+        time.sleep(0.002)
+
+
+def median(values: list[float]) -> float:
+    return statistics.median(values)
+
+
+def ratio(ours: float, theirs: float) -> str:
+    """'3.9x faster' style comparison (how many times less time we take)."""
+    if ours <= 0:
+        return "inf"
+    r = theirs / ours
+    return f"{r:.1f}x faster" if r >= 1 else f"{1 / r:.1f}x slower"
+
+
+def require_ros1() -> None:
+    if not have_ros1():
+        sys.exit("Debian's ROS 1 is not installed: nothing to compare against")
+
+
+__all__ = [
+    "OURS",
+    "REAL",
+    "Core",
+    "free_port",
+    "median",
+    "ratio",
+    "require_ros1",
+    "socket",
+    "start_core",
+    "wait_ready",
+    "wait_rosout",
+]
