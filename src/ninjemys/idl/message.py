@@ -101,7 +101,13 @@ class Message:
         if not isinstance(other, self.__class__):
             return False
         for name in self.__slots__:
-            if getattr(self, name) != getattr(other, name):
+            mine, theirs = getattr(self, name), getattr(other, name)
+            if mine != theirs:
+                # a fixed array is a list when built and a tuple when received (as in genpy);
+                # unlike genpy, equal values compare equal whichever sequence type holds them
+                if isinstance(mine, list | tuple) and isinstance(theirs, list | tuple):
+                    if list(mine) == list(theirs):
+                        continue
                 return False
         return True
 
