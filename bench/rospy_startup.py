@@ -1,0 +1,181 @@
+"""`import rospy; rospy.init_node(...)` process wall time and a seed-style talker's CPU, ninjemys vs Debian's rospy.
+
+    .venv/bin/python bench/rospy_startup.py [--runs 9] [--talker-seconds 5]
+
+Both implementations register with the same master (Debian's rosmaster, so neither side is favoured)
+and run as fresh processes; figures are medians. Besides the bare ``init_node`` process, it times the
+three phases inside the process (import, init_node, exit) and measures the CPU seconds a 10 Hz
+seed-style talker and a 100 Hz talker burn per wall second.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import signal
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+import xmlrpc.client
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
+
+from ninjemys.testing import ROS1_PYTHON, free_port, have_ros1, ros1_env  # noqa: E402
+
+OURS, REAL = "ninjemys", "rospy"
+
+BARE = "import rospy; rospy.init_node('bench_init', anonymous=True)"
+
+PHASES = """
+import time, atexit, sys
+t0 = time.perf_counter()
+import rospy
+t1 = time.perf_counter()
+rospy.init_node('bench_phases', anonymous=True)
+t2 = time.perf_counter()
+def report():
+    sys.stdout.write('%f %f\\n' % (t1 - t0, t2 - t1))
+    sys.stdout.flush()
+report()
+"""
+
+TALKER = """
+import sys, rospy
+from std_msgs.msg import String
+pub = rospy.Publisher('chatter', String, queue_size=10)
+rospy.init_node('bench_talker', anonymous=True)
+rate = rospy.Rate(float(sys.argv[1]))
+try:
+    while not rospy.is_shutdown():
+        pub.publish("hello world %s" % rospy.get_time())
+        rate.sleep()
+except rospy.ROSInterruptException:
+    pass
+"""
+
+
+def _env(impl: str, master: str, home: str) -> dict[str, str]:
+    if impl == REAL:
+        return ros1_env(master, ROS_HOME=home)
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    env.update(ROS_MASTER_URI=master, ROS_HOME=home, ROS_HOSTNAME="localhost")
+    return env
+
+
+def _python(impl: str) -> str:
+    return ROS1_PYTHON if impl == REAL else sys.executable
+
+
+def bare_wall(impl: str, master: str, home: str, runs: int) -> float:
+    walls = []
+    for _ in range(runs):
+        start = time.perf_counter()
+        subprocess.run(
+            [_python(impl), "-c", BARE], env=_env(impl, master, home), check=True, capture_output=True
+        )
+        walls.append(time.perf_counter() - start)
+    return statistics.median(walls)
+
+
+def phases(impl: str, master: str, home: str, runs: int) -> tuple[float, float]:
+    imports, inits = [], []
+    for _ in range(runs):
+        out = subprocess.run(
+            [_python(impl), "-c", PHASES],
+            env=_env(impl, master, home),
+            check=True,
+            capture_output=True,
+            text=True,
+        ).stdout.split()
+        imports.append(float(out[0]))
+        inits.append(float(out[1]))
+    return statistics.median(imports), statistics.median(inits)
+
+
+def talker_cpu(impl: str, master: str, home: str, hz: float, seconds: float) -> float:
+    """CPU seconds per wall second of a seed-style talker (after a 1 s warm-up)."""
+    proc = subprocess.Popen(
+        [_python(impl), "-c", TALKER, str(hz)],
+        env=_env(impl, master, home),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    try:
+        time.sleep(1.0)
+        before = _cpu(proc.pid)
+        start = time.perf_counter()
+        time.sleep(seconds)
+        used = _cpu(proc.pid) - before
+        return used / (time.perf_counter() - start)
+    finally:
+        proc.send_signal(signal.SIGINT)
+        try:
+            proc.wait(5)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+
+
+def _cpu(pid: int) -> float:
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    ticks = os.sysconf("SC_CLK_TCK")
+    return (int(fields[11]) + int(fields[12])) / ticks
+
+
+def _ratio(ours: float, real: float) -> str:
+    return f"{ours / real:.2f}x" if real else "n/a"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--runs", type=int, default=9)
+    parser.add_argument("--talker-seconds", type=float, default=5.0)
+    args = parser.parse_args()
+    if not have_ros1():
+        sys.exit("ERROR: this benchmark compares against Debian's ROS 1 (/usr/bin/python3 with rospy)")
+    port = free_port()
+    master = f"http://localhost:{port}/"
+    with tempfile.TemporaryDirectory() as home:
+        core = subprocess.Popen(
+            ["/usr/bin/rosmaster", "--core", "-p", str(port)],
+            env=ros1_env(master, ROS_HOME=home),
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+        try:
+            deadline = time.monotonic() + 20
+            while True:
+                try:
+                    xmlrpc.client.ServerProxy(master).getPid("/bench")
+                    break
+                except OSError:
+                    if time.monotonic() > deadline:
+                        sys.exit("ERROR: rosmaster did not start")
+                    time.sleep(0.05)
+            for impl in (OURS, REAL):  # warm-up: byte-code caches, page cache
+                bare_wall(impl, master, home, 1)
+            rows = []
+            wall = {impl: bare_wall(impl, master, home, args.runs) for impl in (OURS, REAL)}
+            rows.append(("import rospy; init_node process wall (s)", wall[OURS], wall[REAL]))
+            ph = {impl: phases(impl, master, home, args.runs) for impl in (OURS, REAL)}
+            rows.append(("  of which import rospy (s)", ph[OURS][0], ph[REAL][0]))
+            rows.append(("  of which init_node (s)", ph[OURS][1], ph[REAL][1]))
+            for hz in (10.0, 100.0):
+                cpu = {impl: talker_cpu(impl, master, home, hz, args.talker_seconds) for impl in (OURS, REAL)}
+                rows.append((f"CPU of a {hz:.0f} Hz talker (cpu s / s)", cpu[OURS], cpu[REAL]))
+        finally:
+            core.kill()
+            core.wait()
+    print(
+        f"rospy startup and talker CPU, median of {args.runs} runs (machine load: {os.getloadavg()[0]:.1f})"
+    )
+    print(f"{'figure':<44}{OURS:>10}{REAL:>10}   ratio")
+    for label, ours, real in rows:
+        print(f"{label:<44}{ours:>10.3f}{real:>10.3f}   {_ratio(ours, real)}")
+
+
+if __name__ == "__main__":
+    main()
