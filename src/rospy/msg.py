@@ -49,12 +49,23 @@ class AnyMsg:
 
 
 def args_kwds_to_message(data_class: Any, args: tuple[Any, ...], kwds: dict[str, Any]) -> Any:
-    """Build a ``data_class`` from publish()'s arguments: ``pub.publish("hi")`` makes ``String("hi")``."""
+    """Build a ``data_class`` from publish()'s arguments, with rospy's rules.
+
+    ``pub.publish("hi")`` makes ``String("hi")``; a single message of the right type (same md5) or an
+    AnyMsg is used as is; a single message of another type must match the first field's type.
+    """
     if args and kwds:
         raise TypeError("publish() can be called with arguments or keywords, but not both.")
-    if len(args) == 1 and hasattr(args[0], "_type") and hasattr(args[0], "__slots__"):
-        other = args[0]
-        if other._type != data_class._type:
-            raise TypeError(f"expected [{data_class._type}] but got [{other._type}]")
-        return other
-    return data_class(*args, **kwds)
+    if kwds:
+        return data_class(**kwds)
+    if len(args) == 1:
+        arg = args[0]
+        if hasattr(arg, "_md5sum") and (arg._md5sum == data_class._md5sum or isinstance(arg, AnyMsg)):
+            return arg
+        if hasattr(arg, "_type") and hasattr(arg, "_slot_types"):
+            slot_types = getattr(data_class, "_slot_types", ())
+            if not slot_types:
+                raise TypeError(f"expected [] but got [{arg._type}]")
+            if arg._type != slot_types[0]:
+                raise TypeError(f"expected [{slot_types[0]}] but got [{arg._type}]")
+    return data_class(*args)

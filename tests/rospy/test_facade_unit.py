@@ -52,13 +52,28 @@ def test_core_errors_map_to_rospy_exceptions(core: Exception, expected: type) ->
     assert translate(plain) is plain
 
 
+class _HeaderOnly:
+    _type = "test/HeaderOnly"
+    _md5sum = "0" * 32
+    _slot_types = ("std_msgs/Header",)
+    __slots__ = ("header",)
+
+    def __init__(self, header: object = None) -> None:
+        self.header = header
+
+
 def test_implicit_message_construction() -> None:
     assert args_kwds_to_message(String, ("hi",), {}) == String(data="hi")
     assert args_kwds_to_message(String, (), {"data": "kw"}) == String(data="kw")
     same = String(data="x")
     assert args_kwds_to_message(String, (same,), {}) is same
-    with pytest.raises(TypeError, match="expected \\[std_msgs/String\\] but got \\[std_msgs/Int32\\]"):
+    with pytest.raises(TypeError, match="expected \\[string\\] but got \\[std_msgs/Int32\\]"):
         args_kwds_to_message(String, (Int32(1),), {})
+    # a message whose first field has the given message's type wraps it, as in rospy
+    from std_msgs.msg import Header
+
+    stamped = args_kwds_to_message(_HeaderOnly, (Header(frame_id="f"),), {})
+    assert stamped.header.frame_id == "f"
     with pytest.raises(TypeError, match="not both"):
         args_kwds_to_message(String, ("a",), {"data": "b"})
 

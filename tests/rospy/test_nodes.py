@@ -336,7 +336,7 @@ except rospy.ROSInterruptException:
     node = run_node(code)
     assert "init_node() first" in node.wait_for(r"^before init: (.*)$").group(1)
     assert node.wait_for(r"^resolved (.*)$").group(1) == "/chatter"
-    assert "std_msgs/String" in node.wait_for(r"^wrong type: (.*)$").group(1)
+    assert "but got [std_msgs/Int32]" in node.wait_for(r"^wrong type: (.*)$").group(1)
     node.wait_for("^second init refused$")
     assert "unregistered" in node.wait_for(r"^after unregister: (.*)$").group(1)
     assert node.wait_for(r"^is_shutdown (.*)$").group(1) == "True"
