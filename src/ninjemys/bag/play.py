@@ -196,7 +196,7 @@ class Player:
             ):
                 self._stop.wait(0.1)
         if self.options.delay > 0:
-            self._sleep(self.options.delay)
+            self._hold_clock(self.options.delay)
         while not self._stop.is_set():
             self._play_once()
             if not self.options.loop:
@@ -204,6 +204,22 @@ class Player:
         if not self.options.quiet:
             self.out.write("\nDone.\n")
             self.out.flush()
+
+    def _hold_clock(self, seconds: float) -> None:
+        """Sleep ``seconds``; with --clock keep /clock at the bag's start meanwhile, so sim-time nodes
+        already have the bag's time when the first message arrives."""
+        if self._clock_pub is None:
+            self._sleep(seconds)
+            return
+        start = self.bag_start + int(self.options.start * NSEC)
+        period = 1.0 / self.options.hz
+        end = self._monotonic() + seconds
+        while not self._stop.is_set():
+            self.publish_clock(start)
+            left = end - self._monotonic()
+            if left <= 0:
+                break
+            self._sleep(min(period, left))
 
     def _play_once(self) -> None:
         opts = self.options
