@@ -462,7 +462,7 @@ class Node:
         handles = [h for sub in subs for h in sub.handles]
         for handle in handles:
             handle._closed = True
-            handle._wake.set()
+            handle._wakeup()
         try:
             self.runtime.run(self._close_servers(subs), timeout=5.0)
         except NinjemysError as exc:

@@ -1,19 +1,26 @@
-"""Subscribing over TCPROS: connections read on the I/O loop, callbacks on one worker per Subscriber.
+"""Subscribing over TCPROS: the loop sets connections up, each Subscriber's worker thread does the rest.
 
-The loop reads each publisher's stream with ``recv_into`` into a preallocated buffer and cuts it
-into frames (bytes, still serialized). Every Subscriber handle owns a bounded queue (``queue_size``,
-the oldest frame dropped first) and a worker thread that deserializes and calls back, so:
+After the header exchange (on the I/O loop) a publisher's socket is handed to the worker thread of
+the topic's first Subscriber handle (the *reader*). That thread waits in its own selector on its
+sockets and a wake-up pipe, reads with ``recv_into`` into a preallocated buffer, cuts frames,
+queues them (bounded by ``queue_size``, oldest dropped first), deserializes and calls back. So:
 
+* a message costs one thread wake-up between the kernel and the callback (no hop through the loop);
 * a dropped message is never deserialized;
-* callbacks never run on the I/O thread, and a slow callback delays only its own subscriber;
-* the loop reads everything the kernel has, so ``queue_size=1`` really means "the latest message",
-  whatever ``buff_size`` (rospy's ros_comm#536 does not apply).
+* callbacks never run on the I/O thread, and a slow callback delays only its own subscription;
+* the socket is read only when the queue is empty, and then completely, so ``queue_size=1`` really
+  means "the latest message" whatever ``buff_size`` is (rospy's ros_comm#536 does not apply).
+
+Further Subscriber handles of the same topic in the same node get the reader's frames through their
+own queue and pipe.
 """
 
 from __future__ import annotations
 
 import asyncio
 import logging
+import os
+import selectors
 import socket
 import threading
 from collections import deque
@@ -60,53 +67,50 @@ class SubConnection:
         self.closed = False
         self._reader = FrameReader()
 
-    def start(self) -> None:
-        self.sub.node.runtime.loop.add_reader(self.fd, self._on_readable)
-
-    def _on_readable(self) -> None:
-        reader = self._reader
-        try:
-            n = self.sock.recv_into(reader.buffer())
-        except (BlockingIOError, InterruptedError):
-            return
-        except OSError as exc:
-            self._lost(f"read failed: {exc}")
-            return
-        if n == 0:
-            if reader.pending:
-                self._lost(f"publisher disconnected mid-message ({reader.pending} bytes of a frame received)")
-            else:
-                self._lost("publisher closed the connection")
-            return
-        self.bytes_recv += n
-        try:
-            frames = reader.commit(n)
-        except ProtocolError as exc:
-            _log.warning("topic %s: dropped publisher %s: %s", self.sub.topic, self.publisher, exc)
-            self.close()
-            self.sub.connection_lost(self, retry=False)
-            return
+    def read(self) -> list[bytes | bytearray] | None:
+        """Read everything the kernel has (worker thread); None when the stream has ended."""
+        reader, sock = self._reader, self.sock
+        frames: list[bytes | bytearray] = []
+        while True:
+            try:
+                n = sock.recv_into(reader.buffer())
+            except (BlockingIOError, InterruptedError):
+                break
+            except OSError as exc:
+                self._lost(f"read failed: {exc}")
+                return None
+            if n == 0:
+                if reader.pending:
+                    self._lost(
+                        f"publisher disconnected mid-message ({reader.pending} bytes of a frame received)"
+                    )
+                else:
+                    self._lost("publisher closed the connection")
+                return None
+            self.bytes_recv += n
+            try:
+                frames.extend(reader.commit(n))
+            except ProtocolError as exc:
+                _log.warning("topic %s: dropped publisher %s: %s", self.sub.topic, self.publisher, exc)
+                self.close()
+                self.sub.node.runtime.call_soon(self.sub.connection_lost, self, False)
+                return None
         if frames:
             self.num_recv += len(frames)
             if self.latching:
                 self.last = frames[-1]
-            for handle in self.sub.handles:
-                handle.enqueue(frames, self.header)
+        return frames
 
     def _lost(self, why: str) -> None:
         _log.info("topic %s: %s (%s)", self.sub.topic, why, self.publisher)
         self.close()
-        self.sub.connection_lost(self, retry=True)
+        self.sub.node.runtime.call_soon(self.sub.connection_lost, self, True)
 
     def close(self) -> None:
-        """Close on the loop thread (or before start)."""
+        """Close the socket (any thread; idempotent)."""
         if self.closed:
             return
         self.closed = True
-        try:
-            self.sub.node.runtime.loop.remove_reader(self.fd)
-        except (ValueError, OSError):
-            pass
         transport.close_quietly(self.sock)
 
 
@@ -137,8 +141,8 @@ class Subscription:
         wanted = set(uris)
         for uri, conn in list(self.connections.items()):
             if uri not in wanted:
-                conn.close()
                 del self.connections[uri]
+                self._hand(("drop", conn))
         loop = self.node.runtime.loop
         for uri in uris:
             if uri not in self.connections and uri not in self._connecting:
@@ -173,9 +177,9 @@ class Subscription:
             conn = SubConnection(self, sock, uri, header)
             old = self.connections.pop(uri, None)
             if old is not None:
-                old.close()
+                self._hand(("drop", old))
             self.connections[uri] = conn
-            conn.start()
+            self._hand(("add", conn))
         except (OSError, TimeoutError, NinjemysError, ValueError, TypeError) as exc:
             why = "timed out" if isinstance(exc, TimeoutError) else str(exc) or type(exc).__name__
             _log.info("topic %s: could not connect to publisher %s: %s", self.topic, uri, why)
@@ -198,6 +202,14 @@ class Subscription:
             "tcp_nodelay": "1" if self.tcp_nodelay else "0",
         }
 
+    def _hand(self, op: tuple[str, SubConnection]) -> None:
+        """Give a connection to (or take it from) the reader's worker thread."""
+        reader = self.handles[0] if self.handles else None
+        if reader is None or reader.closed:
+            op[1].close()
+            return
+        reader.post(op)
+
     def connection_lost(self, conn: SubConnection, retry: bool) -> None:
         """A stream ended (on the loop): forget it; if the publisher is still listed, try once more."""
         if self.connections.get(conn.uri) is conn:
@@ -215,7 +227,7 @@ class Subscription:
         return [(c.last, c.header) for c in self.connections.values() if c.last is not None]
 
     def close(self) -> None:
-        """On the loop: close every stream."""
+        """On the loop: close every stream (the workers stop selecting closed sockets)."""
         self.closed = True
         for conn in self.connections.values():
             conn.close()
@@ -248,13 +260,41 @@ class Subscriber:
         self._queue: deque[tuple[bytes | bytearray, Mapping[str, str]]] = deque(
             maxlen=queue_size if queue_size and queue_size > 0 else None
         )
-        self._wake = threading.Event()
         self._closed = False
+        self._ops: list[tuple[str, SubConnection]] = []
+        self._ops_lock = threading.Lock()
+        self._wake_r, self._wake_w = os.pipe()
+        os.set_blocking(self._wake_r, False)
+        os.set_blocking(self._wake_w, False)
+        self._woken = False
+        self._selector = selectors.DefaultSelector()
+        self._selector.register(self._wake_r, selectors.EVENT_READ, None)
+        self._conns: dict[int, SubConnection] = {}
         self._thread = subscription.node.runtime.start_thread(self._work, f"sub:{subscription.topic}")
 
-    # -- producer side (the loop) ----------------------------------------------------------------
+    # -- hand-offs from other threads ------------------------------------------------------------
+
+    def _wakeup(self) -> None:
+        if self._woken:
+            return
+        self._woken = True
+        try:
+            os.write(self._wake_w, b"\0")
+        except (BlockingIOError, OSError):
+            pass
+
+    def post(self, op: tuple[str, SubConnection]) -> None:
+        """Queue a connection add/drop for this (reader) worker."""
+        with self._ops_lock:
+            self._ops.append(op)
+        self._wakeup()
 
     def enqueue(self, frames: list[bytes | bytearray], header: Mapping[str, str]) -> None:
+        """Frames read by another thread (the reader handle, or a latched replay)."""
+        self._push(frames, header)
+        self._wakeup()
+
+    def _push(self, frames: list[bytes | bytearray], header: Mapping[str, str]) -> None:
         queue = self._queue
         maxlen = queue.maxlen
         if maxlen is not None:
@@ -263,27 +303,88 @@ class Subscriber:
                 self.dropped += overflow
                 if len(frames) > maxlen:
                     frames = frames[-maxlen:]
-        queue.extend([(f, header) for f in frames])
-        self._wake.set()
+        if len(frames) == 1:
+            queue.append((frames[0], header))
+        else:
+            queue.extend([(f, header) for f in frames])
 
-    # -- consumer side (the worker thread) -------------------------------------------------------
+    # -- the worker thread -----------------------------------------------------------------------
 
     def _work(self) -> None:
-        queue, wake = self._queue, self._wake
-        while True:
-            try:
-                frame, header = queue.popleft()
-            except IndexError:
-                if self._closed:
-                    return
-                wake.clear()
-                if queue or self._closed:
+        queue = self._queue
+        try:
+            while not self._closed:
+                if queue:
+                    frame, header = queue.popleft()
+                    self._deliver(frame, header)
                     continue
-                wake.wait()
-                continue
-            if self._closed:
-                return
-            self._deliver(frame, header)
+                for key, _ in self._selector.select():
+                    if key.data is None:
+                        self._on_wake()
+                    else:
+                        self._read(key.data)
+        finally:
+            self._finish()
+
+    def _on_wake(self) -> None:
+        self._woken = False
+        try:
+            while os.read(self._wake_r, 4096):
+                pass
+        except (BlockingIOError, OSError):
+            pass
+        with self._ops_lock:
+            ops, self._ops = self._ops, []
+        for op, conn in ops:
+            if op == "add" and not conn.closed:
+                self._conns[conn.fd] = conn
+                self._selector.register(conn.fd, selectors.EVENT_READ, conn)
+                self._read(conn)  # latched data may already be waiting
+            elif op == "drop":
+                self._forget(conn)
+                conn.close()
+
+    def _forget(self, conn: SubConnection) -> None:
+        if self._conns.pop(conn.fd, None) is not None:
+            try:
+                self._selector.unregister(conn.fd)
+            except (KeyError, ValueError, OSError):
+                pass
+
+    def _read(self, conn: SubConnection) -> None:
+        if conn.closed:
+            self._forget(conn)
+            return
+        frames = conn.read()
+        if frames is None:
+            self._forget(conn)
+            return
+        if frames:
+            self._push(frames, conn.header)
+            for other in self._sub.handles[1:]:
+                if other is not self:
+                    other.enqueue(frames, conn.header)
+
+    def _finish(self) -> None:
+        """Worker exit: pass our connections to the next handle of the topic, or close them."""
+        conns = list(self._conns.values())
+        for conn in conns:
+            self._forget(conn)
+        with self._ops_lock:
+            pending = [c for op, c in self._ops if op == "add"]
+            self._ops = []
+        successor = next((h for h in self._sub.handles if h is not self and not h.closed), None)
+        for conn in conns + pending:
+            if successor is not None and not conn.closed:
+                successor.post(("add", conn))
+            else:
+                conn.close()
+        self._selector.close()
+        for fd in (self._wake_r, self._wake_w):
+            try:
+                os.close(fd)
+            except OSError:
+                pass
 
     def _deliver(self, frame: bytes | bytearray, header: Mapping[str, str]) -> None:
         if self.raw or self._sub.msg_class is None:
@@ -322,9 +423,9 @@ class Subscriber:
         """Stop receiving; the worker thread ends (joined unless called from a callback)."""
         if self._closed:
             return
-        self._closed = True
-        self._wake.set()
         self._sub.node._drop_subscriber(self)
+        self._closed = True
+        self._wakeup()
         if threading.current_thread() is not self._thread:
             self._thread.join(2.0)
 
