@@ -158,3 +158,16 @@ with rosbag.Bag(sys.argv[1], 'w', compression=sys.argv[2], chunk_threshold=2000)
     expected = read_with_real_rosbag(path)
     assert len(expected) == 250
     assert read_all(path) == expected
+
+
+@pytest.mark.ros1
+def test_real_rosbag_reads_full_compressible_lz4_chunks(tmp_path):
+    # many 64 KiB lz4 blocks per chunk: roslz4 only follows independent blocks
+    path = tmp_path / "big.bag"
+    data = string_bytes("x" * 1020)
+    with BagWriter(path, compression="lz4") as w:
+        c = w.connection("/a", STRING_HEADER)
+        for i in range(3000):
+            w.write(c, BASE + i, data)
+    got = read_with_real_rosbag(path)
+    assert len(got) == 3000 and got[-1] == ("/a", BASE + 2999, data)

@@ -15,9 +15,14 @@ def compress(kind: str, data: bytes) -> bytes:
     if kind == "bz2":
         return bz2.compress(data, 9)
     if kind == "lz4":
-        # roslz4 insists on a content checksum and rejects a stored content size
+        # what roslz4 accepts: a content checksum, no stored content size, and independent blocks
+        # (it cannot follow linked blocks); 64 KiB blocks also let a cut chunk be partly recovered
         return lz4.frame.compress(
-            data, block_size=lz4.frame.BLOCKSIZE_MAX64KB, content_checksum=True, store_size=False
+            data,
+            block_size=lz4.frame.BLOCKSIZE_MAX64KB,
+            block_linked=False,
+            content_checksum=True,
+            store_size=False,
         )
     raise BagError(f"unknown bag compression {kind!r} (expected none, bz2 or lz4)")
 
