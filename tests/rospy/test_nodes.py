@@ -119,12 +119,13 @@ print("myargv", rospy.myargv(), flush=True)
 
 def test_name_collision_shuts_down_the_old_node(run_node) -> None:
     code = """
+import sys
 import rospy
 rospy.init_node("dup")
-rospy.on_shutdown(lambda: print("hook ran", flush=True))
+rospy.on_shutdown(lambda: sys.stdout.write("hook ran\\n"))
 print("up", flush=True)
 rospy.spin()
-print("spin returned", flush=True)
+sys.stdout.write("spin returned\\n")
 """
     old = run_node(code)
     old.wait_for("^up$")
@@ -367,4 +368,4 @@ for i in range(40):
 rospy.sleep(0.5)
 """
     node = run_node(code)
-    node.wait_for("^fast got 20$", timeout=5)
+    node.wait_for("^fast got 20$", timeout=20)
