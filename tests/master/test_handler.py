@@ -19,6 +19,9 @@ class RecordingNotifier:
     def param_update(self, api: str, key: str, value: Any) -> None:
         self.calls.append(("paramUpdate", api, key, value))
 
+    def revive(self, api: str) -> None:
+        self.calls.append(("revive", api, None, None))
+
     def shutdown_node(self, api: str, message: str) -> None:
         self.calls.append(("shutdown", api, message, None))
 
@@ -30,7 +33,10 @@ def master() -> tuple[MasterHandler, RecordingNotifier]:
 
 
 def call(handler: MasterHandler, method: str, *args: Any) -> list[Any]:
-    return handler._dispatch(method, args)
+    reply = handler._dispatch(method, args)
+    notifier = handler.notifier
+    notifier.calls = [c for c in notifier.calls if c[0] != "revive"]  # type: ignore[attr-defined]
+    return reply
 
 
 def test_register_publisher_notifies_every_subscriber(

@@ -125,3 +125,26 @@ def test_deadline_bounds_a_silent_node(black_holes: list[str]) -> None:
 
     elapsed = asyncio.run(run())
     assert 0.5 <= elapsed < 3
+
+
+def test_refused_node_is_dead_until_it_registers_again() -> None:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        closed = f"http://127.0.0.1:{s.getsockname()[1]}/"  # bound, not listening: refuses
+
+        async def run() -> tuple[bool, int, bool, int]:
+            notifier = Notifier(timeout=2)
+            notifier.publisher_update(closed, "/t", [])
+            await notifier.drain(5)
+            dead = notifier.is_dead(closed)
+            notifier.publisher_update(closed, "/t", ["x"])
+            dropped = notifier.pending()
+            notifier.revive(closed)
+            notifier.publisher_update(closed, "/t", ["y"])
+            queued = notifier.pending()
+            notifier.close()
+            return dead, dropped, notifier.is_dead(closed), queued
+
+        dead, dropped, still_dead, queued = asyncio.run(run())
+    assert dead and dropped == 0
+    assert not still_dead and queued > 0

@@ -12,6 +12,10 @@ three dead or hostile nodes freeze topic discovery for everyone (ros/ros_comm#15
   exhaust file descriptors.
 
 A node that answers ``paramUpdate`` with code -1 is unsubscribed from that key, as in ROS 1.
+
+A node whose API *refuses* connections is not running: it is marked dead and further calls to it are
+dropped (one log line, no sockets) until it registers again (:meth:`Notifier.revive`), which is what a
+restarted node does first. A graph full of crashed nodes thus costs the master nothing.
 """
 
 from __future__ import annotations
@@ -43,6 +47,7 @@ class Notifier:
         self._tasks: dict[str, asyncio.Task[None]] = {}
         self._on_param_rejected = on_param_rejected
         self._closed = False
+        self._dead: set[str] = set()
 
     # ------------------------------------------------------------------------------------ API
 
@@ -54,6 +59,14 @@ class Notifier:
 
     def shutdown_node(self, api: str, message: str) -> None:
         self._enqueue(api, ("shutdown", ""), "shutdown", (MASTER_CALLER_ID, message))
+
+    def revive(self, api: str) -> None:
+        """``api`` registered something: it is alive again (cheap; called on every registration)."""
+        if self._dead:
+            self._dead.discard(api)
+
+    def is_dead(self, api: str) -> bool:
+        return api in self._dead
 
     def pending(self) -> int:
         """Calls queued or in flight (for tests and diagnostics)."""
@@ -76,7 +89,7 @@ class Notifier:
     # ------------------------------------------------------------------------------- internals
 
     def _enqueue(self, api: str, slot: tuple[str, str], method: str, params: tuple[Any, ...]) -> None:
-        if self._closed:
+        if self._closed or api in self._dead:
             return
         queue = self._queues.setdefault(api, {})
         queue[slot] = (method, params)  # a newer update for the same slot replaces the pending one
@@ -105,6 +118,16 @@ class Notifier:
                 result = await xmlrpc_client.call(api, method, params, timeout=self.timeout)
             except asyncio.CancelledError:
                 raise
+            except ConnectionRefusedError:
+                log.info(
+                    "%s%s to %s: connection refused; node considered dead until it registers again",
+                    method,
+                    params[1:2],
+                    api,
+                )
+                self._dead.add(api)
+                self._queues.pop(api, None)
+                return
             except Exception as exc:
                 log.info("%s%s to %s failed: %s", method, params[1:2], api, exc)
                 return

@@ -266,6 +266,7 @@ class MasterHandler:
             value = self.params.get(key)
         except KeyError:
             value = {}
+        self.notifier.revive(caller_api)
         bumped = self.store.register_param_subscriber(subscription_key(key), caller_id, caller_api)
         self._bump(bumped)
         log.info("+CACHEDPARAM [%s] by %s", key, caller_id)
@@ -298,6 +299,7 @@ class MasterHandler:
     # -------------------------------------------------------------------------------- services
 
     def registerService(self, caller_id: str, service: str, service_api: str, caller_api: str) -> list[Any]:
+        self.notifier.revive(caller_api)
         self._bump(self.store.register_service(service, service_api, caller_id, caller_api))
         log.info("+SERVICE [%s] %s %s", service, caller_id, caller_api)
         return [1, f"Registered [{caller_id}] as provider of [{service}]", 1]
@@ -316,6 +318,7 @@ class MasterHandler:
     # ---------------------------------------------------------------------------------- topics
 
     def registerSubscriber(self, caller_id: str, topic: str, topic_type: str, caller_api: str) -> list[Any]:
+        self.notifier.revive(caller_api)
         self._bump(self.store.register_subscriber(topic, topic_type, caller_id, caller_api))
         log.info("+SUB [%s] %s %s", topic, caller_id, caller_api)
         return [1, f"Subscribed to [{topic}]", self.store.publishers.apis(topic)]
@@ -326,6 +329,7 @@ class MasterHandler:
         return [1, message, count]
 
     def registerPublisher(self, caller_id: str, topic: str, topic_type: str, caller_api: str) -> list[Any]:
+        self.notifier.revive(caller_api)
         self._bump(self.store.register_publisher(topic, topic_type, caller_id, caller_api))
         self._notify_topic(topic)
         log.info("+PUB [%s] %s %s", topic, caller_id, caller_api)
