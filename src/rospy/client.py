@@ -92,7 +92,11 @@ def init_node(
         from ninjemys.node.cli_args import network_env
 
         os.environ.update(network_env(args))
-        if not disable_signals and threading.current_thread() is threading.main_thread():
+        if (
+            not disable_signals
+            and threading.current_thread() is threading.main_thread()
+            and not _interactive()
+        ):
             _install_signal_handlers()
         node = _start_node(base, args)
         log = NodeLog(node.name, level=log_level or INFO, log_file=args.log_file)
@@ -198,6 +202,11 @@ def _at_exit() -> None:
 
 
 # -- signals --------------------------------------------------------------------------------------------
+
+
+def _interactive() -> bool:
+    """A REPL or notebook owns Ctrl-C (rospy leaves signals alone there too)."""
+    return hasattr(sys, "ps1") or "IPython" in sys.modules
 
 
 def _install_signal_handlers() -> None:

@@ -96,6 +96,7 @@ print("gains", repr(rospy.get_param("~gains")), flush=True)
 print("label", repr(rospy.get_param("~label")), flush=True)
 import sys
 print("myargv", rospy.myargv(), flush=True)
+print("uri", rospy.get_node_uri(), flush=True)
 """
     node = run_node(
         code,
@@ -105,6 +106,7 @@ print("myargv", rospy.myargv(), flush=True)
         "_rate:=5",
         "_gains:=[1, 2.5]",
         "_label:='7'",
+        "__hostname:=127.0.0.1",
         "extra",
     )
     assert node.wait_for(r"^name (.*)$").group(1) == "/robot/renamed"
@@ -114,6 +116,7 @@ print("myargv", rospy.myargv(), flush=True)
     assert node.wait_for(r"^gains (.*)$").group(1) == "[1, 2.5]"
     assert node.wait_for(r"^label (.*)$").group(1) == "'7'"
     assert node.wait_for(r"^myargv (.*)$").group(1).endswith("'extra']")
+    assert node.wait_for(r"^uri (.*)$").group(1).startswith("http://127.0.0.1:")
     assert node.wait(10) == 0
 
 
