@@ -142,6 +142,7 @@ class LaunchSession:
         self.opts = opts
         self.env = dict(os.environ if env is None else env)
         self.supervisor: Supervisor | None = None
+        self._core = None
 
     def _say(self, text: str) -> None:
         sys.stdout.write(text + "\n")
@@ -156,6 +157,14 @@ class LaunchSession:
         # validate everything user-provided before starting anything
         probe_specs = _process_specs(self.plan, self.opts, uri, log_root / "pending", self.env)
         del probe_specs
+        try:
+            return self._run_with_master(uri, log_root)
+        finally:
+            if self._core is not None and self._core.poll() is None:
+                self._core.kill()
+                self._core.wait()
+
+    def _run_with_master(self, uri: str, log_root: Path) -> int:
         core_proc = None
         if not master_link.master_is_up(uri):
             if self.opts.wait:
@@ -168,6 +177,7 @@ class LaunchSession:
             else:
                 self._say("auto-starting new master")
                 core_proc = master_link.start_core(uri, log_root / "latest-master.log", self.env)
+                self._core = core_proc
                 self._say(f"process[master]: started with pid [{core_proc.pid}]")
         self._say(f"ROS_MASTER_URI={uri}")
         client = MasterClient(uri, master_link.CALLER_ID)

@@ -18,6 +18,7 @@ import yaml
 
 from ninjemys.errors import LaunchError, MasterError, NinjemysError
 from ninjemys.launch.plan import LaunchPlan
+from ninjemys.launch.runner import die_with_parent
 from ninjemys.master.client import MasterClient
 from ninjemys.testing import ninjemys_bin
 
@@ -83,6 +84,7 @@ def start_core(uri: str, log_path: Path, env: dict[str, str]) -> subprocess.Pope
             stderr=subprocess.STDOUT,
             env=env,
             start_new_session=True,
+            preexec_fn=die_with_parent,
         )
     if not wait_for_master(uri, time.monotonic() + 20.0, proc):
         if proc.poll() is None:

@@ -74,7 +74,8 @@ class Supervisor:
     def __init__(self, specs: list[ProcessSpec], write: Callable[[str], None] | None = None) -> None:
         self.procs = [_Running(spec) for spec in specs]
         self.selector = selectors.DefaultSelector()
-        self.write = write or (lambda text: (sys.stdout.write(text), sys.stdout.flush()))
+        self._write = write or _stdout_write
+        self._output_broken = False
         self.failed = False
         self.shutting_down = False
         self._wake_r, self._wake_w = os.pipe()
@@ -83,6 +84,15 @@ class Supervisor:
         self.selector.register(self._wake_r, selectors.EVENT_READ, ("wake", None))
         #: set by the owner (e.g. a test or the ``--required`` CLI) to stop after this many exits
         self.on_event: Callable[[str, str], None] | None = None
+
+    def write(self, text: str) -> None:
+        """Print supervisor and node output; a closed stdout (``| head``) never stops supervision."""
+        if self._output_broken:
+            return
+        try:
+            self._write(text)
+        except (BrokenPipeError, OSError, ValueError):
+            self._output_broken = True
 
     # -- starting --------------------------------------------------------------------------------
     def _start(self, proc: _Running) -> None:
@@ -104,6 +114,7 @@ class Supervisor:
                     env=spec.env,
                     cwd=spec.cwd,
                     start_new_session=True,
+                    preexec_fn=die_with_parent,
                 )
             except OSError as exc:
                 self.write(f"ERROR: cannot launch node [{spec.name}]: {exc.strerror}: {spec.argv[0]}\n")
@@ -219,6 +230,8 @@ class Supervisor:
             proc.restart_at = None
             if proc.spec.is_core:
                 continue
+            if proc.pidfd is not None:
+                self.write(f"[{proc.spec.name}] killing on exit\n")
             self._signal(proc, signal.SIGINT)
             proc.stop_stage = 1
             proc.stop_deadline = now + proc.spec.sigint_timeout
@@ -282,7 +295,26 @@ class Supervisor:
 
     # -- main loop -------------------------------------------------------------------------------
     def run(self) -> int:
-        """Start every process, supervise until shutdown, return 1 if a required node failed."""
+        """Start every process, supervise until shutdown, return 1 if a required node failed.
+
+        Whatever happens inside (even a bug), no child outlives this call: they are killed.
+        """
+        try:
+            return self._run()
+        finally:
+            self.kill_all()
+
+    def kill_all(self) -> None:
+        """SIGKILL every process group still alive and reap it (the last-resort cleanup)."""
+        for proc in self.procs:
+            if proc.popen is not None and proc.popen.poll() is None:
+                try:
+                    os.killpg(proc.popen.pid, signal.SIGKILL)
+                except (ProcessLookupError, PermissionError):
+                    proc.popen.kill()
+                proc.popen.wait()
+
+    def _run(self) -> int:
         for proc in self.procs:
             if self.shutting_down:
                 break
@@ -313,6 +345,9 @@ class Supervisor:
                         self._pump(key.fd, proc)
                 elif kind == "exit" and proc.pidfd == key.fd:
                     self._exited(proc)
+        self.write(
+            "shutting down processing monitor...\n... shutting down processing monitor complete\ndone\n"
+        )
         for proc in self.procs:
             self._drain(proc)
             for fd, (stream, _label) in list(proc.streams.items()):
@@ -329,6 +364,25 @@ class Supervisor:
 
     def respawn_count(self, name: str) -> int:
         return next(p.respawns for p in self.procs if p.spec.name == name)
+
+
+def _stdout_write(text: str) -> None:
+    sys.stdout.write(text)
+    sys.stdout.flush()
+
+
+_PR_SET_PDEATHSIG = 1
+
+
+def die_with_parent() -> None:
+    """In the child before exec: get SIGTERM if roslaunch dies, so no node is ever orphaned (Linux)."""
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM)
+    except (OSError, AttributeError):
+        pass
 
 
 def remote_command(

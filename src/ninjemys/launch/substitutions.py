@@ -9,6 +9,7 @@ is stable within one launch. ``$(eval)`` sees the args as variables (auto-typed)
 
 from __future__ import annotations
 
+import builtins
 import math
 import os
 from collections.abc import Callable, Mapping
@@ -19,6 +20,13 @@ from ninjemys.errors import LaunchError
 from ninjemys.names import anonymous_name
 
 COMMANDS = ("find", "env", "optenv", "dirname", "anon", "arg")
+
+#: builtins $(eval) offers: ROS 1 leaks all of Python's builtins into eval; these are the ones
+#: launch files use, without open/exec/eval/__import__ (and ``__`` is rejected anyway).
+_SAFE_BUILTINS = (
+    "abs all any bin bool chr dict divmod enumerate filter float format hex int isinstance len list map max "
+    "min oct ord pow range repr reversed round set sorted str sum tuple zip"
+).split()
 
 
 class ArgNotSet(LaunchError):
@@ -108,13 +116,13 @@ def _eval(expr: str, ctx: SubstitutionContext) -> str:
     )
     functions["True"] = True
     functions["False"] = False
-    safe_builtins = {"list": list, "dict": dict, "map": map, "str": str, "float": float, "int": int}
+    safe_builtins = {name: getattr(builtins, name) for name in _SAFE_BUILTINS}
 
     class Names(dict):
         def __missing__(self, key: str) -> Any:
             if key in ctx.args:
                 return _auto(ctx.args[key])
-            raise NameError(f"name '{key}' is not defined")
+            raise KeyError(key)
 
     try:
         return str(eval(expr, {"__builtins__": safe_builtins}, Names(functions)))  # noqa: S307 - sandboxed, see docstring

@@ -356,15 +356,19 @@ class _Loader:
                 self.plan.clear_params.append(child.ns)
         return child
 
-    def add_param(self, key: str, value: Any, el: Element, scope: _Scope) -> None:
-        """Set a global parameter; dictionaries unroll into one parameter per leaf, as ROS 1 does."""
+    def add_param(self, key: str, value: Any, el: Element, scope: _Scope, unroll: bool = False) -> None:
+        """Set a global parameter.
+
+        ``<rosparam>`` dictionaries unroll into one parameter per leaf; a ``<param type="yaml">``
+        dictionary stays one parameter, as in ROS 1.
+        """
         if not key:
             raise self.err(el, scope, "no parameter name specified")
-        if key == "/" and not isinstance(value, dict):
+        if unroll and key == "/" and not isinstance(value, dict):
             raise self.err(el, scope, "Cannot load non-dictionary types into global namespace '/'")
-        if isinstance(value, dict):
+        if unroll and isinstance(value, dict):
             for k, v in value.items():
-                self.add_param(ns_join(key, str(k)), v, el, scope)
+                self.add_param(ns_join(key, str(k)), v, el, scope, unroll=True)
             return
         parts = key.strip("/").split("/")
         for i in range(1, len(parts)):
@@ -467,7 +471,7 @@ class _Loader:
                 scope,
                 "error loading <rosparam> tag: 'param' attribute must be set for non-dictionary values",
             )
-        self.add_param(full, data, el, scope)
+        self.add_param(full, data, el, scope, unroll=True)
 
     def env_tag(self, el: Element, scope: _Scope) -> None:
         self.check_attrs(el, scope, ENV_ATTRS)
@@ -597,7 +601,7 @@ class _Loader:
                 self.env_tag(sub, env_scope)
         for p in [*scope.params, *param_scope.params]:
             key = p.key[1:] if is_private(p.key) else p.key
-            self.add_param(param_scope.ns + key, p.value, el, scope)
+            self.add_param(canonicalize_name(param_scope.ns + key), p.value, el, scope)
         spec = NodeSpec(
             package=pkg,
             type=node_type,
