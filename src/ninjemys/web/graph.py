@@ -1,0 +1,249 @@
+"""The ROS computation graph as plain data, built from what any ROS 1 master and node answer.
+
+:func:`build_graph` is pure: it turns the master's ``getSystemState`` and ``getTopicTypes`` results
+plus each node's ``getBusInfo`` into the JSON the graph page draws. :class:`GraphPoller` fetches those
+over XML-RPC (so real ROS 1 nodes appear exactly like ours) and reports only real changes.
+
+The ROS 1 master offers no change notifications, so the poller asks it twice a second; bus
+information (which connections are up, whether a node still answers) is refreshed less often
+because it costs one call per node.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+import threading
+import time
+import xmlrpc.client
+from collections.abc import Callable, Iterable
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+
+log = logging.getLogger(__name__)
+
+#: Names rqt_graph hides with "Hide Debug": the logging plumbing every node is wired to.
+DEBUG_TOPICS = frozenset({"/rosout", "/rosout_agg", "/statistics"})
+DEBUG_NODES = frozenset({"/rosout"})
+
+
+@dataclass(frozen=True)
+class Connection:
+    """One TCPROS/UDPROS link as a node's getBusInfo reports it."""
+
+    topic: str
+    direction: str  # "i" inbound, "o" outbound, "b" both
+    peer: str  # caller id (outbound) or publisher URI (inbound), as ROS reports it
+    transport: str
+    connected: bool
+
+
+def parse_bus_info(rows: Iterable[list]) -> list[Connection]:
+    """Decode getBusInfo rows ``[id, destination, direction, transport, topic, connected, ...]``.
+
+    Rows that do not have that shape (old or foreign implementations) are skipped.
+    """
+    out = []
+    for row in rows:
+        if not isinstance(row, list | tuple) or len(row) < 5:
+            continue
+        connected = bool(row[5]) if len(row) > 5 else True
+        out.append(Connection(str(row[4]), str(row[2]), str(row[1]), str(row[3]), connected))
+    return out
+
+
+def namespace_of(name: str) -> str:
+    """The namespace a graph name lives in: ``/a/b/c`` -> ``/a/b``, ``/talker`` -> ``/``."""
+    head = name.rstrip("/").rsplit("/", 1)[0]
+    return head or "/"
+
+
+def build_graph(
+    system_state: list,
+    topic_types: list,
+    node_uris: dict[str, str],
+    bus_info: dict[str, list[Connection] | None],
+) -> dict:
+    """Plain-data graph: nodes, topics (with type, publishers, subscribers) and node->node edges.
+
+    ``bus_info[node]`` is None when the node did not answer (shown as unreachable), missing when it was
+    not asked yet. An edge is ``connected`` when either end reports a live connection on its topic.
+    """
+    publishers, subscribers = system_state[0], system_state[1]
+    types = {str(t): str(ty) for t, ty in topic_types}
+    pubs = {str(t): sorted(str(n) for n in nodes) for t, nodes in publishers}
+    subs = {str(t): sorted(str(n) for n in nodes) for t, nodes in subscribers}
+    names = set(node_uris)
+    for table in (pubs, subs):
+        for nodes in table.values():
+            names.update(nodes)
+    for _topic, nodes in system_state[2] if len(system_state) > 2 else []:
+        names.update(str(n) for n in nodes)
+
+    live_topics: dict[str, set[str]] = {}
+    for node, conns in bus_info.items():
+        for c in conns or []:
+            if c.connected:
+                live_topics.setdefault(node, set()).add(c.topic)
+
+    nodes = [
+        {
+            "name": name,
+            "namespace": namespace_of(name),
+            "uri": node_uris.get(name, ""),
+            "reachable": bus_info.get(name, []) is not None,
+            "debug": name in DEBUG_NODES,
+        }
+        for name in sorted(names)
+    ]
+    topics = []
+    edges = []
+    for topic in sorted(set(pubs) | set(subs) | set(types)):
+        p, s = pubs.get(topic, []), subs.get(topic, [])
+        topics.append(
+            {
+                "name": topic,
+                "namespace": namespace_of(topic),
+                "type": types.get(topic, ""),
+                "publishers": p,
+                "subscribers": s,
+                "debug": topic in DEBUG_TOPICS,
+            }
+        )
+        for a in p:
+            for b in s:
+                connected = topic in live_topics.get(a, ()) or topic in live_topics.get(b, ())
+                edges.append({"source": a, "target": b, "topic": topic, "connected": connected})
+    graph = {"nodes": nodes, "topics": topics, "edges": edges}
+    graph["version"] = hashlib.sha1(json.dumps(graph, sort_keys=True).encode()).hexdigest()[:16]
+    return graph
+
+
+class _TimeoutTransport(xmlrpc.client.Transport):
+    """xmlrpc.client with a socket timeout, so a hung node cannot stall the poller."""
+
+    def __init__(self, timeout: float) -> None:
+        super().__init__()
+        self._timeout = timeout
+
+    def make_connection(self, host):  # type: ignore[no-untyped-def]
+        conn = super().make_connection(host)
+        conn.timeout = self._timeout
+        return conn
+
+
+def _proxy(uri: str, timeout: float) -> xmlrpc.client.ServerProxy:
+    return xmlrpc.client.ServerProxy(uri, transport=_TimeoutTransport(timeout), allow_none=True)
+
+
+class GraphPoller:
+    """Polls a master (and its nodes) on a thread; calls ``on_change(graph)`` whenever the graph differs.
+
+    ``on_error(message)`` is told when the master cannot be reached (once per outage).
+    """
+
+    def __init__(
+        self,
+        master_uri: str,
+        caller_id: str,
+        on_change: Callable[[dict], None],
+        on_error: Callable[[str], None] | None = None,
+        period: float = 0.5,
+        bus_period: float = 2.0,
+        timeout: float = 2.0,
+    ) -> None:
+        self.master_uri = master_uri
+        self.caller_id = caller_id
+        self.period = period
+        self.bus_period = bus_period
+        self.timeout = timeout
+        self._on_change = on_change
+        self._on_error = on_error or (lambda _m: None)
+        self._stop = threading.Event()
+        self._wake = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._pool = ThreadPoolExecutor(max_workers=8, thread_name_prefix="graph-bus")
+        self._uris: dict[str, str] = {}
+        self._bus: dict[str, list[Connection] | None] = {}
+        self._bus_time = 0.0
+        self.graph: dict | None = None
+        self.master_ok = True
+
+    def start(self) -> None:
+        self._thread = threading.Thread(target=self._run, name="graph-poller", daemon=True)
+        self._thread.start()
+
+    def stop(self) -> None:
+        self._stop.set()
+        self._wake.set()
+        if self._thread is not None:
+            self._thread.join(timeout=self.timeout + 1.0)
+        self._pool.shutdown(wait=False, cancel_futures=True)
+
+    def refresh(self) -> None:
+        """Poll now instead of at the next tick (e.g. the user pressed refresh)."""
+        self._wake.set()
+
+    def poll_once(self, now: float) -> dict | None:
+        """One round: returns the new graph if it changed, else None. Raises OSError when unreachable."""
+        master = _proxy(self.master_uri, self.timeout)
+        code, msg, state = master.getSystemState(self.caller_id)
+        if code != 1:
+            raise OSError(f"getSystemState: {msg}")
+        code, msg, types = master.getTopicTypes(self.caller_id)
+        if code != 1:
+            types = []
+        names = set()
+        for table in state[:3]:
+            for _t, nodes in table:
+                names.update(nodes)
+        for name in names - set(self._uris):
+            code, _msg, uri = master.lookupNode(self.caller_id, name)
+            if code == 1:
+                self._uris[name] = uri
+        for gone in set(self._uris) - names:
+            del self._uris[gone]
+            self._bus.pop(gone, None)
+        new_nodes = [n for n in names if n not in self._bus]
+        if now - self._bus_time >= self.bus_period:
+            self._bus_time = now
+            self._refresh_bus(sorted(names))
+        elif new_nodes:
+            self._refresh_bus(new_nodes)
+        graph = build_graph(state, types, dict(self._uris), dict(self._bus))
+        if self.graph is not None and graph["version"] == self.graph["version"]:
+            return None
+        self.graph = graph
+        return graph
+
+    def _refresh_bus(self, names: list[str]) -> None:
+        def ask(name: str) -> tuple[str, list[Connection] | None]:
+            uri = self._uris.get(name)
+            if not uri:
+                return name, None
+            try:
+                code, _msg, rows = _proxy(uri, self.timeout).getBusInfo(self.caller_id)
+            except (OSError, xmlrpc.client.Error, ValueError):
+                return name, None
+            return name, parse_bus_info(rows) if code == 1 else []
+
+        for name, conns in self._pool.map(ask, names):
+            self._bus[name] = conns
+
+    def _run(self) -> None:
+        while not self._stop.is_set():
+            try:
+                graph = self.poll_once(time.monotonic())
+            except (OSError, xmlrpc.client.Error, ValueError, TypeError) as exc:
+                if self.master_ok:
+                    self.master_ok = False
+                    self._on_error(f"cannot reach the master at {self.master_uri}: {exc}")
+            else:
+                if not self.master_ok:
+                    self.master_ok = True
+                    graph = graph or self.graph
+                if graph is not None:
+                    self._on_change(graph)
+            self._wake.wait(self.period)
+            self._wake.clear()

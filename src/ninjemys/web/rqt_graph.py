@@ -1,0 +1,64 @@
+"""``rqt_graph``: start the web tools and show the node graph of the current ROS master.
+
+Prints the URL (and opens a browser when there is a display), then serves until Ctrl-C.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import signal
+import sys
+import threading
+import webbrowser
+
+from ninjemys.tools.cli import entry
+from ninjemys.web.app import WebApp
+
+DEFAULT_MASTER = "http://localhost:11311"
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="rqt_graph", description="Show the ROS computation graph in a browser.")
+    p.add_argument(
+        "--port", type=int, default=int(os.environ.get("NINJEMYS_WEB_PORT", "0")), help="HTTP port"
+    )
+    p.add_argument("--host", default="127.0.0.1", help="address to serve on (default: localhost only)")
+    p.add_argument("--no-browser", action="store_true", help="only print the URL")
+    return p
+
+
+def _has_display() -> bool:
+    return sys.platform in ("darwin", "win32") or bool(
+        os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
+    )
+
+
+def main(argv: list[str] | None = None) -> int:
+    # ROS passes remappings (name:=value) and __name/__log args; they do not apply to this tool
+    args = _parser().parse_args([a for a in (argv or []) if ":=" not in a])
+    master_uri = os.environ.get("ROS_MASTER_URI", DEFAULT_MASTER)
+    app = WebApp(master_uri, caller_id="/rqt_graph", host=args.host, port=args.port)
+    try:
+        url = app.start()
+    except OSError as exc:
+        print(
+            f"ERROR: cannot serve the web tools on {args.host}:{args.port}: {exc.strerror or exc}",
+            file=sys.stderr,
+        )
+        return 1
+    print(f"rqt_graph: node graph of {master_uri} at {url}", flush=True)
+    if not args.no_browser and _has_display():
+        webbrowser.open(url)
+    stop = threading.Event()
+    signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    try:
+        stop.wait()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        app.stop()
+    return 0
+
+
+console_main = entry(main)

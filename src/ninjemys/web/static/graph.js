@@ -1,0 +1,194 @@
+// The node graph page (rqt_graph in the browser): live from /api/graph/events (Server-Sent Events).
+"use strict";
+
+const SVGNS = "http://www.w3.org/2000/svg";
+const ui = {
+  svg: document.getElementById("graph"),
+  status: document.getElementById("status"),
+  mode: document.getElementById("mode"),
+  group: document.getElementById("group"),
+  hideDebug: document.getElementById("hide-debug"),
+  hideDead: document.getElementById("hide-dead"),
+  hideLeaf: document.getElementById("hide-leaf"),
+  filter: document.getElementById("filter"),
+  details: document.getElementById("details"),
+};
+let current = null; // last {graph, master_uri, error}
+let selectedTopic = null;
+let detailsTimer = null;
+
+function el(tag, attrs, parent) {
+  const e = document.createElementNS(SVGNS, tag);
+  for (const [k, v] of Object.entries(attrs || {})) e.setAttribute(k, v);
+  if (parent) parent.appendChild(e);
+  return e;
+}
+
+function textWidth(s) { return Math.max(60, s.length * 7.2 + 24); }
+
+// What is visible under the current options: {vertices, edges} in layout terms.
+function visibleGraph(graph) {
+  const opt = {
+    topics: ui.mode.value === "topics", debug: !ui.hideDebug.checked, dead: !ui.hideDead.checked,
+    leaf: !ui.hideLeaf.checked, filter: ui.filter.value.trim(),
+  };
+  const nodes = graph.nodes.filter((n) => opt.debug || !n.debug);
+  const nodeSet = new Set(nodes.map((n) => n.name));
+  const topics = graph.topics.filter((t) => {
+    if (!opt.debug && t.debug) return false;
+    const pubs = t.publishers.filter((p) => nodeSet.has(p));
+    const subs = t.subscribers.filter((s) => nodeSet.has(s));
+    if (!opt.dead && subs.length === 0) return false;
+    if (!opt.leaf && pubs.length === 0) return false;
+    return pubs.length + subs.length > 0;
+  });
+  const match = (name) => !opt.filter || name.includes(opt.filter);
+  const vertices = [];
+  const edges = [];
+  const groupOf = (ns) => (ui.group.checked && ns !== "/" ? ns : "");
+  const topicSet = new Set(topics.map((t) => t.name));
+  if (opt.topics) {
+    const used = new Set();
+    for (const t of topics) {
+      if (!match(t.name) && !t.publishers.concat(t.subscribers).some(match)) continue;
+      vertices.push({ id: "t:" + t.name, kind: "topic", name: t.name, w: textWidth(t.name), h: 30, group: groupOf(t.namespace) });
+      for (const p of t.publishers) if (nodeSet.has(p)) { edges.push({ source: "n:" + p, target: "t:" + t.name, topic: t.name }); used.add(p); }
+      for (const s of t.subscribers) if (nodeSet.has(s)) { edges.push({ source: "t:" + t.name, target: "n:" + s, topic: t.name }); used.add(s); }
+    }
+    for (const n of nodes) if (used.has(n.name) || match(n.name)) vertices.push(nodeVertex(n, groupOf));
+  } else {
+    const pairs = new Map();
+    for (const e of graph.edges) {
+      if (!nodeSet.has(e.source) || !nodeSet.has(e.target) || !topicSet.has(e.topic)) continue;
+      if (!(match(e.source) || match(e.target) || match(e.topic))) continue;
+      const key = e.source + "\u0000" + e.target;
+      const p = pairs.get(key) || { source: "n:" + e.source, target: "n:" + e.target, topics: [], connected: true };
+      p.topics.push(e.topic);
+      p.connected = p.connected && e.connected;
+      pairs.set(key, p);
+    }
+    for (const p of pairs.values()) edges.push({ source: p.source, target: p.target, topic: p.topics.join("\n"), connected: p.connected });
+    const used = new Set(edges.flatMap((e) => [e.source, e.target]));
+    for (const n of nodes) if (used.has("n:" + n.name) || match(n.name)) vertices.push(nodeVertex(n, groupOf));
+  }
+  return { vertices, edges };
+}
+
+function nodeVertex(n, groupOf) {
+  return { id: "n:" + n.name, kind: "node", name: n.name, w: textWidth(n.name) + 10, h: 36, group: groupOf(n.namespace), reachable: n.reachable };
+}
+
+function render() {
+  const svg = ui.svg;
+  while (svg.firstChild) svg.removeChild(svg.firstChild);
+  if (!current || !current.graph) return;
+  const { vertices, edges } = visibleGraph(current.graph);
+  const { pos, width, height } = layoutGraph(vertices, edges);
+  svg.setAttribute("width", Math.max(width, 200));
+  svg.setAttribute("height", Math.max(height, 120));
+  const defs = el("defs", {}, svg);
+  const marker = el("marker", { id: "arrow", viewBox: "0 0 10 10", refX: 10, refY: 5, markerWidth: 8, markerHeight: 8, orient: "auto-start-reverse" }, defs);
+  el("path", { d: "M0,0 L10,5 L0,10 z", fill: "#9aa0a6" }, marker);
+  // namespace groups behind everything
+  if (ui.group.checked) {
+    const groups = new Map();
+    for (const v of vertices) if (v.group) (groups.get(v.group) || groups.set(v.group, []).get(v.group)).push(pos.get(v.id));
+    for (const [name, ps] of groups) {
+      const x0 = Math.min(...ps.map((p) => p.x - p.w / 2)) - 10, x1 = Math.max(...ps.map((p) => p.x + p.w / 2)) + 10;
+      const y0 = Math.min(...ps.map((p) => p.y - p.h / 2)) - 22, y1 = Math.max(...ps.map((p) => p.y + p.h / 2)) + 8;
+      const g = el("g", { class: "group", "data-name": name }, svg);
+      el("rect", { x: x0, y: y0, width: x1 - x0, height: y1 - y0, rx: 8 }, g);
+      el("text", { x: x0 + 6, y: y0 + 13 }, g).textContent = name;
+    }
+  }
+  for (const e of edges) {
+    const a = pos.get(e.source), b = pos.get(e.target);
+    if (!a || !b) continue;
+    const x0 = a.x + a.w / 2, y0 = a.y, x1 = b.x - b.w / 2, y1 = b.y;
+    const mid = (x0 + x1) / 2;
+    const d = x1 > x0 ? `M${x0},${y0} C${mid},${y0} ${mid},${y1} ${x1},${y1}` : `M${x0},${y0} C${x0 + 60},${y0 - 80} ${x1 - 60},${y1 - 80} ${x1},${y1}`;
+    const cls = "edge" + (e.connected === false ? " pending" : "") + (selectedTopic && e.topic === selectedTopic ? " selected" : "");
+    el("path", { d, class: cls, "marker-end": "url(#arrow)", "data-source": e.source.slice(2), "data-target": e.target.slice(2), "data-topic": e.topic }, svg);
+    if (ui.mode.value === "nodes") {
+      const t = el("text", { x: mid, y: (y0 + y1) / 2 - 5, class: "edge-label" }, svg);
+      t.textContent = e.topic.split("\n").join(", ");
+    }
+  }
+  for (const v of vertices) {
+    const p = pos.get(v.id);
+    const g = el("g", { class: v.kind + (v.kind === "node" && !v.reachable ? " unreachable" : "") + (v.name === selectedTopic ? " selected" : ""), "data-name": v.name }, svg);
+    if (v.kind === "node") el("ellipse", { cx: p.x, cy: p.y, rx: p.w / 2, ry: p.h / 2 }, g);
+    else {
+      el("rect", { x: p.x - p.w / 2, y: p.y - p.h / 2, width: p.w, height: p.h, rx: 3 }, g);
+      g.addEventListener("click", () => selectTopic(v.name));
+    }
+    el("text", { x: p.x, y: p.y }, g).textContent = v.name;
+    el("title", {}, g).textContent = v.kind === "node" ? v.name + (v.reachable ? "" : " (not answering)") : v.name + " (click for details)";
+  }
+  const g = current.graph;
+  ui.status.textContent = `${g.nodes.length} nodes, ${g.topics.length} topics — master ${current.master_uri}`;
+  ui.status.className = "";
+}
+
+function showState(state) {
+  current = state;
+  if (state.error) {
+    ui.status.textContent = state.error;
+    ui.status.className = "error";
+  }
+  if (state.graph) render();
+  document.body.dataset.version = state.graph ? state.graph.version : "";
+}
+
+// topic details panel: type, publishers, subscribers, rate and last message, refreshed each second
+async function selectTopic(name) {
+  selectedTopic = name;
+  ui.details.hidden = false;
+  document.getElementById("details-title").textContent = name;
+  render();
+  clearInterval(detailsTimer);
+  await loadDetails();
+  detailsTimer = setInterval(loadDetails, 1000);
+}
+
+async function loadDetails() {
+  if (!selectedTopic) return;
+  const name = selectedTopic;
+  let info;
+  try {
+    const resp = await fetch("/api/topic?name=" + encodeURIComponent(name));
+    info = await resp.json();
+    if (!resp.ok) throw new Error(info.error || resp.statusText);
+  } catch (err) {
+    document.getElementById("details-body").textContent = String(err.message || err);
+    return;
+  }
+  if (name !== selectedTopic) return;
+  const body = document.getElementById("details-body");
+  body.textContent = "";
+  const row = (label, value, key) => {
+    const dt = document.createElement("dt"); dt.textContent = label;
+    const dd = document.createElement("dd"); dd.textContent = value; dd.dataset.key = key;
+    body.append(dt, dd);
+  };
+  row("Type", info.type || "(unknown)", "type");
+  row("Publishers", info.publishers.join(", ") || "none", "publishers");
+  row("Subscribers", info.subscribers.join(", ") || "none", "subscribers");
+  if (info.rate !== undefined) row("Rate", info.rate === null ? "no messages yet" : `${info.rate.toFixed(2)} Hz (${info.count} messages)`, "rate");
+  if (info.monitor_error) row("Monitor", info.monitor_error, "monitor");
+  document.getElementById("details-message").textContent = info.last_message || "";
+}
+
+document.getElementById("close-details").addEventListener("click", () => {
+  selectedTopic = null;
+  clearInterval(detailsTimer);
+  ui.details.hidden = true;
+  render();
+});
+for (const input of [ui.mode, ui.group, ui.hideDebug, ui.hideDead, ui.hideLeaf]) input.addEventListener("change", render);
+ui.filter.addEventListener("input", render);
+document.getElementById("refresh").addEventListener("click", () => fetch("/api/graph/refresh", { method: "POST" }));
+
+const events = new EventSource("/api/graph/events");
+events.addEventListener("state", (ev) => showState(JSON.parse(ev.data)));
+events.onerror = () => { ui.status.textContent = "connection to the web tools server lost, retrying…"; ui.status.className = "error"; };

@@ -1,0 +1,47 @@
+"""The graph page in a real headless chromium: talker -> /chatter -> listener, live updates."""
+
+from __future__ import annotations
+
+import signal
+
+import pytest
+
+from conftest import LISTENER, TALKER
+from ninjemys.web.app import WebApp
+
+pytestmark = [pytest.mark.ros1, pytest.mark.browser]
+
+
+def test_graph_page_shows_chatter_and_updates_on_kill(ros1_master: str, rospy_node, browser_page) -> None:  # type: ignore[no-untyped-def]
+    app = WebApp(ros1_master, caller_id="/test_rqt_graph", poll_period=0.2)
+    url = app.start()
+    try:
+        rospy_node(TALKER)
+        listener = rospy_node(LISTENER)
+        page = browser_page
+        page.goto(url)
+        page.wait_for_selector('g.node[data-name="/talker"]', timeout=20000)
+        page.wait_for_selector('g.node[data-name="/listener"]', timeout=20000)
+        page.wait_for_selector('g.topic[data-name="/chatter"]', timeout=20000)
+        assert page.locator('path.edge[data-source="/talker"][data-target="/chatter"]').count() == 1
+        assert page.locator('path.edge[data-source="/chatter"][data-target="/listener"]').count() == 1
+        # /rosout is hidden by default ("Hide debug"); the master has no rosout node here anyway
+        assert page.locator('g.topic[data-name="/rosout"]').count() == 0
+
+        # clicking the topic shows its type
+        page.click('g.topic[data-name="/chatter"]')
+        page.wait_for_selector('#details dd[data-key="type"]:has-text("std_msgs/String")', timeout=10000)
+
+        # nodes-only view draws talker -> listener directly
+        page.select_option("#mode", "nodes")
+        page.wait_for_selector(
+            'path.edge[data-source="/talker"][data-target="/listener"]', state="attached", timeout=10000
+        )
+        page.select_option("#mode", "topics")
+
+        listener.send_signal(signal.SIGINT)
+        listener.wait(10)
+        page.wait_for_selector('g.node[data-name="/listener"]', state="detached", timeout=20000)
+        assert page.locator('g.node[data-name="/talker"]').count() == 1
+    finally:
+        app.stop()
