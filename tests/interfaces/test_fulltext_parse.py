@@ -12,11 +12,11 @@ from typing import Any
 import pytest
 from iface_inventory import NOT_IN_DEBIAN, inventory, package_of
 from iface_oracle import GenpyOracle
-from ninjemys.idl.loader import get_message_class
 from rosbags.typesys import Stores, get_typestore
 from rosbags.typesys.base import Nodetype
 
 from ninjemys.idl.fulltext import split_full_text
+from ninjemys.idl.loader import get_message_class
 from ninjemys.idl.parser import parse_message
 from ninjemys.idl.spec import FieldType, MsgSpec
 
@@ -65,6 +65,8 @@ IN_STORE = [t for t in INV.all_message_like if rosbags_name(t) in STORE.fielddef
 def test_full_text_parses_to_rosbags_definitions(type_name: str) -> None:
     for embedded, spec in parsed_blocks(type_name).items():
         expected_constants, expected_fields = STORE.fielddefs[rosbags_name(embedded)][:2]
+        # rosbags gives empty messages a placeholder field that ROS 1 does not have
+        expected_fields = [f for f in expected_fields if f[0] != "structure_needs_at_least_one_member"]
         constants, fields = as_rosbags(spec)
         assert fields == expected_fields, f"{type_name}: fields of {embedded}"
         assert constants == expected_constants, f"{type_name}: constants of {embedded}"

@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 from iface_inventory import inventory
 from iface_oracle import GenpyOracle
 from iface_values import build_ours, tree_of_ours, tree_strategy
+
 from ninjemys.idl.loader import get_message_class
 
 pytestmark = pytest.mark.ros1
@@ -23,7 +24,7 @@ pytestmark = pytest.mark.ros1
 INV = inventory()
 
 WIRE_SETTINGS = settings(
-    max_examples=5,
+    max_examples=3,
     deadline=None,
     database=None,
     derandomize=False,
@@ -37,7 +38,7 @@ def test_wire_bytes_equal_genpy(type_name: str, genpy_oracle: GenpyOracle) -> No
     genpy_oracle.define(type_name, cls._full_text)
 
     @WIRE_SETTINGS
-    @given(st.lists(tree_strategy(type_name), min_size=1, max_size=4))
+    @given(st.lists(tree_strategy(type_name), min_size=2, max_size=5))
     def check(trees: list[dict]) -> None:
         expected = genpy_oracle.serialize(type_name, trees)
         for tree, theirs in zip(trees, expected, strict=True):
