@@ -372,3 +372,21 @@ rospy.sleep(0.5)
 """
     node = run_node(code)
     node.wait_for("^fast got 20$", timeout=20)
+
+
+def test_any_msg_subscriber_gets_raw_bytes(run_node) -> None:
+    code = r"""
+import rospy
+from std_msgs.msg import String
+rospy.init_node("raw_listener")
+def cb(msg, extra):
+    print("raw", extra, msg._connection_header.get("type"), String.deserialize_from(msg._buff).data, flush=True)
+    rospy.signal_shutdown("done")
+rospy.Subscriber("chatter", rospy.AnyMsg, cb, callback_args="X")
+pub = rospy.Publisher("chatter", String, queue_size=1, latch=True)
+pub.publish("payload")
+rospy.spin()
+"""
+    node = run_node(code)
+    assert node.wait_for(r"^raw (.*)$").group(1) == "X std_msgs/String payload"
+    assert node.wait(10) == 0
