@@ -7,6 +7,7 @@ from typing import Any
 import pytest
 
 from ninjemys.master.server import MasterHandler
+from ninjemys.wire import xmlrpc as wire
 
 
 class RecordingNotifier:
@@ -34,6 +35,8 @@ def master() -> tuple[MasterHandler, RecordingNotifier]:
 
 def call(handler: MasterHandler, method: str, *args: Any) -> list[Any]:
     reply = handler._dispatch(method, args)
+    if isinstance(reply[2], wire.Marshalled):
+        reply[2] = reply[2].value
     notifier = handler.notifier
     notifier.calls = [c for c in notifier.calls if c[0] != "revive"]  # type: ignore[attr-defined]
     return reply

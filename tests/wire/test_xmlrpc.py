@@ -194,3 +194,8 @@ def test_deep_nesting_is_parsed_without_recursion() -> None:
     for _ in range(depth - 1):
         value = value[0]
     assert value == []
+
+
+def test_marshalled_values_are_sent_verbatim() -> None:
+    cached = wire.Marshalled([["/t", ["/n"]]])
+    assert wire.dump_response([1, "s", cached]) == wire.dump_response([1, "s", [["/t", ["/n"]]]])

@@ -118,6 +118,21 @@ def valid_type_name(name: str) -> Validator:
     return check
 
 
+#: calls that may change getSystemState's answer (a name clash can drop topics, even via subscribeParam)
+_CHANGES_GRAPH = frozenset(
+    {
+        "registerService",
+        "unregisterService",
+        "registerSubscriber",
+        "unregisterSubscriber",
+        "registerPublisher",
+        "unregisterPublisher",
+        "subscribeParam",
+        "unsubscribeParam",
+    }
+)
+
+
 @dataclass(frozen=True)
 class _Api:
     fn: Callable[..., list[Any]]
@@ -143,6 +158,7 @@ class MasterHandler:
         self.params = ParamTree()
         self.notifier = notifier or Notifier(on_param_rejected=self._param_rejected)
         self.on_shutdown = on_shutdown
+        self._state_cache: wire.Marshalled | None = None
         nn = non_empty_str
         self._apis: dict[str, _Api] = {
             "shutdown": _Api(self.shutdown, 0, (None,)),
@@ -195,6 +211,8 @@ class MasterHandler:
             raise wire.Fault(1, f"<class 'Exception'>:method \"{method}\" is not supported")
         if not params:
             return [-1, "missing required caller_id parameter", api.error_value]
+        if method in _CHANGES_GRAPH:
+            self._state_cache = None
         if len(params) != len(api.validators) + 1:
             return [-1, "Error: bad call arity", api.error_value]
         caller_id = params[0]
@@ -373,4 +391,7 @@ class MasterHandler:
         return [1, "current system state", [[t, ty] for t, ty in self.store.topic_types.items()]]
 
     def getSystemState(self, caller_id: str) -> list[Any]:
-        return [1, "current system state", self.store.system_state()]
+        # rosnode, rostopic, rqt_graph and the web UI poll this: render it once per graph change
+        if self._state_cache is None:
+            self._state_cache = wire.Marshalled(self.store.system_state())
+        return [1, "current system state", self._state_cache]

@@ -127,9 +127,23 @@ def _dump_int(value: int, out: list[str]) -> None:
         raise ProtocolError(f"XML-RPC: integer {value} does not fit in 64 bits")
 
 
+class Marshalled:
+    """A value rendered to XML-RPC once, sent many times (the master caches getSystemState this way)."""
+
+    __slots__ = ("value", "xml")
+
+    def __init__(self, value: Any) -> None:
+        out: list[str] = []
+        _dump(value, out)
+        self.value = value
+        self.xml = "".join(out)
+
+
 def _dump_other(value: Any, out: list[str]) -> None:
     """Subclasses and foreign types: xmlrpc.client.Binary / DateTime, datetime, numpy scalars."""
-    if isinstance(value, bool):
+    if type(value) is Marshalled:
+        out.append(value.xml)
+    elif isinstance(value, bool):
         _dump(bool(value), out)
     elif isinstance(value, int):
         _dump_int(int(value), out)
