@@ -1,0 +1,138 @@
+"""The process supervisor on its own (no master): respawn, required, escalation, no orphans."""
+
+from __future__ import annotations
+
+import os
+import sys
+import threading
+from pathlib import Path
+
+from ninjemys.launch.runner import ProcessSpec, Supervisor
+
+from .conftest import PKGS
+
+SCRIPTS = PKGS / "corpus_run" / "scripts"
+
+
+def spec(name: str, script: str, *args: str, **kw: object) -> ProcessSpec:
+    return ProcessSpec(
+        name=name,
+        argv=[sys.executable, str(SCRIPTS / script), *args],
+        env=dict(os.environ, PYTHONUNBUFFERED="1"),
+        output="screen",
+        **kw,  # type: ignore[arg-type]
+    )
+
+
+def alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    return True
+
+
+def run_in_thread(sup: Supervisor) -> tuple[threading.Thread, list[int]]:
+    result: list[int] = []
+    thread = threading.Thread(target=lambda: result.append(sup.run()), daemon=True)
+    thread.start()
+    return thread, result
+
+
+def test_respawn_restarts_a_crashing_node() -> None:
+    lines: list[str] = []
+    sup = Supervisor(
+        [spec("crash-1", "crasher.py", "0", respawn=True, respawn_delay=0.05)], write=lines.append
+    )
+    starts: list[str] = []
+
+    def on_event(kind: str, name: str) -> None:
+        if kind == "started":
+            starts.append(name)
+            if len(starts) == 4:
+                sup.request_shutdown()
+
+    sup.on_event = on_event
+    thread, result = run_in_thread(sup)
+    thread.join(60)
+    assert not thread.is_alive()
+    assert result == [0]
+    assert sup.respawn_count("crash-1") >= 3
+    assert sum("restarting process" in line for line in lines) >= 3
+    assert any("process has died" in line and "exit code 3" in line for line in lines)
+
+
+def test_required_node_death_stops_everything_with_failure() -> None:
+    lines: list[str] = []
+    sup = Supervisor(
+        [spec("sleeper-1", "sleeper.py"), spec("crash-2", "crasher.py", "0.2", required=True)],
+        write=lines.append,
+    )
+    thread, result = run_in_thread(sup)
+    thread.join(60)
+    assert not thread.is_alive()
+    assert result == [1]
+    text = "".join(lines)
+    assert "REQUIRED process [crash-2] has died!" in text
+    pids = [p.popen.pid for p in sup.procs if p.popen is not None]
+    assert pids and not any(alive(pid) for pid in pids)
+
+
+def test_screen_output_is_prefixed_per_node() -> None:
+    lines: list[str] = []
+    sup = Supervisor([spec("sleeper-1", "sleeper.py", "__name:=alpha")], write=lines.append)
+    sup.on_event = lambda kind, name: None
+    thread, result = run_in_thread(sup)
+    deadline_hit = threading.Event()
+
+    def stop_when_ready() -> None:
+        while not any("alpha ready" in line for line in lines):
+            if deadline_hit.wait(0.02):
+                return
+        sup.request_shutdown()
+
+    stopper = threading.Thread(target=stop_when_ready, daemon=True)
+    stopper.start()
+    thread.join(60)
+    deadline_hit.set()
+    assert result == [0]
+    assert "[sleeper-1] alpha ready\n" in lines
+
+
+def test_sigint_ignoring_node_is_escalated_to_sigterm() -> None:
+    lines: list[str] = []
+    sup = Supervisor(
+        [spec("stubborn-1", "stubborn.py", sigint_timeout=0.3, sigterm_timeout=0.5)], write=lines.append
+    )
+    ready = threading.Event()
+
+    def on_event(kind: str, name: str) -> None:
+        if kind == "started":
+            ready.set()
+
+    sup.on_event = on_event
+    original = sup.write
+
+    def write(text: str) -> None:
+        original(text)
+        if "stubborn ready" in text:
+            sup.request_shutdown()
+
+    sup.write = write  # type: ignore[method-assign]
+    thread, result = run_in_thread(sup)
+    thread.join(60)
+    assert not thread.is_alive() and ready.is_set()
+    assert any("escalating to SIGTERM" in line for line in lines)
+    assert not alive(sup.procs[0].popen.pid)  # type: ignore[union-attr]
+
+
+def test_log_output_goes_to_a_file(tmp_path: Path) -> None:
+    lines: list[str] = []
+    s = spec("crash-1", "crasher.py", "0")
+    s.output = "log"
+    s.log_dir = tmp_path
+    sup = Supervisor([s], write=lines.append)
+    assert sup.run() == 0
+    assert (tmp_path / "crash-1-stdout.log").read_text() == "crasher running\n"
+    assert not any("crasher running" in line for line in lines)
+    assert any("all processes on machine have died" in line for line in lines)
