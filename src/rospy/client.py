@@ -195,9 +195,14 @@ def _on_node_shutdown() -> None:
 
 
 def _at_exit() -> None:
+    """Process exit: shut the node down, or wait for a shutdown already under way (e.g. started by
+    Ctrl-C on a helper thread) to finish unregistering, so the master is left clean."""
     node = _process.node
-    if node is not None and not node.is_shutdown:
-        signal_shutdown("atexit")
+    if node is not None:
+        if node.is_shutdown:
+            node.shutdown("atexit")
+        else:
+            signal_shutdown("atexit")
     _process.log.close()
 
 

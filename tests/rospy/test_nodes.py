@@ -65,12 +65,16 @@ def test_ctrl_c_ends_spin_within_a_second_without_leftover_threads(run_node) -> 
     assert not any("Traceback" in line for line in node.err), node.err
 
 
-def test_ctrl_c_interrupts_rate_sleep_in_seed_style_talker(run_node) -> None:
+def test_ctrl_c_interrupts_rate_sleep_in_seed_style_talker(run_node, master: str) -> None:
     talker = run_node(EXAMPLES / "talker.py")
     talker.wait_for("greetings from ninjemys #1 ")
+    mine = [n for n in _node_names(master) if n.startswith(f"/talker_{talker.proc.pid}_")]
+    assert mine
     talker.interrupt()
     assert talker.wait(5) == 0
     assert not any("Traceback" in line for line in talker.err), talker.err
+    # the node unregistered everything before the process exited
+    assert not set(mine) & set(_node_names(master))
 
 
 def test_anonymous_names_are_unique(run_node, master: str) -> None:
