@@ -188,3 +188,36 @@ def test_hostile_subscriber_does_not_stop_talker_and_listener(master: str) -> No
 
 if __name__ == "__main__":  # pragma: no cover
     sys.exit(pytest.main([__file__, "-v"]))
+
+
+def test_same_name_shuts_down_the_old_rospy_node(master: str) -> None:
+    first = subprocess.Popen(
+        [ROS1_PYTHON, "-c", TALKER],
+        env=ros1_env(master),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    second = None
+    try:
+        client = MasterClient(master, "/probe")
+        deadline = time.monotonic() + 30
+        while client.get_published_topics() == [] or not any(
+            t == "/chatter" for t, _ in client.get_published_topics()
+        ):
+            assert time.monotonic() < deadline
+            time.sleep(0.05)
+        first_api = client.lookup_node("/talker")
+        second = subprocess.Popen(
+            [ROS1_PYTHON, "-c", TALKER],
+            env=ros1_env(master),
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+        first.wait(timeout=30)  # the master told the old /talker to shut down
+        assert client.lookup_node("/talker") != first_api
+        assert second.poll() is None
+    finally:
+        for proc in (first, second):
+            if proc is not None:
+                proc.kill()
+                proc.wait()
