@@ -316,25 +316,26 @@ class Bag:
     def _iterate(self, source: Iterator[RawMessage], raw: bool, with_header: bool) -> Iterator[Any]:
         decoders = self._decoders
         make_time = Time._raw
+        new_tuple = tuple.__new__  # namedtuple construction without its Python-level __new__
+        # per-connection work (class lookup, header text) is done once, not per message
+        per_conn: dict[int, Any] = {}
         try:
-            for item in source:
-                conn = item.connection
-                stamp = make_time(*divmod(item.time, NSEC))
+            for conn, ns, data, chunk_pos in source:
+                cached = per_conn.get(conn.id)
+                if cached is None:
+                    cls = _pytype_or_none(decoders, conn) if raw else decoders.get(conn)
+                    cached = per_conn[conn.id] = (cls, conn.string_header() if with_header else None)
+                cls = cached[0]
+                secs, nsecs = divmod(ns, NSEC)
+                stamp = make_time(secs, nsecs)
                 if raw:
-                    message: Any = (
-                        conn.datatype,
-                        bytes(item.data),
-                        conn.md5sum,
-                        item.chunk_pos,
-                        _pytype_or_none(decoders, conn),
-                    )
+                    message: Any = (conn.datatype, bytes(data), conn.md5sum, chunk_pos, cls)
                 else:
-                    cls = decoders.get(conn)
-                    message = _deserialize(cls, item.data, conn)
+                    message = _deserialize(cls, data, conn)
                 if with_header:
-                    yield BagMessageWithConnectionHeader(conn.topic, message, stamp, conn.string_header())
+                    yield new_tuple(BagMessageWithConnectionHeader, (conn.topic, message, stamp, cached[1]))
                 else:
-                    yield BagMessage(conn.topic, message, stamp)
+                    yield new_tuple(BagMessage, (conn.topic, message, stamp))
         except ROSBagException:
             raise
         except BagError as exc:

@@ -15,7 +15,7 @@ import os
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import BinaryIO
+from typing import BinaryIO, NamedTuple
 
 from ninjemys.bag.compression import decompress, decompress_partial
 from ninjemys.bag.format import (
@@ -49,9 +49,8 @@ _HEADER_END = len(MAGIC) + FILE_HEADER_LENGTH
 _MAX_RECORD = 1 << 31
 
 
-@dataclass(frozen=True, slots=True)
-class RawMessage:
-    """One message as stored: its connection, time (ns) and serialized bytes."""
+class RawMessage(NamedTuple):
+    """One message as stored: its connection, time (ns) and serialized bytes (a view into the chunk)."""
 
     connection: Connection
     time: int
@@ -484,15 +483,27 @@ class BagReader:
     def _emit(
         self, data: bytes, entries: list[tuple[int, int, int]], info: ChunkInfo, lo: int, hi: int
     ) -> Iterator[RawMessage]:
+        # the hot loop of every read: slicing is inlined, bounds are checked once per message
         view = memoryview(data)
         size = len(data)
         connections = self.connections
         unpack = U32.unpack_from
         clip = info.start_time < lo or info.end_time > hi
+        pos = info.pos
+        make = RawMessage
         for ns, conn, off in entries:
             if clip and not lo <= ns <= hi:
                 continue
-            yield RawMessage(connections[conn], ns, self._slice(view, size, off, info.pos, unpack), info.pos)
+            try:
+                start = off + 8 + unpack(view, off)[0]
+                end = start + unpack(view, start - 4)[0]
+            except Exception:
+                raise BagError(
+                    f"{self.path}: chunk at {pos}: index points outside the chunk (offset {off})"
+                ) from None
+            if end > size:
+                raise BagError(f"{self.path}: chunk at {pos}: message at offset {off} overruns the chunk")
+            yield make(connections[conn], ns, view[start:end], pos)
 
     def _pop(
         self, pending: list[tuple[int, int, int, int, bytes]], connections: dict[int, Connection]
