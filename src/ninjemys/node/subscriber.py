@@ -72,8 +72,9 @@ class SubConnection:
         reader, sock = self._reader, self.sock
         frames: list[bytes | bytearray] = []
         while True:
+            buf = reader.buffer()
             try:
-                n = sock.recv_into(reader.buffer())
+                n = sock.recv_into(buf)
             except (BlockingIOError, InterruptedError):
                 break
             except OSError as exc:
@@ -95,6 +96,8 @@ class SubConnection:
                 self.close()
                 self.sub.node.runtime.call_soon(self.sub.connection_lost, self, False)
                 return None
+            if n < len(buf):
+                break  # the kernel had no more: skip the EAGAIN round trip
         if frames:
             self.num_recv += len(frames)
             if self.latching:

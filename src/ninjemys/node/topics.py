@@ -22,6 +22,7 @@ import itertools
 import logging
 import socket
 import threading
+import time
 from collections import deque
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
@@ -41,6 +42,13 @@ connection_ids = itertools.count(1)
 
 #: Most bytes joined into one send when the loop drains a queue.
 _BATCH_BYTES = 1 << 20
+#: Publishes closer together than this (seconds) are batched by the loop instead of sent directly.
+HOT_INTERVAL = 50e-6
+#: In a burst, the publishing thread itself writes once this many frames are queued.
+_FLUSH_FRAMES = 32
+#: queue_size=None: frames queued before publish() waits for the loop to drain them.
+_SYNC_HIGH_WATER = 256
+_clock = time.perf_counter
 
 
 class PubConnection:
@@ -58,21 +66,31 @@ class PubConnection:
         self.num_sent = 0
         self.dropped = 0
         self.closed = False
-        self._cond = threading.Condition(threading.Lock())
+        self._lock = threading.Lock()
+        self._cond = threading.Condition(self._lock)
         self._partial: memoryview | None = None  # the head frame, partly written
         self._queue: deque[bytes] = deque()
         self._armed = False  # the loop watches the socket for writability
+        self._last = 0.0  # time of the previous send (detects bursts)
 
     @property
     def idle(self) -> bool:
         return self._partial is None and not self._queue
 
     def send(self, data: bytes, queue_size: int | None) -> None:
-        """Queue ``data`` (one or more frames) for this subscriber; never blocks unless queue_size is None."""
-        with self._cond:
+        """Queue ``data`` (one or more frames) for this subscriber; never blocks unless queue_size is None.
+
+        An idle connection is written to directly (lowest latency). While publishes come faster than
+        one per :data:`HOT_INTERVAL`, frames are queued instead and the loop sends them in batches:
+        one system call and one wake-up of the subscriber per batch instead of per message.
+        """
+        with self._lock:
             if self.closed:
                 return
-            if self._partial is None and not self._queue:
+            now = _clock()
+            hot = now - self._last < HOT_INTERVAL
+            self._last = now
+            if self._partial is None and not self._queue and not hot:
                 try:
                     n = self.sock.send(data)
                 except (BlockingIOError, InterruptedError):
@@ -86,14 +104,18 @@ class PubConnection:
                     return
                 self._partial = memoryview(data)[n:]
             else:
-                self._queue.append(data)
-                if queue_size and len(self._queue) > queue_size:
-                    self._queue.popleft()
+                queue = self._queue
+                queue.append(data)
+                if queue_size and len(queue) > queue_size:
+                    queue.popleft()
                     self.dropped += 1
+                if self._partial is None and len(queue) >= _FLUSH_FRAMES and self._write_locked():
+                    return  # a burst: this thread wrote a whole batch in one call
             if not self._armed:
                 self._armed = True
                 self.node.runtime.call_soon(self._arm)
-            if queue_size is None:
+            if queue_size is None and len(self._queue) >= _SYNC_HIGH_WATER:
+                # synchronous publishing: wait for the loop to drain (lossless, bounded memory)
                 while not self.closed and not (self._partial is None and not self._queue):
                     self._cond.wait()
 
@@ -128,29 +150,32 @@ class PubConnection:
 
     def _drain(self) -> None:
         """Writable: push the partial frame, then batches of queued frames (on the loop)."""
-        with self._cond:
-            if self.closed:
-                return
-            try:
-                while True:
-                    if self._partial is None:
-                        if not self._queue:
-                            break
-                        self._partial = memoryview(self._take_batch())
-                    n = self.sock.send(self._partial)
-                    self.bytes_sent += n
-                    if n < len(self._partial):
-                        self._partial = self._partial[n:]
-                        return
-                    self._partial = None
-            except (BlockingIOError, InterruptedError):
-                return
-            except OSError as exc:
-                self._fail(f"write failed: {exc}")
+        with self._lock:
+            if self.closed or not self._write_locked():
                 return
             self._armed = False
             self.node.runtime.loop.remove_writer(self.fd)
             self._cond.notify_all()
+
+    def _write_locked(self) -> bool:
+        """Write what the kernel takes (lock held); True once nothing is left queued."""
+        try:
+            while True:
+                if self._partial is None:
+                    if not self._queue:
+                        return True
+                    self._partial = memoryview(self._take_batch())
+                n = self.sock.send(self._partial)
+                self.bytes_sent += n
+                if n < len(self._partial):
+                    self._partial = self._partial[n:]
+                    return False
+                self._partial = None
+        except (BlockingIOError, InterruptedError):
+            return False
+        except OSError as exc:
+            self._fail(f"write failed: {exc}")
+            return False
 
     def _take_batch(self) -> bytes:
         queue = self._queue

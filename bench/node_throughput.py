@@ -1,0 +1,42 @@
+"""Small-message throughput (std_msgs/String, 16 bytes) from one publisher to one subscriber.
+
+Run: ``.venv/bin/python bench/node_throughput.py [seconds]``. The publisher publishes as fast as it
+can for a few seconds; the subscriber reports how many messages it received per second while data
+was flowing, and the loss. Targets: >= 300k msgs/s with queue_size=10000 (report the loss) and
+>= 400k msgs/s with queue_size=None (lossless).
+"""
+
+from __future__ import annotations
+
+import sys
+
+from node_common import CROSS_CPU, IMPLS, OURS, Role, header, master, ratio, roles
+
+
+def run(uri: str, impl: str, queue_size: str, seconds: str) -> tuple[float, float]:
+    sink = Role(impl, uri, "sink", cpu=CROSS_CPU[1])
+    with roles(sink):
+        sink.ready()
+        flood = Role(impl, uri, "flood", queue_size, seconds, cpu=CROSS_CPU[0])
+        with roles(flood):
+            sent = flood.result()["sent"]
+            got = sink.result()
+    return got["rate"], 1.0 - got["received"] / max(sent, 1)
+
+
+def main() -> None:
+    seconds = sys.argv[1] if len(sys.argv) > 1 else "3"
+    header(f"throughput, 16-byte String, {seconds} s of publishing, across CPUs")
+    with master() as uri:
+        for qs in ("10000", "None"):
+            results = {impl: run(uri, impl, qs, seconds) for impl in IMPLS}
+            for impl, (rate, loss) in results.items():
+                print(
+                    f"queue_size={qs:6s} {impl:9s} {rate / 1e3:8.1f} k msgs/s delivered   loss {loss * 100:5.1f} %"
+                )
+            if len(results) > 1:
+                print(f"queue_size={qs:6s} ratio     {ratio(results[OURS][0], results['rospy'][0])}")
+
+
+if __name__ == "__main__":
+    main()
