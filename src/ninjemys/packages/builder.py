@@ -34,6 +34,7 @@ from ninjemys.packages.setup_scripts import (
     render_setup_bash,
     render_setup_sh,
     render_setup_zsh,
+    underlay_workspaces,
 )
 from ninjemys.packages.workspace import Workspace
 
@@ -123,21 +124,6 @@ def _definitions(pkg: PackageManifest) -> dict[str, list[Path]]:
     return found
 
 
-def _underlays(devel: Path, env: Mapping[str, str]) -> list[WorkspaceEnv]:
-    """Sourced ninjemys workspaces (other than this one), highest precedence first."""
-    result = []
-    for prefix in env.get("CMAKE_PREFIX_PATH", "").split(os.pathsep):
-        marker = Path(prefix) / MARKER if prefix else None
-        if marker is None or not marker.is_file() or Path(prefix).resolve() == devel:
-            continue
-        try:
-            info = json.loads(marker.read_text(encoding="utf-8"))
-            result.append(WorkspaceEnv(source=Path(info["source"]), devel=Path(info["devel"])))
-        except (OSError, ValueError, KeyError):
-            continue
-    return result
-
-
 def build_workspace(
     ws: Workspace, env: Mapping[str, str] | None = None, log: Callable[[str], None] = print
 ) -> BuildReport:
@@ -201,7 +187,7 @@ def build_workspace(
             writer.write(ws.devel / "lib" / pkg.name / script.name, _relay_script(script), executable=True)
 
     wsenv = WorkspaceEnv(source=ws.source, devel=ws.devel)
-    underlays = _underlays(ws.devel, env)
+    underlays = underlay_workspaces(ws.devel, env)
     writer.write(ws.devel / "setup.sh", render_setup_sh(wsenv, underlays))
     writer.write(ws.devel / "setup.bash", render_setup_bash(wsenv))
     writer.write(ws.devel / "setup.zsh", render_setup_zsh(wsenv))

@@ -131,16 +131,16 @@ def parse_manifest(xml_path: str | Path) -> PackageManifest:
     deps: dict[str, list[str]] = {
         k: [] for k in ("build", "buildtool", "build_export", "exec", "test", "doc")
     }
-    for tag, kinds in _DEP_TAGS.items():
-        for el in root.findall(tag):
-            if not _condition_holds(el.get("condition")):
-                continue
-            dep = (el.text or "").strip()
-            if not dep:
-                raise PackageError(f"{xml_path}: empty <{tag}> in package {name}")
-            for kind in kinds:
-                if dep not in deps[kind]:
-                    deps[kind].append(dep)
+    for el in root:
+        kinds = _DEP_TAGS.get(el.tag)
+        if kinds is None or not _condition_holds(el.get("condition")):
+            continue
+        dep = (el.text or "").strip()
+        if not dep:
+            raise PackageError(f"{xml_path}: empty <{el.tag}> in package {name}")
+        for kind in kinds:
+            if dep not in deps[kind]:
+                deps[kind].append(dep)
     exports: dict[str, str] = {}
     export_el = root.find("export")
     if export_el is not None:

@@ -15,8 +15,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ninjemys.errors import PackageError
-from ninjemys.packages.discovery import PackageIndex, crawl
+from ninjemys.packages.discovery import PackageIndex, crawl, package_path_dirs, underlay_dirs
 from ninjemys.packages.manifest import MANIFEST, PackageManifest, parse_manifest
+from ninjemys.packages.setup_scripts import underlay_workspaces
 
 #: packages that exist in ROS 1 as build tooling or C++/Python client libraries; ninjemys provides
 #: their role itself, so depending on them is always satisfied.
@@ -106,7 +107,8 @@ class Workspace:
         """Every build/run dependency must be resolvable; the first missing one is reported."""
         env = os.environ if env is None else env
         local = {p.name for p in self.packages}
-        index = PackageIndex.from_environment(env)
+        underlay_sources = [u.source for u in underlay_workspaces(self.devel, env) if u.source.is_dir()]
+        index = PackageIndex.scan(package_path_dirs(env) + underlay_sources + underlay_dirs())
         for pkg in self.packages:
             for dep in pkg.all_depends:
                 if dep in local or dep in PROVIDED or dep in index.packages or is_system_dependency(dep):
