@@ -20,6 +20,7 @@ from ninjemys.master.client import MasterClient  # noqa: E402
 from ninjemys.testing import free_port, have_ros1, ninjemys_bin, ros1_env  # noqa: E402
 
 OURS = "ninjemys"
+_HOME = tempfile.TemporaryDirectory(prefix="bench_ros_home_")  # logs of every roscore of this run
 
 
 def precompile() -> None:
@@ -42,27 +43,49 @@ class Core:
     started: float  # time.perf_counter() just before Popen
 
     def stop(self) -> float:
-        """Send SIGINT (Ctrl-C) and return the seconds until the process has exited."""
+        """Ctrl-C as a terminal sends it (SIGINT to the process group); seconds until roscore has exited."""
         t0 = time.perf_counter()
-        self.proc.send_signal(signal.SIGINT)
+        os.killpg(self.proc.pid, signal.SIGINT)
         try:
             self.proc.wait(timeout=30)
         except subprocess.TimeoutExpired:
-            self.proc.kill()
-            self.proc.wait()
+            self.kill()
             return float("inf")
         return time.perf_counter() - t0
 
     def kill(self) -> None:
-        if self.proc.poll() is None:
-            self.proc.kill()
-            self.proc.wait()
+        """SIGKILL roscore and every descendant (roslaunch puts rosmaster/rosout in their own sessions)."""
+        for pid in [*_descendants(self.proc.pid), self.proc.pid]:
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+        self.proc.wait()
+
+
+def _descendants(root: int) -> list[int]:
+    children: dict[int, list[int]] = {}
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit():
+            continue
+        try:
+            stat = Path(f"/proc/{entry}/stat").read_text()
+        except OSError:
+            continue
+        ppid = int(stat.rsplit(")", 1)[1].split()[1])
+        children.setdefault(ppid, []).append(int(entry))
+    out, todo = [], [root]
+    while todo:
+        for child in children.get(todo.pop(), []):
+            out.append(child)
+            todo.append(child)
+    return out
 
 
 def start_core(impl: str, home: str | None = None) -> Core:
     port = free_port()
     uri = f"http://localhost:{port}/"
-    home = home or tempfile.mkdtemp(prefix="bench_ros_home_")
+    home = home or _HOME.name
     if impl == OURS:
         env = dict(os.environ, ROS_HOME=home, ROS_MASTER_URI=uri, ROS_HOSTNAME="localhost")
         cmd = [ninjemys_bin("roscore"), "-p", str(port)]
@@ -70,7 +93,9 @@ def start_core(impl: str, home: str | None = None) -> Core:
         env = ros1_env(uri, ROS_HOME=home)
         cmd = ["/usr/bin/roscore", "-p", str(port)]
     started = time.perf_counter()
-    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    proc = subprocess.Popen(
+        cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True
+    )
     return Core(impl, proc, uri, started)
 
 
