@@ -1,6 +1,6 @@
 """Code generation: a message spec -> Python source of its class (a pure function of its inputs).
 
-The generated ``_ser``/``_deser`` are straight-line code specialised for one type:
+The generated ``_ser``/``deserialize_from`` are straight-line code specialised for one type:
 
 * nested messages that are not in arrays are *flattened* into their parent's code, so a run of
   fixed-size fields — also across nesting, e.g. ``Header.seq`` + ``stamp`` + the length of
@@ -113,6 +113,7 @@ class _Emitter:
     counter: int = 0
     run: list[tuple[str, str]] = field(default_factory=list)  # (format, target-or-argument)
     posts: list[str] = field(default_factory=list)  # statements to run after the run is unpacked
+    views: bool = False  # the code slices the buffer into views (needs a memoryview, not bytes)
 
     def tmp(self, prefix: str = "v") -> str:
         self.counter += 1
@@ -208,7 +209,7 @@ class _DeserEmitter(_Emitter):
         fmt = "<" + "".join(f for f, _ in self.run)
         size = _struct_size(fmt)
         targets = [t for _, t in self.run]
-        self.emit(f"({', '.join(targets)},) = {self.struct_name(fmt)}.unpack_from(buf, pos)")
+        self.emit(f"({', '.join(targets)},) = {self.struct_name(fmt)}.unpack_from(mv, pos)")
         self.emit(f"pos += {size}")
         for line in self.posts:
             self.emit(line)
@@ -236,7 +237,7 @@ class _DeserEmitter(_Emitter):
             if n > 32:  # a long fixed array: its own unpack into a tuple instead of N temporaries
                 self.flush()
                 size = n * PRIMITIVE_FORMATS[base][1]
-                self.emit(f"{target} = {self.struct_name(f'<{n}{fmt}')}.unpack_from(buf, pos)")
+                self.emit(f"{target} = {self.struct_name(f'<{n}{fmt}')}.unpack_from(mv, pos)")
                 if base == "bool":
                     self.emit(f"{target} = [x != 0 for x in {target}]")
                 self.emit(f"pos += {size}")
@@ -263,6 +264,7 @@ class _DeserEmitter(_Emitter):
             fmt, size = PRIMITIVE_FORMATS[base]
             nbytes = count if size == 1 else f"{count} * {size}"
             self.check(nbytes, what, count)
+            self.views = True
             if base in ("uint8", "char"):
                 self.emit(f"{target} = mv[pos:pos + {count}]")
             elif base == "bool":
@@ -298,10 +300,14 @@ class _DeserEmitter(_Emitter):
             else:
                 self.run.append((PRIMITIVE_FORMATS[base][0], target))
         elif base in _TIME_FMT:
-            s, ns = self.tmp("t"), self.tmp("t")
-            self.run.append((_TIME_FMT[base], f"{s}, {ns}"))
-            cls = "_Time" if base == "time" else "_Duration"
-            self.posts.append(f"{target} = {cls}._raw({s}, {ns})")
+            v = self.tmp("o")
+            self.emit(f"{v} = _new({'_Time' if base == 'time' else '_Duration'})")
+            self.emit(f"{target} = {v}")
+            self.run.append((_TIME_FMT[base], f"{v}.secs, {v}.nsecs"))
+            if base == "time":
+                self.posts.append(f"if {v}.nsecs >= 1000000000: {v}.canon()")
+            else:
+                self.posts.append(f"if not 0 <= {v}.nsecs < 1000000000: {v}.canon()")
         elif base == "string":
             n = self.tmp("n")
             self.run.append(("I", n))
@@ -372,15 +378,24 @@ def generate_class_source(spec: MsgSpec, lookup: Lookup, md5sum: str, full_text:
     body.append("    def _ser(self, w):")
     body.extend(ser.lines or ["        pass"])
 
-    de = _DeserEmitter(spec.full_name, lookup, structs)
+    de = _DeserEmitter(spec.full_name, lookup, structs, depth=3)
     de.fields(spec, "o")
     de.flush()
     body.append("")
     body.append("    @classmethod")
-    body.append("    def _deser(cls, buf, mv, pos, end):")
-    body.append("        o = _new(cls)")
+    body.append("    def deserialize_from(cls, buf):")
+    if de.views:
+        body.append("        mv = _view(buf)")
+    else:  # strings and numbers only: bytes can be sliced directly
+        body.append("        mv = buf if buf.__class__ is bytes else _view(buf)")
+    body.append("        end = len(mv)")
+    body.append("        pos = 0")
+    body.append("        try:")
+    body.append("            o = _new(cls)")
     body.extend(de.lines)
-    body.append("        return o, pos")
+    body.append("        except _DESER_ERRORS as exc:")
+    body.append("            raise _deser_failed(cls, mv, exc) from None")
+    body.append("        return o")
 
     head = [f"{name} = _struct.Struct({fmt!r})" for fmt, name in structs.items()]
     return "\n".join(head + [""] + body) + "\n"

@@ -32,8 +32,11 @@ from ninjemys.idl.codegen import class_ref, generate_class_source
 from ninjemys.idl.fulltext import all_dependencies, compute_full_text, split_full_text
 from ninjemys.idl.md5 import compute_md5, compute_srv_md5
 from ninjemys.idl.message import (
+    DESER_ERRORS,
     Message,
+    as_view,
     bad_args,
+    deser_failed,
     encode_string,
     fixed_u8,
     pack_numeric,
@@ -65,6 +68,9 @@ _RUNTIME: dict[str, Any] = {
     "_pack_num": pack_numeric,
     "_enc": encode_string,
     "_bad_args": bad_args,
+    "_view": as_view,
+    "_deser_failed": deser_failed,
+    "_DESER_ERRORS": DESER_ERRORS,
 }
 
 

@@ -1,7 +1,7 @@
 """Runtime base class of generated message classes, and the helpers their generated code calls.
 
 Generated classes (see :mod:`ninjemys.idl.codegen`) define the per-type hot paths (``__init__``,
-``_ser``, ``_deser``); this module holds what is the same for every type: the genpy-compatible
+``_ser``, ``deserialize_from``); this module holds what is the same for every type: the genpy-compatible
 surface (``serialize``/``deserialize``, ``__eq__``, the YAML ``__str__`` that ``rostopic echo``
 prints, pickling and copying), the slow-path error diagnosis that names the offending field, and the
 conversions of array values to wire bytes.
@@ -38,10 +38,6 @@ class Message:
     def _ser(self, w: Any) -> None:  # generated
         raise NotImplementedError  # pragma: no cover - every generated class overrides it
 
-    @classmethod
-    def _deser(cls, buf: Any, mv: memoryview, pos: int, end: int) -> tuple[Message, int]:  # generated
-        raise NotImplementedError  # pragma: no cover
-
     def serialize_to_bytes(self) -> bytes:
         """The message in ROS 1 wire format (the fast path the runtime uses)."""
         parts: list[Any] = []
@@ -60,18 +56,12 @@ class Message:
         self.serialize(buff)
 
     @classmethod
-    def deserialize_from(cls, buf: bytes | bytearray | memoryview) -> Message:
-        """Decode wire bytes into a new instance. Large arrays stay views into ``buf`` (do not mutate it)."""
-        mv = buf if isinstance(buf, memoryview) else memoryview(buf)
-        if mv.format != "B" or mv.ndim != 1:
-            mv = mv.cast("B")
-        try:
-            obj, _ = cls._deser(buf, mv, 0, len(mv))
-        except DeserializationError:
-            raise
-        except _DESER_ERRORS as exc:
-            raise DeserializationError(f"{cls._type}: cannot decode {len(mv)} bytes: {exc}") from None
-        return obj
+    def deserialize_from(cls, buf: bytes | bytearray | memoryview) -> Message:  # generated per class
+        """Decode wire bytes into a new instance. Large arrays stay views into ``buf`` (do not mutate it).
+
+        Raises DeserializationError for truncated input or length prefixes beyond the buffer.
+        """
+        raise NotImplementedError  # pragma: no cover - every generated class overrides it
 
     def deserialize(self, data: bytes | bytearray | memoryview) -> Message:
         """genpy API: fill this instance from wire bytes and return it."""
@@ -169,6 +159,24 @@ def _numpyfy(msg: Message) -> None:
 
 
 # --- helpers called by generated code -----------------------------------------------------------
+DESER_ERRORS = _DESER_ERRORS
+
+
+def as_view(buf: Any) -> memoryview:
+    """A flat unsigned-byte memoryview over any buffer (bytes, bytearray, memoryview, numpy ...)."""
+    try:
+        mv = buf if isinstance(buf, memoryview) else memoryview(buf)
+        if mv.format != "B" or mv.ndim != 1:
+            mv = mv.cast("B")
+    except (TypeError, ValueError) as exc:
+        raise DeserializationError(f"cannot decode a {type(buf).__name__}: {exc}") from None
+    return mv
+
+
+def deser_failed(cls: type, mv: Any, exc: BaseException) -> DeserializationError:
+    return DeserializationError(f"{cls._type}: cannot decode {len(mv)} bytes: {type(exc).__name__}: {exc}")
+
+
 def short_buffer(type_name: str, what: str, need: int, have: int) -> DeserializationError:
     return DeserializationError(
         f"{type_name}.{what}: buffer too short (length prefix says {need} bytes/items, {have} bytes left)"
