@@ -101,7 +101,7 @@ def sink() -> None:
         stamps["n"] += 1
         stamps["last"] = now
 
-    rospy.Subscriber("/flood", String, cb, queue_size=100000, tcp_nodelay=True)
+    rospy.Subscriber("/flood", String, cb, queue_size=None, tcp_nodelay=True)
     print("ready", flush=True)
     while stamps["n"] == 0 or time.perf_counter() - stamps["last"] < 1.5:
         time.sleep(0.1)

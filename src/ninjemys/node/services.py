@@ -40,28 +40,60 @@ _log = logging.getLogger(__name__)
 _U32 = struct.Struct("<I")
 
 
-def _recv_exact(sock: socket.socket, n: int) -> bytearray:
-    buf = bytearray(n)
-    view = memoryview(buf)
-    got = 0
-    while got < n:
-        k = sock.recv_into(view[got:])
-        if k == 0:
-            raise ConnectionError(f"peer closed the connection after {got} of {n} bytes")
-        got += k
-    return buf
+class _Reader:
+    """Buffered exact reads on a blocking socket: one ``recv_into`` usually brings a whole
+    response (ok byte, length and body), instead of one system call per field."""
 
+    __slots__ = ("sock", "_buf", "_view", "_start", "_end")
 
-def _recv_frame(sock: socket.socket) -> bytearray:
-    (length,) = _U32.unpack(_recv_exact(sock, 4))
-    if length > MAX_FRAME_LEN:
-        raise ProtocolError(f"length prefix {length} exceeds the {MAX_FRAME_LEN}-byte limit")
-    return _recv_exact(sock, length)
+    def __init__(self, sock: socket.socket, size: int = 1 << 16) -> None:
+        self.sock = sock
+        self._buf = bytearray(size)
+        self._view = memoryview(self._buf)
+        self._start = self._end = 0
 
+    def exact(self, n: int) -> bytes | bytearray:
+        have = self._end - self._start
+        if have >= n:
+            start = self._start
+            self._start += n
+            return self._buf[start : start + n]
+        if n > len(self._buf) // 2:
+            return self._big(n, have)
+        if self._start:
+            self._view[:have] = self._view[self._start : self._end]
+            self._start, self._end = 0, have
+        while self._end - self._start < n:
+            k = self.sock.recv_into(self._view[self._end :])
+            if k == 0:
+                raise ConnectionError(
+                    f"peer closed the connection after {self._end - self._start} of {n} bytes"
+                )
+            self._end += k
+        self._start = n
+        return self._buf[:n]
 
-def _recv_header(sock: socket.socket) -> dict[str, str]:
-    length = headers.header_length(_recv_exact(sock, 4))
-    return headers.decode_header(_recv_exact(sock, length))
+    def _big(self, n: int, have: int) -> bytearray:
+        out = bytearray(n)
+        out[:have] = self._view[self._start : self._end]
+        self._start = self._end = 0
+        view, got = memoryview(out), have
+        while got < n:
+            k = self.sock.recv_into(view[got:])
+            if k == 0:
+                raise ConnectionError(f"peer closed the connection after {got} of {n} bytes")
+            got += k
+        return out
+
+    def frame(self) -> bytes | bytearray:
+        (length,) = _U32.unpack(self.exact(4))
+        if length > MAX_FRAME_LEN:
+            raise ProtocolError(f"length prefix {length} exceeds the {MAX_FRAME_LEN}-byte limit")
+        return self.exact(length)
+
+    def header(self) -> dict[str, str]:
+        length = headers.header_length(self.exact(4))
+        return headers.decode_header(self.exact(length))
 
 
 def make_response(response_class: Any, value: Any) -> Any:
@@ -125,10 +157,11 @@ class ServiceServer:
         self.node.runtime.start_thread(lambda: self._serve(sock, who), f"srv:{self.name}")
 
     def _serve(self, sock: socket.socket, who: str) -> None:
+        reader = _Reader(sock)
         try:
             while not self.closed:
                 try:
-                    body = _recv_frame(sock)
+                    body = reader.frame()
                 except (ConnectionError, OSError):
                     return  # the client is done (non-persistent clients close after one call)
                 sock.sendall(self._handle(body, who))
@@ -141,7 +174,7 @@ class ServiceServer:
                 self._socks.discard(sock)
             transport.close_quietly(sock)
 
-    def _handle(self, body: bytearray, who: str) -> bytes:
+    def _handle(self, body: bytes | bytearray, who: str) -> bytes:
         try:
             request = self.request_class.deserialize_from(body)
         except Exception as exc:
@@ -191,6 +224,7 @@ class ServiceProxy:
         self.persistent = persistent
         self.headers = dict(headers or {})
         self._sock: socket.socket | None = None
+        self._reader: _Reader | None = None
         self._lock = threading.Lock()
         self._closed = False
 
@@ -211,11 +245,14 @@ class ServiceProxy:
         with self._lock:
             if self._closed:
                 raise ShutdownError(f"service proxy for [{self.name}] is closed")
-            sock = self._sock or self._connect()
+            if self._sock is None:
+                self._sock = self._connect()
+                self._reader = _Reader(self._sock)
+            sock, reader = self._sock, self._reader
             try:
                 sock.sendall(frame)
-                ok = _recv_exact(sock, 1)[0]
-                body = _recv_frame(sock)
+                ok = reader.exact(1)[0]
+                body = reader.frame()
             except (OSError, ProtocolError) as exc:
                 self._drop()
                 raise ServiceError(
@@ -223,8 +260,6 @@ class ServiceProxy:
                 ) from None
             if not self.persistent:
                 self._drop()
-            else:
-                self._sock = sock
         if not ok:
             raise ServiceError(
                 f"service [{self.name}] responded with an error: {body.decode('utf-8', 'replace')}"
@@ -266,7 +301,7 @@ class ServiceProxy:
                 fields["persistent"] = "1"
             fields.update(self.headers)
             sock.sendall(headers.encode_header(fields))
-            reply = _recv_header(sock)
+            reply = _Reader(sock, 4096).header()
         except (OSError, NinjemysError) as exc:
             transport.close_quietly(sock)
             raise ServiceError(f"service [{self.name}]: handshake failed: {exc}") from None
