@@ -221,3 +221,32 @@ def test_same_name_shuts_down_the_old_rospy_node(master: str) -> None:
             if proc is not None:
                 proc.kill()
                 proc.wait()
+
+
+@pytest.mark.skipif(
+    not Path("/usr/lib/rosout/rosout").exists(), reason="Debian's C++ rosout is not installed"
+)
+def test_roscpp_node_against_our_master(master: str) -> None:
+    """Debian's rosout is a roscpp program: its XmlRpc++ client registers with and is found through us."""
+    cpp = subprocess.Popen(
+        ["/usr/lib/rosout/rosout", "__name:=rosout_cpp"],
+        env=ros1_env(master),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    try:
+        client = MasterClient(master, "/probe")
+        deadline = time.monotonic() + 30
+        while True:
+            pubs = dict((t, n) for t, n in client.get_system_state()[0])
+            if "/rosout_cpp" in pubs.get("/rosout_agg", []):
+                break
+            assert cpp.poll() is None and time.monotonic() < deadline
+            time.sleep(0.05)
+        info = ros1(["/usr/bin/rosnode", "info", "/rosout_cpp"], master)
+        assert "/rosout_cpp/get_loggers" in info.stdout and "Pid:" in info.stdout, info
+        client.set_param("/cpp_check", 1)
+        assert client.lookup_service("/rosout_cpp/get_loggers").startswith("rosrpc://")
+    finally:
+        cpp.kill()
+        cpp.wait()
