@@ -1,0 +1,297 @@
+"""``rosservice``: list, call, info, type, find, uri, args and node, with ROS 1's output.
+
+Service types are learned the way ROS 1 learns them: a TCPROS probe (``probe=1``, md5 ``*``) to the
+provider, which answers with its header and closes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import socket
+import sys
+from typing import Any
+
+from ninjemys import names
+from ninjemys.errors import MasterError, NinjemysError, ServiceError, TypeNotFoundError
+from ninjemys.net.addresses import split_uri
+from ninjemys.tools.cli import entry, master
+from ninjemys.tools.graph import GraphState
+from ninjemys.wire import headers
+
+NAME = "rosservice"
+ID = "/rosservice"
+USAGE = """Commands:
+\trosservice args\tprint service arguments
+\trosservice call\tcall the service with the provided args
+\trosservice find\tfind services by service type
+\trosservice info\tprint information about service
+\trosservice list\tlist active services
+\trosservice type\tprint service type
+\trosservice uri\tprint service ROSRPC uri
+
+Type rosservice <command> -h for more detailed usage, e.g. 'rosservice call -h'
+"""
+
+
+class ServiceToolError(NinjemysError):
+    """A rosservice usage or lookup error."""
+
+
+def _resolve(name: str) -> str:
+    return names.resolve_name(name, names.get_ros_namespace() + NAME)
+
+
+def service_uri(client: Any, service: str) -> str | None:
+    try:
+        return client.lookup_service(service)
+    except MasterError as exc:
+        if exc.__class__.__name__ == "MasterUnreachable":
+            raise
+        return None
+
+
+def probe(service: str, uri: str, timeout: float = 5.0) -> dict[str, str]:
+    """The provider's connection header for ``service`` (its ``type``, ``md5sum``, ...)."""
+    try:
+        host, port = split_uri(uri)
+    except ValueError:
+        raise ServiceToolError(f"service [{service}] has an invalid RPC URI [{uri}]") from None
+    try:
+        with socket.create_connection((host, port), timeout=timeout) as sock:
+            sock.sendall(
+                headers.encode_header({"probe": "1", "md5sum": "*", "callerid": ID, "service": service})
+            )
+            prefix = _recv_exact(sock, 4)
+            return headers.decode_header(_recv_exact(sock, headers.header_length(prefix)))
+    except (OSError, NinjemysError) as exc:
+        raise ServiceToolError(
+            f"Unable to communicate with service [{service}], address [{uri}]: {exc}"
+        ) from None
+
+
+def _recv_exact(sock: socket.socket, n: int) -> bytes:
+    chunks, have = [], 0
+    while have < n:
+        chunk = sock.recv(n - have)
+        if not chunk:
+            raise ConnectionError("service closed the connection during the handshake")
+        chunks.append(chunk)
+        have += len(chunk)
+    return b"".join(chunks)
+
+
+def service_type(client: Any, service: str) -> str | None:
+    uri = service_uri(client, service)
+    if uri is None:
+        return None
+    return probe(service, uri).get("type")
+
+
+def printable_args(msg: Any, prefix: str = "") -> str:
+    """Request field names as ``rosservice args`` prints them (nested messages flattened)."""
+    from ninjemys.idl.message import Message
+
+    parts = []
+    for name in msg.__slots__:
+        value = getattr(msg, name)
+        if isinstance(value, Message):
+            parts.append(printable_args(value, prefix + name + "."))
+        else:
+            parts.append(prefix + name)
+    return " ".join(p for p in parts if p)
+
+
+def _service_class(type_name: str) -> Any:
+    from ninjemys.idl.loader import get_service_class
+
+    try:
+        return get_service_class(type_name)
+    except TypeNotFoundError:
+        raise ServiceToolError(
+            f"Unable to load type [{type_name}].\nHave you typed 'make' in [{type_name.split('/')[0]}]?"
+        ) from None
+
+
+def _cmd_list(args: argparse.Namespace) -> int:
+    state = GraphState.fetch(master(ID), with_types=False)
+    items = sorted(state.services.items())
+    if args.namespace:
+        ns = names.make_global_ns(_resolve(args.namespace))
+        items = [(s, n) for s, n in items if s.startswith(ns)]
+    for service, providers in items:
+        print(f"{service} {','.join(providers)}" if args.print_nodes else service)
+    return 0
+
+
+def _cmd_info(args: argparse.Namespace) -> int:
+    client = master(ID)
+    service = _resolve(args.service)
+    providers = GraphState.fetch(client, with_types=False).services.get(service)
+    if not providers:
+        print("ERROR: unknown service", file=sys.stderr)
+        return 1
+    print(f"Node: {providers[0]}")
+    uri = service_uri(client, service)
+    if uri is None:
+        print("ERROR: service is no longer available", file=sys.stderr)
+        return 1
+    print(f"URI: {uri}")
+    ttype = probe(service, uri).get("type")
+    if ttype is None:
+        print("ERROR: service is no longer available", file=sys.stderr)
+        return 1
+    print(f"Type: {ttype}")
+    print(f"Args: {printable_args(_service_class(ttype)._request_class())}")
+    return 0
+
+
+def _cmd_type(args: argparse.Namespace) -> int:
+    service = _resolve(args.service)
+    ttype = service_type(master(ID), service)
+    if ttype is None:
+        print(f"Unknown service [{service}]", file=sys.stderr)
+        return 1
+    print(ttype)
+    return 0
+
+
+def _cmd_uri(args: argparse.Namespace) -> int:
+    service = _resolve(args.service)
+    uri = service_uri(master(ID), service)
+    if uri is None:
+        print(f"Unknown service: {service}", file=sys.stderr)
+        return 1
+    print(uri)
+    return 0
+
+
+def _cmd_node(args: argparse.Namespace) -> int:
+    service = _resolve(args.service)
+    providers = GraphState.fetch(master(ID), with_types=False).services.get(service)
+    if not providers:
+        print(f"Unknown service: {service}", file=sys.stderr)
+        return 1
+    print(providers[0])
+    return 0
+
+
+def _cmd_args(args: argparse.Namespace) -> int:
+    service = _resolve(args.service)
+    ttype = service_type(master(ID), service)
+    if ttype is None:
+        raise ServiceToolError(f"Unknown service [{service}]")
+    print(printable_args(_service_class(ttype)._request_class()))
+    return 0
+
+
+def _cmd_find(args: argparse.Namespace) -> int:
+    client = master(ID)
+    found = []
+    for service in GraphState.fetch(client, with_types=False).services:
+        try:
+            if service_type(client, service) == args.type:
+                found.append(service)
+        except ServiceToolError:
+            continue
+    print("\n".join(found))
+    return 0
+
+
+def _cmd_call(args: argparse.Namespace) -> int:
+    from ninjemys.node import Node
+    from ninjemys.rostime import Time
+    from ninjemys.tools.msgargs import fill_message_args, parse_yaml_args, substitution_keys
+
+    client = master(ID)
+    service = _resolve(args.service)
+    values = parse_yaml_args([a if a != "" else "''" for a in args.args])
+    node = Node("rosservice", anonymous=True)
+    try:
+        if args.wait:
+            client.get_pid()
+            proxy = node.service_proxy(service, _probe_class(client, service, wait=True, node=node))
+        else:
+            proxy = node.service_proxy(service, _probe_class(client, service))
+        request = proxy.request_class()
+        fill_message_args(request, values, substitution_keys(Time.now()))
+        try:
+            response = proxy.call(request)
+        except ServiceError as exc:
+            raise ServiceToolError(str(exc)) from None
+        if args.verbose:
+            print(str(request))
+            print("---")
+        print(str(response))
+    finally:
+        node.shutdown("rosservice call done")
+    return 0
+
+
+def _probe_class(client: Any, service: str, wait: bool = False, node: Any = None) -> Any:
+    while True:
+        uri = service_uri(client, service)
+        if uri is not None:
+            try:
+                ttype = probe(service, uri).get("type")
+            except ServiceToolError:
+                ttype = None
+            if ttype:
+                return _service_class(ttype)
+        if not wait:
+            raise ServiceToolError(f"Service [{service}] is not available.")
+        node.wait_for_shutdown(0.1)
+        if node.is_shutdown:
+            raise ServiceToolError(f"gave up waiting for service [{service}]")
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog=NAME, add_help=False)
+    sub = parser.add_subparsers(dest="command")
+    p = sub.add_parser("list", prog=f"{NAME} list")
+    p.add_argument("namespace", nargs="?")
+    p.add_argument(
+        "-n", "--nodes", dest="print_nodes", action="store_true", help="print nodes that provide service(s)"
+    )
+    p.set_defaults(run=_cmd_list)
+    for cmd, run in (
+        ("info", _cmd_info),
+        ("type", _cmd_type),
+        ("uri", _cmd_uri),
+        ("node", _cmd_node),
+        ("args", _cmd_args),
+    ):
+        p = sub.add_parser(cmd, prog=f"{NAME} {cmd}")
+        p.add_argument("service")
+        p.set_defaults(run=run)
+    p = sub.add_parser("find", prog=f"{NAME} find")
+    p.add_argument("type")
+    p.set_defaults(run=_cmd_find)
+    p = sub.add_parser("call", prog=f"{NAME} call")
+    p.add_argument("service")
+    p.add_argument("args", nargs=argparse.REMAINDER)
+    p.add_argument("-v", dest="verbose", action="store_true", help="print verbose output")
+    p.add_argument("--wait", action="store_true", help="wait for service to be advertised")
+    p.set_defaults(run=_cmd_call)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    if not argv or argv[0] in ("-h", "--help", "help"):
+        print(USAGE)
+        return 0 if argv else 1
+    if argv[0] == "call":
+        # options may come before the service name only; everything after it is YAML
+        opts = [a for a in argv[1:] if a in ("-v", "--wait")]
+        rest = [a for a in argv[1:] if a not in ("-v", "--wait")]
+        argv = ["call", *opts, *rest[:1], *(["--"] if len(rest) > 1 else []), *rest[1:]]
+    args = _parser().parse_args(argv)
+    if args.command is None:
+        print(USAGE)
+        return 1
+    if args.command == "call" and args.args and args.args[0] == "--":
+        args.args = args.args[1:]
+    return args.run(args)
+
+
+console_main = entry(main)
