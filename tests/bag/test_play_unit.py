@@ -181,3 +181,84 @@ def test_names_and_durations():
     assert parse_duration("30") == 30 and parse_duration("5m") == 300 and parse_duration("2h") == 7200
     with pytest.raises(BagError):
         parse_duration("soon")
+
+
+class FakeRecordNode:
+    def __init__(self):
+        self.callbacks = {}
+
+    def resolve_name(self, name):
+        return name if name.startswith("/") else "/" + name
+
+    def get_param(self, key, default=None):
+        return default
+
+    def subscriber(self, topic, cls, callback, raw=False):
+        assert cls is None and raw
+        self.callbacks[topic] = callback
+
+        class Handle:
+            def unregister(self_inner):
+                self.callbacks.pop(topic, None)
+
+        return Handle()
+
+
+class Raw:
+    def __init__(self, data, header):
+        self.data, self.connection_header = data, header
+
+
+def test_recorder_counts_and_reports_drops_when_the_buffer_is_full(tmp_path, monkeypatch):
+    from ninjemys.bag.reader import BagReader
+    from ninjemys.bag.record import Recorder
+
+    monkeypatch.chdir(tmp_path)
+    node = FakeRecordNode()
+    logs = []
+    rec = Recorder(node, RecordOptions(topics=["/big"], output_name="drops", buffsize=10_000), logs.append)
+    rec._subscribe("/big")
+    header = {
+        "type": "std_msgs/String",
+        "md5sum": "992ce8a1687cec8c8bd883ec73ca41d1",
+        "message_definition": "string data\n",
+        "callerid": "/pub",
+    }
+    for i in range(50):  # the writer thread is not running yet: the queue must bound itself
+        node.callbacks["/big"](Raw(string_bytes(f"{i:04d}" + "x" * 996), header))
+    assert rec.totals.dropped_total == 41 and rec.queue.bytes <= 10_000
+    assert any("buffer exceeded" in line for line in logs)
+    rec.start()
+    rec.stop()
+    assert "dropped 41" in rec.summary()
+    with BagReader(tmp_path / "drops.bag") as r:
+        got = [bytes(m.data)[4:8] for m in r.read()]
+        assert r.topic_connections("/big")[0].callerid == "/pub"
+    assert got == [b"%04d" % i for i in range(41, 50)]  # the oldest were dropped, the newest kept
+
+
+def test_recorder_regex_and_exclude_select_topics():
+    from ninjemys.bag.record import Recorder
+
+    node = FakeRecordNode()
+    rec = Recorder(node, RecordOptions(topics=["/a_.*"], regex=True, exclude="_2$"))
+    assert rec._wanted("/a_1") and not rec._wanted("/a_2") and not rec._wanted("/b")
+    rec_all = Recorder(node, RecordOptions(all=True, exclude="/rosout"))
+    assert rec_all._wanted("/anything") and not rec_all._wanted("/rosout_agg")
+
+
+def test_progress_line_has_percentage_and_eta():
+    from ninjemys.bag.progress import Progress
+
+    p = Progress("out.bag", 1000, stream=io.StringIO(), enabled=True)
+    p.started = 0.0
+    p.done = 250
+    line = p.line(10.0, final=False)
+    assert "out.bag" in line and " 25%" in line and "00:30 ETA" in line
+    p.done = 1000
+    assert "100%" in p.line(40.0, final=True)
+    quiet = io.StringIO()
+    silent = Progress("x", 10, stream=quiet)  # not a terminal: draws nothing
+    silent.step(5)
+    silent.finish()
+    assert quiet.getvalue() == ""
