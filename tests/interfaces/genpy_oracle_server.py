@@ -190,7 +190,13 @@ def op_deserialize(req: dict) -> list[dict]:
     return [tree_of(cls().deserialize(base64.b64decode(data))) for data in req["data"]]
 
 
+def op_strify(req: dict) -> list[str]:
+    """``str(msg)``: the YAML that rostopic echo prints."""
+    return [str(build(req["type"], tree)) for tree in req["values"]]
+
+
 OPS = {
+    "strify": op_strify,
     "describe": op_describe,
     "srv_md5": op_srv_md5,
     "decode_full_text": op_decode_full_text,

@@ -3,7 +3,7 @@
 For each type, hypothesis draws batches of random value trees; the genpy oracle (one long-lived
 /usr/bin/python3 process) serializes each batch in one round trip. Our ``serialize_to_bytes()`` and classic
 ``serialize(buff)`` must give the same bytes, and our ``deserialize_from`` of genpy's bytes must give back
-the drawn values. Types Debian lacks are built in the oracle by genpy.dynamic from our full text.
+the drawn values; ``str(msg)`` must be genpy's YAML (what rostopic echo prints). Types Debian lacks are built in the oracle by genpy.dynamic from our full text.
 """
 
 from __future__ import annotations
@@ -41,7 +41,8 @@ def test_wire_bytes_equal_genpy(type_name: str, genpy_oracle: GenpyOracle) -> No
     @given(st.lists(tree_strategy(type_name), min_size=2, max_size=5))
     def check(trees: list[dict]) -> None:
         expected = genpy_oracle.serialize(type_name, trees)
-        for tree, theirs in zip(trees, expected, strict=True):
+        expected_text = genpy_oracle.call("strify", type=type_name, values=trees)
+        for tree, theirs, text in zip(trees, expected, expected_text, strict=True):
             msg = build_ours(type_name, tree)
             assert msg.serialize_to_bytes() == theirs, f"{type_name}: serialize_to_bytes differs from genpy"
             buff = io.BytesIO()
@@ -51,6 +52,7 @@ def test_wire_bytes_equal_genpy(type_name: str, genpy_oracle: GenpyOracle) -> No
             assert tree_of_ours(back) == tree, f"{type_name}: deserialize_from(genpy bytes) lost values"
             assert cls().deserialize(theirs) == back
             assert back == msg
+            assert str(msg) == text, f"{type_name}: str() differs from genpy's (the rostopic echo YAML)"
 
     check()
 
