@@ -5,10 +5,11 @@ When the parameter ``/use_sim_time`` is true at node start, ROS time is whatever
 so ``rospy.get_time()`` reads 0.0 before ``rosbag play --clock`` starts). Otherwise ROS time is
 ``time.time()``.
 
-Everything that waits on ROS time (``sleep``, ``Rate``, ``Timer``) waits here, on one condition
-variable that is notified by every /clock message, by :meth:`Clock.wake` and by
-:meth:`Clock.shutdown`. There is no polling loop: a waiter in simulated time sleeps until time
-advances; a waiter in wall time sleeps for exactly the remaining interval. Shutdown wakes every
+Everything that waits on ROS time (``sleep``, ``Rate``, ``Timer``) waits here. In simulated time
+waiters block on one condition variable notified by every /clock message; in wall time each waiter
+blocks on its own thread's "gate" lock for exactly the remaining interval (one futex wait, as cheap as
+``time.sleep``), and :meth:`Clock.wake` / :meth:`Clock.shutdown` open every gate. There is no polling
+loop. Shutdown wakes every
 waiter at once, which is what makes Ctrl-C end a node promptly. A simulated clock that jumps
 backwards (``rosbag play --loop``) bumps an epoch counter, so waiters can tell a jump from progress.
 """
@@ -49,6 +50,11 @@ class Clock:
         self._shutdown = False
         self._cond = threading.Condition(threading.Lock())
         self._subscription: Any = None
+        # wall-time sleepers wait on a per-thread "gate" lock with a timeout (one futex wait, as cheap as
+        # time.sleep); wake() and shutdown() release every registered gate
+        self._gates: set[Any] = set()
+        self._gates_lock = threading.Lock()
+        self._local = threading.local()
 
     # -- reading ------------------------------------------------------------------------------------
     def now(self) -> float:
@@ -98,12 +104,14 @@ class Clock:
         """Wake every waiter so it re-checks its own cancel condition (Timer.shutdown uses this)."""
         with self._cond:
             self._cond.notify_all()
+        self._open_gates()
 
     def shutdown(self) -> None:
         """Wake every waiter for good: all current and future waits return SHUTDOWN."""
         with self._cond:
             self._shutdown = True
             self._cond.notify_all()
+        self._open_gates()
         sub, self._subscription = self._subscription, None
         if sub is not None:
             try:
@@ -113,6 +121,8 @@ class Clock:
 
     def wait_until(self, target: float, cancelled: Callable[[], bool] | None = None) -> Wake:
         """Block until ROS time reaches ``target`` seconds, shutdown, a backwards jump, or ``cancelled()``."""
+        if not self.is_sim:
+            return self._wall_wait(target, cancelled)
         with self._cond:
             epoch = self._epoch
             while True:
@@ -126,6 +136,43 @@ class Clock:
                 if remaining <= 0:
                     return Wake.REACHED
                 self._cond.wait(None if self.is_sim else remaining)
+
+    def _gate(self) -> Any:
+        gate = getattr(self._local, "gate", None)
+        if gate is None:
+            gate = threading.Lock()
+            gate.acquire()
+            self._local.gate = gate
+        return gate
+
+    def _open_gates(self) -> None:
+        with self._gates_lock:
+            gates = list(self._gates)
+        for gate in gates:
+            try:
+                gate.release()
+            except RuntimeError:
+                pass  # already opened and not yet re-armed by its sleeper
+
+    def _wall_wait(self, target: float, cancelled: Callable[[], bool] | None) -> Wake:
+        """Wall-time wait: sleep on this thread's gate until ``target``; an opened gate means re-check."""
+        gate = self._gate()
+        with self._gates_lock:
+            self._gates.add(gate)
+        try:
+            while True:
+                if self._shutdown:
+                    return Wake.SHUTDOWN
+                if cancelled is not None and cancelled():
+                    return Wake.CANCELLED
+                remaining = target - self._wall()
+                if remaining <= 0:
+                    return Wake.REACHED
+                # True: someone opened the gate (we hold it again, re-armed); False: the time is up
+                gate.acquire(True, remaining)
+        finally:
+            with self._gates_lock:
+                self._gates.discard(gate)
 
     def wait_for(self, seconds: float, cancelled: Callable[[], bool] | None = None) -> Wake:
         """Sleep ``seconds`` of ROS time (see :meth:`wait_until`)."""
