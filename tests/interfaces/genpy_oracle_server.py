@@ -195,7 +195,19 @@ def op_strify(req: dict) -> list[str]:
     return [str(build(req["type"], tree)) for tree in req["values"]]
 
 
+def op_defaults(req: dict) -> dict:
+    """Bytes and YAML of a default-constructed instance of each type (the ROS defaults)."""
+    out = {}
+    for name in req["types"]:
+        msg = message_class(name)()
+        buff = io.BytesIO()
+        msg.serialize(buff)
+        out[name] = {"data": base64.b64encode(buff.getvalue()).decode("ascii"), "text": str(msg)}
+    return out
+
+
 OPS = {
+    "defaults": op_defaults,
     "strify": op_strify,
     "describe": op_describe,
     "srv_md5": op_srv_md5,
