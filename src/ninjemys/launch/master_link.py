@@ -18,7 +18,7 @@ import yaml
 
 from ninjemys.errors import LaunchError, MasterError, NinjemysError
 from ninjemys.launch.plan import LaunchPlan
-from ninjemys.launch.runner import die_with_parent
+from ninjemys.launch.runner import DEATH_WRAPPER
 from ninjemys.master.client import MasterClient
 from ninjemys.testing import ninjemys_bin
 
@@ -78,13 +78,12 @@ def start_core(uri: str, log_path: Path, env: dict[str, str]) -> subprocess.Pope
     log_path.parent.mkdir(parents=True, exist_ok=True)
     with open(log_path, "ab") as log:
         proc = subprocess.Popen(
-            [roscore, "-p", str(port)],
+            [*DEATH_WRAPPER, roscore, "-p", str(port)],
             stdin=subprocess.DEVNULL,
             stdout=log,
             stderr=subprocess.STDOUT,
             env=env,
             start_new_session=True,
-            preexec_fn=die_with_parent,
         )
     if not wait_for_master(uri, time.monotonic() + 20.0, proc):
         if proc.poll() is None:
