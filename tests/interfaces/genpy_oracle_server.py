@@ -137,6 +137,8 @@ def _describe(cls) -> dict:
         "slot_types": list(cls._slot_types),
         "constants": constants,
         "has_header": bool(cls._has_header),
+        # the embedded types of the full text, in ROS 1's order
+        "embedded": [line[5:] for line in cls._full_text.split("\n") if line.startswith("MSG: ")],
     }
 
 

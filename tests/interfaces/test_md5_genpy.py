@@ -15,6 +15,7 @@ import pytest
 from iface_inventory import NOT_IN_DEBIAN, SHIPPED_PACKAGES, inventory, package_of
 from iface_oracle import GenpyOracle
 from iface_published import PUBLISHED_MD5
+
 from ninjemys.idl.loader import get_message_class, get_service_class
 
 pytestmark = pytest.mark.ros1
@@ -65,6 +66,8 @@ def test_class_equals_genpy(type_name: str, described: dict[str, Any]) -> None:
     assert list(cls.__slots__) == expected["slots"]
     assert list(cls._slot_types) == expected["slot_types"]
     assert bool(cls._has_header) == expected["has_header"]
+    embedded = [line[5:] for line in cls._full_text.split("\n") if line.startswith("MSG: ")]
+    assert embedded == expected["embedded"], "MSG: blocks of the full text in ROS 1's order"
     assert _constants_of(cls, list(expected["constants"])) == expected["constants"]
     for name, value in expected["constants"].items():
         assert type(getattr(cls, name)) is type(value), f"{type_name}.{name}"
