@@ -122,7 +122,13 @@ class Player:
         self._monotonic = monotonic
         self._stop = threading.Event()
         self._sleep = sleep or self._interruptible_sleep
-        self.readers = [BagReader(path) for path in options.bags]
+        self.readers: list[BagReader] = []
+        try:
+            for path in options.bags:
+                self.readers.append(BagReader(path))
+        except BaseException:
+            self.close()
+            raise
         for reader in self.readers:
             for warning in reader.warnings:
                 print(f"WARNING: {warning}", file=sys.stderr)
@@ -403,11 +409,17 @@ def play_main(argv: list[str], parser_class: type[argparse.ArgumentParser] = arg
     from ninjemys.node import Node
 
     options = options_from_args(build_parser(parser_class).parse_args(argv))
-    node = Node("play", anonymous=True)
-    keyboard = None if options.quiet else Keyboard()
-    player: Player | None = None
+    # open the bags before joining the graph: a bad file is reported without touching the master
+    player = Player(None, options)
     try:
-        player = Player(node, options, keyboard=keyboard)
+        node = Node("play", anonymous=True)
+    except BaseException:
+        player.close()
+        raise
+    player.node = node
+    keyboard = None if options.quiet else Keyboard()
+    player.keyboard = keyboard
+    try:
         previous = {
             sig: signal.signal(sig, lambda *_: player.stop()) for sig in (signal.SIGINT, signal.SIGTERM)
         }
@@ -425,7 +437,6 @@ def play_main(argv: list[str], parser_class: type[argparse.ArgumentParser] = arg
     finally:
         if keyboard is not None:
             keyboard.close()
-        if player is not None:
-            player.close()
+        player.close()
         node.shutdown("rosbag play finished")
     return 0
