@@ -201,7 +201,10 @@ def test_same_name_shuts_down_the_old_rospy_node(master: str) -> None:
     try:
         client = MasterClient(master, "/probe")
         deadline = time.monotonic() + 30
-        while client.get_published_topics() == [] or not any(
+        # rospy registers in the background: wait for all of it, or a late registration of the first
+        # talker would (rightly) bump the second one
+        wanted = {"/talker/get_loggers", "/talker/set_logger_level"}
+        while not wanted <= {name for name, _ in client.get_system_state()[2]} or not any(
             t == "/chatter" for t, _ in client.get_published_topics()
         ):
             assert time.monotonic() < deadline
