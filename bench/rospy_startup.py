@@ -4,8 +4,9 @@
 
 Both implementations register with the same master (Debian's rosmaster, so neither side is favoured)
 and run as fresh processes; figures are medians. Besides the bare ``init_node`` process, it times the
-three phases inside the process (import, init_node, exit) and measures the CPU seconds a 10 Hz
-seed-style talker and a 100 Hz talker burn per wall second.
+phases inside the process (import, init_node) and measures the CPU seconds the seeds' talker loop
+(loginfo + publish + Rate.sleep) burns per wall second at 10 Hz and 100 Hz, and the CPU cost of one
+``rospy.loginfo`` (console, log file and /rosout).
 """
 
 from __future__ import annotations
@@ -50,7 +51,9 @@ rospy.init_node('bench_talker', anonymous=True)
 rate = rospy.Rate(float(sys.argv[1]))
 try:
     while not rospy.is_shutdown():
-        pub.publish("hello world %s" % rospy.get_time())
+        hello_str = "hello world %s" % rospy.get_time()
+        rospy.loginfo(hello_str)
+        pub.publish(hello_str)
         rate.sleep()
 except rospy.ROSInterruptException:
     pass
@@ -119,6 +122,29 @@ def talker_cpu(impl: str, master: str, home: str, hz: float, seconds: float) -> 
             proc.wait()
 
 
+LOGCOST = """
+import sys, time, rospy
+rospy.init_node('bench_log', anonymous=True)
+n = 2000
+t = time.thread_time()
+for i in range(n):
+    rospy.loginfo("hello world %s" % rospy.get_time())
+sys.stderr.write("%f\\n" % ((time.thread_time() - t) / n))
+"""
+
+
+def loginfo_cost(impl: str, master: str, home: str) -> float:
+    done = subprocess.run(
+        [_python(impl), "-c", LOGCOST],
+        env=_env(impl, master, home),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+        check=True,
+    )
+    return float(done.stderr.strip().splitlines()[-1])
+
+
 def _cpu(pid: int) -> float:
     fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
     ticks = os.sysconf("SC_CLK_TCK")
@@ -163,9 +189,11 @@ def main() -> None:
             ph = {impl: phases(impl, master, home, args.runs) for impl in (OURS, REAL)}
             rows.append(("  of which import rospy (s)", ph[OURS][0], ph[REAL][0]))
             rows.append(("  of which init_node (s)", ph[OURS][1], ph[REAL][1]))
+            cost = {impl: loginfo_cost(impl, master, home) * 1e6 for impl in (OURS, REAL)}
+            rows.append(("one rospy.loginfo, CPU (us)", cost[OURS], cost[REAL]))
             for hz in (10.0, 100.0):
                 cpu = {impl: talker_cpu(impl, master, home, hz, args.talker_seconds) for impl in (OURS, REAL)}
-                rows.append((f"CPU of a {hz:.0f} Hz talker (cpu s / s)", cpu[OURS], cpu[REAL]))
+                rows.append((f"CPU of the seed talker at {hz:.0f} Hz (cpu s / s)", cpu[OURS], cpu[REAL]))
         finally:
             core.kill()
             core.wait()
