@@ -85,11 +85,15 @@ def test_unreachable_ssh_machine_is_named_and_nothing_starts(tmp_path: Path, env
     assert not master_is_up(env["ROS_MASTER_URI"])
 
 
-def test_local_option_skips_remote_nodes(tmp_path: Path, env: dict) -> None:  # noqa: F811
+def test_local_option_skips_remote_nodes(tmp_path: Path, env: dict, launches: list) -> None:  # noqa: F811
     body = (
         '<machine name="faraway" address="192.0.2.1" timeout="1"/>\n'
-        '<node name="remote" pkg="corpus_run" type="sleeper.py" machine="faraway"/>'
+        '<node name="remote" pkg="corpus_run" type="sleeper.py" machine="faraway"/>\n'
+        + SLEEPER.format(output="screen")
     )
-    result = run_cli(["--nodes", "--local", str(write_launch(tmp_path, body))], env)
-    assert result.returncode == 0
-    assert result.stdout == "/remote\n"
+    launch = Launch(["--local", str(write_launch(tmp_path, body))], env)
+    launches.append(launch)
+    assert launch.wait_for(lambda ls: any("solo ready" in line for line in ls)), "".join(launch.lines)
+    assert not any("faraway" in line for line in launch.lines)
+    launch.proc.send_signal(signal.SIGINT)
+    assert launch.finish() == 0
