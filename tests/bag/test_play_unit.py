@@ -262,3 +262,22 @@ def test_progress_line_has_percentage_and_eta():
     silent.step(5)
     silent.finish()
     assert quiet.getvalue() == ""
+
+
+def test_recorder_node_option_follows_a_nodes_subscriptions():
+    from ninjemys.bag.record import Recorder
+
+    node = FakeRecordNode()
+
+    class Master:
+        def get_system_state(self):
+            return [
+                [["/pub_only", ["/talker"]]],
+                [["/scan", ["/mapper"]], ["/odom", ["/mapper", "/x"]], ["/other", ["/x"]]],
+                [],
+            ]
+
+    node.master = Master()
+    rec = Recorder(node, RecordOptions(node="/mapper"))
+    rec._discover()
+    assert sorted(node.callbacks) == ["/odom", "/scan"]

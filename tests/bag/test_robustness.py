@@ -137,3 +137,22 @@ def test_reindex_of_garbage_is_a_bag_error(tmp_path):
     path.write_bytes(b"#ROSBAG V2.0\n" + b"\xff" * 5000)
     with pytest.raises(BagError):
         list(reindex_in_place(path))
+
+
+def test_encrypted_bag_is_named_as_such(tmp_path):
+    from ninjemys.bag.format import MAGIC, U32, U64, encode_header
+
+    header = encode_header(
+        {
+            "op": b"\x03",
+            "index_pos": U64.pack(0),
+            "conn_count": U32.pack(0),
+            "chunk_count": U32.pack(0),
+            "encryptor": b"rosbag/AesCbcEncryptor",
+        }
+    )
+    pad = 4096 - 8 - len(header)
+    path = tmp_path / "enc.bag"
+    path.write_bytes(MAGIC + U32.pack(len(header)) + header + U32.pack(pad) + b" " * pad)
+    with pytest.raises(BagError, match="encrypted with rosbag/AesCbcEncryptor"):
+        BagReader(path)

@@ -170,3 +170,20 @@ def test_export_mcap_decodes_with_mcap_ros1_support(tmp_path):
         reader = make_reader(f, decoder_factories=[DecoderFactory()])
         texts = [msg.data for _s, _c, _m, msg in reader.iter_decoded_messages()]
     assert texts == [f"message {i}" for i in range(12)]
+
+
+@pytest.mark.ros1
+def test_info_matches_with_several_connections_per_topic(tmp_path):
+    with BagWriter(tmp_path / "c.bag", compression="bz2") as w:
+        a = w.connection("/chatter", dict(STRING_HEADER, callerid=b"/one"))
+        b = w.connection("/chatter", dict(STRING_HEADER, callerid=b"/two"))
+        c = w.connection("/single", STRING_HEADER)
+        for i in range(100):
+            w.write((a, b, c)[i % 3], BASE + i * 37_000_000, string_bytes(str(i)))
+    for flags in ([], ["-y"], ["--freq"]):
+        ours = rosbag("info", *flags, "c.bag", cwd=tmp_path)
+        theirs = subprocess.run(
+            ["/usr/bin/rosbag", "info", *flags, "c.bag"], capture_output=True, text=True, cwd=tmp_path
+        )
+        assert ours.stdout == theirs.stdout
+    assert "(2 connections)" in ours.stdout

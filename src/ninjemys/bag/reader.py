@@ -58,6 +58,10 @@ class RawMessage(NamedTuple):
     chunk_pos: int
 
 
+class _Encrypted(BagError):
+    """An encrypted bag: reported as such, never scanned as if it were damaged."""
+
+
 @dataclass
 class _Scanned:
     """What a scan learned about one chunk: its entries, and its bytes if the file holds only part."""
@@ -110,9 +114,16 @@ class BagReader:
             fields = self._read_header_at(len(MAGIC))
             if field_op(fields, f"{self.path}:{len(MAGIC)}") != OP_FILE_HEADER:
                 raise BagError(f"{self.path}: the first record is not a file header")
+            encryptor = fields.get("encryptor", b"").decode("latin-1", "replace")
+            if encryptor and encryptor != "rosbag/NoEncryptor":
+                raise _Encrypted(
+                    f"{self.path}: bag is encrypted with {encryptor}, which ninjemys does not support"
+                )
             self.index_pos = field_u64(fields, "index_pos", f"{self.path}: file header")
             conn_count = field_u32(fields, "conn_count", f"{self.path}: file header")
             chunk_count = field_u32(fields, "chunk_count", f"{self.path}: file header")
+        except _Encrypted:
+            raise
         except BagError as exc:
             if self.size <= len(MAGIC) + 8:
                 raise BagError(f"{self.path}: truncated inside the file header ({self.size} bytes)") from None

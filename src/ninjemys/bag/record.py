@@ -196,8 +196,8 @@ class Recorder:
     def _wanted(self, topic: str) -> bool:
         if self._exclude is not None and self._exclude.search(topic):
             return False
-        if self.options.all:
-            return True
+        if self.options.all or self.options.node:
+            return True  # with --node, discovery already lists only that node's subscriptions
         if self._patterns:
             return any(p.fullmatch(topic) for p in self._patterns)
         return topic in {self.node.resolve_name(t) for t in self.options.topics}
