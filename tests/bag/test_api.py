@@ -203,3 +203,32 @@ def test_filter_on_message_fields(tmp_path):
     assert proc.returncode == 0, proc.stderr
     with rosbag.Bag(str(out)) as bag:
         assert [m.message.pose.position.x for m in bag.read_messages()] == [15.0, 22.5, 30.0, 37.5]
+
+
+def test_garbage_message_bytes_and_bad_definitions_are_format_errors(tmp_path):
+    path = tmp_path / "bad.bag"
+    with BagWriter(path) as w:
+        c = w.connection(
+            "/s",
+            {
+                "type": b"std_msgs/String",
+                "md5sum": b"992ce8a1687cec8c8bd883ec73ca41d1",
+                "message_definition": b"string data\n",
+            },
+        )
+        w.write(c, BASE, b"\xff\xff\xff\x7f")  # a string length far past the message end
+        d = w.connection(
+            "/weird",
+            {
+                "type": b"my_pkg/Weird",
+                "md5sum": b"0" * 32,
+                "message_definition": b"not a ! valid definition\n",
+            },
+        )
+        w.write(d, BASE + 1, b"")
+    with rosbag.Bag(str(path)) as bag:
+        with pytest.raises(rosbag.ROSBagFormatException, match="/s"):
+            list(bag.read_messages(topics="/s"))
+        with pytest.raises(rosbag.ROSBagException):
+            list(bag.read_messages(topics="/weird"))
+        assert len(list(bag.read_messages(raw=True))) == 2  # raw reading never needs the classes

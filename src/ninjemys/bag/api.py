@@ -338,7 +338,7 @@ class Bag:
                     yield new_tuple(BagMessage, (conn.topic, message, stamp))
         except ROSBagException:
             raise
-        except BagError as exc:
+        except NinjemysError as exc:  # damaged chunk, or a definition in the bag that does not parse
             raise ROSBagFormatException(str(exc)) from None
 
     def __iter__(self) -> Iterator[Any]:
@@ -457,8 +457,8 @@ def _deserialize(cls: type, data: memoryview, conn: Connection) -> Any:
         if fast is not None:
             return fast(data)
         return cls().deserialize(bytes(data))
-    except NinjemysError as exc:
-        raise ROSBagFormatException(f"{conn.topic} ({conn.datatype}): {exc}") from None
+    except Exception as exc:  # bytes from a file: any decoding failure is a format error, named
+        raise ROSBagFormatException(f"{conn.topic} ({conn.datatype}): cannot deserialize: {exc}") from None
 
 
 def _pytype_or_none(decoders: _Decoders, conn: Connection) -> type | None:
