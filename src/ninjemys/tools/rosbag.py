@@ -164,7 +164,14 @@ def filter_cmd(argv: list[str]) -> int:
 
     def keep(msg) -> bool:  # noqa: ANN001
         conn = msg.connection
-        m = decoders.get(conn)().deserialize(bytes(msg.data)) if needs_m else None
+        m = None
+        if needs_m:
+            try:
+                m = decoders.get(conn)().deserialize(bytes(msg.data))
+            except NinjemysError:
+                raise
+            except Exception as exc:  # bytes from the file that do not decode
+                raise BagError(f"{conn.topic} ({conn.datatype}): cannot deserialize: {exc}") from None
         t = Time(*divmod(msg.time, NSEC))
         try:
             match = bool(predicate(conn.topic, m, t))
