@@ -15,7 +15,7 @@ import threading
 from typing import Any
 
 from ninjemys.errors import MasterError, NameError_, NinjemysError, ParameterError
-from ninjemys.node.log import INFO, NodeLog
+from ninjemys.node.log import INFO, WARN, NodeLog
 from rospy.core import _process, is_shutdown, signal_shutdown
 from rospy.exceptions import ROSException, ROSInitException, ROSInterruptException, mapped, translate
 
@@ -108,8 +108,12 @@ def init_node(
         if not disable_rostime:
             _start_clock(node, log)
         if not disable_rosout:
-            _start_rosout(node, log)
-        _start_logger_services(node, log)
+            log.hold_rosout()
+        done = threading.Event()
+        _process.init_done = done
+        threading.Thread(
+            target=_finish_init, args=(node, log, not disable_rosout, done), name="rospy-init", daemon=True
+        ).start()
         pending, _process.pending = _process.pending, []
     for handle in pending:
         handle._bind(node)
@@ -161,6 +165,20 @@ def _start_clock(node: Any, log: NodeLog) -> None:
     clock.subscribe(node, get_message_class("rosgraph_msgs/Clock"))
     clock.install()
     log.set_ros_time(clock.now)
+
+
+def _finish_init(node: Any, log: NodeLog, rosout: bool, done: threading.Event) -> None:
+    """/rosout and the logger services, set up off the caller's thread: init_node returns as soon as
+    the node is registered, and messages logged meanwhile are held and sent once /rosout exists."""
+    try:
+        if rosout:
+            _start_rosout(node, log)
+        _start_logger_services(node, log)
+    except NinjemysError as exc:
+        if not node.is_shutdown:
+            log.log(WARN, "%s: logging services unavailable: %s", node.name, exc)
+    finally:
+        done.set()
 
 
 def _start_rosout(node: Any, log: NodeLog) -> None:

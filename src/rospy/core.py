@@ -45,6 +45,7 @@ class _Process:
         self.hooks_ran = False
         self.shutdown_requested = False
         self.init_args: tuple[Any, ...] | None = None
+        self.init_done: threading.Event | None = None
 
     def require_node(self) -> Any:
         node = self.node
@@ -97,6 +98,9 @@ def signal_shutdown(reason: str) -> None:
     _process.run_hooks()
     _process.clock.shutdown()
     if node is not None:
+        done = _process.init_done
+        if done is not None:
+            done.wait(5.0)  # let the background part of init_node finish before tearing the node down
         node.shutdown(reason)
 
 

@@ -191,3 +191,18 @@ def test_broken_rosout_does_not_break_logging(tmp_path: Path) -> None:
 def test_level_names() -> None:
     assert nlog.level_from_name("Warn") == WARN
     assert nlog.level_from_name("fatal") == FATAL
+
+
+def test_messages_held_until_rosout_is_attached(tmp_path: Path) -> None:
+    out = io.StringIO()
+    logger = NodeLog("/early", log_file=str(tmp_path / "e.log"), stdout=out, stderr=io.StringIO())
+    logger.hold_rosout(limit=2)
+    logger.info("first")
+    logger.warn("second")
+    logger.error("third (over the limit)")
+    pub = FakePublisher()
+    logger.attach_rosout(pub, FakeLog, list)
+    logger.info("after")
+    assert [(m.level, m.msg) for m in pub.sent] == [(INFO, "first"), (WARN, "second"), (INFO, "after")]
+    assert pub.sent[0].function == "test_messages_held_until_rosout_is_attached"
+    assert "first" in out.getvalue()

@@ -165,6 +165,9 @@ class NodeLog:
         self._lock = threading.Lock()
         self._filter = _CallSiteFilter()
         self._rosout: Any = None
+        self._held: list[tuple[int, str, float, str, str, int]] | None = None
+        self._held_limit = 100
+        self._hold_lock = threading.Lock()
         self._log_class: Any = None
         self._time_class: Any = None
         self._topics: Callable[[], list[str]] = list
@@ -178,7 +181,16 @@ class NodeLog:
         self._time_class = Time
         self._log_class = log_class
         self._topics = topics
-        self._rosout = publisher
+        with self._hold_lock:
+            held, self._held = self._held or [], None
+            for record in held:
+                self._send(publisher, record)
+            self._rosout = publisher
+
+    def hold_rosout(self, limit: int = 100) -> None:
+        """Keep up to ``limit`` messages for /rosout until :meth:`attach_rosout` (set up in the background)."""
+        self._held_limit = limit
+        self._held = []
 
     def set_ros_time(self, ros_time: Callable[[], float] | None) -> None:
         """Show simulated time next to wall time (None: wall clock only)."""
@@ -201,8 +213,26 @@ class NodeLog:
         sim = self._ros_time() if self._ros_time is not None else None
         if level != DEBUG:
             self._write_console(level, format_console(level, text, wall, sim))
-        if self._rosout is not None:
-            self._publish(level, text, sim if sim is not None else wall, sys._getframe(depth))
+        if self._rosout is not None or self._held is not None:
+            code = sys._getframe(depth)
+            record = (
+                level,
+                text,
+                sim if sim is not None else wall,
+                code.f_code.co_filename,
+                code.f_code.co_name,
+                code.f_lineno,
+            )
+            publisher = self._rosout
+            if publisher is not None:
+                self._send(publisher, record)
+                return
+            with self._hold_lock:
+                if self._rosout is None and self._held is not None:
+                    if len(self._held) < self._held_limit:
+                        self._held.append(record)
+                    return
+            self._send(self._rosout, record)
 
     def log_throttle(self, period: float, level: int, msg: Any, *args: Any, depth: int = 1) -> None:
         """Log at most once per ``period`` seconds (of ROS time) from one call site."""
@@ -290,6 +320,7 @@ class NodeLog:
                 self._file.close()
                 self._file = None
         self._rosout = None
+        self._held = None
 
     # -- internals --------------------------------------------------------------------------------------
     def _now(self) -> float:
@@ -321,17 +352,17 @@ class NodeLog:
                     return
             self._file.write(format_file(level, text, wall) + "\n")
 
-    def _publish(self, level: int, text: str, stamp: float, frame: Any) -> None:
-        cls = self._log_class
+    def _send(self, publisher: Any, record: tuple[int, str, float, str, str, int]) -> None:
+        level, text, stamp, path, function, line = record
         try:
-            msg = cls(level=level, name=self.node_name, msg=text)
-            msg.file = os.path.basename(frame.f_code.co_filename)
-            msg.function = frame.f_code.co_name
-            msg.line = frame.f_lineno
+            msg = self._log_class(level=level, name=self.node_name, msg=text)
+            msg.file = os.path.basename(path)
+            msg.function = function
+            msg.line = line
             msg.topics = list(self._topics())
             secs = int(stamp)
             msg.header.stamp = self._time_class(secs, int((stamp - secs) * 1e9))
-            self._rosout.publish(msg)
+            publisher.publish(msg)
         except Exception as exc:  # a broken /rosout must never take the node's logging down with it
             self._rosout = None
             self._write_console(ERROR, format_console(ERROR, f"/rosout disabled: {exc}", time.time()))
