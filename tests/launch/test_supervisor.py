@@ -136,3 +136,16 @@ def test_log_output_goes_to_a_file(tmp_path: Path) -> None:
     assert (tmp_path / "crash-1-stdout.log").read_text() == "crasher running\n"
     assert not any("crasher running" in line for line in lines)
     assert any("all processes on machine have died" in line for line in lines)
+
+
+def test_required_node_finishing_cleanly_ends_launch_without_failure() -> None:
+    lines: list[str] = []
+    done = ProcessSpec(
+        name="done-2", argv=[sys.executable, "-c", "pass"], env=dict(os.environ), required=True
+    )
+    sup = Supervisor([spec("sleeper-1", "sleeper.py"), done], write=lines.append)
+    thread, result = run_in_thread(sup)
+    thread.join(60)
+    assert result == [0]
+    assert "REQUIRED process [done-2] has died!" in "".join(lines)
+    assert not alive(sup.procs[0].popen.pid)  # type: ignore[union-attr]

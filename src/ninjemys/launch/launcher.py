@@ -17,7 +17,7 @@ from pathlib import Path
 from ninjemys.errors import LaunchError
 from ninjemys.launch import master_link
 from ninjemys.launch.plan import LaunchPlan, NodeSpec
-from ninjemys.launch.queries import node_command, node_environment
+from ninjemys.launch.queries import node_command, node_environment, node_executable
 from ninjemys.launch.runner import (
     DEFAULT_SIGINT_TIMEOUT,
     DEFAULT_SIGTERM_TIMEOUT,
@@ -100,8 +100,8 @@ def _process_specs(
         )
         cwd = ros_home
         if node.cwd == "node" and machine.is_local:
-            exe = next((a for a in argv[1:] if os.path.isfile(a)), argv[0] if argv else "")
-            cwd = os.path.dirname(exe) or ros_home
+            exe = node_executable(node, index)
+            cwd = str(exe.path.parent) if exe.path is not None else ros_home
         if not machine.is_local:
             # the remote machine runs its own ninjemys: rosrun there finds the package and executable
             argv = remote_command(machine, ["rosrun", node.package, node.type, *_user_args(node)], proc_env)

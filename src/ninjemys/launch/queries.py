@@ -15,7 +15,7 @@ from ninjemys.errors import LaunchError, NinjemysError
 from ninjemys.launch.plan import LaunchPlan, NodeSpec
 from ninjemys.names import get_ros_namespace, ns_join
 from ninjemys.packages.discovery import PackageIndex
-from ninjemys.packages.executables import find_executable
+from ninjemys.packages.executables import Executable, find_executable
 
 DEFAULT_MASTER_URI = "http://localhost:11311/"
 
@@ -48,20 +48,25 @@ def node_environment(node: NodeSpec, master_uri: str, env: Mapping[str, str]) ->
     return d
 
 
-def node_command(node: NodeSpec, index: PackageIndex | None = None, display: bool = False) -> list[str]:
-    """launch-prefix + executable + args + remaps + ``__name:=``; ``display`` gives ROS 1's path form."""
+def node_executable(node: NodeSpec, index: PackageIndex | None = None) -> Executable:
+    """The executable a node runs; LaunchError in roslaunch's words when it cannot be found."""
     index = index or PackageIndex.from_environment()
     try:
         manifest = index.find(node.package)
     except NinjemysError as exc:
         raise LaunchError(f"{node.filename}: node [{node.resolved_name}]: {exc}") from None
     try:
-        exe = find_executable(manifest, node.type)
+        return find_executable(manifest, node.type)
     except NinjemysError:
         raise LaunchError(
             f"Cannot locate node of type [{node.type}] in package [{node.package}]. Make sure file exists in "
             "package path and permission is set to executable (chmod +x)"
         ) from None
+
+
+def node_command(node: NodeSpec, index: PackageIndex | None = None, display: bool = False) -> list[str]:
+    """launch-prefix + executable + args + remaps + ``__name:=``; ``display`` gives ROS 1's path form."""
+    exe = node_executable(node, index)
     args = shlex.split(node.args) + [f"{a}:={b}" for a, b in node.remap_args] + [f"__name:={node.name}"]
     prefix = shlex.split(node.launch_prefix) if node.launch_prefix else []
     if display:

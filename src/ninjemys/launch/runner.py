@@ -205,7 +205,7 @@ class Supervisor:
             if spec.output == "log" and spec.log_dir is not None:
                 self.write(f"log file: {spec.log_dir / (spec.name + '-stdout.log')}\n")
         if spec.required:
-            self._required_died(proc)
+            self._required_died(proc, failed=code != 0)
         elif spec.respawn:
             proc.restart_at = time.monotonic() + max(spec.respawn_delay, 0.0)
         elif all(p.exit_code is not None and not p.spec.respawn for p in self.procs if not p.spec.is_core):
@@ -213,10 +213,11 @@ class Supervisor:
                 self.write("all processes on machine have died, roslaunch will exit\n")
                 self.shutdown()
 
-    def _required_died(self, proc: _Running) -> None:
+    def _required_died(self, proc: _Running, failed: bool = True) -> None:
+        """A required node ended: the whole launch ends, failing unless the node exited with 0."""
         bar = "=" * 80
         self.write(f"{bar}\nREQUIRED process [{proc.spec.name}] has died!\nInitiating shutdown!\n{bar}\n")
-        self.failed = True
+        self.failed = self.failed or failed
         self.shutdown()
 
     # -- shutdown --------------------------------------------------------------------------------
