@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import itertools
 import logging
+import select
 import socket
 import threading
 import time
@@ -48,6 +49,9 @@ HOT_INTERVAL = 50e-6
 _FLUSH_FRAMES = 32
 #: queue_size=None: frames queued before publish() waits for the loop to drain them.
 _SYNC_HIGH_WATER = 256
+_SYNC_HIGH_WATER_BYTES = 8 << 20
+#: Payloads at least this big are sent with sendmsg (prefix and payload unjoined).
+_LARGE = 1 << 16
 _clock = time.perf_counter
 
 
@@ -72,6 +76,7 @@ class PubConnection:
         self._queue: deque[bytes] = deque()
         self._armed = False  # the loop watches the socket for writability
         self._last = 0.0  # time of the previous send (detects bursts)
+        self._queued_bytes = 0
 
     @property
     def idle(self) -> bool:
@@ -106,18 +111,80 @@ class PubConnection:
             else:
                 queue = self._queue
                 queue.append(data)
+                self._queued_bytes += len(data)
                 if queue_size and len(queue) > queue_size:
-                    queue.popleft()
+                    self._queued_bytes -= len(queue.popleft())
                     self.dropped += 1
                 if self._partial is None and len(queue) >= _FLUSH_FRAMES and self._write_locked():
                     return  # a burst: this thread wrote a whole batch in one call
             if not self._armed:
                 self._armed = True
                 self.node.runtime.call_soon(self._arm)
-            if queue_size is None and len(self._queue) >= _SYNC_HIGH_WATER:
+            if queue_size is None and (
+                len(self._queue) >= _SYNC_HIGH_WATER or self._queued_bytes >= _SYNC_HIGH_WATER_BYTES
+            ):
                 # synchronous publishing: wait for the loop to drain (lossless, bounded memory)
                 while not self.closed and not (self._partial is None and not self._queue):
                     self._cond.wait()
+
+    def send_large(self, prefix: bytes, payload: bytes, queue_size: int | None) -> None:
+        """Like :meth:`send` for a big message: the length prefix and the payload leave in one
+        ``sendmsg`` without being joined (a 6 MB image is not copied once more just to frame it)."""
+        with self._lock:
+            idle = self._partial is None and not self._queue and not self.closed
+            if idle:
+                self._last = _clock()
+                try:
+                    n = self.sock.sendmsg([prefix, payload])
+                except (BlockingIOError, InterruptedError):
+                    n = 0
+                except OSError as exc:
+                    self._fail(f"write failed: {exc}")
+                    return
+                self.bytes_sent += n
+                if n == len(prefix) + len(payload):
+                    self.num_sent += 1
+                    return
+                if n >= len(prefix):
+                    self._partial = memoryview(payload)[n - len(prefix) :]
+                else:
+                    self._partial = memoryview(prefix[n:] + payload)
+                self.num_sent += 1
+                if queue_size is not None and not self._armed:
+                    self._armed = True
+                    self.node.runtime.call_soon(self._arm)
+        if not idle:
+            self.send(prefix + payload, queue_size)
+        elif queue_size is None:
+            self._finish_in_caller()
+
+    def _finish_in_caller(self) -> None:
+        """Synchronous publishing of a big message: write the rest from the caller's thread as the
+        kernel takes it (the subscriber's pace), like a blocking send, without involving the loop."""
+        while True:
+            with self._lock:
+                partial = self._partial
+                if self.closed or partial is None:
+                    return
+                try:
+                    n = self.sock.send(partial)
+                except (BlockingIOError, InterruptedError):
+                    n = 0
+                except OSError as exc:
+                    self._fail(f"write failed: {exc}")
+                    return
+                self.bytes_sent += n
+                if n == len(partial):
+                    self._partial = None
+                    if self._queue and not self._armed:
+                        self._armed = True
+                        self.node.runtime.call_soon(self._arm)
+                    return
+                self._partial = partial[n:]
+            try:
+                select.select([], [self.sock], [], 1.0)
+            except (OSError, ValueError):
+                pass  # closed under us: the next round sees it
 
     def watch(self) -> None:
         """Notice a subscriber that goes away even while we have nothing to send (on the loop)."""
@@ -181,13 +248,16 @@ class PubConnection:
         queue = self._queue
         if len(queue) == 1:
             self.num_sent += 1
-            return queue.popleft()
+            item = queue.popleft()
+            self._queued_bytes -= len(item)
+            return item
         parts, size = [], 0
         while queue and size < _BATCH_BYTES:
             item = queue.popleft()
             parts.append(item)
             size += len(item)
         self.num_sent += len(parts)
+        self._queued_bytes -= size
         return b"".join(parts)
 
     def _fail(self, why: str) -> None:
@@ -201,6 +271,7 @@ class PubConnection:
             return
         self.closed = True
         self._queue.clear()
+        self._queued_bytes = 0
         self._partial = None
         self._cond.notify_all()
         self.node.runtime.call_soon(self._release_socket)
@@ -279,6 +350,16 @@ class Publication:
         for conn in conns:
             conn.send(data, queue_size)
 
+    def publish_large(self, payload: bytes, handle: Publisher) -> None:
+        prefix = pack_len(len(payload))
+        with self.lock:
+            if handle.latch:
+                handle.latched = prefix + payload
+            conns = self.connections
+        queue_size = handle.queue_size
+        for conn in conns:
+            conn.send_large(prefix, payload, queue_size)
+
     def remove_connection(self, conn: PubConnection) -> None:
         with self.lock:
             if conn in self.connections:
@@ -332,7 +413,10 @@ class Publisher:
                     f"topic {self.name}: expected a {self.type} message, got {type(msg).__name__}"
                 ) from None
             raise
-        self._pub.publish_frame(pack_len(len(payload)) + payload, self)
+        if len(payload) >= _LARGE:
+            self._pub.publish_large(payload, self)
+        else:
+            self._pub.publish_frame(pack_len(len(payload)) + payload, self)
 
     def publish_raw(self, payload: bytes | bytearray | memoryview) -> None:
         """Send already-serialized bytes (relays, bag play, AnyMsg)."""
