@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from ninjemys import names
-from ninjemys.errors import MasterError, ParameterError
+from ninjemys.errors import MasterError, MasterUnreachable, ParameterError
 from ninjemys.paramyaml import ParamYamlError, dump_yaml, load_yaml
 from ninjemys.tools.cli import entry, master
 
@@ -106,6 +106,8 @@ def _cmd_get(args: argparse.Namespace) -> int:
         print(f"getting parameter [{param}]")
     try:
         value = master(_caller_id()).get_param(param)
+    except MasterUnreachable:
+        raise
     except MasterError as exc:
         raise ParameterError(f"Parameter [{param}] is not set") from exc
     _print_value(value, args.pretty)
@@ -191,6 +193,8 @@ def _cmd_delete(args: argparse.Namespace) -> int:
         return 0
     try:
         client.delete_param(param)
+    except MasterUnreachable:
+        raise
     except MasterError as exc:
         raise ParameterError(f"parameter [{param}] is not set") from exc
     if args.verbose:

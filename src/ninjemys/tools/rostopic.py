@@ -618,6 +618,7 @@ def _cmd_pub(args: argparse.Namespace) -> int:
     try:
         latch = args.latch or args.rate is None
         pub = node.publisher(topic, cls, queue_size=100, latch=latch)
+        _await_subscribers(node, pub, master(ID), topic)
         if args.file:
             messages = [build([doc]) for doc in _yaml_documents(args.file)]
             period = 1.0 / args.rate if args.rate else 0.1
@@ -660,6 +661,20 @@ def _cmd_pub(args: argparse.Namespace) -> int:
     finally:
         node.shutdown("rostopic pub done")
     return 0
+
+
+def _await_subscribers(node: Any, pub: Any, client: Any, topic: str, timeout: float = 1.0) -> None:
+    """Give the subscribers the master already knows up to ``timeout`` to connect before the first
+    publish, so a short ``rostopic pub`` does not lose its first messages (ros_comm#176)."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and not node.is_shutdown:
+        try:
+            expected = len(GraphState.fetch(client, with_types=False).subscribers.get(topic, []))
+        except MasterError:
+            return
+        if pub.get_num_connections() >= expected:
+            return
+        time.sleep(0.02)
 
 
 def _linger(node: Any, pub: Any, client: Any, topic: str) -> None:
