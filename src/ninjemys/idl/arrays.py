@@ -47,12 +47,18 @@ class NumericArray(Sequence):
 
     __slots__ = ("_view", "_fmt")
 
-    def __init__(self, raw: memoryview, fmt: str) -> None:
-        self._view = raw.cast("B").cast(fmt) if LITTLE_ENDIAN_HOST else None
+    def __init__(self, view: memoryview, fmt: str) -> None:
+        """``view``: a memoryview of format ``fmt`` over little-endian wire bytes (little-endian hosts)."""
+        self._view = view
         self._fmt = fmt
-        if self._view is None:  # big-endian host: convert once, correctly
-            count = len(raw) // struct.calcsize(fmt)
-            self._view = struct.unpack(f"<{count}{fmt}", raw)
+
+    @classmethod
+    def from_wire(cls, raw: bytes | memoryview, fmt: str) -> NumericArray | tuple:
+        """View ``raw`` (wire bytes) as elements of ``fmt``; a tuple on big-endian hosts."""
+        if LITTLE_ENDIAN_HOST:
+            return cls(memoryview(raw).cast("B").cast(fmt), fmt)
+        count = len(raw) // struct.calcsize(fmt)
+        return struct.unpack(f"<{count}{fmt}", raw)
 
     @property
     def format(self) -> str:
@@ -61,10 +67,7 @@ class NumericArray(Sequence):
 
     def raw_bytes(self) -> memoryview | bytes:
         """The elements in ROS wire layout (little-endian), without copying on little-endian hosts."""
-        view = self._view
-        if isinstance(view, memoryview):
-            return view.cast("B")
-        return struct.pack(f"<{len(view)}{self._fmt}", *view)
+        return self._view.cast("B")
 
     def __len__(self) -> int:
         return len(self._view)
@@ -84,8 +87,7 @@ class NumericArray(Sequence):
         return value in self.tolist()
 
     def tolist(self) -> list[Any]:
-        view = self._view
-        return view.tolist() if isinstance(view, memoryview) else list(view)
+        return self._view.tolist()
 
     def __eq__(self, other: object) -> bool:
         if isinstance(other, NumericArray):
@@ -122,10 +124,7 @@ class NumericArray(Sequence):
     def __array__(self, dtype: Any = None, copy: Any = None) -> Any:
         import numpy
 
-        view = self._view
-        arr = numpy.frombuffer(view, dtype=NUMPY_DTYPES[self._fmt]) if isinstance(view, memoryview) else None
-        if arr is None:
-            arr = numpy.array(view, dtype=NUMPY_DTYPES[self._fmt])
+        arr = numpy.frombuffer(self._view, dtype=NUMPY_DTYPES[self._fmt])
         if dtype is not None:
             arr = arr.astype(dtype)
         return arr

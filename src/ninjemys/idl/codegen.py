@@ -25,6 +25,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from ninjemys.errors import DefinitionError
+from ninjemys.idl.arrays import LITTLE_ENDIAN_HOST
 from ninjemys.idl.spec import PRIMITIVE_FORMATS, FieldType, MsgSpec
 
 Lookup = Callable[[str], MsgSpec]
@@ -114,6 +115,7 @@ class _Emitter:
     run: list[tuple[str, str]] = field(default_factory=list)  # (format, target-or-argument)
     posts: list[str] = field(default_factory=list)  # statements to run after the run is unpacked
     views: bool = False  # the code slices the buffer into views (needs a memoryview, not bytes)
+    bytes_buffer: bool = False  # the buffer is bytes (set when the type has no views)
 
     def tmp(self, prefix: str = "v") -> str:
         self.counter += 1
@@ -270,7 +272,10 @@ class _DeserEmitter(_Emitter):
             elif base == "bool":
                 self.emit(f"{target} = [x != 0 for x in mv[pos:pos + {count}]]")
             else:
-                self.emit(f"{target} = _NumArr(mv[pos:pos + {nbytes}], {fmt!r})")
+                if LITTLE_ENDIAN_HOST:  # a typed view straight over the wire bytes
+                    self.emit(f"{target} = _NumArr(mv[pos:pos + {nbytes}].cast({fmt!r}), {fmt!r})")
+                else:
+                    self.emit(f"{target} = _struct.unpack_from('<%d{fmt}' % {count}, mv, pos)")
             self.emit(f"pos += {nbytes}")
             return
         elem_size = _min_elem_size(base, self.lookup)
@@ -313,7 +318,9 @@ class _DeserEmitter(_Emitter):
             self.run.append(("I", n))
             self.flush()
             self.check(n, what, n)
-            self.emit(f"{target} = str(mv[pos:pos + {n}], 'utf-8', 'replace')")
+            # without views the buffer is bytes (sliced and decoded directly), else a memoryview
+            decode = "" if self.bytes_buffer else "bytes"
+            self.emit(f"{target} = {decode}(mv[pos:pos + {n}]).decode('utf-8', 'replace')")
             self.emit(f"pos += {n}")
         else:
             v = self.tmp("o")
@@ -374,6 +381,7 @@ def generate_class_source(spec: MsgSpec, lookup: Lookup, md5sum: str, full_text:
     ser = _SerEmitter(spec.full_name, lookup, structs)
     ser.fields(spec, "self")
     ser.flush()
+    _ser_structs = dict(structs)
     body.append("")
     body.append("    def _ser(self, w):")
     body.extend(ser.lines or ["        pass"])
@@ -381,13 +389,19 @@ def generate_class_source(spec: MsgSpec, lookup: Lookup, md5sum: str, full_text:
     de = _DeserEmitter(spec.full_name, lookup, structs, depth=3)
     de.fields(spec, "o")
     de.flush()
+    if not de.views:  # regenerate for a bytes buffer: strings decode straight from bytes slices
+        structs.clear()
+        structs.update(_ser_structs)
+        de = _DeserEmitter(spec.full_name, lookup, structs, depth=3, bytes_buffer=True)
+        de.fields(spec, "o")
+        de.flush()
     body.append("")
     body.append("    @classmethod")
     body.append("    def deserialize_from(cls, buf):")
     if de.views:
-        body.append("        mv = _view(buf)")
-    else:  # strings and numbers only: bytes can be sliced directly
-        body.append("        mv = buf if buf.__class__ is bytes else _view(buf)")
+        body.append("        mv = memoryview(buf) if buf.__class__ is bytes else _view(buf)")
+    else:  # strings and numbers only: a bytes copy of other buffers, sliced directly
+        body.append("        mv = buf if buf.__class__ is bytes else _view(buf).tobytes()")
     body.append("        end = len(mv)")
     body.append("        pos = 0")
     body.append("        try:")

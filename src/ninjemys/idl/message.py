@@ -210,12 +210,24 @@ _ARRAY_TYPECODES = {
 }
 
 
+_ARRAY_STRUCTS: dict[tuple[str, int], struct.Struct] = {}
+
+
+def _array_struct(fmt: str, count: int) -> struct.Struct:
+    if len(_ARRAY_STRUCTS) > 512:  # bounded: array lengths vary in some streams
+        _ARRAY_STRUCTS.clear()
+    packer = _ARRAY_STRUCTS[(fmt, count)] = struct.Struct(f"<{count}{fmt}")
+    return packer
+
+
 def pack_numeric(value: Any, fmt: str) -> Any:
     """A numeric array value as little-endian wire bytes (views are written back without conversion)."""
-    if isinstance(value, NumericArray) and value.format == fmt:
+    cls = value.__class__
+    if cls is list or cls is tuple:
+        packer = _ARRAY_STRUCTS.get((fmt, len(value))) or _array_struct(fmt, len(value))
+        return packer.pack(*value)
+    if cls is NumericArray and value.format == fmt:
         return value.raw_bytes()
-    if isinstance(value, list | tuple):
-        return struct.pack(f"<{len(value)}{fmt}", *value)
     if type(value).__module__ == "numpy":
         return value.astype(NUMPY_DTYPES[fmt], copy=False).tobytes()
     if fmt == "?":
