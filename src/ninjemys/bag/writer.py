@@ -23,7 +23,7 @@ from ninjemys.bag.format import (
     U32,
     ChunkInfo,
     Connection,
-    encode_record,
+    encode_header,
     file_header_record,
     index_data_record,
     message_record_header,
@@ -178,18 +178,23 @@ class BagWriter:
             return
         f = self._file
         pos = f.tell()
-        raw = bytes(self._chunk)
-        packed = compress(self.compression, raw)
-        fields = {"op": _CHUNK_OP, "compression": self.compression.encode(), "size": U32.pack(len(raw))}
-        parts = [encode_record(fields, packed)]
+        raw = self._chunk
+        # uncompressed chunks go to the file straight from the buffer: no copy of megabyte messages
+        packed = raw if self.compression == "none" else compress(self.compression, bytes(raw))
+        header = encode_header(
+            {"op": _CHUNK_OP, "compression": self.compression.encode(), "size": U32.pack(len(raw))}
+        )
+        index_parts = []
         counts: dict[int, int] = {}
         for conn_id, entries in self._chunk_index.items():
             if not self._chunk_sorted:
                 entries.sort()
-            parts.append(index_data_record(conn_id, entries))
+            index_parts.append(index_data_record(conn_id, entries))
             counts[conn_id] = len(entries)
         try:
-            f.write(b"".join(parts))
+            f.write(U32.pack(len(header)) + header + U32.pack(len(packed)))
+            f.write(packed)
+            f.write(b"".join(index_parts))
             f.flush()
         except OSError as exc:
             raise BagError(f"{self.write_path}: write failed ({exc.strerror})") from None
