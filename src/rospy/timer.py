@@ -13,7 +13,7 @@ from typing import Any
 from ninjemys.node import timers as _timers
 from ninjemys.rostime import Duration, Time
 from rospy.core import _process
-from rospy.exceptions import mapped
+from rospy.exceptions import ROSInterruptException, mapped
 
 __all__ = ["Rate", "sleep", "Timer", "TimerEvent"]
 
@@ -47,6 +47,18 @@ class Rate:
             self._rate.sleep()
 
 
+def _guarded(callback: Callable[[Any], Any]) -> Callable[[Any], Any]:
+    """A timer callback interrupted by shutdown (``rospy.sleep`` inside it) ends the timer quietly."""
+
+    def run(event: Any) -> Any:
+        try:
+            return callback(event)
+        except ROSInterruptException:
+            return None
+
+    return run
+
+
 def _report(exc: BaseException) -> None:
     _process.log.error("Timer callback raised %s: %s", type(exc).__name__, exc)
 
@@ -65,7 +77,12 @@ class Timer:
         self._callback = callback
         self._oneshot = oneshot
         self._timer = _timers.Timer(
-            _process.clock, period, callback, oneshot=oneshot, make_time=Time.from_sec, on_error=_report
+            _process.clock,
+            period,
+            _guarded(callback),
+            oneshot=oneshot,
+            make_time=Time.from_sec,
+            on_error=_report,
         )
 
     def shutdown(self) -> None:

@@ -394,3 +394,25 @@ rospy.spin()
     node = run_node(code)
     assert node.wait_for(r"^raw (.*)$").group(1) == "X std_msgs/String payload"
     assert node.wait(10) == 0
+
+
+def test_shutdown_interrupting_a_sleeping_callback_is_quiet(run_node) -> None:
+    code = r"""
+import rospy
+from std_msgs.msg import String
+rospy.init_node("sleepy")
+def cb(msg):
+    print("in callback", flush=True)
+    rospy.sleep(30)
+def tick(event):
+    rospy.sleep(30)
+rospy.Subscriber("nap", String, cb)
+rospy.Timer(rospy.Duration(0.01), tick, oneshot=True)
+rospy.Publisher("nap", String, queue_size=1, latch=True).publish("zz")
+rospy.spin()
+"""
+    node = run_node(code)
+    node.wait_for("^in callback$")
+    node.interrupt()
+    assert node.wait(5) == 0
+    assert not any("Traceback" in line or "Exception" in line for line in node.err), node.err
