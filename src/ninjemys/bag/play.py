@@ -408,7 +408,7 @@ def play_main(argv: list[str], parser_class: type[argparse.ArgumentParser] = arg
     """Parse ``rosbag play`` arguments and play until the end (or Ctrl-C)."""
     from ninjemys.node import Node
 
-    options = options_from_args(build_parser(parser_class).parse_args(argv))
+    options = options_from_args(build_parser(parser_class).parse_intermixed_args(argv))
     # open the bags before joining the graph: a bad file is reported without touching the master
     player = Player(None, options)
     try:

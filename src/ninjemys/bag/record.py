@@ -474,7 +474,7 @@ def record_main(
     """Parse ``rosbag record`` arguments, record until Ctrl-C / SIGTERM / limit, close the bag."""
     from ninjemys.node import Node
 
-    args = build_parser(parser_class).parse_args(argv)
+    args = build_parser(parser_class).parse_intermixed_args(argv)
     options = options_from_args(args)
 
     def log(text: str) -> None:

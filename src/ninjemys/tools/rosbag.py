@@ -90,7 +90,7 @@ def info_cmd(argv: list[str]) -> int:
     p.add_argument("-k", "--key", default=None, help="print information on the given key")
     p.add_argument("--freq", action="store_true", help="display topic message frequency statistics")
     p.add_argument("bags", nargs="*")
-    opts = p.parse_args(argv)
+    opts = p.parse_intermixed_args(argv)
     if not opts.bags:
         p.error("You must specify at least 1 bag file.")
     if opts.key and not opts.yaml:
@@ -292,7 +292,7 @@ def _bag_op(
 
 
 def reindex_cmd(argv: list[str]) -> int:
-    opts = _bag_op_parser("reindex", False).parse_args(argv)
+    opts = _bag_op_parser("reindex", False).parse_intermixed_args(argv)
     if not opts.bags:
         _bag_op_parser("reindex", False).error("You must specify at least one bag file.")
 
@@ -314,7 +314,7 @@ def reindex_cmd(argv: list[str]) -> int:
 
 def _compression_cmd(name: str, argv: list[str]) -> int:
     parser = _bag_op_parser(name, name == "compress")
-    opts = parser.parse_args(argv)
+    opts = parser.parse_intermixed_args(argv)
     if not opts.bags:
         parser.error("You must specify at least one bag file.")
     compression = opts.compression if name == "compress" else "none"
