@@ -28,6 +28,8 @@ PIXELS_PER_METER = 45.0
 WORLD_SIZE = (CANVAS_PIXELS - 1) / PIXELS_PER_METER
 #: Spawn point of turtle1 (and of every reset).
 CENTER = WORLD_SIZE / 2.0
+#: Pen segments kept for viewers (the path image itself is complete); older ones are dropped in bulk.
+SEGMENT_HISTORY = 20000
 #: ROS turtlesim's timer period: the node steps the world this often.
 UPDATE_PERIOD = 0.016
 #: A velocity command holds for this long, then the turtle stops.
@@ -120,6 +122,8 @@ class World:
         self.image = np.empty((CANVAS_PIXELS, CANVAS_PIXELS, 3), dtype=np.uint8)
         self.turtles: dict[str, Turtle] = {}
         self.segments: list[Segment] = []
+        #: segments drawn since the last clear (including ones dropped from ``segments``)
+        self.segment_total = 0
         #: bumps on every clear so viewers know to drop their trail
         self.clear_count = 0
         self._id_counter = 0
@@ -136,6 +140,7 @@ class World:
             self.background = tuple(int(c) & 0xFF for c in background)  # type: ignore[assignment]
         self.image[:, :] = self.background
         self.segments.clear()
+        self.segment_total = 0
         self.clear_count += 1
 
     def to_pixel(self, x: float, y: float) -> tuple[float, float]:
@@ -155,6 +160,9 @@ class World:
             return
         pen = turtle.pen
         self.segments.append(Segment(x0, y0, turtle.x, turtle.y, pen.r, pen.g, pen.b, pen.width))
+        self.segment_total += 1
+        if len(self.segments) > SEGMENT_HISTORY:
+            del self.segments[: SEGMENT_HISTORY // 2]
         draw_line(self.image, self.to_pixel(x0, y0), self.to_pixel(turtle.x, turtle.y), pen)
 
     # -- turtles ------------------------------------------------------------------------------

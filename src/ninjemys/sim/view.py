@@ -1,0 +1,115 @@
+"""The turtlesim window as a page of the web tools app.
+
+The browser keeps its own copy of the path image: it starts from a PNG of the current path (sent
+when the page connects) and then draws the pen segments each update carries, so the stream stays
+small however long the turtles have been drawing. Turtles are redrawn from their poses.
+"""
+
+from __future__ import annotations
+
+import base64
+import threading
+
+from ninjemys.sim.render import compose_frame, png_bytes
+from ninjemys.sim.world import CANVAS_PIXELS, PIXELS_PER_METER, Segment, Turtle, World
+from ninjemys.web.app import WebApp
+from ninjemys.web.events import Hub
+from ninjemys.web.http import EventStream, Request, Response
+
+
+def turtle_json(turtle: Turtle) -> dict:
+    return {
+        "name": turtle.name,
+        "x": turtle.x,
+        "y": turtle.y,
+        "theta": turtle.theta,
+        "image": turtle.image_index,
+        "pen": None if turtle.pen.off else [turtle.pen.r, turtle.pen.g, turtle.pen.b, turtle.pen.width],
+    }
+
+
+def segment_json(s: Segment) -> list:
+    return [round(s.x0, 5), round(s.y0, 5), round(s.x1, 5), round(s.y1, 5), s.r, s.g, s.b, s.width]
+
+
+class TurtlesimView:
+    """Adds ``/turtlesim`` (page), its state, event stream and PNG snapshot to a :class:`WebApp`.
+
+    ``world`` is shared with the node; every access holds ``lock``. Call :meth:`publish` after each
+    world step (from any thread); it sends what changed since the previous call.
+    """
+
+    def __init__(self, app: WebApp, world: World, lock: threading.Lock, node_name: str) -> None:
+        self.app = app
+        self.world = world
+        self.lock = lock
+        self.node_name = node_name
+        self.hub: Hub | None = None
+        self._sent_segments = 0
+        self._sent_clear = world.clear_count
+        self._last_poses: list | None = None
+        app.add_page("Turtlesim", "/turtlesim")
+        s = app.server
+        s.route("GET", "/turtlesim", lambda _r: app._static_page("turtlesim.html"))
+        s.route("GET", "/api/turtlesim/state", self._state_response)
+        s.route("GET", "/api/turtlesim/events", self._events)
+        s.route("GET", "/api/turtlesim/snapshot.png", self._snapshot)
+
+    def attach(self) -> None:
+        """Create the event hub (the app must be started)."""
+        self.hub = self.app.hub()
+
+    def _full_state(self) -> dict:
+        """Everything a freshly connected page needs (call with the lock held)."""
+        w = self.world
+        return {
+            "node": self.node_name,
+            "size": CANVAS_PIXELS,
+            "scale": PIXELS_PER_METER,
+            "world": w.width,
+            "background": list(w.background),
+            "path_png": base64.b64encode(png_bytes(w.image)).decode("ascii"),
+            "turtles": [turtle_json(t) for t in w.turtles.values()],
+        }
+
+    def _state_response(self, _request: Request) -> Response:
+        with self.lock:
+            state = self._full_state()
+        return Response(state)
+
+    def _events(self, _request: Request) -> EventStream:
+        assert self.hub is not None
+        with self.lock:
+            return self.hub.open([("state", self._full_state())])
+
+    def _snapshot(self, _request: Request) -> Response:
+        with self.lock:
+            frame = compose_frame(self.world)
+        return Response(png_bytes(frame), 200, "image/png", {"Cache-Control": "no-store"})
+
+    def _resync(self) -> dict:
+        with self.lock:
+            return self._full_state()
+
+    def publish(self) -> None:
+        """Send the turtles and new pen segments to every open page (call with the lock held)."""
+        if self.hub is None or self.hub.listeners == 0:
+            self._sent_segments = self.world.segment_total
+            self._sent_clear = self.world.clear_count
+            return
+        w = self.world
+        pending = w.segment_total - self._sent_segments
+        if w.clear_count != self._sent_clear or pending > len(w.segments):
+            self._sent_clear = w.clear_count
+            self._sent_segments = w.segment_total
+            self._last_poses = None
+            self.hub.publish("state", self._full_state(), resync=self._resync)
+            return
+        new = w.segments[len(w.segments) - pending :] if pending else []
+        self._sent_segments = w.segment_total
+        poses = [turtle_json(t) for t in w.turtles.values()]
+        if not new and poses == self._last_poses:
+            return
+        self._last_poses = poses
+        update = {"turtles": poses, "segments": [segment_json(s) for s in new]}
+        self.hub.publish("update", update, resync=self._resync)
