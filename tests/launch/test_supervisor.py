@@ -101,29 +101,33 @@ def test_screen_output_is_prefixed_per_node() -> None:
 
 def test_sigint_ignoring_node_is_escalated_to_sigterm() -> None:
     lines: list[str] = []
-    sup = Supervisor(
-        [spec("stubborn-1", "stubborn.py", sigint_timeout=0.3, sigterm_timeout=0.5)], write=lines.append
-    )
-    ready = threading.Event()
-
-    def on_event(kind: str, name: str) -> None:
-        if kind == "started":
-            ready.set()
-
-    sup.on_event = on_event
-    original = sup.write
+    holder: list[Supervisor] = []
 
     def write(text: str) -> None:
-        original(text)
+        lines.append(text)
         if "stubborn ready" in text:
-            sup.request_shutdown()
+            holder[0].request_shutdown()
 
-    sup.write = write  # type: ignore[method-assign]
+    sup = Supervisor(
+        [spec("stubborn-1", "stubborn.py", sigint_timeout=0.3, sigterm_timeout=0.5)], write=write
+    )
+    holder.append(sup)
     thread, result = run_in_thread(sup)
     thread.join(60)
-    assert not thread.is_alive() and ready.is_set()
+    assert not thread.is_alive() and result == [0]
+    assert any("stubborn ready" in line for line in lines)
     assert any("escalating to SIGTERM" in line for line in lines)
     assert not alive(sup.procs[0].popen.pid)  # type: ignore[union-attr]
+
+
+def test_supervisor_messages_go_to_the_launch_log_but_node_output_does_not() -> None:
+    lines: list[str] = []
+    logged: list[str] = []
+    sup = Supervisor([spec("crash-1", "crasher.py", "0")], write=lines.append, log=logged.append)
+    assert sup.run() == 0
+    assert any("crasher running" in line for line in lines)
+    assert not any("crasher running" in line for line in logged)
+    assert any("process[crash-1]: started with pid" in line for line in logged)
 
 
 def test_log_output_goes_to_a_file(tmp_path: Path) -> None:

@@ -11,6 +11,8 @@ import os
 import signal
 import socket
 import sys
+import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -184,7 +186,8 @@ class LaunchSession:
         run_id = master_link.run_id(client)
         log_dir = log_root / run_id
         log_dir.mkdir(parents=True, exist_ok=True)
-        self._say(f"... logging to {log_dir / f'roslaunch-{socket.gethostname()}-{os.getpid()}.log'}")
+        launch_log = log_dir / f"roslaunch-{socket.gethostname()}-{os.getpid()}.log"
+        self._say(f"... logging to {launch_log}")
         if not self.opts.no_summary:
             self._say(summary(self.plan, {}))
         master_link.load_parameters(client, self.plan)
@@ -202,12 +205,22 @@ class LaunchSession:
                     sigint_timeout=self.opts.sigint_timeout,
                 ),
             )
-        self.supervisor = Supervisor(specs)
+        with open(launch_log, "a", encoding="utf-8") as log_file:
+
+            def log(text: str) -> None:
+                log_file.write(f"[{time.strftime('%Y-%m-%d %H:%M:%S')}] {text}")
+                log_file.flush()
+
+            log(f"roslaunch pid {os.getpid()}, master {uri}, run_id {run_id}, files {self.plan.files}\n")
+            return self._supervise(specs, log)
+
+    def _supervise(self, specs: list[ProcessSpec], log: Callable[[str], None]) -> int:
+        self.supervisor = Supervisor(specs, log=log)
         previous = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
         for sig in previous:
             signal.signal(sig, lambda *_: self.supervisor.request_shutdown() if self.supervisor else None)
         try:
-            if not specs and core_proc is None:
+            if not specs:
                 self._say("no nodes to launch")
                 return 0
             return self.supervisor.run()

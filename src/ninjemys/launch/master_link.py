@@ -119,11 +119,7 @@ def _xmlrpc_value(value: Any) -> Any:
 
 
 def load_parameters(client: MasterClient, plan: LaunchPlan) -> None:
-    """clear_params first, then rosparam dump/delete commands, then every parameter."""
-    for ns in plan.clear_params:
-        key = ns.rstrip("/") or "/"
-        if client.has_param(key):
-            client.delete_param(key)
+    """ROS 1's order: rosparam dump/delete commands, then clear_params, then every parameter."""
     for command in plan.setup_commands:
         if command.command == "delete":
             try:
@@ -133,6 +129,10 @@ def load_parameters(client: MasterClient, plan: LaunchPlan) -> None:
         elif command.command == "dump" and command.file:
             value = client.get_param(command.param) if client.has_param(command.param) else {}
             Path(command.file).write_text(yaml.safe_dump(value), encoding="utf-8")
+    for ns in plan.clear_params:
+        key = ns.rstrip("/") or "/"
+        if client.has_param(key):
+            client.delete_param(key)
     for key, value in plan.params.items():
         try:
             client.set_param(key, _xmlrpc_value(value))

@@ -72,8 +72,15 @@ class _Running:
 class Supervisor:
     """Runs :class:`ProcessSpec` s until shutdown; ``run()`` returns the launch's exit status."""
 
-    def __init__(self, specs: list[ProcessSpec], write: Callable[[str], None] | None = None) -> None:
+    def __init__(
+        self,
+        specs: list[ProcessSpec],
+        write: Callable[[str], None] | None = None,
+        log: Callable[[str], None] | None = None,
+    ) -> None:
         self.procs = [_Running(spec) for spec in specs]
+        #: receives the supervisor's own messages (not node output): the roslaunch log file
+        self._log = log
         self.selector = selectors.DefaultSelector()
         self._write = write or _stdout_write
         self._output_broken = False
@@ -87,7 +94,16 @@ class Supervisor:
         self.on_event: Callable[[str, str], None] | None = None
 
     def write(self, text: str) -> None:
-        """Print supervisor and node output; a closed stdout (``| head``) never stops supervision."""
+        """Print a supervisor message (also to the launch log)."""
+        if self._log is not None:
+            try:
+                self._log(text)
+            except (OSError, ValueError):
+                self._log = None
+        self._print(text)
+
+    def _print(self, text: str) -> None:
+        """Print to the terminal; a closed stdout (``| head``) never stops supervision."""
         if self._output_broken:
             return
         try:
@@ -164,7 +180,7 @@ class Supervisor:
         return True
 
     def _emit(self, proc: _Running, line: bytes) -> None:
-        self.write(f"[{proc.spec.name}] {line.decode('utf-8', errors='replace')}\n")
+        self._print(f"[{proc.spec.name}] {line.decode('utf-8', errors='replace')}\n")
 
     def _drain(self, proc: _Running) -> None:
         """After an exit: print what is left in the pipes without ever blocking."""
