@@ -98,6 +98,7 @@ def init_node(
             and not _interactive()
         ):
             _install_signal_handlers()
+        _quiet_interrupted_callbacks()
         node = _start_node(base, args)
         log = NodeLog(node.name, level=log_level or INFO, log_file=args.log_file)
         _process.node = node
@@ -225,6 +226,21 @@ def _at_exit() -> None:
 
 
 # -- signals --------------------------------------------------------------------------------------------
+
+
+def _quiet_interrupted_callbacks() -> None:
+    """A callback interrupted by shutdown (``rospy.sleep`` inside it) ends quietly, as in rospy.
+
+    The core logs any exception escaping a subscriber callback; a filter on that logger drops the
+    ROSInterruptException ones once the node is shutting down, so delivery costs no wrapper call.
+    """
+    import logging
+
+    def keep(record: logging.LogRecord) -> bool:
+        exc = record.exc_info[0] if record.exc_info else None
+        return not (exc is not None and issubclass(exc, ROSInterruptException) and is_shutdown())
+
+    logging.getLogger("ninjemys.node.subscriber").addFilter(keep)
 
 
 def _interactive() -> bool:

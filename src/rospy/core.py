@@ -85,10 +85,10 @@ def is_initialized() -> bool:
 
 def is_shutdown() -> bool:
     """True once the node is shutting down (Ctrl-C, rosnode kill, a name collision, signal_shutdown)."""
+    if _process.shutdown_requested:
+        return True
     node = _process.node
-    if node is not None:
-        return node.is_shutdown
-    return _process.shutdown_requested
+    return node is not None and node.is_shutdown
 
 
 def signal_shutdown(reason: str) -> None:

@@ -189,7 +189,7 @@ class Subscriber(Topic):
         _process.attach(self)
 
     def _create(self, node: Any) -> Any:
-        callback = None if self.callback is None else _quiet_on_shutdown(self.callback)
+        callback = self.callback
         raw = self.data_class is AnyMsg
         if raw and callback is not None:
             callback = _any_msg_adapter(callback)
@@ -201,18 +201,6 @@ class Subscriber(Topic):
             queue_size=self.queue_size,
             raw=raw,
         )
-
-
-def _quiet_on_shutdown(callback: Callable[..., Any]) -> Callable[..., Any]:
-    """A callback interrupted by shutdown (e.g. ``rospy.sleep`` inside it) ends quietly, as in rospy."""
-
-    def guarded(*args: Any) -> Any:
-        try:
-            return callback(*args)
-        except ROSInterruptException:
-            return None
-
-    return guarded
 
 
 def _any_msg_adapter(callback: Callable[..., Any]) -> Callable[..., Any]:
