@@ -15,7 +15,7 @@ from typing import Any
 
 from ninjemys.node.clock import Clock
 from ninjemys.node.log import DEBUG, ERROR, FATAL, INFO, WARN, NodeLog
-from rospy.exceptions import ROSException
+from rospy.exceptions import ROSInitException
 
 __all__ = [
     "DEBUG",
@@ -50,7 +50,7 @@ class _Process:
     def require_node(self) -> Any:
         node = self.node
         if node is None:
-            raise ROSException("ROS node has not been initialized yet. Please call init_node() first")
+            raise ROSInitException("ROS node has not been initialized yet. Please call init_node() first")
         return node
 
     def attach(self, handle: Any) -> None:
