@@ -91,9 +91,17 @@ def format_console(
     return line.replace("${time}", stamp).replace("${walltime}", "%f" % wall)
 
 
+_stamp_cache: tuple[int, str] = (-1, "")
+
+
 def format_file(level: int, message: str, wall: float) -> str:
     """One log-file line in rospy's layout: ``[rosout][INFO] 2023-02-18 12:34:56,789: msg``."""
-    stamp = time.strftime("%Y-%m-%d %H:%M:%S", time.localtime(wall))
+    global _stamp_cache
+    second = int(wall)
+    cached_second, stamp = _stamp_cache  # one tuple: readers never see a half-updated pair
+    if cached_second != second:  # strftime once per second, not once per message
+        stamp = time.strftime("%Y-%m-%d %H:%M:%S", time.localtime(second))
+        _stamp_cache = (second, stamp)
     return f"[{USER_LOGGER}][{_FILE_LEVEL_NAMES[level]}] {stamp},{int(wall % 1 * 1000):03d}: {message}"
 
 
