@@ -16,7 +16,6 @@ any build, from the import hook (:func:`install_import_hook`, installed by ``imp
 
 from __future__ import annotations
 
-import importlib.abc
 import importlib.machinery
 import struct
 import sys
@@ -43,7 +42,14 @@ from ninjemys.idl.message import (
     short_buffer,
     u8_buffer,
 )
-from ninjemys.idl.parser import ACTION_SUFFIXES, parse_action, parse_file, parse_message, split_type_name
+from ninjemys.idl.parser import (
+    ACTION_SUFFIXES,
+    parse_action,
+    parse_file,
+    parse_message,
+    read_definition,
+    split_type_name,
+)
 from ninjemys.idl.spec import MsgSpec, SrvSpec
 from ninjemys.rostime import Duration, Time
 
@@ -116,9 +122,7 @@ def _load_message_spec(type_name: str) -> MsgSpec:
     for suffix in sorted(ACTION_SUFFIXES, key=len, reverse=True):
         stem = short[: -len(suffix)]
         if short.endswith(suffix) and stem in actions:
-            action = parse_action(
-                actions[stem].read_text(encoding="utf-8"), f"{package}/{stem}", str(actions[stem])
-            )
+            action = parse_action(read_definition(actions[stem]), f"{package}/{stem}", actions[stem])
             for generated in action.generated:
                 _msg_specs.setdefault(generated.full_name, generated)
             return _msg_specs[type_name]
@@ -350,7 +354,9 @@ def package_module_hooks(module_name: str) -> tuple[Callable[[str], Any], Callab
     return __getattr__, __dir__
 
 
-class _InterfaceLoader(importlib.abc.Loader):
+class _InterfaceLoader:
+    """Creates the lazy ``<pkg>``/``<pkg>.msg``/``<pkg>.srv`` modules (importlib's Loader protocol)."""
+
     def create_module(self, spec: importlib.machinery.ModuleSpec) -> ModuleType | None:
         return None
 
@@ -361,8 +367,12 @@ class _InterfaceLoader(importlib.abc.Loader):
         module.__path__ = []  # a package, so that `<pkg>.msg` can be imported below it
 
 
-class InterfaceFinder(importlib.abc.MetaPathFinder):
-    """Imports ``<pkg>``, ``<pkg>.msg`` and ``<pkg>.srv`` for interface packages nobody else provides."""
+class InterfaceFinder:
+    """Imports ``<pkg>``, ``<pkg>.msg`` and ``<pkg>.srv`` for interface packages nobody else provides.
+
+    A plain class implementing importlib's MetaPathFinder protocol (importing ``importlib.abc`` would
+    cost more start-up time than everything else here).
+    """
 
     def find_spec(
         self, fullname: str, path: Any = None, target: Any = None

@@ -20,8 +20,8 @@ Every problem raises :class:`~ninjemys.errors.DefinitionError` carrying the file
 from __future__ import annotations
 
 import ast
+import os
 import re
-from pathlib import Path
 
 from ninjemys.errors import DefinitionError
 from ninjemys.idl.spec import (
@@ -230,19 +230,27 @@ def parse_action(text: str, full_name: str, path: str | None = None) -> ActionSp
     )
 
 
-def parse_file(path: str | Path, package: str) -> MsgSpec | SrvSpec | ActionSpec:
-    """Parse a definition file; its kind comes from the suffix and its name from the file stem."""
-    p = Path(path)
+def read_definition(path: str | os.PathLike[str]) -> str:
+    """The text of a definition file (DefinitionError naming the file when it cannot be read)."""
     try:
-        text = p.read_text(encoding="utf-8")
+        with open(path, encoding="utf-8") as f:
+            return f.read()
     except (OSError, UnicodeDecodeError) as exc:
-        raise DefinitionError(f"cannot read definition: {exc}", str(p)) from None
-    full_name = f"{package}/{p.stem}"
-    match p.suffix:
+        raise DefinitionError(f"cannot read definition: {exc}", os.fspath(path)) from None
+
+
+def parse_file(path: str | os.PathLike[str], package: str) -> MsgSpec | SrvSpec | ActionSpec:
+    """Parse a definition file; its kind comes from the suffix and its name from the file stem."""
+    where = os.fspath(path)
+    stem, suffix = os.path.splitext(os.path.basename(where))
+    if suffix not in (".msg", ".srv", ".action"):
+        raise DefinitionError(f"unknown definition kind {suffix!r} (expected .msg, .srv or .action)", where)
+    text = read_definition(where)
+    full_name = f"{package}/{stem}"
+    match suffix:
         case ".msg":
-            return parse_message(text, full_name, str(p))
+            return parse_message(text, full_name, where)
         case ".srv":
-            return parse_service(text, full_name, str(p))
-        case ".action":
-            return parse_action(text, full_name, str(p))
-    raise DefinitionError(f"unknown definition kind {p.suffix!r} (expected .msg, .srv or .action)", str(p))
+            return parse_service(text, full_name, where)
+        case _:
+            return parse_action(text, full_name, where)

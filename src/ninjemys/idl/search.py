@@ -19,62 +19,85 @@ from __future__ import annotations
 import os
 import re
 import threading
-from dataclasses import dataclass
-from pathlib import Path
 
 from ninjemys.errors import TypeNotFoundError
 
-SHIPPED_ROOT = Path(__file__).resolve().parent.parent / "interfaces"
+#: plain ``os.path`` strings throughout: importing pathlib would be most of this module's start-up cost
+SHIPPED_ROOT = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "interfaces")
 _NAME_RE = re.compile(r"<name>\s*([^<\s]+)\s*</name>")
 _MAX_DEPTH = 8
 
 
-@dataclass(frozen=True, slots=True)
 class Package:
-    name: str
-    path: Path
-    origin: str  # "shipped", "ROS_PACKAGE_PATH" or "CMAKE_PREFIX_PATH"
+    """A package that may hold interface definitions: its name, directory and where it was found."""
 
-    def definitions(self, kind: str) -> dict[str, Path]:
+    __slots__ = ("name", "path", "origin")
+
+    def __init__(self, name: str, path: str, origin: str) -> None:
+        self.name = name
+        self.path = path
+        self.origin = origin  # "shipped", "ROS_PACKAGE_PATH" or "CMAKE_PREFIX_PATH"
+
+    def __repr__(self) -> str:
+        return f"Package({self.name!r}, {self.path!r}, {self.origin!r})"
+
+    def definitions(self, kind: str) -> dict[str, str]:
         """``{"Type": path}`` of the ``.msg``/``.srv``/``.action`` files (kind is the suffix without dot)."""
-        folder = self.path / kind
+        folder = os.path.join(self.path, kind)
+        suffix = "." + kind
         try:
-            return {p.stem: p for p in sorted(folder.glob(f"*.{kind}")) if p.is_file()}
+            names = sorted(os.listdir(folder))
         except OSError:
             return {}
+        found = {}
+        for name in names:
+            full = os.path.join(folder, name)
+            if name.endswith(suffix) and os.path.isfile(full):
+                found[name[: -len(suffix)]] = full
+        return found
 
 
-def _package_name(package_xml: Path) -> str:
+def _package_name(package_xml: str) -> str:
     try:
-        match = _NAME_RE.search(package_xml.read_text(encoding="utf-8", errors="replace"))
+        with open(package_xml, encoding="utf-8", errors="replace") as f:
+            match = _NAME_RE.search(f.read())
     except OSError:
         match = None
-    return match.group(1) if match else package_xml.parent.name
+    return match.group(1) if match else os.path.basename(os.path.dirname(package_xml))
 
 
-def _scan(root: Path, found: dict[str, Package], origin: str, depth: int = 0) -> None:
-    if depth > _MAX_DEPTH or not root.is_dir():
-        return
-    manifest = root / "package.xml"
-    if manifest.is_file():
-        found.setdefault(_package_name(manifest), Package(_package_name(manifest), root, origin))
-        return
-    if (root / "CATKIN_IGNORE").exists() or (root / "rospack_nosubdirs").exists():
-        return
+def _subdirs(root: str) -> list[str]:
     try:
-        children = sorted(p for p in root.iterdir() if p.is_dir() and not p.name.startswith("."))
+        names = sorted(os.listdir(root))
     except OSError:
+        return []
+    return [
+        os.path.join(root, n) for n in names if not n.startswith(".") and os.path.isdir(os.path.join(root, n))
+    ]
+
+
+def _scan(root: str, found: dict[str, Package], origin: str, depth: int = 0) -> None:
+    if depth > _MAX_DEPTH or not os.path.isdir(root):
         return
-    for child in children:
+    manifest = os.path.join(root, "package.xml")
+    if os.path.isfile(manifest):
+        name = _package_name(manifest)
+        found.setdefault(name, Package(name, root, origin))
+        return
+    if os.path.exists(os.path.join(root, "CATKIN_IGNORE")) or os.path.exists(
+        os.path.join(root, "rospack_nosubdirs")
+    ):
+        return
+    for child in _subdirs(root):
         _scan(child, found, origin, depth + 1)
 
 
 def _shipped() -> dict[str, Package]:
     found: dict[str, Package] = {}
-    if SHIPPED_ROOT.is_dir():
-        for child in sorted(SHIPPED_ROOT.iterdir()):
-            if (child / "package.xml").is_file():
-                found[child.name] = Package(child.name, child, "shipped")
+    for child in _subdirs(SHIPPED_ROOT):
+        if os.path.isfile(os.path.join(child, "package.xml")):
+            name = os.path.basename(child)
+            found[name] = Package(name, child, "shipped")
     return found
 
 
@@ -82,15 +105,15 @@ _lock = threading.Lock()
 _cache: dict[tuple[str, str], dict[str, Package]] = {}
 
 
-def search_roots() -> list[tuple[str, Path]]:
+def search_roots() -> list[tuple[str, str]]:
     """The places searched, in order, as (origin, path), for error messages and ``rosmsg``."""
-    roots: list[tuple[str, Path]] = [("shipped", SHIPPED_ROOT)]
+    roots: list[tuple[str, str]] = [("shipped", SHIPPED_ROOT)]
     for entry in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep):
         if entry:
-            roots.append(("ROS_PACKAGE_PATH", Path(entry)))
+            roots.append(("ROS_PACKAGE_PATH", entry))
     for entry in os.environ.get("CMAKE_PREFIX_PATH", "").split(os.pathsep):
         if entry:
-            roots.append(("CMAKE_PREFIX_PATH", Path(entry) / "share"))
+            roots.append(("CMAKE_PREFIX_PATH", os.path.join(entry, "share")))
     return roots
 
 
@@ -105,12 +128,11 @@ def packages() -> dict[str, Package]:
     for origin, root in search_roots()[1:]:
         if origin == "CMAKE_PREFIX_PATH":
             # an install/devel prefix: share/<pkg>/package.xml, one level only
-            if root.is_dir():
-                for child in sorted(root.iterdir()):
-                    manifest = child / "package.xml"
-                    if manifest.is_file():
-                        name = _package_name(manifest)
-                        found.setdefault(name, Package(name, child, origin))
+            for child in _subdirs(root):
+                manifest = os.path.join(child, "package.xml")
+                if os.path.isfile(manifest):
+                    name = _package_name(manifest)
+                    found.setdefault(name, Package(name, child, origin))
         else:
             _scan(root, found, origin)
     with _lock:
@@ -137,7 +159,7 @@ def find_package(name: str) -> Package:
     return pkg
 
 
-def find_definition(package: str, short: str, kind: str) -> Path:
+def find_definition(package: str, short: str, kind: str) -> str:
     """The file defining ``package/short`` of the given kind (``msg``, ``srv`` or ``action``)."""
     pkg = find_package(package)
     path = pkg.definitions(kind).get(short)

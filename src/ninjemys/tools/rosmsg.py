@@ -12,6 +12,7 @@ Both commands share this module; ``rossrv`` is the same code in service mode
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from collections.abc import Callable
 
@@ -69,7 +70,7 @@ def _types_in(package: search.Package, mode: str) -> list[str]:
 
 
 def _packages_with(mode: str) -> list[search.Package]:
-    return [p for _, p in sorted(search.packages().items()) if (p.path / mode).is_dir()]
+    return [p for _, p in sorted(search.packages().items()) if os.path.isdir(os.path.join(p.path, mode))]
 
 
 def _search_bare(mode: str, short: str) -> list[str]:
