@@ -11,12 +11,12 @@ from ninjemys.launch.master_link import master_is_up
 from ninjemys.master.client import MasterClient
 from ninjemys.testing import free_port, ninjemys_bin
 
-from .test_roslaunch_cli import Launch, env, launches, run_cli, write_launch  # noqa: F401 - fixtures
+from .conftest import Launch, run_cli, write_launch
 
 SLEEPER = '<node name="solo" pkg="corpus_run" type="sleeper.py" output="{output}"/>'
 
 
-def test_port_option_starts_master_on_that_port(tmp_path: Path, env: dict, launches: list) -> None:  # noqa: F811
+def test_port_option_starts_master_on_that_port(tmp_path: Path, env: dict, launches: list) -> None:
     port = free_port()
     launch = Launch(["-p", str(port), str(write_launch(tmp_path, SLEEPER.format(output="screen")))], env)
     launches.append(launch)
@@ -28,7 +28,7 @@ def test_port_option_starts_master_on_that_port(tmp_path: Path, env: dict, launc
     assert not master_is_up(f"http://localhost:{port}/")
 
 
-def test_existing_master_is_used_and_left_running(tmp_path: Path, env: dict, launches: list) -> None:  # noqa: F811
+def test_existing_master_is_used_and_left_running(tmp_path: Path, env: dict, launches: list) -> None:
     port = env["ROS_MASTER_URI"].rsplit(":", 1)[1]
     core = subprocess.Popen(
         [ninjemys_bin("roscore"), "-p", port], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
@@ -59,7 +59,7 @@ def test_existing_master_is_used_and_left_running(tmp_path: Path, env: dict, lau
             core.wait()
 
 
-def test_launch_xml_from_stdin(env: dict) -> None:  # noqa: F811
+def test_launch_xml_from_stdin(env: dict) -> None:
     xml = "<launch><node name='piped' pkg='corpus_run' type='sleeper.py'/></launch>"
     result = subprocess.run(
         [ninjemys_bin("roslaunch"), "--nodes", "-"],
@@ -73,7 +73,7 @@ def test_launch_xml_from_stdin(env: dict) -> None:  # noqa: F811
     assert result.stdout == "/piped\n"
 
 
-def test_unreachable_ssh_machine_is_named_and_nothing_starts(tmp_path: Path, env: dict) -> None:  # noqa: F811
+def test_unreachable_ssh_machine_is_named_and_nothing_starts(tmp_path: Path, env: dict) -> None:
     body = (
         '<machine name="faraway" address="192.0.2.1" timeout="1"/>\n'
         '<node name="remote" pkg="corpus_run" type="sleeper.py" machine="faraway"/>'
@@ -85,7 +85,7 @@ def test_unreachable_ssh_machine_is_named_and_nothing_starts(tmp_path: Path, env
     assert not master_is_up(env["ROS_MASTER_URI"])
 
 
-def test_local_option_skips_remote_nodes(tmp_path: Path, env: dict, launches: list) -> None:  # noqa: F811
+def test_local_option_skips_remote_nodes(tmp_path: Path, env: dict, launches: list) -> None:
     body = (
         '<machine name="faraway" address="192.0.2.1" timeout="1"/>\n'
         '<node name="remote" pkg="corpus_run" type="sleeper.py" machine="faraway"/>\n'
