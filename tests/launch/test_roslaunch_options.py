@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import signal
+import socket
 import subprocess
 import time
 from pathlib import Path
@@ -73,15 +74,26 @@ def test_launch_xml_from_stdin(env: dict) -> None:
     assert result.stdout == "/piped\n"
 
 
+REMOTE = (
+    '<machine name="faraway" address="192.0.2.1" timeout="1"/>\n'
+    '<node name="remote" pkg="corpus_run" type="sleeper.py" machine="faraway"/>'
+)
+
+
 def test_unreachable_ssh_machine_is_named_and_nothing_starts(tmp_path: Path, env: dict) -> None:
-    body = (
-        '<machine name="faraway" address="192.0.2.1" timeout="1"/>\n'
-        '<node name="remote" pkg="corpus_run" type="sleeper.py" machine="faraway"/>'
-    )
-    result = run_cli([str(write_launch(tmp_path, body))], env)
+    env["ROS_MASTER_URI"] = env["ROS_MASTER_URI"].replace("localhost", socket.gethostname())
+    result = run_cli([str(write_launch(tmp_path, REMOTE))], env)
     assert result.returncode != 0
     errors = [line for line in result.stderr.splitlines() if line.startswith("ERROR")]
-    assert len(errors) == 1 and "[faraway]" in errors[0], result.stderr
+    assert len(errors) == 1, result.stderr
+    assert "cannot reach machine [faraway]" in errors[0] or "[faraway] (192.0.2.1) needs ssh" in errors[0]
+    assert not master_is_up(env["ROS_MASTER_URI"])
+
+
+def test_remote_machine_with_loopback_master_uri_is_refused(tmp_path: Path, env: dict) -> None:
+    result = run_cli([str(write_launch(tmp_path, REMOTE))], env)
+    assert result.returncode != 0
+    assert "machine [faraway] (192.0.2.1) cannot reach a master at http://localhost:" in result.stderr
     assert not master_is_up(env["ROS_MASTER_URI"])
 
 

@@ -105,6 +105,11 @@ def _process_specs(
             exe = node_executable(node, index)
             cwd = str(exe.path.parent) if exe.path is not None else ros_home
         if not machine.is_local:
+            if master_link.is_loopback_uri(master_uri):
+                raise LaunchError(
+                    f"machine [{machine.name}] ({machine.address}) cannot reach a master at {master_uri}: "
+                    "set ROS_MASTER_URI to this machine's name or address to launch remote nodes"
+                )
             # the remote machine runs its own ninjemys: rosrun there finds the package and executable
             argv = remote_command(machine, ["rosrun", node.package, node.type, *_user_args(node)], proc_env)
             cwd = None

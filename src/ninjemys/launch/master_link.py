@@ -32,18 +32,34 @@ def master_uri_for(port: int | None, env: dict[str, str]) -> str:
     return env.get("ROS_MASTER_URI") or "http://localhost:11311/"
 
 
-def is_local_uri(uri: str) -> bool:
-    host = urlsplit(uri).hostname or ""
-    if host in ("localhost", "127.0.0.1", "::1", "0.0.0.0"):
-        return True
+def is_local_address(host: str) -> bool:
+    """True when ``host`` names this machine (loopback, its host name, or one of its addresses)."""
     import socket
 
+    if host in ("localhost", "127.0.0.1", "::1", "0.0.0.0", ""):
+        return True
     try:
-        return host in (socket.gethostname(), socket.getfqdn()) or socket.gethostbyname(host).startswith(
-            "127."
-        )
+        if host in (socket.gethostname(), socket.getfqdn()):
+            return True
+        address = socket.gethostbyname(host)
     except OSError:
         return False
+    if address.startswith("127."):
+        return True
+    try:
+        return address in {info[4][0] for info in socket.getaddrinfo(socket.gethostname(), None)}
+    except OSError:
+        return False
+
+
+def is_local_uri(uri: str) -> bool:
+    return is_local_address(urlsplit(uri).hostname or "")
+
+
+def is_loopback_uri(uri: str) -> bool:
+    """A URI only this machine can use (``localhost``, ``127.x``): useless to a remote node."""
+    host = urlsplit(uri).hostname or ""
+    return host in ("localhost", "::1", "") or host.startswith("127.")
 
 
 def master_is_up(uri: str, timeout: float = 1.0) -> bool:

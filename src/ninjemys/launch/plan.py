@@ -26,7 +26,12 @@ class Machine:
 
     @property
     def is_local(self) -> bool:
-        return self.address in ("localhost", "127.0.0.1", "::1", "") or self.name == ""
+        """This machine: the implicit local machine, or an address that resolves to this host."""
+        if self.name == "":
+            return True
+        from ninjemys.launch.master_link import is_local_address
+
+        return is_local_address(self.address)
 
 
 @dataclass
