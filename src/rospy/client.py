@@ -12,6 +12,7 @@ import os
 import signal
 import sys
 import threading
+import time
 from typing import Any
 
 from ninjemys.errors import MasterError, NameError_, NinjemysError, ParameterError
@@ -42,6 +43,9 @@ __all__ = [
 
 _UNSPECIFIED = object()
 _signals_installed = False
+_signal_times: list[float] = []
+#: a Ctrl-C arriving this long after the first one, while shutdown is still running, interrupts it
+_INSIST_AFTER = 3.0
 
 
 # -- init ---------------------------------------------------------------------------------------------------
@@ -260,9 +264,14 @@ def _install_signal_handlers() -> None:
 
 def _make_handler(previous: Any) -> Any:
     def handler(signum: int, frame: Any) -> None:
-        if _process.shutdown_requested and signum == signal.SIGINT:
-            # a second Ctrl-C while shutdown is under way: the user insists
-            raise KeyboardInterrupt
+        if _process.shutdown_requested:
+            # Another signal while shutting down (roslaunch and terminals often send two): ignore it,
+            # unless the shutdown has been stuck for a while and the user insists with Ctrl-C.
+            started = _signal_times[0] if _signal_times else time.monotonic()
+            if signum == signal.SIGINT and time.monotonic() - started > _INSIST_AFTER:
+                raise KeyboardInterrupt
+            return
+        _signal_times.append(time.monotonic())
         _process.shutdown_requested = True
         # Shut down on a helper thread: the interrupted main thread may hold locks the shutdown needs.
         threading.Thread(

@@ -71,6 +71,7 @@ def test_ctrl_c_interrupts_rate_sleep_in_seed_style_talker(run_node, master: str
     mine = [n for n in _node_names(master) if n.startswith(f"/talker_{talker.proc.pid}_")]
     assert mine
     talker.interrupt()
+    talker.interrupt()  # terminals and roslaunch often deliver two: the second must not break the exit
     assert talker.wait(5) == 0
     assert not any("Traceback" in line for line in talker.err), talker.err
     # the node unregistered everything before the process exited
