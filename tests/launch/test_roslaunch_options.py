@@ -109,3 +109,30 @@ def test_local_option_skips_remote_nodes(tmp_path: Path, env: dict, launches: li
     assert not any("cannot reach machine" in line for line in launch.lines)
     launch.proc.send_signal(signal.SIGINT)
     assert launch.finish() == 0
+
+
+FAKE_SSH = """#!/bin/sh
+# A stand-in for ssh: "connects" by running the remote command locally (the last argument).
+for last; do :; done
+[ "$last" = "true" ] && exit 0
+echo "fake-ssh ran on $1-style host" >&2
+exec sh -c "$last"
+"""
+
+
+def test_remote_machine_runs_node_over_ssh(tmp_path: Path, env: dict, launches: list) -> None:
+    bin_dir = tmp_path / "bin"
+    bin_dir.mkdir()
+    (bin_dir / "ssh").write_text(FAKE_SSH)
+    (bin_dir / "ssh").chmod(0o755)
+    env["PATH"] = f"{bin_dir}:{Path(ninjemys_bin('rosrun')).parent}:{env['PATH']}"
+    env["ROS_MASTER_URI"] = env["ROS_MASTER_URI"].replace("localhost", socket.gethostname())
+    body = (
+        '<machine name="faraway" address="192.0.2.1" user="robot"/>\n'
+        '<node name="remote" pkg="corpus_run" type="sleeper.py" machine="faraway" output="screen"/>'
+    )
+    launch = Launch([str(write_launch(tmp_path, body))], env)
+    launches.append(launch)
+    assert launch.wait_for(lambda ls: any("remote ready" in line for line in ls)), "".join(launch.lines)
+    launch.proc.send_signal(signal.SIGINT)
+    assert launch.finish() == 0
