@@ -417,3 +417,22 @@ rospy.spin()
     node.interrupt()
     assert node.wait(5) == 0
     assert not any("Traceback" in line or "Exception" in line for line in node.err), node.err
+
+
+def test_numpy_msg_publish_and_subscribe(run_node) -> None:
+    code = r"""
+import numpy, rospy
+from rospy.numpy_msg import numpy_msg
+from rospy_tutorials.msg import Floats
+rospy.init_node("numpy_node")
+def cb(msg):
+    print("got", type(msg.data).__name__, msg.data.dtype, msg.data.tolist(), flush=True)
+    rospy.signal_shutdown("done")
+rospy.Subscriber("floats", numpy_msg(Floats), cb)
+pub = rospy.Publisher("floats", numpy_msg(Floats), queue_size=10, latch=True)
+pub.publish(numpy.array([1.0, 2.5, -3.0], dtype=numpy.float32))
+rospy.spin()
+"""
+    node = run_node(code)
+    assert node.wait_for(r"^got (.*)$").group(1) == "ndarray float32 [1.0, 2.5, -3.0]"
+    assert node.wait(10) == 0
