@@ -244,3 +244,24 @@ def test_workspaces_chain(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> No
     first, found = result.stdout.splitlines()
     assert first == f"{over / 'src'}:{under / 'src'}"
     assert found == str(under / "src" / "base_pkg")
+
+
+def test_setup_bash_completes_packages_launch_files_and_executables(
+    ws: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    pkg = create(ws, monkeypatch, "comp_pkg", "rospy")
+    (pkg / "launch").mkdir()
+    (pkg / "launch" / "demo.launch").write_text("<launch/>")
+    (pkg / "scripts").mkdir()
+    (pkg / "scripts" / "node.py").write_text("print(1)\n")
+    (pkg / "scripts" / "node.py").chmod(0o755)
+    assert make(ws, monkeypatch) == 0
+    script = (
+        f"source {ws / 'devel' / 'setup.bash'}\n"
+        'COMP_WORDS=(roscd comp_); COMP_CWORD=1; _nj_complete_pkg; echo "${COMPREPLY[*]}"\n'
+        'COMP_WORDS=(roslaunch comp_pkg ""); COMP_CWORD=2; _nj_complete_pkg; echo "${COMPREPLY[*]}"\n'
+        'COMP_WORDS=(rosrun comp_pkg ""); COMP_CWORD=2; _nj_complete_pkg; echo "${COMPREPLY[*]}"\n'
+    )
+    env = {k: v for k, v in os.environ.items() if k not in ("ROS_PACKAGE_PATH", "CMAKE_PREFIX_PATH")}
+    result = subprocess.run(["bash", "-c", script], env=env, capture_output=True, text=True, check=False)
+    assert result.stdout.splitlines() == ["comp_pkg", "demo.launch", "node.py"], result.stderr

@@ -77,8 +77,16 @@ rosls() {
 
 _BASH_COMPLETION = """\
 _nj_complete_pkg() {
+  local cur="${COMP_WORDS[COMP_CWORD]}" dir
   if [ "$COMP_CWORD" -eq 1 ]; then
-    COMPREPLY=($(compgen -W "$(rospack list-names 2>/dev/null)" -- "${COMP_WORDS[COMP_CWORD]}"))
+    COMPREPLY=($(compgen -W "$(rospack list-names 2>/dev/null)" -- "$cur"))
+  elif [ "$COMP_CWORD" -eq 2 ]; then
+    dir="$(rospack find "${COMP_WORDS[1]}" 2>/dev/null)" || return
+    case "${COMP_WORDS[0]}" in
+      roslaunch) COMPREPLY=($(compgen -W "$(find -L "$dir" -name '*.launch' -printf '%f\\n' 2>/dev/null)" -- "$cur"));;
+      rosrun) COMPREPLY=($(compgen -W "$(find -L "$dir" -type f -perm -u+x -not -path '*/.*' -printf '%f\\n' 2>/dev/null)" -- "$cur"));;
+      rosed) COMPREPLY=($(compgen -W "$(find -L "$dir" -type f -not -path '*/.*' -printf '%f\\n' 2>/dev/null)" -- "$cur"));;
+    esac
   fi
 }
 complete -o default -F _nj_complete_pkg roscd rosls rosrun roslaunch rosed
