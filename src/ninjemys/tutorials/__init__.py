@@ -5,6 +5,30 @@ classic tutorial commands (talker/listener, add_two_ints server/client) work rig
 ``pip install``; the packages layer maps ``rosrun rospy_tutorials <name>`` to these modules.
 """
 
+from __future__ import annotations
+
+import functools
+import sys
+from collections.abc import Callable
+
+
+def node_main(body: Callable[[list[str] | None], int]) -> Callable[[list[str] | None], int]:
+    """Wrap a tutorial's ``main``: a start-up problem (bad ``_param:=``, bad ``__name:=``, no master for a
+    client) is one ``ERROR:`` line on stderr and exit code 1, never a traceback."""
+
+    @functools.wraps(body)
+    def main(argv: list[str] | None = None) -> int:
+        import rospy
+
+        try:
+            return body(argv)
+        except (rospy.ROSInitException, ValueError) as exc:
+            print(f"ERROR: {exc}", file=sys.stderr)
+            return 1
+
+    return main
+
+
 #: rosrun executable name -> module under ninjemys.tutorials
 EXECUTABLES = {
     "talker": "talker",

@@ -8,11 +8,14 @@ from __future__ import annotations
 import random
 import sys
 
+from ninjemys.tutorials import node_main
+
 
 def _usage(program: str) -> str:
     return "%s [x y]" % program
 
 
+@node_main
 def main(argv: list[str] | None = None) -> int:
     import rospy
     from rospy_tutorials.srv import AddTwoInts, AddTwoIntsRequest

@@ -5,6 +5,8 @@ from __future__ import annotations
 import sys
 from typing import Any
 
+from ninjemys.tutorials import node_main
+
 
 def _add(request: Any) -> Any:
     from rospy_tutorials.srv import AddTwoIntsResponse
@@ -14,6 +16,7 @@ def _add(request: Any) -> Any:
     return AddTwoIntsResponse(total)
 
 
+@node_main
 def main(argv: list[str] | None = None) -> int:
     import rospy
     from rospy_tutorials.srv import AddTwoInts

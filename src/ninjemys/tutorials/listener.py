@@ -5,6 +5,8 @@ from __future__ import annotations
 import sys
 from typing import Any
 
+from ninjemys.tutorials import node_main
+
 
 def _heard(message: Any) -> None:
     import rospy
@@ -12,6 +14,7 @@ def _heard(message: Any) -> None:
     rospy.loginfo(rospy.get_caller_id() + "I heard %s", message.data)
 
 
+@node_main
 def main(argv: list[str] | None = None) -> int:
     import rospy
     from std_msgs.msg import String

@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import sys
 
+from ninjemys.tutorials import node_main
 
+
+@node_main
 def main(argv: list[str] | None = None) -> int:
     import rospy
     from std_msgs.msg import String
