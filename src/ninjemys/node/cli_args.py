@@ -96,7 +96,8 @@ def parse_param_value(text: str, param: str = "") -> Any:
         return yaml.safe_load(text)
     except yaml.YAMLError as exc:
         where = f"_{param}:={text}" if param else text
-        raise ParameterError(f"invalid command-line parameter {where}: {exc}".replace("\n", " ")) from exc
+        problem = getattr(exc, "problem", None) or " ".join(str(exc).split())
+        raise ParameterError(f"invalid command-line parameter {where}: not valid YAML ({problem})") from None
 
 
 def private_params(argv: Sequence[str]) -> dict[str, Any]:
