@@ -92,13 +92,3 @@ def client(master: str):  # type: ignore[no-untyped-def]
         yield node
     finally:
         node.shutdown("test over")
-
-
-def wait_until(predicate: Callable[[], object], timeout: float = 15.0, what: str = "condition") -> object:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        value = predicate()
-        if value:
-            return value
-        time.sleep(0.05)
-    raise AssertionError(f"timed out waiting for {what}")

@@ -6,8 +6,8 @@ import math
 import threading
 
 import pytest
+from sim_helpers import wait_until
 
-from conftest import wait_until
 from geometry_msgs.msg import Twist
 from ninjemys.errors import ServiceError
 from ninjemys.master.client import MasterClient

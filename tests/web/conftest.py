@@ -4,54 +4,12 @@ from __future__ import annotations
 
 import signal
 import subprocess
-import time
-import xmlrpc.client
 from collections.abc import Callable, Iterator
-from pathlib import Path
 
 import pytest
+from web_helpers import CHROMIUM, CHROMIUM_ARGS, wait_for_master
 
 from ninjemys.testing import ROS1_PYTHON, free_port, ros1_env
-
-CHROMIUM = Path("/usr/bin/chromium")
-CHROMIUM_ARGS = [
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--no-first-run",
-]
-
-TALKER = """
-import rospy
-from std_msgs.msg import String
-rospy.init_node("talker")
-pub = rospy.Publisher("chatter", String, queue_size=10)
-rate = rospy.Rate(10)
-while not rospy.is_shutdown():
-    pub.publish("hello world")
-    rate.sleep()
-"""
-
-LISTENER = """
-import rospy
-from std_msgs.msg import String
-rospy.init_node("listener")
-rospy.Subscriber("chatter", String, lambda msg: None)
-rospy.spin()
-"""
-
-
-def wait_for_master(uri: str, timeout: float = 20.0) -> None:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        try:
-            xmlrpc.client.ServerProxy(uri).getPid("/test")
-            return
-        except OSError:
-            time.sleep(0.1)
-    raise RuntimeError(f"master at {uri} did not come up")
 
 
 @pytest.fixture
@@ -100,16 +58,6 @@ def rospy_node(ros1_master: str) -> Iterator[Callable[[str], subprocess.Popen]]:
             except subprocess.TimeoutExpired:
                 proc.kill()
                 proc.wait()
-
-
-def wait_until(predicate: Callable[[], object], timeout: float = 20.0, what: str = "condition") -> object:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        value = predicate()
-        if value:
-            return value
-        time.sleep(0.1)
-    raise AssertionError(f"timed out waiting for {what}")
 
 
 @pytest.fixture

@@ -5,8 +5,8 @@ from __future__ import annotations
 import signal
 
 import pytest
+from web_helpers import LISTENER, TALKER
 
-from conftest import LISTENER, TALKER
 from ninjemys.web.app import WebApp
 
 pytestmark = [pytest.mark.ros1, pytest.mark.browser]

@@ -7,8 +7,8 @@ import signal
 import urllib.request
 
 import pytest
+from web_helpers import LISTENER, TALKER, wait_until
 
-from conftest import LISTENER, TALKER, wait_until
 from ninjemys.web.app import WebApp
 
 pytestmark = pytest.mark.ros1
