@@ -29,3 +29,18 @@ def test_demo_runs_and_cleans_up(tmp_path) -> None:
     # nothing the demo started is left running
     leftover = subprocess.run(["pgrep", "-f", f"-p {port}"], capture_output=True, text=True).stdout.split()
     assert leftover == []
+
+
+def test_tutorial_start_up_error_is_one_line(tmp_path) -> None:
+    env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_MASTER_URI=f"http://localhost:{free_port()}/")
+    done = subprocess.run(
+        [sys.executable, "-m", "ninjemys.tutorials.talker", "_rate:=[1"],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert done.returncode == 1
+    assert done.stderr.splitlines() == [
+        "ERROR: invalid command-line parameter _rate:=[1: not valid YAML (expected ',' or ']', but got '<stream end>')"
+    ]
