@@ -198,3 +198,27 @@ def test_seed_talker_real_rospy_listener_ours(our_master: str, procs, tmp_path: 
     )
     listener = _run(procs, tmp_path, listener_code(), _our_env(our_master, tmp_path))
     _check_pair(talker, listener)
+
+
+ROSOUT_AGG_WATCHER = """
+import rospy
+from rosgraph_msgs.msg import Log
+rospy.init_node('agg_watcher', anonymous=True)
+def cb(m):
+    if m.name.startswith('/talker_') and 'hello world' in m.msg:
+        print('agg %d %s %s' % (m.level, m.name, ','.join(sorted(m.topics))), flush=True)
+rospy.Subscriber('/rosout_agg', Log, cb)
+print('ready', flush=True)
+rospy.spin()
+"""
+
+
+@pytest.mark.ros1
+def test_our_logs_reach_real_rosout_aggregator(real_master: str, procs, tmp_path: Path) -> None:
+    watcher = _run(
+        procs, tmp_path, ROSOUT_AGG_WATCHER, ros1_env(real_master, ROS_HOME=str(tmp_path / "r")), ROS1_PYTHON
+    )
+    watcher.wait_for("^ready$")
+    _run(procs, tmp_path, talker_code(), _our_env(real_master, tmp_path))
+    m = watcher.wait_for(r"^agg 2 (/talker_\d+_\d+) (\S+)$", timeout=30)
+    assert "/chatter" in m.group(2).split(",") and "/rosout" in m.group(2).split(",")
