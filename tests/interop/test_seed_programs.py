@@ -222,3 +222,32 @@ def test_our_logs_reach_real_rosout_aggregator(real_master: str, procs, tmp_path
     _run(procs, tmp_path, talker_code(), _our_env(real_master, tmp_path))
     m = watcher.wait_for(r"^agg 2 (/talker_\d+_\d+) (\S+)$", timeout=30)
     assert "/chatter" in m.group(2).split(",") and "/rosout" in m.group(2).split(",")
+
+
+@pytest.mark.ros1
+def test_real_rosservice_drives_our_logger_services(real_master: str, procs, tmp_path: Path) -> None:
+    env = _our_env(real_master, tmp_path)
+    node = _run(
+        procs,
+        tmp_path,
+        "import rospy\nrospy.init_node('levels')\nprint('up', flush=True)\nrospy.spin()\n",
+        env,
+    )
+    node.wait_for("^up$")
+    real = ros1_env(real_master, ROS_HOME=str(tmp_path / "r"))
+
+    def rosservice(*args: str) -> str:
+        deadline = time.monotonic() + 20
+        while True:
+            done = subprocess.run(
+                ["/usr/bin/rosservice", *args], env=real, capture_output=True, text=True, timeout=30
+            )
+            if done.returncode == 0 or time.monotonic() > deadline:
+                assert done.returncode == 0, done.stderr
+                return done.stdout
+            time.sleep(0.2)
+
+    assert 'name: "rosout"' in rosservice("call", "/levels/get_loggers")
+    rosservice("call", "/levels/set_logger_level", "rosout", "debug")
+    out = rosservice("call", "/levels/get_loggers")
+    assert 'level: "debug"' in out
