@@ -131,3 +131,17 @@ def test_subgraph_filter(master: tuple[MasterHandler, RecordingNotifier]) -> Non
     call(h, "registerPublisher", "/n", "/nsx/b", "std_msgs/String", "http://n/")
     assert call(h, "getPublishedTopics", "/n", "/ns")[2] == [["/ns/a", "std_msgs/String"]]
     assert len(call(h, "getPublishedTopics", "/n", "")[2]) == 2
+
+
+def test_a_replaced_node_cannot_take_its_name_back(master: tuple[MasterHandler, RecordingNotifier]) -> None:
+    h, n = master
+    call(h, "registerPublisher", "/talker", "/x", "std_msgs/String", "http://old/")
+    call(h, "registerPublisher", "/talker", "/x", "std_msgs/String", "http://new/")
+    n.calls.clear()
+    # a dying rospy node re-subscribes an unset parameter on every log call
+    reply = call(h, "subscribeParam", "/talker", "http://old/", "/rosout_disable_topics_generation")
+    assert reply[0] == -1 and "replaced by a newer node" in reply[1]
+    assert call(h, "lookupNode", "/a", "/talker")[2] == "http://new/"
+    assert not any(c[0] == "shutdown" for c in n.calls)
+    # the same API under another name is a different node
+    assert call(h, "registerPublisher", "/other", "/x", "std_msgs/String", "http://old/")[0] == 1

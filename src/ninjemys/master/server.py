@@ -23,7 +23,7 @@ from typing import Any
 
 from ninjemys.master.notify import Notifier
 from ninjemys.master.params import ParamTree, compute_updates, subscription_key
-from ninjemys.master.store import ANYTYPE, Bumped, RegistrationStore
+from ninjemys.master.store import ANYTYPE, Bumped, RegistrationStore, Superseded
 from ninjemys.names import resolve_name
 from ninjemys.wire import xmlrpc as wire
 
@@ -226,6 +226,8 @@ class MasterHandler:
             return [-1, str(exc) or "error", api.error_value]
         try:
             return api.fn(*args)
+        except Superseded as exc:
+            return [-1, str(exc), api.error_value]
         except TypeError as exc:
             return [-1, f"Error: invalid arguments: {exc}", api.error_value]
         except Exception as exc:

@@ -5,6 +5,11 @@ Pure data, no I/O and no locks (the master runs it on one event loop). Semantics
 * A node is known by name (caller_id) and XML-RPC API. Registering anything under a known name but a
   different API *replaces* the node: all of the old node's registrations are dropped and the caller
   learns the old API (the master then asks the old process to shut down).
+* A node that lost its name is told to shut down, but a dying rospy node keeps calling the master for a
+  moment (it re-subscribes an unset parameter on every log message). rosmaster lets such a late call
+  take the name back and shut the *new* node down - two nodes die instead of one. Here a replaced
+  (name, API) pair cannot register again for ``SUPERSEDED_SECONDS``: its calls raise
+  :class:`Superseded` (the master answers -1) and the new node keeps its name.
 * A node that unregistered everything is forgotten (``lookupNode`` fails for it).
 * Topic registrations are multimaps keyed by name, kept in first-registration order (which
   ``getSystemState`` reports); a service has exactly one provider, the latest to register.
@@ -17,9 +22,16 @@ graph of thousands of nodes costs nothing per call but the answer's size.
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 
 ANYTYPE = "*"
+SUPERSEDED_SECONDS = 30.0
+
+
+class Superseded(Exception):
+    """A registration from a node whose name was taken over by a newer node."""
+
 
 Entry = tuple[str, str]  # (caller_id, caller_api)
 
@@ -112,6 +124,7 @@ class RegistrationStore:
         self.param_subscribers = Registrations()
         self.topic_types: dict[str, str] = {}
         self._had_service = False  # rosmaster words one reply differently before the first service
+        self._superseded: dict[Entry, float] = {}  # (name, api) -> when it was replaced
 
     # ----------------------------------------------------------------------------------- nodes
 
@@ -119,8 +132,11 @@ class RegistrationStore:
         node = self.nodes.get(caller_id)
         if node is not None and node.api == caller_api:
             return node, None
+        if self._superseded:
+            self._check_superseded(caller_id, caller_api)
         bumped = None
         if node is not None:
+            self._superseded[(node.name, node.api)] = time.monotonic()
             bumped = Bumped(node.name, node.api, sorted(node.publications))
             self.publishers.unregister_node(caller_id, node.publications)
             self.subscribers.unregister_node(caller_id, node.subscriptions)
@@ -132,6 +148,17 @@ class RegistrationStore:
         node = NodeRef(caller_id, caller_api)
         self.nodes[caller_id] = node
         return node, bumped
+
+    def _check_superseded(self, caller_id: str, caller_api: str) -> None:
+        now = time.monotonic()
+        when = self._superseded.get((caller_id, caller_api))
+        if when is not None and now - when < SUPERSEDED_SECONDS:
+            raise Superseded(
+                f"node [{caller_id}] at {caller_api} was replaced by a newer node with the same name; "
+                "it has been asked to shut down"
+            )
+        if len(self._superseded) > 64 or when is not None:
+            self._superseded = {k: t for k, t in self._superseded.items() if now - t < SUPERSEDED_SECONDS}
 
     def _forget_if_empty(self, node: NodeRef) -> None:
         if node.is_empty() and self.nodes.get(node.name) is node:
