@@ -269,3 +269,13 @@ def test_action_generated_classes() -> None:
     goal.goal_id.id = "g1"
     back = goal_cls.deserialize_from(goal.serialize_to_bytes())
     assert back.goal.order == 5 and back.goal_id.id == "g1" and goal_cls._has_header
+
+
+def test_strify_options_follow_genpy() -> None:
+    from ninjemys.idl.message import strify_message
+
+    cls = get_message_class("std_msgs/Header")
+    msg = cls(seq=7, stamp=Time(12, 5), frame_id="f")
+    text = strify_message(msg, field_filter=lambda m: ["seq", "stamp"], fixed_numeric_width=4)
+    assert text == "seq:    7\nstamp: \n  secs:   12\n  nsecs:    5"
+    assert strify_message(msg, time_offset=Time(10)).split("\n")[2:4] == ["  secs: 2", "  nsecs:         5"]

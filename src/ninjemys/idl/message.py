@@ -387,13 +387,22 @@ def strify_message(
     val: Any,
     indent: str = "",
     time_offset: Time | None = None,
-    field_filter: Callable[[Message], Iterable[str]] | None = None,
+    current_time: Time | None = None,
+    field_filter: Callable[[Any], Iterable[str]] | None = None,
+    fixed_numeric_width: int | None = None,
 ) -> str:
     """Render a value the way genpy/rostopic echo do (YAML-ish, nested indentation by two spaces).
 
-    ``field_filter(msg)`` yields the field names to print (rostopic echo --noarr / --nostr).
+    The parameters are genpy's: ``time_offset`` prints times relative to it, ``field_filter(msg)``
+    selects the fields shown, ``fixed_numeric_width`` pads numbers (``current_time`` is unused, as in
+    genpy).
     """
     t = type(val)
+    if fixed_numeric_width is not None and t in (int, float):
+        if t is float:
+            text = f"%.{fixed_numeric_width}f" % val
+            return text[: max(text.find("."), fixed_numeric_width)]
+        return f"%{fixed_numeric_width}d" % val
     if t in (int, float, bool):
         return str(val)
     if t is str:
@@ -401,6 +410,9 @@ def strify_message(
     if isinstance(val, TVal):
         if time_offset is not None and isinstance(val, Time):
             val = val - time_offset
+        if fixed_numeric_width is not None:
+            width = f"%{fixed_numeric_width}d"
+            return f"\n{indent}secs: {width % val.secs}\n{indent}nsecs: {width % val.nsecs}"
         return f"\n{indent}secs: {val.secs}\n{indent}nsecs: {val.nsecs:9d}"
     if isinstance(val, NumericArray):
         val = val.tolist()
@@ -409,6 +421,12 @@ def strify_message(
         if not val:
             return "[]"
         first = val[0]
+        if type(first) in (int, float) and fixed_numeric_width is not None:
+            parts = "".join(
+                strify_message(v, indent, time_offset, current_time, field_filter, fixed_numeric_width) + ", "
+                for v in val
+            )
+            return "[" + parts.rstrip(", ") + "]"
         if isinstance(first, str):
             import yaml
 
@@ -420,24 +438,30 @@ def strify_message(
             return str(list(val))
         pref = indent + "- "
         sub = indent + "  "
-        return "\n" + "\n".join(pref + strify_message(v, sub, time_offset, field_filter) for v in val)
+        return "\n" + "\n".join(
+            pref + strify_message(v, sub, time_offset, current_time, field_filter, fixed_numeric_width)
+            for v in val
+        )
     if isinstance(val, Message):
+        shown = set(field_filter(val)) if field_filter is not None else None
         sub = "  " + indent
         lines = []
-        shown = set(field_filter(val)) if field_filter is not None else None
         for name, type_ in zip(val.__slots__, val._slot_types, strict=True):
             if shown is not None and name not in shown:
                 continue
             value = getattr(val, name)
             if "uint8[" in type_ and isinstance(value, bytes | bytearray | memoryview):
                 value = list(value)
-            lines.append(f"{indent}{name}: {strify_message(value, sub, time_offset, field_filter)}")
+            text = strify_message(value, sub, time_offset, current_time, field_filter, fixed_numeric_width)
+            lines.append(f"{indent}{name}: {text}")
         body = "\n".join(lines)
         return "\n" + body if indent else body
     if isinstance(val, memoryview):
         return str(val.tobytes())
     if type(val).__module__ == "numpy" and hasattr(val, "tolist"):
-        return strify_message(val.tolist(), indent, time_offset)
+        return strify_message(
+            val.tolist(), indent, time_offset, current_time, field_filter, fixed_numeric_width
+        )
     return str(val)
 
 
