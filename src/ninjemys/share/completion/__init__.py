@@ -1,0 +1,1 @@
+"""Bash completion for every ninjemys command: ``ninjemys.bash`` (see ninjemys.tools.complete)."""
