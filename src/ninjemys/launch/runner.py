@@ -18,7 +18,6 @@ import selectors
 import shlex
 import shutil
 import signal
-import socket
 import subprocess
 import sys
 import time
@@ -90,7 +89,7 @@ class Supervisor:
         os.set_blocking(self._wake_r, False)
         os.set_blocking(self._wake_w, False)
         self.selector.register(self._wake_r, selectors.EVENT_READ, ("wake", None))
-        #: set by the owner (e.g. a test or the ``--required`` CLI) to stop after this many exits
+        #: optional observer of ("started" | "exited", process name) events, called on the supervising thread
         self.on_event: Callable[[str, str], None] | None = None
 
     def write(self, text: str) -> None:
@@ -438,10 +437,6 @@ def remote_command(
         ["env", *assignments, *(shlex.quote(a) for a in loader), *(shlex.quote(a) for a in argv)]
     )
     return [*base, "-tt", target, remote]
-
-
-def local_hostname() -> str:
-    return socket.gethostname()
 
 
 def node_process_name(spec: NodeSpec, counter: int) -> str:
