@@ -8,6 +8,7 @@ nothing.
 from __future__ import annotations
 
 import os
+import shlex
 import signal
 import socket
 import sys
@@ -87,7 +88,8 @@ def _process_specs(
             raise LaunchError(
                 f"{node.filename}: node [{node.resolved_name}]: unknown machine [{node.machine_name}]"
             )
-        if opts.local_only and not machine.is_local:
+        local = machine.is_local
+        if opts.local_only and not local:
             continue
         counter += 1
         name = node_process_name(node, counter)
@@ -95,16 +97,13 @@ def _process_specs(
         proc_env["PYTHONUNBUFFERED"] = "1"
         for key, value in machine.env_args:
             proc_env[key] = value
-        argv = (
-            []
-            if not machine.is_local
-            else node_command(node, index) + [f"__log:={log_dir / (name + '.log')}"]
-        )
-        cwd = ros_home
-        if node.cwd == "node" and machine.is_local:
-            exe = node_executable(node, index)
-            cwd = str(exe.path.parent) if exe.path is not None else ros_home
-        if not machine.is_local:
+        if local:
+            argv = node_command(node, index) + [f"__log:={log_dir / (name + '.log')}"]
+            cwd: str | None = ros_home
+            if node.cwd == "node":
+                exe = node_executable(node, index)
+                cwd = str(exe.path.parent) if exe.path is not None else ros_home
+        else:
             if master_link.is_loopback_uri(master_uri):
                 raise LaunchError(
                     f"machine [{machine.name}] ({machine.address}) cannot reach a master at {master_uri}: "
@@ -136,8 +135,6 @@ def _process_specs(
 
 
 def _user_args(node: NodeSpec) -> list[str]:
-    import shlex
-
     return shlex.split(node.args) + [f"{a}:={b}" for a, b in node.remap_args] + [f"__name:={node.name}"]
 
 
