@@ -157,3 +157,18 @@ def test_png_roundtrip(world: World) -> None:
     assert len(raw) == 500 * (500 * 3 + 1)
     # the turtle is drawn at the centre, the corner is background
     assert tuple(raw[1:4]) == DEFAULT_BACKGROUND
+
+
+def test_commands_between_steps_are_integrated_exactly(world: World) -> None:
+    """Commands at 50 Hz, steps at 62.5 Hz: every command counts for exactly its own interval."""
+    world.step(0.0)
+    t_cmd, t_step, end = 0.0, 0.0, 2.0
+    while t_cmd < end - 1e-9:
+        world.command("turtle1", 0.5, 0.0, 0.0, now=t_cmd)
+        t_cmd += 0.02
+        while t_step + 0.016 <= t_cmd:
+            t_step += 0.016
+            world.step(t_step)
+    world.command("turtle1", 0.0, 0.0, 0.0, now=end)
+    world.step(end + 1.0)
+    assert world.turtles["turtle1"].x - CENTER == pytest.approx(1.0, abs=1e-6)

@@ -79,6 +79,8 @@ class Turtle:
     pen: Pen = field(default_factory=Pen)
     #: which turtle image the browser view draws (ROS picks one at random per spawn)
     image_index: int = 0
+    #: the time the pose was last integrated to (None until the world's clock first reaches it)
+    t_last: float | None = None
 
     @property
     def linear_velocity(self) -> float:
@@ -130,7 +132,6 @@ class World:
         self._image_counter = 0
         self._warn = warn or (lambda _m: None)
         self._info = info or (lambda _m: None)
-        self._last_step: float | None = None
         self.clear(background)
 
     # -- canvas -------------------------------------------------------------------------------
@@ -215,6 +216,8 @@ class World:
                 f"(linear.x={lin_x}, linear.y={lin_y}, angular.z={ang_z})"
             )
             return False
+        # the previous command was in force until now: integrate it before switching
+        self._advance_to(turtle, now)
         turtle.lin_x, turtle.lin_y, turtle.ang_z = float(lin_x), float(lin_y), float(ang_z)
         turtle.command_time = now
         return True
@@ -254,10 +257,14 @@ class World:
     # -- time ---------------------------------------------------------------------------------
     def step(self, now: float) -> None:
         """Advance every turtle to time ``now`` (seconds, any monotonic clock)."""
-        last, self._last_step = self._last_step, now
-        if last is None or now <= last:
-            return
         for turtle in self.turtles.values():
+            self._advance_to(turtle, now)
+
+    def _advance_to(self, turtle: Turtle, now: float) -> None:
+        last = turtle.t_last
+        if last is None or now > last:
+            turtle.t_last = now
+        if last is not None and now > last:
             self._advance(turtle, last, now)
 
     def _advance(self, turtle: Turtle, start: float, end: float) -> None:

@@ -1,0 +1,37 @@
+"""``mimic``: ROS turtlesim's tutorial node that makes one turtle copy another's motion.
+
+Subscribes ``input/pose`` and publishes ``output/cmd_vel`` with the same linear and angular speed;
+remap both (``input:=turtle1 output:=turtle2``) to pair two turtles.
+"""
+
+from __future__ import annotations
+
+import sys
+
+from ninjemys.tools.cli import entry
+
+
+def twist_from_pose(pose, twist_class):  # type: ignore[no-untyped-def]
+    """The command that reproduces a pose's motion."""
+    twist = twist_class()
+    twist.linear.x = pose.linear_velocity
+    twist.angular.z = pose.angular_velocity
+    return twist
+
+
+def main(argv: list[str] | None = None) -> int:
+    import rospy
+    from geometry_msgs.msg import Twist
+    from turtlesim.msg import Pose
+
+    rospy.init_node("turtle_mimic", argv=sys.argv if argv is None else [sys.argv[0], *argv])
+    pub = rospy.Publisher("output/cmd_vel", Twist, queue_size=1)
+    rospy.Subscriber("input/pose", Pose, lambda pose: pub.publish(twist_from_pose(pose, Twist)), queue_size=1)
+    rospy.spin()
+    return 0
+
+
+console_main = entry(main)
+
+if __name__ == "__main__":
+    console_main()
