@@ -12,7 +12,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "node"))
 
-from harness import Child  # noqa: E402
+from node_harness import Child  # noqa: E402
 
 from ninjemys import testing  # noqa: E402
 

@@ -10,8 +10,8 @@ import pytest
 
 sys.path[:0] = [str(Path(__file__).parent), str(Path(__file__).parents[1] / "node")]
 
-from harness import Child, MasterProcess  # noqa: E402
-from msgs import Trigger  # noqa: E402
+from node_harness import Child, MasterProcess  # noqa: E402
+from node_msgs import Trigger  # noqa: E402
 from ros1_peers import ROSPY_CLIENT, ROSPY_SERVICE, roscpp, rospy  # noqa: E402
 
 from ninjemys import testing  # noqa: E402

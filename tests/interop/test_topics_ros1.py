@@ -12,8 +12,8 @@ import pytest
 
 sys.path[:0] = [str(Path(__file__).parent), str(Path(__file__).parents[1] / "node")]
 
-from harness import Child, MasterProcess, wait_until  # noqa: E402
-from msgs import Image, String  # noqa: E402
+from node_harness import Child, MasterProcess, wait_until  # noqa: E402
+from node_msgs import Image, String  # noqa: E402
 from ros1_peers import (  # noqa: E402
     ROSPY_IMAGE_PUB,
     ROSPY_IMAGE_SUB,

@@ -13,7 +13,7 @@ from ninjemys.node import Node
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-from harness import MasterProcess, wait_until  # noqa: E402
+from node_harness import MasterProcess, wait_until  # noqa: E402
 
 __all__ = ["MasterProcess", "wait_until"]
 

@@ -8,7 +8,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-from msgs import String  # noqa: E402
+from node_msgs import String  # noqa: E402
 
 from ninjemys.node import Node  # noqa: E402
 

@@ -9,9 +9,9 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from msgs import String
+from node_harness import wait_until
+from node_msgs import String
 
-from conftest import wait_until
 from ninjemys.master.client import MasterClient
 
 TALKER = str(Path(__file__).parent / "talker_proc.py")

@@ -6,7 +6,7 @@ import socket
 import threading
 
 import pytest
-from msgs import AddTwoInts, Trigger
+from node_msgs import AddTwoInts, Trigger
 
 from ninjemys.errors import ServiceError, TimeoutError_
 from ninjemys.net.addresses import split_uri

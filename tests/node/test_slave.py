@@ -5,9 +5,8 @@ from __future__ import annotations
 import os
 import xmlrpc.client
 
-from msgs import String
-
-from conftest import wait_until
+from node_harness import wait_until
+from node_msgs import String
 
 
 def test_slave_api_shapes(make_node, master) -> None:

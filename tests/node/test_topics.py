@@ -5,9 +5,8 @@ from __future__ import annotations
 import threading
 import time
 
-from msgs import Image, Int64, String
-
-from conftest import wait_until
+from node_harness import wait_until
+from node_msgs import Image, Int64, String
 
 
 def _connected(pub, n: int = 1) -> bool:
