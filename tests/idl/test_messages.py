@@ -279,3 +279,10 @@ def test_strify_options_follow_genpy() -> None:
     text = strify_message(msg, field_filter=lambda m: ["seq", "stamp"], fixed_numeric_width=4)
     assert text == "seq:    7\nstamp: \n  secs:   12\n  nsecs:    5"
     assert strify_message(msg, time_offset=Time(10)).split("\n")[2:4] == ["  secs: 2", "  nsecs:         5"]
+
+
+def test_received_messages_can_carry_the_connection_header() -> None:
+    msg = get_message_class("std_msgs/String")(data="x")
+    msg._connection_header = {"callerid": "/talker"}
+    assert msg._connection_header["callerid"] == "/talker"
+    assert msg == get_message_class("std_msgs/String")(data="x")  # not part of equality

@@ -25,7 +25,8 @@ _DESER_ERRORS = (struct.error, ValueError, IndexError, TypeError, UnicodeError, 
 class Message:
     """Base of every generated message class (genpy.Message's surface)."""
 
-    __slots__ = ()
+    #: like genpy: subscribers may attach the publisher's connection header to a received message
+    __slots__ = ("_connection_header",)
     _type = ""
     _md5sum = ""
     _full_text = ""
