@@ -153,3 +153,24 @@ def test_required_node_finishing_cleanly_ends_launch_without_failure() -> None:
     assert result == [0]
     assert "REQUIRED process [done-2] has died!" in "".join(lines)
     assert not alive(sup.procs[0].popen.pid)  # type: ignore[union-attr]
+
+
+def test_second_interrupt_kills_at_once() -> None:
+    lines: list[str] = []
+    holder: list[Supervisor] = []
+
+    def write(text: str) -> None:
+        lines.append(text)
+        if "stubborn ready" in text:
+            holder[0].request_shutdown()
+        if "killing on exit" in text:
+            holder[0].request_shutdown()
+
+    sup = Supervisor([spec("stubborn-1", "stubborn.py", sigint_timeout=60, sigterm_timeout=60)], write=write)
+    holder.append(sup)
+    thread, result = run_in_thread(sup)
+    thread.join(30)
+    assert not thread.is_alive() and result == [0]
+    assert any("second interrupt" in line for line in lines)
+    assert not any("escalating" in line for line in lines)
+    assert not alive(sup.procs[0].popen.pid)  # type: ignore[union-attr]

@@ -259,6 +259,14 @@ class Supervisor:
         except (BlockingIOError, OSError):
             pass
 
+    def _kill_now(self) -> None:
+        """A second Ctrl-C during shutdown: no more waiting, SIGKILL every process still running."""
+        self.write("second interrupt: killing every remaining process now\n")
+        for proc in self.procs:
+            self._signal(proc, signal.SIGKILL)
+            proc.stop_stage = 3
+            proc.stop_deadline = None
+
     def _signal(self, proc: _Running, sig: int) -> None:
         if proc.popen is None or proc.exit_code is not None or proc.pidfd is None:
             return
@@ -355,7 +363,10 @@ class Supervisor:
                         os.read(self._wake_r, 512)
                     except BlockingIOError:
                         pass
-                    self.shutdown()
+                    if self.shutting_down:
+                        self._kill_now()
+                    else:
+                        self.shutdown()
                 elif kind == "out":
                     if key.fd in proc.streams:
                         self._pump(key.fd, proc)
