@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import resource
 import signal
 import statistics
 import subprocess
@@ -72,15 +73,19 @@ def _python(impl: str) -> str:
     return ROS1_PYTHON if impl == REAL else sys.executable
 
 
-def bare_wall(impl: str, master: str, home: str, runs: int) -> float:
-    walls = []
+def bare(impl: str, master: str, home: str, runs: int) -> tuple[float, float]:
+    """Median wall time and median CPU time (user + system) of the bare init_node process."""
+    walls, cpus = [], []
     for _ in range(runs):
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
         start = time.perf_counter()
         subprocess.run(
             [_python(impl), "-c", BARE], env=_env(impl, master, home), check=True, capture_output=True
         )
         walls.append(time.perf_counter() - start)
-    return statistics.median(walls)
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        cpus.append(after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime)
+    return statistics.median(walls), statistics.median(cpus)
 
 
 def phases(impl: str, master: str, home: str, runs: int) -> tuple[float, float]:
@@ -182,10 +187,11 @@ def main() -> None:
                         sys.exit("ERROR: rosmaster did not start")
                     time.sleep(0.05)
             for impl in (OURS, REAL):  # warm-up: byte-code caches, page cache
-                bare_wall(impl, master, home, 1)
+                bare(impl, master, home, 1)
             rows = []
-            wall = {impl: bare_wall(impl, master, home, args.runs) for impl in (OURS, REAL)}
-            rows.append(("import rospy; init_node process wall (s)", wall[OURS], wall[REAL]))
+            runs = {impl: bare(impl, master, home, args.runs) for impl in (OURS, REAL)}
+            rows.append(("import rospy; init_node process wall (s)", runs[OURS][0], runs[REAL][0]))
+            rows.append(("import rospy; init_node process CPU (s)", runs[OURS][1], runs[REAL][1]))
             ph = {impl: phases(impl, master, home, args.runs) for impl in (OURS, REAL)}
             rows.append(("  of which import rospy (s)", ph[OURS][0], ph[REAL][0]))
             rows.append(("  of which init_node (s)", ph[OURS][1], ph[REAL][1]))

@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import threading
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
 
 from ninjemys.errors import NinjemysError, ShutdownError
@@ -117,15 +116,31 @@ class Rate:
             self.last_time = now
 
 
-@dataclass(frozen=True)
 class TimerEvent:
-    """What a Timer callback is told (rospy.timer.TimerEvent fields, times in ROS seconds or Time)."""
+    """What a Timer callback is told (rospy.timer.TimerEvent fields, times in ROS seconds or Time).
 
-    last_expected: Any
-    last_real: Any
-    current_expected: Any
-    current_real: Any
-    last_duration: float | None
+    A plain slotted class rather than a dataclass: it is built on every tick and imported by every node.
+    """
+
+    __slots__ = ("last_expected", "last_real", "current_expected", "current_real", "last_duration")
+
+    def __init__(
+        self,
+        last_expected: Any,
+        last_real: Any,
+        current_expected: Any,
+        current_real: Any,
+        last_duration: float | None,
+    ) -> None:
+        self.last_expected = last_expected
+        self.last_real = last_real
+        self.current_expected = current_expected
+        self.current_real = current_real
+        self.last_duration = last_duration
+
+    def __repr__(self) -> str:
+        fields = ", ".join(f"{name}={getattr(self, name)!r}" for name in self.__slots__)
+        return f"TimerEvent({fields})"
 
 
 class Timer:
