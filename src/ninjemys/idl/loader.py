@@ -27,6 +27,7 @@ from typing import Any
 from ninjemys.errors import DefinitionError, TypeNotFoundError
 from ninjemys.idl import search
 from ninjemys.idl.arrays import NumericArray
+from ninjemys.idl.codecache import compile_cached
 from ninjemys.idl.codegen import class_ref, generate_class_source
 from ninjemys.idl.fulltext import all_dependencies, compute_full_text, split_full_text
 from ninjemys.idl.md5 import compute_md5, compute_srv_md5
@@ -182,7 +183,7 @@ def _build_class(
     md5sum = compute_md5(spec, lookup, md5_cache)
     full_text = compute_full_text(spec, lookup)
     source = generate_class_source(spec, lookup, md5sum, full_text)
-    exec(compile(source, f"<ninjemys generated {spec.full_name}>", "exec"), namespace)  # noqa: S102
+    exec(compile_cached(source, f"<ninjemys generated {spec.full_name}>"), namespace)  # noqa: S102
     cls = namespace[spec.short_name]
     cls._fields = tuple((f.name, f.type) for f in spec.fields)
     cls.__module__ = module
