@@ -109,3 +109,18 @@ def test_malformed_user_definition_reports_file_and_line(tmp_path: Path) -> None
 def test_usage_without_command() -> None:
     done = ours("rossrv")
     assert done.returncode == 0 and done.stdout.startswith("rossrv is a command-line tool")
+
+
+def test_show_from_a_bag(tmp_path: Path) -> None:
+    from ninjemys.bag.api import Bag
+    from ninjemys.idl.loader import get_message_class
+    from ninjemys.rostime import Time
+
+    path = tmp_path / "one.bag"
+    with Bag(str(path), "w") as bag:
+        bag.write("/pose", get_message_class("geometry_msgs/PoseStamped")(), Time(1))
+    done = ours("rosmsg", "show", "-b", str(path), "geometry_msgs/PoseStamped")
+    assert done.returncode == 0, done.stderr
+    assert done.stdout == ours("rosmsg", "show", "geometry_msgs/PoseStamped").stdout
+    raw = ours("rosmsg", "show", "-r", "-b", str(path), "geometry_msgs/PoseStamped")
+    assert raw.stdout == get_message_class("geometry_msgs/PoseStamped")._full_text + "\n"
