@@ -70,3 +70,29 @@ def test_unreachable_master_is_reported() -> None:
         assert "cannot reach the master" in state
     finally:
         web.stop()
+
+
+def test_topic_details_show_rate_and_last_message(ros1_master: str, rospy_node) -> None:  # type: ignore[no-untyped-def]
+    from ninjemys.node import Node
+    from ninjemys.web.monitor import TopicMonitor
+
+    monitor = TopicMonitor(lambda: Node("test_webtools", anonymous=True, master_uri=ros1_master))
+    web = WebApp(ros1_master, caller_id="/test_rqt_graph", poll_period=0.2, monitor=monitor)
+    web.start()
+    try:
+        rospy_node(TALKER)
+        wait_until(
+            lambda: any(
+                t["name"] == "/chatter"
+                for t in (_get(web.url + "api/graph")["graph"] or {}).get("topics", [])
+            ),
+            what="/chatter in the graph",
+        )
+        details = wait_until(
+            lambda: (d := _get(web.url + "api/topic?name=/chatter"))["count"] >= 5 and d, what="messages"
+        )
+        assert details["type"] == "std_msgs/String"
+        assert details["last_message"] == 'data: "hello world"'
+        assert 2.0 < details["rate"] < 50.0  # the talker publishes at 10 Hz (loose: shared machine)
+    finally:
+        web.stop()

@@ -237,13 +237,16 @@ def main(argv: list[str] | None = None) -> int:
     sim = TurtlesimNode()
     app = None
     if not options.headless:
+        from ninjemys.node import Node
         from ninjemys.node.cli_args import parse_args
         from ninjemys.sim.view import TurtlesimView
         from ninjemys.web.app import WebApp
+        from ninjemys.web.monitor import TopicMonitor
 
-        app = WebApp(
-            parse_args([sys.argv[0], *ros_args]).master_uri, rospy.get_name(), options.host, options.port
-        )
+        master_uri = parse_args([sys.argv[0], *ros_args]).master_uri
+        # the topic monitor's node is only created when someone opens a topic's details in the page
+        monitor = TopicMonitor(lambda: Node("turtlesim_webtools", anonymous=True, master_uri=master_uri))
+        app = WebApp(master_uri, rospy.get_name(), options.host, options.port, monitor=monitor)
         view = TurtlesimView(app, sim.world, sim.lock, rospy.get_name())
         try:
             url = app.start()

@@ -11,13 +11,14 @@ import asyncio
 import contextlib
 import logging
 import threading
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from ninjemys.errors import NinjemysError
 from ninjemys.web.events import Hub
 from ninjemys.web.graph import GraphPoller
 from ninjemys.web.http import HttpError, HttpServer, Request, Response
+from ninjemys.web.monitor import TopicMonitor
 
 log = logging.getLogger(__name__)
 
@@ -35,8 +36,8 @@ class Page:
 class WebApp:
     """The web tools server for one ROS graph.
 
-    ``topic_info(name) -> dict`` (optional) adds live rate and last message to the topic details; the
-    graph node provides it once it can subscribe (:mod:`ninjemys.web.monitor`).
+    ``monitor`` (optional) adds live rate and last message to the topic details
+    (:class:`ninjemys.web.monitor.TopicMonitor`); without it the details are what the master knows.
     """
 
     def __init__(
@@ -46,12 +47,13 @@ class WebApp:
         host: str = "127.0.0.1",
         port: int = 0,
         poll_period: float = 0.5,
+        monitor: TopicMonitor | None = None,
     ) -> None:
         self.master_uri = master_uri
         self.caller_id = caller_id
         self.server = HttpServer(host, port)
         self.pages: list[Page] = [Page("Node graph", "/")]
-        self.topic_info: Callable[[str], dict] | None = None
+        self.monitor = monitor
         self.loop: asyncio.AbstractEventLoop | None = None
         self.graph_hub: Hub | None = None
         self._poll_period = poll_period
@@ -106,7 +108,7 @@ class WebApp:
             self._poller.refresh()
         return Response({"ok": True})
 
-    def _get_topic(self, request: Request) -> Response:
+    async def _get_topic(self, request: Request) -> Response:
         name = request.arg("name")
         if not name:
             raise HttpError(400, "missing ?name=<topic>")
@@ -115,10 +117,12 @@ class WebApp:
         if topic is None:
             raise HttpError(404, f"topic {name} is not in the graph")
         details = dict(topic)
-        if self.topic_info is not None:
+        if self.monitor is not None:
+            # subscribing talks to the master and the publishers: keep it off the event loop
+            loop = asyncio.get_running_loop()
             try:
-                details.update(self.topic_info(name))
-            except Exception as exc:  # monitoring is best effort; the static facts still show
+                details.update(await loop.run_in_executor(None, self.monitor.info, name, topic["type"]))
+            except NinjemysError as exc:  # monitoring is best effort; the master's facts still show
                 details["monitor_error"] = str(exc)
         return Response(details)
 
@@ -174,6 +178,8 @@ class WebApp:
         """Stop polling and serving; joins the loop thread when the app owns it."""
         if self._poller is not None:
             self._poller.stop()
+        if self.monitor is not None:
+            self.monitor.close()
         if self.graph_hub is not None:
             self.graph_hub.close()
         loop = self.loop

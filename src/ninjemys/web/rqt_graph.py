@@ -12,8 +12,10 @@ import sys
 import threading
 import webbrowser
 
+from ninjemys.node import Node
 from ninjemys.tools.cli import entry
 from ninjemys.web.app import WebApp
+from ninjemys.web.monitor import TopicMonitor
 
 DEFAULT_MASTER = "http://localhost:11311"
 
@@ -38,7 +40,8 @@ def main(argv: list[str] | None = None) -> int:
     # ROS passes remappings (name:=value) and __name/__log args; they do not apply to this tool
     args = _parser().parse_args([a for a in (argv or []) if ":=" not in a])
     master_uri = os.environ.get("ROS_MASTER_URI", DEFAULT_MASTER)
-    app = WebApp(master_uri, caller_id="/rqt_graph", host=args.host, port=args.port)
+    monitor = TopicMonitor(lambda: Node("rqt_graph", anonymous=True, master_uri=master_uri))
+    app = WebApp(master_uri, caller_id="/rqt_graph", host=args.host, port=args.port, monitor=monitor)
     try:
         url = app.start()
     except OSError as exc:
