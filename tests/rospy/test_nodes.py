@@ -354,6 +354,7 @@ except rospy.ROSInterruptException:
 
 
 def test_slow_callback_does_not_block_other_subscriber(run_node) -> None:
+    """Different subscriptions run concurrently and the publisher never waits for a slow callback."""
     code = r"""
 import rospy, time
 from std_msgs.msg import String
@@ -365,18 +366,24 @@ def fast(m):
     fast_count[0] += 1
     if fast_count[0] == 20:
         print("fast got 20", flush=True)
-rospy.Subscriber("chatter", String, slow, queue_size=1)
-rospy.Subscriber("chatter", String, fast, queue_size=100)
-pub = rospy.Publisher("chatter", String, queue_size=100)
-while pub.get_num_connections() < 1:
+rospy.Subscriber("chatter_slow", String, slow, queue_size=1)
+rospy.Subscriber("chatter_fast", String, fast, queue_size=100)
+slow_pub = rospy.Publisher("chatter_slow", String, queue_size=100)
+fast_pub = rospy.Publisher("chatter_fast", String, queue_size=100)
+while slow_pub.get_num_connections() < 1 or fast_pub.get_num_connections() < 1:
     rospy.sleep(0.01)
+start = time.monotonic()
 for i in range(40):
-    pub.publish(str(i))
+    slow_pub.publish(str(i))
+    fast_pub.publish(str(i))
     rospy.sleep(0.01)
+print("publishing took %.1f s" % (time.monotonic() - start), flush=True)
 rospy.sleep(0.5)
 """
     node = run_node(code)
     node.wait_for("^fast got 20$", timeout=20)
+    took = float(node.wait_for(r"^publishing took (\S+) s$").group(1))
+    assert took < 5.0  # 40 slow callbacks would take 40 s if the publisher waited for them
 
 
 def test_any_msg_subscriber_gets_raw_bytes(run_node) -> None:
