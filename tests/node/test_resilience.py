@@ -90,3 +90,22 @@ def test_master_restart_heals_the_graph(make_node, master) -> None:
     finally:
         stop.set()
         thread.join()
+
+
+def test_shutdown_is_prompt_without_a_master(master) -> None:
+    import time
+
+    from node_msgs import AddTwoInts
+
+    from ninjemys.node import Node
+
+    node = Node("orphan", master_uri=master.uri)
+    for i in range(5):
+        node.publisher(f"out{i}", String)
+        node.subscriber(f"in{i}", String, lambda m: None)
+    node.service("add", AddTwoInts, lambda r: r.a + r.b)
+    master.kill()
+    started = time.monotonic()
+    node.shutdown("bye")
+    assert time.monotonic() - started < 2.0
+    assert node.is_shutdown

@@ -441,16 +441,10 @@ class Node:
         try:
             for sub in subs:
                 self.registrar.remove_subscriber(sub.topic, quick)
-                if self.registrar._master_down:
-                    break
             for pub in pubs:
-                if not self.registrar._master_down:
-                    self.registrar.remove_publisher(pub.topic, quick)
+                self.registrar.remove_publisher(pub.topic, quick)
             for srv in srvs:
-                if not self.registrar._master_down:
-                    self.registrar.remove_service(srv.name, quick)
-        except MasterError:
-            pass
+                self.registrar.remove_service(srv.name, quick)
         finally:
             quick.close()
         for srv in srvs:

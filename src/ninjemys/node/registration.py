@@ -108,8 +108,13 @@ class Registrar:
             self._quiet(lambda c: c.unregister_service(name, uri), client)
 
     def _quiet(self, fn: Callable[[MasterClient], object], client: MasterClient | None) -> None:
+        if self._master_down and client is not None:
+            return  # shutting down with no master: do not wait once per registration
         try:
             fn(client or self.node.master)
+        except MasterUnreachable as exc:
+            self._master_down = True
+            _log.debug("unregister: %s", exc)
         except MasterError as exc:
             _log.debug("unregister: %s", exc)
 
