@@ -281,3 +281,37 @@ def test_recorder_node_option_follows_a_nodes_subscriptions():
     rec = Recorder(node, RecordOptions(node="/mapper"))
     rec._discover()
     assert sorted(node.callbacks) == ["/odom", "/scan"]
+
+
+def test_split_by_size_repeats_latched_messages_in_every_bag(tmp_path, monkeypatch):
+    from ninjemys.bag.reader import BagReader
+    from ninjemys.bag.record import Recorder
+
+    monkeypatch.chdir(tmp_path)
+    node = FakeRecordNode()
+    opts = RecordOptions(
+        topics=["/map", "/scan"], output_name="s", split=True, split_size=20_000, repeat_latched=True
+    )
+    rec = Recorder(node, opts)
+    rec.start()
+    latched = {
+        "type": "std_msgs/String",
+        "md5sum": "992ce8a1687cec8c8bd883ec73ca41d1",
+        "message_definition": "string data\n",
+        "latching": "1",
+        "callerid": "/map_server",
+    }
+    plain = dict(latched, latching="0", callerid="/laser")
+    node.callbacks["/map"](Raw(string_bytes("the map"), latched))
+    for i in range(60):
+        node.callbacks["/scan"](Raw(string_bytes(f"{i:04d}" + "s" * 1000), plain))
+    rec.stop()
+    assert len(rec.paths) >= 3
+    total_scans = 0
+    for path in rec.paths:
+        with BagReader(path) as r:
+            assert r.indexed
+            topics = [(m.connection.topic, bytes(m.data)) for m in r.read()]
+        assert ("/map", string_bytes("the map")) in topics  # every split bag has the latched map
+        total_scans += sum(1 for t, _ in topics if t == "/scan")
+    assert total_scans == 60

@@ -48,6 +48,7 @@ class RecordOptions:
     compression: str = "none"
     quiet: bool = False
     stats: float = 0.0
+    repeat_latched: bool = False
     discovery_period: float = 0.5
 
 
@@ -159,6 +160,7 @@ class Recorder:
         self._subscribed: dict[str, Any] = {}
         self._counts: collections.Counter[str] = collections.Counter()
         self._conn_ids: dict[int, tuple[Mapping[str, str], int]] = {}
+        self._latched: dict[int, tuple[str, Mapping[str, str], bytes, int]] = {}
         self._writer: BagWriter | None = None
         self._bag_started = 0.0
         self._stop = threading.Event()
@@ -289,13 +291,12 @@ class Recorder:
             writer = self._writer
             if writer is None:
                 writer = self._writer = self._open_writer()
-            key = id(header)
-            known = self._conn_ids.get(key)
-            if known is None or known[0] is not header:
-                fields = {k: v.encode() for k, v in header.items() if k not in ("topic", "tcp_nodelay")}
-                known = (header, writer.connection(topic, fields))
-                self._conn_ids[key] = known
-            writer.write(known[1], ns, data)
+                if opts.repeat_latched:
+                    for l_topic, l_header, l_data, l_ns in list(self._latched.values()):
+                        writer.write(self._connection(writer, l_topic, l_header), l_ns, l_data)
+            writer.write(self._connection(writer, topic, header), ns, data)
+            if opts.repeat_latched and header.get("latching") == "1":
+                self._latched[id(header)] = (topic, header, data, ns)
             self._counts[topic] += 1
             self.totals.messages += 1
             self.totals.bytes += len(data)
@@ -313,6 +314,16 @@ class Recorder:
             if opts.stats and time.monotonic() - last_stats >= opts.stats:
                 last_stats = time.monotonic()
                 self.log(self.summary())
+
+    def _connection(self, writer: BagWriter, topic: str, header: Mapping[str, str]) -> int:
+        """The bag connection for one publisher's header (looked up by identity: one dict per link)."""
+        key = id(header)
+        known = self._conn_ids.get(key)
+        if known is None or known[0] is not header:
+            fields = {k: v.encode() for k, v in header.items() if k not in ("topic", "tcp_nodelay")}
+            known = (header, writer.connection(topic, fields))
+            self._conn_ids[key] = known
+        return known[1]
 
     def _limit_reached(self, topic: str) -> None:
         sub = self._subscribed.get(topic)
@@ -465,6 +476,7 @@ def options_from_args(args: argparse.Namespace) -> RecordOptions:
         compression=args.compression,
         quiet=args.quiet,
         stats=args.stats,
+        repeat_latched=args.repeat_latched,
     )
 
 
