@@ -63,3 +63,8 @@ def test_parse_bus_info_tolerates_odd_rows() -> None:
 def test_namespace_of() -> None:
     assert namespace_of("/talker") == "/"
     assert namespace_of("/a/b/c") == "/a/b"
+
+
+def test_own_nodes_count_as_debug() -> None:
+    g = build_graph(STATE, TYPES, {}, {}, own_nodes=frozenset({"/listener"}))
+    assert next(n for n in g["nodes"] if n["name"] == "/listener")["debug"] is True

@@ -144,7 +144,12 @@ class WebApp:
         self.graph_hub = Hub(self.loop)
         await self.server.start()
         self._poller = GraphPoller(
-            self.master_uri, self.caller_id, self._on_graph, self._on_master_error, period=self._poll_period
+            self.master_uri,
+            self.caller_id,
+            self._on_graph,
+            self._on_master_error,
+            own_nodes=self.monitor.node_names if self.monitor is not None else frozenset,
+            period=self._poll_period,
         )
         self._poller.start()
 

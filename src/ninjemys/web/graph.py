@@ -64,11 +64,13 @@ def build_graph(
     topic_types: list,
     node_uris: dict[str, str],
     bus_info: dict[str, list[Connection] | None],
+    own_nodes: frozenset[str] = frozenset(),
 ) -> dict:
     """Plain-data graph: nodes, topics (with type, publishers, subscribers) and node->node edges.
 
     ``bus_info[node]`` is None when the node did not answer (shown as unreachable), missing when it was
-    not asked yet. An edge is ``connected`` when either end reports a live connection on its topic.
+    not asked yet. ``own_nodes`` (the web tools' own monitor node) count as debug, so "Hide debug"
+    keeps the act of looking at a topic out of the picture. An edge is ``connected`` when either end reports a live connection on its topic.
     """
     publishers, subscribers = system_state[0], system_state[1]
     types = {str(t): str(ty) for t, ty in topic_types}
@@ -93,7 +95,7 @@ def build_graph(
             "namespace": namespace_of(name),
             "uri": node_uris.get(name, ""),
             "reachable": bus_info.get(name, []) is not None,
-            "debug": name in DEBUG_NODES,
+            "debug": name in DEBUG_NODES or name in own_nodes,
         }
         for name in sorted(names)
     ]
@@ -149,6 +151,7 @@ class GraphPoller:
         caller_id: str,
         on_change: Callable[[dict], None],
         on_error: Callable[[str], None] | None = None,
+        own_nodes: Callable[[], frozenset[str]] = frozenset,
         period: float = 0.5,
         bus_period: float = 2.0,
         timeout: float = 2.0,
@@ -160,6 +163,7 @@ class GraphPoller:
         self.timeout = timeout
         self._on_change = on_change
         self._on_error = on_error or (lambda _m: None)
+        self._own_nodes = own_nodes
         self._stop = threading.Event()
         self._wake = threading.Event()
         self._thread: threading.Thread | None = None
@@ -211,7 +215,7 @@ class GraphPoller:
             self._refresh_bus(sorted(names))
         elif new_nodes:
             self._refresh_bus(new_nodes)
-        graph = build_graph(state, types, dict(self._uris), dict(self._bus))
+        graph = build_graph(state, types, dict(self._uris), dict(self._bus), self._own_nodes())
         if self.graph is not None and graph["version"] == self.graph["version"]:
             return None
         self.graph = graph

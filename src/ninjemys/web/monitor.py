@@ -79,6 +79,11 @@ class TopicMonitor:
         self._watches: dict[str, _Watch] = {}
         self._lock = threading.Lock()
 
+    def node_names(self) -> frozenset[str]:
+        """The monitor's own node (once created), for the graph to tag as debug."""
+        node = self._node
+        return frozenset({node.name}) if node is not None else frozenset()
+
     def info(self, topic: str, type_name: str) -> dict:
         """Rate (Hz or None), message count since watching started, and the last message as text."""
         self._expire()
