@@ -76,7 +76,7 @@ def launch_until(args: list[str], env: dict[str, str], wanted: list[str], timeou
             ["test_pub_sub", "animals.launch", "cat_msg:=Purr"],
             ["I heard : Click_and_Squeak", "I heard : Purr"],
         ),
-        (["basic_comms", "readings.launch"], ["reading 1.0 at", "I heard hello world"]),
+        (["basic_comms", "readings.launch"], [".5 at ", "I heard hello world"]),
         (["name_roll", "name_roll.launch", "name:=Grace", "roll:=7"], ["Student Grace has roll number: 7"]),
     ],
     ids=["first_pkg", "animals", "custom_msg", "name_roll"],
