@@ -20,13 +20,17 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
+import node_roscpp  # noqa: E402
 from ninjemys.master.client import MasterClient  # noqa: E402
 from ninjemys.testing import ROS1_PYTHON, free_port, have_ros1, ninjemys_bin, ros1_env  # noqa: E402
 
 ROLES = str(Path(__file__).resolve().parent / "node_roles.py")
 OURS = "ninjemys"
 REAL = "rospy"
+CPP = "roscpp"
 IMPLS = [OURS, REAL] if have_ros1() else [OURS]
+#: With the native reference, for the scenarios the C++ program implements.
+IMPLS_CPP = IMPLS + ([CPP] if have_ros1() and node_roscpp.binary() else [])
 #: CPU placements: both processes on one CPU, or one each.
 SAME_CPU = ("0", "0")
 CROSS_CPU = ("0", "1")
@@ -36,8 +40,10 @@ class Role:
     """A role process; stdout lines are collected by a thread."""
 
     def __init__(self, impl: str, master_uri: str, role: str, *args: str, cpu: str | None = None) -> None:
-        python = sys.executable if impl == OURS else ROS1_PYTHON
-        cmd = [python, ROLES, role, *args]
+        if impl == CPP:
+            cmd = [str(node_roscpp.binary()), role, *args]
+        else:
+            cmd = [sys.executable if impl == OURS else ROS1_PYTHON, ROLES, role, *args]
         if cpu is not None:
             cmd = ["taskset", "-c", cpu, *cmd]
         if impl == OURS:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import sys
 
-from node_common import CROSS_CPU, IMPLS, OURS, SAME_CPU, Role, header, master, ratio, roles
+from node_common import CROSS_CPU, IMPLS_CPP, OURS, SAME_CPU, Role, header, master, ratio, roles
 
 
 def run(uri: str, impl: str, cpus: tuple[str, str], count: int) -> dict:
@@ -23,10 +23,10 @@ def main() -> None:
     header(f"ping-pong RTT, {count} round trips")
     with master() as uri:
         for name, cpus in (("same CPU (taskset -c 0)", SAME_CPU), ("across CPUs (-c 0 / -c 1)", CROSS_CPU)):
-            results = {impl: run(uri, impl, cpus, count) for impl in IMPLS}
+            results = {impl: run(uri, impl, cpus, count) for impl in IMPLS_CPP}
             for impl, r in results.items():
                 print(f"{name:28s} {impl:9s} p50 {r['p50_us']:8.1f} us   p99 {r['p99_us']:8.1f} us")
-            if len(results) > 1:
+            if "rospy" in results:
                 o, t = results[OURS], results["rospy"]
                 print(
                     f"{name:28s} ratio     p50 {ratio(o['p50_us'], t['p50_us'])}   p99 {ratio(o['p99_us'], t['p99_us'])}"
