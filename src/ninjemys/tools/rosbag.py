@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import ast
+import logging
 import os
 import shutil
 import sys
@@ -65,6 +66,7 @@ def main(argv: list[str] | None = None) -> int:
             return main([argv[1], "-h"])
         print(_usage())
         return 0
+    _route_library_warnings()
     cmd, rest = argv[0], argv[1:]
     handler = _HANDLERS.get(cmd)
     if handler is None:
@@ -75,6 +77,34 @@ def main(argv: list[str] | None = None) -> int:
         return handler(rest)
     except SystemExit as exc:
         return int(exc.code or 0) if not isinstance(exc.code, str) else 1
+
+
+class _Once(logging.Filter):
+    """Let each distinct warning through once (a bag opened twice must not warn twice)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.seen: set[str] = set()
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        text = record.getMessage()
+        if text in self.seen:
+            return False
+        self.seen.add(text)
+        return True
+
+
+def _route_library_warnings() -> None:
+    """Bag damage found by the library reaches the user as ``WARNING: ...`` lines on stderr."""
+    logger = logging.getLogger("ninjemys.bag")
+    if any(getattr(h, "_rosbag_tool", False) for h in logger.handlers):
+        return
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("WARNING: %(message)s"))
+    handler.addFilter(_Once())
+    handler._rosbag_tool = True  # type: ignore[attr-defined]
+    logger.addHandler(handler)
+    logger.propagate = False
 
 
 # -- info ---------------------------------------------------------------------------------------
@@ -110,8 +140,6 @@ def info_cmd(argv: list[str]) -> int:
                         print(text)
                 else:
                     print(info_text(reader, name, opts.freq))
-                for warning in reader.warnings:
-                    print(f"WARNING: {warning}", file=sys.stderr)
         except BagError as exc:
             error(f"reading {name}: {exc}")
             return 1
@@ -299,10 +327,6 @@ def reindex_cmd(argv: list[str]) -> int:
     def op(source: Path, target: Path) -> None:
         size = target.stat().st_size
         progress = None if opts.quiet else Progress(str(target), size)
-        with BagReader(target, scan=True) as probe:
-            for warning in probe.warnings:
-                if not opts.quiet and "not indexed" not in warning:
-                    print(f"WARNING: {warning}", file=sys.stderr)
         for offset in reindex_in_place(target):
             if progress is not None:
                 progress.step(offset)
