@@ -166,7 +166,7 @@ def _start_clock(node: Any, log: NodeLog) -> None:
         return
     from ninjemys.idl.loader import get_message_class
 
-    clock.is_sim = True
+    clock.switch_to_sim()
     clock.subscribe(node, get_message_class("rosgraph_msgs/Clock"))
     clock.install()
     log.set_ros_time(clock.now)

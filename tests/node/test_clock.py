@@ -114,3 +114,15 @@ def test_for_node_follows_use_sim_time() -> None:
     ((topic, cls, qs),) = sim_node.subscribed
     assert topic == "/clock" and cls._type == "rosgraph_msgs/Clock" and qs == 1
     assert for_node(_FakeNode(OSError("no master"))).is_wallclock
+
+
+def test_switch_to_sim_wakes_wall_waiters_to_reanchor() -> None:
+    clock = Clock()
+    t, box = _in_thread(lambda: clock.wait_for(60.0))
+    time.sleep(0.05)
+    clock.switch_to_sim()
+    t.join(2)
+    assert box["r"] is Wake.MOVED_BACKWARDS
+    assert clock.is_sim and clock.now() == 0.0
+    clock.switch_to_sim()  # idempotent
+    assert clock.epoch == 1

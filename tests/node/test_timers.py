@@ -209,3 +209,19 @@ def test_sim_sleep_counts_from_first_clock_message() -> None:
     clock.set(102.0)
     t.join(2)
     assert not t.is_alive() and "e" not in box
+
+
+def test_timer_made_in_wall_time_follows_sim_time_after_switch() -> None:
+    clock = Clock()
+    calls = threading.Semaphore(0)
+    timer = Timer(clock, 1.0, lambda _ev: calls.release())
+    try:
+        time.sleep(0.05)
+        clock.switch_to_sim()
+        clock.set_time(50)
+        time.sleep(0.05)
+        clock.set_time(52)
+        assert calls.acquire(timeout=2)
+    finally:
+        clock.shutdown()
+        timer.join(2)

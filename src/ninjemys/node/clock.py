@@ -91,6 +91,20 @@ class Clock:
             self._sim_ns = ns
             self._cond.notify_all()
 
+    def switch_to_sim(self) -> None:
+        """Start following simulated time (at init_node, when /use_sim_time is set).
+
+        Waiters that started in wall time (a Rate or Timer made before init_node) are woken as after a
+        backwards jump, so they re-anchor on simulated time instead of waiting for a wall-clock date.
+        """
+        with self._cond:
+            if self.is_sim:
+                return
+            self.is_sim = True
+            self._epoch += 1
+            self._cond.notify_all()
+        self._open_gates()
+
     def set_time(self, secs: int, nsecs: int = 0) -> None:
         self.set_time_ns(int(secs) * 1_000_000_000 + int(nsecs))
 
@@ -157,6 +171,7 @@ class Clock:
     def _wall_wait(self, target: float, cancelled: Callable[[], bool] | None) -> Wake:
         """Wall-time wait: sleep on this thread's gate until ``target``; an opened gate means re-check."""
         gate = self._gate()
+        epoch = self._epoch
         with self._gates_lock:
             self._gates.add(gate)
         try:
@@ -165,6 +180,8 @@ class Clock:
                     return Wake.SHUTDOWN
                 if cancelled is not None and cancelled():
                     return Wake.CANCELLED
+                if self._epoch != epoch:
+                    return Wake.MOVED_BACKWARDS  # switched to simulated time meanwhile
                 remaining = target - self._wall()
                 if remaining <= 0:
                     return Wake.REACHED
