@@ -74,7 +74,7 @@ def test_header_seq_is_set_per_publisher(make_node) -> None:
     for _ in range(3):
         pub.publish(Image(2, 2, "mono8", 2, b"abcd"))
     assert wait_until(lambda: len(seqs) == 3)
-    assert seqs == [0, 1, 2]
+    assert seqs == [1, 2, 3]  # as rospy: a per-publisher counter from 1
 
 
 def test_large_image_arrives_intact(make_node) -> None:

@@ -402,9 +402,8 @@ class Publisher:
         if self._closed:
             raise ShutdownError(f"publisher of {self.name} is unregistered")
         if self._has_header:
-            header = msg.header
-            header.seq = self._seq
-            self._seq += 1
+            self._seq += 1  # rospy counts from 1
+            msg.header.seq = self._seq
         try:
             payload = msg.serialize_to_bytes()
         except AttributeError:
