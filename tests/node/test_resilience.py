@@ -9,10 +9,12 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from node_harness import wait_until
+from node_harness import MasterProcess, wait_until
 from node_msgs import String
 
 from ninjemys.master.client import MasterClient
+from ninjemys.node import Node
+from ninjemys.testing import free_port
 
 TALKER = str(Path(__file__).parent / "talker_proc.py")
 
@@ -51,7 +53,34 @@ def test_sigkilled_publisher_is_dropped_and_its_restart_reconnected(make_node, m
     assert sub.get_num_connections() == 1
 
 
-def test_master_restart_heals_the_graph(make_node, master) -> None:
+@pytest.fixture(
+    params=["ninjemys", pytest.param("ros1", marks=pytest.mark.ros1)], ids=["our-roscore", "real-rosmaster"]
+)
+def restartable_master(request: pytest.FixtureRequest) -> Iterator[MasterProcess]:
+    m = MasterProcess(free_port(), kind=request.param)
+    m.start()
+    try:
+        yield m
+    finally:
+        m.kill()
+
+
+def test_master_restart_heals_the_graph(restartable_master: MasterProcess) -> None:
+    master = restartable_master
+    nodes: list[Node] = []
+
+    def make_node(name: str) -> Node:
+        nodes.append(Node(name, master_uri=master.uri))
+        return nodes[-1]
+
+    try:
+        _heal(master, make_node)
+    finally:
+        for node in nodes:
+            node.shutdown("test over")
+
+
+def _heal(master: MasterProcess, make_node) -> None:
     talker, listener = make_node("talker"), make_node("listener")
     got: list[str] = []
     listener.subscriber("chatter", String, lambda m: got.append(m.data))
