@@ -107,6 +107,7 @@ def measure(impl: str, nodes: int, threads: int) -> dict[str, float]:
     try:
         wait_ready(core)
         reg_time, failures = register_all(core.uri, nodes, threads)
+        time.sleep(2.0)  # let each master finish the notifications the registrations caused
         state_time, entries = time_system_state(core.uri)
         hot_time, hot_pubs = time_hot_subscribe(core.uri)
         assert hot_pubs == 100, f"{impl}: registerSubscriber returned {hot_pubs} publishers"
