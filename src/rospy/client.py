@@ -176,9 +176,11 @@ def _finish_init(node: Any, log: NodeLog, rosout: bool, done: threading.Event) -
     """/rosout and the logger services, set up off the caller's thread: init_node returns as soon as
     the node is registered, and messages logged meanwhile are held and sent once /rosout exists."""
     try:
-        if rosout:
+        # a process that exits right after init_node (shutdown requested) skips what is left
+        if rosout and not _process.shutdown_requested:
             _start_rosout(node, log)
-        _start_logger_services(node, log)
+        if not _process.shutdown_requested:
+            _start_logger_services(node, log)
     except NinjemysError as exc:
         if not node.is_shutdown:
             log.log(WARN, "%s: logging services unavailable: %s", node.name, exc)
