@@ -31,10 +31,10 @@ def _check_class(data_class: Any, what: str) -> None:
 
 
 def _resolved(name: str) -> str:
-    node = _process.node
-    if node is not None:
-        return node.resolve_name(name)
-    return name if name.startswith("/") else "/" + name.lstrip("~")
+    """The name as resolved now (before init_node: in the namespace, as ``/unnamed``, like rospy)."""
+    from rospy.client import resolve_name
+
+    return resolve_name(name)
 
 
 class SubscribeListener:
