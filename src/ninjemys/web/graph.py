@@ -171,6 +171,7 @@ class GraphPoller:
         self._uris: dict[str, str] = {}
         self._bus: dict[str, list[Connection] | None] = {}
         self._bus_time = 0.0
+        self._names: list[str] = []
         self.graph: dict | None = None
         self.master_ok = True
 
@@ -202,19 +203,22 @@ class GraphPoller:
         for table in state[:3]:
             for _t, nodes in table:
                 names.update(nodes)
-        for name in names - set(self._uris):
-            code, _msg, uri = master.lookupNode(self.caller_id, name)
-            if code == 1:
+        unknown = sorted(names - set(self._uris))
+
+        def lookup(name: str) -> tuple[str, str | None]:
+            try:
+                code, _msg, uri = _proxy(self.master_uri, self.timeout).lookupNode(self.caller_id, name)
+            except (OSError, xmlrpc.client.Error):
+                return name, None
+            return name, uri if code == 1 else None
+
+        for name, uri in self._pool.map(lookup, unknown):
+            if uri:
                 self._uris[name] = uri
         for gone in set(self._uris) - names:
             del self._uris[gone]
             self._bus.pop(gone, None)
-        new_nodes = [n for n in names if n not in self._bus]
-        if now - self._bus_time >= self.bus_period:
-            self._bus_time = now
-            self._refresh_bus(sorted(names))
-        elif new_nodes:
-            self._refresh_bus(new_nodes)
+        self._names = sorted(names)
         graph = build_graph(state, types, dict(self._uris), dict(self._bus), self._own_nodes())
         if self.graph is not None and graph["version"] == self.graph["version"]:
             return None
@@ -249,5 +253,15 @@ class GraphPoller:
                     graph = graph or self.graph
                 if graph is not None:
                     self._on_change(graph)
+                # connection states cost one call per node: after the graph is out, and less often
+                now = time.monotonic()
+                fresh = [n for n in self._names if n not in self._bus]
+                if now - self._bus_time >= self.bus_period:
+                    self._bus_time = now
+                    self._refresh_bus(self._names)
+                elif fresh:
+                    self._refresh_bus(fresh)
+                if fresh or now == self._bus_time:
+                    continue  # publish what the bus information changed right away
             self._wake.wait(self.period)
             self._wake.clear()
