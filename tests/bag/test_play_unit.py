@@ -315,3 +315,104 @@ def test_split_by_size_repeats_latched_messages_in_every_bag(tmp_path, monkeypat
         assert ("/map", string_bytes("the map")) in topics  # every split bag has the latched map
         total_scans += sum(1 for t, _ in topics if t == "/scan")
     assert total_scans == 60
+
+
+def test_command_line_options_parse_into_options():
+    from ninjemys.bag import play, record
+
+    r = record.options_from_args(
+        record.build_parser().parse_intermixed_args(
+            [
+                "/a",
+                "-O",
+                "x",
+                "/b",
+                "--lz4",
+                "--split",
+                "--size",
+                "2",
+                "--max-splits",
+                "3",
+                "-b",
+                "16",
+                "--chunksize",
+                "512",
+                "-l",
+                "9",
+                "--repeat-latched",
+                "--stats",
+                "2",
+                "-x",
+                "/b",
+            ]
+        )
+    )
+    assert (r.topics, r.output_name, r.compression, r.split_size, r.max_splits) == (
+        ["/a", "/b"],
+        "x",
+        "lz4",
+        2 << 20,
+        3,
+    )
+    assert (r.buffsize, r.chunksize, r.limit, r.repeat_latched, r.stats, r.exclude) == (
+        16 << 20,
+        512 << 10,
+        9,
+        True,
+        2.0,
+        "/b",
+    )
+    assert (
+        record.options_from_args(
+            record.build_parser().parse_intermixed_args(["-a", "-j", "--duration", "1m"])
+        ).split_duration
+        == 60
+    )
+    p = play.options_from_args(
+        play.build_parser().parse_intermixed_args(
+            [
+                "a.bag",
+                "-r",
+                "2",
+                "b.bag",
+                "-s",
+                "1",
+                "-u",
+                "3",
+                "-l",
+                "--clock",
+                "--hz",
+                "50",
+                "-d",
+                "0",
+                "-k",
+                "--pause",
+                "-q",
+                "-i",
+                "--topics",
+                "/x",
+                "/y",
+            ]
+        )
+    )
+    assert (p.bags, p.rate, p.start, p.duration, p.loop, p.clock, p.hz) == (
+        ["a.bag", "b.bag"],
+        2.0,
+        1.0,
+        3.0,
+        True,
+        True,
+        50.0,
+    )
+    assert (p.delay, p.keep_alive, p.pause, p.quiet, p.immediate, p.topics) == (
+        0.0,
+        True,
+        True,
+        True,
+        True,
+        ["/x", "/y"],
+    )
+    with pytest.raises(BagError):
+        record.options_from_args(record.build_parser().parse_intermixed_args([]))
+    with pytest.raises(BagError):
+        play.options_from_args(play.build_parser().parse_intermixed_args(["a.bag", "-r", "0"]))

@@ -449,6 +449,11 @@ def build_parser(
         metavar="SEC",
         help="print totals (messages, bytes, drops, queue) every SEC seconds",
     )
+    p.add_argument(
+        "--repeat-latched",
+        action="store_true",
+        help="repeat latched messages at the start of each new bag file when splitting",
+    )
     p.add_argument("topics", nargs="*")
     return p
 
