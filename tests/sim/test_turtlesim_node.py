@@ -142,3 +142,33 @@ def test_set_pen_service(turtlesim, client) -> None:  # type: ignore[no-untyped-
     client.subscriber("/turtle1/color_sensor", Color, seen.append)
     wait_until(lambda: seen, what="color sensor")
     assert (seen[-1].r, seen[-1].g, seen[-1].b) == (255, 0, 0)
+
+
+def test_bad_input_gets_error_responses_and_no_crash(turtlesim, client) -> None:  # type: ignore[no-untyped-def]
+    sim = turtlesim()
+    with pytest.raises(ServiceError, match="non-finite"):
+        _spawn(client, x=math.nan, y=1.0, theta=0.0, name="")
+    client.wait_for_service("/turtle1/teleport_absolute", timeout=10)
+    with pytest.raises(ServiceError, match="non-finite"):
+        client.service_proxy("/turtle1/teleport_absolute", TeleportAbsolute)(
+            TeleportAbsolute._request_class(x=math.inf, y=1.0, theta=0.0)
+        )
+    # the node is still serving, and the failed spawn did not use up a name
+    assert _spawn(client, x=1.0, y=1.0, theta=0.0, name="").name == "turtle2"
+    assert sim.proc.poll() is None
+
+
+def test_clear_reads_background_params(turtlesim, client) -> None:  # type: ignore[no-untyped-def]
+    from turtlesim.msg import Color
+
+    turtlesim()
+    seen: list[Color] = []
+    client.subscriber("/turtle1/color_sensor", Color, seen.append)
+    wait_until(lambda: seen, what="color sensor")
+    assert (seen[-1].r, seen[-1].g, seen[-1].b) == (69, 86, 255)
+    client.set_param("/turtlesim/background_r", 255)
+    client.set_param("/turtlesim/background_g", 255)
+    client.set_param("/turtlesim/background_b", 0)
+    client.wait_for_service("/clear", timeout=10)
+    client.service_proxy("/clear", Empty)(Empty._request_class())
+    wait_until(lambda: (seen[-1].r, seen[-1].g, seen[-1].b) == (255, 255, 0), what="new background")
