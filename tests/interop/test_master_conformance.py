@@ -209,3 +209,74 @@ def test_unknown_method_is_the_same_fault(real_master: str) -> None:
 
     with MasterThread() as uri:
         assert fault(uri) == fault(real_master)
+
+
+class _Recorder:
+    """A fake node's slave API that records what the master tells it."""
+
+    def __init__(self) -> None:
+        self.calls: list[tuple[str, str, Any]] = []
+
+    def paramUpdate(self, caller_id: str, key: str, value: Any) -> list[Any]:  # noqa: N802
+        self.calls.append(("paramUpdate", key, value))
+        return [1, "", 0]
+
+    def publisherUpdate(self, caller_id: str, topic: str, publishers: list[str]) -> list[Any]:  # noqa: N802
+        self.calls.append(("publisherUpdate", topic, publishers))
+        return [1, "", 0]
+
+
+def _notifications(master_uri: str) -> dict[str, list[tuple[str, str, Any]]]:
+    """Run a scripted session against ``master_uri`` with three recording nodes; what each was told."""
+    import asyncio
+    import threading
+
+    from ninjemys.net.xmlrpc_server import XmlRpcServer
+
+    loop = asyncio.new_event_loop()
+    thread = threading.Thread(target=loop.run_forever, daemon=True)
+    thread.start()
+    recorders = {name: _Recorder() for name in ("/n1", "/n2", "/n3")}
+    servers = {}
+    try:
+        for name, rec in recorders.items():
+            server = XmlRpcServer(rec, "127.0.0.1", 0, advertise="127.0.0.1")
+            asyncio.run_coroutine_threadsafe(server.start(), loop).result(5)
+            servers[name] = server
+        proxy = xmlrpc.client.ServerProxy(master_uri)
+        api = {name: server.uri for name, server in servers.items()}
+        steps = [
+            ("subscribeParam", "/n1", api["/n1"], "/cfg"),
+            ("subscribeParam", "/n2", api["/n2"], "/cfg/a"),
+            ("subscribeParam", "/n3", api["/n3"], "/cfg/gone/deep"),
+            ("setParam", "/n1", "/cfg", {"a": 1, "gone": {"deep": 2}}),  # n1 made the change: not told
+            ("setParam", "/other", "/cfg/a", 5),
+            ("setParam", "/other", "/cfg", {"a": {"x": 1}}),
+            ("deleteParam", "/other", "/cfg/a"),
+            ("setParam", "/other", "/unrelated", 1),
+            ("registerSubscriber", "/n2", "/chatter", "std_msgs/String", api["/n2"]),
+            ("registerPublisher", "/talker", "/chatter", "std_msgs/String", "http://127.0.0.1:9/"),
+            ("unregisterPublisher", "/talker", "/chatter", "http://127.0.0.1:9/"),
+        ]
+        for method, *args in steps:
+            before = sum(len(r.calls) for r in recorders.values())
+            getattr(proxy, method)(*args)
+            # rosmaster sends a live reference to its tree: let each change arrive before the next one
+            deadline = time.monotonic() + 0.5
+            while sum(len(r.calls) for r in recorders.values()) == before and time.monotonic() < deadline:
+                time.sleep(0.01)
+            time.sleep(0.05)
+        time.sleep(0.3)  # nothing else may arrive
+        return {name: rec.calls for name, rec in recorders.items()}
+    finally:
+        for server in servers.values():
+            loop.call_soon_threadsafe(server.close)
+        loop.call_soon_threadsafe(loop.stop)
+        thread.join(5)
+
+
+def test_param_and_publisher_updates_match_rosmaster(real_master: str) -> None:
+    expected = _notifications(real_master)
+    with MasterThread() as uri:
+        actual = _notifications(uri)
+    assert actual == expected

@@ -18,6 +18,8 @@ class RecordingNotifier:
         self.calls.append(("publisherUpdate", api, topic, list(publishers)))
 
     def param_update(self, api: str, key: str, value: Any) -> None:
+        if isinstance(value, wire.Marshalled):  # compare what will be sent
+            value, _ = wire.parse_call(wire.dump_call("m", (value,)))[1][0], None
         self.calls.append(("paramUpdate", api, key, value))
 
     def revive(self, api: str) -> None:
@@ -145,3 +147,17 @@ def test_a_replaced_node_cannot_take_its_name_back(master: tuple[MasterHandler, 
     assert not any(c[0] == "shutdown" for c in n.calls)
     # the same API under another name is a different node
     assert call(h, "registerPublisher", "/other", "/x", "std_msgs/String", "http://old/")[0] == 1
+
+
+def test_param_update_carries_the_value_at_the_time_of_the_change(
+    master: tuple[MasterHandler, RecordingNotifier],
+) -> None:
+    h, n = master
+    sent: list[Any] = []
+    n.param_update = lambda api, key, value: sent.append(value)  # type: ignore[method-assign]
+    call(h, "subscribeParam", "/n1", "http://n1/", "/cfg")
+    call(h, "setParam", "/x", "/cfg", {"a": 1})
+    call(h, "setParam", "/x", "/cfg/a", 2)  # mutates the stored dict before anything was sent
+    first = sent[0]
+    assert isinstance(first, wire.Marshalled)
+    assert wire.parse_call(wire.dump_call("m", (first,)))[1] == ({"a": 1},)

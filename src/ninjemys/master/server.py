@@ -307,6 +307,12 @@ class MasterHandler:
 
     def _notify_params(self, updates: list[tuple[list[tuple[str, str]], str, Any]]) -> None:
         for subscribers, key, value in updates:
+            if not subscribers:
+                continue
+            if type(value) is dict or type(value) is list:
+                # snapshot now: the tree may change before the update is sent (rosmaster sends a live
+                # reference and can tell a node a later value); rendered once for all subscribers
+                value = wire.Marshalled(value)
             for _, api in subscribers:
                 self.notifier.param_update(api, key, value)
 
