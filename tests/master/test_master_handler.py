@@ -19,7 +19,7 @@ class RecordingNotifier:
 
     def param_update(self, api: str, key: str, value: Any) -> None:
         if isinstance(value, wire.Marshalled):  # compare what will be sent
-            value, _ = wire.parse_call(wire.dump_call("m", (value,)))[1][0], None
+            value = wire.parse_call(wire.dump_call("m", (value,)))[1][0]
         self.calls.append(("paramUpdate", api, key, value))
 
     def revive(self, api: str) -> None:
