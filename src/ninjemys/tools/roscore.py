@@ -23,6 +23,7 @@ import threading
 import uuid
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 from ninjemys import ROS_DISTRO, ROS_VERSION, __version__
 from ninjemys.errors import MasterError, NinjemysError
@@ -102,7 +103,7 @@ class _Rosout:
     """Starts rosout on a helper thread and stops it within a deadline."""
 
     def __init__(self, master_uri: str, run_dir: Path | None, announce: Callable[[], None]) -> None:
-        self.node = None
+        self.node: Any = None  # a ninjemys.master.rosout.Rosout once started (imported lazily)
         self._stop = threading.Event()
         self._thread = threading.Thread(
             target=self._run, args=(master_uri, run_dir, announce), name="rosout", daemon=True
