@@ -366,7 +366,7 @@ def test_ninjemys_completion_script_enables_completion(tmp_path):
 def test_interpreter_found_from_the_rostopic_shebang(tmp_path):
     """Sourced without ninjemys-completion or NINJEMYS_PYTHON, the helper runs under the interpreter
     of the rostopic found on PATH (a venv's python, not the system python3)."""
-    script = f"source {shlex.quote(BASH_FILE)}\n_nj_python\n"
+    script = f'source {shlex.quote(BASH_FILE)}\n_nj_python\nprintf %s "$_nj_py"\n'
     env = dict(os.environ)
     env.pop("NINJEMYS_PYTHON", None)
     env["PATH"] = f"{Path(ninjemys_bin('rostopic')).parent}{os.pathsep}/usr/bin:/bin"

@@ -13,9 +13,10 @@
 
 # -- plumbing ------------------------------------------------------------------------------------
 
+# sets _nj_py to the interpreter that runs the helper (no subshell: every fork is felt on a Tab press)
 _nj_python() {
   if [[ -n ${NINJEMYS_PYTHON:-} ]]; then
-    printf '%s' "$NINJEMYS_PYTHON"
+    _nj_py=$NINJEMYS_PYTHON
     return
   fi
   if [[ -z ${_NJ_PY:-} ]]; then
@@ -29,7 +30,7 @@ _nj_python() {
       _NJ_PY=python3
     fi
   fi
-  printf '%s' "$_NJ_PY"
+  _nj_py=$_NJ_PY
 }
 
 # `python -c` rather than `-m`: runpy's imports would add a third to every answer
@@ -37,17 +38,16 @@ _NJ_HELPER='from ninjemys.tools.complete import main; raise SystemExit(main())'
 
 # _nj_ask KIND [ARG...]: candidates from the helper, one per line, into COMPREPLY (prefix = $_nj_cur)
 _nj_ask() {
-  local py
-  py=$(_nj_python)
-  mapfile -t COMPREPLY < <("$py" -c "$_NJ_HELPER" "$@" "$_nj_cur" 2>/dev/null)
+  _nj_python
+  mapfile -t COMPREPLY < <("$_nj_py" -c "$_NJ_HELPER" "$@" "$_nj_cur" 2>/dev/null)
   _nj_nospace_dirs
 }
 
 # _nj_ask_one KIND ARG: a single multi-line candidate (a YAML prototype) into COMPREPLY
 _nj_ask_one() {
-  local py reply
-  py=$(_nj_python)
-  reply=$("$py" -c "$_NJ_HELPER" "$1" "$2" "" 2>/dev/null)
+  local reply
+  _nj_python
+  reply=$("$_nj_py" -c "$_NJ_HELPER" "$1" "$2" "" 2>/dev/null)
   COMPREPLY=()
   if [[ -n $reply && $reply == "$_nj_cur"* ]]; then
     COMPREPLY=("$reply")
@@ -56,7 +56,11 @@ _nj_ask_one() {
 
 # _nj_words "WORD..." : the static words that start with $_nj_cur
 _nj_words() {
-  mapfile -t COMPREPLY < <(compgen -W "$1" -- "$_nj_cur")
+  local word
+  COMPREPLY=()
+  for word in $1; do
+    if [[ $word == "$_nj_cur"* ]]; then COMPREPLY+=("$word"); fi
+  done
 }
 
 # _nj_files [EXT...]: file names (only *.EXT, plus directories, when extensions are given)
@@ -109,12 +113,13 @@ _nj_parse() {
   done
 }
 
-# the first word after the command that is not an option: the subcommand
+# sets _nj_sub to the first word after the command that is not an option: the subcommand
 _nj_subcommand() {
   local i
+  _nj_sub=""
   for ((i = 1; i < COMP_CWORD; i++)); do
     if [[ ${COMP_WORDS[i]} != -* ]]; then
-      printf '%s' "${COMP_WORDS[i]}"
+      _nj_sub=${COMP_WORDS[i]}
       return
     fi
   done
@@ -127,7 +132,8 @@ _NJ_NODE_ARGS="__name:= __ns:= __log:= __ip:= __hostname:= __master:="
 
 _rostopic() {
   local sub opts="" values=""
-  sub=$(_nj_subcommand)
+  _nj_subcommand
+  sub=$_nj_sub
   case $sub in
     echo) opts="-h --help -b -p -w --filter --nostr --noarr -c --clear -a --all -n --offset --queue-size"
       values="-b -w --filter -n --queue-size" ;;
@@ -170,7 +176,8 @@ _rostopic() {
 
 _rosnode() {
   local sub opts="" values=""
-  sub=$(_nj_subcommand)
+  _nj_subcommand
+  sub=$_nj_sub
   case $sub in
     list) opts="-h --help -u -a --all" ;;
     info) opts="-h --help -q --quiet" ;;
@@ -199,7 +206,8 @@ _rosnode() {
 
 _rosservice() {
   local sub opts="-h --help"
-  sub=$(_nj_subcommand)
+  _nj_subcommand
+  sub=$_nj_sub
   case $sub in
     list) opts="-h --help -n --nodes" ;;
     call) opts="-h --help -v --wait" ;;
@@ -225,7 +233,8 @@ _rosservice() {
 
 _rosparam() {
   local sub opts="-h --help -v" values=""
-  sub=$(_nj_subcommand)
+  _nj_subcommand
+  sub=$_nj_sub
   case $sub in
     get) opts="-h --help -p -v" ;;
     set) opts="-h --help -t -b -v"; values="-t -b" ;;
@@ -253,7 +262,8 @@ _rosparam() {
 
 _nj_interface_tool() { # KIND (msg|srv)
   local kind=$1 sub opts="-h --help"
-  sub=$(_nj_subcommand)
+  _nj_subcommand
+  sub=$_nj_sub
   case $sub in
     show | info) opts="-h --help -r --raw -b" ;;
     package | packages) opts="-h --help -s" ;;
@@ -281,7 +291,8 @@ _rossrv() { _nj_interface_tool srv; }
 
 _rosbag() {
   local sub opts="-h --help" values=""
-  sub=$(_nj_subcommand)
+  _nj_subcommand
+  sub=$_nj_sub
   case $sub in
     record)
       opts="-h --help -a --all -e --regex -x --exclude -q --quiet -o --output-prefix -O --output-name
@@ -411,7 +422,8 @@ _roslaunch() {
   if [[ -f $first ]]; then # roslaunch FILE... [arg:=value...]
     _nj_files launch test xml
     local -a args
-    mapfile -t args < <("$(_nj_python)" -c "$_NJ_HELPER" launch-args "$first" "$_nj_cur" 2>/dev/null)
+    _nj_python
+    mapfile -t args < <("$_nj_py" -c "$_NJ_HELPER" launch-args "$first" "$_nj_cur" 2>/dev/null)
     COMPREPLY+=("${args[@]}")
     _nj_nospace_dirs
     return
