@@ -318,9 +318,10 @@ class _DeserEmitter(_Emitter):
             self.run.append(("I", n))
             self.flush()
             self.check(n, what, n)
-            # without views the buffer is bytes (sliced and decoded directly), else a memoryview
-            decode = "" if self.bytes_buffer else "bytes"
-            self.emit(f"{target} = {decode}(mv[pos:pos + {n}]).decode('utf-8', 'replace')")
+            if self.bytes_buffer:  # without views the buffer is bytes: slice and decode directly
+                self.emit(f"{target} = mv[pos:pos + {n}].decode('utf-8', 'replace')")
+            else:  # sb: the bytes object when given one (cheaper slices), else the memoryview
+                self.emit(f"{target} = str(sb[pos:pos + {n}], 'utf-8', 'replace')")
             self.emit(f"pos += {n}")
         else:
             v = self.tmp("o")
@@ -400,6 +401,7 @@ def generate_class_source(spec: MsgSpec, lookup: Lookup, md5sum: str, full_text:
     body.append("    def deserialize_from(cls, buf):")
     if de.views:
         body.append("        mv = memoryview(buf) if buf.__class__ is bytes else _view(buf)")
+        body.append("        sb = buf if buf.__class__ is bytes else mv")
     else:  # strings and numbers only: a bytes copy of other buffers, sliced directly
         body.append("        mv = buf if buf.__class__ is bytes else _view(buf).tobytes()")
     body.append("        end = len(mv)")
