@@ -416,3 +416,36 @@ def test_command_line_options_parse_into_options():
         record.options_from_args(record.build_parser().parse_intermixed_args([]))
     with pytest.raises(BagError):
         play.options_from_args(play.build_parser().parse_intermixed_args(["a.bag", "-r", "0"]))
+
+
+def test_empty_bag_and_window_past_the_end_play_nothing(tmp_path):
+    empty = tmp_path / "empty.bag"
+    BagWriter(empty).close()
+    bag = make_bag(tmp_path / "a.bag", [0, 10])
+    for opts in (
+        PlayOptions(bags=[str(empty)], delay=0, quiet=True),
+        PlayOptions(bags=[str(bag)], delay=0, quiet=True, start=100.0),
+    ):
+        clock = FakeTime()
+        node = FakeNode(clock)
+        Player(node, opts, sleep=clock.sleep, monotonic=clock.monotonic).run()
+        assert node.sent == []
+
+
+def test_two_bags_are_merged_in_time_order(tmp_path):
+    a = tmp_path / "a.bag"
+    b = tmp_path / "b.bag"
+    for path, offset in ((a, 0), (b, 5)):
+        with BagWriter(path) as w:
+            c = w.connection("/a", STRING_HEADER)
+            for i in range(5):
+                w.write(c, BASE + (i * 10 + offset) * 1_000_000, string_bytes(f"{path.stem}{i}"))
+    clock = FakeTime()
+    node = FakeNode(clock)
+    Player(
+        node,
+        PlayOptions(bags=[str(a), str(b)], delay=0, quiet=True),
+        sleep=clock.sleep,
+        monotonic=clock.monotonic,
+    ).run()
+    assert [d[4:].decode() for _, _, d in node.sent] == [f"{s}{i}" for i in range(5) for s in "ab"]
