@@ -58,3 +58,21 @@ def test_arrow_keys_publish_twists_and_q_quits(master: str, client, remap: str |
     finally:
         if child.isalive():
             child.terminate(force=True)
+
+
+def test_q_restores_the_terminal(master: str) -> None:
+    """After 'q' the shell's terminal is canonical and echoing again (stty shows icanon and echo)."""
+    env = dict(os.environ, ROS_MASTER_URI=master, PS1="$ ")
+    shell = pexpect.spawn("/bin/sh", ["-i"], env=env, encoding="utf-8", timeout=20)
+    try:
+        shell.expect_exact("$ ")
+        shell.sendline(ninjemys_bin("turtle_teleop_key"))
+        shell.expect_exact("'q' to quit.")
+        shell.send("q")
+        shell.expect_exact("$ ")
+        shell.sendline("stty -a; echo status=$?")
+        shell.expect(r"status=0")
+        modes = shell.before.split()
+        assert "icanon" in modes and "echo" in modes and "isig" in modes
+    finally:
+        shell.terminate(force=True)

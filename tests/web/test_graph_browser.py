@@ -5,7 +5,7 @@ from __future__ import annotations
 import signal
 
 import pytest
-from web_helpers import LISTENER, TALKER
+from web_helpers import LISTENER, ROBOT_BASE, TALKER
 
 from ninjemys.web.app import WebApp
 
@@ -18,6 +18,7 @@ def test_graph_page_shows_chatter_and_updates_on_kill(ros1_master: str, rospy_no
     try:
         rospy_node(TALKER)
         listener = rospy_node(LISTENER)
+        rospy_node(ROBOT_BASE)
         page = browser_page
         page.goto(url)
         page.wait_for_selector('g.node[data-name="/talker"]', timeout=20000)
@@ -27,6 +28,13 @@ def test_graph_page_shows_chatter_and_updates_on_kill(ros1_master: str, rospy_no
         assert page.locator('path.edge[data-source="/chatter"][data-target="/listener"]').count() == 1
         # /rosout is hidden by default ("Hide debug"); the master has no rosout node here anyway
         assert page.locator('g.topic[data-name="/rosout"]').count() == 0
+
+        # namespace grouping: /robot/base sits in a /robot group box (and not when grouping is off)
+        page.wait_for_selector('g.node[data-name="/robot/base"]', timeout=20000)
+        assert page.locator('g.group[data-name="/robot"]').count() == 1
+        page.uncheck("#group")
+        assert page.locator("g.group").count() == 0
+        page.check("#group")
 
         # clicking the topic shows its type
         page.click('g.topic[data-name="/chatter"]')

@@ -28,6 +28,18 @@ while not rospy.is_shutdown():
     rate.sleep()
 """
 
+#: a node in namespace /robot (its topic is /robot/odom), for namespace grouping
+ROBOT_BASE = """
+import os
+os.environ["ROS_NAMESPACE"] = "/robot"  # rospy reads its namespace when it is imported
+import rospy
+from std_msgs.msg import String
+rospy.init_node("base")
+pub = rospy.Publisher("odom", String, queue_size=1)
+rospy.Subscriber("/chatter", String, lambda msg: None)
+rospy.spin()
+"""
+
 LISTENER = """
 import rospy
 from std_msgs.msg import String
