@@ -281,13 +281,11 @@ class Node:
         try:
             return self.master.get_param(resolved)
         except MasterError as exc:
-            if getattr(exc, "code", None) in (-1, 0) and default is not _UNSET:
+            if getattr(exc, "code", None) not in (-1, 0):
+                raise  # unreachable master, protocol trouble: not "unset"
+            if default is not _UNSET:
                 return default
-            if default is not _UNSET and "not set" in str(exc):
-                return default
-            if getattr(exc, "code", None) in (-1, 0):
-                raise ParameterError(f"parameter [{resolved}] is not set") from None
-            raise
+            raise ParameterError(f"parameter [{resolved}] is not set") from None
 
     def set_param(self, key: str, value: Any) -> None:
         self.master.set_param(self.resolve_name(key), value)

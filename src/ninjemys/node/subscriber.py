@@ -41,6 +41,9 @@ if TYPE_CHECKING:
 
 _log = logging.getLogger(__name__)
 
+#: Bytes an unbounded subscription reads from one connection before delivering what it has.
+_READ_BUDGET = 256 * 1024
+
 
 @dataclass(slots=True)
 class RawMessage:
@@ -108,11 +111,13 @@ class SubConnection:
         self.closed = False
         self._reader = FrameReader()
 
-    def read(self) -> list[bytes | bytearray] | None:
-        """Read everything the kernel has (worker thread); None when the stream has ended."""
+    def read(self, budget: int | None = None) -> list[bytes | bytearray] | None:
+        """Read what the kernel has (worker thread), up to about ``budget`` bytes when given; None when
+        the stream has ended."""
         reader, sock = self._reader, self.sock
         frames: list[bytes | bytearray] = []
-        while True:
+        got = 0
+        while budget is None or got < budget:
             buf = reader.buffer()
             try:
                 n = sock.recv_into(buf)
@@ -124,12 +129,14 @@ class SubConnection:
             if n == 0:
                 if reader.pending:
                     self._lost(
-                        f"publisher disconnected mid-message ({reader.pending} bytes of a frame received)"
+                        f"publisher disconnected mid-message ({reader.pending} bytes of a frame received)",
+                        logging.WARNING,
                     )
                 else:
                     self._lost("publisher closed the connection")
                 return None
             self.bytes_recv += n
+            got += n
             try:
                 frames.extend(reader.commit(n))
             except ProtocolError as exc:
@@ -145,8 +152,8 @@ class SubConnection:
                 self.last = frames[-1]
         return frames
 
-    def _lost(self, why: str) -> None:
-        _log.info("topic %s: %s (%s)", self.sub.topic, why, self.publisher)
+    def _lost(self, why: str, level: int = logging.INFO) -> None:
+        _log.log(level, "topic %s: %s (%s)", self.sub.topic, why, self.publisher)
         self.close()
         self.sub.node.runtime.call_soon(self.sub.connection_lost, self, True)
 
@@ -396,7 +403,9 @@ class Subscriber:
         if conn.closed:
             self._forget(conn)
             return
-        frames = conn.read()
+        # a bounded queue keeps the newest: read all there is and drop; an unbounded one delivers as it
+        # goes (reading megabytes of backlog first would stall every callback meanwhile)
+        frames = conn.read(None if self._queue.maxlen is not None else _READ_BUDGET)
         if frames is None:
             self._forget(conn)
             return

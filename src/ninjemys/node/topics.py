@@ -78,10 +78,6 @@ class PubConnection:
         self._last = 0.0  # time of the previous send (detects bursts)
         self._queued_bytes = 0
 
-    @property
-    def idle(self) -> bool:
-        return self._partial is None and not self._queue
-
     def send(self, data: bytes, queue_size: int | None) -> None:
         """Queue ``data`` (one or more frames) for this subscriber; never blocks unless queue_size is None.
 

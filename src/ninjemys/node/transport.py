@@ -10,7 +10,7 @@ from __future__ import annotations
 import asyncio
 import logging
 import socket
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 
 from ninjemys.errors import ProtocolError
 from ninjemys.wire import headers
@@ -78,9 +78,6 @@ def peer_name(sock: socket.socket) -> str:
         return f"{host}:{port}"
     except OSError:
         return "?"
-
-
-InboundHandler = Callable[[socket.socket, Mapping[str, str]], "asyncio.Future[None] | None"]
 
 
 class TcprosServer:
