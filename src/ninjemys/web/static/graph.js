@@ -39,7 +39,7 @@ function visibleGraph(graph) {
     const pubs = t.publishers.filter((p) => nodeSet.has(p));
     const subs = t.subscribers.filter((s) => nodeSet.has(s));
     if (!opt.dead && subs.length === 0) return false;
-    if (!opt.leaf && pubs.length === 0) return false;
+    if (!opt.leaf && new Set(pubs.concat(subs)).size <= 1) return false; // leaf: one node only
     return pubs.length + subs.length > 0;
   });
   const match = (name) => !opt.filter || name.includes(opt.filter);
