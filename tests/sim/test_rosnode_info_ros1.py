@@ -64,3 +64,30 @@ def test_rosnode_info_matches_seed(turtlesim, master, client) -> None:  # type: 
     assert _section(out, "Subscriptions:") == ["/turtle1/cmd_vel [geometry_msgs/Twist]"]
     assert _section(out, "Services:") == SEED_SERVICES
     assert "Pid:" in out
+
+
+def test_seed_rostopic_pub_moves_the_turtle(turtlesim, master, client) -> None:  # type: ignore[no-untyped-def]
+    """The seed's command, run by Debian's real rostopic, drives our turtle (0.2 units in the 1 s hold)."""
+    from turtlesim.msg import Pose
+
+    turtlesim()
+    poses: list[Pose] = []
+    client.subscriber("/turtle1/pose", Pose, poses.append)
+    wait_until(lambda: poses, what="poses")
+    subprocess.run(
+        [
+            ROS1_PYTHON,
+            "/usr/bin/rostopic",
+            "pub",
+            "-1",
+            "/turtle1/cmd_vel",
+            "geometry_msgs/Twist",
+            "{linear: {x: 0.2, y: 0, z: 0}, angular: {x: 0, y: 0, z: 0}}",
+        ],
+        env=ros1_env(master),
+        capture_output=True,
+        timeout=30,
+        check=True,
+    )
+    wait_until(lambda: poses[-1].linear_velocity == 0.0 and poses[-1].x > 5.6, what="the move to end")
+    assert poses[-1].x - 5.544445 == pytest.approx(0.2, rel=0.02)
