@@ -2,8 +2,10 @@
 
 ROS 1 nodes register once; a restarted master knows nothing and the graph stays broken until every
 node is restarted (the most cited ROS 1 complaint). Here the registrar keeps the node's
-registrations and a watchdog thread checks once a second, with one cheap ``lookupNode`` call, that
-the master still knows this node. When the master is back but has forgotten us (a new run), every
+registrations, and a watchdog thread checks with one ``lookupNode`` call that the master still knows
+this node whenever an idle TCP connection it keeps open to the master's port breaks (a restart is
+noticed at once and costs nothing in steady state), every second while the master is down, and every
+15 s as a fallback. When the master is back but has forgotten us (a new run), every
 publisher, subscriber, service and parameter subscription is registered again; subscribers get
 the current publisher list, publishers trigger ``publisherUpdate`` to their subscribers, so the
 graph heals with no user action. If the master reports another URI for our name, a newer node took
@@ -15,21 +17,26 @@ it comes back.
 
 from __future__ import annotations
 
+import asyncio
 import logging
+import socket
 import threading
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
-from ninjemys.errors import MasterError, MasterUnreachable
+from ninjemys.errors import MasterError, MasterUnreachable, ShutdownError
 from ninjemys.master.client import MasterClient
+from ninjemys.net.addresses import split_uri
 
 if TYPE_CHECKING:
     from ninjemys.node.node import Node
 
 _log = logging.getLogger(__name__)
 
-#: Seconds between two checks that the master still knows us.
+#: Seconds between two checks while the master is unreachable (or no link to it could be opened).
 WATCH_PERIOD = 1.0
+#: Seconds between two checks while the link to the master is up (a broken link triggers one at once).
+IDLE_CHECK_PERIOD = 15.0
 
 
 class Registrar:
@@ -47,6 +54,9 @@ class Registrar:
         # the watchdog has its own client (short timeout) so it never waits behind a user call
         self._probe = MasterClient(node.master_uri, node.name, timeout=2.0)
         self._thread: threading.Thread | None = None
+        self._link: socket.socket | None = None
+        self._link_up = False
+        self._link_lost = threading.Event()
 
     def start(self) -> None:
         self._thread = threading.Thread(target=self._watch, name=f"reg:{self.node.name}", daemon=True)
@@ -121,25 +131,81 @@ class Registrar:
     # -- watchdog --------------------------------------------------------------------------------
 
     def _watch(self) -> None:
-        while not self._stop.wait(WATCH_PERIOD):
-            with self._lock:
-                empty = not (self.publications or self.subscriptions or self.services or self.param_keys)
-            if empty and not self._master_down:
-                continue
-            try:
-                known = self._probe.lookup_node(self.node.name)
-            except MasterUnreachable:
-                self._master_down = True
-                continue
-            except MasterError:
-                known = None  # "unknown node": a new master
-            if known == self.node.uri and not self._master_down:
-                continue
-            if known not in (None, self.node.uri):
-                continue  # another node took our name; the master shuts us down
+        """Check the master when the link to it breaks (instantly), every WATCH_PERIOD while it is
+        down, and every IDLE_CHECK_PERIOD otherwise (in case no link could be kept)."""
+        self._spawn_link()
+        while not self._stop.is_set():
+            period = WATCH_PERIOD if self._master_down or not self._link_up else IDLE_CHECK_PERIOD
+            self._link_lost.wait(period)
+            self._link_lost.clear()
             if self._stop.is_set():
                 return
+            self._check()
+            if not self._master_down and not self._link_up:
+                self._spawn_link()
+
+    def _spawn_link(self) -> None:
+        try:
+            self.node.runtime.spawn(self._open_link())
+        except ShutdownError:
+            self._stop.set()
+
+    def _check(self) -> None:
+        with self._lock:
+            empty = not (self.publications or self.subscriptions or self.services or self.param_keys)
+        if empty and not self._master_down:
+            return
+        try:
+            known = self._probe.lookup_node(self.node.name)
+        except MasterUnreachable:
+            self._master_down = True
+            return
+        except MasterError:
+            known = None  # "unknown node": a new master
+        if known == self.node.uri and not self._master_down:
+            return
+        if known not in (None, self.node.uri):
+            return  # another node took our name; the master shuts us down
+        if not self._stop.is_set():
             self._reregister()
+
+    # -- the link: an idle TCP connection to the master whose end tells us it went away -----------
+
+    async def _open_link(self) -> None:
+        """On the loop: connect to the master's port and watch the socket (no request is sent)."""
+        if self._link is not None or self._stop.is_set():
+            return
+        loop = asyncio.get_running_loop()
+        sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        sock.setblocking(False)
+        try:
+            host, port = split_uri(self.node.master_uri)
+            async with asyncio.timeout(2.0):
+                await loop.sock_connect(sock, (host, port))
+        except (OSError, ValueError, TimeoutError):
+            sock.close()
+            return
+        if self._stop.is_set():
+            sock.close()
+            return
+        self._link = sock
+        self._link_up = True
+        loop.add_reader(sock.fileno(), self._on_link_event)
+
+    def _on_link_event(self) -> None:
+        """The master closed our idle connection (it died, restarted, or timed us out): check it."""
+        self._close_link()
+        self._link_lost.set()
+
+    def _close_link(self) -> None:
+        sock, self._link = self._link, None
+        self._link_up = False
+        if sock is not None:
+            try:
+                self.node.runtime.loop.remove_reader(sock.fileno())
+            except (ValueError, OSError):
+                pass
+            sock.close()
 
     def _reregister(self) -> None:
         with self._lock:
@@ -170,6 +236,9 @@ class Registrar:
 
     def stop(self) -> None:
         self._stop.set()
+        self._link_lost.set()
+        if self.node.runtime.alive:
+            self.node.runtime.call_soon(self._close_link)
         if self._thread is not None and self._thread is not threading.current_thread():
             self._thread.join(3.0)
         self._probe.close()
