@@ -118,3 +118,38 @@ def test_class_from_definition_rejects_a_wrong_md5() -> None:
 def test_class_from_definition_with_missing_embedded_type_is_an_error() -> None:
     with pytest.raises(Exception, match="nowhere_pkg"):
         loader.message_class_from_definition("unknown_pkg/Broken", "nowhere_pkg/Missing m\n")
+
+
+@pytest.mark.ros1
+def test_action_expansion_matches_debian_move_base_msgs(tmp_path, monkeypatch) -> None:
+    """Debian ships move_base_msgs built by actionlib's genaction: our expansion gives the same md5s."""
+    import json
+    import subprocess
+
+    from ninjemys.idl import search
+    from ninjemys.testing import ROS1_PYTHON, have_ros1
+
+    if not have_ros1():
+        pytest.skip("needs Debian's ROS 1")
+    pkg = tmp_path / "move_base_msgs"
+    (pkg / "action").mkdir(parents=True)
+    (pkg / "package.xml").write_text("<package><name>move_base_msgs</name></package>")
+    (pkg / "action" / "MoveBase.action").write_text(
+        "geometry_msgs/PoseStamped target_pose\n---\n---\ngeometry_msgs/PoseStamped base_position\n"
+    )
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(tmp_path))
+    search.clear_cache()
+    suffixes = ["Action", "ActionGoal", "ActionResult", "ActionFeedback", "Goal", "Result", "Feedback"]
+    script = (
+        "import json, move_base_msgs.msg as m\n"
+        f"print(json.dumps({{s: getattr(m, 'MoveBase' + s)._md5sum for s in {suffixes!r}}}))\n"
+    )
+    done = subprocess.run(
+        [ROS1_PYTHON, "-c", script], capture_output=True, text=True, env={"PATH": "/usr/bin"}, timeout=60
+    )
+    if done.returncode != 0:
+        pytest.skip(f"Debian's move_base_msgs is not importable: {done.stderr[-200:]}")
+    theirs = json.loads(done.stdout)
+    ours = {s: loader.get_message_class(f"move_base_msgs/MoveBase{s}")._md5sum for s in suffixes}
+    assert ours == theirs
+    search.clear_cache()
