@@ -299,6 +299,11 @@ def test_unknown_kind_is_one_error_line():
     assert done.returncode == 2
     assert done.stderr == "ERROR: unknown completion kind [bogus]\n"
     assert complete.candidates("msg-proto", ["no_such/Type", ""]) == []
+    missing = subprocess.run(
+        [sys.executable, "-m", "ninjemys.tools.complete"], capture_output=True, text=True, timeout=30
+    )
+    assert missing.returncode == 2 and missing.stderr.startswith("ERROR: missing completion kind")
+    assert missing.stdout == ""
 
 
 @pytest.mark.ros1

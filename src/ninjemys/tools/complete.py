@@ -374,9 +374,15 @@ def main(argv: list[str] | None = None) -> int:
     if args and args[0] == "--path":
         print(BASH_FILE)
         return 0
-    if not args or args[0] in ("-h", "--help"):
+    if args and args[0] in ("-h", "--help"):
         print(__doc__)
-        return 0 if args else 2
+        return 0
+    if not args:
+        print(
+            "ERROR: missing completion kind (python -m ninjemys.tools.complete --help lists them)",
+            file=sys.stderr,
+        )
+        return 2
     try:
         found = candidates(args[0], args[1:])
     except KeyError:
