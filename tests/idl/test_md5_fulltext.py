@@ -153,3 +153,9 @@ def test_action_expansion_matches_debian_move_base_msgs(tmp_path, monkeypatch) -
     ours = {s: loader.get_message_class(f"move_base_msgs/MoveBase{s}")._md5sum for s in suffixes}
     assert ours == theirs
     search.clear_cache()
+
+
+def test_recursive_definitions_are_rejected() -> None:
+    full_text = f"Node[] children\n{SEPARATOR}\nMSG: tree_pkg/Node\nNode[] children\n"
+    with pytest.raises(DefinitionError, match="recursive message type: tree_pkg/Node -> tree_pkg/Node"):
+        loader.message_class_from_definition("tree_pkg/Node", full_text)
