@@ -121,8 +121,10 @@ def _parse_constant(raw: str, clean: str) -> Constant:
         raise ValueError(f"{name!r} is not a legal constant name")
     try:
         converted = _constant_value(type_, value)
-    except (ValueError, SyntaxError) as exc:
-        raise ValueError(f"invalid constant value {value.strip()!r} for {type_} {name}: {exc}") from None
+    except (ValueError, SyntaxError, TypeError, MemoryError, RecursionError) as exc:
+        shown = value.strip() if len(value.strip()) <= 60 else value.strip()[:57] + "..."
+        reason = str(exc) if len(str(exc)) <= 100 else type(exc).__name__
+        raise ValueError(f"invalid constant value {shown!r} for {type_} {name}: {reason}") from None
     return Constant(type_, name, converted, value.strip())
 
 
