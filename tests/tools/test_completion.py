@@ -354,6 +354,8 @@ def test_ninjemys_completion_script_enables_completion(tmp_path):
         "complete -p rostopic rosnode rosservice rosparam rosmsg rossrv rosbag rospack roscd rosls rosed rosrun "
         "roslaunch roscore catkin_make catkin_create_pkg turtlesim_node\n"
         'printf "PY=%s\\n" "$_NJ_PY"\n'
+        'printf "ROOT=%s\\n" "$_NJ_ROOT"\n'
+        "_nj_run packages std_m\n"
     )
     env = dict(os.environ)
     env.pop("NINJEMYS_PYTHON", None)
@@ -364,6 +366,8 @@ def test_ninjemys_completion_script_enables_completion(tmp_path):
     assert done.returncode == 0, done.stderr
     assert done.stdout.count("complete -") >= 17
     assert f"PY={sys.executable}" in done.stdout
+    assert f"ROOT={Path(complete.__file__).parents[2]}" in done.stdout
+    assert "\nstd_msgs\n" in done.stdout  # the helper ran (python -S with that root on sys.path)
     bad = subprocess.run([exe, "--bogus"], capture_output=True, text=True, timeout=30)
     assert bad.returncode == 2 and bad.stderr.startswith("ERROR: ") and bad.stderr.count("\n") == 1
 

@@ -397,8 +397,12 @@ def script(python: str = sys.executable) -> str:
     """The bash code to ``eval``: the completion file, bound to this interpreter."""
     with open(BASH_FILE, encoding="utf-8") as f:
         text = f.read()
-    quoted = "'" + python.replace("'", "'\\''") + "'"
-    return f"_NJ_PY={quoted}\n{text}"
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    return f"_NJ_PY={_shell_quote(python)}\n_NJ_ROOT={_shell_quote(root)}\n{text}"
+
+
+def _shell_quote(text: str) -> str:
+    return "'" + text.replace("'", "'\\''") + "'"
 
 
 def completion_main() -> None:

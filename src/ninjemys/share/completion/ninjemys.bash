@@ -35,19 +35,34 @@ _nj_python() {
 
 # `python -c` rather than `-m`: runpy's imports would add a third to every answer
 _NJ_HELPER='from ninjemys.tools.complete import main; raise SystemExit(main())'
+# the directory holding the ninjemys package, when this file sits inside it: the helper then runs
+# with `python -S` (no site-packages scan, no .pth hooks) and this directory as its only addition
+if [[ -z ${_NJ_ROOT:-} && ${BASH_SOURCE[0]:-} == */ninjemys/share/completion/ninjemys.bash ]]; then
+  _NJ_ROOT=${BASH_SOURCE[0]%/ninjemys/share/completion/ninjemys.bash}
+fi
+_NJ_FAST_HELPER='import sys; sys.path.insert(0, sys.argv.pop(1)); '$_NJ_HELPER
+
+# _nj_run KIND [ARG...]: run the helper; the prototypes need PyYAML from site-packages, the rest
+# needs the standard library only
+_nj_run() {
+  _nj_python
+  if [[ -n ${_NJ_ROOT:-} && $1 != *-proto ]]; then
+    "$_nj_py" -S -c "$_NJ_FAST_HELPER" "$_NJ_ROOT" "$@" 2>/dev/null
+  else
+    "$_nj_py" -c "$_NJ_HELPER" "$@" 2>/dev/null
+  fi
+}
 
 # _nj_ask KIND [ARG...]: candidates from the helper, one per line, into COMPREPLY (prefix = $_nj_cur)
 _nj_ask() {
-  _nj_python
-  mapfile -t COMPREPLY < <("$_nj_py" -c "$_NJ_HELPER" "$@" "$_nj_cur" 2>/dev/null)
+  mapfile -t COMPREPLY < <(_nj_run "$@" "$_nj_cur")
   _nj_nospace_dirs
 }
 
 # _nj_ask_one KIND ARG: a single multi-line candidate (a YAML prototype) into COMPREPLY
 _nj_ask_one() {
   local reply
-  _nj_python
-  reply=$("$_nj_py" -c "$_NJ_HELPER" "$1" "$2" "" 2>/dev/null)
+  reply=$(_nj_run "$1" "$2" "")
   COMPREPLY=()
   if [[ -n $reply && $reply == "$_nj_cur"* ]]; then
     COMPREPLY=("$reply")
@@ -422,8 +437,7 @@ _roslaunch() {
   if [[ -f $first ]]; then # roslaunch FILE... [arg:=value...]
     _nj_files launch test xml
     local -a args
-    _nj_python
-    mapfile -t args < <("$_nj_py" -c "$_NJ_HELPER" launch-args "$first" "$_nj_cur" 2>/dev/null)
+    mapfile -t args < <(_nj_run launch-args "$first" "$_nj_cur")
     COMPREPLY+=("${args[@]}")
     _nj_nospace_dirs
     return
