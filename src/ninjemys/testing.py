@@ -12,6 +12,7 @@ import socket
 import sys
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 #: Debian's real ROS 1 runs under the system interpreter, never the project's venv.
 ROS1_PYTHON = "/usr/bin/python3"
@@ -102,3 +103,79 @@ def run_master(
     finally:
         proc.kill()
         proc.wait()
+
+
+def descendants(pid: int) -> list[int]:
+    """Every live descendant of ``pid`` (from /proc), children before grandchildren.
+
+    Needed because roslaunch puts each child (rosmaster, rosout) in its own session, so killing the
+    parent's process group leaves them running.
+    """
+    children: dict[int, list[int]] = {}
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            stat = (entry / "stat").read_text()
+        except OSError:
+            continue
+        ppid = int(stat.rsplit(")", 1)[1].split()[1])
+        children.setdefault(ppid, []).append(int(entry.name))
+    found: list[int] = []
+    frontier = [pid]
+    while frontier:
+        nxt = []
+        for parent in frontier:
+            for child in children.get(parent, []):
+                found.append(child)
+                nxt.append(child)
+        frontier = nxt
+    return found
+
+
+def kill_tree(proc: Any) -> None:
+    """SIGKILL a Popen'd process and all of its descendants, then reap it."""
+    import signal
+
+    for pid in [*descendants(proc.pid), proc.pid]:
+        try:
+            os.kill(pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+    proc.wait()
+
+
+@contextlib.contextmanager
+def run_real_roscore(ros_home: str | os.PathLike[str], timeout: float = 30.0) -> Iterator[str]:
+    """Debian's /usr/bin/roscore on a free port; yields its URI once /rosout is up; kills the whole tree."""
+    import subprocess
+    import time
+    import xmlrpc.client
+
+    port = free_port()
+    uri = f"http://localhost:{port}/"
+    proc = subprocess.Popen(
+        ["/usr/bin/roscore", "-p", str(port)],
+        env=ros1_env(uri, ROS_HOME=str(ros_home)),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        stdin=subprocess.DEVNULL,
+        start_new_session=True,
+    )
+    try:
+        deadline = time.monotonic() + timeout
+        while True:
+            try:
+                code, _, state = xmlrpc.client.ServerProxy(uri).getSystemState("/run_real_roscore")
+                if code == 1 and any(topic == "/rosout_agg" for topic, _ in state[0]):
+                    break
+            except OSError:
+                pass
+            if proc.poll() is not None:
+                raise RuntimeError(f"/usr/bin/roscore -p {port} exited with {proc.returncode}")
+            if time.monotonic() > deadline:
+                raise RuntimeError(f"/usr/bin/roscore -p {port} did not bring up /rosout within {timeout} s")
+            time.sleep(0.1)
+        yield uri
+    finally:
+        kill_tree(proc)

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import os
 import re
-import signal
 import subprocess
 import sys
 import time
@@ -22,7 +21,7 @@ sys.path.insert(0, str(Path(__file__).parents[1] / "rospy"))
 
 from nodeproc import NodeProc  # noqa: E402
 
-from ninjemys.testing import ROS1_PYTHON, free_port, ros1_env, run_master  # noqa: E402
+from ninjemys.testing import ROS1_PYTHON, ros1_env, run_master, run_real_roscore  # noqa: E402
 
 SEEDS = Path(os.environ.get("NINJEMYS_SEEDS", Path(__file__).resolve().parents[3] / "shared" / "seeds"))
 SEED = SEEDS / "000_7aec5b1f38a66cac.txt"
@@ -97,40 +96,9 @@ def our_master(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
 
 @pytest.fixture(scope="module")
 def real_master(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
-    """Debian's /usr/bin/roscore (rosmaster + rosout) on a free port, killed with its children."""
-    port = free_port()
-    uri = f"http://localhost:{port}/"
-    env = ros1_env(uri, ROS_HOME=str(tmp_path_factory.mktemp("real_roscore")))
-    proc = subprocess.Popen(
-        ["/usr/bin/roscore", "-p", str(port)],
-        env=env,
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-        stdin=subprocess.DEVNULL,
-        start_new_session=True,
-    )
-    try:
-        import xmlrpc.client
-
-        deadline = time.monotonic() + 30
-        while True:
-            try:
-                code, _, _ = xmlrpc.client.ServerProxy(uri).getSystemState("/seed_test")
-                state = xmlrpc.client.ServerProxy(uri).getSystemState("/seed_test")[2]
-                if code == 1 and any(t == "/rosout" for t, _ in state[1]):
-                    break
-            except OSError:
-                pass
-            if proc.poll() is not None or time.monotonic() > deadline:
-                raise RuntimeError("Debian's roscore did not come up")
-            time.sleep(0.1)
+    """Debian's /usr/bin/roscore (rosmaster + rosout) on a free port, killed with all its children."""
+    with run_real_roscore(tmp_path_factory.mktemp("real_roscore")) as uri:
         yield uri
-    finally:
-        try:
-            os.killpg(proc.pid, signal.SIGKILL)
-        except ProcessLookupError:
-            pass
-        proc.wait()
 
 
 def test_seed_blocks_are_found() -> None:

@@ -12,7 +12,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from ninjemys.testing import free_port, ninjemys_bin, ros1_env
+from ninjemys.testing import ninjemys_bin, ros1_env, run_real_roscore
 
 #: a ninjemys node (run with our interpreter): talker on /chatter with a counter, a latched topic and
 #: the std_srvs/SetBool service /set_flag. argv: name rate_hz
@@ -73,38 +73,11 @@ def stop(proc: subprocess.Popen) -> None:
 
 @contextmanager
 def real_roscore() -> Iterator[str]:
-    port = free_port()
-    uri = f"http://localhost:{port}/"
-    proc = subprocess.Popen(
-        ["/usr/bin/roscore", "-p", str(port)],
-        env=ros1_env(uri, ROS_HOME=os.environ.get("ROS_HOME", "/tmp")),
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-        start_new_session=True,
-    )
-    try:
-        deadline = time.monotonic() + 30
-        import xmlrpc.client
+    """Debian's roscore with its own ROS_HOME; the whole process tree is killed afterwards."""
+    import tempfile
 
-        while True:
-            try:
-                state = xmlrpc.client.ServerProxy(uri).getSystemState("/test")[2]
-                if any(t == "/rosout_agg" for t, _ in state[0]):
-                    break
-            except OSError:
-                pass
-            if time.monotonic() > deadline:
-                raise RuntimeError("real roscore did not come up")
-            time.sleep(0.1)
+    with tempfile.TemporaryDirectory(prefix="real_roscore_") as home, run_real_roscore(home) as uri:
         yield uri
-    finally:
-        import signal
-
-        try:
-            os.killpg(proc.pid, signal.SIGKILL)
-        except ProcessLookupError:
-            pass
-        proc.wait()
 
 
 @contextmanager
