@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import asyncio
 import logging
-import os
 import select
 import selectors
 import socket
@@ -314,12 +313,13 @@ class Subscriber:
         self._closed = False
         self._ops: list[tuple[str, SubConnection]] = []
         self._ops_lock = threading.Lock()
-        self._wake_r, self._wake_w = os.pipe()
-        os.set_blocking(self._wake_r, False)
-        os.set_blocking(self._wake_w, False)
+        # a socket pair, not a pipe: selectable on every OS (Windows cannot select on pipes)
+        self._wake_r, self._wake_w = socket.socketpair()
+        self._wake_r.setblocking(False)
+        self._wake_w.setblocking(False)
         self._woken = False
         self._poller = _Poller()
-        self._poller.register(self._wake_r, None)
+        self._poller.register(self._wake_r.fileno(), None)
         self._conns: dict[int, SubConnection] = {}
         self._thread = subscription.node.runtime.start_thread(self._work, f"sub:{subscription.topic}")
 
@@ -330,7 +330,7 @@ class Subscriber:
             return
         self._woken = True
         try:
-            os.write(self._wake_w, b"\0")
+            self._wake_w.send(b"\0")
         except (BlockingIOError, OSError):
             pass
 
@@ -380,7 +380,7 @@ class Subscriber:
     def _on_wake(self) -> None:
         self._woken = False
         try:
-            while os.read(self._wake_r, 4096):
+            while self._wake_r.recv(4096):
                 pass
         except (BlockingIOError, OSError):
             pass
@@ -430,11 +430,8 @@ class Subscriber:
             else:
                 conn.close()
         self._poller.close()
-        for fd in (self._wake_r, self._wake_w):
-            try:
-                os.close(fd)
-            except OSError:
-                pass
+        self._wake_r.close()
+        self._wake_w.close()
 
     def _deliver(self, frame: bytes | bytearray, header: Mapping[str, str]) -> None:
         if self.raw or self._sub.msg_class is None:
