@@ -9,8 +9,8 @@ import textwrap
 from pathlib import Path
 
 import pytest
+from idl_fixtures import FIXTURE_SRC
 
-from conftest import FIXTURE_SRC
 from ninjemys.errors import TypeNotFoundError
 from ninjemys.idl import loader, search
 

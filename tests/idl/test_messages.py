@@ -12,8 +12,8 @@ import subprocess
 from pathlib import Path
 
 import pytest
+from idl_fixtures import populated_all_types
 
-from conftest import populated_all_types
 from ninjemys.errors import DeserializationError, SerializationError
 from ninjemys.idl.arrays import NumericArray
 from ninjemys.idl.loader import get_message_class, get_service_class

@@ -45,18 +45,32 @@ LITTLE_ENDIAN_HOST = sys.byteorder == "little"
 class NumericArray(Sequence):
     """An immutable, lazily converted view of a received numeric array (see the module docstring)."""
 
-    __slots__ = ("_view", "_fmt")
+    __slots__ = ("_raw", "_fmt", "_cast")
 
-    def __init__(self, view: memoryview, fmt: str) -> None:
-        """``view``: a memoryview of format ``fmt`` over little-endian wire bytes (little-endian hosts)."""
-        self._view = view
-        self._fmt = fmt
+    def __init__(self, view: memoryview) -> None:
+        """``view``: a typed memoryview (format ``f``, ``d``, ``i`` ...) over little-endian wire bytes.
+
+        Generated code does not call this: it stores ``_raw`` (the wire bytes, a ``B`` memoryview) and
+        ``_fmt`` directly, and the typed view is made on first use, so an array a callback never reads
+        costs one slice.
+        """
+        self._raw = view.cast("B")
+        self._fmt = view.format
+        self._cast = view
+
+    @property
+    def _view(self) -> memoryview:
+        try:
+            return self._cast
+        except AttributeError:
+            typed = self._cast = self._raw.cast(self._fmt)
+            return typed
 
     @classmethod
     def from_wire(cls, raw: bytes | memoryview, fmt: str) -> NumericArray | tuple:
         """View ``raw`` (wire bytes) as elements of ``fmt``; a tuple on big-endian hosts."""
         if LITTLE_ENDIAN_HOST:
-            return cls(memoryview(raw).cast("B").cast(fmt), fmt)
+            return cls(memoryview(raw).cast("B").cast(fmt))
         count = len(raw) // struct.calcsize(fmt)
         return struct.unpack(f"<{count}{fmt}", raw)
 
@@ -65,9 +79,9 @@ class NumericArray(Sequence):
         """The struct format char of the elements (``f`` for float32, ...)."""
         return self._fmt
 
-    def raw_bytes(self) -> memoryview | bytes:
-        """The elements in ROS wire layout (little-endian), without copying on little-endian hosts."""
-        return self._view.cast("B")
+    def raw_bytes(self) -> memoryview:
+        """The elements in ROS wire layout (little-endian), without copying."""
+        return self._raw
 
     def __len__(self) -> int:
         return len(self._view)
@@ -124,7 +138,7 @@ class NumericArray(Sequence):
     def __array__(self, dtype: Any = None, copy: Any = None) -> Any:
         import numpy
 
-        arr = numpy.frombuffer(self._view, dtype=NUMPY_DTYPES[self._fmt])
+        arr = numpy.frombuffer(self._raw, dtype=NUMPY_DTYPES[self._fmt])
         if dtype is not None:
             arr = arr.astype(dtype)
         return arr

@@ -264,16 +264,23 @@ class _DeserEmitter(_Emitter):
             count = str(n)
         if base in PRIMITIVE_FORMATS:  # variable-length numeric block
             fmt, size = PRIMITIVE_FORMATS[base]
-            nbytes = count if size == 1 else f"{count} * {size}"
+            nbytes = count
+            if size > 1:
+                nbytes = self.tmp("b")
+                self.emit(f"{nbytes} = {count} * {size}")
             self.check(nbytes, what, count)
-            self.views = True
+            self.views = self.views or base != "bool"
             if base in ("uint8", "char"):
                 self.emit(f"{target} = mv[pos:pos + {count}]")
             elif base == "bool":
                 self.emit(f"{target} = [x != 0 for x in mv[pos:pos + {count}]]")
             else:
                 if LITTLE_ENDIAN_HOST:  # a typed view straight over the wire bytes
-                    self.emit(f"{target} = _NumArr(mv[pos:pos + {nbytes}].cast({fmt!r}), {fmt!r})")
+                    arr = self.tmp("a")
+                    self.emit(f"{arr} = _new(_NumArr)")
+                    self.emit(f"{arr}._raw = mv[pos:pos + {nbytes}]")
+                    self.emit(f"{arr}._fmt = {fmt!r}")
+                    self.emit(f"{target} = {arr}")
                 else:
                     self.emit(f"{target} = _struct.unpack_from('<%d{fmt}' % {count}, mv, pos)")
             self.emit(f"pos += {nbytes}")
