@@ -1,7 +1,7 @@
 """The YAML dialect of ROS parameters, shared by rosparam, roslaunch ``<rosparam>`` and ``_p:=v`` args.
 
 It is YAML 1.1 (PyYAML's safe loader) plus what rosparam registers: ``!degrees``/``!radians`` tags,
-implicit ``rad(pi/2)`` / ``deg(90)`` scalars, and ``!!binary`` values that travel as XML-RPC base64.
+implicit ``rad(pi/2)`` / ``deg(90)`` scalars, and ``!!binary`` values (``bytes``, sent as XML-RPC base64).
 Dumping uses PyYAML's block style, as ``rosparam get/dump`` print.
 """
 
@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import math
 import re
-import xmlrpc.client
 from typing import Any
 
 import yaml
@@ -51,30 +50,14 @@ def _degrees(loader: yaml.SafeLoader, node: yaml.Node) -> float:
     return math.radians(_angle(_strip_call(str(loader.construct_scalar(node)), "deg(")))
 
 
-def _binary(loader: yaml.SafeLoader, node: yaml.Node) -> xmlrpc.client.Binary:
-    return xmlrpc.client.Binary(loader.construct_yaml_binary(node))
-
-
 _Loader.add_constructor("!radians", _radians)
 _Loader.add_constructor("!degrees", _degrees)
-_Loader.add_constructor("tag:yaml.org,2002:binary", _binary)
 _Loader.add_implicit_resolver("!radians", re.compile(r"^rad\([^)]*\)$"), ["r"])
 _Loader.add_implicit_resolver("!degrees", re.compile(r"^deg\([^)]*\)$"), ["d"])
 
 
 class _Dumper(yaml.SafeDumper):
-    """Block-style dumper that writes XML-RPC binaries as ``!!binary``."""
-
-
-def _represent_binary(dumper: yaml.SafeDumper, data: xmlrpc.client.Binary) -> yaml.Node:
-    import base64
-
-    return dumper.represent_scalar(
-        "tag:yaml.org,2002:binary", base64.b64encode(data.data).decode(), style="|"
-    )
-
-
-_Dumper.add_representer(xmlrpc.client.Binary, _represent_binary)
+    """Block-style dumper; ``bytes`` (XML-RPC base64 values) come out as ``!!binary``."""
 
 
 def _wrap(exc: yaml.YAMLError) -> ParamYamlError:

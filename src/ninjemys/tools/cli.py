@@ -9,7 +9,7 @@ from __future__ import annotations
 import os
 import sys
 from collections.abc import Callable
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from ninjemys.errors import MasterUnreachable, NinjemysError
 
@@ -52,3 +52,35 @@ def master(caller_id: str = "/ninjemys_tool") -> MasterClient:
     from ninjemys.master.client import MasterClient
 
     return MasterClient(caller_id=caller_id, timeout=10.0)
+
+
+class _Unused:
+    """Stands in for the parser of a subcommand that was not invoked (nothing to build)."""
+
+    def add_argument(self, *args: object, **kwargs: object) -> None:
+        return None
+
+    def set_defaults(self, **kwargs: object) -> None:
+        return None
+
+
+class Subcommands:
+    """Builds only the invoked subcommand's argparse parser (``matched`` is False for an unknown one).
+
+    argparse spends most of a short tool's start-up building parsers (and their gettext lookups) for
+    subcommands the user did not type; ``add`` returns a real parser only for ``command``.
+    """
+
+    def __init__(self, prog: str, command: str) -> None:
+        import argparse
+
+        self.command = command
+        self.matched = False
+        self.parser = argparse.ArgumentParser(prog=prog, add_help=False)
+        self._sub = self.parser.add_subparsers(dest="command")
+
+    def add(self, name: str, *aliases: str) -> Any:
+        if self.command != name and self.command not in aliases:
+            return _Unused()
+        self.matched = True
+        return self._sub.add_parser(self.command, prog=f"{self.parser.prog} {name}")

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import re
 import time
-from dataclasses import dataclass, field
 from typing import Any
 
 from ninjemys.errors import MasterError, MasterUnreachable
@@ -19,15 +18,23 @@ from ninjemys.master.client import MasterClient
 CONNECTION_INFO = re.compile(r"\w+ connection on port (\d+) to \[(.*) on socket (\d+)\]")
 
 
-@dataclass
 class GraphState:
-    """getSystemState, indexed: topic -> nodes, node -> topics, plus topic types."""
+    """getSystemState, indexed: topic -> nodes, node -> topics, plus topic types.
 
-    publishers: dict[str, list[str]] = field(default_factory=dict)
-    subscribers: dict[str, list[str]] = field(default_factory=dict)
-    services: dict[str, list[str]] = field(default_factory=dict)
-    published_types: dict[str, str] = field(default_factory=dict)
-    topic_types: dict[str, str] = field(default_factory=dict)
+    (A plain class: tools import this on every start, and dataclasses costs ~20 ms to import.)
+    """
+
+    def __init__(
+        self,
+        publishers: dict[str, list[str]] | None = None,
+        subscribers: dict[str, list[str]] | None = None,
+        services: dict[str, list[str]] | None = None,
+    ) -> None:
+        self.publishers = publishers or {}
+        self.subscribers = subscribers or {}
+        self.services = services or {}
+        self.published_types: dict[str, str] = {}
+        self.topic_types: dict[str, str] = {}
 
     @classmethod
     def fetch(cls, master: MasterClient, with_types: bool = True) -> GraphState:

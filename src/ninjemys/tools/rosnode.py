@@ -10,7 +10,7 @@ from urllib.parse import urlparse
 
 from ninjemys import names
 from ninjemys.errors import MasterError, MasterUnreachable, NinjemysError
-from ninjemys.tools.cli import entry, error, master
+from ninjemys.tools.cli import Subcommands, entry, error, master
 from ninjemys.tools.graph import CONNECTION_INFO, GraphState, bus_info, node_api, ping, slave
 
 NAME = "rosnode"
@@ -340,33 +340,32 @@ def _cmd_cleanup(args: argparse.Namespace) -> int:
     return 0
 
 
-def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog=NAME, add_help=False)
-    sub = parser.add_subparsers(dest="command")
-    p = sub.add_parser("list", prog=f"{NAME} list")
+def _parser(command: str) -> argparse.ArgumentParser | None:
+    sub = Subcommands(NAME, command)
+    p = sub.add("list")
     p.add_argument("namespace", nargs="?")
     p.add_argument("-u", dest="list_uri", action="store_true", help="list XML-RPC URIs")
     p.add_argument("-a", "--all", dest="list_all", action="store_true", help="list all information")
     p.set_defaults(run=_cmd_list)
-    p = sub.add_parser("info", prog=f"{NAME} info")
+    p = sub.add("info")
     p.add_argument("nodes", nargs="+")
     p.add_argument("-q", "--quiet", action="store_true", help="do not contact the nodes")
     p.set_defaults(run=_cmd_info)
-    p = sub.add_parser("ping", prog=f"{NAME} ping")
+    p = sub.add("ping")
     p.add_argument("node", nargs="?")
     p.add_argument("-a", "--all", dest="ping_all", action="store_true", help="ping all nodes")
     p.add_argument("-c", dest="count", type=int, metavar="COUNT", help="number of pings to send")
     p.set_defaults(run=_cmd_ping)
-    p = sub.add_parser("kill", prog=f"{NAME} kill")
+    p = sub.add("kill")
     p.add_argument("nodes", nargs="*")
     p.add_argument("-a", "--all", dest="kill_all", action="store_true", help="kill all nodes")
     p.set_defaults(run=_cmd_kill)
-    p = sub.add_parser("machine", prog=f"{NAME} machine")
+    p = sub.add("machine")
     p.add_argument("machine", nargs="?")
     p.set_defaults(run=_cmd_machine)
-    p = sub.add_parser("cleanup", prog=f"{NAME} cleanup")
+    p = sub.add("cleanup")
     p.set_defaults(run=_cmd_cleanup)
-    return parser
+    return sub.parser if sub.matched else None
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -374,7 +373,11 @@ def main(argv: list[str] | None = None) -> int:
     if not argv or argv[0] in ("-h", "--help", "help"):
         print(USAGE)
         return 0 if argv else 1
-    args = _parser().parse_args(argv)
+    parser = _parser(argv[0])
+    if parser is None:
+        print(USAGE)
+        return 1
+    args = parser.parse_args(argv)
     return args.run(args)
 
 

@@ -10,14 +10,13 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-import xmlrpc.client
 from pathlib import Path
 from typing import Any
 
 from ninjemys import names
 from ninjemys.errors import MasterError, MasterUnreachable, ParameterError
 from ninjemys.paramyaml import ParamYamlError, dump_yaml, load_yaml
-from ninjemys.tools.cli import entry, master
+from ninjemys.tools.cli import Subcommands, entry, master
 
 NAME = "rosparam"
 USAGE = """rosparam is a command-line tool for getting, setting, and deleting parameters from the ROS Parameter Server.
@@ -120,7 +119,7 @@ def _cmd_set(args: argparse.Namespace) -> int:
     if args.textfile:
         value: Any = Path(args.textfile).read_text()
     elif args.binfile:
-        value = xmlrpc.client.Binary(Path(args.binfile).read_bytes())
+        value = Path(args.binfile).read_bytes()
     else:
         if args.value is None:
             raise ParameterError("rosparam set: missing value (use -t FILE or -b FILE, or give a YAML value)")
@@ -202,41 +201,39 @@ def _cmd_delete(args: argparse.Namespace) -> int:
     return 0
 
 
-def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog=NAME, add_help=False)
-    sub = parser.add_subparsers(dest="command")
-    p = sub.add_parser("list", prog=f"{NAME} list")
+def _parser(command: str) -> argparse.ArgumentParser | None:
+    sub = Subcommands(NAME, command)
+    p = sub.add("list")
     p.add_argument("namespace", nargs="?")
     p.add_argument("-v", dest="verbose", action="store_true")
     p.set_defaults(run=_cmd_list)
-    p = sub.add_parser("get", prog=f"{NAME} get")
+    p = sub.add("get")
     p.add_argument("parameter")
     p.add_argument("-p", dest="pretty", action="store_true", help="pretty print. WARNING: not YAML-safe")
     p.add_argument("-v", dest="verbose", action="store_true")
     p.set_defaults(run=_cmd_get)
-    p = sub.add_parser("set", prog=f"{NAME} set")
+    p = sub.add("set")
     p.add_argument("parameter")
     p.add_argument("value", nargs="?")
     p.add_argument("-t", "--textfile", help="set parameters to contents of text file")
     p.add_argument("-b", "--binfile", help="set parameters to contents of binary file")
     p.add_argument("-v", dest="verbose", action="store_true")
     p.set_defaults(run=_cmd_set)
-    p = sub.add_parser("load", prog=f"{NAME} load")
+    p = sub.add("load")
     p.add_argument("file")
     p.add_argument("namespace", nargs="?")
     p.add_argument("-v", dest="verbose", action="store_true")
     p.set_defaults(run=_cmd_load)
-    p = sub.add_parser("dump", prog=f"{NAME} dump")
+    p = sub.add("dump")
     p.add_argument("file", nargs="?")
     p.add_argument("namespace", nargs="?")
     p.add_argument("-v", dest="verbose", action="store_true")
     p.set_defaults(run=_cmd_dump)
-    for alias in ("delete", "del"):
-        p = sub.add_parser(alias, prog=f"{NAME} delete")
-        p.add_argument("parameter")
-        p.add_argument("-v", dest="verbose", action="store_true")
-        p.set_defaults(run=_cmd_delete)
-    return parser
+    p = sub.add("delete", "del")
+    p.add_argument("parameter")
+    p.add_argument("-v", dest="verbose", action="store_true")
+    p.set_defaults(run=_cmd_delete)
+    return sub.parser if sub.matched else None
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -245,7 +242,11 @@ def main(argv: list[str] | None = None) -> int:
         print(USAGE)
         return 0 if argv else 1
     # negative numbers are values, not options: `rosparam set /x -1`
-    args = _parser().parse_args(_protect_negative_numbers(argv))
+    parser = _parser(argv[0])
+    if parser is None:
+        print(USAGE)
+        return 1
+    args = parser.parse_args(_protect_negative_numbers(argv))
     if args.command is None:
         print(USAGE)
         return 1

@@ -14,7 +14,7 @@ from typing import Any
 from ninjemys import names
 from ninjemys.errors import MasterError, NinjemysError, ServiceError, TypeNotFoundError
 from ninjemys.net.addresses import split_uri
-from ninjemys.tools.cli import entry, master
+from ninjemys.tools.cli import Subcommands, entry, master
 from ninjemys.tools.graph import GraphState
 from ninjemys.wire import headers
 
@@ -244,10 +244,9 @@ def _probe_class(client: Any, service: str, wait: bool = False, node: Any = None
             raise ServiceToolError(f"gave up waiting for service [{service}]")
 
 
-def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog=NAME, add_help=False)
-    sub = parser.add_subparsers(dest="command")
-    p = sub.add_parser("list", prog=f"{NAME} list")
+def _parser(command: str) -> argparse.ArgumentParser | None:
+    sub = Subcommands(NAME, command)
+    p = sub.add("list")
     p.add_argument("namespace", nargs="?")
     p.add_argument(
         "-n", "--nodes", dest="print_nodes", action="store_true", help="print nodes that provide service(s)"
@@ -260,19 +259,19 @@ def _parser() -> argparse.ArgumentParser:
         ("node", _cmd_node),
         ("args", _cmd_args),
     ):
-        p = sub.add_parser(cmd, prog=f"{NAME} {cmd}")
+        p = sub.add(cmd)
         p.add_argument("service")
         p.set_defaults(run=run)
-    p = sub.add_parser("find", prog=f"{NAME} find")
+    p = sub.add("find")
     p.add_argument("type")
     p.set_defaults(run=_cmd_find)
-    p = sub.add_parser("call", prog=f"{NAME} call")
+    p = sub.add("call")
     p.add_argument("service")
     p.add_argument("args", nargs=argparse.REMAINDER)
     p.add_argument("-v", dest="verbose", action="store_true", help="print verbose output")
     p.add_argument("--wait", action="store_true", help="wait for service to be advertised")
     p.set_defaults(run=_cmd_call)
-    return parser
+    return sub.parser if sub.matched else None
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -285,7 +284,11 @@ def main(argv: list[str] | None = None) -> int:
         opts = [a for a in argv[1:] if a in ("-v", "--wait")]
         rest = [a for a in argv[1:] if a not in ("-v", "--wait")]
         argv = ["call", *opts, *rest[:1], *(["--"] if len(rest) > 1 else []), *rest[1:]]
-    args = _parser().parse_args(argv)
+    parser = _parser(argv[0])
+    if parser is None:
+        print(USAGE)
+        return 1
+    args = parser.parse_args(argv)
     if args.command is None:
         print(USAGE)
         return 1

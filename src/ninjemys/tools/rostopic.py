@@ -10,7 +10,6 @@ from __future__ import annotations
 import argparse
 import math
 import os
-import queue
 import sys
 import threading
 import time
@@ -21,7 +20,7 @@ from typing import Any
 
 from ninjemys import names
 from ninjemys.errors import MasterError, NinjemysError, TypeNotFoundError
-from ninjemys.tools.cli import entry, master
+from ninjemys.tools.cli import Subcommands, entry, master
 from ninjemys.tools.graph import GraphState, node_api
 
 NAME = "rostopic"
@@ -233,22 +232,6 @@ def _wait_for_type(client: Any, topic: str, announce: bool = True) -> tuple[str,
             return ttype, real, field  # type: ignore[return-value]
 
 
-class _Inbox:
-    """Raw frames handed from the subscriber thread to the tool's main thread (Ctrl-C stays responsive)."""
-
-    def __init__(self) -> None:
-        self.items: queue.SimpleQueue[Any] = queue.SimpleQueue()
-
-    def put(self, raw: Any) -> None:
-        self.items.put(raw)
-
-    def get(self, timeout: float) -> Any | None:
-        try:
-            return self.items.get(timeout=timeout)
-        except queue.Empty:
-            return None
-
-
 def _class_for(ttype: str, header: Any) -> Any:
     from ninjemys.idl.loader import get_message_class, message_class_from_definition
 
@@ -321,27 +304,35 @@ def _cmd_echo(args: argparse.Namespace) -> int:
     getter = field_getter(field)
     predicate = _compile_filter(args.filter_expr)
     node = _make_node()
-    try:
-        inbox = _Inbox()
-        node.subscriber(real, None, inbox.put, raw=True, queue_size=args.queue_size)
-        count, cls = 0, None
-        while not node.is_shutdown:
-            raw = inbox.get(0.2)
-            if raw is None:
-                continue
-            if cls is None:
-                cls = _class_for(ttype, raw.connection_header)
-            msg = cls.deserialize_from(raw.data)
-            if predicate is not None and not predicate(msg, real):
-                continue
-            value = getter(msg) if getter else msg
-            if value is None:
-                continue
+    done = threading.Event()
+    state: dict[str, Any] = {"count": 0, "cls": None}
+
+    def on_message(raw: Any) -> None:
+        # runs on the subscription's own worker thread: printing here costs no extra thread hop
+        if done.is_set():
+            return
+        if state["cls"] is None:
+            state["cls"] = _class_for(ttype, raw.connection_header)
+        msg = state["cls"].deserialize_from(raw.data)
+        if predicate is not None and not predicate(msg, real):
+            return
+        value = getter(msg) if getter else msg
+        if value is None:
+            return
+        try:
             sys.stdout.write(printer.render(value))
             sys.stdout.flush()
-            count += 1
-            if args.count and count >= args.count:
-                break
+        except BrokenPipeError:
+            done.set()
+            return
+        state["count"] += 1
+        if args.count and state["count"] >= args.count:
+            done.set()
+
+    try:
+        node.subscriber(real, None, on_message, raw=True, queue_size=args.queue_size)
+        while not done.wait(0.5) and not node.is_shutdown:
+            pass
     finally:
         node.shutdown("rostopic echo done")
     return 0
@@ -695,10 +686,9 @@ def _linger(node: Any, pub: Any, client: Any, topic: str) -> None:
 # -------------------------------------------------------------------------------------- parsing
 
 
-def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog=NAME, add_help=False)
-    sub = parser.add_subparsers(dest="command")
-    p = sub.add_parser("list", prog=f"{NAME} list")
+def _parser(command: str) -> argparse.ArgumentParser | None:
+    sub = Subcommands(NAME, command)
+    p = sub.add("list")
     p.add_argument("namespace", nargs="?")
     p.add_argument("-b", "--bag", help="list topics in .bag file")
     p.add_argument("-v", "--verbose", action="store_true", help="list full details about each topic")
@@ -706,16 +696,16 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("-s", dest="subscribers_only", action="store_true", help="list only subscribers")
     p.add_argument("--host", action="store_true", help="group by host name")
     p.set_defaults(run=_cmd_list)
-    p = sub.add_parser("info", prog=f"{NAME} info")
+    p = sub.add("info")
     p.add_argument("topic")
     p.set_defaults(run=_cmd_info)
-    p = sub.add_parser("type", prog=f"{NAME} type")
+    p = sub.add("type")
     p.add_argument("topic")
     p.set_defaults(run=_cmd_type)
-    p = sub.add_parser("find", prog=f"{NAME} find")
+    p = sub.add("find")
     p.add_argument("type")
     p.set_defaults(run=_cmd_find)
-    p = sub.add_parser("echo", prog=f"{NAME} echo")
+    p = sub.add("echo")
     p.add_argument("topic")
     p.add_argument("-b", "--bag", help="echo messages from .bag file")
     p.add_argument("-p", dest="plot", action="store_true", help="echo in a plotting friendly format")
@@ -729,7 +719,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--offset", dest="offset_time", action="store_true", help="display time as offsets")
     p.add_argument("--queue-size", dest="queue_size", type=int, default=None)
     p.set_defaults(run=_cmd_echo)
-    p = sub.add_parser("pub", prog=f"{NAME} pub")
+    p = sub.add("pub")
     p.add_argument("topic")
     p.add_argument("type")
     p.add_argument("args", nargs=argparse.REMAINDER)
@@ -740,7 +730,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("-l", "--latch", action="store_true", help="enable latching for -f, -r and piped input")
     p.add_argument("-s", "--substitute-keywords", dest="substitute", action="store_true")
     p.set_defaults(run=_cmd_pub)
-    p = sub.add_parser("hz", prog=f"{NAME} hz")
+    p = sub.add("hz")
     p.add_argument("topics", nargs="+")
     p.add_argument("-w", "--window", type=int, default=-1, help="window size, in # of messages")
     p.add_argument("--filter", dest="filter_expr", help="only measure messages matching the expression")
@@ -749,16 +739,16 @@ def _parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--tcpnodelay", action="store_true")
     p.set_defaults(run=_cmd_hz)
-    p = sub.add_parser("bw", prog=f"{NAME} bw")
+    p = sub.add("bw")
     p.add_argument("topic")
     p.add_argument("-w", "--window", type=int, default=-1)
     p.set_defaults(run=_cmd_bw)
-    p = sub.add_parser("delay", prog=f"{NAME} delay")
+    p = sub.add("delay")
     p.add_argument("topic")
     p.add_argument("-w", "--window", type=int, default=-1)
     p.add_argument("--tcpnodelay", action="store_true")
     p.set_defaults(run=_cmd_delay)
-    return parser
+    return sub.parser if sub.matched else None
 
 
 def _split_pub_options(argv: list[str]) -> list[str]:
@@ -791,7 +781,11 @@ def main(argv: list[str] | None = None) -> int:
     if not argv or argv[0] in ("-h", "--help", "help"):
         print(USAGE)
         return 0 if argv else 1
-    args = _parser().parse_args(_split_pub_options(argv))
+    parser = _parser(argv[0])
+    if parser is None:
+        print(USAGE)
+        return 1
+    args = parser.parse_args(_split_pub_options(argv))
     if args.command is None:
         print(USAGE)
         return 1
