@@ -258,9 +258,9 @@ def test_setup_bash_completes_packages_launch_files_and_executables(
     assert make(ws, monkeypatch) == 0
     script = (
         f"source {ws / 'devel' / 'setup.bash'}\n"
-        'COMP_WORDS=(roscd comp_); COMP_CWORD=1; _nj_complete_pkg; echo "${COMPREPLY[*]}"\n'
-        'COMP_WORDS=(roslaunch comp_pkg ""); COMP_CWORD=2; _nj_complete_pkg; echo "${COMPREPLY[*]}"\n'
-        'COMP_WORDS=(rosrun comp_pkg ""); COMP_CWORD=2; _nj_complete_pkg; echo "${COMPREPLY[*]}"\n'
+        'COMP_WORDS=(roscd comp_); COMP_CWORD=1; _roscd; echo "${COMPREPLY[*]}"\n'
+        'COMP_WORDS=(roslaunch comp_pkg ""); COMP_CWORD=2; _roslaunch; echo "${COMPREPLY[*]}"\n'
+        'COMP_WORDS=(rosrun comp_pkg ""); COMP_CWORD=2; _rosrun; echo "${COMPREPLY[*]}"\n'
     )
     env = {k: v for k, v in os.environ.items() if k not in ("ROS_PACKAGE_PATH", "CMAKE_PREFIX_PATH")}
     result = subprocess.run(["bash", "-c", script], env=env, capture_output=True, text=True, check=False)
