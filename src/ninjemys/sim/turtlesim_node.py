@@ -79,7 +79,11 @@ class TurtlesimNode:
     def _background() -> tuple[int, int, int]:
         values = []
         for key, default in zip(("r", "g", "b"), DEFAULT_BACKGROUND, strict=True):
-            value = rospy.get_param("~background_" + key, default)
+            try:
+                value = rospy.get_param("~background_" + key, default)
+            except rospy.ROSException as exc:  # master away: keep simulating with the default colour
+                rospy.logwarn("~background_%s: %s; using %d", key, exc, default)
+                value = default
             try:
                 values.append(int(value) & 0xFF)
             except (TypeError, ValueError):
