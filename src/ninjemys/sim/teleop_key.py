@@ -83,14 +83,23 @@ def raw_terminal(fd: int) -> Iterator[None]:
         termios.tcsetattr(fd, termios.TCSADRAIN, saved)
 
 
+def _scale(rospy, name: str, default: float = 2.0) -> float:  # type: ignore[no-untyped-def]
+    """A speed scale parameter; the default when it is unset, unusable or the master is away."""
+    try:
+        return float(rospy.get_param(name, default))
+    except (rospy.ROSException, TypeError, ValueError) as exc:
+        rospy.logwarn("%s: %s; using %.1f", name, exc, default)
+        return default
+
+
 def main(argv: list[str] | None = None) -> int:
     import rospy
     from geometry_msgs.msg import Twist
 
     argv = sys.argv if argv is None else [sys.argv[0], *argv]
     rospy.init_node("teleop_turtle", argv=argv)
-    scale_linear = float(rospy.get_param("~scale_linear", 2.0))
-    scale_angular = float(rospy.get_param("~scale_angular", 2.0))
+    scale_linear = _scale(rospy, "~scale_linear")
+    scale_angular = _scale(rospy, "~scale_angular")
     pub = rospy.Publisher("turtle1/cmd_vel", Twist, queue_size=1)
     print(BANNER, flush=True)
     fd = sys.stdin.fileno()
