@@ -110,6 +110,19 @@ int main(int argc, char** argv) {
     ros::Subscriber s = nh.subscribe("/chatter", 100, on_msg, ros::TransportHints().tcpNoDelay());
     std::printf("ready\n"); std::fflush(stdout);
     ros::spin();
+  } else if (mode == "client") {
+    if (!ros::service::waitForService("/ninjemys_trigger", 10000)) return 2;
+    ros::ServiceClient c = nh.serviceClient<std_srvs::Trigger>("/ninjemys_trigger", true);
+    for (int i = 0; i < 3; i++) {
+      std_srvs::Trigger t;
+      if (!c.call(t)) { std::printf("call failed\n"); return 3; }
+      std::printf("response %s %s\n", t.response.success ? "True" : "False", t.response.message.c_str());
+    }
+    std::fflush(stdout);
+    ros::ServiceClient f = nh.serviceClient<std_srvs::Trigger>("/ninjemys_failing");
+    std_srvs::Trigger t;
+    std::printf("failing call %s\n", f.call(t) ? "succeeded" : "failed");
+    std::fflush(stdout);
   } else if (mode == "service") {
     ros::ServiceServer s = nh.advertiseService("/cpp_trigger", on_trigger);
     std::printf("ready\n"); std::fflush(stdout);

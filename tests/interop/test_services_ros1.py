@@ -82,3 +82,21 @@ def test_our_proxy_calls_ros1_service(master, node, peers, impl: str, persistent
         response = proxy()
         assert response.success is True
         assert response.message == f"{impl} says hi"
+
+
+def test_roscpp_client_calls_our_service(master, node, peers) -> None:
+    count = [0]
+
+    def handle(req):
+        count[0] += 1
+        return Trigger._response_class(True, f"ninjemys answer {count[0]}")
+
+    def failing(req):
+        raise RuntimeError("this service always fails")
+
+    node.service("ninjemys_trigger", Trigger, handle)
+    node.service("ninjemys_failing", Trigger, failing)
+    child = roscpp(master.uri, "client")
+    peers.append(child)
+    assert child.proc.wait(30) == 0, child.describe()
+    assert child.lines == [f"response True ninjemys answer {i}" for i in (1, 2, 3)] + ["failing call failed"]
