@@ -96,6 +96,7 @@ ROSCPP_SOURCE = r"""
 #include <ros/ros.h>
 #include <std_msgs/String.h>
 #include <std_srvs/Trigger.h>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 static void on_msg(const std_msgs::String::ConstPtr& m) { std::printf("got %s\n", m->data.c_str()); std::fflush(stdout); }
@@ -108,6 +109,22 @@ int main(int argc, char** argv) {
   ros::NodeHandle nh;
   if (mode == "listener") {
     ros::Subscriber s = nh.subscribe("/chatter", 100, on_msg, ros::TransportHints().tcpNoDelay());
+    std::printf("ready\n"); std::fflush(stdout);
+    ros::spin();
+  } else if (mode == "bigtalker") {
+    ros::Publisher p = nh.advertise<std_msgs::String>("/big", 1, true);
+    std_msgs::String m; m.data.resize(6220800);
+    for (size_t i = 0; i < m.data.size(); i++) m.data[i] = (char)('a' + i % 26);
+    p.publish(m);
+    std::printf("ready\n"); std::fflush(stdout);
+    ros::spin();
+  } else if (mode == "biglistener") {
+    boost::function<void(const std_msgs::String::ConstPtr&)> cb = [](const std_msgs::String::ConstPtr& m) {
+      uint32_t h = 0;
+      for (unsigned char c : m->data) h = h * 31u + c;
+      std::printf("big %zu %u\n", m->data.size(), h); std::fflush(stdout);
+    };
+    ros::Subscriber s = nh.subscribe<std_msgs::String>("/big", 1, cb);
     std::printf("ready\n"); std::fflush(stdout);
     ros::spin();
   } else if (mode == "client") {

@@ -145,3 +145,33 @@ def test_our_image_to_rospy_intact(master, node, peers) -> None:
     child = _start(peers, rospy(ROSPY_IMAGE_SUB, master.uri))
     expected = f"image 1920x1080 rgb8 {len(data)} {hashlib.md5(data).hexdigest()}"
     assert child.wait_line(lambda line: line == expected, timeout=20), child.describe()
+
+
+def _rolling_hash(data: bytes) -> int:
+    """The C++ peer's ``h = h * 31 + byte`` (mod 2**32), vectorized: sum of byte * 31**(n-1-i)."""
+    import numpy as np
+
+    n = len(data)
+    powers = np.ones(n, dtype=np.uint32)
+    powers[1:] = np.cumprod(np.full(n - 1, 31, dtype=np.uint32))  # wraps mod 2**32, as uint32 in C++
+    terms = np.frombuffer(data, dtype=np.uint8).astype(np.uint64) * powers[::-1].astype(np.uint64)
+    return int(terms.sum() % (1 << 32))
+
+
+def test_roscpp_6mb_message_to_us_intact(master, node, peers) -> None:
+    got: list[String] = []
+    node("big_listener").subscriber("big", String, got.append)
+    _start(peers, roscpp(master.uri, "bigtalker"))
+    assert wait_until(lambda: got, timeout=20), peers[0].describe()
+    expected = "".join(chr(ord("a") + i % 26) for i in range(26)) * (6220800 // 26)
+    expected += "".join(chr(ord("a") + i % 26) for i in range(6220800 % 26))
+    assert got[0].data == expected
+
+
+def test_our_6mb_message_to_roscpp_intact(master, node, peers) -> None:
+    text = "".join(chr(ord("A") + (i * 7) % 26) for i in range(256)) * (6220800 // 256)
+    pub = node("big_talker").publisher("big", String, latch=True)
+    pub.publish(String(text))
+    child = _start(peers, roscpp(master.uri, "biglistener"))
+    expected = f"big {len(text)} {_rolling_hash(text.encode())}"
+    assert child.wait_line(lambda line: line == expected, timeout=20), (expected, child.describe())
