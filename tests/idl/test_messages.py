@@ -286,3 +286,9 @@ def test_received_messages_can_carry_the_connection_header() -> None:
     msg._connection_header = {"callerid": "/talker"}
     assert msg._connection_header["callerid"] == "/talker"
     assert msg == get_message_class("std_msgs/String")(data="x")  # not part of equality
+
+
+def test_time_out_of_wire_range_names_the_field() -> None:
+    header = get_message_class("std_msgs/Header")(stamp=Time(2**32, 0))
+    with pytest.raises(SerializationError, match=r"std_msgs/Header\.stamp: secs=4294967296 does not fit"):
+        header.serialize_to_bytes()

@@ -305,11 +305,20 @@ def _check_scalar(base: str, value: Any) -> str | None:
     if base == "time":
         if not isinstance(value, Time) and not (isinstance(value, TVal) and not isinstance(value, Duration)):
             return f"expected Time, got {_type_label(value)}"
-        return None
+        return _check_tval(value, "uint32")
     if base == "duration":
         if not isinstance(value, Duration):
             return f"expected Duration, got {_type_label(value)}"
-        return None
+        return _check_tval(value, "int32")
+    return None
+
+
+def _check_tval(value: TVal, kind: str) -> str | None:
+    lo, hi = _INT_RANGES[kind]
+    for part in ("secs", "nsecs"):
+        number = getattr(value, part)
+        if not isinstance(number, int) or not lo <= number <= hi:
+            return f"{part}={number!r} does not fit the wire's {kind}"
     return None
 
 
