@@ -18,7 +18,7 @@ import threading
 import time
 import xmlrpc.client
 from collections.abc import Callable, Iterable
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 
 log = logging.getLogger(__name__)
@@ -168,6 +168,10 @@ class GraphPoller:
         self._wake = threading.Event()
         self._thread: threading.Thread | None = None
         self._pool = ThreadPoolExecutor(max_workers=8, thread_name_prefix="graph-bus")
+        # bus sweeps run beside the master poll, so a slow sweep never delays a graph change
+        self._sweeper = ThreadPoolExecutor(max_workers=1, thread_name_prefix="graph-sweep")
+        self._sweep: Future | None = None
+        self._bus_lock = threading.Lock()
         self._uris: dict[str, str] = {}
         self._bus: dict[str, list[Connection] | None] = {}
         self._bus_time = 0.0
@@ -184,6 +188,7 @@ class GraphPoller:
         self._wake.set()
         if self._thread is not None:
             self._thread.join(timeout=self.timeout + 1.0)
+        self._sweeper.shutdown(wait=False, cancel_futures=True)
         self._pool.shutdown(wait=False, cancel_futures=True)
 
     def refresh(self) -> None:
@@ -215,11 +220,13 @@ class GraphPoller:
         for name, uri in self._pool.map(lookup, unknown):
             if uri:
                 self._uris[name] = uri
-        for gone in set(self._uris) - names:
-            del self._uris[gone]
-            self._bus.pop(gone, None)
+        with self._bus_lock:
+            for gone in (set(self._uris) | set(self._bus)) - names:
+                self._uris.pop(gone, None)
+                self._bus.pop(gone, None)
+            bus = dict(self._bus)
         self._names = sorted(names)
-        graph = build_graph(state, types, dict(self._uris), dict(self._bus), self._own_nodes())
+        graph = build_graph(state, types, dict(self._uris), bus, self._own_nodes())
         if self.graph is not None and graph["version"] == self.graph["version"]:
             return None
         self.graph = graph
@@ -237,7 +244,17 @@ class GraphPoller:
             return name, parse_bus_info(rows) if code == 1 else []
 
         for name, conns in self._pool.map(ask, names):
-            self._bus[name] = conns
+            with self._bus_lock:
+                self._bus[name] = conns
+
+    def _start_sweep(self, names: list[str]) -> None:
+        if self._sweep is not None and not self._sweep.done():
+            return
+        try:
+            self._sweep = self._sweeper.submit(self._refresh_bus, names)
+        except RuntimeError:  # stopping
+            return
+        self._sweep.add_done_callback(lambda _f: self._wake.set())
 
     def _run(self) -> None:
         while not self._stop.is_set():
@@ -253,15 +270,14 @@ class GraphPoller:
                     graph = graph or self.graph
                 if graph is not None:
                     self._on_change(graph)
-                # connection states cost one call per node: after the graph is out, and less often
+                # connection states cost one call per node: swept beside the poll, and less often
                 now = time.monotonic()
-                fresh = [n for n in self._names if n not in self._bus]
+                with self._bus_lock:
+                    fresh = [n for n in self._names if n not in self._bus]
                 if now - self._bus_time >= self.bus_period:
                     self._bus_time = now
-                    self._refresh_bus(self._names)
+                    self._start_sweep(self._names)
                 elif fresh:
-                    self._refresh_bus(fresh)
-                if fresh or now == self._bus_time:
-                    continue  # publish what the bus information changed right away
+                    self._start_sweep(fresh)
             self._wake.wait(self.period)
             self._wake.clear()
