@@ -1,0 +1,71 @@
+"""``python -m ninjemys.sim.demo``: roscore + turtlesim + square driver, URLs printed, Ctrl-C stops all."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import urllib.request
+
+from sim_helpers import wait_until
+
+from ninjemys.testing import free_port
+
+
+def _children(pid: int) -> set[int]:
+    out = subprocess.run(["ps", "-o", "pid=", "--ppid", str(pid)], capture_output=True, text=True).stdout
+    return {int(p) for p in out.split()}
+
+
+def test_demo_drives_the_square_and_stops_cleanly(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    port, web = free_port(), free_port()
+    log = tmp_path / "demo.log"
+    with open(log, "wb") as out:
+        demo = subprocess.Popen(
+            [sys.executable, "-m", "ninjemys.sim.demo", "--port", str(port), "--web-port", str(web)],
+            env=dict(os.environ, PYTHONUNBUFFERED="1"),
+            stdout=out,
+            stderr=subprocess.STDOUT,
+            stdin=subprocess.DEVNULL,
+        )
+    children: set[int] = set()
+    try:
+        wait_until(lambda: b"Ctrl-C stops the demo" in log.read_bytes(), timeout=30, what="the demo banner")
+        text = log.read_text()
+        assert f"turtlesim view: http://localhost:{web}/turtlesim" in text
+        assert f"node graph: http://localhost:{web}/" in text
+        children = _children(demo.pid)
+
+        def moved() -> bool:
+            with urllib.request.urlopen(f"http://localhost:{web}/api/turtlesim/state", timeout=5) as resp:
+                turtle = json.load(resp)["turtles"][0]
+            return turtle["x"] > 5.8
+
+        wait_until(moved, timeout=20, what="turtle1 to drive")
+        demo.send_signal(signal.SIGINT)
+        assert demo.wait(20) == 0
+        for pid in children:
+            wait_until(
+                lambda p=pid: not os.path.exists(f"/proc/{p}") or _zombie(p),
+                timeout=10,
+                what="children to exit",
+            )
+    finally:
+        if demo.poll() is None:
+            demo.kill()
+            demo.wait()
+        for pid in children:
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+
+
+def _zombie(pid: int) -> bool:
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().rsplit(")", 1)[1].split()[0] == "Z"
+    except FileNotFoundError:
+        return True
