@@ -230,6 +230,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--headless", action="store_true", help="no web view (same behaviour otherwise)")
     p.add_argument("--port", type=int, default=0, help="web view port (default: any free port)")
     p.add_argument("--host", default="127.0.0.1", help="web view address (default: localhost only)")
+    p.add_argument("--no-browser", action="store_true", help="only print the view URL (no browser tab)")
     return p
 
 
@@ -245,6 +246,7 @@ def main(argv: list[str] | None = None) -> int:
         from ninjemys.node.cli_args import parse_args
         from ninjemys.sim.view import TurtlesimView
         from ninjemys.web.app import WebApp
+        from ninjemys.web.browser import open_if_display
         from ninjemys.web.monitor import TopicMonitor
 
         master_uri = parse_args([sys.argv[0], *ros_args]).master_uri
@@ -261,6 +263,8 @@ def main(argv: list[str] | None = None) -> int:
         view.attach()
         sim.view = view
         print(f"turtlesim view: {url}turtlesim   node graph: {url}", flush=True)
+        if not options.no_browser:
+            open_if_display(url + "turtlesim")  # where ROS would open its window
     sim.start()
     try:
         rospy.spin()

@@ -10,11 +10,11 @@ import os
 import signal
 import sys
 import threading
-import webbrowser
 
 from ninjemys.node import Node
 from ninjemys.tools.cli import entry
 from ninjemys.web.app import WebApp
+from ninjemys.web.browser import open_if_display
 from ninjemys.web.monitor import TopicMonitor
 
 DEFAULT_MASTER = "http://localhost:11311"
@@ -51,8 +51,8 @@ def main(argv: list[str] | None = None) -> int:
         )
         return 1
     print(f"rqt_graph: node graph of {master_uri} at {url}", flush=True)
-    if not args.no_browser and _has_display():
-        webbrowser.open(url)
+    if not args.no_browser:
+        open_if_display(url)
     stop = threading.Event()
     signal.signal(signal.SIGTERM, lambda *_: stop.set())
     try:
