@@ -2,7 +2,8 @@
 
 :func:`build_graph` is pure: it turns the master's ``getSystemState`` and ``getTopicTypes`` results
 plus each node's ``getBusInfo`` into the JSON the graph page draws. :class:`GraphPoller` fetches those
-over XML-RPC (so real ROS 1 nodes appear exactly like ours) and reports only real changes.
+over XML-RPC with :class:`~ninjemys.master.client.MasterClient` (so real ROS 1 nodes appear exactly
+like ours) and reports only real changes.
 
 The ROS 1 master offers no change notifications, so the poller asks it twice a second; bus
 information (which connections are up, whether a node still answers) is refreshed less often
@@ -16,10 +17,12 @@ import json
 import logging
 import threading
 import time
-import xmlrpc.client
 from collections.abc import Callable, Iterable
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
+
+from ninjemys.errors import MasterError, MasterUnreachable
+from ninjemys.master.client import MasterClient
 
 log = logging.getLogger(__name__)
 
@@ -122,23 +125,6 @@ def build_graph(
     return graph
 
 
-class _TimeoutTransport(xmlrpc.client.Transport):
-    """xmlrpc.client with a socket timeout, so a hung node cannot stall the poller."""
-
-    def __init__(self, timeout: float) -> None:
-        super().__init__()
-        self._timeout = timeout
-
-    def make_connection(self, host):  # type: ignore[no-untyped-def]
-        conn = super().make_connection(host)
-        conn.timeout = self._timeout
-        return conn
-
-
-def _proxy(uri: str, timeout: float) -> xmlrpc.client.ServerProxy:
-    return xmlrpc.client.ServerProxy(uri, transport=_TimeoutTransport(timeout), allow_none=True)
-
-
 class GraphPoller:
     """Polls a master (and its nodes) on a thread; calls ``on_change(graph)`` whenever the graph differs.
 
@@ -172,6 +158,7 @@ class GraphPoller:
         self._sweeper = ThreadPoolExecutor(max_workers=1, thread_name_prefix="graph-sweep")
         self._sweep: Future | None = None
         self._bus_lock = threading.Lock()
+        self._master = MasterClient(master_uri, caller_id, timeout=timeout)
         self._uris: dict[str, str] = {}
         self._bus: dict[str, list[Connection] | None] = {}
         self._bus_time = 0.0
@@ -189,6 +176,7 @@ class GraphPoller:
         if self._thread is not None:
             self._thread.join(timeout=self.timeout + 1.0)
         self._sweeper.shutdown(wait=False, cancel_futures=True)
+        self._master.close()
         self._pool.shutdown(wait=False, cancel_futures=True)
 
     def refresh(self) -> None:
@@ -196,13 +184,14 @@ class GraphPoller:
         self._wake.set()
 
     def poll_once(self, now: float) -> dict | None:
-        """One round: returns the new graph if it changed, else None. Raises OSError when unreachable."""
-        master = _proxy(self.master_uri, self.timeout)
-        code, msg, state = master.getSystemState(self.caller_id)
-        if code != 1:
-            raise OSError(f"getSystemState: {msg}")
-        code, msg, types = master.getTopicTypes(self.caller_id)
-        if code != 1:
+        """One round: the new graph if it changed, else None. Raises MasterError when the master fails."""
+        master = self._master
+        state = master.call("getSystemState")
+        try:
+            types = master.call("getTopicTypes")
+        except MasterUnreachable:
+            raise
+        except MasterError:
             types = []
         names = set()
         for table in state[:3]:
@@ -210,16 +199,13 @@ class GraphPoller:
                 names.update(nodes)
         unknown = sorted(names - set(self._uris))
 
-        def lookup(name: str) -> tuple[str, str | None]:
+        for name in unknown:  # one keep-alive connection: a lookup is a round trip, not a connect
             try:
-                code, _msg, uri = _proxy(self.master_uri, self.timeout).lookupNode(self.caller_id, name)
-            except (OSError, xmlrpc.client.Error):
-                return name, None
-            return name, uri if code == 1 else None
-
-        for name, uri in self._pool.map(lookup, unknown):
-            if uri:
-                self._uris[name] = uri
+                self._uris[name] = str(master.call("lookupNode", name))
+            except MasterUnreachable:
+                raise
+            except MasterError:
+                continue  # gone between getSystemState and now
         with self._bus_lock:
             for gone in (set(self._uris) | set(self._bus)) - names:
                 self._uris.pop(gone, None)
@@ -237,11 +223,15 @@ class GraphPoller:
             uri = self._uris.get(name)
             if not uri:
                 return name, None
+            # the slave API uses the master's [code, status, value] convention
             try:
-                code, _msg, rows = _proxy(uri, self.timeout).getBusInfo(self.caller_id)
-            except (OSError, xmlrpc.client.Error, ValueError):
+                with MasterClient(uri, self.caller_id, timeout=self.timeout) as node:
+                    rows = node.call("getBusInfo")
+            except MasterUnreachable:
                 return name, None
-            return name, parse_bus_info(rows) if code == 1 else []
+            except MasterError:
+                return name, []
+            return name, parse_bus_info(rows if isinstance(rows, list) else [])
 
         for name, conns in self._pool.map(ask, names):
             with self._bus_lock:
@@ -260,7 +250,7 @@ class GraphPoller:
         while not self._stop.is_set():
             try:
                 graph = self.poll_once(time.monotonic())
-            except (OSError, xmlrpc.client.Error, ValueError, TypeError) as exc:
+            except (MasterError, ValueError, TypeError) as exc:
                 if self.master_ok:
                     self.master_ok = False
                     self._on_error(f"cannot reach the master at {self.master_uri}: {exc}")
