@@ -196,7 +196,10 @@ class TurtlesimNode:
     def _run(self) -> None:
         next_tick = time.monotonic()
         while not self._stop.is_set() and not rospy.is_shutdown():
-            self.tick(time.monotonic())
+            try:
+                self.tick(time.monotonic())
+            except Exception as exc:  # a bug in one tick must not freeze the simulation for good
+                rospy.logerr("turtlesim update failed: %s: %s", type(exc).__name__, exc)
             next_tick += UPDATE_PERIOD
             delay = next_tick - time.monotonic()
             if delay < -UPDATE_PERIOD:  # fell behind (machine busy): do not try to catch up in a burst
