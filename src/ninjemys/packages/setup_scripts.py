@@ -75,6 +75,7 @@ rosls() {
 }
 """
 
+
 def _bash_completion() -> str:
     """Source the completion file ninjemys ships (live graph names, packages, launch files, ...)."""
     from ninjemys.tools.complete import BASH_FILE

@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
 """Logs what arrives on /chatter."""
+
 import rospy
 from std_msgs.msg import String
 

@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
 """Logs each Reading with its time stamp."""
+
 import rospy
 from basic_comms.msg import Reading
 

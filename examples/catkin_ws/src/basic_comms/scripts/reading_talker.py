@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
 """The activity, modified to publish the custom message: a stamped, slowly rising value."""
+
 import rospy
 from basic_comms.msg import Reading
 

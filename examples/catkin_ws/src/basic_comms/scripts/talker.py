@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
 """Publishes "hello world <time>" on /chatter (the simplest communication scheme)."""
+
 import rospy
 from std_msgs.msg import String
 

@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
 """Node 3 of the assignment: subscribes to both topics and prints "Student NAME has roll number: N"."""
+
 import rospy
 from std_msgs.msg import Int32, String
 

@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
 """Node 1 of the assignment: publishes the student's NAME (String) on name_listener."""
+
 import rospy
 from std_msgs.msg import String
 

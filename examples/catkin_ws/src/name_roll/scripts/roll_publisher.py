@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
 """Node 2 of the assignment: publishes the ROLL NUMBER (Int32) on roll_listener."""
+
 import rospy
 from std_msgs.msg import Int32
 

@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
 """Logs every String received on /chatter (the first tutorial's listener)."""
+
 import rospy
 from std_msgs.msg import String
 

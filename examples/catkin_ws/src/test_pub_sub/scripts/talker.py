@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
 """Publishes "hello world <time>" on /chatter at 10 Hz (the first tutorial's talker)."""
+
 import rospy
 from std_msgs.msg import String
 

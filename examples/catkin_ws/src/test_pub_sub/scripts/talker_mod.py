@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
 """A talker whose greeting comes from the command line (the launch file passes it with args=)."""
+
 import sys
 
 import rospy
