@@ -1,9 +1,9 @@
-"""``python -m ninjemys.demo``: roscore + talker + listener, their logs on screen, until Ctrl-C.
+"""``make demo`` / ``python -m ninjemys.demo``: the seeds' first hour in one command.
 
-The seeds' first exercise in one command, from a fresh clone (``make demo``): it starts our roscore,
-the rospy_tutorials talker and listener as separate processes, prefixes each output line with the
-process name, and on Ctrl-C (or after ``--duration`` seconds) stops them all, nodes first, and waits
-for every child to exit.
+It starts our roscore, the seeds' talker and listener, turtlesim (with its browser view) and a node
+driving turtle1 around the third seed's 1 m square, prefixes every output line with the process name,
+prints the URLs of the turtlesim view and the node graph, and on Ctrl-C (or after ``--duration``
+seconds) stops them all, nodes first, and waits for every child to exit.
 """
 
 from __future__ import annotations
@@ -15,9 +15,16 @@ import subprocess
 import sys
 import threading
 import time
+from collections.abc import Callable
 from typing import IO
 
-_COLORS = {"roscore": "\033[36m", "talker": "\033[35m", "listener": "\033[32m"}
+_COLORS = {
+    "roscore": "\033[36m",
+    "talker": "\033[35m",
+    "listener": "\033[32m",
+    "turtlesim": "\033[33m",
+    "square": "\033[34m",
+}
 _RESET = "\033[0m"
 
 
@@ -40,11 +47,20 @@ def _pick_port(requested: int | None) -> int:
     return 11311 if _port_free(11311) else free_port()
 
 
-def _pump(name: str, stream: IO[bytes], out: IO[str], lock: threading.Lock, color: bool) -> None:
+def _pump(
+    name: str,
+    stream: IO[bytes],
+    out: IO[str],
+    lock: threading.Lock,
+    color: bool,
+    watch: Callable[[str], None] | None = None,
+) -> None:
     """Copy a child's output line by line, each prefixed with the child's name."""
     prefix = f"{_COLORS[name]}[{name}]{_RESET} " if color else f"[{name}] "
     for raw in iter(stream.readline, b""):
         line = raw.decode("utf-8", "replace").rstrip("\n")
+        if watch is not None:
+            watch(line)
         with lock:
             out.write(prefix + line + "\n")
             out.flush()
@@ -84,7 +100,13 @@ def _stop(procs: list[tuple[str, subprocess.Popen[bytes]]], grace: float = 5.0) 
                 proc.wait()
 
 
-def run(port: int | None = None, duration: float | None = None, color: bool | None = None) -> int:
+def run(
+    port: int | None = None,
+    duration: float | None = None,
+    color: bool | None = None,
+    web_port: int = 0,
+    turtlesim: bool = True,
+) -> int:
     """Run the demo; returns when interrupted or after ``duration`` seconds."""
     port = _pick_port(port)
     uri = f"http://localhost:{port}/"
@@ -95,17 +117,22 @@ def run(port: int | None = None, duration: float | None = None, color: bool | No
     procs: list[tuple[str, subprocess.Popen[bytes]]] = []
     pumps: list[threading.Thread] = []
 
-    def start(name: str, cmd: list[str]) -> subprocess.Popen[bytes]:
+    def start(
+        name: str, cmd: list[str], watch: Callable[[str], None] | None = None
+    ) -> subprocess.Popen[bytes]:
         proc = subprocess.Popen(
             cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL
         )
         procs.append((name, proc))
-        pump = threading.Thread(target=_pump, args=(name, proc.stdout, sys.stdout, lock, color), daemon=True)
+        pump = threading.Thread(
+            target=_pump, args=(name, proc.stdout, sys.stdout, lock, color, watch), daemon=True
+        )
         pump.start()
         pumps.append(pump)
         return proc
 
-    print(f"ninjemys demo: roscore + talker + listener, ROS_MASTER_URI={uri} (Ctrl-C to stop)", flush=True)
+    what = "roscore + talker + listener" + (" + turtlesim + square driver" if turtlesim else "")
+    print(f"ninjemys demo: {what}, ROS_MASTER_URI={uri} (Ctrl-C to stop)", flush=True)
     interrupted = False
     try:
         core = start(
@@ -121,6 +148,36 @@ def run(port: int | None = None, duration: float | None = None, color: bool | No
         _wait_for_master(uri, core, timeout=20.0)
         start("talker", [sys.executable, "-m", "ninjemys.tutorials.talker"])
         start("listener", [sys.executable, "-m", "ninjemys.tutorials.listener"])
+        if turtlesim:
+            view_line: list[str] = []
+            served = threading.Event()
+
+            def watch(line: str) -> None:
+                if line.startswith("turtlesim view:") and not served.is_set():
+                    view_line.append(line)
+                    served.set()
+
+            start(
+                "turtlesim",
+                [
+                    sys.executable,
+                    "-m",
+                    "ninjemys.sim.turtlesim_node",
+                    "--port",
+                    str(web_port),
+                    "--no-browser",
+                ],
+                watch,
+            )
+            start("square", [sys.executable, "-m", "ninjemys.sim.square_driver"])
+            if not served.wait(30.0):
+                raise RuntimeError("turtlesim did not serve its view within 30 s")
+            view, _, graph = view_line[0].partition("node graph:")
+            with lock:
+                print(
+                    f"ninjemys demo: {view.strip()}  |  node graph: {graph.strip()}  |  Ctrl-C stops the demo.",
+                    flush=True,
+                )
         deadline = None if duration is None else time.monotonic() + duration
         while deadline is None or time.monotonic() < deadline:
             dead = [(n, p) for n, p in procs if p.poll() is not None]
@@ -165,8 +222,16 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("--duration", type=float, default=None, help="stop after this many seconds")
     parser.add_argument("--no-color", action="store_true", help="plain output")
+    parser.add_argument("--web-port", type=int, default=0, help="turtlesim view / graph port (default: any)")
+    parser.add_argument("--no-turtlesim", action="store_true", help="only roscore, talker and listener")
     ns = parser.parse_args(argv)
-    return run(ns.port, ns.duration, color=False if ns.no_color else None)
+    return run(
+        ns.port,
+        ns.duration,
+        color=False if ns.no_color else None,
+        web_port=ns.web_port,
+        turtlesim=not ns.no_turtlesim,
+    )
 
 
 if __name__ == "__main__":

@@ -1,4 +1,4 @@
-"""``python -m ninjemys.sim.demo``: roscore + turtlesim + square driver, URLs printed, Ctrl-C stops all."""
+"""``make demo`` (``python -m ninjemys.demo``): turtlesim, the square driver and the chatter nodes; URLs printed, Ctrl-C stops all."""
 
 from __future__ import annotations
 
@@ -24,7 +24,7 @@ def test_demo_drives_the_square_and_stops_cleanly(tmp_path) -> None:  # type: ig
     log = tmp_path / "demo.log"
     with open(log, "wb") as out:
         demo = subprocess.Popen(
-            [sys.executable, "-m", "ninjemys.sim.demo", "--port", str(port), "--web-port", str(web)],
+            [sys.executable, "-m", "ninjemys.demo", "--port", str(port), "--web-port", str(web)],
             env=dict(os.environ, PYTHONUNBUFFERED="1"),
             stdout=out,
             stderr=subprocess.STDOUT,
