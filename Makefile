@@ -1,5 +1,7 @@
 # ninjemys — set-up, tests and demo. `make test` and `make demo` work from a fresh clone.
-PYTHON ?= python3
+# The venv's interpreter: Debian's /usr/bin/python3 when it is >= 3.11 (the same interpreter build real
+# ROS 1 runs on, so benchmarks compare like with like), else the first python3 on PATH.
+PYTHON ?= $(shell /usr/bin/python3 -c 'import sys, venv, ensurepip; sys.exit(sys.version_info < (3, 11))' 2>/dev/null && echo /usr/bin/python3 || echo python3)
 VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
