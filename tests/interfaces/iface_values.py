@@ -13,8 +13,8 @@ import functools
 from typing import Any
 
 from hypothesis import strategies as st
-from ninjemys.idl.loader import get_message_class
 
+from ninjemys.idl.loader import get_message_class
 from ninjemys.rostime import Duration, Time
 
 INT_RANGES: dict[str, tuple[int, int]] = {
