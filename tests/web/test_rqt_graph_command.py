@@ -29,12 +29,13 @@ def test_rqt_graph_serves_and_exits_cleanly() -> None:
             line = proc.stdout.readline()
             assert line.strip() == f"rqt_graph: node graph of {uri} at http://localhost:{port}/"
 
-            def graph() -> dict | None:
+            def graph_with_rosout() -> dict | None:
+                # run_master() returns once the master answers; rosout registers a moment later
                 with urllib.request.urlopen(f"http://localhost:{port}/api/graph", timeout=5) as resp:
-                    return json.load(resp)["graph"]
+                    g = json.load(resp)["graph"]
+                return g if any(n["name"] == "/rosout" for n in g["nodes"]) else None
 
-            g = wait_until(graph, what="a graph")
-            assert any(n["name"] == "/rosout" for n in g["nodes"])  # our roscore runs rosout
+            assert wait_until(graph_with_rosout, what="a graph showing our roscore's /rosout")
             proc.send_signal(signal.SIGINT)
             assert proc.wait(10) == 0
         finally:
