@@ -292,3 +292,19 @@ def test_time_out_of_wire_range_names_the_field() -> None:
     header = get_message_class("std_msgs/Header")(stamp=Time(2**32, 0))
     with pytest.raises(SerializationError, match=r"std_msgs/Header\.stamp: secs=4294967296 does not fit"):
         header.serialize_to_bytes()
+
+
+def test_string_rendering_fast_path_matches_pyyaml():
+    """rostopic echo's quoted strings: the no-PyYAML fast path must print exactly what PyYAML does."""
+    import random
+    import string
+
+    import yaml
+
+    from ninjemys.idl.message import _yaml_string
+
+    rng = random.Random(7)
+    alphabet = string.printable[:95] + "   é\t"
+    for _ in range(3000):
+        text = "".join(rng.choice(alphabet) for _ in range(rng.randint(1, 120)))
+        assert _yaml_string(text) == yaml.dump(text, default_style='"').rstrip("\n"), text
