@@ -62,8 +62,9 @@ def _logged(caplog, text: str) -> list[logging.LogRecord]:
         (struct.pack("<I", 12) + struct.pack("<I", 100) + b"topic=/x", "claims 100 bytes"),
         (struct.pack("<I", 8) + struct.pack("<I", 4) + b"junk", "no name=value"),
         (struct.pack("<I", 50) + b"short", "closed the connection"),
+        (b"POST /RPC2 HTTP/1.1\r\nContent-Length: 0\r\n\r\n", "an HTTP request arrived"),
     ],
-    ids=["oversized-header", "field-overruns", "no-equals", "disconnect-mid-header"],
+    ids=["oversized-header", "field-overruns", "no-equals", "disconnect-mid-header", "http-to-tcpros-port"],
 )
 def test_garbage_headers_to_publisher(pair, caplog, data: bytes, expected: str) -> None:
     talker, _listener, pub, got = pair

@@ -55,8 +55,15 @@ async def read_exact(sock: socket.socket, n: int) -> bytearray:
 async def read_header(sock: socket.socket, timeout: float = HEADER_TIMEOUT) -> dict[str, str]:
     """Read and decode one connection header, with a deadline."""
     async with asyncio.timeout(timeout):
-        length = headers.header_length(await read_exact(sock, 4))
+        prefix = await read_exact(sock, 4)
+        if bytes(prefix) in _HTTP_STARTS:
+            # ports are reused: a peer still holding a dead node's XML-RPC URI can land here
+            raise ProtocolError("an HTTP request arrived on the TCPROS port (a stale XML-RPC URI?)")
+        length = headers.header_length(prefix)
         return headers.decode_header(await read_exact(sock, length))
+
+
+_HTTP_STARTS = frozenset({b"POST", b"GET ", b"HEAD", b"PUT ", b"HTTP"})
 
 
 async def write_all(sock: socket.socket, data: bytes) -> None:
