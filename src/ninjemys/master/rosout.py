@@ -131,3 +131,34 @@ class Rosout:
         finally:
             if self.file is not None:
                 self.file.close()
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``rosrun rosout rosout``: rosout as a process of its own (``roscore`` runs it in-process).
+
+    Honours the usual node arguments (``__name:=``, ``__master:=``, ...); rosout.log goes to
+    ``<log dir>/<run_id>/`` like roscore's.
+    """
+    import sys
+
+    from ninjemys.errors import MasterError
+    from ninjemys.master.client import MasterClient
+    from ninjemys.node.cli_args import parse_args
+    from ninjemys.node.log import log_directory
+
+    args = parse_args(["rosout", *(sys.argv[1:] if argv is None else argv)])
+    name = args.full_name(args.node_name("rosout"))
+    log_dir = log_directory()
+    try:
+        log_dir = log_dir / str(MasterClient(args.master_uri, name, timeout=5.0).get_param("/run_id"))
+    except MasterError:
+        pass  # no /run_id (a bare master): log straight into the log directory
+    log_dir.mkdir(parents=True, exist_ok=True)
+    rosout = Rosout(args.master_uri, log_dir, node_name=name)
+    try:
+        rosout.node.wait_for_shutdown()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        rosout.stop()
+    return 0
