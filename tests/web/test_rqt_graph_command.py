@@ -33,7 +33,7 @@ def test_rqt_graph_serves_and_exits_cleanly() -> None:
                 # run_master() returns once the master answers; rosout registers a moment later
                 with urllib.request.urlopen(f"http://localhost:{port}/api/graph", timeout=5) as resp:
                     g = json.load(resp)["graph"]
-                return g if any(n["name"] == "/rosout" for n in g["nodes"]) else None
+                return g if g and any(n["name"] == "/rosout" for n in g["nodes"]) else None
 
             assert wait_until(graph_with_rosout, what="a graph showing our roscore's /rosout")
             proc.send_signal(signal.SIGINT)
