@@ -84,3 +84,26 @@ class Subcommands:
             return _Unused()
         self.matched = True
         return self._sub.add_parser(self.command, prog=f"{self.parser.prog} {name}")
+
+
+def run_subcommand(
+    argv: list[str],
+    usage: str,
+    build: Callable[[str], Any],
+    prepare: Callable[[list[str]], list[str]] | None = None,
+) -> int:
+    """Dispatch ``tool <command> [args]``: the usage text for no or an unknown command, else the
+    command's ``run(args)``. ``prepare`` may rewrite argv first (e.g. insert ``--`` before YAML values);
+    a leading ``--`` left in an ``args`` remainder is dropped."""
+    if not argv or argv[0] in ("-h", "--help", "help"):
+        print(usage)
+        return 0 if argv else 1
+    parser = build(argv[0])
+    if parser is None:
+        print(usage)
+        return 1
+    args = parser.parse_args(prepare(argv) if prepare is not None else argv)
+    rest = getattr(args, "args", None)
+    if isinstance(rest, list) and rest[:1] == ["--"]:
+        args.args = rest[1:]
+    return args.run(args)

@@ -10,7 +10,7 @@ from urllib.parse import urlparse
 
 from ninjemys import names
 from ninjemys.errors import MasterError, MasterUnreachable, NinjemysError
-from ninjemys.tools.cli import Subcommands, entry, error, master
+from ninjemys.tools.cli import Subcommands, entry, error, master, run_subcommand
 from ninjemys.tools.graph import CONNECTION_INFO, GraphState, bus_info, node_api, ping, slave
 
 NAME = "rosnode"
@@ -369,16 +369,7 @@ def _parser(command: str) -> argparse.ArgumentParser | None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    argv = sys.argv[1:] if argv is None else argv
-    if not argv or argv[0] in ("-h", "--help", "help"):
-        print(USAGE)
-        return 0 if argv else 1
-    parser = _parser(argv[0])
-    if parser is None:
-        print(USAGE)
-        return 1
-    args = parser.parse_args(argv)
-    return args.run(args)
+    return run_subcommand(sys.argv[1:] if argv is None else argv, USAGE, _parser)
 
 
 console_main = entry(main)

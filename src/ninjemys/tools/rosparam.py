@@ -16,7 +16,7 @@ from typing import Any
 from ninjemys import names
 from ninjemys.errors import MasterError, MasterUnreachable, ParameterError
 from ninjemys.paramyaml import ParamYamlError, dump_yaml, load_yaml
-from ninjemys.tools.cli import Subcommands, entry, master
+from ninjemys.tools.cli import Subcommands, entry, master, run_subcommand
 
 NAME = "rosparam"
 USAGE = """rosparam is a command-line tool for getting, setting, and deleting parameters from the ROS Parameter Server.
@@ -237,20 +237,7 @@ def _parser(command: str) -> argparse.ArgumentParser | None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    argv = sys.argv[1:] if argv is None else argv
-    if not argv or argv[0] in ("-h", "--help", "help"):
-        print(USAGE)
-        return 0 if argv else 1
-    # negative numbers are values, not options: `rosparam set /x -1`
-    parser = _parser(argv[0])
-    if parser is None:
-        print(USAGE)
-        return 1
-    args = parser.parse_args(_protect_negative_numbers(argv))
-    if args.command is None:
-        print(USAGE)
-        return 1
-    return args.run(args)
+    return run_subcommand(sys.argv[1:] if argv is None else argv, USAGE, _parser, _protect_negative_numbers)
 
 
 def _protect_negative_numbers(argv: list[str]) -> list[str]:

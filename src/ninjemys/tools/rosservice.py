@@ -14,7 +14,7 @@ from typing import Any
 from ninjemys import names
 from ninjemys.errors import MasterError, NinjemysError, ServiceError, TypeNotFoundError
 from ninjemys.net.addresses import split_uri
-from ninjemys.tools.cli import Subcommands, entry, master
+from ninjemys.tools.cli import Subcommands, entry, master, run_subcommand
 from ninjemys.tools.graph import GraphState
 from ninjemys.wire import headers
 
@@ -274,27 +274,17 @@ def _parser(command: str) -> argparse.ArgumentParser | None:
     return sub.parser if sub.matched else None
 
 
+def _split_call_options(argv: list[str]) -> list[str]:
+    """``rosservice call``: options come before the service name only; everything after it is YAML."""
+    if argv[0] != "call":
+        return argv
+    opts = [a for a in argv[1:] if a in ("-v", "--wait")]
+    rest = [a for a in argv[1:] if a not in ("-v", "--wait")]
+    return ["call", *opts, *rest[:1], *(["--"] if len(rest) > 1 else []), *rest[1:]]
+
+
 def main(argv: list[str] | None = None) -> int:
-    argv = sys.argv[1:] if argv is None else argv
-    if not argv or argv[0] in ("-h", "--help", "help"):
-        print(USAGE)
-        return 0 if argv else 1
-    if argv[0] == "call":
-        # options may come before the service name only; everything after it is YAML
-        opts = [a for a in argv[1:] if a in ("-v", "--wait")]
-        rest = [a for a in argv[1:] if a not in ("-v", "--wait")]
-        argv = ["call", *opts, *rest[:1], *(["--"] if len(rest) > 1 else []), *rest[1:]]
-    parser = _parser(argv[0])
-    if parser is None:
-        print(USAGE)
-        return 1
-    args = parser.parse_args(argv)
-    if args.command is None:
-        print(USAGE)
-        return 1
-    if args.command == "call" and args.args and args.args[0] == "--":
-        args.args = args.args[1:]
-    return args.run(args)
+    return run_subcommand(sys.argv[1:] if argv is None else argv, USAGE, _parser, _split_call_options)
 
 
 console_main = entry(main)
