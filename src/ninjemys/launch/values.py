@@ -4,8 +4,6 @@ from __future__ import annotations
 
 from typing import Any
 
-import yaml
-
 from ninjemys.errors import LaunchError
 
 
@@ -44,8 +42,10 @@ def convert_value(value: str, type_: str) -> Any:
             return False
         raise LaunchError(f"{value} is not a '{type_}' type")
     if type_ == "yaml":
+        from ninjemys.paramyaml import ParamYamlError, load_yaml
+
         try:
-            return yaml.safe_load(value)
-        except yaml.YAMLError as exc:
+            return load_yaml(value)
+        except ParamYamlError as exc:
             raise LaunchError(f"invalid YAML value: {exc}") from None
     raise LaunchError(f"Unknown type '{type_}'")

@@ -23,14 +23,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from ninjemys.errors import LaunchError, NinjemysError
 from ninjemys.launch.dom import Element, parse_xml
 from ninjemys.launch.plan import LaunchPlan, Machine, NodeSpec, SetupCommand
 from ninjemys.launch.substitutions import ArgNotSet, SubstitutionContext, resolve
 from ninjemys.launch.values import convert_value
-from ninjemys.launch.yaml_loader import load_yaml
 from ninjemys.names import (
     canonicalize_name,
     get_ros_namespace,
@@ -40,6 +37,7 @@ from ninjemys.names import (
     make_global_ns,
     ns_join,
 )
+from ninjemys.paramyaml import ParamYamlError, load_yaml
 
 NODE_ATTRS = (
     "pkg",
@@ -458,7 +456,7 @@ class _Loader:
             text = self.sub(text, scope, el) or ""
         try:
             data = load_yaml(text)
-        except yaml.YAMLError as exc:
+        except ParamYamlError as exc:
             where = f"file {file}" if file else "YAML block"
             raise self.err(
                 el, scope, f"error loading <rosparam> tag: invalid YAML in {where}: {exc}"
