@@ -11,9 +11,7 @@ names and must agree exactly with ROS 1 (rosgraph.names):
 from __future__ import annotations
 
 import os
-import random
 import re
-import socket
 import time
 from collections.abc import Iterable, Mapping
 
@@ -168,6 +166,9 @@ def resolve_remappings(mappings: Mapping[str, str], caller_id: str) -> dict[str,
 
 def anonymous_name(base: str) -> str:
     """``base_<hostname>_<pid>_<random>`` as rosgraph/roslaunch ``$(anon base)`` builds it."""
+    import random  # imported here: every tool and node imports this module, few need anonymous names
+    import socket
+
     host = re.sub(r"[.\-:]", "_", socket.gethostname())
     return f"{base}_{host}_{os.getpid()}_{random.randint(0, 2**63)}"
 
