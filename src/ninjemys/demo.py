@@ -18,6 +18,8 @@ import time
 from collections.abc import Callable
 from typing import IO
 
+from ninjemys.launch.runner import DEATH_WRAPPER
+
 _COLORS = {
     "roscore": "\033[36m",
     "talker": "\033[35m",
@@ -120,8 +122,13 @@ def run(
     def start(
         name: str, cmd: list[str], watch: Callable[[str], None] | None = None
     ) -> subprocess.Popen[bytes]:
+        # children get SIGTERM if the demo itself dies (even by SIGKILL): nothing is left running
         proc = subprocess.Popen(
-            cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL
+            [*DEATH_WRAPPER, *cmd],
+            env=env,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            stdin=subprocess.DEVNULL,
         )
         procs.append((name, proc))
         pump = threading.Thread(
