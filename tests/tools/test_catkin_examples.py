@@ -6,6 +6,7 @@ import os
 import shutil
 import signal
 import subprocess
+import threading
 import time
 from pathlib import Path
 
@@ -40,7 +41,7 @@ def sourced_env(ws: Path, port: int, tmp_path: Path) -> dict[str, str]:
     return env
 
 
-def launch_until(args: list[str], env: dict[str, str], wanted: list[str], timeout: float = 90) -> list[str]:
+def launch_until(args: list[str], env: dict[str, str], wanted: list[str], timeout: float = 60) -> list[str]:
     """Run roslaunch until every ``wanted`` text was printed (or timeout), then Ctrl-C it."""
     proc = subprocess.Popen(
         [ninjemys_bin("roslaunch"), *args],
@@ -54,13 +55,16 @@ def launch_until(args: list[str], env: dict[str, str], wanted: list[str], timeou
         missing = set(wanted)
         deadline = time.monotonic() + timeout
         assert proc.stdout is not None
-        for line in proc.stdout:
-            lines.append(line)
-            missing = {w for w in missing if w not in line}
-            if not missing or time.monotonic() > deadline:
-                break
+        # a reader thread, so a launch that goes quiet cannot block the test past its deadline
+        reader = threading.Thread(target=lambda: lines.extend(proc.stdout), daemon=True)
+        reader.start()
+        while missing and time.monotonic() < deadline and proc.poll() is None:
+            time.sleep(0.1)
+            text = "".join(lines)
+            missing = {w for w in missing if w not in text}
         proc.send_signal(signal.SIGINT)
         proc.wait(30)
+        reader.join(10)
     finally:
         if proc.poll() is None:
             proc.kill()
