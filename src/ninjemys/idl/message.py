@@ -36,8 +36,8 @@ class Message:
     _fields: tuple[Any, ...] = ()
 
     # --- serialization -------------------------------------------------------------------------
-    def _ser(self, w: Any) -> None:  # generated
-        raise NotImplementedError  # pragma: no cover - every generated class overrides it
+    def _ser(self, w: Any) -> None:  # generated per class
+        raise TypeError(f"{type(self).__name__} is not a generated message class (use idl.loader)")
 
     def serialize_to_bytes(self) -> bytes:
         """The message in ROS 1 wire format (the fast path the runtime uses)."""
@@ -62,7 +62,7 @@ class Message:
 
         Raises DeserializationError for truncated input or length prefixes beyond the buffer.
         """
-        raise NotImplementedError  # pragma: no cover - every generated class overrides it
+        raise TypeError(f"{cls.__name__} is not a generated message class (use idl.loader)")
 
     def deserialize(self, data: bytes | bytearray | memoryview) -> Message:
         """genpy API: fill this instance from wire bytes and return it."""
