@@ -31,6 +31,7 @@ from ninjemys.launch.runner import (
 )
 from ninjemys.master.client import MasterClient
 from ninjemys.packages.discovery import PackageIndex
+from ninjemys.roshome import log_directory
 
 
 @dataclass
@@ -157,7 +158,7 @@ class LaunchSession:
             print(f"WARNING: {warning}", file=sys.stderr)
         uri = master_link.master_uri_for(self.opts.port, self.env)
         self.env["ROS_MASTER_URI"] = uri
-        log_root = master_link.default_log_root(self.env)
+        log_root = log_directory(self.env)
         # validate everything user-provided before starting anything
         probe_specs = _process_specs(self.plan, self.opts, uri, log_root / "pending", self.env)
         del probe_specs

@@ -6,7 +6,6 @@ one place that talks to the master is small enough to read at a glance.
 
 from __future__ import annotations
 
-import os
 import subprocess
 import time
 import uuid
@@ -154,10 +153,3 @@ def load_parameters(client: MasterClient, plan: LaunchPlan) -> None:
             client.set_param(key, _xmlrpc_value(value))
         except MasterError as exc:
             raise LaunchError(f"cannot set parameter [{key}] on the master: {exc}") from None
-
-
-def default_log_root(env: dict[str, str]) -> Path:
-    if env.get("ROS_LOG_DIR"):
-        return Path(env["ROS_LOG_DIR"])
-    home = env.get("ROS_HOME") or os.path.join(os.path.expanduser("~"), ".ros")
-    return Path(home) / "log"

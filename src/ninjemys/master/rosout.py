@@ -144,7 +144,7 @@ def main(argv: list[str] | None = None) -> int:
     from ninjemys.errors import MasterError
     from ninjemys.master.client import MasterClient
     from ninjemys.node.cli_args import parse_args
-    from ninjemys.node.log import log_directory
+    from ninjemys.roshome import log_directory
 
     args = parse_args(["rosout", *(sys.argv[1:] if argv is None else argv)])
     name = args.full_name(args.node_name("rosout"))

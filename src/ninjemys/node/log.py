@@ -32,6 +32,7 @@ from pathlib import Path
 from typing import IO, Any
 
 from ninjemys.errors import ParameterError
+from ninjemys.roshome import log_directory
 
 # rosgraph_msgs/Log level constants (also rospy.DEBUG ... rospy.FATAL)
 DEBUG = 1
@@ -59,16 +60,6 @@ def level_from_name(name: str) -> int:
         raise ParameterError(
             f"unknown logger level [{name}]: expected debug, info, warn, error or fatal"
         ) from None
-
-
-def log_directory(env: dict[str, str] | None = None) -> Path:
-    """Where node log files go: ROS_LOG_DIR, else ROS_HOME/log, else ~/.ros/log (rospkg.get_log_dir)."""
-    env = os.environ if env is None else env
-    if env.get("ROS_LOG_DIR"):
-        return Path(env["ROS_LOG_DIR"])
-    if env.get("ROS_HOME"):
-        return Path(env["ROS_HOME"]) / "log"
-    return Path.home() / ".ros" / "log"
 
 
 def log_file_path(node_name: str, log_file: str | None = None, pid: int | None = None) -> Path:

@@ -29,6 +29,7 @@ from ninjemys import ROS_DISTRO, ROS_VERSION, __version__
 from ninjemys.errors import MasterError, NinjemysError
 from ninjemys.master.core import DEFAULT_PORT, Master
 from ninjemys.net.addresses import advertised_host, split_uri
+from ninjemys.roshome import log_directory
 from ninjemys.tools.cli import entry, error
 
 log = logging.getLogger("ninjemys.roscore")
@@ -64,17 +65,9 @@ def _port(requested: int | None) -> int:
     return DEFAULT_PORT
 
 
-def log_root() -> Path:
-    """ROS_LOG_DIR, else $ROS_HOME/log, else ~/.ros/log."""
-    if os.environ.get("ROS_LOG_DIR"):
-        return Path(os.environ["ROS_LOG_DIR"])
-    home = os.environ.get("ROS_HOME") or os.path.join(os.path.expanduser("~"), ".ros")
-    return Path(home) / "log"
-
-
 def _make_run_dir(run_id: str) -> Path | None:
     """Create <log root>/<run_id> and point <log root>/latest at it; None if the disk says no."""
-    root = log_root()
+    root = log_directory()
     run_dir = root / run_id
     try:
         run_dir.mkdir(parents=True, exist_ok=True)
