@@ -19,6 +19,7 @@ from ninjemys.idl.spec import PRIMITIVE_FORMATS
 from ninjemys.rostime import Duration, Time, TVal
 
 _SER_ERRORS = (struct.error, TypeError, AttributeError, ValueError, OverflowError, UnicodeError, IndexError)
+_pack_len = struct.Struct("<I").pack
 _DESER_ERRORS = (struct.error, ValueError, IndexError, TypeError, UnicodeError, MemoryError, OverflowError)
 
 
@@ -46,6 +47,16 @@ class Message:
             self._ser(parts.append)
         except _SER_ERRORS as exc:
             raise diagnose(self, exc) from None
+        return b"".join(parts)
+
+    def serialize_framed(self) -> bytes:
+        """``uint32 len`` + the wire bytes, joined in one copy: a TCPROS frame, ready to send."""
+        parts: list[Any] = [b""]
+        try:
+            self._ser(parts.append)
+        except _SER_ERRORS as exc:
+            raise diagnose(self, exc) from None
+        parts[0] = _pack_len(sum(map(len, parts)))
         return b"".join(parts)
 
     def serialize(self, buff: Any) -> None:

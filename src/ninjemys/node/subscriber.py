@@ -304,9 +304,14 @@ class Subscriber:
         self.queue_size = queue_size
         self.raw = raw
         self.dropped = 0
-        self._callbacks: list[tuple[Callable[..., Any], Any]] = []
+        # a tuple, replaced (never mutated) by add_callback: the worker iterates it without a copy
+        self._callbacks: tuple[tuple[Callable[..., Any], Any], ...] = ()
         if callback is not None:
-            self._callbacks.append((callback, callback_args))
+            self._callbacks = ((callback, callback_args),)
+        msg_class = subscription.msg_class
+        self._decode: Callable[[Any], Any] | None = (
+            None if raw or msg_class is None else msg_class.deserialize_from
+        )
         self._queue: deque[tuple[bytes | bytearray, Mapping[str, str]]] = deque(
             maxlen=queue_size if queue_size and queue_size > 0 else None
         )
@@ -363,11 +368,13 @@ class Subscriber:
 
     def _work(self) -> None:
         queue = self._queue
+        popleft = queue.popleft
+        deliver = self._deliver
         try:
             while not self._closed:
                 if queue:
-                    frame, header = queue.popleft()
-                    self._deliver(frame, header)
+                    frame, header = popleft()
+                    deliver(frame, header)
                     continue
                 for conn in self._poller.wait():
                     if conn is None:
@@ -410,10 +417,16 @@ class Subscriber:
             self._forget(conn)
             return
         if frames:
-            self._push(frames, conn.header)
             for other in self._sub.handles[1:]:
                 if other is not self:
                     other.enqueue(frames, conn.header)
+            maxlen = self._queue.maxlen
+            if maxlen is not None and len(frames) > maxlen:
+                self.dropped += len(frames) - maxlen
+                frames = frames[-maxlen:]
+            # the queue is empty whenever the worker reads (it delivers the queue first), so this
+            # batch can go straight to the callbacks: no per-message queue entry
+            self._deliver_batch(frames, conn.header)
 
     def _finish(self) -> None:
         """Worker exit: pass our connections to the next handle of the topic, or close them."""
@@ -433,23 +446,51 @@ class Subscriber:
         self._wake_r.close()
         self._wake_w.close()
 
+    def _deliver_batch(self, frames: list[bytes | bytearray], header: Mapping[str, str]) -> None:
+        """Deliver frames in order; the common case (decode, one callback without args) is inlined,
+        as this loop runs once per received message."""
+        decode, callbacks = self._decode, self._callbacks
+        if decode is None or len(callbacks) != 1 or callbacks[0][1] is not None:
+            for frame in frames:
+                if self._closed:
+                    return
+                self._deliver(frame, header)
+            return
+        callback = callbacks[0][0]
+        for frame in frames:
+            if self._closed:
+                return
+            try:
+                msg = decode(frame)
+            except Exception as exc:  # generated code raises DeserializationError, struct.error, ...
+                self._undecodable(frame, header, exc)
+                continue
+            try:
+                callback(msg)
+            except Exception:
+                _log.exception("topic %s: callback %r raised", self.name, callback)
+
+    def _undecodable(self, frame: bytes | bytearray, header: Mapping[str, str], exc: Exception) -> None:
+        _log.warning(
+            "topic %s: cannot deserialize a %d-byte %s from %s: %s",
+            self.name,
+            len(frame),
+            self.type,
+            header.get("callerid", "?"),
+            exc,
+        )
+
     def _deliver(self, frame: bytes | bytearray, header: Mapping[str, str]) -> None:
-        if self.raw or self._sub.msg_class is None:
+        decode = self._decode
+        if decode is None:
             msg: Any = RawMessage(frame, header)
         else:
             try:
-                msg = self._sub.msg_class.deserialize_from(frame)
+                msg = decode(frame)
             except Exception as exc:  # generated code raises DeserializationError, struct.error, ...
-                _log.warning(
-                    "topic %s: cannot deserialize a %d-byte %s from %s: %s",
-                    self.name,
-                    len(frame),
-                    self.type,
-                    header.get("callerid", "?"),
-                    exc,
-                )
+                self._undecodable(frame, header, exc)
                 return
-        for callback, args in list(self._callbacks):
+        for callback, args in self._callbacks:
             try:
                 if args is None:
                     callback(msg)
@@ -461,7 +502,7 @@ class Subscriber:
     # -- API -------------------------------------------------------------------------------------
 
     def add_callback(self, callback: Callable[..., Any], callback_args: Any = None) -> None:
-        self._callbacks.append((callback, callback_args))
+        self._callbacks = (*self._callbacks, (callback, callback_args))
 
     def get_num_connections(self) -> int:
         return len(self._sub.connections)

@@ -43,20 +43,31 @@ connection_ids = itertools.count(1)
 
 #: Most bytes joined into one send when the loop drains a queue.
 _BATCH_BYTES = 1 << 20
-#: Publishes closer together than this (seconds) are batched by the loop instead of sent directly.
+#: Publishes closer together than this (seconds) are batched instead of sent one by one.
 HOT_INTERVAL = 50e-6
-#: In a burst, the publishing thread itself writes once this many frames are queued.
+#: In a burst, the publishing thread writes once this many frames are queued ...
 _FLUSH_FRAMES = 32
+#: ... or once the oldest queued frame has waited this long (seconds).
+_MAX_HOLD = 200e-6
+#: While a burst goes on, the loop looks at its leftovers this often (seconds).
+_CHECK_INTERVAL = 1e-3
 #: queue_size=None: frames queued before publish() waits for the loop to drain them.
 _SYNC_HIGH_WATER = 256
 _SYNC_HIGH_WATER_BYTES = 8 << 20
-#: Payloads at least this big are sent with sendmsg (prefix and payload unjoined).
+#: Frames at least this big are never held back to batch them.
 _LARGE = 1 << 16
 _clock = time.perf_counter
 
 
 class PubConnection:
-    """One subscriber of one topic: a non-blocking socket plus the frames the kernel did not take yet."""
+    """One subscriber of one topic: a non-blocking socket plus the frames the kernel did not take yet.
+
+    Who writes: the publishing thread, always (directly when the connection is idle, a batch at a
+    time in a burst, and until the kernel takes it when ``queue_size=None`` must block). The I/O loop
+    only finishes what a burst leaves behind once the publisher goes quiet (:meth:`_check`) and drains
+    a bounded queue the kernel refused (:meth:`_drain`). So a flood keeps one thread busy, not two
+    threads fighting over the GIL and this connection's lock.
+    """
 
     def __init__(self, node: Node, sock: socket.socket, topic: str, subscriber: str, uri: str = "") -> None:
         self.node = node
@@ -74,16 +85,22 @@ class PubConnection:
         self._cond = threading.Condition(self._lock)
         self._partial: memoryview | None = None  # the head frame, partly written
         self._queue: deque[bytes] = deque()
-        self._armed = False  # the loop watches the socket for writability
-        self._last = 0.0  # time of the previous send (detects bursts)
         self._queued_bytes = 0
+        self._oldest = 0.0  # when the head of the queue was queued
+        self._last = 0.0  # time of the previous publish (detects bursts)
+        self._published = 0  # publishes so far; the loop's check compares it to see a burst go on
+        self._seen = 0
+        self._since_try = 0  # publishes queued since this thread last tried to write
+        self._armed = False  # the loop waits for the socket to become writable
+        self._checking = False  # a check of the queue is scheduled on the loop
 
     def send(self, data: bytes, queue_size: int | None) -> None:
-        """Queue ``data`` (one or more frames) for this subscriber; never blocks unless queue_size is None.
+        """Send ``data`` (one or more frames) to this subscriber; blocks only when ``queue_size`` is
+        None and the kernel lags (synchronous, lossless: rospy's blocking send, with a short buffer).
 
-        An idle connection is written to directly (lowest latency). While publishes come faster than
-        one per :data:`HOT_INTERVAL`, frames are queued instead and the loop sends them in batches:
-        one system call and one wake-up of the subscriber per batch instead of per message.
+        An idle connection is written to directly (lowest latency). Publishes closer together than
+        :data:`HOT_INTERVAL` are queued instead and written :data:`_FLUSH_FRAMES` at a time, or once the
+        oldest has waited :data:`_MAX_HOLD`: one system call and one wake-up of the subscriber per batch.
         """
         with self._lock:
             if self.closed:
@@ -91,7 +108,8 @@ class PubConnection:
             now = _clock()
             hot = now - self._last < HOT_INTERVAL
             self._last = now
-            if self._partial is None and not self._queue and not hot:
+            self._published += 1
+            if (not hot or len(data) >= _LARGE) and self._partial is None and not self._queue:
                 try:
                     n = self.sock.send(data)
                 except (BlockingIOError, InterruptedError):
@@ -100,87 +118,85 @@ class PubConnection:
                     self._fail(f"write failed: {exc}")
                     return
                 self.bytes_sent += n
+                self.num_sent += 1
                 if n == len(data):
-                    self.num_sent += 1
                     return
                 self._partial = memoryview(data)[n:]
+                if queue_size is not None or len(data) < _LARGE:
+                    self._kernel_full()
+                    return
+                must_wait = True  # a big synchronous message: finish it here, at the subscriber's pace
             else:
-                queue = self._queue
-                queue.append(data)
-                self._queued_bytes += len(data)
-                if queue_size and len(queue) > queue_size:
-                    self._queued_bytes -= len(queue.popleft())
-                    self.dropped += 1
-                if self._partial is None and len(queue) >= _FLUSH_FRAMES and self._write_locked():
-                    return  # a burst: this thread wrote a whole batch in one call
-            if not self._armed:
-                self._armed = True
-                self.node.runtime.call_soon(self._arm)
-            if queue_size is None and (
-                len(self._queue) >= _SYNC_HIGH_WATER or self._queued_bytes >= _SYNC_HIGH_WATER_BYTES
-            ):
-                # synchronous publishing: wait for the loop to drain (lossless, bounded memory)
-                while not self.closed and not (self._partial is None and not self._queue):
-                    self._cond.wait()
+                must_wait = self._enqueue(data, queue_size, now)
+        if must_wait:
+            self._write_until_below(0)
 
-    def send_large(self, prefix: bytes, payload: bytes, queue_size: int | None) -> None:
-        """Like :meth:`send` for a big message: the length prefix and the payload leave in one
-        ``sendmsg`` without being joined (a 6 MB image is not copied once more just to frame it)."""
-        with self._lock:
-            idle = self._partial is None and not self._queue and not self.closed
-            if idle:
-                self._last = _clock()
-                try:
-                    n = self.sock.sendmsg([prefix, payload])
-                except (BlockingIOError, InterruptedError):
-                    n = 0
-                except OSError as exc:
-                    self._fail(f"write failed: {exc}")
-                    return
-                self.bytes_sent += n
-                if n == len(prefix) + len(payload):
-                    self.num_sent += 1
-                    return
-                if n >= len(prefix):
-                    self._partial = memoryview(payload)[n - len(prefix) :]
-                else:
-                    self._partial = memoryview(prefix[n:] + payload)
-                self.num_sent += 1
-                if queue_size is not None and not self._armed:
-                    self._armed = True
-                    self.node.runtime.call_soon(self._arm)
-        if not idle:
-            self.send(prefix + payload, queue_size)
-        elif queue_size is None:
-            self._finish_in_caller()
+    def _enqueue(self, data: bytes, queue_size: int | None, now: float) -> bool:
+        """Queue a frame of a burst (lock held) and write a batch when one is due. True when a
+        synchronous publisher must now wait for the kernel to take the backlog."""
+        queue = self._queue
+        if not queue:
+            self._oldest = now
+        queue.append(data)
+        self._queued_bytes += len(data)
+        if queue_size and len(queue) > queue_size:
+            self._queued_bytes -= len(queue.popleft())
+            self.dropped += 1
+        self._since_try += 1
+        if self._since_try >= _FLUSH_FRAMES or now - self._oldest > _MAX_HOLD:
+            self._since_try = 0
+            if not self._write_locked():
+                self._kernel_full()
+        if (queue or self._partial is not None) and not self._checking and not self._armed:
+            self._checking = True
+            self._seen = self._published
+            self.node.runtime.call_soon(self._check)
+        return queue_size is None and (
+            len(queue) >= _SYNC_HIGH_WATER or self._queued_bytes >= _SYNC_HIGH_WATER_BYTES
+        )
 
-    def _finish_in_caller(self) -> None:
-        """Synchronous publishing of a big message: write the rest from the caller's thread as the
-        kernel takes it (the subscriber's pace), like a blocking send, without involving the loop."""
+    def _write_until_below(self, frames: int) -> None:
+        """Synchronous publishing: write from the caller's thread as the kernel takes it (the
+        subscriber's pace) until at most ``frames`` frames wait, like a blocking send, without
+        involving the loop."""
         while True:
             with self._lock:
-                partial = self._partial
-                if self.closed or partial is None:
+                if self.closed:
                     return
-                try:
-                    n = self.sock.send(partial)
-                except (BlockingIOError, InterruptedError):
-                    n = 0
-                except OSError as exc:
-                    self._fail(f"write failed: {exc}")
+                self._write_locked()
+                if self._partial is None and len(self._queue) <= frames:
+                    self._cond.notify_all()
                     return
-                self.bytes_sent += n
-                if n == len(partial):
-                    self._partial = None
-                    if self._queue and not self._armed:
-                        self._armed = True
-                        self.node.runtime.call_soon(self._arm)
-                    return
-                self._partial = partial[n:]
             try:
                 select.select([], [self.sock], [], 1.0)
             except (OSError, ValueError):
                 pass  # closed under us: the next round sees it
+
+    def _kernel_full(self) -> None:
+        """The kernel refused part of a write (lock held): have the loop finish when writable."""
+        if not self._armed:
+            self._armed = True
+            self.node.runtime.call_soon(self._arm)
+
+    def _check(self) -> None:
+        """On the loop, after a burst queued frames: write them once the publisher has gone quiet
+        (while it keeps publishing it writes batches itself; look again in :data:`_CHECK_INTERVAL`)."""
+        with self._lock:
+            if self.closed or self._armed:
+                self._checking = False
+                return
+            if self._published != self._seen:
+                # the burst goes on (even if its last batch left nothing queued): stay scheduled
+                # rather than be woken again by the next queued frame
+                self._seen = self._published
+                self.node.runtime.loop.call_later(_CHECK_INTERVAL, self._check)
+                return
+            self._checking = False
+            if self._write_locked():
+                self._cond.notify_all()
+                return
+            self._armed = True
+        self._arm()
 
     def watch(self) -> None:
         """Notice a subscriber that goes away even while we have nothing to send (on the loop)."""
@@ -242,7 +258,7 @@ class PubConnection:
 
     def _take_batch(self) -> bytes:
         queue = self._queue
-        if len(queue) == 1:
+        if len(queue) == 1 or len(queue[0]) >= _BATCH_BYTES:  # never copy a big frame to join it
             self.num_sent += 1
             item = queue.popleft()
             self._queued_bytes -= len(item)
@@ -338,23 +354,16 @@ class Publication:
         conn.watch()
 
     def publish_frame(self, data: bytes, handle: Publisher) -> None:
-        with self.lock:
-            if handle.latch:
+        if handle.latch:
+            # under the lock: a subscriber being accepted gets either this frame latched or live
+            with self.lock:
                 handle.latched = data
-            conns = self.connections
+                conns = self.connections
+        else:
+            conns = self.connections  # a tuple, replaced whole when connections change
         queue_size = handle.queue_size
         for conn in conns:
             conn.send(data, queue_size)
-
-    def publish_large(self, payload: bytes, handle: Publisher) -> None:
-        prefix = pack_len(len(payload))
-        with self.lock:
-            if handle.latch:
-                handle.latched = prefix + payload
-            conns = self.connections
-        queue_size = handle.queue_size
-        for conn in conns:
-            conn.send_large(prefix, payload, queue_size)
 
     def remove_connection(self, conn: PubConnection) -> None:
         with self.lock:
@@ -401,17 +410,22 @@ class Publisher:
             self._seq += 1  # rospy counts from 1
             msg.header.seq = self._seq
         try:
-            payload = msg.serialize_to_bytes()
+            data = msg.serialize_framed()
         except AttributeError:
-            if not hasattr(msg, "serialize_to_bytes"):
-                raise SerializationError(
-                    f"topic {self.name}: expected a {self.type} message, got {type(msg).__name__}"
-                ) from None
-            raise
-        if len(payload) >= _LARGE:
-            self._pub.publish_large(payload, self)
-        else:
-            self._pub.publish_frame(pack_len(len(payload)) + payload, self)
+            if hasattr(msg, "serialize_framed"):
+                raise
+            data = self._frame_other(msg)
+        self._pub.publish_frame(data, self)
+
+    def _frame_other(self, msg: Any) -> bytes:
+        """A message class outside the generated ones that has only ``serialize_to_bytes`` (the
+        contract's minimum, docs/CONTRACTS.md)."""
+        if not hasattr(msg, "serialize_to_bytes"):
+            raise SerializationError(
+                f"topic {self.name}: expected a {self.type} message, got {type(msg).__name__}"
+            )
+        payload = msg.serialize_to_bytes()
+        return pack_len(len(payload)) + payload
 
     def publish_raw(self, payload: bytes | bytearray | memoryview) -> None:
         """Send already-serialized bytes (relays, bag play, AnyMsg)."""

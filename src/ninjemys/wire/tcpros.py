@@ -95,16 +95,18 @@ class FrameReader:
             self._big_fill = 0
             return frames
         self._end += n
-        buf, start, end = self._buf, self._start, self._end
+        buf, view, start, end = self._buf, self._view, self._start, self._end
         unpack_from = _U32.unpack_from
-        while end - start >= 4:
+        append = frames.append
+        while start + 4 <= end:
             (length,) = unpack_from(buf, start)
+            stop = start + 4 + length
+            if stop <= end:  # complete, so it fits the buffer: no limit to check
+                append(view[start + 4 : stop].tobytes())
+                start = stop
+                continue
             if length > self._limit:
                 raise ProtocolError(f"message length prefix {length} exceeds the {self._limit}-byte limit")
-            if end - start - 4 >= length:
-                frames.append(bytes(buf[start + 4 : start + 4 + length]))
-                start += 4 + length
-                continue
             if length >= self._large:
                 have = end - start - 4
                 big = bytearray(length)
