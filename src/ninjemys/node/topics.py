@@ -4,12 +4,14 @@ The publish path is built for latency and throughput:
 
 * the message is serialized once, in the caller's thread, whatever the number of subscribers (so
   the caller may modify it afterwards, as in rospy);
-* for each connection whose queue is empty the frame is written straight to the (non-blocking)
-  socket from the caller's thread: no hand-off, no wake-up of another thread;
-* only when the kernel buffer is full does the frame wait in the connection's queue; the I/O loop
-  then drains the queue in batches (many frames joined into one ``send``).
+* for each idle connection the frame is written straight to the (non-blocking) socket from the
+  caller's thread: no hand-off, no wake-up of another thread;
+* in a burst (publishes closer than ``HOT_INTERVAL``) frames are queued and the caller's thread
+  writes them a batch at a time (many frames joined into one ``send``, one wake-up of the
+  subscriber); the I/O loop only writes what is left once the burst ends, or what the kernel refused;
 * ``queue_size=N`` bounds each connection's queue and drops the oldest frame; ``queue_size=None``
-  waits until the queue has drained (synchronous, lossless, as rospy).
+  makes the caller write the backlog itself, at the subscriber's pace, once it passes a high-water
+  mark (synchronous, lossless, as rospy).
 
 A slow subscriber therefore costs the publisher nothing but its own connection's queue.
 Latching is per Publisher handle: a new subscriber receives the last message of every latched
