@@ -51,13 +51,20 @@ class Message:
 
     def serialize_framed(self) -> bytes:
         """``uint32 len`` + the wire bytes, joined in one copy: a TCPROS frame, ready to send."""
+        return b"".join(self.frame_parts()[1])
+
+    def frame_parts(self) -> tuple[int, list[Any]]:
+        """A TCPROS frame unjoined: (total length, [``uint32 len``, wire pieces...]). The pieces are
+        bytes-like with one byte per item; a big array is the caller's own buffer, not a copy, so
+        a 6 MB image can go to the socket with ``sendmsg`` and no copy in Python."""
         parts: list[Any] = [b""]
         try:
             self._ser(parts.append)
         except _SER_ERRORS as exc:
             raise diagnose(self, exc) from None
-        parts[0] = _pack_len(sum(map(len, parts)))
-        return b"".join(parts)
+        size = sum(map(len, parts))
+        parts[0] = _pack_len(size)
+        return size + 4, parts
 
     def serialize(self, buff: Any) -> None:
         """genpy API: write the wire bytes into a file-like ``buff`` (e.g. ``io.BytesIO``)."""

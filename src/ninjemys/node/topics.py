@@ -58,7 +58,20 @@ _SYNC_HIGH_WATER = 256
 _SYNC_HIGH_WATER_BYTES = 8 << 20
 #: Frames at least this big are never held back to batch them.
 _LARGE = 1 << 16
+#: A big frame in more pieces than this is joined before sending (sendmsg takes at most IOV_MAX).
+_MAX_PARTS = 64
 _clock = time.perf_counter
+
+
+def _unsent(buffers: list[Any], sent: int) -> list[Any] | None:
+    """What is left of ``buffers`` (one-byte items) after ``sent`` bytes were written; None if nothing."""
+    for i, buf in enumerate(buffers):
+        size = len(buf)
+        if sent < size:
+            rest = [memoryview(buf)[sent:]] if sent else [buf]
+            return rest + buffers[i + 1 :]
+        sent -= size
+    return None
 
 
 class PubConnection:
@@ -85,7 +98,7 @@ class PubConnection:
         self.closed = False
         self._lock = threading.Lock()
         self._cond = threading.Condition(self._lock)
-        self._partial: memoryview | None = None  # the head frame, partly written
+        self._partial: list[Any] | None = None  # buffers of the head frame(s) not written yet
         self._queue: deque[bytes] = deque()
         self._queued_bytes = 0
         self._oldest = 0.0  # when the head of the queue was queued
@@ -123,7 +136,7 @@ class PubConnection:
                 self.num_sent += 1
                 if n == len(data):
                     return
-                self._partial = memoryview(data)[n:]
+                self._partial = [memoryview(data)[n:]]
                 if queue_size is not None or len(data) < _LARGE:
                     self._kernel_full()
                     return
@@ -132,6 +145,39 @@ class PubConnection:
                 must_wait = self._enqueue(data, queue_size, now)
         if must_wait:
             self._write_until_below(0)
+
+    def send_parts(self, parts: list[Any], total: int, queue_size: int | None) -> None:
+        """Like :meth:`send` for a big frame still in pieces (see ``Message.frame_parts``): an idle
+        connection gets them in one ``sendmsg``, so the payload is never copied in Python."""
+        with self._lock:
+            if self.closed:
+                return
+            idle = self._partial is None and not self._queue
+            if idle:
+                self._last = _clock()
+                self._published += 1
+                try:
+                    n = self.sock.sendmsg(parts)
+                except (BlockingIOError, InterruptedError):
+                    n = 0
+                except OSError as exc:
+                    self._fail(f"write failed: {exc}")
+                    return
+                self.bytes_sent += n
+                self.num_sent += 1
+                if n == total:
+                    return
+                rest = _unsent(parts, n)
+                if queue_size is not None:
+                    # the caller may change its buffers once publish returns: keep a copy of the rest
+                    self._partial = [b"".join(rest)]
+                    self._kernel_full()
+                    return
+                self._partial = rest
+        if idle:
+            self._write_until_below(0)  # synchronous: finish here, at the subscriber's pace
+        else:
+            self.send(b"".join(parts), queue_size)
 
     def _enqueue(self, data: bytes, queue_size: int | None, now: float) -> bool:
         """Queue a frame of a burst (lock held) and write a batch when one is due. True when a
@@ -242,16 +288,22 @@ class PubConnection:
         """Write what the kernel takes (lock held); True once nothing is left queued."""
         try:
             while True:
-                if self._partial is None:
+                partial = self._partial
+                if partial is None:
                     if not self._queue:
                         return True
-                    self._partial = memoryview(self._take_batch())
-                n = self.sock.send(self._partial)
+                    batch = self._take_batch()
+                    n = self.sock.send(batch)
+                    self.bytes_sent += n
+                    if n < len(batch):
+                        self._partial = [memoryview(batch)[n:]]
+                        return False
+                    continue
+                n = self.sock.sendmsg(partial)
                 self.bytes_sent += n
-                if n < len(self._partial):
-                    self._partial = self._partial[n:]
+                self._partial = _unsent(partial, n)
+                if self._partial is not None:
                     return False
-                self._partial = None
         except (BlockingIOError, InterruptedError):
             return False
         except OSError as exc:
@@ -367,6 +419,17 @@ class Publication:
         for conn in conns:
             conn.send(data, queue_size)
 
+    def publish_parts(self, parts: list[Any], total: int, handle: Publisher) -> None:
+        if handle.latch:
+            with self.lock:
+                handle.latched = b"".join(parts)
+                conns = self.connections
+        else:
+            conns = self.connections
+        queue_size = handle.queue_size
+        for conn in conns:
+            conn.send_parts(parts, total, queue_size)
+
     def remove_connection(self, conn: PubConnection) -> None:
         with self.lock:
             if conn in self.connections:
@@ -412,12 +475,16 @@ class Publisher:
             self._seq += 1  # rospy counts from 1
             msg.header.seq = self._seq
         try:
-            data = msg.serialize_framed()
+            total, parts = msg.frame_parts()
         except AttributeError:
-            if hasattr(msg, "serialize_framed"):
+            if hasattr(msg, "frame_parts"):
                 raise
-            data = self._frame_other(msg)
-        self._pub.publish_frame(data, self)
+            self._pub.publish_frame(self._frame_other(msg), self)
+            return
+        if total < _LARGE or len(parts) > _MAX_PARTS:
+            self._pub.publish_frame(b"".join(parts), self)
+        else:
+            self._pub.publish_parts(parts, total, self)
 
     def _frame_other(self, msg: Any) -> bytes:
         """A message class outside the generated ones that has only ``serialize_to_bytes`` (the
