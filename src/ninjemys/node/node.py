@@ -146,11 +146,16 @@ class Node:
         queue_size: int | None = None,
         raw: bool = False,
         tcp_nodelay: bool = True,
+        coalesce: float = 0.0,
     ) -> Subscriber:
         """Subscribe to ``topic``; ``callback(msg[, callback_args])`` runs on this subscriber's own thread.
 
         ``raw=True`` (or ``msg_class=None``) delivers :class:`~ninjemys.node.subscriber.RawMessage`
         (serialized bytes plus the publisher's connection header) without deserializing.
+        ``coalesce=s`` lets a message wait up to about ``s`` seconds so that one wake-up of the
+        subscriber's thread takes all that arrived meanwhile: on a VM a wake-up costs more CPU than
+        a small message (``rostopic echo`` and ``bw`` use it; not ``hz``, whose statistics need each
+        message's own arrival time, and TCP merges segments that wait, with their kernel times).
         """
         self._check_alive()
         resolved = self.resolve_name(topic)
@@ -160,7 +165,7 @@ class Node:
             if sub is None:
                 sub = Subscription(self, resolved, msg_class, tcp_nodelay)
                 self._subscriptions[resolved] = sub
-            handle = Subscriber(sub, callback, callback_args, queue_size, raw)
+            handle = Subscriber(sub, callback, callback_args, queue_size, raw, coalesce)
             sub.handles.append(handle)
         if new:
             publishers = self.registrar.add_subscriber(resolved, sub.type_name)

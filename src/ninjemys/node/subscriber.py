@@ -23,6 +23,7 @@ import select
 import selectors
 import socket
 import threading
+import time
 from collections import deque
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -294,8 +295,11 @@ class Subscriber:
         callback_args: Any = None,
         queue_size: int | None = None,
         raw: bool = False,
+        coalesce: float = 0.0,
     ) -> None:
         self._sub = subscription
+        #: seconds a message may wait so that one wake-up of the worker takes several (see Node.subscriber)
+        self._coalesce = max(0.0, coalesce)
         self.name = subscription.topic
         self.resolved_name = subscription.topic
         self.data_class = subscription.msg_class
@@ -381,6 +385,8 @@ class Subscriber:
                         self._on_wake()
                     else:
                         self._read(conn)
+                if self._coalesce and not queue:
+                    time.sleep(self._coalesce)  # let messages gather: the next poll takes them all
         finally:
             self._finish()
 
@@ -446,6 +452,16 @@ class Subscriber:
         self._wake_r.close()
         self._wake_w.close()
 
+    def _call(self, msg: Any) -> None:
+        for callback, args in self._callbacks:
+            try:
+                if args is None:
+                    callback(msg)
+                else:
+                    callback(msg, args)
+            except Exception:
+                _log.exception("topic %s: callback %r raised", self.name, callback)
+
     def _deliver_batch(self, frames: list[bytes | bytearray], header: Mapping[str, str]) -> None:
         """Deliver frames in order; the common case (decode, one callback without args) is inlined,
         as this loop runs once per received message."""
@@ -490,14 +506,7 @@ class Subscriber:
             except Exception as exc:  # generated code raises DeserializationError, struct.error, ...
                 self._undecodable(frame, header, exc)
                 return
-        for callback, args in self._callbacks:
-            try:
-                if args is None:
-                    callback(msg)
-                else:
-                    callback(msg, args)
-            except Exception:
-                _log.exception("topic %s: callback %r raised", self.name, callback)
+        self._call(msg)
 
     # -- API -------------------------------------------------------------------------------------
 

@@ -17,6 +17,7 @@ from ninjemys import names
 from ninjemys.tools.cli import Subcommands, entry, master, run_subcommand
 from ninjemys.tools.graph import GraphState, node_api
 from ninjemys.tools.topic_common import (
+    COALESCE,
     ID,
     NAME,
     TopicToolError,
@@ -242,7 +243,7 @@ def _cmd_echo(args: argparse.Namespace) -> int:
             done.set()
 
     try:
-        node.subscriber(real, None, on_message, raw=True, queue_size=args.queue_size)
+        node.subscriber(real, None, on_message, raw=True, queue_size=args.queue_size, coalesce=COALESCE)
         while not done.wait(0.5) and not node.is_shutdown:
             pass
     finally:
