@@ -26,11 +26,13 @@ parse ``<i8>``: a C++ node reading such a parameter sees an XML-RPC error for th
 from __future__ import annotations
 
 import binascii
-from dataclasses import dataclass, field
-from typing import Any
 from xml.parsers import expat
 
 from ninjemys.errors import ProtocolError
+
+TYPE_CHECKING = False  # importing typing costs ~7 ms of every tool's and node's start-up
+if TYPE_CHECKING:
+    from typing import Any
 
 #: ROS 1 status codes.
 ERROR = -1
@@ -350,13 +352,28 @@ def parse_response(body: bytes) -> Any:
 # --------------------------------------------------------------------------------------------- HTTP
 
 
-@dataclass
 class HttpMessage:
-    """One complete HTTP request or response (start line split, lower-cased header names)."""
+    """One complete HTTP request or response (start line split, lower-cased header names).
 
-    start: tuple[str, str, str]
-    headers: dict[str, str] = field(default_factory=dict)
-    body: bytes = b""
+    A plain class, not a dataclass: ``dataclasses`` pulls ``inspect`` and friends into every
+    process start (about 15 ms), and this is on every tool's and node's path."""
+
+    __slots__ = ("start", "headers", "body")
+
+    def __init__(
+        self, start: tuple[str, str, str], headers: dict[str, str] | None = None, body: bytes = b""
+    ) -> None:
+        self.start = start
+        self.headers = {} if headers is None else headers
+        self.body = body
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, HttpMessage):
+            return NotImplemented
+        return (self.start, self.headers, self.body) == (other.start, other.headers, other.body)
+
+    def __repr__(self) -> str:
+        return f"HttpMessage(start={self.start!r}, headers={self.headers!r}, body={self.body!r})"
 
     @property
     def keep_alive(self) -> bool:
