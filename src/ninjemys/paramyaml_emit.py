@@ -54,13 +54,14 @@ STR, INT, FLOAT, BOOL, NULL, OTHER = "str", "int", "float", "bool", "null", "oth
 #: YAML 1.1 implicit types as PyYAML resolves plain scalars, in PyYAML's order, plus rosparam's
 #: ``deg(...)``/``rad(...)`` angles (ROS 1 registers them on the dumper too): (first characters,
 #: required prefix, type, pattern). A string that would read back as another type must be quoted.
-#: Patterns are compiled on first use: most texts are ruled out by their first character.
-_RESOLVERS: list[tuple[str, str, str, str]] = [
+#: Word lists stand for patterns that are a list of words; patterns are compiled on first use (most
+#: texts are ruled out by their first character).
+_RESOLVERS: list[tuple[str, str, str, str | frozenset[str]]] = [
     (
         "yYnNtTfFoO",
         "",
         BOOL,
-        r"^(?:yes|Yes|YES|no|No|NO|true|True|TRUE|false|False|FALSE|on|On|ON|off|Off|OFF)$",
+        frozenset("yes Yes YES no No NO true True TRUE false False FALSE on On ON off Off OFF".split()),
     ),
     (
         "-+0123456789.",
@@ -79,8 +80,8 @@ _RESOLVERS: list[tuple[str, str, str, str]] = [
         r"^(?:[-+]?0b[0-1_]+|[-+]?0[0-7_]+|[-+]?(?:0|[1-9][0-9_]*)"
         r"|[-+]?0x[0-9a-fA-F_]+|[-+]?[1-9][0-9_]*(?::[0-5]?[0-9])+)$",
     ),
-    ("<", "<<", OTHER, r"^(?:<<)$"),
-    ("~nN", "", NULL, r"^(?:~|null|Null|NULL)$"),
+    ("<", "<<", OTHER, frozenset(["<<"])),
+    ("~nN", "", NULL, frozenset(["~", "null", "Null", "NULL"])),
     (
         "0123456789",
         "",
@@ -89,8 +90,8 @@ _RESOLVERS: list[tuple[str, str, str, str]] = [
         r"|[0-9]{4}-[0-9]{1,2}-[0-9]{1,2}(?:[Tt]|[ \t]+)[0-9]{1,2}:[0-9]{2}:[0-9]{2}(?:\.[0-9]*)?"
         r"(?:[ \t]*(?:Z|[-+][0-9]{1,2}(?::[0-9]{2})?))?)$",
     ),
-    ("=", "=", OTHER, r"^(?:=)$"),
-    ("!&*", "", OTHER, r"^(?:!|&|\*)$"),
+    ("=", "=", OTHER, frozenset(["="])),
+    ("!&*", "", OTHER, frozenset(["!", "&", "*"])),
     ("deg(", "deg(", OTHER, r"^deg\([^\)]*\)$"),
     ("rad(", "rad(", OTHER, r"^rad\([^\)]*\)$"),
 ]
@@ -101,19 +102,51 @@ class _Unsupported(Exception):
     """Raised inside the walk when PyYAML's output for this value is not one we reproduce."""
 
 
+#: every character the number and timestamp patterns accept (exponents, 0b, .inf/.nan, T/Z of times)
+_NUMERIC_CHARS = frozenset("0123456789_.:+- \teEbinfINFaAtTZ")
+#: those patterns (float, int, timestamp), by source: skipped (never compiled) for text with other characters
+_NUMERIC_SOURCES = frozenset(
+    source for firsts, _, kind, source in _RESOLVERS if kind in (FLOAT, INT) or firsts == "0123456789"
+)
+
+
+def _numeric_like(text: str) -> bool:
+    """False when no number or timestamp pattern can match (none has two dots: '1.15.15' is text)."""
+    if text.lstrip("+-").startswith("0x"):
+        return True
+    return text.count(".") < 2 and all(ch in _NUMERIC_CHARS for ch in text)
+
+
 def implicit_type(text: str) -> str:
     """The type a plain (unquoted) YAML scalar ``text`` reads back as: ``str``, ``int``, ``float``, ..."""
     if not text:
         return NULL
     first = text[0]
+    numeric: bool | None = None
     for firsts, prefix, kind, source in _RESOLVERS:
-        if first in firsts and text.startswith(prefix):
-            pattern = _compiled.get(source)
-            if pattern is None:
-                pattern = _compiled[source] = re.compile(source)
-            if pattern.match(text):
+        if first not in firsts or not text.startswith(prefix):
+            continue
+        if not isinstance(source, str):
+            # a pattern's '$' also matches before a final line break: 'yes\n' resolves like 'yes'
+            if text in source or (text[-1] == "\n" and text[:-1] in source):
                 return kind
+            continue
+        if source in _NUMERIC_SOURCES:
+            if numeric is None:
+                numeric = _numeric_like(text)
+            if not numeric:
+                continue
+        pattern = _compiled.get(source)
+        if pattern is None:
+            pattern = _compiled[source] = re.compile(source)
+        if pattern.match(text):
+            return kind
     return STR
+
+
+def _word_like(text: str) -> bool:
+    """ASCII letters, digits and ``_`` only: no indicator, space, break or escape can be involved."""
+    return text.isascii() and text.replace("_", "a").isalnum()
 
 
 class _Analysis:
@@ -126,7 +159,7 @@ class _Analysis:
         self.multiline = False
         self.plain = True
         self.single_quoted = True
-        if not text:
+        if not text or _word_like(text):
             return
         n = len(text)
         indicators = text.startswith(("---", "..."))
@@ -287,6 +320,9 @@ class _Emitter:
         if not self.whitespace:
             self._write(" ")
         self.whitespace = self.indention = False
+        if " " not in text:
+            self._write(text)
+            return
         for i, run in enumerate(re.split("( +)", text)):
             if i % 2 and len(run) == 1 and self.column > _WIDTH and fold:
                 self._to_indent()

@@ -196,6 +196,21 @@ def test_implicit_types_match_pyyaml_resolution():
         assert (kind == "str") == (resolved == "tag:yaml.org,2002:str"), text
 
 
+@settings(max_examples=500, deadline=None)
+@given(
+    st.one_of(
+        st.text(
+            alphabet=st.sampled_from(list("0123456789_.:+-eExXbBaAfFinINTtZ \tyesnoul~<=!&*(d)r")),
+            max_size=14,
+        ),
+        st.text(max_size=8),
+    )
+)
+def test_implicit_types_match_pyyaml_on_random_text(text):
+    resolved = RosparamDumper.resolve(RosparamDumper, yaml.ScalarNode, text, (True, False))
+    assert (implicit_type(text) == "str") == (resolved == "tag:yaml.org,2002:str")
+
+
 def test_hands_over_what_it_cannot_print():
     shared = [1, 2]
     for value in ({"a": shared, "b": shared}, b"\x00\x01binary", {1: "int key"}, (1, 2), {"": 1}):
