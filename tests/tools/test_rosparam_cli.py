@@ -153,3 +153,23 @@ def test_parse_errors_are_ros1_usage_errors(capsys, command, argv, message):
     err = capsys.readouterr().err
     assert err.startswith("Usage: rosparam ")
     assert err.endswith(f"\nrosparam: error: {message}\n")
+
+
+@pytest.mark.ros1
+def test_load_set_from_files_and_dump_to_file_match_ros1(master_uri, tmp_path):
+    """Each tool writes its own namespace from the same files; the trees and dumped files agree."""
+    params = tmp_path / "params.yaml"
+    params.write_text("gain: 2.5\nangle: deg(180)\nname: ' spaced'\nnested:\n  list: [1, two, {k: v}]\n")
+    text = tmp_path / "text.txt"
+    text.write_text("<robot name='r'>\n  <link/>\n</robot>\n")
+    for real, ns in ((False, "/ours"), (True, "/theirs")):
+        for args in (["load", str(params), ns], ["set", "-t", str(text), f"{ns}/description"]):
+            result = run_tool("rosparam", args, master_uri, real=real)
+            assert result.returncode == 0, result.stderr
+        dumped = run_tool("rosparam", ["dump", str(tmp_path / f"{ns[1:]}.yaml"), ns], master_uri, real=real)
+        assert dumped.returncode == 0, dumped.stderr
+    proxy = xmlrpc.client.ServerProxy(master_uri)
+    ours, theirs = proxy.getParam("/test", "/ours")[2], proxy.getParam("/test", "/theirs")[2]
+    assert ours == theirs
+    assert ours["angle"] == pytest.approx(3.141592653589793) and ours["description"].startswith("<robot")
+    assert (tmp_path / "ours.yaml").read_text() == (tmp_path / "theirs.yaml").read_text()
