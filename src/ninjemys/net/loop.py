@@ -29,6 +29,8 @@ from collections import deque
 from collections.abc import Callable, Coroutine, Generator
 from typing import Any
 
+from ninjemys.net.addresses import lookup_host
+
 _log = logging.getLogger(__name__)
 
 _PENDING, _DONE, _CANCELLED = 0, 1, 2
@@ -595,6 +597,8 @@ class Loop:
         self, host: Any, port: Any, *, family: int = 0, type: int = 0, proto: int = 0, flags: int = 0
     ) -> list[Any]:  # noqa: A002
         """``socket.getaddrinfo``; numeric hosts answered at once, names resolved on a helper thread."""
+        if isinstance(host, str):
+            host = lookup_host(host)
         if host is None or _is_numeric(host):
             return socket.getaddrinfo(host, port, family, type, proto, flags)
         return await self.run_in_thread(socket.getaddrinfo, host, port, family, type, proto, flags)
@@ -787,6 +791,8 @@ def _connect_result(sock: socket.socket, address: Any) -> None:
 
 
 def _is_numeric(host: Any) -> bool:
+    if isinstance(host, bytes):
+        host = host.decode("ascii", "replace")
     if not isinstance(host, str):
         return True
     for family in (socket.AF_INET, socket.AF_INET6):
