@@ -129,7 +129,7 @@ class ServiceProxy:
 
     def call(self, *args: Any, **kwds: Any) -> Any:
         """Send a request (an instance, or its fields) and return the response."""
-        impl = self._core()
+        impl = self._impl or self._core()  # per call: no extra frame once the core proxy exists
         try:
             return impl.call(*args, **kwds)
         except NinjemysError as exc:

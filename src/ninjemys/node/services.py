@@ -43,6 +43,8 @@ if TYPE_CHECKING:
 
 _log = logging.getLogger(__name__)
 _U32 = struct.Struct("<I")
+_unpack_len = _U32.unpack_from
+_unpack_response_head = SERVICE_RESPONSE_HEAD.unpack_from
 
 
 class _Link:
@@ -66,6 +68,32 @@ class _Link:
         self._buf = bytearray(size)
         self._view = memoryview(self._buf)
         self._start = self._end = 0
+
+    def request(self) -> bytearray:
+        """The next request body. Fast path: nothing buffered and one read brings exactly one record
+        (the length test also rules out short reads: a stale prefix never matches ``end``)."""
+        if self._start == self._end:  # both 0: every path that empties the buffer resets them
+            buf = self._buf
+            end = self._recv_into(buf)
+            if end == _unpack_len(buf)[0] + 4:
+                return buf[4:end]
+            if not end:
+                raise ConnectionError("peer closed the connection")
+            self._end = end
+        return self.take(_U32)[1]
+
+    def response(self) -> tuple[int, bytearray]:
+        """The next response: (ok byte, body). Fast path as :meth:`request`."""
+        if self._start == self._end:
+            buf = self._buf
+            end = self._recv_into(buf)
+            ok, length = _unpack_response_head(buf)
+            if end == length + 5:
+                return ok, buf[5:end]
+            if not end:
+                raise ConnectionError("peer closed the connection")
+            self._end = end
+        return self.take(SERVICE_RESPONSE_HEAD)
 
     def take(self, head: struct.Struct, limit: int = MAX_FRAME_LEN) -> tuple[int, bytearray]:
         """The next record: (the head's first field, the body). ``ConnectionError`` if the peer
@@ -199,7 +227,7 @@ class ServiceServer:
         thread woken. Handler errors become ok=0 responses; the connection stays usable.
         """
         link = _Link(sock)
-        take, send = link.take, link.sendall
+        receive, send = link.request, link.sendall
         deserialize = self.request_class.deserialize_from
         response_class = self.response_class
         handler = self.handler
@@ -207,7 +235,7 @@ class ServiceServer:
         try:
             while not self._closed:
                 try:
-                    _, body = take(_U32)
+                    body = receive()
                 except OSError:
                     return  # the client is done (non-persistent clients close after one call)
                 try:
@@ -316,7 +344,7 @@ class ServiceProxy:
                 self._sock = link.sock
             try:
                 link.sendall(frame)
-                ok, body = link.take(SERVICE_RESPONSE_HEAD)
+                ok, body = link.response()
             except (OSError, ProtocolError) as exc:
                 self._drop()
                 raise ServiceError(
