@@ -473,3 +473,22 @@ def test_persistent_proxy_reconnects_after_the_server_restarts(make_node) -> Non
         proxy()  # the old connection is gone: this call fails, as in rospy
     assert proxy().message == "second"
     assert proxy().message == "second"
+
+
+def test_fieldless_requests_are_fresh_default_instances(make_node) -> None:
+    from std_srvs.srv import Trigger as GeneratedTrigger
+    from std_srvs.srv import TriggerRequest, TriggerResponse
+
+    server, client = make_node("server"), make_node("client")
+    seen: list[object] = []
+
+    def handler(req):
+        seen.append(req)
+        return TriggerResponse(True, f"call {len(seen)}")
+
+    server.service("trigger", GeneratedTrigger, handler)
+    client.wait_for_service("trigger", timeout=5)
+    proxy = client.service_proxy("trigger", GeneratedTrigger, persistent=True)
+    assert [proxy().message for _ in range(3)] == ["call 1", "call 2", "call 3"]
+    assert all(type(req) is TriggerRequest for req in seen)
+    assert len({id(req) for req in seen}) == 3  # never one shared instance
