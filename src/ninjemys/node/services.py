@@ -52,10 +52,11 @@ class _Link:
     body length, then the body) read through one preallocated buffer.
 
     A service exchange is one small record each way, so the usual read is ONE ``recv_into`` that
-    brings the whole record; parsing is one ``unpack_from`` and the body is one slice copy (a fresh
-    ``bytearray`` that deserialization may keep views into). A record split across packets is
-    completed with further reads; one larger than half the buffer is received straight into a
-    buffer of its exact size. Bytes past the record (a client sending ahead) stay for the next one.
+    brings the whole record; parsing is one ``unpack_from`` and the body is one copy out, as
+    ``bytes`` (what generated classes decode fastest, and immutable, so deserialization may keep
+    views into it). A record split across packets is completed with further reads; one larger than
+    half the buffer is received straight into a ``bytearray`` of its exact size (no further copy).
+    Bytes past the record (a client sending ahead) stay for the next one.
     Not thread-safe: its owner (a proxy under its lock, or a server connection's thread) serializes use.
     """
 
@@ -69,33 +70,33 @@ class _Link:
         self._view = memoryview(self._buf)
         self._start = self._end = 0
 
-    def request(self) -> bytearray:
+    def request(self) -> bytes | bytearray:
         """The next request body. Fast path: nothing buffered and one read brings exactly one record
         (the length test also rules out short reads: a stale prefix never matches ``end``)."""
         if self._start == self._end:  # both 0: every path that empties the buffer resets them
             buf = self._buf
             end = self._recv_into(buf)
             if end == _unpack_len(buf)[0] + 4:
-                return buf[4:end]
+                return self._view[4:end].tobytes()
             if not end:
                 raise ConnectionError("peer closed the connection")
             self._end = end
         return self.take(_U32)[1]
 
-    def response(self) -> tuple[int, bytearray]:
+    def response(self) -> tuple[int, bytes | bytearray]:
         """The next response: (ok byte, body). Fast path as :meth:`request`."""
         if self._start == self._end:
             buf = self._buf
             end = self._recv_into(buf)
             ok, length = _unpack_response_head(buf)
             if end == length + 5:
-                return ok, buf[5:end]
+                return ok, self._view[5:end].tobytes()
             if not end:
                 raise ConnectionError("peer closed the connection")
             self._end = end
         return self.take(SERVICE_RESPONSE_HEAD)
 
-    def take(self, head: struct.Struct, limit: int = MAX_FRAME_LEN) -> tuple[int, bytearray]:
+    def take(self, head: struct.Struct, limit: int = MAX_FRAME_LEN) -> tuple[int, bytes | bytearray]:
         """The next record: (the head's first field, the body). ``ConnectionError`` if the peer
         closes first, ``ProtocolError`` if the announced length exceeds ``limit``."""
         buf = self._buf
@@ -120,7 +121,7 @@ class _Link:
             self._start = self._end = 0
         else:
             self._start, self._end = stop, end
-        return fields[0], buf[first:stop]
+        return fields[0], self._view[first:stop].tobytes()
 
     def _more(self, start: int, end: int, need: int) -> tuple[int, int]:
         """Read until ``need`` bytes follow ``start`` (moving them to the front if they would not fit)."""
@@ -134,13 +135,13 @@ class _Link:
             end += k
         return start, end
 
-    def _rest(self, first: int, end: int, length: int) -> bytearray:
+    def _rest(self, first: int, end: int, length: int) -> bytes | bytearray:
         """A body that did not arrive with its head: completed in the buffer, or in its own."""
         if length <= len(self._buf) // 2:
             start, end = self._more(first, end, length)
             stop = start + length
             self._start, self._end = (0, 0) if stop == end else (stop, end)
-            return self._buf[start:stop]
+            return self._view[start:stop].tobytes()
         have = end - first
         out = bytearray(length)
         out[:have] = self._view[first:end]
