@@ -581,7 +581,7 @@ class Loop:
 
     async def sock_connect(self, sock: socket.socket, address: Any) -> None:
         """Connect a non-blocking socket; a host name is resolved first (off the loop)."""
-        if sock.family in (socket.AF_INET, socket.AF_INET6) and not _is_numeric(address[0]):
+        if sock.family in (socket.AF_INET, socket.AF_INET6) and not is_numeric_host(address[0]):
             infos = await self.getaddrinfo(address[0], address[1], family=sock.family, type=sock.type)
             if not infos:
                 raise OSError(f"cannot resolve {address[0]}")
@@ -599,7 +599,7 @@ class Loop:
         """``socket.getaddrinfo``; numeric hosts answered at once, names resolved on a helper thread."""
         if isinstance(host, str):
             host = lookup_host(host)
-        if host is None or _is_numeric(host):
+        if host is None or is_numeric_host(host):
             return socket.getaddrinfo(host, port, family, type, proto, flags)
         return await self.run_in_thread(socket.getaddrinfo, host, port, family, type, proto, flags)
 
@@ -790,7 +790,8 @@ def _connect_result(sock: socket.socket, address: Any) -> None:
         raise OSError(error, f"connect to {address}: {os.strerror(error)}")
 
 
-def _is_numeric(host: Any) -> bool:
+def is_numeric_host(host: Any) -> bool:
+    """True for an IPv4/IPv6 address literal (or a non-string): nothing to look up."""
     if isinstance(host, bytes):
         host = host.decode("ascii", "replace")
     if not isinstance(host, str):

@@ -28,8 +28,8 @@ from collections import deque
 from typing import Any
 
 from ninjemys.errors import ProtocolError
-from ninjemys.net.addresses import advertised_host
-from ninjemys.net.loop import get_running_loop
+from ninjemys.net.addresses import advertised_host, lookup_host
+from ninjemys.net.loop import get_running_loop, is_numeric_host
 from ninjemys.wire import xmlrpc as wire
 
 log = logging.getLogger(__name__)
@@ -81,9 +81,14 @@ class XmlRpcServer:
         """Bind and start accepting (raises ``OSError`` if the port is taken)."""
         loop = get_running_loop()
         host = self.host or "0.0.0.0"
-        infos = await loop.getaddrinfo(
-            host, self._requested_port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE
-        )
+        if is_numeric_host(host):  # no lookup: asyncio would send even this to its thread pool
+            infos = socket.getaddrinfo(
+                lookup_host(host), self._requested_port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE
+            )
+        else:
+            infos = await loop.getaddrinfo(
+                host, self._requested_port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE
+            )
         if not infos:
             raise OSError(f"cannot resolve {host}")
         family, kind, proto, _, address = infos[0]
