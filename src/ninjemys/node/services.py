@@ -3,7 +3,9 @@
 A service call is a strict request/response exchange, so after the header handshake (done on the
 I/O loop for servers) each server connection gets its own thread doing blocking socket I/O and
 calling the handler there; a proxy does its I/O directly in the caller's thread. Neither path
-crosses threads per call, which is what makes a persistent service round trip cheap.
+crosses threads per call, which is what makes a persistent service round trip cheap: per call, each
+side makes one ``sendall`` and (usually) one ``recv_into`` into its connection's preallocated buffer
+(:class:`_Link`), and the Python between them is bound once per connection (see docs/node_services.md).
 
 Wire: request ``uint32 len`` + body; response ``uint8 ok`` then ``uint32 len`` + body, or the error
 text when ok is 0. A client header with ``probe=1`` gets our header and a closed connection (that is
