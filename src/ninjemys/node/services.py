@@ -85,8 +85,10 @@ class _Link:
             self._end = end
         return self.take(_U32)[1]
 
-    def response(self) -> tuple[int, bytes | bytearray]:
-        """The next response: (ok byte, body). Fast path as :meth:`request`."""
+    def exchange(self, frame: bytes) -> tuple[int, bytes | bytearray]:
+        """Send a framed request and read its response: (ok byte, body); a client's whole call on
+        the wire, in one method. Fast path as :meth:`request`."""
+        self.sendall(frame)
         if self._start == self._end:
             buf = self._buf
             end = self._recv_into(buf)
@@ -350,8 +352,7 @@ class ServiceProxy:
                 link = self._link = self._connect()
                 self._sock = link.sock
             try:
-                link.sendall(frame)
-                ok, body = link.response()
+                ok, body = link.exchange(frame)
             except (OSError, ProtocolError) as exc:
                 self._drop()
                 raise ServiceError(
