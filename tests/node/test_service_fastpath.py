@@ -492,3 +492,28 @@ def test_fieldless_requests_are_fresh_default_instances(make_node) -> None:
     assert [proxy().message for _ in range(3)] == ["call 1", "call 2", "call 3"]
     assert all(type(req) is TriggerRequest for req in seen)
     assert len({id(req) for req in seen}) == 3  # never one shared instance
+
+
+def test_rospy_proxy_call_is_direct_and_subclass_overrides_still_apply(make_node, monkeypatch) -> None:
+    import rospy
+    import rospy.service
+
+    server = make_node("server")
+    server.service("add", AddTwoInts, lambda r: r.a + r.b)
+    # no init_node: the proxies talk to this test's master as /unnamed, from a fresh context
+    monkeypatch.setenv("ROS_MASTER_URI", server.master_uri)
+    monkeypatch.setattr(rospy.service, "_unnamed", None)
+
+    class Doubling(rospy.ServiceProxy):
+        def call(self, *args, **kwds):
+            return 2 * super().call(*args, **kwds).sum
+
+    plain = rospy.ServiceProxy("/add", AddTwoInts, persistent=True)
+    doubling = Doubling("/add", AddTwoInts, persistent=True)
+    try:
+        assert rospy.ServiceProxy.__call__ is rospy.ServiceProxy.call
+        assert plain(2, 3).sum == 5
+        assert doubling(2, 3) == 10  # proxy(...) reaches the subclass's call()
+    finally:
+        plain.close()
+        doubling.close()
