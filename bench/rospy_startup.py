@@ -3,8 +3,10 @@
     .venv/bin/python bench/rospy_startup.py [--runs 9] [--talker-seconds 5]
 
 Both implementations register with the same master (Debian's rosmaster, so neither side is favoured)
-and run as fresh processes; figures are medians. Besides the bare ``init_node`` process, it times the
-phases inside the process (import, init_node) and measures the CPU seconds the seeds' talker loop
+and run as fresh processes; figures are medians (the process wall also as the minimum: on a shared
+machine the minimum is the least disturbed run). Besides the bare ``init_node`` process, it times the
+phases of the process (interpreter start, import rospy, init_node, exit: atexit, unregistering and
+interpreter teardown, from the parent's clock and the child's; both are CLOCK_MONOTONIC) and measures the CPU seconds the seeds' talker loop
 (loginfo + publish + Rate.sleep) burns per wall second at 10 Hz and 100 Hz, and the CPU cost of one
 ``rospy.loginfo`` (console, log file and /rosout).
 """
@@ -32,16 +34,15 @@ OURS, REAL = "ninjemys", "rospy"
 BARE = "import rospy; rospy.init_node('bench_init', anonymous=True)"
 
 PHASES = """
-import time, atexit, sys
+import time
 t0 = time.perf_counter()
 import rospy
 t1 = time.perf_counter()
 rospy.init_node('bench_phases', anonymous=True)
 t2 = time.perf_counter()
-def report():
-    sys.stdout.write('%f %f\\n' % (t1 - t0, t2 - t1))
-    sys.stdout.flush()
-report()
+import sys
+sys.stdout.write('%f %f %f\\n' % (t0, t1, t2))
+sys.stdout.flush()
 """
 
 TALKER = """
@@ -73,24 +74,26 @@ def _python(impl: str) -> str:
     return ROS1_PYTHON if impl == REAL else sys.executable
 
 
-def bare(impl: str, master: str, home: str, runs: int) -> tuple[float, float]:
-    """Median wall time and median CPU time (user + system) of the bare init_node process."""
+def bare(impl: str, master: str, home: str, runs: int, code: str = BARE) -> tuple[float, float, float]:
+    """Median wall time, minimum wall time and median CPU time (user + system) of a fresh process."""
     walls, cpus = [], []
     for _ in range(runs):
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         start = time.perf_counter()
         subprocess.run(
-            [_python(impl), "-c", BARE], env=_env(impl, master, home), check=True, capture_output=True
+            [_python(impl), "-c", code], env=_env(impl, master, home), check=True, capture_output=True
         )
         walls.append(time.perf_counter() - start)
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
         cpus.append(after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime)
-    return statistics.median(walls), statistics.median(cpus)
+    return statistics.median(walls), min(walls), statistics.median(cpus)
 
 
-def phases(impl: str, master: str, home: str, runs: int) -> tuple[float, float]:
-    imports, inits = [], []
+def phases(impl: str, master: str, home: str, runs: int) -> tuple[float, float, float, float]:
+    """Medians of: interpreter start-up, import rospy, init_node, exit (init_node return -> reaped)."""
+    starts, imports, inits, exits = [], [], [], []
     for _ in range(runs):
+        spawned = time.perf_counter()
         out = subprocess.run(
             [_python(impl), "-c", PHASES],
             env=_env(impl, master, home),
@@ -98,9 +101,13 @@ def phases(impl: str, master: str, home: str, runs: int) -> tuple[float, float]:
             capture_output=True,
             text=True,
         ).stdout.split()
-        imports.append(float(out[0]))
-        inits.append(float(out[1]))
-    return statistics.median(imports), statistics.median(inits)
+        ended = time.perf_counter()
+        t0, t1, t2 = (float(x) for x in out[-3:])
+        starts.append(t0 - spawned)
+        imports.append(t1 - t0)
+        inits.append(t2 - t1)
+        exits.append(ended - t2)
+    return tuple(statistics.median(v) for v in (starts, imports, inits, exits))  # type: ignore[return-value]
 
 
 def talker_cpu(impl: str, master: str, home: str, hz: float, seconds: float) -> float:
@@ -191,10 +198,15 @@ def main() -> None:
             rows = []
             runs = {impl: bare(impl, master, home, args.runs) for impl in (OURS, REAL)}
             rows.append(("import rospy; init_node process wall (s)", runs[OURS][0], runs[REAL][0]))
-            rows.append(("import rospy; init_node process CPU (s)", runs[OURS][1], runs[REAL][1]))
+            rows.append(("  same, minimum of the runs (s)", runs[OURS][1], runs[REAL][1]))
+            rows.append(("import rospy; init_node process CPU (s)", runs[OURS][2], runs[REAL][2]))
             ph = {impl: phases(impl, master, home, args.runs) for impl in (OURS, REAL)}
-            rows.append(("  of which import rospy (s)", ph[OURS][0], ph[REAL][0]))
-            rows.append(("  of which init_node (s)", ph[OURS][1], ph[REAL][1]))
+            rows.append(("  of which interpreter start (s)", ph[OURS][0], ph[REAL][0]))
+            rows.append(("  of which import rospy (s)", ph[OURS][1], ph[REAL][1]))
+            rows.append(("  of which init_node (s)", ph[OURS][2], ph[REAL][2]))
+            rows.append(("  of which exit (s)", ph[OURS][3], ph[REAL][3]))
+            empty = {impl: bare(impl, master, home, args.runs, "pass") for impl in (OURS, REAL)}
+            rows.append(("bare interpreter, python -c pass (s)", empty[OURS][0], empty[REAL][0]))
             cost = {impl: loginfo_cost(impl, master, home) * 1e6 for impl in (OURS, REAL)}
             rows.append(("one rospy.loginfo, CPU (us)", cost[OURS], cost[REAL]))
             for hz in (10.0, 100.0):

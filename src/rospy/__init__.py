@@ -93,9 +93,9 @@ from rospy.topics import Publisher, SubscribeListener, Subscriber
 
 def _install_import_hook() -> None:
     """``from my_pkg.msg import MyMsg`` for packages on ROS_PACKAGE_PATH, without a build step."""
-    from ninjemys.idl.loader import install_import_hook
+    from ninjemys.idl.hook import install
 
-    install_import_hook()
+    install()
 
 
 _install_import_hook()

@@ -176,11 +176,13 @@ def _finish_init(node: Any, log: NodeLog, rosout: bool, done: threading.Event) -
     """/rosout and the logger services, set up off the caller's thread: init_node returns as soon as
     the node is registered, and messages logged meanwhile are held and sent once /rosout exists."""
     try:
-        # a process that exits right after init_node (shutdown requested) skips what is left
-        if rosout and not _process.shutdown_requested:
+        # a process that exits right after init_node skips what is left: the exit waits for this
+        # thread only once it registers something, and each later step checks again
+        if rosout:
             _start_rosout(node, log)
-        if not _process.shutdown_requested:
-            _start_logger_services(node, log)
+        elif not _process.begin_init_registration():
+            return
+        _start_logger_services(node, log)
     except NinjemysError as exc:
         if not node.is_shutdown:
             log.log(WARN, "%s: logging services unavailable: %s", node.name, exc)
@@ -192,6 +194,8 @@ def _start_rosout(node: Any, log: NodeLog) -> None:
     from ninjemys.idl.loader import get_message_class
 
     log_class = get_message_class("rosgraph_msgs/Log")
+    if not _process.begin_init_registration():
+        return
     pub = node.publisher("/rosout", log_class, queue_size=100, latch=True)
     log.attach_rosout(pub, log_class, lambda: [t for t, _ in node.get_publications()])
 
@@ -199,12 +203,18 @@ def _start_rosout(node: Any, log: NodeLog) -> None:
 def _start_logger_services(node: Any, log: NodeLog) -> None:
     from ninjemys.idl.loader import get_message_class, get_service_class
 
+    if _process.shutdown_requested:
+        return
     get_loggers = get_service_class("roscpp/GetLoggers")
-    set_level = get_service_class("roscpp/SetLoggerLevel")
     logger_class = get_message_class("roscpp/Logger")
+    if _process.shutdown_requested:
+        return
     node.service(
         "~get_loggers", get_loggers, log.get_loggers_handler(get_loggers._response_class, logger_class)
     )
+    set_level = get_service_class("roscpp/SetLoggerLevel")
+    if _process.shutdown_requested:
+        return
     node.service("~set_logger_level", set_level, log.set_logger_level_handler(set_level._response_class))
 
 

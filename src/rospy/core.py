@@ -46,6 +46,17 @@ class _Process:
         self.shutdown_requested = False
         self.init_args: tuple[Any, ...] | None = None
         self.init_done: threading.Event | None = None
+        #: the background part of init_node has started registering (the exit must wait for it)
+        self.init_registering = False
+
+    def begin_init_registration(self) -> bool:
+        """Called by init_node's background thread before its first registration: False if shutdown
+        was requested already (register nothing), else the shutdown will wait for the thread."""
+        with self.lock:
+            if self.shutdown_requested:
+                return False
+            self.init_registering = True
+            return True
 
     def require_node(self) -> Any:
         node = self.node
@@ -93,14 +104,19 @@ def is_shutdown() -> bool:
 
 def signal_shutdown(reason: str) -> None:
     """Initiate shutdown: user hooks first, then the node tears down; sleeps and spin() return at once."""
-    _process.shutdown_requested = True
+    with _process.lock:
+        _process.shutdown_requested = True
+        registering = _process.init_registering
     node = _process.node
     _process.run_hooks()
     _process.clock.shutdown()
     if node is not None:
         done = _process.init_done
-        if done is not None:
-            done.wait(5.0)  # let the background part of init_node finish before tearing the node down
+        if done is not None and registering:
+            # let the background part of init_node finish registering before tearing the node down;
+            # if it had not started yet it never will (a script exiting right after init_node does
+            # not wait for /rosout to be set up just to tear it down)
+            done.wait(5.0)
         node.shutdown(reason)
 
 

@@ -124,16 +124,21 @@ class ServiceProxy:
         with mapped():
             self._core().wait_for_service(timeout)
 
-    def __call__(self, *args: Any, **kwds: Any) -> Any:
-        return self.call(*args, **kwds)
-
     def call(self, *args: Any, **kwds: Any) -> Any:
         """Send a request (an instance, or its fields) and return the response."""
-        impl = self._core()
+        impl = self._impl or self._core()  # per call: no extra frame once the core proxy exists
         try:
             return impl.call(*args, **kwds)
         except NinjemysError as exc:
             raise translate(exc) from None
+
+    __call__ = call  # proxy(...) is call(...) without a forwarding frame
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        # as in rospy, proxy(...) must reach a subclass's own call()
+        super().__init_subclass__(**kwargs)
+        if "call" in vars(cls) and "__call__" not in vars(cls):
+            cls.__call__ = lambda self, *args, **kwds: self.call(*args, **kwds)  # type: ignore[method-assign]
 
     def close(self) -> None:
         """Close a persistent connection."""

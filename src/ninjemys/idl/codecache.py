@@ -10,7 +10,6 @@ or written is skipped silently, never an error. ``NINJEMYS_CODE_CACHE=0`` disabl
 
 from __future__ import annotations
 
-import hashlib
 import marshal
 import os
 import sys
@@ -30,6 +29,8 @@ def compile_cached(source: str, filename: str) -> CodeType:
     folder = cache_dir()
     if folder is None:
         return compile(source, filename, "exec")
+    import hashlib  # here, not at module level: ~4 ms of start-up for processes that never compile
+
     key = hashlib.sha256(f"{filename}\0{source}".encode()).hexdigest()[:40]
     path = os.path.join(folder, f"{key}.{sys.implementation.cache_tag}.code")
     try:

@@ -394,5 +394,7 @@ class InterfaceFinder:
 
 def install_import_hook() -> None:
     """Make ``from my_pkg.msg import MyMsg`` work for packages on ROS_PACKAGE_PATH (idempotent)."""
-    if not any(isinstance(f, InterfaceFinder) for f in sys.meta_path):
+    from ninjemys.idl.hook import LazyInterfaceFinder
+
+    if not any(isinstance(f, InterfaceFinder | LazyInterfaceFinder) for f in sys.meta_path):
         sys.meta_path.append(InterfaceFinder())

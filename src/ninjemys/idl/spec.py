@@ -1,14 +1,12 @@
 """The typed intermediate representation of ROS 1 interface definitions.
 
-The parser produces these plain, frozen dataclasses; md5, full-text and code generation consume them.
+The parser produces these plain, frozen records; md5, full-text and code generation consume them.
 Type names inside a spec are always fully resolved: a bare ``Header`` is ``std_msgs/Header`` and a
 same-package ``Point`` inside geometry_msgs is ``geometry_msgs/Point``. Builtin types keep the spelling
 of the source (``byte`` and ``char`` stay as written, because the md5 text uses them verbatim).
 """
 
 from __future__ import annotations
-
-from dataclasses import dataclass, field
 
 #: primitive type -> (struct format char, size in bytes). ``byte`` is int8 and ``char`` is uint8 (ROS 1).
 PRIMITIVE_FORMATS: dict[str, tuple[str, int]] = {
@@ -29,15 +27,55 @@ PRIMITIVE_FORMATS: dict[str, tuple[str, int]] = {
 #: builtin = primitive numbers + string + time + duration (everything that is not a nested message)
 BUILTIN_TYPES: frozenset[str] = frozenset(PRIMITIVE_FORMATS) | {"string", "time", "duration"}
 HEADER_TYPE = "std_msgs/Header"
+_set = object.__setattr__
 
 
-@dataclass(frozen=True, slots=True)
-class FieldType:
+class _Record:
+    """Immutable, compared and hashed by value: what ``@dataclass(frozen=True, slots=True)`` gave these
+    classes, written out because every node imports this module and the decorator (slots rebuild the
+    class) cost several milliseconds of each start-up."""
+
+    __slots__ = ()
+    _fields: tuple[str, ...] = ()
+
+    def _values(self) -> tuple[object, ...]:
+        return tuple([getattr(self, name) for name in self._fields])
+
+    def __eq__(self, other: object) -> bool:
+        if other.__class__ is self.__class__:
+            return self._values() == other._values()  # type: ignore[attr-defined]
+        return NotImplemented
+
+    def __hash__(self) -> int:
+        return hash(self._values())
+
+    def __repr__(self) -> str:
+        inner = ", ".join(f"{name}={getattr(self, name)!r}" for name in self._fields)
+        return f"{type(self).__name__}({inner})"
+
+    def __setattr__(self, name: str, value: object) -> None:
+        raise AttributeError(f"{type(self).__name__} is immutable: cannot assign to {name!r}")
+
+    def __delattr__(self, name: str) -> None:
+        raise AttributeError(f"{type(self).__name__} is immutable: cannot delete {name!r}")
+
+    def __reduce__(self) -> tuple[object, ...]:
+        return (type(self), self._values())
+
+
+class FieldType(_Record):
     """A field's type: ``base`` is a builtin name or a resolved ``pkg/Type``; arrays carry their length."""
 
+    __slots__ = ("base", "is_array", "array_len")
+    _fields = __slots__
     base: str
-    is_array: bool = False
-    array_len: int | None = None  # None for variable-length arrays (and for non-arrays)
+    is_array: bool
+    array_len: int | None  # None for variable-length arrays (and for non-arrays)
+
+    def __init__(self, base: str, is_array: bool = False, array_len: int | None = None) -> None:
+        _set(self, "base", base)
+        _set(self, "is_array", is_array)
+        _set(self, "array_len", array_len)
 
     @property
     def is_builtin(self) -> bool:
@@ -58,34 +96,62 @@ class FieldType:
         return f"{self.base}[{'' if self.array_len is None else self.array_len}]"
 
 
-@dataclass(frozen=True, slots=True)
-class Field:
+class Field(_Record):
+    __slots__ = ("name", "type", "raw_type")
+    _fields = __slots__
     name: str
     type: FieldType
     #: the type exactly as written in the source (``Header``, ``Point[]``, ``byte``), for display
     raw_type: str
 
+    def __init__(self, name: str, type: FieldType, raw_type: str) -> None:  # noqa: A002
+        _set(self, "name", name)
+        _set(self, "type", type)
+        _set(self, "raw_type", raw_type)
 
-@dataclass(frozen=True, slots=True)
-class Constant:
+
+class Constant(_Record):
+    __slots__ = ("type", "name", "value", "value_text")
+    _fields = __slots__
     type: str  # a primitive or ``string``
     name: str
     value: bool | int | float | str
     #: the value text as written after ``=`` (stripped, comments removed except for string constants)
     value_text: str
 
+    def __init__(self, type: str, name: str, value: bool | int | float | str, value_text: str) -> None:  # noqa: A002
+        _set(self, "type", type)
+        _set(self, "name", name)
+        _set(self, "value", value)
+        _set(self, "value_text", value_text)
 
-@dataclass(frozen=True, slots=True)
-class MsgSpec:
+
+class MsgSpec(_Record):
     """One message type."""
 
+    __slots__ = ("full_name", "fields", "constants", "text", "path")
+    _fields = __slots__
     full_name: str  # "pkg/Type"
-    fields: tuple[Field, ...] = ()
-    constants: tuple[Constant, ...] = ()
+    fields: tuple[Field, ...]
+    constants: tuple[Constant, ...]
     #: the definition text as it appears in the source file (comments kept): used for the full text
-    text: str = ""
+    text: str
     #: where it came from, for error messages (None for generated or in-memory definitions)
-    path: str | None = None
+    path: str | None
+
+    def __init__(
+        self,
+        full_name: str,
+        fields: tuple[Field, ...] = (),
+        constants: tuple[Constant, ...] = (),
+        text: str = "",
+        path: str | None = None,
+    ) -> None:
+        _set(self, "full_name", full_name)
+        _set(self, "fields", fields)
+        _set(self, "constants", constants)
+        _set(self, "text", text)
+        _set(self, "path", path)
 
     @property
     def package(self) -> str:
@@ -114,15 +180,25 @@ class MsgSpec:
         return tuple(seen)
 
 
-@dataclass(frozen=True, slots=True)
-class SrvSpec:
+class SrvSpec(_Record):
     """A service: request and response are ordinary message specs named ``pkg/TypeRequest`` / ``...Response``."""
 
+    __slots__ = ("full_name", "request", "response", "text", "path")
+    _fields = __slots__
     full_name: str
     request: MsgSpec
     response: MsgSpec
-    text: str = ""
-    path: str | None = None
+    text: str
+    path: str | None
+
+    def __init__(
+        self, full_name: str, request: MsgSpec, response: MsgSpec, text: str = "", path: str | None = None
+    ) -> None:
+        _set(self, "full_name", full_name)
+        _set(self, "request", request)
+        _set(self, "response", response)
+        _set(self, "text", text)
+        _set(self, "path", path)
 
     @property
     def package(self) -> str:
@@ -133,18 +209,37 @@ class SrvSpec:
         return self.full_name.split("/", 1)[1]
 
 
-@dataclass(frozen=True, slots=True)
-class ActionSpec:
+class ActionSpec(_Record):
     """An action (.action: goal --- result --- feedback) and the 7 messages actionlib generates from it."""
 
+    __slots__ = ("full_name", "goal", "result", "feedback", "generated", "text", "path")
+    _fields = __slots__
     full_name: str
     goal: MsgSpec
     result: MsgSpec
     feedback: MsgSpec
     #: FooAction, FooActionGoal, FooActionResult, FooActionFeedback, FooGoal, FooResult, FooFeedback
-    generated: tuple[MsgSpec, ...] = field(default=())
-    text: str = ""
-    path: str | None = None
+    generated: tuple[MsgSpec, ...]
+    text: str
+    path: str | None
+
+    def __init__(
+        self,
+        full_name: str,
+        goal: MsgSpec,
+        result: MsgSpec,
+        feedback: MsgSpec,
+        generated: tuple[MsgSpec, ...] = (),
+        text: str = "",
+        path: str | None = None,
+    ) -> None:
+        _set(self, "full_name", full_name)
+        _set(self, "goal", goal)
+        _set(self, "result", result)
+        _set(self, "feedback", feedback)
+        _set(self, "generated", generated)
+        _set(self, "text", text)
+        _set(self, "path", path)
 
     @property
     def package(self) -> str:

@@ -14,8 +14,8 @@ import threading
 from typing import Any
 
 from ninjemys.errors import MasterError, MasterUnreachable, ProtocolError
+from ninjemys.net.addresses import lookup_host, split_uri
 from ninjemys.net.addresses import master_uri as default_master_uri
-from ninjemys.net.addresses import split_uri
 from ninjemys.wire import xmlrpc as wire
 
 TopicTypes = list[list[str]]
@@ -83,7 +83,7 @@ class MasterClient:
 
     def _connect(self) -> socket.socket:
         if self._sock is None:
-            sock = socket.create_connection((self._host, self._port), timeout=self.timeout)
+            sock = socket.create_connection((lookup_host(self._host), self._port), timeout=self.timeout)
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
             self._sock = sock
         return self._sock

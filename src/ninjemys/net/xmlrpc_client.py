@@ -1,11 +1,12 @@
-"""An asyncio XML-RPC client with a hard deadline per call.
+"""An event-loop XML-RPC client with a hard deadline per call.
 
 The master uses it to notify nodes (``publisherUpdate``, ``paramUpdate``, ``shutdown``): a node that
 is dead, slow or hostile costs one timed-out task and a log line, never a blocked thread
 (ros/ros_comm#1555). The deadline covers everything: name lookup, connect, send, and reading the
 whole response.
 
-It works on bare non-blocking sockets (``loop.sock_*``) rather than streams: a call is one socket and
+It runs on the caller's loop, asyncio's (the master) or :class:`ninjemys.net.loop.Loop` (nodes), and
+works on bare non-blocking sockets (``loop.sock_*``) rather than streams: a call is one socket and
 a few syscalls, which matters when the master fans out thousands of notifications. Host names are
 resolved once and cached for a minute (``localhost`` would otherwise cost a thread-pool round trip
 per call).
@@ -13,13 +14,14 @@ per call).
 
 from __future__ import annotations
 
-import asyncio
 import socket
 import time
 from typing import Any
 
 from ninjemys.errors import ProtocolError, TimeoutError_
 from ninjemys.net.addresses import split_uri
+from ninjemys.net.loop import get_running_loop
+from ninjemys.net.loop import timeout as deadline
 from ninjemys.wire import xmlrpc as wire
 
 #: Responses from nodes are small; a peer that sends more is not a ROS node.
@@ -41,13 +43,13 @@ async def call(uri: str, method: str, params: tuple[Any, ...] | list[Any], timeo
         raise ProtocolError(str(exc)) from None
     request = wire.http_request(host, port, wire.dump_call(method, params), keep_alive=False)
     try:
-        async with asyncio.timeout(timeout):
+        async with deadline(timeout):
             return await _exchange(host, port, request)
     except TimeoutError:
         raise TimeoutError_(f"XML-RPC {method} to {uri}: no answer within {timeout:g} s") from None
 
 
-async def _address(loop: asyncio.AbstractEventLoop, host: str, port: int) -> tuple[int, tuple[Any, ...]]:
+async def _address(loop: Any, host: str, port: int) -> tuple[int, tuple[Any, ...]]:
     key = (host, port)
     cached = _resolved.get(key)
     now = time.monotonic()
@@ -64,7 +66,7 @@ async def _address(loop: asyncio.AbstractEventLoop, host: str, port: int) -> tup
 
 
 async def _exchange(host: str, port: int, request: bytes) -> Any:
-    loop = asyncio.get_running_loop()
+    loop = get_running_loop()
     family, address = await _address(loop, host, port)
     sock = socket.socket(family, socket.SOCK_STREAM)
     try:

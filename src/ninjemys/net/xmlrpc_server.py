@@ -1,8 +1,8 @@
-"""An asyncio XML-RPC server (HTTP/1.1 keep-alive) for the master and every node's slave API.
+"""An event-loop XML-RPC server (HTTP/1.1 keep-alive) for the master and every node's slave API.
 
 Why not ``xmlrpc.server``: it spends a thread per request (rosmaster) or serialises everything behind
 one socket (rospy), and a peer that opens a connection and sends nothing can stall it. Here every
-connection is an :class:`asyncio.Protocol` on the caller's event loop, the HTTP parsing is the
+connection is a non-blocking socket watched by the caller's event loop, the HTTP parsing is the
 bounded sans-IO parser of :mod:`ninjemys.wire.xmlrpc`, and each connection has two clocks: a request
 must arrive completely within ``request_timeout`` of its first byte (slowloris), and an idle
 keep-alive connection is closed after ``idle_timeout``. Garbage gets a 400 and a closed connection;
@@ -13,18 +13,23 @@ event loop, so they must not block; a method may return an awaitable, which is a
 response is written (requests on one connection are answered in order). A handler may instead define
 ``_dispatch(method, params)`` to route calls itself. ``system.multicall`` (used by roslaunch to set
 parameters) and ``system.listMethods`` are built in.
+
+The server uses only the loop calls that asyncio's loop and :class:`ninjemys.net.loop.Loop` share
+(``add_reader``/``add_writer``, ``call_later``, ``create_task``), so the same code serves the master
+and the web tools (asyncio) and every node's slave API (the node runtime's small loop, which keeps
+asyncio out of node processes).
 """
 
 from __future__ import annotations
 
-import asyncio
-import inspect
 import logging
+import socket
 from collections import deque
 from typing import Any
 
 from ninjemys.errors import ProtocolError
-from ninjemys.net.addresses import advertised_host
+from ninjemys.net.addresses import advertised_host, lookup_host
+from ninjemys.net.loop import get_running_loop, is_numeric_host
 from ninjemys.wire import xmlrpc as wire
 
 log = logging.getLogger(__name__)
@@ -35,6 +40,11 @@ FAULT_NO_METHOD = -32601
 FAULT_PARSE = -32700
 
 _MAX_QUEUED = 8
+#: Stop reading a connection whose unsent answers exceed this (the peer does not read them).
+_WRITE_HIGH_WATER = 256 * 1024
+_RECV_SIZE = 65536
+#: Connections accepted per readiness event (fairness with the other sockets on the loop).
+_ACCEPT_BATCH = 64
 
 
 class XmlRpcServer:
@@ -62,22 +72,57 @@ class XmlRpcServer:
         self.max_body = max_body
         self._requested_port = port
         self._advertise = advertise
-        self._server: asyncio.base_events.Server | None = None
+        self._sock: socket.socket | None = None
+        self._loop: Any = None
         self._connections: set[_Connection] = set()
         self._dispatch = getattr(handler, "_dispatch", None)
 
     async def start(self) -> None:
         """Bind and start accepting (raises ``OSError`` if the port is taken)."""
-        loop = asyncio.get_running_loop()
-        self._server = await loop.create_server(
-            lambda: _Connection(self), self.host, self._requested_port, reuse_address=True, backlog=1024
-        )
+        loop = get_running_loop()
+        host = self.host or "0.0.0.0"
+        if is_numeric_host(host):  # no lookup: asyncio would send even this to its thread pool
+            infos = socket.getaddrinfo(
+                lookup_host(host), self._requested_port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE
+            )
+        else:
+            infos = await loop.getaddrinfo(
+                host, self._requested_port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE
+            )
+        if not infos:
+            raise OSError(f"cannot resolve {host}")
+        family, kind, proto, _, address = infos[0]
+        sock = socket.socket(family, kind, proto)
+        try:
+            sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            sock.bind(address)
+            sock.listen(1024)
+            sock.setblocking(False)
+        except BaseException:
+            sock.close()
+            raise
+        self._sock, self._loop = sock, loop
+        loop.add_reader(sock.fileno(), self._accept)
+
+    def _accept(self) -> None:
+        sock = self._sock
+        if sock is None:
+            return
+        for _ in range(_ACCEPT_BATCH):
+            try:
+                conn, _ = sock.accept()
+            except (BlockingIOError, InterruptedError):
+                return
+            except OSError as exc:  # out of file descriptors, ...: keep serving the connections we have
+                log.warning("XML-RPC server on port %s: accept failed: %s", self.port, exc)
+                return
+            _Connection(self, conn, self._loop)
 
     @property
     def port(self) -> int:
-        if self._server is None or not self._server.sockets:
+        if self._sock is None:
             return self._requested_port
-        return self._server.sockets[0].getsockname()[1]
+        return self._sock.getsockname()[1]
 
     @property
     def uri(self) -> str:
@@ -86,14 +131,16 @@ class XmlRpcServer:
 
     def close(self) -> None:
         """Stop accepting and drop every open connection."""
-        if self._server is not None:
-            self._server.close()
+        sock, self._sock = self._sock, None
+        if sock is not None:
+            self._requested_port = sock.getsockname()[1]
+            self._loop.remove_reader(sock.fileno())
+            sock.close()
         for conn in list(self._connections):
             conn.close_gracefully()
 
     async def wait_closed(self) -> None:
-        if self._server is not None:
-            await self._server.wait_closed()
+        """Nothing to wait for once :meth:`close` returned (kept for asyncio-style callers)."""
 
     # ----------------------------------------------------------------------------------- dispatch
 
@@ -126,7 +173,7 @@ class XmlRpcServer:
                 if call["methodName"] == "system.multicall":
                     raise wire.Fault(FAULT_APPLICATION, "recursive system.multicall forbidden")
                 result = self.call(call["methodName"], tuple(call.get("params", ())))
-                if inspect.isawaitable(result):
+                if _is_awaitable(result):
                     awaitables.append((len(results), result))
                 results.append([result])
             except wire.Fault as fault:
@@ -147,49 +194,63 @@ class XmlRpcServer:
         return gather()
 
 
+def _is_awaitable(value: Any) -> bool:
+    return hasattr(value, "__await__") and not isinstance(value, type)
+
+
+async def _await(awaitable: Any) -> Any:
+    return await awaitable
+
+
 def _fault_dict(exc: Exception) -> dict[str, Any]:
     if isinstance(exc, wire.Fault):
         return {"faultCode": exc.faultCode, "faultString": exc.faultString}
     return {"faultCode": FAULT_APPLICATION, "faultString": f"{type(exc).__name__}: {exc}"}
 
 
-class _Connection(asyncio.Protocol):
-    """One client connection: parse, dispatch in order, answer, enforce the timeouts."""
+class _Connection:
+    """One client connection: read, parse, dispatch in order, answer, enforce the timeouts."""
 
-    def __init__(self, server: XmlRpcServer) -> None:
+    def __init__(self, server: XmlRpcServer, sock: socket.socket, loop: Any) -> None:
         self.server = server
+        self.sock = sock
+        self.fd = sock.fileno()
+        self.loop = loop
         self.parser = wire.HttpRequestParser(max_body=server.max_body)
-        self.transport: asyncio.Transport | None = None
         self.queue: deque[wire.HttpMessage] = deque()
+        self.out: deque[memoryview] = deque()
+        self.out_bytes = 0
         self.busy = False
         self.closing = False
-        self.read_paused = False
-        self.write_paused = False
-        self.timer: asyncio.TimerHandle | None = None
+        self.closed = False
+        self.eof = False
+        self.reading = False
+        self.timer: Any = None
         self.timer_kind = ""
+        sock.setblocking(False)
+        try:
+            sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        except OSError:
+            pass
+        server._connections.add(self)
+        self._set_reading(True)
+        self._arm(server.idle_timeout, "idle")
 
-    # ----------------------------------------------------------------------------- asyncio hooks
+    # ----------------------------------------------------------------------------------- reading
 
-    def connection_made(self, transport: asyncio.BaseTransport) -> None:
-        assert isinstance(transport, asyncio.Transport)
-        self.transport = transport
-        self.server._connections.add(self)
-        self._arm(self.server.idle_timeout, "idle")
-
-    def connection_lost(self, exc: Exception | None) -> None:
-        self.closing = True
-        self._disarm()
-        self.server._connections.discard(self)
-
-    def pause_writing(self) -> None:
-        self.write_paused = True
-        self._update_reading()
-
-    def resume_writing(self) -> None:
-        self.write_paused = False
-        self._update_reading()
-
-    def data_received(self, data: bytes) -> None:
+    def _on_readable(self) -> None:
+        try:
+            data = self.sock.recv(_RECV_SIZE)
+        except (BlockingIOError, InterruptedError):
+            return
+        except OSError:
+            self.abort()
+            return
+        if not data:
+            self._set_reading(False)
+            self.eof = True
+            self._run_queue()
+            return
         if self.closing:
             return
         try:
@@ -206,6 +267,9 @@ class _Connection(asyncio.Protocol):
     def _run_queue(self) -> None:
         while self.queue and not self.busy and not self.closing:
             self._handle(self.queue.popleft())
+        if self.eof and not self.busy and not self.closing:
+            self.close_gracefully()  # the peer sent all it will; answer what it asked, then close
+            return
         self._rearm()
         self._update_reading()
 
@@ -224,16 +288,17 @@ class _Connection(asyncio.Protocol):
         except Exception as exc:
             self._write(self._fault_body(method, exc), keep_alive)
             return
-        if inspect.isawaitable(result):
+        if _is_awaitable(result):
             self.busy = True
             self._disarm()
-            task = asyncio.ensure_future(result)
-            task.add_done_callback(lambda t: self._finish(method, t, keep_alive))
+            if not hasattr(result, "add_done_callback"):
+                result = self.loop.create_task(result if hasattr(result, "send") else _await(result))
+            result.add_done_callback(lambda t: self._finish(method, t, keep_alive))
             self._update_reading()
             return
         self._write(self._result_body(method, result), keep_alive)
 
-    def _finish(self, method: str, task: asyncio.Future[Any], keep_alive: bool) -> None:
+    def _finish(self, method: str, task: Any, keep_alive: bool) -> None:
         self.busy = False
         if self.closing:
             return
@@ -261,35 +326,78 @@ class _Connection(asyncio.Protocol):
         return wire.dump_fault(FAULT_APPLICATION, f"{type(exc).__name__}: {exc}")
 
     def _write(self, body: bytes, keep_alive: bool) -> None:
-        if self.transport is None or self.closing:
+        if self.closing:
             return
-        self.transport.write(wire.http_response(body, 200, keep_alive))
+        self._send(wire.http_response(body, 200, keep_alive))
         if not keep_alive:
-            self.closing = True
             self.queue.clear()
-            self.transport.close()
+            self.close_gracefully()
 
     def _reply_and_close(self, status: int, message: str) -> None:
-        if self.transport is None or self.closing:
+        if self.closing:
             return
-        self.closing = True
         self.queue.clear()
         body = message.encode("utf-8", "replace") + b"\n"
-        self.transport.write(wire.http_response(body, status, keep_alive=False))
-        self.transport.close()
+        self._send(wire.http_response(body, status, keep_alive=False))
+        self.close_gracefully()
+
+    # ----------------------------------------------------------------------------------- writing
+
+    def _send(self, data: bytes) -> None:
+        """Write at once what the kernel takes; queue the rest and drain it when writable."""
+        if self.closed:
+            return
+        view = memoryview(data)
+        if not self.out:
+            try:
+                view = view[self.sock.send(view) :]
+            except (BlockingIOError, InterruptedError):
+                pass
+            except OSError:
+                self.abort()
+                return
+            if not view:
+                return
+            self.loop.add_writer(self.fd, self._on_writable)
+        self.out.append(view)
+        self.out_bytes += len(view)
+
+    def _on_writable(self) -> None:
+        while self.out:
+            head = self.out[0]
+            try:
+                sent = self.sock.send(head)
+            except (BlockingIOError, InterruptedError):
+                return
+            except OSError:
+                self.abort()
+                return
+            self.out_bytes -= sent
+            if sent < len(head):
+                self.out[0] = head[sent:]
+                return
+            self.out.popleft()
+        self.loop.remove_writer(self.fd)
+        if self.closing:
+            self._close_now()
+        else:
+            self._update_reading()
 
     # ------------------------------------------------------------------------- flow and timeouts
 
+    def _set_reading(self, on: bool) -> None:
+        if on and not self.reading and not self.closed:
+            self.loop.add_reader(self.fd, self._on_readable)
+            self.reading = True
+        elif not on and self.reading:
+            self.loop.remove_reader(self.fd)
+            self.reading = False
+
     def _update_reading(self) -> None:
-        if self.transport is None or self.closing:
+        if self.closing or self.eof:
             return
-        should_pause = self.write_paused or len(self.queue) >= _MAX_QUEUED or self.busy
-        if should_pause and not self.read_paused:
-            self.transport.pause_reading()
-            self.read_paused = True
-        elif not should_pause and self.read_paused:
-            self.transport.resume_reading()
-            self.read_paused = False
+        paused = self.out_bytes > _WRITE_HIGH_WATER or len(self.queue) >= _MAX_QUEUED or self.busy
+        self._set_reading(not paused)
 
     def _rearm(self) -> None:
         """Idle clock between requests, request clock from a request's first byte, none while busy."""
@@ -304,7 +412,7 @@ class _Connection(asyncio.Protocol):
     def _arm(self, delay: float, kind: str) -> None:
         self._disarm()
         self.timer_kind = kind
-        self.timer = asyncio.get_running_loop().call_later(delay, self._timed_out)
+        self.timer = self.loop.call_later(delay, self._timed_out)
 
     def _disarm(self) -> None:
         self.timer_kind = ""
@@ -314,26 +422,47 @@ class _Connection(asyncio.Protocol):
 
     def _timed_out(self) -> None:
         self.timer = None
-        if self.busy:
+        if self.busy and not self.closing:
             return
         log.debug("XML-RPC: closing %s (timeout)", self._peer())
         self.abort()
 
     def close_gracefully(self) -> None:
         """Flush what was already answered, then close; abort if the peer does not read within 1 s."""
+        if self.closing:
+            return
         self.closing = True
         self._disarm()
-        if self.transport is not None:
-            self.transport.close()
-            asyncio.get_running_loop().call_later(1.0, self.transport.abort)
+        self._set_reading(False)
+        if not self.out:
+            self._close_now()
+            return
+        self.timer = self.loop.call_later(1.0, self._timed_out)
 
     def abort(self) -> None:
         self.closing = True
         self._disarm()
-        if self.transport is not None:
-            self.transport.abort()
+        self._close_now()
+
+    def _close_now(self) -> None:
+        if self.closed:
+            return
+        self.closed = True
+        self._disarm()
+        self._set_reading(False)
+        if self.out:
+            self.loop.remove_writer(self.fd)
+            self.out.clear()
+            self.out_bytes = 0
+        self.queue.clear()
+        self.server._connections.discard(self)
+        try:
+            self.sock.close()
+        except OSError:
+            pass
 
     def _peer(self) -> str:
-        if self.transport is None:
+        try:
+            return str(self.sock.getpeername())
+        except OSError:
             return "?"
-        return str(self.transport.get_extra_info("peername"))

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
 from typing import Any
 
 from ninjemys import names
@@ -35,23 +34,60 @@ SPECIAL_KEYS: dict[str, str | None] = {
 }
 
 
-@dataclass(frozen=True)
 class NodeArgs:
     """Everything ROS 1 reads from a node's command line and environment.
 
     ``remappings`` are the user ``from:=to`` pairs exactly as typed (unresolved); use
     :meth:`resolved_remappings` once the node's full name is known.
+
+    A plain class rather than a dataclass: every node parses its arguments at start-up, and the
+    dataclass machinery would cost more than the parsing.
     """
 
-    name: str | None = None
-    namespace: str = "/"
-    master_uri: str = DEFAULT_MASTER_URI
-    ip: str | None = None
-    hostname: str | None = None
-    log_file: str | None = None
-    remappings: dict[str, str] = field(default_factory=dict)
-    private_params: dict[str, Any] = field(default_factory=dict)
-    argv: list[str] = field(default_factory=list)
+    __slots__ = (
+        "name",
+        "namespace",
+        "master_uri",
+        "ip",
+        "hostname",
+        "log_file",
+        "remappings",
+        "private_params",
+        "argv",
+    )
+
+    def __init__(
+        self,
+        name: str | None = None,
+        namespace: str = "/",
+        master_uri: str = DEFAULT_MASTER_URI,
+        ip: str | None = None,
+        hostname: str | None = None,
+        log_file: str | None = None,
+        remappings: dict[str, str] | None = None,
+        private_params: dict[str, Any] | None = None,
+        argv: list[str] | None = None,
+    ) -> None:
+        self.name = name
+        self.namespace = namespace
+        self.master_uri = master_uri
+        self.ip = ip
+        self.hostname = hostname
+        self.log_file = log_file
+        self.remappings: dict[str, str] = {} if remappings is None else remappings
+        self.private_params: dict[str, Any] = {} if private_params is None else private_params
+        self.argv: list[str] = [] if argv is None else argv
+
+    def __eq__(self, other: object) -> bool:
+        if other.__class__ is not NodeArgs:
+            return NotImplemented
+        return all(getattr(self, key) == getattr(other, key) for key in self.__slots__)
+
+    __hash__ = None  # type: ignore[assignment]  # mutable fields (dicts): not hashable
+
+    def __repr__(self) -> str:
+        inner = ", ".join(f"{key}={getattr(self, key)!r}" for key in self.__slots__)
+        return f"NodeArgs({inner})"
 
     def node_name(self, name: str, anonymous: bool = False) -> str:
         """The node's base name: ``__name:=`` wins (and cancels anonymous), else ``name`` (made unique)."""

@@ -28,11 +28,12 @@ import sys
 import threading
 import time
 from collections.abc import Callable
-from pathlib import Path
-from typing import IO, Any
+from typing import IO, TYPE_CHECKING, Any
 
 from ninjemys.errors import ParameterError
-from ninjemys.roshome import log_directory
+
+if TYPE_CHECKING:
+    from pathlib import Path
 
 # rosgraph_msgs/Log level constants (also rospy.DEBUG ... rospy.FATAL)
 DEBUG = 1
@@ -64,6 +65,11 @@ def level_from_name(name: str) -> int:
 
 def log_file_path(node_name: str, log_file: str | None = None, pid: int | None = None) -> Path:
     """``/ns/talker_1_2`` -> ``<log dir>/ns_talker_1_2-<pid>.log``; ``__log:=`` (``log_file``) wins."""
+    # imported here: pathlib is needed only once a message is written to the file, not at start-up
+    from pathlib import Path
+
+    from ninjemys.roshome import log_directory
+
     if log_file:
         return Path(log_file).expanduser()
     stem = node_name.replace("/", "_").lstrip("_") or "node"
@@ -154,7 +160,8 @@ class NodeLog:
     ) -> None:
         self.node_name = node_name
         self.level = level
-        self.path = log_file_path(node_name, log_file)
+        self._log_file = log_file
+        self._path: Path | None = None
         self._ros_time = ros_time
         self._stdout = stdout
         self._stderr = stderr
@@ -171,6 +178,13 @@ class NodeLog:
         self._time_class: Any = None
         self._topics: Callable[[], list[str]] = list
         self._closed = False
+
+    @property
+    def path(self) -> Path:
+        """The log file (created with its directory on the first message written to it)."""
+        if self._path is None:
+            self._path = log_file_path(self.node_name, self._log_file)
+        return self._path
 
     # -- wiring -----------------------------------------------------------------------------------------
     def attach_rosout(self, publisher: Any, log_class: type, topics: Callable[[], list[str]]) -> None:

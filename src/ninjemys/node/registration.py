@@ -17,7 +17,6 @@ it comes back.
 
 from __future__ import annotations
 
-import asyncio
 import logging
 import socket
 import threading
@@ -27,6 +26,7 @@ from typing import TYPE_CHECKING
 from ninjemys.errors import MasterError, MasterUnreachable, ShutdownError
 from ninjemys.master.client import MasterClient
 from ninjemys.net.addresses import split_uri
+from ninjemys.node.transport import connect
 
 if TYPE_CHECKING:
     from ninjemys.node.node import Node
@@ -175,13 +175,12 @@ class Registrar:
         """On the loop: connect to the master's port and watch the socket (no request is sent)."""
         if self._link is not None or self._stop.is_set():
             return
-        loop = asyncio.get_running_loop()
+        loop = self.node.runtime.loop
         sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
         sock.setblocking(False)
         try:
             host, port = split_uri(self.node.master_uri)
-            async with asyncio.timeout(2.0):
-                await loop.sock_connect(sock, (host, port))
+            await connect(sock, (host, port), timeout=2.0)
         except (OSError, ValueError, TimeoutError):
             sock.close()
             return

@@ -1,4 +1,4 @@
-"""The process's one asyncio I/O loop, on its own thread, and the only thread hand-offs.
+"""The process's one I/O loop, on its own thread, and the only thread hand-offs.
 
 Every socket of every Node in the process (TCPROS server and streams, the slave XML-RPC server) is
 served by this loop. The loop never runs user code and never blocks. User threads reach it only
@@ -6,51 +6,44 @@ through :meth:`Runtime.call_soon` (fire and forget) and :meth:`Runtime.run` (wai
 result); work leaves it only through the subscription queues and the helper threads started with
 :meth:`Runtime.start_thread`.
 
+The loop is :class:`ninjemys.net.loop.Loop`, not asyncio's: a node needs a small part of asyncio
+and ``import asyncio`` alone would cost more than the rest of ``import rospy`` (see docs/node.md).
+
 The loop is reference counted by the nodes that use it: it starts with the first node and stops
 (its thread joined) when the last one shuts down, so a finished program leaves no thread behind.
 """
 
 from __future__ import annotations
 
-import asyncio
-import concurrent.futures
 import logging
 import threading
 from collections.abc import Callable, Coroutine
 from typing import Any, TypeVar
 
 from ninjemys.errors import ShutdownError, TimeoutError_
+from ninjemys.net.loop import CancelledError, Loop, ThreadFuture
 
 _log = logging.getLogger(__name__)
 T = TypeVar("T")
 
 
 class Runtime:
-    """An asyncio event loop running on a dedicated daemon thread."""
+    """An event loop running on a dedicated daemon thread."""
 
     def __init__(self) -> None:
-        self.loop = asyncio.new_event_loop()
+        self.loop = Loop()
         self._ready = threading.Event()
         self.thread = threading.Thread(target=self._main, name="ninjemys-io", daemon=True)
         self.thread.start()
         self._ready.wait()
 
     def _main(self) -> None:
-        asyncio.set_event_loop(self.loop)
         self.loop.call_soon(self._ready.set)
         try:
             self.loop.run_forever()
         finally:
-            self._cancel_remaining()
-            self.loop.run_until_complete(self.loop.shutdown_default_executor())
+            self.loop.shutdown_tasks(grace=1.0)
             self.loop.close()
-
-    def _cancel_remaining(self) -> None:
-        tasks = [t for t in asyncio.all_tasks(self.loop) if not t.done()]
-        for task in tasks:
-            task.cancel()
-        if tasks:
-            self.loop.run_until_complete(asyncio.gather(*tasks, return_exceptions=True))
 
     @property
     def on_loop(self) -> bool:
@@ -71,12 +64,11 @@ class Runtime:
         except RuntimeError:
             _log.debug("I/O loop already closed; dropped %r", fn)
 
-    def spawn(self, coro: Coroutine[Any, Any, T]) -> concurrent.futures.Future[T]:
+    def spawn(self, coro: Coroutine[Any, Any, T]) -> ThreadFuture:
         """Schedule ``coro`` on the loop and return a future usable from any thread."""
         try:
-            return asyncio.run_coroutine_threadsafe(coro, self.loop)
+            return self.loop.run_coroutine_threadsafe(coro)
         except RuntimeError:
-            coro.close()
             raise ShutdownError("the ninjemys I/O loop has stopped") from None
 
     def run(self, coro: Coroutine[Any, Any, T], timeout: float | None = None) -> T:
@@ -87,9 +79,13 @@ class Runtime:
         future = self.spawn(coro)
         try:
             return future.result(timeout)
-        except concurrent.futures.TimeoutError:
+        except TimeoutError:
+            if future.done():
+                raise  # the coroutine's own deadline
             future.cancel()
             raise TimeoutError_(f"I/O operation did not finish within {timeout} s") from None
+        except CancelledError:
+            raise ShutdownError("the ninjemys I/O loop stopped before the operation finished") from None
 
     def start_thread(self, target: Callable[[], None], name: str) -> threading.Thread:
         """Start a daemon helper thread (subscription workers, service connections)."""

@@ -3,7 +3,9 @@
 A service call is a strict request/response exchange, so after the header handshake (done on the
 I/O loop for servers) each server connection gets its own thread doing blocking socket I/O and
 calling the handler there; a proxy does its I/O directly in the caller's thread. Neither path
-crosses threads per call, which is what makes a persistent service round trip cheap.
+crosses threads per call, which is what makes a persistent service round trip cheap: per call, each
+side makes one ``sendall`` and (usually) one ``recv_into`` into its connection's preallocated buffer
+(:class:`_Link`), and the Python between them is bound once per connection (see docs/node_services.md).
 
 Wire: request ``uint32 len`` + body; response ``uint8 ok`` then ``uint32 len`` + body, or the error
 text when ok is 0. A client header with ``probe=1`` gets our header and a closed connection (that is
@@ -31,69 +33,135 @@ from ninjemys.errors import (
 from ninjemys.net.addresses import split_uri
 from ninjemys.node import transport
 from ninjemys.wire import headers
-from ninjemys.wire.tcpros import MAX_FRAME_LEN, encode_service_response
+from ninjemys.wire.headers import MAX_HEADER_LEN
+from ninjemys.wire.tcpros import (
+    MAX_FRAME_LEN,
+    SERVICE_RESPONSE_HEAD,
+    encode_service_response,
+)
 
 if TYPE_CHECKING:
     from ninjemys.node.node import Node
 
 _log = logging.getLogger(__name__)
 _U32 = struct.Struct("<I")
+_unpack_len = _U32.unpack_from
+_unpack_response_head = SERVICE_RESPONSE_HEAD.unpack_from
 
 
-class _Reader:
-    """Buffered exact reads on a blocking socket: one ``recv_into`` usually brings a whole
-    response (ok byte, length and body), instead of one system call per field."""
+class _Link:
+    """The receive side of one service connection: records (a fixed head whose last field is the
+    body length, then the body) read through one preallocated buffer.
 
-    __slots__ = ("sock", "_buf", "_view", "_start", "_end")
+    A service exchange is one small record each way, so the usual read is ONE ``recv_into`` that
+    brings the whole record; parsing is one ``unpack_from`` and the body is one copy out, as
+    ``bytes`` (what generated classes decode fastest, and immutable, so deserialization may keep
+    views into it). A record split across packets is completed with further reads; one larger than
+    half the buffer is received straight into a ``bytearray`` of its exact size (no further copy).
+    Bytes past the record (a client sending ahead) stay for the next one.
+    Not thread-safe: its owner (a proxy under its lock, or a server connection's thread) serializes use.
+    """
+
+    __slots__ = ("sock", "sendall", "_recv_into", "_buf", "_view", "_start", "_end")
 
     def __init__(self, sock: socket.socket, size: int = 1 << 16) -> None:
         self.sock = sock
+        self.sendall = sock.sendall
+        self._recv_into = sock.recv_into
         self._buf = bytearray(size)
         self._view = memoryview(self._buf)
         self._start = self._end = 0
 
-    def exact(self, n: int) -> bytes | bytearray:
-        have = self._end - self._start
-        if have >= n:
-            start = self._start
-            self._start += n
-            return self._buf[start : start + n]
-        if n > len(self._buf) // 2:
-            return self._big(n, have)
-        if self._start:
-            self._view[:have] = self._view[self._start : self._end]
-            self._start, self._end = 0, have
-        while self._end - self._start < n:
-            k = self.sock.recv_into(self._view[self._end :])
-            if k == 0:
-                raise ConnectionError(
-                    f"peer closed the connection after {self._end - self._start} of {n} bytes"
-                )
-            self._end += k
-        self._start = n
-        return self._buf[:n]
+    def request(self) -> bytes | bytearray:
+        """The next request body. Fast path: nothing buffered and one read brings exactly one record
+        (the length test also rules out short reads: a stale prefix never matches ``end``)."""
+        if self._start == self._end:  # both 0: every path that empties the buffer resets them
+            buf = self._buf
+            end = self._recv_into(buf)
+            if end == _unpack_len(buf)[0] + 4:
+                return self._view[4:end].tobytes()
+            if not end:
+                raise ConnectionError("peer closed the connection")
+            self._end = end
+        return self.take(_U32)[1]
 
-    def _big(self, n: int, have: int) -> bytearray:
-        out = bytearray(n)
-        out[:have] = self._view[self._start : self._end]
+    def exchange(self, frame: bytes) -> tuple[int, bytes | bytearray]:
+        """Send a framed request and read its response: (ok byte, body); a client's whole call on
+        the wire, in one method. Fast path as :meth:`request`."""
+        self.sendall(frame)
+        if self._start == self._end:
+            buf = self._buf
+            end = self._recv_into(buf)
+            ok, length = _unpack_response_head(buf)
+            if end == length + 5:
+                return ok, self._view[5:end].tobytes()
+            if not end:
+                raise ConnectionError("peer closed the connection")
+            self._end = end
+        return self.take(SERVICE_RESPONSE_HEAD)
+
+    def take(self, head: struct.Struct, limit: int = MAX_FRAME_LEN) -> tuple[int, bytes | bytearray]:
+        """The next record: (the head's first field, the body). ``ConnectionError`` if the peer
+        closes first, ``ProtocolError`` if the announced length exceeds ``limit``."""
+        buf = self._buf
+        start, end = self._start, self._end
+        if start == end:  # the usual case: nothing buffered, read into the start of the buffer
+            start = 0
+            end = self._recv_into(buf)
+            if not end:
+                raise ConnectionError("peer closed the connection")
+        size = head.size
+        if end - start < size:
+            start, end = self._more(start, end, size)
+        fields = head.unpack_from(buf, start)
+        length = fields[-1]
+        if length > limit:
+            raise ProtocolError(f"length prefix {length} exceeds the {limit}-byte limit")
+        first = start + size
+        stop = first + length
+        if stop > end:
+            return fields[0], self._rest(first, end, length)
+        if stop == end:
+            self._start = self._end = 0
+        else:
+            self._start, self._end = stop, end
+        return fields[0], self._view[first:stop].tobytes()
+
+    def _more(self, start: int, end: int, need: int) -> tuple[int, int]:
+        """Read until ``need`` bytes follow ``start`` (moving them to the front if they would not fit)."""
+        if start + need > len(self._buf):
+            self._view[: end - start] = self._view[start:end]
+            start, end = 0, end - start
+        while end - start < need:
+            k = self._recv_into(self._view[end:])
+            if not k:
+                raise ConnectionError(f"peer closed the connection after {end - start} of {need} bytes")
+            end += k
+        return start, end
+
+    def _rest(self, first: int, end: int, length: int) -> bytes | bytearray:
+        """A body that did not arrive with its head: completed in the buffer, or in its own."""
+        if length <= len(self._buf) // 2:
+            start, end = self._more(first, end, length)
+            stop = start + length
+            self._start, self._end = (0, 0) if stop == end else (stop, end)
+            return self._view[start:stop].tobytes()
+        have = end - first
+        out = bytearray(length)
+        out[:have] = self._view[first:end]
         self._start = self._end = 0
         view, got = memoryview(out), have
-        while got < n:
-            k = self.sock.recv_into(view[got:])
-            if k == 0:
-                raise ConnectionError(f"peer closed the connection after {got} of {n} bytes")
+        while got < length:
+            k = self._recv_into(view[got:])
+            if not k:
+                raise ConnectionError(f"peer closed the connection after {got} of {length} bytes")
             got += k
         return out
 
-    def frame(self) -> bytes | bytearray:
-        (length,) = _U32.unpack(self.exact(4))
-        if length > MAX_FRAME_LEN:
-            raise ProtocolError(f"length prefix {length} exceeds the {MAX_FRAME_LEN}-byte limit")
-        return self.exact(length)
-
     def header(self) -> dict[str, str]:
-        length = headers.header_length(self.exact(4))
-        return headers.decode_header(self.exact(length))
+        """A connection header (length-prefixed ``key=value`` fields)."""
+        _, body = self.take(_U32, MAX_HEADER_LEN)
+        return headers.decode_header(body)
 
 
 def make_response(response_class: Any, value: Any) -> Any:
@@ -124,7 +192,7 @@ class ServiceServer:
         self.handler = handler
         self._socks: set[socket.socket] = set()
         self._lock = threading.Lock()
-        self.closed = False
+        self._closed = False
 
     def _reply_header(self) -> dict[str, str]:
         return {
@@ -157,14 +225,42 @@ class ServiceServer:
         self.node.runtime.start_thread(lambda: self._serve(sock, who), f"srv:{self.name}")
 
     def _serve(self, sock: socket.socket, who: str) -> None:
-        reader = _Reader(sock)
+        """This connection's thread: read a request, answer it, repeat until the client leaves.
+
+        Everything a call needs is bound to locals once, so a request costs one ``recv_into``, the
+        deserialize, the handler, the serialize and one ``sendall``, with no lock and no other
+        thread woken. Handler errors become ok=0 responses; the connection stays usable.
+        """
+        link = _Link(sock)
+        receive, send = link.request, link.sendall
+        request_class = self.request_class
+        deserialize = request_class.deserialize_from
+        # a request type without fields (std_srvs/Trigger, Empty) arrives as an empty body: building
+        # the default instance is what decoding it would do, at a fraction of the cost
+        fieldless = not getattr(request_class, "_slot_types", True)
+        response_class = self.response_class
+        handler = self.handler
+        ok_head = SERVICE_RESPONSE_HEAD.pack
         try:
-            while not self.closed:
+            while not self._closed:
                 try:
-                    body = reader.frame()
-                except (ConnectionError, OSError):
+                    body = receive()
+                except OSError:
                     return  # the client is done (non-persistent clients close after one call)
-                sock.sendall(self._handle(body, who))
+                try:
+                    request = request_class() if fieldless and not body else deserialize(body)
+                except Exception as exc:
+                    send(self._bad_request(exc, who))
+                    continue
+                try:
+                    value = handler(request)
+                    if type(value) is not response_class:
+                        value = make_response(response_class, value)
+                    payload = value.serialize_to_bytes()
+                    reply = ok_head(1, len(payload)) + payload
+                except Exception as exc:
+                    reply = self._failed(exc)
+                send(reply)
         except ProtocolError as exc:
             _log.warning("service %s: dropped client %s: %s", self.name, who, exc)
         except OSError as exc:
@@ -174,25 +270,36 @@ class ServiceServer:
                 self._socks.discard(sock)
             transport.close_quietly(sock)
 
-    def _handle(self, body: bytes | bytearray, who: str) -> bytes:
-        try:
-            request = self.request_class.deserialize_from(body)
-        except Exception as exc:
-            _log.warning("service %s: bad request from %s: %s", self.name, who, exc)
-            return encode_service_response(False, f"cannot deserialize request: {exc}")
-        try:
-            response = make_response(self.response_class, self.handler(request))
-            return encode_service_response(True, response.serialize_to_bytes())
-        except Exception as exc:
-            _log.error("service %s: error processing request: %s", self.name, exc)
-            return encode_service_response(False, f"error processing request: {exc}")
+    def _bad_request(self, exc: Exception, who: str) -> bytes:
+        _log.warning("service %s: bad request from %s: %s", self.name, who, exc)
+        return encode_service_response(False, f"cannot deserialize request: {exc}")
+
+    def _failed(self, exc: Exception) -> bytes:
+        _log.error("service %s: error processing request: %s", self.name, exc)
+        return encode_service_response(False, f"error processing request: {exc}")
+
+    @property
+    def closed(self) -> bool:
+        return self._closed
+
+    @closed.setter
+    def closed(self, value: bool) -> None:
+        """``Node.shutdown`` marks its servers closed: that also ends their client connections, so a
+        shut-down node answers no further call on a persistent connection (as rospy)."""
+        self._closed = value
+        if value:
+            self._end_connections()
 
     def shutdown(self) -> None:
         """Stop serving: unregister, and close every client connection."""
-        if self.closed:
+        if self._closed:
             return
-        self.closed = True
+        self._closed = True
         self.node._drop_service(self)
+        self._end_connections()
+
+    def _end_connections(self) -> None:
+        """Wake each connection thread out of its blocking read; it then closes its socket."""
         with self._lock:
             socks = list(self._socks)
         for sock in socks:
@@ -223,16 +330,50 @@ class ServiceProxy:
         self.response_class = service_class._response_class
         self.persistent = persistent
         self.headers = dict(headers or {})
-        self._sock: socket.socket | None = None
-        self._reader: _Reader | None = None
+        self._sock: socket.socket | None = None  # the open connection, if any (persistent, or mid-call)
+        self._link: _Link | None = None
+        self._empty_frame: bytes | None = None
         self._lock = threading.Lock()
         self._closed = False
 
-    def __call__(self, *args: Any, **kwargs: Any) -> Any:
-        return self.call(*args, **kwargs)
-
     def call(self, *args: Any, **kwargs: Any) -> Any:
-        """Call the service with a request instance, or with the request's fields (positional/keyword)."""
+        """Call the service with a request instance, or with the request's fields (positional/keyword).
+
+        The lock makes one proxy usable from several threads (one exchange at a time on its
+        connection); an exchange is one ``sendall`` of the framed request and, usually, one
+        ``recv_into`` of the whole response.
+        """
+        frame = self._frame(args, kwargs) if args or kwargs else self._empty_frame or self._frame((), {})
+        with self._lock:
+            link = self._link
+            if link is None:
+                if self._closed:
+                    raise ShutdownError(f"service proxy for [{self.name}] is closed")
+                link = self._link = self._connect()
+                self._sock = link.sock
+            try:
+                ok, body = link.exchange(frame)
+            except (OSError, ProtocolError) as exc:
+                self._drop()
+                raise ServiceError(
+                    f"service [{self.name}]: transport error completing the call: {exc}"
+                ) from None
+            if not self.persistent:
+                self._drop()
+        if ok:
+            try:
+                return self.response_class.deserialize_from(body)
+            except Exception as exc:
+                raise ServiceError(f"service [{self.name}]: cannot decode the response: {exc}") from None
+        raise ServiceError(
+            f"service [{self.name}] responded with an error: {body.decode('utf-8', 'replace')}"
+        )
+
+    __call__ = call  # an alias, not a forwarding method: one Python frame less per call
+
+    def _frame(self, args: tuple[Any, ...], kwargs: dict[str, Any]) -> bytes:
+        """The framed request for call arguments. A call without arguments sends the default request,
+        whose bytes never change, so they are built once (Trigger, Empty and the like cost nothing)."""
         if len(args) == 1 and not kwargs and isinstance(args[0], self.request_class):
             request = args[0]
         else:
@@ -242,32 +383,9 @@ class ServiceProxy:
                 raise ServiceError(f"service [{self.name}]: bad request arguments: {exc}") from None
         payload = request.serialize_to_bytes()
         frame = _U32.pack(len(payload)) + payload
-        with self._lock:
-            if self._closed:
-                raise ShutdownError(f"service proxy for [{self.name}] is closed")
-            if self._sock is None:
-                self._sock = self._connect()
-                self._reader = _Reader(self._sock)
-            sock, reader = self._sock, self._reader
-            try:
-                sock.sendall(frame)
-                ok = reader.exact(1)[0]
-                body = reader.frame()
-            except (OSError, ProtocolError) as exc:
-                self._drop()
-                raise ServiceError(
-                    f"service [{self.name}]: transport error completing the call: {exc}"
-                ) from None
-            if not self.persistent:
-                self._drop()
-        if not ok:
-            raise ServiceError(
-                f"service [{self.name}] responded with an error: {body.decode('utf-8', 'replace')}"
-            )
-        try:
-            return self.response_class.deserialize_from(body)
-        except Exception as exc:
-            raise ServiceError(f"service [{self.name}]: cannot decode the response: {exc}") from None
+        if not args and not kwargs:
+            self._empty_frame = frame
+        return frame
 
     def _lookup(self) -> tuple[str, int]:
         try:
@@ -279,7 +397,8 @@ class ServiceProxy:
         except ValueError:
             raise ServiceError(f"service [{self.name}]: master gave a bad URI {uri!r}") from None
 
-    def _connect(self, probe: bool = False, timeout: float | None = 10.0) -> socket.socket:
+    def _connect(self, probe: bool = False, timeout: float | None = 10.0) -> _Link:
+        """Look the service up, connect and exchange headers; the link then carries the calls."""
         host, port = self._lookup()
         try:
             sock = socket.create_connection((host, port), timeout=timeout)
@@ -301,7 +420,8 @@ class ServiceProxy:
                 fields["persistent"] = "1"
             fields.update(self.headers)
             sock.sendall(headers.encode_header(fields))
-            reply = _Reader(sock, 4096).header()
+            link = _Link(sock, 4096 if probe else 1 << 16)
+            reply = link.header()
         except (OSError, NinjemysError) as exc:
             transport.close_quietly(sock)
             raise ServiceError(f"service [{self.name}]: handshake failed: {exc}") from None
@@ -309,12 +429,12 @@ class ServiceProxy:
             transport.close_quietly(sock)
             raise ServiceError(f"service [{self.name}]: {reply['error']}")
         sock.settimeout(None)
-        return sock
+        return link
 
     def _drop(self) -> None:
         if self._sock is not None:
             transport.close_quietly(self._sock)
-        self._sock = None
+        self._sock = self._link = None
 
     def wait_for_service(self, timeout: float | None = None) -> None:
         """Block until the service is registered and answers a probe; TimeoutError_ after ``timeout``."""
@@ -324,7 +444,7 @@ class ServiceProxy:
             if self.node.is_shutdown:
                 raise ShutdownError("node shut down while waiting for service")
             try:
-                transport.close_quietly(self._connect(probe=True, timeout=1.0))
+                transport.close_quietly(self._connect(probe=True, timeout=1.0).sock)
                 return
             except ServiceError:
                 pass

@@ -17,7 +17,6 @@ own queue and pipe.
 
 from __future__ import annotations
 
-import asyncio
 import logging
 import select
 import selectors
@@ -213,8 +212,7 @@ class Subscription:
             host, port = proto[1], int(proto[2])
             sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
             transport.tune(sock, self.tcp_nodelay)
-            async with asyncio.timeout(5.0):
-                await asyncio.get_running_loop().sock_connect(sock, (host, port))
+            await transport.connect(sock, (host, port), timeout=5.0)
             await transport.write_all(sock, headers.encode_header(self._header()))
             header = await transport.read_header(sock)
             error = headers.check_publisher_header(header, self.type_name, self.md5sum)

@@ -7,12 +7,14 @@ socket, never a hung or crashed node.
 
 from __future__ import annotations
 
-import asyncio
 import logging
 import socket
 from collections.abc import Callable
+from typing import Any
 
 from ninjemys.errors import ProtocolError
+from ninjemys.net.loop import get_running_loop, sleep
+from ninjemys.net.loop import timeout as deadline
 from ninjemys.wire import headers
 
 _log = logging.getLogger(__name__)
@@ -40,7 +42,7 @@ def close_quietly(sock: socket.socket) -> None:
 
 async def read_exact(sock: socket.socket, n: int) -> bytearray:
     """Exactly ``n`` bytes from a non-blocking socket; ProtocolError if the peer closes first."""
-    loop = asyncio.get_running_loop()
+    loop = get_running_loop()
     buf = bytearray(n)
     view = memoryview(buf)
     got = 0
@@ -54,7 +56,7 @@ async def read_exact(sock: socket.socket, n: int) -> bytearray:
 
 async def read_header(sock: socket.socket, timeout: float = HEADER_TIMEOUT) -> dict[str, str]:
     """Read and decode one connection header, with a deadline."""
-    async with asyncio.timeout(timeout):
+    async with deadline(timeout):
         prefix = await read_exact(sock, 4)
         if bytes(prefix) in _HTTP_STARTS:
             # ports are reused: a peer still holding a dead node's XML-RPC URI can land here
@@ -67,13 +69,19 @@ _HTTP_STARTS = frozenset({b"POST", b"GET ", b"HEAD", b"PUT ", b"HTTP"})
 
 
 async def write_all(sock: socket.socket, data: bytes) -> None:
-    await asyncio.get_running_loop().sock_sendall(sock, data)
+    await get_running_loop().sock_sendall(sock, data)
+
+
+async def connect(sock: socket.socket, address: tuple[Any, ...], timeout: float) -> None:
+    """Connect a non-blocking socket (host names resolved off the loop); ``TimeoutError`` after ``timeout``."""
+    async with deadline(timeout):
+        await get_running_loop().sock_connect(sock, address)
 
 
 async def send_error_header(sock: socket.socket, text: str) -> None:
     """Tell the peer why we refuse (``error=``), as roscpp/rospy do, then the caller closes."""
     try:
-        async with asyncio.timeout(2.0):
+        async with deadline(2.0):
             await write_all(sock, headers.encode_header({"error": text}))
     except (OSError, TimeoutError):
         pass
@@ -103,15 +111,15 @@ class TcprosServer:
         self._sock.listen(128)
         self._sock.setblocking(False)
         self.port: int = self._sock.getsockname()[1]
-        self._task: asyncio.Task[None] | None = None
-        self._conns: set[asyncio.Task[None]] = set()
+        self._task: Any = None
+        self._conns: set[Any] = set()
 
     def start(self) -> None:
         """Begin accepting (call on the loop)."""
-        self._task = asyncio.get_running_loop().create_task(self._accept_loop())
+        self._task = get_running_loop().create_task(self._accept_loop())
 
     async def _accept_loop(self) -> None:
-        loop = asyncio.get_running_loop()
+        loop = get_running_loop()
         while True:
             try:
                 conn, _ = await loop.sock_accept(self._sock)
@@ -119,7 +127,7 @@ class TcprosServer:
                 if self._sock.fileno() < 0:
                     return
                 _log.warning("TCPROS accept failed: %s", exc)
-                await asyncio.sleep(0.05)
+                await sleep(0.05)
                 continue
             tune(conn)
             task = loop.create_task(self._route(conn))

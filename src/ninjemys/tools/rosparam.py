@@ -2,21 +2,27 @@
 
 Values travel as YAML on the command line and in files (rosparam's dialect: ``!!binary``,
 ``!degrees``/``!radians`` and ``rad()``/``deg()`` angles); printing follows real rosparam (PyYAML
-block style, the ``...`` document end stripped from scalars).
+block style, the ``...`` document end stripped from scalars). The command line, its usage texts and
+errors are ROS 1's too (:mod:`ninjemys.tools.rosparam_args`). ``get`` and ``list`` import neither
+PyYAML nor an argument-parsing library: start-up time is most of what these commands cost.
 """
 
 from __future__ import annotations
 
-import argparse
 import os
 import sys
-from pathlib import Path
-from typing import Any
 
 from ninjemys import names
 from ninjemys.errors import MasterError, MasterUnreachable, ParameterError
 from ninjemys.paramyaml import ParamYamlError, dump_yaml, load_yaml
-from ninjemys.tools.cli import Subcommands, entry, master, run_subcommand
+from ninjemys.tools import rosparam_args
+from ninjemys.tools.cli import entry, master
+
+TYPE_CHECKING = False  # importing typing costs ~7 ms of a tool's start-up
+if TYPE_CHECKING:
+    from typing import Any
+
+    from ninjemys.tools.rosparam_args import ParamArgs
 
 NAME = "rosparam"
 USAGE = """rosparam is a command-line tool for getting, setting, and deleting parameters from the ROS Parameter Server.
@@ -53,7 +59,7 @@ def _print_value(value: Any, pretty: bool) -> None:
     else:
         text = dump_yaml(value)
         if text.endswith("\n...\n"):
-            text = text[:-4]
+            text = text[:-5]  # a plain scalar: ROS 1 drops the document end and its line break
         sys.stdout.write(text + "\n")
 
 
@@ -91,16 +97,17 @@ def _set_tree(client: Any, param: str, value: Any, verbose: bool) -> None:
         print(f"set parameter [{param}] to [{value}]")
 
 
-def _cmd_list(args: argparse.Namespace) -> int:
-    ns = names.make_global_ns(_resolve(args.namespace) if args.namespace else "/")
+def _cmd_list(args: ParamArgs) -> int:
+    namespace = args.arg(0)
+    ns = names.make_global_ns(_resolve(namespace) if namespace else "/")
     for name in sorted(master(_caller_id()).get_param_names()):
         if name.startswith(ns) or ns == "/":
             print(name)
     return 0
 
 
-def _cmd_get(args: argparse.Namespace) -> int:
-    param = _resolve(args.parameter)
+def _cmd_get(args: ParamArgs) -> int:
+    param = _resolve(args.args[0])
     if args.verbose:
         print(f"getting parameter [{param}]")
     try:
@@ -113,19 +120,29 @@ def _cmd_get(args: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_set(args: argparse.Namespace) -> int:
-    param = _resolve(args.parameter)
-    client = master(_caller_id())
+def _cmd_set(args: ParamArgs) -> int:
+    param = _resolve(args.args[0])
+    value: Any
     if args.textfile:
-        value: Any = Path(args.textfile).read_text()
+        if not os.path.isfile(args.textfile):
+            rosparam_args.usage_error("set", f"file '{args.textfile}' does not exist")
+        value = _read(args.textfile, "r")
     elif args.binfile:
-        value = Path(args.binfile).read_bytes()
+        value = _read(args.binfile, "rb")
     else:
-        if args.value is None:
-            raise ParameterError("rosparam set: missing value (use -t FILE or -b FILE, or give a YAML value)")
-        value = _load(args.value, "command line")
-    _set_tree(client, param, value, args.verbose)
+        text = args.args[1]
+        # as in ROS 1: '' cannot be typed as YAML on a command line, so it sets the empty string
+        value = "" if text == "" else _load(text, "command line")
+    _set_tree(master(_caller_id()), param, value, args.verbose)
     return 0
+
+
+def _read(path: str, mode: str) -> Any:
+    try:
+        with open(path, mode) as handle:
+            return handle.read()
+    except OSError as exc:
+        raise ParameterError(f"cannot read [{path}]: {exc.strerror}") from None
 
 
 def _load(text: str, where: str) -> Any:
@@ -135,15 +152,15 @@ def _load(text: str, where: str) -> Any:
         raise ParameterError(f"invalid YAML in {where}: {exc}") from None
 
 
-def _cmd_load(args: argparse.Namespace) -> int:
-    ns = _resolve(args.namespace) if args.namespace else names.get_ros_namespace()
-    if args.file == "-":
+def _cmd_load(args: ParamArgs) -> int:
+    file, namespace = args.args[0], args.arg(1)
+    ns = _resolve(namespace) if namespace else names.get_ros_namespace()
+    if file == "-":
         text, where = sys.stdin.read(), "stdin"
     else:
-        path = Path(args.file)
-        if not path.is_file():
-            raise ParameterError(f"file does not exist [{args.file}]")
-        text, where = path.read_text(), str(path)
+        if not os.path.isfile(file):
+            raise ParameterError(f"file does not exist [{file}]")
+        text, where = _read(file, "r"), file
     if args.verbose:
         print(f"reading parameters from [{where}]")
     docs = _load_all(text, where)
@@ -169,21 +186,26 @@ def _load_all(text: str, where: str) -> list[Any]:
         raise ParameterError(f"invalid YAML in {where}: {exc}") from None
 
 
-def _cmd_dump(args: argparse.Namespace) -> int:
-    ns = _resolve(args.namespace) if args.namespace else names.get_ros_namespace().rstrip("/") or "/"
+def _cmd_dump(args: ParamArgs) -> int:
+    file, namespace = args.arg(0), args.arg(1)
+    ns = _resolve(namespace) if namespace else names.get_ros_namespace().rstrip("/") or "/"
     tree = master(_caller_id()).get_param(ns)
     if args.verbose:
-        print(f"dumping namespace [{ns}] to file [{args.file}]")
+        print(f"dumping namespace [{ns}] to file [{file}]")
     text = dump_yaml(tree)
-    if args.file in (None, "-"):
+    if not file or file == "-":  # ROS 1 prints for no (or an empty) file name; "-" is ours
         sys.stdout.write(text)
     else:
-        Path(args.file).write_text(text)
+        try:
+            with open(file, "w") as handle:
+                handle.write(text)
+        except OSError as exc:
+            raise ParameterError(f"cannot write [{file}]: {exc.strerror}") from None
     return 0
 
 
-def _cmd_delete(args: argparse.Namespace) -> int:
-    param = _resolve(args.parameter)
+def _cmd_delete(args: ParamArgs) -> int:
+    param = _resolve(args.args[0])
     client = master(_caller_id())
     if param == "/":
         client.set_param("/", {})
@@ -201,57 +223,24 @@ def _cmd_delete(args: argparse.Namespace) -> int:
     return 0
 
 
-def _parser(command: str) -> argparse.ArgumentParser | None:
-    sub = Subcommands(NAME, command)
-    p = sub.add("list")
-    p.add_argument("namespace", nargs="?")
-    p.add_argument("-v", dest="verbose", action="store_true")
-    p.set_defaults(run=_cmd_list)
-    p = sub.add("get")
-    p.add_argument("parameter")
-    p.add_argument("-p", dest="pretty", action="store_true", help="pretty print. WARNING: not YAML-safe")
-    p.add_argument("-v", dest="verbose", action="store_true")
-    p.set_defaults(run=_cmd_get)
-    p = sub.add("set")
-    p.add_argument("parameter")
-    p.add_argument("value", nargs="?")
-    p.add_argument("-t", "--textfile", help="set parameters to contents of text file")
-    p.add_argument("-b", "--binfile", help="set parameters to contents of binary file")
-    p.add_argument("-v", dest="verbose", action="store_true")
-    p.set_defaults(run=_cmd_set)
-    p = sub.add("load")
-    p.add_argument("file")
-    p.add_argument("namespace", nargs="?")
-    p.add_argument("-v", dest="verbose", action="store_true")
-    p.set_defaults(run=_cmd_load)
-    p = sub.add("dump")
-    p.add_argument("file", nargs="?")
-    p.add_argument("namespace", nargs="?")
-    p.add_argument("-v", dest="verbose", action="store_true")
-    p.set_defaults(run=_cmd_dump)
-    p = sub.add("delete", "del")
-    p.add_argument("parameter")
-    p.add_argument("-v", dest="verbose", action="store_true")
-    p.set_defaults(run=_cmd_delete)
-    return sub.parser if sub.matched else None
+_RUN = {
+    "list": _cmd_list,
+    "get": _cmd_get,
+    "set": _cmd_set,
+    "load": _cmd_load,
+    "dump": _cmd_dump,
+    "delete": _cmd_delete,
+}
 
 
 def main(argv: list[str] | None = None) -> int:
-    return run_subcommand(sys.argv[1:] if argv is None else argv, USAGE, _parser, _protect_negative_numbers)
-
-
-def _protect_negative_numbers(argv: list[str]) -> list[str]:
-    if len(argv) >= 3 and argv[0] == "set" and _is_number(argv[-1]) and argv[-1].startswith("-"):
-        return [*argv[:-1], "--", argv[-1]] if "--" not in argv else argv
-    return argv
-
-
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
+    """``rosparam <command> ...``; no or an unknown command prints the command list (exit 0, as ROS 1)."""
+    argv = sys.argv[1:] if argv is None else argv
+    if not argv or argv[0] not in rosparam_args.COMMANDS:
+        print(USAGE)
+        return 0
+    args = rosparam_args.parse(argv[0], argv[1:])
+    return _RUN[args.command](args)
 
 
 console_main = entry(main)

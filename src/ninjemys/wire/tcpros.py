@@ -21,7 +21,9 @@ from ninjemys.errors import ProtocolError
 MAX_FRAME_LEN = 1 << 30
 
 _U32 = struct.Struct("<I")
-_OK_LEN = struct.Struct("<BI")
+#: The head of a service response: ``uint8 ok`` then ``uint32 len`` of the body that follows.
+SERVICE_RESPONSE_HEAD = struct.Struct("<BI")
+_pack_response_head = SERVICE_RESPONSE_HEAD.pack
 pack_len = _U32.pack
 
 
@@ -33,7 +35,7 @@ def frame(payload: bytes | bytearray | memoryview) -> bytes:
 def encode_service_response(ok: bool, payload: bytes | str) -> bytes:
     """A service response: ok byte, then the framed body (or the framed error text when not ok)."""
     body = payload.encode("utf-8", "replace") if isinstance(payload, str) else payload
-    return _OK_LEN.pack(1 if ok else 0, len(body)) + body
+    return _pack_response_head(1 if ok else 0, len(body)) + body
 
 
 def decode_length(prefix: bytes | bytearray | memoryview, limit: int = MAX_FRAME_LEN) -> int:
