@@ -53,9 +53,12 @@ _FLUSH_FRAMES = 32
 _MAX_HOLD = 200e-6
 #: While a burst goes on, the loop looks at its leftovers this often (seconds).
 _CHECK_INTERVAL = 1e-3
-#: queue_size=None: frames queued before publish() waits for the loop to drain them.
+#: queue_size=None: frames queued before publish() writes the backlog itself ...
 _SYNC_HIGH_WATER = 256
 _SYNC_HIGH_WATER_BYTES = 8 << 20
+#: ... and then writes until the backlog is down to this (the pipeline never runs dry).
+_SYNC_LOW_WATER = 128
+_SYNC_LOW_WATER_BYTES = 4 << 20
 #: Frames at least this big are never held back to batch them.
 _LARGE = 1 << 16
 #: A big frame in more pieces than this is joined before sending (sendmsg takes at most IOV_MAX).
@@ -144,7 +147,7 @@ class PubConnection:
             else:
                 must_wait = self._enqueue(data, queue_size, now)
         if must_wait:
-            self._write_until_below(0)
+            self._write_until_below(len(data) >= _LARGE)
 
     def send_parts(self, parts: list[Any], total: int, queue_size: int | None) -> None:
         """Like :meth:`send` for a big frame still in pieces (see ``Message.frame_parts``): an idle
@@ -175,7 +178,7 @@ class PubConnection:
                     return
                 self._partial = rest
         if idle:
-            self._write_until_below(0)  # synchronous: finish here, at the subscriber's pace
+            self._write_until_below(True)  # synchronous: finish here, at the subscriber's pace
         else:
             self.send(b"".join(parts), queue_size)
 
@@ -203,17 +206,22 @@ class PubConnection:
             len(queue) >= _SYNC_HIGH_WATER or self._queued_bytes >= _SYNC_HIGH_WATER_BYTES
         )
 
-    def _write_until_below(self, frames: int) -> None:
+    def _write_until_below(self, drained: bool) -> None:
         """Synchronous publishing: write from the caller's thread as the kernel takes it (the
-        subscriber's pace) until at most ``frames`` frames wait, like a blocking send, without
-        involving the loop."""
+        subscriber's pace), like a blocking send, without involving the loop; until everything is
+        sent (``drained``) or the backlog is under the low-water marks (the publisher goes on
+        serializing while the kernel still holds plenty to send)."""
         while True:
             with self._lock:
                 if self.closed:
                     return
                 self._write_locked()
-                if self._partial is None and len(self._queue) <= frames:
+                if self._partial is None and not self._queue:
                     self._cond.notify_all()
+                    return
+                if not drained and (
+                    len(self._queue) <= _SYNC_LOW_WATER and self._queued_bytes <= _SYNC_LOW_WATER_BYTES
+                ):
                     return
             try:
                 select.select([], [self.sock], [], 1.0)
