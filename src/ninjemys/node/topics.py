@@ -489,10 +489,21 @@ class Publisher:
                 raise
             self._pub.publish_frame(self._frame_other(msg), self)
             return
-        if total < _LARGE or len(parts) > _MAX_PARTS:
-            self._pub.publish_frame(b"".join(parts), self)
-        else:
+        if total >= _LARGE and len(parts) <= _MAX_PARTS:
             self._pub.publish_parts(parts, total, self)
+            return
+        # Publication.publish_frame, inlined: this is every small message's path
+        data = b"".join(parts)
+        pub = self._pub
+        if self.latch:
+            with pub.lock:
+                self.latched = data
+                conns = pub.connections
+        else:
+            conns = pub.connections
+        queue_size = self.queue_size
+        for conn in conns:
+            conn.send(data, queue_size)
 
     def _frame_other(self, msg: Any) -> bytes:
         """A message class outside the generated ones that has only ``serialize_to_bytes`` (the
