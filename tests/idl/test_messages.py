@@ -82,8 +82,10 @@ def test_fixed_size_runs_are_one_struct_call() -> None:
     source = get_message_class("geometry_msgs/PoseStamped")._source
     deser = source[source.index("def deserialize_from") :]
     assert deser.count(".unpack_from(") == 2
-    ser = source[source.index("def _ser") : source.index("def deserialize_from")]
+    ser = source[source.index("def _ser") : source.index("def frame_parts")]
     assert ser.count(".pack(") == 2
+    straight = source[source.index("def frame_parts") : source.index("def serialize_to_bytes")]
+    assert straight.count(".pack(") == 2
     assert "'<IIII'" in source and "'<ddddddd'" in source
 
 

@@ -33,12 +33,14 @@ from ninjemys.idl.fulltext import all_dependencies, compute_full_text, split_ful
 from ninjemys.idl.md5 import compute_md5, compute_srv_md5
 from ninjemys.idl.message import (
     DESER_ERRORS,
+    SER_ERRORS,
     Message,
     as_view,
     bad_args,
     deser_failed,
     encode_string,
     fixed_u8,
+    pack_len,
     pack_numeric,
     short_buffer,
     u8_buffer,
@@ -78,6 +80,8 @@ _RUNTIME: dict[str, Any] = {
     "_view": as_view,
     "_deser_failed": deser_failed,
     "_DESER_ERRORS": DESER_ERRORS,
+    "_SER_ERRORS": SER_ERRORS,
+    "_pack_len": pack_len,
 }
 
 

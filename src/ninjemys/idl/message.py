@@ -179,6 +179,8 @@ def _numpyfy(msg: Message) -> None:
 
 # --- helpers called by generated code -----------------------------------------------------------
 DESER_ERRORS = _DESER_ERRORS
+SER_ERRORS = _SER_ERRORS
+pack_len = _pack_len
 
 
 def as_view(buf: Any) -> memoryview:
