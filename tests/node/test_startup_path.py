@@ -100,3 +100,39 @@ def test_spec_records_behave_as_frozen_values() -> None:
     assert not hasattr(spec, "__dict__")
     assert pickle.loads(pickle.dumps(spec)) == spec
     assert {spec: 1}[MsgSpec("pkg/M", spec.fields, spec.constants)] == 1
+
+
+def test_the_lazy_hook_imports_nothing_for_other_modules() -> None:
+    """The finder sits last on sys.meta_path and is asked about every missing module (``nt`` while
+    pathlib loads...): importing the loader from there deadlocked against init_node's helper thread."""
+    code = (
+        "import sys, rospy\n"
+        "from ninjemys.idl.hook import LazyInterfaceFinder\n"
+        "finder = LazyInterfaceFinder()\n"
+        "assert finder.find_spec('nt') is None and finder.find_spec('no_such_pkg.msg') is None\n"
+        "assert finder.find_spec('os.path.msg') is None\n"
+        "assert 'ninjemys.idl.loader' not in sys.modules\n"
+        "assert finder.find_spec('std_msgs.msg') is not None\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], env=_env(), capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+
+
+def test_logging_while_init_node_helper_loads_classes_never_hangs(master: MasterProcess) -> None:
+    """The first log line imports pathlib on the main thread while the helper imports the loader."""
+    code = (
+        "import rospy\n"
+        "rospy.init_node('log_race', anonymous=True)\n"
+        "for i in range(300):\n"
+        "    rospy.loginfo('line %d', i)\n"
+    )
+    for _ in range(4):
+        out = subprocess.run(
+            [sys.executable, "-c", code],
+            env=_env(master.uri),
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+            text=True,
+            timeout=30,
+        )
+        assert out.returncode == 0, out.stderr

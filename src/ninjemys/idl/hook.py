@@ -3,7 +3,13 @@
 ``import rospy`` installs it so ``from my_pkg.msg import MyMsg`` works for packages on
 ROS_PACKAGE_PATH. Installing :class:`ninjemys.idl.loader.InterfaceFinder` directly would import the
 loader (parser, code generator, md5, code cache: ~10 ms) in every process, including those that never
-look up an interface package; this finder imports it on the first lookup that could be one.
+import an interface package. This finder decides with the package search alone (``idl.search``:
+``os`` and ``re``, already loaded) and imports the loader only to create a module it found.
+
+It must never import anything for names that are not interface packages: it is the last entry of
+``sys.meta_path``, so it is asked about every module nobody else finds (``nt`` while pathlib is being
+imported, optional C accelerators, ...), possibly while another thread is importing the loader; an
+import from here at that moment could deadlock on the module import locks.
 """
 
 from __future__ import annotations
@@ -11,22 +17,32 @@ from __future__ import annotations
 import sys
 from typing import Any
 
+from ninjemys.idl import search
+
+
+def interface_package(fullname: str) -> bool:
+    """True if ``fullname`` is ``<pkg>``, ``<pkg>.msg`` or ``<pkg>.srv`` of a known interface package."""
+    parts = fullname.split(".")
+    if len(parts) > 2 or (len(parts) == 2 and parts[1] not in ("msg", "srv")):
+        return False
+    try:
+        pkg = search.packages().get(parts[0])
+    except OSError:
+        return False
+    if pkg is None:
+        return False
+    return len(parts) == 2 or any(pkg.definitions(kind) for kind in ("msg", "srv", "action"))
+
 
 class LazyInterfaceFinder:
-    """A MetaPathFinder that hands ``<pkg>``, ``<pkg>.msg`` and ``<pkg>.srv`` to the real finder."""
-
-    def __init__(self) -> None:
-        self._real: Any = None
+    """A MetaPathFinder for ``<pkg>``, ``<pkg>.msg`` and ``<pkg>.srv`` of interface packages."""
 
     def find_spec(self, fullname: str, path: Any = None, target: Any = None) -> Any:
-        parts = fullname.split(".")
-        if len(parts) > 2 or (len(parts) == 2 and parts[1] not in ("msg", "srv")):
+        if not interface_package(fullname):
             return None
-        if self._real is None:
-            from ninjemys.idl.loader import InterfaceFinder
+        from ninjemys.idl.loader import interface_module_spec
 
-            self._real = InterfaceFinder()
-        return self._real.find_spec(fullname, path, target)
+        return interface_module_spec(fullname)
 
 
 def install() -> None:

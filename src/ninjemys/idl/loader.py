@@ -30,6 +30,7 @@ from ninjemys.idl.arrays import NumericArray
 from ninjemys.idl.codecache import compile_cached
 from ninjemys.idl.codegen import class_ref, generate_class_source
 from ninjemys.idl.fulltext import all_dependencies, compute_full_text, split_full_text
+from ninjemys.idl.hook import LazyInterfaceFinder, interface_package
 from ninjemys.idl.md5 import compute_md5, compute_srv_md5
 from ninjemys.idl.message import (
     DESER_ERRORS,
@@ -382,23 +383,15 @@ class InterfaceFinder:
     def find_spec(
         self, fullname: str, path: Any = None, target: Any = None
     ) -> importlib.machinery.ModuleSpec | None:
-        parts = fullname.split(".")
-        if len(parts) > 2 or (len(parts) == 2 and parts[1] not in ("msg", "srv")):
-            return None
-        try:
-            pkg = search.packages().get(parts[0])
-        except OSError:
-            return None
-        if pkg is None:
-            return None
-        if len(parts) == 1 and not any(pkg.definitions(k) for k in ("msg", "srv", "action")):
-            return None
-        return importlib.machinery.ModuleSpec(fullname, _InterfaceLoader(), is_package=True)
+        return interface_module_spec(fullname) if interface_package(fullname) else None
+
+
+def interface_module_spec(fullname: str) -> importlib.machinery.ModuleSpec:
+    """The spec of the lazy module ``<pkg>``, ``<pkg>.msg`` or ``<pkg>.srv`` (an interface package)."""
+    return importlib.machinery.ModuleSpec(fullname, _InterfaceLoader(), is_package=True)
 
 
 def install_import_hook() -> None:
     """Make ``from my_pkg.msg import MyMsg`` work for packages on ROS_PACKAGE_PATH (idempotent)."""
-    from ninjemys.idl.hook import LazyInterfaceFinder
-
     if not any(isinstance(f, InterfaceFinder | LazyInterfaceFinder) for f in sys.meta_path):
         sys.meta_path.append(InterfaceFinder())
