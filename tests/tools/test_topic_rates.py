@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import re
+import statistics
 import subprocess
 import sys
 import threading
@@ -42,9 +43,29 @@ def test_hz_reports_100hz(master_uri, tmp_path):
         )
     assert out.startswith("subscribed to [/chatter]")
     rates = [float(r) for r in re.findall(r"average rate: ([\d.]+)", out)]
-    assert rates, out
-    assert 99.0 <= rates[-1] <= 101.0, out
+    assert len(rates) >= 2, out
+    # the median report: one report may include a stall of the *publisher* on a loaded machine,
+    # which hz then reports faithfully (the computation itself is checked exactly below)
+    assert 99.0 <= statistics.median(rates) <= 101.0, out
     assert re.search(r"min: [\d.]+s max: [\d.]+s std dev: [\d.]+s window: \d+", out)
+
+
+def test_hz_statistics_are_ros1s_formulas():
+    from ninjemys.tools.topic_rates import RateStats
+
+    stats = RateStats(window=5)
+    for t in (10.0, 10.01, 10.03, 10.04, 10.05, 10.07):  # 6 arrivals, window keeps the last 4 gaps
+        stats.arrived(t)
+    rate, lo, hi, std, window = stats.report()
+    gaps = [0.02, 0.01, 0.01, 0.02]
+    assert window == 5
+    assert rate == pytest.approx(1 / statistics.mean(gaps))
+    assert (lo, hi) == pytest.approx((0.01, 0.02))
+    assert std == pytest.approx(statistics.pstdev(gaps))
+    assert stats.report() is None  # nothing new since the last report
+    stats.arrived(9.0)  # time went backwards (a bag loop in sim time): start over
+    stats.arrived(9.01)
+    assert stats.report()[4] == 2
 
 
 def test_echo_keeps_up_with_1khz(master_uri, tmp_path):

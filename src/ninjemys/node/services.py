@@ -20,7 +20,6 @@ import struct
 import threading
 import time
 from collections.abc import Callable, Mapping
-from typing import TYPE_CHECKING, Any
 
 from ninjemys.errors import (
     MasterError,
@@ -40,7 +39,11 @@ from ninjemys.wire.tcpros import (
     encode_service_response,
 )
 
+TYPE_CHECKING = False  # importing typing costs ~7 ms of every node's start-up; checkers set it
+
 if TYPE_CHECKING:
+    from typing import Any
+
     from ninjemys.node.node import Node
 
 _log = logging.getLogger(__name__)
