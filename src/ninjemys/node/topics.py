@@ -52,7 +52,7 @@ _BATCH_BYTES = 1 << 20
 HOT_INTERVAL = 50e-6
 #: In a burst, the publishing thread writes once this many frames are queued ...
 _FLUSH_FRAMES = 32
-#: ... or once the oldest queued frame has waited this long (seconds).
+#: ... or this long after the last try (seconds), so a slow trickle of a burst still goes out.
 _MAX_HOLD = 200e-6
 #: While a burst goes on, the loop looks at its leftovers this often (seconds).
 _CHECK_INTERVAL = 1e-3
@@ -107,7 +107,7 @@ class PubConnection:
         self._partial: list[Any] | None = None  # buffers of the head frame(s) not written yet
         self._queue: deque[bytes] = deque()
         self._queued_bytes = 0
-        self._oldest = 0.0  # when the head of the queue was queued
+        self._tried = 0.0  # when this thread last tried to write a burst's queue (or it began)
         self._last = 0.0  # time of the previous publish (detects bursts)
         self._published = 0  # publishes so far; the loop's check compares it to see a burst go on
         self._seen = 0
@@ -190,17 +190,20 @@ class PubConnection:
         synchronous publisher must now wait for the kernel to take the backlog."""
         queue = self._queue
         if not queue:
-            self._oldest = now
+            self._tried = now
         queue.append(data)
         self._queued_bytes += len(data)
         if queue_size and len(queue) > queue_size:
             self._queued_bytes -= len(queue.popleft())
             self.dropped += 1
         self._since_try += 1
-        if self._since_try >= _FLUSH_FRAMES or now - self._oldest > _MAX_HOLD:
+        if self._since_try >= _FLUSH_FRAMES or now - self._tried > _MAX_HOLD:
             self._since_try = 0
-            if not self._write_locked():
-                self._kernel_full()
+            self._tried = now
+            # what the kernel refuses stays queued: this thread tries again a batch later, and the
+            # loop's check takes over once the burst ends (handing it to the loop now would have two
+            # threads contend for the GIL and this lock for the rest of the burst)
+            self._write_locked()
         if (queue or self._partial is not None) and not self._checking and not self._armed:
             self._checking = True
             self._seen = self._published
