@@ -7,12 +7,12 @@ from __future__ import annotations
 
 import contextlib
 import os
-import shutil
 import socket
-import sys
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
+
+from ninjemys.commands import command_path
 
 #: Debian's real ROS 1 runs under the system interpreter, never the project's venv.
 ROS1_PYTHON = "/usr/bin/python3"
@@ -69,13 +69,7 @@ def ros1_env(master_uri: str, **extra: str) -> dict[str, str]:
 
 def ninjemys_bin(command: str) -> str:
     """Full path of one of our console scripts (the venv's bin/, next to the running interpreter)."""
-    candidate = Path(sys.executable).parent / command
-    if candidate.exists():
-        return str(candidate)
-    found = shutil.which(command)
-    if found is None:
-        raise FileNotFoundError(f"ninjemys command {command!r} is not installed next to {sys.executable}")
-    return found
+    return command_path(command)
 
 
 def FakeClock(start: float = 0.0):  # noqa: N802 - reads as a class at call sites

@@ -15,11 +15,11 @@ from urllib.parse import urlsplit
 
 import yaml
 
+from ninjemys.commands import command_path
 from ninjemys.errors import LaunchError, MasterError, NinjemysError
 from ninjemys.launch.plan import LaunchPlan
 from ninjemys.launch.runner import DEATH_WRAPPER
 from ninjemys.master.client import MasterClient
-from ninjemys.testing import ninjemys_bin
 
 CALLER_ID = "/roslaunch"
 
@@ -87,7 +87,7 @@ def start_core(uri: str, log_path: Path, env: dict[str, str]) -> subprocess.Pope
     """Start our ``roscore`` on the URI's port, its output into ``log_path``; LaunchError if it fails."""
     port = urlsplit(uri).port or 11311
     try:
-        roscore = ninjemys_bin("roscore")
+        roscore = command_path("roscore")
     except FileNotFoundError as exc:
         raise LaunchError(f"cannot auto-start a master: {exc}") from None
     log_path.parent.mkdir(parents=True, exist_ok=True)
