@@ -21,7 +21,7 @@ SYSTEM_DEBS  := $(ROS1_DEBS) $(BROWSER_DEBS) tmux
 all: venv
 
 $(STAMP): pyproject.toml
-	$(PYTHON) -m venv $(VENV)
+	$(PYTHON) -m venv --clear $(VENV)
 	$(PY) -m pip install -q --upgrade pip
 	$(PY) -m pip install -q -e '.[test]'
 	touch $(STAMP)
