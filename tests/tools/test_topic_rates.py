@@ -42,12 +42,19 @@ def test_hz_reports_100hz(master_uri, tmp_path):
             [ninjemys_bin("rostopic"), "hz", "-w", "200", "/chatter"], ninjemys_env(master_uri), 4.5
         )
     assert out.startswith("subscribed to [/chatter]")
-    rates = [float(r) for r in re.findall(r"average rate: ([\d.]+)", out)]
-    assert len(rates) >= 2, out
-    # the median report: one report may include a stall of the *publisher* on a loaded machine,
-    # which hz then reports faithfully (the computation itself is checked exactly below)
-    assert 99.0 <= statistics.median(rates) <= 101.0, out
-    assert re.search(r"min: [\d.]+s max: [\d.]+s std dev: [\d.]+s window: \d+", out)
+    reports = [
+        (float(rate), float(longest))
+        for rate, longest in re.findall(
+            r"average rate: ([\d.]+)\n\tmin: [\d.]+s max: ([\d.]+)s std dev: [\d.]+s window: \d+", out
+        )
+    ]
+    assert len(reports) >= 2, out
+    # a window without a stall of the *publisher* (which a loaded machine causes, and hz then reports
+    # faithfully: its longest gap says so) must read 100 +- 1 Hz; the statistics themselves are
+    # checked exactly in the next test
+    steady = [rate for rate, longest in reports if longest < 0.02]
+    assert steady, out
+    assert all(99.0 <= rate <= 101.0 for rate in steady), out
 
 
 def test_hz_statistics_are_ros1s_formulas():
