@@ -103,7 +103,6 @@ class PubConnection:
         self.dropped = 0
         self.closed = False
         self._lock = threading.Lock()
-        self._cond = threading.Condition(self._lock)
         self._partial: list[Any] | None = None  # buffers of the head frame(s) not written yet
         self._queue: deque[bytes] = deque()
         self._queued_bytes = 0
@@ -223,7 +222,6 @@ class PubConnection:
                     return
                 self._write_locked()
                 if self._partial is None and not self._queue:
-                    self._cond.notify_all()
                     return
                 if not drained and (
                     len(self._queue) <= _SYNC_LOW_WATER and self._queued_bytes <= _SYNC_LOW_WATER_BYTES
@@ -255,7 +253,6 @@ class PubConnection:
                 return
             self._checking = False
             if self._write_locked():
-                self._cond.notify_all()
                 return
             self._armed = True
         self._arm()
@@ -275,7 +272,7 @@ class PubConnection:
         else:
             why = "subscriber closed the connection"
         if not data:
-            with self._cond:
+            with self._lock:
                 if not self.closed:
                     _log.debug("topic %s: %s (%s)", self.topic, why, self.subscriber)
                 self._close_locked()
@@ -286,7 +283,7 @@ class PubConnection:
         try:
             self.node.runtime.loop.add_writer(self.fd, self._drain)
         except (ValueError, OSError) as exc:
-            with self._cond:
+            with self._lock:
                 self._fail(f"cannot watch socket: {exc}")
 
     def _drain(self) -> None:
@@ -296,7 +293,6 @@ class PubConnection:
                 return
             self._armed = False
             self.node.runtime.loop.remove_writer(self.fd)
-            self._cond.notify_all()
 
     def _write_locked(self) -> bool:
         """Write what the kernel takes (lock held); True once nothing is left queued."""
@@ -341,7 +337,7 @@ class PubConnection:
         return b"".join(parts)
 
     def _fail(self, why: str) -> None:
-        """Called with the lock held: log once, close, wake blocked publishers."""
+        """Called with the lock held: log once and close (a publisher writing in its own thread sees it)."""
         if not self.closed:
             _log.info("topic %s: dropped subscriber %s: %s", self.topic, self.subscriber, why)
         self._close_locked()
@@ -353,7 +349,6 @@ class PubConnection:
         self._queue.clear()
         self._queued_bytes = 0
         self._partial = None
-        self._cond.notify_all()
         self.node.runtime.call_soon(self._release_socket)
         self.node.runtime.call_soon(self.node._topic_connection_closed, self)
 
@@ -367,7 +362,7 @@ class PubConnection:
         transport.close_quietly(self.sock)
 
     def close(self) -> None:
-        with self._cond:
+        with self._lock:
             self._close_locked()
 
 
