@@ -269,6 +269,8 @@ def test_logger_services(run_node) -> None:
     target.wait_for("^up$")
     caller = run_node(
         "import rospy\nfrom roscpp.srv import GetLoggers, SetLoggerLevel\n"
+        # init_node's helper thread registers the logger services just after init_node returns
+        "rospy.wait_for_service('/target/set_logger_level', 10)\n"
         "get = rospy.ServiceProxy('/target/get_loggers', GetLoggers)\n"
         "print('before', {l.name: l.level for l in get().loggers}['rosout'], flush=True)\n"
         "rospy.ServiceProxy('/target/set_logger_level', SetLoggerLevel)('rosout', 'debug')\n"
