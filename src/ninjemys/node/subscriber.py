@@ -366,15 +366,21 @@ class Subscriber:
         self._push(frames, header)
         self._wakeup()
 
-    def _push(self, frames: list[bytes | bytearray], header: Mapping[str, str]) -> None:
-        queue = self._queue
-        maxlen = queue.maxlen
+    def _keep_newest(self, frames: list[bytes | bytearray], queued: int) -> list[bytes | bytearray]:
+        """``queue_size`` semantics for ``frames`` arriving behind ``queued`` waiting ones: count what
+        the bounded queue drops (oldest first) and return the frames that can still be delivered."""
+        maxlen = self._queue.maxlen
         if maxlen is not None:
-            overflow = len(queue) + len(frames) - maxlen
+            overflow = queued + len(frames) - maxlen
             if overflow > 0:
                 self.dropped += overflow
                 if len(frames) > maxlen:
                     frames = frames[-maxlen:]
+        return frames
+
+    def _push(self, frames: list[bytes | bytearray], header: Mapping[str, str]) -> None:
+        queue = self._queue
+        frames = self._keep_newest(frames, len(queue))
         if len(frames) == 1:
             queue.append((frames[0], header))
         else:
@@ -438,13 +444,9 @@ class Subscriber:
             for other in self._sub.handles[1:]:
                 if other is not self:
                     other.enqueue(frames, conn.header)
-            maxlen = self._queue.maxlen
-            if maxlen is not None and len(frames) > maxlen:
-                self.dropped += len(frames) - maxlen
-                frames = frames[-maxlen:]
             # the queue is empty whenever the worker reads (it delivers the queue first), so this
             # batch can go straight to the callbacks: no per-message queue entry
-            self._deliver_batch(frames, conn.header)
+            self._deliver_batch(self._keep_newest(frames, 0), conn.header)
 
     def _finish(self) -> None:
         """Worker exit: pass our connections to the next handle of the topic, or close them."""

@@ -27,7 +27,7 @@ import socket
 import threading
 import time
 from collections import deque
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 
 from ninjemys.errors import SerializationError, ShutdownError
 from ninjemys.node import transport
@@ -119,8 +119,8 @@ class PubConnection:
         None and the kernel lags (synchronous, lossless: rospy's blocking send, with a short buffer).
 
         An idle connection is written to directly (lowest latency). Publishes closer together than
-        :data:`HOT_INTERVAL` are queued instead and written :data:`_FLUSH_FRAMES` at a time, or once the
-        oldest has waited :data:`_MAX_HOLD`: one system call and one wake-up of the subscriber per batch.
+        :data:`HOT_INTERVAL` are queued instead and written :data:`_FLUSH_FRAMES` at a time, or
+        :data:`_MAX_HOLD` after the last try: one system call and one wake-up of the subscriber per batch.
         """
         with self._lock:
             if self.closed:
@@ -130,16 +130,8 @@ class PubConnection:
             self._last = now
             self._published += 1
             if (not hot or len(data) >= _LARGE) and self._partial is None and not self._queue:
-                try:
-                    n = self.sock.send(data)
-                except (BlockingIOError, InterruptedError):
-                    n = 0
-                except OSError as exc:
-                    self._fail(f"write failed: {exc}")
-                    return
-                self.bytes_sent += n
-                self.num_sent += 1
-                if n == len(data):
+                n = self._write_direct(self.sock.send, data)
+                if n is None or n == len(data):
                     return
                 self._partial = [memoryview(data)[n:]]
                 if queue_size is not None or len(data) < _LARGE:
@@ -161,16 +153,8 @@ class PubConnection:
             if idle:
                 self._last = _clock()
                 self._published += 1
-                try:
-                    n = self.sock.sendmsg(parts)
-                except (BlockingIOError, InterruptedError):
-                    n = 0
-                except OSError as exc:
-                    self._fail(f"write failed: {exc}")
-                    return
-                self.bytes_sent += n
-                self.num_sent += 1
-                if n == total:
+                n = self._write_direct(self.sock.sendmsg, parts)
+                if n is None or n == total:
                     return
                 rest = _unsent(parts, n)
                 if queue_size is not None:
@@ -183,6 +167,20 @@ class PubConnection:
             self._write_until_below(True)  # synchronous: finish here, at the subscriber's pace
         else:
             self.send(b"".join(parts), queue_size)
+
+    def _write_direct(self, write: Callable[[Any], int], data: Any) -> int | None:
+        """One frame straight to an idle socket (lock held): bytes the kernel took, None if the
+        connection failed (then it is closed)."""
+        try:
+            n = write(data)
+        except (BlockingIOError, InterruptedError):
+            n = 0
+        except OSError as exc:
+            self._fail(f"write failed: {exc}")
+            return None
+        self.bytes_sent += n
+        self.num_sent += 1
+        return n
 
     def _enqueue(self, data: bytes, queue_size: int | None, now: float) -> bool:
         """Queue a frame of a burst (lock held) and write a batch when one is due. True when a
@@ -492,19 +490,8 @@ class Publisher:
             return
         if total >= _LARGE and len(parts) <= _MAX_PARTS:
             self._pub.publish_parts(parts, total, self)
-            return
-        # Publication.publish_frame, inlined: this is every small message's path
-        data = b"".join(parts)
-        pub = self._pub
-        if self.latch:
-            with pub.lock:
-                self.latched = data
-                conns = pub.connections
         else:
-            conns = pub.connections
-        queue_size = self.queue_size
-        for conn in conns:
-            conn.send(data, queue_size)
+            self._pub.publish_frame(b"".join(parts), self)
 
     def _frame_other(self, msg: Any) -> bytes:
         """A message class outside the generated ones that has only ``serialize_to_bytes`` (the
