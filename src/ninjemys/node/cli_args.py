@@ -19,6 +19,7 @@ from collections.abc import Mapping, Sequence
 
 from ninjemys import names
 from ninjemys.errors import NameError_, ParameterError
+from ninjemys.records import SlotRecord
 
 TYPE_CHECKING = False  # importing typing costs ~7 ms of every node's start-up; checkers set it
 if TYPE_CHECKING:
@@ -37,7 +38,7 @@ SPECIAL_KEYS: dict[str, str | None] = {
 }
 
 
-class NodeArgs:
+class NodeArgs(SlotRecord):
     """Everything ROS 1 reads from a node's command line and environment.
 
     ``remappings`` are the user ``from:=to`` pairs exactly as typed (unresolved); use
@@ -80,17 +81,6 @@ class NodeArgs:
         self.remappings: dict[str, str] = {} if remappings is None else remappings
         self.private_params: dict[str, Any] = {} if private_params is None else private_params
         self.argv: list[str] = [] if argv is None else argv
-
-    def __eq__(self, other: object) -> bool:
-        if other.__class__ is not NodeArgs:
-            return NotImplemented
-        return all(getattr(self, key) == getattr(other, key) for key in self.__slots__)
-
-    __hash__ = None  # type: ignore[assignment]  # mutable fields (dicts): not hashable
-
-    def __repr__(self) -> str:
-        inner = ", ".join(f"{key}={getattr(self, key)!r}" for key in self.__slots__)
-        return f"NodeArgs({inner})"
 
     def node_name(self, name: str, anonymous: bool = False) -> str:
         """The node's base name: ``__name:=`` wins (and cancels anonymous), else ``name`` (made unique)."""

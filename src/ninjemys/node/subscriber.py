@@ -30,6 +30,7 @@ from ninjemys.errors import NinjemysError, ProtocolError
 from ninjemys.net import xmlrpc_client
 from ninjemys.node import transport
 from ninjemys.node.topics import connection_ids
+from ninjemys.records import SlotRecord
 from ninjemys.wire import headers
 from ninjemys.wire.tcpros import FrameReader
 
@@ -46,24 +47,14 @@ _log = logging.getLogger(__name__)
 _READ_BUDGET = 256 * 1024
 
 
-class RawMessage:
-    """What a ``raw=True`` subscriber receives: the serialized bytes and the publisher's header.
-
-    A plain slotted class (``dataclasses`` would cost every node ~10 ms of imports at start-up)."""
+class RawMessage(SlotRecord):
+    """What a ``raw=True`` subscriber receives: the serialized bytes and the publisher's header."""
 
     __slots__ = ("data", "connection_header")
 
     def __init__(self, data: bytes | bytearray, connection_header: Mapping[str, str] | None = None) -> None:
         self.data = data
         self.connection_header = {} if connection_header is None else connection_header
-
-    def __eq__(self, other: object) -> bool:
-        if not isinstance(other, RawMessage):
-            return NotImplemented
-        return self.data == other.data and self.connection_header == other.connection_header
-
-    def __repr__(self) -> str:
-        return f"RawMessage(data={self.data!r}, connection_header={self.connection_header!r})"
 
 
 class _Poller:

@@ -29,6 +29,7 @@ import binascii
 from xml.parsers import expat
 
 from ninjemys.errors import ProtocolError
+from ninjemys.records import SlotRecord
 
 TYPE_CHECKING = False  # importing typing costs ~7 ms of every tool's and node's start-up
 if TYPE_CHECKING:
@@ -352,11 +353,8 @@ def parse_response(body: bytes) -> Any:
 # --------------------------------------------------------------------------------------------- HTTP
 
 
-class HttpMessage:
-    """One complete HTTP request or response (start line split, lower-cased header names).
-
-    A plain class, not a dataclass: ``dataclasses`` pulls ``inspect`` and friends into every
-    process start (about 15 ms), and this is on every tool's and node's path."""
+class HttpMessage(SlotRecord):
+    """One complete HTTP request or response (start line split, lower-cased header names)."""
 
     __slots__ = ("start", "headers", "body")
 
@@ -366,14 +364,6 @@ class HttpMessage:
         self.start = start
         self.headers = {} if headers is None else headers
         self.body = body
-
-    def __eq__(self, other: object) -> bool:
-        if not isinstance(other, HttpMessage):
-            return NotImplemented
-        return (self.start, self.headers, self.body) == (other.start, other.headers, other.body)
-
-    def __repr__(self) -> str:
-        return f"HttpMessage(start={self.start!r}, headers={self.headers!r}, body={self.body!r})"
 
     @property
     def keep_alive(self) -> bool:
