@@ -92,6 +92,16 @@ class _Process:
 _process = _Process()
 
 
+def process_node() -> Any:
+    """The core :class:`~ninjemys.node.Node` that ``init_node`` created for this process.
+
+    The library facades (actionlib, tf2_ros, message_filters, dynamic_reconfigure ...) build their
+    ninjemys cores on it, so a ROS 1 program that calls ``rospy.init_node`` first just works.
+    Raises ROSInitException before ``init_node``.
+    """
+    return _process.require_node()
+
+
 def is_initialized() -> bool:
     """True once init_node has registered the node."""
     return _process.node is not None
