@@ -32,10 +32,11 @@ SHIPPED_PACKAGES = (
     "turtlesim",
     "rospy_tutorials",
     "actionlib_tutorials",
+    "gazebo_msgs",
 )
 
 #: packages Debian's ROS 1 lacks; their facts are checked against published md5sums instead
-NOT_IN_DEBIAN = frozenset({"turtlesim", "rospy_tutorials", "actionlib_tutorials"})
+NOT_IN_DEBIAN = frozenset({"turtlesim", "rospy_tutorials", "actionlib_tutorials", "gazebo_msgs"})
 
 #: the messages actionlib generates from one ``Foo.action``
 ACTION_SUFFIXES = ("Action", "ActionGoal", "ActionResult", "ActionFeedback", "Goal", "Result", "Feedback")
