@@ -62,6 +62,7 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
             )
         },
         "rosout": {"rosout": ("ninjemys.master.rosout:main", ())},
+        "dynamic_reconfigure": {"dynparam": ("ninjemys.tools.dynparam:main", ())},
         "rosbag": {
             sub: ("ninjemys.tools.rosbag:main", (sub,))
             for sub in (
