@@ -717,6 +717,12 @@ def main(argv: list[str] | None = None) -> int:
         signal.signal(signal.SIGINT, on_signal)
         signal.signal(signal.SIGTERM, on_signal)
     try:
+        try:
+            if not node.has_param("/use_sim_time"):
+                node.set_param("/use_sim_time", True)
+                log.info("/use_sim_time was not set: set it to true (this simulator publishes /clock)")
+        except NinjemysError as exc:
+            log.warn("could not set /use_sim_time: %s", exc)
         world_arg = _param(node, log, "world", "square", str)
         map_arg = _param(node, log, "map", "", str)
         try:
