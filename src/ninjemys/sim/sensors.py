@@ -17,6 +17,7 @@ from ninjemys.sim.raycast import cast_circles, cast_segments
 
 FLOOR_RGB = np.array([176, 170, 160], dtype=np.float32)
 SKY_RGB = np.array([206, 220, 235], dtype=np.float32)
+_PIXEL = np.dtype("V3")  # an rgb8 pixel as one element
 
 
 @dataclass
@@ -91,10 +92,8 @@ class Camera:
         self.floor_depth_mm = np.rint(floor_depth * 1000).astype(np.uint16)
         # static background: floor shaded with distance, sky above the horizon
         shade = np.clip(1.15 - floor_depth / 12.0, 0.55, 1.0)[:, None] * FLOOR_RGB[None, :]
-        bg = np.where(below[:, None], shade, SKY_RGB[None, :])
-        self.background = np.ascontiguousarray(
-            np.broadcast_to(bg[:, None, :], (height, width, 3)).astype(np.uint8)
-        )
+        bg = np.where(below[:, None], shade, SKY_RGB[None, :]).astype(np.uint8)
+        self._background_rows = np.ascontiguousarray(bg).view(_PIXEL).reshape(height, 1)
         self._neg_slope = -self.row_slope
         self._rows = np.arange(height, dtype=np.int32)[:, None]
 
@@ -127,13 +126,15 @@ class Camera:
         bottom = np.searchsorted(self._neg_slope, -lo_slope, "right")
         wall = (self._rows >= top[None, :]) & (self._rows < bottom[None, :])
         light = np.clip(1.1 - depth / 15.0, 0.45, 1.0)  # flat shading, darker with distance
-        col = (colors * light[:, None]).astype(np.uint8)
-        rgb = self.background.copy()
-        np.copyto(rgb, col[None, :, :], where=wall[:, :, None])
-        depth_mm = np.broadcast_to(self.floor_depth_mm[:, None], wall.shape).copy()
-        np.copyto(
-            depth_mm, np.rint(np.where(found, depth, 0.0) * 1000.0).astype(np.uint16)[None, :], where=wall
+        col = (
+            np.ascontiguousarray((colors * light[:, None]).astype(np.uint8))
+            .view(_PIXEL)
+            .reshape(1, self.width)
         )
+        # one 3-byte pixel per element: a single select over (H, W) instead of three interleaved channels
+        rgb = np.where(wall, col, self._background_rows).view(np.uint8).reshape(self.height, self.width, 3)
+        wall_mm = np.rint(np.where(found, depth, 0.0) * 1000.0).astype(np.uint16)
+        depth_mm = np.where(wall, wall_mm[None, :], self.floor_depth_mm[:, None])
         return rgb, depth_mm
 
     def intrinsics(self) -> tuple[float, float, float, float]:
