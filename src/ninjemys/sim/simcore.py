@@ -115,6 +115,7 @@ class Simulation:
         self._spawned = 0
         self._static: np.ndarray
         self.static_names: list[str] = []
+        self._movers_at: tuple[float, tuple] | None = None
         self._rebuild_static()
 
     @property
@@ -139,8 +140,20 @@ class Simulation:
         self._static_height = np.concatenate(heights)
         self._static_color = np.vstack(colours).astype(np.uint8)
         self.static_names = names
+        st = self._static
+        self._static_lo = np.minimum(st[:, :2], st[:, 2:])  # bounding boxes for the collision broad phase
+        self._static_hi = np.maximum(st[:, :2], st[:, 2:])
+        self._movers_at = None
 
     def _mover_segments(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[str]]:
+        """Moving obstacles' outlines now (computed once per step: collision and sensors share them)."""
+        if self._movers_at is not None and self._movers_at[0] == self.world_time:
+            return self._movers_at[1]
+        out = self._compute_mover_segments()
+        self._movers_at = (self.world_time, out)
+        return out
+
+    def _compute_mover_segments(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[str]]:
         segs, heights, colours, names = [], [], [], []
         for m in self.world.moving:
             o = m.outline_at(self.world_time)
@@ -178,19 +191,19 @@ class Simulation:
         return float(d[0]), name[0]
 
     def _collision_geometry(self, x: float, y: float, reach: float, exclude: str | None) -> tuple:
+        """Segments (with names) and other robots' circles within ``reach`` of (x, y)."""
+        near = np.flatnonzero(
+            (self._static_lo[:, 0] <= x + reach)
+            & (self._static_hi[:, 0] >= x - reach)
+            & (self._static_lo[:, 1] <= y + reach)
+            & (self._static_hi[:, 1] >= y - reach)
+        )
+        segs = self._static[near]
+        names = [self.static_names[i] for i in near]
         ms, _, _, mnames = self._mover_segments()
-        segs = np.vstack([self._static, ms]) if len(ms) else self._static
-        names = self.static_names + mnames
-        if len(segs) and reach < 1e8:
-            lo_x = np.minimum(segs[:, 0], segs[:, 2])
-            hi_x = np.maximum(segs[:, 0], segs[:, 2])
-            lo_y = np.minimum(segs[:, 1], segs[:, 3])
-            hi_y = np.maximum(segs[:, 1], segs[:, 3])
-            near = np.flatnonzero(
-                (lo_x <= x + reach) & (hi_x >= x - reach) & (lo_y <= y + reach) & (hi_y >= y - reach)
-            )
-            segs = segs[near]
-            names = [names[i] for i in near]
+        if len(ms):
+            segs = np.vstack([segs, ms])
+            names += mnames
         others = [r for r in self.robots.values() if r.name != exclude]
         centres = np.array([[r.x, r.y] for r in others]).reshape(-1, 2)
         radii = np.array([r.model.body_radius for r in others])
