@@ -54,7 +54,7 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
                 "add_two_ints_client",
             )
         },
-        "rosout": {"rosout": ("ninjemys.master.rosout:main", ())},
+        "rosout": {"rosout": ("ninjemys.tools.rosout:main", ())},
         "rosbag": {
             sub: ("ninjemys.tools.rosbag:main", (sub,))
             for sub in (
