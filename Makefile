@@ -19,7 +19,7 @@ ROS1_DEBS := ros-core python3-rospy python3-rosbag python3-genpy python3-rosmsg 
 BROWSER_DEBS := chromium chromium-driver fonts-dejavu-core
 SYSTEM_DEBS  := $(ROS1_DEBS) $(BROWSER_DEBS) tmux
 
-.PHONY: all venv system lint format test test-fast demo bench clean
+.PHONY: all venv system lint format typecheck test test-fast demo bench clean
 
 all: venv
 
@@ -48,7 +48,11 @@ format: venv
 	$(VENV)/bin/ruff format src tests bench examples
 	$(VENV)/bin/ruff check --fix src tests bench examples
 
-test: venv system lint
+# Static types of the core layers (wire, idl, net, master, node); the configuration is in pyproject.toml.
+typecheck: venv
+	$(VENV)/bin/mypy
+
+test: venv system lint typecheck
 	$(VENV)/bin/pytest -n 2 -q
 
 test-fast: venv

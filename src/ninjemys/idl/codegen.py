@@ -46,10 +46,11 @@ def min_size(spec: MsgSpec, lookup: Lookup) -> int:
 
 
 def _min_field_size(ftype: FieldType, lookup: Lookup) -> int:
-    if ftype.is_array and ftype.array_len is None:
-        return 4
-    count = ftype.array_len if ftype.is_array else 1
-    return count * _min_elem_size(ftype.base, lookup)
+    if not ftype.is_array:
+        return _min_elem_size(ftype.base, lookup)
+    if ftype.array_len is None:
+        return 4  # the length prefix of an empty variable-length array
+    return ftype.array_len * _min_elem_size(ftype.base, lookup)
 
 
 def _min_elem_size(base: str, lookup: Lookup) -> int:

@@ -182,8 +182,8 @@ class Node:
     def _start_logger_services(self) -> None:
         from ninjemys.idl.loader import get_message_class, get_service_class
 
-        get_loggers = get_service_class("roscpp/GetLoggers")
-        set_level = get_service_class("roscpp/SetLoggerLevel")
+        get_loggers: Any = get_service_class("roscpp/GetLoggers")
+        set_level: Any = get_service_class("roscpp/SetLoggerLevel")
         logger_class = get_message_class("roscpp/Logger")
         log = self.log
         self.service(
@@ -497,16 +497,16 @@ class Node:
                     ]
                 )
         for topic, sub in list(self._subscriptions.items()):
-            for c in list(sub.connections.values()):
+            for s in list(sub.connections.values()):
                 info.append(
                     [
-                        c.id,
-                        c.uri,
+                        s.id,
+                        s.uri,
                         "i",
                         "TCPROS",
                         topic,
-                        not c.closed,
-                        f"TCPROS connection from [{c.publisher}]",
+                        not s.closed,
+                        f"TCPROS connection from [{s.publisher}]",
                     ]
                 )
         return info

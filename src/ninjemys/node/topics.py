@@ -159,6 +159,7 @@ class PubConnection:
                 if n is None or n == total:
                     return
                 rest = _unsent(parts, n)
+                assert rest is not None  # n < total: part of the frame is left
                 if queue_size is not None:
                     # the caller may change its buffers once publish returns: keep a copy of the rest
                     self._partial = [b"".join(rest)]
