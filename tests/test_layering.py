@@ -58,6 +58,9 @@ LAYERS: dict[str, str] = {
     "tf2": "libs",
     "message_filters": "libs",
     "dynamic_reconfigure": "libs",
+    # the .cfg -> Config.py generator is pure code generation (errors only, like idl's codegen) that
+    # catkin_make's build runs: it sits with the packages layer, below the rest of its package
+    "dynamic_reconfigure.generator": "packages",
     "laser_geometry": "libs",
     "cv_bridge": "libs",
     "launch": "libs",
