@@ -83,3 +83,31 @@ def test_unknown_package_in_a_field_type(ws: Path, monkeypatch: pytest.MonkeyPat
     assert str(info.value).startswith(
         f"{srv}:3: p/Q: field type 'nowhere_msgs/Thing' cannot be resolved: package "
     )
+
+
+def test_cpp_targets_are_named_as_not_built(ws: Path, monkeypatch: pytest.MonkeyPatch, capsys) -> None:
+    pkg = create(ws, monkeypatch, "mixed_pkg", "roscpp", "rospy", "std_msgs")
+    cmake = pkg / "CMakeLists.txt"
+    text = cmake.read_text()  # catkin_create_pkg's template: its add_executable lines are comments
+    lines_before = text.count("\n")
+    cmake.write_text(
+        text
+        + "add_executable(${PROJECT_NAME}_talker src/talker.cpp src/util.cpp)\n"
+        + "add_library(helpers STATIC\n  src/helpers.cc)  # a comment (with parentheses)\n"
+        + "# add_executable(old src/old.cpp)\n"
+    )
+    assert make(ws, monkeypatch) == 0
+    out = capsys.readouterr().out
+    assert "-- ~~  - mixed_pkg: 2 C++ target(s) not built" in out
+    assert (
+        f"{cmake}:{lines_before + 1}: add_executable(mixed_pkg_talker) (src/talker.cpp, src/util.cpp)" in out
+    )
+    assert f"{cmake}:{lines_before + 2}: add_library(helpers) (src/helpers.cc)" in out
+    assert "src/old.cpp" not in out
+    assert "-- 2 C++ target(s) not built (see above): mixed_pkg_talker, helpers" in out
+
+
+def test_python_only_package_mentions_no_cpp(ws: Path, monkeypatch: pytest.MonkeyPatch, capsys) -> None:
+    create(ws, monkeypatch, "py_pkg", "rospy")
+    assert make(ws, monkeypatch) == 0
+    assert "C++" not in capsys.readouterr().out

@@ -27,6 +27,7 @@ from typing import Any
 from ninjemys.errors import DefinitionError, PackageError
 from ninjemys.packages import idl_check, msg_types
 from ninjemys.packages.cmake_hints import read_cmake_hints
+from ninjemys.packages.cpp_targets import CppTarget, cpp_targets, skipped_message
 from ninjemys.packages.discovery import PackageIndex, package_path_dirs, underlay_dirs
 from ninjemys.packages.manifest import PackageManifest
 from ninjemys.packages.python_setup import python_packages
@@ -61,6 +62,8 @@ class BuildReport:
     written: list[Path] = field(default_factory=list)
     removed: list[Path] = field(default_factory=list)
     validated: int = 0
+    #: C++ targets declared in CMakeLists.txt files and not built (no compiler here)
+    cpp_skipped: list[CppTarget] = field(default_factory=list)
 
 
 class _Writer:
@@ -126,6 +129,14 @@ def _definitions(pkg: PackageManifest) -> dict[str, list[Path]]:
     return found
 
 
+def _report_cpp_targets(pkg: PackageManifest, report: BuildReport, log: Callable[[str], None]) -> None:
+    """Name the package's C++ targets, which this build skips, instead of ignoring them."""
+    targets = cpp_targets(pkg.path, pkg.name)
+    for line in skipped_message(pkg.name, targets):
+        log(line)
+    report.cpp_skipped.extend(targets)
+
+
 def _package_finder(ws: Workspace, env: Mapping[str, str]) -> Callable[[str], Path | None]:
     """Where a package named in a field type lives: the workspace first, then (scanned once, on the
     first name the workspace lacks) its underlays, ROS_PACKAGE_PATH and ninjemys' own packages."""
@@ -186,6 +197,7 @@ def build_workspace(
     for pkg in ordered:
         log(f"-- ~~  - {pkg.name}")
         report.packages.append(pkg.name)
+        _report_cpp_targets(pkg, report, log)
         defs = _definitions(pkg)
         hints = read_cmake_hints(pkg.path)
         py_packages = (
