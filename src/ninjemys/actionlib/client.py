@@ -126,7 +126,14 @@ class CommStateMachine:
                 self.transition_to(CommState.DONE)
 
     def update_feedback(self, action_feedback: Any) -> None:
-        if self.feedback_cb is not None and self.state != CommState.DONE:
+        with self.mutex:
+            if self.state in (CommState.WAITING_FOR_GOAL_ACK, CommState.PENDING):
+                # feedback can overtake the status list that says the goal is active (another
+                # topic): its own status says so too, so the user sees active before feedback
+                self.update_status(action_feedback.status)
+            if self.state == CommState.DONE:
+                return
+        if self.feedback_cb is not None:
             self.feedback_cb(ClientGoalHandle(self), action_feedback.feedback)
 
 

@@ -15,15 +15,16 @@ before the latest cancel stamp is cancelled on arrival.
 
 Status (``GoalStatusArray``, latched) goes out at ``actionlib_status_frequency`` (5 Hz) and after every
 transition. Terminal goals stay in it for ``status_list_timeout`` (5 s) so late clients still see
-them. Unlike ROS 1, a transition does not serialize the whole list on the caller's thread: it wakes
-the status thread, which publishes at once when idle and merges the transitions of a burst into one
-message (at most one per ``MERGE_INTERVAL``), so a thousand goals a second do not publish a thousand
+them. Unlike ROS 1, transitions in a burst do not each serialize the whole list: a transition
+publishes at once unless one did less than ``MERGE_INTERVAL`` ago, and then the status thread sends
+one list for all the transitions meanwhile, so a thousand goals a second do not publish two thousand
 growing arrays a second.
 """
 
 from __future__ import annotations
 
 import threading
+import time
 from collections.abc import Callable
 
 from ninjemys.actionlib import states
@@ -257,7 +258,8 @@ class ActionServer:
         self.id_generator = GoalIDGenerator(node.name, self.clock.now_pair)
         self._status_class = goal_status_class()
         self._array_class = goal_status_array_class()
-        self._dirty = False
+        self._dirty = False  # transitions wait for a merged status publication
+        self._last_status = 0.0  # time.monotonic() of the last transition-driven publication
         self._wake = threading.Condition(threading.Lock())
         self._stopped = False
         self._status_thread: threading.Thread | None = None
@@ -392,10 +394,18 @@ class ActionServer:
         return copy
 
     def status_changed(self) -> None:
-        """A goal moved: have the status thread publish (merged with others in a burst)."""
+        """A goal moved: publish the status list now, or, within MERGE_INTERVAL of the last such
+        publication, have the status thread send one list for all the transitions meanwhile."""
         with self._wake:
-            self._dirty = True
-            self._wake.notify()
+            if self._dirty:
+                return  # a merged publication is due and will include this transition
+            now = time.monotonic()
+            if now - self._last_status < MERGE_INTERVAL:
+                self._dirty = True
+                self._wake.notify()
+                return
+            self._last_status = now
+        self._publish_status()
 
     def publish_status(self) -> None:
         """ROS 1's name: publish the status list now, from this thread."""
@@ -520,6 +530,8 @@ class ActionServer:
         self._publish_status()
 
     def _status_loop(self) -> None:
+        """Send the merged status lists of bursts (wall time: a paused simulation must not hold
+        status back)."""
         wake = self._wake
         while True:
             with wake:
@@ -527,13 +539,12 @@ class ActionServer:
                     wake.wait()
                 if self._stopped:
                     return
-                self._dirty = False
-            self._publish_status()
-            # merge the transitions of a burst: the next status goes out MERGE_INTERVAL (wall time: a
-            # paused simulation must not hold status back) later at the soonest
-            with wake:
-                if wake.wait_for(lambda: self._stopped, MERGE_INTERVAL):
+                delay = self._last_status + MERGE_INTERVAL - time.monotonic()
+                if delay > 0 and wake.wait_for(lambda: self._stopped, delay):
                     return
+                self._dirty = False
+                self._last_status = time.monotonic()
+            self._publish_status()
 
     def _on_shutdown(self) -> None:
         with self._wake:
