@@ -553,6 +553,10 @@ class Subscriber:
     def get_num_connections(self) -> int:
         return len(self._sub.connections)
 
+    def publisher_ids(self) -> frozenset[str]:
+        """Caller ids of the publishers connected now (handshake done: what they publish reaches us)."""
+        return frozenset(c.publisher for c in list(self._sub.connections.values()) if not c.closed)
+
     def unregister(self) -> None:
         """Stop receiving; the worker thread ends (joined unless called from a callback)."""
         if self._closed:

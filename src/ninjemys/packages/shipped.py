@@ -59,6 +59,15 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
         },
         "rosout": {"rosout": ("ninjemys.tools.rosout:main", ())},
         "dynamic_reconfigure": {"dynparam": ("ninjemys.tools.dynparam:main", ())},
+        "actionlib_tutorials": {
+            "fibonacci_server": ("ninjemys.tutorials.actionlib.fibonacci_server:main", ()),
+            "fibonacci_server.py": ("ninjemys.tutorials.actionlib.fibonacci_server:main", ()),
+            "fibonacci_client": ("ninjemys.tutorials.actionlib.fibonacci_client:main", ()),
+            "fibonacci_client.py": ("ninjemys.tutorials.actionlib.fibonacci_client:main_py", ()),
+            "averaging_server": ("ninjemys.tutorials.actionlib.averaging_server:main", ()),
+            "averaging_client": ("ninjemys.tutorials.actionlib.averaging_client:main", ()),
+            "gen_numbers.py": ("ninjemys.tutorials.actionlib.gen_numbers:main", ()),
+        },
         "rosbag": {
             sub: ("ninjemys.tools.rosbag:main", (sub,))
             for sub in (
