@@ -161,7 +161,16 @@ def _eigvec(m: Any, value: float, what: str, tol: float = 1e-8, last: bool = Tru
 
 
 def _fixed_point(m: Any) -> Any:
-    """A point the homogeneous matrix ``m`` leaves in place."""
+    """A point the homogeneous matrix ``m`` leaves in place (homogeneous, w = 1).
+
+    For an affine ``m`` this solves ``(R - I) x = -t`` in the least-squares sense (the fixed point
+    nearest the origin), which stays well defined where the eigenvectors of a defective matrix (a
+    shear's) degenerate to points at infinity; other matrices use the eigenvector for eigenvalue 1.
+    """
+    if numpy.allclose(m[3], (0.0, 0.0, 0.0, 1.0)):
+        x = numpy.linalg.lstsq(m[:3, :3] - numpy.identity(3), -m[:3, 3], rcond=None)[0]
+        if numpy.allclose(m[:3, :3] @ x + m[:3, 3], x, atol=1e-8):
+            return numpy.append(x, 1.0)
     p = _eigvec(m, 1.0, "eigenvector")
     return p / p[3]
 
