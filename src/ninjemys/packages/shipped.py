@@ -68,6 +68,13 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
             "averaging_client": ("ninjemys.tutorials.actionlib.averaging_client:main", ()),
             "gen_numbers.py": ("ninjemys.tutorials.actionlib.gen_numbers:main", ()),
         },
+        "tf2_ros": {"static_transform_publisher": ("ninjemys.tools.static_transform_publisher:main", ())},
+        "tf": {
+            "tf_echo": ("ninjemys.tools.tf_echo:main", ()),
+            "tf_monitor": ("ninjemys.tools.tf_monitor:main", ()),
+            "static_transform_publisher": ("ninjemys.tools.static_transform_publisher:tf_main", ()),
+        },
+        "tf2_tools": {"view_frames.py": ("ninjemys.tools.view_frames:main", ())},
         "rosbag": {
             sub: ("ninjemys.tools.rosbag:main", (sub,))
             for sub in (
