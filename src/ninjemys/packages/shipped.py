@@ -44,7 +44,11 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
         },
         "rqt_graph": {"rqt_graph": ("ninjemys.web.rqt_graph:main", ())},
         "puzzlebot_sim": {
+            "sim_node": ("ninjemys.sim.puzzlebot_node:main", ()),
             "world_to_map": ("ninjemys.sim.world_to_map:main", ()),
+        },
+        "teleop_twist_keyboard": {
+            "teleop_twist_keyboard.py": ("ninjemys.sim.teleop_twist_keyboard:main", ()),
         },
         "rospy_tutorials": {
             name: (f"ninjemys.tutorials.{name.removesuffix('.py')}:main", ())
