@@ -490,6 +490,7 @@ class Gateway:
 
         def run() -> None:
             loop = self._loop = asyncio.new_event_loop()
+            asyncio.set_event_loop(loop)
             try:
                 assert self._http is not None
                 loop.run_until_complete(self.serve_forever_on(self._http))
@@ -502,6 +503,10 @@ class Gateway:
                 loop.run_forever()
             finally:
                 loop.run_until_complete(self._http.close())
+                pending = [t for t in asyncio.all_tasks(loop) if not t.done()]
+                for task in pending:
+                    task.cancel()
+                loop.run_until_complete(asyncio.gather(*pending, return_exceptions=True))
                 loop.close()
 
         self._thread = threading.Thread(target=run, name="gateway-loop", daemon=True)
