@@ -31,7 +31,7 @@ from websockets.server import ServerProtocol
 
 from ninjemys.bridge.foxglove import SUBPROTOCOLS, FoxgloveSession
 from ninjemys.bridge.graph import Publishers, Services, Taps
-from ninjemys.bridge.outbox import Outbox
+from ninjemys.bridge.outbox import CloseRequest, Outbox
 from ninjemys.bridge.rosbridge import RosbridgeSession
 from ninjemys.errors import NinjemysError
 from ninjemys.idl.loader import get_message_class, get_service_class
@@ -419,6 +419,9 @@ class Gateway:
                 await client.wake.wait()
                 client.wake.clear()
                 while (item := outbox.take()) is not None:
+                    if isinstance(item, CloseRequest):
+                        ws.close(item.code, item.reason)
+                        return
                     if isinstance(item, tuple):
                         for frame in item:
                             ws.send(frame)
@@ -433,9 +436,10 @@ class Gateway:
             return
 
     def close_client(self, client_id: int, code: int, reason: str) -> None:
+        """Close a client's connection once what was queued for it before is sent."""
         client = self._clients.get(client_id)
         if client is not None:
-            client.loop.call_soon_threadsafe(client.ws.close, code, reason)
+            client.outbox.put_control(CloseRequest(code, reason))
 
     async def _report_drops(self) -> None:
         """Once a second, tell each client about data dropped for it since the last report."""
