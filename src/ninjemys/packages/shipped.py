@@ -43,6 +43,9 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
             "mimic": ("ninjemys.sim.mimic:main", ()),
         },
         "rqt_graph": {"rqt_graph": ("ninjemys.web.rqt_graph:main", ())},
+        "puzzlebot_sim": {
+            "world_to_map": ("ninjemys.sim.world_to_map:main", ()),
+        },
         "rospy_tutorials": {
             name: (f"ninjemys.tutorials.{name.removesuffix('.py')}:main", ())
             for name in (
@@ -59,6 +62,7 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
         "foxglove_bridge": {"foxglove_bridge": ("ninjemys.bridge.main:foxglove_main", ())},
         "rosapi": {"rosapi_node": ("ninjemys.bridge.rosapi:main", ())},
         "tf2_web_republisher": {"tf2_web_republisher": ("ninjemys.bridge.tf_republisher:main", ())},
+        "dynamic_reconfigure": {"dynparam": ("ninjemys.tools.dynparam:main", ())},
         "rosbag": {
             sub: ("ninjemys.tools.rosbag:main", (sub,))
             for sub in (
