@@ -120,9 +120,10 @@ def test_parameters_and_rosapi(ros: object, node: Node, rosapi: RosApi) -> None:
 
 def test_tf_through_tfclient(ros: object, master_uri: str) -> None:
     pytest.importorskip("ninjemys.tf2.node")
-    from ninjemys.tf2.node import TransformBroadcaster
+    from roslibpy.tf import TFClient
 
     from ninjemys.bridge.tf_republisher import TFRepublisher
+    from ninjemys.tf2.node import TransformBroadcaster
 
     tf_node = Node("tf2_web_republisher", master_uri=master_uri)
     republisher = TFRepublisher(tf_node)
@@ -130,7 +131,7 @@ def test_tf_through_tfclient(ros: object, master_uri: str) -> None:
         broadcaster = TransformBroadcaster(tf_node)
         Stamped = get_message_class("geometry_msgs/TransformStamped")
         frames: list[dict] = []
-        client = roslibpy.tf.TFClient(ros, fixed_frame="world", rate=10.0, angular_threshold=0.01)
+        client = TFClient(ros, fixed_frame="world", rate=10.0, angular_threshold=0.01)
         client.subscribe("base_link", frames.append)
 
         def broadcast() -> bool:
