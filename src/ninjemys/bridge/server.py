@@ -101,6 +101,7 @@ class Catalog:
         self._service_ids: dict[tuple[str, str], int] = {}
         self._ids = itertools.count(1)
         self._unknown: set[str] = set()
+        self._service_types: dict[str, str] = {}
         self.graph: dict[str, dict[str, list[str]]] = {"pub": {}, "sub": {}, "srv": {}}
         self.topic_types: dict[str, str] = {}
         self._lock = threading.Lock()
@@ -152,8 +153,11 @@ class Catalog:
         added_srv, removed_srv = [], []
         present = set()
         for name in srvs:
+            # a provider's type is probed once per service name, not on every refresh
+            type_name = self._service_types.get(name)
             try:
-                type_name = services.service_type(name)
+                if type_name is None:
+                    type_name = self._service_types[name] = services.service_type(name)
                 service_class = get_service_class(type_name)
             except NinjemysError:
                 continue
@@ -185,6 +189,8 @@ class Catalog:
                     self._service_ids[key] = sid
                     self.services[sid] = entry
                 added_srv.append(entry)
+        for name in [n for n in self._service_types if n not in srvs]:
+            del self._service_types[name]
         for key in [k for k in self._service_ids if k not in present]:
             with self._lock:
                 sid = self._service_ids.pop(key)
@@ -260,6 +266,7 @@ class Gateway:
         self._sim_ns = 0
         self._watched: set[str] = set()
         self._clock_sub: Any = None
+        self._client_count: Any = None
         self._poller = threading.Thread(target=self._poll, name="gateway-graph", daemon=True)
         self._http: HttpServer | None = None
         self._loop: asyncio.AbstractEventLoop | None = None
@@ -286,13 +293,21 @@ class Gateway:
 
     # -- graph polling ----------------------------------------------------------------------
     def start(self) -> None:
-        """Start watching the graph (and /clock under sim time)."""
+        """Start watching the graph (and /clock under sim time); publish ``client_count`` as rosbridge does."""
+        self._client_count = self.node.publisher(
+            "client_count", get_message_class("std_msgs/Int32"), queue_size=1, latch=True
+        )
+        self._count_clients()
         if self.sim_time:
             self._clock_sub = self.node.subscriber(
                 "/clock", get_message_class("rosgraph_msgs/Clock"), self._on_clock, queue_size=1
             )
         self._refresh()
         self._poller.start()
+
+    def _count_clients(self) -> None:
+        if self._client_count is not None:
+            self._client_count.publish(get_message_class("std_msgs/Int32")(data=len(self._clients)))
 
     def _on_clock(self, msg: Any) -> None:
         self._sim_ns = msg.clock.secs * 1_000_000_000 + msg.clock.nsecs
@@ -396,6 +411,7 @@ class Gateway:
             )
         client.session = session
         self._clients[client.id] = client
+        self._count_clients()
         log.info(
             "gateway: client %d (%s) connected from %s", client.id, ws.subprotocol or "rosbridge", ws.peer
         )
@@ -408,6 +424,7 @@ class Gateway:
         finally:
             sender.cancel()
             self._clients.pop(client.id, None)
+            self._count_clients()
             session.close()
             log.info("gateway: client %d disconnected", client.id)
 
