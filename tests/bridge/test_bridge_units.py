@@ -8,11 +8,11 @@ import json
 import math
 import re
 import struct
-import zlib
 
 import cbor2
 import pytest
 
+from conftest import png_pixels
 from ninjemys.bridge.convert import ConversionError, from_value, to_value
 from ninjemys.bridge.outbox import Outbox
 from ninjemys.bridge.rosapi import typedefs
@@ -81,31 +81,9 @@ def test_from_json_errors_name_the_field(value: dict, error: str) -> None:
         from_value(CameraInfo, {"K": [1.0]})
 
 
-def _png_pixels(encoded: str) -> bytes:
-    png = base64.b64decode(encoded)
-    assert png.startswith(b"\x89PNG\r\n\x1a\n")
-    pos, idat, width, height = 8, b"", 0, 0
-    while pos < len(png):
-        (length,) = struct.unpack(">I", png[pos : pos + 4])
-        kind, body = png[pos + 4 : pos + 8], png[pos + 8 : pos + 8 + length]
-        (crc,) = struct.unpack(">I", png[pos + 8 + length : pos + 12 + length])
-        assert zlib.crc32(kind + body) == crc
-        if kind == b"IHDR":
-            width, height = struct.unpack(">II", body[:8])
-            assert body[8:10] == b"\x08\x02"  # 8-bit RGB
-        elif kind == b"IDAT":
-            idat += body
-        pos += 12 + length
-    raw = zlib.decompress(idat)
-    stride = width * 3
-    rows = [raw[r * (stride + 1) : (r + 1) * (stride + 1)] for r in range(height)]
-    assert all(row[0] == 0 for row in rows)  # filter type None
-    return b"".join(row[1:] for row in rows)
-
-
 @pytest.mark.parametrize("text", ["", "a", '{"op": "publish", "topic": "/x", "msg": {"data": "héllo"}}' * 7])
 def test_png_compression_holds_the_text_padded_with_newlines(text: str) -> None:
-    pixels = _png_pixels(png_compress(text))
+    pixels = png_pixels(png_compress(text))
     assert pixels.rstrip(b"\n") == text.encode().rstrip(b"\n")
     assert set(pixels[len(text.encode()) :]) <= {ord("\n")}
 
