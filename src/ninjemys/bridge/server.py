@@ -353,7 +353,9 @@ class Gateway:
 
     # -- the WebSocket endpoint ---------------------------------------------------------------
     def mount(self, server: HttpServer, path: str = "/") -> None:
-        """Serve the gateway on ``server`` at ``path`` (plus its status at /api/bridge/status)."""
+        """Serve the gateway on ``server`` at ``path`` (plus its status at /api/bridge/status).
+
+        Call :meth:`start` too (graph polling); the server's own loop then runs the connections."""
         server.websocket(path, self)
         server.route("GET", "/api/bridge/status", lambda _r: Response(self.status()))
 
@@ -398,6 +400,9 @@ class Gateway:
 
     async def serve(self, ws: WebSocket) -> None:
         loop = asyncio.get_running_loop()
+        if self._reporter is None:  # on whichever server's loop the gateway is mounted
+            self._loop = self._loop or loop
+            self._reporter = loop.create_task(self._report_drops())
         client = _Client(next(self._ids), ws, loop, self.options.max_client_bytes)
         if ws.subprotocol in SUBPROTOCOLS:
             session: RosbridgeSession | FoxgloveSession = FoxgloveSession(self, client.id, client.outbox)
@@ -494,10 +499,6 @@ class Gateway:
         }
 
     # -- standalone server --------------------------------------------------------------------
-    async def serve_forever_on(self, server: HttpServer) -> None:
-        self._reporter = asyncio.create_task(self._report_drops())
-        await server.start()
-
     def run_in_thread(self) -> str:
         """Start the gateway and its own HTTP server on a loop thread; returns the ws:// URL."""
         from ninjemys.web.app import STATIC_DIR
@@ -514,7 +515,7 @@ class Gateway:
             asyncio.set_event_loop(loop)
             try:
                 assert self._http is not None
-                loop.run_until_complete(self.serve_forever_on(self._http))
+                loop.run_until_complete(self._http.start())
             except BaseException as exc:
                 errors.append(exc)
                 started.set()
@@ -549,14 +550,19 @@ class Gateway:
         return self._http.port
 
     def shutdown(self) -> None:
+        """Close every client, stop polling; stops the loop only when the gateway runs its own."""
         self._stop.set()
         loop = self._loop
         if loop is not None and not loop.is_closed():
-            for client in list(self._clients.values()):
-                loop.call_soon_threadsafe(client.ws.close, 1001, "server shutting down")
-            if self._reporter is not None:
-                loop.call_soon_threadsafe(self._reporter.cancel)
-            loop.call_soon_threadsafe(loop.stop)
+            try:
+                for client in list(self._clients.values()):
+                    loop.call_soon_threadsafe(client.ws.close, 1001, "server shutting down")
+                if self._reporter is not None:
+                    loop.call_soon_threadsafe(self._reporter.cancel)
+                if self._thread is not None:
+                    loop.call_soon_threadsafe(loop.stop)
+            except RuntimeError:  # the loop closed meanwhile
+                pass
         if self._thread is not None:
             self._thread.join(5.0)
         self.services.close()
