@@ -13,8 +13,8 @@ from collections.abc import Callable
 from pathlib import Path
 
 import pytest
+from bridge_helpers import wait_for
 
-from conftest import wait_for
 from ninjemys.bridge.server import Gateway
 from ninjemys.idl.loader import get_message_class, get_service_class
 from ninjemys.node import Node

@@ -10,9 +10,9 @@ import subprocess
 from collections.abc import Iterator
 
 import pytest
+from bridge_helpers import wait_for
 from websockets.sync.client import connect
 
-from conftest import wait_for
 from ninjemys.testing import free_port, ninjemys_bin
 
 roslibpy = pytest.importorskip("roslibpy")

@@ -10,9 +10,9 @@ import time
 from collections.abc import Callable
 
 import cbor2
+from bridge_helpers import png_pixels, wait_for
 from websockets.sync.client import ClientConnection, connect
 
-from conftest import png_pixels, wait_for
 from ninjemys.bridge.server import Gateway
 from ninjemys.idl.loader import get_message_class
 from ninjemys.node import Node

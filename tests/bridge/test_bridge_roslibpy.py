@@ -8,8 +8,8 @@ import threading
 from collections.abc import Iterator
 
 import pytest
+from bridge_helpers import wait_for
 
-from conftest import wait_for
 from ninjemys.bridge.rosapi import RosApi
 from ninjemys.bridge.server import Gateway
 from ninjemys.idl.loader import get_message_class, get_service_class

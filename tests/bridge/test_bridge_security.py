@@ -11,10 +11,10 @@ from collections.abc import Callable
 from pathlib import Path
 
 import pytest
+from bridge_helpers import wait_for
 from websockets.exceptions import ConnectionClosed, InvalidStatus
 from websockets.sync.client import ClientConnection, connect
 
-from conftest import wait_for
 from ninjemys.bridge.rosbridge import rosauth_mac
 from ninjemys.bridge.server import Gateway
 from ninjemys.idl.loader import get_message_class

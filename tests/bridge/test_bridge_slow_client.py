@@ -11,9 +11,9 @@ import time
 from collections.abc import Callable
 from typing import Any
 
+from bridge_helpers import wait_for
 from websockets.sync.client import connect
 
-from conftest import wait_for
 from ninjemys.bridge.server import Gateway
 from ninjemys.idl.loader import get_message_class
 from ninjemys.node import Node

@@ -11,8 +11,8 @@ import struct
 
 import cbor2
 import pytest
+from bridge_helpers import png_pixels
 
-from conftest import png_pixels
 from ninjemys.bridge.convert import ConversionError, from_value, to_value
 from ninjemys.bridge.outbox import Outbox
 from ninjemys.bridge.rosapi import typedefs
