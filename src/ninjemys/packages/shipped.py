@@ -62,6 +62,10 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
             )
         },
         "rosout": {"rosout": ("ninjemys.tools.rosout:main", ())},
+        "rosbridge_server": {"rosbridge_websocket": ("ninjemys.bridge.main:rosbridge_main", ())},
+        "foxglove_bridge": {"foxglove_bridge": ("ninjemys.bridge.main:foxglove_main", ())},
+        "rosapi": {"rosapi_node": ("ninjemys.bridge.rosapi:main", ())},
+        "tf2_web_republisher": {"tf2_web_republisher": ("ninjemys.bridge.tf_republisher:main", ())},
         "dynamic_reconfigure": {"dynparam": ("ninjemys.tools.dynparam:main", ())},
         "actionlib_tutorials": {
             "fibonacci_server": ("ninjemys.tutorials.actionlib.fibonacci_server:main", ()),
