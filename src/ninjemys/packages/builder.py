@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ninjemys.errors import DefinitionError, PackageError
-from ninjemys.packages import idl_check
+from ninjemys.packages import cfg_gen, idl_check
 from ninjemys.packages.cmake_hints import read_cmake_hints
 from ninjemys.packages.manifest import PackageManifest
 from ninjemys.packages.python_setup import python_packages
@@ -168,7 +168,7 @@ def build_workspace(
             if not src.is_dir():
                 raise PackageError(f"{pkg.path / 'setup.py'}: package '{name}' has no directory {src}")
         modules: dict[str, list[Path]] = {name: [src] for name, src in py_packages.items()}
-        if defs:
+        if cfg_gen.generate(pkg, dist, writer) or defs:
             modules.setdefault(pkg.name, [])
         for module, sources in modules.items():
             target = dist.joinpath(*module.split("."))

@@ -43,6 +43,9 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
             "mimic": ("ninjemys.sim.mimic:main", ()),
         },
         "rqt_graph": {"rqt_graph": ("ninjemys.web.rqt_graph:main", ())},
+        "puzzlebot_sim": {
+            "world_to_map": ("ninjemys.sim.world_to_map:main", ()),
+        },
         "rospy_tutorials": {
             name: (f"ninjemys.tutorials.{name.removesuffix('.py')}:main", ())
             for name in (
@@ -55,6 +58,7 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
             )
         },
         "rosout": {"rosout": ("ninjemys.master.rosout:main", ())},
+        "dynamic_reconfigure": {"dynparam": ("ninjemys.tools.dynparam:main", ())},
         "rosbag": {
             sub: ("ninjemys.tools.rosbag:main", (sub,))
             for sub in (
