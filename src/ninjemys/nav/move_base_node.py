@@ -318,6 +318,8 @@ class MoveBase:
     def _begin(self, goal: Pose2D, handle: Any) -> None:
         self.goal = goal
         self.handle = handle
+        self.dwa.xy_latched = False
+        self.plan = None
         self.state = "planning"
         self.plan_requested = True
         self.planning_since = rospy.get_time()
