@@ -50,6 +50,14 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
         "teleop_twist_keyboard": {
             "teleop_twist_keyboard.py": ("ninjemys.sim.teleop_twist_keyboard:main", ()),
         },
+        "map_server": {
+            "map_server": ("ninjemys.nav.map_server_node:main", ()),
+            "map_saver": ("ninjemys.nav.map_server_node:saver_main", ()),
+        },
+        "amcl": {"amcl": ("ninjemys.nav.amcl_node:main", ())},
+        "move_base": {"move_base": ("ninjemys.nav.move_base_node:main", ())},
+        "gmapping": {"slam_gmapping": ("ninjemys.nav.slam_node:main", ())},
+        "puzzlebot_safety": {"safety_monitor": ("ninjemys.nav.safety_node:main", ())},
         "rospy_tutorials": {
             name: (f"ninjemys.tutorials.{name.removesuffix('.py')}:main", ())
             for name in (
