@@ -19,12 +19,11 @@ ROS1_DEBS := ros-core python3-rospy python3-rosbag python3-genpy python3-rosmsg 
 BROWSER_DEBS := chromium chromium-driver fonts-dejavu-core
 SYSTEM_DEBS  := $(ROS1_DEBS) $(BROWSER_DEBS) tmux
 
-.PHONY: all venv system lint format typecheck test test-fast demo bench clean
 # npm packages the tests run with Node.js (Foxglove's own WebSocket client), in a git-ignored directory.
 NPM_DIR   := .cache/npm
 NPM_STAMP := $(NPM_DIR)/node_modules/.installed
 
-.PHONY: all venv system npm lint format test test-fast demo bench clean
+.PHONY: all venv system npm lint format typecheck test test-fast demo bench clean
 
 all: venv
 
@@ -65,8 +64,7 @@ format: venv
 typecheck: venv
 	$(VENV)/bin/mypy
 
-test: venv system lint typecheck
-test: venv system npm lint
+test: venv system npm lint typecheck
 	$(VENV)/bin/pytest -n 2 -q
 
 test-fast: venv
