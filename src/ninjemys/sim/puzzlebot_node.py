@@ -228,19 +228,26 @@ class SimNode:
         io.close()
 
     def _static_transforms(self, io: RobotIO) -> list[Any]:
+        """base_link -> each sensor's frame, and camera_link -> the optical frames the images name
+        (z forward, x right, y down: rpy -pi/2, 0, -pi/2, as the RealSense driver publishes)."""
         m = io.robot.model
-        out = []
+        pairs: list[tuple[str, str, tuple[float, float, float], tuple[float, float, float]]] = []
         for spec in (m.laser, m.camera, m.imu):
-            if spec is None:
-                continue
+            if spec is not None:
+                pairs.append(("base_link", spec.pose.frame, spec.pose.xyz, spec.pose.rpy))
+        if m.camera is not None:
+            optical = (-math.pi / 2, 0.0, -math.pi / 2)
+            for child in ("camera_color_optical_frame", "camera_depth_optical_frame"):
+                pairs.append((m.camera.pose.frame, child, (0.0, 0.0, 0.0), optical))
+        out = []
+        for parent, child, xyz, rpy in pairs:
             t = TransformStamped()
             t.header.stamp = self._stamp()
-            t.header.frame_id = io.frame("base_link")
-            t.child_frame_id = io.frame(spec.pose.frame)
-            t.transform.translation.x, t.transform.translation.y, t.transform.translation.z = spec.pose.xyz
-            q = quaternion_rpy(*spec.pose.rpy)
-            r = t.transform.rotation
-            r.x, r.y, r.z, r.w = q
+            t.header.frame_id = io.frame(parent)
+            t.child_frame_id = io.frame(child)
+            t.transform.translation.x, t.transform.translation.y, t.transform.translation.z = xyz
+            q = t.transform.rotation
+            q.x, q.y, q.z, q.w = quaternion_rpy(*rpy)
             out.append(t)
         return out
 
