@@ -116,6 +116,7 @@ class Simulation:
         self._static: np.ndarray
         self.static_names: list[str] = []
         self._movers_at: tuple[float, tuple] | None = None
+        self._mover_fixed: tuple | None = None
         self._rebuild_static()
 
     @property
@@ -154,17 +155,32 @@ class Simulation:
         return out
 
     def _compute_mover_segments(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[str]]:
-        segs, heights, colours, names = [], [], [], []
-        for m in self.world.moving:
-            o = m.outline_at(self.world_time)
-            s = np.hstack([o, np.roll(o, -1, axis=0)])
-            segs.append(s)
-            heights.append(np.full(len(s), m.height))
-            colours.append(np.tile(np.array(m.color, dtype=np.uint8), (len(s), 1)))
-            names += [m.name] * len(s)
-        if not segs:
+        movers = self.world.moving
+        if not movers:
             return np.zeros((0, 4)), np.zeros(0), np.zeros((0, 3), dtype=np.uint8), []
-        return np.vstack(segs), np.concatenate(heights), np.vstack(colours), names
+        if self._mover_fixed is None:  # what does not move: heights, colours, names, outline shapes
+            heights, colours, names, shapes = [], [], [], []
+            for m in movers:
+                # centred on the origin; boxes are turned to their heading at each step
+                if m.kind == "cylinder":
+                    shape = circle_outline(0.0, 0.0, m.size[0])
+                else:
+                    shape = box_outline(0.0, 0.0, m.size[0], m.size[1], 0.0)
+                shapes.append(shape)
+                heights.append(np.full(len(shape), m.height))
+                colours.append(np.tile(np.array(m.color, dtype=np.uint8), (len(shape), 1)))
+                names += [m.name] * len(shape)
+            self._mover_fixed = (np.concatenate(heights), np.vstack(colours), names, shapes)
+        heights, colours, names, shapes = self._mover_fixed
+        outlines = []
+        for m, shape in zip(movers, shapes, strict=True):
+            x, y, heading = m.position(self.world_time)
+            if m.kind != "cylinder":
+                c, s = math.cos(heading), math.sin(heading)
+                shape = shape @ np.array([[c, s], [-s, c]])
+            outlines.append(shape + (x, y))
+        segs = np.vstack([np.hstack([o, np.roll(o, -1, axis=0)]) for o in outlines])
+        return segs, heights, colours, names
 
     def scene(self, exclude: str | None = None) -> Scene:
         """Everything solid now, as seen by robot ``exclude`` (its own body left out)."""
