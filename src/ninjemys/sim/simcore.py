@@ -146,6 +146,10 @@ class Simulation:
         self._static_hi = np.maximum(st[:, :2], st[:, 2:])
         self._movers_at = None
 
+    def map_edges(self) -> np.ndarray:
+        """The outline of the world's occupancy grid as segments (empty without a map)."""
+        return self._static[len(self.world.segments) :]
+
     def _mover_segments(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[str]]:
         """Moving obstacles' outlines now (computed once per step: collision and sensors share them)."""
         if self._movers_at is not None and self._movers_at[0] == self.world_time:
