@@ -7,7 +7,7 @@
 2. One PuzzleBot headless, as fast as possible, driving a tight circle, with subscribers on the 10 Hz scan, the 30 Hz
    320x240 RGB-D camera and the 100 Hz odometry: simulated seconds per wall second, and the
    simulator's CPU (one process: ``sim_node`` with ``_rate:=0``).
-3. Ten robots with lidars at real time (``_rate:=1``, scans subscribed): the simulator's CPU as a
+3. Ten robots driving circles with lidars at real time (``_rate:=1``, scans subscribed): the simulator's CPU as a
    share of one core.
 
 Run alone: ``.venv/bin/python bench/sim_puzzlebot.py [--quick]``. The machine is shared: the load
@@ -265,6 +265,7 @@ def fast_as_possible(duration: float) -> None:
 
 
 def ten_robots(duration: float) -> None:
+    from geometry_msgs.msg import Twist
     from ninjemys.node import Node
     from sensor_msgs.msg import LaserScan
 
@@ -281,8 +282,14 @@ def ten_robots(duration: float) -> None:
             proc = start_sim(master, str(world), 1.0)
             node = Node("bench_sub", anonymous=True, master_uri=master)
             counts = [Counter() for _ in range(10)]
+            drives = []
             for i in range(10):
                 node.subscriber(f"/robot{i}/scan", LaserScan, counts[i], queue_size=10)
+                drive = node.publisher(f"/robot{i}/cmd_vel", Twist, queue_size=1, latch=True)
+                twist = Twist()
+                twist.linear.x, twist.angular.z = 0.1, 0.5  # every robot drives a 0.2 m circle
+                drive.publish(twist)
+                drives.append(drive)
             time.sleep(2.0)
             c0, w0 = cpu_seconds(proc.pid), time.monotonic()
             n0 = sum(c.n for c in counts)
@@ -291,7 +298,9 @@ def ten_robots(duration: float) -> None:
             scans = (sum(c.n for c in counts) - n0) / (w1 - w0)
             node.shutdown("bench over")
             stop(proc)
-    print(f"\n## ten PuzzleBots with lidars at real time ({duration:.0f} s, scans subscribed)")
+    print(
+        f"\n## ten PuzzleBots driving circles with lidars at real time ({duration:.0f} s, scans subscribed)"
+    )
     print("| robots | sim CPU (% of a core) | scans/s received (10 robots x 10 Hz = 100) |")
     print("|---|---:|---:|")
     print(f"| 10 | {100 * (c1 - c0) / (w1 - w0):.0f} | {scans:.0f} |")
