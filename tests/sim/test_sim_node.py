@@ -343,3 +343,28 @@ def test_roslaunch_puzzlebot_launch_sets_pose_and_sim_time(master, client, tmp_p
         except subprocess.TimeoutExpired:
             proc.kill()
             proc.wait()
+
+
+def test_as_fast_as_possible_still_answers(sims, client):
+    """rate 0: time runs flat out, yet commands and services get through between steps."""
+    from geometry_msgs.msg import Twist
+    from nav_msgs.msg import Odometry
+    from rosgraph_msgs.msg import Clock
+    from std_srvs.srv import Empty
+
+    sims("_world:=empty", "_rate:=0")
+    clock = Latest(client, "/clock", Clock)
+    gt = Latest(client, "/base_pose_ground_truth", Odometry)
+    gt.wait()
+    first = clock.wait().clock.to_sec()
+    w0 = time.monotonic()
+    pub = client.publisher("/cmd_vel", Twist, queue_size=1)
+    wait_until(lambda: pub.get_num_connections(), what="sim subscribed to /cmd_vel")
+    twist = Twist()
+    twist.linear.x = 0.2
+    pub.publish(twist)
+    wait_until(lambda: gt.msg.pose.pose.position.x > 0.5, what="the robot moving")
+    client.wait_for_service("/gazebo/reset_world", 10)
+    client.service_proxy("/gazebo/reset_world", Empty)(Empty._request_class())
+    elapsed_sim = clock.msg.clock.to_sec() - first
+    assert elapsed_sim > 2 * (time.monotonic() - w0)  # faster than real time

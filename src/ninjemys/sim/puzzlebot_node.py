@@ -263,34 +263,25 @@ class SimNode:
             io.pubs["contact"].publish(Bool(data=io.robot.contact))
 
     def _on_cmd_vel(self, msg: Any, name: str) -> None:
-        values = (msg.linear.x, msg.angular.z)
-        with self.lock:
-            io = self.io.get(name)
-            if io is None:
-                return
-            if not all(
-                math.isfinite(v)
-                for v in (
-                    msg.linear.x,
-                    msg.linear.y,
-                    msg.linear.z,
-                    msg.angular.x,
-                    msg.angular.y,
-                    msg.angular.z,
+        """Runs on the subscriber's thread without the simulation lock (a command is one atomic
+        assignment), so commands get through even when the stepping thread runs flat out."""
+        io = self.io.get(name)
+        if io is None:
+            return
+        lin, ang = msg.linear, msg.angular
+        if not all(math.isfinite(v) for v in (lin.x, lin.y, lin.z, ang.x, ang.y, ang.z)):
+            if not io.bad_cmd_warned:
+                io.bad_cmd_warned = True
+                self.log.warn(
+                    "%scmd_vel: ignoring a command with a non-finite value (linear.x=%s, angular.z=%s); "
+                    "further ones are ignored silently until a valid command arrives",
+                    "/" + io.prefix if io.prefix else "",
+                    lin.x,
+                    ang.z,
                 )
-            ):
-                if not io.bad_cmd_warned:
-                    io.bad_cmd_warned = True
-                    self.log.warn(
-                        "%scmd_vel: ignoring a command with a non-finite value (linear.x=%s, angular.z=%s); "
-                        "further ones are ignored silently until a valid command arrives",
-                        "/" + io.prefix if io.prefix else "",
-                        values[0],
-                        values[1],
-                    )
-                return
-            io.bad_cmd_warned = False
-            io.robot.command(values[0], values[1])
+            return
+        io.bad_cmd_warned = False
+        io.robot.command(lin.x, ang.z)
 
     # -- services -------------------------------------------------------------------------------
     def _reset_simulation(self, _req: Any) -> Any:
@@ -405,7 +396,9 @@ class SimNode:
                 return  # the node shut down under the stepping thread
             except Exception as exc:  # a bug in one step must not freeze the simulation for good
                 self.log.error("simulation step failed: %s: %s", type(exc).__name__, exc)
-            if self.rate > 0:
+            if self.rate <= 0:
+                time.sleep(0)  # as fast as possible, yet callbacks and services get the lock between steps
+            else:
                 target = wall0 + (self.sim.time - sim0) / self.rate
                 delay = target - time.monotonic()
                 if delay > 0:

@@ -63,8 +63,7 @@ class Robot:
     rng: np.random.Generator
     wl: float = 0.0  # actual wheel speeds (rad/s)
     wr: float = 0.0
-    target_wl: float = 0.0
-    target_wr: float = 0.0
+    target: tuple[float, float] = (0.0, 0.0)  # commanded (wl, wr): one tuple, so a command is atomic
     left_angle: float = 0.0
     right_angle: float = 0.0
     v: float = 0.0
@@ -87,11 +86,12 @@ class Robot:
         if peak > m.max_wheel_speed:
             wl *= m.max_wheel_speed / peak
             wr *= m.max_wheel_speed / peak
-        self.target_wl, self.target_wr = wl, wr
+        self.target = (wl, wr)
 
     def reset(self) -> None:
         self.x, self.y, self.yaw = self.start
-        self.wl = self.wr = self.target_wl = self.target_wr = 0.0
+        self.wl = self.wr = 0.0
+        self.target = (0.0, 0.0)
         self.left_angle = self.right_angle = 0.0
         self.v = self.w = self.v_prev = 0.0
         self.odom = [0.0, 0.0, 0.0]
@@ -364,8 +364,9 @@ class Simulation:
     def _move(self, r: Robot, dt: float) -> bool:
         m = r.model
         step = m.max_wheel_accel * dt
-        r.wl += min(max(r.target_wl - r.wl, -step), step)
-        r.wr += min(max(r.target_wr - r.wr, -step), step)
+        target_wl, target_wr = r.target
+        r.wl += min(max(target_wl - r.wl, -step), step)
+        r.wr += min(max(target_wr - r.wr, -step), step)
         v = m.wheel_radius * (r.wr + r.wl) / 2.0
         w = m.wheel_radius * (r.wr - r.wl) / m.wheel_separation
         r.v_prev = r.v
@@ -405,7 +406,8 @@ class Simulation:
                 new_contact = not r.contact
                 r.contact, r.contact_with = True, who[k]
                 # a kinematic robot stops dead at the wall: wheels and command stop too
-                r.wl = r.wr = r.target_wl = r.target_wr = 0.0
+                r.wl = r.wr = 0.0
+                r.target = (0.0, 0.0)
                 r.v = r.w = 0.0
             elif r.contact:
                 r.contact, r.contact_with = False, ""
