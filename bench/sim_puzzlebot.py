@@ -4,6 +4,8 @@
    traversal, and our cast against the grid's outline), 1,000 random segments. The same office
    geometry and the same 1,000 segments go through ir-sim's Lidar2D (``pip install ir-sim``; skipped
    with a note when it is missing). The issue's reference figure: ir-sim took ~22 ms per scan (ir-sim#332).
+Subscribers count raw messages (no deserialization: the bench process must not be the bottleneck).
+
 2. One PuzzleBot headless, as fast as possible, driving a tight circle, with subscribers on the 10 Hz scan, the 30 Hz
    320x240 RGB-D camera and the 100 Hz odometry: simulated seconds per wall second, and the
    simulator's CPU (one process: ``sim_node`` with ``_rate:=0``).
@@ -237,12 +239,14 @@ def fast_as_possible(duration: float) -> None:
             node = Node("bench_sub", anonymous=True, master_uri=master)
             counts = {k: Counter() for k in ("scan", "image", "depth", "odom", "clock")}
             if "scan" in topics:
-                node.subscriber("/scan", LaserScan, counts["scan"], queue_size=100)
+                node.subscriber("/scan", LaserScan, counts["scan"], queue_size=100, raw=True)
             if "camera" in topics:
-                node.subscriber("/camera/color/image_raw", Image, counts["image"], queue_size=100)
-                node.subscriber("/camera/depth/image_rect_raw", Image, counts["depth"], queue_size=100)
+                node.subscriber("/camera/color/image_raw", Image, counts["image"], queue_size=100, raw=True)
+                node.subscriber(
+                    "/camera/depth/image_rect_raw", Image, counts["depth"], queue_size=100, raw=True
+                )
             if "odom" in topics:
-                node.subscriber("/odom", Odometry, counts["odom"], queue_size=1000)
+                node.subscriber("/odom", Odometry, counts["odom"], queue_size=1000, raw=True)
             node.subscriber("/clock", Clock, counts["clock"], queue_size=1)
             drive = node.publisher("/cmd_vel", Twist, queue_size=1, latch=True)
             twist = Twist()
@@ -284,7 +288,7 @@ def ten_robots(duration: float) -> None:
             counts = [Counter() for _ in range(10)]
             drives = []
             for i in range(10):
-                node.subscriber(f"/robot{i}/scan", LaserScan, counts[i], queue_size=10)
+                node.subscriber(f"/robot{i}/scan", LaserScan, counts[i], queue_size=10, raw=True)
                 drive = node.publisher(f"/robot{i}/cmd_vel", Twist, queue_size=1, latch=True)
                 twist = Twist()
                 twist.linear.x, twist.angular.z = 0.1, 0.5  # every robot drives a 0.2 m circle
