@@ -146,6 +146,8 @@ class SimNode:
         self._wake = threading.Event()
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
+        self._started = (time.monotonic(), time.process_time())
+        self._stepped = 0.0  # simulated seconds stepped (resets of time do not undo them)
         self.view: Any = None
         self.clock_pub = node.publisher("/clock", Clock, queue_size=10)
         self.tf_pub = node.publisher("/tf", TFMessage, queue_size=100)
@@ -371,12 +373,24 @@ class SimNode:
         self._wake.set()
         if self._thread is not None:
             self._thread.join(5.0)
+            self.log.info("%s", self.summary())
+
+    def summary(self) -> str:
+        """How fast the simulation ran: simulated seconds per wall second and per CPU second."""
+        wall = max(time.monotonic() - self._started[0], 1e-9)
+        cpu = max(time.process_time() - self._started[1], 1e-9)
+        stepped = self._stepped
+        return (
+            f"simulated {stepped:.2f} s in {wall:.2f} s of wall time ({stepped / wall:.1f}x real time), "
+            f"{cpu:.2f} s of CPU ({stepped / cpu:.1f} simulated s per CPU s)"
+        )
 
     def _stamp(self) -> Time:
         ns = round(self.sim.steps * self.sim.dt * 1e9)
         return Time(ns // 1_000_000_000, ns % 1_000_000_000)
 
     def _run(self) -> None:
+        self._started = (time.monotonic(), time.process_time())
         wall0 = time.monotonic()
         sim0 = self.sim.time
         while not self._stop.is_set():
@@ -410,6 +424,7 @@ class SimNode:
     def _step_and_publish(self) -> None:
         sim = self.sim
         touched = sim.step()
+        self._stepped += sim.dt
         now = sim.time
         stamp = self._stamp()
         self.clock_pub.publish(Clock(clock=stamp))
