@@ -141,6 +141,11 @@ def test_dynparam_commands(served, tmp_path: Path, capsys) -> None:
     assert node.get_param("~double_param") == 0.25
     assert dynparam.main(["set", "/dyn_server", "int_param", "lots"]) == 0
     assert "error updating parameters: can't set parameter 'int_param'" in capsys.readouterr().out
+    assert (
+        dynparam.main(["set_from_parameters", "/dyn_server", "_int_param:=33", "_str_param:=from_params"])
+        == 0
+    )
+    assert node.get_param("~int_param") == 33 and node.get_param("~str_param") == "from_params"
 
 
 def test_dynparam_errors(master_uri: str, capsys) -> None:
