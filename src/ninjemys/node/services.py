@@ -168,16 +168,26 @@ class _Link:
 
 
 def make_response(response_class: Any, value: Any) -> Any:
-    """Turn what a handler returned into a response, the ways rospy accepts (instance, dict, tuple, value)."""
+    """Turn what a handler returned into a response, the ways rospy accepts (instance, dict, tuple,
+    value); what cannot be one is a ServiceError worded as rospy's, which the caller receives."""
     if isinstance(value, response_class):
         return value
     if value is None:
         raise ServiceError("service handler returned None")
     if isinstance(value, dict):
-        return response_class(**value)
+        try:
+            return response_class(**value)
+        except (AttributeError, TypeError) as exc:
+            raise ServiceError(f"handler returned invalid value: {exc}") from None
     if isinstance(value, list | tuple):
-        return response_class(*value)
-    return response_class(value)
+        try:
+            return response_class(*value)
+        except TypeError as exc:
+            raise ServiceError(f"handler returned wrong number of values: {exc}") from None
+    try:
+        return response_class(value)
+    except TypeError as exc:
+        raise ServiceError(f"handler returned invalid value: {exc}") from None
 
 
 class ServiceServer:
@@ -280,6 +290,12 @@ class ServiceServer:
         return encode_service_response(False, f"cannot deserialize request: {exc}")
 
     def _failed(self, exc: Exception) -> bytes:
+        """The caller's error text, worded as rospy's: a handler that refuses the request on purpose
+        (ServiceError; rospy.ServiceException through the facade) "cannot process" it, any other
+        exception is an "error processing" it and is logged here."""
+        if isinstance(exc, ServiceError):
+            _log.debug("service %s: handler refused the request: %s", self.name, exc)
+            return encode_service_response(False, f"service cannot process request: {exc}")
         _log.error("service %s: error processing request: %s", self.name, exc)
         return encode_service_response(False, f"error processing request: {exc}")
 

@@ -515,6 +515,10 @@ class Publisher:
     def get_num_connections(self) -> int:
         return len(self._pub.connections)
 
+    def subscriber_ids(self) -> frozenset[str]:
+        """Caller ids of the subscribers connected now (handshake done: what is published reaches them)."""
+        return frozenset(c.subscriber for c in self._pub.connections if not c.closed)
+
     def unregister(self) -> None:
         """Stop publishing; the last handle of a topic unregisters it from the master."""
         if self._closed:
