@@ -44,7 +44,7 @@ TYPE_CHECKING = False  # importing typing costs ~7 ms of every node's start-up; 
 if TYPE_CHECKING:
     from typing import Any
 
-    from ninjemys.node.node import Node
+    from ninjemys.node.context import NodeContext
 
 _log = logging.getLogger(__name__)
 _U32 = struct.Struct("<I")
@@ -193,7 +193,9 @@ def make_response(response_class: Any, value: Any) -> Any:
 class ServiceServer:
     """A service this node provides; see :meth:`ninjemys.node.Node.service`."""
 
-    def __init__(self, node: Node, name: str, service_class: Any, handler: Callable[[Any], Any]) -> None:
+    def __init__(
+        self, node: NodeContext, name: str, service_class: Any, handler: Callable[[Any], Any]
+    ) -> None:
         self.node = node
         self.resolved_name = name
         self.name = name
@@ -314,7 +316,7 @@ class ServiceServer:
         if self._closed:
             return
         self._closed = True
-        self.node._drop_service(self)
+        self.node.release_service(self)
         self._end_connections()
 
     def _end_connections(self) -> None:
@@ -335,7 +337,7 @@ class ServiceProxy:
 
     def __init__(
         self,
-        node: Node,
+        node: NodeContext,
         name: str,
         service_class: Any,
         persistent: bool = False,

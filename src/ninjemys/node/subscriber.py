@@ -40,7 +40,7 @@ TYPE_CHECKING = False  # importing typing costs ~7 ms of every node's start-up; 
 if TYPE_CHECKING:
     from typing import Any
 
-    from ninjemys.node.node import Node
+    from ninjemys.node.context import NodeContext
 
 _log = logging.getLogger(__name__)
 
@@ -204,7 +204,7 @@ class SubConnection:
 class Subscription:
     """A topic this node subscribes to: the publisher connections and the handles fed by them."""
 
-    def __init__(self, node: Node, topic: str, msg_class: Any, tcp_nodelay: bool) -> None:
+    def __init__(self, node: NodeContext, topic: str, msg_class: Any, tcp_nodelay: bool) -> None:
         self.node = node
         self.topic = topic
         self.msg_class = msg_class
@@ -553,11 +553,15 @@ class Subscriber:
     def get_num_connections(self) -> int:
         return len(self._sub.connections)
 
+    def publisher_ids(self) -> frozenset[str]:
+        """Caller ids of the publishers connected now (handshake done: what they publish reaches us)."""
+        return frozenset(c.publisher for c in list(self._sub.connections.values()) if not c.closed)
+
     def unregister(self) -> None:
         """Stop receiving; the worker thread ends (joined unless called from a callback)."""
         if self._closed:
             return
-        self._sub.node._drop_subscriber(self)
+        self._sub.node.release_subscriber(self)
         self._closed = True
         self._wakeup()
         if threading.current_thread() is not self._thread:

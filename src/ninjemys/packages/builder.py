@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from ninjemys.errors import DefinitionError, PackageError
-from ninjemys.packages import idl_check, msg_types
+from ninjemys.packages import cfg_gen, idl_check, msg_types
 from ninjemys.packages.cmake_hints import read_cmake_hints
 from ninjemys.packages.cpp_targets import CppTarget, cpp_targets, skipped_message
 from ninjemys.packages.discovery import PackageIndex, package_path_dirs, underlay_dirs
@@ -207,7 +207,7 @@ def build_workspace(
             if not src.is_dir():
                 raise PackageError(f"{pkg.path / 'setup.py'}: package '{name}' has no directory {src}")
         modules: dict[str, list[Path]] = {name: [src] for name, src in py_packages.items()}
-        if defs:
+        if cfg_gen.generate(pkg, dist, writer) or defs:
             modules.setdefault(pkg.name, [])
         for module, sources in modules.items():
             target = dist.joinpath(*module.split("."))
