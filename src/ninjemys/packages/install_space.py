@@ -215,7 +215,9 @@ def install_workspace(
     for pkg in ws.ordered():
         _install_messages(pkg, dist, out)
     space = WorkspaceEnv(source=prefix / "share", devel=prefix)
-    out.write(prefix / "setup.sh", render_setup_sh(space, underlay_workspaces(ws.devel, env)))
+    # a shell that sourced this install space before lists it too: it is no underlay of itself
+    underlays = [u for u in underlay_workspaces(ws.devel, env) if u.devel.resolve() != prefix.resolve()]
+    out.write(prefix / "setup.sh", render_setup_sh(space, underlays))
     out.write(prefix / "setup.bash", render_setup_bash(space))
     out.write(prefix / "setup.zsh", render_setup_zsh(space))
     for shell in ("sh", "bash", "zsh"):
