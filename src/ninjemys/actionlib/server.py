@@ -46,7 +46,7 @@ if TYPE_CHECKING:
     from typing import Any
 
 #: seconds between two status messages caused by transitions (the periodic ones are separate)
-MERGE_INTERVAL = 0.05
+MERGE_INTERVAL = 0.1
 
 _ZERO = Time()
 
