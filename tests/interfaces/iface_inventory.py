@@ -37,10 +37,15 @@ SHIPPED_PACKAGES = (
     "move_base_msgs",
     "map_msgs",
     "control_msgs",
+    "gazebo_msgs",
+    "tf",
+    "dynamic_reconfigure",
 )
 
 #: packages Debian's ROS 1 lacks; their facts are checked against published md5sums instead
-NOT_IN_DEBIAN = frozenset({"turtlesim", "rospy_tutorials", "actionlib_tutorials", "control_msgs"})
+NOT_IN_DEBIAN = frozenset(
+    {"turtlesim", "rospy_tutorials", "actionlib_tutorials", "control_msgs", "gazebo_msgs"}
+)
 
 #: the messages actionlib generates from one ``Foo.action``
 ACTION_SUFFIXES = ("Action", "ActionGoal", "ActionResult", "ActionFeedback", "Goal", "Result", "Feedback")
