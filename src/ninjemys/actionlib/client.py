@@ -244,6 +244,7 @@ class ActionClient:
         pub_queue = pub_queue if isinstance(pub_queue, int) and pub_queue >= 0 else 10
         sub_queue = self._param("actionlib_client_sub_queue_size", -1)
         sub_queue = sub_queue if isinstance(sub_queue, int) and sub_queue > 0 else None
+        self.pub_queue_size, self.sub_queue_size = pub_queue, sub_queue
         ns = self.ns
         self.pub_goal = node.publisher(f"{ns}/goal", self.types.action_goal, queue_size=pub_queue)
         self.pub_cancel = node.publisher(f"{ns}/cancel", goal_id_class(), queue_size=pub_queue)
