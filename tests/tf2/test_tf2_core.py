@@ -204,3 +204,73 @@ def test_reparenting_over_time():
     b.set_transforms([item("b", "c", 3, x=5.0), item("a", "b", 3, x=10.0)])
     assert b.lookup("a", "c", int(1.5 * S))[1][0] == pytest.approx(1.5)
     assert b.lookup("a", "c", 3 * S)[1][0] == pytest.approx(15.0)
+
+
+def _raw_messages(count, start=1, step=0.01, frames=5, bad_at=None, reorder=False):
+    from ninjemys.tf2.wire import encode_tf_message
+
+    out = []
+    for k in range(count):
+        t = start + k * step
+        items = [
+            (
+                "world" if i == 0 else f"f{i - 1}",
+                f"f{i}",
+                int(round(t * S)),
+                math.cos(t + i),
+                math.sin(t),
+                0.1 * i,
+                *yaw_q(t + i),
+            )
+            for i in range(frames)
+        ]
+        if k == bad_at:
+            items[2] = items[2][:3] + (float("nan"),) + items[2][4:]
+        out.append(encode_tf_message(items))
+    if reorder:
+        out[3], out[4] = out[4], out[3]
+    return out
+
+
+@pytest.mark.parametrize("case", ["plain", "bad-in-run", "reordered", "repeated"])
+def test_raw_batches_match_eager_insertion(case):
+    """add_raw (batched numpy decoding) and set_transforms (per transform) give the same buffer."""
+    from ninjemys.tf2.wire import decode_tf_message
+
+    msgs = _raw_messages(40, bad_at=7 if case == "bad-in-run" else None, reorder=case == "reordered")
+    if case == "repeated":
+        msgs = msgs[:10] + msgs[5:10] + msgs[10:]
+    lazy, eager = BufferCore(), BufferCore()
+    lazy_lines: list[str] = []
+    eager_lines: list[str] = []
+    lazy._report, eager._report = lazy_lines.append, eager_lines.append
+    for m in msgs:
+        lazy.add_raw(m, "pub")
+        eager.set_transforms(decode_tf_message(m), "pub")
+    for t in (0, S + 5 * S // 100, S + 123 * S // 10_000, S + 39 * S // 100):
+        for target, source in (("world", "f4"), ("f2", "f4"), ("f4", "f1")):
+            assert lazy.lookup(target, source, t) == eager.lookup(target, source, t)
+    assert lazy.all_frames_as_yaml() == eager.all_frames_as_yaml()
+    assert lazy_lines == eager_lines
+    if case == "bad-in-run":
+        assert len(lazy_lines) == 1 and lazy_lines[0].startswith(
+            'TF_NAN_INPUT: Ignoring transform for child_frame_id "f2"'
+        )
+
+
+def test_raw_queue_is_bounded_and_wakes_waiters():
+    from ninjemys.tf2 import core
+
+    b = BufferCore()
+    for m in _raw_messages(core.PENDING_MAX + 3):
+        b.add_raw(m, "pub")
+    assert len(b._pending) == 3  # the listener's thread decoded the first batch itself
+    msgs = _raw_messages(1, start=5)
+
+    def later():
+        time.sleep(0.2)
+        b.add_raw(msgs[0], "pub")
+
+    threading.Thread(target=later).start()
+    ok, _ = b.wait_for_transform(lambda: b.can_transform("world", "f4", 5 * S), 5.0)
+    assert ok
