@@ -67,6 +67,38 @@ def ros1_env(master_uri: str, **extra: str) -> dict[str, str]:
     return env
 
 
+def ros1_built_interfaces(dest: str | os.PathLike[str]) -> Path:
+    """A copy of the shipped interface packages as a ROS 1 build leaves them, for real rosmsg/rospack.
+
+    catkin runs actionlib_msgs' genaction.py over every ``.action`` and writes the seven generated
+    ``.msg`` files into the package's share ``msg/``; real tools list and show them from there. This
+    runs Debian's own genaction.py the same way, so a comparison against real ROS 1 sees what a built
+    installation holds. Returns the directory to put on ``ROS_PACKAGE_PATH``.
+    """
+    import shutil
+    import subprocess
+
+    from ninjemys.idl.search import SHIPPED_ROOT
+
+    root = Path(dest) / "interfaces"
+    shutil.copytree(SHIPPED_ROOT, root)
+    for action in sorted(root.glob("*/action/*.action")):
+        subprocess.run(
+            [
+                ROS1_PYTHON,
+                "/usr/lib/actionlib_msgs/genaction.py",
+                str(action),
+                "-o",
+                str(action.parent.parent / "msg"),
+            ],
+            env=ros1_env("http://localhost:11311"),
+            capture_output=True,
+            check=True,
+            timeout=60,
+        )
+    return root
+
+
 def ninjemys_bin(command: str) -> str:
     """Full path of one of our console scripts (the venv's bin/, next to the running interpreter)."""
     return command_path(command)
@@ -80,6 +112,27 @@ def FakeClock(start: float = 0.0):  # noqa: N802 - reads as a class at call site
     from ninjemys.node.clock import FakeClock as _FakeClock
 
     return _FakeClock(start)
+
+
+def reset_rospy() -> None:
+    """Shut down the rospy node of this process (if any) and forget all of rospy's state, in-process.
+
+    rospy allows one ``init_node`` per process; after this, the next ``rospy.init_node`` starts a
+    new node, so rospy tests need no subprocess each. User shutdown hooks run first, as on a real
+    shutdown; handles (Publishers, Subscribers, Services) of the old node stay unregistered.
+    Typical use is a fixture::
+
+        @pytest.fixture
+        def rospy_node(master_uri, monkeypatch):
+            monkeypatch.setenv("ROS_MASTER_URI", master_uri)
+            yield
+            ninjemys.testing.reset_rospy()
+    """
+    import sys
+
+    core = sys.modules.get("rospy.core")
+    if core is not None:  # rospy never imported: nothing to reset
+        core._reset()
 
 
 @contextlib.contextmanager

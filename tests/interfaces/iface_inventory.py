@@ -13,7 +13,7 @@ import ninjemys
 
 INTERFACES = Path(ninjemys.__file__).parent / "interfaces"
 
-#: the 17 packages of the Foundation issue, point 5
+#: the 17 packages of the Foundation issue, point 5, and the interface packages of wave 2
 SHIPPED_PACKAGES = (
     "std_msgs",
     "std_srvs",
@@ -32,10 +32,20 @@ SHIPPED_PACKAGES = (
     "turtlesim",
     "rospy_tutorials",
     "actionlib_tutorials",
+    # wave 2 (issue 13, point 6): what actionlib, navigation and controllers need
+    "actionlib",
+    "move_base_msgs",
+    "map_msgs",
+    "control_msgs",
+    "gazebo_msgs",
+    "tf",
+    "dynamic_reconfigure",
 )
 
 #: packages Debian's ROS 1 lacks; their facts are checked against published md5sums instead
-NOT_IN_DEBIAN = frozenset({"turtlesim", "rospy_tutorials", "actionlib_tutorials"})
+NOT_IN_DEBIAN = frozenset(
+    {"turtlesim", "rospy_tutorials", "actionlib_tutorials", "control_msgs", "gazebo_msgs"}
+)
 
 #: the messages actionlib generates from one ``Foo.action``
 ACTION_SUFFIXES = ("Action", "ActionGoal", "ActionResult", "ActionFeedback", "Goal", "Result", "Feedback")

@@ -1,7 +1,9 @@
 """``rosmsg`` / ``rossrv`` output, ours against Debian's real ROS 1, byte for byte.
 
 Real rosmsg reads .msg files through rospack; Debian installs almost none, so both sides are pointed at
-our interface directory with ROS_PACKAGE_PATH. The definitions' facts are proven elsewhere (md5 tests);
+our interface directory with ROS_PACKAGE_PATH. A built ROS 1 package also holds the seven messages each
+``.action`` generates (catkin runs genaction into its share directory): the real side reads a copy of our
+interface directory into which Debian's own genaction.py has written them, as a build would. The definitions' facts are proven elsewhere (md5 tests);
 here the rendering is: ROS 1 prints parsed fields (nested types expanded and indented, constants first),
 so the output of the two programs over the same files must be identical.
 """
@@ -15,15 +17,11 @@ from pathlib import Path
 import pytest
 from iface_inventory import INTERFACES, inventory
 
-from ninjemys.testing import ROS1_PYTHON, ninjemys_bin, ros1_env
+from ninjemys.testing import ROS1_PYTHON, ninjemys_bin, ros1_built_interfaces, ros1_env
 
 pytestmark = pytest.mark.ros1
 
 INV = inventory()
-#: action messages are generated at build time; real rosmsg only sees the msg/ directories
-FILE_MESSAGES = [
-    t for t in INV.messages if (INTERFACES / t.split("/")[0] / "msg" / f"{t.split('/')[1]}.msg").exists()
-]
 ORACLE = Path(__file__).with_name("rosmsg_oracle.py")
 
 CLI_CASES = [
@@ -38,6 +36,12 @@ CLI_CASES = [
     ["rossrv", "show", "nav_msgs/GetPlan"],
     ["rossrv", "md5", "nav_msgs/GetPlan"],
     ["rosmsg", "package", "turtlesim"],
+    ["rosmsg", "package", "actionlib_tutorials"],
+    ["rosmsg", "package", "move_base_msgs"],
+    ["rosmsg", "show", "move_base_msgs/MoveBaseActionGoal"],
+    ["rosmsg", "show", "-r", "control_msgs/FollowJointTrajectoryActionResult"],
+    ["rosmsg", "show", "FibonacciFeedback"],
+    ["rosmsg", "md5", "move_base_msgs/MoveBaseAction"],
     ["rossrv", "package", "roscpp"],
     ["rosmsg", "list"],
     ["rossrv", "list"],
@@ -45,8 +49,13 @@ CLI_CASES = [
 ]
 
 
-def _env(tmp_path: Path) -> dict[str, str]:
-    return ros1_env("http://localhost:11311", ROS_PACKAGE_PATH=str(INTERFACES), HOME=str(tmp_path))
+@pytest.fixture(scope="module")
+def built(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return ros1_built_interfaces(tmp_path_factory.mktemp("built"))
+
+
+def _env(tmp_path: Path, packages: Path = INTERFACES) -> dict[str, str]:
+    return ros1_env("http://localhost:11311", ROS_PACKAGE_PATH=str(packages), HOME=str(tmp_path))
 
 
 def _ours(tmp_path: Path, argv: list[str]) -> subprocess.CompletedProcess[str]:
@@ -60,25 +69,29 @@ def _ours(tmp_path: Path, argv: list[str]) -> subprocess.CompletedProcess[str]:
 
 
 @pytest.mark.parametrize("argv", CLI_CASES, ids=" ".join)
-def test_cli_output_is_byte_identical(argv: list[str], tmp_path: Path) -> None:
+def test_cli_output_is_byte_identical(argv: list[str], tmp_path: Path, built: Path) -> None:
     ours = _ours(tmp_path, argv)
     theirs = subprocess.run(
-        [f"/usr/bin/{argv[0]}", *argv[1:]], env=_env(tmp_path), capture_output=True, text=True, timeout=60
+        [f"/usr/bin/{argv[0]}", *argv[1:]],
+        env=_env(tmp_path, built),
+        capture_output=True,
+        text=True,
+        timeout=60,
     )
     assert theirs.returncode == 0, theirs.stderr
     assert ours.returncode == 0, ours.stderr
     expected = theirs.stdout
-    if argv[1] == "list":
-        # Debian installs its own std_srvs under /usr/share, which real rospack finds besides ours and
-        # lists twice; a user's machine has one of each package
+    if argv[1] in ("list", "packages"):
+        # Debian installs its own std_srvs and actionlib under /usr/share, which real rospack finds
+        # besides ours and lists twice; a user's machine has one of each package
         expected = "".join(dict.fromkeys(expected.splitlines(keepends=True)))
     assert ours.stdout == expected
 
 
-def _real_texts(tmp_path: Path, mode: str, raw: bool, types: list[str]) -> dict[str, str]:
+def _real_texts(tmp_path: Path, built: Path, mode: str, raw: bool, types: list[str]) -> dict[str, str]:
     done = subprocess.run(
         [ROS1_PYTHON, str(ORACLE), mode, "1" if raw else "0", *types],
-        env=_env(tmp_path),
+        env=_env(tmp_path, built),
         capture_output=True,
         text=True,
         timeout=120,
@@ -89,10 +102,10 @@ def _real_texts(tmp_path: Path, mode: str, raw: bool, types: list[str]) -> dict[
 
 @pytest.mark.parametrize("raw", [False, True], ids=["show", "show-r"])
 @pytest.mark.parametrize("mode", ["msg", "srv"])
-def test_show_of_every_type_matches(mode: str, raw: bool, tmp_path: Path) -> None:
-    """Every msg (and every srv) through both programs; one process per side, not one per type."""
-    types = FILE_MESSAGES if mode == "msg" else list(INV.services)
-    theirs = _real_texts(tmp_path, mode, raw, types)
+def test_show_of_every_type_matches(mode: str, raw: bool, tmp_path: Path, built: Path) -> None:
+    """Every msg (action-generated ones too) and every srv through both programs; one process per side."""
+    types = list(INV.messages) if mode == "msg" else list(INV.services)
+    theirs = _real_texts(tmp_path, built, mode, raw, types)
     script = (
         "import contextlib, io, json, sys\n"
         f"from ninjemys.tools.ros{mode} import main\n"

@@ -8,8 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from ninjemys.idl.search import SHIPPED_ROOT
-from ninjemys.testing import have_ros1, ninjemys_bin, ros1_env
+from ninjemys.testing import have_ros1, ninjemys_bin, ros1_built_interfaces, ros1_env
 
 
 def ours(
@@ -27,8 +26,10 @@ def ours(
 
 
 def theirs(tmp_path: Path, *argv: str) -> subprocess.CompletedProcess[str]:
+    """Real rosmsg over our packages as built (with the messages generated from .action files)."""
     command, *rest = argv
-    env = ros1_env("http://localhost:11311", ROS_PACKAGE_PATH=str(SHIPPED_ROOT), HOME=str(tmp_path))
+    built = ros1_built_interfaces(tmp_path / "ws")
+    env = ros1_env("http://localhost:11311", ROS_PACKAGE_PATH=str(built), HOME=str(tmp_path))
     return subprocess.run([f"/usr/bin/{command}", *rest], capture_output=True, text=True, timeout=60, env=env)
 
 
@@ -62,7 +63,11 @@ def test_output_matches_ros1(argv: tuple[str, ...], tmp_path: Path) -> None:
     assert real.returncode == 0, real.stderr
     mine = ours(*argv)
     assert mine.returncode == 0, mine.stderr
-    assert mine.stdout == real.stdout
+    expected = real.stdout
+    if argv[1] in ("list", "packages"):
+        # Debian's own actionlib under /usr/share is found besides ours and listed twice
+        expected = "".join(dict.fromkeys(expected.splitlines(keepends=True)))
+    assert mine.stdout == expected
 
 
 def test_rossrv_show_spawn_has_ros1_format() -> None:

@@ -19,7 +19,7 @@ from collections.abc import Callable
 from ninjemys.errors import DefinitionError, TypeNotFoundError
 from ninjemys.idl import loader, search
 from ninjemys.idl.fulltext import split_full_text
-from ninjemys.idl.parser import parse_message
+from ninjemys.idl.parser import ACTION_SUFFIXES, parse_message
 from ninjemys.idl.spec import MsgSpec
 from ninjemys.tools.cli import entry, error
 
@@ -66,15 +66,29 @@ def srv_text(type_name: str, raw: bool = False) -> str:
 
 
 def _types_in(package: search.Package, mode: str) -> list[str]:
-    return sorted(package.definitions(mode))
+    """The package's types of this mode; messages include the seven each ``.action`` generates.
+
+    A built ROS 1 package has those seven as ``.msg`` files in its share directory (genaction writes
+    them at build time), so real rosmsg lists them with the others; ours come from the ``.action`` file.
+    """
+    names = set(package.definitions(mode))
+    if mode == "msg":
+        for stem in package.definitions("action"):
+            names.update(f"{stem}{suffix}" for suffix in ACTION_SUFFIXES)
+    return sorted(names)
 
 
 def _packages_with(mode: str) -> list[search.Package]:
-    return [p for _, p in sorted(search.packages().items()) if os.path.isdir(os.path.join(p.path, mode))]
+    dirs = (mode, "action") if mode == "msg" else (mode,)
+    return [
+        p
+        for _, p in sorted(search.packages().items())
+        if any(os.path.isdir(os.path.join(p.path, d)) for d in dirs)
+    ]
 
 
 def _search_bare(mode: str, short: str) -> list[str]:
-    return [f"{p.name}/{short}" for p in _packages_with(mode) if short in p.definitions(mode)]
+    return [f"{p.name}/{short}" for p in _packages_with(mode) if short in _types_in(p, mode)]
 
 
 def _one_arg(parser: argparse.ArgumentParser, args: list[str], what: str) -> str:

@@ -18,6 +18,7 @@ import mimetypes
 from collections.abc import Awaitable, Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 from urllib.parse import parse_qs, unquote, urlsplit
 
 log = logging.getLogger(__name__)
@@ -47,6 +48,10 @@ class Request:
     query: dict[str, list[str]]
     headers: dict[str, str]
     body: bytes = b""
+    #: the request target as sent (path and query, still %-encoded)
+    target: str = ""
+    #: every header line in order, names as sent (a WebSocket handshake needs repeated headers)
+    raw_headers: list[tuple[str, str]] = field(default_factory=list)
 
     def arg(self, name: str, default: str | None = None) -> str | None:
         values = self.query.get(name)
@@ -88,6 +93,11 @@ class EventStream:
 
 Handler = Callable[[Request], Awaitable[Response | EventStream] | Response | EventStream]
 
+if TYPE_CHECKING:
+    import ssl
+
+    from ninjemys.web.websocket import WebSocketEndpoint
+
 
 class HttpError(Exception):
     """Raised by a handler to answer with an error status and a one-line reason."""
@@ -101,10 +111,14 @@ class HttpError(Exception):
 class HttpServer:
     """Routes exact paths (and one static directory) to handlers."""
 
-    def __init__(self, host: str = "127.0.0.1", port: int = 0) -> None:
+    def __init__(
+        self, host: str = "127.0.0.1", port: int = 0, ssl_context: ssl.SSLContext | None = None
+    ) -> None:
         self.host = host
         self.port = port
+        self.ssl_context = ssl_context
         self._routes: dict[tuple[str, str], Handler] = {}
+        self._websockets: dict[str, WebSocketEndpoint] = {}
         self._static: list[tuple[str, Path]] = []
         self._server: asyncio.base_events.Server | None = None
         self._writers: set[asyncio.StreamWriter] = set()
@@ -113,6 +127,11 @@ class HttpServer:
     def route(self, method: str, path: str, handler: Handler) -> None:
         self._routes[(method.upper(), path)] = handler
 
+    def websocket(self, path: str, endpoint: WebSocketEndpoint) -> None:
+        """Accept WebSocket upgrades on ``path`` (see :mod:`ninjemys.web.websocket`); a plain GET of
+        the same path still goes to the HTTP route, if there is one."""
+        self._websockets[path] = endpoint
+
     def static(self, prefix: str, directory: Path) -> None:
         """Serve files under ``directory`` at ``prefix`` (no directory listings, no escaping the root)."""
         self._static.append((prefix.rstrip("/") + "/", directory.resolve()))
@@ -120,10 +139,11 @@ class HttpServer:
     @property
     def url(self) -> str:
         host = "localhost" if self.host in ("127.0.0.1", "0.0.0.0", "") else self.host
-        return f"http://{host}:{self.port}/"
+        scheme = "https" if self.ssl_context is not None else "http"
+        return f"{scheme}://{host}:{self.port}/"
 
     async def start(self) -> None:
-        self._server = await asyncio.start_server(self._serve, self.host, self.port)
+        self._server = await asyncio.start_server(self._serve, self.host, self.port, ssl=self.ssl_context)
         self.port = self._server.sockets[0].getsockname()[1]
 
     async def close(self) -> None:
@@ -147,9 +167,15 @@ class HttpServer:
                 if request is None:
                     return
                 keep_alive = request.headers.get("connection", "").lower() != "close"
+                endpoint = self._websockets.get(request.path)
+                if endpoint is not None and request.headers.get("upgrade", "").lower() == "websocket":
+                    from ninjemys.web.websocket import serve_upgrade  # only WebSocket users load it
+
+                    await serve_upgrade(endpoint, request, reader, writer)
+                    return
                 if not await self._dispatch(request, writer) or not keep_alive:
                     return
-        except (ConnectionError, asyncio.IncompleteReadError, asyncio.CancelledError):
+        except (ConnectionError, asyncio.IncompleteReadError, asyncio.CancelledError, OSError):
             return
         finally:
             self._writers.discard(writer)
@@ -175,10 +201,12 @@ class HttpServer:
             return None
         method, target, _version = parts
         headers = {}
+        raw_headers = []
         for line in lines[1:]:
             if ":" in line:
                 key, value = line.split(":", 1)
                 headers[key.strip().lower()] = value.strip()
+                raw_headers.append((key.strip(), value.strip()))
         try:
             length = int(headers.get("content-length", "0"))
         except ValueError:
@@ -188,7 +216,9 @@ class HttpServer:
             return None
         body = await reader.readexactly(length) if length else b""
         split = urlsplit(target)
-        return Request(method.upper(), unquote(split.path), parse_qs(split.query), headers, body)
+        return Request(
+            method.upper(), unquote(split.path), parse_qs(split.query), headers, body, target, raw_headers
+        )
 
     async def _dispatch(self, request: Request, writer: asyncio.StreamWriter) -> bool:
         """Answer one request; False when the connection must close afterwards."""

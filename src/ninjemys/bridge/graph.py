@@ -1,0 +1,276 @@
+"""The gateway's side of the ROS graph: one core Node shared by every WebSocket client.
+
+- :class:`Taps`: one raw subscription per topic, whatever the number of clients; each message is
+  handed, still serialized, to every client's sink on the subscription's own thread. A
+  :class:`Delivery` deserializes (or JSON-encodes) at most once, however many clients want it.
+- :class:`Publishers`: one publisher per topic shared by the clients that advertise it
+  (reference-counted, as rosbridge's publisher manager).
+- :class:`Services`: service calls with a type learned by probing the provider, persistent
+  connections reused between calls; raw calls (bytes in, bytes out) for Foxglove clients.
+
+Everything here may block on the master or a peer: callers run it off the event loop.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable
+from typing import Any
+
+from ninjemys.errors import NinjemysError, ServiceError
+from ninjemys.idl.loader import get_message_class, get_service_class
+from ninjemys.node import Node
+from ninjemys.node.subscriber import RawMessage
+from ninjemys.tools.rosservice import probe
+
+log = logging.getLogger(__name__)
+
+
+def message_class(type_name: str) -> Any:
+    """The class of ``type_name``; an unknown type raises NinjemysError naming it."""
+    try:
+        return get_message_class(type_name)
+    except NinjemysError as exc:
+        raise NinjemysError(f"unknown message type {type_name}: {exc}") from None
+
+
+def service_class(type_name: str) -> Any:
+    try:
+        return get_service_class(type_name)
+    except NinjemysError as exc:
+        raise NinjemysError(f"unknown service type {type_name}: {exc}") from None
+
+
+class Delivery:
+    """One received message, shared by every client sink: raw bytes, receive time, and lazily
+    computed forms (the message object, encoded texts) that are built once."""
+
+    __slots__ = ("topic", "data", "header", "stamp_ns", "msg_class", "_msg", "cache")
+
+    def __init__(self, topic: str, raw: RawMessage, stamp_ns: int, msg_class: Any) -> None:
+        self.topic = topic
+        self.data = raw.data
+        self.header = raw.connection_header
+        self.stamp_ns = stamp_ns
+        self.msg_class = msg_class
+        self._msg: Any = None
+        self.cache: dict[Any, Any] = {}
+
+    def message(self) -> Any:
+        if self._msg is None:
+            cls = self.msg_class
+            if cls is None:
+                cls = get_message_class(self.header.get("type", ""))
+            self._msg = cls.deserialize_from(bytes(self.data))
+        return self._msg
+
+    def encoded(self, key: Any, build: Callable[[Delivery], Any]) -> Any:
+        """``build(self)`` once per ``key`` (all sinks of a topic run on one thread: no lock needed)."""
+        try:
+            return self.cache[key]
+        except KeyError:
+            value = self.cache[key] = build(self)
+            return value
+
+
+Sink = Callable[[Delivery], None]
+
+
+class _Tap:
+    def __init__(self, node: Node, topic: str, msg_class: Any, clock: Callable[[], int]) -> None:
+        self.topic = topic
+        self.msg_class = msg_class
+        self.sinks: dict[object, Sink] = {}
+        self._clock = clock
+        self.sub = node.subscriber(topic, msg_class, self._on_message, raw=True, queue_size=100)
+
+    def _on_message(self, raw: RawMessage) -> None:
+        delivery = Delivery(self.topic, raw, self._clock(), self.msg_class)
+        for sink in list(self.sinks.values()):
+            try:
+                sink(delivery)
+            except Exception as exc:  # one client's bad state must not stop the others
+                log.warning("gateway: delivering %s failed: %s", self.topic, exc)
+
+
+class Taps:
+    """Raw subscriptions shared by all clients, keyed by topic."""
+
+    def __init__(self, node: Node, clock: Callable[[], int]) -> None:
+        self.node = node
+        self._clock = clock
+        self._taps: dict[str, _Tap] = {}
+        self._lock = threading.Lock()
+
+    def add(self, topic: str, type_name: str | None, owner: object, sink: Sink) -> str:
+        """Start delivering ``topic`` to ``sink``; returns the type used. Raises NinjemysError when the
+        type is unknown or differs from the one the gateway already subscribed with."""
+        with self._lock:
+            tap = self._taps.get(topic)
+            if tap is None:
+                msg_class = message_class(type_name) if type_name and type_name != "*" else None
+                tap = self._taps[topic] = _Tap(self.node, topic, msg_class, self._clock)
+            elif type_name and tap.msg_class is not None and type_name not in ("*", tap.msg_class._type):
+                raise NinjemysError(f"topic {topic} is subscribed as {tap.msg_class._type}, not {type_name}")
+            tap.sinks[owner] = sink
+            return tap.msg_class._type if tap.msg_class is not None else "*"
+
+    def remove(self, topic: str, owner: object) -> None:
+        with self._lock:
+            tap = self._taps.get(topic)
+            if tap is None:
+                return
+            tap.sinks.pop(owner, None)
+            if not tap.sinks:
+                del self._taps[topic]
+                tap.sub.unregister()
+
+    def topics(self) -> list[str]:
+        with self._lock:
+            return list(self._taps)
+
+
+class Publishers:
+    """Publishers shared by the clients advertising a topic (reference-counted per owner)."""
+
+    def __init__(self, node: Node) -> None:
+        self.node = node
+        self._pubs: dict[str, tuple[Any, Any, set[object]]] = {}
+        self._lock = threading.Lock()
+
+    def advertise(
+        self, topic: str, type_name: str, owner: object, latch: bool = False, queue_size: int = 100
+    ) -> Any:
+        """The publisher for ``topic`` (created on first use); raises NinjemysError on a type clash."""
+        msg_class = message_class(type_name)
+        with self._lock:
+            entry = self._pubs.get(topic)
+            if entry is None:
+                pub = self.node.publisher(topic, msg_class, queue_size=queue_size, latch=latch)
+                entry = self._pubs[topic] = (pub, msg_class, set())
+            elif entry[1]._md5sum != msg_class._md5sum:
+                raise NinjemysError(
+                    f"topic {topic} is already advertised as {entry[1]._type}, not {type_name}"
+                )
+            entry[2].add(owner)
+            return entry[0]
+
+    def get(self, topic: str) -> tuple[Any, Any] | None:
+        entry = self._pubs.get(topic)
+        return None if entry is None else (entry[0], entry[1])
+
+    def unadvertise(self, topic: str, owner: object) -> None:
+        with self._lock:
+            entry = self._pubs.get(topic)
+            if entry is None:
+                return
+            entry[2].discard(owner)
+            if not entry[2]:
+                del self._pubs[topic]
+                entry[0].unregister()
+
+
+def _raw_service_class(type_name: str, md5sum: str) -> Any:
+    """A service class whose request is bytes already serialized and whose response stays bytes
+    (Foxglove's service calls carry ROS 1 bytes both ways: nothing is decoded in the gateway)."""
+
+    class RawRequest:
+        _type = type_name + "Request"
+        __slots__ = ("payload",)
+
+        def __init__(self, payload: bytes = b"") -> None:
+            self.payload = payload
+
+        def serialize_to_bytes(self) -> bytes:
+            return self.payload
+
+    class RawResponse:
+        _type = type_name + "Response"
+
+        @classmethod
+        def deserialize_from(cls, buf: bytes | bytearray | memoryview) -> bytes:
+            return bytes(buf)
+
+    class RawService:
+        _type = type_name
+        _md5sum = md5sum
+        _request_class = RawRequest
+        _response_class = RawResponse
+
+    return RawService
+
+
+class Services:
+    """Service calls through the gateway's node: typed (rosbridge) and raw (Foxglove)."""
+
+    def __init__(self, node: Node) -> None:
+        self.node = node
+        self._types: dict[str, tuple[str, dict[str, str]]] = {}  # service -> (uri, provider header)
+        self._proxies: dict[tuple[str, str, bool], Any] = {}
+        self._lock = threading.Lock()
+
+    def provider_header(self, service: str) -> dict[str, str]:
+        """The provider's connection header (``type``, ``md5sum``), probed once per provider URI."""
+        try:
+            uri = self.node.master.lookup_service(service)
+        except NinjemysError as exc:
+            raise ServiceError(f"service {service} does not exist: {exc}") from None
+        cached = self._types.get(service)
+        if cached is not None and cached[0] == uri:
+            return cached[1]
+        try:
+            header = probe(service, uri, timeout=5.0)
+        except NinjemysError as exc:
+            raise ServiceError(str(exc)) from None
+        if "error" in header:
+            raise ServiceError(f"service {service}: {header['error']}")
+        self._types[service] = (uri, header)
+        return header
+
+    def service_type(self, service: str) -> str:
+        return self.provider_header(service).get("type", "")
+
+    def _proxy(self, service: str, service_class: Any, raw: bool) -> Any:
+        key = (service, service_class._md5sum, raw)
+        with self._lock:
+            proxy = self._proxies.get(key)
+            if proxy is None:
+                proxy = self._proxies[key] = self.node.service_proxy(service, service_class, persistent=True)
+            return proxy
+
+    def _call(self, service: str, service_class: Any, raw: bool, request: Any) -> Any:
+        proxy = self._proxy(service, service_class, raw)
+        try:
+            return proxy.call(request)
+        except ServiceError as exc:
+            # a persistent connection to a provider that restarted fails once: retry on a new one
+            if "transport error" not in str(exc) and "handshake failed" not in str(exc):
+                raise
+            with self._lock:
+                self._proxies.pop((service, service_class._md5sum, raw), None)
+            proxy.close()
+            return self._proxy(service, service_class, raw).call(request)
+
+    def call(self, service: str, type_name: str | None, build_request: Callable[[Any], Any]) -> Any:
+        """Call ``service``; ``build_request(request_class)`` makes the request. Returns the response."""
+        type_name = type_name or self.service_type(service)
+        cls = service_class(type_name)
+        return self._call(service, cls, False, build_request(cls._request_class))
+
+    def call_raw(self, service: str, payload: bytes) -> bytes:
+        header = self.provider_header(service)
+        service_class = _raw_service_class(header.get("type", ""), header.get("md5sum", "*"))
+        return self._call(service, service_class, True, service_class._request_class(payload))
+
+    def close(self) -> None:
+        with self._lock:
+            proxies = list(self._proxies.values())
+            self._proxies.clear()
+        for proxy in proxies:
+            proxy.close()
+
+
+def wall_ns() -> int:
+    return time.time_ns()

@@ -1,0 +1,571 @@
+"""The gateway: one WebSocket endpoint speaking rosbridge v2 and Foxglove, on the web tools' HTTP server.
+
+A client that offers a Foxglove subprotocol (``foxglove.websocket.v1``, ``foxglove.sdk.v1``) gets
+the Foxglove protocol; any other client (roslibjs, roslibpy: no subprotocol) gets rosbridge. So one
+port serves both, and the same server serves the static web app (:class:`Gateway.mount` puts the
+endpoint on any :class:`ninjemys.web.http.HttpServer`).
+
+Per client: a :class:`~ninjemys.bridge.outbox.Outbox` (bounded, per-topic lanes, fair) filled by
+ROS threads, and one sender task on the event loop that moves it into the socket only as fast as
+the client reads (the transport buffer is capped; see :mod:`ninjemys.web.websocket`). A client that
+stops reading costs at most its budget; the ROS side and the other clients never wait for it.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import hmac
+import itertools
+import json
+import logging
+import ssl
+import threading
+import time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+from urllib.parse import urlsplit
+
+from websockets.server import ServerProtocol
+
+from ninjemys.bridge.foxglove import SUBPROTOCOLS, FoxgloveSession
+from ninjemys.bridge.graph import Publishers, Services, Taps
+from ninjemys.bridge.outbox import CloseRequest, Outbox
+from ninjemys.bridge.rosbridge import RosbridgeSession
+from ninjemys.errors import NinjemysError
+from ninjemys.idl.loader import get_message_class, get_service_class
+from ninjemys.node import Node
+from ninjemys.web.http import HttpServer, Request, Response
+from ninjemys.web.websocket import WRITE_HIGH_WATER, WebSocket
+
+log = logging.getLogger(__name__)
+
+_LOCAL_HOSTS = {"localhost", "127.0.0.1", "::1", "[::1]"}
+
+
+@dataclass
+class GatewayOptions:
+    """What the launch files' arguments set (names follow rosbridge_websocket.launch / foxglove_bridge.launch)."""
+
+    address: str = "127.0.0.1"
+    port: int = 9090
+    certfile: str | None = None
+    keyfile: str | None = None
+    #: rosbridge ``auth`` op required first (rosauth MAC); Foxglove clients need ``token``
+    authenticate: bool = False
+    #: rosauth's shared secret (the file's text, stripped); also the Foxglove token unless ``token`` is set
+    secret_file: str | None = None
+    token: str | None = None
+    auth_time_delta: float = 5.0
+    #: allowed browser Origins; empty: pages served by this host and localhost pages only
+    origins: list[str] = field(default_factory=list)
+    #: largest message a client may send (bytes); a larger frame gets a status error and a 1009 close
+    max_message_size: int = 10 * 1024 * 1024
+    #: queued data per client before the oldest topic data is dropped (bytes)
+    max_client_bytes: int = 8 * 1024 * 1024
+    #: Foxglove lanes: messages kept per client and channel
+    queue_length: int = 10
+    #: how often the topic and service lists are refreshed (s)
+    update_period: float = 1.0
+    node_name: str = "rosbridge_websocket"
+    protocols: tuple[str, ...] = ("rosbridge", "foxglove")
+
+    def secret(self) -> str | None:
+        if not self.authenticate:
+            return None
+        if self.secret_file is None:
+            raise NinjemysError("authentication is on but no secret file is set (secret_file)")
+        return Path(self.secret_file).read_text().strip()
+
+    def foxglove_token(self) -> str | None:
+        if not self.authenticate:
+            return None
+        return self.token if self.token is not None else self.secret()
+
+    def ssl_context(self) -> ssl.SSLContext | None:
+        if not self.certfile:
+            return None
+        ctx = ssl.SSLContext(ssl.PROTOCOL_TLS_SERVER)
+        ctx.load_cert_chain(self.certfile, self.keyfile or None)
+        return ctx
+
+
+class Catalog:
+    """The topics (Foxglove channels), services and connection graph, refreshed from the master."""
+
+    def __init__(self) -> None:
+        self.channels: dict[int, dict[str, Any]] = {}
+        self.services: dict[int, dict[str, Any]] = {}
+        self._channel_ids: dict[tuple[str, str], int] = {}
+        self._service_ids: dict[tuple[str, str], int] = {}
+        self._ids = itertools.count(1)
+        self._unknown: set[str] = set()
+        self._service_types: dict[str, str] = {}
+        self.graph: dict[str, dict[str, list[str]]] = {"pub": {}, "sub": {}, "srv": {}}
+        self.topic_types: dict[str, str] = {}
+        self._lock = threading.Lock()
+
+    def channel(self, channel_id: int) -> dict[str, Any] | None:
+        return self.channels.get(channel_id)
+
+    def refresh(self, node: Node, services: Services) -> dict[str, Any]:
+        """Poll the master; returns what changed: added/removed channels and services, graph diff."""
+        state = node.master.get_system_state()
+        types = dict(node.master.get_topic_types())
+        pubs = {t: sorted(n) for t, n in state[0]}
+        subs = {t: sorted(n) for t, n in state[1]}
+        srvs = {s: sorted(n) for s, n in state[2]}
+        added, removed = [], []
+        wanted: dict[tuple[str, str], None] = {}
+        for topic in pubs:
+            type_name = types.get(topic)
+            if not type_name or type_name == "*":
+                continue
+            try:
+                msg_class = get_message_class(type_name)
+            except NinjemysError as exc:
+                if type_name not in self._unknown:
+                    self._unknown.add(type_name)
+                    log.warning("gateway: topic %s skipped: %s", topic, exc)
+                continue
+            key = (topic, type_name)
+            wanted[key] = None
+            if key not in self._channel_ids:
+                cid = next(self._ids)
+                channel = {
+                    "id": cid,
+                    "topic": topic,
+                    "encoding": "ros1",
+                    "schemaName": type_name,
+                    "schema": msg_class._full_text,
+                    "schemaEncoding": "ros1msg",
+                }
+                with self._lock:
+                    self._channel_ids[key] = cid
+                    self.channels[cid] = channel
+                added.append(channel)
+        for key in [k for k in self._channel_ids if k not in wanted]:
+            with self._lock:
+                cid = self._channel_ids.pop(key)
+                self.channels.pop(cid, None)
+            removed.append(cid)
+        added_srv, removed_srv = [], []
+        present = set()
+        for name in srvs:
+            # a provider's type is probed once per service name, not on every refresh
+            type_name = self._service_types.get(name)
+            try:
+                if type_name is None:
+                    type_name = self._service_types[name] = services.service_type(name)
+                service_class = get_service_class(type_name)
+            except NinjemysError:
+                continue
+            key = (name, type_name)
+            present.add(key)
+            if key not in self._service_ids:
+                sid = next(self._ids)
+                req, resp = service_class._request_class, service_class._response_class
+                entry = {
+                    "id": sid,
+                    "name": name,
+                    "type": type_name,
+                    "requestSchema": req._full_text,
+                    "responseSchema": resp._full_text,
+                    "request": {
+                        "encoding": "ros1",
+                        "schemaName": req._type,
+                        "schemaEncoding": "ros1msg",
+                        "schema": req._full_text,
+                    },
+                    "response": {
+                        "encoding": "ros1",
+                        "schemaName": resp._type,
+                        "schemaEncoding": "ros1msg",
+                        "schema": resp._full_text,
+                    },
+                }
+                with self._lock:
+                    self._service_ids[key] = sid
+                    self.services[sid] = entry
+                added_srv.append(entry)
+        for name in [n for n in self._service_types if n not in srvs]:
+            del self._service_types[name]
+        for key in [k for k in self._service_ids if k not in present]:
+            with self._lock:
+                sid = self._service_ids.pop(key)
+                self.services.pop(sid, None)
+            removed_srv.append(sid)
+        old = self.graph
+        self.graph = {"pub": pubs, "sub": subs, "srv": srvs}
+        self.topic_types = types
+        return {
+            "channels": added,
+            "removed_channels": removed,
+            "services": added_srv,
+            "removed_services": removed_srv,
+            "graph_changed": old != self.graph,
+            "old_graph": old,
+        }
+
+    def graph_update(self, full: bool, old: dict[str, dict[str, list[str]]] | None = None) -> dict[str, Any]:
+        g = self.graph
+        old = old if old is not None and not full else {"pub": {}, "sub": {}, "srv": {}}
+
+        def changed(kind: str) -> list[str]:
+            return [k for k, v in g[kind].items() if old[kind].get(k) != v]
+
+        return {
+            "op": "connectionGraphUpdate",
+            "publishedTopics": [{"name": t, "publisherIds": g["pub"][t]} for t in changed("pub")],
+            "subscribedTopics": [{"name": t, "subscriberIds": g["sub"][t]} for t in changed("sub")],
+            "advertisedServices": [{"name": s, "providerIds": g["srv"][s]} for s in changed("srv")],
+            "removedTopics": sorted((set(old["pub"]) | set(old["sub"])) - (set(g["pub"]) | set(g["sub"]))),
+            "removedServices": sorted(set(old["srv"]) - set(g["srv"])),
+        }
+
+
+class _Client:
+    """One connection: its protocol session, outbox and sender task."""
+
+    def __init__(
+        self, client_id: int, ws: WebSocket, loop: asyncio.AbstractEventLoop, max_bytes: int
+    ) -> None:
+        self.id = client_id
+        self.ws = ws
+        self.loop = loop
+        self.wake = asyncio.Event()
+        self.outbox = Outbox(max_bytes, self._wake_threadsafe)
+        self.session: RosbridgeSession | FoxgloveSession | None = None
+        self.reported: dict[str, int] = {}
+
+    def _wake_threadsafe(self) -> None:
+        try:
+            self.loop.call_soon_threadsafe(self.wake.set)
+        except RuntimeError:  # the loop is gone: the client is being torn down
+            pass
+
+
+class Gateway:
+    """The gateway's node and its WebSocket endpoint; see the module docstring."""
+
+    def __init__(self, options: GatewayOptions | None = None, node: Node | None = None) -> None:
+        self.options = options or GatewayOptions()
+        self.node = node if node is not None else Node(self.options.node_name)
+        self._own_node = node is None
+        self.catalog = Catalog()
+        self.sim_time = bool(self._param("/use_sim_time", False))
+        self.taps = Taps(self.node, self._now_ns)
+        self.publishers = Publishers(self.node)
+        self.services = Services(self.node)
+        self.pool = ThreadPoolExecutor(8, thread_name_prefix="gateway")
+        self.session_id = str(time.time_ns())
+        self._clients: dict[int, _Client] = {}
+        self._ids = itertools.count(1)
+        self._stop = threading.Event()
+        self._sim_ns = 0
+        self._watched: set[str] = set()
+        self._clock_sub: Any = None
+        self._client_count: Any = None
+        self._poller = threading.Thread(target=self._poll, name="gateway-graph", daemon=True)
+        self._http: HttpServer | None = None
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._thread: threading.Thread | None = None
+        self._reporter: asyncio.Task[None] | None = None
+
+    def _param(self, key: str, default: Any) -> Any:
+        try:
+            return self.node.get_param(key, default)
+        except NinjemysError:
+            return default
+
+    def _now_ns(self) -> int:
+        return self._sim_ns if self.sim_time else time.time_ns()
+
+    def topic_type(self, topic: str) -> str | None:
+        known = self.catalog.topic_types.get(topic)
+        if known:
+            return known
+        try:
+            return dict(self.node.master.get_topic_types()).get(topic)
+        except NinjemysError:
+            return None
+
+    # -- graph polling ----------------------------------------------------------------------
+    def start(self) -> None:
+        """Start watching the graph (and /clock under sim time); publish ``client_count`` as rosbridge does."""
+        self._client_count = self.node.publisher(
+            "client_count", get_message_class("std_msgs/Int32"), queue_size=1, latch=True
+        )
+        self._count_clients()
+        if self.sim_time:
+            self._clock_sub = self.node.subscriber(
+                "/clock", get_message_class("rosgraph_msgs/Clock"), self._on_clock, queue_size=1
+            )
+        self._refresh()
+        self._poller.start()
+
+    def _count_clients(self) -> None:
+        if self._client_count is not None:
+            self._client_count.publish(get_message_class("std_msgs/Int32")(data=len(self._clients)))
+
+    def _on_clock(self, msg: Any) -> None:
+        self._sim_ns = msg.clock.secs * 1_000_000_000 + msg.clock.nsecs
+        for client in list(self._clients.values()):
+            if isinstance(client.session, FoxgloveSession):
+                client.session.send_time(self._sim_ns)
+
+    def _poll(self) -> None:
+        while not self._stop.wait(self.options.update_period):
+            self._refresh()
+
+    def _refresh(self) -> None:
+        try:
+            diff = self.catalog.refresh(self.node, self.services)
+        except NinjemysError as exc:
+            log.warning("gateway: graph refresh failed: %s", exc)
+            return
+        foxes = [c.session for c in list(self._clients.values()) if isinstance(c.session, FoxgloveSession)]
+        for fox in foxes:
+            if diff["removed_channels"]:
+                fox.send({"op": "unadvertise", "channelIds": diff["removed_channels"]})
+            if diff["channels"]:
+                fox.send({"op": "advertise", "channels": diff["channels"]})
+            if diff["removed_services"]:
+                fox.send({"op": "unadvertiseServices", "serviceIds": diff["removed_services"]})
+            if diff["services"]:
+                fox.send({"op": "advertiseServices", "services": diff["services"]})
+            if diff["graph_changed"] and fox.graph_subscribed:
+                fox.send(self.catalog.graph_update(full=False, old=diff["old_graph"]))
+
+    def watch_param(self, name: str) -> None:
+        """Forward master paramUpdate for ``name`` to the Foxglove clients that subscribed it."""
+        if name in self._watched:
+            return
+        self._watched.add(name)
+        self.node.subscribe_param(name, self._param_changed)
+
+    def _param_changed(self, key: str, value: Any) -> None:
+        name = key.rstrip("/") or "/"
+        for client in list(self._clients.values()):
+            if isinstance(client.session, FoxgloveSession):
+                client.session.param_changed(name, value)
+
+    # -- the WebSocket endpoint ---------------------------------------------------------------
+    def mount(self, server: HttpServer, path: str = "/") -> None:
+        """Serve the gateway on ``server`` at ``path`` (plus its status at /api/bridge/status).
+
+        Call :meth:`start` too (graph polling); the server's own loop then runs the connections."""
+        server.websocket(path, self)
+        server.route("GET", "/api/bridge/status", lambda _r: Response(self.status()))
+
+    def handshake(self, request: Request) -> ServerProtocol | tuple[int, str]:
+        offered = [
+            p.strip() for p in request.headers.get("sec-websocket-protocol", "").split(",") if p.strip()
+        ]
+        foxglove = any(p in SUBPROTOCOLS for p in offered)
+        kind = "foxglove" if foxglove else "rosbridge"
+        if kind not in self.options.protocols:
+            return (400, f"this server does not speak {kind}")
+        origin = request.headers.get("origin")
+        if origin is not None and not self._origin_ok(origin, request.headers.get("host", "")):
+            return (403, f"origin {origin} is not allowed (see the origins option)")
+        if foxglove:
+            token = self.options.foxglove_token()
+            if token is not None:
+                given = request.arg("token") or ""
+                auth = request.headers.get("authorization", "")
+                if auth.lower().startswith("bearer "):
+                    given = auth[7:].strip()
+                if not hmac.compare_digest(given.encode(), token.encode()):
+                    return (401, "a valid token is required (?token=... or Authorization: Bearer ...)")
+
+        def select(_protocol: ServerProtocol, subprotocols: Any) -> Any:
+            for p in subprotocols:
+                if p in SUBPROTOCOLS:
+                    return p
+            return None
+
+        return ServerProtocol(select_subprotocol=select, max_size=self.options.max_message_size)
+
+    def _origin_ok(self, origin: str, host: str) -> bool:
+        allowed = self.options.origins
+        if "*" in allowed or origin in allowed:
+            return True
+        if allowed:
+            return False
+        origin_host = urlsplit(origin).hostname or ""
+        own_host = urlsplit("//" + host).hostname or ""
+        return origin_host in _LOCAL_HOSTS or origin_host == own_host
+
+    async def serve(self, ws: WebSocket) -> None:
+        loop = asyncio.get_running_loop()
+        if self._reporter is None:  # on whichever server's loop the gateway is mounted
+            self._loop = self._loop or loop
+            self._reporter = loop.create_task(self._report_drops())
+        client = _Client(next(self._ids), ws, loop, self.options.max_client_bytes)
+        if ws.subprotocol in SUBPROTOCOLS:
+            session: RosbridgeSession | FoxgloveSession = FoxgloveSession(self, client.id, client.outbox)
+            ws.on_oversized = lambda why: json.dumps(
+                {"op": "status", "level": 2, "message": f"message too big: {why}"}
+            )
+        else:
+            session = RosbridgeSession(self, client.id, client.outbox, lambda text: None)
+            ws.on_oversized = lambda why: json.dumps(
+                {"op": "status", "level": "error", "msg": f"message too big: {why}"}
+            )
+        client.session = session
+        self._clients[client.id] = client
+        self._count_clients()
+        log.info(
+            "gateway: client %d (%s) connected from %s", client.id, ws.subprotocol or "rosbridge", ws.peer
+        )
+        if isinstance(session, FoxgloveSession):
+            session.hello()
+        sender = asyncio.create_task(self._sender(client))
+        try:
+            async for data in ws.messages():
+                session.receive(data)
+        finally:
+            sender.cancel()
+            self._clients.pop(client.id, None)
+            self._count_clients()
+            session.close()
+            log.info("gateway: client %d disconnected", client.id)
+
+    async def _sender(self, client: _Client) -> None:
+        ws, outbox = client.ws, client.outbox
+        limit = self.options.max_client_bytes
+        try:
+            while not ws.closed:
+                await client.wake.wait()
+                client.wake.clear()
+                while (item := outbox.take()) is not None:
+                    if isinstance(item, CloseRequest):
+                        ws.close(item.code, item.reason)
+                        return
+                    if isinstance(item, tuple):
+                        for frame in item:
+                            ws.send(frame)
+                    else:
+                        ws.send(item)
+                    if ws.buffered > WRITE_HIGH_WATER:
+                        await ws.drain()
+                    if outbox.bytes > 4 * limit:  # replies pile up: the client is not reading at all
+                        ws.close(1008, "client too slow: its replies exceed the memory budget")
+                        return
+        except (ConnectionError, asyncio.CancelledError):
+            return
+
+    def close_client(self, client_id: int, code: int, reason: str) -> None:
+        """Close a client's connection once what was queued for it before is sent."""
+        client = self._clients.get(client_id)
+        if client is not None:
+            client.outbox.put_control(CloseRequest(code, reason))
+
+    async def _report_drops(self) -> None:
+        """Once a second, tell each client about data dropped for it since the last report."""
+        while True:
+            await asyncio.sleep(1.0)
+            for client in list(self._clients.values()):
+                for lane, count in list(client.outbox.dropped.items()):
+                    new = count - client.reported.get(lane, 0)
+                    if new <= 0 or lane.startswith("\0"):
+                        continue
+                    client.reported[lane] = count
+                    topic = lane.split("#", 1)[0]
+                    text = f"dropped {new} messages on {topic} (client reads too slowly; {count} in all)"
+                    if isinstance(client.session, FoxgloveSession):
+                        client.session.status(1, text)
+                    elif isinstance(client.session, RosbridgeSession):
+                        client.session.status("warning", text)
+
+    def status(self) -> dict[str, Any]:
+        """Per client: protocol, queued bytes and drops per topic (GET /api/bridge/status)."""
+        return {
+            "clients": [
+                {
+                    "id": c.id,
+                    "protocol": c.ws.subprotocol or "rosbridge",
+                    "peer": c.ws.peer,
+                    "queued_bytes": c.outbox.bytes,
+                    "dropped": {
+                        k.split("#", 1)[0]: v for k, v in c.outbox.dropped.items() if not k.startswith("\0")
+                    },
+                }
+                for c in list(self._clients.values())
+            ],
+            "subscriptions": self.taps.topics(),
+        }
+
+    # -- standalone server --------------------------------------------------------------------
+    def run_in_thread(self) -> str:
+        """Start the gateway and its own HTTP server on a loop thread; returns the ws:// URL."""
+        from ninjemys.web.app import STATIC_DIR
+
+        self.start()
+        self._http = HttpServer(self.options.address, self.options.port, self.options.ssl_context())
+        self._http.static("/static", STATIC_DIR)
+        self.mount(self._http)
+        started = threading.Event()
+        errors: list[BaseException] = []
+
+        def run() -> None:
+            loop = self._loop = asyncio.new_event_loop()
+            asyncio.set_event_loop(loop)
+            try:
+                assert self._http is not None
+                loop.run_until_complete(self._http.start())
+            except BaseException as exc:
+                errors.append(exc)
+                started.set()
+                return
+            started.set()
+            try:
+                loop.run_forever()
+            finally:
+                loop.run_until_complete(self._http.close())
+                pending = [t for t in asyncio.all_tasks(loop) if not t.done()]
+                for task in pending:
+                    task.cancel()
+                loop.run_until_complete(asyncio.gather(*pending, return_exceptions=True))
+                loop.close()
+
+        self._thread = threading.Thread(target=run, name="gateway-loop", daemon=True)
+        self._thread.start()
+        started.wait(10.0)
+        if errors:
+            self.shutdown()
+            raise errors[0]
+        return self.url
+
+    @property
+    def url(self) -> str:
+        assert self._http is not None
+        return self._http.url.replace("http", "ws", 1)
+
+    @property
+    def port(self) -> int:
+        assert self._http is not None
+        return self._http.port
+
+    def shutdown(self) -> None:
+        """Close every client, stop polling; stops the loop only when the gateway runs its own."""
+        self._stop.set()
+        loop = self._loop
+        if loop is not None and not loop.is_closed():
+            try:
+                for client in list(self._clients.values()):
+                    loop.call_soon_threadsafe(client.ws.close, 1001, "server shutting down")
+                if self._reporter is not None:
+                    loop.call_soon_threadsafe(self._reporter.cancel)
+                if self._thread is not None:
+                    loop.call_soon_threadsafe(loop.stop)
+            except RuntimeError:  # the loop closed meanwhile
+                pass
+        if self._thread is not None:
+            self._thread.join(5.0)
+        self.services.close()
+        self.pool.shutdown(wait=False, cancel_futures=True)
+        if self._own_node:
+            self.node.shutdown("gateway shut down")

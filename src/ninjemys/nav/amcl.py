@@ -1,0 +1,319 @@
+"""Adaptive Monte Carlo localization, as ROS's amcl does it, over numpy arrays of particles.
+
+No ROS in here. The pieces are amcl's:
+
+- the diff-drive odometry model (``odom_alpha1..4``): each odometry step is split into a rotation,
+  a translation and a rotation; each is perturbed with a Gaussian whose variance is
+  ``a1*rot^2 + a2*trans^2`` (rotations) or ``a3*trans^2 + a4*(rot1^2 + rot2^2)`` (translation),
+  rotations measured the short way round whether the robot drove forwards or backwards;
+- the likelihood-field laser model: each used beam's endpoint is looked up in a precomputed field of
+  distances to the nearest occupied cell (capped at ``laser_likelihood_max_dist``);
+  ``pz = z_hit * exp(-d^2 / (2 sigma_hit^2)) + z_rand / range_max`` and a particle's weight is
+  multiplied by ``1 + sum(pz^3)`` (amcl's own ad hoc combination); readings at or beyond
+  ``range_max``, or NaN, are skipped; ``laser_max_beams`` beams are taken evenly;
+- KLD-sampling: after low-variance resampling, the particle count is the smallest n for which the
+  number k of occupied histogram bins (0.5 m x 0.5 m x 10 deg) among the first n needs no more than n
+  (Fox's bound with ``kld_err`` and ``kld_z``), between ``min_particles`` and ``max_particles``;
+- recovery: running averages ``w_slow``/``w_fast`` of the mean weight (``recovery_alpha_slow/fast``)
+  inject uniformly drawn particles with probability ``max(0, 1 - w_fast / w_slow)``;
+- the estimate is the weighted mean of the heaviest cluster of connected bins, with its covariance.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+from ninjemys.nav.costmap import distance_transform
+from ninjemys.nav.mapio import GridMap
+
+BIN_XY = 0.5
+BIN_TH = math.radians(10.0)
+
+
+@dataclass
+class AMCLParams:
+    """amcl's main parameters (``~name`` in ROS 1)."""
+
+    min_particles: int = 100
+    max_particles: int = 2000
+    kld_err: float = 0.01
+    kld_z: float = 0.99
+    update_min_d: float = 0.2
+    update_min_a: float = math.pi / 6.0
+    resample_interval: int = 2
+    recovery_alpha_slow: float = 0.0
+    recovery_alpha_fast: float = 0.0
+    laser_max_beams: int = 30
+    laser_min_range: float = -1.0
+    laser_max_range: float = -1.0
+    laser_z_hit: float = 0.95
+    laser_z_rand: float = 0.05
+    laser_sigma_hit: float = 0.2
+    laser_likelihood_max_dist: float = 2.0
+    odom_alpha1: float = 0.2
+    odom_alpha2: float = 0.2
+    odom_alpha3: float = 0.2
+    odom_alpha4: float = 0.2
+
+    def update(self, values: dict[str, object]) -> None:
+        """Set the named fields that exist (coerced to each field's type)."""
+        for f in fields(self):
+            if f.name in values:
+                kind = type(getattr(self, f.name))
+                setattr(self, f.name, kind(values[f.name]))  # type: ignore[call-arg]
+
+
+def wrap(a: np.ndarray | float) -> np.ndarray | float:
+    """Angles wrapped into [-pi, pi)."""
+    return (np.asarray(a) + math.pi) % (2 * math.pi) - math.pi
+
+
+def kld_limit(k: np.ndarray | int, err: float, z: float) -> np.ndarray:
+    """Fox's KLD bound: particles needed for ``k`` occupied bins (amcl's pf_resample_limit)."""
+    k = np.asarray(k, dtype=float)
+    km1 = np.maximum(k - 1.0, 1e-9)
+    a = 2.0 / (9.0 * km1)
+    n = km1 / (2.0 * err) * (1.0 - a + np.sqrt(a) * z) ** 3
+    return np.where(k <= 1, 0.0, n)
+
+
+def bins_of(poses: np.ndarray) -> np.ndarray:
+    """Integer histogram bins (n, 3) of poses: 0.5 m x 0.5 m x 10 degrees."""
+    return np.column_stack(
+        [
+            np.floor(poses[:, 0] / BIN_XY),
+            np.floor(poses[:, 1] / BIN_XY),
+            np.floor(poses[:, 2] / BIN_TH),
+        ]
+    ).astype(np.int64)
+
+
+class ParticleFilter:
+    """amcl's particle filter over one map. ``poses`` (n, 3) and ``weights`` (n,) are the set."""
+
+    def __init__(self, grid: GridMap, params: AMCLParams | None = None, seed: int | None = None) -> None:
+        self.params = params or AMCLParams()
+        self.rng = np.random.default_rng(seed)
+        self.set_map(grid)
+        self.poses = np.zeros((0, 3))
+        self.weights = np.zeros(0)
+        self.w_slow = 0.0
+        self.w_fast = 0.0
+
+    # -- map --------------------------------------------------------------------------------------
+
+    def set_map(self, grid: GridMap) -> None:
+        """Take a new map: rebuild the likelihood field and the free cells for uniform draws."""
+        self.grid = grid
+        p = self.params
+        reach = max(1, int(math.ceil(p.laser_likelihood_max_dist / grid.resolution)))
+        dist = distance_transform(grid.data >= 65, reach) * grid.resolution
+        self.field = np.minimum(dist, p.laser_likelihood_max_dist)
+        self.free_cells = np.argwhere(grid.data == 0)  # (row, col)
+
+    # -- initialisation ---------------------------------------------------------------------------
+
+    def init_gaussian(
+        self, mean: tuple[float, float, float], cov_xx: float, cov_yy: float, cov_aa: float
+    ) -> None:
+        """Particles around ``mean`` (x, y, yaw) with the given variances (the initialpose topic)."""
+        n = self.params.max_particles
+        self.poses = np.column_stack(
+            [
+                self.rng.normal(mean[0], math.sqrt(max(cov_xx, 0.0)), n),
+                self.rng.normal(mean[1], math.sqrt(max(cov_yy, 0.0)), n),
+                wrap(self.rng.normal(mean[2], math.sqrt(max(cov_aa, 0.0)), n)),
+            ]
+        )
+        self.weights = np.full(n, 1.0 / n)
+        self.w_slow = self.w_fast = 0.0
+
+    def uniform_poses(self, n: int) -> np.ndarray:
+        """``n`` poses drawn uniformly over the map's free cells (the global_localization service)."""
+        g = self.grid
+        if len(self.free_cells) == 0:
+            return np.zeros((0, 3))
+        pick = self.free_cells[self.rng.integers(0, len(self.free_cells), n)]
+        x = g.origin[0] + (pick[:, 1] + self.rng.random(n)) * g.resolution
+        y = g.origin[1] + (pick[:, 0] + self.rng.random(n)) * g.resolution
+        th = self.rng.uniform(-math.pi, math.pi, n)
+        return np.column_stack([x, y, th])
+
+    def init_global(self) -> None:
+        n = self.params.max_particles
+        self.poses = self.uniform_poses(n)
+        self.weights = np.full(len(self.poses), 1.0 / max(1, len(self.poses)))
+        self.w_slow = self.w_fast = 0.0
+
+    # -- motion -----------------------------------------------------------------------------------
+
+    def motion_update(self, old: tuple[float, float, float], new: tuple[float, float, float]) -> None:
+        """Move every particle by the odometry step ``old`` -> ``new`` with amcl's diff noise."""
+        p = self.params
+        n = len(self.poses)
+        if n == 0:
+            return
+        dx, dy = new[0] - old[0], new[1] - old[1]
+        trans = math.hypot(dx, dy)
+        rot1 = float(wrap(math.atan2(dy, dx) - old[2])) if trans >= 0.01 else 0.0
+        rot2 = float(wrap(new[2] - old[2] - rot1))
+        r1n = min(abs(float(wrap(rot1))), abs(float(wrap(rot1 - math.pi))))
+        r2n = min(abs(float(wrap(rot2))), abs(float(wrap(rot2 - math.pi))))
+        rng = self.rng
+        s1 = math.sqrt(p.odom_alpha1 * r1n * r1n + p.odom_alpha2 * trans * trans)
+        st = math.sqrt(p.odom_alpha3 * trans * trans + p.odom_alpha4 * (r1n * r1n + r2n * r2n))
+        s2 = math.sqrt(p.odom_alpha1 * r2n * r2n + p.odom_alpha2 * trans * trans)
+        rot1_h = rot1 - rng.normal(0.0, s1, n) if s1 > 0 else np.full(n, rot1)
+        trans_h = trans - rng.normal(0.0, st, n) if st > 0 else np.full(n, trans)
+        rot2_h = rot2 - rng.normal(0.0, s2, n) if s2 > 0 else np.full(n, rot2)
+        th = self.poses[:, 2]
+        self.poses[:, 0] += trans_h * np.cos(th + rot1_h)
+        self.poses[:, 1] += trans_h * np.sin(th + rot1_h)
+        self.poses[:, 2] = wrap(th + rot1_h + rot2_h)
+
+    # -- sensor -----------------------------------------------------------------------------------
+
+    def sensor_update(
+        self,
+        ranges: np.ndarray,
+        angles: np.ndarray,
+        range_max: float,
+        laser_pose: tuple[float, float, float] = (0.0, 0.0, 0.0),
+        range_min: float = 0.0,
+    ) -> float:
+        """Weigh the particles by one scan (angles in the laser frame); returns the mean weight."""
+        p = self.params
+        n = len(self.poses)
+        if n == 0:
+            return 0.0
+        ranges = np.asarray(ranges, dtype=float)
+        angles = np.asarray(angles, dtype=float)
+        if p.laser_max_range > 0:
+            range_max = min(range_max, p.laser_max_range)
+        if p.laser_min_range > 0:
+            range_min = max(range_min, p.laser_min_range)
+        count = len(ranges)
+        beams = max(2, p.laser_max_beams)
+        if count > beams:
+            idx = (np.arange(beams) * ((count - 1) / (beams - 1))).astype(np.int64)
+            ranges, angles = ranges[idx], angles[idx]
+        use = np.isfinite(ranges) & (ranges < range_max) & (ranges >= range_min)
+        r, a = ranges[use], angles[use]
+        if r.size == 0:
+            return float(self.weights.mean()) if n else 0.0
+        # endpoints in the laser frame, then in the map for every particle
+        lx, ly, lth = laser_pose
+        bx = lx + r * np.cos(lth + a)
+        by = ly + r * np.sin(lth + a)
+        c, s = np.cos(self.poses[:, 2])[:, None], np.sin(self.poses[:, 2])[:, None]
+        mx = self.poses[:, 0:1] + c * bx - s * by
+        my = self.poses[:, 1:2] + s * bx + c * by
+        g = self.grid
+        ix = np.floor((mx - g.origin[0]) / g.resolution).astype(np.int64)
+        iy = np.floor((my - g.origin[1]) / g.resolution).astype(np.int64)
+        inside = (ix >= 0) & (ix < g.width) & (iy >= 0) & (iy < g.height)
+        z = np.full(mx.shape, p.laser_likelihood_max_dist)
+        z[inside] = self.field[iy[inside], ix[inside]]
+        denom = 2.0 * p.laser_sigma_hit * p.laser_sigma_hit
+        pz = p.laser_z_hit * np.exp(-(z * z) / denom) + p.laser_z_rand / range_max
+        like = 1.0 + (pz * pz * pz).sum(axis=1)
+        w = self.weights * like
+        total = float(w.sum())
+        if total <= 0 or not math.isfinite(total):
+            self.weights = np.full(n, 1.0 / n)
+            return 0.0
+        w_avg = total / n
+        self.weights = w / total
+        if self.w_slow == 0.0:
+            self.w_slow = w_avg
+        else:
+            self.w_slow += p.recovery_alpha_slow * (w_avg - self.w_slow)
+        if self.w_fast == 0.0:
+            self.w_fast = w_avg
+        else:
+            self.w_fast += p.recovery_alpha_fast * (w_avg - self.w_fast)
+        return w_avg
+
+    # -- resampling -------------------------------------------------------------------------------
+
+    def resample(self) -> None:
+        """Low-variance resampling with KLD-adapted size and recovery injection."""
+        p = self.params
+        if len(self.poses) == 0:
+            return
+        m = p.max_particles
+        w_diff = 0.0
+        if self.w_slow > 0:
+            w_diff = max(0.0, 1.0 - self.w_fast / self.w_slow)
+        cum = np.cumsum(self.weights)
+        cum[-1] = 1.0
+        u = (self.rng.random() + np.arange(m)) / m
+        picked = self.poses[np.searchsorted(cum, u)]
+        picked = picked[self.rng.permutation(m)]
+        if w_diff > 0:
+            inject = self.rng.random(m) < w_diff
+            k = int(inject.sum())
+            if k:
+                picked[inject] = self.uniform_poses(k)
+        bins = bins_of(picked)
+        _, first = np.unique(bins, axis=0, return_index=True)
+        is_first = np.zeros(m, dtype=np.int64)
+        is_first[first] = 1
+        k_of_n = np.cumsum(is_first)  # occupied bins among the first n+1 particles
+        needed = kld_limit(k_of_n, p.kld_err, p.kld_z)
+        ok = np.nonzero((np.arange(1, m + 1) >= needed) & (np.arange(1, m + 1) >= p.min_particles))[0]
+        count = int(ok[0]) + 1 if ok.size else m
+        count = max(min(count, m), min(p.min_particles, m))
+        self.poses = picked[:count].copy()
+        self.weights = np.full(count, 1.0 / count)
+        if w_diff > 0:
+            self.w_slow = self.w_fast = 0.0  # amcl resets the averages after injecting
+
+    # -- estimate ---------------------------------------------------------------------------------
+
+    def estimate(self) -> tuple[np.ndarray, np.ndarray]:
+        """(mean (3,), covariance (3, 3)) of the heaviest cluster of connected occupied bins."""
+        if len(self.poses) == 0:
+            return np.zeros(3), np.eye(3)
+        bins = bins_of(self.poses)
+        keys, inverse = np.unique(bins, axis=0, return_inverse=True)
+        inverse = inverse.ravel()
+        bin_w = np.bincount(inverse, weights=self.weights, minlength=len(keys))
+        index = {tuple(k): i for i, k in enumerate(keys.tolist())}
+        label = [-1] * len(keys)
+        cluster_w: list[float] = []
+        offsets = [
+            (a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1) if (a, b, c) != (0, 0, 0)
+        ]
+        nth = int(round(2 * math.pi / BIN_TH))
+        for start in range(len(keys)):
+            if label[start] >= 0:
+                continue
+            cid = len(cluster_w)
+            label[start] = cid
+            stack = [start]
+            total = 0.0
+            while stack:
+                i = stack.pop()
+                total += bin_w[i]
+                kx, ky, kt = keys[i]
+                for a, b, c in offsets:
+                    t = kt + c  # theta bins run -nth/2 .. nth/2 - 1 and wrap around
+                    t = t + nth if t < -nth // 2 else t - nth if t >= nth // 2 else t
+                    j = index.get((kx + a, ky + b, t))
+                    if j is not None and label[j] < 0:
+                        label[j] = cid
+                        stack.append(j)
+            cluster_w.append(total)
+        best = int(np.argmax(cluster_w))
+        member = np.asarray(label)[inverse] == best
+        pts, w = self.poses[member], self.weights[member]
+        w = w / w.sum()
+        mx, my = float(w @ pts[:, 0]), float(w @ pts[:, 1])
+        mth = math.atan2(float(w @ np.sin(pts[:, 2])), float(w @ np.cos(pts[:, 2])))
+        d = np.column_stack([pts[:, 0] - mx, pts[:, 1] - my, wrap(pts[:, 2] - mth)])
+        cov = (d * w[:, None]).T @ d
+        return np.array([mx, my, mth]), cov

@@ -1,0 +1,232 @@
+"""The local planner: the Dynamic Window Approach with dwa_local_planner's parameters and scoring.
+
+No ROS in here. Each control cycle samples ``vx_samples x vth_samples`` velocities inside the window
+reachable within one cycle (``acc_lim_x``, ``acc_lim_theta``, ``1 / controller_frequency``), rolls each
+out for ``sim_time`` as an arc, drops those that touch an inscribed, lethal or unknown cell, and scores
+the rest as dwa_local_planner does (all distances in cells of the local costmap)::
+
+    cost = path_distance_bias * 0.5 * res * (distance from the arc's end to the plan)
+         + goal_distance_bias * 0.5 * res * (distance from the arc's end to the local goal)
+         + occdist_scale * (highest cell cost along the arc)
+         + the same two distance terms for a point ``forward_point_distance`` ahead (alignment),
+           left out near the goal
+
+Within ``xy_goal_tolerance`` of the goal the robot stops and turns in place to the goal's yaw
+(``yaw_goal_tolerance``), like dwa's LatchedStopRotateController (``latch_xy_goal_tolerance``).
+Everything for one cycle is a handful of numpy operations over all samples at once.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+from ninjemys.nav.costmap import INSCRIBED, NO_INFORMATION, Costmap, distance_transform
+
+
+def angle_diff(a: float, b: float) -> float:
+    """a - b wrapped into [-pi, pi)."""
+    return (a - b + math.pi) % (2 * math.pi) - math.pi
+
+
+@dataclass
+class DWAParams:
+    """dwa_local_planner's main parameters (``~DWAPlannerROS/<name>`` in ROS 1)."""
+
+    max_vel_x: float = 0.3
+    min_vel_x: float = 0.0
+    max_vel_trans: float = 0.3
+    min_vel_trans: float = 0.05
+    max_vel_theta: float = 1.5
+    min_vel_theta: float = 0.3
+    acc_lim_x: float = 1.5
+    acc_lim_theta: float = 4.0
+    sim_time: float = 1.5
+    sim_granularity: float = 0.05
+    vx_samples: int = 8
+    vth_samples: int = 21
+    controller_frequency: float = 20.0
+    path_distance_bias: float = 32.0
+    goal_distance_bias: float = 20.0
+    occdist_scale: float = 0.02
+    forward_point_distance: float = 0.2
+    xy_goal_tolerance: float = 0.1
+    yaw_goal_tolerance: float = 0.15
+    latch_xy_goal_tolerance: bool = True
+    prune_plan: bool = True
+
+    def update(self, values: dict[str, object]) -> list[str]:
+        """Set the fields named in ``values`` (ints and floats coerced); return the unknown names."""
+        known = {f.name: f.type for f in fields(self)}
+        unknown = []
+        for key, value in values.items():
+            if key not in known:
+                unknown.append(key)
+                continue
+            current = getattr(self, key)
+            if isinstance(current, bool):
+                setattr(self, key, bool(value))
+            elif isinstance(current, int):
+                setattr(self, key, int(value))  # type: ignore[call-overload]
+            else:
+                setattr(self, key, float(value))  # type: ignore[arg-type]
+        return unknown
+
+
+@dataclass
+class Command:
+    """One cycle's answer: a velocity, and whether the goal is reached or no arc was safe."""
+
+    v: float
+    w: float
+    reached: bool = False
+    valid: bool = True
+
+
+class DWAPlanner:
+    """Holds the plan and the latched goal state; :meth:`compute` runs one cycle."""
+
+    def __init__(self, params: DWAParams | None = None) -> None:
+        self.params = params or DWAParams()
+        self.plan = np.zeros((0, 3))
+        self.xy_latched = False
+
+    def set_plan(self, plan: np.ndarray) -> None:
+        """A new global plan (n, 3) in the local costmap's frame; resets the goal latch."""
+        self.plan = np.asarray(plan, dtype=float).reshape(-1, 3)
+        self.xy_latched = False
+
+    def goal_reached_xy(self, x: float, y: float) -> bool:
+        if len(self.plan) == 0:
+            return False
+        gx, gy, _ = self.plan[-1]
+        return math.hypot(gx - x, gy - y) <= self.params.xy_goal_tolerance
+
+    def _prune(self, x: float, y: float) -> None:
+        if not self.params.prune_plan or len(self.plan) < 2:
+            return
+        d = np.hypot(self.plan[:, 0] - x, self.plan[:, 1] - y)
+        window = min(len(d), 60)  # look for the closest point near the start only (no shortcuts)
+        i = int(np.argmin(d[:window]))
+        if i > 0:
+            self.plan = self.plan[i:]
+
+    def compute(
+        self, pose: tuple[float, float, float], vel: tuple[float, float], costmap: Costmap
+    ) -> Command:
+        """The velocity for this cycle from the robot's pose and velocity (costmap frame)."""
+        p = self.params
+        x, y, th = pose
+        if len(self.plan) == 0:
+            return Command(0.0, 0.0, valid=False)
+        self._prune(x, y)
+        gx, gy, gyaw = self.plan[-1]
+        if self.goal_reached_xy(x, y) or (self.xy_latched and p.latch_xy_goal_tolerance):
+            self.xy_latched = True
+            return self._rotate_to(th, gyaw, vel)
+        return self._sample(x, y, th, vel, costmap)
+
+    def _rotate_to(self, th: float, goal_yaw: float, vel: tuple[float, float]) -> Command:
+        p = self.params
+        dt = 1.0 / p.controller_frequency
+        if abs(vel[0]) > 0.02:  # stop first, then turn
+            v = math.copysign(max(0.0, abs(vel[0]) - p.acc_lim_x * dt), vel[0])
+            return Command(v, 0.0)
+        err = angle_diff(goal_yaw, th)
+        if abs(err) <= p.yaw_goal_tolerance:
+            return Command(0.0, 0.0, reached=True)
+        # the fastest turn that can still stop at the goal yaw, within the acceleration limits
+        w_stop = math.sqrt(2 * p.acc_lim_theta * abs(err))
+        w = min(p.max_vel_theta, w_stop, abs(vel[1]) + p.acc_lim_theta * dt)
+        w = max(w, p.min_vel_theta)
+        return Command(0.0, math.copysign(w, err))
+
+    def _sample(self, x: float, y: float, th: float, vel: tuple[float, float], cm: Costmap) -> Command:
+        p = self.params
+        dt = 1.0 / p.controller_frequency
+        v0, w0 = vel
+        v_lo = max(p.min_vel_x, v0 - p.acc_lim_x * dt)
+        v_hi = min(p.max_vel_x, v0 + p.acc_lim_x * dt)
+        w_lo = max(-p.max_vel_theta, w0 - p.acc_lim_theta * dt)
+        w_hi = min(p.max_vel_theta, w0 + p.acc_lim_theta * dt)
+        vs = np.linspace(v_lo, max(v_lo, v_hi), max(1, p.vx_samples))
+        ws = np.linspace(w_lo, max(w_lo, w_hi), max(1, p.vth_samples))
+        if w_lo < 0 < w_hi:
+            ws = np.append(ws, 0.0)
+        V, Wv = (a.ravel() for a in np.meshgrid(vs, ws))
+        slow = (np.abs(V) < p.min_vel_trans) & (np.abs(Wv) < p.min_vel_theta)
+        V, Wv = V[~slow], Wv[~slow]
+        if V.size == 0:
+            return Command(0.0, 0.0, valid=False)
+        # roll out arcs: steps of at most sim_granularity along the fastest sample
+        n = max(2, int(math.ceil(max(p.max_vel_x, 0.05) * p.sim_time / p.sim_granularity)))
+        t = np.linspace(p.sim_time / n, p.sim_time, n)
+        ang = th + Wv[:, None] * t[None, :]
+        straight = np.abs(Wv) < 1e-6
+        wsafe = np.where(straight, 1.0, Wv)[:, None]
+        px = np.where(
+            straight[:, None],
+            x + V[:, None] * t * math.cos(th),
+            x + V[:, None] / wsafe * (np.sin(ang) - math.sin(th)),
+        )
+        py = np.where(
+            straight[:, None],
+            y + V[:, None] * t * math.sin(th),
+            y - V[:, None] / wsafe * (np.cos(ang) - math.cos(th)),
+        )
+        res = cm.resolution
+        cx = np.floor((px - cm.origin_x) / res).astype(np.int64)
+        cy = np.floor((py - cm.origin_y) / res).astype(np.int64)
+        inside = (cx >= 0) & (cx < cm.size_x) & (cy >= 0) & (cy < cm.size_y)
+        cost = np.full(px.shape, NO_INFORMATION, dtype=np.int64)
+        cost[inside] = cm.costs[cy[inside], cx[inside]]
+        valid = (cost < INSCRIBED).all(axis=1)
+        if not valid.any():
+            return Command(0.0, 0.0, valid=False)
+        occ = cost.max(axis=1).astype(float)
+        # distance maps over the local costmap: to the plan's cells and to the local goal
+        plan_cells, goal_cell = self._local_plan_cells(cm)
+        if goal_cell is None:
+            return Command(0.0, 0.0, valid=False)
+        reach = max(cm.size_x, cm.size_y)
+        mask = np.zeros((cm.size_y, cm.size_x), dtype=bool)
+        mask[plan_cells[:, 1], plan_cells[:, 0]] = True
+        path_d = distance_transform(mask, reach)
+        mask[:] = False
+        mask[goal_cell[1], goal_cell[0]] = True
+        goal_d = distance_transform(mask, reach)
+
+        def lookup(grid: np.ndarray, qx: np.ndarray, qy: np.ndarray) -> np.ndarray:
+            ix = np.clip(np.floor((qx - cm.origin_x) / res).astype(np.int64), 0, cm.size_x - 1)
+            iy = np.clip(np.floor((qy - cm.origin_y) / res).astype(np.int64), 0, cm.size_y - 1)
+            return grid[iy, ix]
+
+        ex, ey, eth = px[:, -1], py[:, -1], ang[:, -1]
+        total = p.path_distance_bias * 0.5 * res * lookup(path_d, ex, ey)
+        total += p.goal_distance_bias * 0.5 * res * lookup(goal_d, ex, ey)
+        total += p.occdist_scale * occ
+        gx, gy = self.plan[-1, 0], self.plan[-1, 1]
+        if math.hypot(gx - x, gy - y) > p.forward_point_distance:
+            fx = ex + p.forward_point_distance * np.cos(eth)
+            fy = ey + p.forward_point_distance * np.sin(eth)
+            total += p.path_distance_bias * 0.5 * res * lookup(path_d, fx, fy)
+            total += p.goal_distance_bias * 0.5 * res * lookup(goal_d, fx, fy)
+        total = np.where(valid, total, np.inf)
+        best = int(np.argmin(total))
+        return Command(float(V[best]), float(Wv[best]))
+
+    def _local_plan_cells(self, cm: Costmap) -> tuple[np.ndarray, tuple[int, int] | None]:
+        """The plan's cells inside the local costmap (up to where it first leaves it), and the last one."""
+        res = cm.resolution
+        cx = np.floor((self.plan[:, 0] - cm.origin_x) / res).astype(np.int64)
+        cy = np.floor((self.plan[:, 1] - cm.origin_y) / res).astype(np.int64)
+        inside = (cx >= 0) & (cx < cm.size_x) & (cy >= 0) & (cy < cm.size_y)
+        if not inside.any():
+            return np.zeros((0, 2), dtype=np.int64), None
+        first = int(np.argmax(inside))
+        out = np.nonzero(~inside[first:])[0]
+        last = first + (int(out[0]) if out.size else len(inside) - first)
+        cells = np.column_stack([cx[first:last], cy[first:last]])
+        return cells, (int(cells[-1, 0]), int(cells[-1, 1]))

@@ -1,0 +1,496 @@
+"""The PuzzleBot simulator's world: a 2D floor plan with heights, as plain numpy data.
+
+No ROS in here. Everything solid is reduced to what the ray caster and the collision check need:
+
+* ``segments``: an (N, 4) float array of wall faces ``x0 y0 x1 y1`` with a height and an RGB colour
+  each (walls are thick rectangles, boxes rectangles, cylinders 24-gons);
+* optionally an occupancy ``grid`` (a map_server map used as the world): occupied cells are solid,
+  ``grid_height`` tall;
+* floor ``markings`` (painted lines, no height: the course's 1 m square) for the views;
+* robots' start poses and moving obstacles that follow waypoints.
+
+Worlds come from our YAML format (:func:`load_world`, described in docs/sim.md) or from a
+map_server map (:func:`world_from_map`); :func:`rasterize` turns any world into an
+:class:`~ninjemys.sim.mapfile.OccupancyMap` (what the navigation stack uses as its map).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ninjemys.sim.mapfile import Fields, MapFileError, OccupancyMap, load_map, yaml_lines
+
+CYLINDER_SIDES = 24
+DEFAULT_WALL_HEIGHT = 1.0
+DEFAULT_WALL_THICKNESS = 0.1
+
+COLOURS: dict[str, tuple[int, int, int]] = {
+    "white": (240, 240, 240),
+    "grey": (150, 150, 150),
+    "gray": (150, 150, 150),
+    "darkgrey": (90, 90, 90),
+    "black": (20, 20, 20),
+    "red": (200, 50, 50),
+    "green": (60, 170, 80),
+    "blue": (60, 90, 200),
+    "yellow": (230, 200, 60),
+    "orange": (230, 140, 40),
+    "brown": (140, 90, 50),
+    "wood": (180, 130, 80),
+    "purple": (140, 70, 170),
+    "cyan": (60, 190, 200),
+}
+
+
+@dataclass
+class Obstacle:
+    """A solid shape: its outline polygon (closed, counter-clockwise) or a thin wall (2 points)."""
+
+    name: str
+    kind: str  # wall | box | cylinder
+    outline: np.ndarray  # (K, 2)
+    height: float
+    color: tuple[int, int, int]
+
+    def segments(self) -> np.ndarray:
+        pts = self.outline
+        if len(pts) == 2:
+            return pts.reshape(1, 4).copy()
+        return np.hstack([pts, np.roll(pts, -1, axis=0)])
+
+
+@dataclass
+class Marking:
+    """A line painted on the floor (no height): drawn by the views, invisible to the lidar."""
+
+    points: np.ndarray  # (K, 2)
+    closed: bool
+    width: float
+    color: tuple[int, int, int]
+
+
+@dataclass
+class RobotStart:
+    name: str
+    x: float
+    y: float
+    yaw: float
+    model: str = "puzzlebot"
+
+
+@dataclass
+class MovingObstacle:
+    """A box or cylinder that moves along waypoints at ``speed`` (back to the first when ``loop``)."""
+
+    name: str
+    kind: str  # box | cylinder
+    size: tuple[float, float]  # box: (length, width); cylinder: (radius, radius)
+    height: float
+    color: tuple[int, int, int]
+    waypoints: np.ndarray  # (K, 2)
+    speed: float
+    loop: bool = True
+
+    def position(self, t: float) -> tuple[float, float, float]:
+        """Pose (x, y, heading) at time ``t`` seconds after the start: a pure function of time."""
+        pts = self.waypoints
+        if len(pts) == 1 or self.speed <= 0:
+            return float(pts[0, 0]), float(pts[0, 1]), 0.0
+        path = np.vstack([pts, pts[:1]]) if self.loop else np.vstack([pts, pts[-2::-1]])
+        legs = np.linalg.norm(np.diff(path, axis=0), axis=1)
+        total = float(legs.sum())
+        if total <= 0:
+            return float(pts[0, 0]), float(pts[0, 1]), 0.0
+        s = (t * self.speed) % total
+        for i, leg in enumerate(legs):
+            if s <= leg or i == len(legs) - 1:
+                a, b = path[i], path[i + 1]
+                f = s / leg if leg > 0 else 0.0
+                heading = math.atan2(b[1] - a[1], b[0] - a[0])
+                return float(a[0] + f * (b[0] - a[0])), float(a[1] + f * (b[1] - a[1])), heading
+            s -= leg
+        return float(pts[0, 0]), float(pts[0, 1]), 0.0
+
+    def outline_at(self, t: float) -> np.ndarray:
+        x, y, heading = self.position(t)
+        if self.kind == "cylinder":
+            return circle_outline(x, y, self.size[0])
+        return box_outline(x, y, self.size[0], self.size[1], heading)
+
+
+@dataclass
+class Grid:
+    """Occupied cells of a map used as world geometry (row 0 at ``origin`` y, like OccupancyGrid)."""
+
+    occupied: np.ndarray  # bool (rows, cols)
+    resolution: float
+    origin_x: float
+    origin_y: float
+    height: float = DEFAULT_WALL_HEIGHT
+    color: tuple[int, int, int] = COLOURS["grey"]
+
+
+@dataclass
+class World:
+    name: str
+    obstacles: list[Obstacle] = field(default_factory=list)
+    markings: list[Marking] = field(default_factory=list)
+    robots: list[RobotStart] = field(default_factory=list)
+    moving: list[MovingObstacle] = field(default_factory=list)
+    grid: Grid | None = None
+    bounds: tuple[float, float, float, float] | None = None  # xmin, ymin, xmax, ymax
+    source: str = ""
+
+    def __post_init__(self) -> None:
+        self.rebuild()
+
+    def rebuild(self) -> None:
+        """Recompute the flat segment arrays after obstacles were added or removed."""
+        segs, heights, colours, owner = [], [], [], []
+        for i, ob in enumerate(self.obstacles):
+            s = ob.segments()
+            segs.append(s)
+            heights.append(np.full(len(s), ob.height))
+            colours.append(np.tile(np.array(ob.color, dtype=np.uint8), (len(s), 1)))
+            owner.append(np.full(len(s), i))
+        self.segments = np.vstack(segs) if segs else np.zeros((0, 4))
+        self.seg_height = np.concatenate(heights) if heights else np.zeros(0)
+        self.seg_color = np.vstack(colours) if colours else np.zeros((0, 3), dtype=np.uint8)
+        self.seg_owner = np.concatenate(owner) if owner else np.zeros(0, dtype=int)
+
+    def extent(self) -> tuple[float, float, float, float]:
+        """The area worth drawing and rasterizing: declared bounds, else everything plus a margin."""
+        if self.bounds is not None:
+            return self.bounds
+        xs: list[float] = []
+        ys: list[float] = []
+        if len(self.segments):
+            xs += [float(self.segments[:, [0, 2]].min()), float(self.segments[:, [0, 2]].max())]
+            ys += [float(self.segments[:, [1, 3]].min()), float(self.segments[:, [1, 3]].max())]
+        if self.grid is not None:
+            g = self.grid
+            xs += [g.origin_x, g.origin_x + g.occupied.shape[1] * g.resolution]
+            ys += [g.origin_y, g.origin_y + g.occupied.shape[0] * g.resolution]
+        for m in self.markings:
+            xs += [float(m.points[:, 0].min()), float(m.points[:, 0].max())]
+            ys += [float(m.points[:, 1].min()), float(m.points[:, 1].max())]
+        for r in self.robots:
+            xs.append(r.x)
+            ys.append(r.y)
+        if not xs:
+            return (-5.0, -5.0, 5.0, 5.0)
+        margin = 0.0 if self.grid is not None and not len(self.segments) else 0.5
+        return (min(xs) - margin, min(ys) - margin, max(xs) + margin, max(ys) + margin)
+
+
+def box_outline(cx: float, cy: float, length: float, width: float, yaw: float = 0.0) -> np.ndarray:
+    c, s = math.cos(yaw), math.sin(yaw)
+    local = np.array([[-length, -width], [length, -width], [length, width], [-length, width]]) / 2.0
+    return local @ np.array([[c, s], [-s, c]]) + np.array([cx, cy])
+
+
+def circle_outline(cx: float, cy: float, radius: float, sides: int = CYLINDER_SIDES) -> np.ndarray:
+    """A regular polygon with its vertices on the circle (faces at most r (1 - cos(pi/n)) inside it)."""
+    a = np.arange(sides) * (2 * math.pi / sides)
+    return np.column_stack([cx + radius * np.cos(a), cy + radius * np.sin(a)])
+
+
+def wall_outline(x0: float, y0: float, x1: float, y1: float, thickness: float) -> np.ndarray:
+    if thickness <= 0:
+        return np.array([[x0, y0], [x1, y1]], dtype=float)
+    dx, dy = x1 - x0, y1 - y0
+    n = math.hypot(dx, dy)
+    nx, ny = -dy / n * thickness / 2, dx / n * thickness / 2
+    ex, ey = dx / n * thickness / 2, dy / n * thickness / 2  # square ends: corners meet cleanly
+    return np.array(
+        [
+            [x0 - ex - nx, y0 - ey - ny],
+            [x1 + ex - nx, y1 + ey - ny],
+            [x1 + ex + nx, y1 + ey + ny],
+            [x0 - ex + nx, y0 - ey + ny],
+        ]
+    )
+
+
+# -- our YAML world format ----------------------------------------------------------------------
+
+
+def _colour(f: Fields, value: object, where: str, default: tuple[int, int, int]) -> tuple[int, int, int]:
+    if value is None:
+        return default
+    if isinstance(value, str):
+        text = value.strip().lower()
+        if text in COLOURS:
+            return COLOURS[text]
+        if text.startswith("#") and len(text) == 7:
+            try:
+                return (int(text[1:3], 16), int(text[3:5], 16), int(text[5:7], 16))
+            except ValueError:
+                pass
+        raise f.error(where, f"unknown colour {value!r} (a name like 'red', '#rrggbb' or [r, g, b] 0-255)")
+    if isinstance(value, list) and len(value) == 3:
+        rgb = [f.number(v, f"{where}[{i}]", minimum=0) for i, v in enumerate(value)]
+        if any(v > 255 for v in rgb):
+            raise f.error(where, f"colour components are 0-255, got {value!r}")
+        return (int(rgb[0]), int(rgb[1]), int(rgb[2]))
+    raise f.error(where, f"expected a colour (name, '#rrggbb' or [r, g, b]), got {value!r}")
+
+
+def _check_keys(f: Fields, item: object, where: str, allowed: set[str], required: set[str]) -> dict:
+    if not isinstance(item, dict):
+        raise f.error(where, f"expected a mapping, got {item!r}")
+    for key in item:
+        if key not in allowed:
+            raise f.error(f"{where}.{key}", f"unknown field (expected one of {', '.join(sorted(allowed))})")
+    for key in sorted(required):
+        if key not in item:
+            raise f.error(where, f"missing field '{key}'")
+    return item
+
+
+_TOP = {
+    "name",
+    "bounds",
+    "walls",
+    "boxes",
+    "cylinders",
+    "floor",
+    "robots",
+    "moving",
+    "map",
+    "map_height",
+    "map_color",
+}
+
+
+def load_world(path: str | Path) -> World:
+    """Read a world file of ours, or a map_server map (YAML with an ``image`` field)."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise MapFileError(f"{p}: cannot read world: {exc.strerror or exc}") from None
+    doc, lines = yaml_lines(text, str(p))
+    f = Fields(str(p), lines)
+    if isinstance(doc, dict) and "image" in doc:
+        return world_from_map(p)
+    if not isinstance(doc, dict):
+        raise f.error(
+            "", "a world file is a YAML mapping (walls, boxes, cylinders, floor, robots, moving, ...)"
+        )
+    return parse_world(doc, f, p)
+
+
+def parse_world(doc: dict, f: Fields, path: Path) -> World:
+    _check_keys(f, doc, "", _TOP, set())
+    name = str(doc.get("name", path.stem))
+    obstacles: list[Obstacle] = []
+
+    def items(key: str) -> list:
+        value = doc.get(key, []) or []
+        if not isinstance(value, list):
+            raise f.error(key, f"expected a list, got {value!r}")
+        return value
+
+    for i, w in enumerate(items("walls")):
+        where = f"walls[{i}]"
+        _check_keys(f, w, where, {"from", "to", "thickness", "height", "color", "name"}, {"from", "to"})
+        a = f.vector(w["from"], f"{where}.from", 2)
+        b = f.vector(w["to"], f"{where}.to", 2)
+        if a == b:
+            raise f.error(where, "a wall needs two different end points")
+        t = f.number(w.get("thickness", DEFAULT_WALL_THICKNESS), f"{where}.thickness", minimum=0)
+        h = f.number(w.get("height", DEFAULT_WALL_HEIGHT), f"{where}.height", positive=True)
+        c = _colour(f, w.get("color"), f"{where}.color", COLOURS["white"])
+        obstacles.append(Obstacle(str(w.get("name", f"wall_{i}")), "wall", wall_outline(*a, *b, t), h, c))
+    for i, b in enumerate(items("boxes")):
+        where = f"boxes[{i}]"
+        _check_keys(f, b, where, {"center", "size", "yaw", "height", "color", "name"}, {"center", "size"})
+        cx, cy = f.vector(b["center"], f"{where}.center", 2)
+        sx, sy = f.vector(b["size"], f"{where}.size", 2)
+        if sx <= 0 or sy <= 0:
+            raise f.error(f"{where}.size", f"sizes must be > 0, got {b['size']!r}")
+        yaw = f.number(b.get("yaw", 0.0), f"{where}.yaw")
+        h = f.number(b.get("height", 0.5), f"{where}.height", positive=True)
+        c = _colour(f, b.get("color"), f"{where}.color", COLOURS["wood"])
+        obstacles.append(
+            Obstacle(str(b.get("name", f"box_{i}")), "box", box_outline(cx, cy, sx, sy, yaw), h, c)
+        )
+    for i, c_ in enumerate(items("cylinders")):
+        where = f"cylinders[{i}]"
+        _check_keys(f, c_, where, {"center", "radius", "height", "color", "name"}, {"center", "radius"})
+        cx, cy = f.vector(c_["center"], f"{where}.center", 2)
+        r = f.number(c_["radius"], f"{where}.radius", positive=True)
+        h = f.number(c_.get("height", 0.5), f"{where}.height", positive=True)
+        col = _colour(f, c_.get("color"), f"{where}.color", COLOURS["blue"])
+        obstacles.append(
+            Obstacle(str(c_.get("name", f"cylinder_{i}")), "cylinder", circle_outline(cx, cy, r), h, col)
+        )
+    markings = []
+    for i, m in enumerate(items("floor")):
+        where = f"floor[{i}]"
+        _check_keys(f, m, where, {"points", "closed", "width", "color"}, {"points"})
+        pts = m["points"]
+        if not isinstance(pts, list) or len(pts) < 2:
+            raise f.error(f"{where}.points", "expected a list of at least two [x, y] points")
+        arr = np.array([f.vector(p, f"{where}.points[{j}]", 2) for j, p in enumerate(pts)])
+        width = f.number(m.get("width", 0.03), f"{where}.width", positive=True)
+        markings.append(
+            Marking(
+                arr,
+                bool(m.get("closed", False)),
+                width,
+                _colour(f, m.get("color"), f"{where}.color", (240, 200, 40)),
+            )
+        )
+    robots = []
+    for i, r in enumerate(items("robots")):
+        where = f"robots[{i}]"
+        _check_keys(f, r, where, {"name", "pose", "model"}, {"name"})
+        rname = r["name"]
+        if not isinstance(rname, str) or not rname.replace("_", "a").isalnum() or not rname[0].isalpha():
+            raise f.error(f"{where}.name", f"expected a ROS name (letters, digits, _), got {rname!r}")
+        pose = f.vector(r.get("pose", [0, 0, 0]), f"{where}.pose", 3)
+        robots.append(RobotStart(rname, pose[0], pose[1], pose[2], str(r.get("model", "puzzlebot"))))
+    moving = []
+    for i, m in enumerate(items("moving")):
+        where = f"moving[{i}]"
+        _check_keys(
+            f,
+            m,
+            where,
+            {"name", "shape", "radius", "size", "height", "color", "speed", "waypoints", "loop"},
+            {"waypoints"},
+        )
+        shape = m.get("shape", "cylinder")
+        if shape not in ("cylinder", "box"):
+            raise f.error(f"{where}.shape", f"expected cylinder or box, got {shape!r}")
+        if shape == "cylinder":
+            r = f.number(m.get("radius", 0.2), f"{where}.radius", positive=True)
+            size = (r, r)
+        else:
+            sx, sy = f.vector(m.get("size", [0.4, 0.4]), f"{where}.size", 2)
+            size = (sx, sy)
+        wps = m["waypoints"]
+        if not isinstance(wps, list) or not wps:
+            raise f.error(f"{where}.waypoints", "expected a list of [x, y] points")
+        arr = np.array([f.vector(p, f"{where}.waypoints[{j}]", 2) for j, p in enumerate(wps)])
+        moving.append(
+            MovingObstacle(
+                str(m.get("name", f"mover_{i}")),
+                shape,
+                size,
+                f.number(m.get("height", 0.5), f"{where}.height", positive=True),
+                _colour(f, m.get("color"), f"{where}.color", COLOURS["orange"]),
+                arr,
+                f.number(m.get("speed", 0.3), f"{where}.speed", minimum=0),
+                bool(m.get("loop", True)),
+            )
+        )
+    bounds = None
+    if "bounds" in doc:
+        b4 = f.vector(doc["bounds"], "bounds", 4)
+        if b4[2] <= b4[0] or b4[3] <= b4[1]:
+            raise f.error("bounds", "expected [xmin, ymin, xmax, ymax] with xmax > xmin and ymax > ymin")
+        bounds = (b4[0], b4[1], b4[2], b4[3])
+    grid = None
+    if "map" in doc:
+        mp = doc["map"]
+        if not isinstance(mp, str):
+            raise f.error("map", f"expected the path of a map_server YAML, got {mp!r}")
+        mpath = Path(mp) if Path(mp).is_absolute() else path.parent / mp
+        grid = grid_from_map(load_map(mpath))
+        grid.height = f.number(doc.get("map_height", DEFAULT_WALL_HEIGHT), "map_height", positive=True)
+        grid.color = _colour(f, doc.get("map_color"), "map_color", COLOURS["grey"])
+    return World(name, obstacles, markings, robots, moving, grid, bounds, str(path))
+
+
+def grid_from_map(m: OccupancyMap) -> Grid:
+    """Occupied cells of ``m`` as solid geometry. The origin's yaw is ignored, as amcl and costmap_2d
+    ignore it: their cells stay axis-aligned."""
+    return Grid(m.occupied(), m.resolution, m.origin[0], m.origin[1])
+
+
+def world_from_map(yaml_path: str | Path, height: float = DEFAULT_WALL_HEIGHT) -> World:
+    """A map_server map as a world: occupied cells are walls ``height`` tall (as users do with Stage)."""
+    m = load_map(yaml_path)
+    g = grid_from_map(m)
+    g.height = height
+    p = Path(yaml_path)
+    return World(p.stem, grid=g, source=str(p))
+
+
+# -- rasterizing --------------------------------------------------------------------------------
+
+
+def _inside_polygon(px: np.ndarray, py: np.ndarray, poly: np.ndarray) -> np.ndarray:
+    """Even-odd point-in-polygon test for many points at once."""
+    inside = np.zeros(px.shape, dtype=bool)
+    x0, y0 = poly[:, 0], poly[:, 1]
+    x1, y1 = np.roll(x0, -1), np.roll(y0, -1)
+    for a, b, c, d in zip(x0, y0, x1, y1, strict=True):
+        crosses = (b > py) != (d > py)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            xi = a + (py - b) * (c - a) / (d - b)
+        inside ^= crosses & (px < xi)
+    return inside
+
+
+def rasterize(
+    world: World,
+    resolution: float = 0.05,
+    extent: tuple[float, float, float, float] | None = None,
+    moving_at: float | None = None,
+) -> OccupancyMap:
+    """The world as an occupancy grid (0 free, 100 occupied), cells ``resolution`` m, row 0 at the bottom.
+
+    A cell is occupied when its centre lies inside a solid shape or a thin wall passes through it, so
+    no wall disappears however thin. Moving obstacles are left out (a map for navigation shows the
+    static world), unless ``moving_at`` gives the time at which to draw them.
+    """
+    xmin, ymin, xmax, ymax = extent or world.extent()
+    cols = max(1, int(math.ceil((xmax - xmin) / resolution - 1e-9)))
+    rows = max(1, int(math.ceil((ymax - ymin) / resolution - 1e-9)))
+    occ = np.zeros((rows, cols), dtype=bool)
+    outlines = [ob.outline for ob in world.obstacles]
+    if moving_at is not None:
+        outlines += [m.outline_at(moving_at) for m in world.moving]
+    for poly in outlines:
+        lo = np.floor((poly.min(axis=0) - [xmin, ymin]) / resolution).astype(int) - 1
+        hi = np.ceil((poly.max(axis=0) - [xmin, ymin]) / resolution).astype(int) + 1
+        c0, r0 = max(lo[0], 0), max(lo[1], 0)
+        c1, r1 = min(hi[0], cols), min(hi[1], rows)
+        if c1 <= c0 or r1 <= r0:
+            continue
+        if len(poly) > 2:
+            cx = xmin + (np.arange(c0, c1) + 0.5) * resolution
+            cy = ymin + (np.arange(r0, r1) + 0.5) * resolution
+            gx, gy = np.meshgrid(cx, cy)
+            occ[r0:r1, c0:c1] |= _inside_polygon(gx, gy, poly)
+        # the outline itself, sampled finer than a cell: thin walls and slivers stay solid
+        closed = np.vstack([poly, poly[:1]]) if len(poly) > 2 else poly
+        for a, b in zip(closed[:-1], closed[1:], strict=True):
+            n = max(2, int(np.linalg.norm(b - a) / (resolution / 4)) + 2)
+            s = np.linspace(0, 1, n)[:, None]
+            pts = a + s * (b - a)
+            ci = np.floor((pts[:, 0] - xmin) / resolution).astype(int)
+            ri = np.floor((pts[:, 1] - ymin) / resolution).astype(int)
+            ok = (ci >= 0) & (ci < cols) & (ri >= 0) & (ri < rows)
+            occ[ri[ok], ci[ok]] = True
+    if world.grid is not None:
+        g = world.grid
+        cx = xmin + (np.arange(cols) + 0.5) * resolution
+        cy = ymin + (np.arange(rows) + 0.5) * resolution
+        gc = np.floor((cx - g.origin_x) / g.resolution).astype(int)
+        gr = np.floor((cy - g.origin_y) / g.resolution).astype(int)
+        okc = (gc >= 0) & (gc < g.occupied.shape[1])
+        okr = (gr >= 0) & (gr < g.occupied.shape[0])
+        sub = np.zeros((rows, cols), dtype=bool)
+        sub[np.ix_(okr, okc)] = g.occupied[np.ix_(gr[okr], gc[okc])]
+        occ |= sub
+    data = np.where(occ, 100, 0).astype(np.int8)
+    return OccupancyMap(data, resolution, (xmin, ymin, 0.0))

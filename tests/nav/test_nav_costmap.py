@@ -1,0 +1,108 @@
+"""costmap_2d's layers and values: static, obstacle marking/clearing, inflation, the publisher table."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ninjemys.nav.costmap import (
+    INSCRIBED,
+    LETHAL,
+    NO_INFORMATION,
+    Costmap,
+    CostmapParams,
+    distance_transform,
+    footprint_radii,
+    inflation_costs,
+    parse_footprint,
+    to_occupancy,
+)
+
+
+def test_occupancy_table_matches_costmap_2d():
+    costs = np.arange(256, dtype=np.uint8)
+    occ = to_occupancy(costs)
+    assert occ[0] == 0 and occ[253] == 99 and occ[254] == 100 and occ[255] == -1
+    assert occ[1] == 1 and occ[252] == 98
+    assert np.all(np.diff(occ[1:253].astype(int)) >= 0)
+    assert occ[1:253].min() >= 1 and occ[1:253].max() <= 98
+
+
+def test_distance_transform_is_exact_within_reach():
+    rng = np.random.default_rng(3)
+    mask = rng.random((40, 50)) < 0.02
+    d = distance_transform(mask, 12)
+    pts = np.argwhere(mask)
+    yy, xx = np.mgrid[0:40, 0:50]
+    brute = np.sqrt((yy[..., None] - pts[:, 0]) ** 2 + (xx[..., None] - pts[:, 1]) ** 2).min(axis=2)
+    near = brute <= 12
+    assert np.allclose(d[near], brute[near])
+    assert np.all(d[~near] > 12)
+
+
+def test_inflation_uses_costmap_2d_cost_function():
+    lethal = np.zeros((41, 41), dtype=bool)
+    lethal[20, 20] = True
+    res, inscribed, radius, scale = 0.05, 0.1, 0.5, 5.0
+    cost = inflation_costs(lethal, res, inscribed, radius, scale)
+    assert cost[20, 20] == LETHAL
+    assert cost[20, 22] == INSCRIBED  # 0.10 m away: inside the inscribed radius
+    d = 0.25
+    assert cost[20, 25] == int(252 * math.exp(-scale * (d - inscribed)))
+    assert cost[20, 30] == int(252 * math.exp(-scale * (0.5 - inscribed)))
+    assert cost[20, 31] == 0  # beyond the inflation radius
+
+
+def test_footprint_radii():
+    assert footprint_radii(None, 0.2) == (0.2, 0.2)
+    inscribed, circ = footprint_radii(
+        parse_footprint("[[0.1, 0.08], [-0.1, 0.08], [-0.1, -0.08], [0.1, -0.08]]"), 0
+    )
+    assert math.isclose(inscribed, 0.08) and math.isclose(circ, math.hypot(0.1, 0.08))
+
+
+def test_static_layer_unknown_and_lethal():
+    data = np.array([[0, 100, -1, 99]], dtype=np.int8)
+    cm = Costmap(CostmapParams(inflation_radius=0.0, robot_radius=0.0, track_unknown_space=True))
+    cm.set_static_map(data, 0.05, 0.0, 0.0)
+    assert cm.costs.tolist() == [[0, LETHAL, NO_INFORMATION, 0]]
+    cm = Costmap(CostmapParams(inflation_radius=0.0, robot_radius=0.0, track_unknown_space=False))
+    cm.set_static_map(data, 0.05, 0.0, 0.0)
+    assert cm.costs.tolist() == [[0, LETHAL, 0, 0]]
+
+
+def test_obstacle_layer_marks_clears_and_skips_nan():
+    cm = Costmap(
+        CostmapParams(inflation_radius=0.0, robot_radius=0.0, obstacle_range=2.0, raytrace_range=3.0)
+    )
+    cm.set_static_map(np.zeros((60, 60), dtype=np.int8), 0.05, 0.0, 0.0)
+    cm.add_scan(0.525, 1.525, np.array([0.0]), np.array([1.0]), 5.0)
+    cm.update()
+    assert cm.cost_at(1.525, 1.525) == LETHAL
+    cm.add_scan(0.525, 1.525, np.array([0.0, 0.1, 0.2]), np.array([np.inf, np.nan, 2.8]), 5.0)
+    cm.update()
+    assert cm.cost_at(1.525, 1.525) == 0  # an inf reading clears along its ray
+    assert int((cm.costs == LETHAL).sum()) == 0  # 2.8 m is beyond obstacle_range: clears, no mark
+    cm.add_scan(0.525, 1.525, np.array([0.0]), np.array([1.0]), 5.0)
+    cm.clear_obstacles()
+    assert int(cm.update().max()) == 0
+
+
+def test_rolling_window_follows_the_robot_and_keeps_marks():
+    cm = Costmap(
+        CostmapParams(rolling_window=True, width=2.0, height=2.0, inflation_radius=0.0, robot_radius=0.0)
+    )
+    cm.update_origin(0.0, 0.0)
+    cm.add_scan(0.0, 0.0, np.array([0.0]), np.array([0.5]), 5.0)
+    cm.update()
+    assert cm.cost_at(0.51, 0.01) == LETHAL
+    cm.update_origin(0.3, 0.0)
+    cm.update()
+    assert cm.cost_at(0.51, 0.01) == LETHAL
+    assert math.isclose(cm.origin_x, -0.7, abs_tol=1e-9)
+    static = np.zeros((100, 100), dtype=np.int8)
+    static[:, 50] = 100
+    cm.set_static_map(static, 0.05, -2.5, -2.5)
+    cm.update()
+    assert cm.cost_at(0.01, 0.3) == LETHAL  # the static wall at x = 0 shows in the window
