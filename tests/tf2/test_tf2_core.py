@@ -274,3 +274,13 @@ def test_raw_queue_is_bounded_and_wakes_waiters():
     threading.Thread(target=later).start()
     ok, _ = b.wait_for_transform(lambda: b.can_transform("world", "f4", 5 * S), 5.0)
     assert ok
+
+
+def test_change_listeners_hear_new_data():
+    b = BufferCore()
+    heard: list[bool] = []
+    b.add_change_listener(lambda: heard.append(b.can_transform("world", "f4", 0)[0]))
+    b.set_transforms([item("a", "b", 1)])
+    for m in _raw_messages(1):
+        b.add_raw(m, "pub")
+    assert heard == [False, True]

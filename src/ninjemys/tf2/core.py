@@ -245,6 +245,7 @@ class BufferCore:
         self._last_t = -1  # the time of the previous non-latest lookup (a repeat fills the memos)
         self._topology = 0  # bumped when a frame appears or a newest parent changes
         self._pending: list[tuple[bytes, str, bool]] = []  # raw TFMessages not decoded yet
+        self._listeners: list[Callable[[], None]] = []
         self._layouts: dict[tuple[str, int], Layout] = {}
         self._reported: dict[str, float] = {}
 
@@ -274,6 +275,16 @@ class BufferCore:
             self._drain()
             return [f.name for f in self._order]
 
+    def add_change_listener(self, fn: Callable[[], None]) -> None:
+        """Call ``fn()`` after new data arrived (on the inserting thread, outside the buffer's lock): what a
+        filter that holds messages until their transform is available waits on (tf2's transformable
+        callbacks). ``fn`` may query the buffer; it should be quick."""
+        self._listeners.append(fn)
+
+    def _changed_data(self) -> None:
+        for fn in self._listeners:
+            fn()
+
     # -- insertion -------------------------------------------------------------------------------
     def set_transforms(
         self,
@@ -299,6 +310,8 @@ class BufferCore:
                     self._changed.notify_all()
         if problems:
             self._report_once(problems)
+        if accepted and self._listeners:
+            self._changed_data()
         return accepted
 
     def add_raw(self, data: bytes, authority: str = "default_authority", is_static: bool = False) -> None:
@@ -312,6 +325,8 @@ class BufferCore:
                 self._drain()
             if self._waiters:
                 self._changed.notify_all()
+        if self._listeners:
+            self._changed_data()
 
     def _drain(self) -> None:
         """Decode and insert every queued message, in arrival order (lock held)."""
