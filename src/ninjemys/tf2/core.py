@@ -137,47 +137,51 @@ class Frame:
         data = self.data
         if not data:
             return None
-        if self.static or t == 0:
+        if t == 0 or self.static:
             e = data[-1]
             return e if len(e) == 2 else self._resolve(-1)
         stamps = self.stamps
         n = len(stamps)
-        if n == 1:
-            if stamps[0] == t:
-                return self._resolve(0)
-            if err is not None:
+        i = bisect_left(stamps, t)
+        if 0 < i < n:
+            if stamps[i] == t:
+                return self._resolve(i)
+            return self._interpolate(i, t)
+        if i == 0 and stamps[0] == t:
+            return self._resolve(0)
+        if err is not None:
+            if n == 1:
                 err.append(
                     "Lookup would require extrapolation at time %.09f, but only time %.09f is in the buffer"
                     % (_secs(t), _secs(stamps[0]))
                 )
-            return None
-        latest = stamps[-1]
-        if t == latest:
-            return self._resolve(-1)
-        earliest = stamps[0]
-        if t == earliest:
-            return self._resolve(0)
-        if t > latest:
-            if err is not None:
+            elif i == n:
+                latest = stamps[-1]
                 err.append(
                     "Lookup would require extrapolation %.09fs into the future.  Requested time %.09f but the "
                     "latest data is at time %.09f" % (_secs(t - latest), _secs(t), _secs(latest))
                 )
-            return None
-        if t < earliest:
-            if err is not None:
+            else:
+                earliest = stamps[0]
                 err.append(
                     "Lookup would require extrapolation %.09fs into the past.  Requested time %.09f but the "
                     "earliest data is at time %.09f" % (_secs(earliest - t), _secs(t), _secs(earliest))
                 )
-            return None
-        i = bisect_left(stamps, t)
-        if stamps[i] == t:
-            return self._resolve(i)
-        older = self._resolve(i - 1)
-        newer = self._resolve(i)
-        if older[0] is not newer[0]:  # the parent changed in between: tf2 keeps the older one
+        return None
+
+    def _interpolate(self, i: int, t: int) -> Entry:
+        """Between entries ``i - 1`` and ``i``: lerp for the translation, slerp (the shorter arc) for the
+        rotation, as tf2's ``TimeCache::interpolate``; across a change of parent, the older entry."""
+        data = self.data
+        older = data[i - 1]
+        if len(older) == 3:
+            older = self._resolve(i - 1)
+        newer = data[i]
+        if len(newer) == 3:
+            newer = self._resolve(i)
+        if older[0] is not newer[0]:
             return older
+        stamps = self.stamps
         t0 = stamps[i - 1]
         r = (t - t0) / (stamps[i] - t0)
         r0 = 1.0 - r
@@ -186,29 +190,25 @@ class Frame:
         ax, ay, az, aw = a[3], a[4], a[5], a[6]
         bx, by, bz, bw = b[3], b[4], b[5], b[6]
         dot = ax * bx + ay * by + az * bz + aw * bw
-        if dot < 0.0:  # the shorter arc
+        if dot < 0.0:  # q and -q are one rotation: take the short way round
             bx, by, bz, bw, dot = -bx, -by, -bz, -bw, -dot
-        if dot > 0.9999995:
-            s0, s1 = r0, r
-        else:
+        if dot > 0.9999995:  # nearly equal: a normalized lerp (slerp's sine would vanish)
+            qx = r0 * ax + r * bx
+            qy = r0 * ay + r * by
+            qz = r0 * az + r * bz
+            qw = r0 * aw + r * bw
+            k = 1.0 / sqrt(qx * qx + qy * qy + qz * qz + qw * qw)
+            qx, qy, qz, qw = qx * k, qy * k, qz * k, qw * k
+        else:  # slerp keeps unit length to rounding, as tf2's does
             theta = acos(dot)
             inv = 1.0 / sin(theta)
             s0 = sin(r0 * theta) * inv
             s1 = sin(r * theta) * inv
-        qx = s0 * ax + s1 * bx
-        qy = s0 * ay + s1 * by
-        qz = s0 * az + s1 * bz
-        qw = s0 * aw + s1 * bw
-        n = 1.0 / sqrt(qx * qx + qy * qy + qz * qz + qw * qw)
-        return older[0], (
-            r0 * a[0] + r * b[0],
-            r0 * a[1] + r * b[1],
-            r0 * a[2] + r * b[2],
-            qx * n,
-            qy * n,
-            qz * n,
-            qw * n,
-        )
+            qx = s0 * ax + s1 * bx
+            qy = s0 * ay + s1 * by
+            qz = s0 * az + s1 * bz
+            qw = s0 * aw + s1 * bw
+        return older[0], (r0 * a[0] + r * b[0], r0 * a[1] + r * b[1], r0 * a[2] + r * b[2], qx, qy, qz, qw)
 
     def parent_at(self, t: int, err: list[str] | None) -> Frame | None:
         """tf2's ``getParent``: the parent for time ``t`` (the older entry's), without interpolating."""
