@@ -159,3 +159,28 @@ def test_view_frames_outputs(tmp_path, monkeypatch):
     assert [p.name for p in written] == ["frames.gv", "frames.svg"]
     svg = (tmp_path / "frames.svg").read_text()
     assert svg.startswith("<svg") and ">odom</text>" in svg and "Broadcaster: /amcl" in svg
+
+
+@pytest.mark.slow
+def test_view_frames_end_to_end(env, procs, tmp_path):
+    procs.append(
+        subprocess.Popen(
+            shipped("tf2_ros", "static_transform_publisher", "1", "0", "0", "0", "0", "0", "base", "laser"),
+            env=env,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+    )
+    done = subprocess.run(
+        shipped("tf2_tools", "view_frames.py"),
+        env=env,
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert done.returncode == 0, done.stderr
+    assert "Listening to tf data during 5 seconds..." in done.stdout + done.stderr
+    gv = (tmp_path / "frames.gv").read_text()
+    assert '"base" -> "laser"[label=" Broadcaster: /static_transform_publisher' in gv
+    assert (tmp_path / "frames.pdf").exists() or (tmp_path / "frames.svg").exists()

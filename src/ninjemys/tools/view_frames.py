@@ -42,6 +42,17 @@ def generate_dot(data: dict[str, dict[str, Any]], now: float) -> str:
     return "".join(parts)
 
 
+def _label(info: dict[str, Any]) -> list[str]:
+    """The five lines tf2_tools puts on an edge."""
+    return [
+        f"Broadcaster: {info['broadcaster']}",
+        f"Average rate: {info['rate']}",
+        f"Buffer length: {info['buffer_length']}",
+        f"Most recent transform: {info['most_recent_transform']}",
+        f"Oldest transform: {info['oldest_transform']}",
+    ]
+
+
 def generate_svg(data: dict[str, dict[str, Any]], now: float) -> str:
     """The frame tree as a standalone SVG: frames as ellipses, parents above children, labelled edges."""
     children: dict[str, list[str]] = {}
@@ -66,12 +77,15 @@ def generate_svg(data: dict[str, dict[str, Any]], now: float) -> str:
     seen: set[str] = set()
     for r in roots:
         place(r, 0, seen)
-    col, row = 230.0, 150.0
+    longest = max((len(_label(info)[i]) for info in data.values() for i in range(5)), default=10)
+    col, row = max(180.0, 2.0 * (longest * 5.4 + 16)), 150.0
     width = max(1.0, next_x[0]) * col + 40
     height = (max((d for _, d in pos.values()), default=0) + 1) * row + 60
     out = [
         f'<svg xmlns="http://www.w3.org/2000/svg" width="{width:.0f}" height="{height:.0f}" '
         f'font-family="sans-serif" font-size="11">',
+        '<defs><marker id="arrow" viewBox="0 0 10 10" refX="10" refY="5" markerWidth="7" markerHeight="7" '
+        'orient="auto-start-reverse"><path d="M 0 0 L 10 5 L 0 10 z"/></marker></defs>',
         f'<text x="10" y="{height - 15:.0f}">view_frames Result — Recorded at time: {now:.3f}</text>',
     ]
 
