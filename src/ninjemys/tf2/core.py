@@ -56,7 +56,7 @@ QUATERNION_TOLERANCE = 10e-6  # tf2: |x²+y²+z²+w² - 1| must stay under this
 NO_PARENT = "NO_PARENT"
 REPEAT_REPORT_AFTER = 10.0  # seconds before the same bad-input line is reported again
 PENDING_MAX = 50  # raw messages queued before the listener's thread decodes them itself
-BULK_MIN = 4  # a run this long of one layout is decoded with numpy; shorter ones per transform
+BULK_MIN = 2  # a run this long of one layout is decoded with numpy; a single message per transform
 
 # tf2_msgs/TF2Error codes, as walk results
 NO_ERROR = 0
@@ -235,6 +235,9 @@ class BufferCore:
         """``cache_time`` is seconds of history per frame; ``report`` receives the one line about bad input
         (default: this module's logger at error level)."""
         self.cache_time_ns = int(round(cache_time * 1e9))
+        # history is trimmed back to cache_time once it is this much longer (trimming on every insertion
+        # shifts the whole list each time): a frame keeps between cache_time and 1/16 more
+        self._prune_slack = self.cache_time_ns >> 4
         self._report: Reporter = report or _log.error
         self._frames: dict[str, Frame] = {}
         self._order: list[Frame] = []  # by frame number (tf2's frameIDs_reverse, minus NO_PARENT)
@@ -398,7 +401,9 @@ class BufferCore:
         )
         columns = stamps.T.tolist()
         frames = self._frames
-        cutoff_span = self.cache_time_ns
+        keep = self.cache_time_ns
+        slack = keep + self._prune_slack
+        blocks = list(values.transpose(1, 0, 2))  # one (k, 7) view per transform
         count = 0
         for j, (parent_name, child_name) in enumerate(zip(layout.parents, layout.children, strict=True)):
             col = columns[j]
@@ -423,11 +428,11 @@ class BufferCore:
             child.authority = who
             st = child.stamps
             st.extend(col)
-            child.data.extend(zip(repeat(parent, k), repeat(values[:, j, :], k), range(k), strict=False))
+            child.data.extend(zip(repeat(parent, k), repeat(blocks[j], k), range(k), strict=False))
             latest = col[-1]
             child.latest = latest
-            if st[0] < latest - cutoff_span:
-                cut = bisect_left(st, latest - cutoff_span)
+            if st[0] < latest - slack:
+                cut = bisect_left(st, latest - keep)
                 del st[:cut]
                 del child.data[:cut]
             count += k
@@ -520,9 +525,8 @@ class BufferCore:
             stamps.append(stamp)
             child.data.append(entry)
             child.latest = stamp
-            cutoff = stamp - self.cache_time_ns
-            if stamps[0] < cutoff:
-                i = bisect_left(stamps, cutoff)
+            if stamps[0] < stamp - self.cache_time_ns - self._prune_slack:
+                i = bisect_left(stamps, stamp - self.cache_time_ns)
                 del stamps[:i]
                 del child.data[:i]
             return None
