@@ -284,3 +284,35 @@ def test_change_listeners_hear_new_data():
     for m in _raw_messages(1):
         b.add_raw(m, "pub")
     assert heard == [False, True]
+
+
+def test_listener_clears_on_a_jump_back_in_time():
+    from ninjemys.node.subscriber import RawMessage
+    from ninjemys.tf2.node import TransformListener
+
+    class FakeNode:
+        def subscriber(self, topic, msg_class, callback, **kwargs):
+            class Sub:
+                def unregister(self):
+                    pass
+
+            return Sub()
+
+    clock = [100.0]
+    lines: list[str] = []
+    b = BufferCore()
+    listener = TransformListener(FakeNode(), b, now=lambda: clock[0], report=lines.append)
+    header = {"callerid": "/pub", "md5sum": "94810edda583a504dfda3829e70d7eec"}
+    listener._on_tf_static(RawMessage(_raw_messages(1, frames=2)[0], header))
+    listener._on_tf(RawMessage(_raw_messages(1, start=3, frames=3)[0], header))
+    assert b.can_transform("world", "f2", 0)[0]
+    clock[0] = 50.0  # a bag loop or a simulator reset
+    listener._on_tf(RawMessage(_raw_messages(1, start=1, frames=1)[0], header))
+    assert lines == ["Detected jump back in time of 50.000000s. Clearing TF buffer."]
+    assert not b.can_transform("world", "f2", 0)[0]  # the old dynamic data is gone
+    assert b.can_transform("world", "f1", 0)[0]
+    listener._on_tf(RawMessage(b"\x05\x00", {"callerid": "/odd", "md5sum": "0123"}))
+    assert lines[-1] == "/tf: /odd publishes type None (md5 0123), not tf2_msgs/TFMessage"
+    listener._on_tf(RawMessage(b"\x05\x00\x00\x00", header))  # five transforms announced, none there
+    assert b.can_transform("world", "f1", 0)[0]
+    assert lines[-1].startswith("/tf: dropped a message from /pub: tf2_msgs/TFMessage: cannot decode 4 bytes")
