@@ -300,7 +300,7 @@ def test_listener_clears_on_a_jump_back_in_time():
 
     clock = [100.0]
     lines: list[str] = []
-    b = BufferCore()
+    b = BufferCore(report=lines.append)
     listener = TransformListener(FakeNode(), b, now=lambda: clock[0], report=lines.append)
     header = {"callerid": "/pub", "md5sum": "94810edda583a504dfda3829e70d7eec"}
     listener._on_tf_static(RawMessage(_raw_messages(1, frames=2)[0], header))
