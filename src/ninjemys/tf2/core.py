@@ -1016,11 +1016,6 @@ class BufferCore:
             finally:
                 self._waiters -= 1
 
-    def wake_waiters(self) -> None:
-        """Wake every ``wait_for_transform`` so it re-checks (e.g. at shutdown or after a clock jump)."""
-        with self._lock:
-            self._changed.notify_all()
-
     def latest_common_time(self, target_frame: str, source_frame: str) -> int:
         """tf2_py's ``get_latest_common_time`` (raises LookupException / TransformException)."""
         with self._lock:
