@@ -184,3 +184,30 @@ def test_view_frames_end_to_end(env, procs, tmp_path):
     gv = (tmp_path / "frames.gv").read_text()
     assert '"base" -> "laser"[label=" Broadcaster: /static_transform_publisher' in gv
     assert (tmp_path / "frames.pdf").exists() or (tmp_path / "frames.svg").exists()
+
+
+def test_example_broadcaster_and_listener(env, procs):
+    from pathlib import Path
+
+    examples = Path(__file__).parents[2] / "examples" / "tf"
+    procs.append(
+        subprocess.Popen(
+            [sys.executable, str(examples / "frame_broadcaster.py")], env=env, stderr=subprocess.DEVNULL
+        )
+    )
+    listener = subprocess.Popen(
+        [sys.executable, str(examples / "frame_listener.py")],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+    procs.append(listener)
+    sel = selectors.DefaultSelector()
+    sel.register(listener.stdout, selectors.EVENT_READ)
+    deadline = time.monotonic() + 30
+    seen = ""
+    while "carrot in laser" not in seen and time.monotonic() < deadline:
+        if sel.select(0.2):
+            seen += listener.stdout.readline()
+    assert re.search(r"carrot in laser: x=-?\d+\.\d\d y=-?\d+\.\d\d yaw=-?\d+\.\d\d", seen), seen
