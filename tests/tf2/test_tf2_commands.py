@@ -15,7 +15,7 @@ import pytest
 from ninjemys import testing
 from ninjemys.tools.tf_echo import format_transform
 from ninjemys.tools.tf_monitor import Monitor
-from ninjemys.tools.view_frames import generate_dot, write_outputs
+from ninjemys.tools.view_frames import edges_from_dot, generate_dot, write_graph, write_outputs
 
 
 def shipped(pkg: str, exe: str, *args: str) -> list[str]:
@@ -159,6 +159,32 @@ def test_view_frames_outputs(tmp_path, monkeypatch):
     assert [p.name for p in written] == ["frames.gv", "frames.svg"]
     svg = (tmp_path / "frames.svg").read_text()
     assert svg.startswith("<svg") and ">odom</text>" in svg and "Broadcaster: /amcl" in svg
+
+
+def test_tf_view_frames_draws_tf_dot_text(tmp_path, monkeypatch):
+    """``rosrun tf view_frames`` writes tf's own dot text (allFramesAsDot) and draws it without dot."""
+    from ninjemys.tf2.core import BufferCore
+
+    b = BufferCore()
+    b.set_transforms(
+        [("map", "odom", 10**9, 0, 0, 0, 0, 0, 0, 1), ("odom", "base", 10**9, 0, 0, 0, 0, 0, 0, 1)], "/me"
+    )
+    dot = b.all_frames_as_dot(12.0)
+    edges = edges_from_dot(dot)
+    assert edges[1] == (
+        "odom",
+        "base",
+        [
+            "Broadcaster: /me",
+            "Average rate: 10000.000 Hz",
+            "Most recent transform: 1.000 ( 11.000 sec old)",
+            "Buffer length: 0.000 sec",
+        ],
+    )
+    monkeypatch.setattr("shutil.which", lambda _name: None)
+    written = write_graph(dot, edges, 12.0, tmp_path)
+    assert (tmp_path / "frames.gv").read_text() == dot
+    assert written[-1].name == "frames.svg" and ">base</text>" in written[-1].read_text()
 
 
 @pytest.mark.slow
