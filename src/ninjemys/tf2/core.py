@@ -272,6 +272,12 @@ class BufferCore:
             self._drain()
             return name in self._frames
 
+    def child_frames(self) -> list[str]:
+        """The frames that have a parent now (the keys of :meth:`all_frames_as_yaml`), in tf2's order."""
+        with self._lock:
+            self._drain()
+            return [f.name for f in self._order if f.has_cache and f.data]
+
     def frame_names(self) -> list[str]:
         """Every known frame, in the order tf2 numbered them (``_getFrameStrings``)."""
         with self._lock:
