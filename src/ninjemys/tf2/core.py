@@ -789,11 +789,13 @@ class BufferCore:
                 b = self._to_root(target, t, gen)
                 if b is not None and a[0] is b[0]:
                     return t, tfm.inverse_compose(b[1], a[1])
+            # some link above the common ancestor has no data for t (a slow map->odom under a fast
+            # odom->base_link): the answer only needs the links below it
         else:
             self._last_t = t
-            r = self._to_ancestor(target, source, t)
-            if r is not None:
-                return t, r
+        r = self._to_ancestor(target, source, t)
+        if r is not None:
+            return t, r
         return t, self._walk_transform(target, source, t)
 
     def _to_ancestor(self, target: Frame, source: Frame, t: int) -> tuple | None:
