@@ -18,9 +18,11 @@ Where we differ, on purpose:
   ``inverse(a) * b`` instead of a walk. When that path cannot answer (a frame above the common
   ancestor has no data for that time), the exact tf2 walk runs and gives tf2's answer or error.
 - ``can_transform`` with a timeout waits on a condition that insertions signal (no polling sleeps).
+- Raw TFMessages (``add_raw``, what the listener uses) are queued and decoded in batches on the next
+  query, runs of one layout with numpy (:mod:`ninjemys.tf2.bulk`).
 
-Times are integer nanoseconds in this module's fast API (``lookup``, ``set_transforms``); the
-message-level API (``lookup_transform_core`` ...) takes and returns ``ninjemys.rostime`` values.
+Times are integer nanoseconds and transforms 7-tuples here; :mod:`ninjemys.tf2.buffer` puts the
+message-level API (TransformStamped, ``ninjemys.rostime`` values, timeouts) on top.
 """
 
 from __future__ import annotations
