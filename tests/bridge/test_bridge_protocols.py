@@ -154,3 +154,45 @@ def test_foxglove_connection_graph_and_parameter_updates(gateway: Gateway, node:
             )
         )
         wait_for(lambda: node.has_param("/fox/blob"), what="a byte_array parameter")
+
+
+def test_foxglove_client_publishes_a_type_we_do_not_ship(gateway: Gateway, node: Node) -> None:
+    got: list[bytes] = []
+    node.subscriber("/custom", None, lambda m: got.append(bytes(m.data)), raw=True)
+    schema = "int32 a\nstring label\n"
+    payload = struct.pack("<iI", 7, 3) + b"abc"
+    with connect(f"ws://127.0.0.1:{gateway.port}/", subprotocols=["foxglove.websocket.v1"]) as ws:
+        channel = {
+            "id": 4,
+            "topic": "/custom",
+            "encoding": "ros1",
+            "schemaName": "my_robot/Thing",
+            "schema": schema,
+        }
+        ws.send(json.dumps({"op": "advertise", "channels": [channel]}))
+
+        def sent() -> bool:
+            ws.send(struct.pack("<BI", 1, 4) + payload)
+            return bool(got)
+
+        wait_for(sent, what="the client's custom-type message")
+    assert got[0] == payload
+    assert ["/custom", "my_robot/Thing"] in node.master.get_topic_types()
+
+
+def test_a_flood_of_ops_is_absorbed(gateway: Gateway, node: Node) -> None:
+    """A client sending ops faster than they run: reading pauses (bounded backlog), nothing is lost."""
+    got: list[str] = []
+    node.subscriber("/flood", String, lambda m: got.append(m.data), queue_size=10000)
+    with connect(f"ws://127.0.0.1:{gateway.port}/") as ws:
+        ws.send(json.dumps({"op": "advertise", "topic": "/flood", "type": "std_msgs/String"}))
+        wait_for(
+            lambda: (
+                gateway.publishers.get("/flood") and gateway.publishers.get("/flood")[0].get_num_connections()
+            ),
+            what="the subscriber connected",
+        )
+        for i in range(3000):
+            ws.send(json.dumps({"op": "publish", "topic": "/flood", "msg": {"data": str(i)}}))
+        wait_for(lambda: len(got) == 3000, timeout=60, what="every published message")
+    assert got[-1] == "2999"

@@ -20,7 +20,7 @@ from collections.abc import Callable
 from typing import Any
 
 from ninjemys.errors import NinjemysError, ServiceError
-from ninjemys.idl.loader import get_message_class, get_service_class
+from ninjemys.idl.loader import get_message_class, get_service_class, message_class_from_definition
 from ninjemys.node import Node
 from ninjemys.node.subscriber import RawMessage
 from ninjemys.tools.rosservice import probe
@@ -141,10 +141,17 @@ class Publishers:
         self._lock = threading.Lock()
 
     def advertise(
-        self, topic: str, type_name: str, owner: object, latch: bool = False, queue_size: int = 100
+        self,
+        topic: str,
+        type_name: str,
+        owner: object,
+        latch: bool = False,
+        queue_size: int = 100,
+        msg_class: Any = None,
     ) -> Any:
-        """The publisher for ``topic`` (created on first use); raises NinjemysError on a type clash."""
-        msg_class = message_class(type_name)
+        """The publisher for ``topic`` (created on first use); raises NinjemysError on a type clash.
+        ``msg_class`` is given for a type learned from a client's definition (:meth:`learn`)."""
+        msg_class = msg_class or message_class(type_name)
         with self._lock:
             entry = self._pubs.get(topic)
             if entry is None:
@@ -156,6 +163,18 @@ class Publishers:
                 )
             entry[2].add(owner)
             return entry[0]
+
+    @staticmethod
+    def learn(type_name: str, definition: str) -> Any:
+        """The class of ``type_name``, built from its full definition text when the type is neither
+        shipped nor on the package path (a Foxglove client may advertise its own types)."""
+        try:
+            return get_message_class(type_name)
+        except NinjemysError:
+            try:
+                return message_class_from_definition(type_name, definition)
+            except NinjemysError as exc:
+                raise NinjemysError(f"cannot use the definition of {type_name}: {exc}") from None
 
     def get(self, topic: str) -> tuple[Any, Any] | None:
         entry = self._pubs.get(topic)

@@ -28,7 +28,7 @@ from typing import Any
 from ninjemys.bridge.convert import ConversionError, from_value, to_value
 from ninjemys.bridge.graph import Delivery
 from ninjemys.bridge.graph import service_class as graph_service_class
-from ninjemys.bridge.outbox import Outbox
+from ninjemys.bridge.outbox import Backlog, Outbox
 from ninjemys.errors import NinjemysError
 
 log = logging.getLogger(__name__)
@@ -36,6 +36,8 @@ log = logging.getLogger(__name__)
 _LEVELS = {"none": 0, "error": 1, "warning": 2, "info": 3}
 #: lane length when a subscription asks for queue_length 0 (rosbridge's "no queue" default)
 DEFAULT_QUEUE_LENGTH = 100
+#: fragmented messages a client may have unfinished at once (each is bounded by max_message_size)
+MAX_PENDING_FRAGMENTED = 8
 
 
 class OpError(Exception):
@@ -118,6 +120,7 @@ class RosbridgeSession:
         self._pending: dict[str, tuple[threading.Event, list[Any]]] = {}
         self._fragments: dict[str, dict[int, str]] = {}
         self._counter = itertools.count(1)
+        self.backlog = Backlog()
         self._worker: Executor = ThreadPoolExecutor(1, thread_name_prefix=f"rosbridge-{client_id}")
         self._closed = threading.Event()
         self._lock = threading.Lock()
@@ -157,12 +160,19 @@ class RosbridgeSession:
         if not isinstance(msg, dict) or not isinstance(msg.get("op"), str):
             self.status("error", "a rosbridge message must be an object with an 'op' string")
             return
+        self.backlog.add()
         if msg["op"] == "call_service" and self.authenticated:
             self.gateway.pool.submit(self._run, msg)
         else:
             self._worker.submit(self._run, msg)
 
     def _run(self, msg: dict[str, Any]) -> None:
+        try:
+            self._handle(msg)
+        finally:
+            self.backlog.done()
+
+    def _handle(self, msg: dict[str, Any]) -> None:
         op = msg["op"]
         op_id = msg.get("id")
         if not self.authenticated and op != "auth":
@@ -413,6 +423,10 @@ class RosbridgeSession:
         data = self._field(msg, "data", str)
         if not 0 <= num < total or total > 100_000:
             raise OpError(f"fragment {num} of {total} is out of range")
+        if frag_id not in self._fragments and len(self._fragments) >= MAX_PENDING_FRAGMENTED:
+            oldest = next(iter(self._fragments))
+            del self._fragments[oldest]
+            self.status("warning", f"fragment: dropped the unfinished message {oldest} (too many pending)")
         parts = self._fragments.setdefault(frag_id, {})
         parts[num] = data
         if sum(len(p) for p in parts.values()) > self.gateway.options.max_message_size:

@@ -422,10 +422,12 @@ class Gateway:
         )
         if isinstance(session, FoxgloveSession):
             session.hello()
+        session.backlog.bind(loop, asyncio.Event())
         sender = asyncio.create_task(self._sender(client))
         try:
             async for data in ws.messages():
                 session.receive(data)
+                await session.backlog.wait()
         finally:
             sender.cancel()
             self._clients.pop(client.id, None)
