@@ -23,7 +23,7 @@ SYSTEM_DEBS  := $(ROS1_DEBS) $(BROWSER_DEBS) tmux
 NPM_DIR   := .cache/npm
 NPM_STAMP := $(NPM_DIR)/node_modules/.installed
 
-.PHONY: all venv system npm lint format test test-fast demo bench clean
+.PHONY: all venv system npm lint format typecheck test test-fast demo bench clean
 
 all: venv
 
@@ -60,7 +60,11 @@ format: venv
 	$(VENV)/bin/ruff format src tests bench examples
 	$(VENV)/bin/ruff check --fix src tests bench examples
 
-test: venv system npm lint
+# Static types of the core layers (wire, idl, net, master, node); the configuration is in pyproject.toml.
+typecheck: venv
+	$(VENV)/bin/mypy
+
+test: venv system npm lint typecheck
 	$(VENV)/bin/pytest -n 2 -q
 
 test-fast: venv

@@ -15,7 +15,7 @@ def room_map(size: float = 6.0, res: float = 0.05) -> GridMap:
     n = int(round(size / res))
     data = np.zeros((n, n), dtype=np.int8)
     data[:2, :] = data[-2:, :] = data[:, :2] = data[:, -2:] = 100
-    data[20:40, 30:45] = 100  # a box
+    data[30:45, 90:105] = 100  # a box
     data[80:90, 70:110] = 100  # a long low box
     data[60:62, 2:50] = 100  # a wall stub from the left
     return GridMap(data, res, (0.0, 0.0, 0.0))

@@ -1,0 +1,647 @@
+"""``rosrun move_base move_base``: ROS 1 move_base's interface over the numpy planners.
+
+- Action ``move_base`` (move_base_msgs/MoveBaseAction): a new goal preempts the current one (as
+  SimpleActionServer does); feedback ``base_position`` is the robot's pose in the global frame every
+  control cycle. ``/move_base_simple/goal`` (PoseStamped) sends a goal without a client.
+- Services ``~make_plan`` (nav_msgs/GetPlan) and ``~clear_costmaps`` (std_srvs/Empty).
+- Costmaps ``~global_costmap`` and ``~local_costmap`` (see :mod:`ninjemys.nav.costmap_ros`), the global
+  plan on ``~GlobalPlanner/plan`` (nav_msgs/Path), the local plan on ``~DWAPlannerROS/local_plan``,
+  the goal on ``~current_goal``, ``cmd_vel`` (geometry_msgs/Twist) out; ``odom`` (nav_msgs/Odometry) in
+  for the current velocity.
+- Parameters: move_base's (``~controller_frequency``, ``~planner_frequency``, ``~controller_patience``,
+  ``~planner_patience``, ``~oscillation_timeout``, ``~oscillation_distance``,
+  ``~recovery_behavior_enabled``, ``~clearing_rotation_allowed``, ``~conservative_reset_dist``),
+  the planner's under ``~GlobalPlanner`` (or ``~NavfnROS``): ``allow_unknown``, ``neutral_cost``,
+  ``cost_factor``, ``default_tolerance``, and dwa_local_planner's under ``~DWAPlannerROS``
+  (``~TrajectoryPlannerROS`` names are read too). ``~DWAPlannerROS`` and move_base's own tunables
+  are dynamic_reconfigure servers, as in ROS 1.
+
+Goals outside the global costmap or on a lethal/inscribed cell are rejected with the reason in the
+goal status text (ROS 1 accepts them and aborts after ``planner_patience``); when the local planner
+finds no safe arc for ``controller_patience`` seconds, or the robot oscillates, the recovery
+behaviours run in ROS 1's order (conservative reset, rotate in place, aggressive reset, rotate), then
+the goal is aborted.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from dataclasses import fields
+from typing import Any
+
+import numpy as np
+
+import rospy
+from ninjemys.nav.costmap import INSCRIBED
+from ninjemys.nav.costmap_ros import CostmapROS
+from ninjemys.nav.dwa import DWAParams, DWAPlanner, angle_diff
+from ninjemys.nav.planner import PlanError, plan_path
+from ninjemys.nav.rosglue import (
+    Pose2D,
+    Tf2D,
+    fill_pose,
+    grid_from_msg,
+    param,
+    pose_msg_to_2d,
+    scan_arrays,
+    start_node,
+)
+from ninjemys.nav.slam import compose, inverse
+
+#: dwa_local_planner's names for the base_local_planner (TrajectoryPlannerROS) parameters we map
+TRAJECTORY_ALIASES = {
+    "max_vel_theta": "max_rot_vel",
+    "min_vel_theta": "min_rot_vel",
+    "max_vel_x": "max_vel_x",
+    "min_vel_x": "min_vel_x",
+    "acc_lim_theta": "acc_lim_th",
+    "path_distance_bias": "pdist_scale",
+    "goal_distance_bias": "gdist_scale",
+}
+
+RECOVERIES = ("conservative_reset", "rotate_recovery", "aggressive_reset", "rotate_recovery")
+
+
+def dwa_params(node: Any) -> DWAParams:
+    """DWAParams from ``~DWAPlannerROS/*`` (falling back to ``~TrajectoryPlannerROS/*``)."""
+    p = DWAParams()
+    for f in fields(p):
+        default = getattr(p, f.name)
+        for key in (
+            f"DWAPlannerROS/{f.name}",
+            f"TrajectoryPlannerROS/{TRAJECTORY_ALIASES.get(f.name, f.name)}",
+        ):
+            if node.has_param("~" + key):
+                setattr(p, f.name, param(node, key, default))
+                break
+    p.controller_frequency = param(node, "controller_frequency", 20.0)
+    return p
+
+
+class MoveBase:
+    """The node: costmaps, planners, the control loop and the action server."""
+
+    def __init__(self, node: Any) -> None:
+        from geometry_msgs.msg import PoseStamped, Twist
+        from nav_msgs.msg import OccupancyGrid, Odometry, Path
+        from nav_msgs.srv import GetPlan
+        from std_srvs.srv import Empty
+
+        self.node = node
+        self.lock = threading.RLock()
+        self.frequency = max(1.0, param(node, "controller_frequency", 20.0))
+        self.planner_frequency = param(node, "planner_frequency", 0.0)
+        self.controller_patience = param(node, "controller_patience", 15.0)
+        self.planner_patience = param(node, "planner_patience", 5.0)
+        self.oscillation_timeout = param(node, "oscillation_timeout", 0.0)
+        self.oscillation_distance = param(node, "oscillation_distance", 0.5)
+        self.recovery_enabled = param(node, "recovery_behavior_enabled", True)
+        self.rotation_allowed = param(node, "clearing_rotation_allowed", True)
+        self.conservative_dist = param(node, "conservative_reset_dist", 3.0)
+        planner_ns = "GlobalPlanner" if node.has_param("~GlobalPlanner") else "NavfnROS"
+        self.allow_unknown = param(node, f"{planner_ns}/allow_unknown", True)
+        self.neutral_cost = param(node, f"{planner_ns}/neutral_cost", 50.0)
+        self.cost_factor = param(node, f"{planner_ns}/cost_factor", 3.0)
+        self.goal_tolerance = param(node, f"{planner_ns}/default_tolerance", 0.0)
+        self.global_cm = CostmapROS(node, "~global_costmap")
+        self.local_cm = CostmapROS(node, "~local_costmap")
+        self.dwa = DWAPlanner(dwa_params(node))
+        self.tf = Tf2D(node)
+        self.velocity = (0.0, 0.0)
+        self.goal: Pose2D | None = None  # in the global frame
+        self.handle: Any = None  # the action goal handle being executed (None: a simple goal or idle)
+        self.plan: np.ndarray | None = None
+        self.state = "idle"
+        self.last_valid = 0.0
+        self.last_plan_time = 0.0
+        self.plan_requested = False
+        self.planning_since = 0.0
+        self.recovery_index = 0
+        self.osc_pose: Pose2D | None = None
+        self.osc_time = 0.0
+        self.rotate_start: float | None = None
+        self.rotate_turned = 0.0
+        self.rotate_last_yaw = 0.0
+        self._path_cls, self._pose_stamped = Path, PoseStamped
+        self.cmd_pub = node.publisher("cmd_vel", Twist, queue_size=1)
+        self._twist = Twist
+        self.plan_pub = node.publisher(
+            f"~{planner_ns if planner_ns == 'NavfnROS' else 'GlobalPlanner'}/plan", Path, queue_size=1
+        )
+        self.local_plan_pub = node.publisher("~DWAPlannerROS/local_plan", Path, queue_size=1)
+        self.goal_pub = node.publisher("~current_goal", PoseStamped, queue_size=1, latch=True)
+        self.scan_subs = []
+        topics: dict[str, list[CostmapROS]] = {}
+        for cm in (self.global_cm, self.local_cm):
+            for src in cm.sources:
+                topics.setdefault(src["topic"], []).append(cm)
+        from sensor_msgs.msg import LaserScan
+
+        self.bad_scan_reported = False
+        for topic, cms in topics.items():
+            self.scan_subs.append(
+                node.subscriber(topic, LaserScan, self.on_scan, callback_args=cms, queue_size=1)
+            )
+        if self.global_cm.costmap.params.use_static:
+            node.subscriber("map", OccupancyGrid, self.on_map, queue_size=1)
+        if self.local_cm.costmap.params.use_static:
+            if not self.global_cm.costmap.params.use_static:
+                node.subscriber("map", OccupancyGrid, self.on_map, queue_size=1)
+        node.subscriber("odom", Odometry, self.on_odom, queue_size=1)
+        node.subscriber("move_base_simple/goal", PoseStamped, self.on_simple_goal, queue_size=1)
+        node.service("~make_plan", GetPlan, self.on_make_plan)
+        node.service("~clear_costmaps", Empty, self.on_clear_costmaps)
+        self._start_action_server()
+        self._start_reconfigure()
+        self.thread = threading.Thread(target=self.control_loop, name="move_base-control", daemon=True)
+        self.thread.start()
+        self.cm_thread = threading.Thread(target=self.costmap_loop, name="move_base-costmaps", daemon=True)
+        self.cm_thread.start()
+
+    # -- set-up -------------------------------------------------------------------------------------
+
+    def _start_action_server(self) -> None:
+        from move_base_msgs.msg import MoveBaseAction
+        from ninjemys.actionlib.server import ActionServer
+
+        self.server = ActionServer(self.node, "move_base", MoveBaseAction, self.on_goal, self.on_cancel)
+        self.server.start()
+
+    def _start_reconfigure(self) -> None:
+        from ninjemys.dynamic_reconfigure.server import ReconfigureServer
+        from ninjemys.nav.reconfigure import dwa_config_type, move_base_config_type
+
+        self.dwa_reconf = ReconfigureServer(
+            self.node, dwa_config_type(), self.on_dwa_reconfigure, "~DWAPlannerROS"
+        )
+        self.mb_reconf = ReconfigureServer(self.node, move_base_config_type(), self.on_mb_reconfigure, "~")
+
+    def on_dwa_reconfigure(self, config: Any, _level: int) -> Any:
+        with self.lock:
+            self.dwa.params.update(
+                {k: config[k] for k in config if hasattr(self.dwa.params, k) and k != "controller_frequency"}
+            )
+        return config
+
+    def on_mb_reconfigure(self, config: Any, _level: int) -> Any:
+        with self.lock:
+            for key in (
+                "planner_frequency",
+                "controller_patience",
+                "planner_patience",
+                "oscillation_timeout",
+                "oscillation_distance",
+                "conservative_reset_dist",
+            ):
+                if key in config:
+                    setattr(
+                        self,
+                        {"conservative_reset_dist": "conservative_dist"}.get(key, key),
+                        float(config[key]),
+                    )
+            if "controller_frequency" in config:
+                self.frequency = max(1.0, float(config["controller_frequency"]))
+                self.dwa.params.controller_frequency = self.frequency
+            if "recovery_behavior_enabled" in config:
+                self.recovery_enabled = bool(config["recovery_behavior_enabled"])
+            if "clearing_rotation_allowed" in config:
+                self.rotation_allowed = bool(config["clearing_rotation_allowed"])
+        return config
+
+    # -- inputs -------------------------------------------------------------------------------------
+
+    def on_map(self, msg: Any) -> None:
+        grid = grid_from_msg(msg)
+        with self.lock:
+            for cm in (self.global_cm, self.local_cm):
+                if cm.costmap.params.use_static:
+                    cm.costmap.set_static_map(grid.data, grid.resolution, grid.origin[0], grid.origin[1])
+            if self.global_cm.costmap.params.use_static:
+                self.global_cm.costmap.update()
+        rospy.loginfo(
+            "move_base: received a %d X %d map at %.3f m/pix", grid.width, grid.height, grid.resolution
+        )
+
+    def on_odom(self, msg: Any) -> None:
+        self.velocity = (float(msg.twist.twist.linear.x), float(msg.twist.twist.angular.z))
+
+    def on_scan(self, scan: Any, cms: list[CostmapROS]) -> None:
+        ranges, angles = scan_arrays(scan)
+        if not self.bad_scan_reported and not np.isfinite(ranges).all():
+            self.bad_scan_reported = True
+            rospy.logwarn(
+                "move_base: scan on %s has NaN/inf ranges (%d of %d): NaN is dropped, inf clears without marking",
+                scan.header.frame_id,
+                int((~np.isfinite(ranges)).sum()),
+                len(ranges),
+            )
+        t = scan.header.stamp.to_sec()
+        for cm in cms:
+            sensor = self.tf.lookup(cm.global_frame, scan.header.frame_id, t)
+            if sensor is None:
+                continue
+            with self.lock:
+                if cm.costmap.params.rolling_window:
+                    cm.costmap.update_origin(sensor[0], sensor[1])
+                cm.costmap.add_scan(sensor[0], sensor[1], sensor[2] + angles, ranges, float(scan.range_max))
+
+    # -- goals --------------------------------------------------------------------------------------
+
+    def _goal_in_global(self, pose_stamped: Any) -> tuple[Pose2D | None, str]:
+        p = pose_msg_to_2d(pose_stamped.pose)
+        q = pose_stamped.pose.orientation
+        norm = math.sqrt(q.x**2 + q.y**2 + q.z**2 + q.w**2)
+        if not all(math.isfinite(v) for v in p) or not math.isfinite(norm) or norm < 1e-6:
+            return None, "Aborting on goal because it was sent with an invalid quaternion"
+        frame = pose_stamped.header.frame_id.lstrip("/") or self.global_cm.global_frame
+        if frame != self.global_cm.global_frame:
+            tr = self.tf.lookup(self.global_cm.global_frame, frame, 0.0)
+            if tr is None:
+                return None, f"cannot transform the goal from frame {frame} to {self.global_cm.global_frame}"
+            p = compose(tr, p)
+        cm = self.global_cm.costmap
+        with self.lock:
+            if cm.size_x == 0:
+                return None, "the global costmap has no map yet"
+            cx, cy = cm.world_to_cell(p[0], p[1])
+            if not cm.inside(cx, cy):
+                x1 = cm.origin_x + cm.size_x * cm.resolution
+                y1 = cm.origin_y + cm.size_y * cm.resolution
+                return None, (
+                    f"The goal ({p[0]:.2f}, {p[1]:.2f}) is off the global costmap "
+                    f"([{cm.origin_x:.2f}, {x1:.2f}] x [{cm.origin_y:.2f}, {y1:.2f}])"
+                )
+            cost = int(cm.costs[cy, cx])
+            if INSCRIBED <= cost < 255:
+                what = "an obstacle" if cost > INSCRIBED else "the inflated zone of an obstacle"
+                return None, f"The goal ({p[0]:.2f}, {p[1]:.2f}) is in {what} (cost {cost})"
+        return p, ""
+
+    def on_goal(self, handle: Any) -> None:
+        goal, reason = self._goal_in_global(handle.get_goal().target_pose)
+        if goal is None:
+            rospy.logerr("move_base: %s", reason)
+            handle.set_rejected(None, reason)
+            return
+        with self.lock:
+            if self.handle is not None:
+                self.handle.set_canceled(
+                    None,
+                    "This goal was canceled because another goal was received by the simple action server",
+                )
+            handle.set_accepted("This goal has been accepted by the simple action server")
+            self._begin(goal, handle)
+
+    def on_cancel(self, handle: Any) -> None:
+        with self.lock:
+            if handle is self.handle or (self.handle is not None and handle == self.handle):
+                self._stop()
+                handle.set_canceled(None, "")
+                self.handle = None
+                self.goal = None
+                self.state = "idle"
+
+    def on_simple_goal(self, msg: Any) -> None:
+        goal, reason = self._goal_in_global(msg)
+        if goal is None:
+            rospy.logerr("move_base: %s", reason)
+            return
+        with self.lock:
+            if self.handle is not None:
+                self.handle.set_canceled(
+                    None,
+                    "This goal was canceled because another goal was received by the simple action server",
+                )
+            self._begin(goal, None)
+
+    def _begin(self, goal: Pose2D, handle: Any) -> None:
+        self.goal = goal
+        self.handle = handle
+        self.dwa.xy_latched = False
+        self.plan = None
+        self.state = "planning"
+        self.plan_requested = True
+        self.planning_since = rospy.get_time()
+        self.last_valid = rospy.get_time()
+        self.recovery_index = 0
+        self.osc_pose = None
+        self.osc_time = rospy.get_time()
+        msg = self._pose_stamped()
+        msg.header.frame_id = self.global_cm.global_frame
+        msg.header.stamp = rospy.Time.from_sec(rospy.get_time())
+        fill_pose(msg.pose, goal)
+        self.goal_pub.publish(msg)
+
+    # -- services -----------------------------------------------------------------------------------
+
+    def on_make_plan(self, req: Any) -> Any:
+        from nav_msgs.srv import GetPlanResponse
+
+        resp = GetPlanResponse()
+        resp.plan.header.frame_id = self.global_cm.global_frame
+        goal, reason = self._goal_in_global(req.goal)
+        if goal is None:
+            rospy.logerr("move_base: make_plan: %s", reason)
+            return resp
+        if req.start.header.frame_id:
+            start = pose_msg_to_2d(req.start.pose)
+        else:
+            start = self.tf.lookup(self.global_cm.global_frame, self.global_cm.robot_base_frame)
+            if start is None:
+                rospy.logerr("move_base: make_plan: no robot pose in %s", self.global_cm.global_frame)
+                return resp
+        try:
+            plan = self._make_plan(start, goal)
+        except PlanError as exc:
+            rospy.logerr("move_base: make_plan: %s", exc)
+            return resp
+        resp.plan = self._path_msg(plan, self.global_cm.global_frame)
+        return resp
+
+    def on_clear_costmaps(self, _req: Any) -> Any:
+        from std_srvs.srv import EmptyResponse
+
+        with self.lock:
+            for cm in (self.global_cm, self.local_cm):
+                cm.costmap.clear_obstacles()
+                cm.costmap.update()
+        return EmptyResponse()
+
+    # -- planning and control -----------------------------------------------------------------------
+
+    def _make_plan(self, start: Pose2D, goal: Pose2D) -> np.ndarray:
+        with self.lock:
+            cm = self.global_cm.costmap
+            costs = cm.update().copy()
+            origin = (cm.origin_x, cm.origin_y)
+            res = cm.resolution
+        # the robot's own cell may be inflated: the planner starts from it regardless
+        return plan_path(
+            costs,
+            res,
+            origin,
+            start[:2],
+            goal,
+            self.neutral_cost,
+            self.cost_factor,
+            INSCRIBED,
+            self.allow_unknown,
+        )
+
+    def _path_msg(self, plan: np.ndarray, frame: str) -> Any:
+        from geometry_msgs.msg import PoseStamped
+
+        path = self._path_cls()
+        path.header.frame_id = frame
+        path.header.stamp = rospy.Time.from_sec(rospy.get_time())
+        out = []
+        for x, y, yaw in plan:
+            ps = PoseStamped()
+            ps.header.frame_id = frame
+            fill_pose(ps.pose, (float(x), float(y), float(yaw)))
+            out.append(ps)
+        path.poses = out
+        return path
+
+    def _stop(self) -> None:
+        self.cmd_pub.publish(self._twist())
+
+    def _send(self, v: float, w: float) -> None:
+        msg = self._twist()
+        msg.linear.x = float(v)
+        msg.angular.z = float(w)
+        self.cmd_pub.publish(msg)
+
+    def _finish(self, ok: bool, text: str) -> None:
+        self._stop()
+        if self.handle is not None:
+            if ok:
+                self.handle.set_succeeded(None, text)
+            else:
+                self.handle.set_aborted(None, text)
+        if ok:
+            rospy.loginfo("move_base: %s", text or "goal reached")
+        else:
+            rospy.logerr("move_base: %s", text)
+        self.handle = None
+        self.goal = None
+        self.state = "idle"
+        self.plan = None
+
+    def costmap_loop(self) -> None:
+        """Publish the costmaps at their publish_frequency (the local one is updated by the control loop)."""
+        period = 0.5
+        freqs = [f for f in (self.global_cm.publish_frequency, self.local_cm.publish_frequency) if f > 0]
+        if freqs:
+            period = 1.0 / max(freqs)
+        last = {id(self.global_cm): 0.0, id(self.local_cm): 0.0}
+        while not rospy.is_shutdown():
+            rospy.sleep(period)
+            t = rospy.get_time()
+            for cm in (self.global_cm, self.local_cm):
+                if cm.publish_frequency <= 0 or t - last[id(cm)] < 1.0 / cm.publish_frequency - 1e-6:
+                    continue
+                last[id(cm)] = t
+                with self.lock:
+                    if cm is self.global_cm:
+                        cm.costmap.update()
+                    cm.publish()
+
+    def control_loop(self) -> None:
+        rate = rospy.Rate(self.frequency)
+        while not rospy.is_shutdown():
+            try:
+                self.cycle()
+            except Exception as exc:  # one cycle failing must not kill the controller thread
+                rospy.logerr("move_base: control cycle failed: %s: %s", type(exc).__name__, exc)
+            try:
+                rate.sleep()
+            except rospy.ROSInterruptException:
+                return
+
+    def _robot_poses(self) -> tuple[Pose2D | None, Pose2D | None]:
+        g = self.tf.lookup(self.global_cm.global_frame, self.global_cm.robot_base_frame)
+        if self.local_cm.global_frame == self.global_cm.global_frame:
+            return g, g
+        return g, self.tf.lookup(self.local_cm.global_frame, self.local_cm.robot_base_frame)
+
+    def cycle(self) -> None:
+        with self.lock:
+            if self.goal is None:
+                return
+        gpose, lpose = self._robot_poses()
+        if gpose is None or lpose is None:
+            rospy.logwarn_throttle(
+                5.0,
+                "move_base: no robot pose yet (waiting for TF %s -> %s)",
+                self.global_cm.global_frame,
+                self.global_cm.robot_base_frame,
+            )
+            return
+        now = rospy.get_time()
+        with self.lock:
+            goal = self.goal
+            if goal is None:
+                return
+            self._feedback(gpose)
+            replan_due = (
+                self.planner_frequency > 0 and now - self.last_plan_time >= 1.0 / self.planner_frequency
+            )
+            if self.state == "planning" or (self.state == "controlling" and replan_due):
+                self._plan_step(gpose, goal, now)
+                if self.state not in ("controlling",):
+                    return
+            if self.state == "clearing":
+                self._recovery_step(gpose, lpose, now)
+                return
+            if self.state != "controlling" or self.plan is None:
+                return
+            # the plan in the local costmap's frame
+            to_local = compose(lpose, inverse(gpose))
+            c, s = math.cos(to_local[2]), math.sin(to_local[2])
+            plan = self.plan
+            local_plan = np.column_stack(
+                [
+                    to_local[0] + c * plan[:, 0] - s * plan[:, 1],
+                    to_local[1] + s * plan[:, 0] + c * plan[:, 1],
+                    plan[:, 2] + to_local[2],
+                ]
+            )
+            lcm = self.local_cm.costmap
+            lcm.update_origin(lpose[0], lpose[1])
+            lcm.update()
+            keep_latch = self.dwa.xy_latched
+            self.dwa.set_plan(local_plan)
+            self.dwa.xy_latched = keep_latch
+            cmd = self.dwa.compute(lpose, self.velocity, lcm)
+            # prune the global plan as the local planner did
+            self.plan = plan[len(plan) - len(self.dwa.plan) :]
+        if cmd.reached:
+            with self.lock:
+                self._finish(True, "Goal reached")
+            return
+        if cmd.valid:
+            self.last_valid = now
+            self._send(cmd.v, cmd.w)
+            self._check_oscillation(gpose, now)
+            return
+        self._stop()
+        with self.lock:
+            if now - self.last_valid > self.controller_patience:
+                self._start_recovery(now, "Aborting because a valid control could not be found")
+            elif now - self.last_plan_time > 1.0:
+                self.state = "planning"  # ROS 1 replans when the local planner fails
+                self.planning_since = min(self.planning_since, now) if self.plan_requested else now
+                self.plan_requested = True
+
+    def _feedback(self, gpose: Pose2D) -> None:
+        if self.handle is None:
+            return
+        from move_base_msgs.msg import MoveBaseFeedback
+
+        fb = MoveBaseFeedback()
+        fb.base_position.header.frame_id = self.global_cm.global_frame
+        fb.base_position.header.stamp = rospy.Time.from_sec(rospy.get_time())
+        fill_pose(fb.base_position.pose, gpose)
+        self.handle.publish_feedback(fb)
+
+    def _plan_step(self, gpose: Pose2D, goal: Pose2D, now: float) -> None:
+        self.last_plan_time = now
+        try:
+            plan = self._make_plan(gpose, goal)
+        except PlanError as exc:
+            if self.state == "controlling":
+                rospy.logwarn_throttle(
+                    5.0, "move_base: replanning failed (%s); keeping the current plan", exc
+                )
+                return
+            if now - self.planning_since > self.planner_patience:
+                self._start_recovery(
+                    now, f"Failed to find a valid plan. Even after executing recovery behaviors. ({exc})"
+                )
+            return
+        self.plan = plan
+        self.plan_requested = False
+        if self.state == "planning":
+            self.state = "controlling"
+            self.last_valid = now
+        self.plan_pub.publish(self._path_msg(plan, self.global_cm.global_frame))
+
+    def _check_oscillation(self, gpose: Pose2D, now: float) -> None:
+        if self.oscillation_timeout <= 0:
+            return
+        if (
+            self.osc_pose is None
+            or math.hypot(gpose[0] - self.osc_pose[0], gpose[1] - self.osc_pose[1])
+            >= self.oscillation_distance
+        ):
+            self.osc_pose = gpose
+            self.osc_time = now
+            self.recovery_index = 0 if self.state == "controlling" else self.recovery_index
+            return
+        if now - self.osc_time > self.oscillation_timeout:
+            with self.lock:
+                self._start_recovery(
+                    now, "Aborting because the robot appears to be oscillating over and over"
+                )
+
+    def _start_recovery(self, now: float, failure: str) -> None:
+        if not self.recovery_enabled or self.recovery_index >= len(RECOVERIES):
+            self._finish(False, failure)
+            return
+        self.failure = failure
+        self.state = "clearing"
+        self.rotate_start = None
+        rospy.logwarn(
+            "move_base: %s; running recovery behavior %s",
+            failure.split(".")[0],
+            RECOVERIES[self.recovery_index],
+        )
+
+    def _recovery_step(self, gpose: Pose2D, lpose: Pose2D, now: float) -> None:
+        name = RECOVERIES[self.recovery_index]
+        if name == "rotate_recovery" and self.rotation_allowed:
+            if self.rotate_start is None:
+                self.rotate_start = now
+                self.rotate_turned = 0.0
+                self.rotate_last_yaw = lpose[2]
+            self.rotate_turned += abs(angle_diff(lpose[2], self.rotate_last_yaw))
+            self.rotate_last_yaw = lpose[2]
+            if self.rotate_turned < 2 * math.pi - 0.1 and now - self.rotate_start < 30.0:
+                self._send(0.0, min(1.0, self.dwa.params.max_vel_theta))
+                return
+            self._stop()
+        elif name == "conservative_reset":
+            self._clear_outside(gpose, lpose, self.conservative_dist)
+        elif name == "aggressive_reset":
+            self._clear_outside(gpose, lpose, 0.0)
+        self.recovery_index += 1
+        self.state = "planning"
+        self.plan_requested = True
+        self.planning_since = now
+        self.last_valid = now
+        self.osc_time = now
+        self.osc_pose = None
+
+    def _clear_outside(self, gpose: Pose2D, lpose: Pose2D, size: float) -> None:
+        """Forget obstacle marks outside a ``size`` x ``size`` square around the robot (0: all), in both
+        costmaps, as clear_costmap_recovery does."""
+        for cm, pose in ((self.global_cm, gpose), (self.local_cm, lpose)):
+            c = cm.costmap
+            if c.size_x == 0:
+                continue
+            if size <= 0:
+                c.clear_obstacles()
+                continue
+            xs = c.origin_x + (np.arange(c.size_x) + 0.5) * c.resolution
+            ys = c.origin_y + (np.arange(c.size_y) + 0.5) * c.resolution
+            far = (np.abs(xs[None, :] - pose[0]) > size / 2) | (np.abs(ys[:, None] - pose[1]) > size / 2)
+            c.obstacles[far] = 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    node, _ = start_node("move_base", argv)
+    MoveBase(node)
+    rospy.spin()
+    return 0

@@ -1,0 +1,164 @@
+"""What every navigation node shares: start-up, parameters, message conversions and 2D TF lookups.
+
+A node starts through ``rospy.init_node`` (the process's command line, logging, /rosout and sim
+clock), then works on the core :class:`~ninjemys.node.Node` it made (``rospy.core.process_node``).
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from typing import Any
+
+import numpy as np
+
+import rospy
+from ninjemys.nav.mapio import GridMap
+from ninjemys.tf2.core import BufferCore
+from ninjemys.tf2.errors import TransformException
+from ninjemys.tf2.node import TransformBroadcaster, TransformListener
+
+Pose2D = tuple[float, float, float]
+
+
+def start_node(name: str, argv: list[str] | None) -> tuple[Any, list[str]]:
+    """``rospy.init_node(name)`` with the process's ``name:=value`` arguments; returns the core node and
+    the remaining (non-ROS) arguments."""
+    argv = sys.argv[1:] if argv is None else list(argv)
+    rospy.init_node(name, argv=[sys.argv[0], *argv])
+    rest = [a for a in argv if ":=" not in a]
+    return rospy.core.process_node(), rest
+
+
+def now() -> float:
+    """ROS time in seconds (sim time when /use_sim_time is set)."""
+    return rospy.get_time()
+
+
+def stamp(t: float | None = None) -> Any:
+    return rospy.Time.from_sec(now() if t is None else t)
+
+
+def yaw_to_quat(yaw: float) -> tuple[float, float, float, float]:
+    return (0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0))
+
+
+def quat_to_yaw(x: float, y: float, z: float, w: float) -> float:
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+def pose_msg_to_2d(pose: Any) -> Pose2D:
+    """geometry_msgs/Pose -> (x, y, yaw)."""
+    q = pose.orientation
+    return float(pose.position.x), float(pose.position.y), quat_to_yaw(q.x, q.y, q.z, q.w)
+
+
+def fill_pose(pose: Any, p: Pose2D) -> Any:
+    pose.position.x, pose.position.y, pose.position.z = float(p[0]), float(p[1]), 0.0
+    (pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w) = yaw_to_quat(p[2])
+    return pose
+
+
+def grid_from_msg(msg: Any) -> GridMap:
+    """nav_msgs/OccupancyGrid -> GridMap (the origin's yaw is kept but, as in amcl, not applied)."""
+    info = msg.info
+    data = np.asarray(msg.data, dtype=np.int8).reshape(info.height, info.width)
+    return GridMap(data.copy(), float(info.resolution), pose_msg_to_2d(info.origin))
+
+
+def grid_to_msg(grid: GridMap, frame_id: str, t: float | None = None, cls: Any = None) -> Any:
+    """GridMap -> nav_msgs/OccupancyGrid stamped now (or ``t``)."""
+    from nav_msgs.msg import OccupancyGrid
+
+    msg = (cls or OccupancyGrid)()
+    msg.header.frame_id = frame_id
+    msg.header.stamp = stamp(t)
+    fill_info(msg.info, grid.width, grid.height, grid.resolution, grid.origin, t)
+    msg.data = np.ascontiguousarray(grid.data, dtype=np.int8).ravel()
+    return msg
+
+
+def fill_info(
+    info: Any, width: int, height: int, resolution: float, origin: Pose2D, t: float | None = None
+) -> Any:
+    info.map_load_time = stamp(t)
+    info.resolution = float(resolution)
+    info.width, info.height = int(width), int(height)
+    fill_pose(info.origin, origin)
+    return info
+
+
+def tf_to_2d(t: tuple) -> Pose2D:
+    """The buffer's 7-float transform (x, y, z, qx, qy, qz, qw) as (x, y, yaw)."""
+    return float(t[0]), float(t[1]), quat_to_yaw(t[3], t[4], t[5], t[6])
+
+
+def tf_item(parent: str, child: str, t: float, p: Pose2D) -> tuple:
+    """A broadcaster item for a planar transform at ROS time ``t``."""
+    q = yaw_to_quat(p[2])
+    return (parent, child, int(round(t * 1e9)), float(p[0]), float(p[1]), 0.0, *q)
+
+
+class Tf2D:
+    """A tf2 buffer fed from /tf and /tf_static, answering planar lookups, plus a broadcaster."""
+
+    def __init__(self, node: Any, cache_time: float = 10.0) -> None:
+        self.buffer = BufferCore(cache_time=cache_time, report=lambda text: rospy.logwarn(text))
+        self.listener = TransformListener(node, self.buffer, now=now)
+        self._broadcaster: TransformBroadcaster | None = None
+        self._node = node
+
+    def lookup(self, target: str, source: str, t: float = 0.0) -> Pose2D | None:
+        """``source``'s pose in ``target`` at ROS time ``t`` (0: latest); None when unknown yet.
+        A time just past the newest data falls back to the newest (the scan can beat its odometry)."""
+        try:
+            return tf_to_2d(self.buffer.lookup(target, source, int(round(t * 1e9)))[1])
+        except TransformException:
+            if t == 0.0:
+                return None
+        try:
+            stamp_ns, tr = self.buffer.lookup(target, source, 0)
+        except TransformException:
+            return None
+        if abs(stamp_ns / 1e9 - t) > 0.5:
+            return None
+        return tf_to_2d(tr)
+
+    def send(self, items: list[tuple]) -> None:
+        if self._broadcaster is None:
+            self._broadcaster = TransformBroadcaster(self._node)
+        self._broadcaster.send_items(items)
+
+
+def scan_arrays(scan: Any) -> tuple[np.ndarray, np.ndarray]:
+    """(ranges, angles) of a sensor_msgs/LaserScan as float arrays (NaN/inf kept for the caller)."""
+    ranges = np.asarray(scan.ranges, dtype=np.float64)
+    angles = scan.angle_min + np.arange(len(ranges)) * scan.angle_increment
+    return ranges, angles
+
+
+def param(node: Any, key: str, default: Any) -> Any:
+    """A private parameter with ROS 1's default; a value of the wrong kind is reported and ignored."""
+    value = node.get_param("~" + key, default)
+    if default is None or value is default:
+        return value
+    try:
+        if isinstance(default, bool):
+            if isinstance(value, str):
+                raise ValueError
+            return bool(value)
+        if isinstance(default, int):
+            return int(value)
+        if isinstance(default, float):
+            return float(value)
+    except (TypeError, ValueError):
+        rospy.logerr(
+            "%s: parameter ~%s: expected a %s, got %r; using %r",
+            node.name,
+            key,
+            type(default).__name__,
+            value,
+            default,
+        )
+        return default
+    return value

@@ -1,0 +1,262 @@
+"""``rosrun puzzlebot_safety safety_monitor``: the one node between every command source and the robot.
+
+Inputs are twist_mux-style (``~topics``: a list of ``{name, topic, timeout, priority}``; by default
+``teleop`` on ``teleop/cmd_vel`` with priority 100 and ``navigation`` on ``nav/cmd_vel`` with
+priority 10, both with a 0.5 s timeout). Every ``1 / ~rate`` seconds the freshest input of highest
+priority goes out on ``cmd_vel``, after these guards:
+
+- watchdog: an input older than its timeout does not count; with none left the robot is stopped
+  (zero twists for one second, then silence);
+- stop zone: a forward (or backward) motion is cut to zero when a point of the latest ``scan`` lies in
+  the band the footprint (``~robot_radius`` or ``~footprint``, plus ``~safety_margin``) sweeps within
+  the stopping distance at the commanded or current speed (``~max_decel``, ``~reaction_time``);
+  turning in place stays allowed;
+- localization: when ``amcl_pose``'s position variance (xx + yy) exceeds ``~max_position_covariance``,
+  inputs named in ``~localization_inputs`` (default ``[navigation]``) are ignored;
+- e-stop: ``e_stop`` (std_msgs/Bool, true) or the ``~e_stop`` service (std_srvs/SetBool, true) latches
+  a stop of everything until ``~e_stop`` is called with false (or ``~reset_e_stop``, std_srvs/Trigger);
+  the state is latched on ``~e_stop_active``.
+
+Status goes out as diagnostic_msgs/DiagnosticArray on ``/diagnostics`` once a second.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from typing import Any
+
+import numpy as np
+
+import rospy
+from ninjemys.nav.costmap import footprint_radii, parse_footprint
+from ninjemys.nav.rosglue import Tf2D, param, scan_arrays, start_node
+from ninjemys.nav.safety import MuxInput, TwistMux, blocked
+
+DEFAULT_TOPICS = [
+    {"name": "teleop", "topic": "teleop/cmd_vel", "timeout": 0.5, "priority": 100},
+    {"name": "navigation", "topic": "nav/cmd_vel", "timeout": 0.5, "priority": 10},
+]
+
+
+def parse_topics(value: Any) -> tuple[list[MuxInput], list[str]]:
+    """twist_mux's ``topics`` parameter (a list, or a dict keyed by name) -> inputs, and error lines."""
+    items = list(value.items()) if isinstance(value, dict) else list(enumerate(value or []))
+    inputs, errors = [], []
+    for key, entry in items:
+        if not isinstance(entry, dict):
+            errors.append(f"~topics[{key}]: expected a mapping with name, topic, timeout, priority")
+            continue
+        try:
+            name = str(entry.get("name", key))
+            inputs.append(
+                MuxInput(
+                    name, str(entry["topic"]), int(entry.get("priority", 0)), float(entry.get("timeout", 0.5))
+                )
+            )
+        except (KeyError, TypeError, ValueError) as exc:
+            errors.append(f"~topics[{key}]: {type(exc).__name__} {exc}")
+    return inputs, errors
+
+
+class SafetyMonitor:
+    def __init__(self, node: Any) -> None:
+        from diagnostic_msgs.msg import DiagnosticArray
+        from geometry_msgs.msg import PoseWithCovarianceStamped, Twist
+        from nav_msgs.msg import Odometry
+        from sensor_msgs.msg import LaserScan
+        from std_msgs.msg import Bool
+        from std_srvs.srv import SetBool, Trigger
+
+        self.node = node
+        self.lock = threading.Lock()
+        inputs, errors = parse_topics(node.get_param("~topics", DEFAULT_TOPICS))
+        for line in errors:
+            rospy.logerr("safety_monitor: %s", line)
+        self.mux = TwistMux(inputs or parse_topics(DEFAULT_TOPICS)[0])
+        radius = param(node, "robot_radius", 0.12)
+        fp = node.get_param("~footprint", None)
+        if fp:
+            try:
+                radius = footprint_radii(parse_footprint(fp), radius)[1]
+            except ValueError as exc:
+                rospy.logerr("safety_monitor: ~footprint: %s; using robot_radius %.3f", exc, radius)
+        self.radius = radius
+        self.margin = param(node, "safety_margin", 0.05)
+        self.max_decel = param(node, "max_decel", 1.0)
+        self.reaction = param(node, "reaction_time", 0.15)
+        self.max_cov = param(node, "max_position_covariance", 0.5)
+        self.loc_inputs = set(node.get_param("~localization_inputs", ["navigation"]) or [])
+        self.rate = max(1.0, param(node, "rate", 20.0))
+        self.base_frame = param(node, "base_frame", "base_link")
+        self.tf = Tf2D(node)
+        self.points = np.zeros((0, 2))
+        self.scan_time = -1e9
+        self.velocity = 0.0
+        self.cov: float | None = None
+        self.e_stop = False
+        self.blocked = False
+        self.active: str | None = None
+        self.stale_since: float | None = None
+        self.bad_scan_reported = False
+        self._twist, self._diag_cls = Twist, DiagnosticArray
+        self.cmd_pub = node.publisher("cmd_vel", Twist, queue_size=1)
+        self.diag_pub = node.publisher("/diagnostics", DiagnosticArray, queue_size=1)
+        self.estop_pub = node.publisher("~e_stop_active", Bool, queue_size=1, latch=True)
+        self.estop_pub.publish(Bool(data=False))
+        for inp in self.mux.inputs:
+            node.subscriber(inp.topic, Twist, self.on_cmd, callback_args=inp, queue_size=1)
+        node.subscriber("scan", LaserScan, self.on_scan, queue_size=1)
+        node.subscriber("odom", Odometry, self.on_odom, queue_size=1)
+        node.subscriber("amcl_pose", PoseWithCovarianceStamped, self.on_pose, queue_size=1)
+        node.subscriber("e_stop", Bool, self.on_e_stop_topic, queue_size=10)
+        node.service("~e_stop", SetBool, self.on_e_stop_service)
+        node.service("~reset_e_stop", Trigger, self.on_reset)
+        threading.Thread(target=self.loop, name="safety-loop", daemon=True).start()
+        threading.Thread(target=self.diag_loop, name="safety-diagnostics", daemon=True).start()
+
+    # -- inputs -------------------------------------------------------------------------------------
+
+    def on_cmd(self, msg: Any, inp: MuxInput) -> None:
+        v, w = float(msg.linear.x), float(msg.angular.z)
+        if not (math.isfinite(v) and math.isfinite(w)):
+            rospy.logwarn_throttle(5.0, "safety_monitor: %s: NaN/inf velocity ignored", inp.topic)
+            return
+        with self.lock:
+            inp.v, inp.w, inp.last_time = v, w, rospy.get_time()
+
+    def on_scan(self, scan: Any) -> None:
+        ranges, angles = scan_arrays(scan)
+        ok = np.isfinite(ranges) & (ranges >= scan.range_min) & (ranges <= scan.range_max)
+        if not self.bad_scan_reported and not np.isfinite(ranges).all():
+            self.bad_scan_reported = True
+            rospy.logwarn(
+                "safety_monitor: scan from %s has NaN/inf ranges (%d of %d); they are treated as no return",
+                scan.header.frame_id,
+                int((~np.isfinite(ranges)).sum()),
+                len(ranges),
+            )
+        laser = self.tf.lookup(self.base_frame, scan.header.frame_id or self.base_frame, 0.0) or (
+            0.0,
+            0.0,
+            0.0,
+        )
+        r, a = ranges[ok], angles[ok] + laser[2]
+        pts = np.column_stack([laser[0] + r * np.cos(a), laser[1] + r * np.sin(a)])
+        with self.lock:
+            self.points = pts
+            self.scan_time = rospy.get_time()
+
+    def on_odom(self, msg: Any) -> None:
+        self.velocity = float(msg.twist.twist.linear.x)
+
+    def on_pose(self, msg: Any) -> None:
+        c = msg.pose.covariance
+        self.cov = float(c[0]) + float(c[7])
+
+    def _set_e_stop(self, on: bool, why: str) -> None:
+        from std_msgs.msg import Bool
+
+        with self.lock:
+            changed = self.e_stop != on
+            self.e_stop = on
+        if changed:
+            (rospy.logwarn if on else rospy.loginfo)(
+                "safety_monitor: e-stop %s (%s)", "ENGAGED" if on else "reset", why
+            )
+            self.estop_pub.publish(Bool(data=on))
+            if on:
+                self.cmd_pub.publish(self._twist())
+
+    def on_e_stop_topic(self, msg: Any) -> None:
+        if msg.data:
+            self._set_e_stop(True, "e_stop topic")
+
+    def on_e_stop_service(self, req: Any) -> Any:
+        from std_srvs.srv import SetBoolResponse
+
+        self._set_e_stop(bool(req.data), "~e_stop service")
+        return SetBoolResponse(success=True, message="e-stop engaged" if req.data else "e-stop reset")
+
+    def on_reset(self, _req: Any) -> Any:
+        from std_srvs.srv import TriggerResponse
+
+        self._set_e_stop(False, "~reset_e_stop service")
+        return TriggerResponse(success=True, message="e-stop reset")
+
+    # -- output -------------------------------------------------------------------------------------
+
+    def decide(self, now: float) -> tuple[float, float, bool]:
+        """(v, w, publish?) for this cycle."""
+        with self.lock:
+            if self.e_stop:
+                self.active = "e_stop"
+                return 0.0, 0.0, True
+            allowed = None
+            if self.cov is not None and self.cov > self.max_cov:
+                allowed = {i.name for i in self.mux.inputs} - self.loc_inputs
+            inp = self.mux.select(now, allowed)
+            if inp is None:
+                self.active = None
+                if self.stale_since is None:
+                    self.stale_since = now
+                return 0.0, 0.0, now - self.stale_since <= 1.0
+            self.stale_since = None
+            self.active = inp.name
+            v, w = inp.v, inp.w
+            speed = v if abs(v) >= abs(self.velocity) or v * self.velocity <= 0 else self.velocity
+            self.blocked = v != 0.0 and blocked(
+                self.points, speed, self.radius, self.margin, self.max_decel, self.reaction
+            )
+            if self.blocked:
+                v = 0.0
+            return v, w, True
+
+    def loop(self) -> None:
+        rate = rospy.Rate(self.rate)
+        while not rospy.is_shutdown():
+            v, w, publish = self.decide(rospy.get_time())
+            if publish:
+                msg = self._twist()
+                msg.linear.x, msg.angular.z = v, w
+                self.cmd_pub.publish(msg)
+            try:
+                rate.sleep()
+            except rospy.ROSInterruptException:
+                return
+
+    def diag_loop(self) -> None:
+        from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
+
+        while not rospy.is_shutdown():
+            rospy.sleep(1.0)
+            with self.lock:
+                e_stop, active, is_blocked, cov = self.e_stop, self.active, self.blocked, self.cov
+            status = DiagnosticStatus(name="safety_monitor: Safety", hardware_id="puzzlebot")
+            lost = cov is not None and cov > self.max_cov
+            if e_stop:
+                status.level, status.message = DiagnosticStatus.ERROR, "E-stop engaged"
+            elif is_blocked:
+                status.level, status.message = DiagnosticStatus.WARN, "Obstacle in the stop zone"
+            elif lost:
+                status.level, status.message = DiagnosticStatus.WARN, "Localization lost: navigation stopped"
+            elif active is None:
+                status.level, status.message = DiagnosticStatus.OK, "Idle (no fresh command)"
+            else:
+                status.level, status.message = DiagnosticStatus.OK, f"Passing {active}"
+            status.values = [
+                KeyValue(key="active_input", value=str(active)),
+                KeyValue(key="e_stop", value=str(e_stop)),
+                KeyValue(key="stop_zone_blocked", value=str(is_blocked)),
+                KeyValue(key="position_covariance", value="unknown" if cov is None else f"{cov:.4f}"),
+            ]
+            arr = self._diag_cls(status=[status])
+            arr.header.stamp = rospy.Time.from_sec(rospy.get_time())
+            self.diag_pub.publish(arr)
+
+
+def main(argv: list[str] | None = None) -> int:
+    node, _ = start_node("safety_monitor", argv)
+    SafetyMonitor(node)
+    rospy.spin()
+    return 0

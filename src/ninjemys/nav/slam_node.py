@@ -1,0 +1,120 @@
+"""``rosrun gmapping slam_gmapping``: slam_gmapping's interface over :mod:`ninjemys.nav.slam`.
+
+Subscribes ``scan``; reads odometry from TF (``~odom_frame`` -> ``~base_frame``); publishes ``map``
+and ``map_metadata`` (latched, every ``~map_update_interval`` seconds), the TF ``~map_frame`` ->
+``~odom_frame`` every ``~transform_publish_period`` seconds, and answers ``dynamic_map``
+(nav_msgs/GetMap). gmapping's map parameters (``~delta``, ``~xmin``.., ``~maxUrange``, ``~maxRange``,
+``~linearUpdate``, ``~angularUpdate``, ``~occ_thresh``) keep their names and meaning; the particle
+filter ones (``~particles``, ``~srr``...) have no counterpart in this mapper and are ignored.
+"""
+
+from __future__ import annotations
+
+import threading
+from typing import Any
+
+import numpy as np
+
+import rospy
+from ninjemys.nav.mapio import GridMap
+from ninjemys.nav.rosglue import Tf2D, grid_to_msg, param, scan_arrays, start_node, tf_item
+from ninjemys.nav.slam import ScanMatchMapper, SlamParams
+
+
+class SlamNode:
+    def __init__(self, node: Any) -> None:
+        from nav_msgs.msg import MapMetaData, OccupancyGrid
+        from nav_msgs.srv import GetMap
+        from sensor_msgs.msg import LaserScan
+
+        self.node = node
+        self.lock = threading.Lock()
+        params = SlamParams()
+        params.update(
+            {name: param(node, name, getattr(params, name)) for name in SlamParams.__dataclass_fields__}
+        )
+        self.mapper = ScanMatchMapper(params)
+        self.map_frame = param(node, "map_frame", "map")
+        self.odom_frame = param(node, "odom_frame", "odom")
+        self.base_frame = param(node, "base_frame", "base_link")
+        self.update_interval = param(node, "map_update_interval", 5.0)
+        self.tf_period = param(node, "transform_publish_period", 0.05)
+        self.tf = Tf2D(node)
+        self.correction = (0.0, 0.0, 0.0)
+        self.laser: dict[str, tuple[float, float, float]] = {}
+        self.last_map_time = -1e9
+        self.bad_scan_reported = False
+        self.got_first_scan = False
+        self.map_msg: Any = None
+        self._grid_cls = OccupancyGrid
+        self.map_pub = node.publisher("map", OccupancyGrid, queue_size=1, latch=True)
+        self.meta_pub = node.publisher("map_metadata", MapMetaData, queue_size=1, latch=True)
+        node.service("dynamic_map", GetMap, self.on_dynamic_map)
+        node.subscriber("scan", LaserScan, self.on_scan, queue_size=5)
+        if self.tf_period > 0:
+            threading.Thread(target=self.tf_loop, name="slam-tf", daemon=True).start()
+
+    def tf_loop(self) -> None:
+        while not rospy.is_shutdown():
+            rospy.sleep(self.tf_period)
+            with self.lock:
+                corr = self.correction
+            self.tf.send([tf_item(self.map_frame, self.odom_frame, rospy.get_time() + self.tf_period, corr)])
+
+    def on_scan(self, scan: Any) -> None:
+        t = scan.header.stamp.to_sec()
+        odom = self.tf.lookup(self.odom_frame, self.base_frame, t)
+        if odom is None:
+            rospy.logwarn_throttle(
+                5.0,
+                "slam_gmapping: no transform %s -> %s yet; scan dropped",
+                self.odom_frame,
+                self.base_frame,
+            )
+            return
+        frame = scan.header.frame_id or self.base_frame
+        laser = self.laser.get(frame)
+        if laser is None:
+            laser = self.tf.lookup(self.base_frame, frame, 0.0)
+            if laser is None:
+                return
+            self.laser[frame] = laser
+        ranges, angles = scan_arrays(scan)
+        if not self.bad_scan_reported and not np.isfinite(ranges).all():
+            self.bad_scan_reported = True
+            rospy.logwarn(
+                "slam_gmapping: scan from %s has NaN/inf ranges (%d of %d): NaN is skipped, inf is free space up to maxUrange",
+                frame,
+                int((~np.isfinite(ranges)).sum()),
+                len(ranges),
+            )
+        with self.lock:
+            if not self.mapper.should_process(odom):
+                return
+            self.mapper.process(odom, ranges, angles, laser, float(scan.range_max))
+            self.correction = self.mapper.map_to_odom(odom)
+            publish = t - self.last_map_time >= self.update_interval or not self.got_first_scan
+            self.got_first_scan = True
+            if publish:
+                self.last_map_time = t
+                p = self.mapper.params
+                grid = GridMap(self.mapper.occupancy(), p.delta, (p.xmin, p.ymin, 0.0))
+                self.map_msg = grid_to_msg(grid, self.map_frame, cls=self._grid_cls)
+        if publish:
+            self.meta_pub.publish(self.map_msg.info)
+            self.map_pub.publish(self.map_msg)
+
+    def on_dynamic_map(self, _req: Any) -> Any:
+        from nav_msgs.srv import GetMapResponse
+
+        with self.lock:
+            p = self.mapper.params
+            grid = GridMap(self.mapper.occupancy(), p.delta, (p.xmin, p.ymin, 0.0))
+        return GetMapResponse(map=grid_to_msg(grid, self.map_frame, cls=self._grid_cls))
+
+
+def main(argv: list[str] | None = None) -> int:
+    node, _ = start_node("slam_gmapping", argv)
+    SlamNode(node)
+    rospy.spin()
+    return 0

@@ -1,0 +1,86 @@
+"""amcl's filter: tracking along a drive with noisy odometry, KLD sizes, global localization."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ninjemys.nav.amcl import AMCLParams, ParticleFilter, kld_limit, wrap
+
+
+def lawnmower(steps: int):
+    """A drive around the room's free middle: forward runs and turns, 0.05 m / step."""
+    pose = np.array([1.0, 1.0, 0.0])
+    path = [pose.copy()]
+    for i in range(steps):
+        phase = (i // 50) % 4
+        if phase in (0, 2):
+            pose = pose + [0.05 * math.cos(pose[2]), 0.05 * math.sin(pose[2]), 0.0]
+        else:
+            pose = pose + [0.0, 0.0, math.pi / 2 / 50]
+        path.append(pose.copy())
+    return path
+
+
+def run_filter(room, laser, pf, truth, rng, drift=0.02):
+    angles, cast = laser
+    odom = truth[0].copy()
+    errors = []
+    for prev_t, t in zip(truth, truth[1:], strict=False):
+        step = t - prev_t
+        c, s = math.cos(prev_t[2] - odom[2]), math.sin(prev_t[2] - odom[2])
+        noisy = step * (1 + rng.normal(0, drift, 3))
+        new_odom = odom + [c * noisy[0] + s * noisy[1], -s * noisy[0] + c * noisy[1], noisy[2]]
+        moved = math.hypot(*(new_odom[:2] - odom[:2])) > 0 or abs(noisy[2]) > 0
+        if moved:
+            pf.motion_update(tuple(odom), tuple(new_odom))
+        odom = new_odom
+        ranges = cast(room, tuple(t), angles, 5.0) + rng.normal(0, 0.01, len(angles))
+        pf.sensor_update(ranges, angles, 5.0)
+        pf.resample()
+        mean, _ = pf.estimate()
+        errors.append((math.hypot(mean[0] - t[0], mean[1] - t[1]), abs(float(wrap(mean[2] - t[2])))))
+    return np.array(errors)
+
+
+def test_tracking_stays_within_a_few_centimetres(room, laser):
+    rng = np.random.default_rng(1)
+    pf = ParticleFilter(room, AMCLParams(max_particles=2000, min_particles=100, laser_max_beams=60), seed=2)
+    truth = lawnmower(200)
+    pf.init_gaussian(tuple(truth[0]), 0.25**2, 0.25**2, 0.2**2)
+    errors = run_filter(room, laser, pf, truth, rng)
+    rms = math.sqrt(float(np.mean(errors[20:, 0] ** 2)))
+    assert rms < 0.1
+    assert errors[20:, 1].max() < 0.2
+    assert len(pf.poses) < 1000  # KLD shrank the set once it converged
+
+
+def test_global_localization_converges(room, laser):
+    rng = np.random.default_rng(3)
+    params = AMCLParams(max_particles=3000, min_particles=200, laser_max_beams=60)
+    pf = ParticleFilter(room, params, seed=4)
+    pf.init_global()
+    truth = lawnmower(160)
+    errors = run_filter(room, laser, pf, truth, rng)
+    assert errors[-20:, 0].max() < 0.2
+
+
+def test_kld_limit_grows_with_bins():
+    assert kld_limit(1, 0.01, 0.99) == 0.0
+    values = kld_limit(np.array([2, 10, 100]), 0.01, 0.99)
+    assert np.all(np.diff(values) > 0)
+    assert 100 < values[1] < 1000
+
+
+def test_motion_model_spread_follows_alphas(room):
+    pf = ParticleFilter(
+        room,
+        AMCLParams(max_particles=4000, odom_alpha3=0.04, odom_alpha1=0.0, odom_alpha2=0.0, odom_alpha4=0.0),
+        seed=1,
+    )
+    pf.init_gaussian((2.0, 2.0, 0.0), 0.0, 0.0, 0.0)
+    pf.motion_update((0.0, 0.0, 0.0), (1.0, 0.0, 0.0))
+    assert math.isclose(pf.poses[:, 0].mean(), 3.0, abs_tol=0.02)
+    assert math.isclose(pf.poses[:, 0].std(), 0.2, rel_tol=0.1)  # sqrt(alpha3 * 1^2)
+    assert np.allclose(pf.poses[:, 1], 2.0) and np.allclose(pf.poses[:, 2], 0.0)

@@ -1,0 +1,64 @@
+"""DWA drives a unicycle along a plan to the goal without touching an inscribed cell, then turns."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ninjemys.nav.costmap import INSCRIBED, Costmap, CostmapParams
+from ninjemys.nav.dwa import DWAParams, DWAPlanner
+from ninjemys.nav.planner import plan_path
+
+
+def drive(grid, start, goal, steps=1200):
+    glob = Costmap(CostmapParams(inflation_radius=0.35, robot_radius=0.12, cost_scaling_factor=8.0))
+    glob.set_static_map(grid.data, grid.resolution, 0.0, 0.0)
+    local = Costmap(
+        CostmapParams(rolling_window=True, width=3.0, height=3.0, inflation_radius=0.35, robot_radius=0.12)
+    )
+    local.set_static_map(grid.data, grid.resolution, 0.0, 0.0)
+    plan = plan_path(glob.costs, glob.resolution, (0.0, 0.0), start[:2], goal)
+    dwa = DWAPlanner(DWAParams())
+    dwa.set_plan(plan)
+    x, y, th = start
+    v = w = 0.0
+    dt = 0.05
+    worst = 0
+    for _ in range(steps):
+        local.update_origin(x, y)
+        local.update()
+        cmd = dwa.compute((x, y, th), (v, w), local)
+        if cmd.reached:
+            return (x, y, th), worst, True
+        v, w = cmd.v, cmd.w
+        x += v * math.cos(th) * dt
+        y += v * math.sin(th) * dt
+        th = (th + w * dt + math.pi) % (2 * math.pi) - math.pi
+        worst = max(worst, glob.cost_at(x, y))
+    return (x, y, th), worst, False
+
+
+def test_dwa_reaches_goal_around_obstacles(room):
+    goal = (4.5, 5.0, math.pi / 2)
+    (x, y, th), worst, reached = drive(room, (1.0, 1.0, 0.0), goal)
+    assert reached
+    assert math.hypot(x - goal[0], y - goal[1]) <= 0.1 + 0.02
+    assert abs((th - goal[2] + math.pi) % (2 * math.pi) - math.pi) <= 0.15
+    assert worst < INSCRIBED
+
+
+def test_dwa_reports_no_valid_arc_when_boxed_in():
+    data = np.zeros((40, 40), dtype=np.int8)
+    data[15:25, 15:25] = 100
+    data[18:22, 18:22] = 0
+    cm = Costmap(
+        CostmapParams(rolling_window=True, width=2.0, height=2.0, inflation_radius=0.2, robot_radius=0.12)
+    )
+    cm.set_static_map(data, 0.05, 0.0, 0.0)
+    cm.update_origin(1.0, 1.0)
+    cm.update()
+    dwa = DWAPlanner()
+    dwa.set_plan(np.array([[1.0, 1.0, 0.0], [1.9, 1.0, 0.0]]))
+    cmd = dwa.compute((1.0, 1.0, 0.0), (0.0, 0.0), cm)
+    assert not cmd.valid and cmd.v == 0.0 and cmd.w == 0.0
