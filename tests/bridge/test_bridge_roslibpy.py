@@ -134,16 +134,51 @@ def test_tf_through_tfclient(ros: object, master_uri: str) -> None:
         client = TFClient(ros, fixed_frame="world", rate=10.0, angular_threshold=0.01)
         client.subscribe("base_link", frames.append)
 
-        def broadcast() -> bool:
+        def broadcast(x: float = 1.25) -> bool:
             t = Stamped()
             t.header.frame_id, t.child_frame_id = "world", "base_link"
-            t.transform.translation.x = 1.25
+            t.transform.translation.x = x
             t.transform.rotation.w = 1.0
             broadcaster.sendTransform(t)
             return bool(frames)
 
         wait_for(broadcast, timeout=20, what="a transform through the TFClient")
         assert frames[0]["translation"]["x"] == pytest.approx(1.25)
+
+        # the action interface (TFSubscription): transforms come as the goal's feedback
+        from roslibpy.ros1.actionlib import ActionClient, Goal
+
+        client = ActionClient(ros, "/tf2_web_republisher", "tf2_web_republisher/TFSubscriptionAction")
+        feedback: list[dict] = []
+        goal = Goal(
+            client,
+            roslibpy.Message(
+                {
+                    "source_frames": ["base_link"],
+                    "target_frame": "world",
+                    "angular_thres": 0.01,
+                    "trans_thres": 0.01,
+                    "rate": 10.0,
+                }
+            ),
+        )
+        goal.on("feedback", feedback.append)
+        goal.send()
+        wait_for(lambda: broadcast() and False or feedback, timeout=20, what="TFSubscription feedback")
+        transform = feedback[0]["transforms"][0]
+        assert transform["header"]["frame_id"] == "world" and transform["child_frame_id"] == "base_link"
+        goal.cancel()
+        wait_for(
+            lambda: goal.status and goal.status["status"] == 2,
+            timeout=20,
+            what="the goal cancelled (PREEMPTED)",
+        )
+        # the service's subscription keeps flowing after the goal ended
+        wait_for(
+            lambda: broadcast(2.5) and frames[-1]["translation"]["x"] == pytest.approx(2.5),
+            timeout=20,
+            what="TFClient updates after the goal's end",
+        )
     finally:
         republisher.shutdown()
         tf_node.shutdown("test over")
