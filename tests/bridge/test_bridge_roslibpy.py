@@ -227,3 +227,47 @@ def test_actionlib_goal_through_roslibpy(ros: object, master_uri: str, rosapi: R
     finally:
         proc.terminate()
         proc.wait(10)
+
+
+def test_actionlib_goal_with_feedback_against_ninjemys_actionlib(
+    ros: object, master_uri: str, rosapi: RosApi
+) -> None:
+    """roslibpy's ROS 1 ActionClient against our SimpleActionServer: feedback, then the result."""
+    from roslibpy.ros1.actionlib import ActionClient, Goal
+
+    from ninjemys.actionlib.simple_server import SimpleActionServer
+
+    Fibonacci = get_message_class("actionlib_tutorials/FibonacciAction")
+    Feedback = get_message_class("actionlib_tutorials/FibonacciFeedback")
+    Result = get_message_class("actionlib_tutorials/FibonacciResult")
+    server_node = Node("fibonacci", master_uri=master_uri)
+
+    def execute(goal: object) -> None:
+        seq = [0, 1]
+        for _ in range(1, goal.order):
+            seq.append(seq[-1] + seq[-2])
+            server.publish_feedback(Feedback(sequence=seq))
+        server.set_succeeded(Result(sequence=seq))
+
+    server = SimpleActionServer(server_node, "/fibonacci", Fibonacci, execute)
+    server.start()
+    try:
+        wait_for(lambda: "/fibonacci/goal" in ros.get_topics(), timeout=30, what="the action server")
+        client = ActionClient(ros, "/fibonacci", "actionlib_tutorials/FibonacciAction")
+        done = threading.Event()
+        results: list[dict] = []
+        feedback: list[dict] = []
+
+        def attempt() -> bool:
+            goal = Goal(client, roslibpy.Message({"order": 6}))
+            goal.on("feedback", feedback.append)
+            goal.on("result", lambda r: (results.append(r), done.set()))
+            goal.send()
+            return done.wait(2.0)
+
+        wait_for(attempt, timeout=30, what="the goal's result")
+        assert results[0]["sequence"] == [0, 1, 1, 2, 3, 5, 8]
+        assert feedback and feedback[-1]["sequence"][:3] == [0, 1, 1]
+    finally:
+        server.stop()
+        server_node.shutdown("test over")
