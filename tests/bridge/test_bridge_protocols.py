@@ -254,3 +254,20 @@ def test_real_ros1_publisher_to_foxglove_and_rosbridge(gateway: Gateway, master_
     finally:
         proc.terminate()
         proc.wait(10)
+
+
+def test_rosbridge_subscribes_to_a_type_only_the_publisher_knows(gateway: Gateway, node: Node) -> None:
+    from ninjemys.idl.loader import message_class_from_definition
+
+    Thing = message_class_from_definition("their_robot/Status", "int32 level\nstring[] notes\n")
+    pub = node.publisher("/their_status", Thing)
+    with connect(f"ws://127.0.0.1:{gateway.port}/") as ws:
+        ws.send(json.dumps({"op": "subscribe", "topic": "/their_status", "type": "no_such/Type"}))
+        assert "no_such/Type" in json.loads(ws.recv(timeout=5))["msg"]
+        ws.send(json.dumps({"op": "subscribe", "topic": "/their_status"}))
+        msg = first(
+            ws,
+            lambda m: isinstance(m, dict) and m.get("op") == "publish",
+            lambda: pub.publish(Thing(level=3, notes=["ok"])),
+        )
+        assert msg["msg"] == {"level": 3, "notes": ["ok"]}

@@ -154,7 +154,12 @@ class FoxgloveSession:
                     continue
                 self._subs[sub_id] = channel_id
             topic = channel["topic"]
-            self.gateway.taps.add(topic, channel["schemaName"], (self, sub_id), self._sink(sub_id, topic))
+            try:
+                self.gateway.taps.add(topic, channel["schemaName"], (self, sub_id), self._sink(sub_id, topic))
+            except NinjemysError:
+                with self._lock:
+                    self._subs.pop(sub_id, None)
+                raise
 
     def op_unsubscribe(self, msg: dict[str, Any]) -> None:
         for sub_id in msg["subscriptionIds"]:

@@ -61,8 +61,14 @@ class Delivery:
     def message(self) -> Any:
         if self._msg is None:
             cls = self.msg_class
-            if cls is None:
-                cls = get_message_class(self.header.get("type", ""))
+            if cls is None:  # subscribed with md5 "*": the publisher's header says what it is
+                type_name = self.header.get("type", "")
+                try:
+                    cls = get_message_class(type_name)
+                except NinjemysError:
+                    cls = message_class_from_definition(
+                        type_name, self.header.get("message_definition", ""), self.header.get("md5sum")
+                    )
             self._msg = cls.deserialize_from(bytes(self.data))
         return self._msg
 
@@ -104,18 +110,28 @@ class Taps:
         self._taps: dict[str, _Tap] = {}
         self._lock = threading.Lock()
 
-    def add(self, topic: str, type_name: str | None, owner: object, sink: Sink) -> str:
+    def add(
+        self, topic: str, type_name: str | None, owner: object, sink: Sink, published_as: str | None = None
+    ) -> str:
         """Start delivering ``topic`` to ``sink``; returns the type used. Raises NinjemysError when the
-        type is unknown or differs from the one the gateway already subscribed with."""
+        type is unknown or differs from the one the gateway already subscribed with. A type we cannot
+        load is still accepted when it is what the topic is ``published_as``: the tap then subscribes
+        with md5 ``*`` and decodes from the publisher's ``message_definition`` when it must."""
         with self._lock:
             tap = self._taps.get(topic)
             if tap is None:
-                msg_class = message_class(type_name) if type_name and type_name != "*" else None
+                msg_class = None
+                if type_name and type_name != "*":
+                    try:
+                        msg_class = message_class(type_name)
+                    except NinjemysError:
+                        if type_name != published_as:
+                            raise
                 tap = self._taps[topic] = _Tap(self.node, topic, msg_class, self._clock)
             elif type_name and tap.msg_class is not None and type_name not in ("*", tap.msg_class._type):
                 raise NinjemysError(f"topic {topic} is subscribed as {tap.msg_class._type}, not {type_name}")
             tap.sinks[owner] = sink
-            return tap.msg_class._type if tap.msg_class is not None else "*"
+            return tap.msg_class._type if tap.msg_class is not None else (type_name or "*")
 
     def remove(self, topic: str, owner: object) -> None:
         with self._lock:

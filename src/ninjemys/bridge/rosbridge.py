@@ -307,9 +307,12 @@ class RosbridgeSession:
                     raise OpError(f"cannot infer the type of {topic}: give 'type' or wait for a publisher")
             sub = _Subscription(topic, type_name)
             sub.ids[msg.get("id")] = opts
+            # recorded only once the tap accepted it: a refused subscribe leaves nothing behind
+            sub.type = self.gateway.taps.add(
+                topic, type_name, self, self._sink(sub), published_as=self.gateway.topic_type(topic)
+            )
             with self._lock:
                 self._subs[topic] = sub
-            sub.type = self.gateway.taps.add(topic, type_name, self, self._sink(sub))
         else:
             sub.ids[msg.get("id")] = opts
 
