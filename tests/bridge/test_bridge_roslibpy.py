@@ -5,6 +5,7 @@ from __future__ import annotations
 import subprocess
 import textwrap
 import threading
+import time
 from collections.abc import Iterator
 
 import pytest
@@ -247,6 +248,7 @@ def test_actionlib_goal_with_feedback_against_ninjemys_actionlib(
         for _ in range(1, goal.order):
             seq.append(seq[-1] + seq[-2])
             server.publish_feedback(Feedback(sequence=seq))
+            time.sleep(0.05)
         server.set_succeeded(Result(sequence=seq))
 
     server = SimpleActionServer(server_node, "/fibonacci", Fibonacci, execute)
@@ -259,11 +261,15 @@ def test_actionlib_goal_with_feedback_against_ninjemys_actionlib(
         feedback: list[dict] = []
 
         def attempt() -> bool:
+            # the gateway's subscriptions to feedback/result connect while the first goals run:
+            # retry until one goal was seen whole
+            done.clear()
+            feedback.clear()
             goal = Goal(client, roslibpy.Message({"order": 6}))
             goal.on("feedback", feedback.append)
             goal.on("result", lambda r: (results.append(r), done.set()))
             goal.send()
-            return done.wait(2.0)
+            return done.wait(3.0) and len(feedback) == 5
 
         wait_for(attempt, timeout=30, what="the goal's result")
         assert results[0]["sequence"] == [0, 1, 1, 2, 3, 5, 8]

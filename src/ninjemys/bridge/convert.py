@@ -18,6 +18,9 @@ import math
 from collections.abc import Callable
 from typing import Any
 
+import cbor2
+import numpy
+
 from ninjemys.idl.loader import get_message_class
 from ninjemys.rostime import Duration, Time
 
@@ -119,9 +122,6 @@ def _field_encoder(slot_type: str, cbor: bool) -> Callable[[Any], Any] | None:
             v if isinstance(v, bytes | bytearray | memoryview) else bytes(v)
         ).decode("ascii")
     if cbor and base in _NUMPY_DTYPES:
-        import cbor2
-        import numpy
-
         tag, dtype = _CBOR_TAGS[base], _NUMPY_DTYPES[base]
         return lambda v: cbor2.CBORTag(tag, numpy.asarray(v, dtype=dtype).tobytes())
     if base == "bool":

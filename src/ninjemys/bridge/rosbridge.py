@@ -25,6 +25,8 @@ from collections.abc import Callable
 from concurrent.futures import Executor, ThreadPoolExecutor
 from typing import Any
 
+import cbor2
+
 from ninjemys.bridge.convert import ConversionError, from_value, to_value
 from ninjemys.bridge.graph import Delivery
 from ninjemys.bridge.graph import service_class as graph_service_class
@@ -106,9 +108,7 @@ class _Subscription:
 class RosbridgeSession:
     """The rosbridge v2 protocol for one connected client."""
 
-    def __init__(
-        self, gateway: Any, client_id: int, outbox: Outbox, send_error: Callable[[str], None]
-    ) -> None:
+    def __init__(self, gateway: Any, client_id: int, outbox: Outbox) -> None:
         self.gateway = gateway
         self.client_id = client_id
         self.outbox = outbox
@@ -126,13 +126,9 @@ class RosbridgeSession:
         self._lock = threading.Lock()
 
     # -- sending ------------------------------------------------------------------------------
-    def send(self, obj: dict[str, Any], cbor: bool = False) -> None:
-        if cbor:
-            import cbor2
-
-            self.outbox.put_control(cbor2.dumps(obj))
-        else:
-            self.outbox.put_control(json.dumps(obj))
+    def send(self, obj: dict[str, Any]) -> None:
+        """Replies and statuses (JSON, as rosbridge answers whatever the client sent)."""
+        self.outbox.put_control(json.dumps(obj))
 
     def status(self, level: str, msg: str, op_id: Any = None) -> None:
         if _LEVELS[level] > self.status_level:
@@ -151,8 +147,6 @@ class RosbridgeSession:
             if isinstance(data, str):
                 msg = json.loads(data)
             else:
-                import cbor2
-
                 msg = cbor2.loads(data)
         except (ValueError, EOFError) as exc:
             self.status("error", f"malformed message ({'JSON' if isinstance(data, str) else 'CBOR'}): {exc}")
@@ -466,8 +460,6 @@ def _encoder(opts: dict[str, Any]) -> Callable[[Delivery], Any]:
 
     def build(d: Delivery) -> Any:
         if compression == "cbor-raw":
-            import cbor2
-
             secs, nsecs = divmod(d.stamp_ns, 1_000_000_000)
             return cbor2.dumps(
                 {
@@ -477,8 +469,6 @@ def _encoder(opts: dict[str, Any]) -> Callable[[Delivery], Any]:
                 }
             )
         if compression == "cbor":
-            import cbor2
-
             return cbor2.dumps({"op": "publish", "topic": d.topic, "msg": to_value(d.message(), cbor=True)})
         text = d.encoded(
             "json", lambda d: json.dumps({"op": "publish", "topic": d.topic, "msg": to_value(d.message())})

@@ -410,7 +410,7 @@ class Gateway:
                 {"op": "status", "level": 2, "message": f"message too big: {why}"}
             )
         else:
-            session = RosbridgeSession(self, client.id, client.outbox, lambda text: None)
+            session = RosbridgeSession(self, client.id, client.outbox)
             ws.on_oversized = lambda why: json.dumps(
                 {"op": "status", "level": "error", "msg": f"message too big: {why}"}
             )
