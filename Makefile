@@ -19,7 +19,11 @@ ROS1_DEBS := ros-core python3-rospy python3-rosbag python3-genpy python3-rosmsg 
 BROWSER_DEBS := chromium chromium-driver fonts-dejavu-core
 SYSTEM_DEBS  := $(ROS1_DEBS) $(BROWSER_DEBS) tmux
 
-.PHONY: all venv system lint format test test-fast demo bench clean
+# npm packages the tests run with Node.js (Foxglove's own WebSocket client), in a git-ignored directory.
+NPM_DIR   := .cache/npm
+NPM_STAMP := $(NPM_DIR)/node_modules/.installed
+
+.PHONY: all venv system npm lint format typecheck test test-fast demo bench clean
 
 all: venv
 
@@ -40,6 +44,14 @@ system:
 		$$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends $$missing >/dev/null; \
 	fi
 
+$(NPM_STAMP): tests/bridge/js/package.json tests/bridge/js/package-lock.json
+	@if command -v npm >/dev/null 2>&1; then \
+		mkdir -p $(NPM_DIR) && cp tests/bridge/js/package.json tests/bridge/js/package-lock.json $(NPM_DIR)/ && \
+		cd $(NPM_DIR) && npm ci --no-audit --no-fund --loglevel=error && touch node_modules/.installed; \
+	else echo "npm not found: the Foxglove client tests will skip"; fi
+
+npm: $(NPM_STAMP)
+
 lint: venv
 	$(VENV)/bin/ruff format --check src tests bench examples
 	$(VENV)/bin/ruff check src tests bench examples
@@ -48,7 +60,11 @@ format: venv
 	$(VENV)/bin/ruff format src tests bench examples
 	$(VENV)/bin/ruff check --fix src tests bench examples
 
-test: venv system lint
+# Static types of the core layers (wire, idl, net, master, node); the configuration is in pyproject.toml.
+typecheck: venv
+	$(VENV)/bin/mypy
+
+test: venv system npm lint typecheck
 	$(VENV)/bin/pytest -n 2 -q
 
 test-fast: venv
@@ -61,4 +77,4 @@ bench: venv system
 	$(PY) bench/run_all.py
 
 clean:
-	rm -rf $(VENV) build dist src/*.egg-info .pytest_cache .ruff_cache
+	rm -rf $(VENV) build dist src/*.egg-info .pytest_cache .ruff_cache $(NPM_DIR)

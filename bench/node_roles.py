@@ -27,24 +27,28 @@ def _wait_connections(pub, n: int = 1, timeout: float = 20.0) -> None:
         time.sleep(0.01)
 
 
-def pong() -> None:
+def _queue_size(text: str) -> int | None:
+    return None if text == "None" else int(text)
+
+
+def pong(queue_size: str = "10") -> None:
     import rospy
     from std_msgs.msg import String
 
     rospy.init_node("pong")
-    pub = rospy.Publisher("/pong", String, queue_size=10, tcp_nodelay=True)
+    pub = rospy.Publisher("/pong", String, queue_size=_queue_size(queue_size), tcp_nodelay=True)
     rospy.Subscriber("/ping", String, pub.publish, tcp_nodelay=True)
     rospy.spin()
 
 
-def ping(count: str) -> None:
+def ping(count: str, queue_size: str = "10") -> None:
     import rospy
     from std_msgs.msg import String
 
     rospy.init_node("ping")
     got = threading.Event()
     rospy.Subscriber("/pong", String, lambda m: got.set(), tcp_nodelay=True)
-    pub = rospy.Publisher("/ping", String, queue_size=10, tcp_nodelay=True)
+    pub = rospy.Publisher("/ping", String, queue_size=_queue_size(queue_size), tcp_nodelay=True)
     _wait_connections(pub)
     msg = String("x" * 64)
     deadline = time.monotonic() + 20
@@ -260,6 +264,103 @@ def talker100() -> None:
         rate.sleep()
 
 
+def _stream_msg(kind: str):
+    """A 1 MB PointCloud2 (65,536 points of x, y, z, intensity) or a 640x480 rgb8 Image."""
+    if kind == "cloud":
+        from sensor_msgs.msg import PointCloud2, PointField
+
+        fields = [
+            PointField(n, 4 * i, PointField.FLOAT32, 1) for i, n in enumerate(("x", "y", "z", "intensity"))
+        ]
+        n = (1 << 20) // 16
+        msg = PointCloud2(height=1, width=n, fields=fields, point_step=16, row_step=16 * n, is_dense=True)
+        msg.data = bytes(range(256)) * ((1 << 20) // 256)
+        return PointCloud2, msg
+    from sensor_msgs.msg import Image
+
+    data = bytes(range(256)) * (640 * 480 * 3 // 256)
+    return Image, Image(height=480, width=640, encoding="rgb8", step=640 * 3, data=data)
+
+
+def stream_pub(kind: str, seconds: str) -> None:
+    """Publish ``kind`` back to back for ``seconds`` (queue_size=None: synchronous, full speed)."""
+    import rospy
+
+    rospy.init_node(f"stream_pub_{kind}")
+    msg_class, msg = _stream_msg(kind)
+    pub = rospy.Publisher(f"/stream_{kind}", msg_class, queue_size=None, tcp_nodelay=True)
+    _wait_connections(pub)
+    time.sleep(0.5)
+    sent = 0
+    t0 = time.perf_counter()
+    end = time.monotonic() + float(seconds)
+    while time.monotonic() < end:
+        msg.header.stamp = rospy.Time.from_sec(time.time())
+        pub.publish(msg)
+        sent += 1
+    print(json.dumps({"sent": sent, "rate": sent / (time.perf_counter() - t0)}), flush=True)
+    time.sleep(2)
+    rospy.signal_shutdown("done")
+
+
+def stream_sub(kind: str, small: str = "0") -> None:
+    """Subscribe to ``kind`` with queue_size=10; report callbacks/s and the longest gap while data
+    flows. With ``small`` = 1 also subscribe to /small (100 Hz stamped Headers) in this process and
+    report their one-way latency."""
+    import rospy
+    from std_msgs.msg import Header
+
+    rospy.init_node(f"stream_sub_{kind}")
+    msg_class, _ = _stream_msg(kind)
+    stamps: list[float] = []
+    small_lat: list[float] = []
+
+    def cb(msg) -> None:
+        stamps.append(time.perf_counter())
+
+    def small_cb(msg: Header) -> None:
+        small_lat.append(time.time() - msg.stamp.to_sec())
+
+    rospy.Subscriber(f"/stream_{kind}", msg_class, cb, queue_size=10, buff_size=2**24, tcp_nodelay=True)
+    if small == "1":
+        rospy.Subscriber("/small", Header, small_cb, queue_size=10, tcp_nodelay=True)
+    print("ready", flush=True)
+    while not stamps or time.perf_counter() - stamps[-1] < 1.5:
+        time.sleep(0.1)
+    span = max(stamps[-1] - stamps[0], 1e-9)
+    gap = max((b - a for a, b in zip(stamps, stamps[1:], strict=False)), default=float("nan"))
+    result = {"received": len(stamps), "rate": (len(stamps) - 1) / span, "max_gap_ms": gap * 1e3}
+    if small == "1":
+        lat = small_lat[20:]
+        result.update(small_n=len(lat), small_p50_ms=_pct(lat, 0.5) * 1e3, small_p99_ms=_pct(lat, 0.99) * 1e3)
+        result["small_max_ms"] = max(lat) * 1e3 if lat else float("nan")
+    print(json.dumps(result), flush=True)
+    rospy.signal_shutdown("done")
+
+
+def small_pub(seconds: str) -> None:
+    """Stamped std_msgs/Header at 100 Hz on /small for ``seconds``."""
+    import rospy
+    from std_msgs.msg import Header
+
+    rospy.init_node("small_pub")
+    pub = rospy.Publisher("/small", Header, queue_size=10, tcp_nodelay=True)
+    _wait_connections(pub)
+    msg = Header()
+    nxt = time.perf_counter()
+    end = time.monotonic() + float(seconds)
+    while time.monotonic() < end:
+        msg.stamp = rospy.Time.from_sec(time.time())
+        pub.publish(msg)
+        nxt += 0.01
+        delay = nxt - time.perf_counter()
+        if delay > 0:
+            time.sleep(delay)
+    print(json.dumps({"done": True}), flush=True)
+    time.sleep(2)
+    rospy.signal_shutdown("done")
+
+
 ROLES = {
     "pong": pong,
     "ping": ping,
@@ -273,6 +374,9 @@ ROLES = {
     "trigger_client": trigger_client,
     "init_only": init_only,
     "talker100": talker100,
+    "stream_pub": stream_pub,
+    "stream_sub": stream_sub,
+    "small_pub": small_pub,
 }
 
 if __name__ == "__main__":

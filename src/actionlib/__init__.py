@@ -1,5 +1,55 @@
-"""``actionlib``: ROS 1's action library, and the ROS interface package of its test actions.
+"""``import actionlib``: ROS 1's action library, over :mod:`ninjemys.actionlib`.
 
-``actionlib.msg`` is a lazy module (the Test, TestRequest and TwoInts actions); its definitions live in
-``ninjemys/interfaces/actionlib/``.
+As in ROS 1 the package exposes everything of ``actionlib.action_client``,
+``actionlib.simple_action_client``, ``actionlib.action_server`` and ``actionlib.simple_action_server``
+(``actionlib.SimpleActionClient``, ``actionlib.GoalStatus``, ``actionlib.CommState`` ...). Names are
+resolved on first use, so ``import actionlib`` itself loads nothing. The classes run on the node
+``rospy.init_node()`` made.
+
+``actionlib.msg`` is also here: the interface package of actionlib's test actions (Test, TestRequest,
+TwoInts), a lazy module whose definitions live in ``ninjemys/interfaces/actionlib/``.
 """
+
+from __future__ import annotations
+
+import importlib
+
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from typing import Any
+
+#: public name -> the facade module that defines it (ROS 1's star imports, made lazy)
+_EXPORTS = {
+    "ActionClient": "action_client",
+    "ClientGoalHandle": "action_client",
+    "CommState": "action_client",
+    "CommStateMachine": "action_client",
+    "TerminalState": "action_client",
+    "GoalManager": "action_client",
+    "get_name_of_constant": "action_client",
+    "GoalStatus": "action_client",
+    "GoalID": "action_client",
+    "GoalStatusArray": "action_client",
+    "ActionException": "exceptions",
+    "SimpleActionClient": "simple_action_client",
+    "SimpleGoalState": "simple_action_client",
+    "ActionServer": "action_server",
+    "ServerGoalHandle": "server_goal_handle",
+    "StatusTracker": "status_tracker",
+    "GoalIDGenerator": "goal_id_generator",
+    "nop_cb": "action_server",
+    "SimpleActionServer": "simple_action_server",
+}
+
+
+def __getattr__(name: str) -> Any:
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'actionlib' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"actionlib.{module}"), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_EXPORTS})

@@ -19,6 +19,7 @@ Every error the library raises on purpose derives from :class:`NinjemysError`, s
     +-- PackageError             package.xml / workspace / launch-time package lookup problems
     +-- LaunchError              a launch file is malformed or refers to something missing
     +-- BagError                 a bag file is malformed or cannot be written
+    +-- ActionException          a class given as an action is not one (actionlib's ActionException)
 
 The rospy facade maps these onto rospy.ROSException, ROSInterruptException, ServiceException, ...
 """
@@ -100,3 +101,7 @@ class LaunchError(NinjemysError):
 
 class BagError(NinjemysError):
     """A bag file is malformed or cannot be written."""
+
+
+class ActionException(NinjemysError):
+    """A class given to an action server or client is not an action (no action_goal/result/feedback)."""

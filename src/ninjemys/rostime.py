@@ -6,9 +6,11 @@ on them: values are kept as integer ``secs``/``nsecs`` normalized so that ``0 <=
 into seconds and nanoseconds; arithmetic is exact on nanoseconds; comparing a Time with a Duration is a
 TypeError, equality with another type is simply False.
 
-``Time.now()`` asks a pluggable clock (:func:`set_clock`) so the node runtime can switch a process to
-simulated time (``/clock``) without this module knowing anything about nodes. The default clock is the
-wall clock.
+``Time.now()`` reads the process's *default clock*: the clock of the node that claimed it
+(:func:`claim_default_clock`; the first ``ninjemys.node.Node`` of the process, or rospy's node), so a
+library calling ``Time.now()`` inside a simulated-time node gets simulated time; with no such node it
+is the wall clock. Each Node owns its own clock (``node.now()``); this module only remembers which one
+``Time.now()`` follows, without knowing anything about nodes.
 """
 
 from __future__ import annotations
@@ -19,8 +21,10 @@ from numbers import Integral, Real
 
 _NS = 1_000_000_000
 
-#: returns (secs, nsecs) of "now"; replaced by the node runtime for simulated time
+#: returns (secs, nsecs) of "now" for Time.now(); None is the wall clock (the fast path)
 _clock: Callable[[], tuple[int, int]] | None = None
+#: the node whose clock Time.now() follows (None: no node claimed it)
+_owner: object | None = None
 
 
 def _wall_clock() -> tuple[int, int]:
@@ -32,6 +36,26 @@ def set_clock(clock: Callable[[], tuple[int, int]] | None) -> None:
     """Install the function that ``Time.now()`` uses (``None`` restores the wall clock)."""
     global _clock
     _clock = clock
+
+
+def claim_default_clock(owner: object, clock: Callable[[], tuple[int, int]] | None) -> None:
+    """Make ``clock`` (None: the wall clock) the one ``Time.now()`` reads, on behalf of ``owner``."""
+    global _clock, _owner
+    _owner = owner
+    _clock = clock
+
+
+def release_default_clock(owner: object) -> None:
+    """``owner`` is going away: if it holds the default clock, ``Time.now()`` reverts to wall time."""
+    global _clock, _owner
+    if _owner is owner:
+        _owner = None
+        _clock = None
+
+
+def default_clock_owner() -> object | None:
+    """The node whose clock ``Time.now()`` reads, if one claimed it."""
+    return _owner
 
 
 def get_clock() -> Callable[[], tuple[int, int]]:

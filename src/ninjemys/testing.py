@@ -114,6 +114,27 @@ def FakeClock(start: float = 0.0):  # noqa: N802 - reads as a class at call site
     return _FakeClock(start)
 
 
+def reset_rospy() -> None:
+    """Shut down the rospy node of this process (if any) and forget all of rospy's state, in-process.
+
+    rospy allows one ``init_node`` per process; after this, the next ``rospy.init_node`` starts a
+    new node, so rospy tests need no subprocess each. User shutdown hooks run first, as on a real
+    shutdown; handles (Publishers, Subscribers, Services) of the old node stay unregistered.
+    Typical use is a fixture::
+
+        @pytest.fixture
+        def rospy_node(master_uri, monkeypatch):
+            monkeypatch.setenv("ROS_MASTER_URI", master_uri)
+            yield
+            ninjemys.testing.reset_rospy()
+    """
+    import sys
+
+    core = sys.modules.get("rospy.core")
+    if core is not None:  # rospy never imported: nothing to reset
+        core._reset()
+
+
 @contextlib.contextmanager
 def run_master(
     port: int | None = None, env: dict[str, str] | None = None, timeout: float = 20.0

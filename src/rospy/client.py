@@ -1,8 +1,9 @@
 """init_node and the module-level node API of rospy (names, parameters, spin, wait_for_message, ...).
 
 ``init_node`` reads the command line with :mod:`ninjemys.node.cli_args`, creates the core
-:class:`~ninjemys.node.Node`, and hangs the process's logging, clock and signal handling off it. Every
-other function here forwards to that node and translates core errors into rospy's exceptions.
+:class:`~ninjemys.node.Node` (which sets up its own clock, logging, /rosout and logger services) and
+installs signal handling. Every other function here forwards to that node and translates core errors
+into rospy's exceptions.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ import threading
 import time
 
 from ninjemys.errors import MasterError, NameError_, NinjemysError, ParameterError
-from ninjemys.node.log import INFO, WARN, NodeLog
+from ninjemys.node.log import INFO
 from rospy.core import _process, is_shutdown, signal_shutdown
 from rospy.exceptions import ROSException, ROSInitException, ROSInterruptException, mapped, translate
 
@@ -46,6 +47,7 @@ __all__ = [
 
 _UNSPECIFIED = object()
 _signals_installed = False
+_process_hooks_installed = False
 _signal_times: list[float] = []
 #: a Ctrl-C arriving this long after the first one, while shutdown is still running, interrupts it
 _INSIST_AFTER = 3.0
@@ -105,23 +107,11 @@ def init_node(
             and not _interactive()
         ):
             _install_signal_handlers()
-        _quiet_interrupted_callbacks()
-        node = _start_node(base, args)
-        log = NodeLog(node.name, level=log_level or INFO, log_file=args.log_file)
+        _install_process_hooks()
+        node = _start_node(base, args, log_level or INFO, not disable_rostime, not disable_rosout)
         _process.node = node
-        _process.log = log
         _process.init_args = key
         node.on_shutdown(_on_node_shutdown)
-        atexit.register(_at_exit)
-        if not disable_rostime:
-            _start_clock(node, log)
-        if not disable_rosout:
-            log.hold_rosout()
-        done = threading.Event()
-        _process.init_done = done
-        threading.Thread(
-            target=_finish_init, args=(node, log, not disable_rosout, done), name="rospy-init", daemon=True
-        ).start()
         pending, _process.pending = _process.pending, []
     for handle in pending:
         handle._bind(node)
@@ -141,7 +131,9 @@ def _parse(argv: list[str]) -> Any:
         raise ValueError(str(exc)) from None
 
 
-def _start_node(base: str, args: Any) -> Any:
+def _start_node(base: str, args: Any, log_level: int, rostime: bool, rosout: bool) -> Any:
+    """The process's node: registered, its clock following /clock under /use_sim_time, /rosout and
+    ``~get_loggers``/``~set_logger_level`` registered with the master before it returns (ROS 1)."""
     from ninjemys.node import Node
 
     try:
@@ -151,6 +143,12 @@ def _start_node(base: str, args: Any) -> Any:
             remappings=args.remappings,
             master_uri=args.master_uri,
             params=args.private_params,
+            sim_time="auto" if rostime else False,
+            clock=_process.preinit_clock,
+            rosout=rosout,
+            log_level=log_level,
+            log_file=args.log_file,
+            default_clock=True,
         )
     except NameError_ as exc:
         raise ValueError(str(exc)) from None
@@ -158,74 +156,10 @@ def _start_node(base: str, args: Any) -> Any:
         raise ROSInitException(f"init_node: {exc}") from None
 
 
-def _start_clock(node: Any, log: NodeLog) -> None:
-    """Switch the process clock to simulated time when /use_sim_time is set (read once, at init)."""
-    clock = _process.clock
-    try:
-        sim = bool(node.get_param("/use_sim_time", False))
-    except NinjemysError:
-        sim = False
-    if not sim:
-        return
-    from ninjemys.idl.loader import get_message_class
-
-    clock.switch_to_sim()
-    clock.subscribe(node, get_message_class("rosgraph_msgs/Clock"))
-    clock.install()
-    log.set_ros_time(clock.now)
-
-
-def _finish_init(node: Any, log: NodeLog, rosout: bool, done: threading.Event) -> None:
-    """/rosout and the logger services, set up off the caller's thread: init_node returns as soon as
-    the node is registered, and messages logged meanwhile are held and sent once /rosout exists."""
-    try:
-        # a process that exits right after init_node skips what is left: the exit waits for this
-        # thread only once it registers something, and each later step checks again
-        if rosout:
-            _start_rosout(node, log)
-        elif not _process.begin_init_registration():
-            return
-        _start_logger_services(node, log)
-    except NinjemysError as exc:
-        if not node.is_shutdown:
-            log.log(WARN, "%s: logging services unavailable: %s", node.name, exc)
-    finally:
-        done.set()
-
-
-def _start_rosout(node: Any, log: NodeLog) -> None:
-    from ninjemys.idl.loader import get_message_class
-
-    log_class = get_message_class("rosgraph_msgs/Log")
-    if not _process.begin_init_registration():
-        return
-    pub = node.publisher("/rosout", log_class, queue_size=100, latch=True)
-    log.attach_rosout(pub, log_class, lambda: [t for t, _ in node.get_publications()])
-
-
-def _start_logger_services(node: Any, log: NodeLog) -> None:
-    from ninjemys.idl.loader import get_message_class, get_service_class
-
-    if _process.shutdown_requested:
-        return
-    get_loggers = get_service_class("roscpp/GetLoggers")
-    logger_class = get_message_class("roscpp/Logger")
-    if _process.shutdown_requested:
-        return
-    node.service(
-        "~get_loggers", get_loggers, log.get_loggers_handler(get_loggers._response_class, logger_class)
-    )
-    set_level = get_service_class("roscpp/SetLoggerLevel")
-    if _process.shutdown_requested:
-        return
-    node.service("~set_logger_level", set_level, log.set_logger_level_handler(set_level._response_class))
-
-
 def _on_node_shutdown() -> None:
     """The node is going down (for whatever reason): user hooks, then wake every sleeper."""
     _process.shutdown_requested = True
     _process.run_hooks()
-    _process.clock.shutdown()
     with _process.lock:
         waiters = list(_process.waiters)
     for event in waiters:
@@ -242,6 +176,16 @@ def _at_exit() -> None:
         else:
             signal_shutdown("atexit")
     _process.log.close()
+
+
+def _install_process_hooks() -> None:
+    """Once per process: shut the node down at exit, keep interrupted callbacks quiet."""
+    global _process_hooks_installed
+    if _process_hooks_installed:
+        return
+    _process_hooks_installed = True
+    atexit.register(_at_exit)
+    _quiet_interrupted_callbacks()
 
 
 # -- signals --------------------------------------------------------------------------------------------

@@ -1,10 +1,14 @@
-"""The one piece of global state of the rospy facade: the node of this process, and what hangs off it.
+"""The one piece of global state of the rospy facade: the node of this process.
 
 rospy's API is module-level functions, so something must remember "the" node. Here that is a single
-:class:`_Process` instance holding the core :class:`~ninjemys.node.Node` (None until ``init_node``), its
-:class:`~ninjemys.node.log.NodeLog`, the process's :class:`~ninjemys.node.clock.Clock` (wall time until
-``init_node`` finds ``/use_sim_time``), the handles created before ``init_node`` (the seeds create
-their Publisher first), and the user's shutdown hooks. All behaviour lives in the core modules.
+:class:`_Process` instance holding the core :class:`~ninjemys.node.Node` (None until ``init_node``),
+the handles created before ``init_node`` (the seeds create their Publisher first), and the user's
+shutdown hooks. The node owns its clock, logging, /rosout and logger services; before ``init_node``
+rospy's calls use a wall clock and a console-only log, which ``init_node`` hands to the node (so a
+Rate made before ``init_node`` follows the node's simulated time). All behaviour lives in the core.
+
+``ninjemys.testing.reset_rospy()`` shuts the node down and empties this state in-process, so tests
+can call ``init_node`` again without a new interpreter.
 """
 
 from __future__ import annotations
@@ -38,28 +42,34 @@ class _Process:
     """State shared by the whole facade (one per process, like rospy's module globals)."""
 
     def __init__(self) -> None:
-        self.node: Any = None
-        self.clock = Clock()
-        self.log = NodeLog("/unnamed", write_file=False)
         self.lock = threading.RLock()
-        self.pending: list[Any] = []
-        self.waiters: set[threading.Event] = set()
-        self.hooks: list[Callable[[], Any]] = []
-        self.hooks_ran = False
-        self.shutdown_requested = False
-        self.init_args: tuple[Any, ...] | None = None
-        self.init_done: threading.Event | None = None
-        #: the background part of init_node has started registering (the exit must wait for it)
-        self.init_registering = False
+        self.reset()
 
-    def begin_init_registration(self) -> bool:
-        """Called by init_node's background thread before its first registration: False if shutdown
-        was requested already (register nothing), else the shutdown will wait for the thread."""
+    def reset(self) -> None:
+        """Forget the node and everything hung off it (the caller shut the node down first)."""
         with self.lock:
-            if self.shutdown_requested:
-                return False
-            self.init_registering = True
-            return True
+            self.node: Any = None
+            #: what rospy's time and logging calls use before init_node (init_node hands the clock over)
+            self.preinit_clock = Clock()
+            self.preinit_log = NodeLog("/unnamed", write_file=False)
+            self.pending: list[Any] = []
+            self.waiters: set[threading.Event] = set()
+            self.hooks: list[Callable[[], Any]] = []
+            self.hooks_ran = False
+            self.shutdown_requested = False
+            self.init_args: tuple[Any, ...] | None = None
+
+    @property
+    def clock(self) -> Clock:
+        """The node's clock, or the pre-init_node wall clock."""
+        node = self.node
+        return self.preinit_clock if node is None else node.clock
+
+    @property
+    def log(self) -> NodeLog:
+        """The node's log, or the console-only log of rospy's calls before init_node."""
+        node = self.node
+        return self.preinit_log if node is None else node.log
 
     def require_node(self) -> Any:
         node = self.node
@@ -119,18 +129,25 @@ def signal_shutdown(reason: str) -> None:
     """Initiate shutdown: user hooks first, then the node tears down; sleeps and spin() return at once."""
     with _process.lock:
         _process.shutdown_requested = True
-        registering = _process.init_registering
     node = _process.node
     _process.run_hooks()
     _process.clock.shutdown()
     if node is not None:
-        done = _process.init_done
-        if done is not None and registering:
-            # let the background part of init_node finish registering before tearing the node down;
-            # if it had not started yet it never will (a script exiting right after init_node does
-            # not wait for /rosout to be set up just to tear it down)
-            done.wait(5.0)
         node.shutdown(reason)
+
+
+def _reset() -> None:
+    """Shut the process's node down (user hooks first) and forget every piece of rospy state.
+
+    For tests, through ``ninjemys.testing.reset_rospy()``: the next ``init_node`` starts afresh.
+    """
+    node = _process.node
+    signal_shutdown("rospy reset")
+    if node is not None:
+        node.shutdown("rospy reset")  # waits for a shutdown that another thread started
+    for handle in list(_process.pending):
+        handle.unregister()
+    _process.reset()
 
 
 def on_shutdown(hook: Callable[[], Any]) -> None:

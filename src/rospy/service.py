@@ -11,7 +11,7 @@ import threading
 from collections.abc import Callable, Mapping
 
 from ninjemys import names
-from ninjemys.errors import NinjemysError
+from ninjemys.errors import NinjemysError, ServiceError
 from ninjemys.node.log import ERROR
 from rospy.core import _process
 from rospy.exceptions import ServiceException, mapped, translate
@@ -188,8 +188,9 @@ class Service:
     def _handle(self, request: Any) -> Any:
         try:
             return self.handler(request)
-        except ServiceException:
-            raise
+        except ServiceException as exc:
+            # the core words a ServiceError as rospy does: "service cannot process request: ..."
+            raise ServiceError(str(exc)) from None
         except Exception as exc:
             if self.error_handler is not None:
                 self.error_handler(exc, *sys.exc_info())

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import signal
 import time
 from pathlib import Path
@@ -21,7 +22,8 @@ def test_ctrl_c_stops_twenty_nodes_quickly_and_leaves_nothing(
     )
     launch = Launch([str(write_launch(tmp_path, nodes))], env)
     launches.append(launch)
-    assert launch.wait_for(lambda ls: sum(" ready" in line for line in ls) == 20, timeout=90), "".join(
+    # output passes through unchanged: twenty unbuffered nodes may interleave their writes mid-line
+    assert launch.wait_for(lambda ls: len(re.findall(r"n\d+ ready", "".join(ls))) == 20, timeout=90), "".join(
         launch.lines
     )
     pids = launch.pids()

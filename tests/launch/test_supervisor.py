@@ -78,9 +78,11 @@ def test_required_node_death_stops_everything_with_failure() -> None:
     assert pids and not any(alive(pid) for pid in pids)
 
 
-def test_screen_output_is_prefixed_per_node() -> None:
+def test_screen_output_is_prefixed_per_node_when_asked() -> None:
     lines: list[str] = []
-    sup = Supervisor([spec("sleeper-1", "sleeper.py", "__name:=alpha")], write=lines.append)
+    sup = Supervisor(
+        [spec("sleeper-1", "sleeper.py", "__name:=alpha")], write=lines.append, prefix_output=True
+    )
     sup.on_event = lambda kind, name: None
     thread, result = run_in_thread(sup)
     deadline_hit = threading.Event()
@@ -109,7 +111,9 @@ def test_sigint_ignoring_node_is_escalated_to_sigterm() -> None:
             holder[0].request_shutdown()
 
     sup = Supervisor(
-        [spec("stubborn-1", "stubborn.py", sigint_timeout=0.3, sigterm_timeout=0.5)], write=write
+        [spec("stubborn-1", "stubborn.py", sigint_timeout=0.3, sigterm_timeout=0.5)],
+        write=write,
+        prefix_output=True,
     )
     holder.append(sup)
     thread, result = run_in_thread(sup)
@@ -123,7 +127,9 @@ def test_sigint_ignoring_node_is_escalated_to_sigterm() -> None:
 def test_supervisor_messages_go_to_the_launch_log_but_node_output_does_not() -> None:
     lines: list[str] = []
     logged: list[str] = []
-    sup = Supervisor([spec("crash-1", "crasher.py", "0")], write=lines.append, log=logged.append)
+    sup = Supervisor(
+        [spec("crash-1", "crasher.py", "0")], write=lines.append, log=logged.append, prefix_output=True
+    )
     assert sup.run() == 0
     assert any("crasher running" in line for line in lines)
     assert not any("crasher running" in line for line in logged)
@@ -166,7 +172,11 @@ def test_second_interrupt_kills_at_once() -> None:
         if "killing on exit" in text:
             holder[0].request_shutdown()
 
-    sup = Supervisor([spec("stubborn-1", "stubborn.py", sigint_timeout=60, sigterm_timeout=60)], write=write)
+    sup = Supervisor(
+        [spec("stubborn-1", "stubborn.py", sigint_timeout=60, sigterm_timeout=60)],
+        write=write,
+        prefix_output=True,
+    )
     holder.append(sup)
     thread, result = run_in_thread(sup)
     thread.join(30)

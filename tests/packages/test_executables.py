@@ -65,7 +65,7 @@ def test_shipped_table_has_the_fixed_names() -> None:
     assert shipped_executable("turtlesim", "turtle_teleop_key").target == "ninjemys.sim.teleop_key:main"
     assert shipped_executable("rqt_graph", "rqt_graph").target == "ninjemys.web.rqt_graph:main"
     assert shipped_executable("rospy_tutorials", "talker.py").target == "ninjemys.tutorials.talker:main"
-    assert shipped_executable("rosout", "rosout").target == "ninjemys.master.rosout:main"
+    assert shipped_executable("rosout", "rosout").target == "ninjemys.tools.rosout:main"
     assert shipped_executable("rosbag", "record").prefix_args == ("record",)
     assert set(SHIPPED["rospy_tutorials"]) >= {
         "talker",

@@ -264,54 +264,6 @@ def test_service_client_without_init_node(run_node) -> None:
     assert client.wait(10) == 0
 
 
-def test_logger_services(run_node) -> None:
-    target = run_node("import rospy\nrospy.init_node('target')\nprint('up', flush=True)\nrospy.spin()\n")
-    target.wait_for("^up$")
-    caller = run_node(
-        "import rospy\nfrom roscpp.srv import GetLoggers, SetLoggerLevel\n"
-        # init_node's helper thread registers the logger services just after init_node returns
-        "rospy.wait_for_service('/target/set_logger_level', 10)\n"
-        "get = rospy.ServiceProxy('/target/get_loggers', GetLoggers)\n"
-        "print('before', {l.name: l.level for l in get().loggers}['rosout'], flush=True)\n"
-        "rospy.ServiceProxy('/target/set_logger_level', SetLoggerLevel)('rosout', 'debug')\n"
-        "print('after', {l.name: l.level for l in get().loggers}['rosout'], flush=True)\n"
-        "try:\n    rospy.ServiceProxy('/target/set_logger_level', SetLoggerLevel)('rosout', 'bogus')\n"
-        "except rospy.ServiceException as e:\n    print('bad level', 'bogus' in str(e), flush=True)\n"
-    )
-    assert caller.wait_for(r"^before (\w+)$").group(1) == "info"
-    assert caller.wait_for(r"^after (\w+)$").group(1) == "debug"
-    assert caller.wait_for(r"^bad level (\w+)$").group(1) == "True"
-
-
-def test_sim_time_follows_clock_topic(run_node) -> None:
-    code = r"""
-import rospy, threading
-from rosgraph_msgs.msg import Clock
-rospy.set_param = rospy.set_param
-import xmlrpc.client, os
-xmlrpc.client.ServerProxy(os.environ["ROS_MASTER_URI"]).setParam("/x", "/use_sim_time", True)
-rospy.init_node("simnode")
-print("start", rospy.get_time(), rospy.Time.now().to_sec(), flush=True)
-pub = rospy.Publisher("/clock", Clock, queue_size=10)
-woke = threading.Event()
-def sleeper():
-    rospy.sleep(5.0)
-    woke.set()
-threading.Thread(target=sleeper, daemon=True).start()
-t = 100.0
-while not woke.is_set() and t < 200:
-    pub.publish(Clock(clock=rospy.Time.from_sec(t)))
-    t += 1.0
-    woke.wait(0.05)
-print("woke", woke.is_set(), rospy.get_time() >= 105.0, flush=True)
-rospy.set_param("/use_sim_time", False)
-"""
-    node = run_node(code)
-    assert node.wait_for(r"^start (.*)$").group(1) == "0.0 0.0"
-    assert node.wait_for(r"^woke (.*)$").group(1) == "True True"
-    assert node.wait(10) == 0
-
-
 def test_publish_before_init_and_errors(run_node) -> None:
     code = r"""
 import rospy

@@ -28,6 +28,21 @@ from ninjemys.tools.rosservice import probe
 log = logging.getLogger(__name__)
 
 
+def message_class(type_name: str) -> Any:
+    """The class of ``type_name``; an unknown type raises NinjemysError naming it."""
+    try:
+        return get_message_class(type_name)
+    except NinjemysError as exc:
+        raise NinjemysError(f"unknown message type {type_name}: {exc}") from None
+
+
+def service_class(type_name: str) -> Any:
+    try:
+        return get_service_class(type_name)
+    except NinjemysError as exc:
+        raise NinjemysError(f"unknown service type {type_name}: {exc}") from None
+
+
 class Delivery:
     """One received message, shared by every client sink: raw bytes, receive time, and lazily
     computed forms (the message object, encoded texts) that are built once."""
@@ -95,7 +110,7 @@ class Taps:
         with self._lock:
             tap = self._taps.get(topic)
             if tap is None:
-                msg_class = get_message_class(type_name) if type_name and type_name != "*" else None
+                msg_class = message_class(type_name) if type_name and type_name != "*" else None
                 tap = self._taps[topic] = _Tap(self.node, topic, msg_class, self._clock)
             elif type_name and tap.msg_class is not None and type_name not in ("*", tap.msg_class._type):
                 raise NinjemysError(f"topic {topic} is subscribed as {tap.msg_class._type}, not {type_name}")
@@ -129,7 +144,7 @@ class Publishers:
         self, topic: str, type_name: str, owner: object, latch: bool = False, queue_size: int = 100
     ) -> Any:
         """The publisher for ``topic`` (created on first use); raises NinjemysError on a type clash."""
-        msg_class = get_message_class(type_name)
+        msg_class = message_class(type_name)
         with self._lock:
             entry = self._pubs.get(topic)
             if entry is None:
@@ -241,8 +256,8 @@ class Services:
     def call(self, service: str, type_name: str | None, build_request: Callable[[Any], Any]) -> Any:
         """Call ``service``; ``build_request(request_class)`` makes the request. Returns the response."""
         type_name = type_name or self.service_type(service)
-        service_class = get_service_class(type_name)
-        return self._call(service, service_class, False, build_request(service_class._request_class))
+        cls = service_class(type_name)
+        return self._call(service, cls, False, build_request(cls._request_class))
 
     def call_raw(self, service: str, payload: bytes) -> bytes:
         header = self.provider_header(service)

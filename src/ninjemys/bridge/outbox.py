@@ -20,7 +20,21 @@ import threading
 from collections import Counter, OrderedDict, deque
 from collections.abc import Callable
 
-Frame = str | bytes | bytearray | memoryview
+
+class CloseRequest:
+    """Queued after a session's last words: the sender closes the connection when it gets here."""
+
+    __slots__ = ("code", "reason")
+
+    def __init__(self, code: int, reason: str) -> None:
+        self.code = code
+        self.reason = reason
+
+    def __len__(self) -> int:
+        return 0
+
+
+Frame = str | bytes | bytearray | memoryview | CloseRequest
 #: one message, or several frames that must go together (rosbridge fragments of one message)
 Item = Frame | tuple[Frame, ...]
 

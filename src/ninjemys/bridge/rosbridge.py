@@ -27,6 +27,7 @@ from typing import Any
 
 from ninjemys.bridge.convert import ConversionError, from_value, to_value
 from ninjemys.bridge.graph import Delivery
+from ninjemys.bridge.graph import service_class as graph_service_class
 from ninjemys.bridge.outbox import Outbox
 from ninjemys.errors import NinjemysError
 
@@ -361,9 +362,7 @@ class RosbridgeSession:
     def op_advertise_service(self, msg: dict[str, Any]) -> None:
         service = self._topic(msg, "service")
         type_name = self._field(msg, "type", str)
-        from ninjemys.idl.loader import get_service_class
-
-        service_class = get_service_class(type_name)
+        service_class = graph_service_class(type_name)
         with self._lock:
             old = self._services.pop(service, None)
         if old is not None:

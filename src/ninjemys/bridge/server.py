@@ -31,7 +31,7 @@ from websockets.server import ServerProtocol
 
 from ninjemys.bridge.foxglove import SUBPROTOCOLS, FoxgloveSession
 from ninjemys.bridge.graph import Publishers, Services, Taps
-from ninjemys.bridge.outbox import Outbox
+from ninjemys.bridge.outbox import CloseRequest, Outbox
 from ninjemys.bridge.rosbridge import RosbridgeSession
 from ninjemys.errors import NinjemysError
 from ninjemys.idl.loader import get_message_class, get_service_class
@@ -101,6 +101,7 @@ class Catalog:
         self._service_ids: dict[tuple[str, str], int] = {}
         self._ids = itertools.count(1)
         self._unknown: set[str] = set()
+        self._service_types: dict[str, str] = {}
         self.graph: dict[str, dict[str, list[str]]] = {"pub": {}, "sub": {}, "srv": {}}
         self.topic_types: dict[str, str] = {}
         self._lock = threading.Lock()
@@ -152,8 +153,11 @@ class Catalog:
         added_srv, removed_srv = [], []
         present = set()
         for name in srvs:
+            # a provider's type is probed once per service name, not on every refresh
+            type_name = self._service_types.get(name)
             try:
-                type_name = services.service_type(name)
+                if type_name is None:
+                    type_name = self._service_types[name] = services.service_type(name)
                 service_class = get_service_class(type_name)
             except NinjemysError:
                 continue
@@ -185,6 +189,8 @@ class Catalog:
                     self._service_ids[key] = sid
                     self.services[sid] = entry
                 added_srv.append(entry)
+        for name in [n for n in self._service_types if n not in srvs]:
+            del self._service_types[name]
         for key in [k for k in self._service_ids if k not in present]:
             with self._lock:
                 sid = self._service_ids.pop(key)
@@ -260,6 +266,7 @@ class Gateway:
         self._sim_ns = 0
         self._watched: set[str] = set()
         self._clock_sub: Any = None
+        self._client_count: Any = None
         self._poller = threading.Thread(target=self._poll, name="gateway-graph", daemon=True)
         self._http: HttpServer | None = None
         self._loop: asyncio.AbstractEventLoop | None = None
@@ -286,13 +293,21 @@ class Gateway:
 
     # -- graph polling ----------------------------------------------------------------------
     def start(self) -> None:
-        """Start watching the graph (and /clock under sim time)."""
+        """Start watching the graph (and /clock under sim time); publish ``client_count`` as rosbridge does."""
+        self._client_count = self.node.publisher(
+            "client_count", get_message_class("std_msgs/Int32"), queue_size=1, latch=True
+        )
+        self._count_clients()
         if self.sim_time:
             self._clock_sub = self.node.subscriber(
                 "/clock", get_message_class("rosgraph_msgs/Clock"), self._on_clock, queue_size=1
             )
         self._refresh()
         self._poller.start()
+
+    def _count_clients(self) -> None:
+        if self._client_count is not None:
+            self._client_count.publish(get_message_class("std_msgs/Int32")(data=len(self._clients)))
 
     def _on_clock(self, msg: Any) -> None:
         self._sim_ns = msg.clock.secs * 1_000_000_000 + msg.clock.nsecs
@@ -338,7 +353,9 @@ class Gateway:
 
     # -- the WebSocket endpoint ---------------------------------------------------------------
     def mount(self, server: HttpServer, path: str = "/") -> None:
-        """Serve the gateway on ``server`` at ``path`` (plus its status at /api/bridge/status)."""
+        """Serve the gateway on ``server`` at ``path`` (plus its status at /api/bridge/status).
+
+        Call :meth:`start` too (graph polling); the server's own loop then runs the connections."""
         server.websocket(path, self)
         server.route("GET", "/api/bridge/status", lambda _r: Response(self.status()))
 
@@ -383,6 +400,9 @@ class Gateway:
 
     async def serve(self, ws: WebSocket) -> None:
         loop = asyncio.get_running_loop()
+        if self._reporter is None:  # on whichever server's loop the gateway is mounted
+            self._loop = self._loop or loop
+            self._reporter = loop.create_task(self._report_drops())
         client = _Client(next(self._ids), ws, loop, self.options.max_client_bytes)
         if ws.subprotocol in SUBPROTOCOLS:
             session: RosbridgeSession | FoxgloveSession = FoxgloveSession(self, client.id, client.outbox)
@@ -396,6 +416,7 @@ class Gateway:
             )
         client.session = session
         self._clients[client.id] = client
+        self._count_clients()
         log.info(
             "gateway: client %d (%s) connected from %s", client.id, ws.subprotocol or "rosbridge", ws.peer
         )
@@ -408,6 +429,7 @@ class Gateway:
         finally:
             sender.cancel()
             self._clients.pop(client.id, None)
+            self._count_clients()
             session.close()
             log.info("gateway: client %d disconnected", client.id)
 
@@ -419,6 +441,9 @@ class Gateway:
                 await client.wake.wait()
                 client.wake.clear()
                 while (item := outbox.take()) is not None:
+                    if isinstance(item, CloseRequest):
+                        ws.close(item.code, item.reason)
+                        return
                     if isinstance(item, tuple):
                         for frame in item:
                             ws.send(frame)
@@ -433,9 +458,10 @@ class Gateway:
             return
 
     def close_client(self, client_id: int, code: int, reason: str) -> None:
+        """Close a client's connection once what was queued for it before is sent."""
         client = self._clients.get(client_id)
         if client is not None:
-            client.loop.call_soon_threadsafe(client.ws.close, code, reason)
+            client.outbox.put_control(CloseRequest(code, reason))
 
     async def _report_drops(self) -> None:
         """Once a second, tell each client about data dropped for it since the last report."""
@@ -473,10 +499,6 @@ class Gateway:
         }
 
     # -- standalone server --------------------------------------------------------------------
-    async def serve_forever_on(self, server: HttpServer) -> None:
-        self._reporter = asyncio.create_task(self._report_drops())
-        await server.start()
-
     def run_in_thread(self) -> str:
         """Start the gateway and its own HTTP server on a loop thread; returns the ws:// URL."""
         from ninjemys.web.app import STATIC_DIR
@@ -490,9 +512,10 @@ class Gateway:
 
         def run() -> None:
             loop = self._loop = asyncio.new_event_loop()
+            asyncio.set_event_loop(loop)
             try:
                 assert self._http is not None
-                loop.run_until_complete(self.serve_forever_on(self._http))
+                loop.run_until_complete(self._http.start())
             except BaseException as exc:
                 errors.append(exc)
                 started.set()
@@ -502,6 +525,10 @@ class Gateway:
                 loop.run_forever()
             finally:
                 loop.run_until_complete(self._http.close())
+                pending = [t for t in asyncio.all_tasks(loop) if not t.done()]
+                for task in pending:
+                    task.cancel()
+                loop.run_until_complete(asyncio.gather(*pending, return_exceptions=True))
                 loop.close()
 
         self._thread = threading.Thread(target=run, name="gateway-loop", daemon=True)
@@ -523,14 +550,19 @@ class Gateway:
         return self._http.port
 
     def shutdown(self) -> None:
+        """Close every client, stop polling; stops the loop only when the gateway runs its own."""
         self._stop.set()
         loop = self._loop
         if loop is not None and not loop.is_closed():
-            for client in list(self._clients.values()):
-                loop.call_soon_threadsafe(client.ws.close, 1001, "server shutting down")
-            if self._reporter is not None:
-                loop.call_soon_threadsafe(self._reporter.cancel)
-            loop.call_soon_threadsafe(loop.stop)
+            try:
+                for client in list(self._clients.values()):
+                    loop.call_soon_threadsafe(client.ws.close, 1001, "server shutting down")
+                if self._reporter is not None:
+                    loop.call_soon_threadsafe(self._reporter.cancel)
+                if self._thread is not None:
+                    loop.call_soon_threadsafe(loop.stop)
+            except RuntimeError:  # the loop closed meanwhile
+                pass
         if self._thread is not None:
             self._thread.join(5.0)
         self.services.close()

@@ -67,14 +67,15 @@ class NumericArray(Sequence):
         try:
             return self._cast
         except AttributeError:
-            typed = self._cast = self._raw.cast(self._fmt)
+            # any struct format the message spec allows; typeshed's overloads take only literals
+            typed = self._cast = self._raw.cast(self._fmt)  # type: ignore[call-overload]
             return typed
 
     @classmethod
     def from_wire(cls, raw: bytes | memoryview, fmt: str) -> NumericArray | tuple:
         """View ``raw`` (wire bytes) as elements of ``fmt``; a tuple on big-endian hosts."""
         if LITTLE_ENDIAN_HOST:
-            return cls(memoryview(raw).cast("B").cast(fmt))
+            return cls(memoryview(raw).cast("B").cast(fmt))  # type: ignore[call-overload]  # as in _view
         count = len(raw) // struct.calcsize(fmt)
         return struct.unpack(f"<{count}{fmt}", raw)
 

@@ -22,7 +22,6 @@ from __future__ import annotations
 import keyword
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
 
 from ninjemys.errors import DefinitionError
 from ninjemys.idl.arrays import LITTLE_ENDIAN_HOST
@@ -47,10 +46,11 @@ def min_size(spec: MsgSpec, lookup: Lookup) -> int:
 
 
 def _min_field_size(ftype: FieldType, lookup: Lookup) -> int:
-    if ftype.is_array and ftype.array_len is None:
-        return 4
-    count = ftype.array_len if ftype.is_array else 1
-    return count * _min_elem_size(ftype.base, lookup)
+    if not ftype.is_array:
+        return _min_elem_size(ftype.base, lookup)
+    if ftype.array_len is None:
+        return 4  # the length prefix of an empty variable-length array
+    return ftype.array_len * _min_elem_size(ftype.base, lookup)
 
 
 def _min_elem_size(base: str, lookup: Lookup) -> int:
@@ -102,21 +102,32 @@ def _literal(value: object) -> str:
     return repr(value)
 
 
-@dataclass
 class _Emitter:
-    """Accumulates lines, the pending fixed-size run and the struct formats it needs."""
+    """Accumulates lines, the pending fixed-size run and the struct formats it needs.
 
-    type_name: str
-    lookup: Lookup
-    structs: dict[str, str]
-    lines: list[str] = field(default_factory=list)
-    depth: int = 2
-    counter: int = 0
-    run: list[tuple[str, str]] = field(default_factory=list)  # (format, target-or-argument)
-    posts: list[str] = field(default_factory=list)  # statements to run after the run is unpacked
-    loops: bool = False  # the code has a loop (arrays of messages/strings): no straight-line form
-    views: bool = False  # the code slices the buffer into views (needs a memoryview, not bytes)
-    bytes_buffer: bool = False  # the buffer is bytes (set when the type has no views)
+    A plain class, not a dataclass: ``dataclasses`` costs ~5 ms of every node's start-up (the node
+    loads rosgraph_msgs/Log and the logger services' types before it returns).
+    """
+
+    def __init__(
+        self,
+        type_name: str,
+        lookup: Lookup,
+        structs: dict[str, str],
+        depth: int = 2,
+        bytes_buffer: bool = False,
+    ) -> None:
+        self.type_name = type_name
+        self.lookup = lookup
+        self.structs = structs
+        self.lines: list[str] = []
+        self.depth = depth
+        self.counter = 0
+        self.run: list[tuple[str, str]] = []  # (format, target-or-argument)
+        self.posts: list[str] = []  # statements to run after the run is unpacked
+        self.loops = False  # the code has a loop (arrays of messages/strings): no straight-line form
+        self.views = False  # the code slices the buffer into views (needs a memoryview, not bytes)
+        self.bytes_buffer = bytes_buffer  # the buffer is bytes (set when the type has no views)
 
     def tmp(self, prefix: str = "v") -> str:
         self.counter += 1

@@ -197,7 +197,7 @@ def as_view(buf: Any) -> memoryview:
     return mv
 
 
-def deser_failed(cls: type, mv: Any, exc: BaseException) -> DeserializationError:
+def deser_failed(cls: type[Message], mv: Any, exc: BaseException) -> DeserializationError:
     return DeserializationError(f"{cls._type}: cannot decode {len(mv)} bytes: {type(exc).__name__}: {exc}")
 
 

@@ -46,6 +46,8 @@ class LaunchOptions:
     sigint_timeout: float = DEFAULT_SIGINT_TIMEOUT
     sigterm_timeout: float = DEFAULT_SIGTERM_TIMEOUT
     core_only: bool = False
+    #: print node output line by line behind ``[name] `` instead of passing it through (ROS 1)
+    prefix_output: bool = False
 
 
 def _strip(value: object) -> str:
@@ -95,7 +97,8 @@ def _process_specs(
         counter += 1
         name = node_process_name(node, counter)
         proc_env = node_environment(node, master_uri, env)
-        proc_env["PYTHONUNBUFFERED"] = "1"
+        if opts.prefix_output:  # lines are cut from the pipe as they come; passed through, as in ROS 1
+            proc_env["PYTHONUNBUFFERED"] = "1"
         for key, value in machine.env_args:
             proc_env[key] = value
         if local:
@@ -218,7 +221,7 @@ class LaunchSession:
             return self._supervise(specs, log)
 
     def _supervise(self, specs: list[ProcessSpec], log: Callable[[str], None]) -> int:
-        self.supervisor = Supervisor(specs, log=log)
+        self.supervisor = Supervisor(specs, log=log, prefix_output=self.opts.prefix_output)
         previous = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
         for sig in previous:
             signal.signal(sig, lambda *_: self.supervisor.request_shutdown() if self.supervisor else None)

@@ -1,8 +1,12 @@
 """The process supervisor: start the plan's nodes, watch them, respawn, shut down promptly.
 
 One thread (the caller's) runs everything from one selector: a pidfd per child (readable when it
-exits), its stdout/stderr pipes (output="screen" lines are printed with a ``[name] `` prefix so
-twenty nodes stay readable), and the signal wakeup fd. Timers (respawn delays, shutdown
+exits) and the signal wakeup fd. A node's output goes where ROS 1's roslaunch sends it: with
+output="screen" the node writes to roslaunch's own stdout and stderr, unchanged (scripts that parse
+it keep working); with output="log" its stdout goes to ``<name>-stdout.log`` and its stderr to the
+screen. With ``prefix_output`` (``roslaunch --prefix-output``, ``NINJEMYS_LAUNCH_PREFIX=1``) both
+pipes are read here instead and each line is printed with a ``[name] `` prefix, so twenty nodes'
+output stays readable. Timers (respawn delays, shutdown
 escalation) are the selector timeout. No polling loops, no thread per node.
 
 Shutdown (Ctrl-C, SIGTERM, a required node's death, or the master's death): SIGINT to every
@@ -76,8 +80,11 @@ class Supervisor:
         specs: list[ProcessSpec],
         write: Callable[[str], None] | None = None,
         log: Callable[[str], None] | None = None,
+        prefix_output: bool = False,
     ) -> None:
         self.procs = [_Running(spec) for spec in specs]
+        #: read the nodes' output and print it line by line behind ``[name] `` (else: passed through)
+        self.prefix_output = prefix_output
         #: receives the supervisor's own messages (not node output): the roslaunch log file
         self._log = log
         self.selector = selectors.DefaultSelector()
@@ -116,7 +123,9 @@ class Supervisor:
         if spec.popen is not None and proc.popen is None:
             proc.popen = spec.popen
         else:
-            stdout: int | IO[bytes] = subprocess.PIPE
+            # None: the node inherits roslaunch's stream, as in ROS 1
+            stdout: int | IO[bytes] | None = subprocess.PIPE if self.prefix_output else None
+            stderr: int | None = subprocess.PIPE if self.prefix_output else None
             if spec.output == "log" and spec.log_dir is not None:
                 spec.log_dir.mkdir(parents=True, exist_ok=True)
                 proc.log_file = open(spec.log_dir / f"{spec.name}-stdout.log", "ab")  # noqa: SIM115 - closed on exit
@@ -126,7 +135,7 @@ class Supervisor:
                     [*DEATH_WRAPPER, *spec.argv],
                     stdin=subprocess.DEVNULL,
                     stdout=stdout,
-                    stderr=subprocess.PIPE,
+                    stderr=stderr,
                     env=spec.env,
                     cwd=spec.cwd,
                     start_new_session=True,

@@ -86,7 +86,9 @@ class MasterClient:
 
     def _connect(self) -> socket.socket:
         if self._sock is None:
-            sock = socket.create_connection((lookup_host(self._host), self._port), timeout=self.timeout)
+            # a bytes host skips the idna codec (see lookup_host); getaddrinfo takes it, typeshed says str
+            address = (lookup_host(self._host), self._port)
+            sock = socket.create_connection(address, timeout=self.timeout)  # type: ignore[arg-type]
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
             self._sock = sock
         return self._sock

@@ -738,11 +738,11 @@ class Loop:
         if timers:
             now = time.monotonic()
             while timers and timers[0].when <= now:
-                handle = heapq.heappop(timers)
-                if handle._cancelled:
+                timer = heapq.heappop(timers)
+                if timer._cancelled:
                     self._cancelled_timers -= 1
                 else:
-                    ready.append(handle)
+                    ready.append(timer)
         for _ in range(len(ready)):
             handle = ready.popleft()
             if not handle._cancelled:

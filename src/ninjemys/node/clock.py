@@ -205,7 +205,8 @@ class Clock:
         self._subscription = node.subscriber(CLOCK_TOPIC, clock_class, self.on_clock_message, queue_size=1)
 
     def install(self) -> None:
-        """Make ``ninjemys.rostime.Time.now()`` read this clock (the process's ROS time)."""
+        """Make ``ninjemys.rostime.Time.now()`` read this clock (a Node does this through
+        ``rostime.claim_default_clock`` when it becomes the process's default node)."""
         from ninjemys import rostime
 
         rostime.set_clock(self.now_pair)
@@ -230,7 +231,12 @@ class FakeClock(Clock):
 
 
 def for_node(node: Any) -> Clock:
-    """The clock a node should use: simulated when ``/use_sim_time`` is true at start, else wall time."""
+    """The clock of ``node``: a :class:`~ninjemys.node.Node` owns one (``node.clock``, wall or simulated
+    as ``/use_sim_time`` said at its start); for another object with ``get_param`` and ``subscriber``,
+    a new clock following ``/clock`` when ``/use_sim_time`` is true."""
+    own = getattr(node, "clock", None)
+    if isinstance(own, Clock):
+        return own
     try:
         sim = bool(node.get_param(USE_SIM_TIME, False))
     except Exception:  # an unreachable parameter server means no sim time, as in rospy

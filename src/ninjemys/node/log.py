@@ -327,6 +327,17 @@ class NodeLog:
 
         return handle
 
+    def detach(self) -> None:
+        """The node is shutting down: stop sending to /rosout and close the log file. The program may
+        still log afterwards (console, and the file, reopened on the next message)."""
+        with self._hold_lock:
+            self._rosout = None
+            self._held = None
+        with self._lock:
+            if self._file is not None:
+                self._file.close()
+                self._file = None
+
     def close(self) -> None:
         """Flush and close the log file; later debug/info messages are dropped, warnings still print."""
         self._closed = True

@@ -1,9 +1,23 @@
 """Node: one participant of a ROS graph (several may live in one process).
 
-A Node owns its names (caller id, namespace, remappings), its servers (slave XML-RPC and TCPROS,
-both on the process's I/O loop), its registrations with the master, and every Publisher,
-Subscriber, ServiceServer and ServiceProxy made from it. ``shutdown`` tears all of that down and
-returns when nothing of the node is left running.
+A Node owns its whole lifecycle:
+
+* its names (caller id, namespace, remappings) and its servers (slave XML-RPC and TCPROS, both on
+  the process's I/O loop), its registrations with the master;
+* its ROS clock (:attr:`Node.clock`): wall time, or simulated time following ``/clock`` when
+  ``/use_sim_time`` is set (``sim_time="auto"``), so two Nodes of one process may run on different
+  time sources, each with its own ``rate``/``timer``/``sleep``;
+* its ROS logging (:attr:`Node.log`): console, the log file under ``~/.ros/log`` and ``/rosout``,
+  with ROS 1's level routing, and the ``~get_loggers``/``~set_logger_level`` services;
+* its parameters, and every Publisher, Subscriber, ServiceServer and ServiceProxy made from it.
+
+``shutdown`` tears all of that down and returns when nothing of the node is left running. The parts
+(publications, subscriptions, services, registrar, slave API) reach the node only through
+:class:`~ninjemys.node.context.NodeContext`.
+
+``rostime.Time.now()`` reads the clock of the process's *default* node: the first Node created (or
+the one created with ``default_clock=True``, which ``rospy.init_node`` does), wall time when there
+is none. Libraries handed a Node should prefer :meth:`Node.now`.
 """
 
 from __future__ import annotations
@@ -13,19 +27,21 @@ import socket
 import threading
 from collections.abc import Callable, Mapping
 
-from ninjemys import names
+from ninjemys import names, rostime
 from ninjemys.errors import MasterError, NinjemysError, ParameterError, ShutdownError
 from ninjemys.master.client import MasterClient
 from ninjemys.net.addresses import advertised_host
 from ninjemys.net.addresses import master_uri as env_master_uri
 from ninjemys.net.xmlrpc_server import XmlRpcServer
 from ninjemys.node import runtime as _runtime
-from ninjemys.node import transport
+from ninjemys.node import timers, transport
+from ninjemys.node.clock import CLOCK_TOPIC, USE_SIM_TIME, Clock
+from ninjemys.node.log import INFO, NodeLog
 from ninjemys.node.registration import Registrar
 from ninjemys.node.services import ServiceProxy, ServiceServer
 from ninjemys.node.slave import SlaveApi
 from ninjemys.node.subscriber import Subscriber, Subscription
-from ninjemys.node.topics import Publication, Publisher
+from ninjemys.node.topics import PubConnection, Publication, Publisher
 
 TYPE_CHECKING = False  # importing typing costs ~7 ms of every node's start-up; checkers set it
 if TYPE_CHECKING:
@@ -46,7 +62,36 @@ class Node:
         remappings: Mapping[str, str] | None = None,
         master_uri: str | None = None,
         params: Mapping[str, Any] | None = None,
+        *,
+        sim_time: bool | str = "auto",
+        clock: Clock | None = None,
+        rosout: bool = True,
+        logger_services: bool = True,
+        log_level: int = INFO,
+        log_file: str | None = None,
+        default_clock: bool | None = None,
     ) -> None:
+        """Register node ``name`` with the master and start its servers, clock and logging.
+
+        Args:
+            name: base name (``talker``) or global name; ``anonymous`` appends ``_<pid>_<ms>``.
+            namespace, remappings, master_uri: as ``__ns:=``, ``from:=to`` and ``__master:=``.
+            params: private parameters (``_rate:=10``) set at start.
+            sim_time: ``"auto"`` follows ``/clock`` when ``/use_sim_time`` is true at start (ROS 1);
+                True always follows ``/clock``; False is wall time.
+            clock: a :class:`~ninjemys.node.clock.Clock` to drive instead of a new one. A simulated
+                clock (``ninjemys.testing.FakeClock``) is used as it is, driven by its owner; a wall
+                clock is switched to ``/clock`` when ``sim_time`` says so (rospy hands over the
+                clock its pre-``init_node`` Rates and Timers already wait on).
+            rosout: publish every enabled log message on ``/rosout`` (latched rosgraph_msgs/Log).
+            logger_services: provide ``~get_loggers`` and ``~set_logger_level`` (roscpp/srv).
+            log_level: console and /rosout threshold (``ninjemys.node.log.DEBUG`` ... ``FATAL``).
+            log_file: the log file's path (``__log:=``), else ``<log dir>/<node>-<pid>.log``.
+            default_clock: make this node's clock the one ``rostime.Time.now()`` reads. None
+                (default) takes the place when no live node holds it; True takes it anyway; False never.
+        """
+        if sim_time not in ("auto", True, False):
+            raise ValueError(f"Node: sim_time must be 'auto', True or False, not {sim_time!r}")
         if not name or not names.is_legal_name(name.lstrip("/")) or "~" in name:
             raise names.NameError_(f"node name [{name}] is not a legal ROS name")
         if anonymous:
@@ -63,6 +108,7 @@ class Node:
         self._proxies: list[ServiceProxy] = []
         self._param_callbacks: dict[str, list[Callable[[str, Any], None]]] = {}
         self._shutdown_hooks: list[Callable[[], Any]] = []
+        self._timers: list[timers.Timer] = []
         self._lock = threading.RLock()
         self._shutdown_event = threading.Event()
         self._shutdown_done = threading.Event()
@@ -80,11 +126,70 @@ class Node:
         self.uri: str = self._slave.uri
         self.registrar = Registrar(self)
         self.registrar.start()
-        for key, value in (params or {}).items():
+        # the clock and the log exist before anything can fail, so shutdown always finds them
+        self.clock: Clock = clock if clock is not None else Clock()
+        self.log: NodeLog = NodeLog(self.name, level=log_level, log_file=log_file)
+        try:
+            for key, value in (params or {}).items():
+                try:
+                    self.set_param("~" + key.lstrip("~"), value)
+                except MasterError as exc:
+                    _log.warning("%s: could not set private parameter %s: %s", self.name, key, exc)
+            self._start_clock(sim_time, clock is not None and clock.is_sim)
+            if rosout:
+                self._start_rosout()
+            if logger_services:
+                self._start_logger_services()
+        except BaseException:
+            self.shutdown("start-up failed")
+            raise
+        if default_clock or (default_clock is None and rostime.default_clock_owner() is None):
+            rostime.claim_default_clock(self, None if self.clock.is_wallclock else self.clock.now_pair)
+
+    def _start_clock(self, sim_time: bool | str, driven: bool) -> None:
+        """Follow ``/clock`` when simulated time is asked for (or, for "auto", when ``/use_sim_time``
+        is true: read once, at start, as in ROS 1). A clock already simulated is driven by its owner."""
+        if driven:
+            self.log.set_ros_time(self.clock.now)
+            return
+        if sim_time == "auto":
             try:
-                self.set_param("~" + key.lstrip("~"), value)
-            except MasterError as exc:
-                _log.warning("%s: could not set private parameter %s: %s", self.name, key, exc)
+                sim = bool(self.get_param(USE_SIM_TIME, False))
+            except NinjemysError:
+                sim = False  # an unreachable parameter server means wall time, as in rospy
+        else:
+            sim = bool(sim_time)
+        if not sim:
+            return
+        from ninjemys.idl.loader import get_message_class
+
+        self.clock.switch_to_sim()
+        self.subscriber(
+            CLOCK_TOPIC, get_message_class("rosgraph_msgs/Clock"), self.clock.on_clock_message, queue_size=1
+        )
+        self.log.set_ros_time(self.clock.now)
+
+    def _start_rosout(self) -> None:
+        from ninjemys.idl.loader import get_message_class
+
+        log_class = get_message_class("rosgraph_msgs/Log")
+        pub = self.publisher("/rosout", log_class, queue_size=100, latch=True)
+        self.log.attach_rosout(pub, log_class, self._publication_names)
+
+    def _publication_names(self) -> list[str]:
+        return list(self._publications)
+
+    def _start_logger_services(self) -> None:
+        from ninjemys.idl.loader import get_message_class, get_service_class
+
+        get_loggers: Any = get_service_class("roscpp/GetLoggers")
+        set_level: Any = get_service_class("roscpp/SetLoggerLevel")
+        logger_class = get_message_class("roscpp/Logger")
+        log = self.log
+        self.service(
+            "~get_loggers", get_loggers, log.get_loggers_handler(get_loggers._response_class, logger_class)
+        )
+        self.service("~set_logger_level", set_level, log.set_logger_level_handler(set_level._response_class))
 
     async def _start_servers(self) -> None:
         self._tcpros.start()
@@ -173,7 +278,7 @@ class Node:
         if new:
             publishers = self.registrar.add_subscriber(resolved, sub.type_name)
             if publishers is not None:
-                self._publisher_update(resolved, publishers)
+                self.publisher_update(resolved, publishers)
         else:
             self.runtime.call_soon(self._replay_latched, sub, handle)
         return handle
@@ -183,12 +288,16 @@ class Node:
         for frame, header in sub.latched_frames():
             handle.enqueue([frame], header)
 
-    def _publisher_update(self, topic: str, publishers: list[str]) -> None:
+    # -- NodeContext: calls back from the node's parts ------------------------------------------------
+
+    def publisher_update(self, topic: str, publishers: list[str]) -> None:
+        """Connect to the current publishers of ``topic`` (from the master: slave API, re-registration)."""
         sub = self._subscriptions.get(topic)
         if sub is not None:
             self.runtime.call_soon(sub.update_publishers, publishers)
 
-    def _drop_publisher(self, handle: Publisher) -> None:
+    def release_publisher(self, handle: Publisher) -> None:
+        """Forget an unregistered Publisher handle; the topic's last one unregisters the topic."""
         with self._lock:
             pub = self._publications.get(handle.resolved_name)
             if pub is None or handle not in pub.handles:
@@ -200,7 +309,8 @@ class Node:
         self.registrar.remove_publisher(pub.topic)
         pub.close()
 
-    def _drop_subscriber(self, handle: Subscriber) -> None:
+    def release_subscriber(self, handle: Subscriber) -> None:
+        """Forget an unregistered Subscriber handle; the topic's last one unregisters the topic."""
         with self._lock:
             sub = self._subscriptions.get(handle.resolved_name)
             if sub is None or handle not in sub.handles:
@@ -212,7 +322,8 @@ class Node:
         self.registrar.remove_subscriber(sub.topic)
         self.runtime.call_soon(sub.close)
 
-    def _topic_connection_closed(self, conn: Any) -> None:
+    def connection_closed(self, conn: PubConnection) -> None:
+        """A subscriber's connection to one of our publications ended (on the I/O loop)."""
         pub = self._publications.get(conn.topic)
         if pub is not None:
             pub.remove_connection(conn)
@@ -225,6 +336,10 @@ class Node:
             transport.close_quietly(sock)
             return
         await pub.accept(sock, header)
+
+    def publishes(self, topic: str) -> bool:
+        """True when this node publishes ``topic``."""
+        return topic in self._publications
 
     def get_publications(self) -> list[list[str]]:
         return [[t, p.type_name] for t, p in list(self._publications.items())]
@@ -265,7 +380,8 @@ class Node:
         probe = ServiceProxy(self, self.resolve_name(name), _ProbeService)
         probe.wait_for_service(timeout)
 
-    def _drop_service(self, server: ServiceServer) -> None:
+    def release_service(self, server: ServiceServer) -> None:
+        """Forget a service server its owner shut down, and unregister it."""
         with self._lock:
             if self._services.get(server.name) is not server:
                 return
@@ -329,7 +445,8 @@ class Node:
             self._param_callbacks.setdefault(canonical, []).append(callback)
         return self.registrar.add_param_subscription(resolved)
 
-    def _param_update(self, key: str, value: Any) -> bool:
+    def param_update(self, key: str, value: Any) -> bool:
+        """Run the callbacks of a subscribed parameter that changed; False when none subscribes ``key``."""
         canonical = key.rstrip("/") + "/"
         callbacks = [
             (k, cb)
@@ -380,19 +497,64 @@ class Node:
                     ]
                 )
         for topic, sub in list(self._subscriptions.items()):
-            for c in list(sub.connections.values()):
+            for s in list(sub.connections.values()):
                 info.append(
                     [
-                        c.id,
-                        c.uri,
+                        s.id,
+                        s.uri,
                         "i",
                         "TCPROS",
                         topic,
-                        not c.closed,
-                        f"TCPROS connection from [{c.publisher}]",
+                        not s.closed,
+                        f"TCPROS connection from [{s.publisher}]",
                     ]
                 )
         return info
+
+    # -- time ------------------------------------------------------------------------------------
+
+    def now(self) -> rostime.Time:
+        """This node's ROS time as a Time (simulated time under ``/use_sim_time``: 0 until the first /clock)."""
+        secs, nsecs = self.clock.now_pair()
+        return rostime.Time._raw(secs, nsecs)
+
+    def get_time(self) -> float:
+        """This node's ROS time in float seconds."""
+        return self.clock.now()
+
+    def sleep(self, duration: Any) -> None:
+        """Sleep ``duration`` (seconds or a Duration) of this node's ROS time; ShutdownError on shutdown."""
+        timers.sleep(self.clock, duration)
+
+    def rate(self, hz: float, reset: bool = True) -> timers.Rate:
+        """A :class:`~ninjemys.node.timers.Rate` on this node's clock (``rate.sleep()`` once per loop)."""
+        return timers.Rate(hz, self.clock, reset=reset)
+
+    def timer(
+        self, period: Any, callback: Callable[[timers.TimerEvent], Any], oneshot: bool = False
+    ) -> timers.Timer:
+        """Call ``callback(TimerEvent)`` every ``period`` of this node's ROS time, on its own thread.
+
+        Event times are ``rostime.Time``; an exception in the callback is logged to the node's log
+        and the timer carries on. The timer stops when the node shuts down.
+        """
+        self._check_alive()
+        timer = timers.Timer(
+            self.clock,
+            period,
+            callback,
+            oneshot=oneshot,
+            make_time=rostime.Time.from_sec,
+            on_error=self._timer_failed,
+            name=f"timer:{self.name}",
+        )
+        with self._lock:
+            self._timers = [t for t in self._timers if t.is_alive()]
+            self._timers.append(timer)
+        return timer
+
+    def _timer_failed(self, exc: BaseException) -> None:
+        self.log.error("Timer callback raised %s: %s", type(exc).__name__, exc)
 
     # -- lifecycle -------------------------------------------------------------------------------
 
@@ -434,6 +596,12 @@ class Node:
                 hook()
             except Exception:
                 _log.exception("shutdown hook %r raised", hook)
+        # wake every sleeper, Rate and Timer of this node for good; stop sending to /rosout
+        self.clock.shutdown()
+        self.log.detach()
+        rostime.release_default_clock(self)
+        with self._lock:
+            node_timers, self._timers = self._timers, []
         self.registrar.stop()
         quick = MasterClient(self.master_uri, self.name, timeout=1.0)
         with self._lock:
@@ -470,6 +638,8 @@ class Node:
         for handle in handles:
             if handle._thread is not threading.current_thread():
                 handle._thread.join(2.0)
+        for timer in node_timers:
+            timer.join(2.0)
         self.master.close()
         _runtime.release()
 

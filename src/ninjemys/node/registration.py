@@ -30,7 +30,7 @@ from ninjemys.node.transport import connect
 TYPE_CHECKING = False  # importing typing costs ~7 ms of every node's start-up; checkers set it
 
 if TYPE_CHECKING:
-    from ninjemys.node.node import Node
+    from ninjemys.node.context import NodeContext
 
 _log = logging.getLogger(__name__)
 
@@ -43,7 +43,7 @@ IDLE_CHECK_PERIOD = 15.0
 class Registrar:
     """Registrations of one node, with a watchdog that restores them on a new master."""
 
-    def __init__(self, node: Node) -> None:
+    def __init__(self, node: NodeContext) -> None:
         self.node = node
         self.publications: dict[str, str] = {}
         self.subscriptions: dict[str, str] = {}
@@ -223,7 +223,7 @@ class Registrar:
                 master.register_publisher(topic, type_name, uri)
             for topic, type_name in subs.items():
                 publishers = master.register_subscriber(topic, type_name, uri)
-                self.node._publisher_update(topic, list(publishers))
+                self.node.publisher_update(topic, list(publishers))
             for name, service_uri in srvs.items():
                 master.register_service(name, service_uri, uri)
             for key in keys:

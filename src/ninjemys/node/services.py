@@ -44,7 +44,7 @@ TYPE_CHECKING = False  # importing typing costs ~7 ms of every node's start-up; 
 if TYPE_CHECKING:
     from typing import Any
 
-    from ninjemys.node.node import Node
+    from ninjemys.node.context import NodeContext
 
 _log = logging.getLogger(__name__)
 _U32 = struct.Struct("<I")
@@ -168,22 +168,34 @@ class _Link:
 
 
 def make_response(response_class: Any, value: Any) -> Any:
-    """Turn what a handler returned into a response, the ways rospy accepts (instance, dict, tuple, value)."""
+    """Turn what a handler returned into a response, the ways rospy accepts (instance, dict, tuple,
+    value); what cannot be one is a ServiceError worded as rospy's, which the caller receives."""
     if isinstance(value, response_class):
         return value
     if value is None:
         raise ServiceError("service handler returned None")
     if isinstance(value, dict):
-        return response_class(**value)
+        try:
+            return response_class(**value)
+        except (AttributeError, TypeError) as exc:
+            raise ServiceError(f"handler returned invalid value: {exc}") from None
     if isinstance(value, list | tuple):
-        return response_class(*value)
-    return response_class(value)
+        try:
+            return response_class(*value)
+        except TypeError as exc:
+            raise ServiceError(f"handler returned wrong number of values: {exc}") from None
+    try:
+        return response_class(value)
+    except TypeError as exc:
+        raise ServiceError(f"handler returned invalid value: {exc}") from None
 
 
 class ServiceServer:
     """A service this node provides; see :meth:`ninjemys.node.Node.service`."""
 
-    def __init__(self, node: Node, name: str, service_class: Any, handler: Callable[[Any], Any]) -> None:
+    def __init__(
+        self, node: NodeContext, name: str, service_class: Any, handler: Callable[[Any], Any]
+    ) -> None:
         self.node = node
         self.resolved_name = name
         self.name = name
@@ -278,6 +290,12 @@ class ServiceServer:
         return encode_service_response(False, f"cannot deserialize request: {exc}")
 
     def _failed(self, exc: Exception) -> bytes:
+        """The caller's error text, worded as rospy's: a handler that refuses the request on purpose
+        (ServiceError; rospy.ServiceException through the facade) "cannot process" it, any other
+        exception is an "error processing" it and is logged here."""
+        if isinstance(exc, ServiceError):
+            _log.debug("service %s: handler refused the request: %s", self.name, exc)
+            return encode_service_response(False, f"service cannot process request: {exc}")
         _log.error("service %s: error processing request: %s", self.name, exc)
         return encode_service_response(False, f"error processing request: {exc}")
 
@@ -298,7 +316,7 @@ class ServiceServer:
         if self._closed:
             return
         self._closed = True
-        self.node._drop_service(self)
+        self.node.release_service(self)
         self._end_connections()
 
     def _end_connections(self) -> None:
@@ -319,7 +337,7 @@ class ServiceProxy:
 
     def __init__(
         self,
-        node: Node,
+        node: NodeContext,
         name: str,
         service_class: Any,
         persistent: bool = False,

@@ -18,7 +18,7 @@ TYPE_CHECKING = False  # importing typing costs ~7 ms of every node's start-up; 
 if TYPE_CHECKING:
     from typing import Any
 
-    from ninjemys.node.node import Node
+    from ninjemys.node.context import NodeContext
 
 _log = logging.getLogger(__name__)
 
@@ -32,7 +32,7 @@ def _caller_ok(caller_id: Any) -> list[Any] | None:
 class SlaveApi:
     """XML-RPC handler object: every public method is an RPC method of the node."""
 
-    def __init__(self, node: Node) -> None:
+    def __init__(self, node: NodeContext) -> None:
         self._node = node
 
     def getUri(self, caller_id: str) -> list[Any]:  # noqa: N802 - ROS 1 method names
@@ -74,7 +74,7 @@ class SlaveApi:
         err = _caller_ok(caller_id)
         if err:
             return err
-        if not self._node._param_update(key, value):
+        if not self._node.param_update(key, value):
             return wire.error("not subscribed", 0)
         return wire.ok("", 0)
 
@@ -84,14 +84,14 @@ class SlaveApi:
             return err
         if not isinstance(publishers, list) or not all(isinstance(p, str) for p in publishers):
             return wire.error("publishers must be a list of URIs", 0)
-        self._node._publisher_update(topic, publishers)
+        self._node.publisher_update(topic, publishers)
         return wire.ok("", 0)
 
     def requestTopic(self, caller_id: str, topic: str, protocols: list[Any]) -> list[Any]:  # noqa: N802
         err = _caller_ok(caller_id)
         if err:
             return err
-        if topic not in self._node._publications:
+        if not self._node.publishes(topic):
             return wire.error(f"Not a publisher of [{topic}]", [])
         for proto in protocols if isinstance(protocols, list) else []:
             if isinstance(proto, list) and proto and proto[0] == "TCPROS":

@@ -21,6 +21,7 @@ import logging
 import select
 import selectors
 import socket
+import struct
 import threading
 import time
 from collections import deque
@@ -39,12 +40,37 @@ TYPE_CHECKING = False  # importing typing costs ~7 ms of every node's start-up; 
 if TYPE_CHECKING:
     from typing import Any
 
-    from ninjemys.node.node import Node
+    from ninjemys.node.context import NodeContext
 
 _log = logging.getLogger(__name__)
 
 #: Bytes an unbounded subscription reads from one connection before delivering what it has.
 _READ_BUDGET = 256 * 1024
+
+
+def _kernel_pending(sock: socket.socket) -> int:
+    """Bytes the kernel holds for ``sock`` (the FIONREAD ioctl); 0 where it cannot tell (Windows), which
+    ends a read round early rather than late. Imported on first use: most nodes never get here."""
+    global _ioctl
+    if _ioctl is None:
+        try:
+            import fcntl
+            import termios
+
+            request = termios.FIONREAD
+            _ioctl = lambda fd: fcntl.ioctl(fd, request, b"\0\0\0\0")  # noqa: E731
+        except (ImportError, AttributeError):
+            _ioctl = False
+    if not _ioctl:
+        return 0
+    try:
+        return _unpack_int(_ioctl(sock.fileno()))[0]
+    except (OSError, ValueError):
+        return 0
+
+
+_ioctl: Any = None
+_unpack_int = struct.Struct("i").unpack
 
 
 class RawMessage(SlotRecord):
@@ -116,12 +142,14 @@ class SubConnection:
         self._reader = FrameReader()
 
     def read(self, budget: int | None = None) -> list[bytes | bytearray] | None:
-        """Read what the kernel has (worker thread), up to about ``budget`` bytes when given; None when
-        the stream has ended."""
+        """Read frames from the kernel (worker thread): about ``budget`` bytes at most when given, else
+        what the kernel held when the read began, not what arrives meanwhile (a publisher as fast as
+        this reader would keep it reading, and its callbacks waiting, for as long as the stream
+        lasts). None when the stream has ended."""
         reader, sock = self._reader, self.sock
         frames: list[bytes | bytearray] = []
         got = 0
-        while budget is None or got < budget:
+        while True:
             buf = reader.buffer()
             try:
                 n = sock.recv_into(buf)
@@ -150,6 +178,10 @@ class SubConnection:
                 return None
             if n < len(buf):
                 break  # the kernel had no more: skip the EAGAIN round trip
+            if budget is None:
+                budget = got + _kernel_pending(sock)  # the first full read: this round ends there
+            if got >= budget:
+                break
         if frames:
             self.num_recv += len(frames)
             if self.latching:
@@ -172,7 +204,7 @@ class SubConnection:
 class Subscription:
     """A topic this node subscribes to: the publisher connections and the handles fed by them."""
 
-    def __init__(self, node: Node, topic: str, msg_class: Any, tcp_nodelay: bool) -> None:
+    def __init__(self, node: NodeContext, topic: str, msg_class: Any, tcp_nodelay: bool) -> None:
         self.node = node
         self.topic = topic
         self.msg_class = msg_class
@@ -521,11 +553,15 @@ class Subscriber:
     def get_num_connections(self) -> int:
         return len(self._sub.connections)
 
+    def publisher_ids(self) -> frozenset[str]:
+        """Caller ids of the publishers connected now (handshake done: what they publish reaches us)."""
+        return frozenset(c.publisher for c in list(self._sub.connections.values()) if not c.closed)
+
     def unregister(self) -> None:
         """Stop receiving; the worker thread ends (joined unless called from a callback)."""
         if self._closed:
             return
-        self._sub.node._drop_subscriber(self)
+        self._sub.node.release_subscriber(self)
         self._closed = True
         self._wakeup()
         if threading.current_thread() is not self._thread:

@@ -39,7 +39,7 @@ TYPE_CHECKING = False  # importing typing costs ~7 ms of every node's start-up; 
 if TYPE_CHECKING:
     from typing import Any
 
-    from ninjemys.node.node import Node
+    from ninjemys.node.context import NodeContext
 
 _log = logging.getLogger(__name__)
 
@@ -90,7 +90,9 @@ class PubConnection:
     threads fighting over the GIL and this connection's lock.
     """
 
-    def __init__(self, node: Node, sock: socket.socket, topic: str, subscriber: str, uri: str = "") -> None:
+    def __init__(
+        self, node: NodeContext, sock: socket.socket, topic: str, subscriber: str, uri: str = ""
+    ) -> None:
         self.node = node
         self.sock = sock
         self.fd = sock.fileno()
@@ -157,6 +159,7 @@ class PubConnection:
                 if n is None or n == total:
                     return
                 rest = _unsent(parts, n)
+                assert rest is not None  # n < total: part of the frame is left
                 if queue_size is not None:
                     # the caller may change its buffers once publish returns: keep a copy of the rest
                     self._partial = [b"".join(rest)]
@@ -348,7 +351,7 @@ class PubConnection:
         self._queued_bytes = 0
         self._partial = None
         self.node.runtime.call_soon(self._release_socket)
-        self.node.runtime.call_soon(self.node._topic_connection_closed, self)
+        self.node.runtime.call_soon(self.node.connection_closed, self)
 
     def _release_socket(self) -> None:
         loop = self.node.runtime.loop
@@ -367,7 +370,7 @@ class PubConnection:
 class Publication:
     """A topic this node publishes: type, connections, and the Publisher handles sharing them."""
 
-    def __init__(self, node: Node, topic: str, msg_class: Any) -> None:
+    def __init__(self, node: NodeContext, topic: str, msg_class: Any) -> None:
         self.node = node
         self.topic = topic
         self.msg_class = msg_class
@@ -512,12 +515,16 @@ class Publisher:
     def get_num_connections(self) -> int:
         return len(self._pub.connections)
 
+    def subscriber_ids(self) -> frozenset[str]:
+        """Caller ids of the subscribers connected now (handshake done: what is published reaches them)."""
+        return frozenset(c.subscriber for c in self._pub.connections if not c.closed)
+
     def unregister(self) -> None:
         """Stop publishing; the last handle of a topic unregisters it from the master."""
         if self._closed:
             return
         self._closed = True
-        self._pub.node._drop_publisher(self)
+        self._pub.node.release_publisher(self)
 
     @property
     def closed(self) -> bool:

@@ -22,10 +22,13 @@ import sys
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from ninjemys.errors import DefinitionError, PackageError
-from ninjemys.packages import cfg_gen, idl_check
+from ninjemys.packages import cfg_gen, idl_check, msg_types
 from ninjemys.packages.cmake_hints import read_cmake_hints
+from ninjemys.packages.cpp_targets import CppTarget, cpp_targets, skipped_message
+from ninjemys.packages.discovery import PackageIndex, package_path_dirs, underlay_dirs
 from ninjemys.packages.manifest import PackageManifest
 from ninjemys.packages.python_setup import python_packages
 from ninjemys.packages.setup_scripts import (
@@ -59,6 +62,8 @@ class BuildReport:
     written: list[Path] = field(default_factory=list)
     removed: list[Path] = field(default_factory=list)
     validated: int = 0
+    #: C++ targets declared in CMakeLists.txt files and not built (no compiler here)
+    cpp_skipped: list[CppTarget] = field(default_factory=list)
 
 
 class _Writer:
@@ -124,6 +129,32 @@ def _definitions(pkg: PackageManifest) -> dict[str, list[Path]]:
     return found
 
 
+def _report_cpp_targets(pkg: PackageManifest, report: BuildReport, log: Callable[[str], None]) -> None:
+    """Name the package's C++ targets, which this build skips, instead of ignoring them."""
+    targets = cpp_targets(pkg.path, pkg.name)
+    for line in skipped_message(pkg.name, targets):
+        log(line)
+    report.cpp_skipped.extend(targets)
+
+
+def _package_finder(ws: Workspace, env: Mapping[str, str]) -> Callable[[str], Path | None]:
+    """Where a package named in a field type lives: the workspace first, then (scanned once, on the
+    first name the workspace lacks) its underlays, ROS_PACKAGE_PATH and ninjemys' own packages."""
+    local = {p.name: p.path for p in ws.packages}
+    index: list[PackageIndex] = []
+
+    def find(name: str) -> Path | None:
+        if name in local:
+            return local[name]
+        if not index:
+            underlays = [u.source for u in underlay_workspaces(ws.devel, env) if u.source.is_dir()]
+            index.append(PackageIndex.scan(package_path_dirs(env) + underlays + underlay_dirs()))
+        manifest = index[0].packages.get(name)
+        return None if manifest is None else manifest.path
+
+    return find
+
+
 def build_workspace(
     ws: Workspace, env: Mapping[str, str] | None = None, log: Callable[[str], None] = print
 ) -> BuildReport:
@@ -139,17 +170,24 @@ def build_workspace(
         cache = json.loads(cache_path.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         cache = {}
-    new_cache: dict[str, list[float]] = {}
+    new_cache: dict[str, dict[str, list[Any]]] = {}
 
+    uses: list[tuple[Path, str, list[msg_types.Reference]]] = []
     for pkg in ordered:
         for files in _definitions(pkg).values():
             for path in files:
                 stat = path.stat()
                 key = [stat.st_mtime, stat.st_size]
-                if cache.get(str(path)) != key:
-                    idl_check.validate(path, pkg.name)
+                entry = cache.get(str(path))
+                if isinstance(entry, dict) and entry.get("stat") == key:
+                    refs = [(full, written) for full, written in entry.get("refs", [])]
+                else:
+                    refs = msg_types.references(idl_check.validate(path, pkg.name))
                     report.validated += 1
-                new_cache[str(path)] = key
+                new_cache[str(path)] = {"stat": key, "refs": [list(r) for r in refs]}
+                uses.append((path, pkg.name, refs))
+    # every run: a file that did not change may still use a message another change removed
+    msg_types.check(uses, _package_finder(ws, env))
 
     toplevel = ws.source / "CMakeLists.txt"
     if not toplevel.exists():
@@ -159,6 +197,7 @@ def build_workspace(
     for pkg in ordered:
         log(f"-- ~~  - {pkg.name}")
         report.packages.append(pkg.name)
+        _report_cpp_targets(pkg, report, log)
         defs = _definitions(pkg)
         hints = read_cmake_hints(pkg.path)
         py_packages = (

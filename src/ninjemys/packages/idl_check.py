@@ -9,8 +9,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from ninjemys.idl.parser import parse_file
+from ninjemys.idl.spec import ActionSpec, MsgSpec, SrvSpec
 
 
-def validate(path: Path, package: str) -> None:
+def validate(path: Path, package: str) -> MsgSpec | SrvSpec | ActionSpec:
     """Parse one definition file; DefinitionError (file:line) when it is malformed."""
-    parse_file(path, package)
+    return parse_file(path, package)

@@ -78,7 +78,7 @@ rosls() {
 
 def _bash_completion() -> str:
     """Source the completion file ninjemys ships (live graph names, packages, launch files, ...)."""
-    from ninjemys.tools.complete import BASH_FILE
+    from ninjemys.share.completion import BASH_FILE
 
     return f"_NJ_PY={shlex.quote(sys.executable)}\n. {shlex.quote(BASH_FILE)}\n"
 

@@ -44,7 +44,11 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
         },
         "rqt_graph": {"rqt_graph": ("ninjemys.web.rqt_graph:main", ())},
         "puzzlebot_sim": {
+            "sim_node": ("ninjemys.sim.puzzlebot_node:main", ()),
             "world_to_map": ("ninjemys.sim.world_to_map:main", ()),
+        },
+        "teleop_twist_keyboard": {
+            "teleop_twist_keyboard.py": ("ninjemys.sim.teleop_twist_keyboard:main", ()),
         },
         "map_server": {
             "map_server": ("ninjemys.nav.map_server_node:main", ()),
@@ -65,8 +69,28 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
                 "add_two_ints_client",
             )
         },
-        "rosout": {"rosout": ("ninjemys.master.rosout:main", ())},
+        "rosout": {"rosout": ("ninjemys.tools.rosout:main", ())},
+        "rosbridge_server": {"rosbridge_websocket": ("ninjemys.bridge.main:rosbridge_main", ())},
+        "foxglove_bridge": {"foxglove_bridge": ("ninjemys.bridge.main:foxglove_main", ())},
+        "rosapi": {"rosapi_node": ("ninjemys.bridge.rosapi:main", ())},
+        "tf2_web_republisher": {"tf2_web_republisher": ("ninjemys.bridge.tf_republisher:main", ())},
         "dynamic_reconfigure": {"dynparam": ("ninjemys.tools.dynparam:main", ())},
+        "actionlib_tutorials": {
+            "fibonacci_server": ("ninjemys.tutorials.actionlib.fibonacci_server:main", ()),
+            "fibonacci_server.py": ("ninjemys.tutorials.actionlib.fibonacci_server:main", ()),
+            "fibonacci_client": ("ninjemys.tutorials.actionlib.fibonacci_client:main", ()),
+            "fibonacci_client.py": ("ninjemys.tutorials.actionlib.fibonacci_client:main_py", ()),
+            "averaging_server": ("ninjemys.tutorials.actionlib.averaging_server:main", ()),
+            "averaging_client": ("ninjemys.tutorials.actionlib.averaging_client:main", ()),
+            "gen_numbers.py": ("ninjemys.tutorials.actionlib.gen_numbers:main", ()),
+        },
+        "tf2_ros": {"static_transform_publisher": ("ninjemys.tools.static_transform_publisher:main", ())},
+        "tf": {
+            "tf_echo": ("ninjemys.tools.tf_echo:main", ()),
+            "tf_monitor": ("ninjemys.tools.tf_monitor:main", ()),
+            "static_transform_publisher": ("ninjemys.tools.static_transform_publisher:tf_main", ()),
+        },
+        "tf2_tools": {"view_frames.py": ("ninjemys.tools.view_frames:main", ())},
         "rosbag": {
             sub: ("ninjemys.tools.rosbag:main", (sub,))
             for sub in (

@@ -192,7 +192,7 @@ def cast_grid(
             t = (lines - g_main) / d_main[:, None]  # in cells
         other = g_other + t * d_other[:, None]
         cell_main = np.where(sign[:, None] > 0, lines, lines - 1).astype(np.int64)
-        cell_other = np.floor(other).astype(np.int64)
+        cell_other = np.floor(np.nan_to_num(other, nan=-1.0, posinf=-1.0, neginf=-1.0)).astype(np.int64)
         if axis == 0:
             cc, rr = cell_main, cell_other
         else:

@@ -48,6 +48,7 @@ DEFAULT_CACHE_TIME = 10.0
 MAX_GRAPH_DEPTH = 1000
 QUATERNION_TOLERANCE = 10e-6  # tf2: |x²+y²+z²+w² - 1| must stay under this
 NO_PARENT = "NO_PARENT"
+REPEAT_REPORT_AFTER = 10.0  # seconds before the same bad-input line is reported again
 
 # tf2_msgs/TF2Error codes, as walk results
 NO_ERROR = 0
@@ -201,6 +202,7 @@ class BufferCore:
         self._topology = 0  # bumped when a frame appears or a newest parent changes
         self._pairs: dict[tuple[Frame, Frame], _Pair] = {}
         self._listeners: list[Callable[[], None]] = []
+        self._reported: dict[str, float] = {}
 
     @property
     def cache_time(self) -> float:
@@ -252,12 +254,25 @@ class BufferCore:
                 self._gen += 1
                 if self._waiters:
                     self._changed.notify_all()
-        for line in problems:
-            self._report(line)
+        if problems:
+            self._report_once(problems)
         if accepted:
             for fn in self._listeners:
                 fn()
         return accepted
+
+    def _report_once(self, lines: list[str]) -> None:
+        """Report each line, but the same line at most once per ``REPEAT_REPORT_AFTER`` seconds: a broadcaster
+        that sends the same bad transform at 100 Hz gets one line, not a hundred a second."""
+        now = _wall.monotonic()
+        with self._lock:
+            fresh = [line for line in lines if now - self._reported.get(line, -1e9) >= REPEAT_REPORT_AFTER]
+            for line in fresh:
+                self._reported[line] = now
+            if len(self._reported) > 10_000:
+                self._reported.clear()
+        for line in fresh:
+            self._report(line)
 
     def _insert(self, item: Sequence, authority: str, is_static: bool) -> str | None:
         """Insert one item (lock held). None when stored, else the line to report ('' = stay quiet)."""

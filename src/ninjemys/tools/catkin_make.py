@@ -56,6 +56,9 @@ def main(argv: list[str] | None = None) -> int:
         f"[100%] Built target(s) {' '.join(report.packages) or '(none)'}: "
         f"{len(report.written)} file(s) updated, {report.validated} definition(s) checked, {elapsed:.2f}s"
     )
+    if report.cpp_skipped:
+        names = ", ".join(t.name for t in report.cpp_skipped)
+        print(f"-- {len(report.cpp_skipped)} C++ target(s) not built (see above): {names}")
     return 0
 
 

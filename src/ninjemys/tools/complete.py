@@ -35,6 +35,8 @@ from __future__ import annotations
 import os
 import sys
 
+from ninjemys.share.completion import BASH_FILE
+
 TYPE_CHECKING = False  # typing itself is not worth importing on every Tab press
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -42,9 +44,6 @@ if TYPE_CHECKING:
 #: a completion that waits longer than this for the master is worse than none
 MASTER_TIMEOUT = 1.0
 CALLER_ID = "/ninjemys_complete"
-BASH_FILE = os.path.join(
-    os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "share", "completion", "ninjemys.bash"
-)
 
 
 # -- one XML-RPC call to the master, with nothing heavier than a socket --------------------------

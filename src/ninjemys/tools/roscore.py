@@ -96,7 +96,7 @@ class _Rosout:
     """Starts rosout on a helper thread and stops it within a deadline."""
 
     def __init__(self, master_uri: str, run_dir: Path | None, announce: Callable[[], None]) -> None:
-        self.node: Any = None  # a ninjemys.master.rosout.Rosout once started (imported lazily)
+        self.node: Any = None  # a ninjemys.tools.rosout.Rosout once started (imported lazily)
         self._stop = threading.Event()
         self._thread = threading.Thread(
             target=self._run, args=(master_uri, run_dir, announce), name="rosout", daemon=True
@@ -105,7 +105,7 @@ class _Rosout:
 
     def _run(self, master_uri: str, run_dir: Path | None, announce: Callable[[], None]) -> None:
         try:
-            from ninjemys.master.rosout import Rosout
+            from ninjemys.tools.rosout import Rosout
 
             node = Rosout(master_uri, run_dir)
         except Exception as exc:

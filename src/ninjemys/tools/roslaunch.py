@@ -49,6 +49,13 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--screen", action="store_true", help="Force output of all local nodes to screen")
     p.add_argument("--required", action="store_true", help="Force all nodes to be required")
     p.add_argument("--log", action="store_true", help="Force output of all local nodes to log")
+    p.add_argument(
+        "--prefix-output",
+        action="store_true",
+        default=os.environ.get("NINJEMYS_LAUNCH_PREFIX", "") not in ("", "0"),
+        help="print each line of the nodes' output behind [process-name] (also: NINJEMYS_LAUNCH_PREFIX=1); "
+        "by default output passes through unchanged, as in ROS 1",
+    )
     p.add_argument("-u", "--server_uri", help="accepted for compatibility")
     p.add_argument("--run_id", help="accepted for compatibility (the master's /run_id is used)")
     p.add_argument("--wait", action="store_true", help="wait for master to start before launching")
@@ -212,6 +219,7 @@ def main(argv: list[str] | None = None) -> int:
         no_summary=opts.no_summary,
         sigint_timeout=opts.sigint_timeout,
         sigterm_timeout=opts.sigterm_timeout,
+        prefix_output=opts.prefix_output,
     )
     try:
         return LaunchSession(plan, options).run()

@@ -13,12 +13,16 @@ import logging
 import threading
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ninjemys.errors import NinjemysError
 from ninjemys.web.events import Hub
 from ninjemys.web.graph import GraphPoller
 from ninjemys.web.http import HttpError, HttpServer, Request, Response
 from ninjemys.web.monitor import TopicMonitor
+
+if TYPE_CHECKING:
+    from ninjemys.bridge.server import Gateway
 
 log = logging.getLogger(__name__)
 
@@ -70,6 +74,12 @@ class WebApp:
 
     def add_page(self, title: str, path: str) -> None:
         self.pages.append(Page(title, path))
+
+    def add_gateway(self, gateway: Gateway, path: str = "/ws") -> None:
+        """Serve a started :class:`ninjemys.bridge.server.Gateway` on this app's server at ``path``
+        (``ws://<app>/ws``): the pages' one data path (Foxglove subprotocol: raw ROS 1 bytes and the
+        definitions to decode them), and rosbridge for roslibjs pages. Call before :meth:`start`."""
+        gateway.mount(self.server, path)
 
     def hub(self) -> Hub:
         """A new event hub on the app's loop (call after start)."""

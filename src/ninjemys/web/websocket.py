@@ -182,3 +182,4 @@ async def serve_upgrade(
         ws.close()
         with contextlib.suppress(Exception):
             await asyncio.wait_for(writer.drain(), 1.0)
+        writer.close()

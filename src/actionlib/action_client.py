@@ -1,0 +1,59 @@
+"""``actionlib.action_client``: ActionClient, ClientGoalHandle, CommState, TerminalState (ROS 1's API)."""
+
+from __future__ import annotations
+
+from actionlib import _process
+from actionlib_msgs.msg import GoalID, GoalStatus, GoalStatusArray
+from ninjemys.actionlib import client as _core
+from ninjemys.actionlib.client import ClientGoalHandle, CommStateMachine
+from ninjemys.actionlib.states import CommState, TerminalState, _name_of
+
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from typing import Any
+
+__all__ = [
+    "ActionClient",
+    "ClientGoalHandle",
+    "CommState",
+    "CommStateMachine",
+    "GoalID",
+    "GoalManager",
+    "GoalStatus",
+    "GoalStatusArray",
+    "TerminalState",
+    "get_name_of_constant",
+]
+
+
+def get_name_of_constant(C: type, n: int) -> str:  # noqa: N803 - ROS 1's signature
+    """The name of the integer constant ``n`` in class ``C`` (``NO_SUCH_STATE_<n>`` if none)."""
+    return _name_of(C, n)
+
+
+# ROS 1 gives the message class a to_string too: GoalStatus.to_string(3) == "SUCCEEDED"
+GoalStatus.to_string = classmethod(get_name_of_constant)
+
+
+class ActionClient(_core.ActionClient):
+    """``ActionClient(ns, ActionSpec)`` on the node of ``rospy.init_node``."""
+
+    def __init__(self, ns: str, ActionSpec: Any) -> None:  # noqa: N803 - ROS 1's signature
+        super().__init__(_process.node(), ns, ActionSpec, clock=_process.clock(), log=_process.LOG)
+        self.ActionSpec = ActionSpec
+        self.ActionGoal = self.types.action_goal
+        self.ActionResult = self.types.action_result
+        self.ActionFeedback = self.types.action_feedback
+
+
+class GoalManager:
+    """ROS 1's goal bookkeeping class; ours lives inside ActionClient, so this only names the types."""
+
+    def __init__(self, ActionSpec: Any) -> None:  # noqa: N803 - ROS 1's signature
+        from ninjemys.actionlib.common import ActionTypes
+
+        types = ActionTypes.of(ActionSpec)
+        self.ActionSpec = ActionSpec
+        self.ActionGoal = types.action_goal
+        self.ActionResult = types.action_result
+        self.ActionFeedback = types.action_feedback

@@ -1,0 +1,51 @@
+"""ROS 1's ``message_filters``, as a facade over :mod:`ninjemys.message_filters`.
+
+``Subscriber`` takes rospy.Subscriber's arguments (it subscribes through rospy, so it works after
+``rospy.init_node``); the other filters are the core's. ``message_filters.tf2.MessageFilter`` is
+tf2_ros' C++ MessageFilter for Python.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ninjemys.message_filters import (
+    ApproximateTimeSynchronizer,
+    Cache,
+    Chain,
+    SimpleFilter,
+    TimeSynchronizer,
+)
+
+__all__ = [
+    "ApproximateTimeSynchronizer",
+    "Cache",
+    "Chain",
+    "SimpleFilter",
+    "Subscriber",
+    "TimeSynchronizer",
+]
+
+
+class Subscriber(SimpleFilter):
+    """A source filter with ``rospy.Subscriber``'s arguments; every message is passed on."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        import rospy
+
+        super().__init__()
+        self.topic = args[0] if args else kwargs["name"]
+        kwargs["callback"] = self.callback
+        self.sub = rospy.Subscriber(*args, **kwargs)
+
+    def callback(self, msg: Any) -> None:
+        self.signalMessage(msg)
+
+    def getTopic(self) -> str:  # noqa: N802 - ROS 1 API
+        return self.topic
+
+    def __getattr__(self, key: str) -> Any:
+        """Everything else is rospy.Subscriber's (``unregister``, ``get_num_connections`` ...)."""
+        if key == "sub":
+            raise AttributeError(key)
+        return getattr(self.sub, key)

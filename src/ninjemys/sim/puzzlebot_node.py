@@ -1,0 +1,815 @@
+"""``rosrun puzzlebot_sim sim_node``: the PuzzleBot simulator as a ROS node (the role Gazebo plays).
+
+It binds one :class:`~ninjemys.sim.simcore.Simulation` to ROS names. Per robot (relative names, under
+``<robot>/`` when the world has several robots or the robot was spawned later): ``cmd_vel`` in;
+``wl``, ``wr`` (std_msgs/Float32, rad/s), ``joint_states``, ``odom``, ``base_pose_ground_truth``,
+``scan``, ``imu``, ``camera/color/image_raw`` (rgb8), ``camera/depth/image_rect_raw`` (16UC1, mm),
+``camera/color/camera_info``, ``camera/depth/camera_info`` and ``contact`` (std_msgs/Bool, latched)
+out. Global: ``/clock``, ``/tf`` (odom -> base_link), ``/tf_static`` (base_link -> sensors), and the
+Gazebo services ``/gazebo/reset_simulation``, ``/gazebo/reset_world``, ``/gazebo/pause_physics``,
+``/gazebo/unpause_physics`` (std_srvs/Empty), ``/gazebo/spawn_urdf_model``,
+``/gazebo/spawn_sdf_model`` (gazebo_msgs/SpawnModel) and ``/gazebo/delete_model``
+(gazebo_msgs/DeleteModel).
+
+Private parameters: ``~world`` (a shipped world name or a path; default ``square``), ``~map`` (a
+map_server YAML used as the world instead), ``~rate`` (real-time factor; 0 runs as fast as
+possible), ``~x ~y ~yaw`` (start pose of the first robot), ``~model`` (``puzzlebot``, a YAML or URDF
+path), ``~update_rate`` (physics steps per simulated second, default 100), ``~seed`` (noise),
+``~odom_alpha`` (amcl's α1-α4), ``~laser_noise``, ``~gui`` (serve the browser view).
+
+One thread steps the simulation and publishes; callbacks and services take the same lock. A topic
+nobody subscribes to costs nothing: its sensor is not even computed (Gazebo's sensors behave alike).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import signal
+import sys
+import threading
+import time
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ninjemys.errors import NinjemysError, ShutdownError
+from ninjemys.idl.loader import get_message_class, get_service_class
+from ninjemys.node import Node
+from ninjemys.node.cli_args import parse_args
+from ninjemys.node.log import NodeLog
+from ninjemys.rostime import Time
+from ninjemys.sim.mapfile import MapFileError
+from ninjemys.sim.robot_model import RobotModel, load_robot_model
+from ninjemys.sim.simcore import Robot, Simulation, SpawnError
+from ninjemys.sim.world2d import World, load_world, world_from_map
+from ninjemys.sim.worlds import world_path
+from ninjemys.tools.cli import entry
+
+Twist = get_message_class("geometry_msgs/Twist")
+TransformStamped = get_message_class("geometry_msgs/TransformStamped")
+Float32 = get_message_class("std_msgs/Float32")
+Bool = get_message_class("std_msgs/Bool")
+JointState = get_message_class("sensor_msgs/JointState")
+Odometry = get_message_class("nav_msgs/Odometry")
+LaserScan = get_message_class("sensor_msgs/LaserScan")
+Image = get_message_class("sensor_msgs/Image")
+CameraInfo = get_message_class("sensor_msgs/CameraInfo")
+Imu = get_message_class("sensor_msgs/Imu")
+TFMessage = get_message_class("tf2_msgs/TFMessage")
+Clock = get_message_class("rosgraph_msgs/Clock")
+Log = get_message_class("rosgraph_msgs/Log")
+Empty = get_service_class("std_srvs/Empty")
+SpawnModel = get_service_class("gazebo_msgs/SpawnModel")
+DeleteModel = get_service_class("gazebo_msgs/DeleteModel")
+
+WORLD_FRAME = "map"  # ground truth frame: the shipped maps are rasterized in world coordinates
+
+
+def quaternion(yaw: float) -> tuple[float, float, float, float]:
+    return 0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0)
+
+
+def quaternion_rpy(roll: float, pitch: float, yaw: float) -> tuple[float, float, float, float]:
+    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
+    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
+    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
+    return (
+        sr * cp * cy - cr * sp * sy,
+        cr * sp * cy + sr * cp * sy,
+        cr * cp * sy - sr * sp * cy,
+        cr * cp * cy + sr * sp * sy,
+    )
+
+
+def yaw_of(q: Any) -> float:
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+@dataclass
+class Due:
+    """A periodic output in simulated time: fires at the first step at or after ``next``."""
+
+    period: float
+    next: float = 0.0
+
+    def fire(self, now: float) -> bool:
+        if now + 1e-9 < self.next:
+            return False
+        self.next = max(self.next + self.period, now - self.period)  # no burst after a pause or reset
+        return True
+
+
+@dataclass
+class RobotIO:
+    """The ROS endpoints of one robot and its output schedule."""
+
+    robot: Robot
+    prefix: str  # "" or "name/": topic prefix (relative names)
+    frame_prefix: str  # "" or "name/": tf_prefix-style frame names
+    pubs: dict[str, Any]
+    cmd_sub: Any
+    odom_due: Due
+    scan_due: Due | None
+    camera_due: Due | None
+    imu_due: Due | None
+    bad_cmd_warned: bool = False
+    last_contact: bool | None = None
+    last_scan: np.ndarray | None = None
+    static_tfs: list[Any] = field(default_factory=list)
+
+    def frame(self, name: str) -> str:
+        return self.frame_prefix + name
+
+    def close(self) -> None:
+        self.cmd_sub.unregister()
+        for pub in self.pubs.values():
+            pub.unregister()
+
+
+class SimNode:
+    """The simulator node: a :class:`Simulation`, its ROS endpoints, and the stepping thread."""
+
+    def __init__(
+        self, node: Node, log: NodeLog, sim: Simulation, rate: float, laser_noise: float | None
+    ) -> None:
+        self.node = node
+        self.log = log
+        self.sim = sim
+        self.rate = rate
+        self.laser_noise = laser_noise
+        self.lock = threading.RLock()
+        self.io: dict[str, RobotIO] = {}
+        self.paused = False
+        self._wake = threading.Event()
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+        self.view: Any = None
+        self.clock_pub = node.publisher("/clock", Clock, queue_size=10)
+        self.tf_pub = node.publisher("/tf", TFMessage, queue_size=100)
+        self.tf_static_pub = node.publisher("/tf_static", TFMessage, queue_size=100, latch=True)
+        self.namespaced = False
+        node.service("/gazebo/reset_simulation", Empty, self._reset_simulation)
+        node.service("/gazebo/reset_world", Empty, self._reset_world)
+        node.service("/gazebo/pause_physics", Empty, self._pause)
+        node.service("/gazebo/unpause_physics", Empty, self._unpause)
+        node.service("/gazebo/spawn_urdf_model", SpawnModel, self._spawn)
+        node.service("/gazebo/spawn_sdf_model", SpawnModel, self._spawn)
+        node.service("/gazebo/delete_model", DeleteModel, self._delete)
+
+    # -- robots ---------------------------------------------------------------------------------
+    def add_robot(
+        self, name: str, model: RobotModel, x: float, y: float, yaw: float, namespaced: bool
+    ) -> RobotIO:
+        """Place a robot and create its topics (raises SpawnError when the place is taken)."""
+        with self.lock:
+            robot = self.sim.add_robot(name, model, x, y, yaw)
+            if self.laser_noise is not None and model.laser is not None:
+                model.laser.noise = self.laser_noise
+            prefix = f"{name}/" if namespaced else ""
+            n = self.node
+            pubs = {
+                "wl": n.publisher(prefix + "wl", Float32, queue_size=10),
+                "wr": n.publisher(prefix + "wr", Float32, queue_size=10),
+                "joint_states": n.publisher(prefix + "joint_states", JointState, queue_size=10),
+                "odom": n.publisher(prefix + "odom", Odometry, queue_size=10),
+                "ground_truth": n.publisher(prefix + "base_pose_ground_truth", Odometry, queue_size=10),
+                "contact": n.publisher(prefix + "contact", Bool, queue_size=1, latch=True),
+            }
+            if model.laser is not None:
+                pubs["scan"] = n.publisher(prefix + "scan", LaserScan, queue_size=10)
+            if model.camera is not None:
+                pubs["image"] = n.publisher(prefix + "camera/color/image_raw", Image, queue_size=2)
+                pubs["depth"] = n.publisher(prefix + "camera/depth/image_rect_raw", Image, queue_size=2)
+                pubs["color_info"] = n.publisher(
+                    prefix + "camera/color/camera_info", CameraInfo, queue_size=2
+                )
+                pubs["depth_info"] = n.publisher(
+                    prefix + "camera/depth/camera_info", CameraInfo, queue_size=2
+                )
+            if model.imu is not None:
+                pubs["imu"] = n.publisher(prefix + "imu", Imu, queue_size=10)
+            io = RobotIO(
+                robot,
+                prefix,
+                prefix,
+                pubs,
+                None,
+                Due(1.0 / model.odom_rate, self.sim.time),
+                Due(1.0 / model.laser.rate, self.sim.time) if model.laser else None,
+                Due(1.0 / model.camera.rate, self.sim.time) if model.camera else None,
+                Due(1.0 / model.imu.rate, self.sim.time) if model.imu else None,
+            )
+            io.cmd_sub = n.subscriber(
+                prefix + "cmd_vel", Twist, self._on_cmd_vel, callback_args=name, queue_size=1
+            )
+            io.static_tfs = self._static_transforms(io)
+            self.io[name] = io
+            self._publish_static()
+            self._publish_contact(io)
+        self.log.info(
+            "spawned robot [%s] (%s) at (%.3f, %.3f, %.3f)%s",
+            name,
+            model.name,
+            x,
+            y,
+            yaw,
+            f" in namespace /{name}" if namespaced else "",
+        )
+        return io
+
+    def remove_robot(self, name: str) -> None:
+        with self.lock:
+            self.sim.remove_robot(name)
+            io = self.io.pop(name)
+            self._publish_static()
+        io.close()
+
+    def _static_transforms(self, io: RobotIO) -> list[Any]:
+        m = io.robot.model
+        out = []
+        for spec in (m.laser, m.camera, m.imu):
+            if spec is None:
+                continue
+            t = TransformStamped()
+            t.header.stamp = self._stamp()
+            t.header.frame_id = io.frame("base_link")
+            t.child_frame_id = io.frame(spec.pose.frame)
+            t.transform.translation.x, t.transform.translation.y, t.transform.translation.z = spec.pose.xyz
+            q = quaternion_rpy(*spec.pose.rpy)
+            r = t.transform.rotation
+            r.x, r.y, r.z, r.w = q
+            out.append(t)
+        return out
+
+    def _publish_static(self) -> None:
+        """/tf_static is latched: one message holds every robot's static transforms."""
+        self.tf_static_pub.publish(
+            TFMessage(transforms=[t for io in self.io.values() for t in io.static_tfs])
+        )
+
+    def _publish_contact(self, io: RobotIO) -> None:
+        if io.last_contact != io.robot.contact:
+            io.last_contact = io.robot.contact
+            io.pubs["contact"].publish(Bool(data=io.robot.contact))
+
+    def _on_cmd_vel(self, msg: Any, name: str) -> None:
+        values = (msg.linear.x, msg.angular.z)
+        with self.lock:
+            io = self.io.get(name)
+            if io is None:
+                return
+            if not all(
+                math.isfinite(v)
+                for v in (
+                    msg.linear.x,
+                    msg.linear.y,
+                    msg.linear.z,
+                    msg.angular.x,
+                    msg.angular.y,
+                    msg.angular.z,
+                )
+            ):
+                if not io.bad_cmd_warned:
+                    io.bad_cmd_warned = True
+                    self.log.warn(
+                        "%scmd_vel: ignoring a command with a non-finite value (linear.x=%s, angular.z=%s); "
+                        "further ones are ignored silently until a valid command arrives",
+                        "/" + io.prefix if io.prefix else "",
+                        values[0],
+                        values[1],
+                    )
+                return
+            io.bad_cmd_warned = False
+            io.robot.command(values[0], values[1])
+
+    # -- services -------------------------------------------------------------------------------
+    def _reset_simulation(self, _req: Any) -> Any:
+        with self.lock:
+            self.sim.reset_simulation()
+            self._after_reset()
+        self.log.info("simulation reset: time and robots back to the start")
+        return Empty._response_class()
+
+    def _reset_world(self, _req: Any) -> Any:
+        with self.lock:
+            self.sim.reset_world()
+            self._after_reset()
+        self.log.info("world reset: robots back to their start poses")
+        return Empty._response_class()
+
+    def _after_reset(self) -> None:
+        now = self.sim.time
+        for io in self.io.values():
+            for due in (io.odom_due, io.scan_due, io.camera_due, io.imu_due):
+                if due is not None:
+                    due.next = now
+            self._publish_contact(io)
+        self._wake.set()
+
+    def _pause(self, _req: Any) -> Any:
+        with self.lock:
+            self.paused = True
+        return Empty._response_class()
+
+    def _unpause(self, _req: Any) -> Any:
+        with self.lock:
+            self.paused = False
+        self._wake.set()
+        return Empty._response_class()
+
+    def _spawn(self, req: Any) -> Any:
+        resp = SpawnModel._response_class()
+        name = req.model_name.strip()
+        x, y = req.initial_pose.position.x, req.initial_pose.position.y
+        yaw = yaw_of(req.initial_pose.orientation)
+        try:
+            if not name or not name.replace("_", "a").isalnum() or not name[0].isalpha():
+                raise SpawnError(f"model_name [{req.model_name}] is not a valid ROS name")
+            if req.reference_frame not in ("", "world", "map"):
+                raise SpawnError(
+                    f"reference_frame [{req.reference_frame}] is not supported (use '' or 'world')"
+                )
+            kind, spec = parse_model_xml(req.model_xml)
+            if kind == "robot":
+                self.add_robot(name, spec, x, y, yaw, True)
+            else:
+                shape, size, height, colour = spec
+                with self.lock:
+                    self.sim.add_obstacle(name, shape, size, x, y, yaw, height, colour)
+                self.log.info("spawned %s [%s] at (%.3f, %.3f)", shape, name, x, y)
+        except (SpawnError, MapFileError) as exc:
+            self.log.error("spawn refused: %s", exc)
+            resp.success, resp.status_message = False, f"SpawnModel: Failure - {exc}"
+            return resp
+        resp.success, resp.status_message = True, f"SpawnModel: Successfully spawned entity [{name}]"
+        return resp
+
+    def _delete(self, req: Any) -> Any:
+        resp = DeleteModel._response_class()
+        name = req.model_name
+        try:
+            if name in self.sim.robots:
+                self.remove_robot(name)
+            else:
+                with self.lock:
+                    self.sim.remove_obstacle(name)
+        except SpawnError as exc:
+            resp.success, resp.status_message = False, f"DeleteModel: {exc}"
+            return resp
+        self.log.info("deleted model [%s]", name)
+        resp.success, resp.status_message = True, f"DeleteModel: successfully deleted model [{name}]"
+        return resp
+
+    # -- the stepping thread --------------------------------------------------------------------
+    def start(self) -> None:
+        self._thread = threading.Thread(target=self._run, name="puzzlebot-sim", daemon=True)
+        self._thread.start()
+
+    def stop(self) -> None:
+        self._stop.set()
+        self._wake.set()
+        if self._thread is not None:
+            self._thread.join(5.0)
+
+    def _stamp(self) -> Time:
+        ns = round(self.sim.steps * self.sim.dt * 1e9)
+        return Time(ns // 1_000_000_000, ns % 1_000_000_000)
+
+    def _run(self) -> None:
+        wall0 = time.monotonic()
+        sim0 = self.sim.time
+        while not self._stop.is_set():
+            with self.lock:
+                paused = self.paused
+            if paused:
+                self._wake.wait(0.5)
+                self._wake.clear()
+                wall0, sim0 = time.monotonic(), self.sim.time
+                continue
+            try:
+                with self.lock:
+                    if self.sim.time < sim0:  # reset_simulation: time went back
+                        wall0, sim0 = time.monotonic(), self.sim.time
+                    self._step_and_publish()
+            except ShutdownError:
+                return  # the node shut down under the stepping thread
+            except Exception as exc:  # a bug in one step must not freeze the simulation for good
+                self.log.error("simulation step failed: %s: %s", type(exc).__name__, exc)
+            if self.rate > 0:
+                target = wall0 + (self.sim.time - sim0) / self.rate
+                delay = target - time.monotonic()
+                if delay > 0:
+                    self._wake.wait(delay)
+                    self._wake.clear()
+                elif delay < -0.25:  # far behind (machine busy): run on from now, no burst to catch up
+                    wall0, sim0 = time.monotonic(), self.sim.time
+
+    def _step_and_publish(self) -> None:
+        sim = self.sim
+        touched = sim.step()
+        now = sim.time
+        stamp = self._stamp()
+        self.clock_pub.publish(Clock(clock=stamp))
+        for r in touched:
+            self.log.warn(
+                "robot [%s] hit '%s' at (%.3f, %.3f): stopped at contact", r.name, r.contact_with, r.x, r.y
+            )
+        tfs = []
+        for io in self.io.values():
+            r = io.robot
+            self._publish_contact(io)
+            pubs = io.pubs
+            if io.odom_due.fire(now):
+                tfs.append(self._odometry(io, stamp))
+            if io.imu_due is not None and io.imu_due.fire(now) and pubs["imu"].get_num_connections():
+                self._imu(io, stamp)
+            if io.scan_due is not None and io.scan_due.fire(now):
+                want_view = self.view is not None and self.view.wants_scans()
+                if pubs["scan"].get_num_connections() or want_view:
+                    ranges = sim.scan(r)
+                    io.last_scan = ranges
+                    if pubs["scan"].get_num_connections():
+                        self._scan(io, stamp, ranges)
+            if io.camera_due is not None and io.camera_due.fire(now):
+                want = any(
+                    pubs[k].get_num_connections() for k in ("image", "depth", "color_info", "depth_info")
+                )
+                if want or (self.view is not None and self.view.wants_camera(r.name)):
+                    self._camera(io, stamp)
+        if tfs:
+            self.tf_pub.publish(TFMessage(transforms=tfs))
+        if self.view is not None:
+            self.view.publish(now)
+
+    def _odometry(self, io: RobotIO, stamp: Time) -> Any:
+        r = io.robot
+        pubs = io.pubs
+        ox, oy, oyaw = self.sim.odometry(r)
+        if pubs["odom"].get_num_connections():
+            msg = Odometry()
+            msg.header.stamp = stamp
+            msg.header.frame_id = io.frame("odom")
+            msg.child_frame_id = io.frame("base_link")
+            p = msg.pose.pose
+            p.position.x, p.position.y = ox, oy
+            p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w = quaternion(oyaw)
+            msg.twist.twist.linear.x = r.v
+            msg.twist.twist.angular.z = r.w
+            a1, a2, a3, a4 = r.model.odom_alpha
+            var_xy = 1e-4 + a3 * 0.01
+            var_yaw = 1e-4 + a1 * 0.01
+            msg.pose.covariance = [
+                var_xy,
+                0,
+                0,
+                0,
+                0,
+                0,
+                0,
+                var_xy,
+                0,
+                0,
+                0,
+                0,
+                0,
+                0,
+                1e6,
+                0,
+                0,
+                0,
+                0,
+                0,
+                0,
+                1e6,
+                0,
+                0,
+                0,
+                0,
+                0,
+                0,
+                1e6,
+                0,
+                0,
+                0,
+                0,
+                0,
+                0,
+                var_yaw,
+            ]
+            msg.twist.covariance = msg.pose.covariance
+            pubs["odom"].publish(msg)
+        if pubs["ground_truth"].get_num_connections():
+            gt = Odometry()
+            gt.header.stamp = stamp
+            gt.header.frame_id = WORLD_FRAME
+            gt.child_frame_id = io.frame("base_link")
+            gp = gt.pose.pose
+            gp.position.x, gp.position.y = r.x, r.y
+            gp.orientation.x, gp.orientation.y, gp.orientation.z, gp.orientation.w = quaternion(r.yaw)
+            gt.twist.twist.linear.x = r.v
+            gt.twist.twist.angular.z = r.w
+            pubs["ground_truth"].publish(gt)
+        if pubs["wl"].get_num_connections():
+            pubs["wl"].publish(Float32(data=r.wl))
+        if pubs["wr"].get_num_connections():
+            pubs["wr"].publish(Float32(data=r.wr))
+        if pubs["joint_states"].get_num_connections():
+            js = JointState()
+            js.header.stamp = stamp
+            js.name = [r.model.left_joint, r.model.right_joint]
+            js.position = [r.left_angle, r.right_angle]
+            js.velocity = [r.wl, r.wr]
+            pubs["joint_states"].publish(js)
+        t = TransformStamped()
+        t.header.stamp = stamp
+        t.header.frame_id = io.frame("odom")
+        t.child_frame_id = io.frame("base_link")
+        t.transform.translation.x, t.transform.translation.y = ox, oy
+        q = t.transform.rotation
+        q.x, q.y, q.z, q.w = quaternion(oyaw)
+        return t
+
+    def _imu(self, io: RobotIO, stamp: Time) -> None:
+        r = io.robot
+        spec = r.model.imu
+        yaw, wz, ax, ay = self.sim.imu(r)
+        msg = Imu()
+        msg.header.stamp = stamp
+        msg.header.frame_id = io.frame(spec.pose.frame)
+        o = msg.orientation
+        o.x, o.y, o.z, o.w = quaternion(yaw)
+        msg.angular_velocity.z = wz
+        msg.linear_acceleration.x, msg.linear_acceleration.y, msg.linear_acceleration.z = ax, ay, 9.80665
+        g, a = max(spec.gyro_noise**2, 1e-9), max(spec.accel_noise**2, 1e-9)
+        msg.orientation_covariance = [1e-4, 0, 0, 0, 1e-4, 0, 0, 0, 1e-4]
+        msg.angular_velocity_covariance = [g, 0, 0, 0, g, 0, 0, 0, g]
+        msg.linear_acceleration_covariance = [a, 0, 0, 0, a, 0, 0, 0, a]
+        io.pubs["imu"].publish(msg)
+
+    def _scan(self, io: RobotIO, stamp: Time, ranges: np.ndarray) -> None:
+        spec = io.robot.model.laser
+        msg = LaserScan()
+        msg.header.stamp = stamp
+        msg.header.frame_id = io.frame(spec.pose.frame)
+        inc = 2.0 * math.pi / spec.beams
+        msg.angle_min = -math.pi
+        msg.angle_max = -math.pi + inc * (spec.beams - 1)
+        msg.angle_increment = inc
+        msg.time_increment = 0.0
+        msg.scan_time = 1.0 / spec.rate
+        msg.range_min = spec.range_min
+        msg.range_max = spec.range_max
+        msg.ranges = ranges
+        msg.intensities = []
+        io.pubs["scan"].publish(msg)
+
+    def _camera(self, io: RobotIO, stamp: Time) -> None:
+        r = io.robot
+        spec = r.model.camera
+        rgb, depth = self.sim.render(r)
+        if self.view is not None:
+            self.view.camera_frame(r.name, rgb, depth)
+        pubs = io.pubs
+        frame = io.frame("camera_color_optical_frame")
+        depth_frame = io.frame("camera_depth_optical_frame")
+        if pubs["image"].get_num_connections():
+            img = Image()
+            img.header.stamp = stamp
+            img.header.frame_id = frame
+            img.height, img.width = rgb.shape[0], rgb.shape[1]
+            img.encoding = "rgb8"
+            img.is_bigendian = 0
+            img.step = rgb.shape[1] * 3
+            img.data = rgb.tobytes()
+            pubs["image"].publish(img)
+        if pubs["depth"].get_num_connections():
+            d = Image()
+            d.header.stamp = stamp
+            d.header.frame_id = depth_frame
+            d.height, d.width = depth.shape[0], depth.shape[1]
+            d.encoding = "16UC1"
+            d.is_bigendian = 0
+            d.step = depth.shape[1] * 2
+            d.data = depth.astype("<u2").tobytes()
+            pubs["depth"].publish(d)
+        fx, fy, cx, cy = r.camera.intrinsics()
+        for key, frame_id in (("color_info", frame), ("depth_info", depth_frame)):
+            if pubs[key].get_num_connections():
+                info = CameraInfo()
+                info.header.stamp = stamp
+                info.header.frame_id = frame_id
+                info.height, info.width = spec.height, spec.width
+                info.distortion_model = "plumb_bob"
+                info.D = [0.0, 0.0, 0.0, 0.0, 0.0]
+                info.K = [fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0]
+                info.R = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
+                info.P = [fx, 0.0, cx, 0.0, 0.0, fy, cy, 0.0, 0.0, 0.0, 1.0, 0.0]
+                pubs[key].publish(info)
+
+
+def parse_model_xml(text: str) -> tuple[str, Any]:
+    """What a SpawnModel request's ``model_xml`` describes: ("robot", RobotModel) or
+    ("obstacle", (shape, size, height, colour)). Empty text or ``puzzlebot`` is the PuzzleBot."""
+    body = text.strip()
+    if not body:
+        return "robot", load_robot_model("puzzlebot")
+    if not body.startswith("<"):
+        return "robot", load_robot_model(body)
+    try:
+        root = ET.fromstring(body)
+    except ET.ParseError as exc:
+        raise SpawnError(f"model_xml is not valid XML: {exc}") from None
+    if root.tag == "robot" and len([j for j in root.iter("joint") if j.get("type") == "continuous"]) == 2:
+        return "robot", load_robot_model(body)
+    for geom in root.iter("geometry"):
+        box = geom.find("box")
+        cyl = geom.find("cylinder")
+        if box is not None:
+            size_text = box.get("size") or (box.findtext("size") or "")
+            try:
+                sx, sy, sz = (float(v) for v in size_text.split())
+            except ValueError:
+                raise SpawnError(f"box size {size_text!r} is not three numbers") from None
+            return "obstacle", ("box", (sx, sy), sz, (180, 130, 80))
+        if cyl is not None:
+            try:
+                radius = float(cyl.get("radius") or cyl.findtext("radius") or "")
+                length = float(cyl.get("length") or cyl.findtext("length") or "")
+            except ValueError:
+                raise SpawnError("cylinder needs numeric radius and length") from None
+            return "obstacle", ("cylinder", (radius, radius), length, (60, 90, 200))
+    raise SpawnError(
+        "model_xml describes neither a differential-drive robot (URDF with 2 continuous joints) nor a box or cylinder"
+    )
+
+
+# -- process entry point -------------------------------------------------------------------------
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="sim_node", description="The PuzzleBot simulator (pure Python, Gazebo's role)."
+    )
+    p.add_argument("--headless", action="store_true", help="no browser view (same as _gui:=false)")
+    p.add_argument("--port", type=int, default=0, help="browser view port (default: any free port)")
+    p.add_argument("--host", default="127.0.0.1", help="browser view address (default: localhost only)")
+    p.add_argument("--no-browser", action="store_true", help="only print the view URL (no browser tab)")
+    return p
+
+
+def _param(node: Node, log: NodeLog, key: str, default: Any, kind: type) -> Any:
+    try:
+        value = node.get_param("~" + key, default)
+    except NinjemysError as exc:
+        log.warn("~%s: %s; using %r", key, exc, default)
+        return default
+    if kind is float:
+        try:
+            value = float(value)
+        except (TypeError, ValueError):
+            log.warn("~%s: %r is not a number, using %r", key, value, default)
+            return default
+        if not math.isfinite(value):
+            log.warn("~%s: %r is not finite, using %r", key, value, default)
+            return default
+    elif kind is bool:
+        value = value if isinstance(value, bool) else str(value).lower() in ("1", "true", "yes")
+    elif kind is str:
+        value = str(value)
+    return value
+
+
+def load_sim_world(log: NodeLog, world_arg: str, map_arg: str) -> World:
+    if map_arg:
+        log.info("world from map_server map %s", map_arg)
+        return world_from_map(map_arg)
+    return load_world(world_path(world_arg))
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    ros_args = [a for a in argv if ":=" in a]
+    options = _parser().parse_args([a for a in argv if ":=" not in a])
+    args = parse_args([sys.argv[0], *ros_args])
+    node = Node(
+        args.node_name("puzzlebot_sim"),
+        namespace=args.namespace,
+        remappings=args.remappings,
+        master_uri=args.master_uri,
+        params=args.private_params,
+    )
+    log = NodeLog(node.name, log_file=args.log_file)
+    log.attach_rosout(
+        node.publisher("/rosout", Log, queue_size=100, latch=True),
+        Log,
+        lambda: [t for t, _ in node.get_publications()],
+    )
+    stop = threading.Event()
+
+    def on_signal(_signum: int, _frame: Any) -> None:
+        stop.set()
+        node.shutdown("signal")
+
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, on_signal)
+        signal.signal(signal.SIGTERM, on_signal)
+    try:
+        try:
+            if not node.has_param("/use_sim_time"):
+                node.set_param("/use_sim_time", True)
+                log.info("/use_sim_time was not set: set it to true (this simulator publishes /clock)")
+        except NinjemysError as exc:
+            log.warn("could not set /use_sim_time: %s", exc)
+        world_arg = _param(node, log, "world", "square", str)
+        map_arg = _param(node, log, "map", "", str)
+        try:
+            world = load_sim_world(log, world_arg, map_arg)
+            model = load_robot_model(_param(node, log, "model", "puzzlebot", str))
+        except MapFileError as exc:
+            log.fatal("%s", exc)
+            return 1
+        update_rate = _param(node, log, "update_rate", 100.0, float)
+        if update_rate <= 0:
+            log.warn("~update_rate must be > 0; using 100")
+            update_rate = 100.0
+        rate = _param(node, log, "rate", 1.0, float)
+        if rate < 0:
+            log.warn("~rate must be >= 0 (0: as fast as possible); using 1")
+            rate = 1.0
+        alpha = node.get_param("~odom_alpha", None) if node.has_param("~odom_alpha") else None
+        if alpha is not None:
+            try:
+                values = [float(a) for a in alpha]
+                if len(values) != 4 or any(a < 0 or not math.isfinite(a) for a in values):
+                    raise ValueError
+                model.odom_alpha = (values[0], values[1], values[2], values[3])
+            except (TypeError, ValueError):
+                log.warn("~odom_alpha: expected 4 numbers >= 0, got %r; using %r", alpha, model.odom_alpha)
+        laser_noise = node.get_param("~laser_noise", None) if node.has_param("~laser_noise") else None
+        sim = Simulation(world, 1.0 / update_rate, int(_param(node, log, "seed", 0, float)))
+        app = SimNode(node, log, sim, rate, float(laser_noise) if laser_noise is not None else None)
+        starts = list(world.robots) or []
+        if not starts:
+            from ninjemys.sim.world2d import RobotStart
+
+            starts = [RobotStart("puzzlebot", 0.0, 0.0, 0.0)]
+        first = starts[0]
+        x = _param(node, log, "x", first.x, float)
+        y = _param(node, log, "y", first.y, float)
+        yaw = _param(node, log, "yaw", first.yaw, float)
+        namespaced = len(starts) > 1
+        for i, s in enumerate(starts):
+            pose = (x, y, yaw) if i == 0 else (s.x, s.y, s.yaw)
+            robot_model = model if s.model == "puzzlebot" else load_robot_model(s.model)
+            try:
+                app.add_robot(s.name, robot_model, *pose, namespaced)
+            except SpawnError as exc:
+                log.fatal("%s", exc)
+                return 1
+        log.info(
+            "PuzzleBot simulator: world '%s', %d robot(s), real-time factor %s, physics %.0f Hz",
+            world.name,
+            len(starts),
+            f"{rate:g}" if rate > 0 else "unlimited",
+            update_rate,
+        )
+        web = None
+        gui = _param(node, log, "gui", True, bool) and not options.headless
+        if gui:
+            from ninjemys.sim.puzzlebot_view import PuzzlebotView
+            from ninjemys.web.app import WebApp
+            from ninjemys.web.browser import open_if_display
+
+            web = WebApp(node.master_uri, node.name, options.host, options.port)
+            view = PuzzlebotView(web, app)
+            try:
+                url = web.start()
+            except OSError as exc:
+                log.error("cannot serve the simulator view on %s:%d: %s", options.host, options.port, exc)
+                return 1
+            view.attach()
+            app.view = view
+            print(f"puzzlebot_sim view: {url}puzzlebot   node graph: {url}", flush=True)
+            if not options.no_browser:
+                open_if_display(url + "puzzlebot")
+        app.start()
+        try:
+            node.spin()
+        finally:
+            app.stop()
+            if web is not None:
+                web.stop()
+        return 0
+    finally:
+        node.shutdown("exit")
+        log.close()
+
+
+console_main = entry(main)
+
+
+if __name__ == "__main__":
+    console_main()

@@ -1,0 +1,286 @@
+"""Robot descriptions: the editable YAML of ours and the URDF subset, read into one :class:`RobotModel`.
+
+No ROS in here. ``robots/puzzlebot.yaml`` (share/puzzlebot_sim) is the default and the template; a
+user's YAML overrides any of its fields (missing ones keep the PuzzleBot's values). A URDF gives the
+geometry (body cylinder, wheel radius and separation from the continuous wheel joints, sensor poses
+from the fixed joints to ``laser``, ``camera_link`` and ``imu_link``); rates, limits and noise stay the
+YAML defaults.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import yaml
+
+from ninjemys.sim.mapfile import Fields, MapFileError, yaml_lines
+from ninjemys.sim.worlds import ROBOTS_DIR
+
+
+@dataclass
+class SensorPose:
+    frame: str
+    xyz: tuple[float, float, float]
+    rpy: tuple[float, float, float]
+
+
+@dataclass
+class LaserSpec:
+    pose: SensorPose
+    rate: float = 10.0
+    beams: int = 360
+    range_min: float = 0.15
+    range_max: float = 12.0
+    noise: float = 0.01
+
+
+@dataclass
+class CameraSpec:
+    pose: SensorPose
+    rate: float = 30.0
+    width: int = 320
+    height: int = 240
+    hfov: float = 69.0
+    depth_max: float = 10.0
+
+
+@dataclass
+class ImuSpec:
+    pose: SensorPose
+    rate: float = 100.0
+    gyro_noise: float = 0.001
+    accel_noise: float = 0.01
+
+
+@dataclass
+class RobotModel:
+    name: str
+    wheel_radius: float
+    wheel_separation: float
+    body_radius: float
+    body_height: float
+    color: tuple[int, int, int]
+    max_wheel_speed: float
+    max_wheel_accel: float
+    left_joint: str
+    right_joint: str
+    laser: LaserSpec | None
+    camera: CameraSpec | None
+    imu: ImuSpec | None
+    odom_rate: float = 100.0
+    odom_alpha: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
+    source: str = field(default="")
+
+
+def _merge(base: dict, over: dict) -> dict:
+    out = copy.deepcopy(base)
+    for k, v in over.items():
+        out[k] = _merge(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) else v
+    return out
+
+
+def _default_doc() -> dict:
+    return yaml.safe_load((ROBOTS_DIR / "puzzlebot.yaml").read_text(encoding="utf-8"))
+
+
+def _pose(f: Fields, d: dict, where: str) -> SensorPose:
+    xyz = f.vector(d.get("xyz", [0, 0, 0]), f"{where}.xyz", 3)
+    rpy = f.vector(d.get("rpy", [0, 0, 0]), f"{where}.rpy", 3)
+    frame = d.get("frame")
+    if not isinstance(frame, str) or not frame:
+        raise f.error(f"{where}.frame", f"expected a frame name, got {frame!r}")
+    return SensorPose(frame, (xyz[0], xyz[1], xyz[2]), (rpy[0], rpy[1], rpy[2]))
+
+
+def model_from_doc(doc: dict, f: Fields) -> RobotModel:
+    """Build a model from a (merged) description mapping; errors name file, line and field."""
+    pos = {
+        k: f.number(doc.get(k), k, positive=True)
+        for k in (
+            "wheel_radius",
+            "wheel_separation",
+            "body_radius",
+            "body_height",
+            "max_wheel_speed",
+            "max_wheel_accel",
+        )
+    }
+    colour = doc.get("color", [45, 45, 55])
+    rgb = f.vector(colour, "color", 3)
+    joints = doc.get("joints") or {}
+    sensors = doc.get("sensors") or {}
+    if not isinstance(sensors, dict):
+        raise f.error("sensors", f"expected a mapping of laser/camera/imu, got {sensors!r}")
+    for key in sensors:
+        if key not in ("laser", "camera", "imu"):
+            raise f.error(f"sensors.{key}", "unknown sensor (expected laser, camera or imu)")
+    laser = camera = imu = None
+    if isinstance(sensors.get("laser"), dict):
+        s = sensors["laser"]
+        laser = LaserSpec(
+            _pose(f, s, "sensors.laser"),
+            f.number(s.get("rate", 10.0), "sensors.laser.rate", positive=True),
+            int(f.number(s.get("beams", 360), "sensors.laser.beams", positive=True)),
+            f.number(s.get("range_min", 0.15), "sensors.laser.range_min", minimum=0),
+            f.number(s.get("range_max", 12.0), "sensors.laser.range_max", positive=True),
+            f.number(s.get("noise", 0.01), "sensors.laser.noise", minimum=0),
+        )
+        if laser.range_min >= laser.range_max:
+            raise f.error("sensors.laser.range_min", "must be below range_max")
+    if isinstance(sensors.get("camera"), dict):
+        s = sensors["camera"]
+        camera = CameraSpec(
+            _pose(f, s, "sensors.camera"),
+            f.number(s.get("rate", 30.0), "sensors.camera.rate", positive=True),
+            int(f.number(s.get("width", 320), "sensors.camera.width", positive=True)),
+            int(f.number(s.get("height", 240), "sensors.camera.height", positive=True)),
+            f.number(s.get("hfov", 69.0), "sensors.camera.hfov", positive=True),
+            f.number(s.get("depth_max", 10.0), "sensors.camera.depth_max", positive=True),
+        )
+        if camera.hfov >= 170:
+            raise f.error("sensors.camera.hfov", "a pinhole camera needs hfov < 170 degrees")
+    if isinstance(sensors.get("imu"), dict):
+        s = sensors["imu"]
+        imu = ImuSpec(
+            _pose(f, s, "sensors.imu"),
+            f.number(s.get("rate", 100.0), "sensors.imu.rate", positive=True),
+            f.number(s.get("gyro_noise", 0.001), "sensors.imu.gyro_noise", minimum=0),
+            f.number(s.get("accel_noise", 0.01), "sensors.imu.accel_noise", minimum=0),
+        )
+    odom = doc.get("odometry") or {}
+    alpha = f.vector(odom.get("alpha", [0, 0, 0, 0]), "odometry.alpha", 4)
+    if any(a < 0 for a in alpha):
+        raise f.error("odometry.alpha", "noise parameters must be >= 0")
+    return RobotModel(
+        str(doc.get("name", "robot")),
+        pos["wheel_radius"],
+        pos["wheel_separation"],
+        pos["body_radius"],
+        pos["body_height"],
+        (int(rgb[0]), int(rgb[1]), int(rgb[2])),
+        pos["max_wheel_speed"],
+        pos["max_wheel_accel"],
+        str(joints.get("left", "wheel_left_joint")),
+        str(joints.get("right", "wheel_right_joint")),
+        laser,
+        camera,
+        imu,
+        f.number(odom.get("rate", 100.0), "odometry.rate", positive=True),
+        (alpha[0], alpha[1], alpha[2], alpha[3]),
+        f.path,
+    )
+
+
+def load_robot_model(spec: str = "puzzlebot") -> RobotModel:
+    """``puzzlebot`` (or another shipped name), a YAML description path, or a URDF path / text."""
+    text_is_urdf = spec.lstrip().startswith("<")
+    if text_is_urdf:
+        return model_from_urdf(spec, "<robot_description>")
+    path = Path(spec).expanduser()
+    if "/" not in spec and not spec.endswith((".yaml", ".yml", ".urdf")):
+        path = ROBOTS_DIR / f"{spec}.yaml"
+        if not path.is_file():
+            known = ", ".join(sorted(p.stem for p in ROBOTS_DIR.glob("*.yaml")))
+            raise MapFileError(
+                f"model '{spec}': no such shipped robot (shipped: {known}; or give a YAML/URDF path)"
+            )
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise MapFileError(f"{path}: cannot read robot description: {exc.strerror or exc}") from None
+    if path.suffix == ".urdf" or text.lstrip().startswith("<"):
+        return model_from_urdf(text, str(path))
+    doc, lines = yaml_lines(text, str(path))
+    f = Fields(str(path), lines)
+    if not isinstance(doc, dict):
+        raise f.error("", "a robot description is a YAML mapping (see robots/puzzlebot.yaml)")
+    return model_from_doc(_merge(_default_doc(), doc), f)
+
+
+def _floats(text: str | None, n: int, where: str, source: str) -> list[float]:
+    try:
+        values = [float(v) for v in (text or " ".join(["0"] * n)).split()]
+    except ValueError:
+        raise MapFileError(f"{source}: {where}: expected {n} numbers, got {text!r}") from None
+    if len(values) != n or not all(math.isfinite(v) for v in values):
+        raise MapFileError(f"{source}: {where}: expected {n} finite numbers, got {text!r}")
+    return values
+
+
+def model_from_urdf(text: str, source: str) -> RobotModel:
+    """The URDF subset: base link cylinder, continuous wheel joints, fixed sensor joints."""
+    try:
+        root = ET.fromstring(text)
+    except ET.ParseError as exc:
+        line = exc.position[0] if exc.position else 0
+        raise MapFileError(f"{source}:{line}: invalid URDF XML: {exc}") from None
+    if root.tag != "robot":
+        raise MapFileError(f"{source}: URDF root element is <{root.tag}>, expected <robot>")
+    doc = _default_doc()
+    doc["name"] = root.get("name", "robot")
+    links = {link.get("name"): link for link in root.findall("link")}
+    joints = root.findall("joint")
+
+    def cylinder(link_name: str | None) -> tuple[float, float] | None:
+        link = links.get(link_name)
+        cyl = link.find("collision/geometry/cylinder") if link is not None else None
+        if cyl is None and link is not None:
+            cyl = link.find("visual/geometry/cylinder")
+        if cyl is None:
+            return None
+        radius = _floats(cyl.get("radius"), 1, f"link {link_name} cylinder radius", source)[0]
+        length = _floats(cyl.get("length"), 1, f"link {link_name} cylinder length", source)[0]
+        return radius, length
+
+    wheels = [j for j in joints if j.get("type") == "continuous"]
+    if len(wheels) != 2:
+        raise MapFileError(
+            f"{source}: a differential-drive URDF needs exactly 2 continuous wheel joints, found {len(wheels)}"
+        )
+    ys = []
+    for j in wheels:
+        origin = j.find("origin")
+        xyz = _floats(
+            origin.get("xyz") if origin is not None else None, 3, f"joint {j.get('name')} origin xyz", source
+        )
+        ys.append(xyz[1])
+        child = j.find("child")
+        wheel = cylinder(child.get("link") if child is not None else None)
+        if wheel is not None:
+            doc["wheel_radius"] = wheel[0]
+    left, right = (wheels[0], wheels[1]) if ys[0] > ys[1] else (wheels[1], wheels[0])
+    doc["wheel_separation"] = abs(ys[0] - ys[1])
+    doc["joints"] = {"left": left.get("name"), "right": right.get("name")}
+    root_link = next(
+        (
+            n
+            for n in links
+            if n not in {j.find("child").get("link") for j in joints if j.find("child") is not None}
+        ),
+        None,
+    )
+    body = cylinder(root_link)
+    if body is not None:
+        doc["body_radius"], doc["body_height"] = body
+    sensors: dict = {}
+    for j in joints:
+        if j.get("type") != "fixed" or j.find("child") is None:
+            continue
+        child = j.find("child").get("link")
+        kind = {"laser": "laser", "camera_link": "camera", "imu_link": "imu"}.get(child)
+        if kind is None:
+            continue
+        origin = j.find("origin")
+        xyz = _floats(
+            origin.get("xyz") if origin is not None else None, 3, f"joint {j.get('name')} origin xyz", source
+        )
+        rpy = _floats(
+            origin.get("rpy") if origin is not None else None, 3, f"joint {j.get('name')} origin rpy", source
+        )
+        sensors[kind] = dict(doc["sensors"][kind], frame=child, xyz=xyz, rpy=rpy)
+    doc["sensors"] = sensors
+    return model_from_doc(doc, Fields(source, {}))

@@ -1,0 +1,164 @@
+"""Sensor models on top of the ray caster: lidar ranges, the RGB-D camera's images, IMU readings.
+
+No ROS in here: arrays in, arrays out. The camera casts one ray per image column (the world is 2D
+with heights), then fills each column: wall between the floor and the hit obstacle's top, floor
+below (shaded with distance), sky above; the depth image holds the optical-axis depth in
+millimetres (16UC1, as RealSense's ``depth/image_rect_raw``), 0 where there is no return.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ninjemys.sim.raycast import cast_circles, cast_segments
+
+FLOOR_RGB = np.array([176, 170, 160], dtype=np.float32)
+SKY_RGB = np.array([206, 220, 235], dtype=np.float32)
+
+
+@dataclass
+class Scene:
+    """What sensors see at one instant: solid segments with heights and colours, and round bodies."""
+
+    segments: np.ndarray  # (N, 4)
+    heights: np.ndarray  # (N,)
+    colors: np.ndarray  # (N, 3) uint8
+    circles: np.ndarray  # (M, 2) centres
+    radii: np.ndarray  # (M,)
+    circle_heights: np.ndarray  # (M,)
+    circle_colors: np.ndarray  # (M, 3) uint8
+
+
+def lidar_ranges(
+    scene: Scene,
+    x: float,
+    y: float,
+    z: float,
+    yaw: float,
+    angle_min: float,
+    increment: float,
+    beams: int,
+    range_min: float,
+    range_max: float,
+    noise: float,
+    rng: np.random.Generator,
+) -> np.ndarray:
+    """float32 ranges (REP 117: +inf no return within range_max, -inf closer than range_min).
+
+    Only obstacles at least as tall as the lidar (``z``) are seen, as with a real planar lidar.
+    """
+    angles = yaw + angle_min + increment * np.arange(beams)
+    tall = scene.heights >= z
+    dist, _ = cast_segments(
+        x, y, angles, scene.segments[tall] if not tall.all() else scene.segments, range_max
+    )
+    if len(scene.circles):
+        tall_c = scene.circle_heights >= z
+        cd, _ = cast_circles(x, y, angles, scene.circles[tall_c], scene.radii[tall_c], range_max)
+        dist = np.minimum(dist, cd)
+    if noise > 0:
+        dist = dist + rng.normal(0.0, noise, beams)
+    out = dist.astype(np.float32)
+    out[out > range_max] = np.inf
+    out[out < range_min] = -np.inf
+    return out
+
+
+class Camera:
+    """A pinhole RGB-D camera rendered by column ray casting; the per-row tables are built once."""
+
+    def __init__(self, width: int, height: int, hfov_deg: float, cam_z: float, depth_max: float) -> None:
+        self.width = width
+        self.height = height
+        self.fx = (width / 2.0) / math.tan(math.radians(hfov_deg) / 2.0)
+        self.fy = self.fx  # square pixels
+        self.cx = (width - 1) / 2.0
+        self.cy = (height - 1) / 2.0
+        self.cam_z = cam_z
+        self.depth_max = depth_max
+        u = np.arange(width)
+        self.col_angles = np.arctan((self.cx - u) / self.fx)  # left of the image is +y (counter-clockwise)
+        self.col_cos = np.cos(self.col_angles)
+        v = np.arange(height)
+        self.row_slope = (self.cy - v) / self.fy  # tan of the elevation of each row's ray
+        below = self.row_slope < -1e-9
+        floor_depth = np.zeros(height)
+        floor_depth[below] = cam_z / -self.row_slope[below]
+        floor_depth[floor_depth > depth_max] = 0.0
+        self.floor_depth_mm = np.rint(floor_depth * 1000).astype(np.uint16)
+        # static background: floor shaded with distance, sky above the horizon
+        shade = np.clip(1.15 - floor_depth / 12.0, 0.55, 1.0)[:, None] * FLOOR_RGB[None, :]
+        bg = np.where(below[:, None], shade, SKY_RGB[None, :])
+        self.background = np.ascontiguousarray(
+            np.broadcast_to(bg[:, None, :], (height, width, 3)).astype(np.uint8)
+        )
+        self._neg_slope = -self.row_slope
+        self._rows = np.arange(height, dtype=np.int32)[:, None]
+
+    def render(self, scene: Scene, x: float, y: float, yaw: float) -> tuple[np.ndarray, np.ndarray]:
+        """(rgb8 image (H, W, 3), depth in mm uint16 (H, W)) from a camera at (x, y, cam_z) facing ``yaw``."""
+        angles = yaw + self.col_angles
+        far = self.depth_max / float(self.col_cos.min())
+        dist, seg = cast_segments(x, y, angles, scene.segments, far)
+        heights = np.zeros(self.width)
+        colors = np.zeros((self.width, 3), dtype=np.float32)
+        found = seg >= 0
+        heights[found] = scene.heights[seg[found]]
+        colors[found] = scene.colors[seg[found]]
+        if len(scene.circles):
+            cd, ci = cast_circles(x, y, angles, scene.circles, scene.radii, far)
+            nearer = cd < dist
+            dist = np.where(nearer, cd, dist)
+            heights[nearer] = scene.circle_heights[ci[nearer]]
+            colors[nearer] = scene.circle_colors[ci[nearer]]
+            found |= nearer
+        depth = dist * self.col_cos  # along the optical axis
+        found &= depth <= self.depth_max
+        # rows v whose ray meets the column's obstacle between its foot and its top:
+        # 0 <= cam_z + slope_v * depth <= height, i.e. slope_v in [-cam_z / depth, (height - cam_z) / depth]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            lo_slope = np.where(found, -self.cam_z / depth, np.inf)
+            hi_slope = np.where(found, (heights - self.cam_z) / depth, -np.inf)
+        # row_slope decreases with v: searchsorted on its negation
+        top = np.searchsorted(self._neg_slope, -hi_slope, "left")
+        bottom = np.searchsorted(self._neg_slope, -lo_slope, "right")
+        wall = (self._rows >= top[None, :]) & (self._rows < bottom[None, :])
+        light = np.clip(1.1 - depth / 15.0, 0.45, 1.0)  # flat shading, darker with distance
+        col = (colors * light[:, None]).astype(np.uint8)
+        rgb = self.background.copy()
+        np.copyto(rgb, col[None, :, :], where=wall[:, :, None])
+        depth_mm = np.broadcast_to(self.floor_depth_mm[:, None], wall.shape).copy()
+        np.copyto(
+            depth_mm, np.rint(np.where(found, depth, 0.0) * 1000.0).astype(np.uint16)[None, :], where=wall
+        )
+        return rgb, depth_mm
+
+    def intrinsics(self) -> tuple[float, float, float, float]:
+        return self.fx, self.fy, self.cx, self.cy
+
+
+def imu_reading(
+    yaw: float,
+    v: float,
+    w: float,
+    v_prev: float,
+    dt: float,
+    gyro_noise: float,
+    accel_noise: float,
+    rng: np.random.Generator,
+) -> tuple[float, float, float, float]:
+    """(yaw, angular velocity z, linear acceleration x, y) of a planar robot, with gyro/accel noise.
+
+    The accelerometer reads the body's acceleration: tangential ``dv/dt`` along x, centripetal
+    ``v w`` along y (gravity on z is added by the caller's message)."""
+    ax = (v - v_prev) / dt if dt > 0 else 0.0
+    ay = v * w
+    if gyro_noise > 0:
+        w = w + float(rng.normal(0.0, gyro_noise))
+    if accel_noise > 0:
+        ax += float(rng.normal(0.0, accel_noise))
+        ay += float(rng.normal(0.0, accel_noise))
+    return yaw, w, ax, ay

@@ -1,0 +1,462 @@
+"""The PuzzleBot simulation itself: robots in a world, stepped in simulated time. No ROS in here.
+
+:class:`Simulation` owns the world, the robots and simulated time. :meth:`Simulation.step` advances
+one physics step (``dt``): wheel speeds move toward the commanded ones within the acceleration
+limit, the body moves along the exact arc those speeds give, and a swept collision check stops it
+at first contact (the move is split into pieces shorter than half the body radius, so nothing
+thinner than that is ever jumped over, then the contact point is found by bisection). Odometry
+follows the true motion with amcl's diff-drive noise model (α1-α4) applied per odometry period.
+
+The ROS node (:mod:`ninjemys.sim.puzzlebot_node`) turns commands into :meth:`Robot.command` calls
+and publishes what the sensors here compute.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ninjemys.sim.raycast import grid_edges
+from ninjemys.sim.robot_model import RobotModel
+from ninjemys.sim.sensors import Camera, Scene, imu_reading, lidar_ranges
+from ninjemys.sim.world2d import Obstacle, World, box_outline, circle_outline
+
+TRAIL_LENGTH = 2000
+
+
+class SpawnError(ValueError):
+    """A spawn or delete the simulation refuses; the text says why (shown to the service caller)."""
+
+
+def wrap_angle(a: float) -> float:
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def point_segment_distance(px: np.ndarray, py: np.ndarray, segs: np.ndarray) -> np.ndarray:
+    """(P, N) distances from P points to N segments."""
+    ax, ay = segs[:, 0], segs[:, 1]
+    ex, ey = segs[:, 2] - ax, segs[:, 3] - ay
+    ee = ex * ex + ey * ey
+    wx = px[:, None] - ax[None, :]
+    wy = py[:, None] - ay[None, :]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        u = np.clip((wx * ex + wy * ey) / ee, 0.0, 1.0)
+    u = np.where(ee > 0, u, 0.0)
+    dx = wx - u * ex
+    dy = wy - u * ey
+    return np.sqrt(dx * dx + dy * dy)
+
+
+@dataclass
+class Robot:
+    """One robot's state: true pose, wheels, command, odometry and contact."""
+
+    name: str
+    model: RobotModel
+    x: float
+    y: float
+    yaw: float
+    start: tuple[float, float, float]
+    rng: np.random.Generator
+    wl: float = 0.0  # actual wheel speeds (rad/s)
+    wr: float = 0.0
+    target_wl: float = 0.0
+    target_wr: float = 0.0
+    left_angle: float = 0.0
+    right_angle: float = 0.0
+    v: float = 0.0
+    w: float = 0.0
+    v_prev: float = 0.0
+    odom: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+    odom_ref: tuple[float, float, float] = (0.0, 0.0, 0.0)  # true pose at the last odometry sample
+    contact: bool = False
+    contact_with: str = ""
+    trail: deque = field(default_factory=lambda: deque(maxlen=TRAIL_LENGTH))
+    trail_count: int = 0  # points ever appended (the view sends only the new ones)
+    camera: Camera | None = None
+
+    def command(self, linear: float, angular: float) -> None:
+        """Set the body velocity to reach (cmd_vel): wheel targets, scaled together to the speed limit."""
+        m = self.model
+        wr = (linear + angular * m.wheel_separation / 2.0) / m.wheel_radius
+        wl = (linear - angular * m.wheel_separation / 2.0) / m.wheel_radius
+        peak = max(abs(wl), abs(wr))
+        if peak > m.max_wheel_speed:
+            wl *= m.max_wheel_speed / peak
+            wr *= m.max_wheel_speed / peak
+        self.target_wl, self.target_wr = wl, wr
+
+    def reset(self) -> None:
+        self.x, self.y, self.yaw = self.start
+        self.wl = self.wr = self.target_wl = self.target_wr = 0.0
+        self.left_angle = self.right_angle = 0.0
+        self.v = self.w = self.v_prev = 0.0
+        self.odom = [0.0, 0.0, 0.0]
+        self.odom_ref = self.start
+        self.contact = False
+        self.contact_with = ""
+        self.trail.clear()
+        self.trail_count = 0
+
+
+class Simulation:
+    """Robots in a world; ``time`` is simulated seconds. Not thread-safe: the node holds a lock."""
+
+    def __init__(self, world: World, dt: float = 0.01, seed: int = 0) -> None:
+        self.world = world
+        self.dt = dt
+        self.seed = seed
+        self.steps = 0
+        self.world_time = 0.0  # moving obstacles' clock (reset_world restarts it, time goes on)
+        self.robots: dict[str, Robot] = {}
+        self._spawned = 0
+        self._static: np.ndarray
+        self.static_names: list[str] = []
+        self._rebuild_static()
+
+    @property
+    def time(self) -> float:
+        """Simulated seconds: a whole number of steps, so stamps never drift."""
+        return self.steps * self.dt
+
+    # -- geometry -------------------------------------------------------------------------------
+    def _rebuild_static(self) -> None:
+        w = self.world
+        w.rebuild()
+        segs, heights, colours = [w.segments], [w.seg_height], [w.seg_color]
+        names = [w.obstacles[i].name for i in w.seg_owner]
+        if w.grid is not None:
+            g = w.grid
+            edges = grid_edges(g.occupied, g.resolution, g.origin_x, g.origin_y)
+            segs.append(edges)
+            heights.append(np.full(len(edges), g.height))
+            colours.append(np.tile(np.array(g.color, dtype=np.uint8), (len(edges), 1)))
+            names += ["map"] * len(edges)
+        self._static = np.vstack(segs) if any(len(s) for s in segs) else np.zeros((0, 4))
+        self._static_height = np.concatenate(heights)
+        self._static_color = np.vstack(colours).astype(np.uint8)
+        self.static_names = names
+
+    def _mover_segments(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[str]]:
+        segs, heights, colours, names = [], [], [], []
+        for m in self.world.moving:
+            o = m.outline_at(self.world_time)
+            s = np.hstack([o, np.roll(o, -1, axis=0)])
+            segs.append(s)
+            heights.append(np.full(len(s), m.height))
+            colours.append(np.tile(np.array(m.color, dtype=np.uint8), (len(s), 1)))
+            names += [m.name] * len(s)
+        if not segs:
+            return np.zeros((0, 4)), np.zeros(0), np.zeros((0, 3), dtype=np.uint8), []
+        return np.vstack(segs), np.concatenate(heights), np.vstack(colours), names
+
+    def scene(self, exclude: str | None = None) -> Scene:
+        """Everything solid now, as seen by robot ``exclude`` (its own body left out)."""
+        ms, mh, mc, _ = self._mover_segments()
+        segs = np.vstack([self._static, ms]) if len(ms) else self._static
+        heights = np.concatenate([self._static_height, mh]) if len(ms) else self._static_height
+        colours = np.vstack([self._static_color, mc]) if len(ms) else self._static_color
+        others = [r for r in self.robots.values() if r.name != exclude]
+        return Scene(
+            segs,
+            heights,
+            colours,
+            np.array([[r.x, r.y] for r in others]).reshape(-1, 2),
+            np.array([r.model.body_radius for r in others]),
+            np.array([r.model.body_height for r in others]),
+            np.array([r.model.color for r in others], dtype=np.uint8).reshape(-1, 3),
+        )
+
+    def clearance(self, x: float, y: float, exclude: str | None = None) -> tuple[float, str]:
+        """Distance from a point to the nearest solid thing, and its name."""
+        d, name = self._clearances(
+            np.array([x]), np.array([y]), exclude, self._collision_geometry(x, y, 1e9, exclude)
+        )
+        return float(d[0]), name[0]
+
+    def _collision_geometry(self, x: float, y: float, reach: float, exclude: str | None) -> tuple:
+        ms, _, _, mnames = self._mover_segments()
+        segs = np.vstack([self._static, ms]) if len(ms) else self._static
+        names = self.static_names + mnames
+        if len(segs) and reach < 1e8:
+            lo_x = np.minimum(segs[:, 0], segs[:, 2])
+            hi_x = np.maximum(segs[:, 0], segs[:, 2])
+            lo_y = np.minimum(segs[:, 1], segs[:, 3])
+            hi_y = np.maximum(segs[:, 1], segs[:, 3])
+            near = np.flatnonzero(
+                (lo_x <= x + reach) & (hi_x >= x - reach) & (lo_y <= y + reach) & (hi_y >= y - reach)
+            )
+            segs = segs[near]
+            names = [names[i] for i in near]
+        others = [r for r in self.robots.values() if r.name != exclude]
+        centres = np.array([[r.x, r.y] for r in others]).reshape(-1, 2)
+        radii = np.array([r.model.body_radius for r in others])
+        return segs, names, centres, radii, [r.name for r in others]
+
+    @staticmethod
+    def _clearances(
+        px: np.ndarray, py: np.ndarray, _exclude: str | None, geometry: tuple
+    ) -> tuple[np.ndarray, list[str]]:
+        segs, names, centres, radii, rnames = geometry
+        best = np.full(len(px), np.inf)
+        who = [""] * len(px)
+        if len(segs):
+            d = point_segment_distance(px, py, segs)
+            j = np.argmin(d, axis=1)
+            best = d[np.arange(len(px)), j]
+            who = [names[k] for k in j]
+        if len(centres):
+            dc = (
+                np.hypot(px[:, None] - centres[None, :, 0], py[:, None] - centres[None, :, 1])
+                - radii[None, :]
+            )
+            jc = np.argmin(dc, axis=1)
+            bc = dc[np.arange(len(px)), jc]
+            closer = bc < best
+            best = np.where(closer, bc, best)
+            who = [rnames[jc[i]] if closer[i] else who[i] for i in range(len(px))]
+        return best, who
+
+    # -- robots and obstacles -------------------------------------------------------------------
+    def solid_at(self, x: float, y: float) -> str:
+        """The name of the solid thing covering point (x, y), or "" (inside a box, a thick wall, a map cell)."""
+        for o in self.world.obstacles:
+            if len(o.outline) > 2 and _inside(x, y, o.outline):
+                return o.name
+        for m in self.world.moving:
+            if _inside(x, y, m.outline_at(self.world_time)):
+                return m.name
+        g = self.world.grid
+        if g is not None:
+            col = math.floor((x - g.origin_x) / g.resolution)
+            row = math.floor((y - g.origin_y) / g.resolution)
+            if 0 <= row < g.occupied.shape[0] and 0 <= col < g.occupied.shape[1] and g.occupied[row, col]:
+                return "map"
+        return ""
+
+    def add_robot(self, name: str, model: RobotModel, x: float, y: float, yaw: float) -> Robot:
+        """Place a robot; refused (SpawnError) when the name is taken or the body would overlap anything."""
+        if name in self.robots:
+            raise SpawnError(f"a robot named [{name}] already exists")
+        if not all(math.isfinite(v) for v in (x, y, yaw)):
+            raise SpawnError(f"spawn pose of [{name}] is not finite: ({x}, {y}, {yaw})")
+        gap, what = self.clearance(x, y)
+        solid = self.solid_at(x, y)
+        if solid:
+            gap, what = 0.0, solid
+        if gap < model.body_radius:
+            raise SpawnError(
+                f"cannot spawn [{name}] at ({x:.3f}, {y:.3f}): it would be inside '{what}' "
+                f"(clearance {max(gap, 0.0):.3f} m, body radius {model.body_radius:.3f} m)"
+            )
+        rng = np.random.default_rng([self.seed, self._spawned])
+        self._spawned += 1
+        robot = Robot(name, model, x, y, yaw, (x, y, yaw), rng)
+        robot.odom_ref = (x, y, yaw)
+        if model.camera is not None:
+            robot.camera = Camera(
+                model.camera.width,
+                model.camera.height,
+                model.camera.hfov,
+                model.camera.pose.xyz[2],
+                model.camera.depth_max,
+            )
+        self.robots[name] = robot
+        return robot
+
+    def remove_robot(self, name: str) -> None:
+        if self.robots.pop(name, None) is None:
+            raise SpawnError(f"no robot named [{name}]")
+
+    def add_obstacle(
+        self,
+        name: str,
+        kind: str,
+        size: tuple[float, float],
+        x: float,
+        y: float,
+        yaw: float,
+        height: float,
+        color: tuple[int, int, int],
+    ) -> None:
+        """Add a static box (size = length, width) or cylinder (size[0] = radius); refused on a robot or a name clash."""
+        if any(o.name == name for o in self.world.obstacles) or name in self.robots:
+            raise SpawnError(f"a model named [{name}] already exists")
+        outline = (
+            circle_outline(x, y, size[0]) if kind == "cylinder" else box_outline(x, y, size[0], size[1], yaw)
+        )
+        for r in self.robots.values():
+            d = point_segment_distance(
+                np.array([r.x]), np.array([r.y]), np.hstack([outline, np.roll(outline, -1, axis=0)])
+            )
+            inside = _inside(r.x, r.y, outline)
+            if inside or float(d.min()) < r.model.body_radius:
+                raise SpawnError(f"cannot spawn [{name}]: it would overlap robot [{r.name}]")
+        self.world.obstacles.append(Obstacle(name, kind, outline, height, color))
+        self._rebuild_static()
+
+    def remove_obstacle(self, name: str) -> None:
+        before = len(self.world.obstacles)
+        self.world.obstacles = [o for o in self.world.obstacles if o.name != name]
+        if len(self.world.obstacles) == before:
+            raise SpawnError(f"no model named [{name}]")
+        self._rebuild_static()
+
+    # -- time -----------------------------------------------------------------------------------
+    def reset_world(self) -> None:
+        """Robots back to their start poses, moving obstacles to their start; time goes on (Gazebo's reset_world)."""
+        self.world_time = 0.0
+        for r in self.robots.values():
+            r.reset()
+
+    def reset_simulation(self) -> None:
+        """reset_world, and simulated time back to 0 (Gazebo's reset_simulation)."""
+        self.reset_world()
+        self.steps = 0
+
+    def step(self) -> list[Robot]:
+        """Advance one physics step; returns the robots that came into contact during it."""
+        dt = self.dt
+        self.steps += 1
+        self.world_time += dt
+        touched = []
+        for r in self.robots.values():
+            if self._move(r, dt):
+                touched.append(r)
+        return touched
+
+    def _move(self, r: Robot, dt: float) -> bool:
+        m = r.model
+        step = m.max_wheel_accel * dt
+        r.wl += min(max(r.target_wl - r.wl, -step), step)
+        r.wr += min(max(r.target_wr - r.wr, -step), step)
+        v = m.wheel_radius * (r.wr + r.wl) / 2.0
+        w = m.wheel_radius * (r.wr - r.wl) / m.wheel_separation
+        r.v_prev = r.v
+        r.v, r.w = v, w
+        r.left_angle += r.wl * dt
+        r.right_angle += r.wr * dt
+        if v == 0.0 and w == 0.0:
+            return False
+        th = w * dt
+        if abs(th) > 1e-9:
+            nx = r.x + v / w * (math.sin(r.yaw + th) - math.sin(r.yaw))
+            ny = r.y - v / w * (math.cos(r.yaw + th) - math.cos(r.yaw))
+        else:
+            nx = r.x + v * dt * math.cos(r.yaw)
+            ny = r.y + v * dt * math.sin(r.yaw)
+        ddx, ddy = nx - r.x, ny - r.y
+        travel = math.hypot(ddx, ddy)
+        new_contact = False
+        if travel > 0:
+            radius = m.body_radius
+            geometry = self._collision_geometry(r.x, r.y, travel + radius + 0.05, r.name)
+            pieces = max(1, math.ceil(travel / (radius * 0.5)))
+            f = np.arange(0, pieces + 1) / pieces
+            dist, who = self._clearances(r.x + f * ddx, r.y + f * ddy, r.name, geometry)
+            blocked = np.flatnonzero((dist[1:] < radius) & (dist[1:] < dist[0] - 1e-12))
+            if len(blocked):
+                k = int(blocked[0]) + 1
+                lo, hi = f[k - 1], f[k]
+                for _ in range(12):  # contact point to travel/pieces/4096
+                    mid = (lo + hi) / 2.0
+                    dm, _ = self._clearances(
+                        np.array([r.x + mid * ddx]), np.array([r.y + mid * ddy]), r.name, geometry
+                    )
+                    lo, hi = (mid, hi) if dm[0] >= radius else (lo, mid)
+                nx, ny = r.x + lo * ddx, r.y + lo * ddy
+                th *= lo
+                new_contact = not r.contact
+                r.contact, r.contact_with = True, who[k]
+                # a kinematic robot stops dead at the wall: wheels and command stop too
+                r.wl = r.wr = r.target_wl = r.target_wr = 0.0
+                r.v = r.w = 0.0
+            elif r.contact:
+                r.contact, r.contact_with = False, ""
+        r.x, r.y = nx, ny
+        r.yaw = wrap_angle(r.yaw + th)
+        if not r.trail or math.hypot(r.x - r.trail[-1][0], r.y - r.trail[-1][1]) > 0.02:
+            r.trail.append((round(r.x, 3), round(r.y, 3)))
+            r.trail_count += 1
+        return new_contact
+
+    # -- sensors --------------------------------------------------------------------------------
+    def odometry(self, r: Robot) -> tuple[float, float, float]:
+        """Advance ``r``'s odometry to its current true pose and return it (odom frame: start = origin).
+
+        The true motion since the last sample is split into amcl's rot1 / trans / rot2 and each
+        part gets Gaussian noise with amcl's diff-drive standard deviations
+        (√(α1 rot² + α2 trans²) for rotations, √(α3 trans² + α4 (rot1² + rot2²)) for translation).
+        """
+        a1, a2, a3, a4 = r.model.odom_alpha
+        px, py, pyaw = r.odom_ref
+        dx, dy = r.x - px, r.y - py
+        trans = math.hypot(dx, dy)
+        rot1 = wrap_angle(math.atan2(dy, dx) - pyaw) if trans > 1e-6 else 0.0
+        if abs(rot1) > math.pi / 2 and trans > 1e-6:  # reversing: measure rot1 against the backward heading
+            rot1 = wrap_angle(rot1 + math.pi)
+            trans = -trans
+        rot2 = wrap_angle(r.yaw - pyaw - rot1)
+        if a1 or a2 or a3 or a4:
+            rot1_n = min(abs(rot1), abs(wrap_angle(rot1 - math.pi)))
+            rot2_n = min(abs(rot2), abs(wrap_angle(rot2 - math.pi)))
+            rot1 -= r.rng.normal(0.0, math.sqrt(a1 * rot1_n**2 + a2 * trans**2))
+            trans -= r.rng.normal(0.0, math.sqrt(a3 * trans**2 + a4 * (rot1_n**2 + rot2_n**2)))
+            rot2 -= r.rng.normal(0.0, math.sqrt(a1 * rot2_n**2 + a2 * trans**2))
+        ox, oy, oyaw = r.odom
+        ox += trans * math.cos(oyaw + rot1)
+        oy += trans * math.sin(oyaw + rot1)
+        oyaw = wrap_angle(oyaw + rot1 + rot2)
+        r.odom = [ox, oy, oyaw]
+        r.odom_ref = (r.x, r.y, r.yaw)
+        return ox, oy, oyaw
+
+    @staticmethod
+    def sensor_pose(r: Robot, xyz: tuple[float, float, float]) -> tuple[float, float]:
+        c, s = math.cos(r.yaw), math.sin(r.yaw)
+        return r.x + c * xyz[0] - s * xyz[1], r.y + s * xyz[0] + c * xyz[1]
+
+    def scan(self, r: Robot, scene: Scene | None = None) -> np.ndarray:
+        spec = r.model.laser
+        assert spec is not None
+        lx, ly = self.sensor_pose(r, spec.pose.xyz)
+        inc = 2.0 * math.pi / spec.beams
+        return lidar_ranges(
+            scene or self.scene(r.name),
+            lx,
+            ly,
+            spec.pose.xyz[2],
+            r.yaw + spec.pose.rpy[2],
+            -math.pi,
+            inc,
+            spec.beams,
+            spec.range_min,
+            spec.range_max,
+            spec.noise,
+            r.rng,
+        )
+
+    def render(self, r: Robot, scene: Scene | None = None) -> tuple[np.ndarray, np.ndarray]:
+        spec = r.model.camera
+        assert spec is not None and r.camera is not None
+        cx, cy = self.sensor_pose(r, spec.pose.xyz)
+        return r.camera.render(scene or self.scene(r.name), cx, cy, r.yaw + spec.pose.rpy[2])
+
+    def imu(self, r: Robot) -> tuple[float, float, float, float]:
+        spec = r.model.imu
+        assert spec is not None
+        return imu_reading(r.yaw, r.v, r.w, r.v_prev, self.dt, spec.gyro_noise, spec.accel_noise, r.rng)
+
+
+def _inside(x: float, y: float, poly: np.ndarray) -> bool:
+    inside = False
+    n = len(poly)
+    for i in range(n):
+        ax, ay = poly[i]
+        bx, by = poly[(i + 1) % n]
+        if (ay > y) != (by > y) and x < ax + (y - ay) * (bx - ax) / (by - ay):
+            inside = not inside
+    return inside

@@ -1,0 +1,156 @@
+"""Protocol details with a raw WebSocket client: rosbridge compression and fragments, CBOR input,
+Foxglove time under sim time, connection graph and parameter updates."""
+
+from __future__ import annotations
+
+import base64
+import json
+import struct
+import time
+from collections.abc import Callable
+
+import cbor2
+from bridge_helpers import png_pixels, wait_for
+from websockets.sync.client import ClientConnection, connect
+
+from ninjemys.bridge.server import Gateway
+from ninjemys.idl.loader import get_message_class
+from ninjemys.node import Node
+from ninjemys.rostime import Time
+
+String = get_message_class("std_msgs/String")
+Clock = get_message_class("rosgraph_msgs/Clock")
+
+
+def first(
+    ws: ClientConnection, pred: Callable[[object], bool], publish: Callable[[], None] | None = None
+) -> object:
+    """The first message (JSON decoded, or raw bytes) satisfying ``pred``; ``publish`` is called between reads."""
+    deadline = time.monotonic() + 15
+    while time.monotonic() < deadline:
+        if publish is not None:
+            publish()
+        try:
+            data = ws.recv(timeout=0.2)
+        except TimeoutError:
+            continue
+        item = json.loads(data) if isinstance(data, str) else data
+        if pred(item):
+            return item
+    raise AssertionError("expected message never came")
+
+
+def test_rosbridge_compressions_and_fragments(gateway: Gateway, node: Node) -> None:
+    pub = node.publisher("/words", String)
+    text = "ninjemys " * 40
+    publish = lambda: pub.publish(String(data=text))  # noqa: E731
+    expected = {"op": "publish", "topic": "/words", "msg": {"data": text}}
+    url = f"ws://127.0.0.1:{gateway.port}/"
+    with connect(url) as ws:
+        ws.send(json.dumps({"op": "subscribe", "topic": "/words", "compression": "png"}))
+        png = first(ws, lambda m: isinstance(m, dict) and m.get("op") == "png", publish)
+        assert json.loads(png_pixels(png["data"]).rstrip(b"\n")) == expected
+    with connect(url) as ws:
+        ws.send(json.dumps({"op": "subscribe", "topic": "/words", "compression": "cbor"}))
+        frame = first(ws, lambda m: isinstance(m, bytes), publish)
+        assert cbor2.loads(frame) == expected
+    with connect(url) as ws:
+        ws.send(json.dumps({"op": "subscribe", "topic": "/words", "compression": "cbor-raw"}))
+        raw = cbor2.loads(first(ws, lambda m: isinstance(m, bytes), publish))
+        assert raw["op"] == "publish" and raw["msg"]["bytes"] == String(data=text).serialize_to_bytes()
+        assert abs(raw["msg"]["secs"] - time.time()) < 60
+    with connect(url) as ws:
+        ws.send(json.dumps({"op": "subscribe", "topic": "/words", "fragment_size": 100}))
+        frag = first(
+            ws, lambda m: isinstance(m, dict) and m.get("op") == "fragment" and m["num"] == 0, publish
+        )
+        parts = {0: frag["data"]}
+        while len(parts) < frag["total"]:
+            more = json.loads(ws.recv(timeout=5))
+            if more.get("op") == "fragment" and more["id"] == frag["id"]:
+                parts[more["num"]] = more["data"]
+        assert json.loads("".join(parts[i] for i in range(frag["total"]))) == expected
+
+
+def test_rosbridge_cbor_input_and_incoming_fragments(gateway: Gateway, node: Node) -> None:
+    got: list[str] = []
+    node.subscriber("/cbor_in", String, lambda m: got.append(m.data))
+    with connect(f"ws://127.0.0.1:{gateway.port}/") as ws:
+        ws.send(cbor2.dumps({"op": "advertise", "topic": "/cbor_in", "type": "std_msgs/String"}))
+        publish = json.dumps({"op": "publish", "topic": "/cbor_in", "msg": {"data": "pieced together"}})
+
+        def sent() -> bool:
+            pieces = [publish[i : i + 16] for i in range(0, len(publish), 16)]
+            for n, piece in enumerate(pieces):
+                ws.send(
+                    json.dumps({"op": "fragment", "id": "f1", "data": piece, "num": n, "total": len(pieces)})
+                )
+            return bool(got)
+
+        wait_for(sent, what="a fragmented publish")
+    assert got[0] == "pieced together"
+
+
+def test_foxglove_time_under_sim_time(make_gateway: Callable[..., Gateway], node: Node) -> None:
+    node.set_param("/use_sim_time", True)
+    clock = node.publisher("/clock", Clock)
+    chatter = node.publisher("/sim_chatter", String)
+    gateway = make_gateway()
+    with connect(f"ws://127.0.0.1:{gateway.port}/", subprotocols=["foxglove.websocket.v1"]) as ws:
+        info = json.loads(ws.recv(timeout=5))
+        assert "time" in info["capabilities"]
+        advertised = json.loads(ws.recv(timeout=5))  # the channels known at connection time
+        cid = next(c["id"] for c in advertised["channels"] if c["topic"] == "/sim_chatter")
+
+        def tick() -> None:
+            clock.publish(Clock(clock=Time(1234, 500)))
+
+        frame = first(ws, lambda m: isinstance(m, bytes) and m[0] == 2, tick)
+        assert struct.unpack("<BQ", frame) == (2, 1234 * 10**9 + 500)
+        ws.send(json.dumps({"op": "subscribe", "subscriptions": [{"id": 9, "channelId": cid}]}))
+        data = first(
+            ws, lambda m: isinstance(m, bytes) and m[0] == 1, lambda: chatter.publish(String(data="t"))
+        )
+        _, sub_id, stamp = struct.unpack_from("<BIQ", data)
+        assert sub_id == 9 and stamp == 1234 * 10**9 + 500  # message times come from the sim clock
+
+
+def test_foxglove_connection_graph_and_parameter_updates(gateway: Gateway, node: Node) -> None:
+    node.set_param("/fox/gain", 1)
+    with connect(f"ws://127.0.0.1:{gateway.port}/", subprotocols=["foxglove.websocket.v1"]) as ws:
+        ws.send(json.dumps({"op": "subscribeConnectionGraph"}))
+        graph = first(ws, lambda m: isinstance(m, dict) and m.get("op") == "connectionGraphUpdate")
+        assert any(t["name"] == "/client_count" for t in graph["publishedTopics"])
+        node.publisher("/fresh_topic", String)
+        update = first(
+            ws,
+            lambda m: (
+                isinstance(m, dict)
+                and m.get("op") == "connectionGraphUpdate"
+                and any(t["name"] == "/fresh_topic" for t in m["publishedTopics"])
+            ),
+        )
+        assert {"name": "/fresh_topic", "publisherIds": [node.name]} in update["publishedTopics"]
+        ws.send(json.dumps({"op": "subscribeParameterUpdates", "parameterNames": ["/fox/gain"]}))
+        wait_for(lambda: "/fox/gain" in gateway._watched, what="the parameter subscription")
+        node.set_param("/fox/gain", 2.5)
+        values = first(ws, lambda m: isinstance(m, dict) and m.get("op") == "parameterValues")
+        assert values["parameters"] == [{"name": "/fox/gain", "value": 2.5, "type": "float64"}]
+        ws.send(
+            json.dumps(
+                {"op": "setParameters", "parameters": [{"name": "/fox/list", "value": [1, 2]}], "id": "s1"}
+            )
+        )
+        reply = first(ws, lambda m: isinstance(m, dict) and m.get("id") == "s1")
+        assert reply["parameters"] == [{"name": "/fox/list", "value": [1, 2]}]
+        assert node.get_param("/fox/list") == [1, 2]
+        blob = base64.b64encode(b"\x00\x01").decode()
+        ws.send(
+            json.dumps(
+                {
+                    "op": "setParameters",
+                    "parameters": [{"name": "/fox/blob", "value": blob, "type": "byte_array"}],
+                }
+            )
+        )
+        wait_for(lambda: node.has_param("/fox/blob"), what="a byte_array parameter")

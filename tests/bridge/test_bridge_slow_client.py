@@ -1,0 +1,112 @@
+"""A client that stops reading while a 30 MB/s image topic flows: the gateway's memory for it stays
+within its budget (oldest images dropped and counted), and a 10 Hz small topic still reaches a second
+client on time."""
+
+from __future__ import annotations
+
+import json
+import resource
+import threading
+import time
+from collections.abc import Callable
+from typing import Any
+
+from bridge_helpers import wait_for
+from websockets.sync.client import connect
+
+from ninjemys.bridge.server import Gateway
+from ninjemys.idl.loader import get_message_class
+from ninjemys.node import Node
+
+Image = get_message_class("sensor_msgs/Image")
+String = get_message_class("std_msgs/String")
+BUDGET = 4 * 1024 * 1024
+
+
+def test_stalled_client_is_bounded_and_does_not_starve_others(
+    make_gateway: Callable[..., Gateway], node: Node
+) -> None:
+    gateway = make_gateway(max_client_bytes=BUDGET)
+    url = f"ws://127.0.0.1:{gateway.port}/"
+    images = node.publisher("/camera/image_raw", Image, queue_size=2)
+    beats = node.publisher("/heartbeat", String)
+    wait_for(lambda: len(gateway.catalog.channels) >= 2, what="channels")
+    channels = {c["topic"]: c["id"] for c in gateway.catalog.channels.values()}
+
+    # client 1: Foxglove, subscribes to both, then never reads again (max_queue=1: its socket fills)
+    with (
+        connect(url, subprotocols=["foxglove.websocket.v1"], max_queue=1, close_timeout=0.5) as stalled,
+        connect(url, close_timeout=0.5) as healthy,
+    ):
+        status, peak_queued, arrivals, sent_beats, frame_size, rss_before = _flood(
+            gateway, stalled, healthy, channels, images, beats
+        )
+    # the stalled client's queue stayed within its budget (plus the one message being added)
+    assert peak_queued <= BUDGET + frame_size + 1024
+    fox = next(c for c in status["clients"] if c["protocol"] == "foxglove.websocket.v1")
+    assert fox["dropped"].get("/camera/image_raw", 0) > 50  # drops are counted per topic
+    # ~4 s of 30 MB/s went nowhere: the process did not keep it (ru_maxrss is in KiB)
+    assert resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - rss_before < 150 * 1024
+    # the healthy client got the 10 Hz topic, each beat promptly
+    received = {stamp for stamp, _ in arrivals}
+    assert len(received & set(sent_beats)) >= 0.9 * len(sent_beats)
+    delays = sorted(arrived - stamp for stamp, arrived in arrivals)
+    # generous bounds (a loaded CI machine): starvation behind the images would mean seconds
+    assert delays[len(delays) // 2] < 0.5 and delays[-1] < 2.0, delays[-5:]
+
+
+def _flood(gateway: Gateway, stalled: Any, healthy: Any, channels: dict, images: Any, beats: Any) -> tuple:
+    """4 s of 30 MB/s images and a 10 Hz heartbeat; returns what the test checks."""
+    stalled.send(
+        json.dumps(
+            {
+                "op": "subscribe",
+                "subscriptions": [
+                    {"id": 1, "channelId": channels["/camera/image_raw"]},
+                    {"id": 2, "channelId": channels["/heartbeat"]},
+                ],
+            }
+        )
+    )
+    # client 2: rosbridge, only the small topic
+    arrivals: list[tuple[float, float]] = []
+    healthy.send(json.dumps({"op": "subscribe", "topic": "/heartbeat", "type": "std_msgs/String"}))
+    stop = threading.Event()
+
+    def read_healthy() -> None:
+        while not stop.is_set():
+            try:
+                msg = json.loads(healthy.recv(timeout=0.5))
+            except TimeoutError:
+                continue
+            except Exception:
+                return
+            if msg.get("op") == "publish":
+                arrivals.append((float(msg["msg"]["data"]), time.monotonic()))
+
+    reader = threading.Thread(target=read_healthy, daemon=True)
+    reader.start()
+    wait_for(lambda: images.get_num_connections() and beats.get_num_connections() >= 1, what="taps")
+    frame = Image(height=480, width=640, encoding="rgb8", step=1920, data=bytes(640 * 480 * 3))
+    rss_before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    sent_beats: list[float] = []
+    peak_queued = 0
+    start = time.monotonic()
+    next_image = next_beat = start
+    while time.monotonic() - start < 4.0:  # 33 images/s of 921,600 bytes: 30 MB/s
+        now = time.monotonic()
+        if now >= next_image:
+            images.publish(frame)
+            next_image += 1 / 33
+        if now >= next_beat:
+            stamp = time.monotonic()
+            beats.publish(String(data=repr(stamp)))
+            sent_beats.append(stamp)
+            next_beat += 0.1
+        for client in gateway.status()["clients"]:
+            peak_queued = max(peak_queued, client["queued_bytes"])
+        time.sleep(max(0.0, min(next_image, next_beat) - time.monotonic()))
+    time.sleep(1.0)
+    stop.set()
+    reader.join(5)
+    return gateway.status(), peak_queued, arrivals, sent_beats, len(frame.data), rss_before

@@ -1,0 +1,306 @@
+"""sim_node as a process on our master: topics and namespaces, sim time at a factor, rospy.Rate in a
+user node, services, spawn refusals, bad input. The simulations run on sim time, faster than real time."""
+
+from __future__ import annotations
+
+import math
+import os
+import subprocess
+import sys
+import textwrap
+import threading
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from sim_helpers import wait_until
+
+from ninjemys.packages.shipped import shipped_executable
+from ninjemys.sim.worlds import WORLDS_DIR
+from ninjemys.testing import run_master
+
+
+class SimProcess:
+    def __init__(self, proc: subprocess.Popen, log_path: Path) -> None:
+        self.proc = proc
+        self.log_path = log_path
+
+    def log(self) -> str:
+        return self.log_path.read_text(errors="replace")
+
+    def wait_for_log(self, text: str, timeout: float = 20.0) -> str:
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            out = self.log()
+            if text in out:
+                return out
+            if self.proc.poll() is not None:
+                raise AssertionError(f"sim_node exited ({self.proc.returncode}):\n{out}")
+            time.sleep(0.05)
+        raise AssertionError(f"sim_node never printed {text!r}:\n{self.log()}")
+
+    def stop(self) -> None:
+        if self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(10)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+
+
+def start_sim(master: str, tmp_path: Path, *params: str, wait: bool = True) -> SimProcess:
+    env = dict(os.environ, ROS_MASTER_URI=master, PYTHONUNBUFFERED="1")
+    log_path = tmp_path / f"sim-{len(list(tmp_path.glob('sim-*.log')))}.log"
+    cmd = shipped_executable("puzzlebot_sim", "sim_node").command([*params, "_gui:=false"])
+    with open(log_path, "wb") as out:
+        proc = subprocess.Popen(cmd, env=env, stdout=out, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
+    sim = SimProcess(proc, log_path)
+    if wait:
+        try:
+            sim.wait_for_log("PuzzleBot simulator:")
+        except BaseException:
+            sim.stop()
+            raise
+    return sim
+
+
+@pytest.fixture
+def master() -> Iterator[str]:
+    with run_master() as uri:
+        yield uri
+
+
+@pytest.fixture
+def sims(master: str, tmp_path: Path) -> Iterator:
+    started: list[SimProcess] = []
+
+    def start(*params: str, wait: bool = True) -> SimProcess:
+        s = start_sim(master, tmp_path, *params, wait=wait)
+        started.append(s)
+        return s
+
+    try:
+        yield start
+    finally:
+        for s in started:
+            s.stop()
+
+
+@pytest.fixture
+def client(master: str):  # type: ignore[no-untyped-def]
+    from ninjemys.node import Node
+
+    node = Node("sim_test_client", anonymous=True, master_uri=master)
+    try:
+        yield node
+    finally:
+        node.shutdown("test over")
+
+
+class Latest:
+    """The newest message of a topic, with a count."""
+
+    def __init__(self, node, topic: str, msg_class) -> None:  # type: ignore[no-untyped-def]
+        self.msg = None
+        self.count = 0
+        self._lock = threading.Lock()
+        self.sub = node.subscriber(topic, msg_class, self._on, queue_size=10)
+
+    def _on(self, msg) -> None:  # type: ignore[no-untyped-def]
+        with self._lock:
+            self.msg = msg
+            self.count += 1
+
+    def wait(self, timeout: float = 15.0, what: str = "a message"):  # type: ignore[no-untyped-def]
+        return wait_until(lambda: self.msg, timeout, what)
+
+
+def test_two_robots_in_namespaces(sims, client, master):
+    from geometry_msgs.msg import Twist
+    from nav_msgs.msg import Odometry
+    from sensor_msgs.msg import LaserScan
+
+    sims(f"_world:={WORLDS_DIR / 'two_robots.yaml'}", "_rate:=4.0")
+    topics = {t for t, _ in client.master.get_published_topics("/")}
+    for ns in ("/robot1", "/robot2"):
+        assert {
+            f"{ns}/odom",
+            f"{ns}/scan",
+            f"{ns}/wl",
+            f"{ns}/wr",
+            f"{ns}/camera/color/image_raw",
+            f"{ns}/imu",
+        } <= topics
+    assert "/scan" not in topics and "/odom" not in topics
+    scan1 = Latest(client, "/robot1/scan", LaserScan)
+    scan2 = Latest(client, "/robot2/scan", LaserScan)
+    gt1 = Latest(client, "/robot1/base_pose_ground_truth", Odometry)
+    gt2 = Latest(client, "/robot2/base_pose_ground_truth", Odometry)
+    odom1 = Latest(client, "/robot1/odom", Odometry)
+    s1, s2 = scan1.wait(), scan2.wait()
+    assert s1.header.frame_id == "robot1/laser" and s2.header.frame_id == "robot2/laser"
+    # facing each other 2 m apart: the forward beam sees the other robot's body (radius 0.11)
+    assert s1.ranges[180] == pytest.approx(1.89, abs=0.05)
+    assert s2.ranges[180] == pytest.approx(1.89, abs=0.05)
+    assert odom1.wait().header.frame_id == "robot1/odom" and odom1.msg.child_frame_id == "robot1/base_link"
+    start2 = gt2.wait().pose.pose.position.x
+    pub = client.publisher("/robot1/cmd_vel", Twist, queue_size=1)
+    wait_until(lambda: pub.get_num_connections(), what="sim subscribed to /robot1/cmd_vel")
+    twist = Twist()
+    twist.linear.x = 0.3
+    pub.publish(twist)
+    wait_until(lambda: gt1.msg and gt1.msg.pose.pose.position.x > -0.8, what="robot1 moving")
+    assert gt2.msg.pose.pose.position.x == pytest.approx(start2, abs=1e-6)  # robot2 did not hear it
+
+
+def test_sim_time_factor_and_rospy_rate_follow_it(sims, master, tmp_path, client):
+    sim = sims("_world:=empty", "_rate:=3.0")
+    assert client.get_param("/use_sim_time") is True  # set by the simulator when nobody had
+    assert "/use_sim_time was not set" in sim.log()
+    script = tmp_path / "rate_user.py"
+    script.write_text(
+        textwrap.dedent(
+            """
+            import time
+            import rospy
+            rospy.init_node("rate_user")
+            while rospy.get_time() == 0.0:
+                time.sleep(0.01)
+            rate = rospy.Rate(10)
+            t0, w0 = rospy.get_time(), time.monotonic()
+            for _ in range(30):
+                rate.sleep()
+            print("SIM %.3f WALL %.3f" % (rospy.get_time() - t0, time.monotonic() - w0), flush=True)
+            """
+        )
+    )
+    done = subprocess.run(
+        [sys.executable, str(script)],
+        env=dict(os.environ, ROS_MASTER_URI=master),
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert done.returncode == 0, done.stderr
+    words = done.stdout.split()
+    sim_elapsed, wall_elapsed = float(words[1]), float(words[3])
+    # 30 periods of 0.1 s of *simulated* time, at 3x: about 1 s of wall time
+    assert sim_elapsed == pytest.approx(3.0, abs=0.11)
+    assert 0.6 < wall_elapsed < 2.5
+    assert 1.5 < sim_elapsed / wall_elapsed < 4.5
+
+
+def test_services_pause_reset_spawn_delete(sims, client):
+    from gazebo_msgs.srv import DeleteModel, SpawnModel
+    from rosgraph_msgs.msg import Clock
+    from std_srvs.srv import Empty
+
+    sim = sims("_world:=office", "_rate:=5.0")
+    clock = Latest(client, "/clock", Clock)
+    clock.wait()
+
+    def call(name, cls, **fields):  # type: ignore[no-untyped-def]
+        client.wait_for_service(name, 10)
+        proxy = client.service_proxy(name, cls)
+        req = cls._request_class()
+        for k, v in fields.items():
+            setattr(req, k, v)
+        return proxy(req)
+
+    call("/gazebo/pause_physics", Empty)
+    time.sleep(0.3)
+    t_paused = clock.msg.clock.to_sec()
+    time.sleep(0.5)
+    assert clock.msg.clock.to_sec() == t_paused
+    call("/gazebo/unpause_physics", Empty)
+    wait_until(lambda: clock.msg.clock.to_sec() > t_paused, what="time running again")
+    call("/gazebo/reset_simulation", Empty)
+    wait_until(lambda: clock.msg.clock.to_sec() < t_paused, what="time back near 0")
+
+    req = SpawnModel._request_class()
+    req.model_name = "intruder"
+    req.initial_pose.position.x, req.initial_pose.position.y = -1.2, 3.8  # inside desk_1
+    resp = call("/gazebo/spawn_urdf_model", SpawnModel, model_name="intruder", initial_pose=req.initial_pose)
+    assert not resp.success and "inside 'desk_1'" in resp.status_message
+    sim.wait_for_log("spawn refused: cannot spawn [intruder]")
+    req.initial_pose.position.x, req.initial_pose.position.y = 0.5, -0.5
+    resp = call("/gazebo/spawn_urdf_model", SpawnModel, model_name="guest", initial_pose=req.initial_pose)
+    assert resp.success, resp.status_message
+    topics = {t for t, _ in client.master.get_published_topics("/")}
+    assert "/guest/scan" in topics and "/scan" in topics
+    box = '<sdf version="1.6"><model name="crate"><link name="l"><collision name="c"><geometry><box><size>0.4 0.4 0.5</size></box></geometry></collision></link></model></sdf>'
+    req.initial_pose.position.x, req.initial_pose.position.y = 2.0, 0.0
+    resp = call(
+        "/gazebo/spawn_sdf_model",
+        SpawnModel,
+        model_name="crate",
+        model_xml=box,
+        initial_pose=req.initial_pose,
+    )
+    assert resp.success, resp.status_message
+    assert call("/gazebo/delete_model", DeleteModel, model_name="crate").success
+    assert call("/gazebo/delete_model", DeleteModel, model_name="guest").success
+    wait_until(
+        lambda: "/guest/scan" not in {t for t, _ in client.master.get_published_topics("/")},
+        what="guest topics gone",
+    )
+    gone = call("/gazebo/delete_model", DeleteModel, model_name="crate")
+    assert not gone.success and "no model named [crate]" in gone.status_message
+
+
+def test_non_finite_cmd_vel_ignored_with_one_warning(sims, client):
+    from geometry_msgs.msg import Twist
+    from nav_msgs.msg import Odometry
+
+    sim = sims("_world:=square", "_rate:=4.0")
+    gt = Latest(client, "/base_pose_ground_truth", Odometry)
+    gt.wait()
+    pub = client.publisher("/cmd_vel", Twist, queue_size=10)
+    wait_until(lambda: pub.get_num_connections(), what="sim subscribed to /cmd_vel")
+    for value in (math.nan, math.inf, -math.inf):
+        bad = Twist()
+        bad.linear.x = value
+        pub.publish(bad)
+        time.sleep(0.1)
+    sim.wait_for_log("ignoring a command with a non-finite value")
+    time.sleep(0.3)
+    assert sim.log().count("non-finite") == 1
+    assert gt.msg.pose.pose.position.x == 0.0
+    good = Twist()
+    good.angular.z = 0.5
+    pub.publish(good)
+    wait_until(
+        lambda: abs(gt.msg.pose.pose.orientation.z) > 0.05, what="the robot turning after a valid command"
+    )
+    assert sim.proc.poll() is None
+
+
+@pytest.mark.parametrize(
+    ("content", "expected"),
+    [
+        (
+            "walls:\n  - {from: [0, 0], to: [1, 0], height: tall}\n",
+            "bad.yaml:2: walls[0].height: expected a number, got 'tall'",
+        ),
+        ("walls: [\n", "bad.yaml:2: invalid YAML"),
+    ],
+)
+def test_malformed_world_fails_with_file_line_field(sims, tmp_path, content, expected):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(content)
+    sim = sims(f"_world:={bad}", wait=False)
+    assert sim.proc.wait(30) == 1
+    assert expected in sim.log()
+    assert "Traceback" not in sim.log()
+
+
+def test_map_argument_uses_a_map_server_map(sims, client):
+    from ninjemys.sim.worlds import map_path
+    from sensor_msgs.msg import LaserScan
+
+    sims(f"_map:={map_path('maze')}", "_rate:=4.0")
+    scan = Latest(client, "/scan", LaserScan).wait()
+    finite = [r for r in scan.ranges if math.isfinite(r)]
+    assert len(finite) == 360 and min(finite) > 0.15 and max(finite) < 6.0  # walls all around in the maze
