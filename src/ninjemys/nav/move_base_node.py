@@ -45,6 +45,7 @@ from ninjemys.nav.rosglue import (
     param,
     pose_msg_to_2d,
     scan_arrays,
+    sleep,
     start_node,
 )
 from ninjemys.nav.slam import compose, inverse
@@ -436,8 +437,7 @@ class MoveBase:
         if freqs:
             period = 1.0 / max(freqs)
         last = {id(self.global_cm): 0.0, id(self.local_cm): 0.0}
-        while not rospy.is_shutdown():
-            rospy.sleep(period)
+        while sleep(period):
             t = rospy.get_time()
             for cm in (self.global_cm, self.local_cm):
                 if cm.publish_frequency <= 0 or t - last[id(cm)] < 1.0 / cm.publish_frequency - 1e-6:

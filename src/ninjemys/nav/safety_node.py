@@ -30,7 +30,7 @@ import numpy as np
 
 import rospy
 from ninjemys.nav.costmap import footprint_radii, parse_footprint
-from ninjemys.nav.rosglue import Tf2D, param, scan_arrays, start_node
+from ninjemys.nav.rosglue import Tf2D, param, scan_arrays, sleep, start_node
 from ninjemys.nav.safety import MuxInput, TwistMux, blocked
 
 DEFAULT_TOPICS = [
@@ -229,8 +229,7 @@ class SafetyMonitor:
     def diag_loop(self) -> None:
         from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
 
-        while not rospy.is_shutdown():
-            rospy.sleep(1.0)
+        while sleep(1.0):
             with self.lock:
                 e_stop, active, is_blocked, cov = self.e_stop, self.active, self.blocked, self.cov
             status = DiagnosticStatus(name="safety_monitor: Safety", hardware_id="puzzlebot")
