@@ -152,3 +152,22 @@ def test_config_dict_behaves_like_ros1(tutorials) -> None:
     text = yaml.dump(Config(a=1, groups=Config(b=True)))
     assert text.startswith("!!python/object/new:dynamic_reconfigure.encoding.Config\ndictitems:\n")
     assert "state: []" in text
+
+
+def test_cfg_run_by_hand_like_cmake(tmp_path: Path) -> None:
+    """ROS 1's CMake runs the script with four paths; the fourth gets <python dir>/cfg/<Name>Config.py."""
+    import subprocess
+    import sys
+
+    from dyn_fixtures import TUTORIAL_CFG
+
+    cfg = tmp_path / "Tutorials.cfg"
+    cfg.write_text(TUTORIAL_CFG)
+    out = tmp_path / "py"
+    args = [sys.executable, str(cfg), str(tmp_path), str(tmp_path), str(tmp_path / "cpp"), str(out)]
+    done = subprocess.run(args, capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert load_module(out / "cfg" / "TutorialsConfig.py").defaults["size"] == 1
+    assert (out / "cfg" / "__init__.py").is_file()
+    alone = subprocess.run([sys.executable, str(cfg)], capture_output=True, text=True, timeout=60)
+    assert alone.returncode == 1 and "catkin_make runs it for you" in alone.stderr

@@ -141,6 +141,11 @@ def test_dynparam_commands(served, tmp_path: Path, capsys) -> None:
     assert node.get_param("~double_param") == 0.25
     assert dynparam.main(["set", "/dyn_server", "int_param", "lots"]) == 0
     assert "error updating parameters: can't set parameter 'int_param'" in capsys.readouterr().out
+    assert (
+        dynparam.main(["set_from_parameters", "/dyn_server", "_int_param:=33", "_str_param:=from_params"])
+        == 0
+    )
+    assert node.get_param("~int_param") == 33 and node.get_param("~str_param") == "from_params"
 
 
 def test_dynparam_errors(master_uri: str, capsys) -> None:
@@ -192,3 +197,22 @@ def test_rospy_facade_server_and_client(master_uri: str, tmp_path: Path) -> None
     lines = out.stdout.splitlines()
     assert lines[0] == "9 set [-1, 0] ['/facade_server']", out.stderr
     assert lines[1].startswith("ROSException") and "/missing/set_parameters" in lines[1]
+
+
+def test_server_refuses_bad_values_and_keeps_serving(served, client_node: Node, caplog) -> None:
+    from ninjemys.dynamic_reconfigure.encoding import decode_config
+    from ninjemys.idl.loader import get_message_class, get_service_class
+
+    node, _calls = served
+    msgs = "dynamic_reconfigure/"
+    Reconfigure = get_service_class(msgs + "Reconfigure")
+    config = get_message_class(msgs + "Config")()
+    config.ints.append(get_message_class(msgs + "IntParameter")("nope", 1))
+    config.strs.append(get_message_class(msgs + "StrParameter")("int_param", "many"))
+    config.doubles.append(get_message_class(msgs + "DoubleParameter")("size", 2.0))
+    proxy = client_node.service_proxy("/dyn_server/set_parameters", Reconfigure)
+    reply = decode_config(proxy(config).config)
+    assert reply["int_param"] == 7 and reply["size"] == 2 and "nope" not in reply
+    assert "ignoring unknown parameter 'nope'" in caplog.text
+    assert "parameter 'int_param' is int, got 'many'" in caplog.text
+    assert node.get_param("~size") == 2

@@ -151,3 +151,15 @@ def test_our_client_against_ros1_server(master_uri: str, cfg_dir: Path) -> None:
         node.shutdown("test over")
         proc.kill()
         proc.wait()
+
+
+@pytest.mark.parametrize("args", [[], ["set", "-h"], ["set", "a"], ["load", "a"]])
+def test_usage_and_argument_errors_match(cfg_dir: Path, args: list[str]) -> None:
+    theirs = ros1("http://localhost:1/", cfg_dir, DYNPARAM, *args)
+    mine = subprocess.run(
+        [sys.executable, "-m", "ninjemys.packages.run_shipped", "dynamic_reconfigure", "dynparam", *args],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert (mine.returncode, mine.stdout, mine.stderr) == (theirs.returncode, theirs.stdout, theirs.stderr)

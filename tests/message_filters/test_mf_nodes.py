@@ -82,3 +82,53 @@ def test_rospy_facade_subscriber(tmp_path) -> None:
             [sys.executable, "-c", FACADE], env=env, capture_output=True, text=True, timeout=60
         )
         assert out.stdout.strip() == "[5, 6, 7] /f1", out.stderr
+
+
+def test_tf2_message_filter_on_a_live_graph() -> None:
+    """Scans wait in the filter until the listener's /tf data covers their stamps, then come out in order."""
+    from ninjemys.message_filters.tf2 import MessageFilter
+    from ninjemys.tf2.buffer import Buffer
+    from ninjemys.tf2.node import TransformBroadcaster, TransformListener
+
+    TransformStamped = get_message_class("geometry_msgs/TransformStamped")
+    with MasterThread() as uri:
+        node = Node("mf_tf", master_uri=uri)
+        try:
+            buffer = Buffer()
+            listener = TransformListener(node, buffer)
+            broadcaster = TransformBroadcaster(node)
+            points = node.publisher("/points", PointStamped, queue_size=10)
+            source = Subscriber(node, "/points", PointStamped)
+            mf = MessageFilter(source, buffer, "map", queue_size=10)
+            out: list = []
+            done = threading.Event()
+
+            def on_point(msg):
+                out.append(msg.header.stamp.to_sec())
+                if len(out) == 2:
+                    done.set()
+
+            mf.registerCallback(on_point)
+            deadline = time.monotonic() + 10
+            while (
+                source.get_num_connections() == 0 or broadcaster.pub_tf.get_num_connections() == 0
+            ) and time.monotonic() < deadline:
+                time.sleep(0.01)
+            for secs in (20.2, 20.7):
+                msg = stamped(secs)
+                msg.header.frame_id = "laser"
+                points.publish(msg)
+            while mf.pending() < 2 and time.monotonic() < deadline:
+                time.sleep(0.01)
+            assert out == [] and mf.pending() == 2
+            for secs in (20.0, 21.0):
+                t = TransformStamped()
+                t.header.frame_id, t.child_frame_id = "map", "laser"
+                t.header.stamp = Time.from_sec(secs)
+                t.transform.rotation.w = 1.0
+                broadcaster.sendTransform(t)
+            assert done.wait(10)
+            assert [round(s, 3) for s in out] == [20.2, 20.7]
+            listener.unregister()
+        finally:
+            node.shutdown("test over")

@@ -112,6 +112,8 @@ class CvBridge:
         data = img_msg.data
         if isinstance(data, str):
             data = data.encode("latin-1")
+        elif isinstance(data, list | tuple):
+            data = bytes(data)  # a message built by hand with a list of ints
         size = len(data) if not isinstance(data, memoryview) else data.nbytes
         if step < row or size < step * (height - 1) + row:
             raise CvBridgeError(

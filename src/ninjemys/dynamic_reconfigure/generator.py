@@ -235,7 +235,7 @@ class ParameterGenerator:
         self.pkgname, self.nodename, self.name = pkgname, nodename, name
         if not isinstance(name, str) or not re.match(r"^[A-Za-z_][A-Za-z0-9_]*$", name):
             raise CfgError(f"generate(): config name {name!r} is not a valid Python identifier")
-        for param in self.group.parameters + [p for g in self._groups.values() for p in g.parameters]:
+        for param in (p for g in self._groups.values() for p in g.parameters):
             if param["edit_method"]:
                 _check_enum(param)
         if _sink is not None:
