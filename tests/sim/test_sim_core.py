@@ -304,3 +304,20 @@ def test_reset_world_and_simulation():
     assert (r.x, r.y, r.yaw, r.wl) == (0.0, 0.0, 0.0, 0.0) and sim.time == pytest.approx(1.0)
     sim.reset_simulation()
     assert sim.time == 0.0
+
+
+def test_camera_sees_the_square_painted_on_the_floor():
+    from ninjemys.sim.worlds import world_path
+
+    sim = Simulation(load_world(world_path("square")))
+    r = sim.add_robot(
+        "pb", load_robot_model("puzzlebot"), 0.5, -0.6, math.pi / 2
+    )  # facing the square's near side
+    rgb, depth = sim.render(r)
+    yellow = (rgb[:, :, 0] == 230) & (rgb[:, :, 1] == 200) & (rgb[:, :, 2] == 60)
+    rows = np.flatnonzero(yellow.any(axis=1))
+    assert yellow.sum() > 200 and rows.min() > r.camera.cy  # on the floor, below the horizon
+    # the near side (y = 0, 3 cm wide) is 0.6 - 0.08 m ahead of the camera: its rows see the floor there
+    near = rows.max()
+    assert abs(r.camera.cam_z / -r.camera.row_slope[near] - 0.52) < 0.03
+    assert int(depth[near, 160]) == round(r.camera.cam_z / -r.camera.row_slope[near] * 1000)
