@@ -778,10 +778,10 @@ def main(argv: list[str] | None = None) -> int:
         namespaced = len(starts) > 1
         for i, s in enumerate(starts):
             pose = (x, y, yaw) if i == 0 else (s.x, s.y, s.yaw)
-            robot_model = model if s.model == "puzzlebot" else load_robot_model(s.model)
             try:
+                robot_model = model if s.model == "puzzlebot" else load_robot_model(s.model)
                 app.add_robot(s.name, robot_model, *pose, namespaced)
-            except SpawnError as exc:
+            except (SpawnError, MapFileError) as exc:
                 log.fatal("%s", exc)
                 return 1
         log.info(
