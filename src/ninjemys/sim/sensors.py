@@ -115,7 +115,7 @@ class Camera:
             (forward * ((self.cx - u) / self.fx)[None, :]).astype(np.float32),
         )
         self._neg_slope = -self.row_slope
-        self._rows = np.arange(height, dtype=np.int16)[:, None]
+        self._rows = np.arange(height, dtype=np.uint16)[:, None]
 
     def render(self, scene: Scene, x: float, y: float, yaw: float) -> tuple[np.ndarray, np.ndarray]:
         """(rgb8 image (H, W, 3), depth in mm uint16 (H, W)) from a camera at (x, y, cam_z) facing ``yaw``."""
@@ -146,9 +146,9 @@ class Camera:
         bottom = np.searchsorted(self._neg_slope, -lo_slope, "right")
         # the image as (H, 3W) bytes: one select over bytes against a per-channel mask is cheaper than
         # any interleaving of channels or a select over 3-byte elements
-        wall3 = (self._rows >= np.repeat(top, 3).astype(np.int16)) & (
-            self._rows < np.repeat(bottom, 3).astype(np.int16)
-        )
+        # top <= v < bottom as one unsigned comparison: v - top wraps to a huge value above the top
+        span = np.maximum(bottom - top, 0).astype(np.uint16)
+        wall3 = (self._rows - np.repeat(top.astype(np.uint16), 3)) < np.repeat(span, 3)
         light = np.clip(1.1 - depth / 15.0, 0.45, 1.0)  # flat shading, darker with distance
         col = (colors * light[:, None]).astype(np.uint8).reshape(1, 3 * self.width)
         rgb = np.where(wall3, col, self._background).reshape(self.height, self.width, 3)
