@@ -18,7 +18,7 @@ import pytest
 from actionlib_fakes import ListLog
 
 from actionlib.msg import TwoIntsAction, TwoIntsGoal, TwoIntsResult
-from ninjemys.actionlib import ActionClient, SimpleActionClient, SimpleActionServer
+from ninjemys.actionlib import ActionClient, ActionServer, SimpleActionClient, SimpleActionServer
 from ninjemys.actionlib import states as S
 from ninjemys.actionlib.states import CommState
 from ninjemys.node import Node
@@ -117,6 +117,17 @@ def test_real_client_preempts_with_a_new_goal(master: str, tmp_path: Path, node:
     our_server(node, "add")
     out = real(master, tmp_path, "deb_action_client.py", "preempt", "add")
     assert out == {"first": S.PREEMPTED, "second": S.SUCCEEDED, "sum": 5}
+
+
+def test_real_client_cancel_by_stamp_then_all(master: str, tmp_path: Path, node: Node) -> None:
+    """A plain ActionServer of ours holding four goals; the real client cancels by stamp, then all."""
+    server = ActionServer(node, "hold", TwoIntsAction, lambda gh: gh.set_accepted())
+    server.register_cancel_callback(lambda gh: gh.set_canceled(None, "cancelled"))
+    server.start()
+    out = real(master, tmp_path, "deb_action_client.py", "stamps", "hold")
+    assert out["accepted"] == [S.ACTIVE] * 4
+    assert out["by_stamp"] == [S.PREEMPTED, S.PREEMPTED, S.ACTIVE, S.ACTIVE]
+    assert out["all"] == [S.PREEMPTED] * 4
 
 
 def test_real_client_wait_for_server_on_a_wrong_name(master: str, tmp_path: Path, node: Node) -> None:
