@@ -73,7 +73,7 @@ def our_server(node: Node, name: str, log: Any = None) -> SimpleActionServer:
 
 @pytest.fixture(params=["simple"])
 def real_server(request: pytest.FixtureRequest, master: str, tmp_path: Path) -> Iterator[str]:
-    """A real server process: ``simple`` (SimpleActionServer) or ``plain`` (ActionServer)."""
+    """A real server process: ``simple`` (SimpleActionServer), ``plain`` or ``hold`` (ActionServer)."""
     env = ros1_env(master, ROS_HOME=str(tmp_path))
     proc = subprocess.Popen(
         [ROS1_PYTHON, str(SCRIPTS / "deb_action_server.py"), request.param, "real_add"],
@@ -190,6 +190,30 @@ def test_our_client_preempts_a_real_goal_with_a_new_one(node: Node, real_server:
         time.sleep(0.01)
     assert first.get_terminal_state() == S.PREEMPTED
     assert second.get_terminal_state() == S.SUCCEEDED and second.get_result().sum == 5
+
+
+@pytest.mark.parametrize("real_server", ["hold"], indirect=True)
+def test_our_client_cancels_real_goals_by_stamp_then_all(node: Node, real_server: str) -> None:
+    client = ActionClient(node, real_server, TwoIntsAction)
+    assert client.wait_for_server(10.0)
+    goals = []
+    for i in range(4):
+        goals.append(client.send_goal(TwoIntsGoal(a=-1, b=i)))
+        time.sleep(0.02)
+    deadline = time.monotonic() + 10
+
+    def settle(done: Any) -> list[int]:
+        while not done():
+            assert time.monotonic() < deadline, [g.get_goal_status() for g in goals]
+            time.sleep(0.01)
+        return [g.get_goal_status() for g in goals]
+
+    assert settle(lambda: all(g.get_goal_status() == S.ACTIVE for g in goals)) == [S.ACTIVE] * 4
+    client.cancel_goals_at_and_before_time(goals[1].comm_state_machine.action_goal.goal_id.stamp)
+    by_stamp = settle(lambda: all(g.get_comm_state() == CommState.DONE for g in goals[:2]))
+    assert by_stamp == [S.PREEMPTED, S.PREEMPTED, S.ACTIVE, S.ACTIVE]
+    client.cancel_all_goals()
+    assert settle(lambda: all(g.get_comm_state() == CommState.DONE for g in goals)) == [S.PREEMPTED] * 4
 
 
 def test_our_client_wrong_name_against_real_graph(node: Node, real_server: str) -> None:
