@@ -43,6 +43,7 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
             "mimic": ("ninjemys.sim.mimic:main", ()),
         },
         "rqt_graph": {"rqt_graph": ("ninjemys.web.rqt_graph:main", ())},
+        "rviz": {"rviz": ("ninjemys.web.rviz:main", ())},
         "puzzlebot_sim": {
             "sim_node": ("ninjemys.sim.puzzlebot_node:main", ()),
             "world_to_map": ("ninjemys.sim.world_to_map:main", ()),
