@@ -245,6 +245,7 @@ class MoveBase:
                 int((~np.isfinite(ranges)).sum()),
                 len(ranges),
             )
+        ranges = np.where(np.isneginf(ranges), scan.range_min, ranges)  # REP 117: closer than range_min
         t = scan.header.stamp.to_sec()
         for cm in cms:
             sensor = self.tf.lookup(cm.global_frame, scan.header.frame_id, t)

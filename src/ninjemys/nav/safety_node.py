@@ -128,6 +128,8 @@ class SafetyMonitor:
 
     def on_scan(self, scan: Any) -> None:
         ranges, angles = scan_arrays(scan)
+        # REP 117: -inf is "closer than range_min": something is right at the robot
+        ranges = np.where(np.isneginf(ranges), scan.range_min, ranges)
         ok = np.isfinite(ranges) & (ranges >= scan.range_min) & (ranges <= scan.range_max)
         if not self.bad_scan_reported and not np.isfinite(ranges).all():
             self.bad_scan_reported = True
