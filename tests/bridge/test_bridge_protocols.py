@@ -121,10 +121,12 @@ def test_foxglove_time_under_sim_time(make_gateway: Callable[..., Gateway], node
 
 def test_foxglove_connection_graph_and_parameter_updates(gateway: Gateway, node: Node) -> None:
     node.set_param("/fox/gain", 1)
+    node.publisher("/graph_seed", String)
+    wait_for(lambda: "/graph_seed" in gateway.catalog.graph["pub"], what="the graph poll")
     with connect(f"ws://127.0.0.1:{gateway.port}/", subprotocols=["foxglove.websocket.v1"]) as ws:
         ws.send(json.dumps({"op": "subscribeConnectionGraph"}))
         graph = first(ws, lambda m: isinstance(m, dict) and m.get("op") == "connectionGraphUpdate")
-        assert any(t["name"] == "/client_count" for t in graph["publishedTopics"])
+        assert any(t["name"] == "/graph_seed" for t in graph["publishedTopics"])
         node.publisher("/fresh_topic", String)
         update = first(
             ws,

@@ -71,6 +71,8 @@ class GatewayOptions:
     update_period: float = 1.0
     node_name: str = "rosbridge_websocket"
     protocols: tuple[str, ...] = ("rosbridge", "foxglove")
+    #: publish the number of connected clients on ``client_count`` (latched), as rosbridge_websocket does
+    client_count: bool = False
 
     def secret(self) -> str | None:
         if not self.authenticate:
@@ -304,11 +306,12 @@ class Gateway:
 
     # -- graph polling ----------------------------------------------------------------------
     def start(self) -> None:
-        """Start watching the graph (and /clock under sim time); publish ``client_count`` as rosbridge does."""
-        self._client_count = self.node.publisher(
-            "client_count", get_message_class("std_msgs/Int32"), queue_size=1, latch=True
-        )
-        self._count_clients()
+        """Start watching the graph (and /clock under sim time); publish ``client_count`` if asked."""
+        if self.options.client_count:
+            self._client_count = self.node.publisher(
+                "client_count", get_message_class("std_msgs/Int32"), queue_size=1, latch=True
+            )
+            self._count_clients()
         if self.sim_time:
             self._clock_sub = self.node.subscriber(
                 "/clock", get_message_class("rosgraph_msgs/Clock"), self._on_clock, queue_size=1
