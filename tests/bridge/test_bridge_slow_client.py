@@ -30,7 +30,8 @@ def test_stalled_client_is_bounded_and_does_not_starve_others(
     url = f"ws://127.0.0.1:{gateway.port}/"
     images = node.publisher("/camera/image_raw", Image, queue_size=2)
     beats = node.publisher("/heartbeat", String)
-    wait_for(lambda: len(gateway.catalog.channels) >= 2, what="channels")
+    wanted = {"/camera/image_raw", "/heartbeat"}  # every node also publishes /rosout: wait for these two
+    wait_for(lambda: wanted <= {c["topic"] for c in gateway.catalog.channels.values()}, what="channels")
     channels = {c["topic"]: c["id"] for c in gateway.catalog.channels.values()}
 
     # client 1: Foxglove, subscribes to both, then never reads again (max_queue=1: its socket fills)
