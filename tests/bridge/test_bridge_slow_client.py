@@ -30,7 +30,8 @@ def test_stalled_client_is_bounded_and_does_not_starve_others(
     url = f"ws://127.0.0.1:{gateway.port}/"
     images = node.publisher("/camera/image_raw", Image, queue_size=2)
     beats = node.publisher("/heartbeat", String)
-    wait_for(lambda: len(gateway.catalog.channels) >= 2, what="channels")
+    wanted = {"/camera/image_raw", "/heartbeat"}
+    wait_for(lambda: wanted <= {c["topic"] for c in gateway.catalog.channels.values()}, what="channels")
     channels = {c["topic"]: c["id"] for c in gateway.catalog.channels.values()}
 
     # client 1: Foxglove, subscribes to both, then never reads again (max_queue=1: its socket fills)
@@ -110,3 +111,27 @@ def _flood(gateway: Gateway, stalled: Any, healthy: Any, channels: dict, images:
     stop.set()
     reader.join(5)
     return gateway.status(), peak_queued, arrivals, sent_beats, len(frame.data), rss_before
+
+
+def test_rosbridge_client_is_told_about_its_drops(make_gateway: Callable[..., Gateway], node: Node) -> None:
+    gateway = make_gateway(max_client_bytes=1024 * 1024)
+    images = node.publisher("/camera/small", Image, queue_size=100)
+    frame = Image(height=100, width=1000, encoding="rgb8", step=3000, data=bytes(300_000))
+    with connect(f"ws://127.0.0.1:{gateway.port}/", max_queue=1, close_timeout=0.5) as ws:
+        ws.send(json.dumps({"op": "set_level", "level": "warning"}))
+        ws.send(
+            json.dumps(
+                {"op": "subscribe", "topic": "/camera/small", "type": "sensor_msgs/Image", "queue_length": 2}
+            )
+        )
+        wait_for(lambda: images.get_num_connections(), what="the tap")
+        for _ in range(60):  # 18 MB while the client reads nothing
+            images.publish(frame)
+            time.sleep(0.01)
+        wait_for(lambda: gateway.status()["clients"][0]["dropped"].get("/camera/small"), what="drops counted")
+        deadline = time.monotonic() + 20
+        while time.monotonic() < deadline:
+            msg = json.loads(ws.recv(timeout=10))
+            if msg.get("op") == "status":
+                break
+        assert msg["level"] == "warning" and "dropped" in msg["msg"] and "/camera/small" in msg["msg"]

@@ -3,6 +3,11 @@
 from __future__ import annotations
 
 import math
+import os
+import signal
+import subprocess
+import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -48,3 +53,167 @@ def laser():
     """(angles, cast) for a 360-beam laser with 5 m range."""
     angles = np.linspace(-math.pi, math.pi, 360, endpoint=False)
     return angles, cast
+
+
+# -- whole-stack sessions -------------------------------------------------------------------------------
+
+SHARE = Path(__file__).resolve().parents[2] / "src" / "ninjemys" / "packages" / "share"
+
+
+def world_map(world: str) -> GridMap:
+    """The ground-truth map of a shipped world (what the simulator rasterizes)."""
+    from ninjemys.nav.mapio import load_map
+
+    return load_map(SHARE / "puzzlebot_sim" / "maps" / f"{world}.yaml")
+
+
+def pick_goals(
+    world: str, count: int, seed: int, clearance: float = 0.45, spacing: float = 1.5
+) -> list[tuple]:
+    """``count`` seeded goals (x, y, yaw) on free cells at least ``clearance`` from any obstacle,
+    each at least ``spacing`` from the previous one (the first from the start at the origin)."""
+    from ninjemys.nav.costmap import distance_transform
+
+    grid = world_map(world)
+    reach = int(clearance / grid.resolution) + 1
+    dist = distance_transform(grid.data != 0, reach) * grid.resolution
+    rows, cols = np.nonzero(dist >= clearance)
+    rng = np.random.default_rng(seed)
+    goals: list[tuple] = []
+    last = (0.0, 0.0)
+    while len(goals) < count:
+        i = int(rng.integers(len(rows)))
+        x, y = grid.cell_to_world(cols[i], rows[i])
+        if math.hypot(x - last[0], y - last[1]) < spacing:
+            continue
+        yaw = float(rng.uniform(-math.pi, math.pi))
+        goals.append((round(x, 2), round(y, 2), round(yaw, 2)))
+        last = (x, y)
+    return goals
+
+
+class Probe:
+    """A test node watching the stack: sim time, ground truth, contact, amcl, TF map -> base_link."""
+
+    def __init__(self, master_uri: str) -> None:
+        from ninjemys.idl.loader import get_message_class
+        from ninjemys.node import Node
+        from ninjemys.tf2.core import BufferCore
+        from ninjemys.tf2.node import TransformListener
+
+        self.node = Node("nav_probe", anonymous=True, master_uri=master_uri)
+        self.sim_time = 0.0
+        self.truth: tuple[float, float, float] | None = None
+        self.truth_v = 0.0
+        self.truth_w = 0.0
+        self.contacts = 0
+        self.amcl: tuple[float, float, float] | None = None
+        self.amcl_cov = (0.0, 0.0)
+        self.buffer = BufferCore(cache_time=30.0)
+        self.listener = TransformListener(self.node, self.buffer)
+        Odometry = get_message_class("nav_msgs/Odometry")
+        self.node.subscriber("/clock", get_message_class("rosgraph_msgs/Clock"), self._clock, queue_size=1)
+        self.node.subscriber("/base_pose_ground_truth", Odometry, self._truth, queue_size=1)
+        self.node.subscriber("/contact", get_message_class("std_msgs/Bool"), self._contact, queue_size=10)
+        self.node.subscriber(
+            "/amcl_pose",
+            get_message_class("geometry_msgs/PoseWithCovarianceStamped"),
+            self._amcl,
+            queue_size=1,
+        )
+        self.twist_cls = get_message_class("geometry_msgs/Twist")
+        self.pose_cls = get_message_class("geometry_msgs/PoseStamped")
+
+    @staticmethod
+    def _yaw(q) -> float:
+        return math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z))
+
+    def _clock(self, msg) -> None:
+        self.sim_time = msg.clock.to_sec()
+
+    def _truth(self, msg) -> None:
+        p = msg.pose.pose
+        self.truth = (p.position.x, p.position.y, self._yaw(p.orientation))
+        self.truth_v = msg.twist.twist.linear.x
+        self.truth_w = msg.twist.twist.angular.z
+
+    def _contact(self, msg) -> None:
+        if msg.data:
+            self.contacts += 1
+
+    def _amcl(self, msg) -> None:
+        p = msg.pose.pose
+        self.amcl = (p.position.x, p.position.y, self._yaw(p.orientation))
+        self.amcl_cov = (msg.pose.covariance[0], msg.pose.covariance[7])
+
+    def localized(self) -> tuple[float, float, float] | None:
+        """The robot's pose in the map frame through TF (amcl's map -> odom, the sim's odom -> base)."""
+        from ninjemys.nav.rosglue import tf_to_2d
+        from ninjemys.tf2.errors import TransformException
+
+        try:
+            return tf_to_2d(self.buffer.lookup("map", "base_link", 0)[1])
+        except TransformException:
+            return None
+
+    def wait_sim(self, seconds: float, timeout: float = 120.0) -> None:
+        """Sleep ``seconds`` of simulated time."""
+        end = self.sim_time + seconds
+        deadline = time.monotonic() + timeout
+        while self.sim_time < end and time.monotonic() < deadline:
+            time.sleep(0.02)
+
+    def close(self) -> None:
+        self.node.shutdown()
+
+
+class NavSession:
+    """A master, ``roslaunch puzzlebot_navigation <file> <args>`` and a :class:`Probe`; closed in order."""
+
+    def __init__(self, launch_file: str, args: list[str], tmp_path: Path) -> None:
+        from ninjemys.testing import ninjemys_bin, run_master
+
+        self._master = run_master()
+        self.uri = self._master.__enter__()
+        self.env = dict(os.environ)
+        self.env.update(ROS_MASTER_URI=self.uri, ROS_HOME=str(tmp_path / "ros_home"), PYTHONUNBUFFERED="1")
+        self.log_path = tmp_path / "launch.log"
+        self._log = open(self.log_path, "w")  # noqa: SIM115 - closed in close()
+        self.proc = subprocess.Popen(
+            [ninjemys_bin("roslaunch"), "puzzlebot_navigation", launch_file, *args],
+            env=self.env,
+            stdin=subprocess.DEVNULL,
+            stdout=self._log,
+            stderr=subprocess.STDOUT,
+            start_new_session=True,
+        )
+        self.probe = Probe(self.uri)
+
+    def log(self) -> str:
+        return self.log_path.read_text(errors="replace")
+
+    def wait_for(self, predicate, timeout: float = 60.0) -> bool:
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if predicate():
+                return True
+            if self.proc.poll() is not None:
+                return False
+            time.sleep(0.05)
+        return False
+
+    def close(self) -> None:
+        self.probe.close()
+        if self.proc.poll() is None:
+            os.killpg(self.proc.pid, signal.SIGINT)
+            try:
+                self.proc.wait(15)
+            except subprocess.TimeoutExpired:
+                os.killpg(self.proc.pid, signal.SIGKILL)
+                self.proc.wait(5)
+        try:
+            os.killpg(self.proc.pid, signal.SIGKILL)  # anything the launch left in its group
+        except (ProcessLookupError, PermissionError):
+            pass
+        self._log.close()
+        self._master.__exit__(None, None, None)

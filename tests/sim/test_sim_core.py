@@ -89,7 +89,7 @@ def test_grid_traversal_and_grid_edges_agree():
     b, _ = cast_segments(0.013, 0.021, angles, grid_edges(occ, 0.05, -2.5, -3.0), 12.0)
     both = np.isfinite(a) & np.isfinite(b)
     assert np.array_equal(np.isfinite(a), np.isfinite(b))
-    assert np.allclose(a[both], b[both], atol=1e-9)
+    assert np.allclose(a[both], b[both], atol=1e-5)  # traversal works in float32
 
 
 def test_straight_line_odometry_matches_closed_form(tmp_path):

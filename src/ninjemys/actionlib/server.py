@@ -46,7 +46,7 @@ if TYPE_CHECKING:
     from typing import Any
 
 #: seconds between two status messages caused by transitions (the periodic ones are separate)
-MERGE_INTERVAL = 0.05
+MERGE_INTERVAL = 0.1
 
 _ZERO = Time()
 
@@ -325,6 +325,7 @@ class ActionServer:
             pub_queue = 50
         sub_queue = self._param("actionlib_server_sub_queue_size", -1)
         sub_queue = sub_queue if isinstance(sub_queue, int) and sub_queue > 0 else None
+        self.pub_queue_size, self.sub_queue_size = pub_queue, sub_queue
         self.status_pub = node.publisher(f"{ns}/status", self._array_class, queue_size=pub_queue, latch=True)
         self.result_pub = node.publisher(f"{ns}/result", self.types.action_result, queue_size=pub_queue)
         self.feedback_pub = node.publisher(f"{ns}/feedback", self.types.action_feedback, queue_size=pub_queue)

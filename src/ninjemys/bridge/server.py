@@ -410,7 +410,7 @@ class Gateway:
                 {"op": "status", "level": 2, "message": f"message too big: {why}"}
             )
         else:
-            session = RosbridgeSession(self, client.id, client.outbox, lambda text: None)
+            session = RosbridgeSession(self, client.id, client.outbox)
             ws.on_oversized = lambda why: json.dumps(
                 {"op": "status", "level": "error", "msg": f"message too big: {why}"}
             )
@@ -422,10 +422,12 @@ class Gateway:
         )
         if isinstance(session, FoxgloveSession):
             session.hello()
+        session.backlog.bind(loop, asyncio.Event())
         sender = asyncio.create_task(self._sender(client))
         try:
             async for data in ws.messages():
                 session.receive(data)
+                await session.backlog.wait()
         finally:
             sender.cancel()
             self._clients.pop(client.id, None)

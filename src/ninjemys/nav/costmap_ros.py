@@ -96,7 +96,7 @@ class CostmapROS:
         except (TypeError, ValueError):
             rospy.logerr(
                 "move_base: parameter %s: expected a %s, got %r; using %r",
-                where,
+                self.node.resolve_name(where),
                 type(default).__name__,
                 value,
                 default,

@@ -137,9 +137,10 @@ class DWAPlanner:
         err = angle_diff(goal_yaw, th)
         if abs(err) <= p.yaw_goal_tolerance:
             return Command(0.0, 0.0, reached=True)
-        # the fastest turn that can still stop at the goal yaw, within the acceleration limits
+        # the fastest turn that can still stop at the goal yaw within the acceleration limits, and no
+        # faster than 2 rad/s per radian left: a late or missed cycle near the goal overshoots little
         w_stop = math.sqrt(2 * p.acc_lim_theta * abs(err))
-        w = min(p.max_vel_theta, w_stop, abs(vel[1]) + p.acc_lim_theta * dt)
+        w = min(p.max_vel_theta, w_stop, 2.0 * abs(err), abs(vel[1]) + p.acc_lim_theta * dt)
         w = max(w, p.min_vel_theta)
         return Command(0.0, math.copysign(w, err))
 

@@ -45,6 +45,7 @@ from ninjemys.nav.rosglue import (
     param,
     pose_msg_to_2d,
     scan_arrays,
+    sleep,
     start_node,
 )
 from ninjemys.nav.slam import compose, inverse
@@ -436,8 +437,7 @@ class MoveBase:
         if freqs:
             period = 1.0 / max(freqs)
         last = {id(self.global_cm): 0.0, id(self.local_cm): 0.0}
-        while not rospy.is_shutdown():
-            rospy.sleep(period)
+        while sleep(period):
             t = rospy.get_time()
             for cm in (self.global_cm, self.local_cm):
                 if cm.publish_frequency <= 0 or t - last[id(cm)] < 1.0 / cm.publish_frequency - 1e-6:
@@ -571,14 +571,12 @@ class MoveBase:
     def _check_oscillation(self, gpose: Pose2D, now: float) -> None:
         if self.oscillation_timeout <= 0:
             return
-        if (
-            self.osc_pose is None
-            or math.hypot(gpose[0] - self.osc_pose[0], gpose[1] - self.osc_pose[1])
-            >= self.oscillation_distance
-        ):
-            self.osc_pose = gpose
-            self.osc_time = now
-            self.recovery_index = 0 if self.state == "controlling" else self.recovery_index
+        if self.osc_pose is None:
+            self.osc_pose, self.osc_time = gpose, now
+            return
+        if math.hypot(gpose[0] - self.osc_pose[0], gpose[1] - self.osc_pose[1]) >= self.oscillation_distance:
+            self.osc_pose, self.osc_time = gpose, now
+            self.recovery_index = 0  # real progress: the recovery sequence starts over, as in ROS 1
             return
         if now - self.osc_time > self.oscillation_timeout:
             with self.lock:

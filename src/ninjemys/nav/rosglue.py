@@ -137,6 +137,15 @@ def scan_arrays(scan: Any) -> tuple[np.ndarray, np.ndarray]:
     return ranges, angles
 
 
+def sleep(seconds: float) -> bool:
+    """Sleep ``seconds`` of ROS time; False once the node is shutting down (for background loops)."""
+    try:
+        rospy.sleep(seconds)
+    except rospy.ROSInterruptException:
+        return False
+    return not rospy.is_shutdown()
+
+
 def param(node: Any, key: str, default: Any) -> Any:
     """A private parameter with ROS 1's default; a value of the wrong kind is reported and ignored."""
     value = node.get_param("~" + key, default)
@@ -153,9 +162,9 @@ def param(node: Any, key: str, default: Any) -> Any:
             return float(value)
     except (TypeError, ValueError):
         rospy.logerr(
-            "%s: parameter ~%s: expected a %s, got %r; using %r",
+            "%s: parameter %s: expected a %s, got %r; using %r",
             node.name,
-            key,
+            node.resolve_name("~" + key),
             type(default).__name__,
             value,
             default,

@@ -4,9 +4,10 @@
   than its timeout (the watchdog: a stale input no longer counts; no input at all means stop).
 - :func:`stop_distance` is how far the robot travels before it stands still from speed ``v``:
   ``v * reaction_time + v^2 / (2 * max_decel)``.
-- :func:`blocked` says whether any laser point (base frame) lies in the stop zone: the band swept by
-  the footprint (half-width ``radius + margin``) from the robot's front (or back, when reversing) out
-  to ``radius + margin + stop_distance``.
+- :func:`blocked` says whether the motion, held for the reaction time and then braked, would bring
+  the body (plus a margin) closer to a laser point it is not already moving away from: the stop zone
+  is what the footprint sweeps along the commanded arc, so turning in place and backing away stay
+  allowed.
 """
 
 from __future__ import annotations
@@ -52,12 +53,34 @@ def stop_distance(v: float, max_decel: float, reaction_time: float) -> float:
 
 
 def blocked(
-    points: np.ndarray, v: float, radius: float, margin: float, max_decel: float, reaction_time: float
+    points: np.ndarray,
+    v: float,
+    w: float,
+    radius: float,
+    margin: float,
+    max_decel: float,
+    reaction_time: float,
+    obstacle_speed: float = 0.0,
+    steps: int = 12,
 ) -> bool:
-    """True when a point (n, 2) in the base frame is in the stop zone for moving at ``v``."""
+    """True when moving at (v, w) until standing still would bring the body closer than
+    ``radius + margin + obstacle_speed * T`` to a laser point (n, 2, base frame) that it is not
+    already moving away from. ``T`` is the reaction time plus the braking time; the robot's path over
+    ``T`` is the arc of (v, w). ``obstacle_speed`` covers people walking towards the robot meanwhile.
+    """
     if v == 0.0 or len(points) == 0:
         return False
-    reach = radius + margin + stop_distance(v, max_decel, reaction_time)
-    x = points[:, 0] if v > 0 else -points[:, 0]
-    y = points[:, 1]
-    return bool(np.any((x > 0) & (x < reach) & (np.abs(y) < radius + margin)))
+    horizon = reaction_time + abs(v) / max(max_decel, 1e-6)
+    clearance = radius + margin + obstacle_speed * horizon
+    travel = abs(v) * horizon
+    near = points[np.hypot(points[:, 0], points[:, 1]) < clearance + travel]
+    if len(near) == 0:
+        return False
+    t = np.linspace(0.0, horizon, steps + 1)[1:]
+    if abs(w) < 1e-6:
+        px, py = v * t, np.zeros_like(t)
+    else:
+        px, py = v / w * np.sin(w * t), v / w * (1.0 - np.cos(w * t))
+    d_now = np.hypot(near[:, 0], near[:, 1])
+    d_future = np.hypot(near[:, 0:1] - px[None, :], near[:, 1:2] - py[None, :]).min(axis=1)
+    return bool(np.any((d_future < clearance) & (d_future < d_now - 1e-3)))

@@ -7,10 +7,10 @@ priority goes out on ``cmd_vel``, after these guards:
 
 - watchdog: an input older than its timeout does not count; with none left the robot is stopped
   (zero twists for one second, then silence);
-- stop zone: a forward (or backward) motion is cut to zero when a point of the latest ``scan`` lies in
-  the band the footprint (``~robot_radius`` or ``~footprint``, plus ``~safety_margin``) sweeps within
-  the stopping distance at the commanded or current speed (``~max_decel``, ``~reaction_time``);
-  turning in place stays allowed;
+- stop zone: the linear velocity is cut to zero when driving the commanded arc for ``~reaction_time``
+  and then braking (``~max_decel``) would bring the footprint (``~robot_radius`` or ``~footprint``)
+  within ``~safety_margin`` (+ ``~obstacle_speed`` x that time, for people walking in) of a point of
+  the latest ``scan`` it is not already moving away from; turning in place stays allowed;
 - localization: when ``amcl_pose``'s position variance (xx + yy) exceeds ``~max_position_covariance``,
   inputs named in ``~localization_inputs`` (default ``[navigation]``) are ignored;
 - e-stop: ``e_stop`` (std_msgs/Bool, true) or the ``~e_stop`` service (std_srvs/SetBool, true) latches
@@ -30,7 +30,7 @@ import numpy as np
 
 import rospy
 from ninjemys.nav.costmap import footprint_radii, parse_footprint
-from ninjemys.nav.rosglue import Tf2D, param, scan_arrays, start_node
+from ninjemys.nav.rosglue import Tf2D, param, scan_arrays, sleep, start_node
 from ninjemys.nav.safety import MuxInput, TwistMux, blocked
 
 DEFAULT_TOPICS = [
@@ -85,6 +85,7 @@ class SafetyMonitor:
         self.margin = param(node, "safety_margin", 0.05)
         self.max_decel = param(node, "max_decel", 1.0)
         self.reaction = param(node, "reaction_time", 0.15)
+        self.obstacle_speed = param(node, "obstacle_speed", 0.0)
         self.max_cov = param(node, "max_position_covariance", 0.5)
         self.loc_inputs = set(node.get_param("~localization_inputs", ["navigation"]) or [])
         self.rate = max(1.0, param(node, "rate", 20.0))
@@ -228,8 +229,7 @@ class SafetyMonitor:
     def diag_loop(self) -> None:
         from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
 
-        while not rospy.is_shutdown():
-            rospy.sleep(1.0)
+        while sleep(1.0):
             with self.lock:
                 e_stop, active, is_blocked, cov = self.e_stop, self.active, self.blocked, self.cov
             status = DiagnosticStatus(name="safety_monitor: Safety", hardware_id="puzzlebot")

@@ -17,7 +17,7 @@ import numpy as np
 
 import rospy
 from ninjemys.nav.mapio import GridMap
-from ninjemys.nav.rosglue import Tf2D, grid_to_msg, param, scan_arrays, start_node, tf_item
+from ninjemys.nav.rosglue import Tf2D, grid_to_msg, param, scan_arrays, sleep, start_node, tf_item
 from ninjemys.nav.slam import ScanMatchMapper, SlamParams
 
 
@@ -55,8 +55,7 @@ class SlamNode:
             threading.Thread(target=self.tf_loop, name="slam-tf", daemon=True).start()
 
     def tf_loop(self) -> None:
-        while not rospy.is_shutdown():
-            rospy.sleep(self.tf_period)
+        while sleep(self.tf_period):
             with self.lock:
                 corr = self.correction
             self.tf.send([tf_item(self.map_frame, self.odom_frame, rospy.get_time() + self.tf_period, corr)])

@@ -90,6 +90,7 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
             "tf_echo": ("ninjemys.tools.tf_echo:main", ()),
             "tf_monitor": ("ninjemys.tools.tf_monitor:main", ()),
             "static_transform_publisher": ("ninjemys.tools.static_transform_publisher:tf_main", ()),
+            "view_frames": ("ninjemys.tools.view_frames:tf_main", ()),
         },
         "tf2_tools": {"view_frames.py": ("ninjemys.tools.view_frames:main", ())},
         "rosbag": {

@@ -1,0 +1,98 @@
+"""Bad input to the navigation nodes: one clear line naming the problem, and the node keeps running."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import time
+
+import pytest
+import yaml
+
+from ninjemys.testing import ninjemys_bin, run_master
+
+
+@pytest.fixture
+def master(tmp_path):
+    with run_master() as uri:
+        yield dict(os.environ, ROS_MASTER_URI=uri, ROS_HOME=str(tmp_path / "ros_home"), PYTHONUNBUFFERED="1")
+
+
+def run_node(env: dict[str, str], args: list[str], wait_for: str, timeout: float = 30.0) -> tuple[str, bool]:
+    """Start ``rosrun <args>``, collect its output until ``wait_for`` shows up; (output, still running)."""
+    log = os.path.join(env["ROS_HOME"], f"{args[1]}.out")
+    os.makedirs(env["ROS_HOME"], exist_ok=True)
+    with open(log, "w") as sink:
+        proc = subprocess.Popen(
+            [ninjemys_bin("rosrun"), *args], env=env, stdout=sink, stderr=subprocess.STDOUT
+        )
+    deadline = time.monotonic() + timeout
+    try:
+        while time.monotonic() < deadline and proc.poll() is None:
+            with open(log) as f:
+                if wait_for in f.read():
+                    break
+            time.sleep(0.1)
+        time.sleep(1.0)
+        alive = proc.poll() is None
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+    with open(log) as f:
+        return f.read(), alive
+
+
+def test_map_that_does_not_load(master, tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(
+        "image: m.pgm\nresolution: -1\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.6\nfree_thresh: 0.2\n"
+    )
+    out, alive = run_node(master, ["map_server", "map_server", str(bad)], "must be > 0")
+    lines = [line for line in out.splitlines() if "bad.yaml" in line]
+    assert len(lines) == 1 and "'resolution' must be > 0, got -1" in lines[0]
+    assert "Traceback" not in out
+    assert alive
+
+
+def test_move_base_parameter_of_the_wrong_type(master, tmp_path):
+    params = tmp_path / "params.yaml"
+    params.write_text(
+        yaml.safe_dump({"global_costmap": {"inflation_radius": "wide", "observation_sources": ""}})
+    )
+    subprocess.run(
+        [ninjemys_bin("rosparam"), "load", str(params), "/move_base"], env=master, check=True, timeout=30
+    )
+    out, alive = run_node(master, ["move_base", "move_base"], "inflation_radius")
+    assert (
+        "parameter /move_base/global_costmap/inflation_radius: expected a float, got 'wide'; using 0.55"
+        in out
+    )
+    assert "Traceback" not in out
+    assert alive
+
+
+def test_map_saver_writes_what_map_server_reads(master, tmp_path):
+    from ninjemys.nav.mapio import load_map
+
+    share = os.path.join(os.path.dirname(__file__), "..", "..", "src", "ninjemys", "packages", "share")
+    maze = os.path.abspath(os.path.join(share, "puzzlebot_sim", "maps", "maze.yaml"))
+    server = subprocess.Popen([ninjemys_bin("rosrun"), "map_server", "map_server", maze], env=master)
+    try:
+        saver = subprocess.run(
+            [ninjemys_bin("rosrun"), "map_server", "map_saver", "-f", str(tmp_path / "copy")],
+            env=master,
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
+    finally:
+        server.terminate()
+        server.wait(10)
+    assert saver.returncode == 0, saver.stderr
+    original, copy = load_map(maze), load_map(tmp_path / "copy.yaml")
+    assert copy.data.shape == original.data.shape and copy.origin == original.origin
+    assert (copy.data == original.data).all()

@@ -1,0 +1,305 @@
+"""The whole stack on the simulator: navigation in office and maze, amcl accuracy, safety, bad input.
+
+Each session is one ``roslaunch puzzlebot_navigation navigation.launch gui:=false`` at a real-time
+factor above 1, seeded; the tests check outcomes against the simulator's ground truth
+(``base_pose_ground_truth``, ``contact``), never timings.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import subprocess
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from .conftest import NavSession, pick_goals
+
+pytest.importorskip("ninjemys.sim.puzzlebot_node", reason="the PuzzleBot simulator is not on this branch yet")
+pytest.importorskip("ninjemys.actionlib.server", reason="actionlib is not on this branch yet")
+
+pytestmark = [pytest.mark.slow, pytest.mark.timeout(900)]
+
+DATA = Path(__file__).parent / "data"
+RATE = "4"
+
+
+def ros1_env(session: NavSession) -> dict[str, str]:
+    """Debian's ROS 1 Python environment pointed at the session's master (none of our paths)."""
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV", "PYTHONHOME")}
+    env.update(ROS_MASTER_URI=session.uri, ROS_HOME=session.env["ROS_HOME"], PYTHONUNBUFFERED="1")
+    env["PATH"] = "/usr/bin:/bin"
+    return env
+
+
+def yaw_err(a: float, b: float) -> float:
+    return abs((a - b + math.pi) % (2 * math.pi) - math.pi)
+
+
+def start(world: str, tmp_path: Path, extra: list[str] | None = None) -> NavSession:
+    session = NavSession(
+        "navigation.launch",
+        [f"world:={world}", "gui:=false", f"rate:={RATE}", "seed:=1", *(extra or [])],
+        tmp_path,
+    )
+    probe = session.probe
+    if not session.wait_for(lambda: probe.truth is not None and probe.localized() is not None, 90):
+        log = session.log()
+        session.close()
+        pytest.fail(f"the navigation stack did not come up:\n{log[-3000:]}")
+    return session
+
+
+@pytest.fixture(scope="module")
+def office(tmp_path_factory):
+    session = start("office", tmp_path_factory.mktemp("office"))
+    yield session
+    session.close()
+
+
+def run_ros1_goals(session: NavSession, goals: list[tuple]) -> list[dict]:
+    """Send ``goals`` with Debian's SimpleActionClient; each result carries the ground truth at its end."""
+    proc = subprocess.Popen(
+        ["/usr/bin/python3", str(DATA / "ros1_goals.py"), *(f"{x},{y},{a}" for x, y, a in goals)],
+        env=ros1_env(session),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    results = []
+    assert proc.stdout is not None
+    for line in proc.stdout:
+        try:
+            item = json.loads(line)
+        except ValueError:
+            continue
+        item["truth"] = session.probe.truth
+        results.append(item)
+    proc.wait(30)
+    assert proc.returncode == 0, proc.stderr.read() if proc.stderr else ""
+    return results
+
+
+@pytest.mark.ros1
+def test_office_goals_through_ros1_simple_action_client(office):
+    probe = office.probe
+    goals = pick_goals("office", 20, seed=7)
+    errors: list[float] = []
+    stop = threading.Event()
+    start_time = probe.sim_time
+
+    def sample() -> None:  # amcl's pose (through TF) against the ground truth, every 0.1 s of sim time
+        last = -1.0
+        while not stop.is_set():
+            if probe.sim_time - last >= 0.1:
+                last = probe.sim_time
+                est, truth = probe.localized(), probe.truth
+                if est is not None and truth is not None:
+                    errors.append(math.hypot(est[0] - truth[0], est[1] - truth[1]))
+            time.sleep(0.01)
+
+    sampler = threading.Thread(target=sample, daemon=True)
+    sampler.start()
+    try:
+        results = run_ros1_goals(office, goals)
+    finally:
+        stop.set()
+        sampler.join()
+    assert len(results) == len(goals)
+    reached = 0
+    report = []
+    for item in results:
+        gx, gy, ga = item["goal"]
+        tx, ty, ta = item["truth"]
+        d, a = math.hypot(tx - gx, ty - gy), yaw_err(ta, ga)
+        ok = item["state"] == 3 and d <= 0.2 and a <= 0.3
+        reached += ok
+        report.append(f"{item['goal']} state={item['state']} d={d:.3f} yaw={a:.3f} {item['text']!r}")
+        assert item["feedback"] > 0  # move_base's feedback reached the ROS 1 client
+    assert reached >= 19, "\n".join(report)
+    assert probe.contacts == 0
+    driven = probe.sim_time - start_time
+    rms = math.sqrt(float(np.mean(np.square(errors))))
+    assert driven >= 300, f"only {driven:.0f} s of driving"  # the 5-minute localization run
+    assert rms < 0.10, f"amcl RMS error {rms:.3f} m over {driven:.0f} s"
+
+
+@pytest.mark.ros1
+def test_bad_goals_are_rejected_with_the_reason(office):
+    results = run_ros1_goals(office, [(50.0, 50.0, 0.0), (6.0, 3.0, 0.0)])
+    assert [r["state"] for r in results] == [5, 5]  # REJECTED
+    assert "off the global costmap" in results[0]["text"]
+    assert "in an obstacle" in results[1]["text"]
+    log = office.log()
+    assert "The goal (50.00, 50.00) is off the global costmap" in log
+    assert office.proc.poll() is None
+
+
+def test_stale_teleop_command_stops_the_robot(office):
+    probe = office.probe
+    pub = probe.node.publisher("/teleop/cmd_vel", probe.twist_cls, queue_size=1)
+    time.sleep(1.0)
+    msg = probe.twist_cls()
+    msg.angular.z = 1.0
+    end = probe.sim_time + 1.0
+    while probe.sim_time < end:
+        pub.publish(msg)
+        time.sleep(0.02)
+    assert probe.truth_w > 0.8  # teleop drives the robot through the monitor
+    stale_at = probe.sim_time
+    probe.wait_sim(0.5 + 0.3)  # the watchdog's 0.5 s, then the wheels' deceleration
+    assert abs(probe.truth_w) < 0.05 and abs(probe.truth_v) < 0.02, (
+        f"still moving {probe.sim_time - stale_at:.2f} s after"
+    )
+    pub.unregister()
+
+
+def test_teleop_overrides_navigation(office):
+    probe = office.probe
+    goal_pub = probe.node.publisher("/move_base_simple/goal", probe.pose_cls, queue_size=1, latch=True)
+    teleop = probe.node.publisher("/teleop/cmd_vel", probe.twist_cls, queue_size=1)
+    time.sleep(1.0)
+    target = (-1.0, 0.0, math.pi)
+    if probe.truth and math.hypot(probe.truth[0] - target[0], probe.truth[1] - target[1]) < 1.0:
+        target = (2.0, 0.0, 0.0)
+    goal = probe.pose_cls()
+    goal.header.frame_id = "map"
+    goal.pose.position.x, goal.pose.position.y = target[0], target[1]
+    goal.pose.orientation.z, goal.pose.orientation.w = math.sin(target[2] / 2), math.cos(target[2] / 2)
+    goal_pub.publish(goal)
+    probe.wait_sim(3.0)
+    msg = probe.twist_cls()
+    msg.angular.z = -0.8
+    samples = []
+    end = probe.sim_time + 2.0
+    while probe.sim_time < end:
+        teleop.publish(msg)
+        time.sleep(0.02)
+        samples.append((probe.truth_v, probe.truth_w))
+    late = samples[len(samples) // 2 :]
+    assert all(abs(w + 0.8) < 0.15 and abs(v) < 0.03 for v, w in late), late[:5]
+    # teleop goes quiet: navigation takes over again and reaches its goal
+    ok = office.wait_for(
+        lambda: (
+            probe.truth is not None
+            and math.hypot(probe.truth[0] - target[0], probe.truth[1] - target[1]) < 0.2
+            and abs(probe.truth_v) < 0.01
+        ),
+        120,
+    )
+    assert ok and probe.contacts == 0
+    teleop.unregister()
+    goal_pub.unregister()
+
+
+def test_spawned_obstacle_stops_then_replans_around(office):
+    from ninjemys.idl.loader import get_service_class
+
+    probe = office.probe
+    goal_pub = probe.node.publisher("/move_base_simple/goal", probe.pose_cls, queue_size=1, latch=True)
+    time.sleep(1.0)
+
+    def go(x: float, y: float, yaw: float) -> bool:
+        goal = probe.pose_cls()
+        goal.header.frame_id = "map"
+        goal.pose.position.x, goal.pose.position.y = x, y
+        goal.pose.orientation.z, goal.pose.orientation.w = math.sin(yaw / 2), math.cos(yaw / 2)
+        goal_pub.publish(goal)
+        return office.wait_for(
+            lambda: (
+                probe.truth is not None
+                and math.hypot(probe.truth[0] - x, probe.truth[1] - y) < 0.2
+                and abs(probe.truth_v) < 0.01
+                and abs(probe.truth_w) < 0.05
+            ),
+            150,
+        )
+
+    assert go(-1.0, -0.3, 0.0)
+    probe.wait_sim(1.0)
+    target = (3.0, -0.3, 0.0)
+    goal = probe.pose_cls()
+    goal.header.frame_id = "map"
+    goal.pose.position.x, goal.pose.position.y = target[0], target[1]
+    goal.pose.orientation.w = 1.0
+    goal_pub.publish(goal)
+    assert office.wait_for(lambda: probe.truth is not None and probe.truth[0] > -0.4, 60)
+    spawn = probe.node.service_proxy("/gazebo/spawn_urdf_model", get_service_class("gazebo_msgs/SpawnModel"))
+    req = (
+        spawn.request_class()
+        if hasattr(spawn, "request_class")
+        else get_service_class("gazebo_msgs/SpawnModel")._request_class()
+    )
+    req.model_name = "crate"
+    req.model_xml = '<robot name="crate"><link name="l"><collision><geometry><box size="0.4 0.4 0.5"/></geometry></collision></link></robot>'
+    req.initial_pose.position.x = probe.truth[0] + 1.0
+    req.initial_pose.position.y = -0.3
+    req.initial_pose.orientation.w = 1.0
+    assert spawn(req).success
+    reached = office.wait_for(
+        lambda: (
+            math.hypot(probe.truth[0] - target[0], probe.truth[1] - target[1]) < 0.2
+            and abs(probe.truth_v) < 0.01
+        ),
+        180,
+    )
+    assert probe.contacts == 0, "the robot touched the spawned crate"
+    assert reached, f"did not get around the crate: at {probe.truth}"
+    goal_pub.unregister()
+
+
+def test_nan_inf_scans_are_reported_once_and_skipped(office):
+    log = office.log()
+    assert log.count("amcl: scan from laser has") == 1
+    assert log.count("move_base: scan on laser has NaN/inf ranges") == 1
+    assert office.proc.poll() is None
+
+
+def wait_goal(session: NavSession, goal: tuple, limit: float) -> bool:
+    probe = session.probe
+    start = probe.sim_time
+
+    def arrived() -> bool:
+        t = probe.truth
+        return (
+            t is not None
+            and math.hypot(t[0] - goal[0], t[1] - goal[1]) <= 0.2
+            and yaw_err(t[2], goal[2]) <= 0.3
+            and abs(probe.truth_v) < 0.01
+            and abs(probe.truth_w) < 0.05
+        )
+
+    while probe.sim_time - start < limit and session.proc.poll() is None:
+        if arrived():
+            probe.wait_sim(0.3)
+            return arrived()
+        time.sleep(0.05)
+    return False
+
+
+def test_maze_goals_through_move_base_simple(tmp_path):
+    session = start("maze", tmp_path)
+    try:
+        probe = session.probe
+        pub = probe.node.publisher("/move_base_simple/goal", probe.pose_cls, queue_size=1, latch=True)
+        time.sleep(1.0)
+        reached, report = 0, []
+        for x, y, a in pick_goals("maze", 20, seed=11, clearance=0.4, spacing=1.2):
+            msg = probe.pose_cls()
+            msg.header.frame_id = "map"
+            msg.pose.position.x, msg.pose.position.y = x, y
+            msg.pose.orientation.z, msg.pose.orientation.w = math.sin(a / 2), math.cos(a / 2)
+            pub.publish(msg)
+            probe.wait_sim(0.5)
+            ok = wait_goal(session, (x, y, a), 150.0)
+            reached += ok
+            report.append(f"({x}, {y}, {a}) {'ok' if ok else 'MISSED'} at {probe.truth}")
+        assert reached >= 19, "\n".join(report)
+        assert probe.contacts == 0
+    finally:
+        session.close()
