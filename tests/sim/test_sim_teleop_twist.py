@@ -41,7 +41,7 @@ def test_keys_publish_on_cmd_vel(master: str, client) -> None:  # type: ignore[n
     client.subscriber("/cmd_vel", Twist, on_twist)
     cmd = shipped_executable("teleop_twist_keyboard", "teleop_twist_keyboard.py").command([])
     child = pexpect.spawn(
-        cmd[0], cmd[1:], env=dict(os.environ, ROS_MASTER_URI=master), encoding="utf-8", timeout=20
+        cmd[0], cmd[1:], env=dict(os.environ, ROS_MASTER_URI=master), encoding="utf-8", timeout=40
     )
     try:
         child.expect_exact("Reading from the keyboard  and Publishing to Twist!")
