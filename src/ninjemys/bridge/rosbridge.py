@@ -290,6 +290,11 @@ class RosbridgeSession:
             "fragment_size": self._field(msg, "fragment_size", int, None),
             "compression": self._field(msg, "compression", str, "none"),
         }
+        for name in ("throttle_rate", "queue_length", "fragment_size"):
+            if opts[name] is not None and opts[name] < 0:
+                raise OpError(f"field {name!r} must not be negative, got {opts[name]}")
+        if opts["fragment_size"] == 0:
+            opts["fragment_size"] = None
         if opts["compression"] not in ("none", "png", "cbor", "cbor-raw"):
             raise OpError(f"compression must be none, png, cbor or cbor-raw, got {opts['compression']!r}")
         with self._lock:
