@@ -275,7 +275,10 @@ class MoveBase:
         # read without move_base's lock: the action server calls this with its own lock held, and the
         # control loop takes the two in the other order (the grid and its costs are replaced, not edited)
         cm = self.global_cm.costmap
-        costs, size_x, size_y = cm.costs, cm.size_x, cm.size_y
+        # judged on the map (static layer, inflated), not on what the sensors see now: a person
+        # standing on the goal does not make it a bad goal
+        costs = cm.static_costs if cm.static_costs is not None else cm.costs
+        size_x, size_y = cm.size_x, cm.size_y
         ox, oy, res = cm.origin_x, cm.origin_y, cm.resolution
         if size_x == 0 or costs.shape != (size_y, size_x):
             return None, "the global costmap has no map yet"
