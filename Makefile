@@ -35,9 +35,12 @@ $(STAMP): pyproject.toml
 
 venv: $(STAMP)
 
-# Installs the Debian packages the tests compare against (root or sudo needed; skipped when present).
+# Installs the Debian packages the tests compare against (root or sudo needed; skipped when present),
+# and Node.js with npm for the Foxglove client tests when no node/npm is on PATH (any build will do).
 system:
 	@missing=""; for p in $(SYSTEM_DEBS); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
+	command -v node >/dev/null 2>&1 || missing="$$missing nodejs"; \
+	command -v npm >/dev/null 2>&1 || missing="$$missing npm"; \
 	if [ -n "$$missing" ]; then \
 		echo "installing Debian packages:$$missing"; \
 		SUDO=""; [ "$$(id -u)" = 0 ] || SUDO=sudo; \

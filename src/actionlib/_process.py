@@ -1,8 +1,11 @@
-"""How the actionlib facade reaches rospy's process: its core node, its ROS clock, its log."""
+"""How the actionlib facade reaches rospy's process: the core node ``rospy.init_node`` made.
+
+The cores take their clock (ROS time, simulated under /use_sim_time) and their log (console, log
+file and /rosout) from that node, so a facade object behaves like the rest of the rospy program.
+"""
 
 from __future__ import annotations
 
-import rospy
 import rospy.core
 
 TYPE_CHECKING = False
@@ -13,31 +16,3 @@ if TYPE_CHECKING:
 def node() -> Any:
     """The core Node of ``rospy.init_node`` (ROSInitException before it)."""
     return rospy.core.process_node()
-
-
-def clock() -> Any:
-    """rospy's ROS clock (wall time, or /clock under use_sim_time): waits and stamps follow it."""
-    return getattr(node(), "clock", None) or rospy.core._process.clock
-
-
-class RospyLog:
-    """The cores' log interface onto rospy's loggers (console, log file and /rosout)."""
-
-    @staticmethod
-    def debug(msg: Any, *args: Any) -> None:
-        rospy.logdebug(msg, *args)
-
-    @staticmethod
-    def info(msg: Any, *args: Any) -> None:
-        rospy.loginfo(msg, *args)
-
-    @staticmethod
-    def warn(msg: Any, *args: Any) -> None:
-        rospy.logwarn(msg, *args)
-
-    @staticmethod
-    def error(msg: Any, *args: Any) -> None:
-        rospy.logerr(msg, *args)
-
-
-LOG = RospyLog()

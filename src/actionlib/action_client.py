@@ -39,7 +39,7 @@ class ActionClient(_core.ActionClient):
     """``ActionClient(ns, ActionSpec)`` on the node of ``rospy.init_node``."""
 
     def __init__(self, ns: str, ActionSpec: Any) -> None:  # noqa: N803 - ROS 1's signature
-        super().__init__(_process.node(), ns, ActionSpec, clock=_process.clock(), log=_process.LOG)
+        super().__init__(_process.node(), ns, ActionSpec)
         self.ActionSpec = ActionSpec
         self.ActionGoal = self.types.action_goal
         self.ActionResult = self.types.action_result

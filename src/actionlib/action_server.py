@@ -37,8 +37,6 @@ class ActionServer(_core.ActionServer):
             goal_cb,
             cancel_cb,
             auto_start,
-            clock=_process.clock(),
-            log=_process.LOG,
         )
         self.ActionSpec = ActionSpec
         self.ActionGoal = self.types.action_goal

@@ -23,4 +23,4 @@ class SimpleActionClient(_core.SimpleActionClient):
     """
 
     def __init__(self, ns: str, ActionSpec: Any) -> None:  # noqa: N803 - ROS 1's signature
-        super().__init__(_process.node(), ns, ActionSpec, clock=_process.clock(), log=_process.LOG)
+        super().__init__(_process.node(), ns, ActionSpec)

@@ -30,6 +30,4 @@ class SimpleActionServer(_core.SimpleActionServer):
             ActionSpec,
             execute_cb,
             auto_start,
-            clock=_process.clock(),
-            log=_process.LOG,
         )

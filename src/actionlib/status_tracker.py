@@ -31,6 +31,6 @@ class StatusTracker(_core.StatusTracker):
         if not record.goal_id.id:
             record.goal_id = GoalIDGenerator(_process.node().name).generate_ID()
         if record.goal_id.stamp.is_zero():
-            secs, nsecs = _process.clock().now_pair()
+            secs, nsecs = _process.node().clock.now_pair()
             record.goal_id.stamp = Time(secs, nsecs)
         super().__init__(record, goal)

@@ -127,8 +127,7 @@ class Transformer:
 
     def getFrameStrings(self) -> list[str]:  # noqa: N802
         """The child frames that have data (the keys of ``all_frames_as_yaml``, as ROS 1's tf returns)."""
-        with self._buffer._lock:
-            return [f.name for f in self._buffer._order if f.has_cache and f.data]
+        return self._buffer.child_frames()
 
     def getLatestCommonTime(self, source_frame: str, dest_frame: str) -> Any:  # noqa: N802
         return self._buffer.get_latest_common_time(

@@ -196,3 +196,30 @@ def test_action_client_tracks_many_goals_and_cancel_rules(nodes: Any) -> None:
         assert time.monotonic() < deadline
         time.sleep(0.01)
     assert [g.get_terminal_state() for g in goals] == [S.PREEMPTED] * 4
+
+
+def test_goal_storm_preempting_each_other_ends_every_goal(nodes: Any) -> None:
+    """Goals arriving while others execute, each preempting the previous: locks never cross, and
+    every goal ends PREEMPTED or RECALLED once all are cancelled."""
+
+    def execute(_goal: Any) -> None:
+        while not server.is_preempt_requested():
+            time.sleep(0.001)
+        server.set_preempted()
+
+    server = SimpleActionServer(nodes("server"), "storm", TwoIntsAction, execute)
+    server.start()
+    client = ActionClient(nodes("client"), "storm", TwoIntsAction)
+    assert client.wait_for_server(10.0)
+    goals = [client.send_goal(TwoIntsGoal(a=i)) for i in range(150)]
+    time.sleep(0.2)
+    client.cancel_all_goals()
+    deadline = time.monotonic() + 20
+    while any(g.get_comm_state() != CommState.DONE for g in goals):
+        assert time.monotonic() < deadline, [
+            (i, CommState.to_string(g.get_comm_state()), g.get_goal_status())
+            for i, g in enumerate(goals)
+            if g.get_comm_state() != CommState.DONE
+        ]
+        time.sleep(0.02)
+    assert {g.get_terminal_state() for g in goals} <= {S.PREEMPTED, S.RECALLED}

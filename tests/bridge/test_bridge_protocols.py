@@ -6,10 +6,13 @@ from __future__ import annotations
 import base64
 import json
 import struct
+import subprocess
+import threading
 import time
 from collections.abc import Callable
 
 import cbor2
+import pytest
 from bridge_helpers import png_pixels, wait_for
 from websockets.sync.client import ClientConnection, connect
 
@@ -17,6 +20,7 @@ from ninjemys.bridge.server import Gateway
 from ninjemys.idl.loader import get_message_class
 from ninjemys.node import Node
 from ninjemys.rostime import Time
+from ninjemys.testing import ros1_env
 
 String = get_message_class("std_msgs/String")
 Clock = get_message_class("rosgraph_msgs/Clock")
@@ -117,10 +121,12 @@ def test_foxglove_time_under_sim_time(make_gateway: Callable[..., Gateway], node
 
 def test_foxglove_connection_graph_and_parameter_updates(gateway: Gateway, node: Node) -> None:
     node.set_param("/fox/gain", 1)
+    node.publisher("/graph_seed", String)
+    wait_for(lambda: "/graph_seed" in gateway.catalog.graph["pub"], what="the graph poll")
     with connect(f"ws://127.0.0.1:{gateway.port}/", subprotocols=["foxglove.websocket.v1"]) as ws:
         ws.send(json.dumps({"op": "subscribeConnectionGraph"}))
         graph = first(ws, lambda m: isinstance(m, dict) and m.get("op") == "connectionGraphUpdate")
-        assert any(t["name"] == "/client_count" for t in graph["publishedTopics"])
+        assert any(t["name"] == "/graph_seed" for t in graph["publishedTopics"])
         node.publisher("/fresh_topic", String)
         update = first(
             ws,
@@ -154,3 +160,146 @@ def test_foxglove_connection_graph_and_parameter_updates(gateway: Gateway, node:
             )
         )
         wait_for(lambda: node.has_param("/fox/blob"), what="a byte_array parameter")
+
+
+def test_foxglove_client_publishes_a_type_we_do_not_ship(gateway: Gateway, node: Node) -> None:
+    got: list[bytes] = []
+    node.subscriber("/custom", None, lambda m: got.append(bytes(m.data)), raw=True)
+    schema = "int32 a\nstring label\n"
+    payload = struct.pack("<iI", 7, 3) + b"abc"
+    with connect(f"ws://127.0.0.1:{gateway.port}/", subprotocols=["foxglove.websocket.v1"]) as ws:
+        channel = {
+            "id": 4,
+            "topic": "/custom",
+            "encoding": "ros1",
+            "schemaName": "my_robot/Thing",
+            "schema": schema,
+        }
+        ws.send(json.dumps({"op": "advertise", "channels": [channel]}))
+
+        def sent() -> bool:
+            ws.send(struct.pack("<BI", 1, 4) + payload)
+            return bool(got)
+
+        wait_for(sent, what="the client's custom-type message")
+    assert got[0] == payload
+    assert ["/custom", "my_robot/Thing"] in node.master.get_topic_types()
+
+
+def test_a_flood_of_ops_is_absorbed(gateway: Gateway, node: Node) -> None:
+    """A client sending ops faster than they run: reading pauses (bounded backlog), nothing is lost."""
+    got: list[str] = []
+    node.subscriber("/flood", String, lambda m: got.append(m.data), queue_size=10000)
+    with connect(f"ws://127.0.0.1:{gateway.port}/") as ws:
+        ws.send(json.dumps({"op": "advertise", "topic": "/flood", "type": "std_msgs/String"}))
+        wait_for(
+            lambda: (
+                gateway.publishers.get("/flood") and gateway.publishers.get("/flood")[0].get_num_connections()
+            ),
+            what="the subscriber connected",
+        )
+        for i in range(3000):
+            ws.send(json.dumps({"op": "publish", "topic": "/flood", "msg": {"data": str(i)}}))
+        wait_for(lambda: len(got) == 3000, timeout=60, what="every published message")
+    assert got[-1] == "2999"
+
+
+def test_throttle_rate_and_cleanup_on_disconnect(gateway: Gateway, node: Node) -> None:
+    pub = node.publisher("/fast", String)
+    with connect(f"ws://127.0.0.1:{gateway.port}/") as ws:
+        ws.send(
+            json.dumps({"op": "subscribe", "topic": "/fast", "type": "std_msgs/String", "throttle_rate": 400})
+        )
+        wait_for(lambda: pub.get_num_connections(), what="the gateway's subscription")
+        received = 0
+        end = time.monotonic() + 1.5
+        while time.monotonic() < end:  # 50 Hz for 1.5 s; at most one message per 400 ms gets through
+            pub.publish(String(data="x"))
+            try:
+                while True:
+                    received += json.loads(ws.recv(timeout=0.02)).get("op") == "publish"
+            except TimeoutError:
+                pass
+        assert 2 <= received <= 5
+        ws.send(json.dumps({"op": "advertise", "topic": "/from_client", "type": "std_msgs/String"}))
+        wait_for(lambda: gateway.publishers.get("/from_client"), what="the client's publisher")
+    # the client left: its subscription and publisher are gone from the graph
+    wait_for(
+        lambda: not gateway.taps.topics() and gateway.publishers.get("/from_client") is None, what="cleanup"
+    )
+    wait_for(lambda: pub.get_num_connections() == 0, what="the tap's connection closed")
+
+
+@pytest.mark.ros1
+def test_real_ros1_publisher_to_foxglove_and_rosbridge(gateway: Gateway, master_uri: str) -> None:
+    """Debian's rostopic pub -> gateway: Foxglove gets the exact TCPROS bytes, rosbridge the JSON."""
+    proc = subprocess.Popen(
+        ["/usr/bin/rostopic", "pub", "-r", "20", "/real_chatter", "std_msgs/String", "data: from real ROS"],
+        env=ros1_env(master_uri),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    try:
+        wait_for(
+            lambda: any(c["topic"] == "/real_chatter" for c in gateway.catalog.channels.values()),
+            timeout=30,
+            what="channel",
+        )
+        cid = next(c["id"] for c in gateway.catalog.channels.values() if c["topic"] == "/real_chatter")
+        with connect(f"ws://127.0.0.1:{gateway.port}/", subprotocols=["foxglove.websocket.v1"]) as fox:
+            fox.send(json.dumps({"op": "subscribe", "subscriptions": [{"id": 3, "channelId": cid}]}))
+            data = first(fox, lambda m: isinstance(m, bytes) and m[0] == 1)
+            assert data[13:] == String(data="from real ROS").serialize_to_bytes()
+        with connect(f"ws://127.0.0.1:{gateway.port}/") as ws:
+            ws.send(json.dumps({"op": "subscribe", "topic": "/real_chatter"}))
+            msg = first(ws, lambda m: isinstance(m, dict) and m.get("op") == "publish")
+            assert msg["msg"] == {"data": "from real ROS"}
+    finally:
+        proc.terminate()
+        proc.wait(10)
+
+
+def test_rosbridge_subscribes_to_a_type_only_the_publisher_knows(gateway: Gateway, node: Node) -> None:
+    from ninjemys.idl.loader import message_class_from_definition
+
+    Thing = message_class_from_definition("their_robot/Status", "int32 level\nstring[] notes\n")
+    pub = node.publisher("/their_status", Thing)
+    with connect(f"ws://127.0.0.1:{gateway.port}/") as ws:
+        ws.send(json.dumps({"op": "subscribe", "topic": "/their_status", "type": "no_such/Type"}))
+        assert "no_such/Type" in json.loads(ws.recv(timeout=5))["msg"]
+        ws.send(json.dumps({"op": "subscribe", "topic": "/their_status"}))
+        msg = first(
+            ws,
+            lambda m: isinstance(m, dict) and m.get("op") == "publish",
+            lambda: pub.publish(Thing(level=3, notes=["ok"])),
+        )
+        assert msg["msg"] == {"level": 3, "notes": ["ok"]}
+
+
+def test_foxglove_channel_for_a_type_only_the_publisher_knows(gateway: Gateway, node: Node) -> None:
+    """The schema of a type the gateway cannot load comes from a publisher's connection header."""
+    from ninjemys.idl.loader import message_class_from_definition
+
+    Thing = message_class_from_definition("their_robot/Pose2", "float64 x\nfloat64 y\nstring frame\n")
+    pub = node.publisher("/their_pose", Thing)
+    sample = Thing(x=1.5, y=-2.0, frame="map")
+    stop = threading.Event()
+
+    def publish() -> None:
+        while not stop.wait(0.05):
+            pub.publish(sample)
+
+    threading.Thread(target=publish, daemon=True).start()
+    try:
+        channel = wait_for(
+            lambda: next((c for c in gateway.catalog.channels.values() if c["topic"] == "/their_pose"), None),
+            timeout=20,
+            what="a channel for the unknown type",
+        )
+        assert channel["schemaName"] == "their_robot/Pose2" and channel["schema"] == Thing._full_text
+        with connect(f"ws://127.0.0.1:{gateway.port}/", subprotocols=["foxglove.websocket.v1"]) as ws:
+            ws.send(json.dumps({"op": "subscribe", "subscriptions": [{"id": 5, "channelId": channel["id"]}]}))
+            data = first(ws, lambda m: isinstance(m, bytes) and m[0] == 1)
+            assert data[13:] == sample.serialize_to_bytes()
+    finally:
+        stop.set()

@@ -5,6 +5,7 @@ from __future__ import annotations
 import subprocess
 import textwrap
 import threading
+import time
 from collections.abc import Iterator
 
 import pytest
@@ -134,16 +135,51 @@ def test_tf_through_tfclient(ros: object, master_uri: str) -> None:
         client = TFClient(ros, fixed_frame="world", rate=10.0, angular_threshold=0.01)
         client.subscribe("base_link", frames.append)
 
-        def broadcast() -> bool:
+        def broadcast(x: float = 1.25) -> bool:
             t = Stamped()
             t.header.frame_id, t.child_frame_id = "world", "base_link"
-            t.transform.translation.x = 1.25
+            t.transform.translation.x = x
             t.transform.rotation.w = 1.0
             broadcaster.sendTransform(t)
             return bool(frames)
 
         wait_for(broadcast, timeout=20, what="a transform through the TFClient")
         assert frames[0]["translation"]["x"] == pytest.approx(1.25)
+
+        # the action interface (TFSubscription): transforms come as the goal's feedback
+        from roslibpy.ros1.actionlib import ActionClient, Goal
+
+        client = ActionClient(ros, "/tf2_web_republisher", "tf2_web_republisher/TFSubscriptionAction")
+        feedback: list[dict] = []
+        goal = Goal(
+            client,
+            roslibpy.Message(
+                {
+                    "source_frames": ["base_link"],
+                    "target_frame": "world",
+                    "angular_thres": 0.01,
+                    "trans_thres": 0.01,
+                    "rate": 10.0,
+                }
+            ),
+        )
+        goal.on("feedback", feedback.append)
+        goal.send()
+        wait_for(lambda: broadcast() and False or feedback, timeout=20, what="TFSubscription feedback")
+        transform = feedback[0]["transforms"][0]
+        assert transform["header"]["frame_id"] == "world" and transform["child_frame_id"] == "base_link"
+        goal.cancel()
+        wait_for(
+            lambda: goal.status and goal.status["status"] == 2,
+            timeout=20,
+            what="the goal cancelled (PREEMPTED)",
+        )
+        # the service's subscription keeps flowing after the goal ended
+        wait_for(
+            lambda: broadcast(2.5) and frames[-1]["translation"]["x"] == pytest.approx(2.5),
+            timeout=20,
+            what="TFClient updates after the goal's end",
+        )
     finally:
         republisher.shutdown()
         tf_node.shutdown("test over")
@@ -192,3 +228,52 @@ def test_actionlib_goal_through_roslibpy(ros: object, master_uri: str, rosapi: R
     finally:
         proc.terminate()
         proc.wait(10)
+
+
+def test_actionlib_goal_with_feedback_against_ninjemys_actionlib(
+    ros: object, master_uri: str, rosapi: RosApi
+) -> None:
+    """roslibpy's ROS 1 ActionClient against our SimpleActionServer: feedback, then the result."""
+    from roslibpy.ros1.actionlib import ActionClient, Goal
+
+    from ninjemys.actionlib.simple_server import SimpleActionServer
+
+    Fibonacci = get_message_class("actionlib_tutorials/FibonacciAction")
+    Feedback = get_message_class("actionlib_tutorials/FibonacciFeedback")
+    Result = get_message_class("actionlib_tutorials/FibonacciResult")
+    server_node = Node("fibonacci", master_uri=master_uri)
+
+    def execute(goal: object) -> None:
+        seq = [0, 1]
+        for _ in range(1, goal.order):
+            seq.append(seq[-1] + seq[-2])
+            server.publish_feedback(Feedback(sequence=seq))
+            time.sleep(0.05)
+        server.set_succeeded(Result(sequence=seq))
+
+    server = SimpleActionServer(server_node, "/fibonacci", Fibonacci, execute)
+    server.start()
+    try:
+        wait_for(lambda: "/fibonacci/goal" in ros.get_topics(), timeout=30, what="the action server")
+        client = ActionClient(ros, "/fibonacci", "actionlib_tutorials/FibonacciAction")
+        done = threading.Event()
+        results: list[dict] = []
+        feedback: list[dict] = []
+
+        def attempt() -> bool:
+            # the gateway's subscriptions to feedback/result connect while the first goals run:
+            # retry until one goal was seen whole
+            done.clear()
+            feedback.clear()
+            goal = Goal(client, roslibpy.Message({"order": 6}))
+            goal.on("feedback", feedback.append)
+            goal.on("result", lambda r: (results.append(r), done.set()))
+            goal.send()
+            return done.wait(3.0) and len(feedback) == 5
+
+        wait_for(attempt, timeout=30, what="the goal's result")
+        assert results[0]["sequence"] == [0, 1, 1, 2, 3, 5, 8]
+        assert feedback and feedback[-1]["sequence"][:3] == [0, 1, 1]
+    finally:
+        server.stop()
+        server_node.shutdown("test over")

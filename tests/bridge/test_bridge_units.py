@@ -36,6 +36,9 @@ def test_to_json_follows_rosbridge_message_conversion() -> None:
     marker = to_value(Marker(lifetime=get_message_class("std_msgs/Duration")().data))
     assert marker["lifetime"] == {"secs": 0, "nsecs": 0} and marker["points"] == []
     json.dumps(info)  # plain JSON all the way down
+    scan = to_value(LaserScan(range_max=math.inf, ranges=[1.0, math.nan, -math.inf]))
+    assert scan["range_max"] is None and scan["ranges"] == [1.0, None, None]
+    json.dumps(scan, allow_nan=False)
 
 
 def test_to_cbor_uses_bytes_and_typed_arrays() -> None:

@@ -172,3 +172,52 @@ def test_node_log_reaches_rosout_with_its_name(make_node) -> None:
 
 def _rosout_connections(node: Node) -> int:
     return sum(1 for entry in node.bus_info() if entry[4] == "/rosout")
+
+
+def test_a_core_node_follows_rosbag_play_clock(make_node, master, tmp_path) -> None:
+    """``Node(...)`` with the default ``sim_time="auto"`` just works under ``rosbag play --clock``."""
+    import os
+    import struct
+    import subprocess
+
+    from ninjemys.bag.writer import BagWriter
+    from ninjemys.testing import ninjemys_bin
+
+    base = 1_700_000_000 * 1_000_000_000
+    bag = tmp_path / "clocked.bag"
+    header = {
+        "type": b"std_msgs/String",
+        "md5sum": b"992ce8a1687cec8c8bd883ec73ca41d1",
+        "message_definition": b"string data\n",
+    }
+    with BagWriter(bag) as writer:
+        conn = writer.connection("/chatter", header)
+        for i in range(40):
+            text = f"bag {i}".encode()
+            writer.write(conn, base + i * 50_000_000, struct.pack("<I", len(text)) + text)
+    xmlrpc.client.ServerProxy(master.uri).setParam("/test", "/use_sim_time", True)
+    node = make_node("bag_consumer")
+    assert node.clock.is_sim and node.get_time() == 0.0
+    stamps: list[tuple[str, int]] = []
+    ticks: list = []
+    node.subscriber(
+        "/chatter",
+        get_message_class("std_msgs/String"),
+        lambda m: stamps.append((m.data, node.clock.now_ns())),
+    )
+    node.timer(0.5, ticks.append)
+    env = dict(os.environ, ROS_MASTER_URI=master.uri, ROS_HOSTNAME="localhost")
+    player = subprocess.run(
+        [ninjemys_bin("rosbag"), "play", "--clock", "-d", "1.0", "-q", str(bag)],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert player.returncode == 0, player.stderr
+    assert wait_until(lambda: len(stamps) >= 30)
+    # the node's time is the bag's: every message arrives at (about) its recorded time, not wall time
+    assert all(base <= ns <= base + 3 * 1_000_000_000 for _, ns in stamps)
+    assert ticks and all(base / 1e9 <= ev.current_expected.to_sec() <= base / 1e9 + 3 for ev in ticks), [
+        ev.current_expected for ev in ticks
+    ]

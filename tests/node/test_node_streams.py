@@ -15,8 +15,10 @@ import time
 from pathlib import Path
 from types import SimpleNamespace
 
+import pytest
 from node_harness import Child, wait_until
 
+from ninjemys import testing
 from ninjemys.node.subscriber import SubConnection
 from ninjemys.wire.tcpros import frame
 from sensor_msgs.msg import Image, PointCloud2
@@ -111,6 +113,42 @@ def test_saturated_1mb_stream_keeps_calling_back(master, make_node) -> None:
     assert len(arrivals) >= 25, f"only {len(arrivals)} callbacks in 2.5 s of a saturated stream"
     assert max(gaps) <= 0.1, f"the callback stopped for {max(gaps) * 1e3:.0f} ms while the publisher ran"
     assert stamps == sorted(stamps)  # in order, whatever was dropped
+
+
+ROSPY_CLOUD_PUBLISHER = """
+import sys, time, rospy
+from sensor_msgs.msg import PointCloud2, PointField
+rospy.init_node("rospy_cloud")
+n = (1 << 20) // 16
+fields = [PointField(f, 4 * i, PointField.FLOAT32, 1) for i, f in enumerate(("x", "y", "z", "intensity"))]
+msg = PointCloud2(height=1, width=n, fields=fields, point_step=16, row_step=16 * n, is_dense=True, data=bytes(1 << 20))
+pub = rospy.Publisher("/cloud", PointCloud2, queue_size=None)
+while pub.get_num_connections() < 1:
+    time.sleep(0.01)
+time.sleep(0.2)
+end = time.monotonic() + float(sys.argv[1])
+while time.monotonic() < end:
+    msg.header.stamp = rospy.Time.from_sec(time.time())
+    pub.publish(msg)
+print("done", flush=True)
+"""
+
+
+@pytest.mark.ros1
+@pytest.mark.skipif(not testing.have_ros1(), reason="needs Debian's ROS 1")
+def test_saturated_stream_from_real_rospy_keeps_calling_back(master, make_node) -> None:
+    listener = make_node("cloud_listener")
+    arrivals: list[float] = []
+    listener.subscriber("/cloud", PointCloud2, lambda m: arrivals.append(time.perf_counter()), queue_size=10)
+    cmd = ["taskset", "-c", "0", testing.ROS1_PYTHON, "-c", ROSPY_CLOUD_PUBLISHER, "2.5"]
+    pub = Child(cmd, env=testing.ros1_env(master.uri))
+    try:
+        assert pub.wait_line(lambda line: line == "done", timeout=60), pub.describe()
+    finally:
+        pub.kill()
+    gaps = [b - a for a, b in zip(arrivals, arrivals[1:], strict=False)]
+    assert len(arrivals) >= 25, f"only {len(arrivals)} callbacks in 2.5 s of a saturated rospy stream"
+    assert max(gaps) <= 0.1, f"the callback stopped for {max(gaps) * 1e3:.0f} ms while rospy published"
 
 
 def test_image_stream_does_not_delay_a_small_subscription(master, make_node) -> None:

@@ -442,6 +442,10 @@ def test_server_handler_errors_and_bad_requests_keep_the_connection(make_node) -
             raise RuntimeError("unlucky")
         if req.a == 14:
             return None
+        if req.a == 15:
+            raise ServiceError("not today")  # a refusal on purpose: rospy's ServiceException
+        if req.a == 16:
+            return (1, 2, 3)
         return req.a + req.b
 
     server.service("add", AddTwoInts, handler)
@@ -449,8 +453,16 @@ def test_server_handler_errors_and_bad_requests_keep_the_connection(make_node) -
     proxy = client.service_proxy("add", AddTwoInts, persistent=True)
     with pytest.raises(ServiceError, match="error processing request: unlucky"):
         proxy(13, 0)
-    with pytest.raises(ServiceError, match="returned None"):
+    with pytest.raises(ServiceError, match=r"service cannot process request: service handler returned None$"):
         proxy(14, 0)
+    with pytest.raises(
+        ServiceError, match=r"responded with an error: service cannot process request: not today$"
+    ):
+        proxy(15, 0)
+    with pytest.raises(
+        ServiceError, match=r"service cannot process request: handler returned wrong number of values"
+    ):
+        proxy(16, 0)
     # a request of the wrong size does not deserialize: ok=0, and the connection still serves
     proxy._link.sendall(_U32.pack(3) + b"abc")
     ok, body = proxy._link.take(SERVICE_RESPONSE_HEAD)

@@ -158,7 +158,7 @@ def test_timer_fires_with_events_in_sim_time() -> None:
 
 
 def test_timer_oneshot_and_callback_errors() -> None:
-    clock = FakeClock(0.0)
+    clock = FakeClock(10.0)
     errors: list[BaseException] = []
     calls = threading.Semaphore(0)
 
@@ -225,3 +225,27 @@ def test_timer_made_in_wall_time_follows_sim_time_after_switch() -> None:
     finally:
         clock.shutdown()
         timer.join(2)
+
+
+def test_timer_and_rate_made_before_sim_time_starts_count_from_the_first_clock() -> None:
+    """Simulated time 0 means "no /clock yet" (rospy): the first period starts at the first /clock,
+    instead of firing at once with an expected time of 0.5 when /clock jumps to the bag's start."""
+    clock = FakeClock(0.0)
+    events: list[TimerEvent] = []
+    fired = threading.Semaphore(0)
+    timer = Timer(clock, 0.5, lambda ev: (events.append(ev), fired.release()), oneshot=True)
+    rate = Rate(2, clock)
+    t, box = _run(rate.sleep)
+    try:
+        _wait_blocked(t)
+        clock.set(1000.0)
+        time.sleep(0.05)
+        assert events == [] and t.is_alive()  # neither fires on the first /clock itself
+        clock.set(1000.5)
+        assert fired.acquire(timeout=2)
+        t.join(2)
+        assert not t.is_alive() and "e" not in box
+    finally:
+        timer.shutdown()
+        timer.join(2)
+    assert events[0].current_expected == pytest.approx(1000.5)

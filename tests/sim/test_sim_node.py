@@ -304,3 +304,96 @@ def test_map_argument_uses_a_map_server_map(sims, client):
     scan = Latest(client, "/scan", LaserScan).wait()
     finite = [r for r in scan.ranges if math.isfinite(r)]
     assert len(finite) == 360 and min(finite) > 0.15 and max(finite) < 6.0  # walls all around in the maze
+
+
+def test_roslaunch_puzzlebot_launch_sets_pose_and_sim_time(master, client, tmp_path):
+    from nav_msgs.msg import Odometry
+    from ninjemys.testing import ninjemys_bin
+
+    log = tmp_path / "launch.log"
+    with open(log, "wb") as out:
+        proc = subprocess.Popen(
+            [
+                ninjemys_bin("roslaunch"),
+                "puzzlebot_sim",
+                "puzzlebot.launch",
+                "world:=maze",
+                "gui:=false",
+                "rate:=3",
+                "x:=1",
+                "y:=2",
+                "yaw:=1.5708",
+            ],
+            env=dict(os.environ, ROS_MASTER_URI=master),
+            stdout=out,
+            stderr=subprocess.STDOUT,
+            stdin=subprocess.DEVNULL,
+        )
+    try:
+        gt = Latest(client, "/base_pose_ground_truth", Odometry).wait(30)
+        p = gt.pose.pose
+        assert (p.position.x, p.position.y) == pytest.approx((1.0, 2.0))
+        assert 2 * math.atan2(p.orientation.z, p.orientation.w) == pytest.approx(1.5708, abs=1e-4)
+        assert client.get_param("/use_sim_time") is True
+        assert "world 'maze'" in log.read_text()
+    finally:
+        proc.send_signal(2)
+        try:
+            proc.wait(15)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+
+
+def test_as_fast_as_possible_still_answers(sims, client):
+    """rate 0: time runs flat out, yet commands and services get through between steps."""
+    from geometry_msgs.msg import Twist
+    from nav_msgs.msg import Odometry
+    from rosgraph_msgs.msg import Clock
+    from std_srvs.srv import Empty
+
+    sim = sims("_world:=empty", "_rate:=0")
+    clock = Latest(client, "/clock", Clock)
+    gt = Latest(client, "/base_pose_ground_truth", Odometry)
+    gt.wait()
+    first = clock.wait().clock.to_sec()
+    w0 = time.monotonic()
+    pub = client.publisher("/cmd_vel", Twist, queue_size=1)
+    wait_until(lambda: pub.get_num_connections(), what="sim subscribed to /cmd_vel")
+    twist = Twist()
+    twist.linear.x = 0.2
+    pub.publish(twist)
+    wait_until(lambda: gt.msg.pose.pose.position.x > 0.5, what="the robot moving")
+    client.wait_for_service("/gazebo/reset_world", 10)
+    client.service_proxy("/gazebo/reset_world", Empty)(Empty._request_class())
+    elapsed_sim = clock.msg.clock.to_sec() - first
+    assert elapsed_sim > 2 * (time.monotonic() - w0)  # faster than real time
+    sim.stop()
+    assert "simulated s per CPU s" in sim.log()  # the exit summary says how fast it ran
+
+
+def test_scan_topic_matches_a_wall_in_a_generated_map(sims, client, tmp_path):
+    """/scan over ROS against a map_server map made here: a wall face at x = 1.5 m, robot turned 0.4 rad."""
+    from sensor_msgs.msg import LaserScan
+
+    res, n = 0.05, 160  # an 8 x 8 m map, origin (-4, -4)
+    img = bytearray([254]) * (n * n)
+    for row in range(n):
+        for col in range(round((1.5 + 4) / res), round((1.5 + 4) / res) + 4):
+            img[row * n + col] = 0
+    (tmp_path / "wall.pgm").write_bytes(f"P5\n{n} {n}\n255\n".encode() + bytes(img))
+    (tmp_path / "wall.yaml").write_text(
+        "image: wall.pgm\nresolution: 0.05\norigin: [-4.0, -4.0, 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n"
+    )
+    sims(f"_map:={tmp_path / 'wall.yaml'}", "_yaw:=0.4", "_rate:=4.0")
+    scan = Latest(client, "/scan", LaserScan).wait()
+    assert scan.header.frame_id == "laser" and len(scan.ranges) == 360
+    checked = 0
+    for i, measured in enumerate(scan.ranges):
+        world_angle = 0.4 + scan.angle_min + i * scan.angle_increment
+        if math.cos(world_angle) > 0.2 and abs(1.5 * math.tan(world_angle)) < 3.9:
+            assert measured == pytest.approx(1.5 / math.cos(world_angle), abs=0.05)  # 5 sigma of 0.01 m
+            checked += 1
+        elif math.cos(world_angle) < -0.05:
+            assert math.isinf(measured) and measured > 0  # nothing behind within 12 m: +inf (REP 117)
+    assert checked > 100

@@ -69,6 +69,32 @@ def test_real_rostopic_and_rosservice(sim):
     assert types.stdout.strip() == "std_srvs/Empty"
 
 
+def test_real_tf2_sees_the_robot_frames(sim, tmp_path):
+    script = tmp_path / "tf_user.py"
+    script.write_text(
+        textwrap.dedent(
+            """
+            import rospy
+            import tf2_ros
+
+            rospy.init_node("tf_user")
+            buf = tf2_ros.Buffer()
+            tf2_ros.TransformListener(buf)
+            for target, source in (("odom", "laser"), ("base_link", "camera_color_optical_frame"), ("odom", "imu_link")):
+                t = buf.lookup_transform(target, source, rospy.Time(0), rospy.Duration(20))
+                tr = t.transform.translation
+                print(target, source, "%.3f %.3f %.3f" % (tr.x, tr.y, tr.z), flush=True)
+            """
+        )
+    )
+    done = real(sim, "/usr/bin/python3", str(script), timeout=90)
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    assert lines[0] == "odom laser 0.000 0.000 0.170"
+    assert lines[1] == "base_link camera_color_optical_frame 0.080 0.000 0.120"
+    assert lines[2] == "odom imu_link 0.000 0.000 0.050"
+
+
 def test_real_rospy_node_drives_the_robot(sim, tmp_path):
     script = tmp_path / "driver.py"
     script.write_text(

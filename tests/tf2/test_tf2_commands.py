@@ -15,7 +15,7 @@ import pytest
 from ninjemys import testing
 from ninjemys.tools.tf_echo import format_transform
 from ninjemys.tools.tf_monitor import Monitor
-from ninjemys.tools.view_frames import generate_dot, write_outputs
+from ninjemys.tools.view_frames import edges_from_dot, generate_dot, write_graph, write_outputs
 
 
 def shipped(pkg: str, exe: str, *args: str) -> list[str]:
@@ -159,3 +159,81 @@ def test_view_frames_outputs(tmp_path, monkeypatch):
     assert [p.name for p in written] == ["frames.gv", "frames.svg"]
     svg = (tmp_path / "frames.svg").read_text()
     assert svg.startswith("<svg") and ">odom</text>" in svg and "Broadcaster: /amcl" in svg
+
+
+def test_tf_view_frames_draws_tf_dot_text(tmp_path, monkeypatch):
+    """``rosrun tf view_frames`` writes tf's own dot text (allFramesAsDot) and draws it without dot."""
+    from ninjemys.tf2.core import BufferCore
+
+    b = BufferCore()
+    b.set_transforms(
+        [("map", "odom", 10**9, 0, 0, 0, 0, 0, 0, 1), ("odom", "base", 10**9, 0, 0, 0, 0, 0, 0, 1)], "/me"
+    )
+    dot = b.all_frames_as_dot(12.0)
+    edges = edges_from_dot(dot)
+    assert edges[1] == (
+        "odom",
+        "base",
+        [
+            "Broadcaster: /me",
+            "Average rate: 10000.000 Hz",
+            "Most recent transform: 1.000 ( 11.000 sec old)",
+            "Buffer length: 0.000 sec",
+        ],
+    )
+    monkeypatch.setattr("shutil.which", lambda _name: None)
+    written = write_graph(dot, edges, 12.0, tmp_path)
+    assert (tmp_path / "frames.gv").read_text() == dot
+    assert written[-1].name == "frames.svg" and ">base</text>" in written[-1].read_text()
+
+
+@pytest.mark.slow
+def test_view_frames_end_to_end(env, procs, tmp_path):
+    procs.append(
+        subprocess.Popen(
+            shipped("tf2_ros", "static_transform_publisher", "1", "0", "0", "0", "0", "0", "base", "laser"),
+            env=env,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+    )
+    done = subprocess.run(
+        shipped("tf2_tools", "view_frames.py"),
+        env=env,
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert done.returncode == 0, done.stderr
+    assert "Listening to tf data during 5 seconds..." in done.stdout + done.stderr
+    gv = (tmp_path / "frames.gv").read_text()
+    assert '"base" -> "laser"[label=" Broadcaster: /static_transform_publisher' in gv
+    assert (tmp_path / "frames.pdf").exists() or (tmp_path / "frames.svg").exists()
+
+
+def test_example_broadcaster_and_listener(env, procs):
+    from pathlib import Path
+
+    examples = Path(__file__).parents[2] / "examples" / "tf"
+    procs.append(
+        subprocess.Popen(
+            [sys.executable, str(examples / "frame_broadcaster.py")], env=env, stderr=subprocess.DEVNULL
+        )
+    )
+    listener = subprocess.Popen(
+        [sys.executable, str(examples / "frame_listener.py")],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+    procs.append(listener)
+    sel = selectors.DefaultSelector()
+    sel.register(listener.stdout, selectors.EVENT_READ)
+    deadline = time.monotonic() + 30
+    seen = ""
+    while "carrot in laser" not in seen and time.monotonic() < deadline:
+        if sel.select(0.2):
+            seen += listener.stdout.readline()
+    assert re.search(r"carrot in laser: x=-?\d+\.\d\d y=-?\d+\.\d\d yaw=-?\d+\.\d\d", seen), seen

@@ -105,7 +105,9 @@ def test_lookup_below_a_stale_parent_uses_the_walk():
     b = BufferCore()
     b.set_transforms([item("map", "odom", 1, 1)])
     b.set_transforms([item("odom", "base", 5, 2), item("odom", "base", 6, 3)])
-    assert b.lookup("odom", "base", int(5.5 * S))[1][0] == pytest.approx(2.5)
+    for _ in range(3):  # a one-off time, then the same time again (the memo path), then again
+        assert b.lookup("odom", "base", int(5.5 * S))[1][0] == pytest.approx(2.5)
+        assert b.lookup("odom", "base", 0) == (6 * S, (3.0, 0, 0, 0, 0, 0, 1))
     with pytest.raises(ExtrapolationException):
         b.lookup("map", "base", int(5.5 * S))
 
@@ -204,3 +206,115 @@ def test_reparenting_over_time():
     b.set_transforms([item("b", "c", 3, x=5.0), item("a", "b", 3, x=10.0)])
     assert b.lookup("a", "c", int(1.5 * S))[1][0] == pytest.approx(1.5)
     assert b.lookup("a", "c", 3 * S)[1][0] == pytest.approx(15.0)
+
+
+def _raw_messages(count, start=1, step=0.01, frames=5, bad_at=None, reorder=False):
+    from ninjemys.tf2.wire import encode_tf_message
+
+    out = []
+    for k in range(count):
+        t = start + k * step
+        items = [
+            (
+                "world" if i == 0 else f"f{i - 1}",
+                f"f{i}",
+                int(round(t * S)),
+                math.cos(t + i),
+                math.sin(t),
+                0.1 * i,
+                *yaw_q(t + i),
+            )
+            for i in range(frames)
+        ]
+        if k == bad_at:
+            items[2] = items[2][:3] + (float("nan"),) + items[2][4:]
+        out.append(encode_tf_message(items))
+    if reorder:
+        out[3], out[4] = out[4], out[3]
+    return out
+
+
+@pytest.mark.parametrize("case", ["plain", "bad-in-run", "reordered", "repeated"])
+def test_raw_batches_match_eager_insertion(case):
+    """add_raw (batched numpy decoding) and set_transforms (per transform) give the same buffer."""
+    from ninjemys.tf2.wire import decode_tf_message
+
+    msgs = _raw_messages(40, bad_at=7 if case == "bad-in-run" else None, reorder=case == "reordered")
+    if case == "repeated":
+        msgs = msgs[:10] + msgs[5:10] + msgs[10:]
+    lazy, eager = BufferCore(), BufferCore()
+    lazy_lines: list[str] = []
+    eager_lines: list[str] = []
+    lazy._report, eager._report = lazy_lines.append, eager_lines.append
+    for m in msgs:
+        lazy.add_raw(m, "pub")
+        eager.set_transforms(decode_tf_message(m), "pub")
+    for t in (0, S + 5 * S // 100, S + 123 * S // 10_000, S + 39 * S // 100):
+        for target, source in (("world", "f4"), ("f2", "f4"), ("f4", "f1")):
+            assert lazy.lookup(target, source, t) == eager.lookup(target, source, t)
+    assert lazy.all_frames_as_yaml() == eager.all_frames_as_yaml()
+    assert lazy_lines == eager_lines
+    if case == "bad-in-run":
+        assert len(lazy_lines) == 1 and lazy_lines[0].startswith(
+            'TF_NAN_INPUT: Ignoring transform for child_frame_id "f2"'
+        )
+
+
+def test_raw_queue_is_bounded_and_wakes_waiters():
+    from ninjemys.tf2 import core
+
+    b = BufferCore()
+    for m in _raw_messages(core.PENDING_MAX + 3):
+        b.add_raw(m, "pub")
+    assert len(b._pending) == 3  # the listener's thread decoded the first batch itself
+    msgs = _raw_messages(1, start=5)
+
+    def later():
+        time.sleep(0.2)
+        b.add_raw(msgs[0], "pub")
+
+    threading.Thread(target=later).start()
+    ok, _ = b.wait_for_transform(lambda: b.can_transform("world", "f4", 5 * S), 5.0)
+    assert ok
+
+
+def test_change_listeners_hear_new_data():
+    b = BufferCore()
+    heard: list[bool] = []
+    b.add_change_listener(lambda: heard.append(b.can_transform("world", "f4", 0)[0]))
+    b.set_transforms([item("a", "b", 1)])
+    for m in _raw_messages(1):
+        b.add_raw(m, "pub")
+    assert heard == [False, True]
+
+
+def test_listener_clears_on_a_jump_back_in_time():
+    from ninjemys.node.subscriber import RawMessage
+    from ninjemys.tf2.node import TransformListener
+
+    class FakeNode:
+        def subscriber(self, topic, msg_class, callback, **kwargs):
+            class Sub:
+                def unregister(self):
+                    pass
+
+            return Sub()
+
+    clock = [100.0]
+    lines: list[str] = []
+    b = BufferCore(report=lines.append)
+    listener = TransformListener(FakeNode(), b, now=lambda: clock[0], report=lines.append)
+    header = {"callerid": "/pub", "md5sum": "94810edda583a504dfda3829e70d7eec"}
+    listener._on_tf_static(RawMessage(_raw_messages(1, frames=2)[0], header))
+    listener._on_tf(RawMessage(_raw_messages(1, start=3, frames=3)[0], header))
+    assert b.can_transform("world", "f2", 0)[0]
+    clock[0] = 50.0  # a bag loop or a simulator reset
+    listener._on_tf(RawMessage(_raw_messages(1, start=1, frames=1)[0], header))
+    assert lines == ["Detected jump back in time of 50.000000s. Clearing TF buffer."]
+    assert not b.can_transform("world", "f2", 0)[0]  # the old dynamic data is gone
+    assert b.can_transform("world", "f1", 0)[0]
+    listener._on_tf(RawMessage(b"\x05\x00", {"callerid": "/odd", "md5sum": "0123"}))
+    assert lines[-1] == "/tf: /odd publishes type None (md5 0123), not tf2_msgs/TFMessage"
+    listener._on_tf(RawMessage(b"\x05\x00\x00\x00", header))  # five transforms announced, none there
+    assert b.can_transform("world", "f1", 0)[0]
+    assert lines[-1].startswith("/tf: dropped a message from /pub: tf2_msgs/TFMessage: cannot decode 4 bytes")

@@ -96,15 +96,17 @@ def test_real_tf2_ros_reads_our_broadcasts(master, procs):
 
 def test_ours_reads_real_broadcasts_and_survives_bad_input(master, procs):
     start([testing.ROS1_PYTHON, PEER, "broadcast", "--bad"], testing.ros1_env(master), procs)
+    began = time.monotonic()
     result, stderr = listen([sys.executable, PEER, "listen"], ours_env(master))
+    most = 1 + int((time.monotonic() - began) / 10.0)  # the same line may come back after 10 s
     check(result)
-    # three bad transforms arrive 20 times a second: each is reported in one line, once
+    # three bad transforms arrive 20 times a second: each is reported in one line (again after 10 s)
     for needle in (
         "TF_SELF_TRANSFORM",
         'TF_NAN_INPUT: Ignoring transform for child_frame_id "n"',
         'TF_DENORMALIZED_QUATERNION: Ignoring transform for child_frame_id "q"',
     ):
-        assert stderr.count(needle) == 1, stderr
+        assert 1 <= stderr.count(needle) <= most, stderr
 
 
 def test_legacy_tf_listener_reads_real_broadcasts(master, procs):

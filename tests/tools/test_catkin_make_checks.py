@@ -4,11 +4,14 @@ install`` writes an install space."""
 
 from __future__ import annotations
 
+import os
+import shutil
+import subprocess
 from pathlib import Path
 
 import pytest
 
-from ninjemys.errors import DefinitionError
+from ninjemys.errors import DefinitionError, PackageError
 from ninjemys.tools import catkin_create_pkg, catkin_make
 
 
@@ -111,3 +114,161 @@ def test_python_only_package_mentions_no_cpp(ws: Path, monkeypatch: pytest.Monke
     create(ws, monkeypatch, "py_pkg", "rospy")
     assert make(ws, monkeypatch) == 0
     assert "C++" not in capsys.readouterr().out
+
+
+DEMO_CMAKE = """\
+cmake_minimum_required(VERSION 3.0.2)
+project(demo_pkg)
+find_package(catkin REQUIRED COMPONENTS rospy std_msgs message_generation)
+catkin_python_setup()
+add_message_files(FILES Reading.msg)
+add_service_files(FILES Ask.srv)
+generate_messages(DEPENDENCIES std_msgs)
+catkin_package(CATKIN_DEPENDS message_runtime std_msgs rospy)
+catkin_install_python(PROGRAMS scripts/talker.py DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+install(DIRECTORY launch DESTINATION ${CATKIN_PACKAGE_SHARE_DESTINATION})
+install(FILES notes.txt DESTINATION ${CATKIN_PACKAGE_SHARE_DESTINATION}/doc)
+"""
+
+DEMO_MANIFEST = """\
+<?xml version="1.0"?>
+<package format="2">
+  <name>demo_pkg</name>
+  <version>0.1.0</version>
+  <description>install space demo</description>
+  <maintainer email="dev@example.com">dev</maintainer>
+  <license>BSD</license>
+  <buildtool_depend>catkin</buildtool_depend>
+  <build_depend>message_generation</build_depend>
+  <depend>std_msgs</depend>
+  <depend>rospy</depend>
+  <exec_depend>message_runtime</exec_depend>
+</package>
+"""
+
+#: what real catkin_make install (Debian's catkin) writes for demo_pkg, less its C++/Lisp/CMake/pkg-config
+#: outputs and catkin's own helpers (see _python_relevant)
+CATKIN_INSTALL_LAYOUT = {
+    "setup.sh",
+    "setup.bash",
+    "setup.zsh",
+    "local_setup.sh",
+    "local_setup.bash",
+    "local_setup.zsh",
+    "lib/demo_pkg/talker.py",
+    "lib/python3/dist-packages/demo_pkg/__init__.py",
+    "lib/python3/dist-packages/demo_pkg/msg/__init__.py",
+    "lib/python3/dist-packages/demo_pkg/srv/__init__.py",
+    "share/demo_pkg/package.xml",
+    "share/demo_pkg/launch/demo.launch",
+    "share/demo_pkg/doc/notes.txt",
+    "share/demo_pkg/msg/Reading.msg",
+    "share/demo_pkg/srv/Ask.srv",
+}
+
+
+def demo_workspace(root: Path) -> None:
+    pkg = root / "src" / "demo_pkg"
+    for sub in ("msg", "srv", "scripts", "launch", "src/demo_pkg"):
+        (pkg / sub).mkdir(parents=True, exist_ok=True)
+    (pkg / "package.xml").write_text(DEMO_MANIFEST)
+    (pkg / "CMakeLists.txt").write_text(DEMO_CMAKE)
+    (pkg / "setup.py").write_text(
+        "from setuptools import setup\nfrom catkin_pkg.python_setup import generate_distutils_setup\n"
+        "setup(**generate_distutils_setup(packages=['demo_pkg'], package_dir={'': 'src'}))\n"
+    )
+    (pkg / "msg" / "Reading.msg").write_text("float32 value\n")
+    (pkg / "srv" / "Ask.srv").write_text("string q\n---\nstring a\n")
+    talker = pkg / "scripts" / "talker.py"
+    talker.write_text('#!/usr/bin/env python3\nprint("talker runs")\n')
+    talker.chmod(0o755)
+    (pkg / "launch" / "demo.launch").write_text(
+        '<launch><node pkg="demo_pkg" type="talker.py" name="t"/></launch>\n'
+    )
+    (pkg / "notes.txt").write_text("hello\n")
+    (pkg / "src" / "demo_pkg" / "__init__.py").write_text("X = 1\n")
+
+
+def _files(root: Path) -> set[str]:
+    return {str(p.relative_to(root)) for p in root.rglob("*") if p.is_file() and "__pycache__" not in p.parts}
+
+
+def _python_relevant(path: str) -> bool:
+    """Real catkin's install outputs that a pure-Python build has a counterpart for."""
+    skipped = ("include/", "share/common-lisp/", "lib/pkgconfig/", "share/demo_pkg/cmake/")
+    helpers = {".catkin", ".rosinstall", "_setup_util.py", "env.sh"}
+    name = path.rsplit("/", 1)[-1]
+    return not (
+        path.startswith(skipped)
+        or path in helpers
+        or ".egg-info/" in path
+        or name.startswith("_")
+        and name != "__init__.py"
+    )
+
+
+def test_install_space_works_without_the_sources(ws: Path, monkeypatch: pytest.MonkeyPatch, capsys) -> None:
+    demo_workspace(ws)
+    assert make(ws, monkeypatch, "install") == 0
+    out = capsys.readouterr().out
+    install = ws / "install"
+    assert f"-- Installing: {install / 'lib' / 'demo_pkg' / 'talker.py'}" in out
+    assert _files(install) - {".ninjemys_devel"} == CATKIN_INSTALL_LAYOUT
+    assert os.access(install / "lib" / "demo_pkg" / "talker.py", os.X_OK)
+    # a second run changes nothing
+    assert make(ws, monkeypatch, "install") == 0
+    assert "-- Installing:" not in capsys.readouterr().out
+    # the install space stands alone: move the sources and devel away, source it, use everything
+    (ws / "src").rename(ws / "src.away")
+    shutil.rmtree(ws / "devel")
+    script = (
+        "source install/setup.bash && rospack find demo_pkg && "
+        "python3 -c 'import demo_pkg; from demo_pkg.msg import Reading; from demo_pkg.srv import Ask; "
+        "print(demo_pkg.X, Reading(value=1.5).value, Ask._type)' && rosrun demo_pkg talker.py && "
+        "roslaunch demo_pkg demo.launch --nodes"
+    )
+    env = {"PATH": "/usr/bin:/bin", "HOME": str(ws)}
+    result = subprocess.run(
+        ["bash", "-c", script], cwd=ws, env=env, capture_output=True, text=True, timeout=60
+    )
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.splitlines() == [
+        str(install / "share" / "demo_pkg"),
+        "1 1.5 demo_pkg/Ask",
+        "talker runs",
+        "/t",
+    ]
+
+
+def test_install_names_an_uninstalled_launch_dir_and_a_missing_file(
+    ws: Path, monkeypatch: pytest.MonkeyPatch, capsys
+) -> None:
+    demo_workspace(ws)
+    cmake = ws / "src" / "demo_pkg" / "CMakeLists.txt"
+    cmake.write_text(
+        DEMO_CMAKE.replace("install(DIRECTORY launch DESTINATION ${CATKIN_PACKAGE_SHARE_DESTINATION})\n", "")
+    )
+    assert make(ws, monkeypatch, "install", "-DCMAKE_INSTALL_PREFIX=elsewhere") == 0
+    assert "-- demo_pkg: launch/ is not installed: no install(DIRECTORY launch" in capsys.readouterr().out
+    assert (ws / "elsewhere" / "setup.bash").is_file() and not (
+        ws / "elsewhere" / "share" / "demo_pkg" / "launch"
+    ).exists()
+    (ws / "src" / "demo_pkg" / "notes.txt").unlink()
+    with pytest.raises(PackageError, match=rf"{cmake}:10: install\(FILES notes.txt\) names a missing file"):
+        make(ws, monkeypatch, "install")
+
+
+@pytest.mark.ros1
+@pytest.mark.slow
+@pytest.mark.skipif(
+    shutil.which("cmake") is None or not Path("/usr/bin/catkin_make").exists(), reason="needs Debian's catkin"
+)
+def test_layout_matches_real_catkin_make_install(tmp_path: Path) -> None:
+    real = tmp_path / "real_ws"
+    demo_workspace(real)
+    env = {"PATH": "/usr/bin:/bin", "HOME": str(tmp_path)}
+    result = subprocess.run(
+        ["/usr/bin/catkin_make", "install"], cwd=real, env=env, capture_output=True, text=True, timeout=600
+    )
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
+    assert {p for p in _files(real / "install") if _python_relevant(p)} == CATKIN_INSTALL_LAYOUT

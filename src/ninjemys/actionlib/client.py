@@ -240,10 +240,14 @@ class ActionClient:
         self._server_id: str | None = None  # caller id of the node whose status we heard last
         self._status_seen = threading.Condition(threading.Lock())
         self.last_status_msg: Any = None
-        pub_queue = self._param("actionlib_client_pub_queue_size", 10)
-        pub_queue = pub_queue if isinstance(pub_queue, int) and pub_queue >= 0 else 10
+        # Goals and cancels are never dropped unless the user asks for a bounded queue: ROS 1's
+        # default of 10 would drop goals of a loop that sends more than 10 at once
+        pub_queue = self._param("actionlib_client_pub_queue_size", None)
+        if pub_queue is not None and not (isinstance(pub_queue, int) and pub_queue > 0):
+            pub_queue = 10  # ROS 1 turns a negative size into its default
         sub_queue = self._param("actionlib_client_sub_queue_size", -1)
         sub_queue = sub_queue if isinstance(sub_queue, int) and sub_queue > 0 else None
+        self.pub_queue_size, self.sub_queue_size = pub_queue, sub_queue
         ns = self.ns
         self.pub_goal = node.publisher(f"{ns}/goal", self.types.action_goal, queue_size=pub_queue)
         self.pub_cancel = node.publisher(f"{ns}/cancel", goal_id_class(), queue_size=pub_queue)

@@ -197,10 +197,12 @@ class SimpleActionServer:
                     self.execute_condition.wait(0.5)  # the node's shutdown hook notifies; 0.5 s is a backstop
                 if self.need_to_terminate or self.node.is_shutdown:
                     return
-                if self.is_active():
-                    self.log.error("Should never reach this code with an active goal")
-                    return
-                goal = self.accept_new_goal()
+            if self.is_active():
+                self.log.error("Should never reach this code with an active goal")
+                return
+            # outside the condition: accept_new_goal takes the server's lock first, as the goal
+            # callback (holding it) takes ours, so the two orders never cross
+            goal = self.accept_new_goal()
             if goal is None:
                 continue
             try:

@@ -1,7 +1,8 @@
 """Messages <-> rosbridge's JSON/CBOR values, as rosbridge_library's ``message_conversion`` defines them.
 
 To JSON: time and duration become ``{"secs", "nsecs"}``, ``uint8[]``/``char[]`` (fixed or variable)
-become a base64 string, other arrays lists, nested messages objects. To CBOR: the same, except that
+become a base64 string, other arrays lists, nested messages objects, NaN and infinities ``null``
+(and ``null`` in a float field reads back as NaN). To CBOR: the same, except that
 ``uint8[]`` is a byte string and numeric arrays are RFC 8746 typed arrays (a tag over little-endian
 bytes), as rosbridge's ``cbor_conversion``. From JSON: fields missing from the object keep their
 defaults, unknown fields and values of the wrong type are refused with one line naming the type,
@@ -16,6 +17,9 @@ import base64
 import math
 from collections.abc import Callable
 from typing import Any
+
+import cbor2
+import numpy
 
 from ninjemys.idl.loader import get_message_class
 from ninjemys.rostime import Duration, Time
@@ -90,6 +94,12 @@ def to_value(msg: Any, cbor: bool = False) -> dict:
     return encoder(msg)
 
 
+def _finite(x: float) -> float | None:
+    """NaN and infinities as null: JSON has no spelling for them (a browser's JSON.parse rejects
+    Python's ``NaN``); CBOR keeps them."""
+    return x if x - x == 0 else None
+
+
 def _time_value(t: Any) -> dict:
     return {"secs": t.secs, "nsecs": t.nsecs}
 
@@ -100,6 +110,8 @@ def _field_encoder(slot_type: str, cbor: bool) -> Callable[[Any], Any] | None:
     if not is_array:
         if base in ("time", "duration"):
             return _time_value
+        if base in _FLOATS and not cbor:
+            return _finite
         if base == "string" or base == "bool" or base in _INTS or base in _FLOATS:
             return None
         return lambda v: to_value(v, cbor)
@@ -110,13 +122,12 @@ def _field_encoder(slot_type: str, cbor: bool) -> Callable[[Any], Any] | None:
             v if isinstance(v, bytes | bytearray | memoryview) else bytes(v)
         ).decode("ascii")
     if cbor and base in _NUMPY_DTYPES:
-        import cbor2
-        import numpy
-
         tag, dtype = _CBOR_TAGS[base], _NUMPY_DTYPES[base]
         return lambda v: cbor2.CBORTag(tag, numpy.asarray(v, dtype=dtype).tobytes())
     if base == "bool":
         return lambda v: [bool(x) for x in v]
+    if base in _FLOATS and not cbor:
+        return lambda v: [x if x - x == 0 else None for x in v]
     if base in _INTS or base in _FLOATS or base == "string":
         return list
     if base in ("time", "duration"):

@@ -18,7 +18,7 @@ from concurrent.futures import Executor, ThreadPoolExecutor
 from typing import Any
 
 from ninjemys.bridge.graph import Delivery
-from ninjemys.bridge.outbox import Outbox
+from ninjemys.bridge.outbox import Backlog, Outbox
 from ninjemys.errors import NinjemysError
 
 log = logging.getLogger(__name__)
@@ -41,6 +41,7 @@ class FoxgloveSession:
         self._client_channels: dict[int, tuple[str, Any]] = {}  # client channel id -> (topic, publisher)
         self._param_names: set[str] = set()
         self.graph_subscribed = False
+        self.backlog = Backlog()
         self._worker: Executor = ThreadPoolExecutor(1, thread_name_prefix=f"foxglove-{client_id}")
         self._lock = threading.Lock()
         self._closed = False
@@ -98,6 +99,7 @@ class FoxgloveSession:
         if handler is None:
             self.status(2, f"unknown op {msg['op']!r}")
             return
+        self.backlog.add()
         self._worker.submit(self._run, handler, msg)
 
     def _run(self, handler: Callable[[dict[str, Any]], None], msg: dict[str, Any]) -> None:
@@ -112,6 +114,8 @@ class FoxgloveSession:
         except Exception as exc:
             log.exception("foxglove: op %s failed", msg["op"])
             self.status(2, f"{msg['op']}: {type(exc).__name__}: {exc}")
+        finally:
+            self.backlog.done()
 
     def _binary(self, data: bytes) -> None:
         if not data:
@@ -150,7 +154,19 @@ class FoxgloveSession:
                     continue
                 self._subs[sub_id] = channel_id
             topic = channel["topic"]
-            self.gateway.taps.add(topic, channel["schemaName"], (self, sub_id), self._sink(sub_id, topic))
+            try:
+                # published_as: a channel of a type learned from a publisher's definition is taken raw
+                self.gateway.taps.add(
+                    topic,
+                    channel["schemaName"],
+                    (self, sub_id),
+                    self._sink(sub_id, topic),
+                    published_as=channel["schemaName"],
+                )
+            except NinjemysError:
+                with self._lock:
+                    self._subs.pop(sub_id, None)
+                raise
 
     def op_unsubscribe(self, msg: dict[str, Any]) -> None:
         for sub_id in msg["subscriptionIds"]:
@@ -179,7 +195,16 @@ class FoxgloveSession:
                 self.status(2, f"advertise {topic}: encoding must be ros1, got {channel.get('encoding')!r}")
                 continue
             topic = self.gateway.node.resolve_name(topic)
-            pub = self.gateway.publishers.advertise(topic, str(channel["schemaName"]), (self, channel_id))
+            schema_name = str(channel["schemaName"])
+            # a type we do not ship is learned from the definition the client sent
+            msg_class = (
+                self.gateway.publishers.learn(schema_name, str(channel["schema"]))
+                if channel.get("schema")
+                else None
+            )
+            pub = self.gateway.publishers.advertise(
+                topic, schema_name, (self, channel_id), msg_class=msg_class
+            )
             self._client_channels[channel_id] = (topic, pub)
 
     def op_unadvertise(self, msg: dict[str, Any]) -> None:

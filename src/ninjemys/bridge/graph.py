@@ -20,7 +20,7 @@ from collections.abc import Callable
 from typing import Any
 
 from ninjemys.errors import NinjemysError, ServiceError
-from ninjemys.idl.loader import get_message_class, get_service_class
+from ninjemys.idl.loader import get_message_class, get_service_class, message_class_from_definition
 from ninjemys.node import Node
 from ninjemys.node.subscriber import RawMessage
 from ninjemys.tools.rosservice import probe
@@ -61,8 +61,14 @@ class Delivery:
     def message(self) -> Any:
         if self._msg is None:
             cls = self.msg_class
-            if cls is None:
-                cls = get_message_class(self.header.get("type", ""))
+            if cls is None:  # subscribed with md5 "*": the publisher's header says what it is
+                type_name = self.header.get("type", "")
+                try:
+                    cls = get_message_class(type_name)
+                except NinjemysError:
+                    cls = message_class_from_definition(
+                        type_name, self.header.get("message_definition", ""), self.header.get("md5sum")
+                    )
             self._msg = cls.deserialize_from(bytes(self.data))
         return self._msg
 
@@ -104,18 +110,28 @@ class Taps:
         self._taps: dict[str, _Tap] = {}
         self._lock = threading.Lock()
 
-    def add(self, topic: str, type_name: str | None, owner: object, sink: Sink) -> str:
+    def add(
+        self, topic: str, type_name: str | None, owner: object, sink: Sink, published_as: str | None = None
+    ) -> str:
         """Start delivering ``topic`` to ``sink``; returns the type used. Raises NinjemysError when the
-        type is unknown or differs from the one the gateway already subscribed with."""
+        type is unknown or differs from the one the gateway already subscribed with. A type we cannot
+        load is still accepted when it is what the topic is ``published_as``: the tap then subscribes
+        with md5 ``*`` and decodes from the publisher's ``message_definition`` when it must."""
         with self._lock:
             tap = self._taps.get(topic)
             if tap is None:
-                msg_class = message_class(type_name) if type_name and type_name != "*" else None
+                msg_class = None
+                if type_name and type_name != "*":
+                    try:
+                        msg_class = message_class(type_name)
+                    except NinjemysError:
+                        if type_name != published_as:
+                            raise
                 tap = self._taps[topic] = _Tap(self.node, topic, msg_class, self._clock)
             elif type_name and tap.msg_class is not None and type_name not in ("*", tap.msg_class._type):
                 raise NinjemysError(f"topic {topic} is subscribed as {tap.msg_class._type}, not {type_name}")
             tap.sinks[owner] = sink
-            return tap.msg_class._type if tap.msg_class is not None else "*"
+            return tap.msg_class._type if tap.msg_class is not None else (type_name or "*")
 
     def remove(self, topic: str, owner: object) -> None:
         with self._lock:
@@ -141,10 +157,17 @@ class Publishers:
         self._lock = threading.Lock()
 
     def advertise(
-        self, topic: str, type_name: str, owner: object, latch: bool = False, queue_size: int = 100
+        self,
+        topic: str,
+        type_name: str,
+        owner: object,
+        latch: bool = False,
+        queue_size: int = 100,
+        msg_class: Any = None,
     ) -> Any:
-        """The publisher for ``topic`` (created on first use); raises NinjemysError on a type clash."""
-        msg_class = message_class(type_name)
+        """The publisher for ``topic`` (created on first use); raises NinjemysError on a type clash.
+        ``msg_class`` is given for a type learned from a client's definition (:meth:`learn`)."""
+        msg_class = msg_class or message_class(type_name)
         with self._lock:
             entry = self._pubs.get(topic)
             if entry is None:
@@ -156,6 +179,18 @@ class Publishers:
                 )
             entry[2].add(owner)
             return entry[0]
+
+    @staticmethod
+    def learn(type_name: str, definition: str) -> Any:
+        """The class of ``type_name``, built from its full definition text when the type is neither
+        shipped nor on the package path (a Foxglove client may advertise its own types)."""
+        try:
+            return get_message_class(type_name)
+        except NinjemysError:
+            try:
+                return message_class_from_definition(type_name, definition)
+            except NinjemysError as exc:
+                raise NinjemysError(f"cannot use the definition of {type_name}: {exc}") from None
 
     def get(self, topic: str) -> tuple[Any, Any] | None:
         entry = self._pubs.get(topic)

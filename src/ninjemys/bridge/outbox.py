@@ -19,6 +19,7 @@ from __future__ import annotations
 import threading
 from collections import Counter, OrderedDict, deque
 from collections.abc import Callable
+from typing import Any
 
 
 class CloseRequest:
@@ -134,3 +135,37 @@ class Outbox:
             entry = self._lanes.pop(lane, None)
             if entry is not None:
                 self._lane_bytes -= entry.bytes
+
+
+class Backlog:
+    """Messages a client sent that its session has not handled yet. Past ``limit`` the connection
+    stops reading (TCP then slows the client down) until half of them are done, so a client that
+    sends faster than its ops run cannot grow the server's memory either."""
+
+    def __init__(self, limit: int = 1000) -> None:
+        self.limit = limit
+        self._count = 0
+        self._lock = threading.Lock()
+        self._loop: Any = None
+        self._open: Any = None
+
+    def bind(self, loop: Any, event: Any) -> None:
+        """``event`` (an asyncio.Event of ``loop``) is set while the connection may read."""
+        self._loop, self._open = loop, event
+        event.set()
+
+    def add(self) -> None:
+        with self._lock:
+            self._count += 1
+            if self._count == self.limit and self._loop is not None:
+                self._loop.call_soon_threadsafe(self._open.clear)
+
+    def done(self) -> None:
+        with self._lock:
+            self._count -= 1
+            if self._count == self.limit // 2 and self._loop is not None:
+                self._loop.call_soon_threadsafe(self._open.set)
+
+    async def wait(self) -> None:
+        if self._open is not None:
+            await self._open.wait()

@@ -25,10 +25,12 @@ from collections.abc import Callable
 from concurrent.futures import Executor, ThreadPoolExecutor
 from typing import Any
 
+import cbor2
+
 from ninjemys.bridge.convert import ConversionError, from_value, to_value
 from ninjemys.bridge.graph import Delivery
 from ninjemys.bridge.graph import service_class as graph_service_class
-from ninjemys.bridge.outbox import Outbox
+from ninjemys.bridge.outbox import Backlog, Outbox
 from ninjemys.errors import NinjemysError
 
 log = logging.getLogger(__name__)
@@ -36,6 +38,8 @@ log = logging.getLogger(__name__)
 _LEVELS = {"none": 0, "error": 1, "warning": 2, "info": 3}
 #: lane length when a subscription asks for queue_length 0 (rosbridge's "no queue" default)
 DEFAULT_QUEUE_LENGTH = 100
+#: fragmented messages a client may have unfinished at once (each is bounded by max_message_size)
+MAX_PENDING_FRAGMENTED = 8
 
 
 class OpError(Exception):
@@ -104,9 +108,7 @@ class _Subscription:
 class RosbridgeSession:
     """The rosbridge v2 protocol for one connected client."""
 
-    def __init__(
-        self, gateway: Any, client_id: int, outbox: Outbox, send_error: Callable[[str], None]
-    ) -> None:
+    def __init__(self, gateway: Any, client_id: int, outbox: Outbox) -> None:
         self.gateway = gateway
         self.client_id = client_id
         self.outbox = outbox
@@ -118,18 +120,15 @@ class RosbridgeSession:
         self._pending: dict[str, tuple[threading.Event, list[Any]]] = {}
         self._fragments: dict[str, dict[int, str]] = {}
         self._counter = itertools.count(1)
+        self.backlog = Backlog()
         self._worker: Executor = ThreadPoolExecutor(1, thread_name_prefix=f"rosbridge-{client_id}")
         self._closed = threading.Event()
         self._lock = threading.Lock()
 
     # -- sending ------------------------------------------------------------------------------
-    def send(self, obj: dict[str, Any], cbor: bool = False) -> None:
-        if cbor:
-            import cbor2
-
-            self.outbox.put_control(cbor2.dumps(obj))
-        else:
-            self.outbox.put_control(json.dumps(obj))
+    def send(self, obj: dict[str, Any]) -> None:
+        """Replies and statuses (JSON, as rosbridge answers whatever the client sent)."""
+        self.outbox.put_control(json.dumps(obj))
 
     def status(self, level: str, msg: str, op_id: Any = None) -> None:
         if _LEVELS[level] > self.status_level:
@@ -148,8 +147,6 @@ class RosbridgeSession:
             if isinstance(data, str):
                 msg = json.loads(data)
             else:
-                import cbor2
-
                 msg = cbor2.loads(data)
         except (ValueError, EOFError) as exc:
             self.status("error", f"malformed message ({'JSON' if isinstance(data, str) else 'CBOR'}): {exc}")
@@ -157,12 +154,19 @@ class RosbridgeSession:
         if not isinstance(msg, dict) or not isinstance(msg.get("op"), str):
             self.status("error", "a rosbridge message must be an object with an 'op' string")
             return
+        self.backlog.add()
         if msg["op"] == "call_service" and self.authenticated:
             self.gateway.pool.submit(self._run, msg)
         else:
             self._worker.submit(self._run, msg)
 
     def _run(self, msg: dict[str, Any]) -> None:
+        try:
+            self._handle(msg)
+        finally:
+            self.backlog.done()
+
+    def _handle(self, msg: dict[str, Any]) -> None:
         op = msg["op"]
         op_id = msg.get("id")
         if not self.authenticated and op != "auth":
@@ -297,9 +301,12 @@ class RosbridgeSession:
                     raise OpError(f"cannot infer the type of {topic}: give 'type' or wait for a publisher")
             sub = _Subscription(topic, type_name)
             sub.ids[msg.get("id")] = opts
+            # recorded only once the tap accepted it: a refused subscribe leaves nothing behind
+            sub.type = self.gateway.taps.add(
+                topic, type_name, self, self._sink(sub), published_as=self.gateway.topic_type(topic)
+            )
             with self._lock:
                 self._subs[topic] = sub
-            sub.type = self.gateway.taps.add(topic, type_name, self, self._sink(sub))
         else:
             sub.ids[msg.get("id")] = opts
 
@@ -413,6 +420,10 @@ class RosbridgeSession:
         data = self._field(msg, "data", str)
         if not 0 <= num < total or total > 100_000:
             raise OpError(f"fragment {num} of {total} is out of range")
+        if frag_id not in self._fragments and len(self._fragments) >= MAX_PENDING_FRAGMENTED:
+            oldest = next(iter(self._fragments))
+            del self._fragments[oldest]
+            self.status("warning", f"fragment: dropped the unfinished message {oldest} (too many pending)")
         parts = self._fragments.setdefault(frag_id, {})
         parts[num] = data
         if sum(len(p) for p in parts.values()) > self.gateway.options.max_message_size:
@@ -449,8 +460,6 @@ def _encoder(opts: dict[str, Any]) -> Callable[[Delivery], Any]:
 
     def build(d: Delivery) -> Any:
         if compression == "cbor-raw":
-            import cbor2
-
             secs, nsecs = divmod(d.stamp_ns, 1_000_000_000)
             return cbor2.dumps(
                 {
@@ -460,8 +469,6 @@ def _encoder(opts: dict[str, Any]) -> Callable[[Delivery], Any]:
                 }
             )
         if compression == "cbor":
-            import cbor2
-
             return cbor2.dumps({"op": "publish", "topic": d.topic, "msg": to_value(d.message(), cbor=True)})
         text = d.encoded(
             "json", lambda d: json.dumps({"op": "publish", "topic": d.topic, "msg": to_value(d.message())})

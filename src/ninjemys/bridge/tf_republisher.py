@@ -1,11 +1,16 @@
 """``tf2_web_republisher``: the transforms a web client asks for, relative to one frame, at a set rate.
 
-Web TF clients (roslibjs' and roslibpy's ``TFClient``) call ``/republish_tfs``
-(``tf2_web_republisher/RepublishTFs``): the answer names a new latched topic ``/tf_repub_<n>``
-carrying ``tf2_web_republisher/TFArray`` at ``rate`` Hz, each source frame expressed in
-``target_frame``. A transform is re-sent only when it moved by more than ``trans_thres`` (metres)
-or turned by more than ``angular_thres`` (radians); a topic nobody listens to for ``timeout`` is
-withdrawn. The buffer is tf2's (:mod:`ninjemys.tf2`), fed by a listener on ``/tf`` and ``/tf_static``.
+Web TF clients use one of its two interfaces:
+
+- the service ``/republish_tfs`` (``tf2_web_republisher/RepublishTFs``; roslibjs' and roslibpy's
+  ``TFClient`` by default): the answer names a new latched topic ``/tf_repub_<n>`` carrying
+  ``tf2_web_republisher/TFArray``; a topic nobody listens to for ``timeout`` is withdrawn;
+- the action ``/tf2_web_republisher`` (``tf2_web_republisher/TFSubscription``; older roslibjs): the
+  transforms come as the goal's feedback until the client cancels it.
+
+Either way each source frame is expressed in ``target_frame`` at ``rate`` Hz, and re-sent only when
+it moved by more than ``trans_thres`` (metres) or turned by more than ``angular_thres`` (radians).
+The buffer is tf2's (:mod:`ninjemys.tf2`), fed by a listener on ``/tf`` and ``/tf_static``.
 """
 
 from __future__ import annotations
@@ -19,6 +24,7 @@ import threading
 import time
 from typing import Any
 
+from ninjemys.actionlib.server import ActionServer
 from ninjemys.idl.loader import get_message_class, get_service_class
 from ninjemys.node import Node
 
@@ -26,15 +32,20 @@ log = logging.getLogger(__name__)
 
 
 class _Client:
-    def __init__(self, topic: str, pub: Any, req: Any) -> None:
-        self.topic = topic
+    """One subscription: a ``/tf_repub_<n>`` topic (``pub``) or an action goal (``goal``)."""
+
+    def __init__(self, key: str, req: Any, pub: Any = None, goal: Any = None) -> None:
+        self.key = key
         self.pub = pub
+        self.goal = goal
+        self.cancelled = False
         self.sources = [f.lstrip("/") for f in req.source_frames]
         self.target = req.target_frame.lstrip("/")
         self.angular_thres = float(req.angular_thres)
         self.trans_thres = float(req.trans_thres)
         self.period = 1.0 / req.rate if req.rate > 0 else 0.1
-        self.timeout = req.timeout.to_sec() if hasattr(req.timeout, "to_sec") else float(req.timeout)
+        timeout = getattr(req, "timeout", None)  # the action's goal has none: it lasts until cancelled
+        self.timeout = 0.0 if timeout is None else timeout.to_sec()
         self.last: dict[str, tuple[float, ...]] = {}
         self.unheard_since: float | None = None
 
@@ -48,7 +59,8 @@ def _moved(old: tuple[float, ...], new: tuple[float, ...], trans: float, angular
 
 
 class TFRepublisher:
-    """The ``/republish_tfs`` service and its ``/tf_repub_<n>`` topics on ``node``."""
+    """The ``/republish_tfs`` service (its ``/tf_repub_<n>`` topics) and the ``/tf2_web_republisher``
+    action on ``node``."""
 
     def __init__(self, node: Node, buffer: Any | None = None) -> None:
         from ninjemys.tf2.buffer import Buffer
@@ -65,22 +77,44 @@ class TFRepublisher:
         self._order = itertools.count()
         self._wake = threading.Condition()
         self._stop = False
+        self._feedback = get_message_class("tf2_web_republisher/TFSubscriptionFeedback")
         self.service = node.service(
             "republish_tfs", get_service_class("tf2_web_republisher/RepublishTFs"), self._republish
         )
+        self.action = ActionServer(
+            node,
+            "tf2_web_republisher",
+            get_message_class("tf2_web_republisher/TFSubscriptionAction"),
+            self._goal,
+            self._cancel,
+        )
+        self.action.start()
         self._thread = threading.Thread(target=self._run, name="tf2_web_republisher", daemon=True)
         self._thread.start()
+
+    def _add(self, client: _Client) -> None:
+        with self._wake:
+            self._clients[client.key] = client
+            heapq.heappush(self._due, (time.monotonic(), next(self._order), client.key))
+            self._wake.notify()
+        log.info("tf2_web_republisher: %s for %s in %s", client.key, client.sources, client.target)
 
     def _republish(self, req: Any) -> Any:
         topic = f"/tf_repub_{next(self._ids)}"
         pub = self.node.publisher(topic, self._array, queue_size=10, latch=True)
-        client = _Client(topic, pub, req)
-        with self._wake:
-            self._clients[topic] = client
-            heapq.heappush(self._due, (time.monotonic(), next(self._order), topic))
-            self._wake.notify()
-        log.info("tf2_web_republisher: %s for %s in %s", topic, client.sources, client.target)
+        self._add(_Client(topic, req, pub=pub))
         return {"topic_name": topic}
+
+    def _goal(self, handle: Any) -> None:
+        handle.set_accepted()
+        self._add(_Client(f"goal:{handle.get_goal_id().id}", handle.get_goal(), goal=handle))
+
+    def _cancel(self, handle: Any) -> None:
+        with self._wake:
+            client = self._clients.get(f"goal:{handle.get_goal_id().id}")
+            if client is not None:
+                client.cancelled = True
+        handle.set_canceled()
 
     def _run(self) -> None:
         while True:
@@ -89,23 +123,24 @@ class TFRepublisher:
                     self._wake.wait(None if not self._due else self._due[0][0] - time.monotonic())
                 if self._stop:
                     return
-                _, _, topic = heapq.heappop(self._due)
-                client = self._clients.get(topic)
+                _, _, key = heapq.heappop(self._due)
+                client = self._clients.get(key)
             if client is None:
                 continue
             if self._expired(client):
                 with self._wake:
-                    self._clients.pop(topic, None)
-                client.pub.unregister()
-                log.info(
-                    "tf2_web_republisher: %s withdrawn (no subscriber for %.1f s)", topic, client.timeout
-                )
+                    self._clients.pop(key, None)
+                if client.pub is not None:
+                    client.pub.unregister()
+                log.info("tf2_web_republisher: %s ended (cancelled, or no subscriber)", key)
                 continue
             self._send(client)
             with self._wake:
-                heapq.heappush(self._due, (time.monotonic() + client.period, next(self._order), topic))
+                heapq.heappush(self._due, (time.monotonic() + client.period, next(self._order), key))
 
     def _expired(self, client: _Client) -> bool:
+        if client.goal is not None:
+            return client.cancelled
         if client.pub.get_num_connections() > 0 or client.timeout <= 0:
             client.unheard_since = None
             return False
@@ -130,7 +165,11 @@ class TFRepublisher:
             t.header.frame_id = client.target
             t.child_frame_id = source
             out.append(t)
-        if out:
+        if not out:
+            return
+        if client.goal is not None:
+            client.goal.publish_feedback(self._feedback(transforms=out))
+        else:
             client.pub.publish(self._array(transforms=out))
 
     def shutdown(self) -> None:
@@ -139,6 +178,7 @@ class TFRepublisher:
             self._wake.notify()
         self._thread.join(2.0)
         self.service.shutdown()
+        self.action.stop()
         if self._listener is not None:
             self._listener.unregister()
 

@@ -8,8 +8,10 @@ queues them (bounded by ``queue_size``, oldest dropped first), deserializes and 
 * a message costs one thread wake-up between the kernel and the callback (no hop through the loop);
 * a dropped message is never deserialized;
 * callbacks never run on the I/O thread, and a slow callback delays only its own subscription;
-* the socket is read only when the queue is empty, and then completely, so ``queue_size=1`` really
-  means "the latest message" whatever ``buff_size`` is (rospy's ros_comm#536 does not apply).
+* the socket is read only when the queue is empty, and then in rounds of what the kernel held when
+  the round began, so ``queue_size=1`` really means "the latest message" whatever ``buff_size`` is
+  (rospy's ros_comm#536 does not apply), and a publisher as fast as the reader cannot keep the
+  worker reading instead of delivering (a sustained stream never starves the callback).
 
 Further Subscriber handles of the same topic in the same node get the reader's frames through their
 own queue and pipe.
@@ -432,12 +434,14 @@ class Subscriber:
             self._finish()
 
     def _on_wake(self) -> None:
-        self._woken = False
         try:
             while self._wake_r.recv(4096):
                 pass
         except (BlockingIOError, OSError):
             pass
+        # cleared only after draining: a wake-up written during the drain would otherwise be consumed
+        # while the flag stays set, and every later enqueue would skip its wake-up (a lost wake-up)
+        self._woken = False
         with self._ops_lock:
             ops, self._ops = self._ops, []
         for op, conn in ops:
@@ -457,8 +461,8 @@ class Subscriber:
         if conn.closed:
             self._forget(conn)
             return
-        # a bounded queue keeps the newest: read all there is and drop; an unbounded one delivers as it
-        # goes (reading megabytes of backlog first would stall every callback meanwhile)
+        # a bounded queue keeps the newest: read what the kernel holds and drop; an unbounded one
+        # delivers as it goes (reading megabytes of backlog first would stall every callback meanwhile)
         frames = conn.read(None if self._queue.maxlen is not None else _READ_BUDGET)
         if frames is None:
             self._forget(conn)

@@ -98,6 +98,11 @@ class Rate:
     def sleep(self) -> None:
         """Sleep until the next period boundary; raises ShutdownError when the node shuts down."""
         clock = self._clock
+        if clock.is_sim and self.last_time == 0.0 and clock.now_ns() == 0:
+            # made before simulated time started: the first period counts from the first /clock (rospy)
+            if clock.wait_until(1e-9) is Wake.SHUTDOWN:
+                raise ShutdownError("ROS shutdown request")
+            self.last_time = clock.now()
         now = clock.now()
         if now < self.last_time:
             # time already went backwards between two calls
@@ -200,6 +205,10 @@ class Timer:
         mk = self._make_time
         last_expected = last_real = None
         last_duration: float | None = None
+        if clock.is_sim and clock.now_ns() == 0:
+            # simulated time has not started: the first period counts from the first /clock (rospy)
+            if clock.wait_until(1e-9, self._cancelled) in (Wake.SHUTDOWN, Wake.CANCELLED):
+                return
         expected = clock.now() + self._period
         while True:
             wake = clock.wait_until(expected, self._cancelled)

@@ -43,6 +43,7 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
             "mimic": ("ninjemys.sim.mimic:main", ()),
         },
         "rqt_graph": {"rqt_graph": ("ninjemys.web.rqt_graph:main", ())},
+        "rviz": {"rviz": ("ninjemys.web.rviz:main", ())},
         "puzzlebot_sim": {
             "sim_node": ("ninjemys.sim.puzzlebot_node:main", ()),
             "world_to_map": ("ninjemys.sim.world_to_map:main", ()),
@@ -89,6 +90,7 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
             "tf_echo": ("ninjemys.tools.tf_echo:main", ()),
             "tf_monitor": ("ninjemys.tools.tf_monitor:main", ()),
             "static_transform_publisher": ("ninjemys.tools.static_transform_publisher:tf_main", ()),
+            "view_frames": ("ninjemys.tools.view_frames:tf_main", ()),
         },
         "tf2_tools": {"view_frames.py": ("ninjemys.tools.view_frames:main", ())},
         "rosbag": {

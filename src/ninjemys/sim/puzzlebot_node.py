@@ -146,6 +146,8 @@ class SimNode:
         self._wake = threading.Event()
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
+        self._started = (time.monotonic(), time.process_time())
+        self._stepped = 0.0  # simulated seconds stepped (resets of time do not undo them)
         self.view: Any = None
         self.clock_pub = node.publisher("/clock", Clock, queue_size=10)
         self.tf_pub = node.publisher("/tf", TFMessage, queue_size=100)
@@ -228,19 +230,26 @@ class SimNode:
         io.close()
 
     def _static_transforms(self, io: RobotIO) -> list[Any]:
+        """base_link -> each sensor's frame, and camera_link -> the optical frames the images name
+        (z forward, x right, y down: rpy -pi/2, 0, -pi/2, as the RealSense driver publishes)."""
         m = io.robot.model
-        out = []
+        pairs: list[tuple[str, str, tuple[float, float, float], tuple[float, float, float]]] = []
         for spec in (m.laser, m.camera, m.imu):
-            if spec is None:
-                continue
+            if spec is not None:
+                pairs.append(("base_link", spec.pose.frame, spec.pose.xyz, spec.pose.rpy))
+        if m.camera is not None:
+            optical = (-math.pi / 2, 0.0, -math.pi / 2)
+            for child in ("camera_color_optical_frame", "camera_depth_optical_frame"):
+                pairs.append((m.camera.pose.frame, child, (0.0, 0.0, 0.0), optical))
+        out = []
+        for parent, child, xyz, rpy in pairs:
             t = TransformStamped()
             t.header.stamp = self._stamp()
-            t.header.frame_id = io.frame("base_link")
-            t.child_frame_id = io.frame(spec.pose.frame)
-            t.transform.translation.x, t.transform.translation.y, t.transform.translation.z = spec.pose.xyz
-            q = quaternion_rpy(*spec.pose.rpy)
-            r = t.transform.rotation
-            r.x, r.y, r.z, r.w = q
+            t.header.frame_id = io.frame(parent)
+            t.child_frame_id = io.frame(child)
+            t.transform.translation.x, t.transform.translation.y, t.transform.translation.z = xyz
+            q = t.transform.rotation
+            q.x, q.y, q.z, q.w = quaternion_rpy(*rpy)
             out.append(t)
         return out
 
@@ -256,34 +265,25 @@ class SimNode:
             io.pubs["contact"].publish(Bool(data=io.robot.contact))
 
     def _on_cmd_vel(self, msg: Any, name: str) -> None:
-        values = (msg.linear.x, msg.angular.z)
-        with self.lock:
-            io = self.io.get(name)
-            if io is None:
-                return
-            if not all(
-                math.isfinite(v)
-                for v in (
-                    msg.linear.x,
-                    msg.linear.y,
-                    msg.linear.z,
-                    msg.angular.x,
-                    msg.angular.y,
-                    msg.angular.z,
+        """Runs on the subscriber's thread without the simulation lock (a command is one atomic
+        assignment), so commands get through even when the stepping thread runs flat out."""
+        io = self.io.get(name)
+        if io is None:
+            return
+        lin, ang = msg.linear, msg.angular
+        if not all(math.isfinite(v) for v in (lin.x, lin.y, lin.z, ang.x, ang.y, ang.z)):
+            if not io.bad_cmd_warned:
+                io.bad_cmd_warned = True
+                self.log.warn(
+                    "%scmd_vel: ignoring a command with a non-finite value (linear.x=%s, angular.z=%s); "
+                    "further ones are ignored silently until a valid command arrives",
+                    "/" + io.prefix if io.prefix else "",
+                    lin.x,
+                    ang.z,
                 )
-            ):
-                if not io.bad_cmd_warned:
-                    io.bad_cmd_warned = True
-                    self.log.warn(
-                        "%scmd_vel: ignoring a command with a non-finite value (linear.x=%s, angular.z=%s); "
-                        "further ones are ignored silently until a valid command arrives",
-                        "/" + io.prefix if io.prefix else "",
-                        values[0],
-                        values[1],
-                    )
-                return
-            io.bad_cmd_warned = False
-            io.robot.command(values[0], values[1])
+            return
+        io.bad_cmd_warned = False
+        io.robot.command(lin.x, ang.z)
 
     # -- services -------------------------------------------------------------------------------
     def _reset_simulation(self, _req: Any) -> Any:
@@ -373,12 +373,24 @@ class SimNode:
         self._wake.set()
         if self._thread is not None:
             self._thread.join(5.0)
+            self.log.info("%s", self.summary())
+
+    def summary(self) -> str:
+        """How fast the simulation ran: simulated seconds per wall second and per CPU second."""
+        wall = max(time.monotonic() - self._started[0], 1e-9)
+        cpu = max(time.process_time() - self._started[1], 1e-9)
+        stepped = self._stepped
+        return (
+            f"simulated {stepped:.2f} s in {wall:.2f} s of wall time ({stepped / wall:.1f}x real time), "
+            f"{cpu:.2f} s of CPU ({stepped / cpu:.1f} simulated s per CPU s)"
+        )
 
     def _stamp(self) -> Time:
         ns = round(self.sim.steps * self.sim.dt * 1e9)
         return Time(ns // 1_000_000_000, ns % 1_000_000_000)
 
     def _run(self) -> None:
+        self._started = (time.monotonic(), time.process_time())
         wall0 = time.monotonic()
         sim0 = self.sim.time
         while not self._stop.is_set():
@@ -398,7 +410,9 @@ class SimNode:
                 return  # the node shut down under the stepping thread
             except Exception as exc:  # a bug in one step must not freeze the simulation for good
                 self.log.error("simulation step failed: %s: %s", type(exc).__name__, exc)
-            if self.rate > 0:
+            if self.rate <= 0:
+                time.sleep(0)  # as fast as possible, yet callbacks and services get the lock between steps
+            else:
                 target = wall0 + (self.sim.time - sim0) / self.rate
                 delay = target - time.monotonic()
                 if delay > 0:
@@ -410,6 +424,7 @@ class SimNode:
     def _step_and_publish(self) -> None:
         sim = self.sim
         touched = sim.step()
+        self._stepped += sim.dt
         now = sim.time
         stamp = self._stamp()
         self.clock_pub.publish(Clock(clock=stamp))
@@ -583,7 +598,7 @@ class SimNode:
             img.encoding = "rgb8"
             img.is_bigendian = 0
             img.step = rgb.shape[1] * 3
-            img.data = rgb.tobytes()
+            img.data = rgb.reshape(-1)  # a view: uint8[] fields take numpy arrays without a copy
             pubs["image"].publish(img)
         if pubs["depth"].get_num_connections():
             d = Image()
@@ -593,7 +608,7 @@ class SimNode:
             d.encoding = "16UC1"
             d.is_bigendian = 0
             d.step = depth.shape[1] * 2
-            d.data = depth.astype("<u2").tobytes()
+            d.data = depth.astype("<u2", copy=False).view(np.uint8).reshape(-1)
             pubs["depth"].publish(d)
         fx, fy, cx, cy = r.camera.intrinsics()
         for key, frame_id in (("color_info", frame), ("depth_info", depth_frame)):
@@ -763,10 +778,10 @@ def main(argv: list[str] | None = None) -> int:
         namespaced = len(starts) > 1
         for i, s in enumerate(starts):
             pose = (x, y, yaw) if i == 0 else (s.x, s.y, s.yaw)
-            robot_model = model if s.model == "puzzlebot" else load_robot_model(s.model)
             try:
+                robot_model = model if s.model == "puzzlebot" else load_robot_model(s.model)
                 app.add_robot(s.name, robot_model, *pose, namespaced)
-            except SpawnError as exc:
+            except (SpawnError, MapFileError) as exc:
                 log.fatal("%s", exc)
                 return 1
         log.info(

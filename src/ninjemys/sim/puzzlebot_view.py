@@ -82,10 +82,7 @@ class PuzzlebotView:
             }
             for o in w.obstacles
         ]
-        grid_edges = []
-        if w.grid is not None:
-            n = len(w.segments)
-            grid_edges = np.round(sim._static[n:], 4).tolist()
+        grid_edges = np.round(sim.map_edges(), 4).tolist()
         markings = [
             {
                 "points": np.round(m.points, 4).tolist(),

@@ -21,7 +21,7 @@ import numpy as np
 
 from ninjemys.sim.raycast import grid_edges
 from ninjemys.sim.robot_model import RobotModel
-from ninjemys.sim.sensors import Camera, Scene, imu_reading, lidar_ranges
+from ninjemys.sim.sensors import Camera, FloorPaint, Scene, imu_reading, lidar_ranges
 from ninjemys.sim.world2d import Obstacle, World, box_outline, circle_outline
 
 TRAIL_LENGTH = 2000
@@ -63,8 +63,7 @@ class Robot:
     rng: np.random.Generator
     wl: float = 0.0  # actual wheel speeds (rad/s)
     wr: float = 0.0
-    target_wl: float = 0.0
-    target_wr: float = 0.0
+    target: tuple[float, float] = (0.0, 0.0)  # commanded (wl, wr): one tuple, so a command is atomic
     left_angle: float = 0.0
     right_angle: float = 0.0
     v: float = 0.0
@@ -87,11 +86,12 @@ class Robot:
         if peak > m.max_wheel_speed:
             wl *= m.max_wheel_speed / peak
             wr *= m.max_wheel_speed / peak
-        self.target_wl, self.target_wr = wl, wr
+        self.target = (wl, wr)
 
     def reset(self) -> None:
         self.x, self.y, self.yaw = self.start
-        self.wl = self.wr = self.target_wl = self.target_wr = 0.0
+        self.wl = self.wr = 0.0
+        self.target = (0.0, 0.0)
         self.left_angle = self.right_angle = 0.0
         self.v = self.w = self.v_prev = 0.0
         self.odom = [0.0, 0.0, 0.0]
@@ -115,6 +115,9 @@ class Simulation:
         self._spawned = 0
         self._static: np.ndarray
         self.static_names: list[str] = []
+        self._movers_at: tuple[float, tuple] | None = None
+        self._mover_fixed: tuple | None = None
+        self._floor = floor_paint(world)
         self._rebuild_static()
 
     @property
@@ -139,19 +142,50 @@ class Simulation:
         self._static_height = np.concatenate(heights)
         self._static_color = np.vstack(colours).astype(np.uint8)
         self.static_names = names
+        st = self._static
+        self._static_lo = np.minimum(st[:, :2], st[:, 2:])  # bounding boxes for the collision broad phase
+        self._static_hi = np.maximum(st[:, :2], st[:, 2:])
+        self._movers_at = None
+
+    def map_edges(self) -> np.ndarray:
+        """The outline of the world's occupancy grid as segments (empty without a map)."""
+        return self._static[len(self.world.segments) :]
 
     def _mover_segments(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[str]]:
-        segs, heights, colours, names = [], [], [], []
-        for m in self.world.moving:
-            o = m.outline_at(self.world_time)
-            s = np.hstack([o, np.roll(o, -1, axis=0)])
-            segs.append(s)
-            heights.append(np.full(len(s), m.height))
-            colours.append(np.tile(np.array(m.color, dtype=np.uint8), (len(s), 1)))
-            names += [m.name] * len(s)
-        if not segs:
+        """Moving obstacles' outlines now (computed once per step: collision and sensors share them)."""
+        if self._movers_at is not None and self._movers_at[0] == self.world_time:
+            return self._movers_at[1]
+        out = self._compute_mover_segments()
+        self._movers_at = (self.world_time, out)
+        return out
+
+    def _compute_mover_segments(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[str]]:
+        movers = self.world.moving
+        if not movers:
             return np.zeros((0, 4)), np.zeros(0), np.zeros((0, 3), dtype=np.uint8), []
-        return np.vstack(segs), np.concatenate(heights), np.vstack(colours), names
+        if self._mover_fixed is None:  # what does not move: heights, colours, names, outline shapes
+            heights, colours, names, shapes = [], [], [], []
+            for m in movers:
+                # centred on the origin; boxes are turned to their heading at each step
+                if m.kind == "cylinder":
+                    shape = circle_outline(0.0, 0.0, m.size[0])
+                else:
+                    shape = box_outline(0.0, 0.0, m.size[0], m.size[1], 0.0)
+                shapes.append(shape)
+                heights.append(np.full(len(shape), m.height))
+                colours.append(np.tile(np.array(m.color, dtype=np.uint8), (len(shape), 1)))
+                names += [m.name] * len(shape)
+            self._mover_fixed = (np.concatenate(heights), np.vstack(colours), names, shapes)
+        heights, colours, names, shapes = self._mover_fixed
+        outlines = []
+        for m, shape in zip(movers, shapes, strict=True):
+            x, y, heading = m.position(self.world_time)
+            if m.kind != "cylinder":
+                c, s = math.cos(heading), math.sin(heading)
+                shape = shape @ np.array([[c, s], [-s, c]])
+            outlines.append(shape + (x, y))
+        segs = np.vstack([np.hstack([o, np.roll(o, -1, axis=0)]) for o in outlines])
+        return segs, heights, colours, names
 
     def scene(self, exclude: str | None = None) -> Scene:
         """Everything solid now, as seen by robot ``exclude`` (its own body left out)."""
@@ -168,6 +202,7 @@ class Simulation:
             np.array([r.model.body_radius for r in others]),
             np.array([r.model.body_height for r in others]),
             np.array([r.model.color for r in others], dtype=np.uint8).reshape(-1, 3),
+            self._floor,
         )
 
     def clearance(self, x: float, y: float, exclude: str | None = None) -> tuple[float, str]:
@@ -178,19 +213,19 @@ class Simulation:
         return float(d[0]), name[0]
 
     def _collision_geometry(self, x: float, y: float, reach: float, exclude: str | None) -> tuple:
+        """Segments (with names) and other robots' circles within ``reach`` of (x, y)."""
+        near = np.flatnonzero(
+            (self._static_lo[:, 0] <= x + reach)
+            & (self._static_hi[:, 0] >= x - reach)
+            & (self._static_lo[:, 1] <= y + reach)
+            & (self._static_hi[:, 1] >= y - reach)
+        )
+        segs = self._static[near]
+        names = [self.static_names[i] for i in near]
         ms, _, _, mnames = self._mover_segments()
-        segs = np.vstack([self._static, ms]) if len(ms) else self._static
-        names = self.static_names + mnames
-        if len(segs) and reach < 1e8:
-            lo_x = np.minimum(segs[:, 0], segs[:, 2])
-            hi_x = np.maximum(segs[:, 0], segs[:, 2])
-            lo_y = np.minimum(segs[:, 1], segs[:, 3])
-            hi_y = np.maximum(segs[:, 1], segs[:, 3])
-            near = np.flatnonzero(
-                (lo_x <= x + reach) & (hi_x >= x - reach) & (lo_y <= y + reach) & (hi_y >= y - reach)
-            )
-            segs = segs[near]
-            names = [names[i] for i in near]
+        if len(ms):
+            segs = np.vstack([segs, ms])
+            names += mnames
         others = [r for r in self.robots.values() if r.name != exclude]
         centres = np.array([[r.x, r.y] for r in others]).reshape(-1, 2)
         radii = np.array([r.model.body_radius for r in others])
@@ -331,8 +366,9 @@ class Simulation:
     def _move(self, r: Robot, dt: float) -> bool:
         m = r.model
         step = m.max_wheel_accel * dt
-        r.wl += min(max(r.target_wl - r.wl, -step), step)
-        r.wr += min(max(r.target_wr - r.wr, -step), step)
+        target_wl, target_wr = r.target
+        r.wl += min(max(target_wl - r.wl, -step), step)
+        r.wr += min(max(target_wr - r.wr, -step), step)
         v = m.wheel_radius * (r.wr + r.wl) / 2.0
         w = m.wheel_radius * (r.wr - r.wl) / m.wheel_separation
         r.v_prev = r.v
@@ -372,7 +408,8 @@ class Simulation:
                 new_contact = not r.contact
                 r.contact, r.contact_with = True, who[k]
                 # a kinematic robot stops dead at the wall: wheels and command stop too
-                r.wl = r.wr = r.target_wl = r.target_wr = 0.0
+                r.wl = r.wr = 0.0
+                r.target = (0.0, 0.0)
                 r.v = r.w = 0.0
             elif r.contact:
                 r.contact, r.contact_with = False, ""
@@ -449,6 +486,31 @@ class Simulation:
         spec = r.model.imu
         assert spec is not None
         return imu_reading(r.yaw, r.v, r.w, r.v_prev, self.dt, spec.gyro_noise, spec.accel_noise, r.rng)
+
+
+def floor_paint(world: World, resolution: float = 0.01, max_cells: int = 2000) -> FloorPaint | None:
+    """The world's floor markings rasterized for the camera (None without markings)."""
+    if not world.markings:
+        return None
+    pts = np.vstack([m.points for m in world.markings])
+    margin = max(m.width for m in world.markings)
+    lo = pts.min(axis=0) - margin
+    hi = pts.max(axis=0) + margin
+    res = max(resolution, float((hi - lo).max()) / max_cells)
+    cols, rows = (int(v) + 1 for v in np.ceil((hi - lo) / res))
+    cx = lo[0] + (np.arange(cols) + 0.5) * res
+    cy = lo[1] + (np.arange(rows) + 0.5) * res
+    gx, gy = np.meshgrid(cx, cy)
+    texture = np.zeros((rows, cols), dtype=np.uint8)
+    palette = []
+    for m in world.markings:
+        ink = len(palette) + 1
+        palette.append(m.color)
+        path = np.vstack([m.points, m.points[:1]]) if m.closed else m.points
+        for a, b in zip(path[:-1], path[1:], strict=True):
+            d = point_segment_distance(gx.ravel(), gy.ravel(), np.array([[a[0], a[1], b[0], b[1]]]))[:, 0]
+            texture.ravel()[d <= m.width / 2.0] = ink
+    return FloorPaint(texture, np.array(palette, dtype=np.uint8), float(lo[0]), float(lo[1]), res)
 
 
 def _inside(x: float, y: float, poly: np.ndarray) -> bool:

@@ -3,8 +3,8 @@
 Same keys, parameters and printed text as the ROS package: ``u i o / j k l / m , .`` move (shifted:
 holonomic), ``t``/``b`` up/down, ``q/z w/x e/c`` scale the speeds by 10 %, anything else stops,
 Ctrl-C quits. Parameters ``~speed`` (0.5), ``~turn`` (1.0), ``~speed_limit``/``~turn_limit`` (1000),
-``~repeat_rate`` (0: publish on key presses only), ``~key_timeout`` (0.5 s without a key stops the
-robot; 0 disables), ``~stamped`` (publish geometry_msgs/TwistStamped) and ``~frame_id``. It waits
+``~repeat_rate`` (0: publish on key presses only), ``~key_timeout`` (seconds without a key that stop the
+robot; 0, the default, disables), ``~stamped`` (publish geometry_msgs/TwistStamped) and ``~frame_id``. It waits
 for a subscriber on ``cmd_vel`` first, printing ``Waiting for subscriber to connect to /cmd_vel``
 every 2.5 s as the original does, and publishes a zero twist on exit.
 """
@@ -141,7 +141,7 @@ def main(argv: list[str] | None = None) -> int:
             float(param("turn_limit", 1000)),
         )
         repeat = float(param("repeat_rate", 0.0))
-        key_timeout = float(param("key_timeout", 0.5))
+        key_timeout = float(param("key_timeout", 0.0))
     except (TypeError, ValueError) as exc:
         print(f"teleop_twist_keyboard: bad parameter: {exc}", file=sys.stderr)
         return 1

@@ -6,7 +6,7 @@ No ROS in here. Everything solid is reduced to what the ray caster and the colli
   each (walls are thick rectangles, boxes rectangles, cylinders 24-gons);
 * optionally an occupancy ``grid`` (a map_server map used as the world): occupied cells are solid,
   ``grid_height`` tall;
-* floor ``markings`` (painted lines, no height: the course's 1 m square) for the views;
+* floor ``markings`` (painted lines, no height: the course's 1 m square) for the camera and the views;
 * robots' start poses and moving obstacles that follow waypoints.
 
 Worlds come from our YAML format (:func:`load_world`, described in docs/sim.md) or from a
@@ -65,7 +65,7 @@ class Obstacle:
 
 @dataclass
 class Marking:
-    """A line painted on the floor (no height): drawn by the views, invisible to the lidar."""
+    """A line painted on the floor (no height): seen by the camera and the views, not by the lidar."""
 
     points: np.ndarray  # (K, 2)
     closed: bool
@@ -95,25 +95,35 @@ class MovingObstacle:
     speed: float
     loop: bool = True
 
+    def __post_init__(self) -> None:
+        pts = [(float(x), float(y)) for x, y in self.waypoints]
+        path = pts + pts[:1] if self.loop else pts + pts[-2::-1]
+        #: (x0, y0, x1, y1, length, heading) of each leg of the closed route, in order
+        self._legs = [
+            (
+                a[0],
+                a[1],
+                b[0],
+                b[1],
+                math.hypot(b[0] - a[0], b[1] - a[1]),
+                math.atan2(b[1] - a[1], b[0] - a[0]),
+            )
+            for a, b in zip(path[:-1], path[1:], strict=True)
+        ]
+        self._total = sum(leg[4] for leg in self._legs)
+
     def position(self, t: float) -> tuple[float, float, float]:
         """Pose (x, y, heading) at time ``t`` seconds after the start: a pure function of time."""
-        pts = self.waypoints
-        if len(pts) == 1 or self.speed <= 0:
-            return float(pts[0, 0]), float(pts[0, 1]), 0.0
-        path = np.vstack([pts, pts[:1]]) if self.loop else np.vstack([pts, pts[-2::-1]])
-        legs = np.linalg.norm(np.diff(path, axis=0), axis=1)
-        total = float(legs.sum())
-        if total <= 0:
-            return float(pts[0, 0]), float(pts[0, 1]), 0.0
-        s = (t * self.speed) % total
-        for i, leg in enumerate(legs):
-            if s <= leg or i == len(legs) - 1:
-                a, b = path[i], path[i + 1]
-                f = s / leg if leg > 0 else 0.0
-                heading = math.atan2(b[1] - a[1], b[0] - a[0])
-                return float(a[0] + f * (b[0] - a[0])), float(a[1] + f * (b[1] - a[1])), heading
-            s -= leg
-        return float(pts[0, 0]), float(pts[0, 1]), 0.0
+        x0, y0 = float(self.waypoints[0, 0]), float(self.waypoints[0, 1])
+        if self.speed <= 0 or self._total <= 0:
+            return x0, y0, 0.0
+        s = (t * self.speed) % self._total
+        for i, (ax, ay, bx, by, length, heading) in enumerate(self._legs):
+            if s <= length or i == len(self._legs) - 1:
+                f = s / length if length > 0 else 0.0
+                return ax + f * (bx - ax), ay + f * (by - ay), heading
+            s -= length
+        return x0, y0, 0.0
 
     def outline_at(self, t: float) -> np.ndarray:
         x, y, heading = self.position(t)

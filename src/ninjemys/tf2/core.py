@@ -18,9 +18,11 @@ Where we differ, on purpose:
   ``inverse(a) * b`` instead of a walk. When that path cannot answer (a frame above the common
   ancestor has no data for that time), the exact tf2 walk runs and gives tf2's answer or error.
 - ``can_transform`` with a timeout waits on a condition that insertions signal (no polling sleeps).
+- Raw TFMessages (``add_raw``, what the listener uses) are queued and decoded in batches on the next
+  query, runs of one layout with numpy (:mod:`ninjemys.tf2.bulk`).
 
-Times are integer nanoseconds in this module's fast API (``lookup``, ``set_transforms``); the
-message-level API (``lookup_transform_core`` ...) takes and returns ``ninjemys.rostime`` values.
+Times are integer nanoseconds and transforms 7-tuples here; :mod:`ninjemys.tf2.buffer` puts the
+message-level API (TransformStamped, ``ninjemys.rostime`` values, timeouts) on top.
 """
 
 from __future__ import annotations
@@ -30,9 +32,14 @@ import threading
 import time as _wall
 from bisect import bisect_left
 from collections.abc import Callable, Iterable, Sequence
-from math import isfinite
+from itertools import repeat
+from math import acos, isfinite, sin, sqrt
 
+import numpy
+
+from ninjemys.errors import DeserializationError
 from ninjemys.tf2 import math as tfm
+from ninjemys.tf2.bulk import Layout, valid
 from ninjemys.tf2.errors import (
     ConnectivityException,
     ExtrapolationException,
@@ -41,6 +48,7 @@ from ninjemys.tf2.errors import (
     TimeoutException,
     TransformException,
 )
+from ninjemys.tf2.wire import decode_tf_message
 
 _log = logging.getLogger(__name__)
 
@@ -49,6 +57,8 @@ MAX_GRAPH_DEPTH = 1000
 QUATERNION_TOLERANCE = 10e-6  # tf2: |x²+y²+z²+w² - 1| must stay under this
 NO_PARENT = "NO_PARENT"
 REPEAT_REPORT_AFTER = 10.0  # seconds before the same bad-input line is reported again
+PENDING_MAX = 50  # raw messages queued before the listener's thread decodes them itself
+BULK_MIN = 2  # a run this long of one layout is decoded with numpy; a single message per transform
 
 # tf2_msgs/TF2Error codes, as walk results
 NO_ERROR = 0
@@ -84,6 +94,11 @@ class Frame:
         "memo_val",
         "quiet_repeat",
         "warned_old",
+        "path_topology",
+        "path",
+        "index",
+        "pmin_gen",
+        "pmin",
     )
 
     def __init__(self, name: str, number: int) -> None:
@@ -101,59 +116,101 @@ class Frame:
         self.memo_val: tuple | None = None
         self.quiet_repeat = False
         self.warned_old = 0.0
+        self.path_topology = -1
+        self.path: list[Frame] = []  # this frame, its newest parent, ... up to the top of its tree
+        self.index: dict[Frame, int] = {}
+        self.pmin_gen = -1
+        self.pmin: list[int] = []  # pmin[k]: the oldest non-zero newest stamp among path[:k]
 
     def __repr__(self) -> str:
         return f"Frame({self.name!r})"
 
     # -- tf2's TimeCache -------------------------------------------------------------------------
+    def _resolve(self, i: int) -> Entry:
+        """Entry ``i`` as ``(parent, 7 floats)``. Entries inserted in bulk are ``(parent, block, row)``
+        (a row of a numpy array of their batch) until first read: most history is never looked at."""
+        e = self.data[i]
+        if len(e) == 3:
+            e = self.data[i] = (e[0], tuple(e[1][e[2]].tolist()))
+        return e
+
     def at(self, t: int, err: list[str] | None) -> Entry | None:
         """The entry for time ``t`` (0 = newest), interpolated; None (and a tf2 text in ``err``) if none."""
         data = self.data
         if not data:
             return None
-        if self.static or t == 0:
-            return data[-1]
+        if t == 0 or self.static:
+            e = data[-1]
+            return e if len(e) == 2 else self._resolve(-1)
         stamps = self.stamps
         n = len(stamps)
-        if n == 1:
-            if stamps[0] == t:
-                return data[0]
-            if err is not None:
+        i = bisect_left(stamps, t)
+        if 0 < i < n:
+            if stamps[i] == t:
+                return self._resolve(i)
+            return self._interpolate(i, t)
+        if i == 0 and stamps[0] == t:
+            return self._resolve(0)
+        if err is not None:
+            if n == 1:
                 err.append(
                     "Lookup would require extrapolation at time %.09f, but only time %.09f is in the buffer"
                     % (_secs(t), _secs(stamps[0]))
                 )
-            return None
-        latest = stamps[-1]
-        if t == latest:
-            return data[-1]
-        earliest = stamps[0]
-        if t == earliest:
-            return data[0]
-        if t > latest:
-            if err is not None:
+            elif i == n:
+                latest = stamps[-1]
                 err.append(
                     "Lookup would require extrapolation %.09fs into the future.  Requested time %.09f but the "
                     "latest data is at time %.09f" % (_secs(t - latest), _secs(t), _secs(latest))
                 )
-            return None
-        if t < earliest:
-            if err is not None:
+            else:
+                earliest = stamps[0]
                 err.append(
                     "Lookup would require extrapolation %.09fs into the past.  Requested time %.09f but the "
                     "earliest data is at time %.09f" % (_secs(earliest - t), _secs(t), _secs(earliest))
                 )
-            return None
-        i = bisect_left(stamps, t)
-        if stamps[i] == t:
-            return data[i]
+        return None
+
+    def _interpolate(self, i: int, t: int) -> Entry:
+        """Between entries ``i - 1`` and ``i``: lerp for the translation, slerp (the shorter arc) for the
+        rotation, as tf2's ``TimeCache::interpolate``; across a change of parent, the older entry."""
+        data = self.data
         older = data[i - 1]
+        if len(older) == 3:
+            older = self._resolve(i - 1)
         newer = data[i]
-        if older[0] is not newer[0]:  # the parent changed in between: tf2 keeps the older one
+        if len(newer) == 3:
+            newer = self._resolve(i)
+        if older[0] is not newer[0]:
             return older
+        stamps = self.stamps
         t0 = stamps[i - 1]
-        ratio = (t - t0) / (stamps[i] - t0)
-        return older[0], tfm.interpolate(older[1], newer[1], ratio)
+        r = (t - t0) / (stamps[i] - t0)
+        r0 = 1.0 - r
+        a = older[1]
+        b = newer[1]
+        ax, ay, az, aw = a[3], a[4], a[5], a[6]
+        bx, by, bz, bw = b[3], b[4], b[5], b[6]
+        dot = ax * bx + ay * by + az * bz + aw * bw
+        if dot < 0.0:  # q and -q are one rotation: take the short way round
+            bx, by, bz, bw, dot = -bx, -by, -bz, -bw, -dot
+        if dot > 0.9999995:  # nearly equal: a normalized lerp (slerp's sine would vanish)
+            qx = r0 * ax + r * bx
+            qy = r0 * ay + r * by
+            qz = r0 * az + r * bz
+            qw = r0 * aw + r * bw
+            k = 1.0 / sqrt(qx * qx + qy * qy + qz * qz + qw * qw)
+            qx, qy, qz, qw = qx * k, qy * k, qz * k, qw * k
+        else:  # slerp keeps unit length to rounding, as tf2's does
+            theta = acos(dot)
+            inv = 1.0 / sin(theta)
+            s0 = sin(r0 * theta) * inv
+            s1 = sin(r * theta) * inv
+            qx = s0 * ax + s1 * bx
+            qy = s0 * ay + s1 * by
+            qz = s0 * az + s1 * bz
+            qw = s0 * aw + s1 * bw
+        return older[0], (r0 * a[0] + r * b[0], r0 * a[1] + r * b[1], r0 * a[2] + r * b[2], qx, qy, qz, qw)
 
     def parent_at(self, t: int, err: list[str] | None) -> Frame | None:
         """tf2's ``getParent``: the parent for time ``t`` (the older entry's), without interpolating."""
@@ -173,18 +230,6 @@ class Frame:
         return 0 if self.static or not self.stamps else self.stamps[0]
 
 
-class _Pair:
-    """The frames whose newest stamps decide a pair's latest common time (tf2's ``getLatestCommonTime``)."""
-
-    __slots__ = ("topology", "frames", "gen", "time")
-
-    def __init__(self, topology: int, frames: list[Frame]) -> None:
-        self.topology = topology
-        self.frames = frames
-        self.gen = -1
-        self.time = 0
-
-
 class BufferCore:
     """tf2's BufferCore: set transforms in, look transforms up. Thread-safe (one lock, one condition)."""
 
@@ -192,6 +237,9 @@ class BufferCore:
         """``cache_time`` is seconds of history per frame; ``report`` receives the one line about bad input
         (default: this module's logger at error level)."""
         self.cache_time_ns = int(round(cache_time * 1e9))
+        # history is trimmed back to cache_time once it is this much longer (trimming on every insertion
+        # shifts the whole list each time): a frame keeps between cache_time and 1/16 more
+        self._prune_slack = self.cache_time_ns >> 4
         self._report: Reporter = report or _log.error
         self._frames: dict[str, Frame] = {}
         self._order: list[Frame] = []  # by frame number (tf2's frameIDs_reverse, minus NO_PARENT)
@@ -199,9 +247,11 @@ class BufferCore:
         self._changed = threading.Condition(self._lock)
         self._waiters = 0
         self._gen = 0  # bumped by every accepted insertion: memos of older generations are stale
+        self._last_t = -1  # the time of the previous non-latest lookup (a repeat fills the memos)
         self._topology = 0  # bumped when a frame appears or a newest parent changes
-        self._pairs: dict[tuple[Frame, Frame], _Pair] = {}
+        self._pending: list[tuple[bytes, str, bool]] = []  # raw TFMessages not decoded yet
         self._listeners: list[Callable[[], None]] = []
+        self._layouts: dict[tuple[str, int], Layout] = {}
         self._reported: dict[str, float] = {}
 
     @property
@@ -221,16 +271,30 @@ class BufferCore:
     def frame_exists(self, name: str) -> bool:
         """tf2's ``_frameExists``: the name is known (as a child or as a parent)."""
         with self._lock:
+            self._drain()
             return name in self._frames
+
+    def child_frames(self) -> list[str]:
+        """The frames that have a parent now (the keys of :meth:`all_frames_as_yaml`), in tf2's order."""
+        with self._lock:
+            self._drain()
+            return [f.name for f in self._order if f.has_cache and f.data]
 
     def frame_names(self) -> list[str]:
         """Every known frame, in the order tf2 numbered them (``_getFrameStrings``)."""
         with self._lock:
+            self._drain()
             return [f.name for f in self._order]
 
     def add_change_listener(self, fn: Callable[[], None]) -> None:
-        """Call ``fn()`` (on the inserting thread, outside the lock) after every batch of accepted data."""
+        """Call ``fn()`` after new data arrived (on the inserting thread, outside the buffer's lock): what a
+        filter that holds messages until their transform is available waits on (tf2's transformable
+        callbacks). ``fn`` may query the buffer; it should be quick."""
         self._listeners.append(fn)
+
+    def _changed_data(self) -> None:
+        for fn in self._listeners:
+            fn()
 
     # -- insertion -------------------------------------------------------------------------------
     def set_transforms(
@@ -244,6 +308,7 @@ class BufferCore:
         accepted = 0
         problems: list[str] = []
         with self._lock:
+            self._drain()
             for item in items:
                 why = self._insert(item, authority, is_static)
                 if why is None:
@@ -256,10 +321,130 @@ class BufferCore:
                     self._changed.notify_all()
         if problems:
             self._report_once(problems)
-        if accepted:
-            for fn in self._listeners:
-                fn()
+        if accepted and self._listeners:
+            self._changed_data()
         return accepted
+
+    def add_raw(self, data: bytes, authority: str = "default_authority", is_static: bool = False) -> None:
+        """Queue a serialized TFMessage; it is decoded and inserted with the others that arrived
+        before the next query (or once ``PENDING_MAX`` are waiting), many at a time: consecutive
+        messages of one layout cost a few numpy operations together instead of Python work per
+        transform (a listener's CPU is mostly spent decoding, geometry2#513)."""
+        with self._lock:
+            self._pending.append((data, authority, is_static))
+            if len(self._pending) >= PENDING_MAX:
+                self._drain()
+            if self._waiters:
+                self._changed.notify_all()
+        if self._listeners:
+            self._changed_data()
+
+    def _drain(self) -> None:
+        """Decode and insert every queued message, in arrival order (lock held)."""
+        pending = self._pending
+        if not pending:
+            return
+        self._pending = []
+        problems: list[str] = []
+        accepted = 0
+        i = 0
+        n = len(pending)
+        while i < n:
+            data, who, static = pending[i]
+            size = len(data)
+            j = i + 1
+            while j < n and pending[j][1] == who and pending[j][2] == static and len(pending[j][0]) == size:
+                j += 1
+            run = [p[0] for p in pending[i:j]]
+            got = self._read_run(run, who) if j - i >= BULK_MIN and not static else None
+            if got is not None:
+                accepted += self._insert_columns(got[0], got[1], who, problems)
+            else:
+                for d in run:
+                    try:
+                        items = decode_tf_message(d)
+                    except DeserializationError as exc:
+                        problems.append(
+                            f"{'/tf_static' if static else '/tf'}: dropped a message from {who}: {exc}"
+                        )
+                        continue
+                    for item in items:
+                        why = self._insert(item, who, static)
+                        if why is None:
+                            accepted += 1
+                        elif why:
+                            problems.append(why)
+            i = j
+        if accepted:
+            self._gen += 1
+        if problems:
+            self._report_once(problems)
+
+    def _read_run(self, run: list[bytes], who: str) -> tuple[Layout, tuple] | None:
+        """Stamps and numbers of a run of same-size messages from one publisher, if they share a layout
+        and all their values are good; None sends the run through the per-transform path."""
+        key = (who, len(run[0]))
+        layout = self._layouts.get(key)
+        if layout is None or not layout.matches(run[0]):
+            try:
+                layout = Layout(run[0])
+            except DeserializationError:
+                return None
+            if len(self._layouts) > 1000:
+                self._layouts.clear()
+            self._layouts[key] = layout
+        got = layout.read(run)
+        if got is None or not valid(got[1], QUATERNION_TOLERANCE):
+            return None
+        return layout, got
+
+    def _insert_columns(self, layout: Layout, got: tuple, who: str, problems: list[str]) -> int:
+        """Append each transform's ``k`` new entries to its frame in one go (lock held); a column that
+        does not continue its frame's history in order (new frame or parent, old or repeated stamps)
+        goes through :meth:`_insert` entry by entry."""
+        stamps, values = got
+        k = stamps.shape[0]
+        increasing = (
+            (numpy.diff(stamps, axis=0) > 0).all(axis=0).tolist() if k > 1 else [True] * stamps.shape[1]
+        )
+        columns = stamps.T.tolist()
+        frames = self._frames
+        keep = self.cache_time_ns
+        slack = keep + self._prune_slack
+        blocks = list(values.transpose(1, 0, 2))  # one (k, 7) view per transform
+        count = 0
+        for j, (parent_name, child_name) in enumerate(zip(layout.parents, layout.children, strict=True)):
+            col = columns[j]
+            child = frames.get(child_name)
+            parent = frames.get(parent_name)
+            if (
+                child is None
+                or parent is None
+                or child.static
+                or child.parent is not parent
+                or not increasing[j]
+                or col[0] <= child.latest
+                or not child.stamps
+            ):
+                for stamp, v in zip(col, values[:, j, :].tolist(), strict=True):
+                    why = self._insert((parent_name, child_name, stamp, *v), who, False)
+                    if why is None:
+                        count += 1
+                    elif why:
+                        problems.append(why)
+                continue
+            child.authority = who
+            st = child.stamps
+            st.extend(col)
+            child.data.extend(zip(repeat(parent, k), repeat(blocks[j], k), range(k), strict=False))
+            latest = col[-1]
+            child.latest = latest
+            if st[0] < latest - slack:
+                cut = bisect_left(st, latest - keep)
+                del st[:cut]
+                del child.data[:cut]
+            count += k
+        return count
 
     def _report_once(self, lines: list[str]) -> None:
         """Report each line, but the same line at most once per ``REPEAT_REPORT_AFTER`` seconds: a broadcaster
@@ -348,9 +533,8 @@ class BufferCore:
             stamps.append(stamp)
             child.data.append(entry)
             child.latest = stamp
-            cutoff = stamp - self.cache_time_ns
-            if stamps[0] < cutoff:
-                i = bisect_left(stamps, cutoff)
+            if stamps[0] < stamp - self.cache_time_ns - self._prune_slack:
+                i = bisect_left(stamps, stamp - self.cache_time_ns)
                 del stamps[:i]
                 del child.data[:i]
             return None
@@ -400,6 +584,8 @@ class BufferCore:
     def clear(self) -> None:
         """Forget all non-static data (tf2 keeps static transforms across ``clear``)."""
         with self._lock:
+            self._pending = [p for p in self._pending if p[2]]  # unread static data still counts
+            self._drain()
             for f in self._order:
                 if f.has_cache and not f.static:
                     f.stamps = []
@@ -408,7 +594,6 @@ class BufferCore:
                     f.parent = None
             self._gen += 1
             self._topology += 1
-            self._pairs.clear()
 
     # -- names -----------------------------------------------------------------------------------
     def _validate(self, what: str, name: str) -> Frame:
@@ -439,32 +624,51 @@ class BufferCore:
         return False
 
     # -- latest common time ----------------------------------------------------------------------
-    def _common_time(self, target: Frame, source: Frame, err: list[str] | None) -> tuple[int, int]:
-        """(code, time): tf2's ``getLatestCommonTime``, with the deciding frames cached per pair."""
-        if source is target:
-            return NO_ERROR, (source.latest if source.has_cache else 0)
-        key = (target, source)
-        pair = self._pairs.get(key)
-        gen = self._gen
-        if pair is not None and pair.topology == self._topology:
-            if pair.gen == gen:
-                return NO_ERROR, pair.time
+    def _path(self, f: Frame) -> list[Frame] | None:
+        """``f`` and its newest parents up to the top (cached until the topology changes); None on a loop."""
+        if f.path_topology != self._topology:
+            path = [f]
+            cur = f
+            while cur.data:
+                cur = cur.data[-1][0]
+                path.append(cur)
+                if len(path) > MAX_GRAPH_DEPTH:
+                    return None
+            f.path = path
+            f.index = {frame: i for i, frame in enumerate(path)}
+            f.path_topology = self._topology
+        return f.path
+
+    def _pmin(self, f: Frame) -> list[int]:
+        """Prefix minima of the newest stamps along ``f.path`` (cached until the next insertion)."""
+        if f.pmin_gen != self._gen:
             best = 0
-            for f in pair.frames:
-                lt = f.latest
+            pmin = [0]
+            for frame in f.path:
+                lt = frame.latest
                 if lt and (best == 0 or lt < best):
                     best = lt
-            pair.gen = gen
-            pair.time = best
-            return NO_ERROR, best
-        code, t, frames = self._common_time_walk(target, source, err)
-        if code == NO_ERROR:
-            if len(self._pairs) > 100_000:
-                self._pairs.clear()
-            pair = _Pair(self._topology, frames)
-            pair.gen = gen
-            pair.time = t
-            self._pairs[key] = pair
+                pmin.append(best)
+            f.pmin = pmin
+            f.pmin_gen = self._gen
+        return f.pmin
+
+    def _common_time(self, target: Frame, source: Frame, err: list[str] | None) -> tuple[int, int]:
+        """(code, time): tf2's ``getLatestCommonTime``: the oldest of the newest stamps of the links
+        below the lowest common ancestor, on both sides (static links do not count)."""
+        if source is target:
+            return NO_ERROR, (source.latest if source.has_cache else 0)
+        sp = self._path(source)
+        tp = self._path(target)
+        if sp is not None and tp is not None:
+            index = source.index
+            for j, frame in enumerate(tp):
+                i = index.get(frame)
+                if i is not None:
+                    a = self._pmin(source)[i]
+                    b = self._pmin(target)[j]
+                    return NO_ERROR, (a if b == 0 or (a and a < b) else b)
+        code, t, _ = self._common_time_walk(target, source, err)
         return code, t
 
     def _common_time_walk(
@@ -563,6 +767,7 @@ class BufferCore:
         """``(stamp_ns, 7 floats)``: the transform that maps data in ``source_frame`` into ``target_frame``
         at time ``t`` (0 = latest common). Raises tf2's exceptions with tf2's texts."""
         with self._lock:
+            self._drain()
             if target_frame == source_frame:
                 if t == 0:
                     f = self._frames.get(target_frame)
@@ -579,12 +784,49 @@ class BufferCore:
             if code != NO_ERROR:
                 _raise(code, err)
         gen = self._gen
-        a = self._to_root(source, t, gen)
-        if a is not None:
-            b = self._to_root(target, t, gen)
-            if b is not None and a[0] is b[0]:
-                return t, tfm.inverse_compose(b[1], a[1])
+        if (source.memo_gen == gen and source.memo_t == t) or t == self._last_t:
+            # a time asked for before: each frame's transform to the top of its tree is (or becomes) memoized
+            a = self._to_root(source, t, gen)
+            if a is not None:
+                b = self._to_root(target, t, gen)
+                if b is not None and a[0] is b[0]:
+                    return t, tfm.inverse_compose(b[1], a[1])
+            # some link above the common ancestor has no data for t (a slow map->odom under a fast
+            # odom->base_link): the answer only needs the links below it
+        else:
+            self._last_t = t
+        r = self._to_ancestor(target, source, t)
+        if r is not None:
+            return t, r
         return t, self._walk_transform(target, source, t)
+
+    def _to_ancestor(self, target: Frame, source: Frame, t: int) -> tuple | None:
+        """A one-off lookup at ``t``: compose each side up to the lowest common ancestor only. None when
+        the newest-parent paths do not hold at ``t`` (the exact walk decides then)."""
+        sp = self._path(source)
+        tp = self._path(target)
+        if sp is None or tp is None:
+            return None
+        index = source.index
+        i = j = None
+        for k, frame in enumerate(tp):
+            i = index.get(frame)
+            if i is not None:
+                j = k
+                break
+        if i is None or j is None:
+            return None
+        compose = tfm.compose
+        sides = []
+        for path, n in ((sp, i), (tp, j)):
+            acc = None
+            for k in range(n):
+                e = path[k].at(t, None)
+                if e is None or e[0] is not path[k + 1]:
+                    return None
+                acc = e[1] if acc is None else compose(e[1], acc)
+            sides.append(acc or tfm.IDENTITY)
+        return tfm.inverse_compose(sides[1], sides[0])
 
     def _walk_transform(self, target: Frame, source: Frame, t: int) -> tuple:
         """tf2's ``walkToTopParent`` with ``TransformAccum``; raises tf2's error for this lookup."""
@@ -683,6 +925,7 @@ class BufferCore:
         """The advanced lookup: ``source`` at ``source_t`` into ``fixed``, then ``fixed`` at ``target_t``
         into ``target``. Returns ``(stamp of the second lookup, 7 floats)``."""
         with self._lock:
+            self._drain()
             self._validate("lookupTransform argument target_frame", target_frame)
             self._validate("lookupTransform argument source_frame", source_frame)
             self._validate("lookupTransform argument fixed_frame", fixed_frame)
@@ -699,6 +942,7 @@ class BufferCore:
         ):
             return False, ""
         with self._lock:
+            self._drain()
             target = self._frames.get(target_frame)
             source = self._frames.get(source_frame)
             if target is None or source is None:
@@ -736,6 +980,7 @@ class BufferCore:
             if self._warn_frame_id(what, name):
                 return False, ""
         with self._lock:
+            self._drain()
             target = self._frames.get(target_frame)
             source = self._frames.get(source_frame)
             fixed = self._frames.get(fixed_frame)
@@ -781,14 +1026,10 @@ class BufferCore:
             finally:
                 self._waiters -= 1
 
-    def wake_waiters(self) -> None:
-        """Wake every ``wait_for_transform`` so it re-checks (e.g. at shutdown or after a clock jump)."""
-        with self._lock:
-            self._changed.notify_all()
-
     def latest_common_time(self, target_frame: str, source_frame: str) -> int:
         """tf2_py's ``get_latest_common_time`` (raises LookupException / TransformException)."""
         with self._lock:
+            self._drain()
             target = self._validate("get_latest_common_time", target_frame)
             source = self._validate("get_latest_common_time", source_frame)
             err: list[str] = []
@@ -802,6 +1043,7 @@ class BufferCore:
     ) -> list[str]:
         """tf2's ``_chainAsVector``: the frame names from source to target through ``fixed_frame``."""
         with self._lock:
+            self._drain()
             source = self._frames.get(source_frame)
             fixed = self._frames.get(fixed_frame)
             target = self._frames.get(target_frame)
@@ -836,6 +1078,7 @@ class BufferCore:
     def all_frames_as_string(self) -> str:
         """tf2's ``allFramesAsString``: one "Frame x exists with parent y." line per child frame."""
         with self._lock:
+            self._drain()
             return self._frames_as_string()
 
     def _stats(self, f: Frame) -> tuple[str, float, float, float, float]:
@@ -848,6 +1091,7 @@ class BufferCore:
     def all_frames_as_yaml(self, current_time: float = 0.0) -> str:
         """tf2's ``allFramesAsYAML`` (what ``tf2_frames`` and view_frames read)."""
         with self._lock:
+            self._drain()
             out = [] if self._order else ["{}"]
             for f in self._order:
                 if not f.has_cache or not f.data:
@@ -865,6 +1109,7 @@ class BufferCore:
     def all_frames_as_dot(self, current_time: float = 0.0) -> str:
         """tf2's ``_allFramesAsDot``: the frame tree for Graphviz, with tf2's labels."""
         with self._lock:
+            self._drain()
             out = ["digraph G {\n"]
             if not self._order:
                 out.append('"no tf data recieved"')

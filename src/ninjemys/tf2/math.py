@@ -8,7 +8,7 @@ float code on tuples. Quaternions are (x, y, z, w), ROS's order, and are assumed
 
 from __future__ import annotations
 
-from math import acos, isfinite, sin, sqrt
+from math import acos, sin, sqrt
 
 Transform7 = tuple[float, float, float, float, float, float, float]
 
@@ -130,18 +130,3 @@ def slerp(
     w = s0 * aw + s1 * bw
     n = sqrt(x * x + y * y + z * z + w * w)
     return x / n, y / n, z / n, w / n
-
-
-def interpolate(a: Transform7, b: Transform7, ratio: float) -> Transform7:
-    """Linear interpolation of the translation and slerp of the rotation (tf2's ``TimeCache::interpolate``)."""
-    r0 = 1.0 - ratio
-    qx, qy, qz, qw = slerp((a[3], a[4], a[5], a[6]), (b[3], b[4], b[5], b[6]), ratio)
-    return (r0 * a[0] + ratio * b[0], r0 * a[1] + ratio * b[1], r0 * a[2] + ratio * b[2], qx, qy, qz, qw)
-
-
-def is_finite(values: tuple[float, ...]) -> bool:
-    """True when no component is NaN or infinite."""
-    for v in values:
-        if not isfinite(v):
-            return False
-    return True

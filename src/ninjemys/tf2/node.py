@@ -4,8 +4,9 @@
 Wire behaviour is ROS 1's: ``/tf`` and ``/tf_static`` carry ``tf2_msgs/TFMessage``; ``/tf_static`` is
 latched and a static broadcaster re-sends every frame it ever sent (tf2_ros's C++ broadcaster keeps
 them by child frame; ROS 1's Python one forgets earlier calls, geometry2#406/#455). The listener takes
-raw bytes, decodes them straight into tuples and inserts each message in one batch; the publisher's
-caller id is the authority, as tf2_ros records it.
+raw bytes and hands them to the buffer, which decodes them in batches when it is next asked
+(:meth:`~ninjemys.tf2.core.BufferCore.add_raw`); the publisher's caller id is the authority, as
+tf2_ros records it.
 """
 
 from __future__ import annotations
@@ -15,13 +16,14 @@ import threading
 from collections.abc import Callable, Iterable
 from typing import Any
 
-from ninjemys.errors import DeserializationError, MasterError
+from ninjemys.errors import MasterError
 from ninjemys.idl.loader import get_message_class, get_service_class
 from ninjemys.tf2.buffer import Buffer, to_ns, transform_tuple
 from ninjemys.tf2.core import BufferCore
-from ninjemys.tf2.wire import decode_tf_message, encode_tf_message
+from ninjemys.tf2.wire import encode_tf_message
 
 _log = logging.getLogger(__name__)
+TF_MESSAGE_MD5 = "94810edda583a504dfda3829e70d7eec"
 
 
 class TransformListener:
@@ -61,36 +63,33 @@ class TransformListener:
                 self.buffer.clear()
             self._last = now
 
-    def _decode(self, raw: Any, topic: str) -> tuple[list[tuple], str] | None:
+    def _accept(self, raw: Any, topic: str) -> str | None:
+        """The publisher's caller id when the message is a TFMessage (one line per publisher otherwise)."""
         header = raw.connection_header
         who = header.get("callerid", "default_authority")
-        md5 = header.get("md5sum", "94810edda583a504dfda3829e70d7eec")
-        if md5 not in ("94810edda583a504dfda3829e70d7eec", "*"):
+        md5 = header.get("md5sum", TF_MESSAGE_MD5)
+        if md5 not in (TF_MESSAGE_MD5, "*"):
             if who not in self._bad_reported:
                 self._bad_reported.add(who)
                 self._report(
                     f"{topic}: {who} publishes type {header.get('type')} (md5 {md5}), not tf2_msgs/TFMessage"
                 )
             return None
-        try:
-            return decode_tf_message(raw.data), who
-        except DeserializationError as exc:
-            self._report(f"{topic}: dropped a message from {who}: {exc}")
-            return None
+        return who
 
     def _on_tf(self, raw: Any) -> None:
         if self._now is not None:
             self._check_for_reset()
-        got = self._decode(raw, "/tf")
-        if got is not None:
-            self.buffer.set_transforms(got[0], got[1], False)
+        who = self._accept(raw, "/tf")
+        if who is not None:
+            self.buffer.add_raw(bytes(raw.data), who, False)
 
     def _on_tf_static(self, raw: Any) -> None:
         if self._now is not None:
             self._check_for_reset()
-        got = self._decode(raw, "/tf_static")
-        if got is not None:
-            self.buffer.set_transforms(got[0], got[1], True)
+        who = self._accept(raw, "/tf_static")
+        if who is not None:
+            self.buffer.add_raw(bytes(raw.data), who, True)
 
     def unregister(self) -> None:
         """Stop listening (both subscriptions)."""

@@ -2,7 +2,8 @@
 
 Accepts the usual catkin_make options so habits and scripts keep working: ``-C DIR``,
 ``--source``, ``--build``, ``-j N``/``-lN``, ``-DVAR=VALUE`` and make targets are accepted (targets
-other than ``clean`` and the CMake options have nothing to do in a pure-Python build).
+other than ``clean`` and ``install`` and the CMake options other than ``CMAKE_INSTALL_PREFIX`` have
+nothing to do in a pure-Python build).
 """
 
 from __future__ import annotations
@@ -10,8 +11,10 @@ from __future__ import annotations
 import argparse
 import os
 import time
+from pathlib import Path
 
 from ninjemys.packages.builder import build_workspace, clean_workspace
+from ninjemys.packages.install_space import install_workspace
 from ninjemys.packages.workspace import Workspace
 from ninjemys.tools.cli import entry
 
@@ -31,7 +34,11 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--cmake-args", nargs=argparse.REMAINDER, default=[], help="accepted for compatibility")
     p.add_argument("--make-args", nargs=argparse.REMAINDER, default=[], help="accepted for compatibility")
     p.add_argument("-j", "--jobs", help="accepted for compatibility")
-    p.add_argument("targets", nargs="*", help="make targets: 'clean' removes build/ and devel/")
+    p.add_argument(
+        "targets",
+        nargs="*",
+        help="make targets: 'clean' removes build/ and devel/; 'install' also writes the install space",
+    )
     return p
 
 
@@ -59,7 +66,21 @@ def main(argv: list[str] | None = None) -> int:
     if report.cpp_skipped:
         names = ", ".join(t.name for t in report.cpp_skipped)
         print(f"-- {len(report.cpp_skipped)} C++ target(s) not built (see above): {names}")
+    if "install" in args.targets:
+        _install(ws, passthrough)
     return 0
+
+
+def _install(ws: Workspace, cmake_args: list[str]) -> None:
+    """``catkin_make install``: after the build, the install space (CMAKE_INSTALL_PREFIX, default
+    ``install/`` next to ``devel/``)."""
+    prefix = ws.root / "install"
+    for arg in cmake_args:
+        name, _, value = arg[2:].partition("=")
+        if name.split(":", 1)[0] == "CMAKE_INSTALL_PREFIX" and value:  # -DCMAKE_INSTALL_PREFIX[:PATH]=dir
+            prefix = ws.root / Path(value).expanduser()
+    count = install_workspace(ws, prefix.resolve(), os.environ, log=print)
+    print(f"[100%] Installed {count} file(s) in {prefix}: source {prefix / 'setup.bash'} to use them")
 
 
 console_main = entry(main)

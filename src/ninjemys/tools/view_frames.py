@@ -8,9 +8,11 @@ here (a layered tree, edges labelled as in the PDF), which any browser opens; it
 
 from __future__ import annotations
 
+import re
 import shutil
 import subprocess
 import sys
+import time
 from html import escape
 from pathlib import Path
 from typing import Any
@@ -42,12 +44,40 @@ def generate_dot(data: dict[str, dict[str, Any]], now: float) -> str:
     return "".join(parts)
 
 
-def generate_svg(data: dict[str, dict[str, Any]], now: float) -> str:
+def _label(info: dict[str, Any]) -> list[str]:
+    """The five lines tf2_tools puts on an edge."""
+    return [
+        f"Broadcaster: {info['broadcaster']}",
+        f"Average rate: {info['rate']}",
+        f"Buffer length: {info['buffer_length']}",
+        f"Most recent transform: {info['most_recent_transform']}",
+        f"Oldest transform: {info['oldest_transform']}",
+    ]
+
+
+def edges_from_yaml(data: dict[str, dict[str, Any]]) -> list[tuple[str, str, list[str]]]:
+    """``(parent, child, label lines)`` of every frame in ``all_frames_as_yaml``'s mapping."""
+    return [(str(info["parent"]), str(child), _label(info)) for child, info in data.items()]
+
+
+_DOT_EDGE = re.compile(r'^"([^"]*)" -> "([^"]*)"\[label="(.*)"\];$', re.MULTILINE)
+
+
+def edges_from_dot(dot: str) -> list[tuple[str, str, list[str]]]:
+    """The labelled edges of tf's ``allFramesAsDot`` text."""
+    return [
+        (m[1], m[2], [line.strip() for line in m[3].split("\\n") if line.strip()])
+        for m in _DOT_EDGE.finditer(dot)
+    ]
+
+
+def generate_svg(edges: list[tuple[str, str, list[str]]], now: float) -> str:
     """The frame tree as a standalone SVG: frames as ellipses, parents above children, labelled edges."""
     children: dict[str, list[str]] = {}
-    for child, info in data.items():
-        children.setdefault(str(info["parent"]), []).append(str(child))
-    roots = [p for p in children if p not in data] or list(children)[:1]
+    child_names = {child for _, child, _ in edges}
+    for parent, child, _ in edges:
+        children.setdefault(parent, []).append(child)
+    roots = [p for p in children if p not in child_names] or list(children)[:1]
     pos: dict[str, tuple[float, int]] = {}
     next_x = [0.0]
 
@@ -66,12 +96,15 @@ def generate_svg(data: dict[str, dict[str, Any]], now: float) -> str:
     seen: set[str] = set()
     for r in roots:
         place(r, 0, seen)
-    col, row = 230.0, 150.0
+    longest = max((len(line) for _, _, label in edges for line in label), default=10)
+    col, row = max(180.0, 2.0 * (longest * 5.4 + 16)), 150.0
     width = max(1.0, next_x[0]) * col + 40
     height = (max((d for _, d in pos.values()), default=0) + 1) * row + 60
     out = [
         f'<svg xmlns="http://www.w3.org/2000/svg" width="{width:.0f}" height="{height:.0f}" '
         f'font-family="sans-serif" font-size="11">',
+        '<defs><marker id="arrow" viewBox="0 0 10 10" refX="10" refY="5" markerWidth="7" markerHeight="7" '
+        'orient="auto-start-reverse"><path d="M 0 0 L 10 5 L 0 10 z"/></marker></defs>',
         f'<text x="10" y="{height - 15:.0f}">view_frames Result — Recorded at time: {now:.3f}</text>',
     ]
 
@@ -79,21 +112,14 @@ def generate_svg(data: dict[str, dict[str, Any]], now: float) -> str:
         x, d = pos[frame]
         return 20 + x * col + col / 2, 40 + d * row
 
-    for child, info in data.items():
-        parent = str(info["parent"])
-        if parent not in pos or str(child) not in pos:
+    for parent, child, label in edges:
+        if parent not in pos or child not in pos:
             continue
-        (x1, y1), (x2, y2) = xy(parent), xy(str(child))
+        (x1, y1), (x2, y2) = xy(parent), xy(child)
         out.append(
-            f'<line x1="{x1:.1f}" y1="{y1 + 18:.1f}" x2="{x2:.1f}" y2="{y2 - 18:.1f}" stroke="black"/>'
+            f'<line x1="{x1:.1f}" y1="{y1 + 18:.1f}" x2="{x2:.1f}" y2="{y2 - 18:.1f}" stroke="black" '
+            'marker-end="url(#arrow)"/>'
         )
-        label = [
-            f"Broadcaster: {info['broadcaster']}",
-            f"Average rate: {info['rate']}",
-            f"Buffer length: {info['buffer_length']}",
-            f"Most recent transform: {info['most_recent_transform']}",
-            f"Oldest transform: {info['oldest_transform']}",
-        ]
         lx, ly = (x1 + x2) / 2 + 6, (y1 + y2) / 2 - 30
         for i, line in enumerate(label):
             out.append(f'<text x="{lx:.1f}" y="{ly + 12 * i:.1f}" font-size="9">{escape(line)}</text>')
@@ -106,9 +132,17 @@ def generate_svg(data: dict[str, dict[str, Any]], now: float) -> str:
 
 
 def write_outputs(data: dict[str, dict[str, Any]], now: float, directory: Path) -> list[Path]:
-    """Write frames.gv and frames.pdf (with dot) or frames.svg (without); returns what was written."""
+    """tf2_tools' files: frames.gv and frames.pdf (with dot) or frames.svg (without)."""
+    return write_graph(generate_dot(data, now), edges_from_yaml(data), now, directory)
+
+
+def write_graph(
+    dot_text: str, edges: list[tuple[str, str, list[str]]], now: float, directory: Path
+) -> list[Path]:
+    """Write ``dot_text`` to frames.gv, then frames.pdf with Graphviz's dot if it is installed, else
+    frames.svg drawn from ``edges``; returns the files written."""
     gv = directory / "frames.gv"
-    gv.write_text(generate_dot(data, now))
+    gv.write_text(dot_text)
     written = [gv]
     dot = shutil.which("dot")
     if dot is not None:
@@ -118,7 +152,7 @@ def write_outputs(data: dict[str, dict[str, Any]], now: float, directory: Path) 
             written.append(pdf)
             return written
     svg = directory / "frames.svg"
-    svg.write_text(generate_svg(data, now))
+    svg.write_text(generate_svg(edges, now))
     written.append(svg)
     return written
 
@@ -145,6 +179,52 @@ def main(argv: list[str] | None = None) -> int:
             "Graphviz's dot is not installed: wrote frames.gv and frames.svg (open it in a browser)"
         )
     return 0
+
+
+def tf_main(argv: list[str] | None = None) -> int:
+    """tf's deprecated ``view_frames`` (``[--node NAME]``): tf's dot text, from its own listener or from
+    a node's ``tf_frames`` service."""
+    import argparse
+
+    import rospy
+    import tf
+    from tf.srv import FrameGraph
+
+    full = ["view_frames", *(sys.argv[1:] if argv is None else argv)]
+    parser = argparse.ArgumentParser(prog="view_frames", usage="usage: view_frames [options]")
+    parser.add_argument("--node", metavar="node name", help="Node to get frames from")
+    options = parser.parse_args(rospy.myargv(full)[1:])
+    rospy.init_node("view_frames", argv=full, anonymous=True)
+    if options.node:
+        print("Generating graph for node: ", options.node)
+        service = f"{options.node}/tf_frames"
+        print(f"Waiting for service {service}")
+        rospy.wait_for_service(service)
+        print("Polling service")
+        try:
+            dot_text = rospy.ServiceProxy(service, FrameGraph)().dot_graph
+        except rospy.ServiceException as e:
+            print(f"Service call failed: {e}")
+            return 1
+    else:
+        listener = tf.TransformListener()
+        print("WARNING: tf view_frames is deprecated. Use tf2_tools view_frames.py instead.")
+        print(f"Listening to /tf for {LISTEN_SECONDS} seconds")
+        time.sleep(LISTEN_SECONDS)
+        print("Done Listening")
+        dot_text = listener.allFramesAsDot(rospy.Time.now())
+    written = write_graph(dot_text, edges_from_dot(dot_text), rospy.Time.now().to_sec(), Path.cwd())
+    if written[-1].suffix == ".pdf":
+        print("frames.pdf generated")
+    else:
+        print(
+            "Graphviz's dot is not installed: wrote frames.gv and frames.svg (open it in a browser)",
+            file=sys.stderr,
+        )
+    return 0
+
+
+tf_console_main = entry(tf_main)
 
 
 console_main = entry(main)

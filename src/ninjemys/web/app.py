@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ninjemys.errors import NinjemysError
+from ninjemys.idl.loader import get_message_class
 from ninjemys.web.events import Hub
 from ninjemys.web.graph import GraphPoller
 from ninjemys.web.http import HttpError, HttpServer, Request, Response
@@ -35,6 +36,19 @@ class Page:
 
     title: str
     path: str
+
+
+def _message_definition(request: Request) -> Response:
+    """``GET /api/msgdef?type=pkg/Type``: the full ros1msg text, for a page that publishes a type
+    no channel advertises yet (the browser's ROS client serializes from it)."""
+    type_name = request.arg("type")
+    if not type_name:
+        raise HttpError(400, "missing ?type=pkg/Type")
+    try:
+        msg_class = get_message_class(type_name)
+    except NinjemysError as exc:
+        raise HttpError(404, str(exc)) from exc
+    return Response({"type": type_name, "definition": msg_class._full_text})
 
 
 class WebApp:
@@ -80,6 +94,7 @@ class WebApp:
         (``ws://<app>/ws``): the pages' one data path (Foxglove subprotocol: raw ROS 1 bytes and the
         definitions to decode them), and rosbridge for roslibjs pages. Call before :meth:`start`."""
         gateway.mount(self.server, path)
+        self.server.route("GET", "/api/msgdef", _message_definition)
 
     def hub(self) -> Hub:
         """A new event hub on the app's loop (call after start)."""

@@ -1,0 +1,204 @@
+"""The threading model of a ninjemys process, as data: which thread owns each socket, lock and queue.
+
+A node process mixes mechanisms on purpose (see ARCHITECTURE, "Concurrency"): one I/O loop thread
+(``ninjemys.net.loop``, no asyncio) for every Node's servers and connection set-up; publishing
+threads that write their own bursts; one worker thread per subscription that reads its sockets and
+calls back; one blocking thread per service connection. The master and the web tools run asyncio.
+The rule that keeps this sane: **nothing touches a socket it does not own**; ownership moves only at
+the hand-offs named here (``Runtime.call_soon``/``run``/``start_thread``, ``Subscriber.post``,
+``PubConnection`` under its lock).
+
+:data:`THREADS` names every thread the runtime starts (its ``threading.Thread`` name) and what runs
+on it; :data:`RESOURCES` lists each socket, lock and queue with its owner and who else may touch it,
+and how. ``tests/node/test_node_threads.py`` checks the code against both: every thread started in
+the core has a row here, every lock/queue attribute of ``ninjemys.node`` and ``ninjemys.net`` has one
+(and no row names one that is gone), live nodes run only these threads, and user callbacks run on
+the threads this table says. docs/node.md shows the same table.
+
+Nothing imports this module at run time; it is documentation that a test keeps honest.
+"""
+
+from __future__ import annotations
+
+
+class Thread:
+    """A kind of thread: ``name`` as ``threading.Thread`` shows it (``<x>`` marks the variable part)."""
+
+    __slots__ = ("name", "started_by", "runs", "user_code")
+
+    def __init__(self, name: str, started_by: str, runs: str, user_code: str = "") -> None:
+        self.name = name
+        self.started_by = started_by
+        self.runs = runs
+        #: which user callbacks run here ("" for none: the thread never runs user code)
+        self.user_code = user_code
+
+    @property
+    def prefix(self) -> str:
+        """The fixed start of the name (``sub:`` for ``sub:<topic>``)."""
+        return self.name.split("<", 1)[0]
+
+
+class Resource:
+    """A socket, lock or queue: ``where`` is ``module:Class.attribute`` (or a description for sockets)."""
+
+    __slots__ = ("kind", "where", "owner", "others")
+
+    def __init__(self, kind: str, where: str, owner: str, others: str) -> None:
+        self.kind = kind
+        self.where = where
+        self.owner = owner
+        #: who else touches it, and how
+        self.others = others
+
+
+LOOP = "ninjemys-io"
+
+THREADS: tuple[Thread, ...] = (
+    Thread(
+        LOOP,
+        "node.runtime.Runtime (first Node of the process; joined when the last one shuts down)",
+        "every Node's TCPROS server and slave XML-RPC server, outbound connection set-up "
+        "(requestTopic, header exchange), draining publisher queues, the registrar's master link",
+    ),
+    Thread(
+        "ninjemys-io-helper",
+        "net.loop.Loop.run_in_thread",
+        "one blocking call the loop must not make itself (name resolution), result handed back",
+    ),
+    Thread(
+        "sub:<topic>",
+        "node.subscriber.Subscriber (one per Subscriber handle)",
+        "the topic's reader (first handle): reads its publisher sockets, cuts frames; every handle: "
+        "its queue, deserialization and its callback",
+        "subscriber callbacks",
+    ),
+    Thread(
+        "srv:<service>",
+        "node.services.ServiceServer.accept (one per client connection)",
+        "reads requests, runs the handler, writes responses, until the client leaves",
+        "service handlers",
+    ),
+    Thread(
+        "reg:<node>",
+        "node.registration.Registrar",
+        "the watchdog: checks the master knows the node, re-registers everything after a restart",
+    ),
+    Thread(
+        "timer:<node>",
+        "node.node.Node.timer (one per Timer)",
+        "waits on the node's clock and calls the timer callback",
+        "timer callbacks",
+    ),
+    Thread(
+        "ninjemys-timer",
+        "node.timers.Timer made directly on a Clock (rospy.Timer)",
+        "waits on the clock and calls the timer callback",
+        "timer callbacks",
+    ),
+    Thread(
+        "param-update",
+        "node.node.Node.param_update (one per paramUpdate from the master)",
+        "runs the subscribed parameter's callbacks",
+        "parameter callbacks",
+    ),
+    Thread(
+        "shutdown",
+        "node.slave.SlaveApi.shutdown (the master or rosnode kill asks)",
+        "Node.shutdown, off the loop (shutdown waits for the loop)",
+        "shutdown hooks",
+    ),
+    Thread(
+        "rospy-signal",
+        "rospy.client signal handler (Ctrl-C, SIGTERM)",
+        "rospy.signal_shutdown, off the interrupted main thread (it may hold locks shutdown needs)",
+        "shutdown hooks",
+    ),
+    Thread(
+        "ninjemys-master",
+        "master.core.MasterThread (tests, embedded masters; roscore uses its main thread)",
+        "the master's asyncio loop: its XML-RPC server and every notification to nodes",
+    ),
+    Thread(
+        "rosout",
+        "tools.roscore (starts the rosout node in roscore's process)",
+        "creates the rosout Node; the node's own threads do the rest",
+    ),
+)
+
+#: user threads: the caller's own threads (the main thread, publishing threads, service callers)
+USER = "user thread"
+
+RESOURCES: tuple[Resource, ...] = (
+    # -- sockets ---------------------------------------------------------------------------------
+    Resource("socket", "TCPROS listening socket (node.transport.TcprosServer)", LOOP,
+             "none: accepted connections are routed by header, then handed over as below"),
+    Resource("socket", "slave XML-RPC server and its connections (net.xmlrpc_server)", LOOP, "none"),
+    Resource("socket", "publisher -> subscriber stream (node.topics.PubConnection.sock)", USER + " (publishing)",
+             "publish writes directly under PubConnection._lock; the loop finishes a burst once the "
+             "publisher is idle, drains what the kernel refused, and watches for the peer closing"),
+    Resource("socket", "subscriber <- publisher stream (node.subscriber.SubConnection.sock)", "sub:<topic>",
+             "the loop connects it and exchanges headers, then hands it to the reader with "
+             "Subscriber.post; close() from any thread (idempotent)"),
+    Resource("socket", "service server connection (node.services.ServiceServer._serve)", "srv:<service>",
+             "the loop accepts it and answers the header; Node shutdown shuts it down to wake the thread"),
+    Resource("socket", "service client connection (node.services.ServiceProxy._sock)", USER + " (caller)",
+             "one exchange at a time under ServiceProxy._lock; close() from shutdown"),
+    Resource("socket", "master XML-RPC client (master.client.MasterClient._sock)", USER + " (caller)",
+             "one call at a time under MasterClient._lock (the registrar's probe has its own client)"),
+    Resource("socket", "registrar's idle link to the master (node.registration.Registrar._link)", LOOP,
+             "opened and watched on the loop; a break sets _link_lost for reg:<node>"),
+    Resource("socket", "master XML-RPC server and notifications (master.core, master.notify)",
+             "ninjemys-master / roscore's main thread (asyncio)", "none"),
+    Resource("socket", "web and bridge servers (web, bridge)", "their asyncio loop thread",
+             "ROS data reaches them through Node subscriptions, handed over with call_soon_threadsafe"),
+    # -- locks and events --------------------------------------------------------------------------
+    Resource("lock", "ninjemys.node.node:Node._lock", "any thread",
+             "guards the publication/subscription/service/proxy tables and first-shutdown; held briefly, "
+             "never across a master call"),
+    Resource("event", "ninjemys.node.node:Node._shutdown_event", "any thread", "set once by shutdown; waited on by spin"),
+    Resource("event", "ninjemys.node.node:Node._shutdown_done", "the shutting-down thread",
+             "a second shutdown() waits on it"),
+    Resource("lock", "ninjemys.node.topics:PubConnection._lock", USER + " (publishing)",
+             "the loop takes it to drain or close; serializes writes to the stream"),
+    Resource("queue", "ninjemys.node.topics:PubConnection._queue", USER + " (publishing)",
+             "frames the kernel refused, bounded by queue_size; drained by the loop, under _lock"),
+    Resource("lock", "ninjemys.node.topics:Publication.lock", USER + " (publishing)",
+             "the loop takes it to add a subscriber, so a latched frame is sent either latched or live"),
+    Resource("queue", "ninjemys.node.subscriber:Subscriber._queue", "sub:<topic>",
+             "the reader appends frames for other handles of the topic, the loop appends latched "
+             "replays (both through enqueue/post, then a wake-up); bounded by queue_size"),
+    Resource("lock", "ninjemys.node.subscriber:Subscriber._ops_lock", "sub:<topic>",
+             "connection hand-offs (post) from the loop and enqueue from other threads"),
+    Resource("lock", "ninjemys.node.services:ServiceServer._lock", "srv:<service>",
+             "guards the set of open client sockets; the loop adds, shutdown reads"),
+    Resource("lock", "ninjemys.node.services:ServiceProxy._lock", USER + " (caller)",
+             "one request/response exchange at a time on the proxy's connection"),
+    Resource("lock", "ninjemys.node.registration:Registrar._lock", "any thread",
+             "guards what the node has registered; reg:<node> copies it to re-register"),
+    Resource("event", "ninjemys.node.registration:Registrar._stop", "the shutting-down thread",
+             "reg:<node> waits on it"),
+    Resource("event", "ninjemys.node.registration:Registrar._link_lost", LOOP,
+             "set when the master link breaks; reg:<node> waits on it"),
+    Resource("lock", "ninjemys.node.clock:Clock._cond", "any thread",
+             "simulated time: the /clock callback (sub:/clock) sets the time and notifies; sleepers, "
+             "Rates and Timers of that node's clock wait on it"),
+    Resource("lock", "ninjemys.node.clock:Clock._gates_lock", "any thread",
+             "wall time: guards the set of sleeping threads' gates that wake()/shutdown() open"),
+    Resource("lock", "ninjemys.node.clock:Clock._local", "each sleeping thread", "its own gate lock, nobody else's"),
+    Resource("lock", "ninjemys.node.log:NodeLog._lock", "any logging thread", "serializes log-file writes"),
+    Resource("lock", "ninjemys.node.log:NodeLog._hold_lock", "any logging thread",
+             "messages held until /rosout is attached; attach/detach at start and shutdown"),
+    Resource("lock", "ninjemys.node.log:_CallSiteFilter._lock", "any logging thread",
+             "throttle/once state per call site"),
+    Resource("event", "ninjemys.node.runtime:Runtime._ready", LOOP, "the starting thread waits for the loop"),
+    Resource("lock", "ninjemys.node.runtime:_lock", "any thread", "the process's runtime and its user count"),
+    Resource("lock", "ninjemys.net.loop:Loop._wake_lock", "any thread", "call_soon_threadsafe's wake-up pipe write"),
+    Resource("queue", "ninjemys.net.loop:Loop._ready", LOOP,
+             "other threads append only through call_soon_threadsafe (then a wake-up)"),
+    Resource("event", "ninjemys.net.loop:ThreadFuture._event", LOOP, "set with the result; a user thread waits"),
+    Resource("lock", "ninjemys.net.loop:_current", "each thread", "thread-local: the loop running on it"),
+    Resource("queue", "ninjemys.net.xmlrpc_server:_Connection.queue", LOOP, "none (requests in order)"),
+    Resource("queue", "ninjemys.net.xmlrpc_server:_Connection.out", LOOP, "none (response bytes not yet sent)"),
+    Resource("lock", "ninjemys.master.client:MasterClient._lock", USER + " (caller)", "one call at a time"),
+)  # fmt: skip
