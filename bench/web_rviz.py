@@ -201,22 +201,31 @@ def _measure(page: Any, cdp: Any, seconds: float) -> dict[str, float]:
 # publish-to-paint: the marker's header stamp (its publish time) to the end of the first render after
 # the page decoded it (both clocks are this machine's wall clock)
 LATENCY_HOOK = """() => {
-  window.lat = []; window.pendingStamp = null;
+  window.lat = []; window.parts = []; window.pending = null;
   const d = rviz.displays.find(d => d.cfg.name === 'Marker');
   const orig = d.onMessage.bind(d);
   d.onMessage = (m, info) => { orig(m, info);
-    window.pendingStamp = m.header.stamp.secs * 1000 + m.header.stamp.nsecs / 1e6; };
-  rviz.frameHooks.push(() => { if (window.pendingStamp !== null) {
-    lat.push(Date.now() - window.pendingStamp); window.pendingStamp = null; } });
+    const sent = m.header.stamp.secs * 1000 + m.header.stamp.nsecs / 1e6;
+    window.pending = { sent, gateway: info.receiveTimeNs / 1e6, page: Date.now() }; };
+  rviz.frameHooks.push(() => { const p = window.pending; if (p !== null) { const now = Date.now();
+    lat.push(now - p.sent); parts.push([p.gateway - p.sent, p.page - p.gateway, now - p.page]);
+    window.pending = null; } });
 }"""
 
 
 def _latency(page: Any, scene: Scene, samples: int) -> list[float]:
-    page.evaluate("lat.length = 0")
+    page.evaluate("lat.length = 0; parts.length = 0")
     for _ in range(samples):
         scene.marker()
         time.sleep(0.15)
     page.wait_for_timeout(500)
+    parts = np.array(page.evaluate("parts")).reshape(-1, 3)
+    if len(parts):
+        med = np.median(parts, axis=0)
+        print(
+            f"  latency parts (median ms): publish->gateway {med[0]:.1f}, gateway->page {med[1]:.1f},"
+            f" page->painted {med[2]:.1f}"
+        )
     return list(page.evaluate("lat"))
 
 
