@@ -1,9 +1,14 @@
-"""``make demo`` / ``python -m ninjemys.demo``: the seeds' first hour in one command.
+"""``make demo`` / ``python -m ninjemys.demo``: the seeds' robot navigating, in one command.
 
-It starts our roscore, the seeds' talker and listener, turtlesim (with its browser view) and a node
-driving turtle1 around the third seed's 1 m square, prefixes every output line with the process name,
-prints the URLs of the turtlesim view and the node graph, and on Ctrl-C (or after ``--duration``
-seconds) stops them all, nodes first, and waits for every child to exit.
+By default: our roscore, the PuzzleBot in the ``office`` world with navigation
+(``roslaunch puzzlebot_navigation navigation.launch world:=office``: simulator, map_server, amcl,
+move_base, safety monitor) and ``rviz`` showing the map, scan, particles, plan and camera. Click
+"2D Nav Goal" in rviz and the robot drives there. ``--chatter`` is the seeds' first hour instead: the
+talker and listener, turtlesim (with its browser view) and a node driving turtle1 around the third
+seed's 1 m square.
+
+Every output line is prefixed with the process name; the URLs are printed; on Ctrl-C (or after
+``--duration`` seconds) everything stops, nodes first, and every child is waited for.
 """
 
 from __future__ import annotations
@@ -26,6 +31,8 @@ _COLORS = {
     "listener": "\033[32m",
     "turtlesim": "\033[33m",
     "square": "\033[34m",
+    "navigation": "\033[33m",
+    "rviz": "\033[35m",
 }
 _RESET = "\033[0m"
 
@@ -102,12 +109,29 @@ def _stop(procs: list[tuple[str, subprocess.Popen[bytes]]], grace: float = 5.0) 
                 proc.wait()
 
 
+def _set_robot_description(uri: str) -> None:
+    """``/robot_description`` from the PuzzleBot's URDF, as a launch file's ``<param textfile=...>`` does."""
+    from ninjemys.master.client import MasterClient
+    from ninjemys.packages.discovery import PackageIndex
+
+    urdf = PackageIndex.from_environment().find("puzzlebot_sim").path / "robots" / "puzzlebot.urdf"
+    client = MasterClient(uri, "/demo", timeout=5.0)
+    try:
+        client.set_param("/robot_description", urdf.read_text())
+    finally:
+        client.close()
+
+
 def run(
     port: int | None = None,
     duration: float | None = None,
     color: bool | None = None,
     web_port: int = 0,
     turtlesim: bool = True,
+    chatter: bool = False,
+    world: str = "office",
+    rate: float = 1.0,
+    open_browser: bool = True,
 ) -> int:
     """Run the demo; returns when interrupted or after ``duration`` seconds."""
     port = _pick_port(port)
@@ -138,7 +162,22 @@ def run(
         pumps.append(pump)
         return proc
 
-    what = "roscore + talker + listener" + (" + turtlesim + square driver" if turtlesim else "")
+    def served(prefix: str) -> tuple[Callable[[str], None], threading.Event, list[str]]:
+        """A watcher for the first output line starting with ``prefix`` (a page's URL)."""
+        seen: list[str] = []
+        event = threading.Event()
+
+        def watch(line: str) -> None:
+            if line.startswith(prefix) and not event.is_set():
+                seen.append(line)
+                event.set()
+
+        return watch, event, seen
+
+    if chatter:
+        what = "roscore + talker + listener" + (" + turtlesim + square driver" if turtlesim else "")
+    else:
+        what = f"roscore + PuzzleBot in the '{world}' world with navigation + rviz"
     print(f"ninjemys demo: {what}, ROS_MASTER_URI={uri} (Ctrl-C to stop)", flush=True)
     interrupted = False
     try:
@@ -153,17 +192,11 @@ def run(
             ],
         )
         _wait_for_master(uri, core, timeout=20.0)
-        start("talker", [sys.executable, "-m", "ninjemys.tutorials.talker"])
-        start("listener", [sys.executable, "-m", "ninjemys.tutorials.listener"])
-        if turtlesim:
-            view_line: list[str] = []
-            served = threading.Event()
-
-            def watch(line: str) -> None:
-                if line.startswith("turtlesim view:") and not served.is_set():
-                    view_line.append(line)
-                    served.set()
-
+        if chatter:
+            start("talker", [sys.executable, "-m", "ninjemys.tutorials.talker"])
+            start("listener", [sys.executable, "-m", "ninjemys.tutorials.listener"])
+        if chatter and turtlesim:
+            watch, event, seen = served("turtlesim view:")
             start(
                 "turtlesim",
                 [
@@ -177,14 +210,17 @@ def run(
                 watch,
             )
             start("square", [sys.executable, "-m", "ninjemys.sim.square_driver"])
-            if not served.wait(30.0):
+            if not event.wait(30.0):
                 raise RuntimeError("turtlesim did not serve its view within 30 s")
-            view, _, graph = view_line[0].partition("node graph:")
+            view, _, graph = seen[0].partition("node graph:")
             with lock:
                 print(
                     f"ninjemys demo: {view.strip()}  |  node graph: {graph.strip()}  |  Ctrl-C stops the demo.",
                     flush=True,
                 )
+        if not chatter:
+            _set_robot_description(uri)
+            _navigation(start, served, lock, world, rate, web_port, open_browser)
         deadline = None if duration is None else time.monotonic() + duration
         while deadline is None or time.monotonic() < deadline:
             dead = [(n, p) for n, p in procs if p.poll() is not None]
@@ -212,6 +248,55 @@ def run(
     return 0
 
 
+def _navigation(
+    start: Callable[..., subprocess.Popen[bytes]],
+    served: Callable[[str], tuple[Callable[[str], None], threading.Event, list[str]]],
+    lock: threading.Lock,
+    world: str,
+    rate: float,
+    web_port: int,
+    open_browser: bool,
+) -> None:
+    """The PuzzleBot navigation stack and rviz; prints both pages' URLs."""
+    from ninjemys.packages.discovery import PackageIndex
+    from ninjemys.packages.shipped import shipped_executable
+
+    sim_watch, sim_event, sim_seen = served("puzzlebot_sim view:")
+    start(
+        "navigation",
+        [
+            sys.executable,
+            "-c",
+            "from ninjemys.tools.roslaunch import console_main; console_main()",
+            "puzzlebot_navigation",
+            "navigation.launch",
+            f"world:={world}",
+            f"rate:={rate}",
+        ],
+        sim_watch,
+    )
+    config = PackageIndex.from_environment().find("puzzlebot_navigation").path / "rviz" / "navigation.rviz"
+    rviz_watch, rviz_event, rviz_seen = served("rviz: http")
+    rviz_args = ["-d", str(config), "--port", str(web_port)]
+    if not open_browser:
+        rviz_args.append("--no-browser")
+    rviz = shipped_executable("rviz", "rviz")
+    assert rviz is not None  # shipped with ninjemys (packages/shipped.py)
+    start("rviz", rviz.command(rviz_args), rviz_watch)
+    if not rviz_event.wait(60.0):
+        raise RuntimeError("rviz did not serve its page within 60 s")
+    if not sim_event.wait(60.0):
+        raise RuntimeError("the simulator did not serve its view within 60 s")
+    rviz_url = rviz_seen[0].split("rviz: ", 1)[1].strip()
+    sim_url = sim_seen[0].split("puzzlebot_sim view:", 1)[1].split()[0]
+    with lock:
+        print(
+            f"ninjemys demo: rviz: {rviz_url}  |  simulator: {sim_url}  |  "
+            "click '2D Nav Goal', then a point of the map (drag for the heading)  |  Ctrl-C stops the demo.",
+            flush=True,
+        )
+
+
 class _ignore_sigint:  # noqa: N801 - used as a context manager
     """Let a second Ctrl-C not interrupt the cleanup of the children."""
 
@@ -229,8 +314,16 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("--duration", type=float, default=None, help="stop after this many seconds")
     parser.add_argument("--no-color", action="store_true", help="plain output")
-    parser.add_argument("--web-port", type=int, default=0, help="turtlesim view / graph port (default: any)")
-    parser.add_argument("--no-turtlesim", action="store_true", help="only roscore, talker and listener")
+    parser.add_argument("--web-port", type=int, default=0, help="rviz / turtlesim view port (default: any)")
+    parser.add_argument(
+        "--chatter", action="store_true", help="the seeds' first hour: talker, listener, turtlesim"
+    )
+    parser.add_argument(
+        "--no-turtlesim", action="store_true", help="with --chatter: only roscore, talker and listener"
+    )
+    parser.add_argument("--world", default="office", help="navigation world (empty, square, maze, office)")
+    parser.add_argument("--rate", type=float, default=1.0, help="the simulator's real-time factor")
+    parser.add_argument("--no-browser", action="store_true", help="only print the URLs (no rviz tab)")
     ns = parser.parse_args(argv)
     return run(
         ns.port,
@@ -238,6 +331,10 @@ def main(argv: list[str] | None = None) -> int:
         color=False if ns.no_color else None,
         web_port=ns.web_port,
         turtlesim=not ns.no_turtlesim,
+        chatter=ns.chatter,
+        world=ns.world,
+        rate=ns.rate,
+        open_browser=not ns.no_browser,
     )
 
 

@@ -18,7 +18,7 @@ import pytest
 from actionlib_fakes import ListLog
 
 from actionlib.msg import TwoIntsAction, TwoIntsGoal, TwoIntsResult
-from ninjemys.actionlib import ActionClient, SimpleActionClient, SimpleActionServer
+from ninjemys.actionlib import ActionClient, ActionServer, SimpleActionClient, SimpleActionServer
 from ninjemys.actionlib import states as S
 from ninjemys.actionlib.states import CommState
 from ninjemys.node import Node
@@ -72,8 +72,14 @@ def our_server(node: Node, name: str, log: Any = None) -> SimpleActionServer:
 
 
 @pytest.fixture(params=["simple"])
-def real_server(request: pytest.FixtureRequest, master: str, tmp_path: Path) -> Iterator[str]:
-    """A real server process: ``simple`` (SimpleActionServer) or ``plain`` (ActionServer)."""
+def real_server(request: pytest.FixtureRequest, master: str, tmp_path: Path, node: Node) -> Iterator[str]:
+    """A real server process: ``simple`` (SimpleActionServer), ``plain`` or ``hold`` (ActionServer).
+
+    Its finished goals leave the status list after 0.5 s (ROS 1's ``status_list_timeout``, 5 s by
+    default): the real server serializes the whole list on every transition, and a thousand goals'
+    worth would make the 1,000-goal test measure genpy rather than the protocol.
+    """
+    node.set_param("/real_add/status_list_timeout", 0.5)
     env = ros1_env(master, ROS_HOME=str(tmp_path))
     proc = subprocess.Popen(
         [ROS1_PYTHON, str(SCRIPTS / "deb_action_server.py"), request.param, "real_add"],
@@ -117,6 +123,17 @@ def test_real_client_preempts_with_a_new_goal(master: str, tmp_path: Path, node:
     our_server(node, "add")
     out = real(master, tmp_path, "deb_action_client.py", "preempt", "add")
     assert out == {"first": S.PREEMPTED, "second": S.SUCCEEDED, "sum": 5}
+
+
+def test_real_client_cancel_by_stamp_then_all(master: str, tmp_path: Path, node: Node) -> None:
+    """A plain ActionServer of ours holding four goals; the real client cancels by stamp, then all."""
+    server = ActionServer(node, "hold", TwoIntsAction, lambda gh: gh.set_accepted())
+    server.register_cancel_callback(lambda gh: gh.set_canceled(None, "cancelled"))
+    server.start()
+    out = real(master, tmp_path, "deb_action_client.py", "stamps", "hold")
+    assert out["accepted"] == [S.ACTIVE] * 4
+    assert out["by_stamp"] == [S.PREEMPTED, S.PREEMPTED, S.ACTIVE, S.ACTIVE]
+    assert out["all"] == [S.PREEMPTED] * 4
 
 
 def test_real_client_wait_for_server_on_a_wrong_name(master: str, tmp_path: Path, node: Node) -> None:
@@ -179,6 +196,30 @@ def test_our_client_preempts_a_real_goal_with_a_new_one(node: Node, real_server:
         time.sleep(0.01)
     assert first.get_terminal_state() == S.PREEMPTED
     assert second.get_terminal_state() == S.SUCCEEDED and second.get_result().sum == 5
+
+
+@pytest.mark.parametrize("real_server", ["hold"], indirect=True)
+def test_our_client_cancels_real_goals_by_stamp_then_all(node: Node, real_server: str) -> None:
+    client = ActionClient(node, real_server, TwoIntsAction)
+    assert client.wait_for_server(10.0)
+    goals = []
+    for i in range(4):
+        goals.append(client.send_goal(TwoIntsGoal(a=-1, b=i)))
+        time.sleep(0.02)
+    deadline = time.monotonic() + 10
+
+    def settle(done: Any) -> list[int]:
+        while not done():
+            assert time.monotonic() < deadline, [g.get_goal_status() for g in goals]
+            time.sleep(0.01)
+        return [g.get_goal_status() for g in goals]
+
+    assert settle(lambda: all(g.get_goal_status() == S.ACTIVE for g in goals)) == [S.ACTIVE] * 4
+    client.cancel_goals_at_and_before_time(goals[1].comm_state_machine.action_goal.goal_id.stamp)
+    by_stamp = settle(lambda: all(g.get_comm_state() == CommState.DONE for g in goals[:2]))
+    assert by_stamp == [S.PREEMPTED, S.PREEMPTED, S.ACTIVE, S.ACTIVE]
+    client.cancel_all_goals()
+    assert settle(lambda: all(g.get_comm_state() == CommState.DONE for g in goals)) == [S.PREEMPTED] * 4
 
 
 def test_our_client_wrong_name_against_real_graph(node: Node, real_server: str) -> None:

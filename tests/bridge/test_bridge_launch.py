@@ -67,15 +67,25 @@ def test_rosbridge_websocket_launch(launch, master_uri: str) -> None:
 
         names = wait_for(nodes, timeout=30, what="rosapi")
         assert {"/rosbridge_websocket", "/rosapi"} <= set(names)
+        ws.send(json.dumps({"op": "subscribe", "topic": "/client_count", "type": "std_msgs/Int32"}))
+        count = json.loads(ws.recv(timeout=10))
+        assert count["op"] == "publish" and count["msg"]["data"] >= 1  # latched, as rosbridge's
 
 
-def test_foxglove_bridge_launch(launch) -> None:
+def test_foxglove_bridge_launch(launch, master_uri: str) -> None:
+    from ninjemys.idl.loader import get_message_class
+    from ninjemys.node import Node
+
     port = free_port()
-    launch("foxglove_bridge", "foxglove_bridge.launch", f"port:={port}")
-    with _connect_when_up(f"ws://127.0.0.1:{port}/", subprotocols=["foxglove.websocket.v1"]) as ws:
-        info = json.loads(ws.recv(timeout=10))
-        assert info["op"] == "serverInfo" and info["name"] == "/foxglove_bridge"
-        channels = json.loads(ws.recv(timeout=10))["channels"]
-        assert {"topic": "/client_count", "schemaName": "std_msgs/Int32"}.items() <= next(
-            c for c in channels if c["topic"] == "/client_count"
-        ).items()
+    peer = Node("launch_peer", master_uri=master_uri)
+    try:
+        peer.publisher("/launch_probe", get_message_class("std_msgs/String"))
+        launch("foxglove_bridge", "foxglove_bridge.launch", f"port:={port}")
+        with _connect_when_up(f"ws://127.0.0.1:{port}/", subprotocols=["foxglove.websocket.v1"]) as ws:
+            info = json.loads(ws.recv(timeout=10))
+            assert info["op"] == "serverInfo" and info["name"] == "/foxglove_bridge"
+            channels = json.loads(ws.recv(timeout=10))["channels"]
+            probe = next(c for c in channels if c["topic"] == "/launch_probe")
+            assert probe["schemaName"] == "std_msgs/String" and probe["encoding"] == "ros1"
+    finally:
+        peer.shutdown("test over")

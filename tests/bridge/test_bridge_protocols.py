@@ -7,6 +7,7 @@ import base64
 import json
 import struct
 import subprocess
+import threading
 import time
 from collections.abc import Callable
 
@@ -120,10 +121,12 @@ def test_foxglove_time_under_sim_time(make_gateway: Callable[..., Gateway], node
 
 def test_foxglove_connection_graph_and_parameter_updates(gateway: Gateway, node: Node) -> None:
     node.set_param("/fox/gain", 1)
+    node.publisher("/graph_seed", String)
+    wait_for(lambda: "/graph_seed" in gateway.catalog.graph["pub"], what="the graph poll")
     with connect(f"ws://127.0.0.1:{gateway.port}/", subprotocols=["foxglove.websocket.v1"]) as ws:
         ws.send(json.dumps({"op": "subscribeConnectionGraph"}))
         graph = first(ws, lambda m: isinstance(m, dict) and m.get("op") == "connectionGraphUpdate")
-        assert any(t["name"] == "/client_count" for t in graph["publishedTopics"])
+        assert any(t["name"] == "/graph_seed" for t in graph["publishedTopics"])
         node.publisher("/fresh_topic", String)
         update = first(
             ws,
@@ -271,3 +274,32 @@ def test_rosbridge_subscribes_to_a_type_only_the_publisher_knows(gateway: Gatewa
             lambda: pub.publish(Thing(level=3, notes=["ok"])),
         )
         assert msg["msg"] == {"level": 3, "notes": ["ok"]}
+
+
+def test_foxglove_channel_for_a_type_only_the_publisher_knows(gateway: Gateway, node: Node) -> None:
+    """The schema of a type the gateway cannot load comes from a publisher's connection header."""
+    from ninjemys.idl.loader import message_class_from_definition
+
+    Thing = message_class_from_definition("their_robot/Pose2", "float64 x\nfloat64 y\nstring frame\n")
+    pub = node.publisher("/their_pose", Thing)
+    sample = Thing(x=1.5, y=-2.0, frame="map")
+    stop = threading.Event()
+
+    def publish() -> None:
+        while not stop.wait(0.05):
+            pub.publish(sample)
+
+    threading.Thread(target=publish, daemon=True).start()
+    try:
+        channel = wait_for(
+            lambda: next((c for c in gateway.catalog.channels.values() if c["topic"] == "/their_pose"), None),
+            timeout=20,
+            what="a channel for the unknown type",
+        )
+        assert channel["schemaName"] == "their_robot/Pose2" and channel["schema"] == Thing._full_text
+        with connect(f"ws://127.0.0.1:{gateway.port}/", subprotocols=["foxglove.websocket.v1"]) as ws:
+            ws.send(json.dumps({"op": "subscribe", "subscriptions": [{"id": 5, "channelId": channel["id"]}]}))
+            data = first(ws, lambda m: isinstance(m, bytes) and m[0] == 1)
+            assert data[13:] == sample.serialize_to_bytes()
+    finally:
+        stop.set()

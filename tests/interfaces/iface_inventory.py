@@ -40,11 +40,22 @@ SHIPPED_PACKAGES = (
     "gazebo_msgs",
     "tf",
     "dynamic_reconfigure",
+    # wave 2 (issue 16): the WebSocket gateway's rosapi and tf2_web_republisher
+    "rosapi",
+    "tf2_web_republisher",
 )
 
 #: packages Debian's ROS 1 lacks; their facts are checked against published md5sums instead
 NOT_IN_DEBIAN = frozenset(
-    {"turtlesim", "rospy_tutorials", "actionlib_tutorials", "control_msgs", "gazebo_msgs"}
+    {
+        "turtlesim",
+        "rospy_tutorials",
+        "actionlib_tutorials",
+        "control_msgs",
+        "gazebo_msgs",
+        "rosapi",
+        "tf2_web_republisher",
+    }
 )
 
 #: the messages actionlib generates from one ``Foo.action``

@@ -121,6 +121,8 @@ class Probe:
             self._amcl,
             queue_size=1,
         )
+        self.front = math.inf  # nearest return within +-35 degrees ahead
+        self.node.subscriber("/scan", get_message_class("sensor_msgs/LaserScan"), self._scan, queue_size=1)
         self.twist_cls = get_message_class("geometry_msgs/Twist")
         self.pose_cls = get_message_class("geometry_msgs/PoseStamped")
 
@@ -136,6 +138,34 @@ class Probe:
         self.truth = (p.position.x, p.position.y, self._yaw(p.orientation))
         self.truth_v = msg.twist.twist.linear.x
         self.truth_w = msg.twist.twist.angular.z
+
+    def _scan(self, msg) -> None:
+        r = np.asarray(msg.ranges, dtype=float)
+        a = msg.angle_min + np.arange(len(r)) * msg.angle_increment
+        ahead = np.abs((a + math.pi) % (2 * math.pi) - math.pi) < math.radians(35)
+        r = np.where(np.isneginf(r), 0.0, r)
+        self.front = float(np.nanmin(np.where(ahead, r, np.inf)))
+
+    def wander(self, seconds: float, topic: str = "/teleop/cmd_vel") -> None:
+        """Drive reactively for ``seconds`` of sim time: ahead while the way is clear, else turn left."""
+        pub = self.node.publisher(topic, self.twist_cls, queue_size=1)
+        time.sleep(0.5)
+        end = self.sim_time + seconds
+        deadline = time.monotonic() + seconds * 3 + 60
+        turning_until = 0.0
+        while self.sim_time < end and time.monotonic() < deadline:
+            msg = self.twist_cls()
+            if self.sim_time < turning_until:
+                msg.angular.z = 0.8
+            elif self.front < 0.7:
+                turning_until = self.sim_time + 1.0 + (hash(round(self.sim_time, 1)) % 10) / 10.0
+                msg.angular.z = 0.8
+            else:
+                msg.linear.x = 0.25
+            pub.publish(msg)
+            time.sleep(0.02)
+        pub.publish(self.twist_cls())
+        pub.unregister()
 
     def _contact(self, msg) -> None:
         if msg.data:

@@ -5,11 +5,12 @@ from __future__ import annotations
 import os
 import subprocess
 import time
+from pathlib import Path
 
 import pytest
 import yaml
 
-from ninjemys.testing import ninjemys_bin, run_master
+from ninjemys.testing import ninjemys_bin, ros1_env, run_master
 
 
 @pytest.fixture
@@ -96,3 +97,55 @@ def test_map_saver_writes_what_map_server_reads(master, tmp_path):
     original, copy = load_map(maze), load_map(tmp_path / "copy.yaml")
     assert copy.data.shape == original.data.shape and copy.origin == original.origin
     assert (copy.data == original.data).all()
+
+
+@pytest.mark.ros1
+def test_move_base_tunables_through_ros1_dynparam(master, tmp_path):
+    """ROS 1's own dynparam client changes the DWA's max_vel_x on a running move_base."""
+    log = os.path.join(master["ROS_HOME"], "mb.out")
+    os.makedirs(master["ROS_HOME"], exist_ok=True)
+    with open(log, "w") as sink:
+        proc = subprocess.Popen(
+            [ninjemys_bin("rosrun"), "move_base", "move_base"], env=master, stdout=sink, stderr=sink
+        )
+    # Debian's dynparam calls roslib.load_manifest('dynamic_reconfigure'), and Debian ships no package.xml
+    share = tmp_path / "share" / "dynamic_reconfigure"
+    share.mkdir(parents=True)
+    xml = (
+        Path(__file__).parents[2] / "src" / "ninjemys" / "interfaces" / "dynamic_reconfigure" / "package.xml"
+    )
+    (share / "package.xml").write_text(xml.read_text())
+    env = ros1_env(master["ROS_MASTER_URI"], ROS_PACKAGE_PATH=str(tmp_path / "share"))
+    try:
+        dynparam = ["/usr/bin/python3", "/usr/lib/dynamic_reconfigure/dynparam"]  # Debian's
+        deadline = time.monotonic() + 40
+        while time.monotonic() < deadline:
+            got = subprocess.run(
+                [*dynparam, "get", "/move_base/DWAPlannerROS"],
+                env=env,
+                capture_output=True,
+                text=True,
+                timeout=30,
+            )
+            if got.returncode == 0 and "max_vel_x" in got.stdout:
+                break
+            time.sleep(1.0)
+        assert "'max_vel_x': 0.3" in got.stdout, got.stdout + got.stderr
+        subprocess.run(
+            [*dynparam, "set", "/move_base/DWAPlannerROS", "max_vel_x", "0.2"],
+            env=env,
+            check=True,
+            timeout=30,
+        )
+        got = subprocess.run(
+            [*dynparam, "get", "/move_base/DWAPlannerROS"],
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=30,
+        )
+        assert "'max_vel_x': 0.2" in got.stdout
+        assert proc.poll() is None
+    finally:
+        proc.terminate()
+        proc.wait(10)

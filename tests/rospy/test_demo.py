@@ -13,7 +13,17 @@ def test_demo_runs_and_cleans_up(tmp_path) -> None:
     port = free_port()
     env = dict(os.environ, ROS_HOME=str(tmp_path))
     done = subprocess.run(
-        [sys.executable, "-m", "ninjemys.demo", "-p", str(port), "--duration", "6", "--no-color"],
+        [
+            sys.executable,
+            "-m",
+            "ninjemys.demo",
+            "--chatter",
+            "-p",
+            str(port),
+            "--duration",
+            "6",
+            "--no-color",
+        ],
         env=env,
         capture_output=True,
         text=True,

@@ -304,3 +304,41 @@ def test_reset_world_and_simulation():
     assert (r.x, r.y, r.yaw, r.wl) == (0.0, 0.0, 0.0, 0.0) and sim.time == pytest.approx(1.0)
     sim.reset_simulation()
     assert sim.time == 0.0
+
+
+def test_camera_sees_the_square_painted_on_the_floor():
+    from ninjemys.sim.worlds import world_path
+
+    sim = Simulation(load_world(world_path("square")))
+    r = sim.add_robot(
+        "pb", load_robot_model("puzzlebot"), 0.5, -0.6, math.pi / 2
+    )  # facing the square's near side
+    rgb, depth = sim.render(r)
+    yellow = (rgb[:, :, 0] == 230) & (rgb[:, :, 1] == 200) & (rgb[:, :, 2] == 60)
+    rows = np.flatnonzero(yellow.any(axis=1))
+    assert yellow.sum() > 200 and rows.min() > r.camera.cy  # on the floor, below the horizon
+    # the near side (y = 0, 3 cm wide) is 0.6 - 0.08 m ahead of the camera: its rows see the floor there
+    near = rows.max()
+    assert abs(r.camera.cam_z / -r.camera.row_slope[near] - 0.52) < 0.03
+    assert int(depth[near, 160]) == round(r.camera.cam_z / -r.camera.row_slope[near] * 1000)
+
+
+def test_spawn_model_xml_kinds():
+    from ninjemys.sim.puzzlebot_node import parse_model_xml
+
+    urdf = (ROBOTS_DIR / "puzzlebot.urdf").read_text()
+    kind, model = parse_model_xml(urdf)
+    assert kind == "robot" and model.wheel_separation == pytest.approx(0.18)
+    assert parse_model_xml("")[0] == "robot" and parse_model_xml("puzzlebot")[1].name == "puzzlebot"
+    box = parse_model_xml(
+        '<robot name="b"><link name="l"><collision><geometry><box size="0.4 0.6 0.5"/></geometry></collision></link></robot>'
+    )
+    assert box == ("obstacle", ("box", (0.4, 0.6), 0.5, (180, 130, 80)))
+    cyl = parse_model_xml(
+        "<sdf><model name='c'><link name='l'><collision name='x'><geometry><cylinder><radius>0.2</radius><length>1.0</length></cylinder></geometry></collision></link></model></sdf>"
+    )
+    assert cyl[1][:3] == ("cylinder", (0.2, 0.2), 1.0)
+    with pytest.raises(SpawnError, match="not valid XML"):
+        parse_model_xml("<robot")
+    with pytest.raises(SpawnError, match="neither a differential-drive robot"):
+        parse_model_xml("<robot name='x'><link name='l'/></robot>")

@@ -24,7 +24,7 @@ def test_demo_drives_the_square_and_stops_cleanly(tmp_path) -> None:  # type: ig
     log = tmp_path / "demo.log"
     with open(log, "wb") as out:
         demo = subprocess.Popen(
-            [sys.executable, "-m", "ninjemys.demo", "--port", str(port), "--web-port", str(web)],
+            [sys.executable, "-m", "ninjemys.demo", "--chatter", "--port", str(port), "--web-port", str(web)],
             env=dict(os.environ, PYTHONUNBUFFERED="1"),
             stdout=out,
             stderr=subprocess.STDOUT,

@@ -3,11 +3,15 @@
 from __future__ import annotations
 
 import math
+import signal
+import subprocess
+import threading
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
+import yaml
 from rviz_helpers import M, grid, scan, screenshot_rgb, tf_message, top_view_url, transform
 from web_helpers import wait_until
 
@@ -133,3 +137,151 @@ def test_rviz_file_displays_and_unsupported_ones_are_named(graph: dict[str, Any]
     assert 'rviz/Camera "FrontCamera"' in page.locator("#rv-unsupported").inner_text()
     assert page.locator('.rv-display[data-name="Grid"] .enabled').is_checked() is False
     assert page.locator('.rv-display[data-name="Map"] .topic').input_value() == "/map"
+
+
+GOAL_LISTENER = """
+import sys
+import rospy
+from geometry_msgs.msg import PoseStamped
+rospy.init_node("goal_listener")
+def got(msg):
+    q = msg.pose.orientation
+    print("GOAL", msg.header.frame_id, round(msg.pose.position.x, 2), round(msg.pose.position.y, 2),
+          round(q.z, 3), round(q.w, 3), flush=True)
+rospy.Subscriber("/move_base_simple/goal", PoseStamped, got)
+print("READY", flush=True)
+rospy.spin()
+"""
+
+
+@pytest.mark.ros1
+def test_nav_goal_click_reaches_a_rospy_subscriber(graph: dict[str, Any], browser_page: Any) -> None:
+    from ninjemys.testing import ROS1_PYTHON, have_ros1, ros1_env
+
+    if not have_ros1():
+        pytest.skip("Debian's ROS 1 is not installed")
+    listener = subprocess.Popen(
+        [ROS1_PYTHON, "-u", "-c", GOAL_LISTENER],
+        env=ros1_env(graph["uri"]),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+    )
+    lines: list[str] = []
+
+    def read() -> None:
+        for line in listener.stdout:
+            lines.append(line)
+
+    reader = threading.Thread(target=read, daemon=True)
+    reader.start()
+    try:
+        wait_until(lambda: any("READY" in x for x in lines), what="the rospy listener")
+        page = browser_page
+        _open(page, top_view_url(graph["url"], 0, 0, 50, fixed="odom"))
+        # the tools advertise at start-up (as rviz's): wait for the graph to connect the listener
+        wait_until(
+            lambda: page.evaluate("rviz.ros.topics().some(t => t.name === '/move_base_simple/goal')"),
+            what="the goal topic advertised",
+        )
+        page.wait_for_timeout(1000)
+        page.get_by_role("button", name="2D Nav Goal").click()
+        start = page.evaluate("rviz.project(1.5, -1.0)")
+        end = page.evaluate("rviz.project(1.5, 0.0)")  # dragged towards +y: yaw 90°
+        page.mouse.move(start["x"], start["y"])
+        page.mouse.down()
+        page.mouse.move(end["x"], end["y"], steps=4)
+        page.mouse.up()
+        goal = wait_until(lambda: next((x for x in lines if x.startswith("GOAL")), None), what="the goal")
+        assert goal.split() == ["GOAL", "odom", "1.5", "-1.0", "0.707", "0.707"]
+        # the tool is one-shot, as rviz's: the camera tool is active again
+        assert "active" in page.get_by_role("button", name="Move Camera").get_attribute("class")
+    finally:
+        listener.send_signal(signal.SIGINT)
+        try:
+            listener.wait(5)
+        except subprocess.TimeoutExpired:
+            listener.kill()
+            listener.wait()
+
+
+def test_wrong_type_and_missing_transform_are_named_and_the_page_keeps_working(
+    graph: dict[str, Any], browser_page: Any
+) -> None:
+    peer = graph["peer"]
+    # /scan carries a map (the wrong type for the LaserScan display); /map is in a frame tf does not know
+    bad = peer.publisher("/scan", M("nav_msgs/OccupancyGrid"), queue_size=1, latch=True)
+    bad.publish(grid("map", 2, 2, 1.0, 0, 0, [0, 0, 0, 0]))
+    m = peer.publisher("/map", M("nav_msgs/OccupancyGrid"), queue_size=1, latch=True)
+    m.publish(grid("ghost", 2, 2, 1.0, 0, 0, [0, 100, 0, 100]))
+    page = browser_page
+    _open(page, graph["url"])
+    wait_until(
+        lambda: (
+            "topic /scan is nav_msgs/OccupancyGrid, not sensor_msgs/LaserScan" in _status(page, "LaserScan")
+        ),
+        what="the wrong type message",
+    )
+    wait_until(lambda: "No transform from [ghost] to [map]" in _status(page, "Map"), what="the tf message")
+    # the page keeps working: the map shows once its frame is known, and the scan display can be re-pointed
+    static = peer.publisher("/tf_static", M("tf2_msgs/TFMessage"), queue_size=1, latch=True)
+    static.publish(tf_message(transform("map", "ghost", 0, 0), transform("map", "laser", 0, 0)))
+    wait_until(lambda: "No transform" not in _status(page, "Map"), what="the map placed")
+    good = peer.publisher("/scan2", M("sensor_msgs/LaserScan"), queue_size=1, latch=True)
+    good.publish(scan("laser", [1.0, 1.0], 0.0, 0.1))
+    wait_until(
+        lambda: page.evaluate("rviz.ros.topics().some(t => t.name === '/scan2')"), what="/scan2 listed"
+    )
+    topic = page.locator('.rv-display[data-name="LaserScan"] .topic')
+    topic.fill("/scan2")
+    topic.dispatch_event("change")
+    wait_until(lambda: "2 points in [laser]" in _status(page, "LaserScan"), what="the scan on /scan2")
+    assert "not sensor_msgs/LaserScan" not in _status(page, "LaserScan")
+
+
+def test_a_broken_rviz_file_is_named_with_its_line(tmp_path: Path, browser_page: Any) -> None:
+    config = tmp_path / "broken.rviz"
+    config.write_text("Visualization Manager:\n  Displays:\n    - Class: rviz/Grid\n   Name: [oops\n")
+    with MasterThread() as uri:
+        rviz = Rviz(uri, str(config), update_period=0.2)
+        try:
+            url = rviz.start()
+            page = browser_page
+            _open(page, url)
+            text = page.locator("#rv-messages").inner_text()
+            assert f"{config}:4:" in text
+            # rviz's defaults are shown instead, and they work
+            assert page.locator(".rv-display").evaluate_all("els => els.map(e => e.dataset.name)") == [
+                "Grid",
+                "TF",
+            ]
+        finally:
+            rviz.stop()
+
+
+def test_the_edited_display_list_is_saved_in_rviz_layout(graph: dict[str, Any], browser_page: Any) -> None:
+    page = browser_page
+    _open(page, graph["url"])
+    page.select_option("#rv-add-class", "rviz/Path")
+    page.click("#rv-add")
+    path = page.locator('.rv-display[data-name="Path"]')
+    path.locator(".topic").fill("/move_base/GlobalPlanner/plan")
+    path.locator(".topic").dispatch_event("change")
+    page.locator('.rv-display[data-name="LaserScan"] .remove').click()
+    page.locator('.rv-display[data-name="Grid"] .enabled').check()
+    page.fill("#rv-fixed", "odom")
+    page.dispatch_event("#rv-fixed", "change")
+    page.click("#rv-save")
+    wait_until(lambda: "saved to" in page.locator("#rv-saved").inner_text(), what="the save")
+    doc = yaml.safe_load(graph["config"].read_text())
+    manager = doc["Visualization Manager"]
+    assert manager["Global Options"]["Fixed Frame"] == "odom"
+    by_name = {d["Name"]: d for d in manager["Displays"]}
+    assert set(by_name) == {"Grid", "Map", "Path", "FrontCamera"}  # the camera display is kept as it was
+    assert (
+        by_name["Path"]["Class"] == "rviz/Path"
+        and by_name["Path"]["Topic"] == "/move_base/GlobalPlanner/plan"
+    )
+    assert by_name["Grid"]["Enabled"] is True
+    assert by_name["Map"]["Color Scheme"] == "map" and by_name["Map"]["Topic"] == "/map"
+    assert by_name["FrontCamera"]["Image Topic"] == "/camera/image_raw"

@@ -43,7 +43,7 @@ class GoalIDGenerator:
         stamp = _now(self._now)
         with _lock:
             count = next(_server_count)
-        goal_id = get_message_class("actionlib_msgs/GoalID")()
+        goal_id: Any = get_message_class("actionlib_msgs/GoalID")()
         goal_id.id = f"{self.name}-{count}-{stamp.secs}.{stamp.nsecs}"
         goal_id.stamp = stamp
         return goal_id
@@ -56,7 +56,7 @@ def client_goal_id(name: str, now: Callable[[], tuple[int, int]] | None = None) 
     stamp = _now(now)
     with _lock:
         count = next(_client_count)
-    goal_id = get_message_class("actionlib_msgs/GoalID")()
+    goal_id: Any = get_message_class("actionlib_msgs/GoalID")()
     goal_id.id = f"{name}-{count}-{stamp.to_sec():.3f}"
     goal_id.stamp = stamp
     return goal_id

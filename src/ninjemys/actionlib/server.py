@@ -93,19 +93,23 @@ class ServerGoalHandle:
         """The goal message (FooGoal), or None for an empty handle."""
         return self.goal.goal if self.goal is not None else None
 
+    def _bound(self, what: str) -> tuple[StatusTracker, ActionServer] | None:
+        """The goal's tracker and server; None (and one error line) for an empty handle."""
+        if self.goal is None or self.status_tracker is None or self.action_server is None:
+            self._log_empty(what)
+            return None
+        return self.status_tracker, self.action_server
+
     def get_goal_id(self) -> Any:
-        if self.goal is None:
-            self._log_empty("get a goal id of")
-            return goal_status_class()().goal_id
-        return self.status_tracker.status.goal_id
+        bound = self._bound("get a goal id of")
+        return goal_status_class()().goal_id if bound is None else bound[0].status.goal_id
 
     def get_goal_status(self) -> Any:
-        if self.goal is None:
-            self._log_empty("get the goal status of")
-            return goal_status_class()()
-        return self.status_tracker.status
+        bound = self._bound("get the goal status of")
+        return goal_status_class()() if bound is None else bound[0].status
 
     def get_default_result(self) -> Any:
+        assert self.action_server is not None, "an empty ServerGoalHandle has no action"
         return self.action_server.types.result()
 
     def __eq__(self, other: object) -> bool:
@@ -120,7 +124,7 @@ class ServerGoalHandle:
         return hash(self.get_goal_id().id) if self.goal is not None else 0
 
     def __repr__(self) -> str:
-        if self.goal is None:
+        if self.goal is None or self.status_tracker is None:
             return "ServerGoalHandle(empty)"
         status = self.status_tracker.status
         return f"ServerGoalHandle({status.goal_id.id!r}, {states.status_name(status.status)})"
@@ -166,17 +170,16 @@ class ServerGoalHandle:
         )
 
     def publish_feedback(self, feedback: Any) -> None:
-        if self.goal is None:
-            self._log_empty("publish feedback on")
-            return
-        self.action_server.publish_feedback(self.status_tracker.status, feedback)
+        bound = self._bound("publish feedback on")
+        if bound is not None:
+            bound[1].publish_feedback(bound[0].status, feedback)
 
     def set_cancel_requested(self) -> bool:
         """A cancel reached this goal: PENDING -> RECALLING, ACTIVE -> PREEMPTING.
 
         True when the user's cancel callback must hear of it (the goal was pending or active).
         """
-        if self.goal is None:
+        if self.goal is None or self.status_tracker is None or self.action_server is None:
             return False
         server = self.action_server
         with server.lock:
@@ -189,12 +192,12 @@ class ServerGoalHandle:
         return True
 
     def _move(self, table: dict[int, int], text: str, result: Any, what: str) -> None:
-        if self.goal is None:
-            self._log_empty("set the status of")
+        bound = self._bound("set the status of")
+        if bound is None:
             return
-        server = self.action_server
+        tracker, server = bound
         with server.lock:
-            status = self.status_tracker.status
+            status = tracker.status
             new = table.get(status.status)
             if new is None:
                 server.log.error(
@@ -209,7 +212,7 @@ class ServerGoalHandle:
             status.status = new
             status.text = text
             if new in states.TERMINAL_STATUSES:
-                self.status_tracker.destruction_time = stamp_of(server.clock)
+                tracker.destruction_time = stamp_of(server.clock)
                 server.publish_result(status, result if result else self.get_default_result())
         server.status_changed()
 

@@ -155,7 +155,14 @@ class FoxgloveSession:
                 self._subs[sub_id] = channel_id
             topic = channel["topic"]
             try:
-                self.gateway.taps.add(topic, channel["schemaName"], (self, sub_id), self._sink(sub_id, topic))
+                # published_as: a channel of a type learned from a publisher's definition is taken raw
+                self.gateway.taps.add(
+                    topic,
+                    channel["schemaName"],
+                    (self, sub_id),
+                    self._sink(sub_id, topic),
+                    published_as=channel["schemaName"],
+                )
             except NinjemysError:
                 with self._lock:
                     self._subs.pop(sub_id, None)

@@ -26,7 +26,7 @@ def _truthy(value: Any) -> bool:
     return bool(value)
 
 
-def options_from_params(node: Node, default_port: int, node_name: str) -> GatewayOptions:
+def options_from_params(node: Node, default_port: int, node_name: str, client_count: bool) -> GatewayOptions:
     """GatewayOptions from the node's private parameters (ROS 1's names for both bridges)."""
 
     def param(name: str, default: Any) -> Any:
@@ -58,10 +58,11 @@ def options_from_params(node: Node, default_port: int, node_name: str) -> Gatewa
         else 8 * 1024 * 1024,
         update_period=float(param("max_update_ms", 1000)) / 1000.0,
         node_name=node_name,
+        client_count=client_count,
     )
 
 
-def _run(default_name: str, default_port: int, argv: list[str] | None) -> int:
+def _run(default_name: str, default_port: int, argv: list[str] | None, client_count: bool = False) -> int:
     from ninjemys.node.cli_args import parse_args
 
     args = parse_args([sys.argv[0], *(sys.argv[1:] if argv is None else argv)])
@@ -75,7 +76,7 @@ def _run(default_name: str, default_port: int, argv: list[str] | None) -> int:
         params=args.private_params,
     )
     try:
-        options = options_from_params(node, default_port, default_name)
+        options = options_from_params(node, default_port, default_name, client_count)
         gateway = Gateway(options, node=node)
         url = gateway.run_in_thread()
     except (NinjemysError, OSError, ValueError) as exc:
@@ -95,7 +96,7 @@ def _run(default_name: str, default_port: int, argv: list[str] | None) -> int:
 
 def rosbridge_main(argv: list[str] | None = None) -> int:
     """``rosrun rosbridge_server rosbridge_websocket`` (port 9090)."""
-    return _run("rosbridge_websocket", 9090, argv)
+    return _run("rosbridge_websocket", 9090, argv, client_count=True)
 
 
 def foxglove_main(argv: list[str] | None = None) -> int:

@@ -21,6 +21,7 @@ import logging
 import ssl
 import threading
 import time
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -70,6 +71,8 @@ class GatewayOptions:
     update_period: float = 1.0
     node_name: str = "rosbridge_websocket"
     protocols: tuple[str, ...] = ("rosbridge", "foxglove")
+    #: publish the number of connected clients on ``client_count`` (latched), as rosbridge_websocket does
+    client_count: bool = False
 
     def secret(self) -> str | None:
         if not self.authenticate:
@@ -109,8 +112,13 @@ class Catalog:
     def channel(self, channel_id: int) -> dict[str, Any] | None:
         return self.channels.get(channel_id)
 
-    def refresh(self, node: Node, services: Services) -> dict[str, Any]:
-        """Poll the master; returns what changed: added/removed channels and services, graph diff."""
+    def refresh(
+        self, node: Node, services: Services, learn: Callable[[str, str], str | None] = lambda t, n: None
+    ) -> dict[str, Any]:
+        """Poll the master; returns what changed: added/removed channels and services, graph diff.
+
+        ``learn(topic, type)`` gives the definition text of a type the gateway cannot load (as a
+        publisher sent it), or None while it is not known yet."""
         state = node.master.get_system_state()
         types = dict(node.master.get_topic_types())
         pubs = {t: sorted(n) for t, n in state[0]}
@@ -123,12 +131,15 @@ class Catalog:
             if not type_name or type_name == "*":
                 continue
             try:
-                msg_class = get_message_class(type_name)
+                schema = get_message_class(type_name)._full_text
             except NinjemysError as exc:
-                if type_name not in self._unknown:
-                    self._unknown.add(type_name)
-                    log.warning("gateway: topic %s skipped: %s", topic, exc)
-                continue
+                learned = learn(topic, type_name)
+                if learned is None:
+                    if type_name not in self._unknown:
+                        self._unknown.add(type_name)
+                        log.info("gateway: %s (%s): waiting for its definition from a publisher", topic, exc)
+                    continue
+                schema = learned
             key = (topic, type_name)
             wanted[key] = None
             if key not in self._channel_ids:
@@ -138,7 +149,7 @@ class Catalog:
                     "topic": topic,
                     "encoding": "ros1",
                     "schemaName": type_name,
-                    "schema": msg_class._full_text,
+                    "schema": schema,
                     "schemaEncoding": "ros1msg",
                 }
                 with self._lock:
@@ -265,6 +276,8 @@ class Gateway:
         self._stop = threading.Event()
         self._sim_ns = 0
         self._watched: set[str] = set()
+        self._definitions: dict[str, str] = {}
+        self._probing: set[tuple[str, str]] = set()
         self._clock_sub: Any = None
         self._client_count: Any = None
         self._poller = threading.Thread(target=self._poll, name="gateway-graph", daemon=True)
@@ -293,11 +306,12 @@ class Gateway:
 
     # -- graph polling ----------------------------------------------------------------------
     def start(self) -> None:
-        """Start watching the graph (and /clock under sim time); publish ``client_count`` as rosbridge does."""
-        self._client_count = self.node.publisher(
-            "client_count", get_message_class("std_msgs/Int32"), queue_size=1, latch=True
-        )
-        self._count_clients()
+        """Start watching the graph (and /clock under sim time); publish ``client_count`` if asked."""
+        if self.options.client_count:
+            self._client_count = self.node.publisher(
+                "client_count", get_message_class("std_msgs/Int32"), queue_size=1, latch=True
+            )
+            self._count_clients()
         if self.sim_time:
             self._clock_sub = self.node.subscriber(
                 "/clock", get_message_class("rosgraph_msgs/Clock"), self._on_clock, queue_size=1
@@ -319,9 +333,31 @@ class Gateway:
         while not self._stop.wait(self.options.update_period):
             self._refresh()
 
+    def _learn(self, topic: str, type_name: str) -> str | None:
+        """The definition of a type we cannot load, from a publisher's connection header: a raw
+        subscription (md5 ``*``) takes one message, keeps its ``message_definition`` and leaves."""
+        known = self._definitions.get(type_name)
+        if known is not None or (topic, type_name) in self._probing:
+            return known
+        self._probing.add((topic, type_name))
+        owner = ("definition probe", topic)
+
+        def sink(d: Any) -> None:
+            text = d.header.get("message_definition")
+            if text and d.header.get("type") == type_name:
+                self._definitions.setdefault(type_name, text)
+            # unsubscribing joins the subscription's thread: not from inside its own callback
+            self.pool.submit(self.taps.remove, topic, owner)
+
+        try:
+            self.taps.add(topic, type_name, owner, sink, published_as=type_name)
+        except NinjemysError as exc:
+            log.warning("gateway: cannot learn the definition of %s on %s: %s", type_name, topic, exc)
+        return None
+
     def _refresh(self) -> None:
         try:
-            diff = self.catalog.refresh(self.node, self.services)
+            diff = self.catalog.refresh(self.node, self.services, self._learn)
         except NinjemysError as exc:
             log.warning("gateway: graph refresh failed: %s", exc)
             return

@@ -23,7 +23,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from ninjemys.nav.costmap import INSCRIBED, NO_INFORMATION, Costmap, distance_transform
+from ninjemys.nav.costmap import INSCRIBED, NO_INFORMATION, Costmap
 
 
 def angle_diff(a: float, b: float) -> float:
@@ -159,6 +159,9 @@ class DWAPlanner:
         V, Wv = (a.ravel() for a in np.meshgrid(vs, ws))
         slow = (np.abs(V) < p.min_vel_trans) & (np.abs(Wv) < p.min_vel_theta)
         V, Wv = V[~slow], Wv[~slow]
+        if v_lo <= 0.0:  # turning in place at the slowest allowed rate is always a candidate
+            V = np.append(V, [0.0, 0.0])
+            Wv = np.append(Wv, [p.min_vel_theta, -p.min_vel_theta])
         if V.size == 0:
             return Command(0.0, 0.0, valid=False)
         # roll out arcs: steps of at most sim_granularity along the fastest sample
@@ -188,46 +191,43 @@ class DWAPlanner:
             return Command(0.0, 0.0, valid=False)
         occ = cost.max(axis=1).astype(float)
         # distance maps over the local costmap: to the plan's cells and to the local goal
-        plan_cells, goal_cell = self._local_plan_cells(cm)
-        if goal_cell is None:
+        local = self._local_plan(cm)
+        if len(local) == 0:
             return Command(0.0, 0.0, valid=False)
-        reach = max(cm.size_x, cm.size_y)
-        mask = np.zeros((cm.size_y, cm.size_x), dtype=bool)
-        mask[plan_cells[:, 1], plan_cells[:, 0]] = True
-        path_d = distance_transform(mask, reach)
-        mask[:] = False
-        mask[goal_cell[1], goal_cell[0]] = True
-        goal_d = distance_transform(mask, reach)
+        # distances measured along the plan: to the nearest plan point, and from there to the local
+        # goal along the plan (a wall between an arc's end and the local goal cannot make a shortcut)
+        seg = np.hypot(np.diff(local[:, 0]), np.diff(local[:, 1]))
+        remaining = np.concatenate([np.cumsum(seg[::-1])[::-1], [0.0]])
 
-        def lookup(grid: np.ndarray, qx: np.ndarray, qy: np.ndarray) -> np.ndarray:
-            ix = np.clip(np.floor((qx - cm.origin_x) / res).astype(np.int64), 0, cm.size_x - 1)
-            iy = np.clip(np.floor((qy - cm.origin_y) / res).astype(np.int64), 0, cm.size_y - 1)
-            return grid[iy, ix]
+        def along(qx: np.ndarray, qy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            d = np.hypot(qx[:, None] - local[None, :, 0], qy[:, None] - local[None, :, 1])
+            j = np.argmin(d, axis=1)
+            near = d[np.arange(len(qx)), j]
+            return near, remaining[j] + near
 
         ex, ey, eth = px[:, -1], py[:, -1], ang[:, -1]
-        total = p.path_distance_bias * 0.5 * res * lookup(path_d, ex, ey)
-        total += p.goal_distance_bias * 0.5 * res * lookup(goal_d, ex, ey)
+        path_d, goal_d = along(ex, ey)
+        total = p.path_distance_bias * 0.5 * path_d + p.goal_distance_bias * 0.5 * goal_d
         total += p.occdist_scale * occ
         gx, gy = self.plan[-1, 0], self.plan[-1, 1]
         if math.hypot(gx - x, gy - y) > p.forward_point_distance:
-            fx = ex + p.forward_point_distance * np.cos(eth)
-            fy = ey + p.forward_point_distance * np.sin(eth)
-            total += p.path_distance_bias * 0.5 * res * lookup(path_d, fx, fy)
-            total += p.goal_distance_bias * 0.5 * res * lookup(goal_d, fx, fy)
+            path_f, goal_f = along(
+                ex + p.forward_point_distance * np.cos(eth), ey + p.forward_point_distance * np.sin(eth)
+            )
+            total += p.path_distance_bias * 0.5 * path_f + p.goal_distance_bias * 0.5 * goal_f
         total = np.where(valid, total, np.inf)
         best = int(np.argmin(total))
         return Command(float(V[best]), float(Wv[best]))
 
-    def _local_plan_cells(self, cm: Costmap) -> tuple[np.ndarray, tuple[int, int] | None]:
-        """The plan's cells inside the local costmap (up to where it first leaves it), and the last one."""
+    def _local_plan(self, cm: Costmap) -> np.ndarray:
+        """The plan's points (m, 2) inside the local costmap, up to where it first leaves it."""
         res = cm.resolution
         cx = np.floor((self.plan[:, 0] - cm.origin_x) / res).astype(np.int64)
         cy = np.floor((self.plan[:, 1] - cm.origin_y) / res).astype(np.int64)
         inside = (cx >= 0) & (cx < cm.size_x) & (cy >= 0) & (cy < cm.size_y)
         if not inside.any():
-            return np.zeros((0, 2), dtype=np.int64), None
+            return np.zeros((0, 2))
         first = int(np.argmax(inside))
         out = np.nonzero(~inside[first:])[0]
         last = first + (int(out[0]) if out.size else len(inside) - first)
-        cells = np.column_stack([cx[first:last], cy[first:last]])
-        return cells, (int(cells[-1, 0]), int(cells[-1, 1]))
+        return self.plan[first:last, :2]

@@ -117,6 +117,10 @@ class MoveBase:
         self.last_valid = 0.0
         self.last_plan_time = 0.0
         self.plan_requested = False
+        self.goal_seq = 0  # bumped by every new goal: a plan computed for an older goal is dropped
+        self.plan_event = threading.Event()
+        self.planner_busy = False
+        self.last_request = -1e9
         self.planning_since = 0.0
         self.recovery_index = 0
         self.osc_pose: Pose2D | None = None
@@ -157,6 +161,10 @@ class MoveBase:
         self._start_reconfigure()
         self.thread = threading.Thread(target=self.control_loop, name="move_base-control", daemon=True)
         self.thread.start()
+        self.planner_thread = threading.Thread(
+            target=self.planner_loop, name="move_base-planner", daemon=True
+        )
+        self.planner_thread.start()
         self.cm_thread = threading.Thread(target=self.costmap_loop, name="move_base-costmaps", daemon=True)
         self.cm_thread.start()
 
@@ -237,6 +245,7 @@ class MoveBase:
                 int((~np.isfinite(ranges)).sum()),
                 len(ranges),
             )
+        ranges = np.where(np.isneginf(ranges), scan.range_min, ranges)  # REP 117: closer than range_min
         t = scan.header.stamp.to_sec()
         for cm in cms:
             sensor = self.tf.lookup(cm.global_frame, scan.header.frame_id, t)
@@ -321,6 +330,8 @@ class MoveBase:
         self.handle = handle
         self.dwa.xy_latched = False
         self.plan = None
+        self.goal_seq += 1
+        self.last_request = -1e9
         self.state = "planning"
         self.plan_requested = True
         self.planning_since = rospy.get_time()
@@ -489,9 +500,10 @@ class MoveBase:
                 self.planner_frequency > 0 and now - self.last_plan_time >= 1.0 / self.planner_frequency
             )
             if self.state == "planning" or (self.state == "controlling" and replan_due):
-                self._plan_step(gpose, goal, now)
-                if self.state not in ("controlling",):
-                    return
+                self._request_plan(now)
+            if self.state == "planning":
+                self._stop()  # standing still until there is a plan, as ROS 1's move_base
+                return
             if self.state == "clearing":
                 self._recovery_step(gpose, lpose, now)
                 return
@@ -546,26 +558,62 @@ class MoveBase:
         fill_pose(fb.base_position.pose, gpose)
         self.handle.publish_feedback(fb)
 
-    def _plan_step(self, gpose: Pose2D, goal: Pose2D, now: float) -> None:
-        self.last_plan_time = now
+    def _request_plan(self, now: float) -> None:
+        """Ask the planner thread for a plan (at most every half second while one is being made)."""
+        if self.planner_busy or now - self.last_request < 0.5:
+            return
+        self.last_request = now
+        self.plan_event.set()
+
+    def planner_loop(self) -> None:
+        """The global planner's own thread (as in ROS 1): the control loop keeps its rate meanwhile."""
+        while not rospy.is_shutdown():
+            if not self.plan_event.wait(0.5):
+                continue
+            self.plan_event.clear()
+            with self.lock:
+                goal, seq = self.goal, self.goal_seq
+                wanted = goal is not None and self.state in ("planning", "controlling")
+                self.planner_busy = wanted
+            if not wanted or goal is None:
+                continue
+            try:
+                self._plan_once(goal, seq)
+            except Exception as exc:  # the planner thread must survive anything one plan does
+                rospy.logerr("move_base: planning failed: %s: %s", type(exc).__name__, exc)
+            finally:
+                self.planner_busy = False
+
+    def _plan_once(self, goal: Pose2D, seq: int) -> None:
+        gpose = self.tf.lookup(self.global_cm.global_frame, self.global_cm.robot_base_frame)
+        if gpose is None:
+            return
+        now = rospy.get_time()
         try:
             plan = self._make_plan(gpose, goal)
         except PlanError as exc:
-            if self.state == "controlling":
-                rospy.logwarn_throttle(
-                    5.0, "move_base: replanning failed (%s); keeping the current plan", exc
-                )
-                return
-            if now - self.planning_since > self.planner_patience:
-                self._start_recovery(
-                    now, f"Failed to find a valid plan. Even after executing recovery behaviors. ({exc})"
-                )
+            with self.lock:
+                if seq != self.goal_seq:
+                    return
+                self.last_plan_time = now
+                if self.state == "controlling":
+                    rospy.logwarn_throttle(
+                        5.0, "move_base: replanning failed (%s); keeping the current plan", exc
+                    )
+                elif self.state == "planning" and now - self.planning_since > self.planner_patience:
+                    self._start_recovery(
+                        now, f"Failed to find a valid plan. Even after executing recovery behaviors. ({exc})"
+                    )
             return
-        self.plan = plan
-        self.plan_requested = False
-        if self.state == "planning":
-            self.state = "controlling"
-            self.last_valid = now
+        with self.lock:
+            if seq != self.goal_seq or self.goal is None:
+                return
+            self.plan = plan
+            self.last_plan_time = now
+            self.plan_requested = False
+            if self.state == "planning":
+                self.state = "controlling"
+                self.last_valid = now
         self.plan_pub.publish(self._path_msg(plan, self.global_cm.global_frame))
 
     def _check_oscillation(self, gpose: Pose2D, now: float) -> None:

@@ -128,6 +128,8 @@ class SafetyMonitor:
 
     def on_scan(self, scan: Any) -> None:
         ranges, angles = scan_arrays(scan)
+        # REP 117: -inf is "closer than range_min": something is right at the robot
+        ranges = np.where(np.isneginf(ranges), scan.range_min, ranges)
         ok = np.isfinite(ranges) & (ranges >= scan.range_min) & (ranges <= scan.range_max)
         if not self.bad_scan_reported and not np.isfinite(ranges).all():
             self.bad_scan_reported = True
@@ -207,7 +209,14 @@ class SafetyMonitor:
             v, w = inp.v, inp.w
             speed = v if abs(v) >= abs(self.velocity) or v * self.velocity <= 0 else self.velocity
             self.blocked = v != 0.0 and blocked(
-                self.points, speed, self.radius, self.margin, self.max_decel, self.reaction
+                self.points,
+                speed,
+                w,
+                self.radius,
+                self.margin,
+                self.max_decel,
+                self.reaction,
+                self.obstacle_speed,
             )
             if self.blocked:
                 v = 0.0
@@ -216,7 +225,13 @@ class SafetyMonitor:
     def loop(self) -> None:
         rate = rospy.Rate(self.rate)
         while not rospy.is_shutdown():
-            v, w, publish = self.decide(rospy.get_time())
+            try:
+                v, w, publish = self.decide(rospy.get_time())
+            except Exception as exc:  # the guard must keep guarding: stop and report
+                rospy.logerr_throttle(
+                    5.0, "safety_monitor: %s: %s; stopping the robot", type(exc).__name__, exc
+                )
+                v, w, publish = 0.0, 0.0, True
             if publish:
                 msg = self._twist()
                 msg.linear.x, msg.angular.z = v, w

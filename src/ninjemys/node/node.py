@@ -126,7 +126,7 @@ class Node:
         self.uri: str = self._slave.uri
         self.registrar = Registrar(self)
         self.registrar.start()
-        # the clock and the log exist before anything can fail, so shutdown always finds them
+        # the clock and the log exist before anything below can fail, so shutdown always finds them
         self.clock: Clock = clock if clock is not None else Clock()
         self.log: NodeLog = NodeLog(self.name, level=log_level, log_file=log_file)
         try:

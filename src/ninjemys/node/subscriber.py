@@ -434,12 +434,14 @@ class Subscriber:
             self._finish()
 
     def _on_wake(self) -> None:
-        self._woken = False
         try:
             while self._wake_r.recv(4096):
                 pass
         except (BlockingIOError, OSError):
             pass
+        # cleared only after draining: a wake-up written during the drain would otherwise be consumed
+        # while the flag stays set, and every later enqueue would skip its wake-up (a lost wake-up)
+        self._woken = False
         with self._ops_lock:
             ops, self._ops = self._ops, []
         for op, conn in ops:

@@ -598,7 +598,7 @@ class SimNode:
             img.encoding = "rgb8"
             img.is_bigendian = 0
             img.step = rgb.shape[1] * 3
-            img.data = rgb.tobytes()
+            img.data = rgb.reshape(-1)  # a view: uint8[] fields take numpy arrays without a copy
             pubs["image"].publish(img)
         if pubs["depth"].get_num_connections():
             d = Image()
@@ -608,7 +608,7 @@ class SimNode:
             d.encoding = "16UC1"
             d.is_bigendian = 0
             d.step = depth.shape[1] * 2
-            d.data = depth.astype("<u2").tobytes()
+            d.data = depth.astype("<u2", copy=False).view(np.uint8).reshape(-1)
             pubs["depth"].publish(d)
         fx, fy, cx, cy = r.camera.intrinsics()
         for key, frame_id in (("color_info", frame), ("depth_info", depth_frame)):
@@ -778,10 +778,10 @@ def main(argv: list[str] | None = None) -> int:
         namespaced = len(starts) > 1
         for i, s in enumerate(starts):
             pose = (x, y, yaw) if i == 0 else (s.x, s.y, s.yaw)
-            robot_model = model if s.model == "puzzlebot" else load_robot_model(s.model)
             try:
+                robot_model = model if s.model == "puzzlebot" else load_robot_model(s.model)
                 app.add_robot(s.name, robot_model, *pose, namespaced)
-            except SpawnError as exc:
+            except (SpawnError, MapFileError) as exc:
                 log.fatal("%s", exc)
                 return 1
         log.info(

@@ -30,6 +30,18 @@ class Scene:
     radii: np.ndarray  # (M,)
     circle_heights: np.ndarray  # (M,)
     circle_colors: np.ndarray  # (M, 3) uint8
+    floor: FloorPaint | None = None  # markings painted on the floor
+
+
+@dataclass
+class FloorPaint:
+    """Floor markings rasterized once: ``texture[row, col]`` is 0 (bare floor) or 1 + a palette index."""
+
+    texture: np.ndarray  # uint8 (rows, cols), row 0 at origin_y
+    palette: np.ndarray  # (K, 3) uint8
+    origin_x: float
+    origin_y: float
+    resolution: float
 
 
 def lidar_ranges(
@@ -95,8 +107,15 @@ class Camera:
         self._background = np.ascontiguousarray(np.broadcast_to(bg[:, None, :], (height, width, 3))).reshape(
             height, 3 * width
         )
+        self._floor_rows = np.flatnonzero(floor_depth > 0)  # rows that see the floor within range
+        forward = floor_depth[self._floor_rows][:, None]
+        #: where each floor pixel meets the floor, in the camera's horizontal frame (x ahead, y left)
+        self._floor_points = (
+            np.broadcast_to(forward, (len(self._floor_rows), width)).astype(np.float32),
+            (forward * ((self.cx - u) / self.fx)[None, :]).astype(np.float32),
+        )
         self._neg_slope = -self.row_slope
-        self._rows = np.arange(height, dtype=np.int16)[:, None]
+        self._rows = np.arange(height, dtype=np.uint16)[:, None]
 
     def render(self, scene: Scene, x: float, y: float, yaw: float) -> tuple[np.ndarray, np.ndarray]:
         """(rgb8 image (H, W, 3), depth in mm uint16 (H, W)) from a camera at (x, y, cam_z) facing ``yaw``."""
@@ -127,15 +146,40 @@ class Camera:
         bottom = np.searchsorted(self._neg_slope, -lo_slope, "right")
         # the image as (H, 3W) bytes: one select over bytes against a per-channel mask is cheaper than
         # any interleaving of channels or a select over 3-byte elements
-        wall3 = (self._rows >= np.repeat(top, 3).astype(np.int16)) & (
-            self._rows < np.repeat(bottom, 3).astype(np.int16)
-        )
+        # top <= v < bottom as one unsigned comparison: v - top wraps to a huge value above the top
+        span = np.maximum(bottom - top, 0).astype(np.uint16)
+        wall3 = (self._rows - np.repeat(top.astype(np.uint16), 3)) < np.repeat(span, 3)
         light = np.clip(1.1 - depth / 15.0, 0.45, 1.0)  # flat shading, darker with distance
         col = (colors * light[:, None]).astype(np.uint8).reshape(1, 3 * self.width)
         rgb = np.where(wall3, col, self._background).reshape(self.height, self.width, 3)
+        if scene.floor is not None:
+            self._paint_floor(rgb, wall3[:, ::3], scene.floor, x, y, yaw)
         wall_mm = np.rint(np.where(found, depth, 0.0) * 1000.0).astype(np.uint16)
         depth_mm = np.where(wall3[:, ::3], wall_mm[None, :], self.floor_depth_mm[:, None])
         return rgb, depth_mm
+
+    def _paint_floor(
+        self, rgb: np.ndarray, wall: np.ndarray, paint: FloorPaint, x: float, y: float, yaw: float
+    ) -> None:
+        """Draw the floor markings (the course's 1 m square) where floor pixels see them: each floor
+        pixel's point on the floor looked up in the markings' texture."""
+        rows = self._floor_rows
+        forward, lateral = self._floor_points
+        c, s = np.float32(math.cos(yaw) / paint.resolution), np.float32(math.sin(yaw) / paint.resolution)
+        col = (c * forward - s * lateral + np.float32((x - paint.origin_x) / paint.resolution)).astype(
+            np.int32
+        )
+        row = (s * forward + c * lateral + np.float32((y - paint.origin_y) / paint.resolution)).astype(
+            np.int32
+        )
+        th, tw = paint.texture.shape
+        inside = (col >= 0) & (col < tw) & (row >= 0) & (row < th) & ~wall[rows]
+        if not inside.any():
+            return
+        r_idx, c_idx = np.nonzero(inside)
+        ink = paint.texture[row[r_idx, c_idx], col[r_idx, c_idx]]
+        painted = ink > 0
+        rgb[rows[r_idx[painted]], c_idx[painted]] = paint.palette[ink[painted] - 1]
 
     def intrinsics(self) -> tuple[float, float, float, float]:
         return self.fx, self.fy, self.cx, self.cy

@@ -21,7 +21,7 @@ import numpy as np
 
 from ninjemys.sim.raycast import grid_edges
 from ninjemys.sim.robot_model import RobotModel
-from ninjemys.sim.sensors import Camera, Scene, imu_reading, lidar_ranges
+from ninjemys.sim.sensors import Camera, FloorPaint, Scene, imu_reading, lidar_ranges
 from ninjemys.sim.world2d import Obstacle, World, box_outline, circle_outline
 
 TRAIL_LENGTH = 2000
@@ -117,6 +117,7 @@ class Simulation:
         self.static_names: list[str] = []
         self._movers_at: tuple[float, tuple] | None = None
         self._mover_fixed: tuple | None = None
+        self._floor = floor_paint(world)
         self._rebuild_static()
 
     @property
@@ -201,6 +202,7 @@ class Simulation:
             np.array([r.model.body_radius for r in others]),
             np.array([r.model.body_height for r in others]),
             np.array([r.model.color for r in others], dtype=np.uint8).reshape(-1, 3),
+            self._floor,
         )
 
     def clearance(self, x: float, y: float, exclude: str | None = None) -> tuple[float, str]:
@@ -484,6 +486,31 @@ class Simulation:
         spec = r.model.imu
         assert spec is not None
         return imu_reading(r.yaw, r.v, r.w, r.v_prev, self.dt, spec.gyro_noise, spec.accel_noise, r.rng)
+
+
+def floor_paint(world: World, resolution: float = 0.01, max_cells: int = 2000) -> FloorPaint | None:
+    """The world's floor markings rasterized for the camera (None without markings)."""
+    if not world.markings:
+        return None
+    pts = np.vstack([m.points for m in world.markings])
+    margin = max(m.width for m in world.markings)
+    lo = pts.min(axis=0) - margin
+    hi = pts.max(axis=0) + margin
+    res = max(resolution, float((hi - lo).max()) / max_cells)
+    cols, rows = (int(v) + 1 for v in np.ceil((hi - lo) / res))
+    cx = lo[0] + (np.arange(cols) + 0.5) * res
+    cy = lo[1] + (np.arange(rows) + 0.5) * res
+    gx, gy = np.meshgrid(cx, cy)
+    texture = np.zeros((rows, cols), dtype=np.uint8)
+    palette = []
+    for m in world.markings:
+        ink = len(palette) + 1
+        palette.append(m.color)
+        path = np.vstack([m.points, m.points[:1]]) if m.closed else m.points
+        for a, b in zip(path[:-1], path[1:], strict=True):
+            d = point_segment_distance(gx.ravel(), gy.ravel(), np.array([[a[0], a[1], b[0], b[1]]]))[:, 0]
+            texture.ravel()[d <= m.width / 2.0] = ink
+    return FloorPaint(texture, np.array(palette, dtype=np.uint8), float(lo[0]), float(lo[1]), res)
 
 
 def _inside(x: float, y: float, poly: np.ndarray) -> bool:

@@ -6,7 +6,7 @@ No ROS in here. Everything solid is reduced to what the ray caster and the colli
   each (walls are thick rectangles, boxes rectangles, cylinders 24-gons);
 * optionally an occupancy ``grid`` (a map_server map used as the world): occupied cells are solid,
   ``grid_height`` tall;
-* floor ``markings`` (painted lines, no height: the course's 1 m square) for the views;
+* floor ``markings`` (painted lines, no height: the course's 1 m square) for the camera and the views;
 * robots' start poses and moving obstacles that follow waypoints.
 
 Worlds come from our YAML format (:func:`load_world`, described in docs/sim.md) or from a
@@ -65,7 +65,7 @@ class Obstacle:
 
 @dataclass
 class Marking:
-    """A line painted on the floor (no height): drawn by the views, invisible to the lidar."""
+    """A line painted on the floor (no height): seen by the camera and the views, not by the lidar."""
 
     points: np.ndarray  # (K, 2)
     closed: bool

@@ -57,6 +57,8 @@ class RvizConfig:
     displays: list[dict[str, Any]] = field(default_factory=list)
     unsupported: list[dict[str, Any]] = field(default_factory=list)
     tools: dict[str, str] = field(default_factory=lambda: dict(DEFAULT_TOOLS))
+    #: the current view: {"mode": "top"|"orbit", "scale": px per m, "x", "y": focal point}
+    view: dict[str, Any] = field(default_factory=dict)
     document: dict[str, Any] = field(default_factory=dict)
 
     def to_page(self) -> dict[str, Any]:
@@ -67,6 +69,7 @@ class RvizConfig:
             "displays": self.displays,
             "unsupported": self.unsupported,
             "tools": self.tools,
+            "view": self.view,
         }
 
 
@@ -132,6 +135,17 @@ def parse(text: str, source: str = "<rviz config>") -> RvizConfig:
     if isinstance(options, dict):
         config.fixed_frame = str(options.get("Fixed Frame", config.fixed_frame))
         config.background = str(options.get("Background Color", config.background))
+    current = (manager.get("Views") or {}).get("Current") if isinstance(manager.get("Views"), dict) else None
+    if isinstance(current, dict):
+        top = current.get("Class") == "rviz/TopDownOrtho"
+        config.view = {"mode": "top" if top else "orbit"}
+        if top:
+            for key, name in (("Scale", "scale"), ("X", "x"), ("Y", "y")):
+                if isinstance(current.get(key), int | float):
+                    config.view[name] = current[key]
+        elif isinstance(current.get("Focal Point"), dict):
+            config.view["x"] = current["Focal Point"].get("X", 0)
+            config.view["y"] = current["Focal Point"].get("Y", 0)
     for tool in manager.get("Tools") or []:
         if isinstance(tool, dict) and tool.get("Class") in DEFAULT_TOOLS and tool.get("Topic"):
             config.tools[str(tool["Class"])] = str(tool["Topic"])

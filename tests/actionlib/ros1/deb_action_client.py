@@ -11,6 +11,8 @@ not tracking": actionlib#126, a race inside the real client that a fast server e
   cancel NS       a long goal, cancelled once active (SimpleActionClient.cancel_goal)
   preempt NS      ActionClient: a long goal, then a second one that the simple server takes instead
   wrong NS        wait_for_server(1 s) on a name nobody serves
+  stamps NS       ActionClient: 4 goals, cancel_goals_at_and_before_time(stamp of the 2nd), then
+                  cancel_all_goals; the statuses after each step
 """
 
 import json
@@ -101,6 +103,27 @@ def main():
             "second": second.get_goal_status(),
             "sum": second.get_result().sum if second.get_result() else None,
         }
+    elif mode == "stamps":
+        client = actionlib.ActionClient(ns, TwoIntsAction)
+        client.wait_for_server(rospy.Duration(10))
+        goals = []
+        for i in range(4):
+            goals.append(client.send_goal(TwoIntsGoal(a=LONG, b=i)))
+            time.sleep(0.02)
+        deadline = time.time() + 10
+
+        def settle(done):
+            while time.time() < deadline and not done():
+                time.sleep(0.01)
+            return [g.get_goal_status() for g in goals]
+
+        out["accepted"] = settle(lambda: all(g.get_goal_status() == GoalStatus.ACTIVE for g in goals))
+        client.cancel_goals_at_and_before_time(goals[1].comm_state_machine.action_goal.goal_id.stamp)
+        out["by_stamp"] = settle(
+            lambda: all(g.get_comm_state() == actionlib.CommState.DONE for g in goals[:2])
+        )
+        client.cancel_all_goals()
+        out["all"] = settle(lambda: all(g.get_comm_state() == actionlib.CommState.DONE for g in goals))
     elif mode == "wrong":
         client = actionlib.SimpleActionClient(ns, TwoIntsAction)
         out = {"found": client.wait_for_server(rospy.Duration(1))}

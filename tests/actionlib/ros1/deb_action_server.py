@@ -2,6 +2,7 @@
 
 ``simple NS``: a SimpleActionServer; a goal with ``a == -1`` runs until preempted, any other goal
 succeeds at once with ``a + b``.
+``hold NS``: an ActionServer that accepts every goal and keeps it until it is cancelled.
 ``plain NS``: an ActionServer that accepts and succeeds each goal in its goal callback. (Real
 SimpleActionServer's execute loop can miss the wake-up of a goal that arrives while it finishes the
 previous one and then sleeps 0.1 s: a fast client is held to about 30 goals/s by that, not by the
@@ -41,10 +42,22 @@ def plain(ns):
     return server
 
 
+def hold(ns):
+    server = actionlib.ActionServer(
+        ns,
+        TwoIntsAction,
+        lambda handle: handle.set_accepted(),
+        lambda handle: handle.set_canceled(None, "cancelled"),
+        auto_start=False,
+    )
+    server.start()
+    return server
+
+
 def main():
     rospy.init_node("real_server", anonymous=True)
     kind, ns = sys.argv[1], sys.argv[2]
-    server = simple(ns) if kind == "simple" else plain(ns)
+    server = {"simple": simple, "plain": plain, "hold": hold}[kind](ns)
     print("READY", flush=True)
     rospy.spin()
     return server

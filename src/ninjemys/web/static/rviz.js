@@ -84,7 +84,7 @@ function resize() {
   void cx;
   ortho.updateProjectionMatrix();
 }
-window.addEventListener("resize", resize);
+new ResizeObserver(() => resize()).observe(viewEl);
 
 // ------------------------------------------------------------------------------------------------
 // ROS
@@ -236,7 +236,7 @@ class Display {
       this.sub = ros.subscribe(topic, (msg, info) => {
         this.received++;
         this.lastMsg = msg;
-        if (this.received === 1) this.setStatus("Topic", "ok", `${this.received} messages received`);
+        if (this.received === 1) this.setStatus("Topic", "ok", `receiving ${info.type}`);
         try {
           this.onMessage(msg, info);
         } catch (err) {
@@ -1128,6 +1128,10 @@ async function loadConfig() {
   config = body;
   if (body.error) message(`config: ${body.error}`);
   toolTopics = { ...toolTopics, ...(body.tools || {}) };
+  // advertised up front, as rviz's tools do: subscribers are connected before the first click
+  ros.advertise(toolTopics["rviz/SetGoal"], "geometry_msgs/PoseStamped");
+  ros.advertise(toolTopics["rviz/SetInitialPose"], "geometry_msgs/PoseWithCovarianceStamped");
+  ros.advertise(toolTopics["rviz/PublishPoint"], "geometry_msgs/PointStamped");
   setFixedFrame(params.get("fixed") || body.fixedFrame || "map");
   if (body.background) scene.background = rvizColor(body.background, "48; 48; 48");
   for (const cfg of body.displays) addDisplay(cfg);
@@ -1136,10 +1140,15 @@ async function loadConfig() {
   }
 }
 
-setView(params.get("view") === "top" ? "top" : "orbit");
 $("rv-viewmode").addEventListener("change", (ev) => setView(ev.target.value));
 $("rv-reset-view").addEventListener("click", () => setView($("rv-viewmode").value));
 await loadConfig();
+// the view: URL parameters, else the file's current view (rviz/TopDownOrtho is the top view)
+const fileView = config?.view || {};
+if (!params.has("scale") && fileView.scale) topScale = Number(fileView.scale);
+if (!params.has("cx") && fileView.x !== undefined) viewCentre[0] = Number(fileView.x);
+if (!params.has("cy") && fileView.y !== undefined) viewCentre[1] = Number(fileView.y);
+setView(params.get("view") || fileView.mode || "orbit");
 requestAnimationFrame(frame);
 
 /** For tests and benchmarks: the page's state, and the page pixel of a fixed-frame point. */
