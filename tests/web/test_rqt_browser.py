@@ -18,6 +18,7 @@ from ninjemys.bag.api import Bag
 from ninjemys.dynamic_reconfigure.generator import render_module, run_cfg
 from ninjemys.dynamic_reconfigure.server import ReconfigureServer
 from ninjemys.idl.loader import get_message_class
+from ninjemys.idl.loader import get_service_class as get_message_class_srv
 from ninjemys.master.core import MasterThread
 from ninjemys.node import Node
 from ninjemys.rostime import Time
@@ -371,3 +372,67 @@ def test_tf_tree_shows_frames_with_rates(graph: Graph, browser_page: Any) -> Non
     )
     wait_until(lambda: "Hz" in page.inner_text('li[data-frame="base_link"] > .meta'), what="base_link's rate")
     assert "static" in page.inner_text('li[data-frame="odom"] > .meta')
+
+
+def test_plot_names_a_topic_that_disappears_and_picks_it_up_again(graph: Graph, browser_page: Any) -> None:
+    cls = M("std_msgs/Float64")
+    holder = {"pub": graph.peer.publisher("/flaky", cls, queue_size=10)}
+    graph.every(0.05, lambda k: holder["pub"] and holder["pub"].publish(cls(data=float(k))))
+    page = browser_page
+    _open(page, tool_url(graph.rqt(), "plot", [("topic", "/flaky/data")]))
+    samples = lambda: len(page.evaluate("window.rqt.tools.plot.data()")["/flaky/data"])  # noqa: E731
+    wait_until(lambda: samples() > 5, what="first samples")
+    pub, holder["pub"] = holder["pub"], None
+    pub.unregister()
+    error = '.plot-series-row[data-spec="/flaky/data"] .plot-error'
+    page.wait_for_selector(f"{error} >> text=not published any more", timeout=15000)
+    holder["pub"] = graph.peer.publisher("/flaky", cls, queue_size=10)
+    page.wait_for_selector(error, state="detached", timeout=15000)
+    count = samples()
+    wait_until(lambda: samples() > count + 5, what="samples after the topic came back")
+
+
+def test_logger_level_publisher_and_service_caller(graph: Graph, browser_page: Any) -> None:
+    got: list[str] = []
+    graph.peer.subscriber("/typed", M("std_msgs/String"), lambda m: got.append(m.data))
+    peer = graph.peer.name
+    page = browser_page
+    _open(page, tool_url(graph.rqt(), "logger_level"))
+    page.wait_for_selector(f'.ll-node option[value="{peer}"]', state="attached", timeout=15000)
+    page.select_option(".ll-node", peer)
+    page.wait_for_selector('.ll-logger option[value="rosout"]', state="attached", timeout=10000)
+    page.select_option(".ll-logger", "rosout")
+    page.select_option(".ll-level", "debug")
+    page.wait_for_selector("#pane-logger_level .rq-msgs >> text=rosout set to debug", timeout=10000)
+    proxy = graph.peer.service_proxy(f"{peer}/get_loggers", get_message_class_srv("roscpp/GetLoggers"))
+    levels = {lg.name: lg.level for lg in proxy.call().loggers}
+    assert levels["rosout"] == "debug"
+
+    # message publisher: fields from the type's defaults, edited, published
+    page.click('#rqt-tabs button[data-tool="publisher"]')
+    page.fill(".pub-topic", "/typed")
+    page.fill(".pub-type", "std_msgs/String")
+    page.click("text=load fields")
+    page.wait_for_function("document.querySelector('.pub-message').value.includes('\"data\": \"\"')")
+    page.fill(".pub-message", '{"data": "from the page"}')
+    time.sleep(0.5)
+    for _ in range(20):  # until the subscriber has connected to the page's publisher
+        page.click(".pub-once")
+        if got:
+            break
+        time.sleep(0.3)
+    wait_until(lambda: "from the page" in got, what="the published message")
+    page.fill(".pub-type", "std_msgs/Nope")
+    page.click(".pub-once")
+    page.wait_for_selector("#pane-publisher .rq-msgs >> text=std_msgs/Nope", timeout=5000)
+
+    # service caller: the request's fields, the response shown
+    page.click('#rqt-tabs button[data-tool="service_caller"]')
+    page.wait_for_selector(f'.sc-service option[value="{peer}/get_loggers"]', state="attached", timeout=10000)
+    page.select_option(".sc-service", f"{peer}/get_loggers")
+    page.click(".sc-call")
+    wait_until(lambda: '"name": "rosout"' in page.inner_text(".sc-response"), what="the response")
+    page.select_option(".sc-service", f"{peer}/set_logger_level")
+    page.fill(".sc-request", '{"logger": "rosout", "level": "loud"}')
+    page.click(".sc-call")
+    page.wait_for_selector("#pane-service_caller .rq-msgs >> text=loud", timeout=10000)
