@@ -299,7 +299,7 @@ def test_maze_goals_through_move_base_simple(tmp_path):
             msg.pose.orientation.z, msg.pose.orientation.w = math.sin(a / 2), math.cos(a / 2)
             pub.publish(msg)
             probe.wait_sim(0.5)
-            ok = wait_goal(session, (x, y, a), 150.0)
+            ok = wait_goal(session, (x, y, a), 300.0)
             reached += ok
             report.append(f"({x}, {y}, {a}) {'ok' if ok else 'MISSED'} at {probe.truth}")
         assert reached >= 19, "\n".join(report)
