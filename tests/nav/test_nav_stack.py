@@ -72,8 +72,10 @@ def run_ros1_goals(session: NavSession, goals: list[tuple]) -> list[dict]:
         text=True,
     )
     results = []
+    lines = []
     assert proc.stdout is not None
     for line in proc.stdout:
+        lines.append(line)
         try:
             item = json.loads(line)
         except ValueError:
@@ -81,7 +83,7 @@ def run_ros1_goals(session: NavSession, goals: list[tuple]) -> list[dict]:
         item["truth"] = session.probe.truth
         results.append(item)
     proc.wait(30)
-    assert proc.returncode == 0, proc.stderr.read() if proc.stderr else ""
+    assert proc.returncode == 0, "".join(lines) + (proc.stderr.read() if proc.stderr else "")
     return results
 
 
