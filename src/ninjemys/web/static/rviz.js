@@ -887,6 +887,7 @@ class ImageDisplay extends Display {
   onMessage(m) {
     const { width: w, height: h, encoding, step, data } = m;
     if (!w || !h) throw new Error("empty image");
+    if (step * h > data.length) throw new Error(`image data holds ${data.length} bytes; ${h} rows of ${step} need ${step * h}`);
     if (this.canvas.width !== w || this.canvas.height !== h) { this.canvas.width = w; this.canvas.height = h; }
     const ctx = this.canvas.getContext("2d");
     const img = ctx.createImageData(w, h);
@@ -900,22 +901,32 @@ class ImageDisplay extends Display {
         if (v > depthMax && Number.isFinite(v)) depthMax = v;
       }
     }
-    for (let y = 0; y < h; y++) {
-      for (let x = 0; x < w; x++) {
-        const p = (y * w + x) * 4;
-        let r, g, b;
-        switch (enc) {
-          case "rgb8": { const i = y * step + x * 3; r = data[i]; g = data[i + 1]; b = data[i + 2]; break; }
-          case "bgr8": { const i = y * step + x * 3; b = data[i]; g = data[i + 1]; r = data[i + 2]; break; }
-          case "rgba8": { const i = y * step + x * 4; r = data[i]; g = data[i + 1]; b = data[i + 2]; break; }
-          case "bgra8": { const i = y * step + x * 4; b = data[i]; g = data[i + 1]; r = data[i + 2]; break; }
-          case "mono8": case "8uc1": { r = g = b = data[y * step + x]; break; }
-          case "16uc1": case "mono16": { const v = dv.getUint16(y * step + x * 2, !m.is_bigendian); r = g = b = depthMax ? Math.round((255 * v) / depthMax) : 0; break; }
-          case "32fc1": { const v = dv.getFloat32(y * step + x * 4, !m.is_bigendian); r = g = b = Number.isFinite(v) && depthMax ? Math.round((255 * v) / depthMax) : 0; break; }
-          default: throw new Error(`image encoding ${encoding} is not shown`);
-        }
-        o[p] = r; o[p + 1] = g; o[p + 2] = b; o[p + 3] = 255;
+    // one loop per encoding (no per-pixel dispatch): a 640x480 frame is a few milliseconds
+    const le = !m.is_bigendian;
+    const colour = { rgb8: [3, 0, 1, 2], bgr8: [3, 2, 1, 0], rgba8: [4, 0, 1, 2], bgra8: [4, 2, 1, 0] }[enc];
+    if (colour) {
+      const [n, ri, gi, bi] = colour;
+      for (let y = 0; y < h; y++) {
+        let i = y * step, p = y * w * 4;
+        for (let x = 0; x < w; x++, i += n, p += 4) { o[p] = data[i + ri]; o[p + 1] = data[i + gi]; o[p + 2] = data[i + bi]; o[p + 3] = 255; }
       }
+    } else if (enc === "mono8" || enc === "8uc1") {
+      for (let y = 0; y < h; y++) {
+        let i = y * step, p = y * w * 4;
+        for (let x = 0; x < w; x++, i++, p += 4) { const v = data[i]; o[p] = v; o[p + 1] = v; o[p + 2] = v; o[p + 3] = 255; }
+      }
+    } else if (enc === "16uc1" || enc === "mono16" || enc === "32fc1") {
+      const float = enc === "32fc1";
+      for (let y = 0; y < h; y++) {
+        for (let x = 0; x < w; x++) {
+          const v = float ? dv.getFloat32(y * step + x * 4, le) : dv.getUint16(y * step + x * 2, le);
+          const g = Number.isFinite(v) && depthMax ? Math.round((255 * v) / depthMax) : 0;
+          const p = (y * w + x) * 4;
+          o[p] = g; o[p + 1] = g; o[p + 2] = g; o[p + 3] = 255;
+        }
+      }
+    } else {
+      throw new Error(`image encoding ${encoding} is not shown`);
     }
     ctx.putImageData(img, 0, 0);
     this.setStatus("Image", "ok", `${w}×${h} ${encoding}`);
