@@ -2,7 +2,7 @@
 monitor, robot standing, no goal (the issue's target: at most 30 % of one core).
 
 Starts our roscore and ``roslaunch puzzlebot_navigation navigation.launch gui:=false`` in its own
-process group, waits for it to settle, then sums user+system CPU time of every process in the group
+process group, waits for it to settle, then sums user+system CPU time of roslaunch and every process under it
 over a window. Debian ships no navigation stack, so the reference printed is the issue's target.
 Run alone: ``.venv/bin/python bench/nav_idle.py [seconds]``.
 """
@@ -21,9 +21,9 @@ TARGET = 30.0
 TICK = os.sysconf("SC_CLK_TCK")
 
 
-def group_cpu(pgid: int) -> float:
-    """Seconds of CPU used so far by the live processes of process group ``pgid``."""
-    total = 0
+def tree_cpu(root: int) -> float:
+    """Seconds of CPU used so far by ``root`` and every live descendant of it."""
+    stats: dict[int, tuple[int, float]] = {}
     for pid in os.listdir("/proc"):
         if not pid.isdigit():
             continue
@@ -32,9 +32,17 @@ def group_cpu(pgid: int) -> float:
                 fields = f.read().rsplit(")", 1)[1].split()
         except OSError:
             continue
-        if int(fields[2]) == pgid:  # field 5 of stat: pgrp
-            total += int(fields[11]) + int(fields[12])  # utime + stime
-    return total / TICK
+        stats[int(pid)] = (int(fields[1]), (int(fields[11]) + int(fields[12])) / TICK)  # ppid, utime+stime
+    family, total, grew = {root}, 0.0, True
+    while grew:
+        grew = False
+        for pid, (ppid, _) in stats.items():
+            if ppid in family and pid not in family:
+                family.add(pid)
+                grew = True
+    for pid in family:
+        total += stats.get(pid, (0, 0.0))[1]
+    return total
 
 
 def main() -> None:
@@ -50,9 +58,9 @@ def main() -> None:
         )
         try:
             time.sleep(20.0)  # start-up: imports, map loading, first costmaps
-            c0, t0 = group_cpu(proc.pid), time.monotonic()
+            c0, t0 = tree_cpu(proc.pid), time.monotonic()
             time.sleep(window)
-            c1, t1 = group_cpu(proc.pid), time.monotonic()
+            c1, t1 = tree_cpu(proc.pid), time.monotonic()
         finally:
             os.killpg(proc.pid, signal.SIGINT)
             try:

@@ -193,6 +193,10 @@ def test_bad_input_gets_status_errors_and_the_server_keeps_serving(
                 json.dumps({"op": "subscribe", "topic": "/chatter", "compression": "zip"}),
                 "compression must be",
             ),
+            (
+                json.dumps({"op": "subscribe", "topic": "/chatter", "fragment_size": -5}),
+                "must not be negative",
+            ),
         ]
         for text, expected in cases:
             ws.send(text)

@@ -150,6 +150,7 @@ class Costmap:
     origin_y: float = 0.0
     static: np.ndarray | None = None  # uint8 static-layer costs aligned with the grid (global only)
     static_grid: tuple[np.ndarray, float, float, float] | None = None  # (cells, res, ox, oy) for rolling
+    static_costs: np.ndarray | None = None  # the static layer inflated, without sensor marks (global only)
     obstacles: np.ndarray = field(default_factory=lambda: np.zeros((0, 0), dtype=np.uint8))
     costs: np.ndarray = field(default_factory=lambda: np.zeros((0, 0), dtype=np.uint8))
 
@@ -192,6 +193,10 @@ class Costmap:
         self.size_y, self.size_x = static.shape
         self.origin_x, self.origin_y = origin_x, origin_y
         self.static = static
+        inscribed, _ = p.radii
+        self.static_costs = inflation_costs(
+            static == LETHAL, resolution, inscribed, p.inflation_radius, p.cost_scaling_factor
+        )
         if self.obstacles.shape != static.shape:
             self.obstacles = np.zeros(static.shape, dtype=np.uint8)
         self.update()

@@ -117,6 +117,8 @@ class MoveBase:
         self.last_valid = 0.0
         self.last_plan_time = 0.0
         self.plan_requested = False
+        self.inbox: list[tuple[str, Any, Any]] = []  # goals and cancels from the action server
+        self.inbox_lock = threading.Lock()
         self.goal_seq = 0  # bumped by every new goal: a plan computed for an older goal is dropped
         self.plan_event = threading.Event()
         self.planner_busy = False
@@ -270,47 +272,65 @@ class MoveBase:
             if tr is None:
                 return None, f"cannot transform the goal from frame {frame} to {self.global_cm.global_frame}"
             p = compose(tr, p)
+        # read without move_base's lock: the action server calls this with its own lock held, and the
+        # control loop takes the two in the other order (the grid and its costs are replaced, not edited)
         cm = self.global_cm.costmap
-        with self.lock:
-            if cm.size_x == 0:
-                return None, "the global costmap has no map yet"
-            cx, cy = cm.world_to_cell(p[0], p[1])
-            if not cm.inside(cx, cy):
-                x1 = cm.origin_x + cm.size_x * cm.resolution
-                y1 = cm.origin_y + cm.size_y * cm.resolution
-                return None, (
-                    f"The goal ({p[0]:.2f}, {p[1]:.2f}) is off the global costmap "
-                    f"([{cm.origin_x:.2f}, {x1:.2f}] x [{cm.origin_y:.2f}, {y1:.2f}])"
-                )
-            cost = int(cm.costs[cy, cx])
-            if INSCRIBED <= cost < 255:
-                what = "an obstacle" if cost > INSCRIBED else "the inflated zone of an obstacle"
-                return None, f"The goal ({p[0]:.2f}, {p[1]:.2f}) is in {what} (cost {cost})"
+        # judged on the map (static layer, inflated), not on what the sensors see now: a person
+        # standing on the goal does not make it a bad goal
+        costs = cm.static_costs if cm.static_costs is not None else cm.costs
+        size_x, size_y = cm.size_x, cm.size_y
+        ox, oy, res = cm.origin_x, cm.origin_y, cm.resolution
+        if size_x == 0 or costs.shape != (size_y, size_x):
+            return None, "the global costmap has no map yet"
+        cx, cy = int(math.floor((p[0] - ox) / res)), int(math.floor((p[1] - oy) / res))
+        if not (0 <= cx < size_x and 0 <= cy < size_y):
+            x1, y1 = ox + size_x * res, oy + size_y * res
+            return None, (
+                f"The goal ({p[0]:.2f}, {p[1]:.2f}) is off the global costmap "
+                f"([{ox:.2f}, {x1:.2f}] x [{oy:.2f}, {y1:.2f}])"
+            )
+        cost = int(costs[cy, cx])
+        if INSCRIBED <= cost < 255:
+            what = "an obstacle" if cost > INSCRIBED else "the inflated zone of an obstacle"
+            return None, f"The goal ({p[0]:.2f}, {p[1]:.2f}) is in {what} (cost {cost})"
         return p, ""
 
     def on_goal(self, handle: Any) -> None:
+        """Runs with the action server's lock held: decide here, hand the goal to the control loop."""
         goal, reason = self._goal_in_global(handle.get_goal().target_pose)
         if goal is None:
             rospy.logerr("move_base: %s", reason)
             handle.set_rejected(None, reason)
             return
-        with self.lock:
-            if self.handle is not None:
-                self.handle.set_canceled(
-                    None,
-                    "This goal was canceled because another goal was received by the simple action server",
-                )
-            handle.set_accepted("This goal has been accepted by the simple action server")
-            self._begin(goal, handle)
+        handle.set_accepted("This goal has been accepted by the simple action server")
+        with self.inbox_lock:
+            self.inbox.append(("goal", goal, handle))
 
     def on_cancel(self, handle: Any) -> None:
-        with self.lock:
-            if handle is self.handle or (self.handle is not None and handle == self.handle):
+        """Runs with the action server's lock held: the control loop cancels."""
+        with self.inbox_lock:
+            self.inbox.append(("cancel", None, handle))
+
+    def _take_inbox(self) -> None:
+        """Apply goals and cancels from the action server (control loop, move_base's lock held)."""
+        with self.inbox_lock:
+            items, self.inbox = self.inbox, []
+        for kind, goal, handle in items:
+            if kind == "goal":
+                if self.handle is not None:
+                    self.handle.set_canceled(
+                        None,
+                        "This goal was canceled because another goal was received by the simple action server",
+                    )
+                self._begin(goal, handle)
+            elif self.handle is not None and handle == self.handle:
                 self._stop()
                 handle.set_canceled(None, "")
                 self.handle = None
                 self.goal = None
                 self.state = "idle"
+            elif handle.get_goal_status().status in (0, 1, 6, 7):  # pending, active, preempting, recalling
+                handle.set_canceled(None, "")
 
     def on_simple_goal(self, msg: Any) -> None:
         goal, reason = self._goal_in_global(msg)
@@ -479,6 +499,8 @@ class MoveBase:
 
     def cycle(self) -> None:
         with self.lock:
+            if self.inbox:
+                self._take_inbox()
             if self.goal is None:
                 return
         gpose, lpose = self._robot_poses()

@@ -122,9 +122,9 @@ class ScanMatchMapper:
         ranges = np.asarray(ranges, dtype=float)
         angles = np.asarray(angles, dtype=float)
         limit = min(p.maxRange, range_max) if range_max else p.maxRange
-        ok = ~np.isnan(ranges)
+        ok = ~np.isnan(ranges) & ~np.isneginf(ranges)  # NaN: no reading; -inf: closer than range_min
         ranges, angles = ranges[ok], angles[ok]
-        ranges = np.where(np.isfinite(ranges), ranges, limit)
+        ranges = np.where(np.isfinite(ranges), ranges, limit)  # +inf: no return, free up to maxUrange
         # beam endpoints in the base frame
         lx, ly, lth = laser_pose
         bx = lx + ranges * np.cos(lth + angles)
@@ -207,8 +207,9 @@ class ScanMatchMapper:
         iy = np.floor((ys[along] - p.ymin) / p.delta).astype(np.int64)
         flat = self._flat_unique(ix, iy)
         self.visits.ravel()[flat] += 1
-        ex = sensor[0] + np.cos(world[hit]) * ranges[hit]
-        ey = sensor[1] + np.sin(world[hit]) * ranges[hit]
+        # the hit cell is taken half a cell past the return, inside the surface it came from
+        ex = sensor[0] + np.cos(world[hit]) * (ranges[hit] + p.delta / 2)
+        ey = sensor[1] + np.sin(world[hit]) * (ranges[hit] + p.delta / 2)
         ix = np.floor((ex - p.xmin) / p.delta).astype(np.int64)
         iy = np.floor((ey - p.ymin) / p.delta).astype(np.int64)
         flat = self._flat_unique(ix, iy)

@@ -82,7 +82,7 @@ class SlamNode:
         if not self.bad_scan_reported and not np.isfinite(ranges).all():
             self.bad_scan_reported = True
             rospy.logwarn(
-                "slam_gmapping: scan from %s has NaN/inf ranges (%d of %d): NaN is skipped, inf is free space up to maxUrange",
+                "slam_gmapping: scan from %s has NaN/inf ranges (%d of %d): NaN and -inf are skipped, +inf is free space up to maxUrange",
                 frame,
                 int((~np.isfinite(ranges)).sum()),
                 len(ranges),

@@ -19,7 +19,15 @@ const canvas = $("rv-canvas");
 const viewEl = $("rv-view");
 // colours are given in sRGB bytes (messages, .rviz files) and drawn as given: no colour management
 THREE.ColorManagement.enabled = false;
-const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+/** True when WebGL is rasterized on the CPU (SwiftShader, llvmpipe): multisampling costs too much there. */
+function softwareGL() {
+  const gl = document.createElement("canvas").getContext("webgl");
+  const info = gl?.getExtension("WEBGL_debug_renderer_info");
+  const name = info ? String(gl.getParameter(info.UNMASKED_RENDERER_WEBGL)) : "";
+  gl?.getExtension("WEBGL_lose_context")?.loseContext();
+  return /swiftshader|llvmpipe|software/i.test(name);
+}
+const renderer = new THREE.WebGLRenderer({ canvas, antialias: !softwareGL() });
 renderer.setPixelRatio(1);
 renderer.outputColorSpace = THREE.LinearSRGBColorSpace;
 const scene = new THREE.Scene();
@@ -68,7 +76,9 @@ function setView(mode) {
     controls.target.set(viewCentre[0], viewCentre[1], 0);
   }
   controls.enabled = activeTool === "move";
+  controls.addEventListener("change", markDirty);
   controls.update();
+  dirty = true;
   $("rv-viewmode").value = mode;
   resize();
 }
@@ -83,6 +93,7 @@ function resize() {
   ortho.top = h / 2 / topScale; ortho.bottom = -h / 2 / topScale;
   void cx;
   ortho.updateProjectionMatrix();
+  dirty = true;
 }
 new ResizeObserver(() => resize()).observe(viewEl);
 
@@ -92,6 +103,11 @@ new ResizeObserver(() => resize()).observe(viewEl);
 const ros = new RosClient();
 const tf = new TfBuffer();
 tf.attach(ros);
+// the view is drawn when something changed (a message, tf, the camera, the page), at most at the
+// frame rate of the file's Global Options (rviz's default 30), and once a second regardless
+let dirty = true;
+const markDirty = () => { dirty = true; };
+tf.listeners.add(markDirty);
 let fixedFrame = params.get("fixed") || "map";
 let config = null;
 const displays = [];
@@ -227,6 +243,7 @@ class Display {
 
   start() {
     this.stop();
+    dirty = true;
     this.group.visible = this.cfg.enabled;
     if (!this.cfg.enabled) { this.statuses.clear(); renderStatus(this); return; }
     if (this.msgType) {
@@ -236,6 +253,7 @@ class Display {
       this.sub = ros.subscribe(topic, (msg, info) => {
         this.received++;
         this.lastMsg = msg;
+        dirty = true;
         if (this.received === 1) this.setStatus("Topic", "ok", `receiving ${info.type}`);
         try {
           this.onMessage(msg, info);
@@ -252,6 +270,7 @@ class Display {
   }
   destroy() {
     this.stop();
+    dirty = true;
     scene.remove(this.group);
     disposeTree(this.group);
   }
@@ -777,6 +796,7 @@ class RobotModelDisplay extends Display {
     }
     try {
       this.load(text);
+      dirty = true;
       this.setStatus("URDF", "ok", `${this.links.size} links from ${name}`);
     } catch (err) {
       this.setStatus("URDF", "error", `URDF in ${name}: ${err.message}`);
@@ -983,6 +1003,7 @@ function refreshTopicLists() {
 
 function setFixedFrame(frame) {
   fixedFrame = stripSlash(frame) || "map";
+  dirty = true;
   $("rv-fixed").value = fixedFrame;
   for (const d of displays) if (d instanceof OdometryDisplay) { d.start(); clearGroup(d.group); d.kept = []; d.last = null; }
 }
@@ -1085,7 +1106,15 @@ canvas.addEventListener("pointerup", (ev) => {
 // the loop
 
 const stats = { frames: 0, frameMs: [] };
-function frame() {
+const frameHooks = []; // called after each render (benchmarks: publish-to-paint)
+let frameInterval = 1000 / 30;
+let lastRender = 0;
+function frame(now) {
+  requestAnimationFrame(frame);
+  if (now - lastRender < frameInterval - 2) return;
+  if (!dirty && now - lastRender < 1000 && !drag) return;
+  dirty = false;
+  lastRender = now;
   const t0 = performance.now();
   const known = tf.frameNames();
   const list = $("rv-frames");
@@ -1110,10 +1139,10 @@ function frame() {
   controls?.update();
   renderer.render(scene, camera);
   drawLabels();
+  for (const fn of frameHooks) fn();
   stats.frames++;
   stats.frameMs.push(performance.now() - t0);
   if (stats.frameMs.length > 2000) stats.frameMs.shift();
-  requestAnimationFrame(frame);
 }
 
 async function loadConfig() {
@@ -1133,6 +1162,7 @@ async function loadConfig() {
   ros.advertise(toolTopics["rviz/SetInitialPose"], "geometry_msgs/PoseWithCovarianceStamped");
   ros.advertise(toolTopics["rviz/PublishPoint"], "geometry_msgs/PointStamped");
   setFixedFrame(params.get("fixed") || body.fixedFrame || "map");
+  if (Number(body.frameRate) > 0) frameInterval = 1000 / Number(body.frameRate);
   if (body.background) scene.background = rvizColor(body.background, "48; 48; 48");
   for (const cfg of body.displays) addDisplay(cfg);
   if (body.unsupported?.length) {
@@ -1153,7 +1183,7 @@ requestAnimationFrame(frame);
 
 /** For tests and benchmarks: the page's state, and the page pixel of a fixed-frame point. */
 window.rviz = {
-  ros, tf, displays, stats, groundPoint, setFixedFrame, addDisplay, pageState, setTool,
+  ros, tf, displays, stats, frameHooks, groundPoint, setFixedFrame, addDisplay, pageState, setTool,
   get fixedFrame() { return fixedFrame; },
   project(x, y, z = 0) {
     const rect = canvas.getBoundingClientRect();
