@@ -124,6 +124,17 @@ def test_plot_follows_a_published_sine_and_names_a_non_numeric_field(graph: Grap
         > 100
     )
 
+    # the topic monitor: rate and last value of the same topic
+    page.click('#rqt-tabs button[data-tool="topic"]')
+    page.check('.topic-table tr[data-topic="/wave"] input[type=checkbox]')
+    wait_until(
+        lambda: float(page.inner_text('.topic-table tr[data-topic="/wave"] .hz') or 0) > 10,
+        what="/wave's rate",
+    )
+    assert '"frame_id": "sine"' in page.inner_text(".topic-value")
+    assert "B/s" in page.inner_text('.topic-table tr[data-topic="/wave"] .bw')
+    page.click('#rqt-tabs button[data-tool="plot"]')
+
     # a string field: one line in the page, and the other series keep coming
     page.fill(".plot-input", "/wave/header/frame_id")
     page.press(".plot-input", "Enter")
@@ -264,6 +275,38 @@ def test_image_view_shows_the_published_pixels(graph: Graph, browser_page: Any) 
         "() => Array.from(document.getElementById('iv-canvas').getContext('2d').getImageData(0, 0, 2, 1).data)"
     )
     assert pixels == [0, 0, 0, 255, 255, 255, 255, 255]
+    # a CompressedImage (png): decoded by the browser
+    packed = graph.peer.publisher("/camera/png", M("sensor_msgs/CompressedImage"), queue_size=1, latch=True)
+    packed.publish(
+        M("sensor_msgs/CompressedImage")(
+            format="rgb8; png compressed bgr8", data=_png_rgb(4, 1, (10, 200, 30))
+        )
+    )
+    page.wait_for_selector('.iv-topic option[value="/camera/png"]', state="attached", timeout=10000)
+    page.select_option(".iv-topic", "/camera/png")
+    page.wait_for_function("document.getElementById('iv-canvas').width === 4", timeout=10000)
+    pixels = page.evaluate(
+        "() => Array.from(document.getElementById('iv-canvas').getContext('2d').getImageData(3, 0, 1, 1).data)"
+    )
+    assert pixels == [10, 200, 30, 255]
+
+
+def _png_rgb(width: int, height: int, rgb: tuple[int, int, int]) -> bytes:
+    """A PNG of one colour (8-bit RGB, no filter)."""
+    import struct
+    import zlib
+
+    def chunk(kind: bytes, body: bytes) -> bytes:
+        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
+
+    rows = b"".join(b"\0" + bytes(rgb) * width for _ in range(height))
+    header = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)
+    return (
+        b"\x89PNG\r\n\x1a\n"
+        + chunk(b"IHDR", header)
+        + chunk(b"IDAT", zlib.compress(rows))
+        + chunk(b"IEND", b"")
+    )
 
 
 CFG = """\
