@@ -374,9 +374,12 @@ def test_axclient_drives_a_fibonacci_server(graph: Graph, browser_page: Any) -> 
     def execute(goal: Any) -> None:
         seq = [0, 1]
         for _ in range(1, goal.order):
+            if server.is_preempt_requested():
+                server.set_preempted()
+                return
             seq.append(seq[-1] + seq[-2])
             server.publish_feedback(M("actionlib_tutorials/FibonacciFeedback")(sequence=seq))
-            time.sleep(0.05)
+            time.sleep(0.05 if goal.order < 10 else 0.5)
         server.set_succeeded(M("actionlib_tutorials/FibonacciResult")(sequence=seq))
 
     server = SimpleActionServer(node, "fibonacci", action, execute_cb=execute, auto_start=False)
@@ -393,6 +396,12 @@ def test_axclient_drives_a_fibonacci_server(graph: Graph, browser_page: Any) -> 
             ".ax-result"
         )
         assert "8" in page.inner_text(".ax-feedback")
+        # a long goal, cancelled while it runs
+        page.fill(".ax-goal", '{"order": 40}')
+        page.click(".ax-send")
+        page.wait_for_selector('.ax-status[data-status="ACTIVE"]', timeout=15000)
+        page.click(".ax-cancel")
+        page.wait_for_selector('.ax-status[data-status="PREEMPTED"]', timeout=15000)
         # a goal that is not JSON: a message, the page keeps working
         page.fill(".ax-goal", "{order: 6")
         page.click(".ax-send")
