@@ -223,6 +223,12 @@ def test_bag_timeline_shows_topics_ticks_thumbnails_and_plays(
     # the message under the cursor, then a plot of a field over the bag
     page.click('.bag-row[data-topic="/odom_x"] .bag-name')
     page.wait_for_selector(".bag-message >> text=/odom_x @ 100.000000000", timeout=5000)
+    # scrub: a click half way along the timeline shows the last message before that time
+    canvas = page.locator('.bag-row[data-topic="/odom_x"] canvas')
+    box = canvas.bounding_box()
+    assert box is not None
+    canvas.click(position={"x": box["width"] / 2, "y": 10})
+    page.wait_for_selector(".bag-message >> text=/odom_x @ 104.500000000", timeout=5000)
     page.fill(".bag-plot-input", "/odom_x/data")
     page.click(".bag-plot-button")
     page.wait_for_selector('.bag-plot[data-points="20"]', timeout=5000)
