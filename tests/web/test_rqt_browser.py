@@ -174,6 +174,12 @@ def test_console_lists_a_rospy_nodes_logwarn(graph: Graph, browser_page: Any) ->
         wait_until(lambda: page.locator(f"{row}:has-text('low battery')").count() == 0, what="warn hidden")
         assert page.locator(f"{row}:has-text('all fine')").count() > 0
         page.check('input[data-level="Warn"]')
+        # save: the shown messages as rqt_console's columns
+        with page.expect_download() as download:
+            page.click(".console-save")
+        saved = Path(download.value.path()).read_text()
+        assert saved.startswith("message;severity;node;stamp;topics;location\n")
+        assert '"low battery: 12%";"Warn";"/warner";' in saved
         # a bad regex is named in the page; a good one filters
         page.fill(".console-regex", "battery(")
         page.wait_for_selector("#pane-console .rq-msgs >> text=invalid regular expression", timeout=5000)
