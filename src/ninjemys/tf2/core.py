@@ -17,6 +17,9 @@ Where we differ, on purpose:
   last time it was asked about, valid until the next insertion, so a lookup is usually one
   ``inverse(a) * b`` instead of a walk. When that path cannot answer (a frame above the common
   ancestor has no data for that time), the exact tf2 walk runs and gives tf2's answer or error.
+  A lookup at a time not asked about before composes each side only up to the lowest common
+  ancestor, in one loop, interpolating each link from a per-segment record made on first use
+  (slerp as ``A cos(rθ) + C sin(rθ)``, see :meth:`Frame._segment`).
 - ``can_transform`` with a timeout waits on a condition that insertions signal (no polling sleeps).
 - Raw TFMessages (``add_raw``, what the listener uses) are queued and decoded in batches on the next
   query, runs of one layout with numpy (:mod:`ninjemys.tf2.bulk`).
