@@ -196,17 +196,22 @@ class PubConnection:
         self._since_try += 1
         limit = queue_size or 0  # None and 0: unbounded
         over = 0 < limit < len(queue)
-        if over or self._since_try >= _FLUSH_FRAMES or now - self._tried > _MAX_HOLD:
+        # queue_size bounds only what waits because the kernel refused it (the subscriber lags), as
+        # in ROS 1: a burst queued merely to batch its writes goes to the kernel before anything is
+        # dropped. A refusal leaves a partial frame; until then, a queue past its bound is written now.
+        if (
+            (over and self._partial is None)
+            or self._since_try >= _FLUSH_FRAMES
+            or now - self._tried > _MAX_HOLD
+        ):
             self._since_try = 0
             self._tried = now
             # what the kernel refuses stays queued: this thread tries again a batch later, and the
             # loop's check takes over once the burst ends (handing it to the loop now would have two
             # threads contend for the GIL and this lock for the rest of the burst)
             self._write_locked()
-            if over and len(queue) > limit:
-                # queue_size bounds only what the kernel refused (the subscriber lags), as in ROS 1:
-                # a burst queued to batch its writes is handed to the kernel before anything is dropped
-                self._trim(limit)
+        if over and len(queue) > limit:
+            self._trim(limit)
         if (queue or self._partial is not None) and not self._checking and not self._armed:
             self._checking = True
             self._seen = self._published
