@@ -342,3 +342,17 @@ def test_spawn_model_xml_kinds():
         parse_model_xml("<robot")
     with pytest.raises(SpawnError, match="neither a differential-drive robot"):
         parse_model_xml("<robot name='x'><link name='l'/></robot>")
+
+
+def test_an_obstacle_spawned_ahead_stops_a_moving_robot():
+    sim = Simulation(_empty(), dt=0.01)
+    r = sim.add_robot("pb", load_robot_model("puzzlebot"), 0.0, 0.0, 0.0)
+    r.command(0.5, 0.0)
+    for _ in range(20):
+        sim.step()  # cruising in the open: the static world is not even looked at
+    assert r.free is not None
+    sim.add_obstacle("crate", "box", (0.2, 1.0), r.x + 0.6, 0.0, 0.0, 0.5, (1, 2, 3))
+    for _ in range(300):
+        sim.step()
+    assert r.contact and r.contact_with == "crate"
+    assert r.x == pytest.approx(sim.world.obstacles[-1].outline[:, 0].min() - r.model.body_radius, abs=0.005)

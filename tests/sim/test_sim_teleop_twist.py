@@ -41,23 +41,25 @@ def test_keys_publish_on_cmd_vel(master: str, client) -> None:  # type: ignore[n
     client.subscriber("/cmd_vel", Twist, on_twist)
     cmd = shipped_executable("teleop_twist_keyboard", "teleop_twist_keyboard.py").command([])
     child = pexpect.spawn(
-        cmd[0], cmd[1:], env=dict(os.environ, ROS_MASTER_URI=master), encoding="utf-8", timeout=20
+        cmd[0], cmd[1:], env=dict(os.environ, ROS_MASTER_URI=master), encoding="utf-8", timeout=40
     )
     try:
         child.expect_exact("Reading from the keyboard  and Publishing to Twist!")
         child.expect_exact("CTRL-C to quit")
         child.expect_exact("currently:\tspeed 0.5\tturn 1.0 ")
-        wait_until(lambda: child.send("i") and got, what="first Twist")
+        wait_until(lambda: child.send("i") and got, timeout=40, what="first Twist")
         for key in ("j", ",", "k"):
             child.send(key)
-        wait_until(lambda: got[-3:] == [(0.0, 1.0), (-0.5, 0.0), (0.0, 0.0)], what="the keys' Twists")
+        wait_until(
+            lambda: got[-3:] == [(0.0, 1.0), (-0.5, 0.0), (0.0, 0.0)], timeout=40, what="the keys' Twists"
+        )
         child.send("z")
         child.expect_exact("currently:\tspeed 0.45\tturn 0.9 ")
         child.send("\x03")
         child.expect(pexpect.EOF)
         child.close()
         assert child.exitstatus == 0
-        wait_until(lambda: got[-1] == (0.0, 0.0), what="the stop on exit")
+        wait_until(lambda: got[-1] == (0.0, 0.0), timeout=40, what="the stop on exit")
     finally:
         if child.isalive():
             child.terminate(force=True)

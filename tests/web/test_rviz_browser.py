@@ -285,3 +285,52 @@ def test_the_edited_display_list_is_saved_in_rviz_layout(graph: dict[str, Any], 
     assert by_name["Grid"]["Enabled"] is True
     assert by_name["Map"]["Color Scheme"] == "map" and by_name["Map"]["Topic"] == "/map"
     assert by_name["FrontCamera"]["Image Topic"] == "/camera/image_raw"
+
+
+def test_pose_estimate_and_publish_point_tools(graph: dict[str, Any], browser_page: Any) -> None:
+    peer = graph["peer"]
+    got: dict[str, Any] = {}
+    peer.subscriber(
+        "/initialpose",
+        M("geometry_msgs/PoseWithCovarianceStamped"),
+        lambda m: got.setdefault("pose", m),
+        queue_size=1,
+    )
+    peer.subscriber(
+        "/clicked_point", M("geometry_msgs/PointStamped"), lambda m: got.setdefault("point", m), queue_size=1
+    )
+    page = browser_page
+    errors: list[str] = []
+    page.on("pageerror", lambda exc: errors.append(str(exc)))
+    _open(page, top_view_url(graph["url"], 0, 0, 50))
+    wait_until(
+        lambda: page.evaluate(
+            "['/initialpose', '/clicked_point'].every(n => rviz.ros.topics().some(t => t.name === n))"
+        ),
+        what="the tools advertised",
+    )
+    page.wait_for_timeout(1000)
+    page.get_by_role("button", name="2D Pose Estimate").click()
+    a, b = page.evaluate("rviz.project(-1, 2)"), page.evaluate("rviz.project(-2, 2)")  # heading -x: yaw 180°
+    page.mouse.move(a["x"], a["y"])
+    page.mouse.down()
+    page.mouse.move(b["x"], b["y"], steps=3)
+    page.mouse.up()
+    page.get_by_role("button", name="Publish Point").click()
+    c = page.evaluate("rviz.project(0.5, -0.5)")
+    page.mouse.click(c["x"], c["y"])
+    wait_until(lambda: "pose" in got and "point" in got, what="both tools' messages")
+    pose, point = got["pose"], got["point"]
+    assert pose.header.frame_id == "map"
+    assert (round(pose.pose.pose.position.x, 2), round(pose.pose.pose.position.y, 2)) == (-1.0, 2.0)
+    assert abs(abs(pose.pose.pose.orientation.z) - 1.0) < 1e-3
+    assert pose.pose.covariance[0] == 0.25 and pose.pose.covariance[7] == 0.25
+    assert abs(pose.pose.covariance[35] - (math.pi / 12) ** 2) < 1e-9
+    assert point.header.frame_id == "map"
+    assert (round(point.point.x, 2), round(point.point.y, 2), point.point.z) == (0.5, -0.5, 0.0)
+    # the 3D view draws the same scene: switching views raises nothing
+    page.select_option("#rv-viewmode", "orbit")
+    page.wait_for_timeout(300)
+    page.select_option("#rv-viewmode", "top")
+    page.wait_for_timeout(300)
+    assert errors == []

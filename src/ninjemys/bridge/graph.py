@@ -13,6 +13,7 @@ Everything here may block on the master or a peer: callers run it off the event 
 
 from __future__ import annotations
 
+import functools
 import logging
 import threading
 import time
@@ -207,9 +208,12 @@ class Publishers:
                 entry[0].unregister()
 
 
+@functools.cache
 def _raw_service_class(type_name: str, md5sum: str) -> Any:
     """A service class whose request is bytes already serialized and whose response stays bytes
-    (Foxglove's service calls carry ROS 1 bytes both ways: nothing is decoded in the gateway)."""
+    (Foxglove's service calls carry ROS 1 bytes both ways: nothing is decoded in the gateway).
+    One class per (type, md5sum): the persistent proxy is cached by them and only takes requests
+    of its own request class (a new class per call made every call after the first fail)."""
 
     class RawRequest:
         _type = type_name + "Request"

@@ -290,6 +290,11 @@ class RosbridgeSession:
             "fragment_size": self._field(msg, "fragment_size", int, None),
             "compression": self._field(msg, "compression", str, "none"),
         }
+        for name in ("throttle_rate", "queue_length", "fragment_size"):
+            if opts[name] is not None and opts[name] < 0:
+                raise OpError(f"field {name!r} must not be negative, got {opts[name]}")
+        if opts["fragment_size"] == 0:
+            opts["fragment_size"] = None
         if opts["compression"] not in ("none", "png", "cbor", "cbor-raw"):
             raise OpError(f"compression must be none, png, cbor or cbor-raw, got {opts['compression']!r}")
         with self._lock:
@@ -379,13 +384,15 @@ class RosbridgeSession:
             call_id = f"service_request:{service}:{next(self._counter)}"
             done = threading.Event()
             slot: list[Any] = []
-            self._pending[call_id] = (done, slot)
-            self.send({"op": "call_service", "id": call_id, "service": service, "args": to_value(request)})
-            while not done.wait(0.5):
-                if self._closed.is_set() or service not in self._services:
-                    self._pending.pop(call_id, None)
+            with self._lock:
+                if self._closed.is_set():
                     raise NinjemysError(f"service {service}: the providing WebSocket client went away")
+                self._pending[call_id] = (done, slot)
+            self.send({"op": "call_service", "id": call_id, "service": service, "args": to_value(request)})
+            done.wait()  # set by the client's service_response, or by _abandon when it goes away
             values, result = slot
+            if result is None:
+                raise NinjemysError(f"service {service}: {values}")
             if not result:
                 raise NinjemysError(
                     f"service {service}: the WebSocket client answered with an error: {values}"
@@ -402,11 +409,22 @@ class RosbridgeSession:
             server = self._services.pop(service, None)
         if server is None:
             raise OpError(f"service {service} is not advertised by this client")
+        self._abandon(f"service_request:{service}:", "the WebSocket client unadvertised it")
         server.shutdown()
+
+    def _abandon(self, prefix: str, why: str) -> None:
+        """Fail the ROS callers still waiting for this client's answers (ids starting with ``prefix``)."""
+        with self._lock:
+            ids = [i for i in self._pending if i.startswith(prefix)]
+            abandoned = [self._pending.pop(i) for i in ids]
+        for done, slot in abandoned:
+            slot[:] = [why, None]
+            done.set()
 
     def op_service_response(self, msg: dict[str, Any]) -> None:
         call_id = self._field(msg, "id", str)
-        pending = self._pending.pop(call_id, None)
+        with self._lock:
+            pending = self._pending.pop(call_id, None)
         if pending is None:
             raise OpError(f"no pending service request with id {call_id!r}")
         done, slot = pending
@@ -437,7 +455,9 @@ class RosbridgeSession:
     # -- end ----------------------------------------------------------------------------------
     def close(self) -> None:
         """The client went away: drop its subscriptions, publishers and services."""
-        self._closed.set()
+        with self._lock:
+            self._closed.set()
+        self._abandon("", "the providing WebSocket client went away")
 
         def cleanup() -> None:
             for topic in list(self._subs):

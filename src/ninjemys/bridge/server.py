@@ -43,6 +43,8 @@ from ninjemys.web.websocket import WRITE_HIGH_WATER, WebSocket
 log = logging.getLogger(__name__)
 
 _LOCAL_HOSTS = {"localhost", "127.0.0.1", "::1", "[::1]"}
+#: frames are written to the socket in batches of about this size (or when the outbox is empty)
+_BATCH_BYTES = 64 * 1024
 
 
 @dataclass
@@ -478,20 +480,24 @@ class Gateway:
             while not ws.closed:
                 await client.wake.wait()
                 client.wake.clear()
+                pending = 0  # bytes framed but not yet written: a burst leaves in one write
                 while (item := outbox.take()) is not None:
                     if isinstance(item, CloseRequest):
+                        ws.flush()
                         ws.close(item.code, item.reason)
                         return
-                    if isinstance(item, tuple):
-                        for frame in item:
-                            ws.send(frame)
-                    else:
-                        ws.send(item)
-                    if ws.buffered > WRITE_HIGH_WATER:
-                        await ws.drain()
+                    for frame in item if isinstance(item, tuple) else (item,):
+                        ws.send(frame, flush=False)
+                        pending += len(frame)
+                    if pending >= _BATCH_BYTES:
+                        ws.flush()
+                        pending = 0
+                        if ws.buffered > WRITE_HIGH_WATER:
+                            await ws.drain()
                     if outbox.bytes > 4 * limit:  # replies pile up: the client is not reading at all
                         ws.close(1008, "client too slow: its replies exceed the memory budget")
                         return
+                ws.flush()
         except (ConnectionError, asyncio.CancelledError):
             return
 

@@ -75,6 +75,7 @@ class Robot:
     contact_with: str = ""
     trail: deque = field(default_factory=lambda: deque(maxlen=TRAIL_LENGTH))
     trail_count: int = 0  # points ever appended (the view sends only the new ones)
+    free: tuple[float, float, float] | None = None  # (x, y, r): a disk free of static geometry
     camera: Camera | None = None
 
     def command(self, linear: float, angular: float) -> None:
@@ -100,6 +101,7 @@ class Robot:
         self.contact_with = ""
         self.trail.clear()
         self.trail_count = 0
+        self.free = None
 
 
 class Simulation:
@@ -142,6 +144,8 @@ class Simulation:
         self._static_height = np.concatenate(heights)
         self._static_color = np.vstack(colours).astype(np.uint8)
         self.static_names = names
+        for r in self.robots.values():
+            r.free = None  # the static world changed
         st = self._static
         self._static_lo = np.minimum(st[:, :2], st[:, 2:])  # bounding boxes for the collision broad phase
         self._static_hi = np.maximum(st[:, :2], st[:, 2:])
@@ -212,24 +216,53 @@ class Simulation:
         )
         return float(d[0]), name[0]
 
-    def _collision_geometry(self, x: float, y: float, reach: float, exclude: str | None) -> tuple:
-        """Segments (with names) and other robots' circles within ``reach`` of (x, y)."""
-        near = np.flatnonzero(
+    def _collision_geometry(
+        self, x: float, y: float, reach: float, exclude: str | None, static: bool = True
+    ) -> tuple:
+        """Segments (with names) and other robots' circles within ``reach`` of (x, y); ``static=False``
+        leaves the static world out (only what moves: moving obstacles and robots)."""
+        if static:
+            near = self._static_near(x, y, reach)
+            segs = self._static[near]
+            names = [self.static_names[i] for i in near]
+        else:
+            segs, names = self._static[:0], []
+        ms, _, _, mnames = self._mover_segments()
+        if len(ms):
+            segs = np.vstack([segs, ms])
+            names = names + mnames
+        others = [r for r in self.robots.values() if r.name != exclude]
+        centres = np.array([[r.x, r.y] for r in others]).reshape(-1, 2)
+        radii = np.array([r.model.body_radius for r in others])
+        return segs, names, centres, radii, [r.name for r in others]
+
+    def _static_near(self, x: float, y: float, reach: float) -> np.ndarray:
+        """Indices of the static segments whose bounding box comes within ``reach`` of (x, y)."""
+        return np.flatnonzero(
             (self._static_lo[:, 0] <= x + reach)
             & (self._static_hi[:, 0] >= x - reach)
             & (self._static_lo[:, 1] <= y + reach)
             & (self._static_hi[:, 1] >= y - reach)
         )
-        segs = self._static[near]
-        names = [self.static_names[i] for i in near]
-        ms, _, _, mnames = self._mover_segments()
-        if len(ms):
-            segs = np.vstack([segs, ms])
-            names += mnames
-        others = [r for r in self.robots.values() if r.name != exclude]
-        centres = np.array([[r.x, r.y] for r in others]).reshape(-1, 2)
-        radii = np.array([r.model.body_radius for r in others])
-        return segs, names, centres, radii, [r.name for r in others]
+
+    def _static_free(self, r: Robot, x: float, y: float) -> bool:
+        """True when (x, y) lies in ``r``'s free disk: a disk around a past position holding no static
+        geometry closer than the body radius, so moves inside it need no check against the static
+        world (only against what moves). The disk is renewed from the current position when left."""
+        radius = r.model.body_radius
+        free = r.free
+        if (
+            free is not None
+            and math.hypot(x - free[0], y - free[1]) <= free[2] - radius
+            and math.hypot(r.x - free[0], r.y - free[1]) <= free[2] - radius
+        ):
+            return True  # both ends in the disk: so is the straight move between them (a disk is convex)
+        reach = 2.0
+        segs = self._static[self._static_near(r.x, r.y, reach)]
+        near = point_segment_distance(np.array([r.x]), np.array([r.y]), segs)
+        clear = min(float(near.min()) if near.size else reach, reach)
+        r.free = (r.x, r.y, clear)
+        return math.hypot(x - r.x, y - r.y) <= clear - radius
 
     @staticmethod
     def _clearances(
@@ -389,7 +422,8 @@ class Simulation:
         new_contact = False
         if travel > 0:
             radius = m.body_radius
-            geometry = self._collision_geometry(r.x, r.y, travel + radius + 0.05, r.name)
+            static = not self._static_free(r, nx, ny)
+            geometry = self._collision_geometry(r.x, r.y, travel + radius + 0.05, r.name, static)
             pieces = max(1, math.ceil(travel / (radius * 0.5)))
             f = np.arange(0, pieces + 1) / pieces
             dist, who = self._clearances(r.x + f * ddx, r.y + f * ddy, r.name, geometry)

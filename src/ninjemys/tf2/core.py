@@ -17,6 +17,9 @@ Where we differ, on purpose:
   last time it was asked about, valid until the next insertion, so a lookup is usually one
   ``inverse(a) * b`` instead of a walk. When that path cannot answer (a frame above the common
   ancestor has no data for that time), the exact tf2 walk runs and gives tf2's answer or error.
+  A lookup at a time not asked about before composes each side only up to the lowest common
+  ancestor, in one loop, interpolating each link from a per-segment record made on first use
+  (slerp as ``A cos(rθ) + C sin(rθ)``, see :meth:`Frame._segment`).
 - ``can_transform`` with a timeout waits on a condition that insertions signal (no polling sleeps).
 - Raw TFMessages (``add_raw``, what the listener uses) are queued and decoded in batches on the next
   query, runs of one layout with numpy (:mod:`ninjemys.tf2.bulk`).
@@ -30,10 +33,10 @@ from __future__ import annotations
 import logging
 import threading
 import time as _wall
-from bisect import bisect_left
+from bisect import bisect_left, bisect_right
 from collections.abc import Callable, Iterable, Sequence
 from itertools import repeat
-from math import acos, isfinite, sin, sqrt
+from math import acos, cos, isfinite, sin, sqrt
 
 import numpy
 
@@ -86,6 +89,7 @@ class Frame:
         "has_cache",
         "stamps",
         "data",
+        "segs",
         "latest",
         "parent",
         "authority",
@@ -108,6 +112,9 @@ class Frame:
         self.has_cache = False  # tf2: frames_[id] is null until the frame is somebody's child
         self.stamps: list[int] = []  # ascending
         self.data: list[Entry] = []
+        # segs[i]: the interpolation record of the segment from entry i - 1 to entry i, made on first
+        # use (see _segment); None until then, and again whenever either end changes
+        self.segs: list[tuple | None] = []
         self.latest = 0  # newest stamp (0 for static frames, as tf2's StaticCache says)
         self.parent: Frame | None = None  # parent of the newest entry
         self.authority = ""
@@ -143,6 +150,9 @@ class Frame:
             e = data[-1]
             return e if len(e) == 2 else self._resolve(-1)
         stamps = self.stamps
+        if stamps[-1] == t:  # the newest entry (a latest-time lookup)
+            e = data[-1]
+            return e if len(e) == 2 else self._resolve(-1)
         n = len(stamps)
         i = bisect_left(stamps, t)
         if 0 < i < n:
@@ -174,43 +184,65 @@ class Frame:
     def _interpolate(self, i: int, t: int) -> Entry:
         """Between entries ``i - 1`` and ``i``: lerp for the translation, slerp (the shorter arc) for the
         rotation, as tf2's ``TimeCache::interpolate``; across a change of parent, the older entry."""
-        data = self.data
-        older = data[i - 1]
+        p, t0, inv, x, y, z, dx, dy, dz, qx, qy, qz, qw, cx, cy, cz, cw, th = self.segs[i] or self._segment(i)
+        r = (t - t0) * inv
+        if r:
+            x += r * dx
+            y += r * dy
+            z += r * dz
+            if th:
+                a = r * th
+                co = cos(a)
+                si = sin(a)
+                qx, qy, qz, qw = qx * co + cx * si, qy * co + cy * si, qz * co + cz * si, qw * co + cw * si
+            else:
+                qx, qy, qz, qw = _nlerp(qx, qy, qz, qw, cx, cy, cz, cw, r)
+        return p, (x, y, z, qx, qy, qz, qw)
+
+    def _segment(self, i: int) -> tuple:
+        """The record that makes interpolating between entries ``i - 1`` and ``i`` a few multiplies:
+        ``(parent, t0, 1/(t1 - t0), translation at t0, its change to t1, quaternion A at t0, C, theta)``.
+
+        Slerp from A to B (B negated if that is the shorter arc) by ratio r is
+        ``(A sin((1-r)θ) + B sin(rθ)) / sin θ`` (tf2's form); with ``C = (B - A cos θ) / sin θ``, the unit
+        quaternion orthogonal to A in their plane, it is ``A cos(rθ) + C sin(rθ)``: the same rotation
+        (to rounding) for two trigonometric calls. When A and B are nearly equal (θ under 1e-3, where
+        sin θ vanishes) the record holds ``C = B - A`` and θ = 0: a normalized lerp, exact to rounding
+        there. Across a change of parent tf2 returns the older entry: a record with no change."""
+        older = self.data[i - 1]
         if len(older) == 3:
             older = self._resolve(i - 1)
-        newer = data[i]
+        newer = self.data[i]
         if len(newer) == 3:
             newer = self._resolve(i)
-        if older[0] is not newer[0]:
-            return older
         stamps = self.stamps
         t0 = stamps[i - 1]
-        r = (t - t0) / (stamps[i] - t0)
-        r0 = 1.0 - r
-        a = older[1]
-        b = newer[1]
-        ax, ay, az, aw = a[3], a[4], a[5], a[6]
-        bx, by, bz, bw = b[3], b[4], b[5], b[6]
-        dot = ax * bx + ay * by + az * bz + aw * bw
-        if dot < 0.0:  # q and -q are one rotation: take the short way round
-            bx, by, bz, bw, dot = -bx, -by, -bz, -bw, -dot
-        if dot > 0.9999995:  # nearly equal: a normalized lerp (slerp's sine would vanish)
-            qx = r0 * ax + r * bx
-            qy = r0 * ay + r * by
-            qz = r0 * az + r * bz
-            qw = r0 * aw + r * bw
-            k = 1.0 / sqrt(qx * qx + qy * qy + qz * qz + qw * qw)
-            qx, qy, qz, qw = qx * k, qy * k, qz * k, qw * k
-        else:  # slerp keeps unit length to rounding, as tf2's does
-            theta = acos(dot)
-            inv = 1.0 / sin(theta)
-            s0 = sin(r0 * theta) * inv
-            s1 = sin(r * theta) * inv
-            qx = s0 * ax + s1 * bx
-            qy = s0 * ay + s1 * by
-            qz = s0 * az + s1 * bz
-            qw = s0 * aw + s1 * bw
-        return older[0], (r0 * a[0] + r * b[0], r0 * a[1] + r * b[1], r0 * a[2] + r * b[2], qx, qy, qz, qw)
+        ax, ay, az, aw = older[1][3:]
+        x, y, z = older[1][:3]
+        if older[0] is not newer[0]:
+            rec = (older[0], t0, 0.0, x, y, z, 0.0, 0.0, 0.0, ax, ay, az, aw, 0.0, 0.0, 0.0, 0.0, 1.0)
+        else:
+            b = newer[1]
+            bx, by, bz, bw = b[3], b[4], b[5], b[6]
+            dot = ax * bx + ay * by + az * bz + aw * bw
+            if dot < 0.0:  # q and -q are one rotation: take the short way round
+                bx, by, bz, bw, dot = -bx, -by, -bz, -bw, -dot
+            if dot > 0.9999995:
+                th = 0.0
+                cx, cy, cz, cw = bx - ax, by - ay, bz - az, bw - aw
+            else:
+                th = acos(dot)
+                k = 1.0 / sin(th)
+                cx, cy, cz, cw = (
+                    (bx - ax * dot) * k,
+                    (by - ay * dot) * k,
+                    (bz - az * dot) * k,
+                    (bw - aw * dot) * k,
+                )
+            rec = (older[0], t0, 1.0 / (stamps[i] - t0), x, y, z, b[0] - x, b[1] - y, b[2] - z)
+            rec += (ax, ay, az, aw, cx, cy, cz, cw, th)
+        self.segs[i] = rec
+        return rec
 
     def parent_at(self, t: int, err: list[str] | None) -> Frame | None:
         """tf2's ``getParent``: the parent for time ``t`` (the older entry's), without interpolating."""
@@ -437,12 +469,14 @@ class BufferCore:
             st = child.stamps
             st.extend(col)
             child.data.extend(zip(repeat(parent, k), repeat(blocks[j], k), range(k), strict=False))
+            child.segs.extend(repeat(None, k))
             latest = col[-1]
             child.latest = latest
             if st[0] < latest - slack:
                 cut = bisect_left(st, latest - keep)
                 del st[:cut]
                 del child.data[:cut]
+                del child.segs[:cut]
             count += k
         return count
 
@@ -523,6 +557,7 @@ class BufferCore:
                 self._topology += 1
             child.data = [entry]
             child.stamps = [stamp]
+            child.segs = [None]
             child.parent = parent
             return None
         stamps = child.stamps
@@ -532,11 +567,13 @@ class BufferCore:
                 child.parent = parent
             stamps.append(stamp)
             child.data.append(entry)
+            child.segs.append(None)
             child.latest = stamp
             if stamps[0] < stamp - self.cache_time_ns - self._prune_slack:
                 i = bisect_left(stamps, stamp - self.cache_time_ns)
                 del stamps[:i]
                 del child.data[:i]
+                del child.segs[:i]
             return None
         if stamps[-1] > stamp + self.cache_time_ns:
             now = _wall.monotonic()
@@ -554,6 +591,10 @@ class BufferCore:
                 self._topology += 1
                 child.parent = parent
             child.data[i] = entry
+            segs = child.segs
+            segs[i] = None  # both segments that end on this entry change
+            if i + 1 < len(segs):
+                segs[i + 1] = None
             if not child.quiet_repeat:
                 child.quiet_repeat = True
                 _log.debug(
@@ -567,6 +608,8 @@ class BufferCore:
             return None
         stamps.insert(i, stamp)
         child.data.insert(i, entry)
+        child.segs.insert(i, None)
+        child.segs[i + 1] = None  # the segment the new entry splits
         return None
 
     def _path_to(self, start: Frame, goal: Frame) -> list[Frame] | None:
@@ -590,6 +633,7 @@ class BufferCore:
                 if f.has_cache and not f.static:
                     f.stamps = []
                     f.data = []
+                    f.segs = []
                     f.latest = 0
                     f.parent = None
             self._gen += 1
@@ -658,16 +702,11 @@ class BufferCore:
         below the lowest common ancestor, on both sides (static links do not count)."""
         if source is target:
             return NO_ERROR, (source.latest if source.has_cache else 0)
-        sp = self._path(source)
-        tp = self._path(target)
-        if sp is not None and tp is not None:
-            index = source.index
-            for j, frame in enumerate(tp):
-                i = index.get(frame)
-                if i is not None:
-                    a = self._pmin(source)[i]
-                    b = self._pmin(target)[j]
-                    return NO_ERROR, (a if b == 0 or (a and a < b) else b)
+        m = self._meet(source, target)
+        if m is not None:
+            a = self._pmin(source)[m[0]]
+            b = self._pmin(target)[m[1]]
+            return NO_ERROR, (a if b == 0 or (a and a < b) else b)
         code, t, _ = self._common_time_walk(target, source, err)
         return code, t
 
@@ -756,10 +795,27 @@ class BufferCore:
             cur = parent
             if len(path) > MAX_GRAPH_DEPTH:
                 return None
-        compose = tfm.compose
-        for f, e in reversed(path):
-            if acc is not None:
-                acc = (acc[0], compose(acc[1], e[1]))
+        if acc is None:
+            for f, _ in path:
+                f.memo_gen, f.memo_t, f.memo_val = gen, t, None
+            return None
+        root, (x, y, z, qx, qy, qz, qw) = acc
+        for f, e in reversed(path):  # to_root(f) = to_root(parent) * link, as tfm.compose inline
+            bx, by, bz, bqx, bqy, bqz, bqw = e[1]
+            cx = qy * bz - qz * by + qw * bx
+            cy = qz * bx - qx * bz + qw * by
+            cz = qx * by - qy * bx + qw * bz
+            x = x + bx + 2.0 * (qy * cz - qz * cy)
+            y = y + by + 2.0 * (qz * cx - qx * cz)
+            z = z + bz + 2.0 * (qx * cy - qy * cx)
+            nx = qw * bqx + qx * bqw + qy * bqz - qz * bqy
+            ny = qw * bqy - qx * bqz + qy * bqw + qz * bqx
+            nz = qw * bqz + qx * bqy - qy * bqx + qz * bqw
+            qw = qw * bqw - qx * bqx - qy * bqy - qz * bqz
+            qx = nx
+            qy = ny
+            qz = nz
+            acc = (root, (x, y, z, qx, qy, qz, qw))
             f.memo_gen, f.memo_t, f.memo_val = gen, t, acc
         return acc
 
@@ -767,66 +823,79 @@ class BufferCore:
         """``(stamp_ns, 7 floats)``: the transform that maps data in ``source_frame`` into ``target_frame``
         at time ``t`` (0 = latest common). Raises tf2's exceptions with tf2's texts."""
         with self._lock:
-            self._drain()
-            if target_frame == source_frame:
-                if t == 0:
-                    f = self._frames.get(target_frame)
-                    t = f.latest if f is not None and f.has_cache else 0
-                return t, tfm.IDENTITY
-            target = self._validate("lookupTransform argument target_frame", target_frame)
-            source = self._validate("lookupTransform argument source_frame", source_frame)
+            if self._pending:
+                self._drain()
+            frames = self._frames
+            target = frames.get(target_frame)
+            source = frames.get(source_frame)
+            if target is None or source is None or target is source:
+                if target_frame == source_frame:
+                    if t == 0:
+                        t = target.latest if target is not None and target.has_cache else 0
+                    return t, tfm.IDENTITY
+                target = self._validate("lookupTransform argument target_frame", target_frame)
+                source = self._validate("lookupTransform argument source_frame", source_frame)
             return self._lookup(target, source, t)
 
     def _lookup(self, target: Frame, source: Frame, t: int) -> tuple[int, tuple]:
+        m = None
         if t == 0:
-            err: list[str] = []
-            code, t = self._common_time(target, source, err)
-            if code != NO_ERROR:
-                _raise(code, err)
+            m = self._meet(source, target)
+            if m is None:
+                err: list[str] = []
+                code, t = self._common_time(target, source, err)
+                if code != NO_ERROR:
+                    _raise(code, err)
+            else:  # tf2's latest common time, from the prefix minima of the newest stamps on each side
+                gen = self._gen
+                a = source.pmin[m[0]] if source.pmin_gen == gen else self._pmin(source)[m[0]]
+                b = target.pmin[m[1]] if target.pmin_gen == gen else self._pmin(target)[m[1]]
+                t = a if b == 0 or (a and a < b) else b
         gen = self._gen
         if (source.memo_gen == gen and source.memo_t == t) or t == self._last_t:
             # a time asked for before: each frame's transform to the top of its tree is (or becomes) memoized
-            a = self._to_root(source, t, gen)
+            a = (
+                source.memo_val
+                if source.memo_gen == gen and source.memo_t == t
+                else self._to_root(source, t, gen)
+            )
             if a is not None:
-                b = self._to_root(target, t, gen)
+                b = (
+                    target.memo_val
+                    if target.memo_gen == gen and target.memo_t == t
+                    else self._to_root(target, t, gen)
+                )
                 if b is not None and a[0] is b[0]:
                     return t, tfm.inverse_compose(b[1], a[1])
             # some link above the common ancestor has no data for t (a slow map->odom under a fast
             # odom->base_link): the answer only needs the links below it
         else:
             self._last_t = t
-        r = self._to_ancestor(target, source, t)
-        if r is not None:
-            return t, r
+        # a one-off time: compose each side up to the lowest common ancestor, interpolating on the way
+        if m is None:
+            m = self._meet(source, target)
+        if m is not None:
+            a = _chain_at(source.path, m[0], t)
+            if a is not None:
+                b = _chain_at(target.path, m[1], t)
+                if b is not None:
+                    return t, tfm.inverse_compose(b, a)
         return t, self._walk_transform(target, source, t)
 
-    def _to_ancestor(self, target: Frame, source: Frame, t: int) -> tuple | None:
-        """A one-off lookup at ``t``: compose each side up to the lowest common ancestor only. None when
-        the newest-parent paths do not hold at ``t`` (the exact walk decides then)."""
+    def _meet(self, source: Frame, target: Frame) -> tuple[int, int] | None:
+        """``(i, j)``: the lowest common ancestor of two frames along their newest parents is
+        ``source.path[i]`` and ``target.path[j]`` (paths cached until the topology changes); None when
+        the paths do not meet (the walk then gives tf2's error)."""
         sp = self._path(source)
         tp = self._path(target)
         if sp is None or tp is None:
             return None
         index = source.index
-        i = j = None
-        for k, frame in enumerate(tp):
+        for j, frame in enumerate(tp):  # noqa: B007 (j is the answer)
             i = index.get(frame)
             if i is not None:
-                j = k
-                break
-        if i is None or j is None:
-            return None
-        compose = tfm.compose
-        sides = []
-        for path, n in ((sp, i), (tp, j)):
-            acc = None
-            for k in range(n):
-                e = path[k].at(t, None)
-                if e is None or e[0] is not path[k + 1]:
-                    return None
-                acc = e[1] if acc is None else compose(e[1], acc)
-            sides.append(acc or tfm.IDENTITY)
-        return tfm.inverse_compose(sides[1], sides[0])
+                return i, j
+        return None
 
     def _walk_transform(self, target: Frame, source: Frame, t: int) -> tuple:
         """tf2's ``walkToTopParent`` with ``TransformAccum``; raises tf2's error for this lookup."""
@@ -1139,6 +1208,89 @@ class BufferCore:
                     out.append(f'}}->"{f.name}";\n')
             out.append("}")
             return "".join(out)
+
+
+def _nlerp(
+    ax: float, ay: float, az: float, aw: float, dx: float, dy: float, dz: float, dw: float, r: float
+) -> tuple[float, float, float, float]:
+    """``A + r (B - A)`` normalized: slerp where A and B are too close for its sine (see Frame._segment)."""
+    qx = ax + r * dx
+    qy = ay + r * dy
+    qz = az + r * dz
+    qw = aw + r * dw
+    k = 1.0 / sqrt(qx * qx + qy * qy + qz * qz + qw * qw)
+    return qx * k, qy * k, qz * k, qw * k
+
+
+def _chain_at(path: list[Frame], n: int, t: int) -> tuple | None:
+    """The transform from ``path[0]`` into ``path[n]`` at time ``t``, ``path`` being a frame and its newest
+    parents: each link interpolated from its segment record and composed in place (one lookup's hot
+    loop, kept in one function: calls cost more than the arithmetic). None when a link has no data for
+    ``t`` or another parent then; the exact walk decides those cases."""
+    x = y = z = qx = qy = qz = 0.0
+    qw = 1.0
+    first = True
+    for k in range(n):
+        f = path[k]
+        up = path[k + 1]
+        if f.static:
+            p, e = f.data[-1]
+            if p is not up:
+                return None
+            ex, ey, ez, px, py, pz, pw = e
+        else:
+            stamps = f.stamps
+            i = bisect_right(stamps, t)
+            if i == len(stamps):  # at the newest stamp exactly, or past it (extrapolation)
+                if not i or stamps[-1] != t:
+                    return None
+                e = f.data[-1]
+                if len(e) == 3:
+                    e = f._resolve(-1)
+                if e[0] is not up:
+                    return None
+                ex, ey, ez, px, py, pz, pw = e[1]
+            elif i:
+                p, t0, inv, ex, ey, ez, dx, dy, dz, px, py, pz, pw, cx, cy, cz, cw, th = f.segs[
+                    i
+                ] or f._segment(i)
+                if p is not up:
+                    return None
+                r = (t - t0) * inv
+                if r:
+                    ex += r * dx
+                    ey += r * dy
+                    ez += r * dz
+                    if th:
+                        a = r * th
+                        co = cos(a)
+                        si = sin(a)
+                        px = px * co + cx * si
+                        py = py * co + cy * si
+                        pz = pz * co + cz * si
+                        pw = pw * co + cw * si
+                    else:
+                        px, py, pz, pw = _nlerp(px, py, pz, pw, cx, cy, cz, cw, r)
+            else:
+                return None
+        if first:
+            x, y, z, qx, qy, qz, qw = ex, ey, ez, px, py, pz, pw
+            first = False
+        else:  # link * accumulated, as tfm.compose (plain assignments: no tuple per link)
+            ux = py * z - pz * y + pw * x
+            uy = pz * x - px * z + pw * y
+            uz = px * y - py * x + pw * z
+            x = ex + x + 2.0 * (py * uz - pz * uy)
+            y = ey + y + 2.0 * (pz * ux - px * uz)
+            z = ez + z + 2.0 * (px * uy - py * ux)
+            nx = pw * qx + px * qw + py * qz - pz * qy
+            ny = pw * qy - px * qz + py * qw + pz * qx
+            nz = pw * qz + px * qy - py * qx + pz * qw
+            qw = pw * qw - px * qx - py * qy - pz * qz
+            qx = nx
+            qy = ny
+            qz = nz
+    return x, y, z, qx, qy, qz, qw
 
 
 def _min_stamp(frames: Iterable[Frame]) -> int:

@@ -54,6 +54,7 @@ class RvizConfig:
 
     fixed_frame: str = "map"
     background: str = "48; 48; 48"
+    frame_rate: float = 30.0
     displays: list[dict[str, Any]] = field(default_factory=list)
     unsupported: list[dict[str, Any]] = field(default_factory=list)
     tools: dict[str, str] = field(default_factory=lambda: dict(DEFAULT_TOOLS))
@@ -66,6 +67,7 @@ class RvizConfig:
         return {
             "fixedFrame": self.fixed_frame,
             "background": self.background,
+            "frameRate": self.frame_rate,
             "displays": self.displays,
             "unsupported": self.unsupported,
             "tools": self.tools,
@@ -135,6 +137,8 @@ def parse(text: str, source: str = "<rviz config>") -> RvizConfig:
     if isinstance(options, dict):
         config.fixed_frame = str(options.get("Fixed Frame", config.fixed_frame))
         config.background = str(options.get("Background Color", config.background))
+        if isinstance(options.get("Frame Rate"), int | float) and options["Frame Rate"] > 0:
+            config.frame_rate = float(options["Frame Rate"])
     current = (manager.get("Views") or {}).get("Current") if isinstance(manager.get("Views"), dict) else None
     if isinstance(current, dict):
         top = current.get("Class") == "rviz/TopDownOrtho"

@@ -80,28 +80,35 @@ class WebSocket:
     async def drain(self) -> None:
         await self.writer.drain()
 
-    def send(self, data: str | bytes | bytearray | memoryview) -> None:
-        """Queue one message (str -> text frame, bytes -> binary frame); never blocks."""
+    def send(self, data: str | bytes | bytearray | memoryview, flush: bool = True) -> None:
+        """Queue one message (str -> text frame, bytes -> binary frame); never blocks. With
+        ``flush=False`` the frame waits for :meth:`flush`, so a burst leaves in one write."""
         if self.closed:
             return
         if isinstance(data, str):
             self.protocol.send_text(data.encode("utf-8"))
         else:
             self.protocol.send_binary(data)
-        self._flush()
+        if flush:
+            self.flush()
 
     def close(self, code: int = 1000, reason: str = "") -> None:
         if self.protocol.state.name == "OPEN":
             self.protocol.send_close(code, reason)
-            self._flush()
+            self.flush()
 
-    def _flush(self) -> None:
-        for chunk in self.protocol.data_to_send():
-            if chunk:
-                self.writer.write(chunk)
-            elif self.writer.can_write_eof():
-                with contextlib.suppress(OSError, RuntimeError):
-                    self.writer.write_eof()
+    def flush(self) -> None:
+        """Hand every frame queued so far to the transport (one write for all of them)."""
+        chunks = self.protocol.data_to_send()
+        if not chunks:
+            return
+        eof = not chunks[-1]
+        data = [c for c in chunks if c]
+        if data:
+            self.writer.writelines(data)
+        if eof and self.writer.can_write_eof():
+            with contextlib.suppress(OSError, RuntimeError):
+                self.writer.write_eof()
 
     async def messages(self) -> AsyncIterator[str | bytes]:
         """Each complete message the client sends (text as str, binary as bytes), until it closes."""
@@ -137,7 +144,7 @@ class WebSocket:
                     payload = b"".join(parts)
                     parts = []
                     yield payload.decode("utf-8") if text else payload
-            self._flush()
+            self.flush()
             if not data or protocol.close_expected() or protocol.state.name == "CLOSED":
                 return
 
