@@ -73,10 +73,14 @@ class RvizPage:
         return Response(body)
 
     def _save(self, request: Request) -> Response:
+        # JSON only: a cross-site form or text/plain POST cannot write the file (it needs a CORS
+        # preflight, which this server does not grant); and only the file rviz was started with
+        if not request.headers.get("content-type", "").startswith("application/json"):
+            raise HttpError(415, "POST /api/rviz/config takes application/json")
         page = request.json()
         if not isinstance(page, dict) or not isinstance(page.get("displays"), list):
             raise HttpError(400, "expected {fixedFrame, displays: [...]}")
-        target = Path(str(page["path"])).expanduser() if page.get("path") else self.path
+        target = self.path
         with self._lock:
             text = rvizconfig.dump(page, self.config)
             try:
