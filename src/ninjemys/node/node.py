@@ -225,8 +225,8 @@ class Node:
         tcp_nodelay: bool = True,
         headers: Mapping[str, str] | None = None,
     ) -> Publisher:
-        """Advertise ``topic``. ``tcp_nodelay`` is what our subscribers ask for; a publisher honours
-        each subscriber's own request, so the flag is accepted for API symmetry."""
+        """Advertise ``topic``. ``tcp_nodelay`` is accepted for API symmetry: a publisher sets
+        TCP_NODELAY on every subscriber's socket (it batches bursts itself; docs/node.md)."""
         self._check_alive()
         resolved = self.resolve_name(topic)
         with self._lock:

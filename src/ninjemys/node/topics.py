@@ -193,17 +193,25 @@ class PubConnection:
             self._tried = now
         queue.append(data)
         self._queued_bytes += len(data)
-        if queue_size and len(queue) > queue_size:
-            self._queued_bytes -= len(queue.popleft())
-            self.dropped += 1
         self._since_try += 1
-        if self._since_try >= _FLUSH_FRAMES or now - self._tried > _MAX_HOLD:
+        limit = queue_size or 0  # None and 0: unbounded
+        over = 0 < limit < len(queue)
+        # queue_size bounds only what waits because the kernel refused it (the subscriber lags), as
+        # in ROS 1: a burst queued merely to batch its writes goes to the kernel before anything is
+        # dropped. A refusal leaves a partial frame; until then, a queue past its bound is written now.
+        if (
+            (over and self._partial is None)
+            or self._since_try >= _FLUSH_FRAMES
+            or now - self._tried > _MAX_HOLD
+        ):
             self._since_try = 0
             self._tried = now
             # what the kernel refuses stays queued: this thread tries again a batch later, and the
             # loop's check takes over once the burst ends (handing it to the loop now would have two
             # threads contend for the GIL and this lock for the rest of the burst)
             self._write_locked()
+        if over and len(queue) > limit:
+            self._trim(limit)
         if (queue or self._partial is not None) and not self._checking and not self._armed:
             self._checking = True
             self._seen = self._published
@@ -304,7 +312,10 @@ class PubConnection:
                     if not self._queue:
                         return True
                     batch = self._take_batch()
-                    n = self.sock.send(batch)
+                    try:
+                        n = self.sock.send(batch)
+                    except (BlockingIOError, InterruptedError):
+                        n = 0  # the batch is off the queue already: keep it as the partial frame(s)
                     self.bytes_sent += n
                     if n < len(batch):
                         self._partial = [memoryview(batch)[n:]]
@@ -320,6 +331,14 @@ class PubConnection:
         except OSError as exc:
             self._fail(f"write failed: {exc}")
             return False
+
+    def _trim(self, queue_size: int) -> None:
+        """Drop the oldest queued frames beyond ``queue_size`` (lock held); a frame the kernel has
+        begun to take (``_partial``) is never dropped, or the stream would lose its framing."""
+        queue = self._queue
+        while len(queue) > queue_size:
+            self._queued_bytes -= len(queue.popleft())
+            self.dropped += 1
 
     def _take_batch(self) -> bytes:
         queue = self._queue
@@ -406,8 +425,11 @@ class Publication:
             await transport.send_error_header(sock, error)
             transport.close_quietly(sock)
             return
-        nodelay = header.get("tcp_nodelay", "0") == "1"
-        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1 if nodelay else 0)
+        # TCP_NODELAY on every subscriber's socket, whatever its header asks (rospy subscribers ask
+        # for "0" by default): this publisher joins a burst's frames into one send itself, so Nagle
+        # would only hold back a small message behind the peer's delayed ACK (up to 40 ms); the
+        # option is ours and leaves the bytes on the wire unchanged
+        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         conn = PubConnection(self.node, sock, self.topic, who)
         with self.lock:
             reply = headers.encode_header(self.reply_header({}))
