@@ -229,6 +229,8 @@ def test_bad_input_gets_status_errors_and_the_server_keeps_serving(
         assert recv_until(fox, lambda m: m["op"] == "status")["level"] == 2
         fox.send(json.dumps({"op": "subscribe", "subscriptions": "all"}))
         assert "subscribe" in recv_until(fox, lambda m: m["op"] == "status")["message"]
+        fox.send(json.dumps({"op": "unsubscribe"}))
+        assert "missing field 'subscriptionIds'" in recv_until(fox, lambda m: m["op"] == "status")["message"]
         fox.send(b"\x09garbage")
         assert "binary opcode" in recv_until(fox, lambda m: m["op"] == "status")["message"]
     with connect(url) as again:  # and new clients are served

@@ -124,6 +124,17 @@ def test_plot_follows_a_published_sine_and_names_a_non_numeric_field(graph: Grap
         > 100
     )
 
+    # the topic monitor: rate and last value of the same topic
+    page.click('#rqt-tabs button[data-tool="topic"]')
+    page.check('.topic-table tr[data-topic="/wave"] input[type=checkbox]')
+    wait_until(
+        lambda: float(page.inner_text('.topic-table tr[data-topic="/wave"] .hz') or 0) > 10,
+        what="/wave's rate",
+    )
+    assert '"frame_id": "sine"' in page.inner_text(".topic-value")
+    assert "B/s" in page.inner_text('.topic-table tr[data-topic="/wave"] .bw')
+    page.click('#rqt-tabs button[data-tool="plot"]')
+
     # a string field: one line in the page, and the other series keep coming
     page.fill(".plot-input", "/wave/header/frame_id")
     page.press(".plot-input", "Enter")
@@ -163,6 +174,12 @@ def test_console_lists_a_rospy_nodes_logwarn(graph: Graph, browser_page: Any) ->
         wait_until(lambda: page.locator(f"{row}:has-text('low battery')").count() == 0, what="warn hidden")
         assert page.locator(f"{row}:has-text('all fine')").count() > 0
         page.check('input[data-level="Warn"]')
+        # save: the shown messages as rqt_console's columns
+        with page.expect_download() as download:
+            page.click(".console-save")
+        saved = Path(download.value.path()).read_text()
+        assert saved.startswith("message;severity;node;stamp;topics;location\n")
+        assert '"low battery: 12%";"Warn";"/warner";' in saved
         # a bad regex is named in the page; a good one filters
         page.fill(".console-regex", "battery(")
         page.wait_for_selector("#pane-console .rq-msgs >> text=invalid regular expression", timeout=5000)
@@ -212,6 +229,12 @@ def test_bag_timeline_shows_topics_ticks_thumbnails_and_plays(
     # the message under the cursor, then a plot of a field over the bag
     page.click('.bag-row[data-topic="/odom_x"] .bag-name')
     page.wait_for_selector(".bag-message >> text=/odom_x @ 100.000000000", timeout=5000)
+    # scrub: a click half way along the timeline shows the last message before that time
+    canvas = page.locator('.bag-row[data-topic="/odom_x"] canvas')
+    box = canvas.bounding_box()
+    assert box is not None
+    canvas.click(position={"x": box["width"] / 2, "y": 10})
+    page.wait_for_selector(".bag-message >> text=/odom_x @ 104.500000000", timeout=5000)
     page.fill(".bag-plot-input", "/odom_x/data")
     page.click(".bag-plot-button")
     page.wait_for_selector('.bag-plot[data-points="20"]', timeout=5000)
@@ -264,6 +287,38 @@ def test_image_view_shows_the_published_pixels(graph: Graph, browser_page: Any) 
         "() => Array.from(document.getElementById('iv-canvas').getContext('2d').getImageData(0, 0, 2, 1).data)"
     )
     assert pixels == [0, 0, 0, 255, 255, 255, 255, 255]
+    # a CompressedImage (png): decoded by the browser
+    packed = graph.peer.publisher("/camera/png", M("sensor_msgs/CompressedImage"), queue_size=1, latch=True)
+    packed.publish(
+        M("sensor_msgs/CompressedImage")(
+            format="rgb8; png compressed bgr8", data=_png_rgb(4, 1, (10, 200, 30))
+        )
+    )
+    page.wait_for_selector('.iv-topic option[value="/camera/png"]', state="attached", timeout=10000)
+    page.select_option(".iv-topic", "/camera/png")
+    page.wait_for_function("document.getElementById('iv-canvas').width === 4", timeout=10000)
+    pixels = page.evaluate(
+        "() => Array.from(document.getElementById('iv-canvas').getContext('2d').getImageData(3, 0, 1, 1).data)"
+    )
+    assert pixels == [10, 200, 30, 255]
+
+
+def _png_rgb(width: int, height: int, rgb: tuple[int, int, int]) -> bytes:
+    """A PNG of one colour (8-bit RGB, no filter)."""
+    import struct
+    import zlib
+
+    def chunk(kind: bytes, body: bytes) -> bytes:
+        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
+
+    rows = b"".join(b"\0" + bytes(rgb) * width for _ in range(height))
+    header = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)
+    return (
+        b"\x89PNG\r\n\x1a\n"
+        + chunk(b"IHDR", header)
+        + chunk(b"IDAT", zlib.compress(rows))
+        + chunk(b"IEND", b"")
+    )
 
 
 CFG = """\
@@ -331,9 +386,12 @@ def test_axclient_drives_a_fibonacci_server(graph: Graph, browser_page: Any) -> 
     def execute(goal: Any) -> None:
         seq = [0, 1]
         for _ in range(1, goal.order):
+            if server.is_preempt_requested():
+                server.set_preempted()
+                return
             seq.append(seq[-1] + seq[-2])
             server.publish_feedback(M("actionlib_tutorials/FibonacciFeedback")(sequence=seq))
-            time.sleep(0.05)
+            time.sleep(0.05 if goal.order < 10 else 0.5)
         server.set_succeeded(M("actionlib_tutorials/FibonacciResult")(sequence=seq))
 
     server = SimpleActionServer(node, "fibonacci", action, execute_cb=execute, auto_start=False)
@@ -350,6 +408,12 @@ def test_axclient_drives_a_fibonacci_server(graph: Graph, browser_page: Any) -> 
             ".ax-result"
         )
         assert "8" in page.inner_text(".ax-feedback")
+        # a long goal, cancelled while it runs
+        page.fill(".ax-goal", '{"order": 40}')
+        page.click(".ax-send")
+        page.wait_for_selector('.ax-status[data-status="ACTIVE"]', timeout=15000)
+        page.click(".ax-cancel")
+        page.wait_for_selector('.ax-status[data-status="PREEMPTED"]', timeout=15000)
         # a goal that is not JSON: a message, the page keeps working
         page.fill(".ax-goal", "{order: 6")
         page.click(".ax-send")

@@ -121,3 +121,14 @@ def test_bag_session_index_and_messages(tmp_path: Path) -> None:
                 session.play(None, 0.0, False)
         finally:
             rqt.stop()
+
+
+def test_rqt_standalone_opens_the_plugins_tab() -> None:
+    with run_master() as uri:
+        line, _err, _bag = _run([ninjemys_bin("rqt"), "--no-browser", "-s", "rqt_console"], uri)
+    assert line.startswith("rqt: http://localhost:") and line.endswith("/rqt?tool=console")
+    done = subprocess.run(
+        [ninjemys_bin("rqt"), "--no-browser", "-s", "rqt_nope"], capture_output=True, text=True, timeout=30
+    )
+    assert done.returncode == 2
+    assert "invalid choice: 'rqt_nope'" in done.stderr

@@ -106,11 +106,8 @@ class FoxgloveSession:
         try:
             handler(msg)
         except (NinjemysError, KeyError, TypeError, ValueError) as exc:
-            self.status(
-                2,
-                f"{msg['op']}: {type(exc).__name__}: {exc}",
-                msg.get("id") if isinstance(msg.get("id"), str) else None,
-            )
+            what = f"missing field {exc}" if isinstance(exc, KeyError) else f"{type(exc).__name__}: {exc}"
+            self.status(2, f"{msg['op']}: {what}", msg.get("id") if isinstance(msg.get("id"), str) else None)
         except Exception as exc:
             log.exception("foxglove: op %s failed", msg["op"])
             self.status(2, f"{msg['op']}: {type(exc).__name__}: {exc}")

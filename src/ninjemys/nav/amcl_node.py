@@ -30,8 +30,8 @@ from ninjemys.nav.rosglue import (
     grid_from_msg,
     param,
     pose_msg_to_2d,
+    run_node,
     scan_arrays,
-    start_node,
     tf_item,
 )
 from ninjemys.nav.slam import compose, inverse
@@ -270,7 +270,4 @@ class AmclNode:
 
 
 def main(argv: list[str] | None = None) -> int:
-    node, _ = start_node("amcl", argv)
-    AmclNode(node)
-    rospy.spin()
-    return 0
+    return run_node("amcl", argv, AmclNode)

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import rospy
 from ninjemys.nav.mapio import MapError, load_map, save_map
-from ninjemys.nav.rosglue import grid_from_msg, grid_to_msg, param, start_node
+from ninjemys.nav.rosglue import grid_from_msg, grid_to_msg, param, run_node, start_node
 
 USAGE = "USAGE: map_server <map.yaml>\n  map.yaml: map description file"
 SAVER_USAGE = "Usage: \n  map_saver -h\n  map_saver [--occ <threshold_occupied>] [--free <threshold_free>] [-f <mapname>] [ROS remapping args]"
@@ -32,28 +32,29 @@ def main(argv: list[str] | None = None) -> int:
     from nav_msgs.msg import MapMetaData, OccupancyGrid
     from nav_msgs.srv import GetMap, GetMapResponse
 
-    node, _ = start_node("map_server", args)
-    frame_id = param(node, "frame_id", "map")
-    try:
-        grid = load_map(files[0])
-    except MapError as exc:
-        rospy.logerr("map_server: %s", exc)
-        rospy.spin()
-        return 1
-    msg = grid_to_msg(grid, frame_id, cls=OccupancyGrid)
-    rospy.loginfo("Read a %d X %d map @ %.3f m/cell", grid.width, grid.height, grid.resolution)
-    meta_pub = node.publisher("map_metadata", MapMetaData, latch=True, queue_size=1)
-    map_pub = node.publisher("map", OccupancyGrid, latch=True, queue_size=1)
-    meta_pub.publish(msg.info)
-    map_pub.publish(msg)
+    path = files[0]
 
-    def on_static_map(_req: object) -> object:
-        rospy.loginfo("Sending map")
-        return GetMapResponse(map=msg)
+    def serve(node: object) -> None:
+        frame_id = param(node, "frame_id", "map")
+        try:
+            grid = load_map(path)
+        except MapError as exc:
+            rospy.logerr("map_server: %s", exc)  # and keep running, with nothing to offer
+            return
+        msg = grid_to_msg(grid, frame_id, cls=OccupancyGrid)
+        rospy.loginfo("Read a %d X %d map @ %.3f m/cell", grid.width, grid.height, grid.resolution)
+        meta_pub = node.publisher("map_metadata", MapMetaData, latch=True, queue_size=1)  # type: ignore[attr-defined]
+        map_pub = node.publisher("map", OccupancyGrid, latch=True, queue_size=1)  # type: ignore[attr-defined]
+        meta_pub.publish(msg.info)
+        map_pub.publish(msg)
 
-    node.service("static_map", GetMap, on_static_map)
-    rospy.spin()
-    return 0
+        def on_static_map(_req: object) -> object:
+            rospy.loginfo("Sending map")
+            return GetMapResponse(map=msg)
+
+        node.service("static_map", GetMap, on_static_map)  # type: ignore[attr-defined]
+
+    return run_node("map_server", args, serve)
 
 
 def saver_main(argv: list[str] | None = None) -> int:

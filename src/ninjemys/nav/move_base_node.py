@@ -44,9 +44,9 @@ from ninjemys.nav.rosglue import (
     grid_from_msg,
     param,
     pose_msg_to_2d,
+    run_node,
     scan_arrays,
     sleep,
-    start_node,
 )
 from ninjemys.nav.slam import compose, inverse
 
@@ -709,7 +709,4 @@ class MoveBase:
 
 
 def main(argv: list[str] | None = None) -> int:
-    node, _ = start_node("move_base", argv)
-    MoveBase(node)
-    rospy.spin()
-    return 0
+    return run_node("move_base", argv, MoveBase)

@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 import rospy
+from ninjemys.errors import ShutdownError
 from ninjemys.nav.mapio import GridMap
 from ninjemys.tf2.core import BufferCore
 from ninjemys.tf2.errors import TransformException
@@ -28,6 +29,18 @@ def start_node(name: str, argv: list[str] | None) -> tuple[Any, list[str]]:
     rospy.init_node(name, argv=[sys.argv[0], *argv])
     rest = [a for a in argv if ":=" not in a]
     return rospy.core.process_node(), rest
+
+
+def run_node(name: str, argv: list[str] | None, build: Any) -> int:
+    """Start node ``name``, build its object with ``build(node)``, spin. A shutdown (Ctrl-C, ``rosnode
+    kill``, SIGTERM) while it is still being built ends it quietly, as a spinning node ends."""
+    node, _ = start_node(name, argv)
+    try:
+        build(node)
+    except (ShutdownError, rospy.ROSInterruptException):
+        return 0
+    rospy.spin()
+    return 0
 
 
 def now() -> float:

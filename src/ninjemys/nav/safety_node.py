@@ -30,7 +30,7 @@ import numpy as np
 
 import rospy
 from ninjemys.nav.costmap import footprint_radii, parse_footprint
-from ninjemys.nav.rosglue import Tf2D, param, scan_arrays, sleep, start_node
+from ninjemys.nav.rosglue import Tf2D, param, run_node, scan_arrays, sleep
 from ninjemys.nav.safety import MuxInput, TwistMux, blocked
 
 DEFAULT_TOPICS = [
@@ -271,7 +271,4 @@ class SafetyMonitor:
 
 
 def main(argv: list[str] | None = None) -> int:
-    node, _ = start_node("safety_monitor", argv)
-    SafetyMonitor(node)
-    rospy.spin()
-    return 0
+    return run_node("safety_monitor", argv, SafetyMonitor)

@@ -17,7 +17,7 @@ import numpy as np
 
 import rospy
 from ninjemys.nav.mapio import GridMap
-from ninjemys.nav.rosglue import Tf2D, grid_to_msg, param, scan_arrays, sleep, start_node, tf_item
+from ninjemys.nav.rosglue import Tf2D, grid_to_msg, param, run_node, scan_arrays, sleep, tf_item
 from ninjemys.nav.slam import ScanMatchMapper, SlamParams
 
 
@@ -113,7 +113,4 @@ class SlamNode:
 
 
 def main(argv: list[str] | None = None) -> int:
-    node, _ = start_node("slam_gmapping", argv)
-    SlamNode(node)
-    rospy.spin()
-    return 0
+    return run_node("slam_gmapping", argv, SlamNode)

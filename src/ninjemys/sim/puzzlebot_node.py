@@ -427,18 +427,19 @@ class SimNode:
         self._stepped += sim.dt
         now = sim.time
         stamp = self._stamp()
-        self.clock_pub.publish(Clock(clock=stamp))
+        if self.clock_pub.get_num_connections():  # nobody listening costs nothing (checked every step)
+            self.clock_pub.publish(Clock(clock=stamp))
         for r in touched:
             self.log.warn(
                 "robot [%s] hit '%s' at (%.3f, %.3f): stopped at contact", r.name, r.contact_with, r.x, r.y
             )
-        tfs = []
+        tfs: list[Any] | None = [] if self.tf_pub.get_num_connections() else None
         for io in self.io.values():
             r = io.robot
             self._publish_contact(io)
             pubs = io.pubs
             if io.odom_due.fire(now):
-                tfs.append(self._odometry(io, stamp))
+                self._odometry(io, stamp, tfs)
             if io.imu_due is not None and io.imu_due.fire(now) and pubs["imu"].get_num_connections():
                 self._imu(io, stamp)
             if io.scan_due is not None and io.scan_due.fire(now):
@@ -459,7 +460,9 @@ class SimNode:
         if self.view is not None:
             self.view.publish(now)
 
-    def _odometry(self, io: RobotIO, stamp: Time) -> Any:
+    def _odometry(self, io: RobotIO, stamp: Time, tfs: list[Any] | None) -> None:
+        """Advance the robot's odometry; publish odom, ground truth, wl/wr and joint_states to whoever
+        listens, and append odom -> base_link to ``tfs`` (None: nobody listens to /tf)."""
         r = io.robot
         pubs = io.pubs
         ox, oy, oyaw = self.sim.odometry(r)
@@ -538,6 +541,8 @@ class SimNode:
             js.position = [r.left_angle, r.right_angle]
             js.velocity = [r.wl, r.wr]
             pubs["joint_states"].publish(js)
+        if tfs is None:
+            return
         t = TransformStamped()
         t.header.stamp = stamp
         t.header.frame_id = io.frame("odom")
@@ -545,7 +550,7 @@ class SimNode:
         t.transform.translation.x, t.transform.translation.y = ox, oy
         q = t.transform.rotation
         q.x, q.y, q.z, q.w = quaternion(oyaw)
-        return t
+        tfs.append(t)
 
     def _imu(self, io: RobotIO, stamp: Time) -> None:
         r = io.robot

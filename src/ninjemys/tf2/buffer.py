@@ -73,29 +73,60 @@ class _Classes:
         cls.loaded = True
 
 
-def make_transform_stamped(target: str, source: str, stamp_ns: int, t: tuple) -> Any:
-    """A ``geometry_msgs/TransformStamped`` built slot by slot (a lookup's result; about 1 µs)."""
-    if not _Classes.loaded:
-        _Classes.load()
+def _builder() -> Callable[[str, str, int, tuple], Any]:
+    """The function that builds a lookup's ``geometry_msgs/TransformStamped`` slot by slot, with the
+    classes bound as locals (no constructor argument parsing, no global lookups: about 1 µs)."""
     c = _Classes
-    h = _new(c.Header)
-    h.seq = 0
-    stamp = _new(Time)
-    stamp.secs, stamp.nsecs = divmod(stamp_ns, _NS)
-    h.stamp = stamp
-    h.frame_id = target
-    v = _new(c.Vector3)
-    v.x, v.y, v.z = t[0], t[1], t[2]
-    q = _new(c.Quaternion)
-    q.x, q.y, q.z, q.w = t[3], t[4], t[5], t[6]
-    tr = _new(c.Transform)
-    tr.translation = v
-    tr.rotation = q
-    m = _new(c.TransformStamped)
-    m.header = h
-    m.child_frame_id = source
-    m.transform = tr
-    return m
+    if not c.loaded:
+        c.load()
+
+    def build(
+        target: str,
+        source: str,
+        stamp_ns: int,
+        t: tuple,
+        new: Callable[[type], Any] = _new,
+        stamped: type = c.TransformStamped,
+        header: type = c.Header,
+        time: type = Time,
+        transform: type = c.Transform,
+        vector3: type = c.Vector3,
+        quaternion: type = c.Quaternion,
+    ) -> Any:
+        h = new(header)
+        h.seq = 0
+        stamp = new(time)
+        stamp.secs, stamp.nsecs = divmod(stamp_ns, _NS)
+        h.stamp = stamp
+        h.frame_id = target
+        v = new(vector3)
+        v.x, v.y, v.z, qx, qy, qz, qw = t
+        q = new(quaternion)
+        q.x = qx
+        q.y = qy
+        q.z = qz
+        q.w = qw
+        tr = new(transform)
+        tr.translation = v
+        tr.rotation = q
+        m = new(stamped)
+        m.header = h
+        m.child_frame_id = source
+        m.transform = tr
+        return m
+
+    return build
+
+
+_build: Callable[[str, str, int, tuple], Any] | None = None
+
+
+def make_transform_stamped(target: str, source: str, stamp_ns: int, t: tuple) -> Any:
+    """A ``geometry_msgs/TransformStamped`` for a lookup's result (classes loaded on first use)."""
+    global _build
+    if _build is None:
+        _build = _builder()
+    return _build(target, source, stamp_ns, t)
 
 
 def transform_tuple(msg: Any) -> tuple[float, float, float, float, float, float, float]:
@@ -258,11 +289,14 @@ class Buffer(BufferCore):
     def lookup_transform(self, target_frame: str, source_frame: str, time: Any, timeout: Any = None) -> Any:
         """The transform from ``source_frame`` to ``target_frame`` at ``time`` (0 = latest common), waiting
         up to ``timeout`` for it to become available; raises tf2's exceptions."""
-        t = to_ns(time)
+        try:
+            t = time.secs * _NS + time.nsecs
+        except AttributeError:
+            t = to_ns(time)
         if timeout is not None and to_seconds(timeout) > 0.0:
             self._wait(lambda: self.can_transform_ns(target_frame, source_frame, t), timeout)
         stamp, tr = self.lookup(target_frame, source_frame, t)
-        return make_transform_stamped(target_frame, source_frame, stamp, tr)
+        return (_build or make_transform_stamped)(target_frame, source_frame, stamp, tr)
 
     def lookup_transform_full(
         self,

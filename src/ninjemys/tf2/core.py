@@ -17,6 +17,9 @@ Where we differ, on purpose:
   last time it was asked about, valid until the next insertion, so a lookup is usually one
   ``inverse(a) * b`` instead of a walk. When that path cannot answer (a frame above the common
   ancestor has no data for that time), the exact tf2 walk runs and gives tf2's answer or error.
+  A lookup at a time not asked about before composes each side only up to the lowest common
+  ancestor, in one loop, interpolating each link from a per-segment record made on first use
+  (slerp as ``A cos(rθ) + C sin(rθ)``, see :meth:`Frame._segment`).
 - ``can_transform`` with a timeout waits on a condition that insertions signal (no polling sleeps).
 - Raw TFMessages (``add_raw``, what the listener uses) are queued and decoded in batches on the next
   query, runs of one layout with numpy (:mod:`ninjemys.tf2.bulk`).
@@ -147,6 +150,9 @@ class Frame:
             e = data[-1]
             return e if len(e) == 2 else self._resolve(-1)
         stamps = self.stamps
+        if stamps[-1] == t:  # the newest entry (a latest-time lookup)
+            e = data[-1]
+            return e if len(e) == 2 else self._resolve(-1)
         n = len(stamps)
         i = bisect_left(stamps, t)
         if 0 < i < n:
@@ -789,10 +795,27 @@ class BufferCore:
             cur = parent
             if len(path) > MAX_GRAPH_DEPTH:
                 return None
-        compose = tfm.compose
-        for f, e in reversed(path):
-            if acc is not None:
-                acc = (acc[0], compose(acc[1], e[1]))
+        if acc is None:
+            for f, _ in path:
+                f.memo_gen, f.memo_t, f.memo_val = gen, t, None
+            return None
+        root, (x, y, z, qx, qy, qz, qw) = acc
+        for f, e in reversed(path):  # to_root(f) = to_root(parent) * link, as tfm.compose inline
+            bx, by, bz, bqx, bqy, bqz, bqw = e[1]
+            cx = qy * bz - qz * by + qw * bx
+            cy = qz * bx - qx * bz + qw * by
+            cz = qx * by - qy * bx + qw * bz
+            x = x + bx + 2.0 * (qy * cz - qz * cy)
+            y = y + by + 2.0 * (qz * cx - qx * cz)
+            z = z + bz + 2.0 * (qx * cy - qy * cx)
+            nx = qw * bqx + qx * bqw + qy * bqz - qz * bqy
+            ny = qw * bqy - qx * bqz + qy * bqw + qz * bqx
+            nz = qw * bqz + qx * bqy - qy * bqx + qz * bqw
+            qw = qw * bqw - qx * bqx - qy * bqy - qz * bqz
+            qx = nx
+            qy = ny
+            qz = nz
+            acc = (root, (x, y, z, qx, qy, qz, qw))
             f.memo_gen, f.memo_t, f.memo_val = gen, t, acc
         return acc
 
@@ -800,28 +823,48 @@ class BufferCore:
         """``(stamp_ns, 7 floats)``: the transform that maps data in ``source_frame`` into ``target_frame``
         at time ``t`` (0 = latest common). Raises tf2's exceptions with tf2's texts."""
         with self._lock:
-            self._drain()
-            if target_frame == source_frame:
-                if t == 0:
-                    f = self._frames.get(target_frame)
-                    t = f.latest if f is not None and f.has_cache else 0
-                return t, tfm.IDENTITY
-            target = self._validate("lookupTransform argument target_frame", target_frame)
-            source = self._validate("lookupTransform argument source_frame", source_frame)
+            if self._pending:
+                self._drain()
+            frames = self._frames
+            target = frames.get(target_frame)
+            source = frames.get(source_frame)
+            if target is None or source is None or target is source:
+                if target_frame == source_frame:
+                    if t == 0:
+                        t = target.latest if target is not None and target.has_cache else 0
+                    return t, tfm.IDENTITY
+                target = self._validate("lookupTransform argument target_frame", target_frame)
+                source = self._validate("lookupTransform argument source_frame", source_frame)
             return self._lookup(target, source, t)
 
     def _lookup(self, target: Frame, source: Frame, t: int) -> tuple[int, tuple]:
+        m = None
         if t == 0:
-            err: list[str] = []
-            code, t = self._common_time(target, source, err)
-            if code != NO_ERROR:
-                _raise(code, err)
+            m = self._meet(source, target)
+            if m is None:
+                err: list[str] = []
+                code, t = self._common_time(target, source, err)
+                if code != NO_ERROR:
+                    _raise(code, err)
+            else:  # tf2's latest common time, from the prefix minima of the newest stamps on each side
+                gen = self._gen
+                a = source.pmin[m[0]] if source.pmin_gen == gen else self._pmin(source)[m[0]]
+                b = target.pmin[m[1]] if target.pmin_gen == gen else self._pmin(target)[m[1]]
+                t = a if b == 0 or (a and a < b) else b
         gen = self._gen
         if (source.memo_gen == gen and source.memo_t == t) or t == self._last_t:
             # a time asked for before: each frame's transform to the top of its tree is (or becomes) memoized
-            a = self._to_root(source, t, gen)
+            a = (
+                source.memo_val
+                if source.memo_gen == gen and source.memo_t == t
+                else self._to_root(source, t, gen)
+            )
             if a is not None:
-                b = self._to_root(target, t, gen)
+                b = (
+                    target.memo_val
+                    if target.memo_gen == gen and target.memo_t == t
+                    else self._to_root(target, t, gen)
+                )
                 if b is not None and a[0] is b[0]:
                     return t, tfm.inverse_compose(b[1], a[1])
             # some link above the common ancestor has no data for t (a slow map->odom under a fast
@@ -829,7 +872,8 @@ class BufferCore:
         else:
             self._last_t = t
         # a one-off time: compose each side up to the lowest common ancestor, interpolating on the way
-        m = self._meet(source, target)
+        if m is None:
+            m = self._meet(source, target)
         if m is not None:
             a = _chain_at(source.path, m[0], t)
             if a is not None:
@@ -1221,12 +1265,10 @@ def _chain_at(path: list[Frame], n: int, t: int) -> tuple | None:
                         a = r * th
                         co = cos(a)
                         si = sin(a)
-                        px, py, pz, pw = (
-                            px * co + cx * si,
-                            py * co + cy * si,
-                            pz * co + cz * si,
-                            pw * co + cw * si,
-                        )
+                        px = px * co + cx * si
+                        py = py * co + cy * si
+                        pz = pz * co + cz * si
+                        pw = pw * co + cw * si
                     else:
                         px, py, pz, pw = _nlerp(px, py, pz, pw, cx, cy, cz, cw, r)
             else:
@@ -1234,19 +1276,20 @@ def _chain_at(path: list[Frame], n: int, t: int) -> tuple | None:
         if first:
             x, y, z, qx, qy, qz, qw = ex, ey, ez, px, py, pz, pw
             first = False
-        else:  # link * accumulated, as tfm.compose
+        else:  # link * accumulated, as tfm.compose (plain assignments: no tuple per link)
             ux = py * z - pz * y + pw * x
             uy = pz * x - px * z + pw * y
             uz = px * y - py * x + pw * z
-            x, y, z, qx, qy, qz, qw = (
-                ex + x + 2.0 * (py * uz - pz * uy),
-                ey + y + 2.0 * (pz * ux - px * uz),
-                ez + z + 2.0 * (px * uy - py * ux),
-                pw * qx + px * qw + py * qz - pz * qy,
-                pw * qy - px * qz + py * qw + pz * qx,
-                pw * qz + px * qy - py * qx + pz * qw,
-                pw * qw - px * qx - py * qy - pz * qz,
-            )
+            x = ex + x + 2.0 * (py * uz - pz * uy)
+            y = ey + y + 2.0 * (pz * ux - px * uz)
+            z = ez + z + 2.0 * (px * uy - py * ux)
+            nx = pw * qx + px * qw + py * qz - pz * qy
+            ny = pw * qy - px * qz + py * qw + pz * qx
+            nz = pw * qz + px * qy - py * qx + pz * qw
+            qw = pw * qw - px * qx - py * qy - pz * qz
+            qx = nx
+            qy = ny
+            qz = nz
     return x, y, z, qx, qy, qz, qw
 
 

@@ -377,7 +377,31 @@ def _simple(prog: str, tool: str | None, description: str) -> Callable[[list[str
     return main
 
 
-rqt_main = _simple("rqt", None, "Every rqt plugin as a tab of one page, in a browser.")
+#: rqt's plugin names (``rqt -s rqt_plot``) -> the page's tabs
+PLUGINS = {
+    "rqt_graph": "graph",
+    "rqt_plot": "plot",
+    "rqt_console": "console",
+    "rqt_logger_level": "logger_level",
+    "rqt_bag": "bag",
+    "rqt_image_view": "image_view",
+    "rqt_tf_tree": "tf_tree",
+    "rqt_reconfigure": "reconfigure",
+    "rqt_topic": "topic",
+    "rqt_publisher": "publisher",
+    "rqt_service_caller": "service_caller",
+}
+
+
+def rqt_main(argv: list[str] | None = None) -> int:
+    p = _common(argparse.ArgumentParser(prog="rqt", description="Every rqt plugin as a tab of one page."))
+    p.add_argument(
+        "-s", "--standalone", metavar="PLUGIN", choices=sorted(PLUGINS), help="open on this plugin's tab"
+    )
+    args = p.parse_args(_ros_args(argv))
+    return _serve("rqt", PLUGINS[args.standalone] if args.standalone else None, [], args)
+
+
 console_plugin_main = _simple("rqt_console", "console", "Messages of /rosout_agg, filtered, in a browser.")
 logger_level_main = _simple("rqt_logger_level", "logger_level", "Set the logger levels of running nodes.")
 tf_tree_main = _simple("rqt_tf_tree", "tf_tree", "The TF frame tree with rates and delays.")

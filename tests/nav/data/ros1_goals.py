@@ -14,7 +14,7 @@ from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
 
 rospy.init_node("ros1_goal_sender", anonymous=True)
 client = actionlib.SimpleActionClient("move_base", MoveBaseAction)
-if not client.wait_for_server(rospy.Duration(60)):
+if not client.wait_for_server(rospy.Duration(120)):
     print(json.dumps({"error": "no move_base action server"}), flush=True)
     sys.exit(1)
 for text in sys.argv[1:]:

@@ -226,6 +226,7 @@ class Display {
     this.statuses = new Map();
     this.sub = null;
     this.frame = null; // the frame the group's contents are in
+    this.stamp = null; // and their time: placed with tf at that stamp, as rviz does
     this.el = null;
     this.received = 0;
   }
@@ -277,8 +278,8 @@ class Display {
   onMessage() {}
 
   /** Place `obj` at frame `frame` in the fixed frame; false (and a status) when there is no transform. */
-  place(obj, frame, key = "Transform") {
-    const T = tf.lookup(fixedFrame, frame);
+  place(obj, frame, key = "Transform", stamp = this.stamp) {
+    const T = tf.lookup(fixedFrame, frame, stamp || 0);
     if (!T) {
       obj.visible = false;
       this.setStatus(key, "error", TfBuffer.missing(frame, fixedFrame));
@@ -372,6 +373,7 @@ class LaserScanDisplay extends Display {
     this.geometry.setAttribute("position", new THREE.BufferAttribute(pos.subarray(0, k), 3));
     this.geometry.computeBoundingSphere();
     this.frame = m.header.frame_id;
+    this.stamp = m.header.stamp;
     this.setStatus("Points", "ok", `${k / 3} points in [${stripSlash(this.frame)}]`);
   }
 }
@@ -443,6 +445,7 @@ class PointCloud2Display extends Display {
     this.pos.needsUpdate = true;
     this.geometry.setDrawRange(0, k / 3);
     this.frame = m.header.frame_id;
+    this.stamp = m.header.stamp;
     this.setStatus("Points", "ok", `${k / 3} points in [${stripSlash(this.frame)}]`);
   }
 }
@@ -508,6 +511,7 @@ class MapDisplay extends Display {
     origin.add(plane);
     this.group.add(origin);
     this.frame = m.header.frame_id;
+    this.stamp = m.header.stamp;
     this.setStatus("Map", "ok", `${width}×${height} at ${resolution.toFixed(3)} m/cell`);
   }
   paint(data, x0, y0, w, h) {
@@ -534,6 +538,7 @@ class PathDisplay extends Display {
     const line = new THREE.Line(new THREE.BufferGeometry().setFromPoints(pts), new THREE.LineBasicMaterial({ color: this.color, transparent: true, opacity: Number(this.option("Alpha", 1)) }));
     this.group.add(line);
     this.frame = m.header.frame_id;
+    this.stamp = m.header.stamp;
     this.setStatus("Path", "ok", `${m.poses.length} poses`);
   }
 }
@@ -545,6 +550,7 @@ class PoseDisplay extends Display {
     setPose(a, fromPose(m.pose));
     this.group.add(a);
     this.frame = m.header.frame_id;
+    this.stamp = m.header.stamp;
   }
 }
 
@@ -575,6 +581,7 @@ class PoseArrayDisplay extends Display {
     clearGroup(this.group);
     this.group.add(arrowSegments(m.poses, Number(this.option("Arrow Length", 0.3)), this.color));
     this.frame = m.header.frame_id;
+    this.stamp = m.header.stamp;
     this.setStatus("Poses", "ok", `${m.poses.length} poses`);
   }
 }
@@ -608,6 +615,7 @@ class PoseWithCovarianceDisplay extends Display {
     e.position.set(T.t[0], T.t[1], T.t[2] + 0.01);
     this.group.add(a, e);
     this.frame = m.header.frame_id;
+    this.stamp = m.header.stamp;
     const [r1, r2] = e.userData.radii;
     this.setStatus("Covariance", "ok", `95% ellipse ${(2 * r1).toFixed(2)} × ${(2 * r2).toFixed(2)} m`);
   }
@@ -617,7 +625,7 @@ class OdometryDisplay extends Display {
   constructor(cfg) { super(cfg); this.kept = []; this.last = null; }
   onMessage(m) {
     // rviz keeps arrows where the robot was, in the fixed frame at the time they arrived
-    const T = tf.lookup(fixedFrame, m.header.frame_id);
+    const T = tf.lookup(fixedFrame, m.header.frame_id, m.header.stamp);
     if (!T) { this.setStatus("Transform", "error", TfBuffer.missing(m.header.frame_id, fixedFrame)); return; }
     this.setStatus("Transform", null);
     const P = compose(T, fromPose(m.pose.pose));
@@ -647,6 +655,7 @@ class PolygonDisplay extends Display {
     const line = new THREE.LineLoop(new THREE.BufferGeometry().setFromPoints(pts), new THREE.LineBasicMaterial({ color: this.color }));
     this.group.add(line);
     this.frame = m.header.frame_id;
+    this.stamp = m.header.stamp;
   }
 }
 
@@ -747,7 +756,7 @@ class MarkerDisplay extends Display {
     holder.add(inner);
     this.group.add(holder);
     const life = m.lifetime.secs + m.lifetime.nsecs / 1e9;
-    this.markers.set(key, { holder, inner, text: m.type === 9 ? m.text : null, frame: m.header.frame_id, expires: life > 0 ? performance.now() + life * 1000 : null });
+    this.markers.set(key, { holder, inner, text: m.type === 9 ? m.text : null, frame: m.header.frame_id, stamp: m.frame_locked ? 0 : m.header.stamp, expires: life > 0 ? performance.now() + life * 1000 : null });
   }
   remove(key) {
     const e = this.markers.get(key);
@@ -764,7 +773,7 @@ class MarkerDisplay extends Display {
     const wp = new THREE.Vector3();
     for (const [key, e] of this.markers) {
       if (e.expires !== null && now > e.expires) { this.remove(key); continue; }
-      if (this.place(e.holder, e.frame, `Transform ${stripSlash(e.frame)}`) && e.text !== null) {
+      if (this.place(e.holder, e.frame, `Transform ${stripSlash(e.frame)}`, e.stamp) && e.text !== null) {
         e.inner.getWorldPosition(wp);
         label(`mk:${this.cfg.name}:${key}`, e.text, wp);
       }
@@ -887,6 +896,7 @@ class ImageDisplay extends Display {
   onMessage(m) {
     const { width: w, height: h, encoding, step, data } = m;
     if (!w || !h) throw new Error("empty image");
+    if (step * h > data.length) throw new Error(`image data holds ${data.length} bytes; ${h} rows of ${step} need ${step * h}`);
     if (this.canvas.width !== w || this.canvas.height !== h) { this.canvas.width = w; this.canvas.height = h; }
     const ctx = this.canvas.getContext("2d");
     const img = ctx.createImageData(w, h);
@@ -900,22 +910,32 @@ class ImageDisplay extends Display {
         if (v > depthMax && Number.isFinite(v)) depthMax = v;
       }
     }
-    for (let y = 0; y < h; y++) {
-      for (let x = 0; x < w; x++) {
-        const p = (y * w + x) * 4;
-        let r, g, b;
-        switch (enc) {
-          case "rgb8": { const i = y * step + x * 3; r = data[i]; g = data[i + 1]; b = data[i + 2]; break; }
-          case "bgr8": { const i = y * step + x * 3; b = data[i]; g = data[i + 1]; r = data[i + 2]; break; }
-          case "rgba8": { const i = y * step + x * 4; r = data[i]; g = data[i + 1]; b = data[i + 2]; break; }
-          case "bgra8": { const i = y * step + x * 4; b = data[i]; g = data[i + 1]; r = data[i + 2]; break; }
-          case "mono8": case "8uc1": { r = g = b = data[y * step + x]; break; }
-          case "16uc1": case "mono16": { const v = dv.getUint16(y * step + x * 2, !m.is_bigendian); r = g = b = depthMax ? Math.round((255 * v) / depthMax) : 0; break; }
-          case "32fc1": { const v = dv.getFloat32(y * step + x * 4, !m.is_bigendian); r = g = b = Number.isFinite(v) && depthMax ? Math.round((255 * v) / depthMax) : 0; break; }
-          default: throw new Error(`image encoding ${encoding} is not shown`);
-        }
-        o[p] = r; o[p + 1] = g; o[p + 2] = b; o[p + 3] = 255;
+    // one loop per encoding (no per-pixel dispatch): a 640x480 frame is a few milliseconds
+    const le = !m.is_bigendian;
+    const colour = { rgb8: [3, 0, 1, 2], bgr8: [3, 2, 1, 0], rgba8: [4, 0, 1, 2], bgra8: [4, 2, 1, 0] }[enc];
+    if (colour) {
+      const [n, ri, gi, bi] = colour;
+      for (let y = 0; y < h; y++) {
+        let i = y * step, p = y * w * 4;
+        for (let x = 0; x < w; x++, i += n, p += 4) { o[p] = data[i + ri]; o[p + 1] = data[i + gi]; o[p + 2] = data[i + bi]; o[p + 3] = 255; }
       }
+    } else if (enc === "mono8" || enc === "8uc1") {
+      for (let y = 0; y < h; y++) {
+        let i = y * step, p = y * w * 4;
+        for (let x = 0; x < w; x++, i++, p += 4) { const v = data[i]; o[p] = v; o[p + 1] = v; o[p + 2] = v; o[p + 3] = 255; }
+      }
+    } else if (enc === "16uc1" || enc === "mono16" || enc === "32fc1") {
+      const float = enc === "32fc1";
+      for (let y = 0; y < h; y++) {
+        for (let x = 0; x < w; x++) {
+          const v = float ? dv.getFloat32(y * step + x * 4, le) : dv.getUint16(y * step + x * 2, le);
+          const g = Number.isFinite(v) && depthMax ? Math.round((255 * v) / depthMax) : 0;
+          const p = (y * w + x) * 4;
+          o[p] = g; o[p + 1] = g; o[p + 2] = g; o[p + 3] = 255;
+        }
+      }
+    } else {
+      throw new Error(`image encoding ${encoding} is not shown`);
     }
     ctx.putImageData(img, 0, 0);
     this.setStatus("Image", "ok", `${w}×${h} ${encoding}`);

@@ -1,9 +1,12 @@
 // A tf buffer in the browser, fed by /tf and /tf_static (tf2_msgs/TFMessage) through the ROS client.
 //
-// It keeps the latest transform of every child frame (a page draws "now", so no history is kept: a
-// display looks up the current pose of its message's frame, see docs/rviz.md) and composes chains
-// through the tree's common root. Frame ids are stored without a leading "/" (tf2's convention, and
-// ROS 1 publishers still send "/base_link" now and then).
+// It keeps the last HISTORY_S seconds of every child frame's transforms and composes chains through
+// the tree's common root, at a given stamp (interpolated: lerp and slerp between the two nearest
+// transforms; clamped to the oldest/newest instead of failing, so a display never blinks while tf
+// catches up) or at the latest (stamp 0, tf2's Time(0)). Frame ids are stored without a leading "/"
+// (tf2's convention, and ROS 1 publishers still send "/base_link" now and then).
+
+const HISTORY_S = 10;
 
 /** Quaternion and vector helpers on plain arrays: q = [x, y, z, w], v = [x, y, z]. */
 export function qmul(a, b) {
@@ -27,6 +30,25 @@ export function qrotate(q, v) {
     iy * w + iw * -y + iz * -x - ix * -z,
     iz * w + iw * -z + ix * -y - iy * -x,
   ];
+}
+
+export function slerp(a, b, u) {
+  let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
+  const bb = dot < 0 ? b.map((v) => -v) : b;
+  dot = Math.abs(dot);
+  if (dot > 0.9995) {
+    const q = a.map((v, i) => v + u * (bb[i] - v));
+    const n = Math.hypot(...q);
+    return q.map((v) => v / n);
+  }
+  const th = Math.acos(dot);
+  const s0 = Math.sin((1 - u) * th) / Math.sin(th), s1 = Math.sin(u * th) / Math.sin(th);
+  return a.map((v, i) => s0 * v + s1 * bb[i]);
+}
+
+/** A ROS time {secs, nsecs} as seconds (0 for a missing or zero stamp: "the latest"). */
+export function toSec(stamp) {
+  return stamp ? stamp.secs + stamp.nsecs / 1e9 : 0;
 }
 
 /** A rigid transform {t, q}. */
@@ -62,7 +84,7 @@ export function stripSlash(frame) {
 
 export class TfBuffer {
   constructor() {
-    this.frames = new Map(); // child -> {parent, tf, stamp, isStatic, times: [receive ms]}
+    this.frames = new Map(); // child -> {parent, tf, stamp, isStatic, history: [[sec, tf]], times: [receive ms]}
     this.listeners = new Set();
   }
 
@@ -74,14 +96,21 @@ export class TfBuffer {
       const parent = stripSlash(ts.header.frame_id);
       if (!child || !parent || child === parent) continue;
       let entry = this.frames.get(child);
-      if (!entry) {
-        entry = { parent, tf: IDENTITY, stamp: null, isStatic, times: [] };
+      if (!entry || entry.parent !== parent) {
+        entry = { parent, tf: IDENTITY, stamp: null, isStatic, history: [], times: [] };
         this.frames.set(child, entry);
       }
-      entry.parent = parent;
       entry.tf = fromPose(ts.transform);
       entry.stamp = ts.header.stamp;
       entry.isStatic = isStatic;
+      const sec = toSec(ts.header.stamp);
+      const h = entry.history;
+      if (h.length && sec < h[h.length - 1][0] - HISTORY_S) h.length = 0; // time went back (sim reset)
+      let k = h.length;
+      while (k > 0 && h[k - 1][0] > sec) k--;
+      if (k > 0 && h[k - 1][0] === sec) h[k - 1] = [sec, entry.tf];
+      else h.splice(k, 0, [sec, entry.tf]);
+      while (h.length > 2 && h[h.length - 1][0] - h[0][0] > HISTORY_S) h.shift();
       entry.times.push(now);
       if (entry.times.length > 50) entry.times.shift();
     }
@@ -102,7 +131,21 @@ export class TfBuffer {
     return [...names].sort();
   }
 
-  _toRoot(frame) {
+  /** A frame's transform to its parent at `sec` (0: the latest). */
+  _at(e, sec) {
+    const h = e.history;
+    if (!sec || e.isStatic || h.length < 2) return e.tf;
+    if (sec >= h[h.length - 1][0]) return h[h.length - 1][1];
+    if (sec <= h[0][0]) return h[0][1];
+    let k = h.length - 1;
+    while (h[k - 1][0] > sec) k--;
+    const [s0, a] = h[k - 1];
+    const [s1, b] = h[k];
+    const u = (sec - s0) / (s1 - s0);
+    return { t: a.t.map((v, i) => v + u * (b.t[i] - v)), q: slerp(a.q, b.q, u) };
+  }
+
+  _toRoot(frame, sec) {
     let tf = IDENTITY;
     let cur = frame;
     const seen = new Set();
@@ -110,7 +153,7 @@ export class TfBuffer {
       if (seen.has(cur)) return null; // a loop in the tree: nothing sensible to compose
       seen.add(cur);
       const e = this.frames.get(cur);
-      tf = compose(e.tf, tf);
+      tf = compose(this._at(e, sec), tf);
       cur = e.parent;
     }
     return { root: cur, tf };
@@ -125,15 +168,16 @@ export class TfBuffer {
   }
 
   /**
-   * The pose of `source` in `target` (maps points in source to target), or null. `why(error)` gets
-   * rviz's wording when there is none.
+   * The pose of `source` in `target` (maps points in source to target) at `stamp` ({secs, nsecs}
+   * or seconds; omitted or zero: the latest), or null when they are not connected.
    */
-  lookup(target, source) {
+  lookup(target, source, stamp = 0) {
     target = stripSlash(target);
     source = stripSlash(source);
     if (target === source) return IDENTITY;
-    const a = this._toRoot(target);
-    const b = this._toRoot(source);
+    const sec = typeof stamp === "number" ? stamp : toSec(stamp);
+    const a = this._toRoot(target, sec);
+    const b = this._toRoot(source, sec);
     if (!a || !b || a.root !== b.root) return null;
     return compose(invert(a.tf), b.tf);
   }

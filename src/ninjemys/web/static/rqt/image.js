@@ -41,15 +41,20 @@ export function imageToImageData(msg) {
     return new ImageData(rgba, w, h);
   }
   const bgr = enc.startsWith("bgr") || enc === "8uc3" || enc === "8uc4"; // OpenCV's order for untyped 8UC3
+  // one 32-bit store per pixel (ImageData is RGBA in memory: ABGR as a little-endian word)
+  const out = new Uint32Array(rgba.buffer);
+  const r0 = bgr ? 2 : 0;
+  const b0 = bgr ? 0 : 2;
   for (let y = 0; y < h; y++) {
     let src = y * step;
-    let dst = y * w * 4;
-    for (let x = 0; x < w; x++, src += bpp, dst += 4) {
-      if (channels === 1) { rgba[dst] = rgba[dst + 1] = rgba[dst + 2] = data[src]; rgba[dst + 3] = 255; continue; }
-      rgba[dst] = data[bgr ? src + 2 : src];
-      rgba[dst + 1] = data[src + 1];
-      rgba[dst + 2] = data[bgr ? src : src + 2];
-      rgba[dst + 3] = channels === 4 ? data[src + 3] : 255;
+    let dst = y * w;
+    const end = dst + w;
+    if (channels === 1) {
+      for (; dst < end; dst++, src++) { const g = data[src]; out[dst] = 0xff000000 | (g << 16) | (g << 8) | g; }
+    } else if (channels === 3) {
+      for (; dst < end; dst++, src += 3) out[dst] = 0xff000000 | (data[src + b0] << 16) | (data[src + 1] << 8) | data[src + r0];
+    } else {
+      for (; dst < end; dst++, src += 4) out[dst] = ((data[src + 3] << 24) | (data[src + b0] << 16) | (data[src + 1] << 8) | data[src + r0]) >>> 0;
     }
   }
   return new ImageData(rgba, w, h);
