@@ -90,39 +90,44 @@ class _Poller:
     per wait, which is on every message's path), else the portable ``selectors`` default."""
 
     def __init__(self) -> None:
-        self._objs: dict[int, object] = {}
+        self._objs: dict[int, SubConnection | None] = {}
         self._epoll = select.epoll() if hasattr(select, "epoll") else None
         self._selector = None if self._epoll is not None else selectors.DefaultSelector()
 
-    def register(self, fd: int, obj: object) -> None:
+    def register(self, fd: int, obj: SubConnection | None) -> None:
+        """Watch ``fd``; :meth:`wait` reports it as ``obj`` (None is the worker's wake-up socket)."""
         self._objs[fd] = obj
         if self._epoll is not None:
             self._epoll.register(fd, select.EPOLLIN)
         else:
+            assert self._selector is not None
             self._selector.register(fd, selectors.EVENT_READ, obj)
 
     def unregister(self, fd: int) -> None:
-        if self._objs.pop(fd, None) is None:
+        if fd not in self._objs:
             return
+        del self._objs[fd]
         try:
             if self._epoll is not None:
                 self._epoll.unregister(fd)
             else:
+                assert self._selector is not None
                 self._selector.unregister(fd)
         except (KeyError, ValueError, OSError):
             pass
 
-    def wait(self) -> list[object]:
+    def wait(self) -> list[SubConnection | None]:
         if self._epoll is not None:
             objs = self._objs
             return [objs[fd] for fd, _ in self._epoll.poll() if fd in objs]
+        assert self._selector is not None
         return [key.data for key, _ in self._selector.select()]
 
     def close(self) -> None:
         if self._epoll is not None:
             self._epoll.close()
-        else:
-            self._poller.close()
+        elif self._selector is not None:
+            self._selector.close()
 
 
 class SubConnection:
