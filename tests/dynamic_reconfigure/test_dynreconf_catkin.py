@@ -57,6 +57,25 @@ def test_cfg_generates_importable_config(ws: Path) -> None:
     assert not generated.exists()
 
 
+def test_install_space_carries_the_config_modules(ws: Path) -> None:
+    """As generate_dynamic_reconfigure_options installs them: <pkg>/cfg/ in dist-packages, importable
+    from install/setup.bash once the sources and devel/ are gone."""
+    assert catkin_make.main(["install"]) == 0
+    dist = ws / "install" / "lib" / "python3" / "dist-packages" / "dyn_demo"
+    # Debian's catkin_make install writes these (plus .pyc, the C++ header and pkg-config file)
+    written = {str(p.relative_to(dist)) for p in dist.rglob("*") if p.is_file()}
+    assert written == {"__init__.py", "cfg/__init__.py", "cfg/TutorialsConfig.py"}
+    assert (dist / "__init__.py").read_text() == ""
+    for gone in ("src", "devel", "build"):
+        (ws / gone).rename(ws.parent / f"{gone}.moved")
+    script = (
+        f"source {ws / 'install' / 'setup.bash'} && {sys.executable} -c "
+        "'from dyn_demo.cfg import TutorialsConfig as T; print(T.defaults[\"int_param\"], T.__file__)'"
+    )
+    out = subprocess.run(["bash", "-c", script], capture_output=True, text=True, timeout=60)
+    assert out.stdout.split() == ["50", str(dist / "cfg" / "TutorialsConfig.py")], out.stderr
+
+
 def test_cfg_error_fails_build_with_file_line(ws: Path) -> None:
     cfg = ws / "src" / "dyn_demo" / "cfg" / "Tutorials.cfg"
     cfg.write_text(

@@ -10,6 +10,9 @@ this writes, from the same CMakeLists.txt:
   add_message_files & co install);
 * ``lib/python3/dist-packages/<module>/``: the catkin_python_setup() packages, copied, with the
   message and service modules of the package;
+* ``lib/python3/dist-packages/<pkg>/cfg/``: the dynamic_reconfigure Config modules of the
+  package's ``cfg/*.cfg`` (what generate_dynamic_reconfigure_options installs), with an empty
+  ``<pkg>/__init__.py`` when catkin_python_setup() installs none;
 * ``lib/<pkg>/<script>``: catkin_install_python(PROGRAMS ...) scripts, executable;
 * whatever ``install(FILES|PROGRAMS|DIRECTORY ... DESTINATION ...)`` names, e.g. the tutorials'
   ``install(DIRECTORY launch DESTINATION ${CATKIN_PACKAGE_SHARE_DESTINATION})``. As with catkin, a
@@ -30,6 +33,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ninjemys.errors import PackageError
+from ninjemys.packages import cfg_gen
 from ninjemys.packages.builder import STUB
 from ninjemys.packages.cmake_hints import read_cmake_hints
 from ninjemys.packages.manifest import MANIFEST, PackageManifest
@@ -214,6 +218,9 @@ def install_workspace(
     dist = prefix / "lib" / "python3" / "dist-packages"
     for pkg in ws.ordered():
         _install_messages(pkg, dist, out)
+        # regenerated rather than copied from devel/, whose <pkg>/__init__.py relays to the sources
+        if cfg_gen.generate(pkg, dist, out) and not (dist / pkg.name / "__init__.py").exists():
+            out.write(dist / pkg.name / "__init__.py", "")
     space = WorkspaceEnv(source=prefix / "share", devel=prefix)
     # a shell that sourced this install space before lists it too: it is no underlay of itself
     underlays = [u for u in underlay_workspaces(ws.devel, env) if u.devel.resolve() != prefix.resolve()]
