@@ -75,6 +75,9 @@ class GatewayOptions:
     protocols: tuple[str, ...] = ("rosbridge", "foxglove")
     #: publish the number of connected clients on ``client_count`` (latched), as rosbridge_websocket does
     client_count: bool = False
+    #: a service call not answered within this many seconds gets a failed reply (rosbridge's
+    #: ``default_call_service_timeout``; a rosbridge call's own ``timeout`` field overrides it)
+    call_service_timeout: float = 5.0
 
     def secret(self) -> str | None:
         if not self.authenticate:
