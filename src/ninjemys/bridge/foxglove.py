@@ -180,8 +180,14 @@ class FoxgloveSession:
         pack = _MESSAGE_HEAD.pack
         depth = self.gateway.options.queue_length
 
+        key = ("foxglove", sub_id)
+
+        def frame(d: Delivery) -> bytes:
+            return pack(0x01, sub_id, d.stamp_ns) + bytes(d.data)
+
         def deliver(d: Delivery) -> None:
-            put(lane, pack(0x01, sub_id, d.stamp_ns) + bytes(d.data), depth)
+            # clients with the same subscription id (Foxglove numbers from 1) share one frame per message
+            put(lane, d.encoded(key, frame), depth)
 
         return deliver
 
