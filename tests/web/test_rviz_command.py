@@ -117,3 +117,35 @@ def test_rviz_d_opens_the_navigation_displays(how: str, tmp_path: Path, browser_
         finally:
             proc.send_signal(signal.SIGINT)
             assert proc.wait(20) == 0
+
+
+def test_saving_takes_json_only_and_writes_the_started_file(tmp_path: Path) -> None:
+    import json
+    import urllib.error
+    import urllib.request
+
+    from ninjemys.web.rviz import Rviz
+
+    config = tmp_path / "mine.rviz"
+    config.write_text("Visualization Manager:\n  Displays: []\n")
+    with MasterThread() as uri:
+        rviz = Rviz(uri, str(config), update_period=0.2)
+        try:
+            base = rviz.start().removesuffix("rviz")
+            body = json.dumps(
+                {"fixedFrame": "odom", "displays": [], "path": str(tmp_path / "other.rviz")}
+            ).encode()
+            plain = urllib.request.Request(base + "api/rviz/config", body, {"Content-Type": "text/plain"})
+            with pytest.raises(urllib.error.HTTPError) as err:
+                urllib.request.urlopen(plain, timeout=10)
+            assert err.value.code == 415
+            ok = urllib.request.Request(base + "api/rviz/config", body, {"Content-Type": "application/json"})
+            with urllib.request.urlopen(ok, timeout=10) as resp:
+                assert json.load(resp)["path"] == str(config)
+            assert not (tmp_path / "other.rviz").exists()
+            assert (
+                yaml.safe_load(config.read_text())["Visualization Manager"]["Global Options"]["Fixed Frame"]
+                == "odom"
+            )
+        finally:
+            rviz.stop()

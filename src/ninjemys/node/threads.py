@@ -162,7 +162,7 @@ RESOURCES: tuple[Resource, ...] = (
     Resource("lock", "ninjemys.node.topics:PubConnection._lock", USER + " (publishing)",
              "the loop takes it to drain or close; serializes writes to the stream"),
     Resource("queue", "ninjemys.node.topics:PubConnection._queue", USER + " (publishing)",
-             "frames the kernel refused, bounded by queue_size; drained by the loop, under _lock"),
+             "frames of a burst and frames the kernel refused; only the refused are bounded by queue_size; drained by the loop, under _lock"),
     Resource("lock", "ninjemys.node.topics:Publication.lock", USER + " (publishing)",
              "the loop takes it to add a subscriber, so a latched frame is sent either latched or live"),
     Resource("queue", "ninjemys.node.subscriber:Subscriber._queue", "sub:<topic>",

@@ -444,6 +444,8 @@ class BufferCore:
         keep = self.cache_time_ns
         slack = keep + self._prune_slack
         blocks = list(values.transpose(1, 0, 2))  # one (k, 7) view per transform
+        rows = range(k)
+        nones = [None] * k
         count = 0
         for j, (parent_name, child_name) in enumerate(zip(layout.parents, layout.children, strict=True)):
             col = columns[j]
@@ -468,8 +470,8 @@ class BufferCore:
             child.authority = who
             st = child.stamps
             st.extend(col)
-            child.data.extend(zip(repeat(parent, k), repeat(blocks[j], k), range(k), strict=False))
-            child.segs.extend(repeat(None, k))
+            child.data.extend(zip(repeat(parent, k), repeat(blocks[j], k), rows, strict=False))
+            child.segs.extend(nones)
             latest = col[-1]
             child.latest = latest
             if st[0] < latest - slack:

@@ -13,6 +13,7 @@ import os
 import signal
 import sys
 import threading
+import time
 from pathlib import Path
 from typing import Any
 
@@ -72,10 +73,14 @@ class RvizPage:
         return Response(body)
 
     def _save(self, request: Request) -> Response:
+        # JSON only: a cross-site form or text/plain POST cannot write the file (it needs a CORS
+        # preflight, which this server does not grant); and only the file rviz was started with
+        if not request.headers.get("content-type", "").startswith("application/json"):
+            raise HttpError(415, "POST /api/rviz/config takes application/json")
         page = request.json()
         if not isinstance(page, dict) or not isinstance(page.get("displays"), list):
             raise HttpError(400, "expected {fixedFrame, displays: [...]}")
-        target = Path(str(page["path"])).expanduser() if page.get("path") else self.path
+        target = self.path
         with self._lock:
             text = rvizconfig.dump(page, self.config)
             try:
@@ -134,10 +139,34 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
+def _wait_for_master(uri: str) -> None:
+    """Block until the master answers, saying so once (rviz waits for roscore rather than failing)."""
+    from ninjemys.errors import MasterError
+    from ninjemys.master.client import MasterClient
+
+    client = MasterClient(uri, "/rviz", timeout=2.0)
+    told = False
+    try:
+        while True:
+            try:
+                client.get_pid()
+                return
+            except MasterError:
+                if not told:
+                    print(
+                        f"rviz: waiting for the master at {uri} (start roscore)", file=sys.stderr, flush=True
+                    )
+                    told = True
+                time.sleep(0.5)
+    finally:
+        client.close()
+
+
 def main(argv: list[str] | None = None) -> int:
     # ROS passes remappings (name:=value) and __name/__log args; they do not apply to the page
     args = _parser().parse_args([a for a in (argv if argv is not None else sys.argv[1:]) if ":=" not in a])
     master_uri = os.environ.get("ROS_MASTER_URI", DEFAULT_MASTER)
+    _wait_for_master(master_uri)
     try:
         rviz = Rviz(master_uri, args.display_config, args.fixed_frame, args.host, args.port)
     except NinjemysError as exc:
