@@ -133,7 +133,7 @@ class FoxgloveSession:
             _, service_id, call_id, enc_len = _SERVICE_HEAD.unpack_from(data)
             encoding = data[_SERVICE_HEAD.size : _SERVICE_HEAD.size + enc_len].decode("utf-8", "replace")
             payload = data[_SERVICE_HEAD.size + enc_len :]
-            self.gateway.pool.submit(self._call_service, service_id, call_id, encoding, payload)
+            self._dispatch_call(service_id, call_id, encoding, payload)
         else:
             self.status(2, f"unknown or truncated binary opcode 0x{opcode:02x}")
 
@@ -180,8 +180,14 @@ class FoxgloveSession:
         pack = _MESSAGE_HEAD.pack
         depth = self.gateway.options.queue_length
 
+        key = ("foxglove", sub_id)
+
+        def frame(d: Delivery) -> bytes:
+            return pack(0x01, sub_id, d.stamp_ns) + bytes(d.data)
+
         def deliver(d: Delivery) -> None:
-            put(lane, pack(0x01, sub_id, d.stamp_ns) + bytes(d.data), depth)
+            # clients with the same subscription id (Foxglove numbers from 1) share one frame per message
+            put(lane, d.encoded(key, frame), depth)
 
         return deliver
 
@@ -272,7 +278,9 @@ class FoxgloveSession:
     def op_unsubscribeConnectionGraph(self, msg: dict[str, Any]) -> None:  # noqa: N802
         self.graph_subscribed = False
 
-    def _call_service(self, service_id: int, call_id: int, encoding: str, payload: bytes) -> None:
+    def _dispatch_call(self, service_id: int, call_id: int, encoding: str, payload: bytes) -> None:
+        """Run a call on its service's lane; every way it can end answers the client at once (a
+        response, or ``serviceCallFailure`` with the reason), and a hung one fails at the deadline."""
         service = self.gateway.catalog.services.get(service_id)
         if service is None:
             self._failure(service_id, call_id, f"unknown service id {service_id}")
@@ -280,13 +288,33 @@ class FoxgloveSession:
         if encoding != "ros1":
             self._failure(service_id, call_id, f"service call encoding must be ros1, got {encoding!r}")
             return
+        name = service["name"]
+        timeout = self.gateway.options.call_service_timeout
+
+        def work(claim: Callable[[], bool]) -> None:
+            try:
+                response = self.gateway.services.call_raw(name, payload)
+            except NinjemysError as exc:
+                if claim():
+                    self._failure(service_id, call_id, str(exc))
+                return
+            except Exception as exc:  # a gateway bug still answers this call, and is logged
+                log.exception("foxglove: call to %s failed", name)
+                if claim():
+                    self._failure(service_id, call_id, f"{name}: {type(exc).__name__}: {exc}")
+                return
+            if claim():
+                enc = b"ros1"
+                head = _SERVICE_HEAD.pack(0x03, service_id, call_id, len(enc))
+                self.outbox.put_control(head + enc + response)
+
+        def expired() -> None:
+            self._failure(service_id, call_id, f"service {name} did not answer within {timeout:g} s")
+
         try:
-            response = self.gateway.services.call_raw(service["name"], payload)
+            self.gateway.services.dispatch(name, timeout, work, expired)
         except NinjemysError as exc:
             self._failure(service_id, call_id, str(exc))
-            return
-        enc = b"ros1"
-        self.outbox.put_control(_SERVICE_HEAD.pack(0x03, service_id, call_id, len(enc)) + enc + response)
 
     def _failure(self, service_id: int, call_id: int, message: str) -> None:
         self.send(

@@ -14,10 +14,13 @@ Everything here may block on the master or a peer: callers run it off the event 
 from __future__ import annotations
 
 import functools
+import heapq
+import itertools
 import logging
 import threading
 import time
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 from ninjemys.errors import NinjemysError, ServiceError
@@ -244,11 +247,60 @@ def _raw_service_class(type_name: str, md5sum: str) -> Any:
 class Services:
     """Service calls through the gateway's node: typed (rosbridge) and raw (Foxglove)."""
 
+    #: calls to one service in flight at once (each on its own connection, as rosbridge's per-call threads)
+    LANE_WORKERS = 4
+
     def __init__(self, node: Node) -> None:
         self.node = node
         self._types: dict[str, tuple[str, dict[str, str]]] = {}  # service -> (uri, provider header)
-        self._proxies: dict[tuple[str, str, bool], Any] = {}
+        # one connection per (service, type, raw, lane thread): a hung call holds only its own
+        self._proxies: dict[tuple[str, str, bool, int], Any] = {}
         self._lock = threading.Lock()
+        self._lanes: dict[str, ThreadPoolExecutor] = {}
+        self._deadlines = _Deadlines()
+        self._closed = False
+
+    def dispatch(
+        self,
+        service: str,
+        timeout: float | None,
+        work: Callable[[Callable[[], bool]], None],
+        on_timeout: Callable[[], None],
+    ) -> None:
+        """Run one client's call on ``service``'s own lane, answered within ``timeout`` seconds.
+
+        Each service has its own small pool (a lane), so calls that hang on one service (a stuck
+        provider, a hostile client calling it over and over) hold only that lane: calls to every
+        other service still start at once. ``work(claim)`` makes the call and, before it answers,
+        calls ``claim()``: True when it is first, False when the deadline already answered (then it
+        must stay silent). At the deadline ``on_timeout()`` runs, unless the work claimed first. A
+        call that hangs keeps its lane thread until the provider answers or goes away (a blocked
+        socket read cannot be interrupted safely), which is why the lanes are per service."""
+        answered = threading.Lock()
+
+        def claim() -> bool:
+            return answered.acquire(blocking=False)
+
+        def expire() -> None:
+            if claim():
+                on_timeout()
+
+        def run() -> None:
+            if answered.locked():  # its deadline passed while it waited in the lane
+                return
+            work(claim)
+
+        with self._lock:
+            if self._closed:
+                raise ServiceError("the gateway is shutting down")
+            lane = self._lanes.get(service)
+            if lane is None:
+                lane = self._lanes[service] = ThreadPoolExecutor(
+                    self.LANE_WORKERS, thread_name_prefix=f"gateway-call {service}"
+                )
+        if timeout is not None and timeout > 0:
+            self._deadlines.add(time.monotonic() + timeout, expire)
+        lane.submit(run)
 
     def provider_header(self, service: str) -> dict[str, str]:
         """The provider's connection header (``type``, ``md5sum``), probed once per provider URI."""
@@ -272,7 +324,7 @@ class Services:
         return self.provider_header(service).get("type", "")
 
     def _proxy(self, service: str, service_class: Any, raw: bool) -> Any:
-        key = (service, service_class._md5sum, raw)
+        key = (service, service_class._md5sum, raw, threading.get_ident())
         with self._lock:
             proxy = self._proxies.get(key)
             if proxy is None:
@@ -288,7 +340,7 @@ class Services:
             if "transport error" not in str(exc) and "handshake failed" not in str(exc):
                 raise
             with self._lock:
-                self._proxies.pop((service, service_class._md5sum, raw), None)
+                self._proxies.pop((service, service_class._md5sum, raw, threading.get_ident()), None)
             proxy.close()
             return self._proxy(service, service_class, raw).call(request)
 
@@ -304,11 +356,64 @@ class Services:
         return self._call(service, service_class, True, service_class._request_class(payload))
 
     def close(self) -> None:
+        """Stop the lanes and close the connections; never waits for a call that hangs (closing a
+        proxy waits for its call, so that runs on a daemon thread)."""
         with self._lock:
+            self._closed = True
             proxies = list(self._proxies.values())
             self._proxies.clear()
-        for proxy in proxies:
-            proxy.close()
+            lanes = list(self._lanes.values())
+            self._lanes.clear()
+        self._deadlines.stop()
+        for lane in lanes:
+            lane.shutdown(wait=False, cancel_futures=True)
+
+        def close_all() -> None:
+            for proxy in proxies:
+                proxy.close()
+
+        threading.Thread(target=close_all, name="gateway-proxies-close", daemon=True).start()
+
+
+class _Deadlines:
+    """One thread that runs callbacks at their deadlines (a heap), so a call's bounded wait costs
+    an entry here, not a thread of its own."""
+
+    def __init__(self) -> None:
+        self._heap: list[tuple[float, int, Callable[[], None]]] = []
+        self._seq = itertools.count()
+        self._cond = threading.Condition()
+        self._thread: threading.Thread | None = None
+        self._stopped = False
+
+    def add(self, when: float, callback: Callable[[], None]) -> None:
+        with self._cond:
+            if self._stopped:
+                return
+            heapq.heappush(self._heap, (when, next(self._seq), callback))
+            if self._thread is None:
+                self._thread = threading.Thread(target=self._run, name="gateway-deadlines", daemon=True)
+                self._thread.start()
+            self._cond.notify()
+
+    def stop(self) -> None:
+        with self._cond:
+            self._stopped = True
+            self._heap.clear()
+            self._cond.notify()
+
+    def _run(self) -> None:
+        while True:
+            with self._cond:
+                while not self._stopped and (not self._heap or self._heap[0][0] > time.monotonic()):
+                    self._cond.wait(self._heap[0][0] - time.monotonic() if self._heap else None)
+                if self._stopped:
+                    return
+                callback = heapq.heappop(self._heap)[2]
+            try:
+                callback()
+            except Exception:  # one client's reply failing must not stop everyone's deadlines
+                log.exception("gateway: service call deadline handler failed")
 
 
 def wall_ns() -> int:

@@ -57,6 +57,7 @@ def options_from_params(node: Node, default_port: int, node_name: str, client_co
         if send_buffer_limit not in (None, "None")
         else 8 * 1024 * 1024,
         update_period=float(param("max_update_ms", 1000)) / 1000.0,
+        call_service_timeout=float(param("default_call_service_timeout", 5.0) or 5.0),
         node_name=node_name,
         client_count=client_count,
     )

@@ -124,6 +124,8 @@ class RosbridgeSession:
         self._worker: Executor = ThreadPoolExecutor(1, thread_name_prefix=f"rosbridge-{client_id}")
         self._closed = threading.Event()
         self._lock = threading.Lock()
+        #: per lane thread: the running call's claim on its reply (see :meth:`_dispatch_call`)
+        self._call = threading.local()
 
     # -- sending ------------------------------------------------------------------------------
     def send(self, obj: dict[str, Any]) -> None:
@@ -156,9 +158,47 @@ class RosbridgeSession:
             return
         self.backlog.add()
         if msg["op"] == "call_service" and self.authenticated:
-            self.gateway.pool.submit(self._run, msg)
+            self._dispatch_call(msg)
         else:
             self._worker.submit(self._run, msg)
+
+    def _dispatch_call(self, msg: dict[str, Any]) -> None:
+        """A call runs on its service's lane with a bounded wait: the ``timeout`` field (seconds, as
+        in rosbridge's newer protocol) or the gateway's ``call_services_timeout``."""
+        timeout = msg.get("timeout")
+        if not isinstance(timeout, (int, float)) or isinstance(timeout, bool) or timeout <= 0:
+            timeout = self.gateway.options.call_service_timeout
+        service = str(msg.get("service"))
+
+        def work(claim: Callable[[], bool]) -> None:
+            won: list[bool] = []
+
+            def first() -> bool:
+                if not won:
+                    won.append(claim())
+                return won[0]
+
+            self._call.claim = first
+            try:
+                self._handle(msg)
+            finally:
+                self._call.claim = None
+                if first():  # this call answered (or errored before the deadline): free its slot
+                    self.backlog.done()
+
+        def expired() -> None:
+            reply: dict[str, Any] = {"op": "service_response", "service": service, "result": False}
+            reply["values"] = f"service {service} did not answer within {timeout:g} s"
+            if msg.get("id") is not None:
+                reply["id"] = msg["id"]
+            self.send(reply)
+            self.backlog.done()
+
+        try:
+            self.gateway.services.dispatch(service, timeout, work, expired)
+        except NinjemysError as exc:
+            self.status("error", f"call_service: {exc}", msg.get("id"))
+            self.backlog.done()
 
     def _run(self, msg: dict[str, Any]) -> None:
         try:
@@ -369,7 +409,9 @@ class RosbridgeSession:
             reply.update(result=False, values=str(exc))
         else:
             reply.update(result=True, values=to_value(response))
-        self.send(reply)
+        claim = getattr(self._call, "claim", None)
+        if claim is None or claim():  # not past its deadline (then the client has its answer)
+            self.send(reply)
 
     def op_advertise_service(self, msg: dict[str, Any]) -> None:
         service = self._topic(msg, "service")

@@ -75,6 +75,9 @@ class GatewayOptions:
     protocols: tuple[str, ...] = ("rosbridge", "foxglove")
     #: publish the number of connected clients on ``client_count`` (latched), as rosbridge_websocket does
     client_count: bool = False
+    #: a service call not answered within this many seconds gets a failed reply (rosbridge's
+    #: ``default_call_service_timeout``; a rosbridge call's own ``timeout`` field overrides it)
+    call_service_timeout: float = 5.0
 
     def secret(self) -> str | None:
         if not self.authenticate:
@@ -438,8 +441,8 @@ class Gateway:
 
     async def serve(self, ws: WebSocket) -> None:
         loop = asyncio.get_running_loop()
-        if self._reporter is None:  # on whichever server's loop the gateway is mounted
-            self._loop = self._loop or loop
+        self._loop = self._loop or loop  # whichever server's loop the gateway is mounted on
+        if self._reporter is None:  # runs while clients are connected (see the end of serve)
             self._reporter = loop.create_task(self._report_drops())
         client = _Client(next(self._ids), ws, loop, self.options.max_client_bytes)
         if ws.subprotocol in SUBPROTOCOLS:
@@ -467,11 +470,18 @@ class Gateway:
                 session.receive(data)
                 await session.backlog.wait()
         finally:
+            # the tasks this connection started end before it does, so a server closing its
+            # connections leaves nothing pending on the loop
             sender.cancel()
             self._clients.pop(client.id, None)
+            reporter = self._reporter if not self._clients else None
+            if reporter is not None:
+                self._reporter = None
+                reporter.cancel()
             self._count_clients()
             session.close()
             log.info("gateway: client %d disconnected", client.id)
+            await asyncio.gather(sender, *([reporter] if reporter else []), return_exceptions=True)
 
     async def _sender(self, client: _Client) -> None:
         ws, outbox = client.ws, client.outbox

@@ -122,6 +122,7 @@ class HttpServer:
         self._static: list[tuple[str, Path]] = []
         self._server: asyncio.base_events.Server | None = None
         self._writers: set[asyncio.StreamWriter] = set()
+        self._tasks: set[asyncio.Task[None]] = set()  # the connections' handlers (closed in order)
         self._streams: set[EventStream] = set()
 
     def route(self, method: str, path: str, handler: Handler) -> None:
@@ -152,6 +153,14 @@ class HttpServer:
         self._server.close()
         for stream in list(self._streams):
             stream.queue.put_nowait(None)
+        # every connection's handler is cancelled and awaited: a WebSocket sends its close frame and
+        # its endpoint stops its own tasks, so the loop can close with nothing left pending
+        # (otherwise "Task was destroyed but it is pending" at exit while a page is still open)
+        tasks = [t for t in self._tasks if not t.done() and t is not asyncio.current_task()]
+        for task in tasks:
+            task.cancel()
+        if tasks:
+            await asyncio.wait(tasks, timeout=2.0)
         for writer in list(self._writers):
             writer.close()
         with contextlib.suppress(Exception):
@@ -160,6 +169,10 @@ class HttpServer:
 
     # -- connection handling ----------------------------------------------------------------
     async def _serve(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+        task = asyncio.current_task()
+        if task is not None:
+            self._tasks.add(task)
+            task.add_done_callback(self._tasks.discard)
         self._writers.add(writer)
         try:
             while True:

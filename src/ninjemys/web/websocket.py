@@ -185,6 +185,9 @@ async def serve_upgrade(
     ws = WebSocket(protocol, request, reader, writer)
     try:
         await endpoint.serve(ws)
+    except asyncio.CancelledError:  # the server is closing: tell the client it goes away
+        ws.close(1001, "server shutting down")
+        raise
     finally:
         ws.close()
         with contextlib.suppress(Exception):
