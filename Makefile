@@ -23,7 +23,7 @@ SYSTEM_DEBS  := $(ROS1_DEBS) $(BROWSER_DEBS) tmux
 NPM_DIR   := .cache/npm
 NPM_STAMP := $(NPM_DIR)/node_modules/.installed
 
-.PHONY: all venv system npm lint format typecheck test test-fast demo bench clean
+.PHONY: all venv system npm lint format typecheck test test-long test-fast demo bench clean
 
 all: venv
 
@@ -67,11 +67,16 @@ format: venv
 typecheck: venv
 	$(VENV)/bin/mypy
 
+# --dist loadgroup keeps each xdist_group on one worker (the navigation sessions run one at a time).
 test: venv system npm lint typecheck
-	$(VENV)/bin/pytest -n 2 -q
+	$(VENV)/bin/pytest -n 2 -q --dist loadgroup -m "not long"
+
+# The acceptance runs of many minutes (20 maze goals through move_base); not part of `make test`.
+test-long: venv system
+	$(VENV)/bin/pytest -q -m long
 
 test-fast: venv
-	$(VENV)/bin/pytest -n 2 -q -m "not ros1 and not browser and not slow"
+	$(VENV)/bin/pytest -n 2 -q -m "not ros1 and not browser and not slow and not long"
 
 demo: venv
 	$(PY) -m ninjemys.demo

@@ -23,7 +23,9 @@ from .conftest import NavSession, pick_goals
 pytest.importorskip("ninjemys.sim.puzzlebot_node", reason="the PuzzleBot simulator is not on this branch yet")
 pytest.importorskip("ninjemys.actionlib.server", reason="actionlib is not on this branch yet")
 
-pytestmark = [pytest.mark.slow, pytest.mark.timeout(900)]
+# One navigation session at a time (``make test`` runs with ``--dist loadgroup``): two stacks at a
+# real-time factor of 4 on the same two cores starve each other's control loops.
+pytestmark = [pytest.mark.slow, pytest.mark.timeout(900), pytest.mark.xdist_group("nav")]
 
 DATA = Path(__file__).parent / "data"
 RATE = "4"
@@ -299,6 +301,7 @@ def wait_goal(session: NavSession, goal: tuple, limit: float) -> bool:
     "stood within 5 cm turning, and the next goal never started",
     strict=False,
 )
+@pytest.mark.long  # 20 goals take about 7 minutes: `make test-long`
 def test_maze_goals_through_move_base_simple(tmp_path):
     session = start("maze", tmp_path)
     try:
