@@ -9,8 +9,7 @@ given orientations: each pose faces the next, the last takes the goal's.
 Why not a heap A*: in Python it spends ~3 us per expanded cell, and behind walls it expands most of
 a 400x400 map (0.1-1 s). The search here computes the same shortest-path costs with whole-row numpy
 operations instead (see :func:`astar`), exact for the step costs rounded to ``1 / scale`` of a cost
-unit (``scale`` is 2**20 on maps up to ~1,000 x 1,000 cells, smaller on larger ones so the integer
-arithmetic cannot overflow): the path's cost in the float model is within ``(n + n*) / (2 scale)``
+unit (``scale`` is 2**20, less on large and costly maps so the integer arithmetic cannot overflow): the path's cost in the float model is within ``(n + n*) / (2 scale)``
 of the optimum, ``n`` and ``n*`` being the two paths' step counts.
 """
 
@@ -165,7 +164,8 @@ def astar(
         scale /= 2.0
     w1_table = np.maximum(np.rint(weight * scale), 1).astype(np.int64)
     w2_table = np.maximum(np.rint(weight * (scale * SQRT2)), 1).astype(np.int64)
-    big = 1 << int(np.dot(free_counts, w2_table) + 2 * ncells + 2).bit_length()
+    start_step = max(int(np.rint((neutral_cost + cost_factor * start_cost) * scale * SQRT2)), 1)
+    big = 1 << int(np.dot(free_counts, w2_table) + start_step + 2 * ncells + 2).bit_length()
     w1_table[blocked_value] = _INF
     w2_table[blocked_value] = _INF
     sum_table = np.where(blocked_value, big, w1_table)
@@ -180,7 +180,7 @@ def astar(
         grid[[0, -1], :] = blocked_border
         grid[:, [0, -1]] = blocked_border
     w1[sy, sx] = max(int(np.rint((neutral_cost + cost_factor * start_cost) * scale)), 1)
-    w2[sy, sx] = max(int(np.rint((neutral_cost + cost_factor * start_cost) * scale * SQRT2)), 1)
+    w2[sy, sx] = start_step
     sums[sy, sx] = w1[sy, sx]
 
     # an octile lower bound to the goal, from the cheapest straight and diagonal steps
