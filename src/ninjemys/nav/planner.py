@@ -24,7 +24,7 @@ SQRT2 = math.sqrt(2.0)
 
 #: "not reached yet"; every real cost, and every sum formed below, stays under 2**63
 _INF = 1 << 61
-#: below this many cells left to re-check, a heap search finishes the job (cheaper than a sweep)
+#: below this many cells left to re-check (and the goal reached), a heap search finishes the job
 _REPAIR_CELLS = 4000
 #: sweep pairs before the heap search takes over whatever is left (bounds the worst case); the heap
 #: search also takes over as soon as a pair fails to halve the cells left (sweeps stall on maps whose
@@ -214,9 +214,10 @@ def astar(
             d[...] = dt.T
         np.putmask(d, d >= big, _INF)  # costs only a crossing of a barrier explains
         seeds = np.flatnonzero(changed)
-        seeds = seeds[d.ravel()[seeds] + bound.of(seeds) < d[gy, gx]]
-        if len(seeds) <= _REPAIR_CELLS or 2 * len(seeds) > left:
-            break
+        if d[gy, gx] < _INF:
+            seeds = seeds[d.ravel()[seeds] + bound.of(seeds) < d[gy, gx]]
+        if (len(seeds) <= _REPAIR_CELLS and d[gy, gx] < _INF) or not len(seeds) or 2 * len(seeds) > left:
+            break  # (a goal not reached yet would make the repair a search of the whole map)
         left = len(seeds)
     if len(seeds) >= _FRESH_SEARCH:
         _heap_astar(d, w1, w2, bound, sy * wp + sx, gy * wp + gx)
@@ -323,8 +324,8 @@ def _walk_back(d: np.ndarray, w1: np.ndarray, w2: np.ndarray, start: int, goal: 
         else:
             _no_predecessor(v, wp, dv)
         cells.append(v)
-    cells.reverse()
-    return [(c % wp - 1, c // wp - 1) for c in cells]
+    flat = np.asarray(cells[::-1])
+    return list(zip((flat % wp - 1).tolist(), (flat // wp - 1).tolist(), strict=True))
 
 
 def _walk_table(d: np.ndarray, w1: np.ndarray, w2: np.ndarray, start: int, cell: int) -> list[int]:
