@@ -70,18 +70,21 @@ def check_plan(costs, start, goal, neutral=50.0, factor=3.0, allow_unknown=True,
     return path
 
 
-@pytest.fixture(params=["default", "sweeps", "columns", "fresh", "table"])
+@pytest.fixture(params=["default", "sweeps", "columns", "budget", "fresh", "table"])
 def stage(request, monkeypatch):
     """Force one stage of the planner: the defaults, sweeps until settled (no repair), the column
-    sweeps first of all, the plain A* fallback, or the predecessor-table walk from the first step."""
+    sweeps first of all, heap searches cut short after one cell (sweeping on in between), the plain
+    A* fallback, or the predecessor-table walk from the first step."""
     if request.param == "sweeps":
         monkeypatch.setattr(planner, "_REPAIR_CELLS", 0)
     elif request.param == "columns":
         monkeypatch.setattr(planner, "_REPAIR_CELLS", 0)
         monkeypatch.setattr(planner, "_MAX_PAIRS", 30)
+    elif request.param == "budget":
+        monkeypatch.setattr(planner, "_REPAIR_CELLS", 10**9)
+        monkeypatch.setattr(planner, "_REPAIR_POPS", 1)
     elif request.param == "fresh":
         monkeypatch.setattr(planner, "_REPAIR_CELLS", -1)
-        monkeypatch.setattr(planner, "_FRESH_SEARCH", 0)
     elif request.param == "table":
         monkeypatch.setattr(planner, "_WALK_STEPS", 0)
     return request.param
@@ -135,7 +138,7 @@ def test_plan_errors_name_the_reason():
 
 def test_planner_matches_the_exact_search_on_random_maps(stage):
     rng = np.random.default_rng(11)
-    for _ in range(25):
+    for _ in range(80):
         h, w = (int(v) for v in rng.integers(1, 28, 2))
         occ = rng.random((h, w)) < rng.uniform(0.0, 0.35)
         costs = inflation_costs(occ, 0.05, 0.0, float(rng.uniform(0.0, 0.3)), 10.0)

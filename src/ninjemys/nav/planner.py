@@ -24,14 +24,15 @@ SQRT2 = math.sqrt(2.0)
 
 #: "not reached yet"; every real cost, and every sum formed below, stays under 2**63
 _INF = 1 << 61
-#: below this many cells left to re-check (and the goal reached), a heap search finishes the job
-_REPAIR_CELLS = 4000
-#: sweep pairs before the heap search takes over whatever is left (bounds the worst case); the heap
-#: search also takes over as soon as a pair fails to halve the cells left (sweeps stall on maps whose
-#: cheapest paths wind in every direction, like a dense field of scattered obstacles)
+#: at most this many cells left to re-check (and the goal reached): a heap search finishes the job,
+#: unless it has to expand more than _REPAIR_POPS cells (a long cascade: sweeps do those better)
+_REPAIR_CELLS = 2000
+_REPAIR_POPS = 3000
+#: sweep pairs before a heap search takes over whatever is left (bounds the worst case); it also
+#: takes over as soon as a pair fails to halve the cells left (sweeps stall on maps whose cheapest
+#: paths wind in every direction, like a dense field of scattered obstacles). With more than
+#: _REPAIR_CELLS cells left, that is a plain A* from the start (on Python lists: cheaper then).
 _MAX_PAIRS = 8
-#: from this many cells left to re-check, a plain A* from the start (on Python lists) is cheaper
-_FRESH_SEARCH = 20000
 #: path steps read back one by one before reading the rest from a predecessor table
 _WALK_STEPS = 1500
 
@@ -193,13 +194,17 @@ def astar(
     d[sy, sx] = 0
     rows = _Sweeper(w1, w2, sums)
     cols: _Sweeper | None = None
-    seeds = np.empty(0, dtype=np.intp)
     left = d.size
+    # each pair sweeps from the start's side towards the goal's first: a path that heads that way
+    # is then settled by the first sweep, and the second one changes little
+    towards_rows, towards_cols = gy >= sy, gx >= sx
+    goal_cell = gy * wp + gx
+    pending: list[tuple[int, int]] | None = None  # the heap search's cells left when its budget ran out
     for pair in range(_MAX_PAIRS):
         if pair % 2 == 0:
-            rows.sweep(d, downward=True)
+            rows.sweep(d, downward=towards_rows)
             before = d.copy()
-            rows.sweep(d, downward=False)
+            rows.sweep(d, downward=not towards_rows)
             changed = d < before
         else:
             if cols is None:
@@ -207,31 +212,64 @@ def astar(
                     np.ascontiguousarray(w1.T), np.ascontiguousarray(w2.T), np.ascontiguousarray(sums.T)
                 )
             dt = np.ascontiguousarray(d.T)
-            cols.sweep(dt, downward=True)
+            cols.sweep(dt, downward=towards_cols)
             before = dt.copy()
-            cols.sweep(dt, downward=False)
+            cols.sweep(dt, downward=not towards_cols)
             changed = (dt < before).T
             d[...] = dt.T
         np.putmask(d, d >= big, _INF)  # costs only a crossing of a barrier explains
         seeds = np.flatnonzero(changed)
+        seeds = seeds[d.ravel()[seeds] < _INF]  # (barrier cells, the border's among them, changed too)
         if d[gy, gx] < _INF:
             seeds = seeds[d.ravel()[seeds] + bound.of(seeds) < d[gy, gx]]
-        if (len(seeds) <= _REPAIR_CELLS and d[gy, gx] < _INF) or not len(seeds) or 2 * len(seeds) > left:
-            break  # (a goal not reached yet would make the repair a search of the whole map)
-        left = len(seeds)
-    if len(seeds) >= _FRESH_SEARCH:
-        _heap_astar(d, w1, w2, bound, sy * wp + sx, gy * wp + gx)
-    else:
-        _repair(d, w1, w2, bound, seeds, gy * wp + gx)
+        seeds = _lowering(d, w1, w2, seeds)
+        pending = list(zip(d.ravel()[seeds].tolist(), seeds.tolist(), strict=True))
+        if not pending:
+            break
+        # (a goal not reached yet would make the heap search a search of the whole map)
+        if len(pending) <= _REPAIR_CELLS and d[gy, gx] < _INF:
+            pending = _repair(d, w1, w2, bound, pending, goal_cell, _REPAIR_POPS)
+            if not pending:
+                break
+            continue  # the next pair relaxes every step of the cells it had not reached
+        if 2 * len(pending) > left:
+            break
+        left = len(pending)
+    if pending and len(pending) > _REPAIR_CELLS:
+        _heap_astar(d, w1, w2, bound, sy * wp + sx, goal_cell)
+    elif pending:
+        _repair(d, w1, w2, bound, pending, goal_cell, None)
     if d[gy, gx] >= big:
         raise PlanError(f"no path from cell ({start[0]}, {start[1]}) to cell ({goal[0]}, {goal[1]})")
     return _walk_back(d, w1, w2, sy * wp + sx, gy * wp + gx)
 
 
+def _lowering(d: np.ndarray, w1: np.ndarray, w2: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    """The cells that would lower a neighbour's cost now (most changed cells changed by a little
+    and lower none: they need no re-check until they change again)."""
+    df, w1f, w2f = d.ravel(), w1.ravel(), w2.ravel()
+    wp = d.shape[1]
+    lowers = np.zeros(len(cells), dtype=bool)
+    dc = df[cells]
+    for off, wf in ((1, w1f), (-1, w1f), (wp, w1f), (-wp, w1f)):
+        lowers |= dc + wf[cells + off] < df[cells + off]
+    for off in (wp + 1, wp - 1, 1 - wp, -1 - wp):
+        lowers |= dc + w2f[cells + off] < df[cells + off]
+    return cells[lowers]
+
+
 def _repair(
-    d: np.ndarray, w1: np.ndarray, w2: np.ndarray, bound: _Octile, seeds: np.ndarray, goal: int
-) -> None:
-    """Finish ``d`` for the goal: a heap search from the cells that may still lower something.
+    d: np.ndarray,
+    w1: np.ndarray,
+    w2: np.ndarray,
+    bound: _Octile,
+    heap: list[tuple[int, int]],
+    goal: int,
+    budget: int | None,
+) -> list[tuple[int, int]]:
+    """Finish ``d`` for the goal: a heap search from the cells (cost, index) that may still lower
+    something. Returns what is left on the heap: nothing once the goal is exact, or the rest when
+    ``budget`` cells have been expanded.
 
     Every other cell's steps are already relaxed, so a Dijkstra seeded with these cells (keyed by
     their cost) and pruned by ``cost + bound >= goal's cost`` (A*'s rule) makes the goal exact.
@@ -248,22 +286,26 @@ def _repair(
         (1 - wp, w2f),
         (-1 - wp, w2f),
     )
-    heap = [(int(df[s]), int(s)) for s in seeds]
     heapq.heapify(heap)
     pop, push = heapq.heappop, heapq.heappush
+    expanded = 0
     while heap:
+        if budget is not None and expanded >= budget:
+            return heap
         du, v = pop(heap)
         if du != df[v]:
             continue
         dx, dy = abs(v % wp - gx), abs(v // wp - gy)
         if du + (d0 * dx + s0 * (dy - dx) if dx < dy else d0 * dy + s0 * (dx - dy)) >= df[goal]:
             continue
+        expanded += 1
         for off, wf in steps:
             n = v + off
             nd = du + int(wf[n])
             if nd < df[n]:
                 df[n] = nd
                 push(heap, (nd, n))
+    return heap
 
 
 def _heap_astar(d: np.ndarray, w1: np.ndarray, w2: np.ndarray, bound: _Octile, start: int, goal: int) -> None:
