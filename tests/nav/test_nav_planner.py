@@ -87,6 +87,7 @@ def stage(request, monkeypatch):
         monkeypatch.setattr(planner, "_REPAIR_CELLS", -1)
     elif request.param == "table":
         monkeypatch.setattr(planner, "_WALK_STEPS", 0)
+        monkeypatch.setattr(planner, "_TABLE_CELLS", 10**9)
     return request.param
 
 

@@ -33,8 +33,10 @@ _REPAIR_POPS = 3000
 #: paths wind in every direction, like a dense field of scattered obstacles). With more than
 #: _REPAIR_CELLS cells left, that is a plain A* from the start (on Python lists: cheaper then).
 _MAX_PAIRS = 8
-#: path steps read back one by one before reading the rest from a predecessor table
+#: path steps read back one by one before reading the rest from a predecessor table of the whole
+#: grid, and at least one step per _TABLE_CELLS grid cells (a step costs ~30x a cell of the table)
 _WALK_STEPS = 1500
+_TABLE_CELLS = 32
 
 
 class PlanError(ValueError):
@@ -128,11 +130,12 @@ def astar(
     right/left over columns, ... see :class:`_Sweeper`), on integer costs so sums are exact. After a
     pair, a cell that did not change in its second sweep has had all its 8 steps relaxed since it
     last changed, so only the cells changed in that sweep can still lower anything; of those, the
-    ones whose cost plus an octile lower bound to the goal is below the goal's current cost are
-    re-checked by a heap search (an A* from many sources, usually a few hundred cells). The goal's
-    cost is then exact, and the path is read back from the goal by always stepping to the
-    neighbour that accounts for the cell's cost. Same result as the heap A* it replaces (ties
-    aside), ~5-20x faster on 400x400 maps.
+    ones that lower a neighbour right now and whose cost plus an octile lower bound to the goal is
+    below the goal's current cost are re-checked by a heap search (an A* from many sources, usually
+    a handful of cells; cut short when it cascades, and the sweeps go on). The goal's cost is then
+    exact, and the path is read back from the goal by always stepping to the neighbour that
+    accounts for the cell's cost. Same result as the heap A* it replaces (ties aside), 5-20x
+    faster on 400x400 maps.
     """
     h, w = costs.shape
     for what, (cx, cy) in (("start", start), ("goal", goal)):
@@ -353,8 +356,9 @@ def _walk_back(d: np.ndarray, w1: np.ndarray, w2: np.ndarray, start: int, goal: 
     offsets = (1, -1, wp, -wp, wp + 1, wp - 1, 1 - wp, -1 - wp)
     v = goal
     cells = [v]
+    table_from = max(_WALK_STEPS, df.size // _TABLE_CELLS)
     while v != start:
-        if len(cells) > _WALK_STEPS:
+        if len(cells) > table_from:
             cells += _walk_table(d, w1, w2, start, v)[1:]
             break
         dv = int(df[v])
