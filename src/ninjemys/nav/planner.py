@@ -59,45 +59,49 @@ class _Sweeper:
     def __init__(self, w1: np.ndarray, w2: np.ndarray, barrier_sum: np.ndarray) -> None:
         off_e = np.cumsum(barrier_sum, axis=1)
         off_w = off_e[:, -1:] - off_e + barrier_sum  # the running sum from the right, exact
-        self.a_e, self.a_w = list(-off_e), list(-off_w)
-        self.b_e, self.b_w = list(off_e), list(off_w)
-        self.w1 = list(w1)
-        self.w2_left, self.w2_right = list(w2[:, :-1]), list(w2[:, 1:])
+        # both directions of a row go through one running minimum: [eastward, westward reversed]
+        both = np.stack([off_e, off_w[:, ::-1]], axis=1)
+        self.a_e, self.a_w_rev = (
+            list(np.ascontiguousarray(-both[:, 0])),
+            list(np.ascontiguousarray(-both[:, 1])),
+        )
+        self.b_both = list(both)
+        # inner columns only: the border columns are barriers and stay so
+        self.w1, self.w2 = list(w1[:, 1:-1]), list(w2[:, 1:-1])
         n = w1.shape[1]
-        self.t = np.empty(n, dtype=np.int64)
-        self.u = np.empty(n - 1, dtype=np.int64)
-        self.e = np.empty(n, dtype=np.int64)
-        self.x = np.empty(n, dtype=np.int64)
+        self.t = np.empty(n - 2, dtype=np.int64)
+        self.m = np.empty(n - 2, dtype=np.int64)
+        self.buf = np.empty((2, n), dtype=np.int64)
         self.rows = w1.shape[0]
 
     def sweep(self, d: np.ndarray, downward: bool) -> None:
         """Relax ``d`` (this orientation's layout, padded) row after row, in place."""
         add, least, running = np.add, np.minimum, np.minimum.accumulate
-        t, u, e, x = self.t, self.u, self.e, self.x
-        t_left, t_right, x_rev = t[:-1], t[1:], x[::-1]
-        rows, left, right = list(d), list(d[:, :-1]), list(d[:, 1:])
-        w1, w2l, w2r = self.w1, self.w2_left, self.w2_right
-        a_e, b_e, a_w, b_w = self.a_e, self.b_e, self.a_w, self.b_w
+        t, m, buf = self.t, self.m, self.buf
+        east, west_rev = buf[0], buf[1]
+        west = west_rev[::-1]
+        rows, rows_rev = list(d), list(d[:, ::-1])
+        inner, left, right = list(d[:, 1:-1]), list(d[:, :-2]), list(d[:, 2:])
+        w1, w2 = self.w1, self.w2
+        a_e, a_w_rev, b_both = self.a_e, self.a_w_rev, self.b_both
         last = self.rows - 2
         order = range(1, last + 1) if downward else range(last, 0, -1)
         p = -1
         for r in order:
             row = rows[r]
             if p >= 0:
-                add(rows[p], w1[r], out=t)
-                add(left[p], w2r[r], out=u)  # diagonal from column c-1
-                least(t_right, u, out=t_right)
-                add(right[p], w2l[r], out=u)  # diagonal from column c+1
-                least(t_left, u, out=t_left)
-                least(row, t, out=row)
-            add(row, a_e[r], out=e)
-            running(e, out=e)
-            add(e, b_e[r], out=e)
-            add(row, a_w[r], out=x)
-            running(x_rev, out=x_rev)
-            add(x, b_w[r], out=x)
-            least(row, e, out=row)
-            least(row, x, out=row)
+                # both diagonal steps into a cell cost the same: the cheaper of the two sources
+                least(left[p], right[p], out=m)
+                add(m, w2[r], out=m)
+                add(inner[p], w1[r], out=t)
+                least(t, m, out=t)
+                least(inner[r], t, out=inner[r])
+            add(row, a_e[r], out=east)
+            add(rows_rev[r], a_w_rev[r], out=west_rev)
+            running(buf, axis=1, out=buf)
+            add(buf, b_both[r], out=buf)
+            least(row, east, out=row)
+            least(row, west, out=row)
             p = r
 
 
