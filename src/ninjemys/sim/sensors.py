@@ -104,8 +104,8 @@ class Camera:
         # static background: floor shaded with distance, sky above the horizon
         shade = np.clip(1.15 - floor_depth / 12.0, 0.55, 1.0)[:, None] * FLOOR_RGB[None, :]
         bg = np.where(below[:, None], shade, SKY_RGB[None, :]).astype(np.uint8)
-        self._background = np.ascontiguousarray(np.broadcast_to(bg[:, None, :], (height, width, 3))).reshape(
-            height, 3 * width
+        self._background = _padded_copy(
+            np.broadcast_to(bg[:, None, :], (height, width, 3)).reshape(height, 3 * width)
         )
         self._floor_rows = np.flatnonzero(floor_depth > 0)  # rows that see the floor within range
         forward = floor_depth[self._floor_rows][:, None]
@@ -115,7 +115,12 @@ class Camera:
             (forward * ((self.cx - u) / self.fx)[None, :]).astype(np.float32),
         )
         self._neg_slope = -self.row_slope
-        self._rows = np.arange(height, dtype=np.uint16)[:, None]
+        # a column's wall rows are top <= v < bottom, with top and bottom in [0, height]: compared
+        # in the narrowest unsigned type that holds them (uint8 up to 255 rows), so building the
+        # masks is one byte-wide vectorised comparison per pixel
+        self._row_type = np.uint8 if height <= 255 else np.uint16
+        self._rows = np.arange(height, dtype=self._row_type)[:, None]
+        self._floor_depth_image = _padded_copy(np.broadcast_to(self.floor_depth_mm[:, None], (height, width)))
 
     def render(self, scene: Scene, x: float, y: float, yaw: float) -> tuple[np.ndarray, np.ndarray]:
         """(rgb8 image (H, W, 3), depth in mm uint16 (H, W)) from a camera at (x, y, cam_z) facing ``yaw``."""
@@ -142,20 +147,22 @@ class Camera:
             lo_slope = np.where(found, -self.cam_z / depth, np.inf)
             hi_slope = np.where(found, (heights - self.cam_z) / depth, -np.inf)
         # row_slope decreases with v: searchsorted on its negation
-        top = np.searchsorted(self._neg_slope, -hi_slope, "left")
-        bottom = np.searchsorted(self._neg_slope, -lo_slope, "right")
-        # the image as (H, 3W) bytes: one select over bytes against a per-channel mask is cheaper than
-        # any interleaving of channels or a select over 3-byte elements
-        # top <= v < bottom as one unsigned comparison: v - top wraps to a huge value above the top
-        span = np.maximum(bottom - top, 0).astype(np.uint16)
-        wall3 = (self._rows - np.repeat(top.astype(np.uint16), 3)) < np.repeat(span, 3)
+        top = np.searchsorted(self._neg_slope, -hi_slope, "left").astype(self._row_type)
+        bottom = np.searchsorted(self._neg_slope, -lo_slope, "right").astype(self._row_type)
+        rows = self._rows
+        wall = rows >= top
+        wall &= rows < bottom
         light = np.clip(1.1 - depth / 15.0, 0.45, 1.0)  # flat shading, darker with distance
         col = (colors * light[:, None]).astype(np.uint8).reshape(1, 3 * self.width)
-        rgb = np.where(wall3, col, self._background).reshape(self.height, self.width, 3)
+        # the image as (H, 3W) bytes, each pixel's mask repeated over its three channels: selecting
+        # bytes is cheaper than any interleaving of channels or a select over 3-byte elements
+        wall3 = rows >= np.repeat(top, 3)
+        wall3 &= rows < np.repeat(bottom, 3)
+        rgb = _select(wall3, col, self._background).reshape(self.height, self.width, 3)
         if scene.floor is not None:
-            self._paint_floor(rgb, wall3[:, ::3], scene.floor, x, y, yaw)
+            self._paint_floor(rgb, wall, scene.floor, x, y, yaw)
         wall_mm = np.rint(np.where(found, depth, 0.0) * 1000.0).astype(np.uint16)
-        depth_mm = np.where(wall3[:, ::3], wall_mm[None, :], self.floor_depth_mm[:, None])
+        depth_mm = _select(wall, wall_mm[None, :], self._floor_depth_image)
         return rgb, depth_mm
 
     def _paint_floor(
@@ -183,6 +190,46 @@ class Camera:
 
     def intrinsics(self) -> tuple[float, float, float, float]:
         return self.fx, self.fy, self.cx, self.cy
+
+
+def _padded_empty(shape: tuple[int, ...], dtype: type) -> np.ndarray:
+    """An uninitialised C-contiguous array on a buffer of whole 8-byte words (``.base``, uint64)."""
+    size = math.prod(shape) * np.dtype(dtype).itemsize
+    words = np.empty(-(-size // 8), dtype=np.uint64)
+    return words.view(np.uint8)[:size].view(dtype).reshape(shape)
+
+
+def _padded_copy(image: np.ndarray) -> np.ndarray:
+    out = _padded_empty(image.shape, image.dtype.type)
+    out[...] = image
+    return out
+
+
+def _words(image: np.ndarray) -> np.ndarray:
+    """The 8-byte words under an array made by :func:`_padded_empty`."""
+    base = image
+    while base.base is not None:
+        base = base.base
+    return base
+
+
+def _select(mask: np.ndarray, fore: np.ndarray, back: np.ndarray) -> np.ndarray:
+    """``np.where(mask, fore, back)`` for an unsigned-integer image ``back`` from :func:`_padded_copy`
+    (``fore`` broadcasts to its shape, ``mask`` is bool of its shape), a few times faster:
+    ``back ^ ((back ^ fore) & lanes)`` on 8-byte words, where ``lanes`` is all ones in each masked
+    element. The lanes are the mask as 0 / 1 elements times 0xFF (0xFFFF, ...): 1 times that fits its
+    own element, so no carry reaches the next one."""
+    dtype = back.dtype.type
+    out = _padded_empty(back.shape, dtype)
+    np.bitwise_xor(back, fore, out=out)
+    lanes = _padded_empty(back.shape, dtype)
+    np.copyto(lanes, mask, casting="unsafe")
+    lane_words = _words(lanes)
+    lane_words *= np.uint64((1 << (8 * back.itemsize)) - 1)
+    words = _words(out)
+    words &= lane_words
+    words ^= _words(back)
+    return out
 
 
 def imu_reading(
