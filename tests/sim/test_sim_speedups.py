@@ -158,3 +158,39 @@ def test_keep_freed_memory_is_harmless():
     assert keep_freed_memory() in (True, False)
     a = np.ones(1 << 20)
     assert float(a.sum()) == 1 << 20
+
+
+def brute_force_cast(ox, oy, angles, segments, max_range):  # type: ignore[no-untyped-def]
+    """Every ray against every segment."""
+    dx, dy = np.cos(angles)[:, None], np.sin(angles)[:, None]
+    px, py = segments[None, :, 0] - ox, segments[None, :, 1] - oy
+    ex, ey = segments[None, :, 2] - segments[None, :, 0], segments[None, :, 3] - segments[None, :, 1]
+    denom = dx * ey - dy * ex
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (px * ey - py * ex) / denom
+        u = (px * dy - py * dx) / denom
+    t = np.where((u >= -1e-9) & (u <= 1 + 1e-9) & (t >= 0) & np.isfinite(t), t, np.inf)
+    dist = t.min(axis=1)
+    return np.where(dist <= max_range, dist, np.inf)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_cast_segments_equals_brute_force(seed):
+    """Random segments (some out of range, some crossing the rays' first angle), lidar-like and
+    camera-like fans and scattered rays."""
+    rng = np.random.default_rng(seed)
+    start = rng.uniform(-15, 15, (300, 2))
+    segments = np.hstack([start, start + rng.uniform(-3, 3, (300, 2))])
+    for angles in (
+        np.linspace(-math.pi, math.pi, 360, endpoint=False) + rng.uniform(-3, 3),
+        rng.uniform(-3, 3) + np.arctan((159.5 - np.arange(320)) / 233.0),
+        rng.uniform(-10, 10, 40),
+    ):
+        ox, oy = rng.uniform(-5, 5, 2)
+        for max_range in (12.0, 2.0):
+            dist, hit = cast_segments(ox, oy, angles, segments, max_range)
+            expected = brute_force_cast(ox, oy, angles, segments, max_range)
+            assert np.array_equal(np.isinf(dist), np.isinf(expected))
+            seen = np.isfinite(dist)
+            assert np.allclose(dist[seen], expected[seen], rtol=0, atol=1e-9)
+            assert (hit[seen] >= 0).all() and (hit[~seen] == -1).all()
