@@ -15,7 +15,7 @@ import pytest
 from ninjemys.sim.puzzlebot_node import StepLock, keep_freed_memory
 from ninjemys.sim.raycast import cast_segments
 from ninjemys.sim.robot_model import load_robot_model
-from ninjemys.sim.sensors import FLOOR_RGB, SKY_RGB, _padded_copy, _select
+from ninjemys.sim.sensors import FLOOR_RGB, SKY_RGB, _padded_copy, _padded_empty, _select
 from ninjemys.sim.simcore import Simulation
 from ninjemys.sim.world2d import load_world
 from ninjemys.sim.worlds import world_path
@@ -33,7 +33,9 @@ def test_bitwise_select_equals_where(dtype, shape):
         rng.integers(0, top, (1, shape[1]), dtype=dtype, endpoint=True),
         rng.integers(0, top, shape, dtype=dtype, endpoint=True),
     ):
-        out = _select(mask, fore, back)
+        lanes = _padded_empty(shape, dtype)
+        np.copyto(lanes, mask)
+        out = _select(lanes, fore, back)
         assert out.dtype == dtype and out.shape == shape and out.flags.c_contiguous
         assert np.array_equal(out, np.where(mask, fore, back))
 

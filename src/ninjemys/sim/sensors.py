@@ -121,6 +121,10 @@ class Camera:
         self._row_type = np.uint8 if height <= 255 else np.uint16
         self._rows = np.arange(height, dtype=self._row_type)[:, None]
         self._floor_depth_image = _padded_copy(np.broadcast_to(self.floor_depth_mm[:, None], (height, width)))
+        # scratch masks, reused by every frame (render runs on one thread at a time: the node's lock)
+        self._lanes3 = _padded_empty((height, 3 * width), np.uint8)
+        self._below3 = np.empty((height, 3 * width), dtype=bool)
+        self._lanes1 = _padded_empty((height, width), np.uint16)
 
     def render(self, scene: Scene, x: float, y: float, yaw: float) -> tuple[np.ndarray, np.ndarray]:
         """(rgb8 image (H, W, 3), depth in mm uint16 (H, W)) from a camera at (x, y, cam_z) facing ``yaw``."""
@@ -156,13 +160,16 @@ class Camera:
         col = (colors * light[:, None]).astype(np.uint8).reshape(1, 3 * self.width)
         # the image as (H, 3W) bytes, each pixel's mask repeated over its three channels: selecting
         # bytes is cheaper than any interleaving of channels or a select over 3-byte elements
-        wall3 = rows >= np.repeat(top, 3)
-        wall3 &= rows < np.repeat(bottom, 3)
-        rgb = _select(wall3, col, self._background).reshape(self.height, self.width, 3)
+        wall3 = self._lanes3.view(bool)
+        np.greater_equal(rows, np.repeat(top, 3), out=wall3)
+        np.less(rows, np.repeat(bottom, 3), out=self._below3)
+        wall3 &= self._below3
+        rgb = _select(self._lanes3, col, self._background).reshape(self.height, self.width, 3)
         if scene.floor is not None:
             self._paint_floor(rgb, wall, scene.floor, x, y, yaw)
         wall_mm = np.rint(np.where(found, depth, 0.0) * 1000.0).astype(np.uint16)
-        depth_mm = _select(wall, wall_mm[None, :], self._floor_depth_image)
+        np.copyto(self._lanes1, wall)
+        depth_mm = _select(self._lanes1, wall_mm[None, :], self._floor_depth_image)
         return rgb, depth_mm
 
     def _paint_floor(
@@ -213,17 +220,14 @@ def _words(image: np.ndarray) -> np.ndarray:
     return base
 
 
-def _select(mask: np.ndarray, fore: np.ndarray, back: np.ndarray) -> np.ndarray:
-    """``np.where(mask, fore, back)`` for an unsigned-integer image ``back`` from :func:`_padded_copy`
-    (``fore`` broadcasts to its shape, ``mask`` is bool of its shape), a few times faster:
-    ``back ^ ((back ^ fore) & lanes)`` on 8-byte words, where ``lanes`` is all ones in each masked
-    element. The lanes are the mask as 0 / 1 elements times 0xFF (0xFFFF, ...): 1 times that fits its
-    own element, so no carry reaches the next one."""
-    dtype = back.dtype.type
-    out = _padded_empty(back.shape, dtype)
+def _select(lanes: np.ndarray, fore: np.ndarray, back: np.ndarray) -> np.ndarray:
+    """``np.where(lanes, fore, back)`` for an unsigned-integer image ``back`` from :func:`_padded_copy`,
+    a few times faster. ``lanes`` (from :func:`_padded_empty`, ``back``'s shape and type) holds 0 or 1
+    per element and is used up; ``fore`` broadcasts to ``back``'s shape. Computed as
+    ``back ^ ((back ^ fore) & lanes)`` on 8-byte words, with each lane turned into all ones by one
+    multiplication: 1 times 0xFF (0xFFFF, ...) fits its own element, so no carry reaches the next."""
+    out = _padded_empty(back.shape, back.dtype.type)
     np.bitwise_xor(back, fore, out=out)
-    lanes = _padded_empty(back.shape, dtype)
-    np.copyto(lanes, mask, casting="unsafe")
     lane_words = _words(lanes)
     lane_words *= np.uint64((1 << (8 * back.itemsize)) - 1)
     words = _words(out)
