@@ -131,11 +131,12 @@ class Camera:
         angles = yaw + self.col_angles
         far = self.depth_max / float(self.col_cos.min())
         dist, seg = cast_segments(x, y, angles, scene.segments, far)
-        heights = np.zeros(self.width)
-        colors = np.zeros((self.width, 3), dtype=np.float32)
         found = seg >= 0
-        heights[found] = scene.heights[seg[found]]
-        colors[found] = scene.colors[seg[found]]
+        if len(scene.heights):
+            # a column with no hit (-1) reads the last segment's: never drawn, ``found`` masks it out
+            heights, colors = scene.heights[seg], scene.colors[seg]
+        else:
+            heights, colors = np.zeros(self.width), np.zeros((self.width, 3), dtype=np.uint8)
         if len(scene.circles):
             cd, ci = cast_circles(x, y, angles, scene.circles, scene.radii, far)
             nearer = cd < dist
