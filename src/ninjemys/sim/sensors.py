@@ -201,9 +201,13 @@ class Camera:
 
 
 def _padded_empty(shape: tuple[int, ...], dtype: type) -> np.ndarray:
-    """An uninitialised C-contiguous array on a buffer of whole 8-byte words (``.base``, uint64)."""
+    """An uninitialised C-contiguous array on a buffer of whole 8-byte words (``.base``, uint64).
+    The last word is zeroed, so padding past the array's end holds no garbage that a
+    multiplication on words could carry into the array (on a big-endian machine)."""
     size = math.prod(shape) * np.dtype(dtype).itemsize
     words = np.empty(-(-size // 8), dtype=np.uint64)
+    if len(words):
+        words[-1] = 0
     return words.view(np.uint8)[:size].view(dtype).reshape(shape)
 
 
