@@ -457,8 +457,11 @@ class Simulation:
             geometry = self._collision_geometry(r.x, r.y, travel + radius + 0.05, r.name, static)
             pieces = max(1, math.ceil(travel / (radius * 0.5)))
             f = np.arange(0, pieces + 1) / pieces
-            dist, who = self._clearances(r.x + f * ddx, r.y + f * ddy, r.name, geometry)
-            blocked = np.flatnonzero((dist[1:] < radius) & (dist[1:] < dist[0] - 1e-12))
+            if len(geometry[0]) or len(geometry[2]):
+                dist, who = self._clearances(r.x + f * ddx, r.y + f * ddy, r.name, geometry)
+                blocked = np.flatnonzero((dist[1:] < radius) & (dist[1:] < dist[0] - 1e-12))
+            else:
+                blocked = f[:0]  # nothing within reach: the move is free
             if len(blocked):
                 k = int(blocked[0]) + 1
                 lo, hi = f[k - 1], f[k]
