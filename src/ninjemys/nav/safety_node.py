@@ -11,13 +11,18 @@ priority goes out on ``cmd_vel``, after these guards:
   and then braking (``~max_decel``) would bring the footprint (``~robot_radius`` or ``~footprint``)
   within ``~safety_margin`` (+ ``~obstacle_speed`` x that time, for people walking in) of a point of
   the latest ``scan`` it is not already moving away from; turning in place stays allowed;
-- localization: when ``amcl_pose``'s position variance (xx + yy) exceeds ``~max_position_covariance``,
-  inputs named in ``~localization_inputs`` (default ``[navigation]``) are ignored;
+- scan watchdog: once a scan has come, a latest scan older than ``~scan_timeout`` (1 s; 0: off) no
+  longer shows the way ahead, so linear motion is cut until scans come again (turning stays allowed);
+- localization: when ``amcl_pose``'s position variance (xx + yy) exceeds ``~max_position_covariance``
+  (or is not a number), inputs named in ``~localization_inputs`` (default ``[navigation]``) are ignored
+  until an ``amcl_pose`` within the limit comes;
 - e-stop: ``e_stop`` (std_msgs/Bool, true) or the ``~e_stop`` service (std_srvs/SetBool, true) latches
   a stop of everything until ``~e_stop`` is called with false (or ``~reset_e_stop``, std_srvs/Trigger);
   the state is latched on ``~e_stop_active``.
 
-Status goes out as diagnostic_msgs/DiagnosticArray on ``/diagnostics`` once a second.
+Status goes out as diagnostic_msgs/DiagnosticArray on ``/diagnostics`` every ``~diagnostic_period``
+seconds (1), laid out as diagnostic_updater does: one status named ``<node name>: Safety`` with a
+level, a message, ``~hardware_id`` (``puzzlebot``) and key/values.
 """
 
 from __future__ import annotations
@@ -86,15 +91,21 @@ class SafetyMonitor:
         self.max_decel = param(node, "max_decel", 1.0)
         self.reaction = param(node, "reaction_time", 0.15)
         self.obstacle_speed = param(node, "obstacle_speed", 0.0)
+        self.scan_timeout = param(node, "scan_timeout", 1.0)
         self.max_cov = param(node, "max_position_covariance", 0.5)
         self.loc_inputs = set(node.get_param("~localization_inputs", ["navigation"]) or [])
         self.rate = max(1.0, param(node, "rate", 20.0))
         self.base_frame = param(node, "base_frame", "base_link")
+        self.diag_period = param(node, "diagnostic_period", 1.0)
+        self.hardware_id = param(node, "hardware_id", "puzzlebot")
+        # diagnostic_updater names a status "<node name without the leading slash>: <task>"
+        self.diag_name = f"{node.name.lstrip('/')}: Safety"
         self.tf = Tf2D(node)
         self.points = np.zeros((0, 2))
-        self.scan_time = -1e9
+        self.scan_time: float | None = None
         self.velocity = 0.0
         self.cov: float | None = None
+        self.scan_stale = False
         self.e_stop = False
         self.blocked = False
         self.active: str | None = None
@@ -156,6 +167,14 @@ class SafetyMonitor:
     def on_pose(self, msg: Any) -> None:
         c = msg.pose.covariance
         self.cov = float(c[0]) + float(c[7])
+        if math.isnan(self.cov):
+            rospy.logwarn_throttle(
+                5.0, "safety_monitor: amcl_pose: NaN position covariance; treated as localization lost"
+            )
+
+    def localization_lost(self) -> bool:
+        """A variance over the limit, or NaN (which compares false with everything), is lost."""
+        return self.cov is not None and not self.cov <= self.max_cov
 
     def _set_e_stop(self, on: bool, why: str) -> None:
         from std_msgs.msg import Bool
@@ -195,8 +214,9 @@ class SafetyMonitor:
             if self.e_stop:
                 self.active = "e_stop"
                 return 0.0, 0.0, True
+            self._check_scan_age(now)
             allowed = None
-            if self.cov is not None and self.cov > self.max_cov:
+            if self.localization_lost():
                 allowed = {i.name for i in self.mux.inputs} - self.loc_inputs
             inp = self.mux.select(now, allowed)
             if inp is None:
@@ -218,9 +238,28 @@ class SafetyMonitor:
                 self.reaction,
                 self.obstacle_speed,
             )
-            if self.blocked:
+            if self.blocked or self.scan_stale:
                 v = 0.0
             return v, w, True
+
+    def _check_scan_age(self, now: float) -> None:
+        """Update ``scan_stale`` (no scan yet is not stale: a robot may run without a laser)."""
+        stale = (
+            self.scan_timeout > 0.0
+            and self.scan_time is not None
+            and now - self.scan_time > self.scan_timeout
+        )
+        if stale != self.scan_stale:
+            if stale:
+                rospy.logwarn(
+                    "safety_monitor: no scan on %s for %.2f s (~scan_timeout %.2f); linear motion stopped",
+                    self.node.resolve_name("scan"),
+                    now - (self.scan_time or 0.0),
+                    self.scan_timeout,
+                )
+            else:
+                rospy.loginfo("safety_monitor: scans again on %s", self.node.resolve_name("scan"))
+        self.scan_stale = stale
 
     def loop(self) -> None:
         rate = rospy.Rate(self.rate)
@@ -244,13 +283,15 @@ class SafetyMonitor:
     def diag_loop(self) -> None:
         from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
 
-        while sleep(1.0):
+        while sleep(self.diag_period):
             with self.lock:
                 e_stop, active, is_blocked, cov = self.e_stop, self.active, self.blocked, self.cov
-            status = DiagnosticStatus(name="safety_monitor: Safety", hardware_id="puzzlebot")
-            lost = cov is not None and cov > self.max_cov
+                lost, scan_stale = self.localization_lost(), self.scan_stale
+            status = DiagnosticStatus(name=self.diag_name, hardware_id=self.hardware_id)
             if e_stop:
                 status.level, status.message = DiagnosticStatus.ERROR, "E-stop engaged"
+            elif scan_stale:
+                status.level, status.message = DiagnosticStatus.WARN, "Scan stale: linear motion stopped"
             elif is_blocked:
                 status.level, status.message = DiagnosticStatus.WARN, "Obstacle in the stop zone"
             elif lost:
@@ -263,6 +304,7 @@ class SafetyMonitor:
                 KeyValue(key="active_input", value=str(active)),
                 KeyValue(key="e_stop", value=str(e_stop)),
                 KeyValue(key="stop_zone_blocked", value=str(is_blocked)),
+                KeyValue(key="scan_stale", value=str(scan_stale)),
                 KeyValue(key="position_covariance", value="unknown" if cov is None else f"{cov:.4f}"),
             ]
             arr = self._diag_cls(status=[status])
