@@ -178,6 +178,11 @@ class Rig:
         with self.lock:
             self.scan = wall_scan(distance)
 
+    def jump(self, seconds: float) -> None:
+        """Move sim time by ``seconds`` at once (negative: a simulation reset)."""
+        with self.lock:
+            self.now = round(self.now + seconds, 6)
+
     def scan_off(self) -> None:
         """The laser goes quiet."""
         with self.lock:
@@ -281,6 +286,24 @@ def test_safety_live_teleop_over_navigation_and_the_watchdog_on_sim_time(rig):
     assert max(zeros) - first_zero == pytest.approx(1.0, abs=0.15)
     rig.stream("teleop", 0.05, 0.0)
     assert rig.output() == pytest.approx((0.05, 0.0))  # a fresh command passes again
+
+
+def test_safety_live_watchdog_survives_time_moving_backwards(rig):
+    rig.jump(20.0)
+    rig.stream("navigation", 0.2, 0.0)
+    assert rig.output() == pytest.approx((0.2, 0.0))
+    diags = len(rig.diags)
+    rig.stream("navigation", None)
+    rig.jump(-15.0)  # /gazebo/reset_simulation: the last command now lies 15 s in the future
+    back = rig.now
+    assert rig.output(1.0) == (0.0, 0.0)
+    first_zero = next(t for t, v, w in rig.cmds_from(back) if v == 0.0)
+    assert first_zero - back <= 0.5 + 0.1
+    rig.settle(1.5)
+    assert len(rig.diags) > diags + 1  # diagnostics go on after the jump
+    rig.stream("teleop", 0.1, 0.0)
+    assert rig.output() == pytest.approx((0.1, 0.0))
+    assert "ROS time moved backwards" in rig.log()
 
 
 def test_safety_live_e_stop_topic_and_services_latch_until_reset(rig):

@@ -35,7 +35,7 @@ import numpy as np
 
 import rospy
 from ninjemys.nav.costmap import footprint_radii, parse_footprint
-from ninjemys.nav.rosglue import Tf2D, param, run_node, scan_arrays, sleep
+from ninjemys.nav.rosglue import Tf2D, param, run_node, scan_arrays
 from ninjemys.nav.safety import MuxInput, TwistMux, blocked
 
 DEFAULT_TOPICS = [
@@ -75,6 +75,7 @@ class SafetyMonitor:
 
         self.node = node
         self.lock = threading.Lock()
+        self.out_lock = threading.Lock()  # one twist decided and published at a time
         inputs, errors = parse_topics(node.get_param("~topics", DEFAULT_TOPICS))
         for line in errors:
             rospy.logerr("safety_monitor: %s", line)
@@ -110,6 +111,7 @@ class SafetyMonitor:
         self.blocked = False
         self.active: str | None = None
         self.stale_since: float | None = None
+        self.last_now = -1e9
         self.bad_scan_reported = False
         self._twist, self._diag_cls = Twist, DiagnosticArray
         self.cmd_pub = node.publisher("cmd_vel", Twist, queue_size=1)
@@ -179,16 +181,18 @@ class SafetyMonitor:
     def _set_e_stop(self, on: bool, why: str) -> None:
         from std_msgs.msg import Bool
 
-        with self.lock:
-            changed = self.e_stop != on
-            self.e_stop = on
+        with self.out_lock:  # no twist decided before the e-stop goes out after its stop
+            with self.lock:
+                changed = self.e_stop != on
+                self.e_stop = on
+            if changed:
+                self.estop_pub.publish(Bool(data=on))
+                if on:
+                    self.cmd_pub.publish(self._twist())
         if changed:
             (rospy.logwarn if on else rospy.loginfo)(
                 "safety_monitor: e-stop %s (%s)", "ENGAGED" if on else "reset", why
             )
-            self.estop_pub.publish(Bool(data=on))
-            if on:
-                self.cmd_pub.publish(self._twist())
 
     def on_e_stop_topic(self, msg: Any) -> None:
         if msg.data:
@@ -211,6 +215,9 @@ class SafetyMonitor:
     def decide(self, now: float) -> tuple[float, float, bool]:
         """(v, w, publish?) for this cycle."""
         with self.lock:
+            if now < self.last_now:
+                self._time_moved_backwards(now)
+            self.last_now = now
             if self.e_stop:
                 self.active = "e_stop"
                 return 0.0, 0.0, True
@@ -242,6 +249,19 @@ class SafetyMonitor:
                 v = 0.0
             return v, w, True
 
+    def _time_moved_backwards(self, now: float) -> None:
+        """A simulation reset or a looping bag: every age measured before is meaningless now, and a
+        command stamped in the old future would otherwise stay fresh until time caught up with it."""
+        rospy.loginfo(
+            "safety_monitor: ROS time moved backwards (%.3f -> %.3f); inputs and scan forgotten",
+            self.last_now,
+            now,
+        )
+        for inp in self.mux.inputs:
+            inp.last_time = -1e9
+        self.scan_time = None
+        self.stale_since = None
+
     def _check_scan_age(self, now: float) -> None:
         """Update ``scan_stale`` (no scan yet is not stale: a robot may run without a laser)."""
         stale = (
@@ -264,26 +284,41 @@ class SafetyMonitor:
     def loop(self) -> None:
         rate = rospy.Rate(self.rate)
         while not rospy.is_shutdown():
-            try:
-                v, w, publish = self.decide(rospy.get_time())
-            except Exception as exc:  # the guard must keep guarding: stop and report
-                rospy.logerr_throttle(
-                    5.0, "safety_monitor: %s: %s; stopping the robot", type(exc).__name__, exc
-                )
-                v, w, publish = 0.0, 0.0, True
-            if publish:
-                msg = self._twist()
-                msg.linear.x, msg.angular.z = v, w
-                self.cmd_pub.publish(msg)
+            with self.out_lock:
+                try:
+                    v, w, publish = self.decide(rospy.get_time())
+                except Exception as exc:  # the guard must keep guarding: stop and report
+                    rospy.logerr_throttle(
+                        5.0, "safety_monitor: %s: %s; stopping the robot", type(exc).__name__, exc
+                    )
+                    v, w, publish = 0.0, 0.0, True
+                if publish:
+                    msg = self._twist()
+                    msg.linear.x, msg.angular.z = v, w
+                    self.cmd_pub.publish(msg)
             try:
                 rate.sleep()
+            except rospy.ROSTimeMovedBackwardsException:
+                continue
             except rospy.ROSInterruptException:
                 return
+
+    @staticmethod
+    def _sleep(seconds: float) -> bool:
+        """Sleep ``seconds`` of ROS time; False on shutdown. Time moving backwards (a simulation
+        reset) ends the sleep early, and the loop goes on."""
+        try:
+            rospy.sleep(seconds)
+        except rospy.ROSTimeMovedBackwardsException:
+            pass
+        except rospy.ROSInterruptException:
+            return False
+        return not rospy.is_shutdown()
 
     def diag_loop(self) -> None:
         from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
 
-        while sleep(self.diag_period):
+        while self._sleep(self.diag_period):
             with self.lock:
                 e_stop, active, is_blocked, cov = self.e_stop, self.active, self.blocked, self.cov
                 lost, scan_stale = self.localization_lost(), self.scan_stale
