@@ -448,18 +448,35 @@ def test_safety_live_diagnostics_in_diagnostic_updater_layout(renamed_rig):
 @pytest.mark.ros1
 @pytest.mark.skipif(not have_ros1(), reason="Debian's ROS 1 is not installed")
 def test_safety_live_diagnostics_read_by_debian_rostopic(rig, tmp_path):
-    rig.e_stop_pub.publish(Bool(data=True))
+    """Debian's rostopic and rosservice drive the e-stop and read /diagnostics: the types are ROS 1's."""
+    env = ros1_env(rig.uri, ROS_HOME=str(tmp_path / "ros1_home"))
+
+    def ros1(*args: str) -> str:
+        out = subprocess.run(args, env=env, capture_output=True, text=True, timeout=60)
+        assert out.returncode == 0, out.stderr
+        return out.stdout
+
+    def echoed_status() -> dict:
+        return yaml.safe_load(ros1("/usr/bin/rostopic", "echo", "-n", "1", "/diagnostics").split("---")[0])[
+            "status"
+        ][0]
+
+    rig.stream("navigation", 0.2, 0.0)
+    ros1("/usr/bin/rostopic", "pub", "-1", "/e_stop", "std_msgs/Bool", "data: true")
     assert rig.wait_real(lambda: rig.e_stop_active[-1:] == [True])
-    out = subprocess.run(
-        ["/usr/bin/rostopic", "echo", "-n", "1", "/diagnostics"],
-        env=ros1_env(rig.uri, ROS_HOME=str(tmp_path / "ros1_home")),
-        capture_output=True,
-        text=True,
-        timeout=60,
-    )
-    assert out.returncode == 0, out.stderr
-    echoed = yaml.safe_load(out.stdout.split("---")[0])
-    status = echoed["status"][0]
+    status = echoed_status()
     assert status["name"] == "safety_monitor: Safety" and status["level"] == 2  # ERROR
-    assert status["message"] == "E-stop engaged" and status["hardware_id"]
+    assert status["message"] == "E-stop engaged" and status["hardware_id"] == "puzzlebot"
     assert {kv["key"]: kv["value"] for kv in status["values"]}["e_stop"] == "True"
+    assert "True" in ros1("/usr/bin/rostopic", "echo", "-n", "1", "/safety_monitor/e_stop_active")
+
+    reply = yaml.safe_load(ros1("/usr/bin/rosservice", "call", "/safety_monitor/reset_e_stop"))
+    assert reply["success"] is True
+    assert rig.output() == pytest.approx((0.2, 0.0))
+    reply = yaml.safe_load(ros1("/usr/bin/rosservice", "call", "/safety_monitor/e_stop", "data: true"))
+    assert reply["success"] is True
+    assert rig.output() == (0.0, 0.0)
+    ros1("/usr/bin/rosservice", "call", "/safety_monitor/e_stop", "data: false")
+    assert rig.output() == pytest.approx((0.2, 0.0))
+    status = echoed_status()
+    assert status["level"] == 0 and status["message"] == "Passing navigation"
