@@ -55,7 +55,7 @@ def wall_scan(distance: float | None) -> Any:
 class Rig:
     """A master on sim time, the monitor as a process, and a test node feeding it and watching it."""
 
-    def __init__(self, tmp_path: Path, name: str = "safety_monitor") -> None:
+    def __init__(self, tmp_path: Path, name: str = "safety_monitor", params: dict | None = None) -> None:
         from ninjemys.node import Node
 
         self._master = run_master()
@@ -65,11 +65,12 @@ class Rig:
         )
         self.node = Node("safety_rig", anonymous=True, master_uri=self.uri, sim_time=False)
         self.node.set_param("/use_sim_time", True)
-        for key, value in yaml.safe_load(PARAMS.read_text()).items():
+        for key, value in {**yaml.safe_load(PARAMS.read_text()), **(params or {})}.items():
             self.node.set_param(f"/{name}/{key}", value)
         self.lock = threading.Lock()
         self.now = 1.0
         self.streams: dict[str, tuple[float, float]] = {}
+        self.flags: dict[str, tuple[Any, bool]] = {}  # Bool topics streamed: publisher, value
         self.last_sent: dict[str, float] = {}
         self.scan: Any = None
         self.odom_v: float | None = None
@@ -111,7 +112,7 @@ class Rig:
         self.node.wait_for_service(f"/{name}/reset_e_stop", timeout=30.0)
         # every input of the monitor connected: the master lists it as their subscriber
         deadline = time.monotonic() + 30.0
-        wanted = {"/teleop/cmd_vel", "/nav/cmd_vel", "/scan", "/odom", "/amcl_pose", "/e_stop", "/clock"}
+        wanted = {"/scan", "/odom", "/amcl_pose", "/e_stop", "/clock"}  # the inputs depend on ~topics
         while time.monotonic() < deadline:
             state = self.node.master.get_system_state()
             subscribed = {topic for topic, nodes in state[1] if f"/{name}" in nodes}
@@ -129,7 +130,7 @@ class Rig:
             with self.lock:
                 self.now = round(self.now + STEP, 6)
                 now = self.now
-                streams = dict(self.streams)
+                streams, flags = dict(self.streams), dict(self.flags)
                 scan, odom_v = self.scan, self.odom_v
             self._clock_msg.clock = _time(now)
             self._clock_pub.publish(self._clock_msg)
@@ -141,6 +142,8 @@ class Rig:
                     self.pubs[name].publish(msg)
                     with self.lock:
                         self.last_sent[name] = now
+                for pub, value in flags.values():
+                    pub.publish(Bool(data=value))
                 if odom_v is not None:
                     odom = self._odom_cls()
                     odom.header.stamp = _time(now)
@@ -168,6 +171,8 @@ class Rig:
 
     def stream(self, name: str, v: float | None, w: float = 0.0) -> None:
         """Publish (v, w) on input ``name`` at 20 Hz sim from now on (None: stop publishing)."""
+        if v is not None:
+            assert self.wait_real(lambda: self.pubs[name].get_num_connections() > 0)
         with self.lock:
             if v is None:
                 self.streams.pop(name, None)
@@ -177,6 +182,17 @@ class Rig:
     def set_scan(self, distance: float | None) -> None:
         with self.lock:
             self.scan = wall_scan(distance)
+
+    def flag(self, topic: str, value: bool | None) -> None:
+        """Publish std_msgs/Bool ``value`` on ``topic`` at 20 Hz sim from now on (None: stop)."""
+        if value is None:
+            with self.lock:
+                self.flags.pop(topic, None)
+            return
+        pub = self.flags[topic][0] if topic in self.flags else self.node.publisher(topic, Bool, queue_size=1)
+        assert self.wait_real(lambda: pub.get_num_connections() > 0)
+        with self.lock:
+            self.flags[topic] = (pub, value)
 
     def jump(self, seconds: float) -> None:
         """Move sim time by ``seconds`` at once (negative: a simulation reset)."""
@@ -306,6 +322,70 @@ def test_safety_live_watchdog_survives_time_moving_backwards(rig):
     assert "ROS time moved backwards" in rig.log()
 
 
+LOCKS = [
+    {"name": "pause", "topic": "pause_navigation", "timeout": 0.0, "priority": 50},
+    {"name": "heartbeat", "topic": "nav_heartbeat", "timeout": 0.5, "priority": 20},
+]
+
+
+def test_safety_live_twist_mux_locks_mask_lower_priorities(tmp_path):
+    rig = Rig(tmp_path, params={"locks": LOCKS})
+    try:
+        rig.stream("navigation", 0.2, 0.0)
+        start = rig.settle(0.5)
+        # a lock with a timeout that has never spoken is locked (twist_mux): navigation is masked
+        assert all(v == 0.0 for t, v, w in rig.cmds_from(start))
+        rig.flag("/nav_heartbeat", False)
+        assert rig.output() == pytest.approx((0.2, 0.0))
+        rig.flag("/pause_navigation", True)
+        assert rig.output() == (0.0, 0.0)
+        values = {kv.key: kv.value for kv in rig.status(rig.now).values}
+        assert values["lock pause"].startswith("locked") and values["current priority"] == "50"
+        assert values["velocity navigation"].startswith("masked")
+        rig.stream("teleop", 0.1, 0.3)  # teleop's priority 100 is above the lock's 50
+        assert rig.output() == pytest.approx((0.1, 0.3))
+        rig.stream("teleop", None)
+        rig.flag("/pause_navigation", False)
+        assert rig.output(0.8) == pytest.approx((0.2, 0.0))
+        rig.flag("/nav_heartbeat", None)  # the heartbeat stops: locked again after its 0.5 s
+        stopped = rig.now
+        assert rig.output(0.8) == (0.0, 0.0)
+        cut = next(t for t, v, w in rig.cmds_from(stopped) if v == 0.0)
+        assert cut - stopped <= 0.5 + 0.1 + 0.1
+    finally:
+        rig.close()
+    assert "Traceback" not in rig.log()
+
+
+def test_safety_live_mux_parameters_are_checked_one_line_each(tmp_path):
+    rig = Rig(
+        tmp_path,
+        params={
+            "topics": [
+                {"name": "joystick", "topic": "joy_vel", "timeout": 0.0, "priority": 300},
+                {"name": "navigation", "topic": "nav/cmd_vel", "timeout": "soon", "priority": 10},
+            ],
+            "locks": [{"name": "nowhere", "priority": 5}],
+        },
+    )
+    try:
+        assert rig.wait_real(lambda: "~locks[0]" in rig.log())
+        log = rig.log()
+        assert len([line for line in log.splitlines() if "~topics[1]" in line]) == 1
+        assert "could not convert string to float: 'soon'" in log
+        assert "~locks[0]: missing 'topic'" in log
+        assert "input joystick (/joy_vel) has no timeout" in log
+        joy = rig.node.publisher("/joy_vel", Twist, queue_size=1)
+        assert rig.wait_real(lambda: joy.get_num_connections() > 0)
+        msg = Twist()
+        msg.linear.x = 0.1
+        joy.publish(msg)  # once: with no timeout it holds, as in twist_mux
+        assert rig.output(1.5) == pytest.approx((0.1, 0.0))
+    finally:
+        rig.close()
+    assert "Traceback" not in rig.log()
+
+
 def test_safety_live_e_stop_topic_and_services_latch_until_reset(rig):
     SetBool = get_service_class("std_srvs/SetBool")
     Trigger = get_service_class("std_srvs/Trigger")
@@ -422,13 +502,17 @@ def renamed_rig(tmp_path):
 def test_safety_live_diagnostics_in_diagnostic_updater_layout(renamed_rig):
     rig = renamed_rig  # started as __name:=base_guard: the status is named after the node
     rig.stream("navigation", 0.2, 0.0)
-    status = rig.status(rig.settle(0.3))
+    assert rig.output() == pytest.approx((0.2, 0.0))
+    status = rig.status(rig.now)
     msg = rig.diags[-1]
     assert msg._type == "diagnostic_msgs/DiagnosticArray" and len(msg.status) == 1
     assert status.name == "base_guard: Safety"  # diagnostic_updater's "<node>: <task>"
     assert status.hardware_id and status.level == status.OK and status.message == "Passing navigation"
     values = {kv.key: kv.value for kv in status.values}
     assert values["active_input"] == "navigation" and values["e_stop"] == "False"
+    # and twist_mux's own keys
+    assert values["velocity navigation"].startswith("unmasked (listening to /nav/cmd_vel @ 0.5")
+    assert values["velocity teleop"].startswith("masked") and values["current priority"] == "0"
     # once a second of ROS time, as diagnostic_updater's default ~diagnostic_period
     stamps = sorted({d.header.stamp.to_sec() for d in rig.diags})
     assert all(b - a == pytest.approx(1.0, abs=0.15) for a, b in zip(stamps, stamps[1:], strict=False))

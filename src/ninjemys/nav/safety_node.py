@@ -36,7 +36,7 @@ import numpy as np
 import rospy
 from ninjemys.nav.costmap import footprint_radii, parse_footprint
 from ninjemys.nav.rosglue import Tf2D, param, run_node, scan_arrays
-from ninjemys.nav.safety import MuxInput, TwistMux, blocked
+from ninjemys.nav.safety import NEVER, MuxInput, MuxLock, TwistMux, blocked
 
 DEFAULT_TOPICS = [
     {"name": "teleop", "topic": "teleop/cmd_vel", "timeout": 0.5, "priority": 100},
@@ -44,24 +44,43 @@ DEFAULT_TOPICS = [
 ]
 
 
-def parse_topics(value: Any) -> tuple[list[MuxInput], list[str]]:
-    """twist_mux's ``topics`` parameter (a list, or a dict keyed by name) -> inputs, and error lines."""
-    items = list(value.items()) if isinstance(value, dict) else list(enumerate(value or []))
-    inputs, errors = [], []
+def _parse_handles(value: Any, param: str, cls: type[Any]) -> tuple[list[Any], list[str]]:
+    """twist_mux's ``topics``/``locks`` layout (a list of ``{name, topic, timeout, priority}``, or a
+    dict keyed by name) -> handles of ``cls``, and one error line per bad entry. Priorities are
+    clamped to 0..255 and a missing timeout is 0.5 s for topics, none for locks."""
+    if value is None:
+        return [], []
+    if not isinstance(value, (list, dict)):
+        return [], [
+            f"~{param}: expected a list of mappings with name, topic, timeout, priority, got {value!r}"
+        ]
+    items = list(value.items()) if isinstance(value, dict) else list(enumerate(value))
+    handles, errors = [], []
     for key, entry in items:
         if not isinstance(entry, dict):
-            errors.append(f"~topics[{key}]: expected a mapping with name, topic, timeout, priority")
+            errors.append(f"~{param}[{key}]: expected a mapping with name, topic, timeout, priority")
+            continue
+        if "topic" not in entry:
+            errors.append(f"~{param}[{key}]: missing 'topic'")
             continue
         try:
-            name = str(entry.get("name", key))
-            inputs.append(
-                MuxInput(
-                    name, str(entry["topic"]), int(entry.get("priority", 0)), float(entry.get("timeout", 0.5))
-                )
-            )
-        except (KeyError, TypeError, ValueError) as exc:
-            errors.append(f"~topics[{key}]: {type(exc).__name__} {exc}")
-    return inputs, errors
+            priority = min(255, max(0, int(entry.get("priority", 0))))
+            timeout = float(entry.get("timeout", 0.5 if cls is MuxInput else 0.0))
+        except (TypeError, ValueError) as exc:
+            errors.append(f"~{param}[{key}]: {exc}")
+            continue
+        handles.append(cls(str(entry.get("name", key)), str(entry["topic"]), priority, timeout))
+    return handles, errors
+
+
+def parse_topics(value: Any) -> tuple[list[MuxInput], list[str]]:
+    """twist_mux's ``topics`` parameter -> inputs, and error lines."""
+    return _parse_handles(value, "topics", MuxInput)
+
+
+def parse_locks(value: Any) -> tuple[list[MuxLock], list[str]]:
+    """twist_mux's ``locks`` parameter -> locks, and error lines."""
+    return _parse_handles(value, "locks", MuxLock)
 
 
 class SafetyMonitor:
@@ -77,9 +96,18 @@ class SafetyMonitor:
         self.lock = threading.Lock()
         self.out_lock = threading.Lock()  # one twist decided and published at a time
         inputs, errors = parse_topics(node.get_param("~topics", DEFAULT_TOPICS))
-        for line in errors:
+        locks, lock_errors = parse_locks(node.get_param("~locks", []))
+        for line in errors + lock_errors:
             rospy.logerr("safety_monitor: %s", line)
-        self.mux = TwistMux(inputs or parse_topics(DEFAULT_TOPICS)[0])
+        self.mux = TwistMux(inputs or parse_topics(DEFAULT_TOPICS)[0], locks)
+        for inp in self.mux.inputs:
+            if inp.timeout <= 0.0:
+                rospy.logwarn(
+                    "safety_monitor: input %s (%s) has no timeout: its last command holds until "
+                    "another input takes over",
+                    inp.name,
+                    node.resolve_name(inp.topic),
+                )
         radius = param(node, "robot_radius", 0.12)
         fp = node.get_param("~footprint", None)
         if fp:
@@ -111,7 +139,7 @@ class SafetyMonitor:
         self.blocked = False
         self.active: str | None = None
         self.stale_since: float | None = None
-        self.last_now = -1e9
+        self.last_now = NEVER
         self.bad_scan_reported = False
         self._twist, self._diag_cls = Twist, DiagnosticArray
         self.cmd_pub = node.publisher("cmd_vel", Twist, queue_size=1)
@@ -120,6 +148,8 @@ class SafetyMonitor:
         self.estop_pub.publish(Bool(data=False))
         for inp in self.mux.inputs:
             node.subscriber(inp.topic, Twist, self.on_cmd, callback_args=inp, queue_size=1)
+        for lock in self.mux.locks:
+            node.subscriber(lock.topic, Bool, self.on_lock, callback_args=lock, queue_size=1)
         node.subscriber("scan", LaserScan, self.on_scan, queue_size=1)
         node.subscriber("odom", Odometry, self.on_odom, queue_size=1)
         node.subscriber("amcl_pose", PoseWithCovarianceStamped, self.on_pose, queue_size=1)
@@ -138,6 +168,10 @@ class SafetyMonitor:
             return
         with self.lock:
             inp.v, inp.w, inp.last_time = v, w, rospy.get_time()
+
+    def on_lock(self, msg: Any, lock: MuxLock) -> None:
+        with self.lock:
+            lock.data, lock.last_time = bool(msg.data), rospy.get_time()
 
     def on_scan(self, scan: Any) -> None:
         ranges, angles = scan_arrays(scan)
@@ -218,6 +252,7 @@ class SafetyMonitor:
             if now < self.last_now:
                 self._time_moved_backwards(now)
             self.last_now = now
+            self.blocked = False
             if self.e_stop:
                 self.active = "e_stop"
                 return 0.0, 0.0, True
@@ -257,8 +292,8 @@ class SafetyMonitor:
             self.last_now,
             now,
         )
-        for inp in self.mux.inputs:
-            inp.last_time = -1e9
+        for handle in [*self.mux.inputs, *self.mux.locks]:
+            handle.last_time = NEVER
         self.scan_time = None
         self.stale_since = None
 
@@ -319,9 +354,27 @@ class SafetyMonitor:
         from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
 
         while self._sleep(self.diag_period):
+            now = rospy.get_time()
             with self.lock:
                 e_stop, active, is_blocked, cov = self.e_stop, self.active, self.blocked, self.cov
                 lost, scan_stale = self.localization_lost(), self.scan_stale
+                floor = self.mux.lock_priority(now)
+                # twist_mux's own keys: each input masked or not, each lock locked or free
+                mux_values = [
+                    (
+                        f"velocity {inp.name}",
+                        f"{'masked' if self.mux.masked(inp, now) else 'unmasked'} (listening to "
+                        f"{self.node.resolve_name(inp.topic)} @ {inp.timeout:f}s with priority #{inp.priority})",
+                    )
+                    for inp in self.mux.inputs
+                ] + [
+                    (
+                        f"lock {lock.name}",
+                        f"{'locked' if lock.locked(now) else 'free'} (listening to "
+                        f"{self.node.resolve_name(lock.topic)} @ {lock.timeout:f}s with priority #{lock.priority})",
+                    )
+                    for lock in self.mux.locks
+                ]
             status = DiagnosticStatus(name=self.diag_name, hardware_id=self.hardware_id)
             if e_stop:
                 status.level, status.message = DiagnosticStatus.ERROR, "E-stop engaged"
@@ -331,6 +384,8 @@ class SafetyMonitor:
                 status.level, status.message = DiagnosticStatus.WARN, "Obstacle in the stop zone"
             elif lost:
                 status.level, status.message = DiagnosticStatus.WARN, "Localization lost: navigation stopped"
+            elif active is None and floor > 0:
+                status.level, status.message = DiagnosticStatus.OK, f"Locked below priority {floor}"
             elif active is None:
                 status.level, status.message = DiagnosticStatus.OK, "Idle (no fresh command)"
             else:
@@ -341,6 +396,8 @@ class SafetyMonitor:
                 KeyValue(key="stop_zone_blocked", value=str(is_blocked)),
                 KeyValue(key="scan_stale", value=str(scan_stale)),
                 KeyValue(key="position_covariance", value="unknown" if cov is None else f"{cov:.4f}"),
+                *(KeyValue(key=key, value=value) for key, value in mux_values),
+                KeyValue(key="current priority", value=str(floor)),
             ]
             arr = self._diag_cls(status=[status])
             arr.header.stamp = rospy.Time.from_sec(rospy.get_time())
