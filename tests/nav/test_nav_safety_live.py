@@ -487,6 +487,12 @@ def test_safety_live_stop_zone_from_footprint_and_velocity_against_the_latest_sc
     assert status.level == status.WARN and "Scan stale" in status.message
     rig.set_scan(None)
     assert rig.output() == pytest.approx((0.2, 0.4))
+    rig.set_scan(0.25)
+    assert rig.output() == pytest.approx((0.0, 0.4))
+    rig.stream("navigation", None)  # nothing drives any more: nothing is blocked either
+    rig.settle(0.8)
+    status = rig.status(rig.now)
+    assert status.level == status.OK and status.message == "Idle (no fresh command)"
 
 
 @pytest.fixture
