@@ -381,6 +381,10 @@ def test_safety_live_mux_parameters_are_checked_one_line_each(tmp_path):
         msg.linear.x = 0.1
         joy.publish(msg)  # once: with no timeout it holds, as in twist_mux
         assert rig.output(1.5) == pytest.approx((0.1, 0.0))
+        msg.linear.x = float("nan")
+        joy.publish(msg)  # ignored with one line; the last good command still holds
+        assert rig.output(0.5) == pytest.approx((0.1, 0.0))
+        assert rig.wait_real(lambda: "/joy_vel: NaN/inf velocity ignored" in rig.log())
     finally:
         rig.close()
     assert "Traceback" not in rig.log()

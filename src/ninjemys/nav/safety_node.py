@@ -2,8 +2,9 @@
 
 Inputs are twist_mux-style (``~topics``: a list of ``{name, topic, timeout, priority}``; by default
 ``teleop`` on ``teleop/cmd_vel`` with priority 100 and ``navigation`` on ``nav/cmd_vel`` with
-priority 10, both with a 0.5 s timeout). Every ``1 / ~rate`` seconds the freshest input of highest
-priority goes out on ``cmd_vel``, after these guards:
+priority 10, both with a 0.5 s timeout), and so are ``~locks`` (std_msgs/Bool topics that mask the
+inputs below their priority while true or silent past their timeout). Every ``1 / ~rate`` seconds
+the fresh, unmasked input of highest priority goes out on ``cmd_vel``, after these guards:
 
 - watchdog: an input older than its timeout does not count; with none left the robot is stopped
   (zero twists for one second, then silence);
@@ -164,7 +165,9 @@ class SafetyMonitor:
     def on_cmd(self, msg: Any, inp: MuxInput) -> None:
         v, w = float(msg.linear.x), float(msg.angular.z)
         if not (math.isfinite(v) and math.isfinite(w)):
-            rospy.logwarn_throttle(5.0, "safety_monitor: %s: NaN/inf velocity ignored", inp.topic)
+            rospy.logwarn_throttle(
+                5.0, "safety_monitor: %s: NaN/inf velocity ignored", self.node.resolve_name(inp.topic)
+            )
             return
         with self.lock:
             inp.v, inp.w, inp.last_time = v, w, rospy.get_time()
