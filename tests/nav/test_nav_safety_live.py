@@ -56,16 +56,24 @@ class Rig:
     """A master on sim time, the monitor as a process, and a test node feeding it and watching it."""
 
     def __init__(self, tmp_path: Path, name: str = "safety_monitor", params: dict | None = None) -> None:
-        from ninjemys.node import Node
-
         self._master = run_master()
         self.uri = self._master.__enter__()
+        self._running = False
+        try:
+            self._start(tmp_path, name, params or {})
+        except BaseException:
+            self.close()
+            raise
+
+    def _start(self, tmp_path: Path, name: str, params: dict) -> None:
+        from ninjemys.node import Node
+
         self.env = dict(
             os.environ, ROS_MASTER_URI=self.uri, ROS_HOME=str(tmp_path / "ros_home"), PYTHONUNBUFFERED="1"
         )
         self.node = Node("safety_rig", anonymous=True, master_uri=self.uri, sim_time=False)
         self.node.set_param("/use_sim_time", True)
-        for key, value in {**yaml.safe_load(PARAMS.read_text()), **(params or {})}.items():
+        for key, value in {**yaml.safe_load(PARAMS.read_text()), **params}.items():
             self.node.set_param(f"/{name}/{key}", value)
         self.lock = threading.Lock()
         self.now = 1.0
@@ -110,16 +118,9 @@ class Rig:
             stderr=subprocess.STDOUT,
         )
         self.node.wait_for_service(f"/{name}/reset_e_stop", timeout=30.0)
-        # every input of the monitor connected: the master lists it as their subscriber
-        deadline = time.monotonic() + 30.0
-        wanted = {"/scan", "/odom", "/amcl_pose", "/e_stop", "/clock"}  # the inputs depend on ~topics
-        while time.monotonic() < deadline:
-            state = self.node.master.get_system_state()
-            subscribed = {topic for topic, nodes in state[1] if f"/{name}" in nodes}
-            if wanted <= subscribed:
-                break
-            time.sleep(0.05)
-        time.sleep(0.3)  # the connections themselves
+        # the monitor connected to every fixed input (the command inputs depend on ~topics: stream())
+        fixed = [self._clock_pub, self._scan_pub, self._odom_pub, self._pose_pub, self.e_stop_pub]
+        assert self.wait_real(lambda: all(pub.get_num_connections() > 0 for pub in fixed), 30.0)
 
     # -- the clock thread: sim time and the periodic inputs --------------------------------------------
 
@@ -254,16 +255,22 @@ class Rig:
             return next(d for d in self.diags if d.header.stamp.to_sec() > since).status[0]
 
     def close(self) -> None:
-        self.proc.terminate()
-        try:
-            self.proc.wait(10)
-        except subprocess.TimeoutExpired:
-            self.proc.kill()
-            self.proc.wait()
+        """Stop whatever was started, in reverse order (also after a failed start)."""
+        proc = getattr(self, "proc", None)
+        if proc is not None:
+            proc.terminate()
+            try:
+                proc.wait(10)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()
+        if hasattr(self, "_log"):
+            self._log.close()
         self._running = False
-        self._clock_thread.join(5)
-        self.node.shutdown()
-        self._log.close()
+        if hasattr(self, "_clock_thread"):
+            self._clock_thread.join(5)
+        if hasattr(self, "node"):
+            self.node.shutdown()
         self._master.__exit__(None, None, None)
 
 
@@ -484,9 +491,10 @@ def test_safety_live_stop_zone_from_footprint_and_velocity_against_the_latest_sc
     rig.stream("navigation", 0.2, 0.4)
     rig.scan_off()
     off = rig.now
-    assert rig.output(1.5) == pytest.approx((0.0, 0.4))
+    timeout = yaml.safe_load(PARAMS.read_text())["scan_timeout"]
+    assert rig.output(timeout + 0.5) == pytest.approx((0.0, 0.4))
     cut = next(t for t, v, w in rig.cmds_from(off) if v == 0.0)
-    assert cut - off <= 1.0 + 0.1 + 0.1  # ~scan_timeout, the last scan's age and one cycle
+    assert timeout - 0.1 <= cut - off <= timeout + 0.1 + 0.1  # the last scan's age and one cycle
     status = rig.status(rig.now)
     assert status.level == status.WARN and "Scan stale" in status.message
     rig.set_scan(None)
