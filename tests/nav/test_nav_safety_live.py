@@ -373,6 +373,7 @@ def test_safety_live_mux_parameters_are_checked_one_line_each(tmp_path):
                 {"name": "navigation", "topic": "nav/cmd_vel", "timeout": "soon", "priority": 10},
             ],
             "locks": [{"name": "nowhere", "priority": 5}],
+            "footprint": "[[0.3, 0.2], [0.3",
         },
     )
     try:
@@ -382,6 +383,8 @@ def test_safety_live_mux_parameters_are_checked_one_line_each(tmp_path):
         assert "could not convert string to float: 'soon'" in log
         assert "~locks[0]: missing 'topic'" in log
         assert "input joystick (/joy_vel) has no timeout" in log
+        lines = [line for line in log.splitlines() if "~footprint" in line]
+        assert len(lines) == 1 and "using robot_radius 0.110" in lines[0]
         joy = rig.node.publisher("/joy_vel", Twist, queue_size=1)
         assert rig.wait_real(lambda: joy.get_num_connections() > 0)
         msg = Twist()
@@ -515,6 +518,24 @@ def renamed_rig(tmp_path):
     finally:
         r.close()
     assert "Traceback" not in r.log()
+
+
+def test_safety_live_stop_zone_from_a_footprint_polygon(tmp_path):
+    # a 0.4 m long box reaching 0.3 m ahead: circumscribed radius 0.36 m instead of robot_radius 0.11
+    footprint = [[0.3, 0.2], [0.3, -0.2], [-0.1, -0.2], [-0.1, 0.2]]
+    rig = Rig(tmp_path, params={"footprint": str(footprint)})  # costmap_2d's string form
+    try:
+        rig.set_scan(0.55)
+        rig.stream("navigation", 0.1, 0.0)  # passes with the round 0.11 m robot (test above)
+        assert rig.output() == (0.0, 0.0)
+        rig.stream("navigation", 0.0, 0.5)
+        assert rig.output() == pytest.approx((0.0, 0.5))
+        rig.set_scan(1.2)
+        rig.stream("navigation", 0.1, 0.0)
+        assert rig.output() == pytest.approx((0.1, 0.0))
+    finally:
+        rig.close()
+    assert "Traceback" not in rig.log()
 
 
 def test_safety_live_diagnostics_in_diagnostic_updater_layout(renamed_rig):

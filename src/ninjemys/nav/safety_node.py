@@ -33,6 +33,7 @@ import threading
 from typing import Any
 
 import numpy as np
+import yaml
 
 import rospy
 from ninjemys.nav.costmap import footprint_radii, parse_footprint
@@ -114,8 +115,9 @@ class SafetyMonitor:
         if fp:
             try:
                 radius = footprint_radii(parse_footprint(fp), radius)[1]
-            except ValueError as exc:
-                rospy.logerr("safety_monitor: ~footprint: %s; using robot_radius %.3f", exc, radius)
+            except (ValueError, TypeError, yaml.YAMLError) as exc:
+                reason = " ".join(str(exc).split())  # a YAML error spans lines: one line here
+                rospy.logerr("safety_monitor: ~footprint: %s; using robot_radius %.3f", reason, radius)
         self.radius = radius
         self.margin = param(node, "safety_margin", 0.05)
         self.max_decel = param(node, "max_decel", 1.0)
