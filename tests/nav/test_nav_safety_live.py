@@ -374,6 +374,7 @@ def test_safety_live_mux_parameters_are_checked_one_line_each(tmp_path):
             ],
             "locks": [{"name": "nowhere", "priority": 5}],
             "footprint": "[[0.3, 0.2], [0.3",
+            "localization_inputs": "joystick",  # one name, not a list: still a name, not letters
         },
     )
     try:
@@ -391,6 +392,10 @@ def test_safety_live_mux_parameters_are_checked_one_line_each(tmp_path):
         msg.linear.x = 0.1
         joy.publish(msg)  # once: with no timeout it holds, as in twist_mux
         assert rig.output(1.5) == pytest.approx((0.1, 0.0))
+        rig.pose(0.4)  # 0.8 > 0.5: lost, and the joystick is the input that needs localization
+        assert rig.output() == (0.0, 0.0)
+        rig.pose(0.01)
+        assert rig.output() == pytest.approx((0.1, 0.0))
         msg.linear.x = float("nan")
         joy.publish(msg)  # ignored with one line; the last good command still holds
         assert rig.output(0.5) == pytest.approx((0.1, 0.0))

@@ -125,7 +125,7 @@ class SafetyMonitor:
         self.obstacle_speed = param(node, "obstacle_speed", 0.0)
         self.scan_timeout = param(node, "scan_timeout", 1.0)
         self.max_cov = param(node, "max_position_covariance", 0.5)
-        self.loc_inputs = set(node.get_param("~localization_inputs", ["navigation"]) or [])
+        self.loc_inputs = self._input_names(node.get_param("~localization_inputs", ["navigation"]))
         self.rate = max(1.0, param(node, "rate", 20.0))
         self.base_frame = param(node, "base_frame", "base_link")
         self.diag_period = param(node, "diagnostic_period", 1.0)
@@ -161,6 +161,27 @@ class SafetyMonitor:
         node.service("~reset_e_stop", Trigger, self.on_reset)
         threading.Thread(target=self.loop, name="safety-loop", daemon=True).start()
         threading.Thread(target=self.diag_loop, name="safety-diagnostics", daemon=True).start()
+
+    def _input_names(self, value: Any) -> set[str]:
+        """``~localization_inputs``: a list of input names (one name alone is taken as a list of one);
+        names that are no input are reported, as they would never be stopped."""
+        if isinstance(value, str):
+            value = [value]
+        if not isinstance(value, list):
+            rospy.logerr(
+                "safety_monitor: ~localization_inputs: expected a list of input names, got %r; using [navigation]",
+                value,
+            )
+            value = ["navigation"]
+        names = {str(name) for name in value}
+        known = {inp.name for inp in self.mux.inputs}
+        for name in sorted(names - known):
+            rospy.logerr(
+                "safety_monitor: ~localization_inputs: %s is not one of the inputs (%s)",
+                name,
+                ", ".join(sorted(known)),
+            )
+        return names
 
     # -- inputs -------------------------------------------------------------------------------------
 
