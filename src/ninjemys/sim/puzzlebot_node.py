@@ -110,11 +110,18 @@ class StepLock:
         with self._count_lock:
             self._waiting += 1
             self._nobody_waits.clear()
-        self._lock.acquire()
+        try:
+            self._lock.acquire()
+        except BaseException:  # interrupted while waiting (KeyboardInterrupt): no longer a waiter
+            self._done_waiting()
+            raise
         return self
 
     def __exit__(self, *_exc: object) -> None:
         self._lock.release()
+        self._done_waiting()
+
+    def _done_waiting(self) -> None:
         with self._count_lock:
             self._waiting -= 1
             if not self._waiting:
