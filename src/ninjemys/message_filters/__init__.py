@@ -8,7 +8,11 @@ objects; the matching rules (slop inclusive per candidate, strict across a set; 
 nearest first; the first complete set wins) are exactly ROS 1's.
 
 ``Subscriber`` here wraps a :class:`ninjemys.node.Node` subscription; the ``message_filters``
-facade's Subscriber wraps a ``rospy.Subscriber`` instead.
+facade's Subscriber wraps a ``rospy.Subscriber`` instead. Both subscribe through
+:func:`shared_subscriber`: all message_filters Subscribers of one node are read and called back by
+one thread, so the messages a synchronizer waits for, which arrive together, cost one wake-up of
+that thread instead of one per topic (ROS 1's rospy wakes a thread per connection; that wake-up,
+not the matching, is most of a synchronizing node's CPU).
 """
 
 from __future__ import annotations
@@ -16,6 +20,7 @@ from __future__ import annotations
 import itertools
 import logging
 import threading
+import weakref
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -36,6 +41,7 @@ __all__ = [
     "SimpleFilter",
     "Subscriber",
     "TimeSynchronizer",
+    "shared_subscriber",
 ]
 
 
@@ -57,6 +63,25 @@ def _to_ns(t: Any) -> int:
     return t.secs * _NS + t.nsecs
 
 
+#: per node, the subscription whose thread its message_filters Subscribers share
+_hosts: weakref.WeakKeyDictionary[Any, Any] = weakref.WeakKeyDictionary()
+_hosts_lock = threading.Lock()
+
+
+def shared_subscriber(node: Any, topic: str, msg_class: Any, callback: Any, **kwargs: Any) -> Any:
+    """``node.subscriber(topic, msg_class, callback, **kwargs)`` on the thread every message_filters
+    Subscriber of ``node`` shares (the first one's, while it is open; else this one starts a new one).
+    Their callbacks then run one after another, as under roscpp's single spinner."""
+    with _hosts_lock:
+        host = _hosts.get(node)
+        if host is not None and host.closed:
+            host = None
+        handle = node.subscriber(topic, msg_class, callback, share_thread=host, **kwargs)
+        if host is None:
+            _hosts[node] = handle
+    return handle
+
+
 class SimpleFilter:
     """The output side every filter shares: callbacks registered in order, called with the outputs."""
 
@@ -75,12 +100,13 @@ class SimpleFilter:
 
 
 class Subscriber(SimpleFilter):
-    """A source filter: every message of a Node subscription is passed on."""
+    """A source filter: every message of a Node subscription is passed on (on the node's shared
+    message_filters thread, see :func:`shared_subscriber`)."""
 
     def __init__(self, node: Any, topic: str, msg_class: Any, **kwargs: Any) -> None:
         super().__init__()
         self.topic = topic
-        self.sub = node.subscriber(topic, msg_class, self.callback, **kwargs)
+        self.sub = shared_subscriber(node, topic, msg_class, self.callback, **kwargs)
 
     def callback(self, msg: Any) -> None:
         self.signalMessage(msg)
