@@ -24,7 +24,7 @@ import weakref
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from ninjemys.rostime import Time
+from ninjemys.rostime import Time, get_clock
 
 _log = logging.getLogger("message_filters")
 _NS = 1_000_000_000
@@ -46,8 +46,9 @@ __all__ = [
 
 
 def _now_ns() -> int:
-    now = Time.now()
-    return now.secs * _NS + now.nsecs
+    """``Time.now()`` in nanoseconds, without making a Time (this runs for every synchronized message)."""
+    secs, nsecs = get_clock()()
+    return secs * _NS + nsecs
 
 
 def _stamp_ns(msg: Any) -> int | None:
@@ -263,18 +264,30 @@ class ApproximateTimeSynchronizer(TimeSynchronizer):
         self.allow_headerless = allow_headerless
         self._last_added = 0
 
+    def connectInput(self, fs: Sequence[SimpleFilter]) -> None:  # noqa: N802 - ROS 1 API
+        super().connectInput(fs)
+        queues = self.queues
+        #: per input, the other inputs' queues (what a message from that input is matched against)
+        self._others = [queues[:i] + queues[i + 1 :] for i in range(len(queues))]
+
     def add(self, msg: Any, my_queue: dict[int, Any], my_queue_index: int | None = None) -> None:
-        stamp = _stamp_ns(msg)
+        """Match ``msg`` (from input ``my_queue_index``) against the other inputs; this runs for every
+        message of every input, so the common case is written out (no Time objects, no helpers)."""
+        header = getattr(msg, "header", None)
+        stamp = getattr(header, "stamp", None)
         if stamp is None:
             if not self.allow_headerless:
                 _log.warning(_HEADERLESS)
                 return
             stamp = _now_ns()
+        else:
+            stamp = stamp.secs * _NS + stamp.nsecs
         slop = self._slop_ns
         with self.lock:
-            reset_now = self._reset_check(my_queue, my_queue_index)
+            reset_now = self._reset_check(my_queue, my_queue_index) if self.enable_reset else None
             my_queue[stamp] = msg
-            now = _now_ns()
+            secs, nsecs = get_clock()()
+            now = secs * _NS + nsecs
             if now < self._last_added:
                 _log.info("ApproximateTimeSynchronizer: Detected jump back in time. Clearing buffer.")
                 for q in self.queues:
@@ -285,21 +298,20 @@ class ApproximateTimeSynchronizer(TimeSynchronizer):
             if reset_now is not None and max(self.latest_stamps) != reset_now:
                 return
             queues = self.queues
-            if my_queue_index is None:
-                others = queues
-            else:
-                others = queues[:my_queue_index] + queues[my_queue_index + 1 :]
+            others = queues if my_queue_index is None else self._others[my_queue_index]
             candidates: list[list[int]] = []
             for queue in others:
-                near = [(abs(s - stamp), s) for s in queue if abs(s - stamp) <= slop]
+                near = [(d if d >= 0 else -d, s) for s in queue for d in (s - stamp,) if -slop <= d <= slop]
                 if not near:
                     return
-                near.sort(key=_first)  # stable: equal distances keep arrival order, as ROS 1
+                if len(near) > 1:
+                    near.sort(key=_first)  # stable: equal distances keep arrival order, as ROS 1
                 candidates.append([s for _d, s in near])
             for combo in itertools.product(*candidates):
-                stamps = list(combo)
-                if my_queue_index is not None:
-                    stamps.insert(my_queue_index, stamp)
+                if my_queue_index is None:
+                    stamps = combo
+                else:
+                    stamps = (*combo[:my_queue_index], stamp, *combo[my_queue_index:])
                 if max(stamps) - min(stamps) < slop and all(
                     t in q for q, t in zip(queues, stamps, strict=True)
                 ):
