@@ -338,6 +338,16 @@ class Subscription:
 class Subscriber:
     """A callback subscription; see :meth:`ninjemys.node.Node.subscriber`."""
 
+    # declared here because a handle made with ``share`` reads them on its host before its own are set
+    #: the handle whose worker thread reads and delivers for this one (itself unless made with ``share``)
+    _host: Subscriber
+    #: the handles a worker delivers for (itself first); replaced, never mutated
+    _served: tuple[Subscriber, ...]
+    #: the worker decided to end: no handle may join it any more
+    _retired: bool
+    _thread: threading.Thread
+    _ops_lock: threading.Lock
+
     def __init__(
         self,
         subscription: Subscription,
@@ -380,9 +390,8 @@ class Subscriber:
                     host._served = (*host._served, self)
                     return
         self._host = self
-        #: the handles this worker delivers for (itself first); replaced, never mutated
-        self._served: tuple[Subscriber, ...] = (self,)
-        self._retired = False  # the worker decided to end: no handle may join it any more
+        self._served = (self,)
+        self._retired = False
         self._ops: list[tuple[str, Any]] = []
         self._ops_lock = threading.Lock()
         # a socket pair, not a pipe: selectable on every OS (Windows cannot select on pipes)
