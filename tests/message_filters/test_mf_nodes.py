@@ -98,6 +98,7 @@ def test_tf2_message_filter_on_a_live_graph() -> None:
         try:
             buffer = Buffer()
             listener = TransformListener(node, buffer)
+            assert listener.tf_static_sub._thread is listener.tf_sub._thread  # one thread reads both
             broadcaster = TransformBroadcaster(node)
             points = node.publisher("/points", PointStamped, queue_size=10)
             source = Subscriber(node, "/points", PointStamped)
