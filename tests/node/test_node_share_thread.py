@@ -27,7 +27,7 @@ def test_shared_thread_serves_every_topic_and_hands_streams_on() -> None:
         pub_node = Node("share_pub", anonymous=True, master_uri=uri)
         sub_node = Node("share_sub", anonymous=True, master_uri=uri)
         try:
-            pubs = {t: pub_node.publisher(t, String, queue_size=10) for t in ("/a", "/b")}
+            pubs = {t: pub_node.publisher(t, String, queue_size=10) for t in ("/share_a", "/share_b")}
             got: dict[str, list[str]] = {"a": [], "b": [], "b2": []}
             threads: set[str] = set()
 
@@ -38,29 +38,29 @@ def test_shared_thread_serves_every_topic_and_hands_streams_on() -> None:
 
                 return cb
 
-            before = threading.active_count()
-            host = sub_node.subscriber("/a", String, on("a"))
-            guest = sub_node.subscriber("/b", String, on("b"), share_thread=host)
-            assert threading.active_count() == before + 1  # one worker for both
+            host = sub_node.subscriber("/share_a", String, on("a"))
+            guest = sub_node.subscriber("/share_b", String, on("b"), share_thread=host)
+            assert guest._thread is host._thread  # one worker for both
+            assert "sub:/share_b" not in {t.name for t in threading.enumerate()}
             assert _wait(lambda: all(p.get_num_connections() for p in pubs.values()))
-            pubs["/a"].publish(String("a1"))
-            pubs["/b"].publish(String("b1"))
+            pubs["/share_a"].publish(String("a1"))
+            pubs["/share_b"].publish(String("b1"))
             assert _wait(lambda: got["a"] == ["a1"] and got["b"] == ["b1"])
-            assert threads == {"sub:/a"}
+            assert threads == {"sub:/share_a"}
 
             # the host closes: its thread goes on delivering the guest's topic
             host.unregister()
-            pubs["/b"].publish(String("b2"))
+            pubs["/share_b"].publish(String("b2"))
             assert _wait(lambda: got["b"] == ["b1", "b2"])
 
             # a second handle of /b (its own thread); when the guest closes, /b's stream goes to it
-            second = sub_node.subscriber("/b", String, on("b2"))
+            second = sub_node.subscriber("/share_b", String, on("b2"))
             assert _wait(lambda: second.get_num_connections() == 1)
-            pubs["/b"].publish(String("b3"))
+            pubs["/share_b"].publish(String("b3"))
             assert _wait(lambda: got["b2"] == ["b3"] and got["b"] == ["b1", "b2", "b3"])
             guest.unregister()
             assert not host._thread.is_alive()  # the last handle it served closed: it ended
-            pubs["/b"].publish(String("b4"))
+            pubs["/share_b"].publish(String("b4"))
             assert _wait(lambda: got["b2"] == ["b3", "b4"])
             assert got["b"] == ["b1", "b2", "b3"]
             assert got["a"] == ["a1"]
@@ -74,10 +74,10 @@ def test_guest_closing_first_leaves_the_host_serving_and_a_closed_host_is_not_jo
         pub_node = Node("share_pub2", anonymous=True, master_uri=uri)
         sub_node = Node("share_sub2", anonymous=True, master_uri=uri)
         try:
-            pub_a = pub_node.publisher("/a", String, queue_size=10)
+            pub_a = pub_node.publisher("/share_a", String, queue_size=10)
             got: list[str] = []
-            host = sub_node.subscriber("/a", String, lambda m: got.append(m.data))
-            guest = sub_node.subscriber("/c", String, lambda m: None, share_thread=host)
+            host = sub_node.subscriber("/share_a", String, lambda m: got.append(m.data))
+            guest = sub_node.subscriber("/share_c", String, lambda m: None, share_thread=host)
             guest.unregister()
             assert host._thread.is_alive()
             assert _wait(lambda: pub_a.get_num_connections() == 1)
@@ -86,7 +86,7 @@ def test_guest_closing_first_leaves_the_host_serving_and_a_closed_host_is_not_jo
             host.unregister()
             assert not host._thread.is_alive()
             # a handle asked to share a finished thread gets a thread of its own
-            late = sub_node.subscriber("/a", String, lambda m: got.append(m.data), share_thread=host)
+            late = sub_node.subscriber("/share_a", String, lambda m: got.append(m.data), share_thread=host)
             assert late._thread is not host._thread and late._thread.is_alive()
             assert _wait(lambda: late.get_num_connections() == 1)
             pub_a.publish(String("y"))
