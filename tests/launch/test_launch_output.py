@@ -4,6 +4,7 @@ line behind ``[process-name]`` instead."""
 
 from __future__ import annotations
 
+import re
 import subprocess
 from pathlib import Path
 
@@ -49,6 +50,9 @@ def test_prefixed_output_is_opt_in(tmp_path: Path, env: dict, how: str) -> None:
         assert f"[streams-1] {text}" in lines, result.stdout
 
 
+_STARTED = re.compile(r"(\x1b\[1m)?process\[[^\]]*\]: started with pid \[\d+\](\x1b\[0m)?\n?")
+
+
 @pytest.mark.ros1
 @pytest.mark.skipif(not have_ros1(), reason="needs Debian's ROS 1")
 def test_real_roslaunch_passes_output_through_too(tmp_path: Path, env: dict) -> None:
@@ -60,5 +64,8 @@ def test_real_roslaunch_passes_output_through_too(tmp_path: Path, env: dict) -> 
     real = _roslaunch(["/usr/bin/roslaunch", str(launch)], real_env)
     ours = _roslaunch([ninjemys_bin("roslaunch"), str(launch)], env)
     for result in (real, ours):
-        assert [line for line in result.stdout.splitlines() if "line" in line] == ["out line 1", "out line 2"]
+        # roslaunch's own "process[...]: started with pid [...]" shares the terminal with the child and,
+        # under load, Debian's can land on the same line as the child's first output: not ours to judge
+        stdout = _STARTED.sub("", result.stdout)
+        assert [line for line in stdout.splitlines() if "line" in line] == ["out line 1", "out line 2"]
         assert "err line 1" in result.stderr.splitlines()

@@ -199,12 +199,12 @@ def main(argv: list[str] | None = None) -> int:
                 if not data:
                     break
                 last_key = now
-                for ch in data.decode("utf-8", "replace"):
+                for ch in data.decode("utf-8", "replace"):  # keys typed ahead arrive in one read
                     if ch == "\x03":
                         return 0
                     for line in state.key(ch):
                         print(line, flush=True)
-                publish()
+                    publish()  # one Twist per key, as the original's read-one-key loop
                 last_pub = now
     finally:
         state.stop()
