@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import subprocess
 import sys
+import time
+import xmlrpc.client
 from pathlib import Path
 
 import pytest
@@ -93,6 +95,12 @@ def test_seed_commands_work(live_graph):
     assert ttype.stdout == "std_msgs/String\n"
 
 
+def _echo_subscribed(uri: str, topic: str) -> bool:
+    """True once a ``rostopic`` node subscribes to ``topic`` (asked of the master's XML-RPC API)."""
+    _, _, (_, subscribers, _) = xmlrpc.client.ServerProxy(uri).getSystemState("/golden_test")
+    return any(name == topic and any("rostopic" in n for n in nodes) for name, nodes in subscribers)
+
+
 def test_pub_reaches_real_echo(live_graph):
     """`rostopic pub -1 /turtle1/cmd_vel geometry_msgs/Twist '{linear: {x: 0.2}}'` as the seed prints it,
     received by Debian's real rostopic echo."""
@@ -109,6 +117,10 @@ def test_pub_reaches_real_echo(live_graph):
         text=True,
     )
     try:
+        # `pub -1` latches for 3 s and exits: under load Debian's echo could still be starting by then
+        deadline = time.monotonic() + 30
+        while time.monotonic() < deadline and not _echo_subscribed(uri, "/turtle1/cmd_vel"):
+            time.sleep(0.1)
         pub = subprocess.run(
             [
                 ninjemys_bin("rostopic"),
