@@ -181,19 +181,22 @@ class AmclNode:
     # -- the filter ---------------------------------------------------------------------------------
 
     def on_scan(self, scan: Any) -> None:
+        if self.pf is None:
+            return
+        t = scan.header.stamp.to_sec()
+        # the odometry of the scan's own instant (waiting for it, as amcl's message filter does)
+        odom = self.tf.lookup_at(self.odom_frame, self.base_frame, t)
+        if odom is None:
+            rospy.logwarn_throttle(
+                5.0,
+                "amcl: no transform %s -> %s at the scan's stamp %.3f; scan dropped",
+                self.odom_frame,
+                self.base_frame,
+                t,
+            )
+            return
         with self.lock:
             if self.pf is None:
-                return
-            t = scan.header.stamp.to_sec()
-            odom = self.tf.lookup(self.odom_frame, self.base_frame, t)
-            if odom is None:
-                rospy.logwarn_throttle(
-                    5.0,
-                    "amcl: no transform %s -> %s at %.3f yet; scan dropped",
-                    self.odom_frame,
-                    self.base_frame,
-                    t,
-                )
                 return
             laser_frame = scan.header.frame_id or self.base_frame
             laser = self.laser_pose.get(laser_frame)

@@ -250,7 +250,7 @@ class MoveBase:
         ranges = np.where(np.isneginf(ranges), scan.range_min, ranges)  # REP 117: closer than range_min
         t = scan.header.stamp.to_sec()
         for cm in cms:
-            sensor = self.tf.lookup(cm.global_frame, scan.header.frame_id, t)
+            sensor = self.tf.lookup_at(cm.global_frame, scan.header.frame_id, t)  # the costmap's filter
             if sensor is None:
                 continue
             with self.lock:
