@@ -279,11 +279,12 @@ class ParticleFilter:
 
     # -- resampling -------------------------------------------------------------------------------
 
-    def resample(self) -> None:
-        """Low-variance resampling with KLD-adapted size and recovery injection."""
+    def resample(self) -> int:
+        """Low-variance resampling with KLD-adapted size and recovery injection; returns how many
+        uniformly drawn (not yet weighed) particles the new set holds."""
         p = self.params
         if len(self.poses) == 0:
-            return
+            return 0
         m = p.max_particles
         w_diff = 0.0
         if self.w_slow > 0:
@@ -293,6 +294,7 @@ class ParticleFilter:
         u = (self.rng.random() + np.arange(m)) / m
         picked = self.poses[np.searchsorted(cum, u)]
         picked = picked[self.rng.permutation(m)]
+        inject = np.zeros(m, dtype=bool)
         if w_diff > 0:
             inject = self.rng.random(m) < w_diff
             k = int(inject.sum())
@@ -311,6 +313,7 @@ class ParticleFilter:
         self.weights = np.full(count, 1.0 / count)
         if w_diff > 0:
             self.w_slow = self.w_fast = 0.0  # amcl resets the averages after injecting
+        return int(inject[:count].sum())
 
     # -- estimate ---------------------------------------------------------------------------------
 

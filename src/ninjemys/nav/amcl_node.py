@@ -9,7 +9,8 @@ Subscribes ``scan`` (sensor_msgs/LaserScan), ``initialpose`` (PoseWithCovariance
 
 The filter updates when odometry moved more than ``~update_min_d`` along x or y or turned more than
 ``~update_min_a`` since the last update (amcl compares each component), and resamples every
-``~resample_interval`` updates. Only the likelihood-field laser model and the diff-drive odometry
+``~resample_interval`` updates. After a resampling that injected uniform particles (recovery), the next
+scan updates the filter even without motion, so the injected particles are weighed at once. Only the likelihood-field laser model and the diff-drive odometry
 model exist: other ``~laser_model_type``/``~odom_model_type`` values are reported once and replaced.
 """
 
@@ -233,9 +234,14 @@ class AmclNode:
                 self.last_odom = odom
                 self.pf.sensor_update(ranges, angles, float(scan.range_max), laser, float(scan.range_min))
                 self.updates += 1
+                injected = 0
                 if self.updates % max(1, self.params.resample_interval) == 0:
-                    self.pf.resample()
-                self.force_update = False
+                    injected = self.pf.resample()
+                # Particles injected for recovery are weighed by the next scan even if the robot does
+                # not move (ROS 1's amcl waits for motion). Unweighed, thousands of uniform particles
+                # join the real cluster into one spanning the map: a huge covariance, which makes the
+                # safety monitor stop the robot, which then never moves to clear it.
+                self.force_update = injected > 0
                 mean, cov = self.pf.estimate()
                 est = (float(mean[0]), float(mean[1]), float(mean[2]))
                 self._publish_pose(scan, est, cov)
