@@ -234,15 +234,16 @@ class AmclNode:
                 self.last_odom = odom
                 self.pf.sensor_update(ranges, angles, float(scan.range_max), laser, float(scan.range_min))
                 self.updates += 1
+                # the estimate of the weighed set, before resampling: particles injected for recovery
+                # are not weighed yet, and thousands of them would connect the real cluster into one
+                # spanning the map (a huge covariance, which makes the safety monitor stop the robot)
+                mean, cov = self.pf.estimate()
                 injected = 0
                 if self.updates % max(1, self.params.resample_interval) == 0:
                     injected = self.pf.resample()
-                # Particles injected for recovery are weighed by the next scan even if the robot does
-                # not move (ROS 1's amcl waits for motion). Unweighed, thousands of uniform particles
-                # join the real cluster into one spanning the map: a huge covariance, which makes the
-                # safety monitor stop the robot, which then never moves to clear it.
+                # injected particles are weighed by the next scan even if the robot does not move
+                # (ROS 1's amcl waits for motion; a robot stopped for its covariance would wait forever)
                 self.force_update = injected > 0
-                mean, cov = self.pf.estimate()
                 est = (float(mean[0]), float(mean[1]), float(mean[2]))
                 self._publish_pose(scan, est, cov)
                 self.map_to_odom = compose(est, inverse(odom))
