@@ -15,6 +15,7 @@ from ninjemys.message_filters import (
     Chain,
     SimpleFilter,
     TimeSynchronizer,
+    shared_subscriber,
 )
 
 __all__ = [
@@ -31,12 +32,10 @@ class Subscriber(SimpleFilter):
     """A source filter with ``rospy.Subscriber``'s arguments; every message is passed on."""
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
-        import rospy
-
         super().__init__()
         self.topic = args[0] if args else kwargs["name"]
         kwargs["callback"] = self.callback
-        self.sub = rospy.Subscriber(*args, **kwargs)
+        self.sub = _shared_rospy_subscriber()(*args, **kwargs)
 
     def callback(self, msg: Any) -> None:
         self.signalMessage(msg)
@@ -49,3 +48,31 @@ class Subscriber(SimpleFilter):
         if key == "sub":
             raise AttributeError(key)
         return getattr(self.sub, key)
+
+
+def _shared_rospy_subscriber() -> type:
+    """A ``rospy.Subscriber`` whose core subscription is made by :func:`shared_subscriber` (one thread
+    for all message_filters Subscribers of the process); rospy is imported on first use."""
+    global _SharedSubscriber
+    if _SharedSubscriber is None:
+        import rospy
+        from rospy.msg import AnyMsg
+
+        class SharedSubscriber(rospy.Subscriber):
+            def _create(self, node: Any) -> Any:
+                if self.data_class is AnyMsg:  # raw bytes: rospy's own adapter, on a thread of its own
+                    return super()._create(node)
+                return shared_subscriber(
+                    node,
+                    self._requested,
+                    self.data_class,
+                    self.callback,
+                    callback_args=self.callback_args,
+                    queue_size=self.queue_size,
+                )
+
+        _SharedSubscriber = SharedSubscriber
+    return _SharedSubscriber
+
+
+_SharedSubscriber: type | None = None

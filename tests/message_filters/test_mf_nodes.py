@@ -30,6 +30,8 @@ def test_core_subscribers_feed_a_synchronizer() -> None:
             pubs = [node.publisher(f"/s{i}", PointStamped, queue_size=10) for i in range(2)]
             subs = [Subscriber(node, f"/s{i}", PointStamped) for i in range(2)]
             assert subs[0].getTopic() == "/s0"
+            # one thread reads and calls back for all of a node's message_filters Subscribers
+            assert subs[1].sub._thread is subs[0].sub._thread
             sync = ApproximateTimeSynchronizer(subs, 10, 0.05)
             got: list = []
             done = threading.Event()
@@ -71,7 +73,7 @@ for k in range(3):
 deadline = rospy.get_time() + 10
 while len(got) < 3 and rospy.get_time() < deadline:
     rospy.sleep(0.01)
-print(got, subs[1].getTopic())
+print(got, subs[1].getTopic(), len({s.sub._impl._thread for s in subs}))
 """
 
 
@@ -81,7 +83,7 @@ def test_rospy_facade_subscriber(tmp_path) -> None:
         out = subprocess.run(
             [sys.executable, "-c", FACADE], env=env, capture_output=True, text=True, timeout=60
         )
-        assert out.stdout.strip() == "[5, 6, 7] /f1", out.stderr
+        assert out.stdout.strip() == "[5, 6, 7] /f1 1", out.stderr
 
 
 def test_tf2_message_filter_on_a_live_graph() -> None:
@@ -96,6 +98,7 @@ def test_tf2_message_filter_on_a_live_graph() -> None:
         try:
             buffer = Buffer()
             listener = TransformListener(node, buffer)
+            assert listener.tf_static_sub._thread is listener.tf_sub._thread  # one thread reads both
             broadcaster = TransformBroadcaster(node)
             points = node.publisher("/points", PointStamped, queue_size=10)
             source = Subscriber(node, "/points", PointStamped)

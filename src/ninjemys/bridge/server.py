@@ -283,6 +283,7 @@ class Gateway:
         self._watched: set[str] = set()
         self._definitions: dict[str, str] = {}
         self._probing: set[tuple[str, str]] = set()
+        self._refresh_failing = False
         self._clock_sub: Any = None
         self._client_count: Any = None
         self._poller = threading.Thread(target=self._poll, name="gateway-graph", daemon=True)
@@ -364,8 +365,16 @@ class Gateway:
         try:
             diff = self.catalog.refresh(self.node, self.services, self._learn)
         except NinjemysError as exc:
-            log.warning("gateway: graph refresh failed: %s", exc)
+            # once per outage (a dead master fails every refresh), then once more when it is back
+            if not self._refresh_failing:
+                log.warning(
+                    "gateway: graph refresh failed (retrying every %g s): %s", self.options.update_period, exc
+                )
+                self._refresh_failing = True
             return
+        if self._refresh_failing:
+            log.info("gateway: graph refresh works again")
+            self._refresh_failing = False
         foxes = [c.session for c in list(self._clients.values()) if isinstance(c.session, FoxgloveSession)]
         for fox in foxes:
             if diff["removed_channels"]:

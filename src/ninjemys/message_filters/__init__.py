@@ -8,7 +8,11 @@ objects; the matching rules (slop inclusive per candidate, strict across a set; 
 nearest first; the first complete set wins) are exactly ROS 1's.
 
 ``Subscriber`` here wraps a :class:`ninjemys.node.Node` subscription; the ``message_filters``
-facade's Subscriber wraps a ``rospy.Subscriber`` instead.
+facade's Subscriber wraps a ``rospy.Subscriber`` instead. Both subscribe through
+:func:`shared_subscriber`: all message_filters Subscribers of one node are read and called back by
+one thread, so the messages a synchronizer waits for, which arrive together, cost one wake-up of
+that thread instead of one per topic (ROS 1's rospy wakes a thread per connection; that wake-up,
+not the matching, is most of a synchronizing node's CPU).
 """
 
 from __future__ import annotations
@@ -16,10 +20,11 @@ from __future__ import annotations
 import itertools
 import logging
 import threading
+import weakref
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from ninjemys.rostime import Time
+from ninjemys.rostime import Time, get_clock
 
 _log = logging.getLogger("message_filters")
 _NS = 1_000_000_000
@@ -36,12 +41,14 @@ __all__ = [
     "SimpleFilter",
     "Subscriber",
     "TimeSynchronizer",
+    "shared_subscriber",
 ]
 
 
 def _now_ns() -> int:
-    now = Time.now()
-    return now.secs * _NS + now.nsecs
+    """``Time.now()`` in nanoseconds, without making a Time (this runs for every synchronized message)."""
+    secs, nsecs = get_clock()()
+    return secs * _NS + nsecs
 
 
 def _stamp_ns(msg: Any) -> int | None:
@@ -55,6 +62,25 @@ def _stamp_ns(msg: Any) -> int | None:
 
 def _to_ns(t: Any) -> int:
     return t.secs * _NS + t.nsecs
+
+
+#: per node, the subscription whose thread its message_filters Subscribers share
+_hosts: weakref.WeakKeyDictionary[Any, Any] = weakref.WeakKeyDictionary()
+_hosts_lock = threading.Lock()
+
+
+def shared_subscriber(node: Any, topic: str, msg_class: Any, callback: Any, **kwargs: Any) -> Any:
+    """``node.subscriber(topic, msg_class, callback, **kwargs)`` on the thread every message_filters
+    Subscriber of ``node`` shares (the first one's, while it is open; else this one starts a new one).
+    Their callbacks then run one after another, as under roscpp's single spinner."""
+    with _hosts_lock:
+        host = _hosts.get(node)
+        if host is not None and host.closed:
+            host = None
+        handle = node.subscriber(topic, msg_class, callback, share_thread=host, **kwargs)
+        if host is None:
+            _hosts[node] = handle
+    return handle
 
 
 class SimpleFilter:
@@ -75,12 +101,13 @@ class SimpleFilter:
 
 
 class Subscriber(SimpleFilter):
-    """A source filter: every message of a Node subscription is passed on."""
+    """A source filter: every message of a Node subscription is passed on (on the node's shared
+    message_filters thread, see :func:`shared_subscriber`)."""
 
     def __init__(self, node: Any, topic: str, msg_class: Any, **kwargs: Any) -> None:
         super().__init__()
         self.topic = topic
-        self.sub = node.subscriber(topic, msg_class, self.callback, **kwargs)
+        self.sub = shared_subscriber(node, topic, msg_class, self.callback, **kwargs)
 
     def callback(self, msg: Any) -> None:
         self.signalMessage(msg)
@@ -237,18 +264,30 @@ class ApproximateTimeSynchronizer(TimeSynchronizer):
         self.allow_headerless = allow_headerless
         self._last_added = 0
 
+    def connectInput(self, fs: Sequence[SimpleFilter]) -> None:  # noqa: N802 - ROS 1 API
+        super().connectInput(fs)
+        queues = self.queues
+        #: per input, the other inputs' queues (what a message from that input is matched against)
+        self._others = [queues[:i] + queues[i + 1 :] for i in range(len(queues))]
+
     def add(self, msg: Any, my_queue: dict[int, Any], my_queue_index: int | None = None) -> None:
-        stamp = _stamp_ns(msg)
+        """Match ``msg`` (from input ``my_queue_index``) against the other inputs; this runs for every
+        message of every input, so the common case is written out (no Time objects, no helpers)."""
+        header = getattr(msg, "header", None)
+        stamp = getattr(header, "stamp", None)
         if stamp is None:
             if not self.allow_headerless:
                 _log.warning(_HEADERLESS)
                 return
             stamp = _now_ns()
+        else:
+            stamp = stamp.secs * _NS + stamp.nsecs
         slop = self._slop_ns
         with self.lock:
-            reset_now = self._reset_check(my_queue, my_queue_index)
+            reset_now = self._reset_check(my_queue, my_queue_index) if self.enable_reset else None
             my_queue[stamp] = msg
-            now = _now_ns()
+            secs, nsecs = get_clock()()
+            now = secs * _NS + nsecs
             if now < self._last_added:
                 _log.info("ApproximateTimeSynchronizer: Detected jump back in time. Clearing buffer.")
                 for q in self.queues:
@@ -259,21 +298,20 @@ class ApproximateTimeSynchronizer(TimeSynchronizer):
             if reset_now is not None and max(self.latest_stamps) != reset_now:
                 return
             queues = self.queues
-            if my_queue_index is None:
-                others = queues
-            else:
-                others = queues[:my_queue_index] + queues[my_queue_index + 1 :]
+            others = queues if my_queue_index is None else self._others[my_queue_index]
             candidates: list[list[int]] = []
             for queue in others:
-                near = [(abs(s - stamp), s) for s in queue if abs(s - stamp) <= slop]
+                near = [(d if d >= 0 else -d, s) for s in queue for d in (s - stamp,) if -slop <= d <= slop]
                 if not near:
                     return
-                near.sort(key=_first)  # stable: equal distances keep arrival order, as ROS 1
+                if len(near) > 1:
+                    near.sort(key=_first)  # stable: equal distances keep arrival order, as ROS 1
                 candidates.append([s for _d, s in near])
             for combo in itertools.product(*candidates):
-                stamps = list(combo)
-                if my_queue_index is not None:
-                    stamps.insert(my_queue_index, stamp)
+                if my_queue_index is None:
+                    stamps = combo
+                else:
+                    stamps = (*combo[:my_queue_index], stamp, *combo[my_queue_index:])
                 if max(stamps) - min(stamps) < slop and all(
                     t in q for q, t in zip(queues, stamps, strict=True)
                 ):

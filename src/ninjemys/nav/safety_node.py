@@ -2,8 +2,9 @@
 
 Inputs are twist_mux-style (``~topics``: a list of ``{name, topic, timeout, priority}``; by default
 ``teleop`` on ``teleop/cmd_vel`` with priority 100 and ``navigation`` on ``nav/cmd_vel`` with
-priority 10, both with a 0.5 s timeout). Every ``1 / ~rate`` seconds the freshest input of highest
-priority goes out on ``cmd_vel``, after these guards:
+priority 10, both with a 0.5 s timeout), and so are ``~locks`` (std_msgs/Bool topics that mask the
+inputs below their priority while true or silent past their timeout). Every ``1 / ~rate`` seconds
+the fresh, unmasked input of highest priority goes out on ``cmd_vel``, after these guards:
 
 - watchdog: an input older than its timeout does not count; with none left the robot is stopped
   (zero twists for one second, then silence);
@@ -11,13 +12,18 @@ priority goes out on ``cmd_vel``, after these guards:
   and then braking (``~max_decel``) would bring the footprint (``~robot_radius`` or ``~footprint``)
   within ``~safety_margin`` (+ ``~obstacle_speed`` x that time, for people walking in) of a point of
   the latest ``scan`` it is not already moving away from; turning in place stays allowed;
-- localization: when ``amcl_pose``'s position variance (xx + yy) exceeds ``~max_position_covariance``,
-  inputs named in ``~localization_inputs`` (default ``[navigation]``) are ignored;
+- scan watchdog: once a scan has come, a latest scan older than ``~scan_timeout`` (1 s; 0: off) no
+  longer shows the way ahead, so linear motion is cut until scans come again (turning stays allowed);
+- localization: when ``amcl_pose``'s position variance (xx + yy) exceeds ``~max_position_covariance``
+  (or is not a number), inputs named in ``~localization_inputs`` (default ``[navigation]``) are ignored
+  until an ``amcl_pose`` within the limit comes;
 - e-stop: ``e_stop`` (std_msgs/Bool, true) or the ``~e_stop`` service (std_srvs/SetBool, true) latches
   a stop of everything until ``~e_stop`` is called with false (or ``~reset_e_stop``, std_srvs/Trigger);
   the state is latched on ``~e_stop_active``.
 
-Status goes out as diagnostic_msgs/DiagnosticArray on ``/diagnostics`` once a second.
+Status goes out as diagnostic_msgs/DiagnosticArray on ``/diagnostics`` every ``~diagnostic_period``
+seconds (1), laid out as diagnostic_updater does: one status named ``<node name>: Safety`` with a
+level, a message, ``~hardware_id`` (``puzzlebot``) and key/values.
 """
 
 from __future__ import annotations
@@ -27,11 +33,12 @@ import threading
 from typing import Any
 
 import numpy as np
+import yaml
 
 import rospy
 from ninjemys.nav.costmap import footprint_radii, parse_footprint
-from ninjemys.nav.rosglue import Tf2D, param, run_node, scan_arrays, sleep
-from ninjemys.nav.safety import MuxInput, TwistMux, blocked
+from ninjemys.nav.rosglue import Tf2D, param, run_node, scan_arrays
+from ninjemys.nav.safety import NEVER, MuxInput, MuxLock, TwistMux, blocked
 
 DEFAULT_TOPICS = [
     {"name": "teleop", "topic": "teleop/cmd_vel", "timeout": 0.5, "priority": 100},
@@ -39,24 +46,43 @@ DEFAULT_TOPICS = [
 ]
 
 
-def parse_topics(value: Any) -> tuple[list[MuxInput], list[str]]:
-    """twist_mux's ``topics`` parameter (a list, or a dict keyed by name) -> inputs, and error lines."""
-    items = list(value.items()) if isinstance(value, dict) else list(enumerate(value or []))
-    inputs, errors = [], []
+def _parse_handles(value: Any, param: str, cls: type[Any]) -> tuple[list[Any], list[str]]:
+    """twist_mux's ``topics``/``locks`` layout (a list of ``{name, topic, timeout, priority}``, or a
+    dict keyed by name) -> handles of ``cls``, and one error line per bad entry. Priorities are
+    clamped to 0..255 and a missing timeout is 0.5 s for topics, none for locks."""
+    if value is None:
+        return [], []
+    if not isinstance(value, (list, dict)):
+        return [], [
+            f"~{param}: expected a list of mappings with name, topic, timeout, priority, got {value!r}"
+        ]
+    items = list(value.items()) if isinstance(value, dict) else list(enumerate(value))
+    handles, errors = [], []
     for key, entry in items:
         if not isinstance(entry, dict):
-            errors.append(f"~topics[{key}]: expected a mapping with name, topic, timeout, priority")
+            errors.append(f"~{param}[{key}]: expected a mapping with name, topic, timeout, priority")
+            continue
+        if "topic" not in entry:
+            errors.append(f"~{param}[{key}]: missing 'topic'")
             continue
         try:
-            name = str(entry.get("name", key))
-            inputs.append(
-                MuxInput(
-                    name, str(entry["topic"]), int(entry.get("priority", 0)), float(entry.get("timeout", 0.5))
-                )
-            )
-        except (KeyError, TypeError, ValueError) as exc:
-            errors.append(f"~topics[{key}]: {type(exc).__name__} {exc}")
-    return inputs, errors
+            priority = min(255, max(0, int(entry.get("priority", 0))))
+            timeout = float(entry.get("timeout", 0.5 if cls is MuxInput else 0.0))
+        except (TypeError, ValueError) as exc:
+            errors.append(f"~{param}[{key}]: {exc}")
+            continue
+        handles.append(cls(str(entry.get("name", key)), str(entry["topic"]), priority, timeout))
+    return handles, errors
+
+
+def parse_topics(value: Any) -> tuple[list[MuxInput], list[str]]:
+    """twist_mux's ``topics`` parameter -> inputs, and error lines."""
+    return _parse_handles(value, "topics", MuxInput)
+
+
+def parse_locks(value: Any) -> tuple[list[MuxLock], list[str]]:
+    """twist_mux's ``locks`` parameter -> locks, and error lines."""
+    return _parse_handles(value, "locks", MuxLock)
 
 
 class SafetyMonitor:
@@ -70,35 +96,53 @@ class SafetyMonitor:
 
         self.node = node
         self.lock = threading.Lock()
+        self.out_lock = threading.Lock()  # one twist decided and published at a time
         inputs, errors = parse_topics(node.get_param("~topics", DEFAULT_TOPICS))
-        for line in errors:
+        locks, lock_errors = parse_locks(node.get_param("~locks", []))
+        for line in errors + lock_errors:
             rospy.logerr("safety_monitor: %s", line)
-        self.mux = TwistMux(inputs or parse_topics(DEFAULT_TOPICS)[0])
+        self.mux = TwistMux(inputs or parse_topics(DEFAULT_TOPICS)[0], locks)
+        for inp in self.mux.inputs:
+            if inp.timeout <= 0.0:
+                rospy.logwarn(
+                    "safety_monitor: input %s (%s) has no timeout: its last command holds until "
+                    "another input takes over",
+                    inp.name,
+                    node.resolve_name(inp.topic),
+                )
         radius = param(node, "robot_radius", 0.12)
         fp = node.get_param("~footprint", None)
         if fp:
             try:
                 radius = footprint_radii(parse_footprint(fp), radius)[1]
-            except ValueError as exc:
-                rospy.logerr("safety_monitor: ~footprint: %s; using robot_radius %.3f", exc, radius)
+            except (ValueError, TypeError, yaml.YAMLError) as exc:
+                reason = " ".join(str(exc).split())  # a YAML error spans lines: one line here
+                rospy.logerr("safety_monitor: ~footprint: %s; using robot_radius %.3f", reason, radius)
         self.radius = radius
         self.margin = param(node, "safety_margin", 0.05)
         self.max_decel = param(node, "max_decel", 1.0)
         self.reaction = param(node, "reaction_time", 0.15)
         self.obstacle_speed = param(node, "obstacle_speed", 0.0)
+        self.scan_timeout = param(node, "scan_timeout", 1.0)
         self.max_cov = param(node, "max_position_covariance", 0.5)
-        self.loc_inputs = set(node.get_param("~localization_inputs", ["navigation"]) or [])
+        self.loc_inputs = self._input_names(node.get_param("~localization_inputs", ["navigation"]))
         self.rate = max(1.0, param(node, "rate", 20.0))
         self.base_frame = param(node, "base_frame", "base_link")
+        self.diag_period = param(node, "diagnostic_period", 1.0)
+        self.hardware_id = param(node, "hardware_id", "puzzlebot")
+        # diagnostic_updater names a status "<node name without the leading slash>: <task>"
+        self.diag_name = f"{node.name.lstrip('/')}: Safety"
         self.tf = Tf2D(node)
         self.points = np.zeros((0, 2))
-        self.scan_time = -1e9
+        self.scan_time: float | None = None
         self.velocity = 0.0
         self.cov: float | None = None
+        self.scan_stale = False
         self.e_stop = False
         self.blocked = False
         self.active: str | None = None
         self.stale_since: float | None = None
+        self.last_now = NEVER
         self.bad_scan_reported = False
         self._twist, self._diag_cls = Twist, DiagnosticArray
         self.cmd_pub = node.publisher("cmd_vel", Twist, queue_size=1)
@@ -107,6 +151,8 @@ class SafetyMonitor:
         self.estop_pub.publish(Bool(data=False))
         for inp in self.mux.inputs:
             node.subscriber(inp.topic, Twist, self.on_cmd, callback_args=inp, queue_size=1)
+        for lock in self.mux.locks:
+            node.subscriber(lock.topic, Bool, self.on_lock, callback_args=lock, queue_size=1)
         node.subscriber("scan", LaserScan, self.on_scan, queue_size=1)
         node.subscriber("odom", Odometry, self.on_odom, queue_size=1)
         node.subscriber("amcl_pose", PoseWithCovarianceStamped, self.on_pose, queue_size=1)
@@ -116,15 +162,42 @@ class SafetyMonitor:
         threading.Thread(target=self.loop, name="safety-loop", daemon=True).start()
         threading.Thread(target=self.diag_loop, name="safety-diagnostics", daemon=True).start()
 
+    def _input_names(self, value: Any) -> set[str]:
+        """``~localization_inputs``: a list of input names (one name alone is taken as a list of one);
+        names that are no input are reported, as they would never be stopped."""
+        if isinstance(value, str):
+            value = [value]
+        if not isinstance(value, list):
+            rospy.logerr(
+                "safety_monitor: ~localization_inputs: expected a list of input names, got %r; using [navigation]",
+                value,
+            )
+            value = ["navigation"]
+        names = {str(name) for name in value}
+        known = {inp.name for inp in self.mux.inputs}
+        for name in sorted(names - known):
+            rospy.logerr(
+                "safety_monitor: ~localization_inputs: %s is not one of the inputs (%s)",
+                name,
+                ", ".join(sorted(known)),
+            )
+        return names
+
     # -- inputs -------------------------------------------------------------------------------------
 
     def on_cmd(self, msg: Any, inp: MuxInput) -> None:
         v, w = float(msg.linear.x), float(msg.angular.z)
         if not (math.isfinite(v) and math.isfinite(w)):
-            rospy.logwarn_throttle(5.0, "safety_monitor: %s: NaN/inf velocity ignored", inp.topic)
+            rospy.logwarn_throttle(
+                5.0, "safety_monitor: %s: NaN/inf velocity ignored", self.node.resolve_name(inp.topic)
+            )
             return
         with self.lock:
             inp.v, inp.w, inp.last_time = v, w, rospy.get_time()
+
+    def on_lock(self, msg: Any, lock: MuxLock) -> None:
+        with self.lock:
+            lock.data, lock.last_time = bool(msg.data), rospy.get_time()
 
     def on_scan(self, scan: Any) -> None:
         ranges, angles = scan_arrays(scan)
@@ -156,20 +229,30 @@ class SafetyMonitor:
     def on_pose(self, msg: Any) -> None:
         c = msg.pose.covariance
         self.cov = float(c[0]) + float(c[7])
+        if math.isnan(self.cov):
+            rospy.logwarn_throttle(
+                5.0, "safety_monitor: amcl_pose: NaN position covariance; treated as localization lost"
+            )
+
+    def localization_lost(self) -> bool:
+        """A variance over the limit, or NaN (which compares false with everything), is lost."""
+        return self.cov is not None and not self.cov <= self.max_cov
 
     def _set_e_stop(self, on: bool, why: str) -> None:
         from std_msgs.msg import Bool
 
-        with self.lock:
-            changed = self.e_stop != on
-            self.e_stop = on
+        with self.out_lock:  # no twist decided before the e-stop goes out after its stop
+            with self.lock:
+                changed = self.e_stop != on
+                self.e_stop = on
+            if changed:
+                self.estop_pub.publish(Bool(data=on))
+                if on:
+                    self.cmd_pub.publish(self._twist())
         if changed:
             (rospy.logwarn if on else rospy.loginfo)(
                 "safety_monitor: e-stop %s (%s)", "ENGAGED" if on else "reset", why
             )
-            self.estop_pub.publish(Bool(data=on))
-            if on:
-                self.cmd_pub.publish(self._twist())
 
     def on_e_stop_topic(self, msg: Any) -> None:
         if msg.data:
@@ -192,11 +275,16 @@ class SafetyMonitor:
     def decide(self, now: float) -> tuple[float, float, bool]:
         """(v, w, publish?) for this cycle."""
         with self.lock:
+            if now < self.last_now:
+                self._time_moved_backwards(now)
+            self.last_now = now
+            self.blocked = False
             if self.e_stop:
                 self.active = "e_stop"
                 return 0.0, 0.0, True
+            self._check_scan_age(now)
             allowed = None
-            if self.cov is not None and self.cov > self.max_cov:
+            if self.localization_lost():
                 allowed = {i.name for i in self.mux.inputs} - self.loc_inputs
             inp = self.mux.select(now, allowed)
             if inp is None:
@@ -218,43 +306,112 @@ class SafetyMonitor:
                 self.reaction,
                 self.obstacle_speed,
             )
-            if self.blocked:
+            if self.blocked or self.scan_stale:
                 v = 0.0
             return v, w, True
+
+    def _time_moved_backwards(self, now: float) -> None:
+        """A simulation reset or a looping bag: every age measured before is meaningless now, and a
+        command stamped in the old future would otherwise stay fresh until time caught up with it."""
+        rospy.loginfo(
+            "safety_monitor: ROS time moved backwards (%.3f -> %.3f); inputs and scan forgotten",
+            self.last_now,
+            now,
+        )
+        for handle in [*self.mux.inputs, *self.mux.locks]:
+            handle.last_time = NEVER
+        self.scan_time = None
+        self.stale_since = None
+
+    def _check_scan_age(self, now: float) -> None:
+        """Update ``scan_stale`` (no scan yet is not stale: a robot may run without a laser)."""
+        stale = (
+            self.scan_timeout > 0.0
+            and self.scan_time is not None
+            and now - self.scan_time > self.scan_timeout
+        )
+        if stale != self.scan_stale:
+            if stale:
+                rospy.logwarn(
+                    "safety_monitor: no scan on %s for %.2f s (~scan_timeout %.2f); linear motion stopped",
+                    self.node.resolve_name("scan"),
+                    now - (self.scan_time or 0.0),
+                    self.scan_timeout,
+                )
+            else:
+                rospy.loginfo("safety_monitor: scans again on %s", self.node.resolve_name("scan"))
+        self.scan_stale = stale
 
     def loop(self) -> None:
         rate = rospy.Rate(self.rate)
         while not rospy.is_shutdown():
-            try:
-                v, w, publish = self.decide(rospy.get_time())
-            except Exception as exc:  # the guard must keep guarding: stop and report
-                rospy.logerr_throttle(
-                    5.0, "safety_monitor: %s: %s; stopping the robot", type(exc).__name__, exc
-                )
-                v, w, publish = 0.0, 0.0, True
-            if publish:
-                msg = self._twist()
-                msg.linear.x, msg.angular.z = v, w
-                self.cmd_pub.publish(msg)
+            with self.out_lock:
+                try:
+                    v, w, publish = self.decide(rospy.get_time())
+                except Exception as exc:  # the guard must keep guarding: stop and report
+                    rospy.logerr_throttle(
+                        5.0, "safety_monitor: %s: %s; stopping the robot", type(exc).__name__, exc
+                    )
+                    v, w, publish = 0.0, 0.0, True
+                if publish:
+                    msg = self._twist()
+                    msg.linear.x, msg.angular.z = v, w
+                    self.cmd_pub.publish(msg)
             try:
                 rate.sleep()
+            except rospy.ROSTimeMovedBackwardsException:
+                continue
             except rospy.ROSInterruptException:
                 return
+
+    @staticmethod
+    def _sleep(seconds: float) -> bool:
+        """Sleep ``seconds`` of ROS time; False on shutdown. Time moving backwards (a simulation
+        reset) ends the sleep early, and the loop goes on."""
+        try:
+            rospy.sleep(seconds)
+        except rospy.ROSTimeMovedBackwardsException:
+            pass
+        except rospy.ROSInterruptException:
+            return False
+        return not rospy.is_shutdown()
 
     def diag_loop(self) -> None:
         from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
 
-        while sleep(1.0):
+        while self._sleep(self.diag_period):
+            now = rospy.get_time()
             with self.lock:
                 e_stop, active, is_blocked, cov = self.e_stop, self.active, self.blocked, self.cov
-            status = DiagnosticStatus(name="safety_monitor: Safety", hardware_id="puzzlebot")
-            lost = cov is not None and cov > self.max_cov
+                lost, scan_stale = self.localization_lost(), self.scan_stale
+                floor = self.mux.lock_priority(now)
+                # twist_mux's own keys: each input masked or not, each lock locked or free
+                mux_values = [
+                    (
+                        f"velocity {inp.name}",
+                        f"{'masked' if self.mux.masked(inp, now) else 'unmasked'} (listening to "
+                        f"{self.node.resolve_name(inp.topic)} @ {inp.timeout:f}s with priority #{inp.priority})",
+                    )
+                    for inp in self.mux.inputs
+                ] + [
+                    (
+                        f"lock {lock.name}",
+                        f"{'locked' if lock.locked(now) else 'free'} (listening to "
+                        f"{self.node.resolve_name(lock.topic)} @ {lock.timeout:f}s with priority #{lock.priority})",
+                    )
+                    for lock in self.mux.locks
+                ]
+            status = DiagnosticStatus(name=self.diag_name, hardware_id=self.hardware_id)
             if e_stop:
                 status.level, status.message = DiagnosticStatus.ERROR, "E-stop engaged"
+            elif scan_stale:
+                status.level, status.message = DiagnosticStatus.WARN, "Scan stale: linear motion stopped"
             elif is_blocked:
                 status.level, status.message = DiagnosticStatus.WARN, "Obstacle in the stop zone"
             elif lost:
                 status.level, status.message = DiagnosticStatus.WARN, "Localization lost: navigation stopped"
+            elif active is None and floor > 0:
+                status.level, status.message = DiagnosticStatus.OK, f"Locked below priority {floor}"
             elif active is None:
                 status.level, status.message = DiagnosticStatus.OK, "Idle (no fresh command)"
             else:
@@ -263,7 +420,10 @@ class SafetyMonitor:
                 KeyValue(key="active_input", value=str(active)),
                 KeyValue(key="e_stop", value=str(e_stop)),
                 KeyValue(key="stop_zone_blocked", value=str(is_blocked)),
+                KeyValue(key="scan_stale", value=str(scan_stale)),
                 KeyValue(key="position_covariance", value="unknown" if cov is None else f"{cov:.4f}"),
+                *(KeyValue(key=key, value=value) for key, value in mux_values),
+                KeyValue(key="current priority", value=str(floor)),
             ]
             arr = self._diag_cls(status=[status])
             arr.header.stamp = rospy.Time.from_sec(rospy.get_time())

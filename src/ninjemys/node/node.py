@@ -255,6 +255,7 @@ class Node:
         raw: bool = False,
         tcp_nodelay: bool = True,
         coalesce: float = 0.0,
+        share_thread: Subscriber | None = None,
     ) -> Subscriber:
         """Subscribe to ``topic``; ``callback(msg[, callback_args])`` runs on this subscriber's own thread.
 
@@ -264,6 +265,9 @@ class Node:
         subscriber's thread takes all that arrived meanwhile: on a VM a wake-up costs more CPU than
         a small message (``rostopic echo`` and ``bw`` use it; not ``hz``, whose statistics need each
         message's own arrival time, and TCP merges segments that wait, with their kernel times).
+        ``share_thread=handle`` delivers on ``handle``'s thread instead of a new one: one wake-up then
+        serves messages of several topics that arrive together (message_filters' synchronizers), and
+        the callbacks of those subscriptions run one after another, as under roscpp's single spinner.
         """
         self._check_alive()
         resolved = self.resolve_name(topic)
@@ -273,7 +277,7 @@ class Node:
             if sub is None:
                 sub = Subscription(self, resolved, msg_class, tcp_nodelay)
                 self._subscriptions[resolved] = sub
-            handle = Subscriber(sub, callback, callback_args, queue_size, raw, coalesce)
+            handle = Subscriber(sub, callback, callback_args, queue_size, raw, coalesce, share_thread)
             sub.handles.append(handle)
         if new:
             publishers = self.registrar.add_subscriber(resolved, sub.type_name)

@@ -15,6 +15,12 @@ queues them (bounded by ``queue_size``, oldest dropped first), deserializes and 
 
 Further Subscriber handles of the same topic in the same node get the reader's frames through their
 own queue and pipe.
+
+A handle made with ``share=other`` has no thread of its own: ``other``'s worker (the *host*) polls its
+sockets too and delivers its messages, so messages of several topics that arrive together cost one
+wake-up instead of one per topic (on a VM a wake-up costs more CPU than decoding a small message).
+The host's thread runs until every handle it serves is closed; a closed handle's connections go on
+to the next handle of its topic, as a reader's do.
 """
 
 from __future__ import annotations
@@ -143,6 +149,8 @@ class SubConnection:
         self.latching = header.get("latching", "0") == "1"
         self.last: bytes | bytearray | None = None
         self.id = next(connection_ids)
+        #: the handle whose callbacks this stream feeds (set when handed to a worker)
+        self.reader: Subscriber | None = None
         self.bytes_recv = 0
         self.num_recv = 0
         self.closed = False
@@ -330,6 +338,16 @@ class Subscription:
 class Subscriber:
     """A callback subscription; see :meth:`ninjemys.node.Node.subscriber`."""
 
+    # declared here because a handle made with ``share`` reads them on its host before its own are set
+    #: the handle whose worker thread reads and delivers for this one (itself unless made with ``share``)
+    _host: Subscriber
+    #: the handles a worker delivers for (itself first); replaced, never mutated
+    _served: tuple[Subscriber, ...]
+    #: the worker decided to end: no handle may join it any more
+    _retired: bool
+    _thread: threading.Thread
+    _ops_lock: threading.Lock
+
     def __init__(
         self,
         subscription: Subscription,
@@ -338,6 +356,7 @@ class Subscriber:
         queue_size: int | None = None,
         raw: bool = False,
         coalesce: float = 0.0,
+        share: Subscriber | None = None,
     ) -> None:
         self._sub = subscription
         #: seconds a message may wait so that one wake-up of the worker takes several (see Node.subscriber)
@@ -362,7 +381,18 @@ class Subscriber:
             maxlen=queue_size if queue_size and queue_size > 0 else None
         )
         self._closed = False
-        self._ops: list[tuple[str, SubConnection]] = []
+        if share is not None:
+            host = share._host
+            with host._ops_lock:
+                if not host._retired:  # its thread still runs: serve this handle too
+                    self._host = host
+                    self._thread = host._thread
+                    host._served = (*host._served, self)
+                    return
+        self._host = self
+        self._served = (self,)
+        self._retired = False
+        self._ops: list[tuple[str, Any]] = []
         self._ops_lock = threading.Lock()
         # a socket pair, not a pipe: selectable on every OS (Windows cannot select on pipes)
         self._wake_r, self._wake_w = socket.socketpair()
@@ -377,18 +407,22 @@ class Subscriber:
     # -- hand-offs from other threads ------------------------------------------------------------
 
     def _wakeup(self) -> None:
-        if self._woken:
+        host = self._host
+        if host._woken:
             return
-        self._woken = True
+        host._woken = True
         try:
-            self._wake_w.send(b"\0")
+            host._wake_w.send(b"\0")
         except (BlockingIOError, OSError):
             pass
 
     def post(self, op: tuple[str, SubConnection]) -> None:
-        """Queue a connection add/drop for this (reader) worker."""
-        with self._ops_lock:
-            self._ops.append(op)
+        """Queue a connection add/drop for the worker that reads for this (reader) handle."""
+        if op[0] == "add":
+            op[1].reader = self
+        host = self._host
+        with host._ops_lock:
+            host._ops.append(op)
         self._wakeup()
 
     def enqueue(self, frames: list[bytes | bytearray], header: Mapping[str, str]) -> None:
@@ -419,24 +453,34 @@ class Subscriber:
     # -- the worker thread -----------------------------------------------------------------------
 
     def _work(self) -> None:
-        queue = self._queue
-        popleft = queue.popleft
-        deliver = self._deliver
         try:
-            while not self._closed:
-                if queue:
-                    frame, header = popleft()
-                    deliver(frame, header)
+            while not (self._closed and self._retire()):
+                busy = False
+                for handle in self._served:
+                    queue = handle._queue
+                    if queue:
+                        frame, header = queue.popleft()
+                        handle._deliver(frame, header)
+                        busy = True
+                if busy:
                     continue
                 for conn in self._poller.wait():
                     if conn is None:
                         self._on_wake()
                     else:
                         self._read(conn)
-                if self._coalesce and not queue:
+                if self._coalesce and not any(h._queue for h in self._served):
                     time.sleep(self._coalesce)  # let messages gather: the next poll takes them all
         finally:
             self._finish()
+
+    def _retire(self) -> bool:
+        """True (and no handle may join any more) when every handle this worker serves is closed."""
+        with self._ops_lock:
+            if any(not h._closed for h in self._served):
+                return False
+            self._retired = True
+            return True
 
     def _on_wake(self) -> None:
         try:
@@ -449,14 +493,27 @@ class Subscriber:
         self._woken = False
         with self._ops_lock:
             ops, self._ops = self._ops, []
-        for op, conn in ops:
-            if op == "add" and not conn.closed:
-                self._conns[conn.fd] = conn
-                self._poller.register(conn.fd, conn)
-                self._read(conn)  # latched data may already be waiting
+        for op, obj in ops:
+            if op == "add" and not obj.closed:
+                self._conns[obj.fd] = obj
+                self._poller.register(obj.fd, obj)
+                self._read(obj)  # latched data may already be waiting
             elif op == "drop":
-                self._forget(conn)
-                conn.close()
+                self._forget(obj)
+                obj.close()
+            elif op == "release":  # a served handle closed while others still use this thread
+                for conn in [c for c in self._conns.values() if c.reader is obj]:
+                    self._forget(conn)
+                    self._pass_on(conn, obj)
+
+    @staticmethod
+    def _pass_on(conn: SubConnection, old: Subscriber) -> None:
+        """Give the stream of closed handle ``old`` to the next open handle of its topic, or close it."""
+        successor = next((h for h in conn.sub.handles if h is not old and not h.closed), None)
+        if successor is not None and not conn.closed:
+            successor.post(("add", conn))
+        else:
+            conn.close()
 
     def _forget(self, conn: SubConnection) -> None:
         if self._conns.pop(conn.fd, None) is not None:
@@ -466,34 +523,32 @@ class Subscriber:
         if conn.closed:
             self._forget(conn)
             return
+        owner = conn.reader or self
         # a bounded queue keeps the newest: read what the kernel holds and drop; an unbounded one
         # delivers as it goes (reading megabytes of backlog first would stall every callback meanwhile)
-        frames = conn.read(None if self._queue.maxlen is not None else _READ_BUDGET)
+        frames = conn.read(None if owner._queue.maxlen is not None else _READ_BUDGET)
         if frames is None:
             self._forget(conn)
             return
         if frames:
-            for other in self._sub.handles[1:]:
-                if other is not self:
+            for other in owner._sub.handles[1:]:
+                if other is not owner:
                     other.enqueue(frames, conn.header)
-            # the queue is empty whenever the worker reads (it delivers the queue first), so this
+            # the queues are empty whenever the worker reads (it delivers them first), so this
             # batch can go straight to the callbacks: no per-message queue entry
-            self._deliver_batch(self._keep_newest(frames, 0), conn.header)
+            owner._deliver_batch(owner._keep_newest(frames, 0), conn.header)
 
     def _finish(self) -> None:
-        """Worker exit: pass our connections to the next handle of the topic, or close them."""
+        """Worker exit: pass our connections to the next handle of their topic, or close them."""
         conns = list(self._conns.values())
         for conn in conns:
             self._forget(conn)
         with self._ops_lock:
+            self._retired = True
             pending = [c for op, c in self._ops if op == "add"]
             self._ops = []
-        successor = next((h for h in self._sub.handles if h is not self and not h.closed), None)
         for conn in conns + pending:
-            if successor is not None and not conn.closed:
-                successor.post(("add", conn))
-            else:
-                conn.close()
+            self._pass_on(conn, conn.reader or self)
         self._poller.close()
         self._wake_r.close()
         self._wake_w.close()
@@ -571,9 +626,14 @@ class Subscriber:
         if self._closed:
             return
         self._sub.node.release_subscriber(self)
-        self._closed = True
+        host = self._host
+        with host._ops_lock:
+            self._closed = True
+            shared = any(not h._closed for h in host._served)
+            if shared:  # the thread goes on for the others: it hands this handle's streams on
+                host._ops.append(("release", self))
         self._wakeup()
-        if threading.current_thread() is not self._thread:
+        if not shared and threading.current_thread() is not self._thread:
             self._thread.join(2.0)
 
     @property

@@ -4,8 +4,8 @@ No ROS in here. The lidar, the camera's per-column rays and the depth image all 
 functions; each returns the distance along every ray to the first hit (``inf`` when nothing is
 hit within ``max_range``) and, for segments and circles, which one was hit.
 
-* Segments: ray/segment intersections from 2D cross products, then a min per ray. Segments farther
-  than ``max_range`` are culled first, and each remaining segment is paired only with the rays
+* Segments: ray/segment intersections from 2D cross products, then a min per ray. Segments out of
+  reach of ``max_range`` are culled first, and each remaining segment is paired only with the rays
   inside the angle it subtends (one ``searchsorted`` over the sorted rays), so the work follows what
   is visible (a few thousand pairs) instead of the full rays x segments product.
 * Circles: the closed-form ray/circle intersection (robots and round obstacles seen by others).
@@ -22,20 +22,6 @@ import math
 import numpy as np
 
 
-def cull_segments(ox: float, oy: float, segments: np.ndarray, max_range: float) -> np.ndarray:
-    """Indices of the segments that come within ``max_range`` of the origin."""
-    if not len(segments):
-        return np.zeros(0, dtype=np.intp)
-    p = segments[:, :2] - (ox, oy)
-    e = segments[:, 2:] - segments[:, :2]
-    ee = np.einsum("ij,ij->i", e, e)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        u = np.clip(-np.einsum("ij,ij->i", p, e) / ee, 0.0, 1.0)
-    u = np.where(ee > 0, u, 0.0)
-    closest = p + u[:, None] * e
-    return np.flatnonzero(np.einsum("ij,ij->i", closest, closest) <= max_range * max_range)
-
-
 def cast_segments(
     ox: float, oy: float, angles: np.ndarray, segments: np.ndarray, max_range: float
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -43,47 +29,57 @@ def cast_segments(
 
     ``angles`` are the rays' world angles in any order. Each segment is tested only against the
     rays inside the angle it subtends from the origin (found with one ``searchsorted`` over the
-    sorted rays), so the work grows with what is visible, not with rays x segments.
+    sorted rays), so the work grows with what is visible, not with rays x segments. Every step is
+    done for all segments at once (both end points in one ``arctan2``, all span ends in two
+    ``searchsorted``): at a few hundred segments the cost is the number of numpy calls.
     """
     angles = np.asarray(angles, dtype=np.float64)
     n = len(angles)
     dist = np.full(n, np.inf)
     hit = np.full(n, -1, dtype=np.intp)
-    keep = cull_segments(ox, oy, segments, max_range)
-    if not len(keep) or not n:
+    if not n or not len(segments):
         return dist, hit
+    # first end point relative to the origin (p), edge vector (e), second end point (q = p + e)
+    px, py = segments[:, 0] - ox, segments[:, 1] - oy
+    ex, ey = segments[:, 2] - segments[:, 0], segments[:, 3] - segments[:, 1]
+    qx, qy = px + ex, py + ey
+    # broad phase: a segment whose middle is farther than max_range plus half its length cannot be
+    # hit within range (a superset of the segments that come within range: same answers)
+    near = np.hypot(px + qx, py + qy) - np.hypot(ex, ey) <= 2.0 * max_range + 1e-9
+    if not near.all():
+        keep = np.flatnonzero(near)
+        if not len(keep):
+            return dist, hit
+        px, py, ex, ey, qx, qy = px[keep], py[keep], ex[keep], ey[keep], qx[keep], qy[keep]
+    else:
+        keep = None
+    k = len(px)
     two_pi = 2.0 * math.pi
     a0 = float(angles.min())
     rel = (angles - a0) % two_pi
     order = np.argsort(rel, kind="stable")
     rel_sorted = rel[order]
-    s = segments[keep]
-    px, py = s[:, 0] - ox, s[:, 1] - oy
-    ex, ey = s[:, 2] - s[:, 0], s[:, 3] - s[:, 1]
-    r1 = (np.arctan2(py, px) - a0) % two_pi
-    r2 = (np.arctan2(py + ey, px + ex) - a0) % two_pi
+    ends = (np.arctan2(np.concatenate([py, qy]), np.concatenate([px, qx])) - a0) % two_pi
+    r1, r2 = ends[:k], ends[k:]
     lo, hi = np.minimum(r1, r2), np.maximum(r1, r2)
-    wrap = (hi - lo) > math.pi  # the short arc between the end points crosses the first ray
-    i_lo = np.searchsorted(rel_sorted, lo - 1e-12, "left")
-    i_hi = np.searchsorted(rel_sorted, hi + 1e-12, "right")
-    # spans of sorted ray positions: [lo, hi] or, wrapping, [hi, end) and [0, lo]
-    starts = np.concatenate(
-        [np.where(wrap, np.searchsorted(rel_sorted, hi - 1e-12, "left"), i_lo), np.zeros(len(s), np.intp)]
-    )
-    ends = np.concatenate(
-        [np.where(wrap, n, i_hi), np.where(wrap, np.searchsorted(rel_sorted, lo + 1e-12, "right"), 0)]
-    )
-    seg_ids = np.concatenate([np.arange(len(s)), np.arange(len(s))])
-    counts = np.maximum(ends - starts, 0)
+    wrap = (hi - lo) > math.pi
+    left = np.searchsorted(rel_sorted, np.concatenate([lo, hi]) - 1e-12, "left")
+    right = np.searchsorted(rel_sorted, np.concatenate([hi, lo]) + 1e-12, "right")
+    # spans of sorted ray positions: [lo, hi] or, for a segment whose short arc crosses the first
+    # ray, [hi, end) and then [0, lo] (the wrapping ones get a second span, after all the first ones)
+    w = np.flatnonzero(wrap)
+    starts = np.concatenate([np.where(wrap, left[k:], left[:k]), np.zeros(len(w), np.intp)])
+    stops = np.concatenate([np.where(wrap, n, right[:k]), right[k:][w]])
+    seg_ids = np.concatenate([np.arange(k), w])
+    counts = np.maximum(stops - starts, 0)
     total = int(counts.sum())
     if not total:
         return dist, hit
     seg_of = np.repeat(seg_ids, counts)
-    first = np.cumsum(counts) - counts
-    ray_of = order[np.repeat(starts, counts) + (np.arange(total) - np.repeat(first, counts))]
+    shift = np.repeat(starts - (np.cumsum(counts) - counts), counts)
+    ray_of = order[np.arange(total) + shift]
     dx, dy = np.cos(angles)[ray_of], np.sin(angles)[ray_of]
     sx, sy, gx, gy = px[seg_of], py[seg_of], ex[seg_of], ey[seg_of]
-    # o + t d = p + u e  ->  t = (p x e) / (d x e),  u = (p x d) / (d x e)
     denom = dx * gy - dy * gx
     with np.errstate(divide="ignore", invalid="ignore"):
         t = (sx * gy - sy * gx) / denom
@@ -91,7 +87,7 @@ def cast_segments(
     t[~((u >= -1e-9) & (u <= 1 + 1e-9) & (t >= 0) & np.isfinite(t))] = np.inf
     np.minimum.at(dist, ray_of, t)
     won = np.isfinite(t) & (t == dist[ray_of])
-    hit[ray_of[won]] = keep[seg_of[won]]
+    hit[ray_of[won]] = seg_of[won] if keep is None else keep[seg_of[won]]
     far = dist > max_range
     dist[far] = np.inf
     hit[far] = -1

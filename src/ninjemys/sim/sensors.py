@@ -104,8 +104,8 @@ class Camera:
         # static background: floor shaded with distance, sky above the horizon
         shade = np.clip(1.15 - floor_depth / 12.0, 0.55, 1.0)[:, None] * FLOOR_RGB[None, :]
         bg = np.where(below[:, None], shade, SKY_RGB[None, :]).astype(np.uint8)
-        self._background = np.ascontiguousarray(np.broadcast_to(bg[:, None, :], (height, width, 3))).reshape(
-            height, 3 * width
+        self._background = _padded_copy(
+            np.broadcast_to(bg[:, None, :], (height, width, 3)).reshape(height, 3 * width)
         )
         self._floor_rows = np.flatnonzero(floor_depth > 0)  # rows that see the floor within range
         forward = floor_depth[self._floor_rows][:, None]
@@ -115,18 +115,28 @@ class Camera:
             (forward * ((self.cx - u) / self.fx)[None, :]).astype(np.float32),
         )
         self._neg_slope = -self.row_slope
-        self._rows = np.arange(height, dtype=np.uint16)[:, None]
+        # a column's wall rows are top <= v < bottom, with top and bottom in [0, height]: compared
+        # in the narrowest unsigned type that holds them (uint8 up to 255 rows), so building the
+        # masks is one byte-wide vectorised comparison per pixel
+        self._row_type = np.uint8 if height <= 255 else np.uint16
+        self._rows = np.arange(height, dtype=self._row_type)[:, None]
+        self._floor_depth_image = _padded_copy(np.broadcast_to(self.floor_depth_mm[:, None], (height, width)))
+        # scratch masks, reused by every frame (render runs on one thread at a time: the node's lock)
+        self._lanes3 = _padded_empty((height, 3 * width), np.uint8)
+        self._below3 = np.empty((height, 3 * width), dtype=bool)
+        self._lanes1 = _padded_empty((height, width), np.uint16)
 
     def render(self, scene: Scene, x: float, y: float, yaw: float) -> tuple[np.ndarray, np.ndarray]:
         """(rgb8 image (H, W, 3), depth in mm uint16 (H, W)) from a camera at (x, y, cam_z) facing ``yaw``."""
         angles = yaw + self.col_angles
         far = self.depth_max / float(self.col_cos.min())
         dist, seg = cast_segments(x, y, angles, scene.segments, far)
-        heights = np.zeros(self.width)
-        colors = np.zeros((self.width, 3), dtype=np.float32)
         found = seg >= 0
-        heights[found] = scene.heights[seg[found]]
-        colors[found] = scene.colors[seg[found]]
+        if len(scene.heights):
+            # a column with no hit (-1) reads the last segment's: never drawn, ``found`` masks it out
+            heights, colors = scene.heights[seg], scene.colors[seg]
+        else:
+            heights, colors = np.zeros(self.width), np.zeros((self.width, 3), dtype=np.uint8)
         if len(scene.circles):
             cd, ci = cast_circles(x, y, angles, scene.circles, scene.radii, far)
             nearer = cd < dist
@@ -142,20 +152,25 @@ class Camera:
             lo_slope = np.where(found, -self.cam_z / depth, np.inf)
             hi_slope = np.where(found, (heights - self.cam_z) / depth, -np.inf)
         # row_slope decreases with v: searchsorted on its negation
-        top = np.searchsorted(self._neg_slope, -hi_slope, "left")
-        bottom = np.searchsorted(self._neg_slope, -lo_slope, "right")
-        # the image as (H, 3W) bytes: one select over bytes against a per-channel mask is cheaper than
-        # any interleaving of channels or a select over 3-byte elements
-        # top <= v < bottom as one unsigned comparison: v - top wraps to a huge value above the top
-        span = np.maximum(bottom - top, 0).astype(np.uint16)
-        wall3 = (self._rows - np.repeat(top.astype(np.uint16), 3)) < np.repeat(span, 3)
+        top = np.searchsorted(self._neg_slope, -hi_slope, "left").astype(self._row_type)
+        bottom = np.searchsorted(self._neg_slope, -lo_slope, "right").astype(self._row_type)
+        rows = self._rows
+        wall = rows >= top
+        wall &= rows < bottom
         light = np.clip(1.1 - depth / 15.0, 0.45, 1.0)  # flat shading, darker with distance
         col = (colors * light[:, None]).astype(np.uint8).reshape(1, 3 * self.width)
-        rgb = np.where(wall3, col, self._background).reshape(self.height, self.width, 3)
+        # the image as (H, 3W) bytes, each pixel's mask repeated over its three channels: selecting
+        # bytes is cheaper than any interleaving of channels or a select over 3-byte elements
+        wall3 = self._lanes3.view(bool)
+        np.greater_equal(rows, np.repeat(top, 3), out=wall3)
+        np.less(rows, np.repeat(bottom, 3), out=self._below3)
+        wall3 &= self._below3
+        rgb = _select(self._lanes3, col, self._background).reshape(self.height, self.width, 3)
         if scene.floor is not None:
-            self._paint_floor(rgb, wall3[:, ::3], scene.floor, x, y, yaw)
+            self._paint_floor(rgb, wall, scene.floor, x, y, yaw)
         wall_mm = np.rint(np.where(found, depth, 0.0) * 1000.0).astype(np.uint16)
-        depth_mm = np.where(wall3[:, ::3], wall_mm[None, :], self.floor_depth_mm[:, None])
+        np.copyto(self._lanes1, wall)
+        depth_mm = _select(self._lanes1, wall_mm[None, :], self._floor_depth_image)
         return rgb, depth_mm
 
     def _paint_floor(
@@ -183,6 +198,47 @@ class Camera:
 
     def intrinsics(self) -> tuple[float, float, float, float]:
         return self.fx, self.fy, self.cx, self.cy
+
+
+def _padded_empty(shape: tuple[int, ...], dtype: type) -> np.ndarray:
+    """An uninitialised C-contiguous array on a buffer of whole 8-byte words (``.base``, uint64).
+    The last word is zeroed, so padding past the array's end holds no garbage that a
+    multiplication on words could carry into the array (on a big-endian machine)."""
+    size = math.prod(shape) * np.dtype(dtype).itemsize
+    words = np.empty(-(-size // 8), dtype=np.uint64)
+    if len(words):
+        words[-1] = 0
+    return words.view(np.uint8)[:size].view(dtype).reshape(shape)
+
+
+def _padded_copy(image: np.ndarray) -> np.ndarray:
+    out = _padded_empty(image.shape, image.dtype.type)
+    out[...] = image
+    return out
+
+
+def _words(image: np.ndarray) -> np.ndarray:
+    """The 8-byte words under an array made by :func:`_padded_empty`."""
+    base = image
+    while base.base is not None:
+        base = base.base
+    return base
+
+
+def _select(lanes: np.ndarray, fore: np.ndarray, back: np.ndarray) -> np.ndarray:
+    """``np.where(lanes, fore, back)`` for an unsigned-integer image ``back`` from :func:`_padded_copy`,
+    a few times faster. ``lanes`` (from :func:`_padded_empty`, ``back``'s shape and type) holds 0 or 1
+    per element and is used up; ``fore`` broadcasts to ``back``'s shape. Computed as
+    ``back ^ ((back ^ fore) & lanes)`` on 8-byte words, with each lane turned into all ones by one
+    multiplication: 1 times 0xFF (0xFFFF, ...) fits its own element, so no carry reaches the next."""
+    out = _padded_empty(back.shape, back.dtype.type)
+    np.bitwise_xor(back, fore, out=out)
+    lane_words = _words(lanes)
+    lane_words *= np.uint64((1 << (8 * back.itemsize)) - 1)
+    words = _words(out)
+    words &= lane_words
+    words ^= _words(back)
+    return out
 
 
 def imu_reading(

@@ -163,33 +163,64 @@ class Simulation:
         self._movers_at = (self.world_time, out)
         return out
 
+    def _mover_shapes(self) -> tuple:
+        """What does not move about the moving obstacles, built once: heights, colours and names per
+        outline segment, each mover's outline as segments centred on the origin (boxes are turned to
+        their heading at each step), and each mover's bounding radius (for the collision broad phase)."""
+        if self._mover_fixed is None:
+            heights, colours, names, shapes, bounds = [], [], [], [], []
+            for m in self.world.moving:
+                if m.kind == "cylinder":
+                    outline = circle_outline(0.0, 0.0, m.size[0])
+                else:
+                    outline = box_outline(0.0, 0.0, m.size[0], m.size[1], 0.0)
+                shapes.append(np.hstack([outline, np.roll(outline, -1, axis=0)]))
+                bounds.append(float(np.hypot(outline[:, 0], outline[:, 1]).max()))
+                heights.append(np.full(len(outline), m.height))
+                colours.append(np.tile(np.array(m.color, dtype=np.uint8), (len(outline), 1)))
+                names.append([m.name] * len(outline))
+            self._mover_fixed = (heights, colours, names, shapes, bounds)
+        return self._mover_fixed
+
+    def _mover_outline(self, index: int, x: float, y: float, heading: float) -> np.ndarray:
+        """Mover ``index``'s outline segments at pose (x, y, heading)."""
+        m = self.world.moving[index]
+        segs = self._mover_shapes()[3][index]
+        if m.kind != "cylinder":
+            c, s = math.cos(heading), math.sin(heading)
+            turn = np.array([[c, s, 0.0, 0.0], [-s, c, 0.0, 0.0], [0.0, 0.0, c, s], [0.0, 0.0, -s, c]])
+            segs = segs @ turn
+        return segs + (x, y, x, y)
+
     def _compute_mover_segments(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[str]]:
         movers = self.world.moving
         if not movers:
             return np.zeros((0, 4)), np.zeros(0), np.zeros((0, 3), dtype=np.uint8), []
-        if self._mover_fixed is None:  # what does not move: heights, colours, names, outline shapes
-            heights, colours, names, shapes = [], [], [], []
-            for m in movers:
-                # centred on the origin; boxes are turned to their heading at each step
-                if m.kind == "cylinder":
-                    shape = circle_outline(0.0, 0.0, m.size[0])
-                else:
-                    shape = box_outline(0.0, 0.0, m.size[0], m.size[1], 0.0)
-                shapes.append(shape)
-                heights.append(np.full(len(shape), m.height))
-                colours.append(np.tile(np.array(m.color, dtype=np.uint8), (len(shape), 1)))
-                names += [m.name] * len(shape)
-            self._mover_fixed = (np.concatenate(heights), np.vstack(colours), names, shapes)
-        heights, colours, names, shapes = self._mover_fixed
-        outlines = []
-        for m, shape in zip(movers, shapes, strict=True):
-            x, y, heading = m.position(self.world_time)
-            if m.kind != "cylinder":
-                c, s = math.cos(heading), math.sin(heading)
-                shape = shape @ np.array([[c, s], [-s, c]])
-            outlines.append(shape + (x, y))
-        segs = np.vstack([np.hstack([o, np.roll(o, -1, axis=0)]) for o in outlines])
-        return segs, heights, colours, names
+        heights, colours, names, _, _ = self._mover_shapes()
+        segs = [self._mover_outline(i, *m.position(self.world_time)) for i, m in enumerate(movers)]
+        return (
+            np.vstack(segs),
+            np.concatenate(heights),
+            np.vstack(colours),
+            [n for group in names for n in group],
+        )
+
+    def _movers_near(self, x: float, y: float, reach: float) -> tuple[np.ndarray, list[str]]:
+        """Outline segments and names of the moving obstacles that come within ``reach`` of (x, y)
+        now; the others are left out without building their outlines (a step's broad phase)."""
+        if not self.world.moving:
+            return self._static[:0], []
+        if self._movers_at is not None and self._movers_at[0] == self.world_time:
+            ms, _, _, mnames = self._movers_at[1]  # the sensors built them all this step already
+            return ms, mnames
+        _, _, names, _, bounds = self._mover_shapes()
+        segs, near_names = [], []
+        for i, m in enumerate(self.world.moving):
+            mx, my, heading = m.position(self.world_time)
+            if math.hypot(mx - x, my - y) <= reach + bounds[i]:
+                segs.append(self._mover_outline(i, mx, my, heading))
+                near_names += names[i]
+        return (np.vstack(segs) if segs else self._static[:0]), near_names
 
     def scene(self, exclude: str | None = None) -> Scene:
         """Everything solid now, as seen by robot ``exclude`` (its own body left out)."""
@@ -227,7 +258,7 @@ class Simulation:
             names = [self.static_names[i] for i in near]
         else:
             segs, names = self._static[:0], []
-        ms, _, _, mnames = self._mover_segments()
+        ms, mnames = self._movers_near(x, y, reach)
         if len(ms):
             segs = np.vstack([segs, ms])
             names = names + mnames
@@ -426,8 +457,11 @@ class Simulation:
             geometry = self._collision_geometry(r.x, r.y, travel + radius + 0.05, r.name, static)
             pieces = max(1, math.ceil(travel / (radius * 0.5)))
             f = np.arange(0, pieces + 1) / pieces
-            dist, who = self._clearances(r.x + f * ddx, r.y + f * ddy, r.name, geometry)
-            blocked = np.flatnonzero((dist[1:] < radius) & (dist[1:] < dist[0] - 1e-12))
+            if len(geometry[0]) or len(geometry[2]):
+                dist, who = self._clearances(r.x + f * ddx, r.y + f * ddy, r.name, geometry)
+                blocked = np.flatnonzero((dist[1:] < radius) & (dist[1:] < dist[0] - 1e-12))
+            else:
+                blocked = f[:0]  # nothing within reach: the move is free
             if len(blocked):
                 k = int(blocked[0]) + 1
                 lo, hi = f[k - 1], f[k]

@@ -51,8 +51,15 @@ class TransformListener:
         self.tf_sub = node.subscriber(
             "/tf", None, self._on_tf, queue_size=queue_size, raw=True, tcp_nodelay=tcp_nodelay
         )
+        # one thread reads both topics (/tf_static is mostly silent: a thread of its own would only wait)
         self.tf_static_sub = node.subscriber(
-            "/tf_static", None, self._on_tf_static, queue_size=queue_size, raw=True, tcp_nodelay=tcp_nodelay
+            "/tf_static",
+            None,
+            self._on_tf_static,
+            queue_size=queue_size,
+            raw=True,
+            tcp_nodelay=tcp_nodelay,
+            share_thread=self.tf_sub,
         )
 
     def _check_for_reset(self) -> None:

@@ -7,8 +7,11 @@ over the terminal, so without a display the URL is only printed.
 from __future__ import annotations
 
 import os
+import signal
 import sys
+import threading
 import webbrowser
+from collections.abc import Callable
 
 
 def has_display() -> bool:
@@ -25,3 +28,19 @@ def open_if_display(url: str) -> bool:
         return webbrowser.open(url)
     except webbrowser.Error:
         return False
+
+
+def serve_until_stopped(url: str, open_browser: bool, stop: Callable[[], None]) -> int:
+    """The tail every page tool shares: open ``url`` (when asked and there is a display), wait for
+    SIGTERM or Ctrl-C as a ROS GUI tool's window would, then ``stop`` the server; exit status 0."""
+    if open_browser:
+        open_if_display(url)
+    stopped = threading.Event()
+    signal.signal(signal.SIGTERM, lambda *_: stopped.set())
+    try:
+        stopped.wait()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        stop()
+    return 0

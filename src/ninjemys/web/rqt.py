@@ -16,7 +16,6 @@ import argparse
 import base64
 import bisect
 import os
-import signal
 import sys
 import threading
 import time
@@ -31,7 +30,7 @@ from ninjemys.errors import NinjemysError
 from ninjemys.node import Node
 from ninjemys.tools.cli import entry
 from ninjemys.web.app import STATIC_DIR, WebApp
-from ninjemys.web.browser import open_if_display
+from ninjemys.web.browser import serve_until_stopped
 from ninjemys.web.http import HttpError, Request, Response
 
 DEFAULT_MASTER = "http://localhost:11311"
@@ -349,17 +348,7 @@ def _serve(
         print(f"{prog}: {error}", file=sys.stderr)
     url = tool_url(base, tool, query)
     print(f"{prog}: {url}", flush=True)
-    if not args.no_browser:
-        open_if_display(url)
-    stop = threading.Event()
-    signal.signal(signal.SIGTERM, lambda *_: stop.set())
-    try:
-        stop.wait()
-    except KeyboardInterrupt:
-        pass
-    finally:
-        rqt.stop()
-    return 0
+    return serve_until_stopped(url, not args.no_browser, rqt.stop)
 
 
 def _ros_args(argv: list[str] | None) -> list[str]:

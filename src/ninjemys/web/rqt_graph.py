@@ -7,14 +7,12 @@ from __future__ import annotations
 
 import argparse
 import os
-import signal
 import sys
-import threading
 
 from ninjemys.node import Node
 from ninjemys.tools.cli import entry
 from ninjemys.web.app import WebApp
-from ninjemys.web.browser import open_if_display
+from ninjemys.web.browser import serve_until_stopped
 from ninjemys.web.monitor import TopicMonitor
 
 DEFAULT_MASTER = "http://localhost:11311"
@@ -51,17 +49,7 @@ def main(argv: list[str] | None = None) -> int:
         )
         return 1
     print(f"rqt_graph: node graph of {master_uri} at {url}", flush=True)
-    if not args.no_browser:
-        open_if_display(url)
-    stop = threading.Event()
-    signal.signal(signal.SIGTERM, lambda *_: stop.set())
-    try:
-        stop.wait()
-    except KeyboardInterrupt:
-        pass
-    finally:
-        app.stop()
-    return 0
+    return serve_until_stopped(url, not args.no_browser, app.stop)
 
 
 console_main = entry(main)

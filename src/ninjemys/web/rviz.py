@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import signal
 import sys
 import threading
 import time
@@ -23,7 +22,7 @@ from ninjemys.node import Node
 from ninjemys.tools.cli import entry
 from ninjemys.web import rvizconfig
 from ninjemys.web.app import STATIC_DIR, WebApp
-from ninjemys.web.browser import open_if_display
+from ninjemys.web.browser import serve_until_stopped
 from ninjemys.web.http import HttpError, Request, Response
 
 DEFAULT_MASTER = "http://localhost:11311"
@@ -181,17 +180,7 @@ def main(argv: list[str] | None = None) -> int:
     if rviz.page.error:
         print(f"rviz: {rviz.page.error} (opened with the default displays)", file=sys.stderr)
     print(f"rviz: {url}", flush=True)
-    if not args.no_browser:
-        open_if_display(url)
-    stop = threading.Event()
-    signal.signal(signal.SIGTERM, lambda *_: stop.set())
-    try:
-        stop.wait()
-    except KeyboardInterrupt:
-        pass
-    finally:
-        rviz.stop()
-    return 0
+    return serve_until_stopped(url, not args.no_browser, rviz.stop)
 
 
 console_main: Any = entry(main)

@@ -1,0 +1,198 @@
+"""The simulator's fast paths give the same answers as the plain ones: the camera's bitwise select
+against ``np.where`` and a per-column renderer, the collision broad phase for moving obstacles,
+and the simulation lock that the stepping thread hands over only when someone waits."""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ninjemys.sim.puzzlebot_node import StepLock, keep_freed_memory
+from ninjemys.sim.raycast import cast_segments
+from ninjemys.sim.robot_model import load_robot_model
+from ninjemys.sim.sensors import FLOOR_RGB, SKY_RGB, _padded_copy, _padded_empty, _select
+from ninjemys.sim.simcore import Simulation
+from ninjemys.sim.world2d import load_world
+from ninjemys.sim.worlds import world_path
+
+
+@pytest.mark.parametrize("dtype", [np.uint8, np.uint16])
+@pytest.mark.parametrize("shape", [(240, 960), (7, 5), (1, 3), (33, 17)])
+def test_bitwise_select_equals_where(dtype, shape):
+    """Any shape (sizes that are not whole 8-byte words too), a broadcast row and a full image."""
+    rng = np.random.default_rng(1)
+    top = np.iinfo(dtype).max
+    back = _padded_copy(rng.integers(0, top, shape, dtype=dtype, endpoint=True))
+    mask = rng.random(shape) > 0.4
+    for fore in (
+        rng.integers(0, top, (1, shape[1]), dtype=dtype, endpoint=True),
+        rng.integers(0, top, shape, dtype=dtype, endpoint=True),
+    ):
+        lanes = _padded_empty(shape, dtype)
+        np.copyto(lanes, mask)
+        out = _select(lanes, fore, back)
+        assert out.dtype == dtype and out.shape == shape and out.flags.c_contiguous
+        assert np.array_equal(out, np.where(mask, fore, back))
+
+
+def reference_render(sim: Simulation, r) -> tuple[np.ndarray, np.ndarray]:  # type: ignore[no-untyped-def]
+    """The camera image drawn the slow, obvious way: one ray per column, then row by row within the
+    column, a pixel is wall when its ray meets the obstacle between the floor and its top."""
+    cam = r.camera
+    spec = r.model.camera
+    scene = sim.scene(r.name)
+    x, y = sim.sensor_pose(r, spec.pose.xyz)
+    yaw = r.yaw + spec.pose.rpy[2]
+    far = cam.depth_max / float(cam.col_cos.min())
+    dist, seg = cast_segments(x, y, yaw + cam.col_angles, scene.segments, far)
+    rgb = np.zeros((cam.height, cam.width, 3), dtype=np.uint8)
+    depth = np.zeros((cam.height, cam.width), dtype=np.uint16)
+    for u in range(cam.width):
+        d = dist[u] * cam.col_cos[u]
+        seen = seg[u] >= 0 and d <= cam.depth_max
+        for v in range(cam.height):
+            slope = cam.row_slope[v]
+            if seen and 0.0 <= cam.cam_z + slope * d <= scene.heights[seg[u]] + 1e-12:
+                light = min(max(1.1 - d / 15.0, 0.45), 1.0)
+                rgb[v, u] = (scene.colors[seg[u]].astype(np.float32) * light).astype(np.uint8)
+                depth[v, u] = round(d * 1000.0)
+            elif slope < -1e-9:
+                floor = cam.cam_z / -slope
+                floor = floor if floor <= cam.depth_max else 0.0  # beyond the depth range: no data
+                shade = min(max(1.15 - floor / 12.0, 0.55), 1.0)
+                rgb[v, u] = (shade * FLOOR_RGB).astype(np.uint8)
+                depth[v, u] = round(floor * 1000.0)
+            else:
+                rgb[v, u] = SKY_RGB.astype(np.uint8)
+    return rgb, depth
+
+
+def test_camera_matches_a_per_pixel_renderer():
+    """Colour and depth of the office seen from three poses, pixel by pixel (a pixel on a wall's
+    exact top or foot row may go either way in floating point: at most one such row per column)."""
+    sim = Simulation(load_world(world_path("office")), 0.01, 0)
+    r = sim.add_robot("pb", load_robot_model("puzzlebot"), 0.0, 0.0, 0.0)
+    for x, y, yaw in ((0.0, 0.0, 0.3), (-3.0, 0.2, 1.4), (2.5, -0.3, -2.0)):
+        r.x, r.y, r.yaw = x, y, yaw
+        rgb, depth = sim.render(r)
+        ref_rgb, ref_depth = reference_render(sim, r)
+        assert rgb.shape == ref_rgb.shape and depth.dtype == np.uint16
+        rgb_off = (rgb != ref_rgb).any(axis=2).sum(axis=0)
+        depth_off = (depth != ref_depth).sum(axis=0)
+        assert rgb_off.max() <= 1 and depth_off.max() <= 1
+        assert rgb_off.sum() < 20 and depth_off.sum() < 20
+
+
+def walker_world(tmp_path: Path, waypoints: str) -> Simulation:
+    (tmp_path / "w.yaml").write_text(
+        "bounds: [-3, -3, 12, 3]\n"
+        "moving:\n"
+        f"  - {{name: walker, shape: cylinder, radius: 0.25, height: 1.0, speed: 0.5, waypoints: {waypoints}, loop: false}}\n"
+    )
+    return Simulation(load_world(tmp_path / "w.yaml"), dt=0.01)
+
+
+def test_a_moving_obstacle_crossing_the_path_stops_the_robot(tmp_path):
+    sim = walker_world(tmp_path, "[[1.5, -2.0], [1.5, 2.0]]")
+    r = sim.add_robot("pb", load_robot_model("puzzlebot"), 0.0, 0.0, 0.0)
+    r.command(0.3, 0.0)
+    for _ in range(1000):
+        sim.step()
+        if r.contact:
+            break
+    assert r.contact and r.contact_with == "walker"
+    wx, wy, _ = sim.world.moving[0].position(sim.world_time)
+    gap = math.hypot(r.x - wx, r.y - wy) - 0.25 - r.model.body_radius
+    assert -0.02 < gap < 0.01  # the walker is a 24-sided polygon inside its circle
+
+
+def test_a_far_moving_obstacle_is_left_out_of_the_step(tmp_path):
+    """The walker paces 8 m away: steps never build its outline, the sensors still see it."""
+    sim = walker_world(tmp_path, "[[8.0, -1.0], [8.0, 1.0]]")
+    r = sim.add_robot("pb", load_robot_model("puzzlebot"), 0.0, 0.0, 0.0)
+    built = []
+    outline = sim._mover_outline
+    sim._mover_outline = lambda *a: built.append(a) or outline(*a)  # type: ignore[method-assign]
+    r.command(0.2, 0.0)
+    for _ in range(100):
+        sim.step()
+    assert not built and not r.contact
+    ranges = sim.scan(r)
+    assert built  # the scan builds it
+    wx, wy, _ = sim.world.moving[0].position(sim.world_time)
+    nearest = math.hypot(wx - r.x, wy - r.y) - 0.25
+    assert float(np.min(ranges)) == pytest.approx(nearest, abs=0.06)
+
+
+def test_step_lock_gives_way_only_to_waiters():
+    lock = StepLock()
+    t = time.monotonic()
+    lock.give_way(2.0)
+    assert time.monotonic() - t < 0.5  # nobody waits: no pause at all
+    got = threading.Event()
+
+    def service() -> None:
+        with lock:
+            time.sleep(0.05)
+            got.set()
+
+    lock.stepping.acquire()
+    worker = threading.Thread(target=service)
+    worker.start()
+    time.sleep(0.05)  # the service now waits for the lock
+    lock.stepping.release()
+    lock.give_way(5.0)  # returns once the service has had the lock and let it go
+    assert got.is_set()
+    worker.join(5)
+    with lock, lock:  # reentrant
+        pass
+    t = time.monotonic()
+    lock.give_way(2.0)
+    assert time.monotonic() - t < 0.5
+
+
+def test_keep_freed_memory_is_harmless():
+    assert keep_freed_memory() in (True, False)
+    a = np.ones(1 << 20)
+    assert float(a.sum()) == 1 << 20
+
+
+def brute_force_cast(ox, oy, angles, segments, max_range):  # type: ignore[no-untyped-def]
+    """Every ray against every segment."""
+    dx, dy = np.cos(angles)[:, None], np.sin(angles)[:, None]
+    px, py = segments[None, :, 0] - ox, segments[None, :, 1] - oy
+    ex, ey = segments[None, :, 2] - segments[None, :, 0], segments[None, :, 3] - segments[None, :, 1]
+    denom = dx * ey - dy * ex
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (px * ey - py * ex) / denom
+        u = (px * dy - py * dx) / denom
+    t = np.where((u >= -1e-9) & (u <= 1 + 1e-9) & (t >= 0) & np.isfinite(t), t, np.inf)
+    dist = t.min(axis=1)
+    return np.where(dist <= max_range, dist, np.inf)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_cast_segments_equals_brute_force(seed):
+    """Random segments (some out of range, some crossing the rays' first angle), lidar-like and
+    camera-like fans and scattered rays."""
+    rng = np.random.default_rng(seed)
+    start = rng.uniform(-15, 15, (300, 2))
+    segments = np.hstack([start, start + rng.uniform(-3, 3, (300, 2))])
+    for angles in (
+        np.linspace(-math.pi, math.pi, 360, endpoint=False) + rng.uniform(-3, 3),
+        rng.uniform(-3, 3) + np.arctan((159.5 - np.arange(320)) / 233.0),
+        rng.uniform(-10, 10, 40),
+    ):
+        ox, oy = rng.uniform(-5, 5, 2)
+        for max_range in (12.0, 2.0):
+            dist, hit = cast_segments(ox, oy, angles, segments, max_range)
+            expected = brute_force_cast(ox, oy, angles, segments, max_range)
+            assert np.array_equal(np.isinf(dist), np.isinf(expected))
+            seen = np.isfinite(dist)
+            assert np.allclose(dist[seen], expected[seen], rtol=0, atol=1e-9)
+            assert (hit[seen] >= 0).all() and (hit[~seen] == -1).all()
