@@ -8,6 +8,7 @@ import signal
 import subprocess
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -122,6 +123,7 @@ class Probe:
             queue_size=1,
         )
         self.front = math.inf  # nearest return within +-35 degrees ahead
+        self._wander_pubs: dict[str, Any] = {}
         self.node.subscriber("/scan", get_message_class("sensor_msgs/LaserScan"), self._scan, queue_size=1)
         self.twist_cls = get_message_class("geometry_msgs/Twist")
         self.pose_cls = get_message_class("geometry_msgs/PoseStamped")
@@ -148,8 +150,14 @@ class Probe:
 
     def wander(self, seconds: float, topic: str = "/teleop/cmd_vel") -> None:
         """Drive reactively for ``seconds`` of sim time: ahead while the way is clear, else turn left."""
-        pub = self.node.publisher(topic, self.twist_cls, queue_size=1)
-        time.sleep(0.5)
+        pub = self._wander_pubs.get(topic)
+        if pub is None:  # one publisher per topic for the probe's life: a new one per call would stand
+            # the robot still for its connection time on every call (2 s of sim time at rate 4)
+            pub = self._wander_pubs[topic] = self.node.publisher(topic, self.twist_cls, queue_size=1)
+            deadline = time.monotonic() + 5.0
+            while pub.get_num_connections() == 0 and time.monotonic() < deadline:
+                time.sleep(0.02)
+            time.sleep(0.2)
         end = self.sim_time + seconds
         deadline = time.monotonic() + seconds * 3 + 60
         turning_until = 0.0
@@ -165,7 +173,6 @@ class Probe:
             pub.publish(msg)
             time.sleep(0.02)
         pub.publish(self.twist_cls())
-        pub.unregister()
 
     def _contact(self, msg) -> None:
         if msg.data:

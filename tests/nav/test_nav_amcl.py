@@ -84,3 +84,20 @@ def test_motion_model_spread_follows_alphas(room):
     assert math.isclose(pf.poses[:, 0].mean(), 3.0, abs_tol=0.02)
     assert math.isclose(pf.poses[:, 0].std(), 0.2, rel_tol=0.1)  # sqrt(alpha3 * 1^2)
     assert np.allclose(pf.poses[:, 1], 2.0) and np.allclose(pf.poses[:, 2], 0.0)
+
+
+def test_resample_reports_injected_particles(room, laser):
+    """Recovery injection (w_fast below w_slow) says how many unweighed uniform particles it added: the
+    node weighs them with the next scan even when the robot stands still."""
+    angles, cast = laser
+    params = AMCLParams(recovery_alpha_slow=0.001, recovery_alpha_fast=0.1, max_particles=500)
+    pf = ParticleFilter(room, params, seed=3)
+    pf.init_gaussian((1.0, 1.0, 0.0), 0.01, 0.01, 0.01)
+    good = cast(room, (1.0, 1.0, 0.0), angles, 5.0)
+    pf.sensor_update(good, angles, 5.0)
+    assert pf.resample() == 0  # the averages agree: nothing injected
+    pf.sensor_update(good + 1.0, angles, 5.0)  # scans that fit badly: w_fast drops below w_slow
+    injected = pf.resample()
+    assert injected > 0
+    spread = np.hypot(pf.poses[:, 0] - 1.0, pf.poses[:, 1] - 1.0) > 1.0
+    assert spread.sum() >= injected // 2  # uniform draws land all over the room

@@ -62,3 +62,26 @@ def test_dwa_reports_no_valid_arc_when_boxed_in():
     dwa.set_plan(np.array([[1.0, 1.0, 0.0], [1.9, 1.0, 0.0]]))
     cmd = dwa.compute((1.0, 1.0, 0.0), (0.0, 0.0), cm)
     assert not cmd.valid and cmd.v == 0.0 and cmd.w == 0.0
+
+
+def test_dwa_final_turn_settles_when_cycles_run_late():
+    """Every cycle over a second late (a stalled control thread at 4x real time): the turn to the goal's yaw must still end
+    inside yaw_goal_tolerance instead of swinging past it back and forth."""
+    data = np.zeros((60, 60), dtype=np.int8)
+    cm = Costmap(CostmapParams(rolling_window=True, width=2.0, height=2.0, robot_radius=0.12))
+    cm.set_static_map(data, 0.05, 0.0, 0.0)
+    cm.update_origin(1.5, 1.5)
+    cm.update()
+    params = DWAParams(yaw_goal_tolerance=0.1, min_vel_theta=0.3)
+    dwa = DWAPlanner(params)
+    dwa.set_plan(np.array([[1.45, 1.5, 0.0], [1.5, 1.5, 2.0]]))
+    th, w = 0.0, 0.0
+    period = 1.2
+    for _ in range(40):
+        cmd = dwa.compute((1.5, 1.5, th), (0.0, w), cm, period)
+        if cmd.reached:
+            break
+        w = cmd.w
+        th += w * period
+    assert cmd.reached, th
+    assert abs(th - 2.0) <= params.yaw_goal_tolerance

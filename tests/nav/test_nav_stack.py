@@ -296,11 +296,6 @@ def wait_goal(session: NavSession, goal: tuple, limit: float) -> bool:
     return False
 
 
-@pytest.mark.xfail(
-    reason="issue 15 open: the last runs reached 18 of 20 maze goals (target 19); at one goal the robot "
-    "stood within 5 cm turning, and the next goal never started",
-    strict=False,
-)
 @pytest.mark.long  # 20 goals take about 7 minutes: `make test-long`
 def test_maze_goals_through_move_base_simple(tmp_path):
     session = start("maze", tmp_path)

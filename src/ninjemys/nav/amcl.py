@@ -91,6 +91,46 @@ def bins_of(poses: np.ndarray) -> np.ndarray:
     ).astype(np.int64)
 
 
+def connected_bins(keys: np.ndarray) -> np.ndarray:
+    """Cluster labels of occupied histogram bins ``keys`` (k, 3): bins touching in x, y or heading
+    (the 26 neighbours, heading wrapping around) share a label (the smallest index in the cluster).
+
+    Neighbour pairs are found by binary search over the encoded keys, then labels spread along them
+    with pointer jumping: a few numpy passes instead of a Python walk over thousands of bins (the
+    particle cloud right after ``global_localization`` occupies most of the map's bins)."""
+    k = len(keys)
+    nth = int(round(2 * math.pi / BIN_TH))
+    lo = keys.min(axis=0) - 1
+    span = keys.max(axis=0) - lo + 2
+    x, y, t = keys[:, 0] - lo[0], keys[:, 1] - lo[1], (keys[:, 2] + nth // 2) % nth
+    code = (x * span[1] + y) * nth + t
+    order = np.argsort(code)
+    sorted_code = code[order]
+    src: list[np.ndarray] = []
+    dst: list[np.ndarray] = []
+    for a, b, c in ((a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1)):
+        if (a, b, c) <= (0, 0, 0):  # each pair once: the 13 offsets after (0, 0, 0)
+            continue
+        other = ((x + a) * span[1] + (y + b)) * nth + (t + c) % nth
+        pos = np.minimum(np.searchsorted(sorted_code, other), k - 1)
+        hit = sorted_code[pos] == other
+        src.append(np.nonzero(hit)[0])
+        dst.append(order[pos[hit]])
+    label = np.arange(k)
+    if k < 2:
+        return label
+    i, j = np.concatenate(src), np.concatenate(dst)
+    while True:
+        low = np.minimum(label[i], label[j])
+        new = label.copy()
+        np.minimum.at(new, i, low)
+        np.minimum.at(new, j, low)
+        new = new[new]  # pointer jumping: follow each label to its own label
+        if np.array_equal(new, label):
+            return label
+        label = new
+
+
 class ParticleFilter:
     """amcl's particle filter over one map. ``poses`` (n, 3) and ``weights`` (n,) are the set."""
 
@@ -239,11 +279,12 @@ class ParticleFilter:
 
     # -- resampling -------------------------------------------------------------------------------
 
-    def resample(self) -> None:
-        """Low-variance resampling with KLD-adapted size and recovery injection."""
+    def resample(self) -> int:
+        """Low-variance resampling with KLD-adapted size and recovery injection; returns how many
+        uniformly drawn (not yet weighed) particles the new set holds."""
         p = self.params
         if len(self.poses) == 0:
-            return
+            return 0
         m = p.max_particles
         w_diff = 0.0
         if self.w_slow > 0:
@@ -253,6 +294,7 @@ class ParticleFilter:
         u = (self.rng.random() + np.arange(m)) / m
         picked = self.poses[np.searchsorted(cum, u)]
         picked = picked[self.rng.permutation(m)]
+        inject = np.zeros(m, dtype=bool)
         if w_diff > 0:
             inject = self.rng.random(m) < w_diff
             k = int(inject.sum())
@@ -271,6 +313,7 @@ class ParticleFilter:
         self.weights = np.full(count, 1.0 / count)
         if w_diff > 0:
             self.w_slow = self.w_fast = 0.0  # amcl resets the averages after injecting
+        return int(inject[:count].sum())
 
     # -- estimate ---------------------------------------------------------------------------------
 
@@ -282,34 +325,10 @@ class ParticleFilter:
         keys, inverse = np.unique(bins, axis=0, return_inverse=True)
         inverse = inverse.ravel()
         bin_w = np.bincount(inverse, weights=self.weights, minlength=len(keys))
-        index = {tuple(k): i for i, k in enumerate(keys.tolist())}
-        label = [-1] * len(keys)
-        cluster_w: list[float] = []
-        offsets = [
-            (a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1) if (a, b, c) != (0, 0, 0)
-        ]
-        nth = int(round(2 * math.pi / BIN_TH))
-        for start in range(len(keys)):
-            if label[start] >= 0:
-                continue
-            cid = len(cluster_w)
-            label[start] = cid
-            stack = [start]
-            total = 0.0
-            while stack:
-                i = stack.pop()
-                total += bin_w[i]
-                kx, ky, kt = keys[i]
-                for a, b, c in offsets:
-                    t = kt + c  # theta bins run -nth/2 .. nth/2 - 1 and wrap around
-                    t = t + nth if t < -nth // 2 else t - nth if t >= nth // 2 else t
-                    j = index.get((kx + a, ky + b, t))
-                    if j is not None and label[j] < 0:
-                        label[j] = cid
-                        stack.append(j)
-            cluster_w.append(total)
+        label = connected_bins(keys)
+        cluster_w = np.bincount(label, weights=bin_w, minlength=len(keys))
         best = int(np.argmax(cluster_w))
-        member = np.asarray(label)[inverse] == best
+        member = label[inverse] == best
         pts, w = self.poses[member], self.weights[member]
         w = w / w.sum()
         mx, my = float(w @ pts[:, 0]), float(w @ pts[:, 1])

@@ -9,7 +9,8 @@ Subscribes ``scan`` (sensor_msgs/LaserScan), ``initialpose`` (PoseWithCovariance
 
 The filter updates when odometry moved more than ``~update_min_d`` along x or y or turned more than
 ``~update_min_a`` since the last update (amcl compares each component), and resamples every
-``~resample_interval`` updates. Only the likelihood-field laser model and the diff-drive odometry
+``~resample_interval`` updates. After a resampling that injected uniform particles (recovery), the next
+scan updates the filter even without motion, so the injected particles are weighed at once. Only the likelihood-field laser model and the diff-drive odometry
 model exist: other ``~laser_model_type``/``~odom_model_type`` values are reported once and replaced.
 """
 
@@ -181,19 +182,22 @@ class AmclNode:
     # -- the filter ---------------------------------------------------------------------------------
 
     def on_scan(self, scan: Any) -> None:
+        if self.pf is None:
+            return
+        t = scan.header.stamp.to_sec()
+        # the odometry of the scan's own instant (waiting for it, as amcl's message filter does)
+        odom = self.tf.lookup_at(self.odom_frame, self.base_frame, t)
+        if odom is None:
+            rospy.logwarn_throttle(
+                5.0,
+                "amcl: no transform %s -> %s at the scan's stamp %.3f; scan dropped",
+                self.odom_frame,
+                self.base_frame,
+                t,
+            )
+            return
         with self.lock:
             if self.pf is None:
-                return
-            t = scan.header.stamp.to_sec()
-            odom = self.tf.lookup(self.odom_frame, self.base_frame, t)
-            if odom is None:
-                rospy.logwarn_throttle(
-                    5.0,
-                    "amcl: no transform %s -> %s at %.3f yet; scan dropped",
-                    self.odom_frame,
-                    self.base_frame,
-                    t,
-                )
                 return
             laser_frame = scan.header.frame_id or self.base_frame
             laser = self.laser_pose.get(laser_frame)
@@ -230,10 +234,16 @@ class AmclNode:
                 self.last_odom = odom
                 self.pf.sensor_update(ranges, angles, float(scan.range_max), laser, float(scan.range_min))
                 self.updates += 1
-                if self.updates % max(1, self.params.resample_interval) == 0:
-                    self.pf.resample()
-                self.force_update = False
+                # the estimate of the weighed set, before resampling: particles injected for recovery
+                # are not weighed yet, and thousands of them would connect the real cluster into one
+                # spanning the map (a huge covariance, which makes the safety monitor stop the robot)
                 mean, cov = self.pf.estimate()
+                injected = 0
+                if self.updates % max(1, self.params.resample_interval) == 0:
+                    injected = self.pf.resample()
+                # injected particles are weighed by the next scan even if the robot does not move
+                # (ROS 1's amcl waits for motion; a robot stopped for its covariance would wait forever)
+                self.force_update = injected > 0
                 est = (float(mean[0]), float(mean[1]), float(mean[2]))
                 self._publish_pose(scan, est, cov)
                 self.map_to_odom = compose(est, inverse(odom))

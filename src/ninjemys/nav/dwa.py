@@ -114,9 +114,17 @@ class DWAPlanner:
             self.plan = self.plan[i:]
 
     def compute(
-        self, pose: tuple[float, float, float], vel: tuple[float, float], costmap: Costmap
+        self,
+        pose: tuple[float, float, float],
+        vel: tuple[float, float],
+        costmap: Costmap,
+        period: float | None = None,
     ) -> Command:
-        """The velocity for this cycle from the robot's pose and velocity (costmap frame)."""
+        """The velocity for this cycle from the robot's pose and velocity (costmap frame).
+
+        ``period`` is how long the command will actually stand (the measured cycle period, when the
+        controller runs late); the turn to the goal's yaw never goes further than it can stop within
+        that time, so a late cycle does not swing the robot past ``yaw_goal_tolerance``."""
         p = self.params
         x, y, th = pose
         if len(self.plan) == 0:
@@ -125,10 +133,12 @@ class DWAPlanner:
         gx, gy, gyaw = self.plan[-1]
         if self.goal_reached_xy(x, y) or (self.xy_latched and p.latch_xy_goal_tolerance):
             self.xy_latched = True
-            return self._rotate_to(th, gyaw, vel)
+            return self._rotate_to(th, gyaw, vel, period)
         return self._sample(x, y, th, vel, costmap)
 
-    def _rotate_to(self, th: float, goal_yaw: float, vel: tuple[float, float]) -> Command:
+    def _rotate_to(
+        self, th: float, goal_yaw: float, vel: tuple[float, float], period: float | None = None
+    ) -> Command:
         p = self.params
         dt = 1.0 / p.controller_frequency
         if abs(vel[0]) > 0.02:  # stop first, then turn
@@ -142,6 +152,10 @@ class DWAPlanner:
         w_stop = math.sqrt(2 * p.acc_lim_theta * abs(err))
         w = min(p.max_vel_theta, w_stop, 2.0 * abs(err), abs(vel[1]) + p.acc_lim_theta * dt)
         w = max(w, p.min_vel_theta)
+        # a command stands until the next cycle: turning for the whole (measured) period must end inside
+        # the tolerance window, else a late cycle swings past it and the robot hunts back and forth
+        hold = max(dt, period or 0.0)
+        w = min(w, (abs(err) + 0.5 * p.yaw_goal_tolerance) / hold)
         return Command(0.0, math.copysign(w, err))
 
     def _sample(self, x: float, y: float, th: float, vel: tuple[float, float], cm: Costmap) -> Command:

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 import threading
+from collections import deque
 from dataclasses import fields
 from typing import Any
 
@@ -130,6 +131,8 @@ class MoveBase:
         self.rotate_start: float | None = None
         self.rotate_turned = 0.0
         self.rotate_last_yaw = 0.0
+        self.last_cycle: float | None = None
+        self.periods: deque[float] = deque(maxlen=20)  # measured control periods (ROS time)
         self._path_cls, self._pose_stamped = Path, PoseStamped
         self.cmd_pub = node.publisher("cmd_vel", Twist, queue_size=1)
         self._twist = Twist
@@ -250,7 +253,7 @@ class MoveBase:
         ranges = np.where(np.isneginf(ranges), scan.range_min, ranges)  # REP 117: closer than range_min
         t = scan.header.stamp.to_sec()
         for cm in cms:
-            sensor = self.tf.lookup(cm.global_frame, scan.header.frame_id, t)
+            sensor = self.tf.lookup_at(cm.global_frame, scan.header.frame_id, t)  # the costmap's filter
             if sensor is None:
                 continue
             with self.lock:
@@ -513,6 +516,9 @@ class MoveBase:
             )
             return
         now = rospy.get_time()
+        if self.last_cycle is not None and now > self.last_cycle:
+            self.periods.append(now - self.last_cycle)
+        self.last_cycle = now
         with self.lock:
             goal = self.goal
             if goal is None:
@@ -548,7 +554,8 @@ class MoveBase:
             keep_latch = self.dwa.xy_latched
             self.dwa.set_plan(local_plan)
             self.dwa.xy_latched = keep_latch
-            cmd = self.dwa.compute(lpose, self.velocity, lcm)
+            # the longest recent cycle: how long this command may stand before the next one
+            cmd = self.dwa.compute(lpose, self.velocity, lcm, max(self.periods, default=None))
             # prune the global plan as the local planner did
             self.plan = plan[len(plan) - len(self.dwa.plan) :]
         if cmd.reached:

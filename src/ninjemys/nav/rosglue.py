@@ -21,6 +21,10 @@ from ninjemys.tf2.node import TransformBroadcaster, TransformListener
 
 Pose2D = tuple[float, float, float]
 
+#: how long (wall seconds) a scan waits for the transform at its stamp before it is dropped; ROS 1's
+#: message filters hold up to their queue size of scans, about a second of a 40 Hz (4x sim) laser
+STAMP_WAIT = 1.0
+
 
 def start_node(name: str, argv: list[str] | None) -> tuple[Any, list[str]]:
     """``rospy.init_node(name)`` with the process's ``name:=value`` arguments; returns the core node and
@@ -122,20 +126,28 @@ class Tf2D:
         self._node = node
 
     def lookup(self, target: str, source: str, t: float = 0.0) -> Pose2D | None:
-        """``source``'s pose in ``target`` at ROS time ``t`` (0: latest); None when unknown yet.
-        A time just past the newest data falls back to the newest (the scan can beat its odometry)."""
+        """``source``'s pose in ``target`` at ROS time ``t`` (0: latest); None when unknown."""
         try:
             return tf_to_2d(self.buffer.lookup(target, source, int(round(t * 1e9)))[1])
         except TransformException:
-            if t == 0.0:
-                return None
-        try:
-            stamp_ns, tr = self.buffer.lookup(target, source, 0)
-        except TransformException:
             return None
-        if abs(stamp_ns / 1e9 - t) > 0.5:
+
+    def lookup_at(self, target: str, source: str, t: float, timeout: float = STAMP_WAIT) -> Pose2D | None:
+        """``source``'s pose in ``target`` at exactly the data's stamp ``t``, waiting up to ``timeout``
+        wall seconds for the transform to arrive; None when it does not (the data is then dropped).
+
+        This is what ROS 1's ``tf2_ros::MessageFilter`` does for amcl, gmapping and the costmaps: a scan
+        is used only with the odometry of its own instant. A scan often arrives before the /tf message
+        of the same simulation step, and under load /tf lags by many cycles; pairing the scan with the
+        newest (older) odometry instead would shift it by whatever the robot moved meanwhile (0.4 rad
+        for half a second of turning), which is what sent amcl and the mapper astray under load."""
+        t_ns = int(round(t * 1e9))
+        ok, _ = self.buffer.wait_for_transform(
+            lambda: self.buffer.can_transform(target, source, t_ns), timeout
+        )
+        if not ok:
             return None
-        return tf_to_2d(tr)
+        return self.lookup(target, source, t)
 
     def send(self, items: list[tuple]) -> None:
         if self._broadcaster is None:

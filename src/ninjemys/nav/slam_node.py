@@ -62,11 +62,11 @@ class SlamNode:
 
     def on_scan(self, scan: Any) -> None:
         t = scan.header.stamp.to_sec()
-        odom = self.tf.lookup(self.odom_frame, self.base_frame, t)
+        odom = self.tf.lookup_at(self.odom_frame, self.base_frame, t)  # gmapping's message filter
         if odom is None:
             rospy.logwarn_throttle(
                 5.0,
-                "slam_gmapping: no transform %s -> %s yet; scan dropped",
+                "slam_gmapping: no transform %s -> %s at the scan's stamp; scan dropped",
                 self.odom_frame,
                 self.base_frame,
             )
