@@ -95,10 +95,12 @@ def test_seed_commands_work(live_graph):
     assert ttype.stdout == "std_msgs/String\n"
 
 
-def _echo_subscribed(uri: str, topic: str) -> bool:
-    """True once a ``rostopic`` node subscribes to ``topic`` (asked of the master's XML-RPC API)."""
-    _, _, (_, subscribers, _) = xmlrpc.client.ServerProxy(uri).getSystemState("/golden_test")
-    return any(name == topic and any("rostopic" in n for n in nodes) for name, nodes in subscribers)
+def _rostopic_node_up(uri: str) -> bool:
+    """True once a ``rostopic`` node has registered with the master (init_node registers its /rosout
+    publisher). Debian's echo subscribes only once the topic has a publisher to take the type from,
+    then polls for it every 0.1 s: well within ``pub -1``'s 3 s latch once it is up."""
+    _, _, state = xmlrpc.client.ServerProxy(uri).getSystemState("/golden_test")
+    return any("rostopic" in node for kind in state for _, nodes in kind for node in nodes)
 
 
 def test_pub_reaches_real_echo(live_graph):
@@ -119,7 +121,7 @@ def test_pub_reaches_real_echo(live_graph):
     try:
         # `pub -1` latches for 3 s and exits: under load Debian's echo could still be starting by then
         deadline = time.monotonic() + 30
-        while time.monotonic() < deadline and not _echo_subscribed(uri, "/turtle1/cmd_vel"):
+        while time.monotonic() < deadline and not _rostopic_node_up(uri):
             time.sleep(0.1)
         pub = subprocess.run(
             [
