@@ -67,9 +67,10 @@ format: venv
 typecheck: venv
 	$(VENV)/bin/mypy
 
-# --dist loadgroup keeps each xdist_group on one worker (the navigation sessions run one at a time).
+# --dist loadfile: each test file runs on one worker, in order (the navigation sessions of
+# tests/nav/test_nav_stack.py run one at a time, and the office session's tests follow its goals run).
 test: venv system npm lint typecheck
-	$(VENV)/bin/pytest -n 2 -q --dist loadgroup -m "not long"
+	$(VENV)/bin/pytest -n 2 -q --dist loadfile -m "not long"
 
 # The acceptance runs of many minutes (20 maze goals through move_base); not part of `make test`.
 test-long: venv system

@@ -23,9 +23,10 @@ from .conftest import NavSession, pick_goals
 pytest.importorskip("ninjemys.sim.puzzlebot_node", reason="the PuzzleBot simulator is not on this branch yet")
 pytest.importorskip("ninjemys.actionlib.server", reason="actionlib is not on this branch yet")
 
-# One navigation session at a time (``make test`` runs with ``--dist loadgroup``): two stacks at a
-# real-time factor of 4 on the same two cores starve each other's control loops.
-pytestmark = [pytest.mark.slow, pytest.mark.timeout(900), pytest.mark.xdist_group("nav")]
+# ``make test`` runs with ``--dist loadfile``: this file's tests run on one worker, in order, so there
+# is one navigation session at a time (two stacks at a real-time factor of 4 on the same two cores
+# starve each other's control loops) and the office session's tests follow its goals run.
+pytestmark = [pytest.mark.slow, pytest.mark.timeout(900)]
 
 DATA = Path(__file__).parent / "data"
 RATE = "4"

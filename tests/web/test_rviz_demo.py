@@ -18,7 +18,7 @@ from ninjemys.idl.loader import get_message_class
 from ninjemys.node import Node
 from ninjemys.testing import free_port
 
-pytestmark = [pytest.mark.browser, pytest.mark.slow, pytest.mark.xdist_group("nav")]
+pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
 GOAL = (3.5, 0.0)  # along the office corridor the robot starts in, facing +x
 
