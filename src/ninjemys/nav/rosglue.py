@@ -163,9 +163,14 @@ def scan_arrays(scan: Any) -> tuple[np.ndarray, np.ndarray]:
 
 
 def sleep(seconds: float) -> bool:
-    """Sleep ``seconds`` of ROS time; False once the node is shutting down (for background loops)."""
+    """Sleep ``seconds`` of ROS time; False once the node is shutting down (for background loops).
+
+    ROS time moving backwards (a simulation reset, a looping bag) ends this sleep early but not the
+    loop: rospy raises it as a kind of ROSInterruptException, which must not stop the node's threads."""
     try:
         rospy.sleep(seconds)
+    except rospy.ROSTimeMovedBackwardsException:
+        pass
     except rospy.ROSInterruptException:
         return False
     return not rospy.is_shutdown()
