@@ -37,7 +37,7 @@ import yaml
 
 import rospy
 from ninjemys.nav.costmap import footprint_radii, parse_footprint
-from ninjemys.nav.rosglue import Tf2D, param, run_node, scan_arrays
+from ninjemys.nav.rosglue import Tf2D, param, run_node, scan_arrays, sleep
 from ninjemys.nav.safety import NEVER, MuxInput, MuxLock, TwistMux, blocked
 
 DEFAULT_TOPICS = [
@@ -364,22 +364,10 @@ class SafetyMonitor:
             except rospy.ROSInterruptException:
                 return
 
-    @staticmethod
-    def _sleep(seconds: float) -> bool:
-        """Sleep ``seconds`` of ROS time; False on shutdown. Time moving backwards (a simulation
-        reset) ends the sleep early, and the loop goes on."""
-        try:
-            rospy.sleep(seconds)
-        except rospy.ROSTimeMovedBackwardsException:
-            pass
-        except rospy.ROSInterruptException:
-            return False
-        return not rospy.is_shutdown()
-
     def diag_loop(self) -> None:
         from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
 
-        while self._sleep(self.diag_period):
+        while sleep(self.diag_period):  # goes on across a simulation reset
             now = rospy.get_time()
             with self.lock:
                 e_stop, active, is_blocked, cov = self.e_stop, self.active, self.blocked, self.cov
