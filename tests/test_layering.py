@@ -6,7 +6,7 @@ own layer and any layer below; anything else fails with ``file:line``.
 
 The order, bottom to top (``LAYERS``)::
 
-    base       leaf modules every layer may use (errors, names, rostime, roshome, records, paramyaml, ...)
+    base       leaf modules every layer may use (errors, names, rostime, roshome, records, paramyaml, interrupt, ...)
     idl        message definitions and classes, and the interface stub packages (src/std_msgs, ...)
     packages   ROS packages on disk: discovery, manifests, shipped executables, catkin workspaces
     wire       ROS 1 serialization, TCPROS framing and headers, XML-RPC encoding (sans-IO)
@@ -47,6 +47,7 @@ LAYERS: dict[str, str] = {
     "paramyaml_emit": "base",
     "paramyaml_pyyaml": "base",
     "share": "base",
+    "interrupt": "base",
     "idl": "idl",
     "interfaces": "idl",
     "packages": "packages",

@@ -16,6 +16,7 @@ import threading
 import time
 
 from ninjemys.errors import MasterError, NameError_, NinjemysError, ParameterError
+from ninjemys.interrupt import wait_event
 from ninjemys.node.log import INFO
 from rospy.core import _process, is_shutdown, signal_shutdown
 from rospy.exceptions import ROSException, ROSInitException, ROSInterruptException, mapped, translate
@@ -383,7 +384,7 @@ def wait_for_message(topic: str, topic_type: Any, timeout: float | None = None) 
     if node.is_shutdown:
         got.set()
     try:
-        got.wait(timeout)
+        wait_event(got, timeout)
     finally:
         with _process.lock:
             _process.waiters.discard(got)

@@ -12,6 +12,7 @@ from collections.abc import Callable, Mapping
 
 from ninjemys import names
 from ninjemys.errors import NinjemysError, ServiceError
+from ninjemys.interrupt import wait_event
 from ninjemys.node.log import ERROR
 from rospy.core import _process
 from rospy.exceptions import ServiceException, mapped, translate
@@ -57,7 +58,7 @@ class _Unnamed:
         return self._stop.is_set()
 
     def wait_for_shutdown(self, timeout: float | None = None) -> bool:
-        return self._stop.wait(timeout)
+        return wait_event(self._stop, timeout)
 
     def resolve_name(self, name: str) -> str:
         return names.resolve_name(name, self.name, self.remappings)

@@ -26,6 +26,7 @@ from typing import Any, TextIO
 from ninjemys.bag.format import NSEC, Connection
 from ninjemys.bag.reader import BagReader, RawMessage
 from ninjemys.errors import BagError
+from ninjemys.interrupt import wait_event
 
 CLOCK_TYPE = "rosgraph_msgs/Clock"
 CLOCK_MD5 = "a9c97c1d230cfc112e270351a944ee47"
@@ -307,7 +308,7 @@ class Player:
 
     def keep_alive(self) -> None:
         """``-k``: stay up after the bag ends (latched topics keep serving) until stopped."""
-        self._stop.wait()
+        wait_event(self._stop)
 
     def close(self) -> None:
         for reader in self.readers:

@@ -25,6 +25,7 @@ from typing import Any
 from ninjemys.bag.format import DEFAULT_CHUNK_THRESHOLD
 from ninjemys.bag.writer import BagWriter
 from ninjemys.errors import BagError, NinjemysError
+from ninjemys.interrupt import wait_event
 
 
 @dataclass
@@ -346,7 +347,7 @@ class Recorder:
 
     def wait(self, timeout: float | None = None) -> bool:
         """Block until recording stops by itself (limit reached) or ``timeout``; True if stopped."""
-        return self._stop.wait(timeout)
+        return wait_event(self._stop, timeout)
 
     def request_stop(self) -> None:
         """Ask the recording to end (signal handlers and node shutdown call this); returns at once."""

@@ -29,6 +29,7 @@ from ninjemys.dynamic_reconfigure.errors import (
 )
 from ninjemys.errors import ServiceError, TimeoutError_
 from ninjemys.idl.loader import get_message_class, get_service_class
+from ninjemys.interrupt import wait_slice
 
 
 def reconfigure_servers(node: Any) -> list[str]:
@@ -102,7 +103,7 @@ class ReconfigureClient:
                 left = None if deadline is None else deadline - time.monotonic()
                 if left is not None and left <= 0.0:
                     break
-                self._cv.wait(left)
+                self._cv.wait(wait_slice(left))
             return getattr(self, attr)
 
     def get_configuration(self, timeout: float | None = None) -> Config | None:

@@ -21,6 +21,8 @@ import threading
 import time
 from collections.abc import Callable
 
+from ninjemys.interrupt import wait_slice
+
 TYPE_CHECKING = False  # importing typing costs ~7 ms of every node's start-up; checkers set it
 if TYPE_CHECKING:
     from typing import Any
@@ -153,7 +155,7 @@ class Clock:
                 remaining = target - self.now()
                 if remaining <= 0:
                     return Wake.REACHED
-                self._cond.wait(None if self.is_sim else remaining)
+                self._cond.wait(wait_slice(None if self.is_sim else remaining))
 
     def _gate(self) -> Any:
         gate = getattr(self._local, "gate", None)
@@ -190,7 +192,7 @@ class Clock:
                 if remaining <= 0:
                     return Wake.REACHED
                 # True: someone opened the gate (we hold it again, re-armed); False: the time is up
-                gate.acquire(True, remaining)
+                gate.acquire(True, wait_slice(remaining))
         finally:
             with self._gates_lock:
                 self._gates.discard(gate)

@@ -29,6 +29,7 @@ from collections.abc import Callable, Mapping
 
 from ninjemys import names, rostime
 from ninjemys.errors import MasterError, NinjemysError, ParameterError, ShutdownError
+from ninjemys.interrupt import wait_event
 from ninjemys.master.client import MasterClient
 from ninjemys.net.addresses import advertised_host
 from ninjemys.net.addresses import master_uri as env_master_uri
@@ -571,11 +572,11 @@ class Node:
 
     def wait_for_shutdown(self, timeout: float | None = None) -> bool:
         """Block until the node is shut down (or ``timeout`` passes); True if it is."""
-        return self._shutdown_event.wait(timeout)
+        return wait_event(self._shutdown_event, timeout)
 
     def spin(self) -> None:
         """Block until shutdown."""
-        self._shutdown_event.wait()
+        wait_event(self._shutdown_event)
 
     def shutdown(self, reason: str = "") -> None:
         """Unregister everything, close every connection and stop every thread of this node."""

@@ -41,6 +41,7 @@ from math import acos, cos, isfinite, sin, sqrt
 import numpy
 
 from ninjemys.errors import DeserializationError
+from ninjemys.interrupt import wait_slice
 from ninjemys.tf2 import math as tfm
 from ninjemys.tf2.bulk import Layout, valid
 from ninjemys.tf2.errors import (
@@ -1093,7 +1094,9 @@ class BufferCore:
                     current = clock()
                     if ok or current >= deadline or current + 3.0 < start or (cancelled and cancelled()):
                         return ok, why
-                    self._changed.wait(min(deadline - current, 1.0) if cancelled else deadline - current)
+                    self._changed.wait(
+                        wait_slice(min(deadline - current, 1.0) if cancelled else deadline - current)
+                    )
             finally:
                 self._waiters -= 1
 

@@ -13,6 +13,8 @@ import threading
 import webbrowser
 from collections.abc import Callable
 
+from ninjemys.interrupt import wait_event
+
 
 def has_display() -> bool:
     return sys.platform in ("darwin", "win32") or bool(
@@ -30,17 +32,28 @@ def open_if_display(url: str) -> bool:
         return False
 
 
-def serve_until_stopped(url: str, open_browser: bool, stop: Callable[[], None]) -> int:
-    """The tail every page tool shares: open ``url`` (when asked and there is a display), wait for
-    SIGTERM or Ctrl-C as a ROS GUI tool's window would, then ``stop`` the server; exit status 0."""
-    if open_browser:
-        open_if_display(url)
+def stop_signals() -> threading.Event:
+    """From now on SIGINT and SIGTERM set the returned Event instead of raising.
+
+    A page tool calls this before it starts its server: a Ctrl-C landing between the server's start
+    and the wait would otherwise raise KeyboardInterrupt where nothing stops the server, and the node
+    would leave without unregistering from the master."""
     stopped = threading.Event()
-    signal.signal(signal.SIGTERM, lambda *_: stopped.set())
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, lambda *_: stopped.set())
+    return stopped
+
+
+def serve_until_stopped(
+    url: str, open_browser: bool, stop: Callable[[], None], stopped: threading.Event
+) -> int:
+    """The tail every page tool shares: open ``url`` (when asked and there is a display), wait for
+    ``stopped`` (from :func:`stop_signals`: SIGTERM or Ctrl-C, as closing a ROS GUI tool's window),
+    then ``stop`` the server; exit status 0."""
     try:
-        stopped.wait()
-    except KeyboardInterrupt:
-        pass
+        if open_browser:
+            open_if_display(url)
+        wait_event(stopped)
     finally:
         stop()
     return 0

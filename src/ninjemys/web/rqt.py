@@ -30,7 +30,7 @@ from ninjemys.errors import NinjemysError
 from ninjemys.node import Node
 from ninjemys.tools.cli import entry
 from ninjemys.web.app import STATIC_DIR, WebApp
-from ninjemys.web.browser import serve_until_stopped
+from ninjemys.web.browser import serve_until_stopped, stop_signals
 from ninjemys.web.http import HttpError, Request, Response
 
 DEFAULT_MASTER = "http://localhost:11311"
@@ -336,6 +336,7 @@ def _serve(
     except NinjemysError as exc:
         print(f"ERROR: {prog}: {exc}", file=sys.stderr)
         return 1
+    stopped = stop_signals()
     try:
         base = rqt.start()
     except OSError as exc:
@@ -348,7 +349,7 @@ def _serve(
         print(f"{prog}: {error}", file=sys.stderr)
     url = tool_url(base, tool, query)
     print(f"{prog}: {url}", flush=True)
-    return serve_until_stopped(url, not args.no_browser, rqt.stop)
+    return serve_until_stopped(url, not args.no_browser, rqt.stop, stopped)
 
 
 def _ros_args(argv: list[str] | None) -> list[str]:

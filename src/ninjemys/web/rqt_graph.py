@@ -12,7 +12,7 @@ import sys
 from ninjemys.node import Node
 from ninjemys.tools.cli import entry
 from ninjemys.web.app import WebApp
-from ninjemys.web.browser import serve_until_stopped
+from ninjemys.web.browser import serve_until_stopped, stop_signals
 from ninjemys.web.monitor import TopicMonitor
 
 DEFAULT_MASTER = "http://localhost:11311"
@@ -28,18 +28,13 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
-def _has_display() -> bool:
-    return sys.platform in ("darwin", "win32") or bool(
-        os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
-    )
-
-
 def main(argv: list[str] | None = None) -> int:
     # ROS passes remappings (name:=value) and __name/__log args; they do not apply to this tool
     args = _parser().parse_args([a for a in (argv or []) if ":=" not in a])
     master_uri = os.environ.get("ROS_MASTER_URI", DEFAULT_MASTER)
     monitor = TopicMonitor(lambda: Node("rqt_graph", anonymous=True, master_uri=master_uri))
     app = WebApp(master_uri, caller_id="/rqt_graph", host=args.host, port=args.port, monitor=monitor)
+    stopped = stop_signals()
     try:
         url = app.start()
     except OSError as exc:
@@ -49,7 +44,7 @@ def main(argv: list[str] | None = None) -> int:
         )
         return 1
     print(f"rqt_graph: node graph of {master_uri} at {url}", flush=True)
-    return serve_until_stopped(url, not args.no_browser, app.stop)
+    return serve_until_stopped(url, not args.no_browser, app.stop, stopped)
 
 
 console_main = entry(main)

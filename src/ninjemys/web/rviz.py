@@ -22,7 +22,7 @@ from ninjemys.node import Node
 from ninjemys.tools.cli import entry
 from ninjemys.web import rvizconfig
 from ninjemys.web.app import STATIC_DIR, WebApp
-from ninjemys.web.browser import serve_until_stopped
+from ninjemys.web.browser import serve_until_stopped, stop_signals
 from ninjemys.web.http import HttpError, Request, Response
 
 DEFAULT_MASTER = "http://localhost:11311"
@@ -171,6 +171,7 @@ def main(argv: list[str] | None = None) -> int:
     except NinjemysError as exc:
         print(f"ERROR: rviz: {exc}", file=sys.stderr)
         return 1
+    stopped = stop_signals()
     try:
         url = rviz.start()
     except OSError as exc:
@@ -180,7 +181,7 @@ def main(argv: list[str] | None = None) -> int:
     if rviz.page.error:
         print(f"rviz: {rviz.page.error} (opened with the default displays)", file=sys.stderr)
     print(f"rviz: {url}", flush=True)
-    return serve_until_stopped(url, not args.no_browser, rviz.stop)
+    return serve_until_stopped(url, not args.no_browser, rviz.stop, stopped)
 
 
 console_main: Any = entry(main)
