@@ -106,3 +106,55 @@ def test_rolling_window_follows_the_robot_and_keeps_marks():
     cm.set_static_map(static, 0.05, -2.5, -2.5)
     cm.update()
     assert cm.cost_at(0.01, 0.3) == LETHAL  # the static wall at x = 0 shows in the window
+
+
+def reference_clear_cells(
+    cm: Costmap, sx: float, sy: float, angles: np.ndarray, ranges: np.ndarray, rmax: float
+):
+    """The cells the obstacle layer clears, from the rays x steps grid (the straightforward form)."""
+    p = cm.params
+    keep = ~np.isnan(ranges)
+    ranges, angles = ranges[keep], angles[keep]
+    beyond = ~np.isfinite(ranges) | (ranges >= rmax)
+    clear_len = np.minimum(np.where(beyond, p.raytrace_range, ranges), p.raytrace_range)
+    step = cm.resolution / 2
+    t = np.arange(int(math.ceil(p.raytrace_range / step)) + 1) * step
+    valid = t[None, :] < (clear_len[:, None] - cm.resolution * 0.5)
+    xs = sx + np.cos(angles)[:, None] * t[None, :]
+    ys = sy + np.sin(angles)[:, None] * t[None, :]
+    cx = np.floor((xs[valid] - cm.origin_x) / cm.resolution).astype(int)
+    cy = np.floor((ys[valid] - cm.origin_y) / cm.resolution).astype(int)
+    inside = (cx >= 0) & (cx < cm.size_x) & (cy >= 0) & (cy < cm.size_y)
+    return set(zip(cy[inside].tolist(), cx[inside].tolist(), strict=True))
+
+
+def test_incremental_update_equals_a_full_recompute(room, laser):
+    """Scans from many poses (marks appear and are cleared again), people-like blobs, a cleared
+    square: after every step the costs equal those of a costmap rebuilt from scratch."""
+    angles, cast = laser
+    params = dict(robot_radius=0.16, inflation_radius=0.4, cost_scaling_factor=8.0, track_unknown_space=True)
+    static = room.data.copy()
+    static[100:110, 10:20] = -1  # an unknown patch
+    cm = Costmap(CostmapParams(**params))
+    cm.set_static_map(static, room.resolution, 0.0, 0.0)
+    rng = np.random.default_rng(5)
+    for i in range(40):
+        pose = (rng.uniform(0.5, 5.5), rng.uniform(0.5, 5.5), rng.uniform(-math.pi, math.pi))
+        ranges = cast(room, pose, angles, 5.0)
+        ranges = ranges - rng.uniform(0.0, 0.3, ranges.shape) * (rng.random(ranges.shape) < 0.2)  # "people"
+        ranges[rng.random(ranges.shape) < 0.02] = np.nan
+        before = cm.obstacles.copy()
+        cm.add_scan(pose[0], pose[1], pose[2] + angles, ranges, 5.0)
+        cleared = reference_clear_cells(cm, pose[0], pose[1], pose[2] + angles, ranges, 5.0)
+        for cy, cx in cleared:
+            before[cy, cx] = 0
+        marked = cm.obstacles == LETHAL
+        assert np.array_equal(cm.obstacles[~marked], before[~marked])  # cleared exactly those cells
+        if i == 25:
+            cm.obstacles[20:60, 20:60] = 0  # what a clearing recovery does
+        fresh = Costmap(CostmapParams(**params))
+        fresh.set_static_map(static, room.resolution, 0.0, 0.0)
+        fresh.obstacles = cm.obstacles.copy()
+        old = cm.costs
+        assert np.array_equal(cm.update(), fresh.update()), i
+        assert old is cm.costs or not np.shares_memory(old, cm.costs)  # replaced, never edited

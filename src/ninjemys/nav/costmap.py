@@ -14,6 +14,10 @@ centre there means a collision), 254 lethal, 255 no information. :func:`to_occup
   beyond it, up to ``inflation_radius``.
 
 A rolling window (the local costmap) follows the robot by whole cells; what scrolled out is lost.
+
+Why updates are incremental: a map-sized costmap (the global one) is re-inflated only over the window
+a changed lethal cell can reach (most scans of a known world change no lethal cell at all, and then
+nothing is recomputed), with the same result as inflating the whole grid.
 """
 
 from __future__ import annotations
@@ -153,6 +157,10 @@ class Costmap:
     static_costs: np.ndarray | None = None  # the static layer inflated, without sensor marks (global only)
     obstacles: np.ndarray = field(default_factory=lambda: np.zeros((0, 0), dtype=np.uint8))
     costs: np.ndarray = field(default_factory=lambda: np.zeros((0, 0), dtype=np.uint8))
+    #: what ``costs`` was last computed from (fixed grids): the lethal mask and the inflation's
+    #: parameters; None forces a full recompute
+    _lethal: np.ndarray | None = field(default=None, repr=False)
+    _inflation_key: tuple | None = field(default=None, repr=False)
 
     # -- geometry ---------------------------------------------------------------------------------
 
@@ -199,6 +207,7 @@ class Costmap:
         )
         if self.obstacles.shape != static.shape:
             self.obstacles = np.zeros(static.shape, dtype=np.uint8)
+        self._lethal = None
         self.update()
 
     def _resize_rolling(self, cx: float, cy: float) -> None:
@@ -275,18 +284,22 @@ class Costmap:
         ranges, angles = ranges[keep], angles[keep]
         beyond = ~np.isfinite(ranges) | (ranges >= range_max)
         clear_len = np.minimum(np.where(beyond, p.raytrace_range, ranges), p.raytrace_range)
-        # clear: sample every ray at half-cell steps, stopping short of the hit cell
+        # clear: sample every ray at half-cell steps, stopping short of the hit cell (only the samples
+        # each ray needs: a flat list of (ray, step) pairs rather than a rays x steps grid)
         step = self.resolution / 2
         n = int(math.ceil(p.raytrace_range / step)) + 1
         t = np.arange(n) * step
         cos, sin = np.cos(angles), np.sin(angles)
-        valid = t[None, :] < (clear_len[:, None] - self.resolution * 0.5)
-        xs = sensor_x + cos[:, None] * t[None, :]
-        ys = sensor_y + sin[:, None] * t[None, :]
-        cx = np.floor((xs[valid] - self.origin_x) / self.resolution).astype(np.int64)
-        cy = np.floor((ys[valid] - self.origin_y) / self.resolution).astype(np.int64)
-        inside = (cx >= 0) & (cx < self.size_x) & (cy >= 0) & (cy < self.size_y)
-        self.obstacles[cy[inside], cx[inside]] = 0
+        counts = np.searchsorted(t, clear_len - self.resolution * 0.5, side="left")
+        total = int(counts.sum())
+        if total:
+            ray = np.repeat(np.arange(len(counts)), counts)
+            first = np.repeat(np.cumsum(counts) - counts, counts)
+            ts = t[np.arange(total) - first]
+            cx = np.floor((sensor_x + cos[ray] * ts - self.origin_x) / self.resolution).astype(np.int64)
+            cy = np.floor((sensor_y + sin[ray] * ts - self.origin_y) / self.resolution).astype(np.int64)
+            inside = (cx >= 0) & (cx < self.size_x) & (cy >= 0) & (cy < self.size_y)
+            self.obstacles[cy[inside], cx[inside]] = 0
         # mark
         mark = ~beyond & (ranges <= p.obstacle_range)
         hx = sensor_x + cos[mark] * ranges[mark]
@@ -301,7 +314,11 @@ class Costmap:
         self.obstacles[:] = 0
 
     def update(self) -> np.ndarray:
-        """Combine the layers into ``costs`` and return it."""
+        """Combine the layers into ``costs`` and return it.
+
+        A fixed grid recomputes only the window a changed lethal cell can reach (nothing when no
+        lethal cell changed); ``costs`` is replaced, never edited in place, so a reader holding the
+        old array sees a consistent grid."""
         if self.size_x == 0:
             return self.costs
         base = self._static_window()
@@ -309,10 +326,42 @@ class Costmap:
             self.obstacles = np.zeros(base.shape, dtype=np.uint8)
         lethal = (base == LETHAL) | (self.obstacles == LETHAL)
         inscribed, _ = self.params.radii
+        key = (inscribed, self.params.inflation_radius, self.params.cost_scaling_factor, self.resolution)
+        prev = self._lethal
+        if (
+            self.params.rolling_window
+            or prev is None
+            or prev.shape != lethal.shape
+            or self.costs.shape != lethal.shape
+            or key != self._inflation_key
+        ):
+            self.costs = self._combine(base, lethal, inscribed)
+        else:
+            changed = lethal != prev
+            rows = np.flatnonzero(changed.any(axis=1))
+            if rows.size == 0:
+                return self.costs
+            cols = np.flatnonzero(changed.any(axis=0))
+            reach = max(0, int(math.ceil(self.params.inflation_radius / self.resolution)))
+            h, w = lethal.shape
+            # costs can change within ``reach`` of a changed cell; computing them exactly needs the
+            # lethal cells within ``reach`` of those, hence the margin of twice ``reach``
+            y0, y1 = max(0, rows[0] - reach), min(h, rows[-1] + 1 + reach)
+            x0, x1 = max(0, cols[0] - reach), min(w, cols[-1] + 1 + reach)
+            sy0, sy1 = max(0, y0 - reach), min(h, y1 + reach)
+            sx0, sx1 = max(0, x0 - reach), min(w, x1 + reach)
+            sub = self._combine(base[sy0:sy1, sx0:sx1], lethal[sy0:sy1, sx0:sx1], inscribed)
+            costs = self.costs.copy()
+            costs[y0:y1, x0:x1] = sub[y0 - sy0 : y1 - sy0, x0 - sx0 : x1 - sx0]
+            self.costs = costs
+        self._lethal = lethal
+        self._inflation_key = key
+        return self.costs
+
+    def _combine(self, base: np.ndarray, lethal: np.ndarray, inscribed: float) -> np.ndarray:
+        """The master grid's costs for a block: inflation of ``lethal``, unknown static cells kept."""
         inflated = inflation_costs(
             lethal, self.resolution, inscribed, self.params.inflation_radius, self.params.cost_scaling_factor
         )
         unknown = (base == NO_INFORMATION) & ~lethal
-        costs = np.where(unknown & (inflated == FREE), NO_INFORMATION, inflated).astype(np.uint8)
-        self.costs = costs
-        return costs
+        return np.where(unknown & (inflated == FREE), NO_INFORMATION, inflated).astype(np.uint8)

@@ -68,6 +68,8 @@ class CostmapROS:
         self._grid_cls, self._update_cls = OccupancyGrid, OccupancyGridUpdate
         self.pub = node.publisher(ns + "/costmap", OccupancyGrid, queue_size=1, latch=True)
         self.update_pub = node.publisher(ns + "/costmap_updates", OccupancyGridUpdate, queue_size=1)
+        #: the newest scan of each observation source (topic) since the last update (move_base fills it)
+        self.observations: dict[str, Any] = {}
         self._published: tuple | None = None  # (shape, origin) of the last full grid
         self._last_costs: np.ndarray | None = None
 

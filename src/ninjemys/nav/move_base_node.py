@@ -151,7 +151,7 @@ class MoveBase:
         self.bad_scan_reported = False
         for topic, cms in topics.items():
             self.scan_subs.append(
-                node.subscriber(topic, LaserScan, self.on_scan, callback_args=cms, queue_size=1)
+                node.subscriber(topic, LaserScan, self.on_scan, callback_args=(topic, cms), queue_size=1)
             )
         if self.global_cm.costmap.params.use_static:
             node.subscriber("map", OccupancyGrid, self.on_map, queue_size=1)
@@ -240,26 +240,47 @@ class MoveBase:
     def on_odom(self, msg: Any) -> None:
         self.velocity = (float(msg.twist.twist.linear.x), float(msg.twist.twist.angular.z))
 
-    def on_scan(self, scan: Any, cms: list[CostmapROS]) -> None:
-        ranges, angles = scan_arrays(scan)
-        if not self.bad_scan_reported and not np.isfinite(ranges).all():
-            self.bad_scan_reported = True
-            rospy.logwarn(
-                "move_base: scan on %s has NaN/inf ranges (%d of %d): NaN is dropped, inf clears without marking",
-                scan.header.frame_id,
-                int((~np.isfinite(ranges)).sum()),
-                len(ranges),
-            )
-        ranges = np.where(np.isneginf(ranges), scan.range_min, ranges)  # REP 117: closer than range_min
-        t = scan.header.stamp.to_sec()
+    def on_scan(self, scan: Any, source: tuple[str, list[CostmapROS]]) -> None:
+        """Keep the newest scan of each source for each costmap: its next update uses it (ROS 1's
+        observation buffer with ``observation_persistence`` 0), so a costmap costs per its
+        update_frequency, not per scan."""
+        topic, cms = source
         for cm in cms:
-            sensor = self.tf.lookup_at(cm.global_frame, scan.header.frame_id, t)  # the costmap's filter
+            cm.observations[topic] = scan
+
+    def _apply_scans(self, cm: CostmapROS) -> None:
+        """Raytrace and mark the scans ``cm`` got since its last update (move_base's lock not held:
+        the sensor's pose may take a moment to arrive)."""
+        pending, cm.observations = cm.observations, {}
+        for scan in pending.values():
+            ranges, angles = scan_arrays(scan)
+            if not self.bad_scan_reported and not np.isfinite(ranges).all():
+                self.bad_scan_reported = True
+                rospy.logwarn(
+                    "move_base: scan on %s has NaN/inf ranges (%d of %d): NaN is dropped, inf clears without marking",
+                    scan.header.frame_id,
+                    int((~np.isfinite(ranges)).sum()),
+                    len(ranges),
+                )
+            ranges = np.where(np.isneginf(ranges), scan.range_min, ranges)  # REP 117: closer than range_min
+            # the costmap's message filter: the sensor's pose at the scan's own stamp
+            sensor = self.tf.lookup_at(cm.global_frame, scan.header.frame_id, scan.header.stamp.to_sec())
             if sensor is None:
                 continue
             with self.lock:
-                if cm.costmap.params.rolling_window:
-                    cm.costmap.update_origin(sensor[0], sensor[1])
                 cm.costmap.add_scan(sensor[0], sensor[1], sensor[2] + angles, ranges, float(scan.range_max))
+
+    def update_costmap(self, cm: CostmapROS) -> None:
+        """One update of ``cm`` (ROS 1's updateMap): move a rolling window onto the robot, take the
+        newest scans, recompute the costs."""
+        if cm.costmap.params.rolling_window:
+            robot = self.tf.lookup(cm.global_frame, cm.robot_base_frame)
+            if robot is not None:
+                with self.lock:
+                    cm.costmap.update_origin(robot[0], robot[1])
+        self._apply_scans(cm)
+        with self.lock:
+            cm.costmap.update()
 
     # -- goals --------------------------------------------------------------------------------------
 
@@ -465,22 +486,23 @@ class MoveBase:
         self.plan = None
 
     def costmap_loop(self) -> None:
-        """Publish the costmaps at their publish_frequency (the local one is updated by the control loop)."""
-        period = 0.5
-        freqs = [f for f in (self.global_cm.publish_frequency, self.local_cm.publish_frequency) if f > 0]
-        if freqs:
-            period = 1.0 / max(freqs)
-        last = {id(self.global_cm): 0.0, id(self.local_cm): 0.0}
+        """Update each costmap at its update_frequency and publish it at its publish_frequency (as
+        costmap_2d's map update thread; a frequency of 0 never updates or publishes, as in ROS 1)."""
+        cms = (self.global_cm, self.local_cm)
+        freqs = [f for cm in cms for f in (cm.update_frequency, cm.publish_frequency) if f > 0]
+        period = 1.0 / max(freqs) if freqs else 0.5
+        updated = {id(cm): -math.inf for cm in cms}
+        published = dict(updated)
         while sleep(period):
             t = rospy.get_time()
-            for cm in (self.global_cm, self.local_cm):
-                if cm.publish_frequency <= 0 or t - last[id(cm)] < 1.0 / cm.publish_frequency - 1e-6:
-                    continue
-                last[id(cm)] = t
-                with self.lock:
-                    if cm is self.global_cm:
-                        cm.costmap.update()
-                    cm.publish()
+            for cm in cms:
+                if cm.update_frequency > 0 and t - updated[id(cm)] >= 1.0 / cm.update_frequency - 1e-6:
+                    updated[id(cm)] = t
+                    self.update_costmap(cm)
+                if cm.publish_frequency > 0 and t - published[id(cm)] >= 1.0 / cm.publish_frequency - 1e-6:
+                    published[id(cm)] = t
+                    with self.lock:
+                        cm.publish()
 
     def control_loop(self) -> None:
         rate = rospy.Rate(self.frequency)
@@ -548,9 +570,7 @@ class MoveBase:
                     plan[:, 2] + to_local[2],
                 ]
             )
-            lcm = self.local_cm.costmap
-            lcm.update_origin(lpose[0], lpose[1])
-            lcm.update()
+            lcm = self.local_cm.costmap  # as the costmap thread last updated it
             keep_latch = self.dwa.xy_latched
             self.dwa.set_plan(local_plan)
             self.dwa.xy_latched = keep_latch

@@ -6,7 +6,9 @@ so ``rospy.get_time()`` reads 0.0 before ``rosbag play --clock`` starts). Otherw
 ``time.time()``.
 
 Everything that waits on ROS time (``sleep``, ``Rate``, ``Timer``) waits here. In simulated time
-waiters block on one condition variable notified by every /clock message; in wall time each waiter
+each waiter blocks on its own condition (sharing the clock's lock) and a /clock message notifies only
+the waiters whose time has come (a simulator publishes /clock every physics step: waking every
+sleeper on each one cost move_base about a third of its CPU); in wall time each waiter
 blocks on its own thread's "gate" lock for exactly the remaining interval (one futex wait, as cheap as
 ``time.sleep``), and :meth:`Clock.wake` / :meth:`Clock.shutdown` open every gate. There is no polling
 loop. Shutdown wakes every
@@ -54,7 +56,10 @@ class Clock:
         self._sim_ns = 0
         self._epoch = 0
         self._shutdown = False
-        self._cond = threading.Condition(threading.Lock())
+        self._lock = threading.Lock()
+        self._cond = threading.Condition(self._lock)
+        #: simulated-time waiters: each thread's own condition on the clock's lock -> its target
+        self._sim_waiters: dict[threading.Condition, float] = {}
         self._subscription: Any = None
         # wall-time sleepers wait on a per-thread "gate" lock with a timeout (one futex wait, as cheap as
         # time.sleep); wake() and shutdown() release every registered gate
@@ -94,8 +99,19 @@ class Clock:
         with self._cond:
             if ns < self._sim_ns:
                 self._epoch += 1
+                self._sim_ns = ns
+                self._notify_all()
+                return
             self._sim_ns = ns
-            self._cond.notify_all()
+            now = ns / 1e9
+            for waiter, target in self._sim_waiters.items():
+                if target - now <= 0:
+                    waiter.notify()
+
+    def _notify_all(self) -> None:
+        """Wake every simulated-time waiter (the clock's lock held)."""
+        for waiter in self._sim_waiters:
+            waiter.notify()
 
     def switch_to_sim(self) -> None:
         """Start following simulated time (at init_node, when /use_sim_time is set).
@@ -108,7 +124,7 @@ class Clock:
                 return
             self.is_sim = True
             self._epoch += 1
-            self._cond.notify_all()
+            self._notify_all()
         self._open_gates()
 
     def set_time(self, secs: int, nsecs: int = 0) -> None:
@@ -123,14 +139,14 @@ class Clock:
     def wake(self) -> None:
         """Wake every waiter so it re-checks its own cancel condition (Timer.shutdown uses this)."""
         with self._cond:
-            self._cond.notify_all()
+            self._notify_all()
         self._open_gates()
 
     def shutdown(self) -> None:
         """Wake every waiter for good: all current and future waits return SHUTDOWN."""
         with self._cond:
             self._shutdown = True
-            self._cond.notify_all()
+            self._notify_all()
         self._open_gates()
         sub, self._subscription = self._subscription, None
         if sub is not None:
@@ -143,19 +159,26 @@ class Clock:
         """Block until ROS time reaches ``target`` seconds, shutdown, a backwards jump, or ``cancelled()``."""
         if not self.is_sim:
             return self._wall_wait(target, cancelled)
+        waiter = getattr(self._local, "waiter", None)
+        if waiter is None:
+            waiter = self._local.waiter = threading.Condition(self._lock)
         with self._cond:
             epoch = self._epoch
-            while True:
-                if self._shutdown:
-                    return Wake.SHUTDOWN
-                if cancelled is not None and cancelled():
-                    return Wake.CANCELLED
-                if self._epoch != epoch:
-                    return Wake.MOVED_BACKWARDS
-                remaining = target - self.now()
-                if remaining <= 0:
-                    return Wake.REACHED
-                self._cond.wait(wait_slice(None if self.is_sim else remaining))
+            self._sim_waiters[waiter] = target
+            try:
+                while True:
+                    if self._shutdown:
+                        return Wake.SHUTDOWN
+                    if cancelled is not None and cancelled():
+                        return Wake.CANCELLED
+                    if self._epoch != epoch:
+                        return Wake.MOVED_BACKWARDS
+                    remaining = target - self.now()
+                    if remaining <= 0:
+                        return Wake.REACHED
+                    waiter.wait(wait_slice(None))
+            finally:
+                del self._sim_waiters[waiter]
 
     def _gate(self) -> Any:
         gate = getattr(self._local, "gate", None)

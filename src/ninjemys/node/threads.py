@@ -183,6 +183,9 @@ RESOURCES: tuple[Resource, ...] = (
     Resource("lock", "ninjemys.node.clock:Clock._cond", "any thread",
              "simulated time: the /clock callback (sub:/clock) sets the time and notifies; sleepers, "
              "Rates and Timers of that node's clock wait on it"),
+    Resource("lock", "ninjemys.node.clock:Clock._lock", "any thread",
+             "simulated time: the lock of _cond and of each sleeping thread's own condition (notified "
+             "by the /clock callback only when that thread's time has come)"),
     Resource("lock", "ninjemys.node.clock:Clock._gates_lock", "any thread",
              "wall time: guards the set of sleeping threads' gates that wake()/shutdown() open"),
     Resource("lock", "ninjemys.node.clock:Clock._local", "each sleeping thread", "its own gate lock, nobody else's"),
