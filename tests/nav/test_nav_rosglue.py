@@ -23,3 +23,24 @@ def test_sleep_ends_the_loop_on_shutdown(monkeypatch: pytest.MonkeyPatch) -> Non
 
     monkeypatch.setattr(rospy, "sleep", interrupted)
     assert rosglue.sleep(0.1) is False
+
+
+def test_ctrl_c_during_init_node_ends_the_node_quietly(monkeypatch: pytest.MonkeyPatch) -> None:
+    def interrupted(*_args, **_kwargs) -> None:
+        raise rospy.ROSInitException("init_node interrupted before it could complete")
+
+    monkeypatch.setattr(rospy, "init_node", interrupted)
+    monkeypatch.setattr(rospy, "is_shutdown", lambda: True)
+    built = []
+    assert rosglue.run_node("move_base", [], built.append) == 0
+    assert built == []
+
+
+def test_a_failed_init_node_is_not_hidden(monkeypatch: pytest.MonkeyPatch) -> None:
+    def failed(*_args, **_kwargs) -> None:
+        raise rospy.ROSInitException("Unable to register with master node")
+
+    monkeypatch.setattr(rospy, "init_node", failed)
+    monkeypatch.setattr(rospy, "is_shutdown", lambda: False)
+    with pytest.raises(rospy.ROSInitException):
+        rosglue.run_node("move_base", [], lambda node: None)

@@ -37,8 +37,14 @@ def start_node(name: str, argv: list[str] | None) -> tuple[Any, list[str]]:
 
 def run_node(name: str, argv: list[str] | None, build: Any) -> int:
     """Start node ``name``, build its object with ``build(node)``, spin. A shutdown (Ctrl-C, ``rosnode
-    kill``, SIGTERM) while it is still being built ends it quietly, as a spinning node ends."""
-    node, _ = start_node(name, argv)
+    kill``, SIGTERM) while it is still starting or being built ends it quietly, as a spinning node ends
+    (``init_node`` reports a Ctrl-C during its registration as ROSInitException)."""
+    try:
+        node, _ = start_node(name, argv)
+    except rospy.ROSInitException:
+        if rospy.is_shutdown():
+            return 0
+        raise
     try:
         build(node)
     except (ShutdownError, rospy.ROSInterruptException):

@@ -29,6 +29,8 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     try:
         module = importlib.import_module(exe.module)
+    except KeyboardInterrupt:  # Ctrl-C while the node was still importing: it ends quietly, as below
+        return 0
     except ModuleNotFoundError as exc:
         if exc.name and exe.module.startswith(exc.name):
             print(
