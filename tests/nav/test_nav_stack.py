@@ -352,6 +352,7 @@ def test_maze_goals_through_move_base_simple(tmp_path):
                 f"truth {tuple(round(v, 2) for v in truth or ())}, "
                 f"amcl {tuple(round(v, 2) for v in est or ())}, contacts {probe.contacts}"
             )
+        print("\n".join(report))  # shown with -s / -rP: the outcome of every goal, passed or not
         assert reached >= 19, "\n".join(report)
         assert probe.contacts == 0, "\n".join(report)
     finally:

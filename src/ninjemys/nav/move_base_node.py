@@ -661,8 +661,10 @@ class MoveBase:
             self.last_plan_time = now
             self.plan_requested = False
             if self.state == "planning":
+                # controller_patience keeps counting from the last valid command (as ROS 1's
+                # last_valid_control_): a new plan the local planner cannot follow either must not
+                # restart it, or the robot stands replanning forever and no recovery ever runs
                 self.state = "controlling"
-                self.last_valid = now
         self.plan_pub.publish(self._path_msg(plan, self.global_cm.global_frame))
 
     def _check_oscillation(self, gpose: Pose2D, now: float) -> None:
