@@ -70,6 +70,7 @@ class CostmapROS:
         self.update_pub = node.publisher(ns + "/costmap_updates", OccupancyGridUpdate, queue_size=1)
         #: the newest scan of each observation source (topic) since the last update (move_base fills it)
         self.observations: dict[str, Any] = {}
+        self.dirty = False  # marks added since the costs were last computed
         self._published: tuple | None = None  # (shape, origin) of the last full grid
         self._last_costs: np.ndarray | None = None
 

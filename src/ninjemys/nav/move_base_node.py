@@ -241,44 +241,60 @@ class MoveBase:
         self.velocity = (float(msg.twist.twist.linear.x), float(msg.twist.twist.angular.z))
 
     def on_scan(self, scan: Any, source: tuple[str, list[CostmapROS]]) -> None:
-        """Keep the newest scan of each source for each costmap: its next update uses it (ROS 1's
-        observation buffer with ``observation_persistence`` 0), so a costmap costs per its
-        update_frequency, not per scan."""
+        """A rolling window (the local costmap the controller reads) marks the scan at once; a map-sized
+        costmap keeps the newest scan of each source for its next update (ROS 1's observation buffer
+        with ``observation_persistence`` 0), so it costs per its update_frequency, not per scan."""
         topic, cms = source
         for cm in cms:
-            cm.observations[topic] = scan
+            if cm.costmap.params.rolling_window:
+                self._apply_scan(cm, scan)
+            else:
+                cm.observations[topic] = scan
 
-    def _apply_scans(self, cm: CostmapROS) -> None:
-        """Raytrace and mark the scans ``cm`` got since its last update (move_base's lock not held:
-        the sensor's pose may take a moment to arrive)."""
-        pending, cm.observations = cm.observations, {}
-        for scan in pending.values():
-            ranges, angles = scan_arrays(scan)
-            if not self.bad_scan_reported and not np.isfinite(ranges).all():
-                self.bad_scan_reported = True
-                rospy.logwarn(
-                    "move_base: scan on %s has NaN/inf ranges (%d of %d): NaN is dropped, inf clears without marking",
-                    scan.header.frame_id,
-                    int((~np.isfinite(ranges)).sum()),
-                    len(ranges),
-                )
-            ranges = np.where(np.isneginf(ranges), scan.range_min, ranges)  # REP 117: closer than range_min
-            # the costmap's message filter: the sensor's pose at the scan's own stamp
-            sensor = self.tf.lookup_at(cm.global_frame, scan.header.frame_id, scan.header.stamp.to_sec())
-            if sensor is None:
-                continue
-            with self.lock:
-                cm.costmap.add_scan(sensor[0], sensor[1], sensor[2] + angles, ranges, float(scan.range_max))
+    def _apply_scan(self, cm: CostmapROS, scan: Any) -> None:
+        """Raytrace and mark one scan (move_base's lock not held while the sensor's pose arrives)."""
+        ranges, angles = scan_arrays(scan)
+        if not self.bad_scan_reported and not np.isfinite(ranges).all():
+            self.bad_scan_reported = True
+            rospy.logwarn(
+                "move_base: scan on %s has NaN/inf ranges (%d of %d): NaN is dropped, inf clears without marking",
+                scan.header.frame_id,
+                int((~np.isfinite(ranges)).sum()),
+                len(ranges),
+            )
+        ranges = np.where(np.isneginf(ranges), scan.range_min, ranges)  # REP 117: closer than range_min
+        # the costmap's message filter: the sensor's pose at the scan's own stamp
+        sensor = self.tf.lookup_at(cm.global_frame, scan.header.frame_id, scan.header.stamp.to_sec())
+        if sensor is None:
+            return
+        with self.lock:
+            if cm.costmap.params.rolling_window:
+                cm.costmap.update_origin(sensor[0], sensor[1])
+            cm.costmap.add_scan(sensor[0], sensor[1], sensor[2] + angles, ranges, float(scan.range_max))
+            cm.dirty = True
+
+    def _refresh(self, cm: CostmapROS, robot: Pose2D) -> None:
+        """Centre a rolling window on ``robot`` and recompute its costs if it moved or got new marks
+        (move_base's lock held)."""
+        c = cm.costmap
+        before = (c.origin_x, c.origin_y, c.size_x)
+        c.update_origin(robot[0], robot[1])
+        if cm.dirty or before != (c.origin_x, c.origin_y, c.size_x):
+            c.update()
+            cm.dirty = False
 
     def update_costmap(self, cm: CostmapROS) -> None:
-        """One update of ``cm`` (ROS 1's updateMap): move a rolling window onto the robot, take the
-        newest scans, recompute the costs."""
+        """One update of ``cm`` (ROS 1's updateMap): a map-sized costmap takes its newest scans, a
+        rolling window follows the robot; then the costs are recomputed where needed."""
         if cm.costmap.params.rolling_window:
             robot = self.tf.lookup(cm.global_frame, cm.robot_base_frame)
             if robot is not None:
                 with self.lock:
-                    cm.costmap.update_origin(robot[0], robot[1])
-        self._apply_scans(cm)
+                    self._refresh(cm, robot)
+            return
+        pending, cm.observations = cm.observations, {}
+        for scan in pending.values():
+            self._apply_scan(cm, scan)
         with self.lock:
             cm.costmap.update()
 
@@ -570,7 +586,8 @@ class MoveBase:
                     plan[:, 2] + to_local[2],
                 ]
             )
-            lcm = self.local_cm.costmap  # as the costmap thread last updated it
+            lcm = self.local_cm.costmap
+            self._refresh(self.local_cm, lpose)  # new marks since the last cycle, or the window moved
             keep_latch = self.dwa.xy_latched
             self.dwa.set_plan(local_plan)
             self.dwa.xy_latched = keep_latch
