@@ -314,7 +314,8 @@ def wait_goal(session: NavSession, goal: tuple, limit: float) -> bool:
     while probe.sim_time - start < limit and session.proc.poll() is None:
         if arrived():
             probe.wait_sim(0.3)
-            return arrived()
+            if arrived():  # stopped there for 0.3 s; a pause on the way (before the final turn) is not
+                return True  # the end: the robot is judged where it comes to rest, within the limit
         time.sleep(0.05)
     return False
 
