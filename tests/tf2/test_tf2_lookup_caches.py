@@ -149,7 +149,8 @@ def test_cached_answers_equal_a_fresh_buffer(seed):
                 parents[child] = names[rnd.randrange(names.index(child))]
             static = child in ("f3",)
             t = 0 if static else rnd.choice([rnd.randrange(1, 60) / 10, step / 20 + 1])
-            batch = [item(parents[child], child, t, rnd.uniform(-2, 2), tilt_q(rnd.uniform(-3, 3)))]
+            turn = tilt_q if rnd.random() < 0.5 else yaw_q  # chains mix general and planar links
+            batch = [item(parents[child], child, t, rnd.uniform(-2, 2), turn(rnd.uniform(-3, 3)))]
             live.set_transforms(batch, is_static=static)
             log.append((batch, static))
             continue
@@ -188,3 +189,54 @@ def test_raw_batches_between_lookups_match_eager_insertion():
             for t in (0, int((1.0 + 0.01 * k - 0.035) * S)):
                 assert lazy.lookup("world", "f3", t) == eager.lookup("world", "f3", t)
                 assert lazy.lookup("f1", "f3", t) == eager.lookup("f1", "f3", t)
+
+
+@pytest.mark.parametrize("kinds", ["pppp", "pgpp", "ppgp", "gggg", "sppp", "pspg"])
+def test_planar_links_compose_like_general_ones(kinds):
+    """A chain mixing planar links (rotations about z only: complex-number arithmetic), general ones
+    and static ones gives, at interpolated times, what composing each link's tf2 interpolation
+    (lerp + tfm.slerp) gives, for both directions and through a common ancestor. The planar
+    segments include a quaternion sign flip (the short way round) and a nearly constant rotation."""
+    rnd = random.Random(kinds)
+    b = BufferCore()
+    chain = ["root", "l1", "l2", "l3", "l4"]
+    pairs: dict[str, tuple[tuple, tuple]] = {}
+    for k, kind in enumerate(kinds):
+        parent, child = chain[k], chain[k + 1]
+        if kind == "s":
+            b.set_transforms([item(parent, child, 0, 0.3, yaw_q(0.4))], is_static=True)
+            pairs[child] = (item(parent, child, 1, 0.3, yaw_q(0.4)), item(parent, child, 3, 0.3, yaw_q(0.4)))
+            continue
+        turn = yaw_q if kind == "p" else tilt_q
+        a0 = rnd.uniform(-3, 3)
+        a1 = a0 + (1e-7 if k == 2 else rnd.uniform(-2.5, 2.5))
+        q1 = turn(a1)
+        if k == 1:  # -q is the same rotation: the interpolation must take the short way round
+            q1 = tuple(-v for v in q1)
+        first, second = item(parent, child, 1, rnd.uniform(-2, 2), turn(a0)), item(parent, child, 3, 1.0, q1)
+        b.set_transforms([first, second])
+        pairs[child] = (first, second)
+    b.set_transforms([item("root", "other", 1, 0.5, yaw_q(1.0)), item("root", "other", 3, -0.5, yaw_q(-2.0))])
+    pairs["other"] = (item("root", "other", 1, 0.5, yaw_q(1.0)), item("root", "other", 3, -0.5, yaw_q(-2.0)))
+
+    def to_root(frame: str, t: float) -> tuple:
+        acc = tfm.IDENTITY
+        while frame != "root":
+            acc = tfm.compose(expected(*pairs[frame], t), acc)
+            frame = pairs[frame][0][0]
+        return acc
+
+    for t in (1.0, 1.25, 2.0, 2.9, 3.0):
+        ns = int(round(t * S))
+        for target, source in (
+            ("root", "l4"),
+            ("l4", "root"),
+            ("l1", "l4"),
+            ("other", "l3"),
+            ("l4", "other"),
+        ):
+            want = tfm.compose(tfm.inverse(to_root(target, t)), to_root(source, t))
+            got = b.lookup(target, source, ns)[1]
+            if (got[6] < 0) != (want[6] < 0):
+                want = want[:3] + tuple(-v for v in want[3:])
+            assert got == pytest.approx(want, abs=1e-9), (t, target, source)

@@ -34,9 +34,10 @@ import logging
 import threading
 import time as _wall
 from bisect import bisect_left, bisect_right
+from cmath import rect
 from collections.abc import Callable, Iterable, Sequence
 from itertools import repeat
-from math import acos, cos, isfinite, sin, sqrt
+from math import acos, atan2, cos, isfinite, sin, sqrt
 
 import numpy
 
@@ -62,6 +63,7 @@ QUATERNION_TOLERANCE = 10e-6  # tf2: |x²+y²+z²+w² - 1| must stay under this
 NO_PARENT = "NO_PARENT"
 REPEAT_REPORT_AFTER = 10.0  # seconds before the same bad-input line is reported again
 PENDING_MAX = 50  # raw messages queued before the listener's thread decodes them itself
+SIDES_MAX = 65536  # frame pairs whose paths to their common ancestor are remembered (~300 bytes each)
 BULK_MIN = 2  # a run this long of one layout is decoded with numpy; a single message per transform
 
 # tf2_msgs/TF2Error codes, as walk results
@@ -104,6 +106,8 @@ class Frame:
         "index",
         "pmin_gen",
         "pmin",
+        "point_of",
+        "point",
     )
 
     def __init__(self, name: str, number: int) -> None:
@@ -129,6 +133,8 @@ class Frame:
         self.index: dict[Frame, int] = {}
         self.pmin_gen = -1
         self.pmin: list[int] = []  # pmin[k]: the oldest non-zero newest stamp among path[:k]
+        self.point_of: Entry | None = None  # the entry ``point`` was made from (the newest one)
+        self.point: tuple = ()
 
     def __repr__(self) -> str:
         return f"Frame({self.name!r})"
@@ -185,8 +191,17 @@ class Frame:
     def _interpolate(self, i: int, t: int) -> Entry:
         """Between entries ``i - 1`` and ``i``: lerp for the translation, slerp (the shorter arc) for the
         rotation, as tf2's ``TimeCache::interpolate``; across a change of parent, the older entry."""
-        p, t0, inv, x, y, z, dx, dy, dz, qx, qy, qz, qw, cx, cy, cz, cw, th = self.segs[i] or self._segment(i)
-        r = (t - t0) * inv
+        rec = self.segs[i] or self._segment(i)
+        r = (t - rec[2]) * rec[3]
+        if rec[0]:
+            _, p, _, _, e, z, de, dz, c, th = rec
+            if r:
+                e += r * de
+                z += r * dz
+                if th:
+                    c *= rect(1.0, r * th)
+            return p, (e.real, e.imag, z, 0.0, 0.0, c.imag, c.real)
+        _, p, _, _, x, y, z, dx, dy, dz, qx, qy, qz, qw, cx, cy, cz, cw, th = rec
         if r:
             x += r * dx
             y += r * dy
@@ -200,16 +215,39 @@ class Frame:
                 qx, qy, qz, qw = _nlerp(qx, qy, qz, qw, cx, cy, cz, cw, r)
         return p, (x, y, z, qx, qy, qz, qw)
 
+    def _point(self) -> tuple:
+        """The newest entry as a record (see :meth:`_segment`) that interpolates to itself: what a lookup
+        at the newest stamp, or through a static frame, composes. Remade when the newest entry changes."""
+        e = self.data[-1]
+        if e is self.point_of:
+            return self.point
+        if len(e) == 3:
+            e = self._resolve(-1)
+        self.point_of = e
+        p, (x, y, z, qx, qy, qz, qw) = e
+        if qx == 0.0 and qy == 0.0:
+            rec: tuple = (True, p, 0, 0.0, complex(x, y), z, 0j, 0.0, complex(qw, qz), 0.0)
+        else:
+            rec = (False, p, 0, 0.0, x, y, z, 0.0, 0.0, 0.0, qx, qy, qz, qw, 0.0, 0.0, 0.0, 0.0, 0.0)
+        self.point = rec
+        return rec
+
     def _segment(self, i: int) -> tuple:
         """The record that makes interpolating between entries ``i - 1`` and ``i`` a few multiplies:
-        ``(parent, t0, 1/(t1 - t0), translation at t0, its change to t1, quaternion A at t0, C, theta)``.
+        ``(planar, parent, t0, 1/(t1 - t0), ...)``, then for a general segment the translation at t0 and
+        its change to t1, quaternion A at t0, C and theta; for a planar one (both rotations about z
+        only, as most mobile-robot links are) the translation's x + iy at t0 and its change as complex
+        numbers, z and its change, A's w + iz as a complex number and the signed angle theta.
 
         Slerp from A to B (B negated if that is the shorter arc) by ratio r is
         ``(A sin((1-r)θ) + B sin(rθ)) / sin θ`` (tf2's form); with ``C = (B - A cos θ) / sin θ``, the unit
         quaternion orthogonal to A in their plane, it is ``A cos(rθ) + C sin(rθ)``: the same rotation
         (to rounding) for two trigonometric calls. When A and B are nearly equal (θ under 1e-3, where
         sin θ vanishes) the record holds ``C = B - A`` and θ = 0: a normalized lerp, exact to rounding
-        there. Across a change of parent tf2 returns the older entry: a record with no change."""
+        there. For rotations about z alone, quaternions ``w + z k`` multiply as complex numbers
+        ``w + z i``, and C is A times i: the slerp is ``A e^{irθ}`` (one complex multiply by
+        ``cmath.rect(1, rθ)``, exact at any θ). Across a change of parent tf2 returns the older entry: a
+        record with no change."""
         older = self.data[i - 1]
         if len(older) == 3:
             older = self._resolve(i - 1)
@@ -218,13 +256,24 @@ class Frame:
             newer = self._resolve(i)
         stamps = self.stamps
         t0 = stamps[i - 1]
-        ax, ay, az, aw = older[1][3:]
-        x, y, z = older[1][:3]
-        if older[0] is not newer[0]:
-            rec = (older[0], t0, 0.0, x, y, z, 0.0, 0.0, 0.0, ax, ay, az, aw, 0.0, 0.0, 0.0, 0.0, 1.0)
+        x, y, z, ax, ay, az, aw = older[1]
+        b = newer[1]
+        bx, by, bz, bw = b[3], b[4], b[5], b[6]
+        rec: tuple
+        if ax == 0.0 and ay == 0.0 and (bx == 0.0 and by == 0.0 or older[0] is not newer[0]):
+            qa = complex(aw, az)
+            if older[0] is not newer[0]:
+                rec = (True, older[0], t0, 0.0, complex(x, y), z, 0j, 0.0, qa, 0.0)
+            else:
+                qb = complex(bw, bz)
+                d = qa.conjugate() * qb  # A⁻¹B = e^{iθ}
+                if d.real < 0.0:  # q and -q are one rotation: take the short way round
+                    d = -d
+                rec = (True, older[0], t0, 1.0 / (stamps[i] - t0), complex(x, y), z)
+                rec += (complex(b[0] - x, b[1] - y), b[2] - z, qa, atan2(d.imag, d.real))
+        elif older[0] is not newer[0]:
+            rec = (False, older[0], t0, 0.0, x, y, z, 0.0, 0.0, 0.0, ax, ay, az, aw, 0.0, 0.0, 0.0, 0.0, 1.0)
         else:
-            b = newer[1]
-            bx, by, bz, bw = b[3], b[4], b[5], b[6]
             dot = ax * bx + ay * by + az * bz + aw * bw
             if dot < 0.0:  # q and -q are one rotation: take the short way round
                 bx, by, bz, bw, dot = -bx, -by, -bz, -bw, -dot
@@ -240,7 +289,7 @@ class Frame:
                     (bz - az * dot) * k,
                     (bw - aw * dot) * k,
                 )
-            rec = (older[0], t0, 1.0 / (stamps[i] - t0), x, y, z, b[0] - x, b[1] - y, b[2] - z)
+            rec = (False, older[0], t0, 1.0 / (stamps[i] - t0), x, y, z, b[0] - x, b[1] - y, b[2] - z)
             rec += (ax, ay, az, aw, cx, cy, cz, cw, th)
         self.segs[i] = rec
         return rec
@@ -282,6 +331,8 @@ class BufferCore:
         self._gen = 0  # bumped by every accepted insertion: memos of older generations are stale
         self._last_t = -1  # the time of the previous non-latest lookup (a repeat fills the memos)
         self._topology = 0  # bumped when a frame appears or a newest parent changes
+        self._sides_cache: dict[tuple[Frame, Frame], tuple[tuple, tuple]] = {}
+        self._sides_topology = -1
         self._pending: list[tuple[bytes, str, bool]] = []  # raw TFMessages not decoded yet
         self._listeners: list[Callable[[], None]] = []
         self._layouts: dict[tuple[str, int], Layout] = {}
@@ -841,20 +892,22 @@ class BufferCore:
             return self._lookup(target, source, t)
 
     def _lookup(self, target: Frame, source: Frame, t: int) -> tuple[int, tuple]:
-        m = None
+        sides = (
+            self._sides_cache.get((source, target)) if self._sides_topology == self._topology else None
+        ) or self._sides(source, target)
+        gen = self._gen
         if t == 0:
-            m = self._meet(source, target)
-            if m is None:
+            if sides is None:
                 err: list[str] = []
                 code, t = self._common_time(target, source, err)
                 if code != NO_ERROR:
                     _raise(code, err)
             else:  # tf2's latest common time, from the prefix minima of the newest stamps on each side
-                gen = self._gen
-                a = source.pmin[m[0]] if source.pmin_gen == gen else self._pmin(source)[m[0]]
-                b = target.pmin[m[1]] if target.pmin_gen == gen else self._pmin(target)[m[1]]
+                i = len(sides[0])
+                j = len(sides[1])
+                a = source.pmin[i] if source.pmin_gen == gen else self._pmin(source)[i]
+                b = target.pmin[j] if target.pmin_gen == gen else self._pmin(target)[j]
                 t = a if b == 0 or (a and a < b) else b
-        gen = self._gen
         if (source.memo_gen == gen and source.memo_t == t) or t == self._last_t:
             # a time asked for before: each frame's transform to the top of its tree is (or becomes) memoized
             a = (
@@ -875,15 +928,34 @@ class BufferCore:
         else:
             self._last_t = t
         # a one-off time: compose each side up to the lowest common ancestor, interpolating on the way
-        if m is None:
-            m = self._meet(source, target)
-        if m is not None:
-            a = _chain_at(source.path, m[0], t)
-            if a is not None:
-                b = _chain_at(target.path, m[1], t)
-                if b is not None:
-                    return t, tfm.inverse_compose(b, a)
+        if sides is not None:
+            tr = _relative_at(sides[0], sides[1], t)
+            if tr is not None:
+                return t, tr
         return t, self._walk_transform(target, source, t)
+
+    def _sides(self, source: Frame, target: Frame) -> tuple[tuple, tuple] | None:
+        """Each frame's links ``(frame, parent)`` up to their lowest common ancestor along newest parents,
+        remembered per pair until the topology changes; None when the paths do not meet."""
+        if self._sides_topology != self._topology:
+            self._sides_cache.clear()
+            self._sides_topology = self._topology
+        key = (source, target)
+        got = self._sides_cache.get(key)
+        if got is None:
+            m = self._meet(source, target)
+            if m is None:
+                return None
+            sp = source.path
+            tp = target.path
+            got = (
+                tuple(zip(sp[: m[0]], sp[1 : m[0] + 1], strict=True)),
+                tuple(zip(tp[: m[1]], tp[1 : m[1] + 1], strict=True)),
+            )
+            if len(self._sides_cache) >= SIDES_MAX:
+                self._sides_cache.clear()
+            self._sides_cache[key] = got
+        return got
 
     def _meet(self, source: Frame, target: Frame) -> tuple[int, int] | None:
         """``(i, j)``: the lowest common ancestor of two frames along their newest parents is
@@ -1227,41 +1299,63 @@ def _nlerp(
     return qx * k, qy * k, qz * k, qw * k
 
 
-def _chain_at(path: list[Frame], n: int, t: int) -> tuple | None:
-    """The transform from ``path[0]`` into ``path[n]`` at time ``t``, ``path`` being a frame and its newest
-    parents: each link interpolated from its segment record and composed in place (one lookup's hot
-    loop, kept in one function: calls cost more than the arithmetic). None when a link has no data for
-    ``t`` or another parent then; the exact walk decides those cases."""
-    x = y = z = qx = qy = qz = 0.0
-    qw = 1.0
-    first = True
-    for k in range(n):
-        f = path[k]
-        up = path[k + 1]
-        if f.static:
-            p, e = f.data[-1]
-            if p is not up:
+def _relative_at(up: tuple, down: tuple, t: int) -> tuple | None:
+    """The transform from frame ``up[0][0]`` into ``down[0][0]`` at time ``t``, through their lowest common
+    ancestor: ``up`` and ``down`` are each side's links ``(frame, its parent)`` from the frame to that
+    ancestor. Each link is interpolated from its segment record (:meth:`Frame._segment`) and composed
+    onto its side's transform in place; the two sides then meet in one ``inverse(down) * up``. None
+    when a link has no data for ``t`` or another parent then: the exact walk decides those cases.
+
+    This is one lookup's hot loop, kept in one function (calls cost more than the arithmetic). While
+    every link so far is planar (rotations about z only, the usual case for a mobile robot's links)
+    a side is a complex translation ``x + iy``, a float z and a complex rotation ``w + iz``: composing
+    a link is three complex operations instead of about sixty float ones. The first non-planar link
+    turns its side into the general form ``(x, y, z, qx, qy, qz, qw)`` for the links after it."""
+    sides = []
+    for links in (up, down):
+        planar = True  # this side is (P, Z, Q); else (x, y, z, qx, qy, qz, qw)
+        P = 0j
+        Z = 0.0
+        Q = 1.0 + 0j
+        x = y = z = qx = qy = qz = qw = 0.0
+        for f, parent in links:
+            if f.static:
+                rec = f._point()
+                r = 0.0
+            else:
+                stamps = f.stamps
+                i = bisect_right(stamps, t)
+                if i == len(stamps):  # at the newest stamp exactly, or past it (extrapolation)
+                    if not i or stamps[-1] != t:
+                        return None
+                    rec = f._point()
+                    r = 0.0
+                elif i:
+                    rec = f.segs[i] or f._segment(i)
+                    r = (t - rec[2]) * rec[3]
+                else:
+                    return None
+            if rec[1] is not parent:
                 return None
-            ex, ey, ez, px, py, pz, pw = e
-        else:
-            stamps = f.stamps
-            i = bisect_right(stamps, t)
-            if i == len(stamps):  # at the newest stamp exactly, or past it (extrapolation)
-                if not i or stamps[-1] != t:
-                    return None
-                e = f.data[-1]
-                if len(e) == 3:
-                    e = f._resolve(-1)
-                if e[0] is not up:
-                    return None
-                ex, ey, ez, px, py, pz, pw = e[1]
-            elif i:
-                p, t0, inv, ex, ey, ez, dx, dy, dz, px, py, pz, pw, cx, cy, cz, cw, th = f.segs[
-                    i
-                ] or f._segment(i)
-                if p is not up:
-                    return None
-                r = (t - t0) * inv
+            if rec[0]:  # a planar link
+                _, _, _, _, e, ez, de, dz, c, th = rec
+                if r:
+                    e += r * de
+                    ez += r * dz
+                    if th:
+                        c *= rect(1.0, r * th)
+                if planar:  # link * side: rotate by c² (c is the half angle), then translate
+                    P = c * c * P + e
+                    Z += ez
+                    Q = c * Q
+                    continue
+                ex = e.real
+                ey = e.imag
+                px = py = 0.0
+                pz = c.imag
+                pw = c.real
+            else:
+                _, _, _, _, ex, ey, ez, dx, dy, dz, px, py, pz, pw, cx, cy, cz, cw, th = rec
                 if r:
                     ex += r * dx
                     ey += r * dy
@@ -1276,12 +1370,14 @@ def _chain_at(path: list[Frame], n: int, t: int) -> tuple | None:
                         pw = pw * co + cw * si
                     else:
                         px, py, pz, pw = _nlerp(px, py, pz, pw, cx, cy, cz, cw, r)
-            else:
-                return None
-        if first:
-            x, y, z, qx, qy, qz, qw = ex, ey, ez, px, py, pz, pw
-            first = False
-        else:  # link * accumulated, as tfm.compose (plain assignments: no tuple per link)
+                if planar:
+                    planar = False
+                    x = P.real
+                    y = P.imag
+                    z = Z
+                    qz = Q.imag
+                    qw = Q.real
+            # link * side, as tfm.compose (plain assignments: no tuple per link)
             ux = py * z - pz * y + pw * x
             uy = pz * x - px * z + pw * y
             uz = px * y - py * x + pw * z
@@ -1295,7 +1391,20 @@ def _chain_at(path: list[Frame], n: int, t: int) -> tuple | None:
             qx = nx
             qy = ny
             qz = nz
-    return x, y, z, qx, qy, qz, qw
+        sides.append((P, Z, Q) if planar else (x, y, z, qx, qy, qz, qw))
+    a, b = sides
+    if len(a) == 3 and len(b) == 3:  # inverse(b) * a, planar
+        P, Z, Q = a
+        Pb, Zb, Qb = b
+        Qb = Qb.conjugate()
+        P = Qb * Qb * (P - Pb)
+        Q = Qb * Q
+        return P.real, P.imag, Z - Zb, 0.0, 0.0, Q.imag, Q.real
+    if len(a) == 3:
+        a = (a[0].real, a[0].imag, a[1], 0.0, 0.0, a[2].imag, a[2].real)
+    if len(b) == 3:
+        b = (b[0].real, b[0].imag, b[1], 0.0, 0.0, b[2].imag, b[2].real)
+    return tfm.inverse_compose(b, a)
 
 
 def _min_stamp(frames: Iterable[Frame]) -> int:
