@@ -240,3 +240,70 @@ def test_planar_links_compose_like_general_ones(kinds):
             if (got[6] < 0) != (want[6] < 0):
                 want = want[:3] + tuple(-v for v in want[3:])
             assert got == pytest.approx(want, abs=1e-9), (t, target, source)
+
+
+def _planar_tree(b: BufferCore, stamps: list[float], static_x: float = 0.3) -> None:
+    """root <- a <- b2 <- c (planar, sent together at each stamp), root <- d, and a static link c <- s."""
+    for k, t in enumerate(stamps):
+        b.set_transforms(
+            [
+                item("root", "a", t, 0.1 * k, yaw_q(0.3 * k)),
+                item("a", "b2", t, -0.2 * k, yaw_q(-0.5 * k)),
+                item("b2", "c", t, 0.05 * k, yaw_q(0.9 + 0.1 * k)),
+                item("root", "d", t, 1.0 - 0.1 * k, yaw_q(2.0 - 0.2 * k)),
+            ]
+        )
+    b.set_transforms([item("c", "s", 0, static_x, yaw_q(0.7))], is_static=True)
+
+
+def _fresh_answer(log: list[tuple[list[tuple], bool]], target: str, source: str, t: int) -> tuple:
+    fresh = BufferCore(cache_time=2.0)
+    for batch, static in log:
+        fresh.set_transforms(batch, is_static=static)
+    return _answer(fresh, target, source, t)
+
+
+def test_side_composites_follow_history_changes():
+    """Many lookups at different times inside one segment (where a side's composite serves them) agree
+    with a buffer that never cached anything, also after an out-of-order insert splits the segment,
+    a repeated stamp replaces an end of it, a static link changes, and pruning removes it."""
+    live = BufferCore(cache_time=2.0)
+    log: list[tuple[list[tuple], bool]] = []
+
+    class Recording:
+        def set_transforms(self, batch: list[tuple], is_static: bool = False) -> None:
+            live.set_transforms(batch, is_static=is_static)
+            log.append((list(batch), is_static))
+
+    _planar_tree(Recording(), [1.0, 1.5, 2.0])  # type: ignore[arg-type]
+
+    def check() -> None:
+        for t in (1.05, 1.1, 1.2, 1.3, 1.45, 1.55, 1.6, 1.7, 1.8, 1.9):
+            ns = int(round(t * S))
+            for target, source in (("d", "s"), ("s", "d"), ("root", "c"), ("a", "s"), ("d", "a")):
+                want = _fresh_answer(log, target, source, ns)
+                for _ in range(3):  # the second and later lookups in a segment use the composite
+                    got = _answer(live, target, source, ns)
+                    assert got[:2] == want[:2], (t, target, source)
+                    if got[0] == "ok":
+                        assert got[2] == pytest.approx(want[2], abs=1e-9), (t, target, source)
+
+    check()
+    # b2 alone moves on and prunes its 1.0..1.5 while c (the segment's lead for s's side) keeps it
+    Recording().set_transforms([item("a", "b2", 3.5, 0.2, yaw_q(-1.0))])
+    check()
+    Recording().set_transforms([item("root", "a", 1.75, 5.0, yaw_q(-1.0))])  # splits a's 1.5..2.0
+    check()
+    Recording().set_transforms([item("b2", "c", 2.0, -3.0, yaw_q(2.5))])  # replaces an end
+    check()
+    Recording().set_transforms([item("c", "s", 0, -0.9, yaw_q(-0.2))], is_static=True)
+    check()
+    for t in (2.5, 3.0, 3.5, 4.0):  # 1.0..2.0 pruned away: those lookups now extrapolate
+        batch = [
+            item("root", "a", t, 0.3, yaw_q(t)),
+            item("a", "b2", t, 0.2, yaw_q(-t)),
+            item("b2", "c", t, 0.1, yaw_q(2 * t)),
+            item("root", "d", t, 0.0, yaw_q(0.5 * t)),
+        ]
+        Recording().set_transforms(batch)
+    check()
