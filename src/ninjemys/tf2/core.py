@@ -63,7 +63,6 @@ QUATERNION_TOLERANCE = 10e-6  # tf2: |x²+y²+z²+w² - 1| must stay under this
 NO_PARENT = "NO_PARENT"
 REPEAT_REPORT_AFTER = 10.0  # seconds before the same bad-input line is reported again
 PENDING_MAX = 50  # raw messages queued before the listener's thread decodes them itself
-SIDES_MAX = 65536  # frame pairs whose paths to their common ancestor are remembered (~300 bytes each)
 BULK_MIN = 2  # a run this long of one layout is decoded with numpy; a single message per transform
 
 # tf2_msgs/TF2Error codes, as walk results
@@ -108,6 +107,7 @@ class Frame:
         "pmin",
         "point_of",
         "point",
+        "sides",
     )
 
     def __init__(self, name: str, number: int) -> None:
@@ -135,6 +135,9 @@ class Frame:
         self.pmin: list[int] = []  # pmin[k]: the oldest non-zero newest stamp among path[:k]
         self.point_of: Entry | None = None  # the entry ``point`` was made from (the newest one)
         self.point: tuple = ()
+        # by ancestor: [composites by segment start (None: off), lead frame, links (frame, parent) up to
+        # it]; the lead is the first dynamic link, whose stamps locate the segment around a time
+        self.sides: dict[Frame, list] = {}
 
     def __repr__(self) -> str:
         return f"Frame({self.name!r})"
@@ -331,9 +334,6 @@ class BufferCore:
         self._gen = 0  # bumped by every accepted insertion: memos of older generations are stale
         self._last_t = -1  # the time of the previous non-latest lookup (a repeat fills the memos)
         self._topology = 0  # bumped when a frame appears or a newest parent changes
-        self._sides_cache: dict[tuple[Frame, Frame], tuple] = {}
-        self._side_states: dict[tuple[Frame, Frame], list] = {}
-        self._sides_topology = -1
         self._history = 0  # bumped when stored history changes other than at its new end (composites)
         self._floor = 0  # the newest oldest-kept stamp after any pruning: older composites are stale
         self._pending: list[tuple[bytes, str, bool]] = []  # raw TFMessages not decoded yet
@@ -744,6 +744,7 @@ class BufferCore:
                     return None
             f.path = path
             f.index = {frame: i for i, frame in enumerate(path)}
+            f.sides = {}
             f.path_topology = self._topology
         return f.path
 
@@ -902,19 +903,24 @@ class BufferCore:
             return self._lookup(target, source, t)
 
     def _lookup(self, target: Frame, source: Frame, t: int) -> tuple[int, tuple]:
-        sides = (
-            self._sides_cache.get((source, target)) if self._sides_topology == self._topology else None
-        ) or self._sides(source, target)
+        topology = self._topology
+        sp = source.path if source.path_topology == topology else self._path(source)
+        tp = target.path if target.path_topology == topology else self._path(target)
         gen = self._gen
+        i = j = -1  # the lowest common ancestor is sp[i] and tp[j] (-1: the paths do not meet)
+        if sp is not None and tp is not None and sp[-1] is tp[-1]:
+            i = len(sp) - 1
+            j = len(tp) - 1
+            while i and j and sp[i - 1] is tp[j - 1]:
+                i -= 1
+                j -= 1
         if t == 0:
-            if sides is None:
+            if i < 0:
                 err: list[str] = []
                 code, t = self._common_time(target, source, err)
                 if code != NO_ERROR:
                     _raise(code, err)
             else:  # tf2's latest common time, from the prefix minima of the newest stamps on each side
-                i = len(sides[0])
-                j = len(sides[1])
                 a = source.pmin[i] if source.pmin_gen == gen else self._pmin(source)[i]
                 b = target.pmin[j] if target.pmin_gen == gen else self._pmin(target)[j]
                 t = a if b == 0 or (a and a < b) else b
@@ -938,34 +944,24 @@ class BufferCore:
         else:
             self._last_t = t
         # a one-off time: compose each side up to the lowest common ancestor, interpolating on the way
-        if sides is not None:
+        if i >= 0:
+            lca = sp[i]
+            up = source.sides.get(lca) or _side(source, i)
+            down = target.sides.get(lca) or _side(target, j)
             tr = None
-            if sides[2][0] is not None and sides[3][0] is not None:
-                a = self._side_composite(sides[0], sides[2], t)
+            if up[0] is not None and down[0] is not None:
+                a = self._side_composite(up, t)
                 if a is not None:
-                    b = self._side_composite(sides[1], sides[3], t)
+                    b = self._side_composite(down, t)
                     if b is not None:
                         tr = _planar_between(a, b)
             if tr is None:
-                tr = _relative_at(sides[0], sides[1], t)
+                tr = _relative_at(up[2], down[2], t)
             if tr is not None:
                 return t, tr
         return t, self._walk_transform(target, source, t)
 
-    def _side_state(self, links: tuple, top: Frame) -> list:
-        """``[composites by segment start (None: off), lead frame]`` for the side from ``links[0][0]`` up
-        to ``top``, shared by every pair with that side (kept until the topology changes). The lead is
-        the first dynamic link: its stamps locate the segment around a lookup's time."""
-        if not links:
-            return [{}, None]
-        key = (links[0][0], top)
-        state = self._side_states.get(key)
-        if state is None:
-            lead = next((f for f, _ in links if not f.static), None)
-            state = self._side_states[key] = [None if lead is None else {}, lead]
-        return state
-
-    def _side_composite(self, links: tuple, state: list, t: int) -> tuple | None:
+    def _side_composite(self, side: list, t: int) -> tuple | None:
         """One side of a frame pair (its links up to the common ancestor) at time ``t`` as ``(P, Z, Q)``
         from the side's composite for the segment around ``t``, or None (then the links are composed one
         by one). Rotations about one axis commute, so when every link of the side is planar and the
@@ -975,9 +971,9 @@ class BufferCore:
         angle for the translation: a composite made of the segment records once, on the second lookup
         in that segment, and valid until history changes other than at its new end
         (``_history``) or the segment is pruned (``_floor``)."""
+        comps, lead, links = side
         if not links:
             return 0j, 0.0, 1.0 + 0j
-        comps, lead = state
         stamps = lead.stamps
         i = bisect_right(stamps, t)
         if not 0 < i < len(stamps):
@@ -992,7 +988,7 @@ class BufferCore:
         if c == 1 or c[0] != self._history or t0 < self._floor:
             c = _build_composite(links, t, t0, stamps[i], self._history)
             if c is None:  # a link is not planar: never for this side
-                state[0] = None
+                side[0] = None
                 return None
             comps[t0] = c
         if len(c) == 1:  # the links do not share this segment
@@ -1003,30 +999,6 @@ class BufferCore:
         for phi, F, G in terms:
             P += (F + r * G) * rect(1.0, r * phi) if phi else F + r * G
         return P, z0 + r * dz, q0 * rect(1.0, r * theta) if theta else q0
-
-    def _sides(self, source: Frame, target: Frame) -> tuple | None:
-        """Each frame's links ``(frame, parent)`` up to their lowest common ancestor along newest parents,
-        remembered per pair until the topology changes; None when the paths do not meet."""
-        if self._sides_topology != self._topology:
-            self._sides_cache.clear()
-            self._side_states.clear()
-            self._sides_topology = self._topology
-        key = (source, target)
-        got = self._sides_cache.get(key)
-        if got is None:
-            m = self._meet(source, target)
-            if m is None:
-                return None
-            sp = source.path
-            tp = target.path
-            up = tuple(zip(sp[: m[0]], sp[1 : m[0] + 1], strict=True))
-            down = tuple(zip(tp[: m[1]], tp[1 : m[1] + 1], strict=True))
-            # each side's composites are shared by all pairs with that side (a frame and an ancestor)
-            got = (up, down, self._side_state(up, sp[m[0]]), self._side_state(down, tp[m[1]]))
-            if len(self._sides_cache) >= SIDES_MAX:
-                self._sides_cache.clear()
-            self._sides_cache[key] = got
-        return got
 
     def _meet(self, source: Frame, target: Frame) -> tuple[int, int] | None:
         """``(i, j)``: the lowest common ancestor of two frames along their newest parents is
@@ -1471,6 +1443,16 @@ def _relative_at(up: tuple, down: tuple, t: int) -> tuple | None:
     if len(b) == 3:
         b = (b[0].real, b[0].imag, b[1], 0.0, 0.0, b[2].imag, b[2].real)
     return tfm.inverse_compose(b, a)
+
+
+def _side(frame: Frame, n: int) -> list:
+    """``frame.sides`` entry for its ancestor ``frame.path[n]`` (made on first use)."""
+    path = frame.path
+    links = tuple(zip(path[:n], path[1 : n + 1], strict=True))
+    lead = next((f for f, _ in links if not f.static), None)
+    side = [None if links and lead is None else {}, lead, links]
+    frame.sides[path[n]] = side
+    return side
 
 
 def _planar_between(a: tuple, b: tuple) -> tuple:
