@@ -26,7 +26,19 @@ _NS = 1_000_000_000
 class Layout:
     """The byte layout of one TFMessage: where each transform's stamp, ids and numbers are."""
 
-    __slots__ = ("length", "parents", "children", "text_idx", "text", "stride", "pad", "values", "stamps")
+    __slots__ = (
+        "length",
+        "parents",
+        "children",
+        "text_idx",
+        "text",
+        "stride",
+        "pad",
+        "values",
+        "stamps",
+        "frames",
+        "_cells",
+    )
 
     def __init__(self, data: bytes) -> None:
         """Learn the layout of ``data`` (raises DeserializationError when it does not decode)."""
@@ -55,6 +67,18 @@ class Layout:
         self.pad = bytes(self.stride - self.length)
         self.values = _groups(value_idx[::8], 8)  # the first byte of every double
         self.stamps = _groups(stamp_idx[::4], 4)  # of every uint32 (secs, nsecs)
+        self.frames: list | None = None  # (parent, child) frame objects, set by the buffer that reads it
+        self._cells: dict[int, list[list[tuple[int, int]]]] = {}
+
+    def cells(self, k: int) -> list[list[tuple[int, int]]]:
+        """Per transform ``j``, the indices ``(row, j)`` of its ``k`` entries in a batch's values array
+        (made once per batch size: the buffer keeps them as lazy references to the numbers)."""
+        got = self._cells.get(k)
+        if got is None:
+            if len(self._cells) > 64:
+                self._cells.clear()
+            got = self._cells[k] = [[(r, j) for r in range(k)] for j in range(len(self.parents))]
+        return got
 
     def matches(self, data: bytes) -> bool:
         """Cheap pre-check: same length and same transform count (the full check is in :meth:`read`)."""

@@ -39,8 +39,6 @@ from collections.abc import Callable, Iterable, Sequence
 from itertools import repeat
 from math import acos, atan2, cos, isfinite, sin, sqrt
 
-import numpy
-
 from ninjemys.errors import DeserializationError
 from ninjemys.interrupt import wait_slice
 from ninjemys.tf2 import math as tfm
@@ -144,8 +142,9 @@ class Frame:
 
     # -- tf2's TimeCache -------------------------------------------------------------------------
     def _resolve(self, i: int) -> Entry:
-        """Entry ``i`` as ``(parent, 7 floats)``. Entries inserted in bulk are ``(parent, block, row)``
-        (a row of a numpy array of their batch) until first read: most history is never looked at."""
+        """Entry ``i`` as ``(parent, 7 floats)``. Entries inserted in bulk are ``(parent, values, (row,
+        column))`` (a place in the numpy array of their batch) until first read: most history is never
+        looked at."""
         e = self.data[i]
         if len(e) == 3:
             e = self.data[i] = (e[0], tuple(e[1][e[2]].tolist()))
@@ -488,35 +487,41 @@ class BufferCore:
     def _insert_columns(self, layout: Layout, got: tuple, who: str, problems: list[str]) -> int:
         """Append each transform's ``k`` new entries to its frame in one go (lock held); a column that
         does not continue its frame's history in order (new frame or parent, old or repeated stamps)
-        goes through :meth:`_insert` entry by entry."""
+        goes through :meth:`_insert` entry by entry. The layout remembers its frames once they all
+        exist (frames are never removed), and an entry stays ``(parent, values, (row, column))`` of
+        the batch's array until first read: a listener that is asked 20 times a second decodes
+        batches of a few messages, where per-column numpy views and name lookups cost more than the
+        numbers."""
         stamps, values = got
         k = stamps.shape[0]
-        increasing = (
-            (numpy.diff(stamps, axis=0) > 0).all(axis=0).tolist() if k > 1 else [True] * stamps.shape[1]
-        )
+        in_order = k == 1 or bool((stamps[1:] > stamps[:-1]).all())
         columns = stamps.T.tolist()
         frames = self._frames
         keep = self.cache_time_ns
         slack = keep + self._prune_slack
-        blocks = list(values.transpose(1, 0, 2))  # one (k, 7) view per transform
-        rows = range(k)
+        pairs = layout.frames
+        if pairs is None:
+            pairs = [
+                (frames.get(p), frames.get(c)) for p, c in zip(layout.parents, layout.children, strict=True)
+            ]
+            if all(p is not None and c is not None for p, c in pairs):
+                layout.frames = pairs
+        cells = layout.cells(k)
         nones = [None] * k
         count = 0
-        for j, (parent_name, child_name) in enumerate(zip(layout.parents, layout.children, strict=True)):
+        for j, (parent, child) in enumerate(pairs):
             col = columns[j]
-            child = frames.get(child_name)
-            parent = frames.get(parent_name)
             if (
                 child is None
                 or parent is None
                 or child.static
                 or child.parent is not parent
-                or not increasing[j]
                 or col[0] <= child.latest
                 or not child.stamps
+                or not (in_order or all(a < b for a, b in zip(col, col[1:], strict=False)))
             ):
                 for stamp, v in zip(col, values[:, j, :].tolist(), strict=True):
-                    why = self._insert((parent_name, child_name, stamp, *v), who, False)
+                    why = self._insert((layout.parents[j], layout.children[j], stamp, *v), who, False)
                     if why is None:
                         count += 1
                     elif why:
@@ -525,7 +530,7 @@ class BufferCore:
             child.authority = who
             st = child.stamps
             st.extend(col)
-            child.data.extend(zip(repeat(parent, k), repeat(blocks[j], k), rows, strict=False))
+            child.data.extend(zip(repeat(parent, k), repeat(values, k), cells[j], strict=True))
             child.segs.extend(nones)
             latest = col[-1]
             child.latest = latest
