@@ -61,6 +61,7 @@ QUATERNION_TOLERANCE = 10e-6  # tf2: |x²+y²+z²+w² - 1| must stay under this
 NO_PARENT = "NO_PARENT"
 REPEAT_REPORT_AFTER = 10.0  # seconds before the same bad-input line is reported again
 PENDING_MAX = 50  # raw messages queued before the listener's thread decodes them itself
+_SEEN = (-1,)  # a segment looked up once: its composite is made on the second lookup (no history is -1)
 BULK_MIN = 2  # a run this long of one layout is decoded with numpy; a single message per transform
 
 # tf2_msgs/TF2Error codes, as walk results
@@ -988,17 +989,17 @@ class BufferCore:
         if c is None:  # first seen: not worth a composite yet
             if len(comps) >= 256:
                 comps.clear()
-            comps[t0] = 1
+            comps[t0] = _SEEN
             return None
-        if c == 1 or c[0] != self._history or t0 < self._floor:
+        if c[0] != self._history or t0 < self._floor:
             c = _build_composite(links, t, t0, stamps[i], self._history)
             if c is None:  # a link is not planar: never for this side
                 side[0] = None
                 return None
             comps[t0] = c
-        if len(c) == 1:  # the links do not share this segment
-            return None
         _, inv, q0, theta, z0, dz, terms = c
+        if q0 is None:  # the links do not share this segment
+            return None
         r = (t - t0) * inv
         P = 0j
         for phi, F, G in terms:
@@ -1472,8 +1473,8 @@ def _planar_between(a: tuple, b: tuple) -> tuple:
 
 def _build_composite(links: tuple, t: int, t0: int, t1: int, history: int) -> tuple | None:
     """``(history, 1/(t1 - t0), Q0, Θ, Z0, dZ, terms)``: a planar side over the segment t0..t1 (see
-    :meth:`BufferCore._side_composite`); ``(history,)`` when a link has another parent then or its
-    segment around ``t`` is not t0..t1; None when a link is not planar. Built from the top link down: the rotation above link k
+    :meth:`BufferCore._side_composite`); the same with Q0 None when a link has another parent then or
+    its segment around ``t`` is not t0..t1; None when a link is not planar. Built from the top link down: the rotation above link k
     (the product of the A² of the links above it, and the sum of their 2θ) multiplies its translation."""
     recs = []
     for f, parent in links:
@@ -1483,12 +1484,12 @@ def _build_composite(links: tuple, t: int, t0: int, t1: int, history: int) -> tu
             stamps = f.stamps
             i = bisect_right(stamps, t)
             if not 0 < i < len(stamps) or stamps[i - 1] != t0 or stamps[i] != t1:
-                return (history,)
+                return (history, 0.0, None, 0.0, 0.0, 0.0, ())
             rec = f.segs[i] or f._segment(i)
             if not rec[3]:  # a change of parent inside the segment
-                return (history,)
+                return (history, 0.0, None, 0.0, 0.0, 0.0, ())
         if rec[1] is not parent:
-            return (history,)
+            return (history, 0.0, None, 0.0, 0.0, 0.0, ())
         if not rec[0]:
             return None
         recs.append(rec)
