@@ -860,7 +860,8 @@ class BufferCore:
             parent = e[0]
             if not parent.data:  # the top of the tree (no cache, or emptied by clear)
                 f, e = path.pop()
-                acc = (parent, e[1])
+                x, y, z, qx, qy, qz, qw = e[1]
+                acc = (parent, (complex(x, y), z, complex(qw, qz)) if qx == 0.0 and qy == 0.0 else e[1])
                 f.memo_gen, f.memo_t, f.memo_val = gen, t, acc
                 break
             cur = parent
@@ -870,9 +871,30 @@ class BufferCore:
             for f, _ in path:
                 f.memo_gen, f.memo_t, f.memo_val = gen, t, None
             return None
-        root, (x, y, z, qx, qy, qz, qw) = acc
-        for f, e in reversed(path):  # to_root(f) = to_root(parent) * link, as tfm.compose inline
+        root, value = acc
+        planar = len(value) == 3  # (P, Z, Q) as in _relative_at, else 7 floats
+        if planar:
+            P, Z, Q = value
+        else:
+            x, y, z, qx, qy, qz, qw = value
+        for f, e in reversed(path):  # to_root(f) = to_root(parent) * link
             bx, by, bz, bqx, bqy, bqz, bqw = e[1]
+            if planar:
+                if bqx == 0.0 and bqy == 0.0:  # both planar: rotate by Q² (Q is the half angle)
+                    P += Q * Q * complex(bx, by)
+                    Z += bz
+                    Q *= complex(bqw, bqz)
+                    acc = (root, (P, Z, Q))
+                    f.memo_gen, f.memo_t, f.memo_val = gen, t, acc
+                    continue
+                planar = False
+                x = P.real
+                y = P.imag
+                z = Z
+                qx = qy = 0.0
+                qz = Q.imag
+                qw = Q.real
+            # as tfm.compose inline
             cx = qy * bz - qz * by + qw * bx
             cy = qz * bx - qx * bz + qw * by
             cz = qx * by - qy * bx + qw * bz
@@ -944,7 +966,7 @@ class BufferCore:
                     else self._to_root(target, t, gen)
                 )
                 if b is not None and a[0] is b[0]:
-                    return t, tfm.inverse_compose(b[1], a[1])
+                    return t, _between(a[1], b[1])
             # some link above the common ancestor has no data for t (a slow map->odom under a fast
             # odom->base_link): the answer only needs the links below it
         else:
@@ -1441,7 +1463,11 @@ def _relative_at(up: tuple, down: tuple, t: int) -> tuple | None:
             qy = ny
             qz = nz
         sides.append((P, Z, Q) if planar else (x, y, z, qx, qy, qz, qw))
-    a, b = sides
+    return _between(sides[0], sides[1])
+
+
+def _between(a: tuple, b: tuple) -> tuple:
+    """``inverse(b) * a`` as 7 floats, for transforms each planar ``(P, Z, Q)`` or 7 floats."""
     if len(a) == 3 and len(b) == 3:
         return _planar_between(a, b)
     if len(a) == 3:
