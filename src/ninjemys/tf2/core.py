@@ -19,7 +19,9 @@ Where we differ, on purpose:
   ancestor has no data for that time), the exact tf2 walk runs and gives tf2's answer or error.
   A lookup at a time not asked about before composes each side only up to the lowest common
   ancestor, in one loop, interpolating each link from a per-segment record made on first use
-  (slerp as ``A cos(rθ) + C sin(rθ)``, see :meth:`Frame._segment`).
+  (slerp as ``A cos(rθ) + C sin(rθ)``, see :meth:`Frame._segment`). Links that rotate about z only
+  are composed as complex numbers, and a side whose planar links share a segment is evaluated from a
+  per-side composite (:meth:`BufferCore._side_composite`); both equal the general path to rounding.
 - ``can_transform`` with a timeout waits on a condition that insertions signal (no polling sleeps).
 - Raw TFMessages (``add_raw``, what the listener uses) are queued and decoded in batches on the next
   query, runs of one layout with numpy (:mod:`ninjemys.tf2.bulk`).
