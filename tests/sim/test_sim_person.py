@@ -37,12 +37,17 @@ def gap(sim: Simulation) -> float:
 def test_the_person_steps_around_a_robot_standing_in_its_lane(tmp_path):
     sim = corridor(tmp_path, 1.0)
     sim.add_robot("pb", load_robot_model("puzzlebot"), 4.0, 0.3, math.pi)
-    closest = math.inf
+    person = sim.world.moving[0]
+    closest, reversals, last_y, last_dir = math.inf, 0, 0.0, 0.0
     for _ in range(3000):  # 30 s: there (4 m), past the robot and on
         sim.step()
         closest = min(closest, gap(sim))
-    person = sim.world.moving[0]
+        move = person.aside[1] - last_y
+        if abs(move) > 1e-9 and person.walked < 7.5:  # until it turns back at the route's end
+            reversals += last_dir * move < 0
+            last_dir, last_y = move, person.aside[1]
     assert closest >= PERSONAL_SPACE - 1e-6
+    assert reversals == 1  # out, then back onto its route once past: no hunting at the edge
     assert person.walked > 6.0  # it got past the robot, not stuck behind it
     assert not sim.robots["pb"].contact
 

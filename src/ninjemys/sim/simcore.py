@@ -512,10 +512,11 @@ class Simulation:
         want = (0.0, 0.0)  # back onto the route unless a robot is in the way
         nearest = math.inf
         for r in self.robots.values():
-            keep = radius + r.model.body_radius + PERSONAL_SPACE + 0.05
+            keep = radius + r.model.body_radius + PERSONAL_SPACE + 0.1  # how far across it passes
             dx, dy = r.x - x, r.y - y
             along, lateral = dx * ux + dy * uy, dx * -uy + dy * ux
-            if not (-0.1 < along < LOOK_AHEAD and abs(lateral) < keep) or along >= nearest:
+            # a robot counts as in the way a little beyond ``keep``: once aside, it stays aside
+            if not (-0.1 < along < LOOK_AHEAD and abs(lateral) < keep + 0.05) or along >= nearest:
                 continue
             nearest = along
             now_lat = ax * -uy + ay * ux  # its own offset from the route, across the route
