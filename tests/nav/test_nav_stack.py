@@ -58,6 +58,12 @@ def start(world: str, tmp_path: Path, extra: list[str] | None = None) -> NavSess
         log = session.log()
         session.close()
         pytest.fail(f"the navigation stack did not come up:\n{log[-3000:]}")
+    # let the nodes' start-up work end before driving: on a loaded machine it starves the safety
+    # monitor and move_base for seconds while the simulator runs on at its rate (a robot sent off at
+    # once drove on its last command for 3 s of sim time, blind, into a door jamb)
+    settle_until = time.monotonic() + 5.0
+    probe.wait_sim(5.0)
+    time.sleep(max(0.0, settle_until - time.monotonic()))
     return session
 
 
