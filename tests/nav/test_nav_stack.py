@@ -86,15 +86,20 @@ def run_ros1_goals(session: NavSession, goals: list[tuple]) -> list[dict]:
     results = []
     lines = []
     assert proc.stdout is not None
-    for line in proc.stdout:
-        lines.append(line)
-        try:
-            item = json.loads(line)
-        except ValueError:
-            continue
-        item["truth"] = session.probe.truth
-        results.append(item)
-    proc.wait(30)
+    try:
+        for line in proc.stdout:
+            lines.append(line)
+            try:
+                item = json.loads(line)
+            except ValueError:
+                continue
+            item["truth"] = session.probe.truth
+            results.append(item)
+        proc.wait(30)
+    finally:  # an interrupted or failed run leaves no client behind
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
     assert proc.returncode == 0, "".join(lines) + (proc.stderr.read() if proc.stderr else "")
     return results
 
