@@ -159,12 +159,6 @@ def test_office_goals_through_ros1_simple_action_client(office):
     )
 
 
-@pytest.mark.xfail(
-    reason="issue 15 open: the office run's targets are not met every time under CI load (last runs: "
-    "19-20 of 20 goals; a person walking the corridor touched the robot in 1 of 3 runs; amcl RMS "
-    "0.139 m in one run at load 13)",
-    strict=False,
-)
 def test_office_run_meets_the_navigation_targets():
     """The issue's targets on the run above: >= 19 of 20 goals, no contact, amcl RMS < 0.10 m over 5 min."""
     if not OFFICE_RUN:
