@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from ninjemys.nav.slam import ScanMatchMapper, SlamParams, compose, inverse
+from ninjemys.nav.slam import ParticleMapper, SlamParams, compose, inverse
 
 
 def test_compose_inverse_roundtrip():
@@ -19,7 +19,9 @@ def test_compose_inverse_roundtrip():
 def test_map_agrees_with_ground_truth_despite_drift(room, laser):
     angles, cast = laser
     rng = np.random.default_rng(7)
-    mapper = ScanMatchMapper(SlamParams(xmin=-1, ymin=-1, xmax=7, ymax=7, maxUrange=4.5, maxRange=5.0))
+    mapper = ParticleMapper(
+        SlamParams(xmin=-1, ymin=-1, xmax=7, ymax=7, maxUrange=4.5, maxRange=5.0, particles=8)
+    )
     truth = np.array([1.0, 1.0, 0.0])
     odom = truth.copy()
     plan = [(0.05, 0.0)] * 60 + [(0.0, math.pi / 40)] * 20 + [(0.05, 0.0)] * 50 + [(0.0, math.pi / 40)] * 20

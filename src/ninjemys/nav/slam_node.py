@@ -1,11 +1,16 @@
 """``rosrun gmapping slam_gmapping``: slam_gmapping's interface over :mod:`ninjemys.nav.slam`.
 
-Subscribes ``scan``; reads odometry from TF (``~odom_frame`` -> ``~base_frame``); publishes ``map``
-and ``map_metadata`` (latched, every ``~map_update_interval`` seconds), the TF ``~map_frame`` ->
-``~odom_frame`` every ``~transform_publish_period`` seconds, and answers ``dynamic_map``
-(nav_msgs/GetMap). gmapping's map parameters (``~delta``, ``~xmin``.., ``~maxUrange``, ``~maxRange``,
-``~linearUpdate``, ``~angularUpdate``, ``~occ_thresh``) keep their names and meaning; the particle
-filter ones (``~particles``, ``~srr``...) have no counterpart in this mapper and are ignored.
+Subscribes ``scan``; reads odometry from TF (``~odom_frame`` -> ``~base_frame``) at each scan's own
+stamp (gmapping's tf message filter: a scan waits for the odometry of its instant, however late /tf
+runs under load); publishes ``map`` and ``map_metadata`` (latched, every ``~map_update_interval``
+seconds), the TF ``~map_frame`` -> ``~odom_frame`` every ``~transform_publish_period`` seconds, and
+answers ``dynamic_map`` (nav_msgs/GetMap). gmapping's parameters keep their names and meaning: the map
+(``~delta``, ``~xmin``.., ``~occ_thresh``), the laser (``~maxUrange``, ``~maxRange``, ``~lskip``), the
+update rule (``~linearUpdate``, ``~angularUpdate``), the filter (``~particles``,
+``~resampleThreshold``, the motion model ``~srr`` ``~srt`` ``~str`` ``~stt``) and the matcher
+(``~sigma``, ``~lstep``, ``~astep``, ``~ogain``). ``~kernelSize``, ``~iterations``, ``~lsigma`` and the
+``~l?sample*`` ranges belong to gmapping's hill-climbing matcher, which the grid search here replaces;
+they are ignored.
 """
 
 from __future__ import annotations
@@ -18,7 +23,7 @@ import numpy as np
 import rospy
 from ninjemys.nav.mapio import GridMap
 from ninjemys.nav.rosglue import Tf2D, grid_to_msg, param, run_node, scan_arrays, sleep, tf_item
-from ninjemys.nav.slam import ScanMatchMapper, SlamParams
+from ninjemys.nav.slam import ParticleMapper, SlamParams
 
 
 class SlamNode:
@@ -33,7 +38,7 @@ class SlamNode:
         params.update(
             {name: param(node, name, getattr(params, name)) for name in SlamParams.__dataclass_fields__}
         )
-        self.mapper = ScanMatchMapper(params)
+        self.mapper = ParticleMapper(params)
         self.map_frame = param(node, "map_frame", "map")
         self.odom_frame = param(node, "odom_frame", "odom")
         self.base_frame = param(node, "base_frame", "base_link")
@@ -56,8 +61,8 @@ class SlamNode:
 
     def tf_loop(self) -> None:
         while sleep(self.tf_period):
-            with self.lock:
-                corr = self.correction
+            corr = self.correction  # one tuple, swapped whole: no lock, so a long filter step never
+            # holds back the transform (amcl and move_base would see map -> odom go stale)
             self.tf.send([tf_item(self.map_frame, self.odom_frame, rospy.get_time() + self.tf_period, corr)])
 
     def on_scan(self, scan: Any) -> None:
