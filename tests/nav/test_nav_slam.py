@@ -50,3 +50,27 @@ def test_map_agrees_with_ground_truth_despite_drift(room, laser):
     agree = (built[known] == truth_grid[known]).mean()
     assert known.sum() > 2000
     assert agree >= 0.95
+
+
+def test_a_featureless_corridor_does_not_pull_the_pose_along_it(laser):
+    """Walls that constrain only the across-corridor position: there the motion model holds the pose.
+    The matcher this filter replaced took the best score anywhere in its window: the beams that end
+    past the mapped part of the walls pulled it back towards the map, 3.2 m over these 6 m."""
+    from ninjemys.sim.mapfile import GridMap
+
+    angles, cast = laser
+    data = np.zeros((40, 400), dtype=np.int8)  # 20 x 2 m, walls along its length only
+    data[:2, :] = data[-2:, :] = 100
+    corridor = GridMap(data, 0.05, (0.0, -1.0, 0.0))
+    rng = np.random.default_rng(3)
+    params = SlamParams(xmin=-1, ymin=-2, xmax=21, ymax=2, maxUrange=3.0, maxRange=3.5, particles=4)
+    mapper = ParticleMapper(params)
+    worst = 0.0
+    for i in range(60):  # 6 m along the middle, perfect odometry, ends of the corridor out of range
+        pose = (2.0 + 0.1 * i, 0.0, 0.0)
+        ranges = cast(corridor, pose, angles, 3.5) + rng.normal(0, 0.01, len(angles))
+        if mapper.should_process(pose):
+            mapper.process(pose, ranges, angles, range_max=3.5)
+        est = compose(mapper.map_to_odom(pose), pose)
+        worst = max(worst, math.hypot(est[0] - pose[0], est[1] - pose[1]))
+    assert worst < 0.25
