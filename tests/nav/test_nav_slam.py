@@ -74,3 +74,14 @@ def test_a_featureless_corridor_does_not_pull_the_pose_along_it(laser):
         est = compose(mapper.map_to_odom(pose), pose)
         worst = max(worst, math.hypot(est[0] - pose[0], est[1] - pose[1]))
     assert worst < 0.25
+
+
+def test_entropy_of_the_particle_weights():
+    mapper = ParticleMapper(SlamParams(xmin=-1, ymin=-1, xmax=1, ymax=1, particles=4))
+    assert mapper.entropy() == 0.0  # no particles before the first scan
+    angles = np.linspace(-math.pi, math.pi, 36, endpoint=False)
+    mapper.process((0.0, 0.0, 0.0), np.full(36, 0.5), angles, range_max=5.0)
+    assert math.isclose(mapper.entropy(), math.log(4))  # all alike
+    for i, q in enumerate(mapper.particles):
+        q.logw = 0.0 if i == 0 else -50.0
+    assert mapper.entropy() < 1e-6  # one particle holds the weight

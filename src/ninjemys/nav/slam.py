@@ -9,10 +9,11 @@ rule), and then, for every particle:
    gmapping's motion model (``srr`` translation from translation, ``srt`` translation from rotation,
    ``str`` rotation from translation, ``stt`` rotation from rotation: standard deviations per unit);
 2. the improved proposal (Grisetti, Stachniss, Burgard 2007, the paper behind GMapping): the scan is
-   scored against the particle's own map, built so far, over a grid of poses around the prediction,
-   coarse to fine (``lstep``/``astep`` the finest steps). A pose's score is the beams' log-likelihood
-   in a likelihood field of the occupied cells (``-d^2 / 2 sigma^2``, ``d`` the distance from a beam
-   end to the nearest occupied cell), tempered by ``ogain``, plus the motion model's log density. The
+   scored against the particle's own map, built so far, over a grid of poses around the prediction
+   spanning 3 sigma of the motion model (at least ``lstep``/``astep``), refined twice around its
+   best pose. A pose's score is the beams' log-likelihood in a likelihood field of the occupied
+   cells (``-d^2 / 2 sigma^2``, ``d`` the distance from a beam end to the nearest occupied cell),
+   tempered by ``ogain``, plus the motion model's log density. The
    new pose is drawn from the Gaussian fitted to that posterior around its mode, and the particle's
    weight is multiplied by the posterior's mass (``eta``): particles whose maps explain the scan win;
 3. the map update, only now, with the corrected pose: the cells a beam crosses count a visit, its end
@@ -135,6 +136,17 @@ class ParticleMapper:
         """The best particle's pose (map frame) at the last processed scan."""
         b = self.best()
         return b.pose if b else None
+
+    def entropy(self) -> float:
+        """slam_gmapping's ``~entropy``: -sum(w log w) over the particles' normalized weights (0 when
+        one particle holds all the weight, log(particles) when they are all alike)."""
+        if not self.particles:
+            return 0.0
+        lw = np.array([q.logw for q in self.particles])
+        w = np.exp(lw - lw.max())
+        w /= w.sum()
+        w = w[w > 0]
+        return float(-(w * np.log(w)).sum())
 
     def occupancy(self) -> np.ndarray:
         """int8 (height, width) map of the best particle, as slam_gmapping publishes it."""

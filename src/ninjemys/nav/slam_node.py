@@ -4,7 +4,8 @@ Subscribes ``scan``; reads odometry from TF (``~odom_frame`` -> ``~base_frame``)
 stamp (gmapping's tf message filter: a scan waits for the odometry of its instant, however late /tf
 runs under load); publishes ``map`` and ``map_metadata`` (latched, every ``~map_update_interval``
 seconds), the TF ``~map_frame`` -> ``~odom_frame`` every ``~transform_publish_period`` seconds, and
-answers ``dynamic_map`` (nav_msgs/GetMap). gmapping's parameters keep their names and meaning: the map
+answers ``dynamic_map`` (nav_msgs/GetMap); ``~entropy`` (std_msgs/Float64) carries the particle
+weights' entropy with each map update. gmapping's parameters keep their names and meaning: the map
 (``~delta``, ``~xmin``.., ``~occ_thresh``), the laser (``~maxUrange``, ``~maxRange``, ``~lskip``), the
 update rule (``~linearUpdate``, ``~angularUpdate``), the filter (``~particles``,
 ``~resampleThreshold``, the motion model ``~srr`` ``~srt`` ``~str`` ``~stt``) and the matcher
@@ -31,6 +32,7 @@ class SlamNode:
         from nav_msgs.msg import MapMetaData, OccupancyGrid
         from nav_msgs.srv import GetMap
         from sensor_msgs.msg import LaserScan
+        from std_msgs.msg import Float64
 
         self.node = node
         self.lock = threading.Lock()
@@ -52,8 +54,10 @@ class SlamNode:
         self.got_first_scan = False
         self.map_msg: Any = None
         self._grid_cls = OccupancyGrid
+        self._float_cls = Float64
         self.map_pub = node.publisher("map", OccupancyGrid, queue_size=1, latch=True)
         self.meta_pub = node.publisher("map_metadata", MapMetaData, queue_size=1, latch=True)
+        self.entropy_pub = node.publisher("~entropy", Float64, queue_size=1, latch=True)
         node.service("dynamic_map", GetMap, self.on_dynamic_map)
         node.subscriber("scan", LaserScan, self.on_scan, queue_size=5)
         if self.tf_period > 0:
@@ -101,10 +105,13 @@ class SlamNode:
             self.got_first_scan = True
             if publish:
                 self.last_map_time = t
+                entropy = self.mapper.entropy()
                 p = self.mapper.params
                 grid = GridMap(self.mapper.occupancy(), p.delta, (p.xmin, p.ymin, 0.0))
                 self.map_msg = grid_to_msg(grid, self.map_frame, cls=self._grid_cls)
         if publish:
+            if entropy > 0.0:  # as slam_gmapping: published with each map update, when above zero
+                self.entropy_pub.publish(self._float_cls(data=entropy))
             self.meta_pub.publish(self.map_msg.info)
             self.map_pub.publish(self.map_msg)
 
