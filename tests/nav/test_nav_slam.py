@@ -85,3 +85,13 @@ def test_entropy_of_the_particle_weights():
     for i, q in enumerate(mapper.particles):
         q.logw = 0.0 if i == 0 else -50.0
     assert mapper.entropy() < 1e-6  # one particle holds the weight
+
+
+def test_parameters_out_of_range_are_named_and_ignored():
+    p = SlamParams()
+    rejected = p.update({"delta": 0.0, "particles": 0, "srr": 0.05, "xmin": 5.0, "xmax": 2.0, "lskip": -1})
+    names = [name for name, _ in rejected]
+    assert names == ["delta", "lskip", "particles", "xmax"]
+    assert "must be > 0, got 0.0; using 0.05" in rejected[0][1]
+    assert p.delta == 0.05 and p.particles == 30 and p.srr == 0.05 and p.lskip == 0
+    assert (p.xmin, p.xmax) == (-15.0, 15.0)

@@ -80,10 +80,38 @@ class SlamParams:
     particles: int = 30
     resampleThreshold: float = 0.5  # noqa: N815
 
-    def update(self, values: dict[str, object]) -> None:
+    def update(self, values: dict[str, object]) -> list[tuple[str, str]]:
+        """Take ``values`` by name; a value out of its range keeps the current one. Returns (name,
+        reason) for each rejected value: the node logs them and goes on."""
+        rejected = []
         for f in fields(self):
-            if f.name in values:
-                setattr(self, f.name, type(getattr(self, f.name))(values[f.name]))  # type: ignore[call-arg]
+            if f.name not in values:
+                continue
+            old = getattr(self, f.name)
+            value = type(old)(values[f.name])  # type: ignore[call-arg]
+            problem = _out_of_range(f.name, value)
+            if problem:
+                rejected.append((f.name, f"{problem}, got {values[f.name]!r}; using {old!r}"))
+            else:
+                setattr(self, f.name, value)
+        for low, high in (("xmin", "xmax"), ("ymin", "ymax")):
+            if not getattr(self, low) < getattr(self, high):
+                rejected.append((high, f"must be above {low} ({getattr(self, low)!r}); using both defaults"))
+                setattr(self, low, getattr(SlamParams, low))
+                setattr(self, high, getattr(SlamParams, high))
+        return rejected
+
+
+def _out_of_range(name: str, value: float) -> str:
+    if name in ("delta", "maxUrange", "maxRange", "sigma", "lstep", "astep", "ogain") and not value > 0:
+        return "must be > 0"
+    if name in ("linearUpdate", "angularUpdate", "srr", "srt", "str", "stt", "lskip") and value < 0:
+        return "must be >= 0"
+    if name == "particles" and value < 1:
+        return "must be >= 1"
+    if name == "resampleThreshold" and not 0.0 <= value <= 1.0:
+        return "must be within 0..1"
+    return ""
 
 
 class _Particle:
@@ -193,16 +221,14 @@ class ParticleMapper:
         p = self.params
         ranges = np.asarray(ranges, dtype=float)
         angles = np.asarray(angles, dtype=float)
-        if p.lskip > 0:
-            ranges, angles = ranges[:: p.lskip + 1], angles[:: p.lskip + 1]
         limit = min(p.maxRange, range_max) if range_max else p.maxRange
         ok = ~np.isnan(ranges) & ~np.isneginf(ranges)  # NaN: no reading; -inf: closer than range_min
         ranges, angles = ranges[ok], angles[ok]
         ranges = np.where(np.isfinite(ranges), ranges, limit)  # +inf: no return, free up to maxUrange
         hit = ranges < min(limit, p.maxUrange)
         lx, ly, lth = laser_pose
-        # beam ends that score a pose, in the base frame
-        mr, ma = ranges[hit], angles[hit]
+        # beam ends that score a pose, in the base frame (every lskip+1-th, as gmapping's matcher)
+        mr, ma = ranges[hit][:: p.lskip + 1], angles[hit][:: p.lskip + 1]
         if mr.size > self.MATCH_BEAMS:
             take = np.linspace(0, mr.size - 1, self.MATCH_BEAMS).astype(np.int64)
             mr, ma = mr[take], ma[take]

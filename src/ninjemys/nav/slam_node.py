@@ -37,9 +37,11 @@ class SlamNode:
         self.node = node
         self.lock = threading.Lock()
         params = SlamParams()
-        params.update(
+        rejected = params.update(
             {name: param(node, name, getattr(params, name)) for name in SlamParams.__dataclass_fields__}
         )
+        for name, reason in rejected:
+            rospy.logerr("slam_gmapping: parameter %s: %s", node.resolve_name("~" + name), reason)
         self.mapper = ParticleMapper(params)
         self.map_frame = param(node, "map_frame", "map")
         self.odom_frame = param(node, "odom_frame", "odom")
