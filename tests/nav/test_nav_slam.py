@@ -39,6 +39,8 @@ def test_map_agrees_with_ground_truth_despite_drift(room, laser):
         worst_raw = max(worst_raw, math.hypot(odom[0] - truth[0], odom[1] - truth[1]))
         worst_slam = max(worst_slam, math.hypot(corrected[0] - truth[0], corrected[1] - truth[1]))
     assert worst_raw > 0.3  # the odometry alone drifts far
+    assert mapper.resamples > 0  # the weights degenerated and the particles were drawn again
+    assert len({id(q.hits) for q in mapper.particles}) == len(mapper.particles)  # each its own map
     assert worst_slam < 0.12
     built = mapper.occupancy()
     p = mapper.params

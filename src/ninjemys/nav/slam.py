@@ -159,12 +159,6 @@ class ParticleMapper:
             return None
         return max(self.particles, key=lambda q: q.logw)
 
-    @property
-    def pose(self) -> tuple[float, float, float] | None:
-        """The best particle's pose (map frame) at the last processed scan."""
-        b = self.best()
-        return b.pose if b else None
-
     def entropy(self) -> float:
         """slam_gmapping's ``~entropy``: -sum(w log w) over the particles' normalized weights (0 when
         one particle holds all the weight, log(particles) when they are all alike)."""
@@ -285,7 +279,7 @@ class ParticleMapper:
             c, s = math.cos(center[2]), math.sin(center[2])
             ex, ey = cands[:, 0] - center[0], cands[:, 1] - center[1]
             along, across = c * ex + s * ey, -s * ex + c * ey
-            eth = eth_wrap(cands[:, 2] - center[2])
+            eth = _wrap_array(cands[:, 2] - center[2])
             score -= 0.5 * ((along**2 + across**2) / s_xy**2 + eth**2 / s_th**2)
             i = int(np.argmax(score))
             best = cands[i]
@@ -293,9 +287,9 @@ class ParticleMapper:
         w = np.exp(score - score[i])
         total = float(w.sum())
         mean = (w[:, None] * cands).sum(axis=0) / total
-        mean[2] = cands[i, 2] + float((w * eth_wrap(cands[:, 2] - cands[i, 2])).sum() / total)
+        mean[2] = cands[i, 2] + float((w * _wrap_array(cands[:, 2] - cands[i, 2])).sum() / total)
         dev = cands - mean
-        dev[:, 2] = eth_wrap(dev[:, 2])
+        dev[:, 2] = _wrap_array(dev[:, 2])
         cov = (w[:, None, None] * dev[:, :, None] * dev[:, None, :]).sum(axis=0) / total
         cov += np.diag([1e-6, 1e-6, 1e-6])
         draw = self.rng.multivariate_normal(mean, cov)
@@ -418,6 +412,6 @@ class ParticleMapper:
         return iy * self.width + ix
 
 
-def eth_wrap(a: np.ndarray) -> np.ndarray:
+def _wrap_array(a: np.ndarray) -> np.ndarray:
     """Angles wrapped to [-pi, pi)."""
     return (a + np.pi) % (2 * np.pi) - np.pi
