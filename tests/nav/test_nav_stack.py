@@ -387,10 +387,6 @@ def test_global_localization_converges_in_office(tmp_path):
         session.close()
 
 
-@pytest.mark.xfail(
-    reason="issue 15 open: >= 95 % agreement in 3 of 4 runs under load (0.90-0.92 in the misses)",
-    strict=False,
-)
 def test_slam_map_of_office_agrees_with_ground_truth(tmp_path):
     from ninjemys.idl.loader import get_service_class
     from ninjemys.nav.rosglue import grid_from_msg

@@ -11,7 +11,7 @@ No ROS in here. Everything solid is reduced to what the ray caster and the colli
 
 Worlds come from our YAML format (:func:`load_world`, described in docs/sim.md) or from a
 map_server map (:func:`world_from_map`); :func:`rasterize` turns any world into an
-:class:`~ninjemys.sim.mapfile.OccupancyMap` (what the navigation stack uses as its map).
+:class:`~ninjemys.sim.mapfile.GridMap` (what the navigation stack uses as its map).
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ninjemys.sim.mapfile import Fields, MapFileError, OccupancyMap, load_map, yaml_lines
+from ninjemys.sim.mapfile import Fields, GridMap, MapFileError, load_map, yaml_lines
 
 CYLINDER_SIDES = 24
 DEFAULT_WALL_HEIGHT = 1.0
@@ -440,7 +440,7 @@ def parse_world(doc: dict, f: Fields, path: Path) -> World:
     return World(name, obstacles, markings, robots, moving, grid, bounds, str(path))
 
 
-def grid_from_map(m: OccupancyMap) -> Grid:
+def grid_from_map(m: GridMap) -> Grid:
     """Occupied cells of ``m`` as solid geometry. The origin's yaw is ignored, as amcl and costmap_2d
     ignore it: their cells stay axis-aligned."""
     return Grid(m.occupied(), m.resolution, m.origin[0], m.origin[1])
@@ -476,7 +476,7 @@ def rasterize(
     resolution: float = 0.05,
     extent: tuple[float, float, float, float] | None = None,
     moving_at: float | None = None,
-) -> OccupancyMap:
+) -> GridMap:
     """The world as an occupancy grid (0 free, 100 occupied), cells ``resolution`` m, row 0 at the bottom.
 
     A cell is occupied when its centre lies inside a solid shape or a thin wall passes through it, so
@@ -524,4 +524,4 @@ def rasterize(
         sub[np.ix_(okr, okc)] = g.occupied[np.ix_(gr[okr], gc[okc])]
         occ |= sub
     data = np.where(occ, 100, 0).astype(np.int8)
-    return OccupancyMap(data, resolution, (xmin, ymin, 0.0))
+    return GridMap(data, resolution, (xmin, ymin, 0.0))
