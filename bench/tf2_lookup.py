@@ -11,7 +11,12 @@ microseconds. Scenarios:
 - latest: ``rospy.Time(0)``, the buffer unchanged between lookups (a node between two /tf messages);
 - latest+updates: the same, with a new stamp inserted on every link after each 100 lookups (/tf at
   100 Hz under ~10k lookups a second: our per-frame memo is invalidated that often);
-- interpolated: a random time between two stamps for every call (our memo never hits: the worst case).
+- interpolated: a random time between two stamps for every call (our per-time memo never hits). Every
+  link rotates about z only (a mobile robot's links mostly do): ours composes such "planar" links as
+  complex numbers, and from the second lookup of a frame's side within one segment (two stamps) on,
+  from a per-side composite (see docs/tf2.md);
+- interpolated, 3D: the same with every link rotating about a tilted axis: the general path, a
+  quaternion product per link.
 
 The machine is shared: the load average is printed with the figures.
 """
@@ -45,8 +50,10 @@ def worker(n: int) -> dict[str, float]:
         yaw = rnd.uniform(-3, 3)
         links[child] = (parent, rnd.uniform(-2, 2), rnd.uniform(-2, 2), rnd.uniform(-1, 1), yaw)
     buf = tf2_ros.Buffer(debug=False)
+    tilted = tf2_ros.Buffer(debug=False)  # the same tree, rotating about a tilted axis
+    axis = (0.36, -0.48, 0.8)  # unit length
 
-    def insert(stamp: float) -> None:
+    def insert(stamp: float, into=buf, about=(0.0, 0.0, 1.0)) -> None:
         for child, (parent, x, y, z, yaw) in links.items():
             if child in static:
                 continue
@@ -58,11 +65,14 @@ def worker(n: int) -> dict[str, float]:
                 y,
                 z + stamp * 0.01,
             )
-            m.transform.rotation.z, m.transform.rotation.w = (
-                math.sin(yaw / 2 + stamp),
-                math.cos(yaw / 2 + stamp),
+            r, half = m.transform.rotation, yaw / 2 + stamp
+            r.x, r.y, r.z, r.w = (
+                about[0] * math.sin(half),
+                about[1] * math.sin(half),
+                about[2] * math.sin(half),
+                math.cos(half),
             )
-            buf.set_transform(m, "bench")
+            into.set_transform(m, "bench")
 
     static = set(rnd.sample(sorted(links), STATIC))
     for child in static:
@@ -71,9 +81,11 @@ def worker(n: int) -> dict[str, float]:
         m.header.frame_id, m.child_frame_id = parent, child
         m.transform.translation.x, m.transform.rotation.w = x, 1.0
         buf.set_transform_static(m, "bench")
+        tilted.set_transform_static(m, "bench")
     stamp = 100.0
     for _ in range(STAMPS):
         insert(stamp)
+        insert(stamp, tilted, axis)
         stamp += 0.1
     pairs = [(rnd.choice(names), rnd.choice(names)) for _ in range(n)]
     latest = rospy.Time(0)
@@ -113,6 +125,17 @@ def worker(n: int) -> dict[str, float]:
         lookup(target, source, t)
         samples.append(clock() - t0)
     stats("interp", samples)
+
+    times = [rospy.Time.from_sec(100.0 + (STAMPS - 1) * 0.1 - rnd.uniform(0.05, 0.85)) for _ in range(n)]
+    lookup = tilted.lookup_transform
+    for target, source in pairs[:1000]:  # warm up
+        lookup(target, source, latest)
+    samples = []
+    for (target, source), t in zip(pairs, times, strict=True):
+        t0 = clock()
+        lookup(target, source, t)
+        samples.append(clock() - t0)
+    stats("interp3d", samples)
     return results
 
 
@@ -139,7 +162,12 @@ def main() -> int:
     print(
         f"{'scenario':<18}{'ninjemys p50':>14}{'ROS 1 p50':>12}{'ratio':>8}{'ninjemys p90':>15}{'ROS 1 p90':>12}"
     )
-    for key, label in (("latest", "latest"), ("updates", "latest+updates"), ("interp", "interpolated")):
+    for key, label in (
+        ("latest", "latest"),
+        ("updates", "latest+updates"),
+        ("interp", "interpolated"),
+        ("interp3d", "interpolated, 3D"),
+    ):
         a, b = ours[key + "_p50"], ros1[key + "_p50"]
         print(
             f"{label:<18}{a:>14.2f}{b:>12.2f}{a / b:>8.2f}{ours[key + '_p90']:>15.2f}{ros1[key + '_p90']:>12.2f}"

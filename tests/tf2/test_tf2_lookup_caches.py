@@ -149,7 +149,8 @@ def test_cached_answers_equal_a_fresh_buffer(seed):
                 parents[child] = names[rnd.randrange(names.index(child))]
             static = child in ("f3",)
             t = 0 if static else rnd.choice([rnd.randrange(1, 60) / 10, step / 20 + 1])
-            batch = [item(parents[child], child, t, rnd.uniform(-2, 2), tilt_q(rnd.uniform(-3, 3)))]
+            turn = tilt_q if rnd.random() < 0.5 else yaw_q  # chains mix general and planar links
+            batch = [item(parents[child], child, t, rnd.uniform(-2, 2), turn(rnd.uniform(-3, 3)))]
             live.set_transforms(batch, is_static=static)
             log.append((batch, static))
             continue
@@ -188,3 +189,121 @@ def test_raw_batches_between_lookups_match_eager_insertion():
             for t in (0, int((1.0 + 0.01 * k - 0.035) * S)):
                 assert lazy.lookup("world", "f3", t) == eager.lookup("world", "f3", t)
                 assert lazy.lookup("f1", "f3", t) == eager.lookup("f1", "f3", t)
+
+
+@pytest.mark.parametrize("kinds", ["pppp", "pgpp", "ppgp", "gggg", "sppp", "pspg"])
+def test_planar_links_compose_like_general_ones(kinds):
+    """A chain mixing planar links (rotations about z only: complex-number arithmetic), general ones
+    and static ones gives, at interpolated times, what composing each link's tf2 interpolation
+    (lerp + tfm.slerp) gives, for both directions and through a common ancestor. The planar
+    segments include a quaternion sign flip (the short way round) and a nearly constant rotation."""
+    rnd = random.Random(kinds)
+    b = BufferCore()
+    chain = ["root", "l1", "l2", "l3", "l4"]
+    pairs: dict[str, tuple[tuple, tuple]] = {}
+    for k, kind in enumerate(kinds):
+        parent, child = chain[k], chain[k + 1]
+        if kind == "s":
+            b.set_transforms([item(parent, child, 0, 0.3, yaw_q(0.4))], is_static=True)
+            pairs[child] = (item(parent, child, 1, 0.3, yaw_q(0.4)), item(parent, child, 3, 0.3, yaw_q(0.4)))
+            continue
+        turn = yaw_q if kind == "p" else tilt_q
+        a0 = rnd.uniform(-3, 3)
+        a1 = a0 + (1e-7 if k == 2 else rnd.uniform(-2.5, 2.5))
+        q1 = turn(a1)
+        if k == 1:  # -q is the same rotation: the interpolation must take the short way round
+            q1 = tuple(-v for v in q1)
+        first, second = item(parent, child, 1, rnd.uniform(-2, 2), turn(a0)), item(parent, child, 3, 1.0, q1)
+        b.set_transforms([first, second])
+        pairs[child] = (first, second)
+    b.set_transforms([item("root", "other", 1, 0.5, yaw_q(1.0)), item("root", "other", 3, -0.5, yaw_q(-2.0))])
+    pairs["other"] = (item("root", "other", 1, 0.5, yaw_q(1.0)), item("root", "other", 3, -0.5, yaw_q(-2.0)))
+
+    def to_root(frame: str, t: float) -> tuple:
+        acc = tfm.IDENTITY
+        while frame != "root":
+            acc = tfm.compose(expected(*pairs[frame], t), acc)
+            frame = pairs[frame][0][0]
+        return acc
+
+    for t in (1.0, 1.25, 2.0, 2.9, 3.0):
+        ns = int(round(t * S))
+        for target, source in (
+            ("root", "l4"),
+            ("l4", "root"),
+            ("l1", "l4"),
+            ("other", "l3"),
+            ("l4", "other"),
+        ):
+            want = tfm.compose(tfm.inverse(to_root(target, t)), to_root(source, t))
+            got = b.lookup(target, source, ns)[1]
+            if (got[6] < 0) != (want[6] < 0):
+                want = want[:3] + tuple(-v for v in want[3:])
+            assert got == pytest.approx(want, abs=1e-9), (t, target, source)
+
+
+def _planar_tree(b: BufferCore, stamps: list[float], static_x: float = 0.3) -> None:
+    """root <- a <- b2 <- c (planar, sent together at each stamp), root <- d, and a static link c <- s."""
+    for k, t in enumerate(stamps):
+        b.set_transforms(
+            [
+                item("root", "a", t, 0.1 * k, yaw_q(0.3 * k)),
+                item("a", "b2", t, -0.2 * k, yaw_q(-0.5 * k)),
+                item("b2", "c", t, 0.05 * k, yaw_q(0.9 + 0.1 * k)),
+                item("root", "d", t, 1.0 - 0.1 * k, yaw_q(2.0 - 0.2 * k)),
+            ]
+        )
+    b.set_transforms([item("c", "s", 0, static_x, yaw_q(0.7))], is_static=True)
+
+
+def _fresh_answer(log: list[tuple[list[tuple], bool]], target: str, source: str, t: int) -> tuple:
+    fresh = BufferCore(cache_time=2.0)
+    for batch, static in log:
+        fresh.set_transforms(batch, is_static=static)
+    return _answer(fresh, target, source, t)
+
+
+def test_side_composites_follow_history_changes():
+    """Many lookups at different times inside one segment (where a side's composite serves them) agree
+    with a buffer that never cached anything, also after an out-of-order insert splits the segment,
+    a repeated stamp replaces an end of it, a static link changes, and pruning removes it."""
+    live = BufferCore(cache_time=2.0)
+    log: list[tuple[list[tuple], bool]] = []
+
+    class Recording:
+        def set_transforms(self, batch: list[tuple], is_static: bool = False) -> None:
+            live.set_transforms(batch, is_static=is_static)
+            log.append((list(batch), is_static))
+
+    _planar_tree(Recording(), [1.0, 1.5, 2.0])  # type: ignore[arg-type]
+
+    def check() -> None:
+        for t in (1.05, 1.1, 1.2, 1.3, 1.45, 1.55, 1.6, 1.7, 1.8, 1.9):
+            ns = int(round(t * S))
+            for target, source in (("d", "s"), ("s", "d"), ("root", "c"), ("a", "s"), ("d", "a")):
+                want = _fresh_answer(log, target, source, ns)
+                for _ in range(3):  # the second and later lookups in a segment use the composite
+                    got = _answer(live, target, source, ns)
+                    assert got[:2] == want[:2], (t, target, source)
+                    if got[0] == "ok":
+                        assert got[2] == pytest.approx(want[2], abs=1e-9), (t, target, source)
+
+    check()
+    # b2 alone moves on and prunes its 1.0..1.5 while c (the segment's lead for s's side) keeps it
+    Recording().set_transforms([item("a", "b2", 3.5, 0.2, yaw_q(-1.0))])
+    check()
+    Recording().set_transforms([item("root", "a", 1.75, 5.0, yaw_q(-1.0))])  # splits a's 1.5..2.0
+    check()
+    Recording().set_transforms([item("b2", "c", 2.0, -3.0, yaw_q(2.5))])  # replaces an end
+    check()
+    Recording().set_transforms([item("c", "s", 0, -0.9, yaw_q(-0.2))], is_static=True)
+    check()
+    for t in (2.5, 3.0, 3.5, 4.0):  # 1.0..2.0 pruned away: those lookups now extrapolate
+        batch = [
+            item("root", "a", t, 0.3, yaw_q(t)),
+            item("a", "b2", t, 0.2, yaw_q(-t)),
+            item("b2", "c", t, 0.1, yaw_q(2 * t)),
+            item("root", "d", t, 0.0, yaw_q(0.5 * t)),
+        ]
+        Recording().set_transforms(batch)
+    check()

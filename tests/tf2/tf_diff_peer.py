@@ -1,5 +1,6 @@
 """Random tf2 BufferCore operations, printed as JSON: run under Debian's ROS 1 and under ninjemys (both offer
-``tf2_py.BufferCore``) and compare. Stamps never repeat per frame: a repeated stamp is where we differ on
+``tf2_py.BufferCore``) and compare. Half the rotations are about z only, so chains mix planar and general
+links. Stamps never repeat per frame: a repeated stamp is where we differ on
 purpose (the newest data wins; tf2 keeps the first)."""
 
 import json
@@ -34,6 +35,8 @@ def run(seed):
             t, r = m.transform.translation, m.transform.rotation
             t.x, t.y, t.z = (rnd.uniform(-2, 2) for _ in range(3))
             q = [rnd.gauss(0, 1) for _ in range(4)]
+            if rnd.random() < 0.5:  # about z only (a planar link, our complex-number path)
+                q[0] = q[1] = 0.0
             n = math.sqrt(sum(v * v for v in q))
             r.x, r.y, r.z, r.w = (v / n for v in q)
             (buf.set_transform_static if rnd.random() < 0.1 else buf.set_transform)(m, "peer")

@@ -11,7 +11,9 @@ The numbers are gathered as whole doubles (and the stamps as whole uint32), not 
 messages are joined with padding to a multiple of 8 bytes each, so a number at byte offset ``p`` of
 a message is element ``(p - p % 8) / 8`` of that row in the float64 view of the buffer shifted by
 ``p % 8``; one gather per distinct shift (at most 8) reads them all, 8 times fewer elements than
-gathering bytes.
+gathering bytes. Runs of up to ``SMALL_RUN`` messages (a node that looks transforms up often drains a
+few at a time) are gathered byte by byte instead, in one numpy call per kind: there the number of
+calls, not of bytes, is the cost.
 """
 
 from __future__ import annotations
@@ -21,12 +23,29 @@ import numpy
 from ninjemys.tf2.wire import decode_tf_message
 
 _NS = 1_000_000_000
+# up to this many messages the numbers are gathered byte by byte in one numpy call (a node that looks
+# transforms up often decodes a few messages at a time, where the calls cost more than the bytes)
+SMALL_RUN = 24
 
 
 class Layout:
     """The byte layout of one TFMessage: where each transform's stamp, ids and numbers are."""
 
-    __slots__ = ("length", "parents", "children", "text_idx", "text", "stride", "pad", "values", "stamps")
+    __slots__ = (
+        "length",
+        "parents",
+        "children",
+        "text_idx",
+        "text",
+        "stride",
+        "pad",
+        "values",
+        "stamps",
+        "frames",
+        "_cells",
+        "value_bytes",
+        "stamp_bytes",
+    )
 
     def __init__(self, data: bytes) -> None:
         """Learn the layout of ``data`` (raises DeserializationError when it does not decode)."""
@@ -55,6 +74,20 @@ class Layout:
         self.pad = bytes(self.stride - self.length)
         self.values = _groups(value_idx[::8], 8)  # the first byte of every double
         self.stamps = _groups(stamp_idx[::4], 4)  # of every uint32 (secs, nsecs)
+        self.value_bytes = numpy.array(value_idx, dtype=numpy.intp)
+        self.stamp_bytes = numpy.array(stamp_idx, dtype=numpy.intp)
+        self.frames: list | None = None  # (parent, child) frame objects, set by the buffer that reads it
+        self._cells: dict[int, list[list[tuple[int, int]]]] = {}
+
+    def cells(self, k: int) -> list[list[tuple[int, int]]]:
+        """Per transform ``j``, the indices ``(row, j)`` of its ``k`` entries in a batch's values array
+        (made once per batch size: the buffer keeps them as lazy references to the numbers)."""
+        got = self._cells.get(k)
+        if got is None:
+            if len(self._cells) > 64:
+                self._cells.clear()
+            got = self._cells[k] = [[(r, j) for r in range(k)] for j in range(len(self.parents))]
+        return got
 
     def matches(self, data: bytes) -> bool:
         """Cheap pre-check: same length and same transform count (the full check is in :meth:`read`)."""
@@ -71,9 +104,13 @@ class Layout:
         if not (raw[:, self.text_idx] == self.text).all():
             return None
         n = len(self.parents)
-        secs = _gather(joined, k, stride, "<u4", self.stamps).reshape(k, n, 2).astype(numpy.int64)
+        if k <= SMALL_RUN:  # one byte gather each: fewer numpy calls than one per shift
+            secs = raw.take(self.stamp_bytes, axis=1).view("<u4").reshape(k, n, 2).astype(numpy.int64)
+            values = raw.take(self.value_bytes, axis=1).view("<f8").reshape(k, n, 7)
+        else:
+            secs = _gather(joined, k, stride, "<u4", self.stamps).reshape(k, n, 2).astype(numpy.int64)
+            values = _gather(joined, k, stride, "<f8", self.values).reshape(k, n, 7)
         stamps = secs[:, :, 0] * _NS + secs[:, :, 1]
-        values = _gather(joined, k, stride, "<f8", self.values).reshape(k, n, 7)
         return stamps, values
 
 
