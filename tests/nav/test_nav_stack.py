@@ -343,6 +343,10 @@ def test_maze_goals_through_move_base_simple(tmp_path):
         probe = session.probe
         if not session.wait_for(lambda: probe.truth is not None and probe.localized() is not None, 90):
             pytest.fail(f"the navigation stack did not come up:\n{session.log()[-3000:]}")
+        # as start(): the nodes' start-up work ends before the robot is sent off
+        settle_until = time.monotonic() + 5.0
+        probe.wait_sim(5.0)
+        time.sleep(max(0.0, settle_until - time.monotonic()))
         pub = probe.node.publisher("/move_base_simple/goal", probe.pose_cls, queue_size=1, latch=True)
         time.sleep(1.0)
         reached, report = 0, []
