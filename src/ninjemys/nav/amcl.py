@@ -46,6 +46,7 @@ class AMCLParams:
     update_min_a: float = math.pi / 6.0
     resample_interval: int = 2
     selective_resampling: bool = False
+    global_candidates: int = 0
     recovery_alpha_slow: float = 0.0
     recovery_alpha_fast: float = 0.0
     laser_max_beams: int = 30
@@ -153,6 +154,7 @@ class ParticleFilter:
         self.weights = np.zeros(0)
         self.w_slow = 0.0
         self.w_fast = 0.0
+        self.spread_pending = False  # the set is a uniform spread no scan has weighed yet
 
     # -- map --------------------------------------------------------------------------------------
 
@@ -198,6 +200,7 @@ class ParticleFilter:
         )
         self.weights = np.full(n, 1.0 / n)
         self.w_slow = self.w_fast = 0.0
+        self.spread_pending = False
 
     def uniform_poses(self, n: int) -> np.ndarray:
         """``n`` poses drawn uniformly over the map's free cells (the global_localization service)."""
@@ -211,10 +214,13 @@ class ParticleFilter:
         return np.column_stack([x, y, th])
 
     def init_global(self) -> None:
+        """``max_particles`` uniform particles; with ``global_candidates`` above that, the first scan
+        picks them (see :meth:`sensor_update`)."""
         n = self.params.max_particles
         self.poses = self.uniform_poses(n)
         self.weights = np.full(len(self.poses), 1.0 / max(1, len(self.poses)))
         self.w_slow = self.w_fast = 0.0
+        self.spread_pending = True
 
     # -- motion -----------------------------------------------------------------------------------
 
@@ -272,33 +278,19 @@ class ParticleFilter:
         r, a = ranges[use], angles[use]
         if r.size == 0:
             return float(self.weights.mean()) if n else 0.0
-        # endpoints in the laser frame, then in the map for every particle (float32: 20 m maps need
-        # micrometres, and half the memory traffic makes the update faster)
-        lx, ly, lth = laser_pose
-        bx = (lx + r * np.cos(lth + a)).astype(np.float32)
-        by = (ly + r * np.sin(lth + a)).astype(np.float32)
-        g = self.grid
-        inv = np.float32(1.0 / g.resolution)
-        bx *= inv
-        by *= inv
-        table = self._pz_cubed(range_max)
-        like = np.empty(n)
-        # blocks of particles whose (block, beams) index arrays stay in the CPU cache: one pass over
-        # 10000 particles at once is several times slower per particle than blocks of 1000
-        for lo in range(0, n, SENSOR_BLOCK):
-            poses = self.poses[lo : lo + SENSOR_BLOCK].astype(np.float32)
-            c, s = np.cos(poses[:, 2:3]), np.sin(poses[:, 2:3])
-            # padded-field cell coordinates: +1 for the border, clipped so an endpoint off the map
-            # lands on it
-            fx = (poses[:, 0:1] - np.float32(g.origin[0])) * inv + np.float32(1.0)
-            fy = (poses[:, 1:2] - np.float32(g.origin[1])) * inv + np.float32(1.0)
-            ix = np.floor(fx + c * bx - s * by).astype(np.int64)
-            iy = np.floor(fy + s * bx + c * by).astype(np.int64)
-            np.clip(ix, 0, g.width + 1, out=ix)
-            np.clip(iy, 0, g.height + 1, out=iy)
-            iy *= g.width + 2
-            iy += ix
-            like[lo : lo + SENSOR_BLOCK] = 1.0 + table[iy].sum(axis=1, dtype=np.float64)
+        if self.spread_pending and p.global_candidates > n:
+            # global localization: of many uniform candidates, the scan keeps the max_particles that
+            # explain it best. A uniform spread of max_particles leaves the true pose's basin (a few
+            # centimetres and degrees wide under sigma_hit 0.1) with no particle near its peak, and
+            # the partial fits elsewhere outweigh it before it can climb there.
+            cand = self.uniform_poses(p.global_candidates)
+            like = self._likelihood(cand, r, a, laser_pose, range_max)
+            keep = np.argpartition(like, -n)[-n:]
+            self.poses, like = cand[keep], like[keep]
+            self.weights = np.full(n, 1.0 / n)
+        else:
+            like = self._likelihood(self.poses, r, a, laser_pose, range_max)
+        self.spread_pending = False
         w = self.weights * like
         total = float(w.sum())
         if total <= 0 or not math.isfinite(total):
@@ -318,6 +310,44 @@ class ParticleFilter:
         else:
             self.w_fast += p.recovery_alpha_fast * (w_avg - self.w_fast)
         return w_avg
+
+    def _likelihood(
+        self,
+        poses: np.ndarray,
+        r: np.ndarray,
+        a: np.ndarray,
+        laser_pose: tuple[float, float, float],
+        range_max: float,
+    ) -> np.ndarray:
+        """amcl's ``1 + sum(pz^3)`` of each pose for the used beams (ranges ``r`` at angles ``a``)."""
+        # endpoints in the laser frame, then in the map for every particle (float32: 20 m maps need
+        # micrometres, and half the memory traffic makes the update faster)
+        lx, ly, lth = laser_pose
+        bx = (lx + r * np.cos(lth + a)).astype(np.float32)
+        by = (ly + r * np.sin(lth + a)).astype(np.float32)
+        g = self.grid
+        inv = np.float32(1.0 / g.resolution)
+        bx *= inv
+        by *= inv
+        table = self._pz_cubed(range_max)
+        like = np.empty(len(poses))
+        # blocks of particles whose (block, beams) index arrays stay in the CPU cache: one pass over
+        # 10000 particles at once is several times slower per particle than blocks of 1000
+        for lo in range(0, len(poses), SENSOR_BLOCK):
+            block = poses[lo : lo + SENSOR_BLOCK].astype(np.float32)
+            c, s = np.cos(block[:, 2:3]), np.sin(block[:, 2:3])
+            # padded-field cell coordinates: +1 for the border, clipped so an endpoint off the map
+            # lands on it
+            fx = (block[:, 0:1] - np.float32(g.origin[0])) * inv + np.float32(1.0)
+            fy = (block[:, 1:2] - np.float32(g.origin[1])) * inv + np.float32(1.0)
+            ix = np.floor(fx + c * bx - s * by).astype(np.int64)
+            iy = np.floor(fy + s * bx + c * by).astype(np.int64)
+            np.clip(ix, 0, g.width + 1, out=ix)
+            np.clip(iy, 0, g.height + 1, out=iy)
+            iy *= g.width + 2
+            iy += ix
+            like[lo : lo + SENSOR_BLOCK] = 1.0 + table[iy].sum(axis=1, dtype=np.float64)
+        return like
 
     # -- resampling -------------------------------------------------------------------------------
 
