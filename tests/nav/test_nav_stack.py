@@ -148,7 +148,7 @@ def test_office_goals_through_ros1_simple_action_client(office):
 @pytest.mark.xfail(
     reason="issue 15 open: the office run's targets are not met every time under CI load (last runs: "
     "19-20 of 20 goals; a person walking the corridor touched the robot in 1 of 3 runs; amcl RMS "
-    "0.139 m in one run at load 13)",
+    "0.072 m at load 24-26 in the last run, 0.139 m once at load 13 before)",
     strict=False,
 )
 def test_office_run_meets_the_navigation_targets():
