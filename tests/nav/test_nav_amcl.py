@@ -148,3 +148,17 @@ def test_selective_resampling_keeps_a_set_whose_weights_are_even(room, laser):
     pf.sensor_update(cast(room, (1.0, 1.0, 0.0), angles, 5.0), angles, 5.0)  # a few fit well
     pf.resample()
     assert len(pf.poses) != 500 or not np.array_equal(kept, pf.poses)
+
+
+def test_recovery_average_does_not_follow_the_set_size(room, laser):
+    """w_avg is the set's mean likelihood: the same particles' scan gives the same w_avg whether KLD
+    left 2000 of them or 200 (amcl's divides by the count, so a resize alone moved w_fast)."""
+    angles, cast = laser
+    ranges = cast(room, (1.0, 1.0, 0.0), angles, 5.0)
+    pf = ParticleFilter(room, AMCLParams(max_particles=2000), seed=4)
+    pf.init_gaussian((1.0, 1.0, 0.0), 0.01, 0.01, 0.01)
+    poses = pf.poses.copy()
+    big = pf.sensor_update(ranges, angles, 5.0)
+    pf.poses, pf.weights = poses[::10].copy(), np.full(200, 1.0 / 200)
+    small = pf.sensor_update(ranges, angles, 5.0)
+    assert big > 10 and math.isclose(big, small, rel_tol=0.1)
