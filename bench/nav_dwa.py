@@ -4,7 +4,8 @@ than 1 missed cycle per 1,000).
 Starts our roscore and the PuzzleBot simulator (office, real time), feeds its scans into a rolling
 local costmap in this process, and runs the control cycle (costmap update + DWA) every 50 ms of wall
 time for ``N`` cycles while the robot drives along a plan down the office corridor. A cycle is missed
-when its work ends after the next cycle's start. Debian ships no dwa_local_planner, so the reference
+when its work ends after the next cycle's start; the cycle's CPU time is printed beside its wall
+time, to tell the planner's cost from waiting for a core. Debian ships no dwa_local_planner, so the reference
 printed is the target. Run alone: ``.venv/bin/python bench/nav_dwa.py [cycles]``.
 """
 
@@ -68,10 +69,10 @@ def main() -> None:
                 if time.monotonic() > deadline:
                     raise SystemExit("the simulator did not start")
                 time.sleep(0.1)
-            missed, work = 0, []
+            missed, work, cpu = 0, [], []
             start = time.monotonic()
             for k in range(cycles):
-                t0 = time.monotonic()
+                t0, c0 = time.monotonic(), time.thread_time()
                 with lock:
                     odom, scan = latest["odom"], latest["scan"]
                 p = odom.pose.pose  # type: ignore[attr-defined]
@@ -91,6 +92,7 @@ def main() -> None:
                 cmd.publish(msg)
                 t1 = time.monotonic()
                 work.append(t1 - t0)
+                cpu.append(time.thread_time() - c0)
                 next_start = start + (k + 1) * PERIOD
                 if t1 > next_start:
                     missed += 1
@@ -104,7 +106,11 @@ def main() -> None:
             except subprocess.TimeoutExpired:
                 os.killpg(sim.pid, signal.SIGKILL)
     w = np.array(work) * 1000
+    c = np.array(cpu) * 1000
     print(f"load average {os.getloadavg()[0]:.2f} (2 cores shared)")
+    # the cycle's own cost (CPU time of this thread) against its wall time: the difference is
+    # waiting for a core (the load) or for the GIL (this process's message threads)
+    print(f"cycle CPU time: median {np.median(c):.1f} ms, p99 {np.percentile(c, 99):.1f} ms")
     print(
         f"local planner cycle (costmap + DWA, {DWAParams().vx_samples}x{DWAParams().vth_samples} samples): "
         f"median {np.median(w):.1f} ms, p99 {np.percentile(w, 99):.1f} ms, max {w.max():.1f} ms; "

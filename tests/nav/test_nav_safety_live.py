@@ -454,6 +454,14 @@ def test_safety_live_localization_loss_stops_navigation_and_recovery_resumes_it(
     status = rig.status(rig.now)
     assert status.level == status.WARN and "Localization lost" in status.message
     assert dict((kv.key, kv.value) for kv in status.values)["position_covariance"] == "0.6000"
+    # turning in place stays allowed (move_base's rotate recovery is how amcl finds itself again);
+    # an arc loses its translation and keeps its turn
+    rig.stream("navigation", 0.0, 0.6)
+    assert rig.output() == pytest.approx((0.0, 0.6))
+    rig.stream("navigation", 0.2, -0.4)
+    assert rig.output() == pytest.approx((0.0, -0.4))
+    rig.stream("navigation", 0.2, 0.0)
+    assert rig.output() == (0.0, 0.0)
     rig.stream("teleop", 0.1, 0.2)  # a person driving does not need amcl
     assert rig.output() == pytest.approx((0.1, 0.2))
     rig.stream("teleop", None)

@@ -58,6 +58,12 @@ def start(world: str, tmp_path: Path, extra: list[str] | None = None) -> NavSess
         log = session.log()
         session.close()
         pytest.fail(f"the navigation stack did not come up:\n{log[-3000:]}")
+    # let the nodes' start-up work end before driving: on a loaded machine it starves the safety
+    # monitor and move_base for seconds while the simulator runs on at its rate (a robot sent off at
+    # once drove on its last command for 3 s of sim time, blind, into a door jamb)
+    settle_until = time.monotonic() + 5.0
+    probe.wait_sim(5.0)
+    time.sleep(max(0.0, settle_until - time.monotonic()))
     return session
 
 
@@ -80,15 +86,20 @@ def run_ros1_goals(session: NavSession, goals: list[tuple]) -> list[dict]:
     results = []
     lines = []
     assert proc.stdout is not None
-    for line in proc.stdout:
-        lines.append(line)
-        try:
-            item = json.loads(line)
-        except ValueError:
-            continue
-        item["truth"] = session.probe.truth
-        results.append(item)
-    proc.wait(30)
+    try:
+        for line in proc.stdout:
+            lines.append(line)
+            try:
+                item = json.loads(line)
+            except ValueError:
+                continue
+            item["truth"] = session.probe.truth
+            results.append(item)
+        proc.wait(30)
+    finally:  # an interrupted or failed run leaves no client behind
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
     assert proc.returncode == 0, "".join(lines) + (proc.stderr.read() if proc.stderr else "")
     return results
 
@@ -136,6 +147,9 @@ def test_office_goals_through_ros1_simple_action_client(office):
         assert item["state"] in (3, 4) and item["text"], item  # SUCCEEDED or ABORTED, with its text
     # the action interface works end to end with Debian's client: most goals are reached
     assert reached >= 15, "\n".join(report)
+    # the simulator's own account of each contact: which robot moved into what, and where
+    hits = [line for line in office.log().splitlines() if "] hit '" in line]
+    report.append(f"load average {os.getloadavg()[0]:.1f}; contacts: {hits or 'none'}")
     OFFICE_RUN.update(
         reached=reached,
         contacts=probe.contacts - contacts,
@@ -145,21 +159,16 @@ def test_office_goals_through_ros1_simple_action_client(office):
     )
 
 
-@pytest.mark.xfail(
-    reason="issue 15 open: the office run's targets are not met every time under CI load (last runs: "
-    "19-20 of 20 goals; a person walking the corridor touched the robot in 1 of 3 runs; amcl RMS "
-    "0.072 m at load 24-26 in the last run, 0.139 m once at load 13 before)",
-    strict=False,
-)
 def test_office_run_meets_the_navigation_targets():
     """The issue's targets on the run above: >= 19 of 20 goals, no contact, amcl RMS < 0.10 m over 5 min."""
     if not OFFICE_RUN:
         pytest.skip("the office goals run did not finish")
     run = OFFICE_RUN
+    print(run["report"], f"\namcl RMS {run['rms']:.3f} m over {run['driven']:.0f} s")  # shown by -rA
     assert run["reached"] >= 19, run["report"]
     assert run["contacts"] == 0, run["report"]
-    assert run["driven"] >= 300, f"only {run['driven']:.0f} s of driving"  # the 5-minute localization run
-    assert run["rms"] < 0.10, f"amcl RMS error {run['rms']:.3f} m over {run['driven']:.0f} s"
+    assert run["driven"] >= 300, f"only {run['driven']:.0f} s of driving\n{run['report']}"  # 5-minute run
+    assert run["rms"] < 0.10, f"amcl RMS error {run['rms']:.3f} m over {run['driven']:.0f} s\n{run['report']}"
 
 
 @pytest.mark.ros1
@@ -373,10 +382,6 @@ def test_global_localization_converges_in_office(tmp_path):
         session.close()
 
 
-@pytest.mark.xfail(
-    reason="issue 15 open: >= 95 % agreement in 3 of 4 runs under load (0.90-0.92 in the misses)",
-    strict=False,
-)
 def test_slam_map_of_office_agrees_with_ground_truth(tmp_path):
     from ninjemys.idl.loader import get_service_class
     from ninjemys.nav.rosglue import grid_from_msg

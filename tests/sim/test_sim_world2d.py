@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ninjemys.sim.mapfile import MapFileError, OccupancyMap, load_map, occupancy_from_pixels, save_map
+from ninjemys.sim.mapfile import GridMap, MapFileError, load_map, occupancy_from_pixels, save_map
 from ninjemys.sim.world2d import load_world, rasterize, world_from_map
 from ninjemys.sim.worlds import SHIPPED_WORLDS, map_path, resolve_world
 
@@ -19,10 +19,10 @@ def write(tmp_path: Path, name: str, text: str) -> Path:
 
 
 def test_map_server_pixel_rule_trinary_negate_scale():
-    grey = np.array([[0, 100, 205, 254]], dtype=np.uint8)  # black, dark grey, map_saver's unknown, free
-    assert occupancy_from_pixels(grey, None, 0.65, 0.196, False, "trinary").tolist() == [[100, -1, -1, 0]]
-    assert occupancy_from_pixels(grey, None, 0.65, 0.196, True, "trinary").tolist() == [[0, -1, 100, 100]]
-    scaled = occupancy_from_pixels(grey, None, 0.65, 0.196, False, "scale")
+    grey = np.array([[[0], [100], [205], [254]]], dtype=float)  # black, dark grey, map_saver's unknown, free
+    assert occupancy_from_pixels(grey, False, False, 0.65, 0.196, "trinary").tolist() == [[100, -1, -1, 0]]
+    assert occupancy_from_pixels(grey, False, True, 0.65, 0.196, "trinary").tolist() == [[0, -1, 100, 100]]
+    scaled = occupancy_from_pixels(grey, False, False, 0.65, 0.196, "scale")
     assert scaled[0, 0] == 100 and scaled[0, 3] == 0 and 0 <= scaled[0, 1] <= 99
 
 
@@ -44,7 +44,7 @@ def test_save_then_load_round_trips(tmp_path):
     data = np.zeros((5, 7), dtype=np.int8)
     data[1, 2] = 100
     data[4, 6] = -1
-    save_map(OccupancyMap(data, 0.1, (-1.0, -2.0, 0.0)), tmp_path / "x.yaml")
+    save_map(GridMap(data, 0.1, (-1.0, -2.0, 0.0)), tmp_path / "x")
     m = load_map(tmp_path / "x.yaml")
     assert np.array_equal(m.data, data) and m.origin == (-1.0, -2.0, 0.0)
 

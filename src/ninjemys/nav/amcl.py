@@ -27,7 +27,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from ninjemys.nav.costmap import distance_transform
-from ninjemys.nav.mapio import GridMap
+from ninjemys.sim.mapfile import GridMap
 
 BIN_XY = 0.5
 BIN_TH = math.radians(10.0)

@@ -277,7 +277,12 @@ class Costmap:
         clear_len = np.minimum(np.where(beyond, p.raytrace_range, ranges), p.raytrace_range)
         # clear: sample every ray at half-cell steps, stopping short of the hit cell
         step = self.resolution / 2
-        n = int(math.ceil(p.raytrace_range / step)) + 1
+        # no sample beyond the grid's farthest corner from the sensor can land in it (a rolling
+        # window is much smaller than raytrace_range: this is most of the local costmap's work)
+        x0, y0 = self.origin_x - sensor_x, self.origin_y - sensor_y
+        x1, y1 = x0 + self.size_x * self.resolution, y0 + self.size_y * self.resolution
+        reach = math.sqrt(max(x0 * x0, x1 * x1) + max(y0 * y0, y1 * y1))
+        n = int(math.ceil(min(p.raytrace_range, reach) / step)) + 1
         t = np.arange(n) * step
         cos, sin = np.cos(angles), np.sin(angles)
         valid = t[None, :] < (clear_len[:, None] - self.resolution * 0.5)

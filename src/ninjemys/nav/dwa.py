@@ -195,15 +195,17 @@ class DWAPlanner:
             y - V[:, None] / wsafe * (np.cos(ang) - math.cos(th)),
         )
         res = cm.resolution
-        cx = np.floor((px - cm.origin_x) / res).astype(np.int64)
-        cy = np.floor((py - cm.origin_y) / res).astype(np.int64)
+        cx = np.floor((px - cm.origin_x) / res).astype(np.intp)
+        cy = np.floor((py - cm.origin_y) / res).astype(np.intp)
         inside = (cx >= 0) & (cx < cm.size_x) & (cy >= 0) & (cy < cm.size_y)
-        cost = np.full(px.shape, NO_INFORMATION, dtype=np.int64)
-        cost[inside] = cm.costs[cy[inside], cx[inside]]
-        valid = (cost < INSCRIBED).all(axis=1)
+        # one gather for all points (indices clipped), then off-map points read as unknown
+        cost = np.where(
+            inside, cm.costs[np.clip(cy, 0, cm.size_y - 1), np.clip(cx, 0, cm.size_x - 1)], NO_INFORMATION
+        )
+        occ = cost.max(axis=1)
+        valid = occ < INSCRIBED
         if not valid.any():
             return Command(0.0, 0.0, valid=False)
-        occ = cost.max(axis=1).astype(float)
         # distance maps over the local costmap: to the plan's cells and to the local goal
         local = self._local_plan(cm)
         if len(local) == 0:
@@ -213,22 +215,20 @@ class DWAPlanner:
         seg = np.hypot(np.diff(local[:, 0]), np.diff(local[:, 1]))
         remaining = np.concatenate([np.cumsum(seg[::-1])[::-1], [0.0]])
 
-        def along(qx: np.ndarray, qy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            d = np.hypot(qx[:, None] - local[None, :, 0], qy[:, None] - local[None, :, 1])
-            j = np.argmin(d, axis=1)
-            near = d[np.arange(len(qx)), j]
-            return near, remaining[j] + near
-
         ex, ey, eth = px[:, -1], py[:, -1], ang[:, -1]
-        path_d, goal_d = along(ex, ey)
-        total = p.path_distance_bias * 0.5 * path_d + p.goal_distance_bias * 0.5 * goal_d
-        total += p.occdist_scale * occ
         gx, gy = self.plan[-1, 0], self.plan[-1, 1]
-        if math.hypot(gx - x, gy - y) > p.forward_point_distance:
-            path_f, goal_f = along(
-                ex + p.forward_point_distance * np.cos(eth), ey + p.forward_point_distance * np.sin(eth)
-            )
-            total += p.path_distance_bias * 0.5 * path_f + p.goal_distance_bias * 0.5 * goal_f
+        qx, qy = ex, ey
+        if math.hypot(gx - x, gy - y) > p.forward_point_distance:  # the arcs' ends and points ahead, at once
+            qx = np.concatenate([ex, ex + p.forward_point_distance * np.cos(eth)])
+            qy = np.concatenate([ey, ey + p.forward_point_distance * np.sin(eth)])
+        d2 = np.square(qx[:, None] - local[None, :, 0]) + np.square(qy[:, None] - local[None, :, 1])
+        j = np.argmin(d2, axis=1)
+        near = np.sqrt(d2[np.arange(len(qx)), j])
+        # each point's score: its distance to the plan, and to the local goal along the plan
+        score = p.path_distance_bias * 0.5 * near + p.goal_distance_bias * 0.5 * (remaining[j] + near)
+        total = score[: len(ex)] + p.occdist_scale * occ
+        if len(qx) > len(ex):
+            total += score[len(ex) :]
         total = np.where(valid, total, np.inf)
         best = int(np.argmin(total))
         return Command(float(V[best]), float(Wv[best]))

@@ -15,8 +15,11 @@ the fresh, unmasked input of highest priority goes out on ``cmd_vel``, after the
 - scan watchdog: once a scan has come, a latest scan older than ``~scan_timeout`` (1 s; 0: off) no
   longer shows the way ahead, so linear motion is cut until scans come again (turning stays allowed);
 - localization: when ``amcl_pose``'s position variance (xx + yy) exceeds ``~max_position_covariance``
-  (or is not a number), inputs named in ``~localization_inputs`` (default ``[navigation]``) are ignored
-  until an ``amcl_pose`` within the limit comes;
+  (or is not a number), inputs named in ``~localization_inputs`` (default ``[navigation]``) may only
+  turn in place until an ``amcl_pose`` within the limit comes: their linear velocity is cut to zero and
+  their angular velocity passes (a turn in place sweeps nothing new, and it is how move_base's
+  rotate recovery gives amcl the new views it needs to find itself again; stopping turns as well
+  would deadlock that recovery). They still win over lower priorities, as in twist_mux;
 - e-stop: ``e_stop`` (std_msgs/Bool, true) or the ``~e_stop`` service (std_srvs/SetBool, true) latches
   a stop of everything until ``~e_stop`` is called with false (or ``~reset_e_stop``, std_srvs/Trigger);
   the state is latched on ``~e_stop_active``.
@@ -283,10 +286,7 @@ class SafetyMonitor:
                 self.active = "e_stop"
                 return 0.0, 0.0, True
             self._check_scan_age(now)
-            allowed = None
-            if self.localization_lost():
-                allowed = {i.name for i in self.mux.inputs} - self.loc_inputs
-            inp = self.mux.select(now, allowed)
+            inp = self.mux.select(now)
             if inp is None:
                 self.active = None
                 if self.stale_since is None:
@@ -295,6 +295,10 @@ class SafetyMonitor:
             self.stale_since = None
             self.active = inp.name
             v, w = inp.v, inp.w
+            # lost: an input that needs localization may still turn in place (the footprint sweeps
+            # nothing new, and amcl needs the rotate recovery's new views to find itself again)
+            if inp.name in self.loc_inputs and self.localization_lost():
+                v = 0.0
             speed = v if abs(v) >= abs(self.velocity) or v * self.velocity <= 0 else self.velocity
             self.blocked = v != 0.0 and blocked(
                 self.points,
@@ -397,7 +401,10 @@ class SafetyMonitor:
             elif is_blocked:
                 status.level, status.message = DiagnosticStatus.WARN, "Obstacle in the stop zone"
             elif lost:
-                status.level, status.message = DiagnosticStatus.WARN, "Localization lost: navigation stopped"
+                status.level, status.message = (
+                    DiagnosticStatus.WARN,
+                    "Localization lost: navigation may only turn in place",
+                )
             elif active is None and floor > 0:
                 status.level, status.message = DiagnosticStatus.OK, f"Locked below priority {floor}"
             elif active is None:

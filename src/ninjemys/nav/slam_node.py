@@ -1,11 +1,17 @@
 """``rosrun gmapping slam_gmapping``: slam_gmapping's interface over :mod:`ninjemys.nav.slam`.
 
-Subscribes ``scan``; reads odometry from TF (``~odom_frame`` -> ``~base_frame``); publishes ``map``
-and ``map_metadata`` (latched, every ``~map_update_interval`` seconds), the TF ``~map_frame`` ->
-``~odom_frame`` every ``~transform_publish_period`` seconds, and answers ``dynamic_map``
-(nav_msgs/GetMap). gmapping's map parameters (``~delta``, ``~xmin``.., ``~maxUrange``, ``~maxRange``,
-``~linearUpdate``, ``~angularUpdate``, ``~occ_thresh``) keep their names and meaning; the particle
-filter ones (``~particles``, ``~srr``...) have no counterpart in this mapper and are ignored.
+Subscribes ``scan``; reads odometry from TF (``~odom_frame`` -> ``~base_frame``) at each scan's own
+stamp (gmapping's tf message filter: a scan waits for the odometry of its instant, however late /tf
+runs under load); publishes ``map`` and ``map_metadata`` (latched, every ``~map_update_interval``
+seconds), the TF ``~map_frame`` -> ``~odom_frame`` every ``~transform_publish_period`` seconds, and
+answers ``dynamic_map`` (nav_msgs/GetMap); ``~entropy`` (std_msgs/Float64) carries the particle
+weights' entropy with each map update. gmapping's parameters keep their names and meaning: the map
+(``~delta``, ``~xmin``.., ``~occ_thresh``), the laser (``~maxUrange``, ``~maxRange``, ``~lskip``), the
+update rule (``~linearUpdate``, ``~angularUpdate``), the filter (``~particles``,
+``~resampleThreshold``, the motion model ``~srr`` ``~srt`` ``~str`` ``~stt``) and the matcher
+(``~sigma``, ``~lstep``, ``~astep``, ``~ogain``). ``~kernelSize``, ``~iterations``, ``~lsigma`` and the
+``~l?sample*`` ranges belong to gmapping's hill-climbing matcher, which the grid search here replaces;
+they are ignored.
 """
 
 from __future__ import annotations
@@ -16,9 +22,9 @@ from typing import Any
 import numpy as np
 
 import rospy
-from ninjemys.nav.mapio import GridMap
 from ninjemys.nav.rosglue import Tf2D, grid_to_msg, param, run_node, scan_arrays, sleep, tf_item
-from ninjemys.nav.slam import ScanMatchMapper, SlamParams
+from ninjemys.nav.slam import ParticleMapper, SlamParams
+from ninjemys.sim.mapfile import GridMap
 
 
 class SlamNode:
@@ -26,14 +32,17 @@ class SlamNode:
         from nav_msgs.msg import MapMetaData, OccupancyGrid
         from nav_msgs.srv import GetMap
         from sensor_msgs.msg import LaserScan
+        from std_msgs.msg import Float64
 
         self.node = node
         self.lock = threading.Lock()
         params = SlamParams()
-        params.update(
+        rejected = params.update(
             {name: param(node, name, getattr(params, name)) for name in SlamParams.__dataclass_fields__}
         )
-        self.mapper = ScanMatchMapper(params)
+        for name, reason in rejected:
+            rospy.logerr("slam_gmapping: parameter %s: %s", node.resolve_name("~" + name), reason)
+        self.mapper = ParticleMapper(params)
         self.map_frame = param(node, "map_frame", "map")
         self.odom_frame = param(node, "odom_frame", "odom")
         self.base_frame = param(node, "base_frame", "base_link")
@@ -47,8 +56,10 @@ class SlamNode:
         self.got_first_scan = False
         self.map_msg: Any = None
         self._grid_cls = OccupancyGrid
+        self._float_cls = Float64
         self.map_pub = node.publisher("map", OccupancyGrid, queue_size=1, latch=True)
         self.meta_pub = node.publisher("map_metadata", MapMetaData, queue_size=1, latch=True)
+        self.entropy_pub = node.publisher("~entropy", Float64, queue_size=1, latch=True)
         node.service("dynamic_map", GetMap, self.on_dynamic_map)
         node.subscriber("scan", LaserScan, self.on_scan, queue_size=5)
         if self.tf_period > 0:
@@ -56,8 +67,8 @@ class SlamNode:
 
     def tf_loop(self) -> None:
         while sleep(self.tf_period):
-            with self.lock:
-                corr = self.correction
+            corr = self.correction  # one tuple, swapped whole: no lock, so a long filter step never
+            # holds back the transform (amcl and move_base would see map -> odom go stale)
             self.tf.send([tf_item(self.map_frame, self.odom_frame, rospy.get_time() + self.tf_period, corr)])
 
     def on_scan(self, scan: Any) -> None:
@@ -96,10 +107,13 @@ class SlamNode:
             self.got_first_scan = True
             if publish:
                 self.last_map_time = t
+                entropy = self.mapper.entropy()
                 p = self.mapper.params
                 grid = GridMap(self.mapper.occupancy(), p.delta, (p.xmin, p.ymin, 0.0))
                 self.map_msg = grid_to_msg(grid, self.map_frame, cls=self._grid_cls)
         if publish:
+            if entropy > 0.0:  # as slam_gmapping: published with each map update, when above zero
+                self.entropy_pub.publish(self._float_cls(data=entropy))
             self.meta_pub.publish(self.map_msg.info)
             self.map_pub.publish(self.map_msg)
 

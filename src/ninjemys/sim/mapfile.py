@@ -1,16 +1,28 @@
-"""map_server maps: the YAML + image pair, read and written with map_server's semantics.
+"""map_server maps: the YAML + image pair, read as ``map_server`` reads it and written as ``map_saver``
+writes it; and the line-aware YAML reading that the simulator's world and robot files share.
 
-No ROS in here. :func:`load_map` gives an :class:`OccupancyMap` (int8 cells 0 free / 100 occupied /
--1 unknown, row 0 at the *bottom* like ``nav_msgs/OccupancyGrid.data``) from the same fields
-map_server's loader reads (``image``, ``resolution``, ``origin``, ``occupied_thresh``,
-``free_thresh``, ``negate``, optional ``mode``): a pixel's occupancy is ``(255 - mean) / 255``
-(``mean`` inverted first when ``negate``), above ``occupied_thresh`` occupied, below ``free_thresh``
-free, unknown between (``mode: scale`` maps the between-band linearly to 0..100 and ``raw`` takes
-the value as is). Images are PGM (P2/P5, 8 or 16 bit) or 8-bit PNG (grey, grey+alpha, RGB, RGBA).
-:func:`save_map` writes what ``map_saver`` writes: a P5 PGM (254 free, 0 occupied, 205 unknown) and
-its YAML.
+No ROS in here. The simulator (worlds made from maps, ``world_to_map``) and the navigation stack
+(``map_server``, ``map_saver``, amcl, slam_gmapping, the costmaps) both use this one module.
 
-Errors name the file and, for YAML, the line: ``office.yaml:3: resolution: expected a number > 0``.
+:func:`load_map` reads the fields map_server reads (``image``, ``resolution``, ``origin``, ``negate``,
+``occupied_thresh``, ``free_thresh``, optional ``mode``) and gives a :class:`GridMap` whose cells are
+what ``nav_msgs/OccupancyGrid.data`` holds (row 0 at the bottom, the image's last row), by map_server's
+exact rules:
+
+- a pixel's value is the mean of its channels; in ``trinary`` mode the alpha channel is averaged in
+  too, in the other modes it is left out (and ``scale`` makes a fully transparent pixel unknown);
+  ``negate`` inverts it (``255 - v``);
+- ``raw`` mode stores that value as is (an int8, as map_server's assignment wraps it);
+- otherwise ``occ = (255 - v) / 255``: above ``occupied_thresh`` is 100, below ``free_thresh`` is 0,
+  between is -1 (``trinary``, the default) or ``1 + 98 * ratio`` truncated (``scale``).
+
+Images are PGM/PPM (P2/P3/P5/P6, 8 or 16 bit) or 8-bit PNG (grey, grey+alpha, RGB, RGBA).
+:func:`save_map` writes what ``map_saver`` writes: a P5 PGM (254 free for 0..``free``, 0 occupied for
+``occ``..100, 205 otherwise, first image row = top of the map) and a YAML with ``negate: 0``,
+``occupied_thresh: 0.65``, ``free_thresh: 0.196``.
+
+Every error is a :class:`MapFileError` naming the file and, for YAML, the line and field:
+``office.yaml:3: resolution: expected a number > 0, got -1``.
 """
 
 from __future__ import annotations
@@ -26,18 +38,20 @@ import yaml
 
 from ninjemys.errors import NinjemysError
 
+MODES = ("trinary", "scale", "raw")
+
 
 class MapFileError(NinjemysError, ValueError):
     """A map or world file that cannot be used; the text names the file, line or field, and why."""
 
 
 @dataclass
-class OccupancyMap:
-    """An occupancy grid as ``nav_msgs/OccupancyGrid`` holds it (``data[row, col]``, row 0 at y = origin)."""
+class GridMap:
+    """An occupancy grid as ``nav_msgs/OccupancyGrid``: ``data[row, col]``, row 0 at ``origin``'s y."""
 
     data: np.ndarray  # int8 (height, width): 0 free, 100 occupied, -1 unknown (scale mode: 0..100)
     resolution: float
-    origin: tuple[float, float, float]  # x, y, yaw of the cell (0, 0) corner, as map_server's YAML
+    origin: tuple[float, float, float]  # x, y, yaw of the corner of cell (0, 0), as map_server's YAML
 
     @property
     def width(self) -> int:
@@ -50,6 +64,26 @@ class OccupancyMap:
     def occupied(self, threshold: int = 50) -> np.ndarray:
         """Boolean (height, width): cells at or above ``threshold`` (unknown cells are not obstacles)."""
         return self.data >= threshold
+
+    def world_to_cell(self, x: float, y: float) -> tuple[int, int]:
+        """(col, row) of the cell holding world point (x, y) (the map's yaw is taken as 0, like amcl)."""
+        return (
+            int(math.floor((x - self.origin[0]) / self.resolution)),
+            int(math.floor((y - self.origin[1]) / self.resolution)),
+        )
+
+    def cell_to_world(self, col: float, row: float) -> tuple[float, float]:
+        """World (x, y) of the centre of cell (col, row)."""
+        return (
+            self.origin[0] + (col + 0.5) * self.resolution,
+            self.origin[1] + (row + 0.5) * self.resolution,
+        )
+
+    def inside(self, col: int, row: int) -> bool:
+        return 0 <= col < self.width and 0 <= row < self.height
+
+
+# -- YAML with lines ----------------------------------------------------------------------------------
 
 
 def yaml_lines(text: str, path: str) -> tuple[object, dict[str, int]]:
@@ -124,7 +158,7 @@ class Fields:
         return [self.number(v, f"{where}[{i}]") for i, v in enumerate(value)]
 
 
-def load_map(yaml_path: str | Path) -> OccupancyMap:
+def load_map(yaml_path: str | Path) -> GridMap:
     """Read a map_server map (YAML naming its image). Raises MapFileError naming file, line and field."""
     path = Path(yaml_path)
     try:
@@ -151,175 +185,187 @@ def load_map(yaml_path: str | Path) -> OccupancyMap:
     if negate not in (0, 1, True, False):
         raise f.error("negate", f"expected 0 or 1, got {negate!r}")
     mode = doc.get("mode", "trinary")
-    if mode not in ("trinary", "scale", "raw"):
+    if mode not in MODES:
         raise f.error("mode", f"expected trinary, scale or raw, got {mode!r}")
     image_path = Path(image) if Path(image).is_absolute() else path.parent / image
-    pixels, alpha = read_image(image_path)
-    data = occupancy_from_pixels(pixels, alpha, occ, free, bool(negate), str(mode))
-    return OccupancyMap(data, resolution, (origin[0], origin[1], origin[2]))
-
-
-def occupancy_from_pixels(
-    grey: np.ndarray,
-    alpha: np.ndarray | None,
-    occupied_thresh: float,
-    free_thresh: float,
-    negate: bool,
-    mode: str,
-) -> np.ndarray:
-    """map_server's per-pixel rule on an image (row 0 at the top); returns OccupancyGrid rows (row 0 at the bottom)."""
-    value = grey.astype(np.float64)
-    if mode == "raw":
-        out = value.astype(np.int16)
-        out[out > 100] = -1
-        return out[::-1].astype(np.int8).copy()
-    if negate:
-        value = 255.0 - value
-    occ = (255.0 - value) / 255.0
-    out = np.full(grey.shape, -1, dtype=np.int8)
-    out[occ > occupied_thresh] = 100
-    out[occ < free_thresh] = 0
-    if mode == "scale":
-        between = (occ >= free_thresh) & (occ <= occupied_thresh)
-        if occupied_thresh > free_thresh:
-            scaled = 99.0 * (occ - free_thresh) / (occupied_thresh - free_thresh)
-            out[between] = np.clip(np.rint(scaled[between]), 0, 99).astype(np.int8)
-        if alpha is not None:
-            out[alpha < 255] = -1
-    return out[::-1].copy()
-
-
-def read_image(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
-    """Grey levels 0..255 (uint8, row 0 at the top) and the alpha channel if any, from PGM or PNG."""
     try:
-        raw = path.read_bytes()
+        pixels, alpha = read_image(image_path)
     except OSError as exc:
-        raise MapFileError(f"{path}: cannot read map image: {exc.strerror or exc}") from None
-    if raw[:2] in (b"P5", b"P2"):
-        return _read_pgm(raw, path), None
-    if raw[:8] == b"\x89PNG\r\n\x1a\n":
-        return _read_png(raw, path)
-    raise MapFileError(f"{path}: unsupported map image (expected PGM P2/P5 or PNG)")
+        raise MapFileError(
+            f"{path}: image {image_path}: cannot read map image: {exc.strerror or exc}"
+        ) from None
+    except (ValueError, zlib.error) as exc:
+        raise MapFileError(f"{path}: image {image_path}: {exc}") from None
+    cells = occupancy_from_pixels(pixels, alpha, bool(negate), occ, free, str(mode))
+    return GridMap(cells, resolution, (origin[0], origin[1], origin[2]))
 
 
-def _read_pgm(raw: bytes, path: Path) -> np.ndarray:
-    tokens: list[bytes] = []
+# -- images -------------------------------------------------------------------------------------------
+
+
+def _pgm_tokens(blob: bytes, count: int) -> tuple[list[int], int]:
+    """The first ``count`` header integers of a PNM file and the offset just past the last one."""
+    values: list[int] = []
     pos = 2
-    while len(tokens) < 3:
-        while pos < len(raw) and raw[pos : pos + 1].isspace():
+    while len(values) < count:
+        while pos < len(blob) and blob[pos : pos + 1].isspace():
             pos += 1
-        if pos < len(raw) and raw[pos : pos + 1] == b"#":
-            while pos < len(raw) and raw[pos : pos + 1] not in (b"\n", b"\r"):
+        if blob[pos : pos + 1] == b"#":
+            while pos < len(blob) and blob[pos] not in (10, 13):
                 pos += 1
             continue
         start = pos
-        while pos < len(raw) and not raw[pos : pos + 1].isspace():
+        while pos < len(blob) and blob[pos : pos + 1].isdigit():
             pos += 1
         if start == pos:
-            raise MapFileError(f"{path}: truncated PGM header")
-        tokens.append(raw[start:pos])
-    try:
-        width, height, maxval = (int(t) for t in tokens)
-    except ValueError:
-        raise MapFileError(f"{path}: PGM header is not 'width height maxval'") from None
+            raise ValueError("truncated or malformed PNM header")
+        values.append(int(blob[start:pos]))
+    return values, pos
+
+
+def _read_pnm(blob: bytes) -> np.ndarray:
+    magic = blob[:2]
+    channels = {b"P2": 1, b"P5": 1, b"P3": 3, b"P6": 3}.get(magic)
+    if channels is None:
+        raise ValueError(f"not a PGM/PPM or PNG image (magic {magic!r})")
+    (width, height, maxval), pos = _pgm_tokens(blob, 3)
     if width <= 0 or height <= 0 or not 0 < maxval < 65536:
-        raise MapFileError(f"{path}: PGM header has width {width}, height {height}, maxval {maxval}")
-    count = width * height
-    if raw[:2] == b"P5":
-        body = raw[pos + 1 :]
-        dtype = np.dtype(">u2") if maxval > 255 else np.dtype(np.uint8)
-        if len(body) < count * dtype.itemsize:
-            raise MapFileError(f"{path}: PGM data is {len(body)} bytes, {count * dtype.itemsize} expected")
-        values = np.frombuffer(body, dtype=dtype, count=count).astype(np.float64)
+        raise ValueError(f"bad PNM size {width}x{height} maxval {maxval}")
+    count = width * height * channels
+    if magic in (b"P2", b"P3"):
+        values = np.array(blob[pos:].split(), dtype=np.int64)[:count]
     else:
-        try:
-            values = np.array(raw[pos:].split()[:count], dtype=np.float64)
-        except ValueError:
-            raise MapFileError(f"{path}: P2 PGM data holds a non-number") from None
-        if values.size < count:
-            raise MapFileError(f"{path}: PGM data has {values.size} values, {count} expected")
-    grey = np.rint(values * (255.0 / maxval)).astype(np.uint8)
-    return grey.reshape(height, width)
+        dtype = np.dtype(">u2") if maxval > 255 else np.dtype(np.uint8)
+        raw = blob[pos + 1 : pos + 1 + count * dtype.itemsize]
+        values = np.frombuffer(raw, dtype=dtype)
+    if values.size != count:
+        raise ValueError(f"image data truncated: {values.size} of {count} samples")
+    values = values.astype(np.float64)
+    if maxval != 255:
+        values = np.floor(values * 255.0 / maxval)
+    return values.reshape(height, width, channels)
 
 
-def _read_png(raw: bytes, path: Path) -> tuple[np.ndarray, np.ndarray | None]:
+def _read_png(blob: bytes) -> np.ndarray:
     pos = 8
+    idat = bytearray()
     header = None
-    chunks = []
-    while pos + 8 <= len(raw):
-        length, kind = struct.unpack(">I4s", raw[pos : pos + 8])
-        body = raw[pos + 8 : pos + 8 + length]
+    while pos + 8 <= len(blob):
+        (length,) = struct.unpack(">I", blob[pos : pos + 4])
+        kind = blob[pos + 4 : pos + 8]
+        body = blob[pos + 8 : pos + 8 + length]
         pos += 12 + length
         if kind == b"IHDR":
             header = struct.unpack(">IIBBBBB", body)
         elif kind == b"IDAT":
-            chunks.append(body)
+            idat += body
         elif kind == b"IEND":
             break
     if header is None:
-        raise MapFileError(f"{path}: PNG without IHDR")
-    width, height, depth, colour, _comp, _filt, interlace = header
+        raise ValueError("PNG without IHDR")
+    width, height, depth, colour, _, _, interlace = header
     channels = {0: 1, 2: 3, 4: 2, 6: 4}.get(colour)
     if depth != 8 or channels is None or interlace:
-        raise MapFileError(
-            f"{path}: PNG must be 8-bit grey/RGB(A), not interlaced (got depth {depth}, colour type {colour})"
+        raise ValueError(
+            f"PNG with bit depth {depth}, colour type {colour}, interlace {interlace} is not supported"
         )
-    try:
-        data = zlib.decompress(b"".join(chunks))
-    except zlib.error as exc:
-        raise MapFileError(f"{path}: corrupt PNG data: {exc}") from None
+    raw = np.frombuffer(zlib.decompress(bytes(idat)), dtype=np.uint8)
     stride = width * channels
-    if len(data) < height * (stride + 1):
-        raise MapFileError(f"{path}: PNG data is truncated")
-    rows = np.frombuffer(data, dtype=np.uint8, count=height * (stride + 1)).reshape(height, stride + 1)
+    rows = raw.reshape(height, stride + 1)
     out = np.zeros((height, stride), dtype=np.int32)
     prev = np.zeros(stride, dtype=np.int32)
-    for y in range(height):
-        kind, line = rows[y, 0], rows[y, 1:].astype(np.int32)
+    for r in range(height):
+        kind, line = int(rows[r, 0]), rows[r, 1:].astype(np.int32)
         if kind == 0:
             cur = line
         elif kind == 2:
-            cur = (line + prev) & 0xFF
-        else:  # Sub, Average, Paeth depend on the pixel to the left: one pass per pixel
+            cur = (line + prev) & 255
+        else:
             cur = np.zeros(stride, dtype=np.int32)
-            for x in range(stride):
-                left = cur[x - channels] if x >= channels else 0
-                up = prev[x]
-                upleft = prev[x - channels] if x >= channels else 0
+            for i in range(stride):
+                left = int(cur[i - channels]) if i >= channels else 0
+                up = int(prev[i])
+                ul = int(prev[i - channels]) if i >= channels else 0
                 if kind == 1:
                     pred = left
                 elif kind == 3:
                     pred = (left + up) // 2
                 else:
-                    p = left + up - upleft
-                    pa, pb, pc = abs(p - left), abs(p - up), abs(p - upleft)
-                    pred = left if pa <= pb and pa <= pc else up if pb <= pc else upleft
-                cur[x] = (line[x] + pred) & 0xFF
-        out[y] = cur
+                    p = left + up - ul
+                    pa, pb, pc = abs(p - left), abs(p - up), abs(p - ul)
+                    pred = left if pa <= pb and pa <= pc else up if pb <= pc else ul
+                cur[i] = (int(line[i]) + pred) & 255
+        out[r] = cur
         prev = cur
-    pix = out.reshape(height, width, channels)
-    colour_channels = pix[:, :, :3] if channels >= 3 else pix[:, :, :1]
-    grey = np.rint(colour_channels.mean(axis=2)).astype(np.uint8)
-    alpha = pix[:, :, channels - 1].astype(np.uint8) if channels in (2, 4) else None
-    return grey, alpha
+    return out.reshape(height, width, channels).astype(np.float64)
 
 
-def save_map(grid: OccupancyMap, yaml_path: str | Path, image_name: str | None = None) -> Path:
-    """Write ``grid`` as map_saver does (P5 PGM + YAML); returns the YAML path."""
-    path = Path(yaml_path)
-    image = image_name or path.with_suffix(".pgm").name
-    pixels = np.full(grid.data.shape, 205, dtype=np.uint8)
-    pixels[grid.data == 0] = 254
-    pixels[grid.data >= 65] = 0
-    body = pixels[::-1].tobytes()
-    header = (
-        f"P5\n# CREATOR: ninjemys world_to_map {grid.resolution:.3f} m/pix\n{grid.width} {grid.height}\n255\n"
+def read_image(path: Path) -> tuple[np.ndarray, bool]:
+    """(pixels as float (height, width, channels), has_alpha) of a PGM/PPM or 8-bit PNG file."""
+    blob = path.read_bytes()
+    if blob[:8] == b"\x89PNG\r\n\x1a\n":
+        pixels = _read_png(blob)
+        return pixels, pixels.shape[2] in (2, 4)
+    return _read_pnm(blob), False
+
+
+# -- the pixel rule ---------------------------------------------------------------------------------
+
+
+def occupancy_from_pixels(
+    pixels: np.ndarray,
+    has_alpha: bool,
+    negate: bool,
+    occupied_thresh: float,
+    free_thresh: float,
+    mode: str = "trinary",
+) -> np.ndarray:
+    """map_server's pixel rule over a whole image; returns int8 cells with row 0 at the image's bottom."""
+    channels = pixels.shape[2]
+    # map_server averages the alpha channel in too in trinary mode, and leaves it out otherwise
+    colour = pixels[:, :, : channels - 1] if (has_alpha and mode != "trinary") else pixels
+    avg = colour.sum(axis=2) / colour.shape[2]
+    if negate:
+        avg = 255.0 - avg
+    if mode == "raw":
+        cells = avg.astype(np.int64).astype(np.int8)
+    else:
+        occ = (255.0 - avg) / 255.0
+        cells = np.full(avg.shape, -1, dtype=np.int8)
+        cells[occ > occupied_thresh] = 100
+        cells[occ < free_thresh] = 0
+        if mode == "scale":
+            between = (occ <= occupied_thresh) & (occ >= free_thresh)
+            if has_alpha:
+                between &= pixels[:, :, channels - 1] >= 1.0
+            ratio = (occ - free_thresh) / (occupied_thresh - free_thresh)
+            cells[between] = (1 + 98 * ratio[between]).astype(np.int8)
+    return np.ascontiguousarray(cells[::-1])
+
+
+# -- saving -------------------------------------------------------------------------------------------
+
+
+def map_saver_pixels(data: np.ndarray, occupied: int = 65, free: int = 25) -> np.ndarray:
+    """map_saver's trinary image (top row first): 254 free, 0 occupied, 205 unknown."""
+    cells = np.asarray(data, dtype=np.int16)
+    img = np.full(cells.shape, 205, dtype=np.uint8)
+    img[(cells >= 0) & (cells <= free)] = 254
+    img[cells >= occupied] = 0
+    return np.ascontiguousarray(img[::-1])
+
+
+def save_map(grid: GridMap, base: str | Path, occupied: int = 65, free: int = 25) -> tuple[Path, Path]:
+    """Write ``base.pgm`` and ``base.yaml`` as ``map_saver -f base`` does; return both paths."""
+    base = Path(base)
+    pgm = base.with_name(base.name + ".pgm")
+    yml = base.with_name(base.name + ".yaml")
+    img = map_saver_pixels(grid.data, occupied, free)
+    header = f"P5\n# CREATOR: map_saver.cpp {grid.resolution:.3f} m/pix\n{grid.width} {grid.height}\n255\n"
+    pgm.write_bytes(header.encode() + img.tobytes())
+    x, y, yaw = grid.origin
+    yml.write_text(
+        f"image: {pgm.name}\nresolution: {grid.resolution:f}\norigin: [{x:f}, {y:f}, {yaw:f}]\n"
+        "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n\n"
     )
-    (path.parent / image).write_bytes(header.encode("ascii") + body)
-    ox, oy, oyaw = grid.origin
-    path.write_text(
-        f"image: {image}\nresolution: {grid.resolution:.6f}\norigin: [{ox:.6f}, {oy:.6f}, {oyaw:.6f}]\n"
-        "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n",
-        encoding="utf-8",
-    )
-    return path
+    return pgm, yml

@@ -15,7 +15,10 @@ Private parameters: ``~world`` (a shipped world name or a path; default ``square
 map_server YAML used as the world instead), ``~rate`` (real-time factor; 0 runs as fast as
 possible), ``~x ~y ~yaw`` (start pose of the first robot), ``~model`` (``puzzlebot``, a YAML or URDF
 path), ``~update_rate`` (physics steps per simulated second, default 100), ``~seed`` (noise),
-``~odom_alpha`` (amcl's α1-α4), ``~laser_noise``, ``~gui`` (serve the browser view).
+``~odom_alpha`` (amcl's α1-α4), ``~laser_noise``, ``~gui`` (serve the browser view),
+``~cmd_vel_timeout`` (simulated seconds without a command after which the wheels are stopped, as
+diff_drive_controller's ``cmd_vel_timeout`` does; default 0: off, the last command holds, as with
+Gazebo's diff drive plugin).
 
 One thread steps the simulation and publishes; callbacks and services take the same lock. A topic
 nobody subscribes to costs nothing: its sensor is not even computed (Gazebo's sensors behave alike).
@@ -166,6 +169,7 @@ class RobotIO:
     camera_due: Due | None
     imu_due: Due | None
     bad_cmd_warned: bool = False
+    last_cmd: float | None = None  # sim time of the last command (for ~cmd_vel_timeout)
     last_contact: bool | None = None
     last_scan: np.ndarray | None = None
     static_tfs: list[Any] = field(default_factory=list)
@@ -198,6 +202,7 @@ class SimNode:
         self._thread: threading.Thread | None = None
         self._started = (time.monotonic(), time.process_time())
         self._stepped = 0.0  # simulated seconds stepped (resets of time do not undo them)
+        self.cmd_timeout = 0.0  # ~cmd_vel_timeout (0: off)
         self.view: Any = None
         self.clock_pub = node.publisher("/clock", Clock, queue_size=10)
         self.tf_pub = node.publisher("/tf", TFMessage, queue_size=100)
@@ -334,6 +339,7 @@ class SimNode:
             return
         io.bad_cmd_warned = False
         io.robot.command(lin.x, ang.z)
+        io.last_cmd = self.sim.time
 
     # -- services -------------------------------------------------------------------------------
     def _reset_simulation(self, _req: Any) -> Any:
@@ -486,6 +492,10 @@ class SimNode:
         tfs: list[Any] | None = [] if self.tf_pub.get_num_connections() else None
         for io in self.io.values():
             r = io.robot
+            last = io.last_cmd
+            if self.cmd_timeout > 0 and last is not None and not 0.0 <= now - last <= self.cmd_timeout:
+                io.last_cmd = None  # a driver that went quiet (or starved) does not drive on blind
+                r.command(0.0, 0.0)
             self._publish_contact(io)
             pubs = io.pubs
             if io.odom_due.fire(now):
@@ -838,6 +848,7 @@ def main(argv: list[str] | None = None) -> int:
         keep_freed_memory()
         sim = Simulation(world, 1.0 / update_rate, int(_param(node, log, "seed", 0, float)))
         app = SimNode(node, log, sim, rate, float(laser_noise) if laser_noise is not None else None)
+        app.cmd_timeout = max(0.0, _param(node, log, "cmd_vel_timeout", 0.0, float))
         starts = list(world.robots) or []
         if not starts:
             from ninjemys.sim.world2d import RobotStart

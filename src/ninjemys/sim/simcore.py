@@ -22,9 +22,11 @@ import numpy as np
 from ninjemys.sim.raycast import grid_edges
 from ninjemys.sim.robot_model import RobotModel
 from ninjemys.sim.sensors import Camera, FloorPaint, Scene, imu_reading, lidar_ranges
-from ninjemys.sim.world2d import Obstacle, World, box_outline, circle_outline
+from ninjemys.sim.world2d import MovingObstacle, Obstacle, World, box_outline, circle_outline
 
 TRAIL_LENGTH = 2000
+PERSONAL_SPACE = 0.2  # m: the gap a person who gives way keeps from a robot's body
+LOOK_AHEAD = 2.0  # m: how far ahead on its route such a person starts to step aside
 
 
 class SpawnError(ValueError):
@@ -408,6 +410,9 @@ class Simulation:
     def reset_world(self) -> None:
         """Robots back to their start poses, moving obstacles to their start; time goes on (Gazebo's reset_world)."""
         self.world_time = 0.0
+        for m in self.world.moving:
+            m.walked, m.aside = 0.0, (0.0, 0.0)
+        self._movers_at = None
         for r in self.robots.values():
             r.reset()
 
@@ -421,6 +426,9 @@ class Simulation:
         dt = self.dt
         self.steps += 1
         self.world_time += dt
+        for m in self.world.moving:
+            if m.gives_way:
+                self._walk(m, dt)
         touched = []
         for r in self.robots.values():
             if self._move(r, dt):
@@ -487,6 +495,71 @@ class Simulation:
             r.trail.append((round(r.x, 3), round(r.y, 3)))
             r.trail_count += 1
         return new_contact
+
+    def _walk(self, m: MovingObstacle, dt: float) -> None:
+        """One step of a moving obstacle that gives way, as a person in a corridor does.
+
+        It walks its route at ``speed``. A robot ahead on the route (within ``LOOK_AHEAD``, closer to
+        the route than the two bodies plus ``PERSONAL_SPACE``) makes it step aside to whichever side
+        needs the shorter step and has room (no wall or obstacle within its radius); with the robot
+        behind it, it drifts back onto the route. It never takes a step that brings it closer to a
+        robot than ``PERSONAL_SPACE`` (it waits instead): a robot that stands still is never walked
+        into. Deterministic: the step depends only on the state and the robots' poses."""
+        radius = m.size[0] if m.kind == "cylinder" else math.hypot(m.size[0], m.size[1]) / 2.0
+        x, y, heading = m.position(self.world_time)
+        ux, uy = math.cos(heading), math.sin(heading)
+        ax, ay = m.aside
+        want = (0.0, 0.0)  # back onto the route unless a robot is in the way
+        nearest = math.inf
+        for r in self.robots.values():
+            keep = radius + r.model.body_radius + PERSONAL_SPACE + 0.1  # how far across it passes
+            dx, dy = r.x - x, r.y - y
+            along, lateral = dx * ux + dy * uy, dx * -uy + dy * ux
+            # a robot counts as in the way a little beyond ``keep``: once aside, it stays aside
+            if not (-0.1 < along < LOOK_AHEAD and abs(lateral) < keep + 0.05) or along >= nearest:
+                continue
+            nearest = along
+            now_lat = ax * -uy + ay * ux  # its own offset from the route, across the route
+            robot_lat = now_lat + lateral
+            sides = sorted((robot_lat + keep, robot_lat - keep), key=lambda o: abs(o - now_lat))
+            want = (ax, ay)  # no room on either side: stay in the lane and wait
+            for offset in sides:  # room all the way across, not just a free spot beyond a wall
+                tx, ty = x + (offset - now_lat) * -uy, y + (offset - now_lat) * ux
+                if self._room_for(np.linspace(x, tx, 12), np.linspace(y, ty, 12), radius):
+                    want = (-offset * uy, offset * ux)
+                    break
+        reach = m.speed * dt
+        gx, gy = want[0] - ax, want[1] - ay
+        g = math.hypot(gx, gy)
+        step_aside = (gx * min(1.0, reach / g), gy * min(1.0, reach / g)) if g > 1e-9 else (0.0, 0.0)
+        # forward and aside, aside only, forward only: the first that keeps clear of every robot
+        for walk, side in ((reach, step_aside), (0.0, step_aside), (reach, (0.0, 0.0))):
+            if walk == 0.0 and side == (0.0, 0.0):
+                continue
+            nx, ny, _ = m.route_pose(m.walked + walk)
+            nx, ny = nx + ax + side[0], ny + ay + side[1]
+            if side != (0.0, 0.0) and not self._room_for(np.array([nx]), np.array([ny]), radius):
+                continue
+            if all(self._keeps_clear(r, x, y, nx, ny, radius) for r in self.robots.values()):
+                m.walked += walk
+                m.aside = (ax + side[0], ay + side[1])
+                return
+
+    @staticmethod
+    def _keeps_clear(r: Robot, x: float, y: float, nx: float, ny: float, radius: float) -> bool:
+        """True when moving a body of ``radius`` from (x, y) to (nx, ny) keeps ``PERSONAL_SPACE`` from
+        robot ``r``, or at least does not bring it closer."""
+        after = math.hypot(r.x - nx, r.y - ny)
+        return after - radius - r.model.body_radius >= PERSONAL_SPACE or after >= math.hypot(r.x - x, r.y - y)
+
+    def _room_for(self, xs: np.ndarray, ys: np.ndarray, radius: float) -> bool:
+        """True when disks of ``radius`` (plus 2 cm) at every (xs, ys) touch no static geometry."""
+        cx, cy = float(xs.mean()), float(ys.mean())
+        span = float(np.hypot(xs - cx, ys - cy).max())
+        segs = self._static[self._static_near(cx, cy, span + radius + 0.02)]
+        if not len(segs):
+            return True
+        return float(point_segment_distance(xs, ys, segs).min()) >= radius + 0.02
 
     # -- sensors --------------------------------------------------------------------------------
     def odometry(self, r: Robot) -> tuple[float, float, float]:

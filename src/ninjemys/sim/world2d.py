@@ -11,7 +11,7 @@ No ROS in here. Everything solid is reduced to what the ray caster and the colli
 
 Worlds come from our YAML format (:func:`load_world`, described in docs/sim.md) or from a
 map_server map (:func:`world_from_map`); :func:`rasterize` turns any world into an
-:class:`~ninjemys.sim.mapfile.OccupancyMap` (what the navigation stack uses as its map).
+:class:`~ninjemys.sim.mapfile.GridMap` (what the navigation stack uses as its map).
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ninjemys.sim.mapfile import Fields, MapFileError, OccupancyMap, load_map, yaml_lines
+from ninjemys.sim.mapfile import Fields, GridMap, MapFileError, load_map, yaml_lines
 
 CYLINDER_SIDES = 24
 DEFAULT_WALL_HEIGHT = 1.0
@@ -84,7 +84,13 @@ class RobotStart:
 
 @dataclass
 class MovingObstacle:
-    """A box or cylinder that moves along waypoints at ``speed`` (back to the first when ``loop``)."""
+    """A box or cylinder that moves along waypoints at ``speed`` (back to the first when ``loop``).
+
+    By default it is a pure function of time and goes through whatever stands on its route. One that
+    ``gives_way`` walks as people do instead (:meth:`Simulation.step` drives it): it keeps its route
+    but steps aside around a robot in its way and waits when there is no room, so it never walks into
+    a robot. Its pose is then state (``walked`` along the route, ``aside`` from it), not a function
+    of time."""
 
     name: str
     kind: str  # box | cylinder
@@ -94,6 +100,9 @@ class MovingObstacle:
     waypoints: np.ndarray  # (K, 2)
     speed: float
     loop: bool = True
+    gives_way: bool = False
+    walked: float = 0.0  # metres along the route so far (a mover that gives way)
+    aside: tuple[float, float] = (0.0, 0.0)  # its step away from the route (world frame, metres)
 
     def __post_init__(self) -> None:
         pts = [(float(x), float(y)) for x, y in self.waypoints]
@@ -113,11 +122,19 @@ class MovingObstacle:
         self._total = sum(leg[4] for leg in self._legs)
 
     def position(self, t: float) -> tuple[float, float, float]:
-        """Pose (x, y, heading) at time ``t`` seconds after the start: a pure function of time."""
+        """Pose (x, y, heading) at time ``t`` seconds after the start; for a mover that gives way,
+        where its walk has brought it (``t`` is then not used: its path depends on the robots)."""
+        if self.gives_way:
+            x, y, heading = self.route_pose(self.walked)
+            return x + self.aside[0], y + self.aside[1], heading
+        return self.route_pose(t * self.speed)
+
+    def route_pose(self, travelled: float) -> tuple[float, float, float]:
+        """Pose (x, y, heading) on the route after ``travelled`` metres from the first waypoint."""
         x0, y0 = float(self.waypoints[0, 0]), float(self.waypoints[0, 1])
         if self.speed <= 0 or self._total <= 0:
             return x0, y0, 0.0
-        s = (t * self.speed) % self._total
+        s = travelled % self._total
         for i, (ax, ay, bx, by, length, heading) in enumerate(self._legs):
             if s <= length or i == len(self._legs) - 1:
                 f = s / length if length > 0 else 0.0
@@ -373,7 +390,7 @@ def parse_world(doc: dict, f: Fields, path: Path) -> World:
             f,
             m,
             where,
-            {"name", "shape", "radius", "size", "height", "color", "speed", "waypoints", "loop"},
+            {"name", "shape", "radius", "size", "height", "color", "speed", "waypoints", "loop", "gives_way"},
             {"waypoints"},
         )
         shape = m.get("shape", "cylinder")
@@ -389,6 +406,9 @@ def parse_world(doc: dict, f: Fields, path: Path) -> World:
         if not isinstance(wps, list) or not wps:
             raise f.error(f"{where}.waypoints", "expected a list of [x, y] points")
         arr = np.array([f.vector(p, f"{where}.waypoints[{j}]", 2) for j, p in enumerate(wps)])
+        gives_way = m.get("gives_way", False)
+        if not isinstance(gives_way, bool):
+            raise f.error(f"{where}.gives_way", f"expected true or false, got {gives_way!r}")
         moving.append(
             MovingObstacle(
                 str(m.get("name", f"mover_{i}")),
@@ -399,6 +419,7 @@ def parse_world(doc: dict, f: Fields, path: Path) -> World:
                 arr,
                 f.number(m.get("speed", 0.3), f"{where}.speed", minimum=0),
                 bool(m.get("loop", True)),
+                gives_way,
             )
         )
     bounds = None
@@ -419,7 +440,7 @@ def parse_world(doc: dict, f: Fields, path: Path) -> World:
     return World(name, obstacles, markings, robots, moving, grid, bounds, str(path))
 
 
-def grid_from_map(m: OccupancyMap) -> Grid:
+def grid_from_map(m: GridMap) -> Grid:
     """Occupied cells of ``m`` as solid geometry. The origin's yaw is ignored, as amcl and costmap_2d
     ignore it: their cells stay axis-aligned."""
     return Grid(m.occupied(), m.resolution, m.origin[0], m.origin[1])
@@ -455,7 +476,7 @@ def rasterize(
     resolution: float = 0.05,
     extent: tuple[float, float, float, float] | None = None,
     moving_at: float | None = None,
-) -> OccupancyMap:
+) -> GridMap:
     """The world as an occupancy grid (0 free, 100 occupied), cells ``resolution`` m, row 0 at the bottom.
 
     A cell is occupied when its centre lies inside a solid shape or a thin wall passes through it, so
@@ -503,4 +524,4 @@ def rasterize(
         sub[np.ix_(okr, okc)] = g.occupied[np.ix_(gr[okr], gc[okc])]
         occ |= sub
     data = np.where(occ, 100, 0).astype(np.int8)
-    return OccupancyMap(data, resolution, (xmin, ymin, 0.0))
+    return GridMap(data, resolution, (xmin, ymin, 0.0))

@@ -32,11 +32,12 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     try:
         world = resolve_world(options.world)
-        out = save_map(rasterize(world, options.resolution), Path(options.output))
+        out = Path(options.output)
+        pgm, yml = save_map(rasterize(world, options.resolution), out.with_suffix(""))
     except (MapFileError, OSError) as exc:
         print(f"world_to_map: {exc}", file=sys.stderr)
         return 1
-    print(f"wrote {out} and {out.with_suffix('.pgm').name}")
+    print(f"wrote {yml} and {pgm.name}")
     return 0
 
 

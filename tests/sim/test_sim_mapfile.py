@@ -1,4 +1,4 @@
-"""map_server's loading rules and map_saver's output, on small images written here."""
+"""map_server's loading rules and map_saver's output (ninjemys.sim.mapfile), on small images written here."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ninjemys.nav.mapio import GridMap, MapError, load_map, map_saver_pixels, save_map
+from ninjemys.sim.mapfile import GridMap, MapFileError, load_map, map_saver_pixels, save_map
 
 
 def write_pgm(path: Path, img: np.ndarray) -> None:
@@ -114,7 +114,7 @@ def test_saver_output_reads_back_as_map_server_would(tmp_path):
             "image: nothere.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.6\nfree_thresh: 0.2\n",
             "nothere.pgm",
         ),
-        ("image: [unclosed\n", "does not parse"),
+        ("image: [unclosed\n", "invalid YAML"),
         (
             "image: m.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.6\nfree_thresh: 0.2\nmode: fuzzy\n",
             "mode",
@@ -124,15 +124,15 @@ def test_saver_output_reads_back_as_map_server_would(tmp_path):
 def test_bad_map_files_name_the_problem(tmp_path, text, needle):
     write_pgm(tmp_path / "m.pgm", ROW)
     (tmp_path / "bad.yaml").write_text(text)
-    with pytest.raises(MapError) as info:
+    with pytest.raises(MapFileError) as info:
         load_map(tmp_path / "bad.yaml")
     message = str(info.value)
     assert "bad.yaml" in message and needle in message and "\n" not in message
 
 
 def test_missing_yaml_and_bad_image(tmp_path):
-    with pytest.raises(MapError, match="cannot read"):
+    with pytest.raises(MapFileError, match="cannot read"):
         load_map(tmp_path / "none.yaml")
     (tmp_path / "m.pgm").write_bytes(b"GIF89a")
-    with pytest.raises(MapError, match="not a PGM"):
+    with pytest.raises(MapFileError, match="not a PGM"):
         load_map(write_yaml(tmp_path / "m.yaml", "m.pgm"))
