@@ -101,3 +101,64 @@ def test_resample_reports_injected_particles(room, laser):
     assert injected > 0
     spread = np.hypot(pf.poses[:, 0] - 1.0, pf.poses[:, 1] - 1.0) > 1.0
     assert spread.sum() >= injected // 2  # uniform draws land all over the room
+
+
+def test_global_candidates_put_particles_at_the_true_pose(laser):
+    """In the nearly symmetric office, a uniform spread of max_particles leaves the true pose's
+    basin without a particle near its peak; weighing many more candidates with the first scan and
+    keeping the best max_particles puts particles at the true pose."""
+    from .conftest import world_map
+
+    angles, cast = laser
+    office = world_map("office")
+    truth = (1.5, 0.2, 0.3)
+    ranges = cast(office, truth, angles, 5.0)
+
+    def near(pf: ParticleFilter) -> int:
+        d = np.hypot(pf.poses[:, 0] - truth[0], pf.poses[:, 1] - truth[1])
+        return int(((d < 0.3) & (np.abs(wrap(pf.poses[:, 2] - truth[2])) < 0.15)).sum())
+
+    plain = ParticleFilter(
+        office, AMCLParams(max_particles=2000, laser_max_beams=60, laser_sigma_hit=0.1), seed=5
+    )
+    plain.init_global()
+    plain.sensor_update(ranges, angles, 5.0)
+    params = AMCLParams(max_particles=2000, laser_max_beams=60, laser_sigma_hit=0.1, global_candidates=60000)
+    pf = ParticleFilter(office, params, seed=6)
+    pf.init_global()
+    pf.sensor_update(ranges, angles, 5.0)
+    assert len(pf.poses) == 2000 and math.isclose(float(pf.weights.sum()), 1.0)
+    assert near(pf) >= 3 and near(plain) == 0
+    # later scans weigh the kept set as usual (no second draw)
+    kept = pf.poses.copy()
+    pf.sensor_update(ranges, angles, 5.0)
+    assert np.array_equal(kept, pf.poses)
+
+
+def test_selective_resampling_keeps_a_set_whose_weights_are_even(room, laser):
+    """amcl's ~selective_resampling: no resampling while N_eff = 1 / sum(w^2) > n / 2."""
+    angles, cast = laser
+    pf = ParticleFilter(room, AMCLParams(max_particles=500, selective_resampling=True), seed=3)
+    pf.init_gaussian((1.0, 1.0, 0.0), 0.0001, 0.0001, 0.0001)
+    pf.sensor_update(cast(room, (1.0, 1.0, 0.0), angles, 5.0), angles, 5.0)  # all fit alike
+    kept = pf.poses.copy()
+    pf.resample()
+    assert np.array_equal(kept, pf.poses)
+    pf.init_global()
+    pf.sensor_update(cast(room, (1.0, 1.0, 0.0), angles, 5.0), angles, 5.0)  # a few fit well
+    pf.resample()
+    assert len(pf.poses) != 500 or not np.array_equal(kept, pf.poses)
+
+
+def test_recovery_average_does_not_follow_the_set_size(room, laser):
+    """w_avg is the set's mean likelihood: the same particles' scan gives the same w_avg whether KLD
+    left 2000 of them or 200 (amcl's divides by the count, so a resize alone moved w_fast)."""
+    angles, cast = laser
+    ranges = cast(room, (1.0, 1.0, 0.0), angles, 5.0)
+    pf = ParticleFilter(room, AMCLParams(max_particles=2000), seed=4)
+    pf.init_gaussian((1.0, 1.0, 0.0), 0.01, 0.01, 0.01)
+    poses = pf.poses.copy()
+    big = pf.sensor_update(ranges, angles, 5.0)
+    pf.poses, pf.weights = poses[::10].copy(), np.full(200, 1.0 / 200)
+    small = pf.sensor_update(ranges, angles, 5.0)
+    assert big > 10 and math.isclose(big, small, rel_tol=0.1)

@@ -373,11 +373,6 @@ def test_maze_goals_through_move_base_simple(tmp_path):
         session.close()
 
 
-@pytest.mark.xfail(
-    reason="issue 15 open: converged in 5 of 7 runs under load (the office corridor is nearly symmetric "
-    "for the likelihood field; a miss locks onto the mirrored pose)",
-    strict=False,
-)
 def test_global_localization_converges_in_office(tmp_path):
     from ninjemys.idl.loader import get_service_class
 

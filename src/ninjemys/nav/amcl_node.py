@@ -9,9 +9,12 @@ Subscribes ``scan`` (sensor_msgs/LaserScan), ``initialpose`` (PoseWithCovariance
 
 The filter updates when odometry moved more than ``~update_min_d`` along x or y or turned more than
 ``~update_min_a`` since the last update (amcl compares each component), and resamples every
-``~resample_interval`` updates. After a resampling that injected uniform particles (recovery), the next
-scan updates the filter even without motion, so the injected particles are weighed at once. Only the likelihood-field laser model and the diff-drive odometry
-model exist: other ``~laser_model_type``/``~odom_model_type`` values are reported once and replaced.
+``~resample_interval`` updates (``~selective_resampling``: only when the effective sample size is below
+half the set). After a resampling that injected uniform particles (recovery), the next scan updates the
+filter even without motion, so the injected particles are weighed at once. ``~global_candidates`` (ours,
+0 = ROS 1's behaviour): the first scan after ``global_localization`` keeps the ``~max_particles`` best of
+that many uniform candidates. Only the likelihood-field laser model and the diff-drive odometry model
+exist: other ``~laser_model_type``/``~odom_model_type`` values are reported once and replaced.
 """
 
 from __future__ import annotations
