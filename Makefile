@@ -23,7 +23,7 @@ SYSTEM_DEBS  := $(ROS1_DEBS) $(BROWSER_DEBS) tmux
 NPM_DIR   := .cache/npm
 NPM_STAMP := $(NPM_DIR)/node_modules/.installed
 
-.PHONY: all venv system npm lint format typecheck test test-long test-fast demo bench clean
+.PHONY: all venv system npm lint format typecheck test test-fast demo bench clean
 
 all: venv
 
@@ -70,14 +70,10 @@ typecheck: venv
 # --dist loadfile: each test file runs on one worker, in order (the navigation sessions of
 # tests/nav/test_nav_stack.py run one at a time, and the office session's tests follow its goals run).
 test: venv system npm lint typecheck
-	$(VENV)/bin/pytest -n 2 -q --dist loadfile -m "not long"
-
-# The acceptance runs of many minutes (20 maze goals through move_base); not part of `make test`.
-test-long: venv system
-	$(VENV)/bin/pytest -q -m long
+	$(VENV)/bin/pytest -n 2 -q --dist loadfile
 
 test-fast: venv
-	$(VENV)/bin/pytest -n 2 -q -m "not ros1 and not browser and not slow and not long"
+	$(VENV)/bin/pytest -n 2 -q -m "not ros1 and not browser and not slow"
 
 demo: venv
 	$(PY) -m ninjemys.demo
