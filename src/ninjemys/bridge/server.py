@@ -281,6 +281,7 @@ class Gateway:
         self._stop = threading.Event()
         self._sim_ns = 0
         self._watched: set[str] = set()
+        self._watch_lock = threading.Lock()
         self._definitions: dict[str, str] = {}
         self._probing: set[tuple[str, str]] = set()
         self._refresh_failing = False
@@ -390,10 +391,13 @@ class Gateway:
 
     def watch_param(self, name: str) -> None:
         """Forward master paramUpdate for ``name`` to the Foxglove clients that subscribed it."""
-        if name in self._watched:
-            return
-        self._watched.add(name)
-        self.node.subscribe_param(name, self._param_changed)
+        with self._watch_lock:
+            if name in self._watched:
+                return
+            # marked only once the master has the subscription: a change right after a client's
+            # subscribeParameterUpdates was answered must reach it
+            self.node.subscribe_param(name, self._param_changed)
+            self._watched.add(name)
 
     def _param_changed(self, key: str, value: Any) -> None:
         name = key.rstrip("/") or "/"
