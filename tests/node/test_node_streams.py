@@ -27,6 +27,23 @@ from std_msgs.msg import Header
 STREAM_PROC = str(Path(__file__).with_name("stream_proc.py"))
 
 
+#: A callback gap counts as starvation only when the publisher got more messages through meanwhile than
+#: the subscriber's queue (10) and both sides' kernel socket buffers (tcp_wmem/tcp_rmem max: 4 + 6 MB,
+#: ~10 one-MB messages) can hold. A machine too loaded to run the subscriber for 100 ms also blocks
+#: the publisher on its full socket, so its seq numbers stop too: that gap is the scheduler's, not ours.
+#: The starvation this guards against (a worker reading and trimming for seconds) let hundreds through.
+BUFFERED = 25
+
+
+def _starved_gaps(arrivals: list[tuple[float, int]]) -> list[str]:
+    """Gaps over 100 ms between callbacks while the publisher got more than ``BUFFERED`` messages out."""
+    return [
+        f"{(b - a) * 1e3:.0f} ms while {sb - sa} messages were published"
+        for (a, sa), (b, sb) in zip(arrivals, arrivals[1:], strict=False)
+        if b - a > 0.1 and sb - sa > BUFFERED
+    ]
+
+
 def _publisher(master_uri: str, kind: str, rate: float, seconds: float) -> Child:
     cmd = [sys.executable, STREAM_PROC, master_uri, kind, str(rate), str(seconds)]
     return Child(["taskset", "-c", "0", *cmd])
@@ -97,9 +114,12 @@ def test_a_read_round_ends_while_the_publisher_keeps_up() -> None:
 
 def test_saturated_1mb_stream_keeps_calling_back(master, make_node) -> None:
     listener = make_node("cloud_listener")
-    arrivals: list[tuple[float, float]] = []
+    arrivals: list[tuple[float, float, int]] = []
     listener.subscriber(
-        "/cloud", PointCloud2, lambda m: arrivals.append((time.perf_counter(), _stamp(m))), queue_size=10
+        "/cloud",
+        PointCloud2,
+        lambda m: arrivals.append((time.perf_counter(), _stamp(m), m.header.seq)),
+        queue_size=10,
     )
     pub = _publisher(master.uri, "cloud", 0, 2.5)
     try:
@@ -107,11 +127,10 @@ def test_saturated_1mb_stream_keeps_calling_back(master, make_node) -> None:
         assert wait_until(lambda: arrivals and time.perf_counter() - arrivals[-1][0] > 0.3, timeout=10)
     finally:
         pub.kill()
-    times = [t for t, _ in arrivals]
-    stamps = [s for _, s in arrivals]
-    gaps = [b - a for a, b in zip(times, times[1:], strict=False)]
+    stamps = [s for _, s, _ in arrivals]
     assert len(arrivals) >= 25, f"only {len(arrivals)} callbacks in 2.5 s of a saturated stream"
-    assert max(gaps) <= 0.1, f"the callback stopped for {max(gaps) * 1e3:.0f} ms while the publisher ran"
+    starved = _starved_gaps([(t, seq) for t, _, seq in arrivals])
+    assert not starved, f"the callback stopped for {starved} while the publisher ran"
     assert stamps == sorted(stamps)  # in order, whatever was dropped
 
 
@@ -138,17 +157,19 @@ print("done", flush=True)
 @pytest.mark.skipif(not testing.have_ros1(), reason="needs Debian's ROS 1")
 def test_saturated_stream_from_real_rospy_keeps_calling_back(master, make_node) -> None:
     listener = make_node("cloud_listener")
-    arrivals: list[float] = []
-    listener.subscriber("/cloud", PointCloud2, lambda m: arrivals.append(time.perf_counter()), queue_size=10)
+    arrivals: list[tuple[float, int]] = []
+    listener.subscriber(
+        "/cloud", PointCloud2, lambda m: arrivals.append((time.perf_counter(), m.header.seq)), queue_size=10
+    )
     cmd = ["taskset", "-c", "0", testing.ROS1_PYTHON, "-c", ROSPY_CLOUD_PUBLISHER, "2.5"]
     pub = Child(cmd, env=testing.ros1_env(master.uri))
     try:
         assert pub.wait_line(lambda line: line == "done", timeout=60), pub.describe()
     finally:
         pub.kill()
-    gaps = [b - a for a, b in zip(arrivals, arrivals[1:], strict=False)]
     assert len(arrivals) >= 25, f"only {len(arrivals)} callbacks in 2.5 s of a saturated rospy stream"
-    assert max(gaps) <= 0.1, f"the callback stopped for {max(gaps) * 1e3:.0f} ms while rospy published"
+    starved = _starved_gaps(arrivals)  # rospy numbers each message it publishes in header.seq
+    assert not starved, f"the callback stopped for {starved} while rospy published"
 
 
 def test_image_stream_does_not_delay_a_small_subscription(master, make_node) -> None:
