@@ -12,27 +12,12 @@ from __future__ import annotations
 import math
 import os
 import time
-from pathlib import Path
 
 import numpy as np
 
+from nav_amcl import MAP, cast  # the office map and its plain numpy ray march
 from ninjemys.nav.slam import ParticleMapper, SlamParams, compose
 from ninjemys.sim.mapfile import load_map
-
-MAP = Path(__file__).resolve().parents[1] / "src/ninjemys/packages/share/puzzlebot_sim/maps/office.yaml"
-
-
-def cast(grid, pose: tuple[float, float, float], angles: np.ndarray, max_range: float) -> np.ndarray:
-    """Ranges from ``pose`` to the first occupied cell (a plain numpy ray march), inf past range."""
-    t = np.arange(0.0, max_range, grid.resolution / 4)
-    xs = pose[0] + np.cos(pose[2] + angles)[:, None] * t
-    ys = pose[1] + np.sin(pose[2] + angles)[:, None] * t
-    ix = np.floor((xs - grid.origin[0]) / grid.resolution).astype(int)
-    iy = np.floor((ys - grid.origin[1]) / grid.resolution).astype(int)
-    inside = (ix >= 0) & (ix < grid.width) & (iy >= 0) & (iy < grid.height)
-    occ = np.ones(xs.shape, dtype=bool)
-    occ[inside] = grid.data[iy[inside], ix[inside]] >= 50
-    return np.where(occ.any(axis=1), t[np.argmax(occ, axis=1)], np.inf)
 
 
 def drive() -> list[tuple[float, float]]:

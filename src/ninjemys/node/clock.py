@@ -167,18 +167,24 @@ class Clock:
             self._sim_waiters[waiter] = target
             try:
                 while True:
-                    if self._shutdown:
-                        return Wake.SHUTDOWN
-                    if cancelled is not None and cancelled():
-                        return Wake.CANCELLED
-                    if self._epoch != epoch:
-                        return Wake.MOVED_BACKWARDS
-                    remaining = target - self.now()
-                    if remaining <= 0:
-                        return Wake.REACHED
+                    wake = self._why_awake(epoch, cancelled, target - self.now())
+                    if wake is not None:
+                        return wake
                     waiter.wait(wait_slice(None))
             finally:
                 del self._sim_waiters[waiter]
+
+    def _why_awake(self, epoch: int, cancelled: Callable[[], bool] | None, remaining: float) -> Wake | None:
+        """Why a sleeper must return now (shutdown first, then cancel, a time jump, the time reached), or None."""
+        if self._shutdown:
+            return Wake.SHUTDOWN
+        if cancelled is not None and cancelled():
+            return Wake.CANCELLED
+        if self._epoch != epoch:
+            return Wake.MOVED_BACKWARDS
+        if remaining <= 0:
+            return Wake.REACHED
+        return None
 
     def _gate(self) -> Any:
         gate = getattr(self._local, "gate", None)
@@ -205,15 +211,10 @@ class Clock:
             self._gates.add(gate)
         try:
             while True:
-                if self._shutdown:
-                    return Wake.SHUTDOWN
-                if cancelled is not None and cancelled():
-                    return Wake.CANCELLED
-                if self._epoch != epoch:
-                    return Wake.MOVED_BACKWARDS  # switched to simulated time meanwhile
                 remaining = target - self._wall()
-                if remaining <= 0:
-                    return Wake.REACHED
+                wake = self._why_awake(epoch, cancelled, remaining)  # an epoch change: now simulated
+                if wake is not None:
+                    return wake
                 # True: someone opened the gate (we hold it again, re-armed); False: the time is up
                 gate.acquire(True, wait_slice(remaining))
         finally:
