@@ -74,6 +74,11 @@ class CommStateMachine:
     def __hash__(self) -> int:
         return hash(self.goal_id)
 
+    def set_state(self, state: int) -> None:
+        """Set the comm state without telling the user (ROS 1's name; :meth:`transition_to` tells)."""
+        with self.mutex:
+            self.state = state
+
     def transition_to(self, state: int) -> None:
         self.state = state
         if self.transition_cb is not None:

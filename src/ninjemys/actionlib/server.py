@@ -66,7 +66,12 @@ class StatusTracker:
 
     @property
     def handle_destruction_time(self) -> Time:
+        """ROS 1's name for :attr:`destruction_time` (HandleTrackerDeleter sets it)."""
         return self.destruction_time
+
+    @handle_destruction_time.setter
+    def handle_destruction_time(self, stamp: Time) -> None:
+        self.destruction_time = stamp
 
 
 class ServerGoalHandle:
@@ -285,8 +290,8 @@ class ActionServer:
     def register_goal_callback(self, cb: Callable[[ServerGoalHandle], Any]) -> None:
         self.goal_callback = cb
 
-    def register_cancel_callback(self, cb: Callable[[ServerGoalHandle], Any]) -> None:
-        self.cancel_callback = cb
+    def register_cancel_callback(self, cancel_cb: Callable[[ServerGoalHandle], Any]) -> None:
+        self.cancel_callback = cancel_cb
 
     def start(self) -> None:
         """Advertise the five topics (with ROS 1's parameters) and publish the first status."""
