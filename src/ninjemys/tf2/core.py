@@ -1148,7 +1148,7 @@ class BufferCore:
             self._validate("lookupTransform argument fixed_frame", fixed_frame)
             _, first = self.lookup(fixed_frame, source_frame, source_t)
             stamp, second = self.lookup(target_frame, fixed_frame, target_t)
-            return stamp, tfm.compose(second, first)
+            return stamp, tfm.matrix_signed(tfm.compose(second, first))
 
     def can_transform(self, target_frame: str, source_frame: str, t: int) -> tuple[bool, str]:
         """tf2's ``canTransform`` with its error text: (possible, why not)."""
