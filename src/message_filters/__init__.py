@@ -9,14 +9,15 @@ from __future__ import annotations
 
 from typing import Any
 
+from ninjemys import message_filters as _core
 from ninjemys.message_filters import (
-    ApproximateTimeSynchronizer,
     Cache,
     Chain,
     SimpleFilter,
     TimeSynchronizer,
     shared_subscriber,
 )
+from ninjemys.rostime import Duration
 
 __all__ = [
     "ApproximateTimeSynchronizer",
@@ -26,6 +27,22 @@ __all__ = [
     "Subscriber",
     "TimeSynchronizer",
 ]
+
+
+class ApproximateTimeSynchronizer(_core.ApproximateTimeSynchronizer):
+    """``ApproximateTimeSynchronizer(fs, queue_size, slop, allow_headerless=False, reset=False)``;
+    ``slop`` is kept as a ``rospy.Duration``, as ROS 1 keeps it."""
+
+    def __init__(
+        self,
+        fs: Any,
+        queue_size: int,
+        slop: float,
+        allow_headerless: bool = False,
+        reset: bool = False,
+    ) -> None:
+        super().__init__(fs, queue_size, slop, allow_headerless, reset)
+        self.slop = Duration.from_sec(slop)
 
 
 class Subscriber(SimpleFilter):

@@ -55,3 +55,7 @@ def compare(peer: str, *args: str) -> None:
 
 def test_tf_and_tf2_calls_match_ros1() -> None:
     compare("parity_tf_peer.py")
+
+
+def test_message_filters_cache_and_synchronizers_match_ros1() -> None:
+    compare("parity_mf_peer.py")
