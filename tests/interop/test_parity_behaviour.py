@@ -5,6 +5,7 @@ and prints JSON; the two outputs must agree."""
 from __future__ import annotations
 
 import json
+import os
 import re
 import subprocess
 import sys
@@ -19,9 +20,9 @@ pytestmark = pytest.mark.ros1
 HERE = Path(__file__).parent
 
 
-def run_peer(python: str, name: str, env: dict[str, str] | None, *args: str) -> dict:
+def run_peer(python: str, name: str, env: dict[str, str]) -> dict:
     done = subprocess.run(
-        [python, str(HERE / name), *args], capture_output=True, text=True, env=env, timeout=120, cwd="/"
+        [python, str(HERE / name)], capture_output=True, text=True, env=env, timeout=120, cwd="/"
     )
     assert done.returncode == 0, done.stderr
     return json.loads(done.stdout.strip().splitlines()[-1])
@@ -41,11 +42,10 @@ def normalized(x):
     return x
 
 
-def compare(peer: str, *args: str) -> None:
-    theirs = normalized(
-        run_peer(testing.ROS1_PYTHON, peer, testing.ros1_env("http://localhost:11311"), *args)
-    )
-    ours = normalized(run_peer(sys.executable, peer, None, *args))
+def compare(peer: str, master: str = "http://localhost:11311") -> None:
+    theirs = normalized(run_peer(testing.ROS1_PYTHON, peer, testing.ros1_env(master)))
+    ours_env = {**os.environ, "ROS_MASTER_URI": master, "ROS_HOSTNAME": "localhost"}
+    ours = normalized(run_peer(sys.executable, peer, ours_env))
     for section, values in theirs.items():
         for key, value in values.items():
             assert ours[section].get(key) == value, (
@@ -59,3 +59,10 @@ def test_tf_and_tf2_calls_match_ros1() -> None:
 
 def test_message_filters_cache_and_synchronizers_match_ros1() -> None:
     compare("parity_mf_peer.py")
+
+
+def test_actionlib_clients_and_servers_report_as_ros1() -> None:
+    """Each terminal state (succeeded, aborted, preempted, auto-aborted, raising callback, rejected,
+    recalled) as SimpleActionClient, ActionClient and the servers' goal handles report it."""
+    with testing.run_master() as master:
+        compare("parity_actionlib_peer.py", master)
