@@ -1184,15 +1184,16 @@ class BufferCore:
         """tf2's ``canTransform`` with its error text: (possible, why not)."""
         if target_frame == source_frame:
             return True, ""
-        if self._warn_frame_id("canTransform argument target_frame", target_frame) or self._warn_frame_id(
-            "canTransform argument source_frame", source_frame
-        ):
-            return False, ""
         with self._lock:
-            self._drain()
+            if self._pending:
+                self._drain()
             target = self._frames.get(target_frame)
             source = self._frames.get(source_frame)
             if target is None or source is None:
+                if self._warn_frame_id("canTransform argument target_frame", target_frame) or (
+                    self._warn_frame_id("canTransform argument source_frame", source_frame)
+                ):
+                    return False, ""
                 parts = []
                 if target is None:
                     parts.append(f"canTransform: target_frame {target_frame} does not exist.")
@@ -1204,13 +1205,11 @@ class BufferCore:
     def _can(self, target: Frame, source: Frame, t: int) -> tuple[bool, str]:
         if target is source:
             return True, ""
-        if t != 0:  # the memo answers most checks without a walk
-            gen = self._gen
-            a = self._to_root(source, t, gen)
-            if a is not None:
-                b = self._to_root(target, t, gen)
-                if b is not None and a[0] is b[0]:
-                    return True, ""
+        try:  # the lookup's caches answer most checks without a walk
+            self._lookup(target, source, t)
+            return True, ""
+        except TransformException:
+            pass  # the walk says why, in tf2's words
         err: list[str] = []
         code, _, _ = self._walk(target, source, t, err, accumulate=False)
         return code == NO_ERROR, "".join(err)
