@@ -42,15 +42,28 @@ def normalized(x):
     return x
 
 
-def compare(peer: str, master: str = "http://localhost:11311") -> None:
-    theirs = normalized(run_peer(testing.ROS1_PYTHON, peer, testing.ros1_env(master)))
-    ours_env = {**os.environ, "ROS_MASTER_URI": master, "ROS_HOSTNAME": "localhost"}
-    ours = normalized(run_peer(sys.executable, peer, ours_env))
+def compare(peer: str, with_master: bool = False) -> None:
+    """Run ``peer`` under Debian's Python and ours (each with a master of its own when it needs one:
+    a parameter one run leaves must not reach the other) and compare every entry."""
+    runs = []
+    for python in (testing.ROS1_PYTHON, sys.executable):
+        if with_master:
+            with testing.run_master() as master:
+                runs.append(run_peer(python, peer, _env(python, master)))
+        else:
+            runs.append(run_peer(python, peer, _env(python, "http://localhost:11311")))
+    theirs, ours = (normalized(r) for r in runs)
     for section, values in theirs.items():
         for key, value in values.items():
             assert ours[section].get(key) == value, (
                 f"{section}.{key}: ours {ours[section].get(key)} != {value}"
             )
+
+
+def _env(python: str, master: str) -> dict[str, str]:
+    if python == testing.ROS1_PYTHON:
+        return testing.ros1_env(master)
+    return {**os.environ, "ROS_MASTER_URI": master, "ROS_HOSTNAME": "localhost"}
 
 
 def test_tf_and_tf2_calls_match_ros1() -> None:
@@ -64,5 +77,10 @@ def test_message_filters_cache_and_synchronizers_match_ros1() -> None:
 def test_actionlib_clients_and_servers_report_as_ros1() -> None:
     """Each terminal state (succeeded, aborted, preempted, auto-aborted, raising callback, rejected,
     recalled) as SimpleActionClient, ActionClient and the servers' goal handles report it."""
-    with testing.run_master() as master:
-        compare("parity_actionlib_peer.py", master)
+    compare("parity_actionlib_peer.py", with_master=True)
+
+
+def test_dynamic_reconfigure_encoding_server_and_client_match_ros1() -> None:
+    """Debian's generated TestConfig: the encoded messages byte for byte, the decoded dicts, and a
+    Server and Client talking (updates, clamping, what the callback receives, the descriptions)."""
+    compare("parity_dynreconf_peer.py", with_master=True)
