@@ -51,10 +51,6 @@ class ActionClient(_core.ActionClient):
 
     def __init__(self, ns: str, ActionSpec: Any) -> None:  # noqa: N803 - ROS 1's signature
         super().__init__(_process.node(), ns, ActionSpec)
-        self.ActionSpec = ActionSpec
-        self.ActionGoal = self.types.action_goal
-        self.ActionResult = self.types.action_result
-        self.ActionFeedback = self.types.action_feedback
 
 
 class GoalManager:

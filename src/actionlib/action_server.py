@@ -54,10 +54,6 @@ class ActionServer(_core.ActionServer):
             cancel_cb,
             auto_start,
         )
-        self.ActionSpec = ActionSpec
-        self.ActionGoal = self.types.action_goal
-        self.ActionResult = self.types.action_result
-        self.ActionFeedback = self.types.action_feedback
 
     # ROS 1's internal entry points, public there (subclasses and tests call them)
 

@@ -84,3 +84,31 @@ def test_dynamic_reconfigure_encoding_server_and_client_match_ros1() -> None:
     """Debian's generated TestConfig: the encoded messages byte for byte, the decoded dicts, and a
     Server and Client talking (updates, clamping, what the callback receives, the descriptions)."""
     compare("parity_dynreconf_peer.py", with_master=True)
+
+
+#: instance attributes of ROS 1's objects that ours deliberately lack: object.attribute -> reason
+INSTANCE_ALLOWED = {
+    "SimpleActionServer.terminate_mutex": "ROS 1's lock around its execute thread's stop flag; ours uses a condition",
+    "ActionClient.manager": "ours keeps the goals inside ActionClient, with no GoalManager object",
+    "Buffer.CAN_TRANSFORM_POLLING_SCALE": "ours waits on the buffer's condition instead of polling",
+    "TransformListener.last_update": "the time-jump check's state, internal (check_for_reset uses it)",
+    "TransformListener.last_update_lock": "the lock of that state",
+    "ApproximateTimeSynchronizer.last_added": "the headerless stamp counter, internal",
+}
+
+
+def test_instances_carry_ros1s_attributes() -> None:
+    """The attributes ROS 1's constructors set (``client.action_client``, ``buffer.registration`` ...)
+    are there on ours too, as attributes or properties."""
+    runs = []
+    for python in (testing.ROS1_PYTHON, sys.executable):
+        with testing.run_master() as master:
+            runs.append(run_peer(python, "parity_instances_peer.py", _env(python, master)))
+    theirs, ours = runs
+    missing = [
+        f"{name}.{attr}"
+        for name, attrs in theirs.items()
+        for attr in attrs["own"]
+        if attr not in ours[name]["reachable"] and f"{name}.{attr}" not in INSTANCE_ALLOWED
+    ]
+    assert not missing, missing

@@ -236,6 +236,11 @@ class ActionClient:
     ) -> None:
         self.node = node
         self.types = ActionTypes.of(action_class)
+        # ROS 1's attribute names for the action's classes
+        self.ActionSpec = action_class
+        self.ActionGoal = self.types.action_goal
+        self.ActionResult = self.types.action_result
+        self.ActionFeedback = self.types.action_feedback
         self.ns = node.resolve_name(ns)
         self.clock = resolve_clock(node, clock)
         self.log = resolve_log(node, log, __name__)

@@ -253,6 +253,12 @@ class ActionServer:
     ) -> None:
         self.node = node
         self.types = ActionTypes.of(action_class)
+        # ROS 1's attribute names for the action's classes
+        self.ActionSpec = action_class
+        self.ActionGoal = self.types.action_goal
+        self.ActionResult = self.types.action_result
+        self.ActionFeedback = self.types.action_feedback
+        self.auto_start = auto_start
         self.ns = node.resolve_name(ns)
         self.clock = resolve_clock(node, clock)
         self.log = resolve_log(node, log, __name__)
@@ -286,6 +292,17 @@ class ActionServer:
     @property
     def ActionResultType(self) -> type:  # noqa: N802 - ROS 1's attribute name
         return self.types.result
+
+    @property
+    def status_list(self) -> list[StatusTracker]:
+        """ROS 1's list of the goals' trackers, in arrival order (a copy: the server owns the list)."""
+        with self.lock:
+            return list(self.trackers.values())
+
+    @property
+    def status_timer(self) -> Timer | None:
+        """The timer that publishes the status list ``actionlib_status_frequency`` times a second."""
+        return self._timer
 
     def register_goal_callback(self, cb: Callable[[ServerGoalHandle], Any]) -> None:
         self.goal_callback = cb
