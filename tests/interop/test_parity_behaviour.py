@@ -112,3 +112,9 @@ def test_instances_carry_ros1s_attributes() -> None:
         if attr not in ours[name]["reachable"] and f"{name}.{attr}" not in INSTANCE_ALLOWED
     ]
     assert not missing, missing
+
+
+def test_tf_in_a_running_node_matches_ros1() -> None:
+    """Broadcasters feeding listeners: lookups that wait for data, the errors when it never comes,
+    the static broadcaster keeping every frame, tf.TransformListener's waitForTransform."""
+    compare("parity_tf_live_peer.py", with_master=True)

@@ -175,9 +175,13 @@ class Frame:
             return self._resolve(0)
         if err is not None:
             if n == 1:
+                # tf2 formats this one into a 116-byte buffer: with two ten-digit times it loses its
+                # tail ("... is in the buffe"), and programs see exactly that
                 err.append(
-                    "Lookup would require extrapolation at time %.09f, but only time %.09f is in the buffer"
-                    % (_secs(t), _secs(stamps[0]))
+                    (
+                        "Lookup would require extrapolation at time %.09f, but only time %.09f is in the buffer"
+                        % (_secs(t), _secs(stamps[0]))
+                    )[:115]
                 )
             elif i == n:
                 latest = stamps[-1]
