@@ -268,7 +268,57 @@ def transformations_checks():
         "vector": [tt.unit_vector((1, 2, 2)), tt.vector_norm((3, 4, 0))],
         "concat": tt.concatenate_matrices(m, tt.translation_matrix((1, 0, 0))),
         "is_same": tt.is_same_transform(m, m),
+        "random": [tt.random_quaternion((0.1, 0.5, 0.9)), tt.random_rotation_matrix((0.2, 0.4, 0.6))],
+        "scale": [
+            tt.scale_matrix(2.0, (1, 2, 3)),
+            tt.scale_matrix(0.5, None, (1, 0, 0)),
+            list(tt.scale_from_matrix(tt.scale_matrix(2.0, (1, 2, 3))))[:1],
+        ],
+        "reflection": [
+            tt.reflection_matrix((1, 2, 3), (0, 0, 1)),
+            [list(v) for v in tt.reflection_from_matrix(tt.reflection_matrix((1, 2, 3), (0, 0, 1)))],
+        ],
+        "projection": [
+            tt.projection_matrix((0, 0, 0), (1, 0, 0)),
+            tt.projection_matrix((0, 0, 0), (1, 0, 0), perspective=(5, 0, 0)),
+            tt.projection_matrix((0, 0, 0), (1, 0, 0), direction=(1, 1, 0)),
+        ],
+        "clip": [tt.clip_matrix(-1, 1, -1, 1, 1, 10), tt.clip_matrix(-1, 1, -1, 1, 1, 10, perspective=True)],
+        "shear": [
+            tt.shear_matrix(0.3, (1, 0, 0), (0, 0, 0), (0, 0, 1)),
+            [
+                list(v) if hasattr(v, "__len__") else v
+                for v in tt.shear_from_matrix(tt.shear_matrix(0.3, (1, 0, 0), (0, 0, 0), (0, 0, 1)))
+            ][:1],
+        ],
+        "ortho": tt.orthogonalization_matrix((10, 10, 10), (90, 90, 90)),
+        "superimposition": tt.superimposition_matrix(
+            [[0, 1, 2, 3], [0, 0, 1, 1], [0, 0, 0, 1]],
+            [[1, 1, 2, 4], [0, 1, 1, 2], [2, 2, 2, 3]],
+            scaling=True,
+        ),
+        "arcball": [
+            tt.arcball_map_to_sphere((320, 240), (320, 240), 200),
+            tt.arcball_map_to_sphere((400, 100), (320, 240), 200),
+            tt.arcball_constrain_to_axis((0.3, 0.4, 0.8), (1, 0, 0)),
+            tt.arcball_nearest_axis((0.3, 0.4, 0.8), [(1, 0, 0), (0, 1, 0)]),
+        ],
+        "slerp_ends": [
+            tt.quaternion_slerp(q, [0, 0, 0, 1], 0.0),
+            tt.quaternion_slerp(q, [0, 0, 0, 1], 1.0),
+            tt.quaternion_slerp(q, q, 0.5),
+            tt.quaternion_slerp(q, -q, 0.5, spin=1),
+        ],
+        "euler_edge": [
+            tt.euler_from_matrix(tt.euler_matrix(0, math.pi / 2, 0)),
+            tt.quaternion_from_euler(0, 0, 0, "rxyz"),
+        ],
     }
+    ball = tt.Arcball()
+    ball.place([320, 320], 320)
+    ball.down([500, 250])
+    ball.drag([475, 275])
+    out["arcball_drag"] = ball.matrix()
     return rounded(json.loads(json.dumps(out, default=lambda o: rounded(o))))
 
 
