@@ -64,7 +64,47 @@ def on_cancel(gh):
 raw = actionlib.ActionServer("raw", TestAction, on_goal, on_cancel, auto_start=False)
 raw.start()
 
+callbacks = actionlib.SimpleActionServer("cbs", TestAction, auto_start=False)
+
+
+def cbs_goal():
+    goal = callbacks.accept_new_goal()
+    server_log.append(["cbs_accepted", goal.goal, callbacks.is_active(), callbacks.is_preempt_requested()])
+    if goal.goal == 1:
+        callbacks.set_succeeded(TestResult(10), "quick")
+
+
+def cbs_preempt():
+    server_log.append(["cbs_preempt", callbacks.is_preempt_requested(), callbacks.is_new_goal_available()])
+    callbacks.set_preempted(TestResult(30), "made way")
+
+
+callbacks.register_goal_callback(cbs_goal)
+callbacks.register_preempt_callback(cbs_preempt)
+callbacks.start()
+
 out = {"simple_client": {}, "action_client": {}, "server": {}}
+first = actionlib.SimpleActionClient("cbs", TestAction)
+second = actionlib.SimpleActionClient("cbs", TestAction)
+first.wait_for_server(rospy.Duration(10.0))
+second.wait_for_server(rospy.Duration(10.0))
+first.send_goal(TestGoal(3))
+deadline = time.time() + 10.0
+while first.get_state() != GoalStatus.ACTIVE and time.time() < deadline:
+    time.sleep(0.01)
+second.send_goal(TestGoal(1))
+second.wait_for_result(rospy.Duration(10.0))
+first.wait_for_result(rospy.Duration(10.0))
+out["simple_client"]["callbacks_first"] = [
+    first.get_state(),
+    first.get_goal_status_text(),
+    first.get_result().result,
+]
+out["simple_client"]["callbacks_second"] = [
+    second.get_state(),
+    second.get_goal_status_text(),
+    second.get_result().result,
+]
 client = actionlib.SimpleActionClient("simple", TestAction)
 out["simple_client"]["connected"] = client.wait_for_server(rospy.Duration(10.0))
 out["simple_client"]["no_goal"] = [client.get_state(), client.get_goal_status_text(), client.get_result()]
