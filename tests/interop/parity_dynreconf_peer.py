@@ -80,6 +80,29 @@ changes = [
 for i, change in enumerate(changes):
     result = client.update_configuration(change)
     out["live"][f"update_{i}"] = plain({k: v for k, v in result.items() if k != "groups"})
+
+
+def outcome(fn, *args, **kwargs):
+    try:
+        return ["ok", plain(fn(*args, **kwargs))]
+    except Exception as exc:
+        bases = [c.__name__ for c in type(exc).__mro__ if c.__name__ not in ("NinjemysError", "object")]
+        return ["raise", bases, str(exc)]
+
+
+def update(change):
+    result = client.update_configuration(change)
+    return {k: v for k, v in result.items() if k != "groups"}
+
+
+out["live"]["unknown_name"] = outcome(update, {"no_such_param": 1})
+out["live"]["bad_int"] = outcome(update, {"int_": "abc"})
+out["live"]["bad_bool"] = outcome(update, {"bool_": "maybe"})
+out["live"]["int_from_float"] = outcome(update, {"int_": 2.7})
+out["live"]["double_from_int"] = outcome(update, {"double_": 4})
+out["live"]["bool_from_str"] = outcome(update, {"bool_": "True"})
+out["live"]["str_from_int"] = outcome(update, {"str_": 5})
+out["live"]["no_server"] = outcome(Client, "no_such_server", timeout=0.3)
 out["live"]["groups"] = plain(client.get_configuration(timeout=10)["groups"])
 out["live"]["param_names"] = [p["name"] for p in client.get_parameter_descriptions(timeout=10)]
 out["live"]["param_first"] = plain(client.get_parameter_descriptions(timeout=10)[0])
