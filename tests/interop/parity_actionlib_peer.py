@@ -9,7 +9,7 @@ import time
 
 import actionlib
 import rospy
-from actionlib.msg import TestAction, TestGoal, TestResult
+from actionlib.msg import TestAction, TestFeedback, TestGoal, TestResult
 from actionlib_msgs.msg import GoalStatus
 
 rospy.init_node("parity_actionlib_peer")
@@ -32,6 +32,14 @@ def execute(goal):
         return  # no terminal state: ROS 1 aborts it, with a warning
     elif kind == 5:
         raise ValueError("boom")
+    elif kind == 9:
+        for i in range(3):
+            simple.publish_feedback(TestFeedback(i))
+            time.sleep(0.05)
+        deadline = time.time() + 10.0
+        while not simple.is_preempt_requested() and time.time() < deadline:
+            time.sleep(0.01)
+        simple.set_preempted(TestResult(99), "timed out by the client")
 
 
 simple = actionlib.SimpleActionServer("simple", TestAction, execute_cb=execute, auto_start=False)
@@ -140,6 +148,21 @@ time.sleep(0.2)
 client.cancel_goal()
 out["simple_client"]["goal_3"] = [client.wait_for_result(rospy.Duration(10.0)), record(client)]
 out["simple_client"]["send_goal_and_wait"] = client.send_goal_and_wait(TestGoal(1), rospy.Duration(10.0))
+feedback = []
+client.send_goal(TestGoal(9), feedback_cb=lambda fb: feedback.append(type(fb).__name__))
+out["simple_client"]["short_wait"] = [
+    client.wait_for_result(rospy.Duration(0.05)),
+    client.get_state(),
+    client.get_result(),
+]
+client.wait_for_result(rospy.Duration(0.5))
+client.cancel_all_goals()
+out["simple_client"]["cancel_all"] = [client.wait_for_result(rospy.Duration(10.0)), record(client)]
+out["simple_client"]["feedback_types"] = sorted(set(feedback))
+out["simple_client"]["send_goal_and_wait_timeout"] = client.send_goal_and_wait(
+    TestGoal(9), rospy.Duration(0.5), rospy.Duration(5.0)
+)
+out["simple_client"]["after_timeout"] = record(client)
 out["simple_client"]["wrong_name"] = actionlib.SimpleActionClient("nowhere", TestAction).wait_for_server(
     rospy.Duration(0.5)
 )
