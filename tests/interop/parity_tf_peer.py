@@ -6,6 +6,7 @@ with its text. tests/interop/test_parity_behaviour.py compares ours with Debian'
 
 import json
 import math
+import re
 
 import numpy
 
@@ -23,6 +24,8 @@ from geometry_msgs.msg import (
     TransformStamped,
     Vector3,
     Vector3Stamped,
+    Wrench,
+    WrenchStamped,
 )
 from std_msgs.msg import Header
 
@@ -37,6 +40,11 @@ def rounded(x):
     if isinstance(x, numpy.ndarray):
         return rounded(x.tolist())
     return x
+
+
+def printed(msg):
+    """``str(msg)`` (the YAML form programs print) with its floats to 9 decimals."""
+    return re.sub(r"-?\d+\.\d+(e-?\d+)?", lambda m: "%.9f" % (float(m.group()) + 0.0), str(msg))
 
 
 def outcome(fn, *args, **kwargs):
@@ -209,6 +217,20 @@ def tf2_checks():
     out["new_type_unknown"] = outcome(
         b.transform, PointStamped(Header(frame_id="laser", stamp=zero), Point()), "map", new_type=Point
     )
+    link = b.lookup_transform("map", "laser", mid)
+    direct = {
+        "point": PointStamped(Header(frame_id="laser", stamp=mid), Point(1.0, 2.0, 3.0)),
+        "vector3": Vector3Stamped(Header(frame_id="laser", stamp=mid), Vector3(1.0, 2.0, 3.0)),
+        "pose": PoseStamped(
+            Header(frame_id="laser", stamp=mid), Pose(Point(1, 2, 3), Quaternion(0, 0.6, 0, 0.8))
+        ),
+    }
+    for name, msg in direct.items():
+        res = getattr(tf2_geometry_msgs, f"do_transform_{name}")(msg, link)
+        out[f"do_{name}"] = [type(res).__name__, res.header.frame_id, printed(res)]
+    wrench = WrenchStamped(Header(frame_id="laser", stamp=mid), Wrench(Vector3(1, 2, 3), Vector3(-1, 0, 2)))
+    res = tf2_geometry_msgs.do_transform_wrench(wrench, link)
+    out["do_wrench"] = [type(res).__name__, res.header.frame_id, printed(res)]
     out["yaml_keys"] = sorted(__import__("yaml").safe_load(b.all_frames_as_yaml()) or {})
     bad = TransformStamped()
     bad.header.frame_id = "a"
