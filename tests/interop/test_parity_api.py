@@ -36,8 +36,9 @@ PACKAGES = {
         "actionlib.goal_id_generator",
         "actionlib.exceptions",
         "actionlib.handle_tracker_deleter",
+        "actionlib.msg",
     ],
-    "tf": ["tf", "tf.transformations", "tf.listener", "tf.broadcaster"],
+    "tf": ["tf", "tf.transformations", "tf.listener", "tf.broadcaster", "tf.msg", "tf.srv"],
     "tf2_ros": [
         "tf2_ros",
         "tf2_ros.buffer",
@@ -55,6 +56,8 @@ PACKAGES = {
         "dynamic_reconfigure.client",
         "dynamic_reconfigure.encoding",
         "dynamic_reconfigure.parameter_generator_catkin",
+        "dynamic_reconfigure.msg",
+        "dynamic_reconfigure.srv",
     ],
     "laser_geometry": ["laser_geometry", "laser_geometry.laser_geometry"],
     "cv_bridge": ["cv_bridge", "cv_bridge.core", "cv_bridge.boost.cv_bridge_boost"],
@@ -125,8 +128,9 @@ ALLOWED = {
     "tf2_ros.BufferCore.__init__": "see tf2_py.BufferCore.__init__",
 }
 
-#: Python 2 ``from __future__`` names that leak into ROS 1's modules
-FUTURE = {"absolute_import", "division", "print_function", "with_statement", "unicode_literals"}
+#: Python 2 leftovers that leak into ROS 1's modules: ``from __future__`` names, and genpy's
+#: ``python3`` flag (star-imported from every generated message module)
+FUTURE = {"absolute_import", "division", "print_function", "with_statement", "unicode_literals", "python3"}
 #: a root every ninjemys error shares; an extra base, so ``except`` clauses behave as in ROS 1
 EXTRA_BASES = {"NinjemysError"}
 #: zero, None and rospy.Duration(0) all mean "no timeout" in ROS 1's timeouts
