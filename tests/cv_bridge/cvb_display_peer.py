@@ -6,6 +6,7 @@ import json
 
 import numpy as np
 
+from cv_bridge import CvBridge
 from cv_bridge.boost.cv_bridge_boost import cvtColor2, cvtColorForDisplay, getCvType
 
 depth = np.array([[0.5, 1.0], [2.0, 20.0]], np.float32)
@@ -62,4 +63,12 @@ out = [outcome(cvtColorForDisplay, *a) for a in DISPLAY]
 out += [outcome(getCvType, e) for e in ("bgr8", "mono16", "32FC3", "bayer_rggb8", "yuv422", "16SC4", "foo")]
 for a in ((rgb, "rgb8", "bgr8"), (rgb, "rgb8", "32FC1"), (rgb, "foo", "bgr8"), (rgb, "8UC3", "bgr8")):
     out.append(outcome(cvtColor2, *a))
+bridge = CvBridge()
+for enc in ("bgr8", "mono16", "32FC1", "8SC4", "nope"):
+    out.append(outcome(lambda e=enc: [bridge.encoding_to_cvtype2(e)]))
+    out.append(outcome(lambda e=enc: list(bridge.encoding_to_dtype_with_channels(e))))
+for dtype, channels in (("uint8", 3), ("float32", 1), ("int16", 2), ("float64", 4)):
+    out.append(outcome(lambda d=dtype, c=channels: [bridge.dtype_with_channels_to_cvtype2(np.dtype(d), c)]))
+for cvtype in (0, 16, 21, 13, 30):
+    out.append(outcome(lambda t=cvtype: list(bridge.cvtype2_to_dtype_with_channels(t))))
 print(json.dumps(out))
