@@ -132,6 +132,10 @@ def tf_checks():
         )
     bad = PointStamped(Header(frame_id="nowhere", stamp=zero), Point(1.0, 2.0, 3.0))
     out["point_unknown"] = outcome(t.transformPoint, "map", bad)
+    out["frames_string"] = sorted(t.allFramesAsString().splitlines())
+    out["chain"] = outcome(t.chain, "laser", mid, "lonely", mid, "map")
+    out["chain_ok"] = outcome(lambda: sorted(t.chain("laser", mid, "odom", mid, "map")))
+    out["dot"] = outcome(lambda: sorted(t.allFramesAsDot().splitlines()))
     out["wait_no_thread"] = outcome(t.waitForTransform, "map", "laser", zero, rospy.Duration(0.01))
     out["twist"] = outcome(
         lambda: rounded(
@@ -231,7 +235,20 @@ def tf2_checks():
     wrench = WrenchStamped(Header(frame_id="laser", stamp=mid), Wrench(Vector3(1, 2, 3), Vector3(-1, 0, 2)))
     res = tf2_geometry_msgs.do_transform_wrench(wrench, link)
     out["do_wrench"] = [type(res).__name__, res.header.frame_id, printed(res)]
-    out["yaml_keys"] = sorted(__import__("yaml").safe_load(b.all_frames_as_yaml()) or {})
+    frames = __import__("yaml").safe_load(b.all_frames_as_yaml()) or {}
+    out["yaml"] = {k: sorted(v) for k, v in frames.items()}
+    out["yaml_values"] = {
+        k: [
+            v["parent"],
+            v["broadcaster"],
+            v["rate"],
+            v["most_recent_transform"],
+            v["oldest_transform"],
+            v["buffer_length"],
+        ]
+        for k, v in frames.items()
+    }
+    out["string"] = sorted(b.all_frames_as_string().splitlines())
     bad = TransformStamped()
     bad.header.frame_id = "a"
     bad.child_frame_id = "a"
