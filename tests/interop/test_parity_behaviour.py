@@ -94,6 +94,7 @@ INSTANCE_ALLOWED = {
     "TransformListener.last_update": "the time-jump check's state, internal (check_for_reset uses it)",
     "TransformListener.last_update_lock": "the lock of that state",
     "ApproximateTimeSynchronizer.last_added": "the headerless stamp counter, internal",
+    "StatusTracker.id_generator": "ids of goals without one come from the server's generator, not each tracker's",
 }
 
 
