@@ -32,6 +32,13 @@ def execute(goal):
         return  # no terminal state: ROS 1 aborts it, with a warning
     elif kind == 5:
         raise ValueError("boom")
+    elif kind == 10:
+        # lose the goal as ROS 1's own tests do: through the server's innards
+        for i, tracker in enumerate(simple.action_server.status_list):
+            if tracker.status.goal_id.id == simple.current_goal.goal.goal_id.id:
+                del simple.action_server.status_list[i]
+                break
+        simple.current_goal = actionlib.ServerGoalHandle()
     elif kind == 9:
         for i in range(3):
             simple.publish_feedback(TestFeedback(i))
@@ -130,7 +137,7 @@ def record(c):
     ]
 
 
-for kind in (1, 2, 4, 5):
+for kind in (1, 2, 4, 5, 10):
     done = []
 
     def on_done(state, result, done=done):
