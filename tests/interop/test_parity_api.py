@@ -61,6 +61,7 @@ PACKAGES = {
     ],
     "laser_geometry": ["laser_geometry", "laser_geometry.laser_geometry"],
     "cv_bridge": ["cv_bridge", "cv_bridge.core", "cv_bridge.boost.cv_bridge_boost"],
+    "sensor_msgs": ["sensor_msgs.point_cloud2"],
 }
 
 _GENERATOR_INTERNALS = "the C++/Python/doc file writers behind generate(); ours generates differently"
@@ -97,6 +98,11 @@ ALLOWED = {
     "tf2_geometry_msgs.transform_to_kdl": "returns a PyKDL.Frame; ours computes with numpy, PyKDL is not a dependency",
     "tf2_geometry_msgs.tf2_geometry_msgs.transform_to_kdl": "see tf2_geometry_msgs.transform_to_kdl",
     "message_filters.reduce": "functools.reduce leaking from ROS 1's imports",
+    "sensor_msgs.point_cloud2.ctypes": "a module ROS 1's create_cloud uses, leaking",
+    "sensor_msgs.point_cloud2.math": "a module leaking from ROS 1's imports",
+    "sensor_msgs.point_cloud2.namedtuple": "collections.namedtuple leaking from ROS 1's imports",
+    "sensor_msgs.point_cloud2.roslib": "a module leaking from ROS 1's imports",
+    "sensor_msgs.point_cloud2.struct": "a module leaking from ROS 1's imports",
     "dynamic_reconfigure.parameter_generator_catkin.LINEDEBUG": _GENERATOR_INTERNALS,
     "dynamic_reconfigure.parameter_generator_catkin.Template": "string.Template leaking from ROS 1's imports",
     "dynamic_reconfigure.parameter_generator_catkin.id": "the generator's group id counter, internal",
@@ -156,6 +162,8 @@ def _default(name: str, default: str | None) -> str | None:
     default = re.sub(r" at 0x[0-9a-f]+", "", default)
     if "timeout" in name and default in ZERO_TIMEOUT:
         return "<no timeout>"
+    if default in ("()", "[]"):
+        return "<empty>"  # ROS 1's mutable [] default and our () behave alike
     return default
 
 
