@@ -140,6 +140,15 @@ def tf_checks():
         kind(t.getFrameStrings()),
         kind(t.asMatrix("map", Header(frame_id="laser", stamp=mid))),
     ]
+    odd = tf.Transformer(True, rospy.Duration(10.0))
+    slash = stamped("/world", "/thing", 5.0, (1, 0, 0), (0, 0, 0))
+    empty = stamped("world", "", 5.0, (1, 0, 0), (0, 0, 0))
+    nan = stamped("world", "nan_frame", 5.0, (float("nan"), 0, 0), (0, 0, 0))
+    for m in (slash, empty, nan):
+        out[f"odd_set_{m.child_frame_id or 'empty'}"] = outcome(odd.setTransform, m, "peer")
+    out["odd_frames"] = sorted(odd.getFrameStrings())
+    out["odd_lookup"] = outcome(lambda: rounded(odd.lookupTransform("world", "thing", zero)))
+    out["odd_lookup_slash"] = outcome(lambda: rounded(odd.lookupTransform("/world", "/thing", zero)))
     out["frames_string"] = sorted(t.allFramesAsString().splitlines())
     out["chain"] = outcome(t.chain, "laser", mid, "lonely", mid, "map")
     out["chain_ok"] = outcome(lambda: sorted(t.chain("laser", mid, "odom", mid, "map")))
