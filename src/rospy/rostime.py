@@ -54,6 +54,13 @@ def _set_rostime(t: Any) -> None:
         clock.install()  # before init_node, Time.now() reads the wall clock unless told otherwise
 
 
+def switch_to_wallclock() -> None:
+    """Back to wall time after :func:`_set_rostime` (ROS 1's test helper); sleepers re-check their clock."""
+    clock = _process.clock
+    clock.is_sim = False
+    clock.wake()
+
+
 def wallsleep(duration: float | Duration) -> None:
     """Sleep ``duration`` seconds of wall time, whatever ROS time does."""
     _time.sleep(duration.to_sec() if isinstance(duration, Duration) else float(duration))

@@ -57,6 +57,10 @@ for t in (3, 1, 2):
 for t in (2, 3, 1):
     b.signalMessage(Mock(t, "b%d" % t))
 assert sorted(pairs) == [("a1", "b1"), ("a2", "b2"), ("a3", "b3")], pairs
+
+import time
+rospy.rostime.switch_to_wallclock()
+assert rospy.rostime.is_wallclock() and abs(rospy.get_time() - time.time()) < 5.0
 print("ok")
 """
 
