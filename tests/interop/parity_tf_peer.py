@@ -16,6 +16,7 @@ import tf2_geometry_msgs  # noqa: F401 - registers the stamped types with Buffer
 import tf2_ros
 from geometry_msgs.msg import (
     Point,
+    Point32,
     PointStamped,
     Pose,
     PoseStamped,
@@ -27,6 +28,7 @@ from geometry_msgs.msg import (
     Wrench,
     WrenchStamped,
 )
+from sensor_msgs.msg import ChannelFloat32, PointCloud
 from std_msgs.msg import Header
 
 
@@ -149,6 +151,22 @@ def tf_checks():
     out["odd_frames"] = sorted(odd.getFrameStrings())
     out["odd_lookup"] = outcome(lambda: rounded(odd.lookupTransform("world", "thing", zero)))
     out["odd_lookup_slash"] = outcome(lambda: rounded(odd.lookupTransform("/world", "/thing", zero)))
+    cloud = PointCloud(
+        Header(frame_id="laser", stamp=mid),
+        [Point32(1, 2, 3), Point32(-1, 0, 0.5)],
+        [ChannelFloat32("intensity", [0.5, 0.25])],
+    )
+    moved = t.transformPointCloud("map", cloud)
+    out["point_cloud"] = [
+        moved.header.frame_id,
+        rounded([[p.x, p.y, p.z] for p in moved.points]),
+        [(c.name, c.values) for c in moved.channels],
+    ]
+    out["can_full"] = [
+        t.canTransformFull("laser", mid, "base_link", mid, "map"),
+        t.canTransformFull("laser", mid, "lonely", mid, "map"),
+    ]
+    out["prefix"] = t.getTFPrefix()
     out["frames_string"] = sorted(t.allFramesAsString().splitlines())
     out["chain"] = outcome(t.chain, "laser", mid, "lonely", mid, "map")
     out["chain_ok"] = outcome(lambda: sorted(t.chain("laser", mid, "odom", mid, "map")))
