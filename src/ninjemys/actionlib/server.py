@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import threading
 import time
-from collections.abc import Callable, Iterable, MutableSequence
+from collections.abc import Callable, Iterable, Iterator, MutableSequence
 
 from ninjemys.actionlib import states
 from ninjemys.actionlib.common import (
@@ -97,6 +97,10 @@ class StatusList(MutableSequence):
 
     def __len__(self) -> int:
         return len(self._server.trackers)
+
+    def __iter__(self) -> Iterator[StatusTracker]:
+        with self._server.lock:
+            return iter(self._items())  # a snapshot: the loop may edit the list
 
     def __getitem__(self, i: Any) -> Any:
         with self._server.lock:
