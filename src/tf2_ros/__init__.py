@@ -2,8 +2,8 @@
 
 ``Buffer``, ``TransformListener``, ``TransformBroadcaster`` and ``StaticTransformBroadcaster`` work after
 ``rospy.init_node()`` on the process's core Node. Timeouts run on ROS time and wait on the buffer's
-condition (new data wakes them), not on polling sleeps. ``BufferClient`` (the action-based remote
-buffer) is not provided.
+condition (new data wakes them), not on polling sleeps. ``BufferClient`` (lookups answered by
+``rosrun tf2_ros buffer_server`` over an action) loads on first use.
 """
 
 from __future__ import annotations
