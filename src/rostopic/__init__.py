@@ -1,0 +1,444 @@
+"""rostopic's Python API as ROS 1 programs and test harnesses import it: a topic's type and class
+(``get_topic_class("/odom/pose")`` included, with the function that extracts the field), the rate,
+bandwidth and delay meters ``rostopic hz/bw/delay`` are built from, topic listings and info text.
+
+It sits on the rosgraph and rospy facades (the ``rostopic`` command is ninjemys.tools.rostopic; the
+layering keeps facades below the tools, so the two share the master API, not code).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import sys
+import threading
+import time
+from collections import defaultdict
+from collections.abc import Callable, Sequence
+from io import StringIO
+from typing import Any
+
+import rosgraph
+import rosgraph.names
+import rospy
+from roslib.message import get_message_class
+
+__all__ = [
+    "ROSTopicException",
+    "ROSTopicIOException",
+    "ROSTopicHz",
+    "ROSTopicDelay",
+    "ROSTopicBandwidth",
+    "msgevalgen",
+    "get_topic_type",
+    "get_topic_class",
+    "get_topic_list",
+    "get_info_text",
+    "get_api",
+    "find_by_type",
+]
+
+_CALLER = "/rostopic"
+
+
+class ROSTopicException(Exception):
+    """A rostopic operation failed (unknown topic, unloadable type ...)."""
+
+
+class ROSTopicIOException(ROSTopicException):
+    """The master or a node could not be reached."""
+
+
+def _master() -> rosgraph.Master:
+    return rosgraph.Master(_CALLER)
+
+
+def _topic_types(master: rosgraph.Master) -> list[list[str]]:
+    try:
+        return master.getTopicTypes()
+    except OSError:
+        raise ROSTopicIOException("Unable to communicate with master!") from None
+
+
+def _index_or_slice(text: str) -> int | slice:
+    """``3`` -> 3, ``1:-1:2`` -> slice(1, -1, 2); ValueError naming the bad part."""
+    if text == "":
+        raise ValueError("empty array index")
+    parts = text.split(":")
+    if len(parts) == 1:
+        try:
+            return int(parts[0])
+        except ValueError:
+            raise ValueError(f"non-integer array index step '{parts[0]}'") from None
+    if len(parts) > 3:
+        raise ValueError("too many slice arguments")
+    args: list[int | None] = [None, None, None]
+    for i, (part, what) in enumerate(zip(parts, ("start", "stop", "step"), strict=False)):
+        if part != "":
+            try:
+                args[i] = int(part)
+            except ValueError:
+                raise ValueError(f"non-integer slice {what} '{part}'") from None
+    return slice(*args)
+
+
+def msgevalgen(pattern: str) -> Callable[[Any], Any] | None:
+    """A function taking a message to the field ``pattern`` names (``/x[2:]/y``), or None for an
+    empty pattern; a malformed slice prints why on stderr and gives None, as in ROS 1."""
+    evals: list[tuple[str, int | slice | None]] = []
+    for f in (f for f in pattern.split("/") if f):
+        if "[" not in f:
+            evals.append((f, None))
+            continue
+        name, rest = f.split("[", 1)
+        if not rest.endswith("]"):
+            print(f"missing closing ']' in slice spec '{f}'", file=sys.stderr)
+            return None
+        try:
+            evals.append((name, _index_or_slice(rest[:-1])))
+        except ValueError as exc:
+            print(f"field '{name}' has invalid slice argument '{rest[:-1]}': {exc}", file=sys.stderr)
+            return None
+
+    def msgeval(msg: Any, evals: list[tuple[str, int | slice | None]]) -> Any:
+        for i, (name, index) in enumerate(evals):
+            try:
+                msg = getattr(msg, name)
+            except AttributeError:
+                print(f"no field named {name} in {pattern}", file=sys.stderr)
+                return None
+            if index is not None:
+                try:
+                    msg = msg[index]
+                except IndexError as exc:
+                    print(f"{exc}: {pattern}", file=sys.stderr)
+                    return None
+                if isinstance(msg, list):
+                    return [msgeval(m, evals[i + 1 :]) for m in msg]
+        return msg
+
+    return (lambda msg: msgeval(msg, evals)) if evals else None
+
+
+def _has_field(msg_class: Any, path: str) -> bool:
+    value = msg_class()
+    try:
+        for attr in path.split("/"):
+            value = getattr(value, attr)
+    except AttributeError:
+        return False
+    return True
+
+
+def _get_topic_type(topic: str) -> tuple[str | None, str | None, Callable[[Any], Any] | None]:
+    types = _topic_types(_master())
+    matches = [(t, tt) for t, tt in types if t == topic]
+    if not matches:
+        # a field of a topic (/odom/pose/pose): the longest topic that has that field
+        matches = sorted(((t, tt) for t, tt in types if topic.startswith(t + "/")), reverse=True)
+        while matches:
+            t, tt = matches[0]
+            cls = get_message_class(tt)
+            path = topic[len(t) + 1 :].rstrip("/").split("[")[0]
+            if not cls or path == "":
+                break
+            if _has_field(cls, path):
+                matches = [(t, tt)]
+                break
+            matches.pop(0)
+    if not matches:
+        return None, None, None
+    t, tt = matches[0]
+    if tt == rosgraph.names.ANYTYPE:
+        return None, None, None
+    return tt, t, msgevalgen(topic[len(t) :])
+
+
+def get_topic_type(
+    topic: str, blocking: bool = False
+) -> tuple[str | None, str | None, Callable[[Any], Any] | None]:
+    """``(type, real topic, field extractor or None)`` of ``topic`` (which may name a field inside a
+    topic); ``(None, None, None)`` if unknown, or waits for it with ``blocking``."""
+    found = _get_topic_type(topic)
+    if found[0] or not blocking:
+        return found
+    sys.stderr.write(f"WARNING: topic [{topic}] does not appear to be published yet\n")
+    while not rospy.is_shutdown():
+        found = _get_topic_type(topic)
+        if found[0]:
+            return found
+        time.sleep(0.1)
+    return None, None, None
+
+
+def get_topic_class(
+    topic: str, blocking: bool = False
+) -> tuple[Any, str | None, Callable[[Any], Any] | None]:
+    """Like get_topic_type, with the message class instead of the type name."""
+    topic_type, real_topic, msg_eval = get_topic_type(topic, blocking=blocking)
+    if topic_type is None:
+        return None, None, None
+    cls = get_message_class(topic_type)
+    if not cls:
+        raise ROSTopicException(f"Cannot load message class for [{topic_type}]. Are your messages built?")
+    return cls, real_topic, msg_eval
+
+
+def get_topic_list(master: rosgraph.Master | None = None) -> tuple[list[tuple[str, str, list[str]]], ...]:
+    """``(publications, subscriptions)``, each ``[(topic, type, [node, ...]), ...]``."""
+    master = master or _master()
+    pubs, subs, _srvs = master.getSystemState()
+    types: dict[str, str] = {t: tt for t, tt in _topic_types(master)}
+    return tuple([(t, types.get(t, "unknown type"), nodes) for t, nodes in part] for part in (pubs, subs))
+
+
+_caller_apis: dict[str, str] = {}
+
+
+def get_api(master: rosgraph.Master, caller_id: str) -> str:
+    """The XML-RPC URI of node ``caller_id`` (cached), or ``unknown address NODE``."""
+    api = _caller_apis.get(caller_id)
+    if not api:
+        try:
+            api = master.lookupNode(caller_id)
+            _caller_apis[caller_id] = api
+        except OSError:
+            raise ROSTopicIOException("Unable to communicate with master!") from None
+        except rosgraph.MasterError:
+            api = f"unknown address {caller_id}"
+    return api
+
+
+def get_info_text(topic: str) -> str:
+    """What ``rostopic info TOPIC`` prints: its type, publishers and subscribers with their URIs."""
+    master = _master()
+    try:
+        pubs, subs = get_topic_list(master=master)
+    except OSError:
+        raise ROSTopicIOException("Unable to communicate with master!") from None
+    pubs = [x for x in pubs if x[0] == topic]
+    subs = [x for x in subs if x[0] == topic]
+    if not pubs and not subs:
+        raise ROSTopicException(f"Unknown topic {topic}")
+    buff = StringIO()
+    buff.write(f"Type: {(pubs or subs)[0][1]}\n\n")
+    for title, entries in (("Publishers", pubs), ("Subscribers", subs)):
+        if entries:
+            buff.write(f"{title}: \n")
+            for node in itertools.chain(*[nodes for _t, _tt, nodes in entries]):
+                buff.write(f" * {node} ({get_api(master, node)})\n")
+        else:
+            buff.write(f"{title}: None\n")
+        buff.write("\n")
+    return buff.getvalue()
+
+
+def find_by_type(topic_type: str) -> list[str]:
+    """The topics of type ``topic_type``."""
+    return [t for t, tt in _topic_types(_master()) if tt == topic_type]
+
+
+class ROSTopicHz:
+    """Receives messages (``callback_hz``) and computes their rate statistics, per topic."""
+
+    def __init__(
+        self, window_size: int, filter_expr: Callable[[Any], bool] | None = None, use_wtime: bool = False
+    ):
+        self.lock = threading.Lock()
+        self.last_printed_tn: float = 0
+        self.msg_t0: float = -1
+        self.msg_tn: float = 0
+        self.times: list[float] = []
+        self._last_printed_tn: dict[Any, float] = defaultdict(int)
+        self._msg_t0: dict[Any, float] = defaultdict(lambda: -1)
+        self._msg_tn: dict[Any, float] = defaultdict(int)
+        self._times: dict[Any, list[float]] = defaultdict(list)
+        self.filter_expr = filter_expr
+        self.use_wtime = use_wtime
+        self.window_size = 50000 if window_size < 0 else window_size
+
+    # the per-topic state; topic None is the single-topic state ROS 1 kept in plain attributes
+    def get_last_printed_tn(self, topic: str | None = None) -> float:
+        return self.last_printed_tn if topic is None else self._last_printed_tn[topic]
+
+    def set_last_printed_tn(self, value: float, topic: str | None = None) -> None:
+        if topic is None:
+            self.last_printed_tn = value
+        self._last_printed_tn[topic] = value
+
+    def get_msg_t0(self, topic: str | None = None) -> float:
+        return self.msg_t0 if topic is None else self._msg_t0[topic]
+
+    def set_msg_t0(self, value: float, topic: str | None = None) -> None:
+        if topic is None:
+            self.msg_t0 = value
+        self._msg_t0[topic] = value
+
+    def get_msg_tn(self, topic: str | None = None) -> float:
+        return self.msg_tn if topic is None else self._msg_tn[topic]
+
+    def set_msg_tn(self, value: float, topic: str | None = None) -> None:
+        if topic is None:
+            self.msg_tn = value
+        self._msg_tn[topic] = value
+
+    def get_times(self, topic: str | None = None) -> list[float]:
+        return self.times if topic is None else self._times[topic]
+
+    def set_times(self, value: list[float], topic: str | None = None) -> None:
+        if topic is None:
+            self.times = value
+        self._times[topic] = value
+
+    def callback_hz(self, m: Any, topic: str | None = None) -> None:
+        """Subscriber callback: record the arrival time (ROS time, or wall time with use_wtime)."""
+        if self.filter_expr is not None and not self.filter_expr(m):
+            return
+        with self.lock:
+            now = rospy.Time.from_sec(time.time()) if self.use_wtime else rospy.get_rostime()
+            if now.is_zero():
+                if self.get_times(topic):
+                    print("time has reset, resetting counters")
+                    self.set_times([], topic)
+                return
+            curr = now.to_sec()
+            t0 = self.get_msg_t0(topic)
+            if t0 < 0 or t0 > curr:
+                self.set_msg_t0(curr, topic)
+                self.set_msg_tn(curr, topic)
+                self.set_times([], topic)
+            else:
+                self.get_times(topic).append(curr - self.get_msg_tn(topic))
+                self.set_msg_tn(curr, topic)
+            if len(self.get_times(topic)) > self.window_size - 1:
+                self.get_times(topic).pop(0)
+
+    def get_hz(self, topic: str | None = None) -> tuple[float, float, float, float, int] | None:
+        """``(rate, min_delta, max_delta, std_dev, window)``, or None without new messages."""
+        times = self.get_times(topic)
+        if not times or self.get_msg_tn(topic) == self.get_last_printed_tn(topic):
+            return None
+        with self.lock:
+            n = len(times)
+            mean = sum(times) / n
+            rate = 1.0 / mean if mean > 0.0 else 0
+            std_dev = math.sqrt(sum((x - mean) ** 2 for x in times) / n)
+            self.set_last_printed_tn(self.get_msg_tn(topic), topic)
+            return rate, min(times), max(times), std_dev, n + 1
+
+    def print_hz(self, topics: Sequence[str | None] = (None,)) -> None:
+        """Print the rate of one topic, or a table of several, as ``rostopic hz`` does."""
+        if len(topics) == 1:
+            ret = self.get_hz(topics[0])
+            if ret is None:
+                print("no new messages")
+                return
+            rate, lo, hi, std, window = ret
+            print(
+                f"average rate: {rate:.3f}\n\tmin: {lo:.3f}s max: {hi:.3f}s std dev: {std:.5f}s window: {window}"
+            )
+            return
+        header = ["topic", "rate", "min_delta", "max_delta", "std_dev", "window"]
+        rows = [(t, s) for t in topics if (s := self.get_hz(t)) is not None]
+        if not rows:
+            print("no new messages")
+            return
+        cells = [[str(t), *(f"{v:.4}" for v in s[:4]), str(s[4])] for t, s in rows]
+        widths = [max(len(h), *(len(c[i]) for c in cells)) for i, h in enumerate(header)]
+        head = "   ".join(h.center(w) for h, w in zip(header, widths, strict=True))
+        body = "\n".join("   ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)) for row in cells)
+        print(f"{head}\n{'=' * (sum(widths) + 3 * (len(header) - 1))}\n{body}\n")
+
+
+class ROSTopicDelay:
+    """Receives stamped messages (``callback_delay``) and computes the delay of their stamps."""
+
+    def __init__(self, window_size: int):
+        self.lock = threading.Lock()
+        self.last_msg_tn: float = 0
+        self.msg_t0: float = -1.0
+        self.msg_tn: float = 0
+        self.delays: list[float] = []
+        self.window_size = 50000 if window_size < 0 else window_size
+
+    def callback_delay(self, msg: Any) -> None:
+        """Subscriber callback: record now minus the message's header stamp."""
+        if not msg._has_header:
+            rospy.logerr("msg does not have header")
+            return
+        with self.lock:
+            now = rospy.get_rostime()
+            if now.is_zero():
+                if self.delays:
+                    print("time has reset, resetting counters")
+                    self.delays = []
+                return
+            curr = now.to_sec()
+            if self.msg_t0 < 0 or self.msg_t0 > curr:
+                self.msg_t0 = self.msg_tn = curr
+                self.delays = []
+            else:
+                self.delays.append(curr - msg.header.stamp.to_sec())
+                self.msg_tn = curr
+            if len(self.delays) > self.window_size - 1:
+                self.delays.pop(0)
+
+    def get_delay(self) -> tuple[float, float, float, float, int] | None:
+        """``(mean, min, max, std_dev, window)`` of the delays, or None without new messages."""
+        if self.msg_tn == self.last_msg_tn:
+            return None
+        with self.lock:
+            if not self.delays:
+                return None
+            n = len(self.delays)
+            mean = sum(self.delays) / n
+            std_dev = math.sqrt(sum((x - mean) ** 2 for x in self.delays) / n)
+            self.last_msg_tn = self.msg_tn
+            return mean, min(self.delays), max(self.delays), std_dev, n + 1
+
+    def print_delay(self) -> None:
+        """Print the delay statistics as ``rostopic delay`` does."""
+        if not self.delays:
+            return
+        ret = self.get_delay()
+        if ret is None:
+            print("no new messages")
+            return
+        mean, lo, hi, std, window = ret
+        print(
+            f"average delay: {mean:.3f}\n\tmin: {lo:.3f}s max: {hi:.3f}s std dev: {std:.5f}s window: {window}"
+        )
+
+
+class ROSTopicBandwidth:
+    """Receives raw messages (``rospy.AnyMsg``, ``callback``) and computes the bandwidth they use."""
+
+    def __init__(self, window_size: int = 100):
+        self.lock = threading.Lock()
+        self.last_printed_tn: float = 0
+        self.sizes: list[int] = []
+        self.times: list[float] = []
+        self.window_size = window_size or 100
+
+    def callback(self, data: Any) -> None:
+        """Subscriber callback: record the message's wire size and arrival (wall) time."""
+        with self.lock:
+            self.times.append(time.time())
+            self.sizes.append(len(data._buff))
+            if len(self.times) > self.window_size:
+                self.times.pop(0)
+                self.sizes.pop(0)
+
+    def print_bw(self) -> None:
+        """Print average bandwidth and message sizes as ``rostopic bw`` does (nothing before 2 messages)."""
+        if len(self.times) < 2:
+            return
+        with self.lock:
+            n = len(self.times)
+            total = sum(self.sizes)
+            values = [total / (time.time() - self.times[0]), total / n, min(self.sizes), max(self.sizes)]
+        scale, unit = (
+            (1, "B") if values[0] < 1000 else (1000, "KB") if values[0] < 1000000 else (1000000, "MB")
+        )
+        bw, mean, lo, hi = (f"{v / scale:.2f}{unit}" for v in values)
+        print(f"average: {bw}/s\n\tmean: {mean} min: {lo} max: {hi} window: {n}")
