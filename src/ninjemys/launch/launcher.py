@@ -138,6 +138,14 @@ def _process_specs(
     return specs
 
 
+def process_specs(
+    plan: LaunchPlan, opts: LaunchOptions, master_uri: str, log_dir: Path, env: dict[str, str]
+) -> list[ProcessSpec]:
+    """The processes ``plan``'s nodes run as (command, environment, output, respawn ...), for callers
+    that supervise nodes one at a time (the roslaunch.scriptapi facade) instead of a whole session."""
+    return _process_specs(plan, opts, master_uri, log_dir, env)
+
+
 def _user_args(node: NodeSpec) -> list[str]:
     return shlex.split(node.args) + [f"{a}:={b}" for a, b in node.remap_args] + [f"__name:={node.name}"]
 

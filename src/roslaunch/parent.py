@@ -1,0 +1,196 @@
+"""roslaunch.parent: ROSLaunchParent, a whole launch run from a script (``start()`` returns once the
+nodes are started; ``spin()`` waits for the launch to end; ``shutdown()`` stops it).
+
+It is ninjemys's own launch session (the ``roslaunch`` command's: same plan, master auto-start,
+parameters, supervision), run on a thread of the script instead of owning the process: no signal
+handlers are installed, so the script's own Ctrl-C handling stays in place.
+"""
+
+from __future__ import annotations
+
+import sys
+import threading
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from ninjemys.errors import NinjemysError
+from ninjemys.launch.launcher import LaunchOptions, LaunchSession
+from ninjemys.launch.plan import LaunchPlan
+from ninjemys.launch.runner import DEFAULT_SIGINT_TIMEOUT, DEFAULT_SIGTERM_TIMEOUT, ProcessSpec, Supervisor
+from ninjemys.launch.xml import load_launch
+
+from .core import RLException
+
+__all__ = ["ROSLaunchParent"]
+
+#: ROS 1's name for the number of roslaunch XML-RPC workers; kept for signature compatibility
+NUM_WORKERS = 3
+
+
+def _merge(into: LaunchPlan, plan: LaunchPlan) -> None:
+    """Add ``plan`` (one file with its own arguments) to the combined launch."""
+    into.files += plan.files
+    into.nodes += plan.nodes
+    into.tests += plan.tests
+    into.params.update(plan.params)
+    into.clear_params += plan.clear_params
+    into.machines.update(plan.machines)
+    into.setup_commands += plan.setup_commands
+    into.warnings += plan.warnings
+
+
+def load_plan(roslaunch_files: Sequence[Any], roslaunch_strs: Sequence[str] | None = None) -> LaunchPlan:
+    """One plan from files (each a path or ``(path, ["arg:=value", ...])``) and XML strings."""
+    plan = LaunchPlan()
+    try:
+        for entry in roslaunch_files:
+            path, args = (entry, []) if isinstance(entry, str) else (entry[0], list(entry[1]))
+            _merge(plan, load_launch([path], argv=args))
+        for text in roslaunch_strs or []:
+            _merge(plan, load_launch([], xml_text=text))
+    except NinjemysError as exc:
+        raise RLException(str(exc)) from None
+    return plan
+
+
+class _ScriptSession(LaunchSession):
+    """A launch session for a script's thread: no signal handlers; ``started`` is set once every
+    process has been started (or the launch ended first); with ``keep_up`` it runs until shutdown
+    even when it has no node (the master it may have started stays up)."""
+
+    def __init__(self, plan: LaunchPlan, opts: LaunchOptions, keep_up: bool) -> None:
+        super().__init__(plan, opts)
+        self.keep_up = keep_up
+        self.started = threading.Event()
+        self.stopping = False
+
+    def _supervise(self, specs: list[ProcessSpec], log: Callable[[str], None]) -> int:
+        self.supervisor = Supervisor(specs, log=log, prefix_output=self.opts.prefix_output)
+        pending = {s.name for s in specs if not s.is_core}
+
+        def on_event(kind: str, name: str) -> None:
+            pending.discard(name)
+            if not pending:
+                self.started.set()
+
+        self.supervisor.on_event = on_event
+        if not pending:
+            self.started.set()
+        if self.stopping:
+            return 0
+        if not specs and not self.keep_up:
+            self._say("no nodes to launch")
+            return 0
+        return self.supervisor.run()
+
+
+class ROSLaunchParent:
+    """A launch of ``roslaunch_files`` (paths, or ``(path, [arg:=value ...])``) and ``roslaunch_strs``
+    (XML texts), as ROS 1 scripts and rostest run them."""
+
+    def __init__(
+        self,
+        run_id: str,
+        roslaunch_files: Sequence[Any],
+        is_core: bool = False,
+        port: int | None = None,
+        local_only: bool = False,
+        process_listeners: Sequence[Any] | None = None,
+        verbose: bool = False,
+        force_screen: bool = False,
+        force_log: bool = False,
+        is_rostest: bool = False,
+        roslaunch_strs: Sequence[str] | None = None,
+        num_workers: int = NUM_WORKERS,
+        timeout: float | None = None,
+        master_logger_level: bool | str = False,
+        show_summary: bool = True,
+        force_required: bool = False,
+        sigint_timeout: float = DEFAULT_SIGINT_TIMEOUT,
+        sigterm_timeout: float = DEFAULT_SIGTERM_TIMEOUT,
+    ) -> None:
+        self.run_id = run_id
+        self.roslaunch_files = roslaunch_files
+        self.roslaunch_strs = roslaunch_strs
+        self.is_core = is_core
+        self.port = port
+        self.local_only = local_only
+        self.process_listeners = list(process_listeners or [])
+        self.verbose = verbose
+        self.is_rostest = is_rostest
+        self.timeout = timeout
+        self.options = LaunchOptions(
+            screen=force_screen,
+            log=force_log,
+            port=port,
+            required=force_required,
+            local_only=local_only,
+            no_summary=not show_summary,
+            sigint_timeout=sigint_timeout,
+            sigterm_timeout=sigterm_timeout,
+        )
+        self._session: _ScriptSession | None = None
+        self._thread: threading.Thread | None = None
+        self._error: BaseException | None = None
+        self.exit_code: int | None = None
+        #: set by start(): ROS 1 scripts test ``parent.runner`` before spinning
+        self.runner: Any = None
+
+    def _run(self) -> None:
+        assert self._session is not None
+        try:
+            self.exit_code = self._session.run()
+        except BaseException as exc:  # noqa: BLE001  (handed to start() on the script's thread)
+            self._error = exc
+            self.exit_code = 1
+        finally:
+            self._session.started.set()
+
+    def start(self, auto_terminate: bool = True) -> None:
+        """Load the files, start a master if none runs, set the parameters, start the nodes; returns
+        once they are started. With ``auto_terminate`` the launch ends when its nodes have all exited."""
+        if self._thread is not None:
+            raise RLException("ROSLaunchParent has already been started")
+        plan = load_plan(self.roslaunch_files, self.roslaunch_strs)
+        self._session = _ScriptSession(plan, self.options, keep_up=not auto_terminate)
+        self._thread = threading.Thread(target=self._run, name="roslaunch", daemon=True)
+        self._thread.start()
+        self._session.started.wait()
+        if self._error is not None:
+            error, self._error = self._error, None
+            raise RLException(str(error)) from None
+        self.runner = self._session
+
+    def spin_once(self) -> None:
+        """ROS 1 runs one round of its process monitor here; ours runs on its own thread, so this
+        only gives it the chance to report (nothing to do on the caller's thread)."""
+        if self._thread is not None:
+            self._thread.join(0.0)
+
+    def is_alive(self) -> bool:
+        """True while the launch runs."""
+        return self._thread is not None and self._thread.is_alive()
+
+    def spin(self) -> None:
+        """Wait until the launch ends (Ctrl-C shuts it down), then clean up."""
+        if self._thread is None:
+            raise RLException("parent not started yet")
+        try:
+            while self._thread.is_alive():
+                self._thread.join(0.2)
+        except KeyboardInterrupt:
+            pass
+        finally:
+            self.shutdown()
+
+    def shutdown(self) -> None:
+        """Stop every process (SIGINT, then SIGTERM, then SIGKILL) and the master it started."""
+        session = self._session
+        if session is None or self._thread is None:
+            return
+        session.stopping = True
+        if session.supervisor is not None:
+            session.supervisor.request_shutdown()
+        self._thread.join()
+        if self._error is not None and not isinstance(self._error, KeyboardInterrupt):
+            print(f"roslaunch: {self._error}", file=sys.stderr)
