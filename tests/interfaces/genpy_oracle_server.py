@@ -19,9 +19,9 @@ import json
 import sys
 import traceback
 
-import genpy
 import genpy.dynamic
 
+import genpy
 import roslib.message
 
 _classes: dict[str, type] = {}

@@ -11,7 +11,6 @@ import json
 import sys
 
 import rosmsg
-
 import rospkg
 
 
