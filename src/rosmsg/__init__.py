@@ -31,6 +31,7 @@ __all__ = [
     "list_types",
     "iterate_packages",
     "rosmsg_search",
+    "rosmsg_md5",
 ]
 
 MODE_MSG = ".msg"
@@ -140,3 +141,13 @@ def rosmsg_search(rospack: Any, mode: str, base_type: str) -> Iterator[str]:
     for p, path in iterate_packages(rospack, mode):
         if os.path.isfile(os.path.join(path, f"{base_type}{mode}")):
             yield f"{p}/{base_type}"
+
+
+def rosmsg_md5(mode: str, type_: str) -> str:
+    """The md5sum of message (MODE_MSG) or service (MODE_SRV) ``type_``; IOError if it cannot load."""
+    from roslib.message import get_message_class, get_service_class
+
+    cls = get_message_class(type_) if mode == MODE_MSG else get_service_class(type_)
+    if cls is None:
+        raise OSError(f"cannot load [{type_}]")
+    return cls._md5sum

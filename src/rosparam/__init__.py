@@ -18,7 +18,14 @@ import yaml
 
 import rosgraph
 from ninjemys.paramyaml import ParamYamlError, dump_yaml, load_yaml, load_yaml_documents
-from rosgraph.names import GLOBALNS, get_ros_namespace, make_caller_id, make_global_ns, ns_join
+from rosgraph.names import (
+    GLOBALNS,
+    get_ros_namespace,
+    make_caller_id,
+    make_global_ns,
+    ns_join,
+    script_resolve_name,
+)
 
 __all__ = [
     "NAME",
@@ -37,6 +44,7 @@ __all__ = [
     "set_param",
     "upload_params",
     "list_params",
+    "script_resolve_name",
 ]
 
 NAME = "rosparam"

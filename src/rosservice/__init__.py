@@ -22,6 +22,7 @@ import rospy
 from roslib.message import get_service_class
 
 __all__ = [
+    "NAME",
     "ROSServiceException",
     "ROSServiceIOException",
     "get_service_headers",
@@ -36,6 +37,7 @@ __all__ = [
     "get_service_args",
 ]
 
+NAME = "rosservice"
 _IO_ERROR = "Unable to communicate with master!"
 
 

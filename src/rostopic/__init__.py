@@ -36,9 +36,15 @@ __all__ = [
     "get_info_text",
     "get_api",
     "find_by_type",
+    "create_publisher",
+    "publish_message",
+    "NAME",
 ]
 
+NAME = "rostopic"
 _CALLER = "/rostopic"
+#: seconds ``publish_message(..., once=True)`` keeps a latched message up
+_ONCE_DELAY = 3.0
 
 
 class ROSTopicException(Exception):
@@ -442,3 +448,81 @@ class ROSTopicBandwidth:
         )
         bw, mean, lo, hi = (f"{v / scale:.2f}{unit}" for v in values)
         print(f"average: {bw}/s\n\tmean: {mean} min: {lo} max: {hi} window: {n}")
+
+
+def create_publisher(
+    topic_name: str, topic_type: str, latch: bool, disable_rostime: bool = True
+) -> tuple[Any, Any]:
+    """A publisher of ``topic_type`` on ``topic_name`` (resolved as rostopic resolves it) and the
+    message class, in an anonymous ``rostopic`` node started for it, as ``rostopic pub`` does."""
+    topic_name = rosgraph.names.script_resolve_name("rostopic", topic_name)
+    if "/" not in topic_type:  # not pkg/Type: ROS 1's class lookup raises on it
+        raise ROSTopicException(f"invalid topic type: {topic_type}")
+    msg_class = get_message_class(topic_type)
+    if msg_class is None:
+        pkg = topic_type.split("/")[0] if "/" in topic_type else None
+        raise ROSTopicException(
+            f"invalid message type: {topic_type}.\nIf this is a valid message type, perhaps you need to type 'rosmake {pkg}'"
+        )
+    rospy.init_node("rostopic", anonymous=True, disable_rosout=True, disable_rostime=disable_rostime)
+    return rospy.Publisher(topic_name, msg_class, latch=latch, queue_size=100), msg_class
+
+
+def _fill_message_args(msg: Any, pub_args: list[Any]) -> None:
+    import genpy.message
+    from std_msgs.msg import Header
+
+    now = rospy.get_rostime()
+    try:
+        genpy.message.fill_message_args(msg, pub_args, keys={"now": now, "auto": Header(stamp=now)})
+    except genpy.message.MessageException as e:
+        raise ROSTopicException(
+            f"{e}\n\nArgs are: [{genpy.message.get_printable_message_args(msg)}]"
+        ) from None
+
+
+def publish_message(
+    pub: Any,
+    msg_class: Any,
+    pub_args: list[Any],
+    rate: float | None = None,
+    once: bool = False,
+    verbose: bool = False,
+    substitute_keywords: bool = False,
+) -> None:
+    """Fill a ``msg_class`` from YAML-parsed ``pub_args`` and publish it: latched (until shutdown,
+    or ``once``), or at ``rate`` Hz (refilled each time with ``substitute_keywords``, so ``now``
+    advances), as ``rostopic pub`` does."""
+    import genpy
+
+    msg = msg_class()
+    _fill_message_args(msg, pub_args)
+    try:
+        if rate is None:
+            text = f"publishing and latching [{msg}]" if verbose else "publishing and latching message"
+            print(text + (f" for {_ONCE_DELAY} seconds" if once else ". Press ctrl-C to terminate"))
+            try:
+                pub.publish(msg)
+            except TypeError as e:
+                raise ROSTopicException(str(e)) from None
+            if not once:
+                rospy.spin()
+            return
+        try:
+            r = rospy.Rate(float(rate))
+        except ValueError:
+            raise ROSTopicException("Rate must be a number") from None
+        while not rospy.is_shutdown():
+            if substitute_keywords:
+                _fill_message_args(msg, pub_args)
+            if verbose:
+                print(f"publishing {msg}")
+            pub.publish(msg)
+            r.sleep()
+    except (rospy.ROSSerializationException, genpy.SerializationError) as e:
+        import rosmsg
+
+        raise ROSTopicException(
+            "Unable to publish message. One of the fields has an incorrect type:\n"
+            f"  {e}\n\nmsg file:\n{rosmsg.get_msg_text(msg_class._type)}"
+        ) from None

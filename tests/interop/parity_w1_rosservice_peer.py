@@ -119,5 +119,10 @@ out["msg"]["list_bad"] = [
 ]
 out["msg"]["search"] = sorted(rosmsg.rosmsg_search(rp, rosmsg.MODE_MSG, "Config"))
 out["msg"]["search_srv"] = sorted(rosmsg.rosmsg_search(rp, rosmsg.MODE_SRV, "SetBool"))
+out["msg"]["md5"] = [
+    rosmsg.rosmsg_md5(rosmsg.MODE_MSG, "std_msgs/String"),
+    rosmsg.rosmsg_md5(rosmsg.MODE_SRV, "std_srvs/SetBool"),
+    attempt(rosmsg.rosmsg_md5, rosmsg.MODE_MSG, "nope/Nope"),
+]
 out["msg"]["modes"] = [rosmsg.MODE_MSG, rosmsg.MODE_SRV]
 print(json.dumps(out, sort_keys=True))

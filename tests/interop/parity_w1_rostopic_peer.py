@@ -6,6 +6,9 @@ import contextlib
 import io
 import json
 import re
+import subprocess
+import sys
+import time
 
 import rospy
 import rostopic
@@ -121,4 +124,41 @@ out["meters"]["exceptions"] = [
     issubclass(rostopic.ROSTopicIOException, rostopic.ROSTopicException),
     Header()._has_header,
 ]
+# rostopic pub's publishing functions start a node of their own: in a process without one
+PUBLISHER = r"""
+import json
+import time
+import rostopic
+
+out = {}
+for bad in ("nope/Nope", "notatype"):
+    try:
+        rostopic.create_publisher("/w1/pubtest", bad, True)
+    except rostopic.ROSTopicException as exc:
+        out[bad] = str(exc)
+pub, cls = rostopic.create_publisher("w1/pubtest", "std_msgs/String", True)
+out["class"] = [cls._type, pub.resolved_name]
+for args in (["a", "b"], [{"nope": 1}]):
+    try:
+        rostopic.publish_message(pub, cls, args, once=True)
+    except rostopic.ROSTopicException as exc:
+        out[str(args)] = str(exc)
+rostopic.publish_message(pub, cls, ["hello"], once=True)
+print(json.dumps(out), flush=True)
+time.sleep(10)
+"""
+got = []
+rospy.Subscriber("/w1/pubtest", String, lambda m: got.append(m.data))
+publisher = subprocess.Popen([sys.executable, "-c", PUBLISHER], stdout=subprocess.PIPE, text=True)
+printed_lines = []
+line = publisher.stdout.readline()
+while line and not line.startswith("{"):
+    printed_lines.append(line)
+    line = publisher.stdout.readline()
+deadline = time.time() + 20
+while not got and time.time() < deadline:
+    time.sleep(0.05)
+publisher.kill()
+publisher.wait()
+out["publish"] = {"calls": json.loads(line) if line else None, "received": got[:1], "printed": printed_lines}
 print(json.dumps(out, sort_keys=True))
