@@ -8,6 +8,7 @@ handlers are installed, so the script's own Ctrl-C handling stays in place.
 
 from __future__ import annotations
 
+import itertools
 import sys
 import threading
 from collections.abc import Callable, Sequence
@@ -15,7 +16,7 @@ from typing import Any
 
 from ninjemys.errors import NinjemysError
 from ninjemys.launch.launcher import LaunchOptions, LaunchSession
-from ninjemys.launch.plan import LaunchPlan
+from ninjemys.launch.plan import LaunchPlan, NodeSpec
 from ninjemys.launch.runner import DEFAULT_SIGINT_TIMEOUT, DEFAULT_SIGTERM_TIMEOUT, ProcessSpec, Supervisor
 from ninjemys.launch.xml import load_launch
 
@@ -25,6 +26,31 @@ __all__ = ["ROSLaunchParent"]
 
 #: ROS 1's name for the number of roslaunch XML-RPC workers; kept for signature compatibility
 NUM_WORKERS = 3
+
+
+_counter = itertools.count(1)
+_counter_lock = threading.Lock()
+
+
+def next_process_number() -> int:
+    """ROS 1 numbers node processes (``talker-3``) with one counter for the whole script process,
+    across every launch and scripted node."""
+    with _counter_lock:
+        return next(_counter)
+
+
+def renumber(spec: ProcessSpec, node: NodeSpec | None) -> str:
+    """Number ``spec`` as ROS 1 numbers node processes and return ROS 1's process name, ``ns/name-N``
+    with N the script-wide number. The spec keeps a file-safe form (``ns-name-N``) for its log files
+    (``__log:=`` follows)."""
+    old = spec.name
+    base = node.resolved_name.lstrip("/") if node is not None else old.rsplit("-", 1)[0]
+    name = f"{base}-{next_process_number()}"
+    spec.name = name.replace("/", "-")
+    spec.argv = [
+        a.replace(f"{old}.log", f"{spec.name}.log") if a.startswith("__log:=") else a for a in spec.argv
+    ]
+    return name
 
 
 def _merge(into: LaunchPlan, plan: LaunchPlan) -> None:
@@ -58,13 +84,22 @@ class _ScriptSession(LaunchSession):
     process has been started (or the launch ended first); with ``keep_up`` it runs until shutdown
     even when it has no node (the master it may have started stays up)."""
 
-    def __init__(self, plan: LaunchPlan, opts: LaunchOptions, keep_up: bool) -> None:
+    def __init__(
+        self, plan: LaunchPlan, opts: LaunchOptions, keep_up: bool, listeners: Sequence[Any] = ()
+    ) -> None:
         super().__init__(plan, opts)
         self.keep_up = keep_up
+        #: ROS 1's process listeners: ``process_died(name, exit_code)`` when a process ends
+        self.listeners = list(listeners)
         self.started = threading.Event()
         self.stopping = False
 
     def _supervise(self, specs: list[ProcessSpec], log: Callable[[str], None]) -> int:
+        nodes = [s for s in specs if not s.is_core]
+        plan_nodes = self.plan.nodes if len(self.plan.nodes) == len(nodes) else [None] * len(nodes)
+        ros1_names = {}
+        for spec, node in zip(nodes, plan_nodes, strict=True):
+            ros1_names[spec.name] = renumber(spec, node)
         self.supervisor = Supervisor(specs, log=log, prefix_output=self.opts.prefix_output)
         pending = {s.name for s in specs if not s.is_core}
 
@@ -72,6 +107,10 @@ class _ScriptSession(LaunchSession):
             pending.discard(name)
             if not pending:
                 self.started.set()
+            if kind == "exited" and self.supervisor is not None:
+                code = next((p.exit_code for p in self.supervisor.procs if p.spec.name == name), None)
+                for listener in self.listeners:
+                    listener.process_died(ros1_names.get(name, name), code)
 
         self.supervisor.on_event = on_event
         if not pending:
@@ -152,7 +191,7 @@ class ROSLaunchParent:
         if self._thread is not None:
             raise RLException("ROSLaunchParent has already been started")
         plan = load_plan(self.roslaunch_files, self.roslaunch_strs)
-        self._session = _ScriptSession(plan, self.options, keep_up=not auto_terminate)
+        self._session = _ScriptSession(plan, self.options, not auto_terminate, self.process_listeners)
         self._thread = threading.Thread(target=self._run, name="roslaunch", daemon=True)
         self._thread.start()
         self._session.started.wait()

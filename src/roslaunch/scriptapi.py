@@ -21,7 +21,7 @@ from ninjemys.roshome import log_directory
 
 from . import rlutil
 from .core import Node, RLException
-from .parent import ROSLaunchParent
+from .parent import ROSLaunchParent, renumber
 
 __all__ = ["ROSLaunch", "NodeProcess"]
 
@@ -90,7 +90,6 @@ class ROSLaunch:
         self.parent = ROSLaunchParent(uuid, [], is_core=False)
         self.started = False
         self._processes: list[NodeProcess] = []
-        self._count = 0
 
     def load(self, f: str) -> None:
         """Add launch file ``f`` to what start() launches (before start(), RLException after)."""
@@ -111,7 +110,6 @@ class ROSLaunch:
         if not isinstance(node, Node):
             raise ValueError("arg must be of type Node")
         spec = _spec(node)
-        self._count += 1
         env = dict(os.environ)
         uri = rosgraph.get_master_uri()
         env["ROS_MASTER_URI"] = uri
@@ -122,9 +120,9 @@ class ROSLaunch:
             raise RLException(f"failed to launch {node.package}/{node.type}: {exc}") from None
         if not procs:
             raise RLException(f"failed to launch {node.package}/{node.type}")
-        procs[0].name = f"{spec.name.rsplit('/', 1)[-1]}-{self._count}"
+        name = renumber(procs[0], spec)
         node.process_name = procs[0].name
-        process = NodeProcess(procs[0].name, Supervisor(procs))
+        process = NodeProcess(name, Supervisor(procs))
         if process.pid is None:
             raise RLException(f"failed to launch {node.package}/{node.type}")
         self._processes.append(process)

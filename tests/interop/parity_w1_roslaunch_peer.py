@@ -37,6 +37,10 @@ with open(node_path, "w") as f:
         "rospy.spin()\n"
     )
 os.chmod(node_path, os.stat(node_path).st_mode | stat.S_IEXEC)
+exit_path = os.path.join(pkg, "scripts", "exit3.py")
+with open(exit_path, "w") as f:
+    f.write(f"#!{sys.executable}\nimport sys\nsys.exit(3)\n")
+os.chmod(exit_path, os.stat(exit_path).st_mode | stat.S_IEXEC)
 launch_path = os.path.join(pkg, "launch", "w1.launch")
 with open(launch_path, "w") as f:
     f.write(
@@ -115,6 +119,26 @@ out["parent"]["from_string"] = wait_param("/w1/seen/s")
 strs.shutdown()
 out["parent"]["from_string_stopped"] = wait_gone("/s")
 
+
+class Listener:
+    def __init__(self):
+        self.died = []
+
+    def process_died(self, name, exit_code):
+        self.died.append([name, exit_code])
+
+
+listener = Listener()
+quick = roslaunch.parent.ROSLaunchParent(
+    uuid,
+    [],
+    roslaunch_strs=['<launch><node pkg="w1launch" type="exit3.py" name="quick"/></launch>'],
+    process_listeners=[listener],
+)
+quick.start()
+quick.spin()
+out["parent"]["listener"] = listener.died
+
 launch = roslaunch.scriptapi.ROSLaunch()
 out["errors"]["before_start"] = attempt(launch.launch, roslaunch.core.Node("w1launch", "w1node.py", name="b"))
 launch.start()
@@ -123,7 +147,7 @@ proc = launch.launch(
     roslaunch.core.Node("w1launch", "w1node.py", name="b", namespace="ns1", args="_p:=fromargs")
 )
 out["script"]["param"] = wait_param("/w1/seen/ns1_b")
-out["script"]["alive"] = [proc.is_alive(), node_up("/ns1/b")]
+out["script"]["alive"] = [proc.is_alive(), node_up("/ns1/b"), proc.name]
 proc.stop()
 out["script"]["after_stop"] = [proc.is_alive(), wait_gone("/ns1/b")]
 launch.stop()
