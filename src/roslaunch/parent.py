@@ -17,15 +17,18 @@ from typing import Any
 from ninjemys.errors import NinjemysError
 from ninjemys.launch.launcher import LaunchOptions, LaunchSession
 from ninjemys.launch.plan import LaunchPlan, NodeSpec
-from ninjemys.launch.runner import DEFAULT_SIGINT_TIMEOUT, DEFAULT_SIGTERM_TIMEOUT, ProcessSpec, Supervisor
+from ninjemys.launch.runner import ProcessSpec, Supervisor
 from ninjemys.launch.xml import load_launch
 
 from .core import RLException
 
 __all__ = ["ROSLaunchParent"]
 
-#: ROS 1's name for the number of roslaunch XML-RPC workers; kept for signature compatibility
+#: ROS 1's number of roslaunch XML-RPC workers (ours has none; kept for the signature)
 NUM_WORKERS = 3
+#: seconds a node has after SIGINT, then after SIGTERM, at shutdown: ROS 1's script defaults
+DEFAULT_TIMEOUT_SIGINT = 15.0
+DEFAULT_TIMEOUT_SIGTERM = 2.0
 
 
 _counter = itertools.count(1)
@@ -145,8 +148,8 @@ class ROSLaunchParent:
         master_logger_level: bool | str = False,
         show_summary: bool = True,
         force_required: bool = False,
-        sigint_timeout: float = DEFAULT_SIGINT_TIMEOUT,
-        sigterm_timeout: float = DEFAULT_SIGTERM_TIMEOUT,
+        sigint_timeout: float = DEFAULT_TIMEOUT_SIGINT,
+        sigterm_timeout: float = DEFAULT_TIMEOUT_SIGTERM,
     ) -> None:
         self.run_id = run_id
         self.roslaunch_files = roslaunch_files

@@ -12,7 +12,9 @@ from ninjemys.packages.discovery import PackageIndex
 
 from .core import RLException, generate_run_id
 
-__all__ = ["get_or_generate_uuid", "resolve_launch_arguments"]
+__all__ = ["get_or_generate_uuid", "resolve_launch_arguments", "DEFAULT_MASTER_PORT"]
+
+DEFAULT_MASTER_PORT = 11311
 
 
 def get_or_generate_uuid(options_runid: str | None, options_wait_for_master: bool) -> str:

@@ -32,6 +32,7 @@ __all__ = [
     "iterate_packages",
     "rosmsg_search",
     "rosmsg_md5",
+    "rosmsgmain",
 ]
 
 MODE_MSG = ".msg"
@@ -151,3 +152,16 @@ def rosmsg_md5(mode: str, type_: str) -> str:
     if cls is None:
         raise OSError(f"cannot load [{type_}]")
     return cls._md5sum
+
+
+def rosmsgmain(mode: str = MODE_MSG) -> None:
+    """The ``rosmsg`` (MODE_MSG) or ``rossrv`` (MODE_SRV) command with sys.argv, as ROS 1's entry
+    point: ours runs it; a failure exits with its status."""
+    import subprocess
+    import sys
+
+    from ninjemys.commands import command_path
+
+    code = subprocess.call([command_path("rossrv" if mode == MODE_SRV else "rosmsg"), *sys.argv[1:]])
+    if code:
+        sys.exit(code)

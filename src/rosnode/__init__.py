@@ -42,6 +42,7 @@ __all__ = [
     "get_node_connection_info_description",
     "rosnode_info",
     "rosnode_debugnode",
+    "rosnodemain",
 ]
 
 NAME = "rosnode"
@@ -390,3 +391,16 @@ def rosnode_info(node_name: str, quiet: bool = False) -> None:
 
 
 rosnode_debugnode = rosnode_info
+
+
+def rosnodemain(argv: list[str] | None = None) -> None:
+    """The ``rosnode`` command with ``argv`` (``argv[0]`` is the program name), as ROS 1's entry point:
+    our ``rosnode`` runs it; a failure exits with its status."""
+    import subprocess
+
+    from ninjemys.commands import command_path
+
+    argv = sys.argv if argv is None else argv
+    code = subprocess.call([command_path("rosnode"), *argv[1:]])
+    if code:
+        sys.exit(code)

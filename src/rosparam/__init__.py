@@ -45,6 +45,7 @@ __all__ = [
     "upload_params",
     "list_params",
     "script_resolve_name",
+    "yamlmain",
 ]
 
 NAME = "rosparam"
@@ -221,3 +222,16 @@ def list_params(ns: str) -> list[str]:
         return [n for n in sorted(get_param_server().getParamNames()) if n.startswith(prefix)]
     except OSError:
         raise RosParamIOException(_IO_ERROR) from None
+
+
+def yamlmain(argv: list[str] | None = None) -> None:
+    """The ``rosparam`` command with ``argv`` (``argv[0]`` is the program name), as ROS 1's entry point:
+    our ``rosparam`` runs it; a failure exits with its status."""
+    import subprocess
+
+    from ninjemys.commands import command_path
+
+    argv = sys.argv if argv is None else argv
+    code = subprocess.call([command_path("rosparam"), *argv[1:]])
+    if code:
+        sys.exit(code)

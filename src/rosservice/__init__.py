@@ -9,6 +9,7 @@ ninjemys.tools.rosservice (the layering keeps facades below the tools).
 from __future__ import annotations
 
 import socket
+import sys
 from io import BytesIO
 from typing import Any
 
@@ -35,6 +36,7 @@ __all__ = [
     "call_service",
     "has_service_args",
     "get_service_args",
+    "rosservicemain",
 ]
 
 NAME = "rosservice"
@@ -217,3 +219,15 @@ def get_service_args(service_name: str) -> str:
     """The request's field names as ``rosservice args`` prints them."""
     service_name = rosgraph.names.script_resolve_name("rosservice", service_name)
     return genpy.message.get_printable_message_args(get_service_class_by_name(service_name)._request_class)
+
+
+def rosservicemain(argv: list[str] = sys.argv) -> None:
+    """The ``rosservice`` command with ``argv`` (``argv[0]`` is the program name), as ROS 1's entry point:
+    our ``rosservice`` runs it; a failure exits with its status."""
+    import subprocess
+
+    from ninjemys.commands import command_path
+
+    code = subprocess.call([command_path("rosservice"), *argv[1:]])
+    if code:
+        sys.exit(code)

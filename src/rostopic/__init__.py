@@ -39,10 +39,14 @@ __all__ = [
     "create_publisher",
     "publish_message",
     "NAME",
+    "SUBSCRIBER_TIMEOUT",
+    "rostopicmain",
 ]
 
 NAME = "rostopic"
 _CALLER = "/rostopic"
+#: seconds ``rostopic pub --once`` waits for a subscriber
+SUBSCRIBER_TIMEOUT = 5.0
 #: seconds ``publish_message(..., once=True)`` keeps a latched message up
 _ONCE_DELAY = 3.0
 
@@ -526,3 +530,16 @@ def publish_message(
             "Unable to publish message. One of the fields has an incorrect type:\n"
             f"  {e}\n\nmsg file:\n{rosmsg.get_msg_text(msg_class._type)}"
         ) from None
+
+
+def rostopicmain(argv: list[str] | None = None) -> None:
+    """The ``rostopic`` command with ``argv`` (``argv[0]`` is the program name), as ROS 1's entry point:
+    our ``rostopic`` runs it; a failure exits with its status."""
+    import subprocess
+
+    from ninjemys.commands import command_path
+
+    argv = sys.argv if argv is None else argv
+    code = subprocess.call([command_path("rostopic"), *argv[1:]])
+    if code:
+        sys.exit(code)

@@ -102,6 +102,12 @@ out["errors"]["upload_global"] = attempt(rosparam.upload_params, "/", 5)
 out["errors"]["set_bad_yaml"] = yaml_error(rosparam.set_param, "/w1/q", "[1,")
 out["errors"]["int_keys"] = attempt(rosparam.set_param_raw, "/w1/q", {1: 2})
 out["errors"]["classes"] = [issubclass(rosparam.RosParamIOException, rosparam.RosParamException)]
+rosparam.yamlmain(["rosparam", "set", "/w1/cli", "[1, two]"])
+out["server"]["yamlmain"] = rosparam.get_param("/w1/cli")
+try:
+    rosparam.yamlmain(["rosparam", "get", "/w1/none_here"])
+except SystemExit as exc:
+    out["server"]["yamlmain_error"] = exc.code
 rosparam.delete_param("/")
 out["errors"]["deleted_all"] = [
     n
