@@ -231,8 +231,11 @@ class ROSLaunchParent:
         if session is None or self._thread is None:
             return
         session.stopping = True
-        if session.supervisor is not None:
-            session.supervisor.request_shutdown()
-        self._thread.join()
+        asked = False
+        while self._thread.is_alive():  # the supervisor may not exist yet: ask once it does (a
+            if not asked and session.supervisor is not None:  # second request would SIGKILL at once)
+                session.supervisor.request_shutdown()
+                asked = True
+            self._thread.join(0.1)
         if self._error is not None and not isinstance(self._error, KeyboardInterrupt):
             print(f"roslaunch: {self._error}", file=sys.stderr)
