@@ -610,12 +610,17 @@ class Subscriber:
             self._forget(conn)
             return
         if frames:
-            for other in owner._sub.handles[1:]:
-                if other is not owner:
-                    other.enqueue(frames, conn.header)
+            handles = owner._sub.handles
+            if len(handles) > 1:
+                for other in handles[1:]:
+                    if other is not owner:
+                        other.enqueue(frames, conn.header)
             # the queues are empty whenever the worker reads (it delivers them first), so this
             # batch can go straight to the callbacks: no per-message queue entry
-            owner._deliver_batch(owner._keep_newest(frames, 0), conn.header)
+            maxlen = owner._queue.maxlen
+            if maxlen is not None and len(frames) > maxlen:
+                frames = owner._keep_newest(frames, 0)
+            owner._deliver_batch(frames, conn.header)
 
     def _finish(self) -> None:
         """Worker exit: pass our connections to the next handle of their topic, or close them."""
