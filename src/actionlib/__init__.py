@@ -30,6 +30,10 @@ _EXPORTS = {
     "GoalStatus": "action_client",
     "GoalID": "action_client",
     "GoalStatusArray": "action_client",
+    "Header": "action_client",
+    "NO_TRANSITION": "action_client",
+    "INVALID_TRANSITION": "action_client",
+    "HandleTrackerDeleter": "handle_tracker_deleter",
     "ActionException": "exceptions",
     "SimpleActionClient": "simple_action_client",
     "SimpleGoalState": "simple_action_client",
@@ -42,7 +46,23 @@ _EXPORTS = {
 }
 
 
+#: ROS 1's ``import actionlib`` loads these modules; here they load when first reached
+_SUBMODULES = {
+    "action_client",
+    "action_server",
+    "exceptions",
+    "goal_id_generator",
+    "handle_tracker_deleter",
+    "server_goal_handle",
+    "simple_action_client",
+    "simple_action_server",
+    "status_tracker",
+}
+
+
 def __getattr__(name: str) -> Any:
+    if name in _SUBMODULES:
+        return importlib.import_module(f"actionlib.{name}")  # the import binds it in this namespace
     module = _EXPORTS.get(name)
     if module is None:
         raise AttributeError(f"module 'actionlib' has no attribute {name!r}")
@@ -52,4 +72,4 @@ def __getattr__(name: str) -> Any:
 
 
 def __dir__() -> list[str]:
-    return sorted({*globals(), *_EXPORTS})
+    return sorted({*globals(), *_EXPORTS, *_SUBMODULES})

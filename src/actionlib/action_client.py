@@ -3,17 +3,22 @@
 from __future__ import annotations
 
 from actionlib import _process
+from actionlib.exceptions import ActionException
 from actionlib_msgs.msg import GoalID, GoalStatus, GoalStatusArray
 from ninjemys.actionlib import client as _core
 from ninjemys.actionlib.client import ClientGoalHandle, CommStateMachine
 from ninjemys.actionlib.states import CommState, TerminalState, _name_of
+from std_msgs.msg import Header
 
 TYPE_CHECKING = False
 if TYPE_CHECKING:
     from typing import Any
 
 __all__ = [
+    "INVALID_TRANSITION",
+    "NO_TRANSITION",
     "ActionClient",
+    "ActionException",
     "ClientGoalHandle",
     "CommState",
     "CommStateMachine",
@@ -21,9 +26,15 @@ __all__ = [
     "GoalManager",
     "GoalStatus",
     "GoalStatusArray",
+    "Header",
     "TerminalState",
     "get_name_of_constant",
 ]
+
+
+#: ROS 1's markers in its transition table: the status changes nothing / cannot happen in this state
+NO_TRANSITION = -1
+INVALID_TRANSITION = -2
 
 
 def get_name_of_constant(C: type, n: int) -> str:  # noqa: N803 - ROS 1's signature
@@ -40,10 +51,6 @@ class ActionClient(_core.ActionClient):
 
     def __init__(self, ns: str, ActionSpec: Any) -> None:  # noqa: N803 - ROS 1's signature
         super().__init__(_process.node(), ns, ActionSpec)
-        self.ActionSpec = ActionSpec
-        self.ActionGoal = self.types.action_goal
-        self.ActionResult = self.types.action_result
-        self.ActionFeedback = self.types.action_feedback
 
 
 class GoalManager:

@@ -5,14 +5,30 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from actionlib import _process
+from actionlib.exceptions import ActionException
+from actionlib.goal_id_generator import GoalIDGenerator
+from actionlib.handle_tracker_deleter import HandleTrackerDeleter
 from actionlib.server_goal_handle import ServerGoalHandle
+from actionlib.status_tracker import StatusTracker
+from actionlib_msgs.msg import GoalID, GoalStatus, GoalStatusArray
 from ninjemys.actionlib import server as _core
 
 TYPE_CHECKING = False
 if TYPE_CHECKING:
     from typing import Any
 
-__all__ = ["ActionServer", "nop_cb"]
+__all__ = [
+    "ActionException",
+    "ActionServer",
+    "GoalID",
+    "GoalIDGenerator",
+    "GoalStatus",
+    "GoalStatusArray",
+    "HandleTrackerDeleter",
+    "ServerGoalHandle",
+    "StatusTracker",
+    "nop_cb",
+]
 
 
 def nop_cb(goal_handle: ServerGoalHandle) -> None:
@@ -38,7 +54,21 @@ class ActionServer(_core.ActionServer):
             cancel_cb,
             auto_start,
         )
-        self.ActionSpec = ActionSpec
-        self.ActionGoal = self.types.action_goal
-        self.ActionResult = self.types.action_result
-        self.ActionFeedback = self.types.action_feedback
+
+    # ROS 1's internal entry points, public there (subclasses and tests call them)
+
+    def initialize(self) -> None:
+        """Advertise the topics and start the status publication (what :meth:`start` does)."""
+        self.start()
+
+    def internal_goal_callback(self, goal: Any) -> None:
+        """Handle an ActionGoal message as if it came on the ``goal`` topic."""
+        self._on_goal(goal)
+
+    def internal_cancel_callback(self, goal_id: Any) -> None:
+        """Handle a GoalID as if it came on the ``cancel`` topic."""
+        self._on_cancel(goal_id)
+
+    def publish_status_async(self, event: Any) -> None:
+        """The status timer's callback: publish the status list."""
+        self._on_timer(event)

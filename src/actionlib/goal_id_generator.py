@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 from actionlib import _process
+from actionlib_msgs.msg import GoalID
 from ninjemys.actionlib import goal_id as _core
 
-__all__ = ["GoalIDGenerator"]
+__all__ = ["GoalID", "GoalIDGenerator"]
 
 
 class GoalIDGenerator(_core.GoalIDGenerator):

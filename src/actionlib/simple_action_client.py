@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from actionlib import _process
-from actionlib.action_client import CommState, get_name_of_constant
+from actionlib.action_client import ActionClient, CommState, get_name_of_constant
 from actionlib_msgs.msg import GoalStatus
 from ninjemys.actionlib import simple_client as _core
 from ninjemys.actionlib.states import SimpleGoalState
@@ -12,7 +12,14 @@ TYPE_CHECKING = False
 if TYPE_CHECKING:
     from typing import Any
 
-__all__ = ["CommState", "GoalStatus", "SimpleActionClient", "SimpleGoalState", "get_name_of_constant"]
+__all__ = [
+    "ActionClient",
+    "CommState",
+    "GoalStatus",
+    "SimpleActionClient",
+    "SimpleGoalState",
+    "get_name_of_constant",
+]
 
 
 class SimpleActionClient(_core.SimpleActionClient):

@@ -5,13 +5,16 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from actionlib import _process
+from actionlib.action_server import ActionServer, nop_cb
+from actionlib.server_goal_handle import ServerGoalHandle
+from actionlib_msgs.msg import GoalStatus
 from ninjemys.actionlib import simple_server as _core
 
 TYPE_CHECKING = False
 if TYPE_CHECKING:
     from typing import Any
 
-__all__ = ["SimpleActionServer"]
+__all__ = ["ActionServer", "GoalStatus", "ServerGoalHandle", "SimpleActionServer", "nop_cb"]
 
 
 class SimpleActionServer(_core.SimpleActionServer):
@@ -31,3 +34,17 @@ class SimpleActionServer(_core.SimpleActionServer):
             execute_cb,
             auto_start,
         )
+
+    # ROS 1's internal entry points, public there
+
+    def internal_goal_callback(self, goal: ServerGoalHandle) -> None:
+        """The action server's goal callback: ``goal`` becomes the next goal (preempting the current)."""
+        self._on_goal(goal)
+
+    def internal_preempt_callback(self, preempt: ServerGoalHandle) -> None:
+        """The action server's cancel callback: a preempt request for the current or next goal."""
+        self._on_preempt(preempt)
+
+    def executeLoop(self) -> None:  # noqa: N802 - ROS 1's name
+        """The execute thread's body: run ``execute_cb`` for each accepted goal until shutdown."""
+        self._execute_loop()

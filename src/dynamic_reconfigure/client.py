@@ -5,10 +5,28 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from dynamic_reconfigure import DynamicReconfigureCallbackException, DynamicReconfigureParameterException
 from dynamic_reconfigure._mapping import mapped
+from dynamic_reconfigure.encoding import decode_config, decode_description, encode_config, extract_params
+from dynamic_reconfigure.msg import Config as ConfigMsg
+from dynamic_reconfigure.msg import ConfigDescription as ConfigDescrMsg
+from dynamic_reconfigure.srv import Reconfigure as ReconfigureSrv
 from ninjemys.dynamic_reconfigure.client import ReconfigureClient
+from rospy.service import ServiceException
 
-__all__ = ["Client"]
+__all__ = [
+    "Client",
+    "ConfigDescrMsg",
+    "ConfigMsg",
+    "DynamicReconfigureCallbackException",
+    "DynamicReconfigureParameterException",
+    "ReconfigureSrv",
+    "ServiceException",
+    "decode_config",
+    "decode_description",
+    "encode_config",
+    "extract_params",
+]
 
 
 class Client(ReconfigureClient):

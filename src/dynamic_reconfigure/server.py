@@ -4,10 +4,34 @@ from __future__ import annotations
 
 from typing import Any
 
+from dynamic_reconfigure import DynamicReconfigureCallbackException
 from dynamic_reconfigure._mapping import mapped
+from dynamic_reconfigure.encoding import (
+    decode_config,
+    encode_config,
+    encode_description,
+    extract_params,
+    get_tree,
+    initial_config,
+)
+from dynamic_reconfigure.msg import Config as ConfigMsg
+from dynamic_reconfigure.msg import ConfigDescription as ConfigDescrMsg
+from dynamic_reconfigure.srv import Reconfigure as ReconfigureSrv
 from ninjemys.dynamic_reconfigure.server import Callback, ReconfigureServer
 
-__all__ = ["Server"]
+__all__ = [
+    "ConfigDescrMsg",
+    "ConfigMsg",
+    "DynamicReconfigureCallbackException",
+    "ReconfigureSrv",
+    "Server",
+    "decode_config",
+    "encode_config",
+    "encode_description",
+    "extract_params",
+    "get_tree",
+    "initial_config",
+]
 
 
 class Server(ReconfigureServer):

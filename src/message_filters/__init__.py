@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from typing import Any
 
+from ninjemys import message_filters as _core
 from ninjemys.message_filters import (
-    ApproximateTimeSynchronizer,
     Cache,
     Chain,
     SimpleFilter,
@@ -18,6 +18,7 @@ from ninjemys.message_filters import (
     shared_subscriber,
 )
 from ninjemys.message_filters import _pass_on as _pass_on
+from ninjemys.rostime import Duration
 
 __all__ = [
     "ApproximateTimeSynchronizer",
@@ -27,6 +28,22 @@ __all__ = [
     "Subscriber",
     "TimeSynchronizer",
 ]
+
+
+class ApproximateTimeSynchronizer(_core.ApproximateTimeSynchronizer):
+    """``ApproximateTimeSynchronizer(fs, queue_size, slop, allow_headerless=False, reset=False)``;
+    ``slop`` is kept as a ``rospy.Duration``, as ROS 1 keeps it."""
+
+    def __init__(
+        self,
+        fs: Any,
+        queue_size: int,
+        slop: float,
+        allow_headerless: bool = False,
+        reset: bool = False,
+    ) -> None:
+        super().__init__(fs, queue_size, slop, allow_headerless, reset)
+        self.slop = Duration.from_sec(slop)
 
 
 class Subscriber(SimpleFilter):

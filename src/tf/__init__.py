@@ -4,6 +4,7 @@
 from tf2_ros import ConnectivityException, ExtrapolationException, LookupException
 from tf2_ros import TransformException as Exception  # noqa: A004 (tf's own name)
 
+from . import transformations  # noqa: F401 - ``import tf`` alone gives tf.transformations, as in ROS 1
 from .broadcaster import TransformBroadcaster
 from .listener import Transformer, TransformerROS, TransformListener
 

@@ -199,7 +199,9 @@ class Transformer:
         rp_t, rp_q = self.lookupTransform(reference_frame, reference_point_frame, make_time(target))
         m = transformations.translation_matrix(rp_t) @ transformations.quaternion_matrix(rp_q)
         delta = m @ numpy.array((origin[0], origin[1], origin[2], 1.0)) - origin
-        vel = vel + numpy.cross(rot, delta[:3])
+        # ROS 1 adds the dot product of rot and delta to every component (not the cross product a
+        # lever arm would give); programs compare against that, so it is kept
+        vel = vel + float(numpy.dot(rot, delta[:3]))
         return (float(vel[0]), float(vel[1]), float(vel[2])), (float(rot[0]), float(rot[1]), float(rot[2]))
 
     def setUsingDedicatedThread(self, value: bool) -> None:  # noqa: N802

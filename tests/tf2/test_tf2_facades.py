@@ -75,6 +75,25 @@ def test_can_transform_timeout_and_debug_tuple(buffer):
     assert buffer.can_transform_full("laser", Time(10), "laser", Time(11), "map")
 
 
+def test_lookup_with_timeout_answers_at_once_or_waits_for_the_data(buffer):
+    """Available data is returned without waiting; missing data is waited for (another thread
+    sends it) up to the timeout, then tf2's exception for the lookup is raised."""
+    start = time.monotonic()
+    assert buffer.lookup_transform("map", "laser", Time(0), Duration(5.0)).header.stamp == Time(11)
+    assert time.monotonic() - start < 1.0
+    import threading
+
+    sender = threading.Timer(0.2, lambda: buffer.set_transform(ts("base", "arm", 11, x=3.0), "test"))
+    sender.start()
+    m = buffer.lookup_transform("map", "arm", Time(0), Duration(5.0))
+    sender.join()
+    assert m.transform.translation.y == pytest.approx(3.0) and time.monotonic() - start >= 0.19
+    start = time.monotonic()
+    with pytest.raises(tf2_ros.LookupException, match="nowhere"):
+        buffer.lookup_transform("map", "nowhere", Time(0), Duration(0.2))
+    assert time.monotonic() - start >= 0.19
+
+
 def test_transform_registered_types(buffer):
     p = PointStamped()
     p.header.frame_id, p.header.stamp = "laser", Time(11)

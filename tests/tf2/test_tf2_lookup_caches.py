@@ -307,3 +307,72 @@ def test_side_composites_follow_history_changes():
         ]
         Recording().set_transforms(batch)
     check()
+
+
+def _deep_tree(rnd: random.Random, n: int) -> dict[str, str]:
+    """Mostly a chain, with side branches: lowest common ancestors at every depth."""
+    names = [f"d{i}" for i in range(n)]
+    return {names[i]: names[i - 1] if rnd.random() < 0.8 else names[rnd.randrange(i)] for i in range(1, n)}
+
+
+@pytest.mark.parametrize("seed", [4, 5])
+def test_deep_trees_answer_as_the_exact_walk(seed):
+    """Frames 20-60 links deep (the lowest common ancestor is found by bisection on depth there):
+    every lookup, at the latest time after each batch (the first lookup since an insertion takes the
+    newest stamps along the sides) and at an interpolated time, equals tf2's exact walk."""
+    rnd = random.Random(seed)
+    parents = _deep_tree(rnd, 60)
+    b = BufferCore()
+    names = ["d0", *parents]
+    for step in range(6):
+        batch = [
+            item(
+                p,
+                c,
+                1 + step * 0.5 + (0.25 if c == "d7" and step == 5 else 0.0),
+                rnd.uniform(-1, 1),
+                yaw_q(rnd.uniform(-3, 3)),
+            )
+            for c, p in parents.items()
+        ]
+        b.set_transforms(batch)
+        for _ in range(40):
+            target, source = rnd.choice(names), rnd.choice(names)
+            for t in (0, int((1 + step * 0.5 - rnd.uniform(0, 0.5 * min(step, 1))) * S)):
+                got = _answer(b, target, source, t)
+                tf, sf = b._frames[target], b._frames[source]
+                err: list[str] = []
+                if t == 0:
+                    code, t_exact = b._common_time(tf, sf, err)
+                    assert code == 0
+                else:
+                    t_exact = t
+                if got[0] != "ok":
+                    with pytest.raises(TransformException):
+                        b._walk_transform(tf, sf, t_exact)
+                    continue
+                assert got[1] == t_exact, (target, source)
+                assert got[2] == pytest.approx(b._walk_transform(tf, sf, t_exact), abs=1e-9)
+
+
+def test_a_repeated_lookup_from_the_root_is_memoized(monkeypatch):
+    """The top of a tree ("map") has no links: its transform to itself is memoized like any frame's,
+    so asking again for a deep frame in the root at the same time composes no link (it walked all
+    99 links on every call before)."""
+    import ninjemys.tf2.core as core
+
+    def fail(*_args):
+        raise AssertionError("a memoized lookup composed links")
+
+    b = BufferCore()
+    for t in (1, 2):
+        b.set_transforms([item(f"c{i - 1}", f"c{i}", t, 0.1 * i, yaw_q(0.01 * i * t)) for i in range(1, 100)])
+    for target, source, t in (("c0", "c99", int(1.5 * S)), ("c99", "c0", 0)):
+        first = b.lookup(target, source, t)
+        b.lookup(target, source, t)  # the repeat fills the memos
+        with monkeypatch.context() as patch:
+            patch.setattr(core, "_relative_at", fail)
+            patch.setattr(core.Frame, "at", fail)
+            for _ in range(3):
+                again = b.lookup(target, source, t)
+                assert again[0] == first[0] and again[1] == pytest.approx(first[1], abs=1e-9)

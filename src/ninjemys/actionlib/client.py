@@ -74,6 +74,11 @@ class CommStateMachine:
     def __hash__(self) -> int:
         return hash(self.goal_id)
 
+    def set_state(self, state: int) -> None:
+        """Set the comm state without telling the user (ROS 1's name; :meth:`transition_to` tells)."""
+        with self.mutex:
+            self.state = state
+
     def transition_to(self, state: int) -> None:
         self.state = state
         if self.transition_cb is not None:
@@ -231,6 +236,11 @@ class ActionClient:
     ) -> None:
         self.node = node
         self.types = ActionTypes.of(action_class)
+        # ROS 1's attribute names for the action's classes
+        self.ActionSpec = action_class
+        self.ActionGoal = self.types.action_goal
+        self.ActionResult = self.types.action_result
+        self.ActionFeedback = self.types.action_feedback
         self.ns = node.resolve_name(ns)
         self.clock = resolve_clock(node, clock)
         self.log = resolve_log(node, log, __name__)

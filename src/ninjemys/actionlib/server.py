@@ -66,7 +66,12 @@ class StatusTracker:
 
     @property
     def handle_destruction_time(self) -> Time:
+        """ROS 1's name for :attr:`destruction_time` (HandleTrackerDeleter sets it)."""
         return self.destruction_time
+
+    @handle_destruction_time.setter
+    def handle_destruction_time(self, stamp: Time) -> None:
+        self.destruction_time = stamp
 
 
 class ServerGoalHandle:
@@ -248,6 +253,12 @@ class ActionServer:
     ) -> None:
         self.node = node
         self.types = ActionTypes.of(action_class)
+        # ROS 1's attribute names for the action's classes
+        self.ActionSpec = action_class
+        self.ActionGoal = self.types.action_goal
+        self.ActionResult = self.types.action_result
+        self.ActionFeedback = self.types.action_feedback
+        self.auto_start = auto_start
         self.ns = node.resolve_name(ns)
         self.clock = resolve_clock(node, clock)
         self.log = resolve_log(node, log, __name__)
@@ -282,11 +293,22 @@ class ActionServer:
     def ActionResultType(self) -> type:  # noqa: N802 - ROS 1's attribute name
         return self.types.result
 
+    @property
+    def status_list(self) -> list[StatusTracker]:
+        """ROS 1's list of the goals' trackers, in arrival order (a copy: the server owns the list)."""
+        with self.lock:
+            return list(self.trackers.values())
+
+    @property
+    def status_timer(self) -> Timer | None:
+        """The timer that publishes the status list ``actionlib_status_frequency`` times a second."""
+        return self._timer
+
     def register_goal_callback(self, cb: Callable[[ServerGoalHandle], Any]) -> None:
         self.goal_callback = cb
 
-    def register_cancel_callback(self, cb: Callable[[ServerGoalHandle], Any]) -> None:
-        self.cancel_callback = cb
+    def register_cancel_callback(self, cancel_cb: Callable[[ServerGoalHandle], Any]) -> None:
+        self.cancel_callback = cancel_cb
 
     def start(self) -> None:
         """Advertise the five topics (with ROS 1's parameters) and publish the first status."""

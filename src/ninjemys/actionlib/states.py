@@ -60,8 +60,8 @@ class CommState:
     LOST = 8
 
     @classmethod
-    def to_string(cls, value: int) -> str:
-        return _name_of(cls, value)
+    def to_string(cls, n: int) -> str:
+        return _name_of(cls, n)
 
 
 class TerminalState:
@@ -75,8 +75,8 @@ class TerminalState:
     LOST = LOST
 
     @classmethod
-    def to_string(cls, value: int) -> str:
-        return _name_of(cls, value)
+    def to_string(cls, n: int) -> str:
+        return _name_of(cls, n)
 
 
 class SimpleGoalState:
@@ -87,8 +87,8 @@ class SimpleGoalState:
     DONE = 2
 
     @classmethod
-    def to_string(cls, value: int) -> str:
-        return _name_of(cls, value)
+    def to_string(cls, n: int) -> str:
+        return _name_of(cls, n)
 
 
 def status_name(value: int) -> str:

@@ -181,25 +181,27 @@ class ReconfigureClient:
         self._updates_sub.unregister()
         self._set_service.close()
 
-    @property
-    def config_callback(self) -> Callable[[Config | None], Any] | None:
+    def get_config_callback(self) -> Callable[[Config | None], Any] | None:
         return self._config_callback
 
-    @config_callback.setter
-    def config_callback(self, value: Callable[[Config | None], Any] | None) -> None:
+    def set_config_callback(self, value: Callable[[Config | None], Any] | None) -> None:
+        """Set the callback for new configurations; it runs at once with the current one, as in ROS 1."""
         self._config_callback = value
         if value is not None:
             value(self.config)
 
-    @property
-    def description_callback(self) -> Callable[[list[dict[str, Any]] | None], Any] | None:
+    config_callback = property(get_config_callback, set_config_callback)
+
+    def get_description_callback(self) -> Callable[[list[dict[str, Any]] | None], Any] | None:
         return self._description_callback
 
-    @description_callback.setter
-    def description_callback(self, value: Callable[[list[dict[str, Any]] | None], Any] | None) -> None:
+    def set_description_callback(self, value: Callable[[list[dict[str, Any]] | None], Any] | None) -> None:
+        """Set the callback for new descriptions; it runs at once with the current one, as in ROS 1."""
         self._description_callback = value
         if value is not None:
             value(self.param_description)
+
+    description_callback = property(get_description_callback, set_description_callback)
 
     def _on_update(self, msg: Any) -> None:
         if self.group_description is None:

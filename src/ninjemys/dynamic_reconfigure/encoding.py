@@ -87,9 +87,13 @@ def _group_states(tree: Mapping[str, Any]) -> list[Any]:
     return out
 
 
-def encode_config(config: Mapping[str, Any]) -> Any:
-    """A ``dynamic_reconfigure/Config`` message from a name->value dict (``groups`` as a state tree)."""
-    ConfigMsg = _msg("Config")
+def encode_config(config: Mapping[str, Any], flat: bool = True) -> Any:
+    """A ``dynamic_reconfigure/Config`` message from a name->value dict.
+
+    A group entry is a state tree (``flat``, the form every caller in ROS 1 uses) or, with
+    ``flat=False``, a list of group dicts taken as they are.
+    """
+    ConfigMsg, GroupState = _msg("Config"), _msg("GroupState")
     msg = ConfigMsg()
     kinds = {bool: (msg.bools, "BoolParameter"), int: (msg.ints, "IntParameter")}
     kinds[str] = (msg.strs, "StrParameter")
@@ -98,31 +102,47 @@ def encode_config(config: Mapping[str, Any]) -> Any:
         kind = kinds.get(type(value))
         if kind is not None:
             kind[0].append(_msg(kind[1])(key, value))
-        elif isinstance(value, Mapping):
+        elif isinstance(value, Mapping) and flat:
             msg.groups.extend(_group_states(value))
+        elif isinstance(value, (list, tuple)) and not flat:
+            msg.groups = [GroupState(g["name"], bool(g["state"]), g["id"], g["parent"]) for g in value]
     return msg
 
 
-def encode_description(config_type: Any) -> Any:
+def encode_groups(parent: Any, group: Mapping[str, Any]) -> list[Any]:
+    """The ``Group`` messages of a description tree (``group`` first, then its subgroups, depth first);
+    ``parent`` is unused, as in ROS 1 (each group names its parent by id)."""
+    Group, ParamDescription = _msg("Group"), _msg("ParamDescription")
+    params = [
+        ParamDescription(p["name"], p["type"], p["level"], p["description"], p["edit_method"])
+        for p in group["parameters"]
+    ]
+    msg = Group(group["name"], group["type"], params, group["parent"], group["id"])
+    out = [msg]
+    for child in group["groups"]:
+        out.extend(encode_groups(msg, child))
+    return out
+
+
+def encode_description(descr: Any) -> Any:
     """A ``ConfigDescription`` message from a generated ``<Name>Config`` module (or any object with
     ``config_description``, ``min``, ``max`` and ``defaults``)."""
-    Group, ParamDescription = _msg("Group"), _msg("ParamDescription")
     msg = _msg("ConfigDescription")()
-    msg.max = encode_config(config_type.max)
-    msg.min = encode_config(config_type.min)
-    msg.dflt = encode_config(config_type.defaults)
-
-    def walk(group: Mapping[str, Any]) -> None:
-        params = [
-            ParamDescription(p["name"], p["type"], p["level"], p["description"], p["edit_method"])
-            for p in group["parameters"]
-        ]
-        msg.groups.append(Group(group["name"], group["type"], params, group["parent"], group["id"]))
-        for child in group["groups"]:
-            walk(child)
-
-    walk(config_type.config_description)
+    msg.max = encode_config(descr.max)
+    msg.min = encode_config(descr.min)
+    msg.dflt = encode_config(descr.defaults)
+    msg.groups = encode_groups(None, descr.config_description)
     return msg
+
+
+def get_parents(group: Mapping[str, Any], descriptions: Mapping[str, Any]) -> list[Any]:
+    """The ancestors of ``group`` among ``descriptions['group']``, the root first."""
+    parents: list[Any] = []
+    for candidate in descriptions["group"]:
+        if candidate["id"] == group["parent"]:
+            parents.extend(get_parents(candidate, descriptions))
+            parents.append(candidate)
+    return parents
 
 
 def group_dict(group: Any) -> Config:
@@ -144,17 +164,17 @@ def _children(groups: Iterable[Any], parent: Any) -> list[Any]:
     return [g for g in groups if g.id != 0 and g.parent == parent.id]
 
 
-def get_tree(msg: Any, group: Any = None) -> Config:
-    """The group state tree of a Config or ConfigDescription message (children keyed by name)."""
-    root = group is None
-    if root:
-        group = next(g for g in msg.groups if g.id == 0)
+def get_tree(m: Any, group: Any = None) -> Config:
+    """The group state tree of a Config or ConfigDescription message (children keyed by name); below
+    the root group (id 0) only the children, as in ROS 1."""
+    if group is None:
+        group = next(g for g in m.groups if g.id == 0)
     children = Config({})
-    for g in _children(msg.groups, group):
+    for g in _children(m.groups, group):
         node = group_dict(g)
-        node["groups"] = get_tree(msg, g)
+        node["groups"] = get_tree(m, g)
         children[node["name"]] = node
-    if not root:
+    if group.id != 0:
         return children
     tree = group_dict(group)
     tree["groups"] = children

@@ -85,7 +85,7 @@ class ReconfigureServer:
         self.type = config_type
         self.ns = server_namespace(namespace)
         self.callback = callback
-        self._lock = threading.Lock()
+        self.mutex = threading.Lock()
         self._params = extract_params(config_type.config_description)
         self.description = encode_description(config_type)
         config = Config(config_type.defaults)
@@ -93,24 +93,24 @@ class ReconfigureServer:
         clamp(config_type, config)
         config["groups"] = get_tree(self.description)
         self.config: Config = initial_config(encode_config(config), config_type.config_description)
-        self._descriptions = node.publisher(
+        self.descr_topic = node.publisher(
             self.ns + "parameter_descriptions",
             get_message_class("dynamic_reconfigure/ConfigDescription"),
             queue_size=10,
             latch=True,
         )
-        self._descriptions.publish(self.description)
-        self._updates = node.publisher(
+        self.descr_topic.publish(self.description)
+        self.update_topic = node.publisher(
             self.ns + "parameter_updates",
             get_message_class("dynamic_reconfigure/Config"),
             queue_size=10,
             latch=True,
         )
-        with self._lock:
+        with self.mutex:
             self._change(self.config, ~0)
         service = get_service_class("dynamic_reconfigure/Reconfigure")
         self._response = service._response_class
-        self._service = node.service(self.ns + "set_parameters", service, self._on_set)
+        self.set_service = node.service(self.ns + "set_parameters", service, self._on_set)
 
     def _read_parameter_server(self, config: Config) -> None:
         for param in self._params:
@@ -147,7 +147,7 @@ class ReconfigureServer:
             raise DynamicReconfigureCallbackException(msg)
         self.config = result
         self._write_parameter_server()
-        self._updates.publish(encode_config(self.config))
+        self.update_topic.publish(encode_config(self.config))
         return self.config
 
     def _level(self, new: Mapping[str, Any], old: Mapping[str, Any]) -> int:
@@ -160,7 +160,7 @@ class ReconfigureServer:
     def update_configuration(self, changes: Mapping[str, Any]) -> Config:
         """Apply ``changes`` (name -> value, optionally ``groups``), run the callback, publish the result."""
         known = {p["name"]: p for p in self._params}
-        with self._lock:
+        with self.mutex:
             new = copy.deepcopy(self.config)
             for name, value in changes.items():
                 if name == "groups":
@@ -181,6 +181,6 @@ class ReconfigureServer:
 
     def shutdown(self) -> None:
         """Stop serving: the service and both topics go away."""
-        self._service.shutdown()
-        self._descriptions.unregister()
-        self._updates.unregister()
+        self.set_service.shutdown()
+        self.descr_topic.unregister()
+        self.update_topic.unregister()

@@ -293,9 +293,14 @@ class Buffer(BufferCore):
             t = time.secs * _NS + time.nsecs
         except AttributeError:
             t = to_ns(time)
-        if timeout is not None and to_seconds(timeout) > 0.0:
+        try:
+            stamp, tr = self.lookup(target_frame, source_frame, t)
+        except TransformException:
+            if timeout is None or to_seconds(timeout) <= 0.0:
+                raise
+            # not yet: wait for it (as tf2_ros's can_transform with the timeout), then look again
             self._wait(lambda: self.can_transform_ns(target_frame, source_frame, t), timeout)
-        stamp, tr = self.lookup(target_frame, source_frame, t)
+            stamp, tr = self.lookup(target_frame, source_frame, t)
         return (_build or make_transform_stamped)(target_frame, source_frame, stamp, tr)
 
     def lookup_transform_full(
@@ -327,7 +332,10 @@ class Buffer(BufferCore):
     ) -> Any:
         """Whether the lookup would succeed, waiting up to ``timeout``; ``(bool, why)`` on request."""
         t = to_ns(time)
-        result = self._wait(lambda: self.can_transform_ns(target_frame, source_frame, t), timeout)
+        if timeout is None or to_seconds(timeout) <= 0.0:
+            result = BufferCore.can_transform(self, target_frame, source_frame, t)
+        else:
+            result = self._wait(lambda: self.can_transform_ns(target_frame, source_frame, t), timeout)
         return result if return_debug_tuple else result[0]
 
     def can_transform_full(  # type: ignore[override]

@@ -210,9 +210,13 @@ class Frame:
             return self._resolve(0)
         if err is not None:
             if n == 1:
+                # tf2 formats this one into a 116-byte buffer: with two ten-digit times it loses its
+                # tail ("... is in the buffe"), and programs see exactly that
                 err.append(
-                    "Lookup would require extrapolation at time %.09f, but only time %.09f is in the buffer"
-                    % (_secs(t), _secs(stamps[0]))
+                    (
+                        "Lookup would require extrapolation at time %.09f, but only time %.09f is in the buffer"
+                        % (_secs(t), _secs(stamps[0]))
+                    )[:115]
                 )
             elif i == n:
                 latest = stamps[-1]
@@ -374,6 +378,7 @@ class BufferCore:
         self._sources: list[Any] = []
         self._gen = 0  # bumped by every accepted insertion: memos of older generations are stale
         self._last_t = -1  # the time of the previous non-latest lookup (a repeat fills the memos)
+        self._asked_gen = -1  # the generation of the previous latest-time lookup (a repeat caches minima)
         self._topology = 0  # bumped when a frame appears or a newest parent changes
         self._history = 0  # bumped when stored history changes other than at its new end (composites)
         self._floor = 0  # the newest oldest-kept stamp after any pruning: older composites are stale
@@ -1073,6 +1078,10 @@ class BufferCore:
         per frame until the next insertion (``gen``); None when some link has no data for ``t``."""
         if frame.memo_gen == gen and frame.memo_t == t:
             return frame.memo_val
+        if not frame.data:  # the top of its tree ("map", "world"): itself, at any time
+            acc = (frame, (0j, 0.0, 1.0 + 0j))
+            frame.memo_gen, frame.memo_t, frame.memo_val = gen, t, acc
+            return acc
         path: list[tuple[Frame, Entry]] = []
         cur = frame
         acc: tuple | None
@@ -1170,19 +1179,42 @@ class BufferCore:
         if sp is not None and tp is not None and sp[-1] is tp[-1]:
             i = len(sp) - 1
             j = len(tp) - 1
-            while i and j and sp[i - 1] is tp[j - 1]:
-                i -= 1
-                j -= 1
+            if i > 12 and j > 12:  # deep frames: bisect on depth (the ancestors at a depth match up to it)
+                lo = 0
+                hi = min(i, j)
+                while lo < hi:
+                    mid = (lo + hi + 1) >> 1
+                    if sp[i - mid] is tp[j - mid]:
+                        lo = mid
+                    else:
+                        hi = mid - 1
+                i -= lo
+                j -= lo
+            else:
+                while i and j and sp[i - 1] is tp[j - 1]:
+                    i -= 1
+                    j -= 1
         if t == 0:
             if i < 0:
                 err: list[str] = []
                 code, t = self._common_time(target, source, err)
                 if code != NO_ERROR:
                     _raise(code, err)
-            else:  # tf2's latest common time, from the prefix minima of the newest stamps on each side
+            elif self._asked_gen == gen:  # tf2's latest common time, from cached prefix minima
                 a = source.pmin[i] if source.pmin_gen == gen else self._pmin(source)[i]
                 b = target.pmin[j] if target.pmin_gen == gen else self._pmin(target)[j]
                 t = a if b == 0 or (a and a < b) else b
+            else:  # the first lookup since an insertion (data streams in between lookups): just the sides
+                self._asked_gen = gen
+                t = 0
+                for k in range(i):
+                    b = sp[k].latest
+                    if b and (t == 0 or b < t):
+                        t = b
+                for k in range(j):
+                    b = tp[k].latest
+                    if b and (t == 0 or b < t):
+                        t = b
         if (source.memo_gen == gen and source.memo_t == t) or t == self._last_t:
             # a time asked for before: each frame's transform to the top of its tree is (or becomes) memoized
             a = (
@@ -1233,9 +1265,11 @@ class BufferCore:
         comps, lead, links = side
         if not links:
             return 0j, 0.0, 1.0 + 0j
+        if t >= lead.latest:  # at (or past) the newest stamp: there is no segment around t
+            return None
         stamps = lead.stamps
         i = bisect_right(stamps, t)
-        if not 0 < i < len(stamps):
+        if not i:
             return None
         t0 = stamps[i - 1]
         c = comps.get(t0)
@@ -1378,22 +1412,23 @@ class BufferCore:
             self._validate("lookupTransform argument fixed_frame", fixed_frame)
             _, first = self.lookup(fixed_frame, source_frame, source_t)
             stamp, second = self.lookup(target_frame, fixed_frame, target_t)
-            return stamp, tfm.compose(second, first)
+            return stamp, tfm.matrix_signed(tfm.compose(second, first))
 
     def can_transform(self, target_frame: str, source_frame: str, t: int) -> tuple[bool, str]:
         """tf2's ``canTransform`` with its error text: (possible, why not)."""
         if target_frame == source_frame:
             return True, ""
-        if self._warn_frame_id("canTransform argument target_frame", target_frame) or self._warn_frame_id(
-            "canTransform argument source_frame", source_frame
-        ):
-            return False, ""
         self._pull()
         with self._lock:
-            self._drain_for(target_frame, source_frame)
+            if self._pending or self._owing:
+                self._drain_for(target_frame, source_frame)
             target = self._frames.get(target_frame)
             source = self._frames.get(source_frame)
             if target is None or source is None:
+                if self._warn_frame_id("canTransform argument target_frame", target_frame) or (
+                    self._warn_frame_id("canTransform argument source_frame", source_frame)
+                ):
+                    return False, ""
                 parts = []
                 if target is None:
                     parts.append(f"canTransform: target_frame {target_frame} does not exist.")
@@ -1405,13 +1440,11 @@ class BufferCore:
     def _can(self, target: Frame, source: Frame, t: int) -> tuple[bool, str]:
         if target is source:
             return True, ""
-        if t != 0:  # the memo answers most checks without a walk
-            gen = self._gen
-            a = self._to_root(source, t, gen)
-            if a is not None:
-                b = self._to_root(target, t, gen)
-                if b is not None and a[0] is b[0]:
-                    return True, ""
+        try:  # the lookup's caches answer most checks without a walk
+            self._lookup(target, source, t)
+            return True, ""
+        except TransformException:
+            pass  # the walk says why, in tf2's words
         err: list[str] = []
         code, _, _ = self._walk(target, source, t, err, accumulate=False)
         return code == NO_ERROR, "".join(err)
@@ -1641,25 +1674,41 @@ def _relative_at(up: tuple, down: tuple, t: int) -> tuple | None:
         Q = 1.0 + 0j
         x = y = z = qx = qy = qz = qw = 0.0
         for f, parent in links:
-            if f.static:
-                rec = f._point()
-                r = 0.0
+            if f.static or f.latest == t:  # the newest entry as it is (a static frame's only one)
+                d = f.data[-1]
+                if len(d) == 3:
+                    d = f._resolve(-1)
+                if d[0] is not parent:
+                    return None
+                ex, ey, ez, px, py, pz, pw = d[1]
+                if px == 0.0 and py == 0.0:
+                    if planar:
+                        c = complex(pw, pz)
+                        P = c * c * P + complex(ex, ey)
+                        Z += ez
+                        Q = c * Q
+                        continue
+                elif planar:
+                    planar = False
+                    x = P.real
+                    y = P.imag
+                    z = Z
+                    qz = Q.imag
+                    qw = Q.real
+                rec = None
             else:
                 stamps = f.stamps
                 i = bisect_right(stamps, t)
-                if i == len(stamps):  # at the newest stamp exactly, or past it (extrapolation)
-                    if not i or stamps[-1] != t:
-                        return None
-                    rec = f._point()
-                    r = 0.0
-                elif i:
+                if 0 < i < len(stamps):
                     rec = f.segs[i] or f._segment(i)
                     r = (t - rec[2]) * rec[3]
-                else:
+                else:  # before the oldest or after the newest stamp: extrapolation
                     return None
-            if rec[1] is not parent:
-                return None
-            if rec[0]:  # a planar link
+                if rec[1] is not parent:
+                    return None
+            if rec is None:
+                pass
+            elif rec[0]:  # a planar link
                 _, _, _, _, e, ez, de, dz, c, th = rec
                 if r:
                     e += r * de

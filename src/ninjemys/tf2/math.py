@@ -34,6 +34,24 @@ def compose(a: Transform7, b: Transform7) -> Transform7:
     )
 
 
+def matrix_signed(a: Transform7) -> Transform7:
+    """``a`` with the quaternion sign tf2 gets when it composes through 3x3 matrices (the full lookup):
+    ``w`` positive when the matrix trace is, else the component of the largest diagonal element."""
+    x, y, z, qx, qy, qz, qw = a
+    r00, r11, r22 = (
+        1.0 - 2.0 * (qy * qy + qz * qz),
+        1.0 - 2.0 * (qx * qx + qz * qz),
+        1.0 - 2.0 * (qx * qx + qy * qy),
+    )
+    if r00 + r11 + r22 > 0.0:
+        lead = qw
+    elif r00 < r11:
+        lead = qz if r11 < r22 else qy
+    else:
+        lead = qz if r00 < r22 else qx
+    return a if lead >= 0.0 else (x, y, z, -qx, -qy, -qz, -qw)
+
+
 def inverse(a: Transform7) -> Transform7:
     """The inverse transform."""
     tx, ty, tz, qx, qy, qz, qw = a
