@@ -89,7 +89,7 @@ def test_the_sockets_wake_the_thread_before_they_fill(pair) -> None:
     sub = listener.tf_sub
     (conn,) = sub._host._conns.values()
     mark = conn.sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVLOWAT)
-    assert mark == max(1, conn.sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF) // 8)
+    assert mark == max(1, conn.sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF) // 4)
     sub.set_eager(True)
     assert _wait(lambda: conn.sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVLOWAT) == 1)
     sub.set_eager(False)

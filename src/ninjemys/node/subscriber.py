@@ -24,7 +24,7 @@ to the next handle of its topic, as a reader's do.
 
 A handle made with ``lazy=period`` (a tf listener's ``/tf``: its data is needed only when a lookup
 asks) does not wake per message: its worker reads what the kernel holds once ``period`` seconds
-have passed since the sockets were last read, or as soon as one holds an eighth of its receive
+have passed since the sockets were last read, or as soon as one holds a quarter of its receive
 buffer (``SO_RCVLOWAT``: the kernel wakes it then, so a publisher never finds the buffer full), and
 a reader that needs the data now calls :meth:`Subscriber.pull`, which reads and delivers on the
 caller's thread. :meth:`Subscriber.set_eager` makes the worker wake per message again while
@@ -90,13 +90,14 @@ _unpack_int = struct.Struct("i").unpack
 
 
 def _low_water(sock: socket.socket, lazy: bool) -> bool:
-    """Set ``sock``'s ``SO_RCVLOWAT`` to an eighth of its receive buffer (``lazy``) or back to one byte;
-    False where the platform cannot."""
+    """Set ``sock``'s ``SO_RCVLOWAT`` to a quarter of its receive buffer (``lazy``) or back to one byte;
+    False where the platform cannot. A quarter: the kernel counts its bookkeeping in that buffer and
+    offers the sender as little as half of it, so a quarter of it in data is reached, never the end."""
     option = getattr(socket, "SO_RCVLOWAT", None)
     if option is None:
         return False
     try:
-        mark = max(1, sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF) // 8) if lazy else 1
+        mark = max(1, sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF) // 4) if lazy else 1
         sock.setsockopt(socket.SOL_SOCKET, option, mark)
     except OSError:
         return False
@@ -539,8 +540,8 @@ class Subscriber:
                 self._last_read = time.monotonic()
 
     def _set_lowat(self, lazy: bool) -> None:
-        """Make the sockets report readable only at an eighth of their receive buffer (about a
-        quarter of the data it holds) while lazy, at any byte otherwise (read lock not needed: the
+        """Make the sockets report readable only at a quarter of their receive buffer (at most half
+        of the data it holds) while lazy, at any byte otherwise (read lock not needed: the
         worker's own sockets). Without ``SO_RCVLOWAT`` the worker stays one wake-up per message."""
         ok = True
         for conn in list(self._conns.values()):

@@ -711,8 +711,9 @@ class BufferCore:
             data.extend(zip(repeat(parent, k), repeat(values, k), layout.cells(k)[j], strict=True))
             segs.extend(repeat(None, k))
         f.applied = layout.owed_end
-        f.latest = st[-1]
-        self._prune((f,), missed)
+        f.latest = latest = st[-1]
+        if missed or st[0] < latest - self.cache_time_ns - self._prune_slack:
+            self._prune((f,), missed)
 
     def _settle_layout(self, layout: Layout) -> None:
         """Append every owed batch of ``layout`` to all its frames and forget the batches (lock held).

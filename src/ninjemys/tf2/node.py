@@ -33,7 +33,7 @@ from ninjemys.tf2.wire import encode_tf_message
 _log = logging.getLogger(__name__)
 TF_MESSAGE_MD5 = "94810edda583a504dfda3829e70d7eec"
 #: seconds between the lazy /tf subscription's reads when nobody asks (at most; it adapts down)
-LAZY_PERIOD = 0.1
+LAZY_PERIOD = 0.25
 
 
 class TransformListener:
