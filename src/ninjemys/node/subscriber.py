@@ -503,24 +503,36 @@ class Subscriber:
                         busy = True
                 if busy:
                     continue
-                lazy = bool(self._lazy) and not self._eager
-                if lazy != self._lowat:
-                    self._set_lowat(lazy)
-                if self._lowat:
-                    self._lazy_wait()
+                if self._lazy:  # reads may also come from pulls: under the read lock
+                    self._lazy_round()
                     continue
-                ready = self._poller.wait()
-                with self._read_lock:
-                    for conn in ready:
-                        if conn is None:
-                            self._on_wake()
-                        else:
-                            self._read(conn)
+                for conn in self._poller.wait():
+                    if conn is None:
+                        self._on_wake()
+                    else:
+                        self._read(conn)
                 if self._coalesce and not any(h._queue for h in self._served):
                     time.sleep(self._coalesce)  # let messages gather: the next poll takes them all
         finally:
             with self._read_lock:
                 self._finish()
+
+    def _lazy_round(self) -> None:
+        """One wait of a lazy handle's worker: on the low-water marks (:meth:`_lazy_wait`), or per
+        message while eager."""
+        lazy = not self._eager
+        if lazy != self._lowat:
+            self._set_lowat(lazy)
+        if self._lowat:
+            self._lazy_wait()
+            return
+        ready = self._poller.wait()
+        with self._read_lock:
+            for conn in ready:
+                if conn is None:
+                    self._on_wake()
+                else:
+                    self._read(conn)
 
     def _lazy_wait(self) -> None:
         """One wait of a lazy worker: until ``lazy`` seconds have passed since the sockets were last
