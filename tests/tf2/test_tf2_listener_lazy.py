@@ -104,3 +104,18 @@ def test_unregister_ends_the_lazy_thread(pair) -> None:
     thread.join(5.0)
     assert not thread.is_alive()
     assert listener.buffer._sources == []
+
+
+def test_under_simulated_time_every_message_wakes_the_listener() -> None:
+    """A jump back of /clock clears the buffer: only messages delivered as they arrive are known to be
+    older or newer than the jump, so the listener is not lazy under simulated time."""
+    with testing.run_master() as uri:
+        node = Node("tf_lazy_sim", master_uri=uri, sim_time=True)
+        try:
+            listener = tfnode.TransformListener(node, BufferCore(), now=lambda: node.clock.now())
+            assert listener.tf_sub._host._eager
+            listener.buffer.set_transforms([("odom", "base", 1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0)])
+            listener.buffer.lookup("odom", "base", 0)  # pulls: still eager
+            assert listener.tf_sub._host._eager
+        finally:
+            node.shutdown("test done")
