@@ -57,7 +57,7 @@ npm: $(NPM_STAMP)
 
 lint: venv
 	$(VENV)/bin/ruff format --check src tests bench examples
-	$(VENV)/bin/ruff check src tests bench examples
+	$(VENV)/bin/ruff check --no-cache src tests bench examples
 
 format: venv
 	$(VENV)/bin/ruff format src tests bench examples

@@ -202,7 +202,7 @@ class Transformer:
         # ROS 1 adds the dot product of rot and delta to every component (not the cross product a
         # lever arm would give); programs compare against that, so it is kept
         vel = vel + float(numpy.dot(rot, delta[:3]))
-        return (float(vel[0]), float(vel[1]), float(vel[2])), (float(rot[0]), float(rot[1]), float(rot[2]))
+        return (vel[0], vel[1], vel[2]), (rot[0], rot[1], rot[2])  # numpy floats, as ROS 1 returns
 
     def setUsingDedicatedThread(self, value: bool) -> None:  # noqa: N802
         self._using_dedicated_thread = value

@@ -2,8 +2,8 @@
 
 ``Buffer``, ``TransformListener``, ``TransformBroadcaster`` and ``StaticTransformBroadcaster`` work after
 ``rospy.init_node()`` on the process's core Node. Timeouts run on ROS time and wait on the buffer's
-condition (new data wakes them), not on polling sleeps. ``BufferClient`` (the action-based remote
-buffer) is not provided.
+condition (new data wakes them), not on polling sleeps. ``BufferClient`` (lookups answered by
+``rosrun tf2_ros buffer_server`` over an action) loads on first use.
 """
 
 from __future__ import annotations
@@ -35,8 +35,10 @@ _log = logging.getLogger("tf2_ros")
 #: buffer's condition instead (new data wakes it), the name stays for code that reads it
 DEFAULT_CAN_TRANSFORM_POLLING_SCALE = 0.01
 
-#: message classes ROS 1's tf2_ros namespace carries along (its star imports); loaded on first use
-_MESSAGE_NAMES = {
+#: names loaded on first use: BufferClient, and the message classes ROS 1's tf2_ros namespace carries
+#: along (its star imports)
+_LAZY_NAMES = {
+    "BufferClient": ("tf2_ros.buffer_client", "BufferClient"),
     "TransformStamped": ("geometry_msgs.msg", "TransformStamped"),
     "TFMessage": ("tf2_msgs.msg", "TFMessage"),
     "Header": ("std_msgs.msg", "Header"),
@@ -49,18 +51,20 @@ _MESSAGE_NAMES = {
 
 
 def __getattr__(name: str) -> Any:
-    spec = _MESSAGE_NAMES.get(name)
-    if spec is None:
-        raise AttributeError(f"module 'tf2_ros' has no attribute {name!r}")
     import importlib
 
+    if name == "buffer_client":  # loads actionlib and rospy: only when asked for
+        return importlib.import_module("tf2_ros.buffer_client")
+    spec = _LAZY_NAMES.get(name)
+    if spec is None:
+        raise AttributeError(f"module 'tf2_ros' has no attribute {name!r}")
     value = getattr(importlib.import_module(spec[0]), spec[1])
     globals()[name] = value
     return value
 
 
 def __dir__() -> list[str]:
-    return sorted({*globals(), *_MESSAGE_NAMES})
+    return sorted({*globals(), *_LAZY_NAMES, "buffer_client"})
 
 
 def _rospy() -> Any:

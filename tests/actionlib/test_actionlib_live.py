@@ -117,6 +117,34 @@ def test_goal_right_after_wait_for_server_never_loses_its_result(nodes: Any) -> 
         client.action_client.stop()
 
 
+def test_wait_for_server_waits_until_the_server_lists_our_connections(nodes: Any) -> None:
+    """rospy answers a subscriber's handshake before it adds the connection to its publisher, so both
+    ends can look connected while a result sent then is lost. The client asks the server's
+    getBusInfo: here a server whose bus info leaves our result connection out for its first 0.5 s
+    (as a preempted rospy thread would) is not ready before it lists it."""
+    server_node = nodes("server")
+    adder(server_node)
+    real_bus_info = server_node.bus_info
+    hide_until = time.monotonic() + 0.5
+    asked: list[float] = []
+
+    def lagging_bus_info() -> list[Any]:
+        asked.append(time.monotonic())
+        rows = real_bus_info()
+        if time.monotonic() < hide_until:
+            rows = [row for row in rows if not row[4].endswith("/add/result")]
+        return rows
+
+    server_node.bus_info = lagging_bus_info  # type: ignore[method-assign]
+    client = SimpleActionClient(nodes("client"), "add", TwoIntsAction)
+    assert client.wait_for_server(10.0)
+    assert time.monotonic() >= hide_until and len(asked) >= 2
+    client.send_goal(TwoIntsGoal(a=2, b=3))
+    assert client.wait_for_result(10.0) and client.get_result().sum == 5
+    asked.clear()
+    assert client.wait_for_server(1.0) and asked == []  # confirmed once per server connection
+
+
 def test_many_goals_back_to_back(nodes: Any) -> None:
     adder(nodes("server"))
     client = SimpleActionClient(nodes("client"), "add", TwoIntsAction)

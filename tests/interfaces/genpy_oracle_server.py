@@ -21,6 +21,7 @@ import traceback
 
 import genpy
 import genpy.dynamic
+
 import roslib.message
 
 _classes: dict[str, type] = {}

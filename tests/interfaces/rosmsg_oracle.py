@@ -11,6 +11,7 @@ import json
 import sys
 
 import rosmsg
+
 import rospkg
 
 

@@ -6,6 +6,7 @@ returns (clamped values included), what the server callback receives, and the cl
 import io
 import json
 import threading
+import time
 import types
 
 import rospy
@@ -103,6 +104,14 @@ out["live"]["double_from_int"] = outcome(update, {"double_": 4})
 out["live"]["bool_from_str"] = outcome(update, {"bool_": "True"})
 out["live"]["str_from_int"] = outcome(update, {"str_": 5})
 out["live"]["no_server"] = outcome(Client, "no_such_server", timeout=0.3)
+server_side = server.update_configuration({"int_": 4, "double_": 100.0, "str_": "srv"})
+out["live"]["server_update"] = plain({k: v for k, v in server_side.items() if k != "groups"})
+deadline = time.time() + 10.0  # the update reaches the client on its own thread
+while client.get_configuration(timeout=10)["int_"] != 4 and time.time() < deadline:
+    time.sleep(0.01)
+out["live"]["server_update_seen"] = plain(
+    {k: v for k, v in client.get_configuration(timeout=10).items() if k in ("int_", "double_", "str_")}
+)
 out["live"]["groups"] = plain(client.get_configuration(timeout=10)["groups"])
 out["live"]["param_names"] = [p["name"] for p in client.get_parameter_descriptions(timeout=10)]
 out["live"]["param_first"] = plain(client.get_parameter_descriptions(timeout=10)[0])

@@ -12,7 +12,7 @@ import message_filters
 import rospy
 import tf
 import tf2_ros
-from actionlib.msg import TestAction
+from actionlib.msg import TestAction, TestGoal, TestResult
 from dynamic_reconfigure.client import Client
 from dynamic_reconfigure.server import Server
 from geometry_msgs.msg import PointStamped
@@ -27,18 +27,31 @@ rospy.init_node("parity_instances_peer")
 
 def public(obj):
     """The object's own public attributes, and what else it answers (properties, methods)."""
-    own = sorted(k for k in vars(obj) if not k.startswith("_"))
+    names = (
+        vars(obj)
+        if hasattr(obj, "__dict__")
+        else [n for c in type(obj).__mro__ for n in getattr(c, "__slots__", ())]
+    )
+    own = sorted(k for k in names if not k.startswith("_"))
     return {"own": own, "reachable": sorted(k for k in dir(obj) if not k.startswith("_"))}
 
 
 objects = {}
-simple_server = actionlib.SimpleActionServer("sas", TestAction, execute_cb=lambda g: None, auto_start=False)
+simple_server = actionlib.SimpleActionServer(
+    "sas", TestAction, execute_cb=lambda g: simple_server.set_succeeded(TestResult(1)), auto_start=False
+)
 simple_server.start()
 objects["SimpleActionServer"] = simple_server
 objects["ActionServer"] = simple_server.action_server
 client = actionlib.SimpleActionClient("sas", TestAction)
 client.wait_for_server(rospy.Duration(10.0))
 objects["SimpleActionClient"] = client
+client.send_goal(TestGoal(1))
+client.wait_for_result(rospy.Duration(10.0))
+objects["ClientGoalHandle"] = client.gh
+objects["CommStateMachine"] = client.gh.comm_state_machine
+objects["ServerGoalHandle"] = simple_server.current_goal
+objects["StatusTracker"] = simple_server.current_goal.status_tracker
 objects["ActionClient"] = client.action_client
 buffer = tf2_ros.Buffer()
 objects["Buffer"] = buffer

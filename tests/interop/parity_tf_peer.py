@@ -16,6 +16,7 @@ import tf2_geometry_msgs  # noqa: F401 - registers the stamped types with Buffer
 import tf2_ros
 from geometry_msgs.msg import (
     Point,
+    Point32,
     PointStamped,
     Pose,
     PoseStamped,
@@ -27,6 +28,7 @@ from geometry_msgs.msg import (
     Wrench,
     WrenchStamped,
 )
+from sensor_msgs.msg import ChannelFloat32, PointCloud
 from std_msgs.msg import Header
 
 
@@ -132,6 +134,43 @@ def tf_checks():
         )
     bad = PointStamped(Header(frame_id="nowhere", stamp=zero), Point(1.0, 2.0, 3.0))
     out["point_unknown"] = outcome(t.transformPoint, "map", bad)
+    out["kinds"] = [
+        kind(t.lookupTransform("map", "laser", zero)),
+        kind(t.lookupTransformFull("laser", mid, "base_link", mid, "map")),
+        kind(t.lookupTwist("base_link", "map", rospy.Time.from_sec(11.0), rospy.Duration(1.0))),
+        type(t.getLatestCommonTime("map", "laser")).__name__,
+        kind(t.getFrameStrings()),
+        kind(t.asMatrix("map", Header(frame_id="laser", stamp=mid))),
+    ]
+    odd = tf.Transformer(True, rospy.Duration(10.0))
+    slash = stamped("/world", "/thing", 5.0, (1, 0, 0), (0, 0, 0))
+    empty = stamped("world", "", 5.0, (1, 0, 0), (0, 0, 0))
+    nan = stamped("world", "nan_frame", 5.0, (float("nan"), 0, 0), (0, 0, 0))
+    for m in (slash, empty, nan):
+        out[f"odd_set_{m.child_frame_id or 'empty'}"] = outcome(odd.setTransform, m, "peer")
+    out["odd_frames"] = sorted(odd.getFrameStrings())
+    out["odd_lookup"] = outcome(lambda: rounded(odd.lookupTransform("world", "thing", zero)))
+    out["odd_lookup_slash"] = outcome(lambda: rounded(odd.lookupTransform("/world", "/thing", zero)))
+    cloud = PointCloud(
+        Header(frame_id="laser", stamp=mid),
+        [Point32(1, 2, 3), Point32(-1, 0, 0.5)],
+        [ChannelFloat32("intensity", [0.5, 0.25])],
+    )
+    moved = t.transformPointCloud("map", cloud)
+    out["point_cloud"] = [
+        moved.header.frame_id,
+        rounded([[p.x, p.y, p.z] for p in moved.points]),
+        [(c.name, c.values) for c in moved.channels],
+    ]
+    out["can_full"] = [
+        t.canTransformFull("laser", mid, "base_link", mid, "map"),
+        t.canTransformFull("laser", mid, "lonely", mid, "map"),
+    ]
+    out["prefix"] = t.getTFPrefix()
+    out["frames_string"] = sorted(t.allFramesAsString().splitlines())
+    out["chain"] = outcome(t.chain, "laser", mid, "lonely", mid, "map")
+    out["chain_ok"] = outcome(lambda: sorted(t.chain("laser", mid, "odom", mid, "map")))
+    out["dot"] = outcome(lambda: sorted(t.allFramesAsDot().splitlines()))
     out["wait_no_thread"] = outcome(t.waitForTransform, "map", "laser", zero, rospy.Duration(0.01))
     out["twist"] = outcome(
         lambda: rounded(
@@ -231,7 +270,20 @@ def tf2_checks():
     wrench = WrenchStamped(Header(frame_id="laser", stamp=mid), Wrench(Vector3(1, 2, 3), Vector3(-1, 0, 2)))
     res = tf2_geometry_msgs.do_transform_wrench(wrench, link)
     out["do_wrench"] = [type(res).__name__, res.header.frame_id, printed(res)]
-    out["yaml_keys"] = sorted(__import__("yaml").safe_load(b.all_frames_as_yaml()) or {})
+    frames = __import__("yaml").safe_load(b.all_frames_as_yaml()) or {}
+    out["yaml"] = {k: sorted(v) for k, v in frames.items()}
+    out["yaml_values"] = {
+        k: [
+            v["parent"],
+            v["broadcaster"],
+            v["rate"],
+            v["most_recent_transform"],
+            v["oldest_transform"],
+            v["buffer_length"],
+        ]
+        for k, v in frames.items()
+    }
+    out["string"] = sorted(b.all_frames_as_string().splitlines())
     bad = TransformStamped()
     bad.header.frame_id = "a"
     bad.child_frame_id = "a"
@@ -344,8 +396,58 @@ def transformations_checks():
     return rounded(json.loads(json.dumps(out, default=lambda o: rounded(o))))
 
 
+def kind(v):
+    """The shape of a return value: what programs print and index."""
+    if isinstance(v, numpy.ndarray):
+        return ["ndarray", str(v.dtype), list(v.shape)]
+    if isinstance(v, (tuple, list)):
+        return [type(v).__name__, [kind(x) for x in v]]
+    return type(v).__name__
+
+
+def return_types():
+    tt = tf.transformations
+    q = tt.quaternion_from_euler(0.1, -0.4, 2.0)
+    m = tt.euler_matrix(0.3, 0.2, -0.1)
+    calls = {
+        "quaternion_from_euler": lambda: tt.quaternion_from_euler(0.1, 0.2, 0.3),
+        "euler_from_quaternion": lambda: tt.euler_from_quaternion(q),
+        "euler_from_quaternion_list": lambda: tt.euler_from_quaternion([0, 0, 0, 1]),
+        "euler_from_matrix": lambda: tt.euler_from_matrix(m),
+        "quaternion_multiply": lambda: tt.quaternion_multiply(q, q),
+        "quaternion_inverse": lambda: tt.quaternion_inverse(q),
+        "quaternion_conjugate": lambda: tt.quaternion_conjugate(q),
+        "quaternion_matrix": lambda: tt.quaternion_matrix(q),
+        "quaternion_from_matrix": lambda: tt.quaternion_from_matrix(m),
+        "quaternion_slerp": lambda: tt.quaternion_slerp(q, [0, 0, 0, 1], 0.5),
+        "quaternion_about_axis": lambda: tt.quaternion_about_axis(0.3, (0, 0, 1)),
+        "translation_from_matrix": lambda: tt.translation_from_matrix(m),
+        "translation_matrix": lambda: tt.translation_matrix((1, 2, 3)),
+        "rotation_from_matrix": lambda: tt.rotation_from_matrix(tt.rotation_matrix(0.3, (0, 0, 1))),
+        "decompose_matrix": lambda: tt.decompose_matrix(m),
+        "unit_vector": lambda: tt.unit_vector([1, 2, 3]),
+        "vector_norm": lambda: tt.vector_norm([1, 2, 3]),
+        "random_quaternion": lambda: tt.random_quaternion(),
+        "random_vector": lambda: tt.random_vector(3),
+        "identity_matrix": lambda: tt.identity_matrix(),
+        "is_same_transform": lambda: tt.is_same_transform(m, m),
+        "inverse_matrix": lambda: tt.inverse_matrix(m),
+        "concatenate_matrices": lambda: tt.concatenate_matrices(m, m),
+        "from_translation_rotation": lambda: tf.TransformerROS().fromTranslationRotation(
+            (1, 2, 3), (0, 0, 0, 1)
+        ),
+    }
+    return {name: kind(call()) for name, call in calls.items()}
+
+
 print(
     json.dumps(
-        {"tf": tf_checks(), "tf2": tf2_checks(), "transformations": transformations_checks()}, default=str
+        {
+            "types": return_types(),
+            "tf": tf_checks(),
+            "tf2": tf2_checks(),
+            "transformations": transformations_checks(),
+        },
+        default=str,
     )
 )

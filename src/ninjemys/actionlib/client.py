@@ -29,6 +29,8 @@ from ninjemys.actionlib.common import (
 )
 from ninjemys.actionlib.goal_id import client_goal_id
 from ninjemys.actionlib.states import CommState
+from ninjemys.errors import NinjemysError
+from ninjemys.master.client import MasterClient
 from ninjemys.node.clock import Clock
 from ninjemys.rostime import Time
 
@@ -248,6 +250,7 @@ class ActionClient:
         self._goals_lock = threading.Lock()
         self._status_class = goal_status_array_class()
         self._server_id: str | None = None  # caller id of the node whose status we heard last
+        self._confirmed: str | None = None  # the server whose own bus info listed our subscriptions
         self._status_seen = threading.Condition(threading.Lock())
         self.last_status_msg: Any = None
         # Goals and cancels are never dropped unless the user asks for a bounded queue: ROS 1's
@@ -350,8 +353,38 @@ class ActionClient:
             if server not in ids()
         ]
         if lacking:
+            self._confirmed = None  # a lost connection is confirmed again when it is back
             return f"action server {server} is not connected yet on {', '.join(lacking)}"
+        if self._confirmed != server:
+            if not self._server_lists_us(server):
+                return (
+                    f"action server {server} has not added our {self.ns}/result and feedback connections yet"
+                )
+            self._confirmed = server
         return None
+
+    def _server_lists_us(self, server: str) -> bool:
+        """Whether the server's own getBusInfo lists our result and feedback subscriptions. rospy answers
+        a subscriber's handshake before it adds the connection to the publisher, so a result published
+        in between (a fast server, a loaded machine) is lost although both ends look connected here.
+        A server we cannot ask (no slave API, a timeout) is trusted on the handshake."""
+        wanted = {f"{self.ns}/result", f"{self.ns}/feedback"}
+        me = self.node.name
+        try:
+            client = MasterClient(self.node.master.lookup_node(server), caller_id=me, timeout=2.0)
+            try:
+                rows = client.call("getBusInfo")
+            finally:
+                client.close()
+        except (NinjemysError, OSError, ValueError) as exc:
+            self.log.debug("action client %s: cannot ask %s for its connections (%s)", self.ns, server, exc)
+            return True
+        listed = {
+            row[4]
+            for row in rows
+            if isinstance(row, (list, tuple)) and len(row) > 4 and row[1] == me and row[2] == "o"
+        }
+        return wanted <= listed
 
     def wait_for_server(self, timeout: Any = 0.0) -> bool:
         """True once a server is connected on all five topics; False after ``timeout`` seconds (0: forever).

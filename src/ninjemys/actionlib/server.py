@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Iterator, MutableSequence
 
 from ninjemys.actionlib import states
 from ninjemys.actionlib.common import (
@@ -72,6 +72,60 @@ class StatusTracker:
     @handle_destruction_time.setter
     def handle_destruction_time(self, stamp: Time) -> None:
         self.destruction_time = stamp
+
+
+class StatusList(MutableSequence):
+    """ROS 1's ``ActionServer.status_list``: the server's trackers in arrival order, live.
+
+    Code written for ROS 1 edits it directly (its own tests "lose" a goal by deleting its tracker); an
+    edit here changes the goals the server lists, under the server's lock.
+    """
+
+    def __init__(self, server: ActionServer) -> None:
+        self._server = server
+
+    def _items(self) -> list[StatusTracker]:
+        return list(self._server.trackers.values())
+
+    def _replace(self, items: Iterable[StatusTracker]) -> None:
+        # transitions still waiting for a merged status publication go out first: clients must see
+        # the goals as they were before the edit (ROS 1 publishes every transition at once)
+        self._server.flush_status()
+        trackers = self._server.trackers
+        trackers.clear()
+        trackers.update((t.status.goal_id.id, t) for t in items)
+
+    def __len__(self) -> int:
+        return len(self._server.trackers)
+
+    def __iter__(self) -> Iterator[StatusTracker]:
+        with self._server.lock:
+            return iter(self._items())  # a snapshot: the loop may edit the list
+
+    def __getitem__(self, i: Any) -> Any:
+        with self._server.lock:
+            return self._items()[i]
+
+    def __setitem__(self, i: Any, value: Any) -> None:
+        with self._server.lock:
+            items = self._items()
+            items[i] = value
+            self._replace(items)
+
+    def __delitem__(self, i: Any) -> None:
+        with self._server.lock:
+            items = self._items()
+            del items[i]
+            self._replace(items)
+
+    def insert(self, index: int, value: StatusTracker) -> None:
+        with self._server.lock:
+            items = self._items()
+            items.insert(index, value)
+            self._replace(items)
+
+    def __repr__(self) -> str:
+        return repr(self._items())
 
 
 class ServerGoalHandle:
@@ -294,10 +348,9 @@ class ActionServer:
         return self.types.result
 
     @property
-    def status_list(self) -> list[StatusTracker]:
-        """ROS 1's list of the goals' trackers, in arrival order (a copy: the server owns the list)."""
-        with self.lock:
-            return list(self.trackers.values())
+    def status_list(self) -> StatusList:
+        """ROS 1's list of the goals' trackers, in arrival order; editing it edits the server's goals."""
+        return StatusList(self)
 
     @property
     def status_timer(self) -> Timer | None:
@@ -435,6 +488,15 @@ class ActionServer:
 
     def publish_status(self) -> None:
         """ROS 1's name: publish the status list now, from this thread."""
+        self._publish_status()
+
+    def flush_status(self) -> None:
+        """Publish now the status list a merged publication is pending for, if any."""
+        with self._wake:
+            if not self._dirty:
+                return
+            self._dirty = False
+            self._last_status = time.monotonic()
         self._publish_status()
 
     # -- topic callbacks -----------------------------------------------------------------------------

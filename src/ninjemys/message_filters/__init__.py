@@ -57,7 +57,10 @@ def _stamp_ns(msg: Any) -> int | None:
     stamp = getattr(header, "stamp", None)
     if stamp is None:
         return None
-    return stamp.secs * _NS + stamp.nsecs
+    try:
+        return stamp.secs * _NS + stamp.nsecs
+    except AttributeError:  # a bare number of seconds, as the mock messages of ROS 1's own tests carry
+        return round(stamp * _NS)
 
 
 def _to_ns(t: Any) -> int:

@@ -97,7 +97,10 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
             "averaging_client": ("ninjemys.tutorials.actionlib.averaging_client:main", ()),
             "gen_numbers.py": ("ninjemys.tutorials.actionlib.gen_numbers:main", ()),
         },
-        "tf2_ros": {"static_transform_publisher": ("ninjemys.tools.static_transform_publisher:main", ())},
+        "tf2_ros": {
+            "static_transform_publisher": ("ninjemys.tools.static_transform_publisher:main", ()),
+            "buffer_server": ("ninjemys.tools.buffer_server:main", ()),
+        },
         "tf": {
             "tf_echo": ("ninjemys.tools.tf_echo:main", ()),
             "tf_monitor": ("ninjemys.tools.tf_monitor:main", ()),
