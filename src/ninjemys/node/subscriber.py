@@ -426,8 +426,8 @@ class Subscriber:
         self._ops: list[tuple[str, Any]] = []
         self._ops_lock = threading.Lock()
         # held while the sockets are read and their frames delivered: by the worker, and by a thread
-        # that pulls (lazy handles); reentrant for callbacks that pull from the worker's own thread
-        self._read_lock = threading.RLock()
+        # that pulls (lazy handles); a callback's own pull returns at once, so it is never taken twice
+        self._read_lock = threading.Lock()
         self._lazy = max(0.0, lazy)
         self._eager = False
         self._last_read = 0.0  # monotonic time of the last read of every socket (a round or a pull)
@@ -783,7 +783,12 @@ class Subscriber:
             if shared:  # the thread goes on for the others: it hands this handle's streams on
                 host._ops.append(("release", self))
         self._wakeup()
-        if not shared and threading.current_thread() is not self._thread:
+        # not from a callback: on the worker's thread, or in a pull, which holds what the worker needs
+        if (
+            not shared
+            and threading.current_thread() is not self._thread
+            and host._puller != threading.get_ident()
+        ):
             self._thread.join(2.0)
 
     @property
