@@ -3,7 +3,8 @@
 Run: ``.venv/bin/python bench/tf2_listener.py`` (``--seconds N``, default 10).
 
 Two rounds: a listener that only listens, and one that also looks a transform up 20 times a second
-(ours decodes queued messages in batches when asked, so a node that asks more often pays more).
+(ours reads /tf lazily and decodes what arrived in batches when asked, so a node that asks more
+often pays more).
 
 One broadcaster (ours) publishes /tf; two listeners subscribe at the same time, each a process of
 its own running this file as ``--listen``: ninjemys's ``tf2_ros.Buffer`` + ``TransformListener``

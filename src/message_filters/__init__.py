@@ -17,6 +17,7 @@ from ninjemys.message_filters import (
     TimeSynchronizer,
     shared_subscriber,
 )
+from ninjemys.message_filters import _pass_on as _pass_on
 from ninjemys.rostime import Duration
 
 __all__ = [
@@ -55,7 +56,7 @@ class Subscriber(SimpleFilter):
         self.sub = _shared_rospy_subscriber()(*args, **kwargs)
 
     def callback(self, msg: Any) -> None:
-        self.signalMessage(msg)
+        _pass_on(self, msg)
 
     def getTopic(self) -> str:  # noqa: N802 - ROS 1 API
         return self.topic

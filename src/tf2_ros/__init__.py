@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import logging
 import time as _time
+from collections.abc import Callable
 from typing import Any
 
 from ninjemys.tf2 import node as _tfnode
@@ -65,6 +66,24 @@ def __getattr__(name: str) -> Any:
 
 def __dir__() -> list[str]:
     return sorted({*globals(), *_LAZY_NAMES, "buffer_client"})
+
+
+def _lazy_messages(
+    module: str, names: tuple[str, ...]
+) -> tuple[Callable[[str], Any], Callable[[], list[str]]]:
+    """``__getattr__`` and ``__dir__`` for a submodule that carries message classes as ROS 1's does,
+    loaded on first use like the package's (``import tf2_ros`` loads every submodule, and a stub
+    package reads no definition file until a name is used)."""
+    import sys
+
+    def getattr_(name: str) -> Any:
+        if name not in names:
+            raise AttributeError(f"module {module!r} has no attribute {name!r}")
+        value = __getattr__(name)
+        setattr(sys.modules[module], name, value)
+        return value
+
+    return getattr_, lambda: sorted({*vars(sys.modules[module]), *names})
 
 
 def _rospy() -> Any:

@@ -1,6 +1,8 @@
 """``tf2_ros.transform_listener``, ROS 1's module path (the classes live in the package, :mod:`tf2_ros`)."""
 
-from tf2_msgs.msg import TFMessage
-from tf2_ros import TransformListener
+from tf2_ros import TransformListener, _lazy_messages
 
-__all__ = ["TFMessage", "TransformListener"]
+__all__ = ["TFMessage", "TransformListener"]  # noqa: F822 (loaded by __getattr__)
+
+# the message classes load on first use
+__getattr__, __dir__ = _lazy_messages(__name__, ("TFMessage",))

@@ -10,7 +10,7 @@ import time
 
 from ninjemys.idl.loader import get_message_class
 from ninjemys.master.core import MasterThread
-from ninjemys.message_filters import ApproximateTimeSynchronizer, Subscriber
+from ninjemys.message_filters import ApproximateTimeSynchronizer, SimpleFilter, Subscriber, _pass_on
 from ninjemys.node import Node
 from ninjemys.rostime import Time
 
@@ -135,3 +135,20 @@ def test_tf2_message_filter_on_a_live_graph() -> None:
             listener.unregister()
         finally:
             node.shutdown("test over")
+
+
+def test_a_source_passes_each_message_to_every_filter_even_one_added_meanwhile() -> None:
+    """A Subscriber's messages go straight to its one filter, or to all of them; a filter connected
+    from inside that call gets the next message."""
+    src = SimpleFilter()
+    got: list[tuple[str, int]] = []
+
+    def first(m: int) -> None:
+        got.append(("first", m))
+        if len(src.callbacks) == 1:
+            src.registerCallback(lambda m: got.append(("second", m)))
+
+    src.registerCallback(first)
+    _pass_on(src, 1)
+    _pass_on(src, 2)
+    assert got == [("first", 1), ("first", 2), ("second", 2)]

@@ -25,7 +25,7 @@ def _message(rng: random.Random, names: list[tuple[str, str]], stamp: int) -> by
     return encode_tf_message(items)
 
 
-@pytest.mark.parametrize("k", [1, 2, 7, 24, 25, 50])  # both sides of SMALL_RUN
+@pytest.mark.parametrize("k", [1, 2, 7, 24, 25, 50])  # one message to many
 def test_bulk_read_equals_the_decoder_at_every_alignment(k: int) -> None:
     rng = random.Random(k)
     # frame ids of lengths 1..9 put the numbers of successive transforms at every offset modulo 8

@@ -86,6 +86,17 @@ def shared_subscriber(node: Any, topic: str, msg_class: Any, callback: Any, **kw
     return handle
 
 
+def _pass_on(source: SimpleFilter, msg: Any) -> None:
+    """``source.signalMessage(msg)`` for a source filter, per received message: with one connected
+    filter (a synchronizer input) that filter is called directly."""
+    callbacks = source.callbacks
+    if len(callbacks) == 1:
+        ((cb, args),) = callbacks.values()  # taken out first: the call may register more
+        cb(msg, *args)
+    else:
+        source.signalMessage(msg)
+
+
 class SimpleFilter:
     """The output side every filter shares: callbacks registered in order, called with the outputs."""
 
@@ -113,7 +124,7 @@ class Subscriber(SimpleFilter):
         self.sub = shared_subscriber(node, topic, msg_class, self.callback, **kwargs)
 
     def callback(self, msg: Any) -> None:
-        self.signalMessage(msg)
+        _pass_on(self, msg)
 
     def getTopic(self) -> str:  # noqa: N802 - ROS 1 API
         return self.topic

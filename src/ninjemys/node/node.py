@@ -257,6 +257,8 @@ class Node:
         tcp_nodelay: bool = True,
         coalesce: float = 0.0,
         share_thread: Subscriber | None = None,
+        lazy: float = 0.0,
+        batch: bool = False,
     ) -> Subscriber:
         """Subscribe to ``topic``; ``callback(msg[, callback_args])`` runs on this subscriber's own thread.
 
@@ -269,6 +271,13 @@ class Node:
         ``share_thread=handle`` delivers on ``handle``'s thread instead of a new one: one wake-up then
         serves messages of several topics that arrive together (message_filters' synchronizers), and
         the callbacks of those subscriptions run one after another, as under roscpp's single spinner.
+        ``lazy=s`` is for data read only when asked for (a tf listener's ``/tf``): the thread reads
+        what the kernel holds every ``s`` seconds at most (sooner when that much would fill a socket's
+        receive buffer) instead of waking per message; ``handle.pull()`` reads and delivers on the
+        caller's thread before the data is used, and ``handle.set_eager(True)`` restores a wake-up per
+        message while something waits for the data (with ``share_thread``, the host's setting rules).
+        ``batch=True`` calls back with a list: the messages read in one go, in order (a lazy reader's
+        round or pull can hold many; one call saves the per-message call overhead).
         """
         self._check_alive()
         resolved = self.resolve_name(topic)
@@ -278,7 +287,9 @@ class Node:
             if sub is None:
                 sub = Subscription(self, resolved, msg_class, tcp_nodelay)
                 self._subscriptions[resolved] = sub
-            handle = Subscriber(sub, callback, callback_args, queue_size, raw, coalesce, share_thread)
+            handle = Subscriber(
+                sub, callback, callback_args, queue_size, raw, coalesce, share_thread, lazy, batch
+            )
             sub.handles.append(handle)
         if new:
             publishers = self.registrar.add_subscriber(resolved, sub.type_name)

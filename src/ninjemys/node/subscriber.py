@@ -21,6 +21,14 @@ sockets too and delivers its messages, so messages of several topics that arrive
 wake-up instead of one per topic (on a VM a wake-up costs more CPU than decoding a small message).
 The host's thread runs until every handle it serves is closed; a closed handle's connections go on
 to the next handle of its topic, as a reader's do.
+
+A handle made with ``lazy=period`` (a tf listener's ``/tf``: its data is needed only when a lookup
+asks) does not wake per message: its worker reads what the kernel holds once ``period`` seconds
+have passed since the sockets were last read, or as soon as one holds a quarter of its receive
+buffer (``SO_RCVLOWAT``: the kernel wakes it then, so a publisher never finds the buffer full), and
+a reader that needs the data now calls :meth:`Subscriber.pull`, which reads and delivers on the
+caller's thread. :meth:`Subscriber.set_eager` makes the worker wake per message again while
+someone waits for data. Where ``SO_RCVLOWAT`` cannot be set, a lazy handle wakes per message.
 """
 
 from __future__ import annotations
@@ -81,6 +89,21 @@ _ioctl: Any = None
 _unpack_int = struct.Struct("i").unpack
 
 
+def _low_water(sock: socket.socket, lazy: bool) -> bool:
+    """Set ``sock``'s ``SO_RCVLOWAT`` to a quarter of its receive buffer (``lazy``) or back to one byte;
+    False where the platform cannot. A quarter: the kernel counts its bookkeeping in that buffer and
+    offers the sender as little as half of it, so a quarter of it in data is reached, never the end."""
+    option = getattr(socket, "SO_RCVLOWAT", None)
+    if option is None:
+        return False
+    try:
+        mark = max(1, sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF) // 4) if lazy else 1
+        sock.setsockopt(socket.SOL_SOCKET, option, mark)
+    except OSError:
+        return False
+    return True
+
+
 class RawMessage(SlotRecord):
     """What a ``raw=True`` subscriber receives: the serialized bytes and the publisher's header."""
 
@@ -122,12 +145,13 @@ class _Poller:
         except (KeyError, ValueError, OSError):
             pass
 
-    def wait(self) -> list[SubConnection | None]:
+    def wait(self, timeout: float | None = None) -> list[SubConnection | None]:
+        """What is readable, waiting at most ``timeout`` seconds (None: until something is)."""
         if self._epoll is not None:
             objs = self._objs
-            return [objs[fd] for fd, _ in self._epoll.poll() if fd in objs]
+            return [objs[fd] for fd, _ in self._epoll.poll(-1 if timeout is None else timeout) if fd in objs]
         assert self._selector is not None
-        return [key.data for key, _ in self._selector.select()]
+        return [key.data for key, _ in self._selector.select(timeout)]
 
     def close(self) -> None:
         if self._epoll is not None:
@@ -347,6 +371,9 @@ class Subscriber:
     _retired: bool
     _thread: threading.Thread
     _ops_lock: threading.Lock
+    #: seconds a lazy worker lets data wait (0: it wakes per message); see :meth:`set_eager`
+    _lazy: float
+    _eager: bool
 
     def __init__(
         self,
@@ -357,6 +384,8 @@ class Subscriber:
         raw: bool = False,
         coalesce: float = 0.0,
         share: Subscriber | None = None,
+        lazy: float = 0.0,
+        batch: bool = False,
     ) -> None:
         self._sub = subscription
         #: seconds a message may wait so that one wake-up of the worker takes several (see Node.subscriber)
@@ -368,6 +397,8 @@ class Subscriber:
         self.md5sum = subscription.md5sum
         self.queue_size = queue_size
         self.raw = raw
+        #: the callbacks get a list: every message read in one go (see Node.subscriber)
+        self.batch = batch
         self.dropped = 0
         # a tuple, replaced (never mutated) by add_callback: the worker iterates it without a copy
         self._callbacks: tuple[tuple[Callable[..., Any], Any], ...] = ()
@@ -394,6 +425,14 @@ class Subscriber:
         self._retired = False
         self._ops: list[tuple[str, Any]] = []
         self._ops_lock = threading.Lock()
+        # held while the sockets are read and their frames delivered: by the worker, and by a thread
+        # that pulls (lazy handles); a callback's own pull returns at once, so it is never taken twice
+        self._read_lock = threading.Lock()
+        self._lazy = max(0.0, lazy)
+        self._eager = False
+        self._last_read = 0.0  # monotonic time of the last read of every socket (a round or a pull)
+        self._lowat = False  # the sockets wake the worker only when well filled (lazy, not eager)
+        self._puller = 0  # the thread that is pulling now (its callbacks must not pull again)
         # a socket pair, not a pipe: selectable on every OS (Windows cannot select on pipes)
         self._wake_r, self._wake_w = socket.socketpair()
         self._wake_r.setblocking(False)
@@ -464,6 +503,9 @@ class Subscriber:
                         busy = True
                 if busy:
                     continue
+                if self._lazy:  # reads may also come from pulls: under the read lock
+                    self._lazy_round()
+                    continue
                 for conn in self._poller.wait():
                     if conn is None:
                         self._on_wake()
@@ -472,7 +514,51 @@ class Subscriber:
                 if self._coalesce and not any(h._queue for h in self._served):
                     time.sleep(self._coalesce)  # let messages gather: the next poll takes them all
         finally:
-            self._finish()
+            with self._read_lock:
+                self._finish()
+
+    def _lazy_round(self) -> None:
+        """One wait of a lazy handle's worker: on the low-water marks (:meth:`_lazy_wait`), or per
+        message while eager."""
+        lazy = not self._eager
+        if lazy != self._lowat:
+            self._set_lowat(lazy)
+        if self._lowat:
+            self._lazy_wait()
+            return
+        ready = self._poller.wait()
+        with self._read_lock:
+            for conn in ready:
+                if conn is None:
+                    self._on_wake()
+                else:
+                    self._read(conn)
+
+    def _lazy_wait(self) -> None:
+        """One wait of a lazy worker: until ``lazy`` seconds have passed since the sockets were last
+        read (by a round or a pull), or one of them holds its low-water mark; then read them all."""
+        wait = self._last_read + self._lazy - time.monotonic()
+        ready = self._poller.wait(wait) if wait > 0.0 else []
+        with self._read_lock:
+            full = False
+            for conn in ready:
+                if conn is None:
+                    self._on_wake()
+                else:
+                    full = True
+            if full or time.monotonic() >= self._last_read + self._lazy:
+                for conn in list(self._conns.values()):
+                    self._read(conn)
+                self._last_read = time.monotonic()
+
+    def _set_lowat(self, lazy: bool) -> None:
+        """Make the sockets report readable only at a quarter of their receive buffer (at most half
+        of the data it holds) while lazy, at any byte otherwise (read lock not needed: the
+        worker's own sockets). Without ``SO_RCVLOWAT`` the worker stays one wake-up per message."""
+        ok = True
+        for conn in list(self._conns.values()):
+            ok = _low_water(conn.sock, lazy) and ok
+        self._lowat = lazy and ok
 
     def _retire(self) -> bool:
         """True (and no handle may join any more) when every handle this worker serves is closed."""
@@ -491,10 +577,16 @@ class Subscriber:
         # cleared only after draining: a wake-up written during the drain would otherwise be consumed
         # while the flag stays set, and every later enqueue would skip its wake-up (a lost wake-up)
         self._woken = False
+        self._apply_ops()
+
+    def _apply_ops(self) -> None:
+        """Connections to add, drop or pass on (read lock held)."""
         with self._ops_lock:
             ops, self._ops = self._ops, []
         for op, obj in ops:
             if op == "add" and not obj.closed:
+                if self._lowat and not _low_water(obj.sock, True):
+                    self._set_lowat(False)
                 self._conns[obj.fd] = obj
                 self._poller.register(obj.fd, obj)
                 self._read(obj)  # latched data may already be waiting
@@ -531,12 +623,17 @@ class Subscriber:
             self._forget(conn)
             return
         if frames:
-            for other in owner._sub.handles[1:]:
-                if other is not owner:
-                    other.enqueue(frames, conn.header)
+            handles = owner._sub.handles
+            if len(handles) > 1:
+                for other in handles[1:]:
+                    if other is not owner:
+                        other.enqueue(frames, conn.header)
             # the queues are empty whenever the worker reads (it delivers them first), so this
             # batch can go straight to the callbacks: no per-message queue entry
-            owner._deliver_batch(owner._keep_newest(frames, 0), conn.header)
+            maxlen = owner._queue.maxlen
+            if maxlen is not None and len(frames) > maxlen:
+                frames = owner._keep_newest(frames, 0)
+            owner._deliver_batch(frames, conn.header)
 
     def _finish(self) -> None:
         """Worker exit: pass our connections to the next handle of their topic, or close them."""
@@ -567,13 +664,30 @@ class Subscriber:
         """Deliver frames in order; the common case (decode, one callback without args) is inlined,
         as this loop runs once per received message."""
         decode, callbacks = self._decode, self._callbacks
-        if decode is None or len(callbacks) != 1 or callbacks[0][1] is not None:
+        if self.batch:
+            if decode is None:
+                msgs: list[Any] = [RawMessage(frame, header) for frame in frames]
+            else:
+                msgs = [m for m in (self._decoded(f, header) for f in frames) if m is not None]
+            if msgs and not self._closed:
+                self._call(msgs)
+            return
+        if len(callbacks) != 1 or callbacks[0][1] is not None:
             for frame in frames:
                 if self._closed:
                     return
                 self._deliver(frame, header)
             return
         callback = callbacks[0][0]
+        if decode is None:  # raw: the bytes and the publisher's header
+            for frame in frames:
+                if self._closed:
+                    return
+                try:
+                    callback(RawMessage(frame, header))
+                except Exception:
+                    _log.exception("topic %s: callback %r raised", self.name, callback)
+            return
         for frame in frames:
             if self._closed:
                 return
@@ -597,19 +711,55 @@ class Subscriber:
             exc,
         )
 
+    def _decoded(self, frame: bytes | bytearray, header: Mapping[str, str]) -> Any:
+        """The message in ``frame`` (None, after one line saying why, when it does not decode)."""
+        try:
+            return self._decode(frame)  # type: ignore[misc]
+        except Exception as exc:  # generated code raises DeserializationError, struct.error, ...
+            self._undecodable(frame, header, exc)
+            return None
+
     def _deliver(self, frame: bytes | bytearray, header: Mapping[str, str]) -> None:
-        decode = self._decode
-        if decode is None:
+        if self._decode is None:
             msg: Any = RawMessage(frame, header)
         else:
-            try:
-                msg = decode(frame)
-            except Exception as exc:  # generated code raises DeserializationError, struct.error, ...
-                self._undecodable(frame, header, exc)
+            msg = self._decoded(frame, header)
+            if msg is None:
                 return
-        self._call(msg)
+        self._call([msg] if self.batch else msg)
 
     # -- API -------------------------------------------------------------------------------------
+
+    def pull(self) -> None:
+        """Read what the kernel holds now for this handle's worker and deliver it on the calling thread
+        (a lazy handle's reader calls this before it uses its data). A no-op while the worker wakes
+        per message (not lazy, or :meth:`set_eager`), and on the worker's own thread."""
+        host = self._host
+        if not host._lazy or host._eager or threading.current_thread() is host._thread:
+            return
+        me = threading.get_ident()
+        if host._puller == me:  # a callback of this pull pulls again: its frames come in order anyway
+            return
+        with host._read_lock:
+            if host._retired:
+                return
+            host._puller = me
+            try:
+                host._apply_ops()  # a connection handed over a moment ago may hold data already
+                for conn in list(host._conns.values()):
+                    host._read(conn)
+                host._last_read = time.monotonic()
+            finally:
+                host._puller = 0
+
+    def set_eager(self, eager: bool) -> None:
+        """For a lazy handle: while ``eager``, its worker wakes per message (someone waits for data);
+        then lazy again. Applies to every handle its worker serves."""
+        host = self._host
+        if not host._lazy or host._eager == eager:
+            return
+        host._eager = eager
+        self._wakeup()  # the worker switches to the other kind of wait
 
     def add_callback(self, callback: Callable[..., Any], callback_args: Any = None) -> None:
         self._callbacks = (*self._callbacks, (callback, callback_args))
@@ -633,7 +783,12 @@ class Subscriber:
             if shared:  # the thread goes on for the others: it hands this handle's streams on
                 host._ops.append(("release", self))
         self._wakeup()
-        if not shared and threading.current_thread() is not self._thread:
+        # not from a callback: on the worker's thread, or in a pull, which holds what the worker needs
+        if (
+            not shared
+            and threading.current_thread() is not self._thread
+            and host._puller != threading.get_ident()
+        ):
             self._thread.join(2.0)
 
     @property

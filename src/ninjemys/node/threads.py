@@ -170,6 +170,9 @@ RESOURCES: tuple[Resource, ...] = (
              "replays (both through enqueue/post, then a wake-up); bounded by queue_size"),
     Resource("lock", "ninjemys.node.subscriber:Subscriber._ops_lock", "sub:<topic>",
              "connection hand-offs (post) from the loop and enqueue from other threads"),
+    Resource("lock", "ninjemys.node.subscriber:Subscriber._read_lock", "sub:<topic>",
+             "held while the sockets are read and their frames delivered: by the worker, "
+             "and by a thread that pulls a lazy handle (its callbacks then run on that thread)"),
     Resource("lock", "ninjemys.node.services:ServiceServer._lock", "srv:<service>",
              "guards the set of open client sockets; the loop adds, shutdown reads"),
     Resource("lock", "ninjemys.node.services:ServiceProxy._lock", USER + " (caller)",

@@ -37,9 +37,12 @@ import threading
 import time as _wall
 from bisect import bisect_left, bisect_right
 from cmath import rect
+from collections import deque
 from collections.abc import Callable, Iterable, Sequence
 from itertools import repeat
 from math import acos, atan2, cos, isfinite, sin, sqrt
+from operator import attrgetter, itemgetter, lt
+from typing import Any
 
 from ninjemys.errors import DeserializationError
 from ninjemys.interrupt import wait_slice
@@ -63,6 +66,7 @@ QUATERNION_TOLERANCE = 10e-6  # tf2: |x²+y²+z²+w² - 1| must stay under this
 NO_PARENT = "NO_PARENT"
 REPEAT_REPORT_AFTER = 10.0  # seconds before the same bad-input line is reported again
 PENDING_MAX = 50  # raw messages queued before the listener's thread decodes them itself
+OWED_BATCHES = 4096  # batches a layout may owe its frames (they expire after cache_time)
 _SEEN = (-1,)  # a segment looked up once: its composite is made on the second lookup (no history is -1)
 BULK_MIN = 2  # a run this long of one layout is decoded with numpy; a single message per transform
 
@@ -73,6 +77,28 @@ CONNECTIVITY_ERROR = 2
 EXTRAPOLATION_ERROR = 3
 
 Entry = tuple  # (parent: Frame, (tx, ty, tz, qx, qy, qz, qw))
+# C-level getters for the bulk appends (map over the frames of a layout)
+_BULK = attrgetter("bulk")
+_STAMPS = attrgetter("stamps")
+_DATA = attrgetter("data")
+_SEGS = attrgetter("segs")
+_LAST = itemgetter(-1)
+
+
+def _ascending(prev: list[int], rows: list[list[int]]) -> bool:
+    """Every column strictly increases from ``prev`` through ``rows`` (C-level loops over columns)."""
+    for row in rows:
+        if not all(map(lt, prev, row)):
+            return False
+        prev = row
+    return True
+
+
+def _consume(iterator: Iterable[Any]) -> None:
+    """Run a ``map`` for its effects."""
+    deque(iterator, 0)
+
+
 Reporter = Callable[[str], None]
 
 
@@ -109,6 +135,9 @@ class Frame:
         "point_of",
         "point",
         "sides",
+        "bulk",
+        "bulk_j",
+        "applied",
     )
 
     def __init__(self, name: str, number: int) -> None:
@@ -139,6 +168,12 @@ class Frame:
         # by ancestor: [composites by segment start (None: off), lead frame, links (frame, parent) up to
         # it]; the lead is the first dynamic link, whose stamps locate the segment around a time
         self.sides: dict[Frame, list] = {}
+        # the Layout whose batches alone wrote this frame's history since its last check (None after
+        # any other insertion): its batches then append without per-frame checks, and may be owed
+        # (kept in the layout until a query needs this frame, see BufferCore._settle_frame)
+        self.bulk: Layout | None = None
+        self.bulk_j = 0  # this frame's transform in that layout
+        self.applied = 0  # how many of the layout's batches (counted from its first) are in our lists
 
     def __repr__(self) -> str:
         return f"Frame({self.name!r})"
@@ -335,8 +370,12 @@ class BufferCore:
         self._frames: dict[str, Frame] = {}
         self._order: list[Frame] = []  # by frame number (tf2's frameIDs_reverse, minus NO_PARENT)
         self._lock = threading.RLock()
-        self._changed = threading.Condition(self._lock)
+        # waiters for new data sleep on their own condition, not the buffer's lock: a waiter's check
+        # pulls from the sources outside that lock (see add_source), and the notifier never blocks
+        self._changed = threading.Condition(threading.Lock())
         self._waiters = 0
+        self._seq = 0  # bumped (while anybody waits) by every insertion: what waiters wait for
+        self._sources: list[Any] = []
         self._gen = 0  # bumped by every accepted insertion: memos of older generations are stale
         self._last_t = -1  # the time of the previous non-latest lookup (a repeat fills the memos)
         self._asked_gen = -1  # the generation of the previous latest-time lookup (a repeat caches minima)
@@ -346,6 +385,10 @@ class BufferCore:
         self._pending: list[tuple[bytes, str, bool]] = []  # raw TFMessages not decoded yet
         self._listeners: list[Callable[[], None]] = []
         self._layouts: dict[tuple[str, int], Layout] = {}
+        self._owing: set[Layout] = set()  # layouts holding batches not yet in all their frames' lists
+        # some frame's history holds more than one parent: a lookup may then reach frames off the
+        # newest-parent paths, so queries settle every owed batch (until clear)
+        self._mixed = False
         self._reported: dict[str, float] = {}
 
     @property
@@ -364,18 +407,21 @@ class BufferCore:
 
     def frame_exists(self, name: str) -> bool:
         """tf2's ``_frameExists``: the name is known (as a child or as a parent)."""
+        self._pull()
         with self._lock:
             self._drain()
             return name in self._frames
 
     def child_frames(self) -> list[str]:
         """The frames that have a parent now (the keys of :meth:`all_frames_as_yaml`), in tf2's order."""
+        self._pull()
         with self._lock:
             self._drain()
             return [f.name for f in self._order if f.has_cache and f.data]
 
     def frame_names(self) -> list[str]:
         """Every known frame, in the order tf2 numbered them (``_getFrameStrings``)."""
+        self._pull()
         with self._lock:
             self._drain()
             return [f.name for f in self._order]
@@ -385,6 +431,35 @@ class BufferCore:
         filter that holds messages until their transform is available waits on (tf2's transformable
         callbacks). ``fn`` may query the buffer; it should be quick."""
         self._listeners.append(fn)
+        self._tell_sources()
+
+    def add_source(self, source: Any) -> None:
+        """Register a feeder that delivers lazily (the listener of a lazy ``/tf`` subscription):
+        ``source.pull()`` is called before every query, outside the buffer's lock, to deliver what
+        has arrived, so a lookup sees every message the kernel already holds; ``source.set_eager(b)``
+        is told whether anybody waits for new data (a ``wait_for_transform`` waiter or a change
+        listener), which then must arrive without being asked for."""
+        self._sources.append(source)
+        source.set_eager(bool(self._waiters or self._listeners))
+
+    def remove_source(self, source: Any) -> None:
+        if source in self._sources:
+            self._sources.remove(source)
+
+    def _pull(self) -> None:
+        for source in self._sources:
+            source.pull()
+
+    def _tell_sources(self) -> None:
+        eager = bool(self._waiters or self._listeners)
+        for source in self._sources:
+            source.set_eager(eager)
+
+    def _notify(self) -> None:
+        """Wake the ``wait_for_transform`` waiters (new data may answer them)."""
+        with self._changed:
+            self._seq += 1
+            self._changed.notify_all()
 
     def _changed_data(self) -> None:
         for fn in self._listeners:
@@ -411,8 +486,8 @@ class BufferCore:
                     problems.append(why)
             if accepted:
                 self._gen += 1
-                if self._waiters:
-                    self._changed.notify_all()
+        if accepted and self._waiters:
+            self._notify()
         if problems:
             self._report_once(problems)
         if accepted and self._listeners:
@@ -424,20 +499,57 @@ class BufferCore:
         before the next query (or once ``PENDING_MAX`` are waiting), many at a time: consecutive
         messages of one layout cost a few numpy operations together instead of Python work per
         transform (a listener's CPU is mostly spent decoding, geometry2#513)."""
+        self.add_raw_many((data,), authority, is_static)
+
+    def add_raw_many(
+        self, data: Sequence[bytes], authority: str = "default_authority", is_static: bool = False
+    ) -> None:
+        """:meth:`add_raw` for several messages of one publisher, in order."""
         with self._lock:
-            self._pending.append((data, authority, is_static))
+            self._pending.extend(zip(data, repeat(authority), repeat(is_static)))
             if len(self._pending) >= PENDING_MAX:
-                self._drain()
-            if self._waiters:
-                self._changed.notify_all()
+                self._decode_pending()
+        if self._waiters:
+            self._notify()
         if self._listeners:
             self._changed_data()
 
     def _drain(self) -> None:
-        """Decode and insert every queued message, in arrival order (lock held)."""
-        pending = self._pending
-        if not pending:
+        """Decode and insert every queued message, in arrival order, and settle every owed batch (lock
+        held): what a query that may read any frame needs."""
+        if self._pending:
+            self._decode_pending()
+        if self._owing:
+            self._settle_all()
+
+    def _drain_for(self, *names: str) -> None:
+        """As :meth:`_drain`, but settle owed batches only in the frames a lookup or check between
+        ``names`` can read: each named frame and its newest parents up to the top of its tree. Owed
+        batches never change a frame's parent, so while no history holds two parents for a frame
+        (``_mixed``) a lookup reads no other frame (lock held)."""
+        if self._pending:
+            self._decode_pending()
+        if not self._owing:
             return
+        if self._mixed:
+            self._settle_all()
+            return
+        frames = self._frames
+        for name in names:
+            f = frames.get(name)
+            if f is None:
+                continue
+            path = self._path(f)
+            if path is None:  # a loop (cannot be stored, but tf2's answer then needs every frame)
+                self._settle_all()
+                return
+            for g in path:
+                layout = g.bulk
+                if layout is not None and g.applied < layout.owed_end:
+                    self._settle_frame(g)
+
+    def _decode_pending(self) -> None:
+        pending = self._pending
         self._pending = []
         problems: list[str] = []
         accepted = 0
@@ -493,17 +605,41 @@ class BufferCore:
         return layout, got
 
     def _insert_columns(self, layout: Layout, got: tuple, who: str, problems: list[str]) -> int:
-        """Append each transform's ``k`` new entries to its frame in one go (lock held); a column that
-        does not continue its frame's history in order (new frame or parent, old or repeated stamps)
-        goes through :meth:`_insert` entry by entry. The layout remembers its frames once they all
-        exist (frames are never removed), and an entry stays ``(parent, values, (row, column))`` of
-        the batch's array until first read: a listener that is asked 20 times a second decodes
-        batches of a few messages, where per-column numpy views and name lookups cost more than the
-        numbers."""
+        """Append each transform's ``k`` new entries to its frame (lock held). An entry stays
+        ``(parent, values, (row, column))`` of the batch's array until first read: most history is
+        never looked at.
+
+        When every frame of the layout was last written by this layout's batches and the new stamps
+        continue each frame's history in order (one vectorized check), the batch is not appended
+        now: the layout keeps it, owed to its frames, and a query appends it to the frames it reads
+        (:meth:`_drain_for`, :meth:`_settle_frame`). A listener asked 20 times a second for one chain
+        then touches the few frames of that chain, not all 50; batches older than ``cache_time`` that
+        no query needed expire unread. Otherwise each column is checked on its own, and a column
+        that does not continue its frame's history (new frame or parent, old or repeated stamps)
+        goes through :meth:`_insert` entry by entry."""
         stamps, values = got
         k = stamps.shape[0]
-        in_order = k == 1 or bool((stamps[1:] > stamps[:-1]).all())
-        columns = stamps.T.tolist()
+        rows = stamps.tolist()
+        in_order = _ascending(rows[0], rows[1:])
+        children = layout.children_frames
+        if (
+            in_order
+            and children is not None
+            and layout.last_row is not None
+            and list(map(_BULK, children)).count(layout) == len(children)
+            and _ascending(layout.last_row, rows[:1])
+        ):
+            last = rows[-1]
+            layout.owe(list(zip(*rows, strict=True)), values, k, max(last))
+            layout.last_row = last
+            # a frame nobody asks about never needs batches older than cache_time: they expire
+            # unread (a frame that missed some is cut back to cache_time when it is settled)
+            layout.expire(min(last) - self.cache_time_ns)
+            self._owing.add(layout)
+            if len(layout.owed) >= OWED_BATCHES:  # stamps that hardly advance: bound the memory
+                self._settle_layout(layout)
+            return k * len(children)
+        columns = list(zip(*rows, strict=True))
         frames = self._frames
         keep = self.cache_time_ns
         slack = keep + self._prune_slack
@@ -514,11 +650,15 @@ class BufferCore:
             ]
             if all(p is not None and c is not None for p, c in pairs):
                 layout.frames = pairs
+                layout.children_frames = [c for _, c in pairs]
         cells = layout.cells(k)
         nones = [None] * k
         count = 0
+        whole = True  # every column went in as a column: the layout owns all its frames now
         for j, (parent, child) in enumerate(pairs):
             col = columns[j]
+            if child is not None and child.bulk is not None and child.applied < child.bulk.owed_end:
+                self._settle_frame(child)
             if (
                 child is None
                 or parent is None
@@ -528,6 +668,7 @@ class BufferCore:
                 or not child.stamps
                 or not (in_order or all(a < b for a, b in zip(col, col[1:], strict=False)))
             ):
+                whole = False
                 for stamp, v in zip(col, values[:, j, :].tolist(), strict=True):
                     why = self._insert((layout.parents[j], layout.children[j], stamp, *v), who, False)
                     if why is None:
@@ -536,6 +677,10 @@ class BufferCore:
                         problems.append(why)
                 continue
             child.authority = who
+            if child.bulk is not layout:
+                child.bulk = layout
+                child.bulk_j = j
+                child.applied = layout.owed_end
             st = child.stamps
             st.extend(col)
             child.data.extend(zip(repeat(parent, k), repeat(values, k), cells[j], strict=True))
@@ -550,7 +695,77 @@ class BufferCore:
                 if st[0] > self._floor:
                     self._floor = st[0]
             count += k
+        layout.last_row = rows[-1] if whole and in_order else None
         return count
+
+    def _settle_frame(self, f: Frame) -> None:
+        """Append to ``f``'s lists the batches its layout owes it (lock held)."""
+        layout = f.bulk
+        assert layout is not None
+        j = f.bulk_j
+        parent = layout.frames[j][0]  # type: ignore[index]
+        st, data, segs = f.stamps, f.data, f.segs
+        missed = f.applied < layout.owed_base  # batches expired before this frame took them
+        for columns, values, k, _newest in layout.owed[max(0, f.applied - layout.owed_base) :]:
+            st.extend(columns[j])
+            data.extend(zip(repeat(parent, k), repeat(values, k), layout.cells(k)[j], strict=True))
+            segs.extend(repeat(None, k))
+        f.applied = layout.owed_end
+        f.latest = latest = st[-1]
+        if missed or st[0] < latest - self.cache_time_ns - self._prune_slack:
+            self._prune((f,), missed)
+
+    def _settle_layout(self, layout: Layout) -> None:
+        """Append every owed batch of ``layout`` to all its frames and forget the batches (lock held).
+        The frames no lookup settled meanwhile (usually all but a few) take each batch in C-level
+        ``map`` loops over the frames: a Python loop per frame costs more than the numbers when a
+        batch holds only a few messages."""
+        children = layout.children_frames or []
+        end = layout.owed_end
+        base = layout.owed_base
+        behind = [f for f in children if f.bulk is layout and f.applied <= base]
+        if behind and layout.owed:
+            missed = any(f.applied < base for f in behind)
+            pick = itemgetter(*[f.bulk_j for f in behind])
+            one = len(behind) == 1
+            cols: Any = ()
+            for columns, values, k, _newest in layout.owed:
+                flat, slices, nones = layout.entries(k)
+                entries = list(zip(flat[0], repeat(values, len(flat[1])), flat[1], strict=True))
+                cols = [pick(columns)] if one else pick(columns)
+                _consume(map(list.extend, map(_STAMPS, behind), cols))
+                spans = [pick(slices)] if one else pick(slices)
+                _consume(map(list.extend, map(_DATA, behind), map(entries.__getitem__, spans)))
+                _consume(map(list.extend, map(_SEGS, behind), repeat(nones, len(behind))))
+            _consume(map(setattr, behind, repeat("latest"), map(_LAST, cols)))
+            _consume(map(setattr, behind, repeat("applied"), repeat(end, len(behind))))
+            self._prune(behind, missed)
+        for f in children:
+            if f.bulk is layout and f.applied < end:
+                self._settle_frame(f)
+        layout.forget_owed()
+        self._owing.discard(layout)
+
+    def _settle_all(self) -> None:
+        for layout in list(self._owing):
+            self._settle_layout(layout)
+
+    def _prune(self, frames: Iterable[Frame], exact: bool = False) -> None:
+        """Trim each frame's history back to ``cache_time`` once it is ``_prune_slack`` longer; with
+        ``exact`` (a frame whose expired batches it never took) to ``cache_time`` itself, so that no
+        lookup interpolates across the batches it lacks: they all lie before that."""
+        keep = self.cache_time_ns
+        slack = keep if exact else keep + self._prune_slack
+        for f in frames:
+            st = f.stamps
+            latest = f.latest
+            if st and st[0] < latest - slack:
+                cut = bisect_left(st, latest - keep)
+                del st[:cut]
+                del f.data[:cut]
+                del f.segs[:cut]
+                if st[0] > self._floor:
+                    self._floor = st[0]
 
     def _report_once(self, lines: list[str]) -> None:
         """Report each line, but the same line at most once per ``REPEAT_REPORT_AFTER`` seconds: a broadcaster
@@ -610,6 +825,8 @@ class BufferCore:
         frames = self._frames
         child = frames.get(child_name) or self._frame_or_new(child_name)
         parent = frames.get(parent_name) or self._frame_or_new(parent_name)
+        if child.bulk is not None and child.applied < child.bulk.owed_end:
+            self._settle_frame(child)  # its history in order before it changes
         if parent.has_cache and parent.parent is not None and child.parent is not parent:
             loop = self._path_to(parent, child)
             if loop is not None:
@@ -620,10 +837,13 @@ class BufferCore:
                     + f" -> {child_name}"
                 )
         entry = (parent, (tx, ty, tz, qx, qy, qz, qw))
+        if child.stamps and parent is not child.parent and not child.static:
+            self._mixed = True  # this history will hold two parents
         if not child.has_cache:
             child.has_cache = True
             child.static = is_static
         child.authority = authority
+        child.bulk = None
         if child.static:
             if not child.data or child.data[-1][0] is not parent:
                 self._topology += 1
@@ -703,8 +923,15 @@ class BufferCore:
 
     def clear(self) -> None:
         """Forget all non-static data (tf2 keeps static transforms across ``clear``)."""
+        self._pull()  # what arrived before the clear goes too
         with self._lock:
             self._pending = [p for p in self._pending if p[2]]  # unread static data still counts
+            for layout in self._owing:
+                layout.forget_owed()
+            self._owing.clear()
+            for layout in self._layouts.values():
+                layout.last_row = None
+            self._mixed = False
             self._drain()
             for f in self._order:
                 if f.has_cache and not f.static:
@@ -713,6 +940,7 @@ class BufferCore:
                     f.segs = []
                     f.latest = 0
                     f.parent = None
+                    f.bulk = None
             self._gen += 1
             self._topology += 1
 
@@ -926,9 +1154,11 @@ class BufferCore:
     def lookup(self, target_frame: str, source_frame: str, t: int) -> tuple[int, tuple]:
         """``(stamp_ns, 7 floats)``: the transform that maps data in ``source_frame`` into ``target_frame``
         at time ``t`` (0 = latest common). Raises tf2's exceptions with tf2's texts."""
+        if self._sources:
+            self._pull()
         with self._lock:
-            if self._pending:
-                self._drain()
+            if self._pending or self._owing:
+                self._drain_for(target_frame, source_frame)
             frames = self._frames
             target = frames.get(target_frame)
             source = frames.get(source_frame)
@@ -1175,8 +1405,9 @@ class BufferCore:
     ) -> tuple[int, tuple]:
         """The advanced lookup: ``source`` at ``source_t`` into ``fixed``, then ``fixed`` at ``target_t``
         into ``target``. Returns ``(stamp of the second lookup, 7 floats)``."""
+        self._pull()
         with self._lock:
-            self._drain()
+            self._drain_for(target_frame, source_frame, fixed_frame)
             self._validate("lookupTransform argument target_frame", target_frame)
             self._validate("lookupTransform argument source_frame", source_frame)
             self._validate("lookupTransform argument fixed_frame", fixed_frame)
@@ -1188,9 +1419,10 @@ class BufferCore:
         """tf2's ``canTransform`` with its error text: (possible, why not)."""
         if target_frame == source_frame:
             return True, ""
+        self._pull()
         with self._lock:
-            if self._pending:
-                self._drain()
+            if self._pending or self._owing:
+                self._drain_for(target_frame, source_frame)
             target = self._frames.get(target_frame)
             source = self._frames.get(source_frame)
             if target is None or source is None:
@@ -1229,8 +1461,9 @@ class BufferCore:
         ):
             if self._warn_frame_id(what, name):
                 return False, ""
+        self._pull()
         with self._lock:
-            self._drain()
+            self._drain_for(target_frame, source_frame, fixed_frame)
             target = self._frames.get(target_frame)
             source = self._frames.get(source_frame)
             fixed = self._frames.get(fixed_frame)
@@ -1264,22 +1497,35 @@ class BufferCore:
         clock = now or _wall.monotonic
         start = clock()
         deadline = start + timeout
-        with self._lock:
+        ok, why = check()
+        if ok or timeout <= 0.0:
+            return ok, why
+        changed = self._changed
+        with changed:
             self._waiters += 1
-            try:
-                while True:
-                    ok, why = check()
-                    current = clock()
-                    if ok or current >= deadline or current + 3.0 < start or (cancelled and cancelled()):
-                        return ok, why
-                    self._changed.wait(
-                        wait_slice(min(deadline - current, 1.0) if cancelled else deadline - current)
-                    )
-            finally:
+        if self._waiters == 1 and self._sources:
+            self._tell_sources()  # data must now arrive by itself, as it comes
+        try:
+            while True:
+                seen = self._seq  # read before the check: an insertion after it bumps it
+                ok, why = check()
+                current = clock()
+                if ok or current >= deadline or current + 3.0 < start or (cancelled and cancelled()):
+                    return ok, why
+                with changed:
+                    if self._seq == seen:
+                        changed.wait(
+                            wait_slice(min(deadline - current, 1.0) if cancelled else deadline - current)
+                        )
+        finally:
+            with changed:
                 self._waiters -= 1
+            if not self._waiters and self._sources:
+                self._tell_sources()
 
     def latest_common_time(self, target_frame: str, source_frame: str) -> int:
         """tf2_py's ``get_latest_common_time`` (raises LookupException / TransformException)."""
+        self._pull()
         with self._lock:
             self._drain()
             target = self._validate("get_latest_common_time", target_frame)
@@ -1294,6 +1540,7 @@ class BufferCore:
         self, target_frame: str, target_t: int, source_frame: str, source_t: int, fixed_frame: str
     ) -> list[str]:
         """tf2's ``_chainAsVector``: the frame names from source to target through ``fixed_frame``."""
+        self._pull()
         with self._lock:
             self._drain()
             source = self._frames.get(source_frame)
@@ -1329,6 +1576,7 @@ class BufferCore:
 
     def all_frames_as_string(self) -> str:
         """tf2's ``allFramesAsString``: one "Frame x exists with parent y." line per child frame."""
+        self._pull()
         with self._lock:
             self._drain()
             return self._frames_as_string()
@@ -1342,6 +1590,7 @@ class BufferCore:
 
     def all_frames_as_yaml(self, current_time: float = 0.0) -> str:
         """tf2's ``allFramesAsYAML`` (what ``tf2_frames`` and view_frames read)."""
+        self._pull()
         with self._lock:
             self._drain()
             out = [] if self._order else ["{}"]
@@ -1360,6 +1609,7 @@ class BufferCore:
 
     def all_frames_as_dot(self, current_time: float = 0.0) -> str:
         """tf2's ``_allFramesAsDot``: the frame tree for Graphviz, with tf2's labels."""
+        self._pull()
         with self._lock:
             self._drain()
             out = ["digraph G {\n"]

@@ -7,6 +7,14 @@ them by child frame; ROS 1's Python one forgets earlier calls, geometry2#406/#45
 raw bytes and hands them to the buffer, which decodes them in batches when it is next asked
 (:meth:`~ninjemys.tf2.core.BufferCore.add_raw`); the publisher's caller id is the authority, as
 tf2_ros records it.
+
+The listener's thread does not wake per ``/tf`` message: its subscription is lazy (see
+:meth:`ninjemys.node.Node.subscriber`), read every ``LAZY_PERIOD`` seconds or sooner if the socket
+would fill, and the buffer pulls what the kernel holds before every query, so a lookup still sees
+every message that has arrived. While something waits for data (``can_transform`` with a timeout,
+a tf2 MessageFilter) the thread wakes per message, as it also does under simulated time: a jump back
+of ``/clock`` clears the buffer, and only messages delivered as they arrive are known to be older or
+newer than the jump.
 """
 
 from __future__ import annotations
@@ -24,6 +32,8 @@ from ninjemys.tf2.wire import encode_tf_message
 
 _log = logging.getLogger(__name__)
 TF_MESSAGE_MD5 = "94810edda583a504dfda3829e70d7eec"
+#: seconds between the lazy /tf subscription's reads when nobody asks (at most; it adapts down)
+LAZY_PERIOD = 0.25
 
 
 class TransformListener:
@@ -48,19 +58,50 @@ class TransformListener:
         self._last = now() if now is not None else 0.0
         self._reset_lock = threading.Lock()
         self._bad_reported: set[str] = set()
+        self._tf_header: Any = None  # the connection header of the last /tf message, and its authority
+        self._tf_who: str | None = None
+        clock = getattr(node, "clock", None)
+        self._sim = (lambda: clock.is_sim) if clock is not None else (lambda: False)
         self.tf_sub = node.subscriber(
-            "/tf", None, self._on_tf, queue_size=queue_size, raw=True, tcp_nodelay=tcp_nodelay
+            "/tf",
+            None,
+            self._on_tf_batch,
+            queue_size=queue_size,
+            raw=True,
+            tcp_nodelay=tcp_nodelay,
+            lazy=LAZY_PERIOD,
+            batch=True,
         )
         # one thread reads both topics (/tf_static is mostly silent: a thread of its own would only wait)
         self.tf_static_sub = node.subscriber(
             "/tf_static",
             None,
-            self._on_tf_static,
+            self._on_tf_static_batch,
             queue_size=queue_size,
             raw=True,
             tcp_nodelay=tcp_nodelay,
             share_thread=self.tf_sub,
+            batch=True,
         )
+        # a buffer that pulls before it answers gets the lazy subscription; any other buffer (or a node
+        # whose subscriptions cannot be pulled) gets every message as it comes
+        add_source = getattr(buffer, "add_source", None)
+        self._source = add_source is not None and hasattr(self.tf_sub, "pull")
+        if self._source:
+            add_source(self)  # type: ignore[misc]
+        elif hasattr(self.tf_sub, "set_eager"):
+            self.tf_sub.set_eager(True)
+
+    # -- the buffer's source protocol (BufferCore.add_source) ----------------------------------------
+    def pull(self) -> None:
+        """Deliver what the kernel holds for /tf and /tf_static now (on the caller's thread)."""
+        if self._sim():  # (a no-op once the subscription wakes per message)
+            self.tf_sub.set_eager(True)
+        self.tf_sub.pull()
+
+    def set_eager(self, eager: bool) -> None:
+        """Wake per message while ``eager`` (somebody waits for data) or under simulated time."""
+        self.tf_sub.set_eager(eager or self._sim())
 
     def _check_for_reset(self) -> None:
         now = self._now()  # type: ignore[misc]
@@ -70,9 +111,8 @@ class TransformListener:
                 self.buffer.clear()
             self._last = now
 
-    def _accept(self, raw: Any, topic: str) -> str | None:
-        """The publisher's caller id when the message is a TFMessage (one line per publisher otherwise)."""
-        header = raw.connection_header
+    def _accept(self, header: Any, topic: str) -> str | None:
+        """The publisher's caller id when it sends TFMessages (one line per publisher otherwise)."""
         who = header.get("callerid", "default_authority")
         md5 = header.get("md5sum", TF_MESSAGE_MD5)
         if md5 not in (TF_MESSAGE_MD5, "*"):
@@ -85,21 +125,41 @@ class TransformListener:
         return who
 
     def _on_tf(self, raw: Any) -> None:
-        if self._now is not None:
-            self._check_for_reset()
-        who = self._accept(raw, "/tf")
-        if who is not None:
-            self.buffer.add_raw(bytes(raw.data), who, False)
+        self._on_tf_batch([raw])
 
     def _on_tf_static(self, raw: Any) -> None:
+        self._on_tf_static_batch([raw])
+
+    def _on_tf_batch(self, raws: list[Any]) -> None:
+        """Messages read from /tf in one go (all delivered now: one reset check stands for each)."""
         if self._now is not None:
             self._check_for_reset()
-        who = self._accept(raw, "/tf_static")
-        if who is not None:
-            self.buffer.add_raw(bytes(raw.data), who, True)
+        header = raws[0].connection_header
+        if header is self._tf_header:  # the same connection as before: already accepted
+            who = self._tf_who
+        else:
+            who = self._tf_who = self._accept(header, "/tf")
+            self._tf_header = header
+        if len(raws) > 1 and any(r.connection_header is not header for r in raws):
+            self._add_each(raws, "/tf", False)
+        elif who is not None:
+            self.buffer.add_raw_many([bytes(r.data) for r in raws], who, False)
+
+    def _on_tf_static_batch(self, raws: list[Any]) -> None:
+        if self._now is not None:
+            self._check_for_reset()
+        self._add_each(raws, "/tf_static", True)
+
+    def _add_each(self, raws: list[Any], topic: str, static: bool) -> None:
+        for raw in raws:
+            who = self._accept(raw.connection_header, topic)
+            if who is not None:
+                self.buffer.add_raw(bytes(raw.data), who, static)
 
     def unregister(self) -> None:
         """Stop listening (both subscriptions)."""
+        if self._source:
+            self.buffer.remove_source(self)  # type: ignore[attr-defined]
         self.tf_sub.unregister()
         self.tf_static_sub.unregister()
 
