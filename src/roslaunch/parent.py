@@ -19,6 +19,7 @@ from ninjemys.launch.launcher import LaunchOptions, LaunchSession
 from ninjemys.launch.plan import LaunchPlan, NodeSpec
 from ninjemys.launch.runner import ProcessSpec, Supervisor
 from ninjemys.launch.xml import load_launch
+from ninjemys.master.client import MasterClient
 
 from .core import RLException
 
@@ -88,9 +89,15 @@ class _ScriptSession(LaunchSession):
     even when it has no node (the master it may have started stays up)."""
 
     def __init__(
-        self, plan: LaunchPlan, opts: LaunchOptions, keep_up: bool, listeners: Sequence[Any] = ()
+        self,
+        plan: LaunchPlan,
+        opts: LaunchOptions,
+        run_id: str,
+        keep_up: bool,
+        listeners: Sequence[Any] = (),
     ) -> None:
         super().__init__(plan, opts)
+        self.run_id = run_id
         self.keep_up = keep_up
         #: ROS 1's process listeners: ``process_died(name, exit_code)`` when a process ends
         self.listeners = list(listeners)
@@ -98,6 +105,9 @@ class _ScriptSession(LaunchSession):
         self.stopping = False
 
     def _supervise(self, specs: list[ProcessSpec], log: Callable[[str], None]) -> int:
+        if self._core is not None:  # a master we started carries the script's run id, as in ROS 1
+            with MasterClient(self.env["ROS_MASTER_URI"], "/roslaunch") as client:
+                client.set_param("/run_id", self.run_id)
         nodes = [s for s in specs if not s.is_core]
         plan_nodes = self.plan.nodes if len(self.plan.nodes) == len(nodes) else [None] * len(nodes)
         ros1_names = {}
@@ -194,7 +204,9 @@ class ROSLaunchParent:
         if self._thread is not None:
             raise RLException("ROSLaunchParent has already been started")
         plan = load_plan(self.roslaunch_files, self.roslaunch_strs)
-        self._session = _ScriptSession(plan, self.options, not auto_terminate, self.process_listeners)
+        self._session = _ScriptSession(
+            plan, self.options, self.run_id, not auto_terminate, self.process_listeners
+        )
         self._thread = threading.Thread(target=self._run, name="roslaunch", daemon=True)
         self._thread.start()
         self._session.started.wait()
