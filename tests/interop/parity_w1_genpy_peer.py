@@ -132,4 +132,32 @@ try:
     String().deserialize(b"\x09\x00\x00\x00ab")
 except genpy.DeserializationError as exc:
     out["errors"]["deserialize"] = type(exc).__name__
+import genpy.dynamic  # noqa: E402
+
+SEP = "=" * 80
+CAT = (
+    "Header header\nw1/Inner[] inners\ngeometry_msgs/Point where\nint32 K=3\n"
+    f"{SEP}\nMSG: std_msgs/Header\nuint32 seq\ntime stamp\nstring frame_id\n"
+    f"{SEP}\nMSG: w1/Inner\nstring label\nfloat64[2] pair\n"
+    f"{SEP}\nMSG: geometry_msgs/Point\nfloat64 x\nfloat64 y\nfloat64 z\n"
+)
+out["dynamic"] = {}
+classes = genpy.dynamic.generate_dynamic("w1/Thing", CAT)
+out["dynamic"]["types"] = sorted(classes)
+out["dynamic"]["md5"] = {t: c._md5sum for t, c in sorted(classes.items())}
+thing = classes["w1/Thing"]()
+thing.header.frame_id = "f"
+inner = classes["w1/Inner"](label="a", pair=[1.0, 2.0])
+thing.inners = [inner]
+thing.where.x = 4.0
+buf = io.BytesIO()
+thing.serialize(buf)
+out["dynamic"]["wire"] = buf.getvalue().hex()
+out["dynamic"]["back"] = str(classes["w1/Thing"]().deserialize(buf.getvalue()))
+out["dynamic"]["const"] = classes["w1/Thing"].K
+out["dynamic"]["slots"] = list(classes["w1/Thing"].__slots__)
+try:
+    genpy.dynamic.generate_dynamic("w1/Bad", "int32 x\n" + SEP + "\nnot a msg line\n")
+except Exception as exc:  # noqa: BLE001
+    out["dynamic"]["bad"] = type(exc).__name__
 print(json.dumps(out, sort_keys=True))

@@ -1,5 +1,6 @@
 """genpy against Debian's: genpy.Message/Time/Duration identities, fill_message_args (results and
-MessageException texts), check_type, strify_message, and the errors messages raise."""
+MessageException texts), check_type, strify_message, the errors messages raise, and genpy.dynamic.generate_dynamic (classes from a full
+text: md5sums, wire bytes, constants)."""
 
 from __future__ import annotations
 

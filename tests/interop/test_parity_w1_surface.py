@@ -15,7 +15,7 @@ pytestmark = pytest.mark.ros1
 
 PACKAGES = {
     "rosgraph": ["rosgraph", "rosgraph.names", "rosgraph.network", "rosgraph.masterapi", "rosgraph.rosenv"],
-    "genpy": ["genpy", "genpy.message", "genpy.rostime", "genpy.base"],
+    "genpy": ["genpy", "genpy.message", "genpy.rostime", "genpy.base", "genpy.dynamic"],
     "rostopic": ["rostopic"],
     "rosnode": ["rosnode"],
     "rosservice": ["rosservice"],
@@ -53,6 +53,9 @@ ALLOWED: dict[str, str] = {
     "genpy.message.Time.to_time": _TOTIME,
     "genpy.rostime.Time.to_time": _TOTIME,
     "genpy.message.long": _PY2,
+    "genpy.dynamic.MsgContext": _PY2,
+    "genpy.dynamic.StringIO": _PY2,
+    "genpy.dynamic.msg_generator": _PY2,
     "rosgraph.network.BytesIO": _PY2,
     "rosnode.OptionParser": _PY2,
     "rosparam.OptionParser": _PY2,
