@@ -124,6 +124,24 @@ out["meters"]["exceptions"] = [
     issubclass(rostopic.ROSTopicIOException, rostopic.ROSTopicException),
     Header()._has_header,
 ]
+# the meters as rostopic hz/bw wire them: AnyMsg subscribers, the topic as callback argument
+live_hz = rostopic.ROSTopicHz(-1)
+live_bw = rostopic.ROSTopicBandwidth(10)
+rospy.Subscriber("/w1/live", rospy.AnyMsg, live_hz.callback_hz, callback_args="/w1/live")
+rospy.Subscriber("/w1/live", rospy.AnyMsg, live_bw.callback)
+live = rospy.Publisher("/w1/live", String, queue_size=10)
+deadline = time.time() + 20
+while live.get_num_connections() < 2 and time.time() < deadline:
+    time.sleep(0.05)
+for i in range(12):
+    live.publish(String(data="x" * i))
+    time.sleep(0.02)
+deadline = time.time() + 20
+while len(live_bw.sizes) < 10 and time.time() < deadline:
+    time.sleep(0.05)
+got = live_hz.get_hz("/w1/live")
+out["meters"]["live"] = [got[4] if got else None, sorted(live_bw.sizes), len(live_bw.times)]
+
 # rostopic pub's publishing functions start a node of their own: in a process without one
 PUBLISHER = r"""
 import json
