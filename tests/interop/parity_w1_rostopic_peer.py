@@ -131,7 +131,7 @@ rospy.Subscriber("/w1/live", rospy.AnyMsg, live_hz.callback_hz, callback_args="/
 rospy.Subscriber("/w1/live", rospy.AnyMsg, live_bw.callback)
 live = rospy.Publisher("/w1/live", String, queue_size=10)
 deadline = time.time() + 20
-while live.get_num_connections() < 2 and time.time() < deadline:
+while live.get_num_connections() < 1 and time.time() < deadline:  # one per subscribing node
     time.sleep(0.05)
 for i in range(12):
     live.publish(String(data="x" * i))
