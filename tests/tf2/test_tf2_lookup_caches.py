@@ -376,3 +376,41 @@ def test_a_repeated_lookup_from_the_root_is_memoized(monkeypatch):
             for _ in range(3):
                 again = b.lookup(target, source, t)
                 assert again[0] == first[0] and again[1] == pytest.approx(first[1], abs=1e-9)
+
+
+@pytest.mark.parametrize("cache_time", [2, 9, 17, 33, 50])
+def test_history_is_exactly_cache_time_long(cache_time):
+    """tf2 prunes on every insertion: an entry older than the newest minus cache_time is gone. Ours
+    trims its lists in steps but hides those entries from every lookup path (single link, memo,
+    per-link chain, side composite), with tf2's error text (ROS 1's tf test_cache_time)."""
+    b = BufferCore(cache_time=float(cache_time))
+    for ti in range(101):
+        b.set_transforms([item("p", "c", ti, 1.0, yaw_q(0.1 * ti)), item("c", "d", ti, 2.0, yaw_q(0.2 * ti))])
+    first = 100 - cache_time
+    for ti in range(1, 100):
+        for target, source in (("p", "c"), ("p", "d"), ("d", "p")):
+            for t in (ti * S, ti * S + S // 2):  # a stored stamp, and between two
+                for _ in range(2):  # the second lookup in a segment uses the side composite
+                    if t >= first * S:
+                        b.lookup(target, source, t)
+                    else:
+                        with pytest.raises(
+                            TransformException, match=f"earliest data is at time {first}.000000000"
+                        ):
+                            b.lookup(target, source, t)
+    assert b._frames["c"].oldest() == first * S
+
+
+def test_a_composite_made_before_its_segment_aged_out_is_not_used():
+    """A side composite built while its segment was in the history stops answering once newer data
+    moves the segment past cache_time."""
+    b = BufferCore(cache_time=16.0)  # the lists are trimmed once 1 s longer than that
+    for ti in range(1, 4):
+        b.set_transforms([item("p", "c", ti, 1.0, yaw_q(0.1 * ti)), item("c", "d", ti, 2.0, yaw_q(0.2 * ti))])
+    for r in (0.3, 0.5, 0.7):  # different times in one segment: the 1..2 segment's composite
+        b.lookup("p", "d", int((1 + r) * S))
+    assert any(isinstance(c, tuple) and len(c) > 1 for c in b._frames["d"].sides[b._frames["p"]][0].values())
+    b.set_transforms([item("p", "c", 17.5, 1.0, yaw_q(0.6)), item("c", "d", 17.5, 2.0, yaw_q(1.3))])
+    assert b._frames["d"].stamps[0] == S  # still stored, but older than 17.5 - 16: pruned for tf2
+    with pytest.raises(TransformException, match="earliest data is at time 2.000000000"):
+        b.lookup("p", "d", int(1.4 * S))

@@ -284,6 +284,7 @@ class Subscription:
             code, status, proto = reply
             if code != 1 or not proto or proto[0] != "TCPROS":
                 _log.info("topic %s: publisher %s declined: %s", self.topic, uri, status)
+                self._retry_later(uri, attempt)
                 return
             host, port = proto[1], int(proto[2])
             sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
@@ -310,6 +311,7 @@ class Subscription:
             _log.info("topic %s: could not connect to publisher %s: %s", self.topic, uri, why)
             if sock is not None:
                 transport.close_quietly(sock)
+            self._retry_later(uri, attempt)
         except Exception as exc:  # an unexpected reply shape from a foreign peer
             _log.warning("topic %s: bad answer from publisher %s: %s", self.topic, uri, exc)
             if sock is not None:
@@ -342,11 +344,19 @@ class Subscription:
         if retry and not self.closed and conn.uri in self.publishers:
             self.node.runtime.loop.call_later(0.5, self._retry, conn.uri)
 
-    def _retry(self, uri: str) -> None:
+    def _retry(self, uri: str, attempt: int = 0) -> None:
         if self.closed or uri not in self.publishers or uri in self.connections or uri in self._connecting:
             return
         self._connecting.add(uri)
-        self.node.runtime.loop.create_task(self._connect(uri))
+        self.node.runtime.loop.create_task(self._connect(uri, attempt))
+
+    def _retry_later(self, uri: str, attempt: int) -> None:
+        """Try a failed publisher again while the master still lists it, as rospy does: after 0.5 s,
+        doubling up to 30 s (a publisher too busy to answer, or asked a moment before its node knew
+        the topic, is not left unconnected for good)."""
+        if not self.closed and uri in self.publishers:
+            delay = min(0.5 * 2**attempt, 30.0)
+            self.node.runtime.loop.call_later(delay, self._retry, uri, attempt + 1)
 
     def latched_frames(self) -> list[tuple[bytes | bytearray, Mapping[str, str]]]:
         return [(c.last, c.header) for c in self.connections.values() if c.last is not None]

@@ -114,6 +114,7 @@ class Frame:
     __slots__ = (
         "name",
         "number",
+        "keep",
         "static",
         "has_cache",
         "stamps",
@@ -140,9 +141,12 @@ class Frame:
         "applied",
     )
 
-    def __init__(self, name: str, number: int) -> None:
+    def __init__(self, name: str, number: int, keep: int = 0) -> None:
         self.name = name
         self.number = number
+        # history tf2 keeps (ns): an entry older than the newest minus this is pruned there, so it
+        # is invisible here too, although the list is trimmed in steps (see BufferCore._prune_slack)
+        self.keep = keep or 1 << 62
         self.static = False
         self.has_cache = False  # tf2: frames_[id] is null until the frame is somebody's child
         self.stamps: list[int] = []  # ascending
@@ -202,20 +206,23 @@ class Frame:
             return e if len(e) == 2 else self._resolve(-1)
         n = len(stamps)
         i = bisect_left(stamps, t)
-        if 0 < i < n:
+        lo = 0  # the oldest entry tf2 would still hold (it prunes on every insertion)
+        if stamps[0] + self.keep < self.latest:
+            lo = bisect_left(stamps, self.latest - self.keep)
+        if lo < i < n:
             if stamps[i] == t:
                 return self._resolve(i)
             return self._interpolate(i, t)
-        if i == 0 and stamps[0] == t:
-            return self._resolve(0)
+        if i == lo and stamps[i] == t:
+            return self._resolve(i)
         if err is not None:
-            if n == 1:
+            if n - lo == 1:
                 # tf2 formats this one into a 116-byte buffer: with two ten-digit times it loses its
                 # tail ("... is in the buffe"), and programs see exactly that
                 err.append(
                     (
                         "Lookup would require extrapolation at time %.09f, but only time %.09f is in the buffer"
-                        % (_secs(t), _secs(stamps[0]))
+                        % (_secs(t), _secs(stamps[lo]))
                     )[:115]
                 )
             elif i == n:
@@ -225,7 +232,7 @@ class Frame:
                     "latest data is at time %.09f" % (_secs(t - latest), _secs(t), _secs(latest))
                 )
             else:
-                earliest = stamps[0]
+                earliest = stamps[lo]
                 err.append(
                     "Lookup would require extrapolation %.09fs into the past.  Requested time %.09f but the "
                     "earliest data is at time %.09f" % (_secs(earliest - t), _secs(t), _secs(earliest))
@@ -353,7 +360,13 @@ class Frame:
         return self.latest, self.data[-1][0]
 
     def oldest(self) -> int:
-        return 0 if self.static or not self.stamps else self.stamps[0]
+        """The oldest stamp tf2 would hold (0 for static frames)."""
+        if self.static or not self.stamps:
+            return 0
+        stamps = self.stamps
+        if stamps[0] + self.keep < self.latest:
+            return stamps[bisect_left(stamps, self.latest - self.keep)]
+        return stamps[0]
 
 
 class BufferCore:
@@ -399,7 +412,7 @@ class BufferCore:
     def _frame_or_new(self, name: str) -> Frame:
         f = self._frames.get(name)
         if f is None:
-            f = Frame(name, len(self._order) + 1)
+            f = Frame(name, len(self._order) + 1, self.cache_time_ns)
             self._frames[name] = f
             self._order.append(f)
             self._topology += 1
@@ -1273,6 +1286,8 @@ class BufferCore:
         if not i:
             return None
         t0 = stamps[i - 1]
+        if t0 + lead.keep < lead.latest:  # tf2 has pruned the segment's older end
+            return None
         c = comps.get(t0)
         if c is None:  # first seen: not worth a composite yet
             if len(comps) >= 256:
@@ -1700,10 +1715,10 @@ def _relative_at(up: tuple, down: tuple, t: int) -> tuple | None:
             else:
                 stamps = f.stamps
                 i = bisect_right(stamps, t)
-                if 0 < i < len(stamps):
+                if 0 < i < len(stamps) and stamps[i - 1] + f.keep >= f.latest:
                     rec = f.segs[i] or f._segment(i)
                     r = (t - rec[2]) * rec[3]
-                else:  # before the oldest or after the newest stamp: extrapolation
+                else:  # before the oldest (kept) or after the newest stamp: extrapolation
                     return None
                 if rec[1] is not parent:
                     return None
@@ -1810,7 +1825,7 @@ def _build_composite(links: tuple, t: int, t0: int, t1: int, history: int) -> tu
         else:
             stamps = f.stamps
             i = bisect_right(stamps, t)
-            if not 0 < i < len(stamps) or stamps[i - 1] != t0 or stamps[i] != t1:
+            if not 0 < i < len(stamps) or stamps[i - 1] != t0 or stamps[i] != t1 or t0 + f.keep < f.latest:
                 return (history, 0.0, None, 0.0, 0.0, 0.0, ())
             rec = f.segs[i] or f._segment(i)
             if not rec[3]:  # a change of parent inside the segment
