@@ -19,9 +19,8 @@ import json
 import sys
 import traceback
 
-import genpy.dynamic
-
 import genpy
+import genpy.dynamic
 import roslib.message
 
 _classes: dict[str, type] = {}
