@@ -1697,73 +1697,61 @@ def _relative_at(up: tuple, down: tuple, t: int) -> tuple | None:
                 if d[0] is not parent:
                     return None
                 ex, ey, ez, px, py, pz, pw = d[1]
-                if px == 0.0 and py == 0.0:
-                    if planar:
-                        c = complex(pw, pz)
-                        P = c * c * P + complex(ex, ey)
-                        Z += ez
-                        Q = c * Q
-                        continue
-                elif planar:
-                    planar = False
-                    x = P.real
-                    y = P.imag
-                    z = Z
-                    qz = Q.imag
-                    qw = Q.real
-                rec = None
-            else:
-                stamps = f.stamps
-                i = bisect_right(stamps, t)
-                if 0 < i < len(stamps) and stamps[i - 1] + f.keep >= f.latest:
-                    rec = f.segs[i] or f._segment(i)
-                    r = (t - rec[2]) * rec[3]
-                else:  # before the oldest (kept) or after the newest stamp: extrapolation
-                    return None
-                if rec[1] is not parent:
-                    return None
-            if rec is None:
-                pass
-            elif rec[0]:  # a planar link
-                _, _, _, _, e, ez, de, dz, c, th = rec
-                if r:
-                    e += r * de
-                    ez += r * dz
-                    if th:
-                        c *= rect(1.0, r * th)
-                if planar:  # link * side: rotate by c² (c is the half angle), then translate
-                    P = c * c * P + e
+                if planar and px == 0.0 and py == 0.0:
+                    c = complex(pw, pz)
+                    P = c * c * P + complex(ex, ey)
                     Z += ez
                     Q = c * Q
                     continue
-                ex = e.real
-                ey = e.imag
-                px = py = 0.0
-                pz = c.imag
-                pw = c.real
             else:
-                _, _, _, _, ex, ey, ez, dx, dy, dz, px, py, pz, pw, cx, cy, cz, cw, th = rec
-                if r:
-                    ex += r * dx
-                    ey += r * dy
-                    ez += r * dz
-                    if th:
-                        a = r * th
-                        co = cos(a)
-                        si = sin(a)
-                        px = px * co + cx * si
-                        py = py * co + cy * si
-                        pz = pz * co + cz * si
-                        pw = pw * co + cw * si
-                    else:
-                        px, py, pz, pw = _nlerp(px, py, pz, pw, cx, cy, cz, cw, r)
-                if planar:
-                    planar = False
-                    x = P.real
-                    y = P.imag
-                    z = Z
-                    qz = Q.imag
-                    qw = Q.real
+                stamps = f.stamps
+                i = bisect_right(stamps, t)
+                if not (0 < i < len(stamps) and stamps[i - 1] + f.keep >= f.latest):
+                    return None  # before the oldest (kept) or after the newest stamp: extrapolation
+                rec = f.segs[i] or f._segment(i)
+                if rec[1] is not parent:
+                    return None
+                r = (t - rec[2]) * rec[3]
+                if rec[0]:  # a planar link
+                    _, _, _, _, e, ez, de, dz, c, th = rec
+                    if r:
+                        e += r * de
+                        ez += r * dz
+                        if th:
+                            c *= rect(1.0, r * th)
+                    if planar:  # link * side: rotate by c² (c is the half angle), then translate
+                        P = c * c * P + e
+                        Z += ez
+                        Q = c * Q
+                        continue
+                    ex = e.real
+                    ey = e.imag
+                    px = py = 0.0
+                    pz = c.imag
+                    pw = c.real
+                else:
+                    _, _, _, _, ex, ey, ez, dx, dy, dz, px, py, pz, pw, cx, cy, cz, cw, th = rec
+                    if r:
+                        ex += r * dx
+                        ey += r * dy
+                        ez += r * dz
+                        if th:
+                            a = r * th
+                            co = cos(a)
+                            si = sin(a)
+                            px = px * co + cx * si
+                            py = py * co + cy * si
+                            pz = pz * co + cz * si
+                            pw = pw * co + cw * si
+                        else:
+                            px, py, pz, pw = _nlerp(px, py, pz, pw, cx, cy, cz, cw, r)
+            if planar:  # the first general link: the side continues in the 7-float form
+                planar = False
+                x = P.real
+                y = P.imag
+                z = Z
+                qz = Q.imag
+                qw = Q.real
             # link * side, as tfm.compose (plain assignments: no tuple per link)
             ux = py * z - pz * y + pw * x
             uy = pz * x - px * z + pw * y
