@@ -6,7 +6,6 @@ clock), then works on the core :class:`~ninjemys.node.Node` it made (``rospy.cor
 
 from __future__ import annotations
 
-import math
 import sys
 from typing import Any
 
@@ -17,9 +16,8 @@ from ninjemys.errors import ShutdownError
 from ninjemys.sim.mapfile import GridMap
 from ninjemys.tf2.core import BufferCore
 from ninjemys.tf2.errors import TransformException
+from ninjemys.tf2.math import Pose2D, quaternion_from_yaw, yaw_from_quaternion
 from ninjemys.tf2.node import TransformBroadcaster, TransformListener
-
-Pose2D = tuple[float, float, float]
 
 #: how long (wall seconds) a scan waits for the transform at its stamp before it is dropped; ROS 1's
 #: message filters hold up to their queue size of scans, about a second of a 40 Hz (4x sim) laser
@@ -62,23 +60,17 @@ def stamp(t: float | None = None) -> Any:
     return rospy.Time.from_sec(now() if t is None else t)
 
 
-def yaw_to_quat(yaw: float) -> tuple[float, float, float, float]:
-    return (0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0))
-
-
-def quat_to_yaw(x: float, y: float, z: float, w: float) -> float:
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-
-
 def pose_msg_to_2d(pose: Any) -> Pose2D:
     """geometry_msgs/Pose -> (x, y, yaw)."""
     q = pose.orientation
-    return float(pose.position.x), float(pose.position.y), quat_to_yaw(q.x, q.y, q.z, q.w)
+    return float(pose.position.x), float(pose.position.y), yaw_from_quaternion(q.x, q.y, q.z, q.w)
 
 
 def fill_pose(pose: Any, p: Pose2D) -> Any:
     pose.position.x, pose.position.y, pose.position.z = float(p[0]), float(p[1]), 0.0
-    (pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w) = yaw_to_quat(p[2])
+    (pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w) = quaternion_from_yaw(
+        p[2]
+    )
     return pose
 
 
@@ -113,12 +105,12 @@ def fill_info(
 
 def tf_to_2d(t: tuple) -> Pose2D:
     """The buffer's 7-float transform (x, y, z, qx, qy, qz, qw) as (x, y, yaw)."""
-    return float(t[0]), float(t[1]), quat_to_yaw(t[3], t[4], t[5], t[6])
+    return float(t[0]), float(t[1]), yaw_from_quaternion(t[3], t[4], t[5], t[6])
 
 
 def tf_item(parent: str, child: str, t: float, p: Pose2D) -> tuple:
     """A broadcaster item for a planar transform at ROS time ``t``."""
-    q = yaw_to_quat(p[2])
+    q = quaternion_from_yaw(p[2])
     return (parent, child, int(round(t * 1e9)), float(p[0]), float(p[1]), 0.0, *q)
 
 
