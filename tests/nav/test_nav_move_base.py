@@ -62,9 +62,9 @@ def make(**overrides):
     params = MoveBaseParams(**overrides)
     cleared: list[float] = []
     recoveries = [
-        ClearCostmaps("conservative_reset", lambda g, l, size: cleared.append(size), lambda: 3.0),
+        ClearCostmaps("conservative_reset", lambda g, lp, size: cleared.append(size), lambda: 3.0),
         RotateRecovery(lambda: 1.5, lambda: params.clearing_rotation_allowed),
-        ClearCostmaps("aggressive_reset", lambda g, l, size: cleared.append(size), lambda: 0.0),
+        ClearCostmaps("aggressive_reset", lambda g, lp, size: cleared.append(size), lambda: 0.0),
         RotateRecovery(lambda: 1.5, lambda: params.clearing_rotation_allowed),
     ]
     fsm = MoveBaseFsm(params, FakePlanner(), FakeController(), recoveries)
