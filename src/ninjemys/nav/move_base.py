@@ -123,6 +123,8 @@ class Outcome:
     token: Any
     status: int
     text: str
+    goal: Pose2D | None = None
+    pose: Pose2D | None = None  # the robot's last pose in the global frame (None: not seen yet)
 
     @property
     def name(self) -> str:
@@ -244,6 +246,8 @@ class MoveBaseFsm:
         self.last_request = -math.inf
         self.recovery_index = 0
         self.failure = ""
+        self.replan_warned = -math.inf
+        self.pose: Pose2D | None = None  # the last global pose a cycle saw
         self.started_recovery = False
         self.last_cycle: float | None = None
         self.periods: deque[float] = deque(maxlen=20)  # measured control periods
@@ -255,7 +259,7 @@ class MoveBaseFsm:
         does."""
         step = Step()
         if self.state != IDLE:
-            step.ended.append(Outcome(self.token, states.PREEMPTED, PREEMPTED_TEXT))
+            step.ended.append(Outcome(self.token, states.PREEMPTED, PREEMPTED_TEXT, self.goal, self.pose))
         self.goal, self.token = goal, token
         self.seq += 1
         self.controller.new_goal()
@@ -274,7 +278,7 @@ class MoveBaseFsm:
         step = Step()
         if self.state != IDLE and token is self.token:
             step.cmd = (0.0, 0.0)
-            step.ended.append(Outcome(self.token, states.PREEMPTED, ""))
+            step.ended.append(Outcome(self.token, states.PREEMPTED, "", self.goal, self.pose))
             self._idle()
         return step
 
@@ -288,7 +292,7 @@ class MoveBaseFsm:
 
     def _finish(self, step: Step, status: int, text: str) -> Step:
         step.cmd = (0.0, 0.0)
-        step.ended.append(Outcome(self.token, status, text))
+        step.ended.append(Outcome(self.token, status, text, self.goal, self.pose))
         self._idle()
         return step
 
@@ -311,7 +315,9 @@ class MoveBaseFsm:
         self.last_plan = now
         if plan is None:
             if self.state == CONTROLLING:
-                step.log.append(("warn", f"replanning failed ({error}); keeping the current plan"))
+                if now - self.replan_warned >= 5.0:  # at most every 5 s, as a throttled ROS warning
+                    self.replan_warned = now
+                    step.log.append(("warn", f"replanning failed ({error}); keeping the current plan"))
             elif self.state == PLANNING and now - self.planning_since > self.params.planner_patience:
                 self._start_recovery(
                     step,
@@ -352,6 +358,7 @@ class MoveBaseFsm:
         step = Step()
         if self.state == IDLE or self.goal is None:
             return step
+        self.pose = gpose
         if self.last_cycle is not None and now > self.last_cycle:
             self.periods.append(now - self.last_cycle)
         self.last_cycle = now
@@ -416,10 +423,16 @@ class MoveBaseFsm:
         self.state = CLEARING
         self.started_recovery = False
         step.cmd = (0.0, 0.0)
+        where = ""
+        if self.pose is not None and self.goal is not None:
+            x, y, yaw = self.pose
+            away = math.hypot(self.goal[0] - x, self.goal[1] - y)
+            where = f" at ({x:.2f}, {y:.2f}, {yaw:.2f}), {away:.2f} m from the goal"
         step.log.append(
             (
                 "warn",
-                f"{failure.split('.')[0]}; running recovery behavior {self.recoveries[self.recovery_index].name}",
+                f"{failure.split('.')[0]}{where}; running recovery behavior "
+                f"{self.recoveries[self.recovery_index].name}",
             )
         )
 

@@ -506,6 +506,12 @@ class MoveBase:
 
     def _end(self, outcome: Outcome) -> None:
         handle = outcome.token
+        if outcome.goal is not None and outcome.pose is not None:
+            (gx, gy, gyaw), (x, y, yaw) = outcome.goal, outcome.pose
+            rospy.loginfo(
+                "move_base: goal (%.2f, %.2f, %.2f) %s at (%.2f, %.2f, %.2f)",
+                gx, gy, gyaw, outcome.name, x, y, yaw,
+            )  # fmt: skip
         if outcome.status == states.SUCCEEDED:
             rospy.loginfo("move_base: %s", outcome.text or "goal reached")
             if handle is not None:
