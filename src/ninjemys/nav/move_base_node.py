@@ -32,8 +32,8 @@ from typing import Any
 
 import numpy as np
 
-import rospy
 from ninjemys.actionlib import states
+from ninjemys.errors import ShutdownError
 from ninjemys.nav.costmap import INSCRIBED
 from ninjemys.nav.costmap_ros import CostmapROS
 from ninjemys.nav.dwa import DWAParams, DWAPlanner
@@ -53,12 +53,13 @@ from ninjemys.nav.rosglue import (
     Tf2D,
     fill_pose,
     grid_from_msg,
+    node_sleep,
     param,
     pose_msg_to_2d,
-    run_node,
+    run_core_node,
     scan_arrays,
-    sleep,
 )
+from ninjemys.node.log import WARN
 from ninjemys.tf2.math import se2_compose
 
 #: dwa_local_planner's names for the base_local_planner (TrajectoryPlannerROS) parameters we map
@@ -144,6 +145,7 @@ class MoveBase:
         from std_srvs.srv import Empty
 
         self.node = node
+        self.log = node.log
         self.lock = threading.RLock()
         self.params = move_base_params(node)
         planner_ns = "GlobalPlanner" if node.has_param("~GlobalPlanner") else "NavfnROS"
@@ -262,7 +264,7 @@ class MoveBase:
                     cm.costmap.set_static_map(grid.data, grid.resolution, grid.origin[0], grid.origin[1])
             if self.global_cm.costmap.params.use_static:
                 self.global_cm.costmap.update()
-        rospy.loginfo(
+        self.log.info(
             "move_base: received a %d X %d map at %.3f m/pix", grid.width, grid.height, grid.resolution
         )
 
@@ -285,7 +287,7 @@ class MoveBase:
         ranges, angles = scan_arrays(scan)
         if not self.bad_scan_reported and not np.isfinite(ranges).all():
             self.bad_scan_reported = True
-            rospy.logwarn(
+            self.log.warn(
                 "move_base: scan on %s has NaN/inf ranges (%d of %d): NaN is dropped, inf clears without marking",
                 scan.header.frame_id,
                 int((~np.isfinite(ranges)).sum()),
@@ -368,7 +370,7 @@ class MoveBase:
         """Runs with the action server's lock held: decide here, hand the goal to the control loop."""
         goal, reason = self._goal_in_global(handle.get_goal().target_pose)
         if goal is None:
-            rospy.logerr("move_base: %s", reason)
+            self.log.error("move_base: %s", reason)
             handle.set_rejected(None, reason)
             return
         handle.set_accepted("This goal has been accepted by the simple action server")
@@ -382,7 +384,7 @@ class MoveBase:
         """A ``move_base_simple/goal``: through the same inbox as action goals, with no handle."""
         goal, reason = self._goal_in_global(msg)
         if goal is None:
-            rospy.logerr("move_base: %s", reason)
+            self.log.error("move_base: %s", reason)
             return
         self._post("goal", goal, None)
 
@@ -397,7 +399,7 @@ class MoveBase:
         steps = []
         for kind, goal, handle in items:
             if kind == "goal":
-                steps.append(self.fsm.accept(goal, handle, rospy.get_time()))
+                steps.append(self.fsm.accept(goal, handle, self.node.get_time()))
                 self._publish_goal(goal)
             elif self.fsm.is_current(handle):
                 steps.append(self.fsm.cancel(handle))
@@ -408,7 +410,7 @@ class MoveBase:
     def _publish_goal(self, goal: Pose2D) -> None:
         msg = self._pose_stamped()
         msg.header.frame_id = self.global_cm.global_frame
-        msg.header.stamp = rospy.Time.from_sec(rospy.get_time())
+        msg.header.stamp = self.node.now()
         fill_pose(msg.pose, goal)
         self.goal_pub.publish(msg)
 
@@ -421,18 +423,18 @@ class MoveBase:
         resp.plan.header.frame_id = self.global_cm.global_frame
         goal, reason = self._goal_in_global(req.goal)
         if goal is None:
-            rospy.logerr("move_base: make_plan: %s", reason)
+            self.log.error("move_base: make_plan: %s", reason)
             return resp
         start: Pose2D | None = pose_msg_to_2d(req.start.pose) if req.start.header.frame_id else None
         if start is None:
             start = self.tf.lookup(self.global_cm.global_frame, self.global_cm.robot_base_frame)
         if start is None:
-            rospy.logerr("move_base: make_plan: no robot pose in %s", self.global_cm.global_frame)
+            self.log.error("move_base: make_plan: no robot pose in %s", self.global_cm.global_frame)
             return resp
         try:
             plan = self._make_plan(start, goal)
         except PlanError as exc:
-            rospy.logerr("move_base: make_plan: %s", exc)
+            self.log.error("move_base: make_plan: %s", exc)
             return resp
         resp.plan = self._path_msg(plan, self.global_cm.global_frame)
         return resp
@@ -472,7 +474,7 @@ class MoveBase:
 
         path = self._path_cls()
         path.header.frame_id = frame
-        path.header.stamp = rospy.Time.from_sec(rospy.get_time())
+        path.header.stamp = self.node.now()
         out = []
         for x, y, yaw in plan:
             ps = PoseStamped()
@@ -494,7 +496,7 @@ class MoveBase:
     def _apply(self, step: Step) -> None:
         """Carry out what the state machine asked (move_base's lock not held)."""
         for level, text in step.log:
-            (rospy.logwarn if level == "warn" else rospy.loginfo)("move_base: %s", text)
+            (self.log.warn if level == "warn" else self.log.info)("move_base: %s", text)
         if step.cmd is not None:
             self._send(*step.cmd)
         for outcome in step.ended:
@@ -508,16 +510,16 @@ class MoveBase:
         handle = outcome.token
         if outcome.goal is not None and outcome.pose is not None:
             (gx, gy, gyaw), (x, y, yaw) = outcome.goal, outcome.pose
-            rospy.loginfo(
+            self.log.info(
                 "move_base: goal (%.2f, %.2f, %.2f) %s at (%.2f, %.2f, %.2f)",
                 gx, gy, gyaw, outcome.name, x, y, yaw,
             )  # fmt: skip
         if outcome.status == states.SUCCEEDED:
-            rospy.loginfo("move_base: %s", outcome.text or "goal reached")
+            self.log.info("move_base: %s", outcome.text or "goal reached")
             if handle is not None:
                 handle.set_succeeded(None, outcome.text)
         elif outcome.status == states.ABORTED:
-            rospy.logerr("move_base: %s", outcome.text)
+            self.log.error("move_base: %s", outcome.text)
             if handle is not None:
                 handle.set_aborted(None, outcome.text)
         elif handle is not None:  # PREEMPTED: a cancel, or a newer goal
@@ -531,8 +533,8 @@ class MoveBase:
         period = 1.0 / max(freqs) if freqs else 0.5
         updated = {id(cm): -math.inf for cm in cms}
         published = dict(updated)
-        while sleep(period):
-            t = rospy.get_time()
+        while node_sleep(self.node, period):
+            t = self.node.get_time()
             for cm in cms:
                 if cm.update_frequency > 0 and t - updated[id(cm)] >= 1.0 / cm.update_frequency - 1e-6:
                     updated[id(cm)] = t
@@ -543,15 +545,15 @@ class MoveBase:
                         cm.publish()
 
     def control_loop(self) -> None:
-        rate = rospy.Rate(self.params.controller_frequency)
-        while not rospy.is_shutdown():
+        rate = self.node.rate(self.params.controller_frequency)
+        while not self.node.is_shutdown:
             try:
                 self.cycle()
             except Exception as exc:  # one cycle failing must not kill the controller thread
-                rospy.logerr("move_base: control cycle failed: %s: %s", type(exc).__name__, exc)
+                self.log.error("move_base: control cycle failed: %s: %s", type(exc).__name__, exc)
             try:
                 rate.sleep()
-            except rospy.ROSInterruptException:
+            except ShutdownError:
                 return
 
     def _robot_poses(self) -> tuple[Pose2D | None, Pose2D | None]:
@@ -571,8 +573,9 @@ class MoveBase:
             return
         gpose, lpose = self._robot_poses()
         if gpose is None or lpose is None:
-            rospy.logwarn_throttle(
+            self.log.log_throttle(
                 5.0,
+                WARN,
                 "move_base: no robot pose yet (waiting for TF %s -> %s)",
                 self.global_cm.global_frame,
                 self.global_cm.robot_base_frame,
@@ -580,7 +583,7 @@ class MoveBase:
             return
         with self.lock:
             handle = self.fsm.token
-            step = self.fsm.cycle(rospy.get_time(), gpose, lpose, self.velocity)
+            step = self.fsm.cycle(self.node.get_time(), gpose, lpose, self.velocity)
         if step.feedback is not None and handle is not None:
             self._feedback(handle, step.feedback)
         self._apply(step)
@@ -590,20 +593,20 @@ class MoveBase:
 
         fb = MoveBaseFeedback()
         fb.base_position.header.frame_id = self.global_cm.global_frame
-        fb.base_position.header.stamp = rospy.Time.from_sec(rospy.get_time())
+        fb.base_position.header.stamp = self.node.now()
         fill_pose(fb.base_position.pose, gpose)
         handle.publish_feedback(fb)
 
     def planner_loop(self) -> None:
         """The global planner's own thread (as in ROS 1): the control loop keeps its rate meanwhile."""
-        while not rospy.is_shutdown():
+        while not self.node.is_shutdown:
             if not self.plan_event.wait(0.5):
                 continue
             self.plan_event.clear()
             try:
                 self._plan_once()
             except Exception as exc:  # the planner thread must survive anything one plan does
-                rospy.logerr("move_base: planning failed: %s: %s", type(exc).__name__, exc)
+                self.log.error("move_base: planning failed: %s: %s", type(exc).__name__, exc)
                 with self.lock:
                     self.fsm.planner_busy = False
 
@@ -611,7 +614,7 @@ class MoveBase:
         gpose = self.tf.lookup(self.global_cm.global_frame, self.global_cm.robot_base_frame)
         if gpose is None:
             return
-        now = rospy.get_time()
+        now = self.node.get_time()
         with self.lock:
             job = self.fsm.take_plan_job(now)
         if job is None:
@@ -642,4 +645,4 @@ class MoveBase:
 
 
 def main(argv: list[str] | None = None) -> int:
-    return run_node("move_base", argv, MoveBase)
+    return run_core_node("move_base", argv, MoveBase)
