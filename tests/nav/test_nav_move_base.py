@@ -182,3 +182,22 @@ def test_oscillation_runs_a_full_rotation_and_progress_resets_the_recovery_list(
     fsm.cycle(t, POSE, POSE, (0, 0))
     fsm.cycle(t + 0.05, (0.5, 0.0, 0.0), (0.5, 0.0, 0.0), (0, 0))  # real progress
     assert fsm.recovery_index == 0
+
+
+def test_final_turn_is_progress_only_while_the_heading_error_shrinks():
+    fsm, _ = make(oscillation_timeout=2.0, oscillation_distance=0.2)
+    goal = (0.0, 0.0, 3.0)
+    fsm.accept(goal, "h1", 0.0)
+    fsm.plan_now(POSE, 0.0)
+    fsm.controller.answer = Command(0.0, 0.5, turning=True)
+    t, yaw = 0.0, 0.0
+    while yaw < 2.9:  # turning towards the goal's heading at 0.5 rad/s: 6 s, far past the timeout
+        t += 0.05
+        yaw += 0.5 * 0.05
+        fsm.cycle(t, (0.0, 0.0, yaw), (0.0, 0.0, yaw), (0.0, 0.5))
+        assert fsm.state == CONTROLLING, t
+    stalled = t
+    while fsm.state == CONTROLLING:  # the turn stalls (or hunts): the oscillation check fires again
+        t += 0.05
+        fsm.cycle(t, (0.0, 0.0, yaw), (0.0, 0.0, yaw), (0.0, 0.0))
+    assert fsm.state == CLEARING and 1.8 < t - stalled < 2.2  # from the last 0.05 rad of progress

@@ -47,6 +47,8 @@ CANCELABLE = frozenset({states.PENDING, states.ACTIVE, states.PREEMPTING, states
 PREEMPTED_TEXT = "This goal was canceled because another goal was received by the simple action server"
 #: how often a plan is asked for while one is being made or keeps failing (seconds)
 PLAN_RETRY = 0.5
+#: how much the final turn must shrink the heading error (rad) to count as progress
+TURN_PROGRESS = 0.05
 
 
 @dataclass
@@ -96,7 +98,14 @@ class Controller(Protocol):
 class ProgressChecker(Protocol):
     """nav2's ProgressChecker: has the robot made progress lately?"""
 
-    def reset(self, pose: Pose2D | None, now: float) -> None: ...
+    def reset(self, pose: Pose2D | None, now: float) -> None:
+        """Start counting afresh from ``pose`` (None: from the next pose seen) at ``now``."""
+        ...
+
+    def moved(self, pose: Pose2D, now: float) -> bool:
+        """True when ``pose`` is real progress (a new reference; move_base then starts its recovery
+        list over)."""
+        ...
 
     def check(self, pose: Pose2D, now: float) -> bool:
         """False when the robot has been stuck too long (move_base then runs a recovery)."""
@@ -245,7 +254,7 @@ class MoveBaseFsm:
         self.planner_busy = False
         self.last_request = -math.inf
         self.recovery_index = 0
-        self.failure = ""
+        self.turn_best = math.inf  # the smallest heading error of the final turn so far
         self.replan_warned = -math.inf
         self.pose: Pose2D | None = None  # the last global pose a cycle saw
         self.started_recovery = False
@@ -269,6 +278,7 @@ class MoveBaseFsm:
         self.planning_since = self.last_valid = now
         self.last_request = -math.inf
         self.recovery_index = 0
+        self.turn_best = math.inf
         self.progress.reset(None, now)
         step.plan_wanted = True
         return step
@@ -391,11 +401,16 @@ class MoveBaseFsm:
             self.last_valid = now
             step.cmd = (cmd.v, cmd.w)
             if cmd.turning:
-                # the final turn at the goal is progress although the robot stays put: counted as
-                # oscillation, a slow turn in a narrow spot ran the recoveries (whose full turns end
-                # anywhere) and then aborted the goal at whatever heading the robot had
-                self.progress.reset(gpose, now)
-            elif isinstance(self.progress, OscillationChecker) and self.progress.moved(gpose, now):
+                # the final turn at the goal is progress although the robot stays put, as long as the
+                # heading error keeps shrinking: counted as oscillation, a slow turn in a narrow spot
+                # ran the recoveries (whose full turns end anywhere) and then aborted the goal at
+                # whatever heading the robot had. A turn that stalls or hunts still times out.
+                assert self.goal is not None
+                err = abs(angle_diff(self.goal[2], gpose[2]))
+                if err < self.turn_best - TURN_PROGRESS:
+                    self.turn_best = err
+                    self.progress.reset(gpose, now)
+            elif self.progress.moved(gpose, now):
                 self.recovery_index = 0  # real progress: the recovery list starts over, as in ROS 1
             if not self.progress.check(gpose, now):
                 self._start_recovery(
@@ -419,7 +434,6 @@ class MoveBaseFsm:
         if not self.params.recovery_behavior_enabled or self.recovery_index >= len(self.recoveries):
             self._finish(step, states.ABORTED, failure)
             return
-        self.failure = failure
         self.state = CLEARING
         self.started_recovery = False
         step.cmd = (0.0, 0.0)
