@@ -21,6 +21,12 @@ goal status text (ROS 1 accepts them and aborts after ``planner_patience``); whe
 finds no safe arc for ``controller_patience`` seconds, or the robot oscillates, the recovery
 behaviours run in ROS 1's order (conservative reset, rotate in place, aggressive reset, rotate), then
 the goal is aborted.
+
+Those rules are :class:`~ninjemys.nav.move_base.MoveBaseFsm`'s, which has no ROS inside; this module
+keeps the I/O and three threads (control, planner, costmaps), plugs DWA, the grid planner and the
+costmap-clearing recoveries into its seams, and feeds it from one goal inbox (action goals,
+``move_base_simple`` goals and cancels, in arrival order). The node is a core
+:class:`~ninjemys.node.Node` made from the command line (no rospy).
 """
 
 from __future__ import annotations
