@@ -123,7 +123,7 @@ def test_final_approach_turns_in_place_at_the_goal_in_a_narrow_corridor():
 def test_final_approach_where_no_arc_is_safe_near_the_goal_still_turns_to_the_heading():
     """A corridor 0.4 m wide and the robot 0.06 m off its centre line, 0.12 m from the goal: its own cell
     is inscribed in the costmap (a tight spot, or a wall marked a little off), so no arc at all is safe.
-    Within 2 x xy_goal_tolerance that ends the approach with the turn in place, instead of
+    Within 1.5 x xy_goal_tolerance, standing, that ends the approach with the turn in place, instead of
     controller_patience, the recoveries and an abort at whatever heading the robot had."""
     goal = (1.65, 2.0, 2.9)
     outcome, (x, y, th), runs, _ = approach((1.55, 2.06, 0.0), goal, width=0.4)

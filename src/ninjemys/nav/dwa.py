@@ -14,7 +14,7 @@ the rest as dwa_local_planner does (all distances in cells of the local costmap)
 Within ``xy_goal_tolerance`` of the goal the robot stops and turns in place to the goal's yaw
 (``yaw_goal_tolerance``), like dwa's LatchedStopRotateController (``latch_xy_goal_tolerance``). In
 a narrow spot the last centimetres may have no safe arc at all; within ``NEAR_GOAL`` tolerances of
-the goal that also ends the approach with the turn in place (ours; dwa would fail the cycle).
+the goal, standing, that also ends the approach with the turn in place (ours; dwa fails the cycle).
 Everything for one cycle is a handful of numpy operations over all samples at once.
 """
 
@@ -28,9 +28,9 @@ import numpy as np
 from ninjemys.nav.costmap import INSCRIBED, NO_INFORMATION, Costmap
 from ninjemys.tf2.math import angle_diff
 
-#: within this many xy_goal_tolerance of the goal, a cycle with no safe arc ends the approach: the
-#: robot stops and turns in place to the goal's yaw
-NEAR_GOAL = 2.0
+#: within this many xy_goal_tolerance of the goal, a standing robot with no safe arc ends the approach:
+#: it turns in place to the goal's yaw
+NEAR_GOAL = 1.5
 
 
 @dataclass
@@ -139,11 +139,13 @@ class DWAPlanner:
             self.xy_latched = True
             return self._rotate_to(th, gyaw, vel, period)
         cmd = self._sample(x, y, th, vel, costmap)
-        if not cmd.valid and math.hypot(gx - x, gy - y) <= NEAR_GOAL * p.xy_goal_tolerance:
-            # the last centimetres of a narrow spot: every arc at the minimum speeds runs into an
-            # inscribed cell within sim_time, but the goal is practically reached and a turn in
-            # place sweeps nothing new for a round robot. Without this the robot stood there until
-            # controller_patience ran out, and the recoveries and the abort left it at any heading.
+        stopped = abs(vel[0]) <= p.acc_lim_x / p.controller_frequency  # turning in place was sampled
+        if not cmd.valid and stopped and math.hypot(gx - x, gy - y) <= NEAR_GOAL * p.xy_goal_tolerance:
+            # the last centimetres of a narrow spot: standing next to the goal, even the turns in
+            # place touch an inscribed cell (the robot's own cell reads inscribed), but the goal is
+            # practically reached and a turn in place sweeps nothing new for a round robot. Without
+            # this the robot stood there until controller_patience ran out, and the recoveries and
+            # the abort left it at any heading. (A robot still moving first stops: no arc is safe.)
             self.xy_latched = True
             return self._rotate_to(th, gyaw, vel, period)
         return cmd
