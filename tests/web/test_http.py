@@ -6,8 +6,8 @@ import asyncio
 import json
 from pathlib import Path
 
-from ninjemys.web.events import Hub
-from ninjemys.web.http import HttpError, HttpServer, Request, Response
+from ninjemys.serve.events import Hub
+from ninjemys.serve.http import HttpError, HttpServer, Request, Response
 
 
 async def _request(port: int, raw: bytes) -> bytes:

@@ -3,11 +3,11 @@
 A client that offers a Foxglove subprotocol (``foxglove.websocket.v1``, ``foxglove.sdk.v1``) gets
 the Foxglove protocol; any other client (roslibjs, roslibpy: no subprotocol) gets rosbridge. So one
 port serves both, and the same server serves the static web app (:class:`Gateway.mount` puts the
-endpoint on any :class:`ninjemys.web.http.HttpServer`).
+endpoint on any :class:`ninjemys.serve.http.HttpServer`).
 
 Per client: a :class:`~ninjemys.bridge.outbox.Outbox` (bounded, per-topic lanes, fair) filled by
 ROS threads, and one sender task on the event loop that moves it into the socket only as fast as
-the client reads (the transport buffer is capped; see :mod:`ninjemys.web.websocket`). A client that
+the client reads (the transport buffer is capped; see :mod:`ninjemys.serve.websocket`). A client that
 stops reading costs at most its budget; the ROS side and the other clients never wait for it.
 """
 
@@ -37,8 +37,8 @@ from ninjemys.bridge.rosbridge import RosbridgeSession
 from ninjemys.errors import NinjemysError
 from ninjemys.idl.loader import get_message_class, get_service_class
 from ninjemys.node import Node
-from ninjemys.web.http import HttpServer, Request, Response
-from ninjemys.web.websocket import WRITE_HIGH_WATER, WebSocket
+from ninjemys.serve.http import HttpServer, Request, Response
+from ninjemys.serve.websocket import WRITE_HIGH_WATER, WebSocket
 
 log = logging.getLogger(__name__)
 
@@ -78,6 +78,10 @@ class GatewayOptions:
     #: a service call not answered within this many seconds gets a failed reply (rosbridge's
     #: ``default_call_service_timeout``; a rosbridge call's own ``timeout`` field overrides it)
     call_service_timeout: float = 5.0
+    #: a folder the standalone server (:meth:`Gateway.run_in_thread`) serves at ``/static`` (e.g. the
+    #: web app's pages and scripts); None serves no files. The gateway does not know the web app:
+    #: the web app sits above it and passes its folder in.
+    static_dir: str | None = None
 
     def secret(self) -> str | None:
         if not self.authenticate:
@@ -568,11 +572,10 @@ class Gateway:
     # -- standalone server --------------------------------------------------------------------
     def run_in_thread(self) -> str:
         """Start the gateway and its own HTTP server on a loop thread; returns the ws:// URL."""
-        from ninjemys.web.app import STATIC_DIR
-
         self.start()
         self._http = HttpServer(self.options.address, self.options.port, self.options.ssl_context())
-        self._http.static("/static", STATIC_DIR)
+        if self.options.static_dir is not None:
+            self._http.static("/static", Path(self.options.static_dir))
         self.mount(self._http)
         started = threading.Event()
         errors: list[BaseException] = []

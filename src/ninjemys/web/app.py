@@ -1,7 +1,7 @@
 """The web tools app: one HTTP server, one static front end, pages that plug in.
 
 The node graph is always there (it is the first page); other tools add pages and API routes, e.g. the
-turtlesim node adds its live view (:mod:`ninjemys.sim.view`). The app runs its server on its own
+turtlesim node adds its live view (:mod:`ninjemys.web.turtlesim_view`). The app runs its server on its own
 event loop thread by default, or on a loop the caller already runs (:meth:`WebApp.start_on`).
 """
 
@@ -17,9 +17,9 @@ from typing import TYPE_CHECKING
 
 from ninjemys.errors import NinjemysError
 from ninjemys.idl.loader import get_message_class
-from ninjemys.web.events import Hub
+from ninjemys.serve.events import Hub
+from ninjemys.serve.http import HttpError, HttpServer, Request, Response
 from ninjemys.web.graph import GraphPoller
-from ninjemys.web.http import HttpError, HttpServer, Request, Response
 from ninjemys.web.monitor import TopicMonitor
 
 if TYPE_CHECKING:

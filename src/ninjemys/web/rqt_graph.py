@@ -9,8 +9,8 @@ import argparse
 import os
 import sys
 
+from ninjemys.commands import entry
 from ninjemys.node import Node
-from ninjemys.tools.cli import entry
 from ninjemys.web.app import WebApp
 from ninjemys.web.browser import serve_until_stopped, stop_signals
 from ninjemys.web.monitor import TopicMonitor

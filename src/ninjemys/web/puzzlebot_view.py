@@ -12,19 +12,24 @@ a ``cmd_vel`` message would; ``POST /api/puzzlebot/control`` pauses, resumes and
 
 from __future__ import annotations
 
+import argparse
 import math
 import threading
 import time
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ninjemys.commands import entry
+from ninjemys.serve.events import Hub
+from ninjemys.serve.http import EventStream, Request, Response
 from ninjemys.sim.render import png_bytes
 from ninjemys.web.app import WebApp
-from ninjemys.web.events import Hub
-from ninjemys.web.http import EventStream, Request, Response
+from ninjemys.web.browser import open_if_display
 
 if TYPE_CHECKING:
+    from ninjemys.node.log import NodeLog
     from ninjemys.sim.puzzlebot_node import SimNode
 
 UPDATE_PERIOD = 0.05  # wall seconds between updates sent to the pages
@@ -233,3 +238,36 @@ class PuzzlebotView:
             return Response({"error": f"unknown action {action!r}"}, 400)
         handlers[action](None)
         return Response({"ok": True})
+
+
+def start_view(sim_node: SimNode, options: argparse.Namespace, log: NodeLog) -> Callable[[], None] | None:
+    """Serve the PuzzleBot page and the node graph for a running simulator; returns the stop
+    function (None when the server cannot start: the error is logged)."""
+    node = sim_node.node
+    web = WebApp(node.master_uri, node.name, options.host, options.port)
+    view = PuzzlebotView(web, sim_node)
+    try:
+        url = web.start()
+    except OSError as exc:
+        log.error("cannot serve the simulator view on %s:%d: %s", options.host, options.port, exc)
+        return None
+    view.attach()
+    sim_node.view = view
+    print(f"puzzlebot_sim view: {url}puzzlebot   node graph: {url}", flush=True)
+    if not options.no_browser:
+        open_if_display(url + "puzzlebot")
+    return web.stop
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``rosrun puzzlebot_sim sim_node``: the simulator (:mod:`ninjemys.sim.puzzlebot_node`) with its view."""
+    from ninjemys.sim import puzzlebot_node
+
+    return puzzlebot_node.main(argv, view=start_view)
+
+
+console_main = entry(main)
+
+
+if __name__ == "__main__":
+    console_main()

@@ -21,6 +21,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 from urllib.parse import parse_qs, unquote, urlsplit
 
+from ninjemys.errors import NinjemysError
+
 log = logging.getLogger(__name__)
 
 MAX_HEADER_BYTES = 64 * 1024
@@ -96,10 +98,10 @@ Handler = Callable[[Request], Awaitable[Response | EventStream] | Response | Eve
 if TYPE_CHECKING:
     import ssl
 
-    from ninjemys.web.websocket import WebSocketEndpoint
+    from ninjemys.serve.websocket import WebSocketEndpoint
 
 
-class HttpError(Exception):
+class HttpError(NinjemysError):
     """Raised by a handler to answer with an error status and a one-line reason."""
 
     def __init__(self, status: int, reason: str) -> None:
@@ -129,7 +131,7 @@ class HttpServer:
         self._routes[(method.upper(), path)] = handler
 
     def websocket(self, path: str, endpoint: WebSocketEndpoint) -> None:
-        """Accept WebSocket upgrades on ``path`` (see :mod:`ninjemys.web.websocket`); a plain GET of
+        """Accept WebSocket upgrades on ``path`` (see :mod:`ninjemys.serve.websocket`); a plain GET of
         the same path still goes to the HTTP route, if there is one."""
         self._websockets[path] = endpoint
 
@@ -182,7 +184,7 @@ class HttpServer:
                 keep_alive = request.headers.get("connection", "").lower() != "close"
                 endpoint = self._websockets.get(request.path)
                 if endpoint is not None and request.headers.get("upgrade", "").lower() == "websocket":
-                    from ninjemys.web.websocket import serve_upgrade  # only WebSocket users load it
+                    from ninjemys.serve.websocket import serve_upgrade  # only WebSocket users load it
 
                     await serve_upgrade(endpoint, request, reader, writer)
                     return

@@ -1,4 +1,4 @@
-"""The turtlesim window as a page of the web tools app.
+"""The turtlesim window as a page of the web tools app, and the ``turtlesim_node`` command that shows it.
 
 The browser keeps its own copy of the path image: it starts from a PNG of the current path (sent
 when the page connects) and then draws the pen segments each update carries, so the stream stays
@@ -7,14 +7,24 @@ small however long the turtles have been drawing. Turtles are redrawn from their
 
 from __future__ import annotations
 
+import argparse
 import base64
+import sys
 import threading
+from collections.abc import Callable
+from typing import TYPE_CHECKING
 
+from ninjemys.commands import entry
+from ninjemys.serve.events import Hub
+from ninjemys.serve.http import EventStream, Request, Response
 from ninjemys.sim.render import compose_frame, png_bytes
 from ninjemys.sim.world import CANVAS_PIXELS, PIXELS_PER_METER, Segment, Turtle, World
 from ninjemys.web.app import WebApp
-from ninjemys.web.events import Hub
-from ninjemys.web.http import EventStream, Request, Response
+from ninjemys.web.browser import open_if_display
+from ninjemys.web.monitor import TopicMonitor
+
+if TYPE_CHECKING:
+    from ninjemys.sim.turtlesim_node import TurtlesimNode
 
 
 def turtle_json(turtle: Turtle) -> dict:
@@ -113,3 +123,44 @@ class TurtlesimView:
         self._last_poses = poses
         update = {"turtles": poses, "segments": [segment_json(s) for s in new]}
         self.hub.publish("update", update, resync=self._resync)
+
+
+def start_view(
+    sim: TurtlesimNode, options: argparse.Namespace, ros_args: list[str]
+) -> Callable[[], None] | None:
+    """Serve the turtlesim page and the node graph for a running sim; returns the stop function
+    (None when the server cannot start: the error is logged)."""
+    import rospy
+    from ninjemys.node import Node
+    from ninjemys.node.cli_args import parse_args
+
+    master_uri = parse_args([sys.argv[0], *ros_args]).master_uri
+    # the topic monitor's node is only created when someone opens a topic's details in the page
+    monitor = TopicMonitor(lambda: Node("turtlesim_webtools", anonymous=True, master_uri=master_uri))
+    app = WebApp(master_uri, rospy.get_name(), options.host, options.port, monitor=monitor)
+    view = TurtlesimView(app, sim.world, sim.lock, rospy.get_name())
+    try:
+        url = app.start()
+    except OSError as exc:
+        rospy.logerr("cannot serve the turtlesim view on %s:%d: %s", options.host, options.port, exc)
+        return None
+    view.attach()
+    sim.view = view
+    print(f"turtlesim view: {url}turtlesim   node graph: {url}", flush=True)
+    if not options.no_browser:
+        open_if_display(url + "turtlesim")  # where ROS would open its window
+    return app.stop
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``turtlesim_node``: the simulator (:mod:`ninjemys.sim.turtlesim_node`) with its browser view."""
+    from ninjemys.sim import turtlesim_node
+
+    return turtlesim_node.main(argv, view=start_view)
+
+
+console_main = entry(main)
+
+
+if __name__ == "__main__":
+    console_main()

@@ -11,7 +11,7 @@ from __future__ import annotations
 import asyncio
 from collections.abc import Callable
 
-from ninjemys.web.http import EventStream
+from ninjemys.serve.http import EventStream
 
 #: Events a single slow browser may lag behind before it is resynchronised.
 QUEUE_LIMIT = 1000
