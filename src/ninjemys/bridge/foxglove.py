@@ -1,7 +1,8 @@
 """The Foxglove WebSocket protocol (foxglove/ws-protocol ``docs/spec.md``, v1) for one client.
 
 Channels are the graph's topics with encoding ``ros1``, schema name ``pkg/Type`` and the full
-definition text (``ros1msg``) as schema; message data is the TCPROS payload as received, never
+definition text (``ros1msg``) as schema (plus the ``json`` channels of an in-process app,
+:mod:`ninjemys.bridge.appchannels`); message data is the TCPROS payload as received, never
 deserialized (the tap subscribes raw). Client publishing sends the client's bytes as they are
 (``publish_raw``), and service calls carry ROS 1 bytes both ways.
 """
@@ -151,6 +152,10 @@ class FoxgloveSession:
                     continue
                 self._subs[sub_id] = channel_id
             topic = channel["topic"]
+            app = self.gateway.catalog.app.get(channel_id)
+            if app is not None:  # a channel of this process's own app (a simulator's view)
+                app.add((self, sub_id), self._sink(sub_id, topic))
+                continue
             try:
                 # published_as: a channel of a type learned from a publisher's definition is taken raw
                 self.gateway.taps.add(
@@ -171,8 +176,15 @@ class FoxgloveSession:
                 channel_id = self._subs.pop(int(sub_id), None)
             channel = self.gateway.catalog.channel(channel_id) if channel_id is not None else None
             if channel is not None:
-                self.gateway.taps.remove(channel["topic"], (self, int(sub_id)))
+                self._drop(int(sub_id), channel)
                 self.outbox.discard(f"{channel['topic']}#{sub_id}")
+
+    def _drop(self, sub_id: int, channel: dict[str, Any]) -> None:
+        app = self.gateway.catalog.app.get(channel["id"])
+        if app is not None:
+            app.remove((self, sub_id))
+        else:
+            self.gateway.taps.remove(channel["topic"], (self, sub_id))
 
     def _sink(self, sub_id: int, topic: str) -> Callable[[Delivery], None]:
         lane = f"{topic}#{sub_id}"
@@ -329,7 +341,7 @@ class FoxgloveSession:
             for sub_id, channel_id in list(self._subs.items()):
                 channel = self.gateway.catalog.channel(channel_id)
                 if channel is not None:
-                    self.gateway.taps.remove(channel["topic"], (self, sub_id))
+                    self._drop(sub_id, channel)
             self._subs.clear()
             for channel_id, (topic, _pub) in list(self._client_channels.items()):
                 self.gateway.publishers.unadvertise(topic, (self, channel_id))

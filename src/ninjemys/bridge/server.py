@@ -30,6 +30,7 @@ from urllib.parse import urlsplit
 
 from websockets.server import ServerProtocol
 
+from ninjemys.bridge.appchannels import AppChannel
 from ninjemys.bridge.foxglove import SUBPROTOCOLS, FoxgloveSession
 from ninjemys.bridge.graph import Publishers, Services, Taps
 from ninjemys.bridge.outbox import CloseRequest, Outbox
@@ -116,10 +117,21 @@ class Catalog:
         self._service_types: dict[str, str] = {}
         self.graph: dict[str, dict[str, list[str]]] = {"pub": {}, "sub": {}, "srv": {}}
         self.topic_types: dict[str, str] = {}
+        #: channels an in-process app publishes (not ROS topics): id -> channel; never refreshed away
+        self.app: dict[int, AppChannel] = {}
         self._lock = threading.Lock()
 
     def channel(self, channel_id: int) -> dict[str, Any] | None:
         return self.channels.get(channel_id)
+
+    def add_app_channel(
+        self, topic: str, schema_name: str, snapshot: Callable[[], Any] | None, lock: Any
+    ) -> AppChannel:
+        app = AppChannel(next(self._ids), topic, schema_name, snapshot, lock)
+        with self._lock:
+            self.app[app.id] = app
+            self.channels[app.id] = app.channel
+        return app
 
     def refresh(
         self, node: Node, services: Services, learn: Callable[[str, str], str | None] = lambda t, n: None
@@ -314,6 +326,17 @@ class Gateway:
             return dict(self.node.master.get_topic_types()).get(topic)
         except NinjemysError:
             return None
+
+    def app_channel(
+        self, topic: str, schema_name: str, snapshot: Callable[[], Any] | None = None, lock: Any = None
+    ) -> AppChannel:
+        """A JSON channel this process publishes on the gateway (not a ROS topic; see
+        :mod:`ninjemys.bridge.appchannels`), advertised to the Foxglove clients at once."""
+        app = self.catalog.add_app_channel(topic, schema_name, snapshot, lock)
+        for client in list(self._clients.values()):
+            if isinstance(client.session, FoxgloveSession):
+                client.session.send({"op": "advertise", "channels": [app.channel]})
+        return app
 
     # -- graph polling ----------------------------------------------------------------------
     def start(self) -> None:

@@ -514,7 +514,7 @@ class SimNode:
                 want = any(
                     pubs[k].get_num_connections() for k in ("image", "depth", "color_info", "depth_info")
                 )
-                if want or (self.view is not None and self.view.wants_camera(r.name)):
+                if want:  # a browser view watches the cameras as ROS topics too (through its gateway)
                     self._camera(io, stamp)
         if tfs:
             self.tf_pub.publish(TFMessage(transforms=tfs))
@@ -651,8 +651,6 @@ class SimNode:
         r = io.robot
         spec = r.model.camera
         rgb, depth = self.sim.render(r)
-        if self.view is not None:
-            self.view.camera_frame(r.name, rgb, depth)
         pubs = io.pubs
         frame = io.frame("camera_color_optical_frame")
         depth_frame = io.frame("camera_depth_optical_frame")

@@ -9,19 +9,17 @@ from __future__ import annotations
 
 import argparse
 import base64
-import sys
 import threading
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
+from ninjemys.bridge.server import Gateway, GatewayOptions
 from ninjemys.commands import entry
-from ninjemys.serve.events import Hub
-from ninjemys.serve.http import EventStream, Request, Response
+from ninjemys.serve.http import Request, Response
 from ninjemys.sim.render import compose_frame, png_bytes
 from ninjemys.sim.world import CANVAS_PIXELS, PIXELS_PER_METER, Segment, Turtle, World
 from ninjemys.web.app import WebApp
 from ninjemys.web.browser import open_if_display
-from ninjemys.web.monitor import TopicMonitor
 
 if TYPE_CHECKING:
     from ninjemys.sim.turtlesim_node import TurtlesimNode
@@ -42,37 +40,40 @@ def segment_json(s: Segment) -> list:
     return [round(s.x0, 5), round(s.y0, 5), round(s.x1, 5), round(s.y1, 5), s.r, s.g, s.b, s.width]
 
 
-class TurtlesimView:
-    """Adds ``/turtlesim`` (page), its state, event stream and PNG snapshot to a :class:`WebApp`.
+#: the gateway channel the page subscribes to (JSON; not a ROS topic, see ninjemys.bridge.appchannels)
+CHANNEL = "view:turtlesim"
 
-    ``world`` is shared with the node; every access holds ``lock``. Call :meth:`publish` after each
-    world step (from any thread); it sends what changed since the previous call.
+
+class TurtlesimView:
+    """The ``/turtlesim`` page of a :class:`WebApp`, fed through the gateway mounted on it.
+
+    The page subscribes to the gateway's :data:`CHANNEL`: a new subscriber gets the full state (path
+    PNG, turtles), then updates. ``world`` is shared with the node; every access holds ``lock``.
+    Call :meth:`publish` after each world step with the lock held; it sends what changed since the
+    previous call, and nothing while no page is open. ``/api/turtlesim/snapshot.png`` is the
+    server's own rendering (for checks and for saving a picture).
     """
 
-    def __init__(self, app: WebApp, world: World, lock: threading.Lock, node_name: str) -> None:
-        self.app = app
+    def __init__(
+        self, app: WebApp, gateway: Gateway, world: World, lock: threading.Lock, node_name: str
+    ) -> None:
         self.world = world
         self.lock = lock
         self.node_name = node_name
-        self.hub: Hub | None = None
-        self._sent_segments = 0
+        self._sent_segments = world.segment_total
         self._sent_clear = world.clear_count
         self._last_poses: list | None = None
         app.add_page("Turtlesim", "/turtlesim")
         s = app.server
         s.route("GET", "/turtlesim", lambda _r: app._static_page("turtlesim.html"))
-        s.route("GET", "/api/turtlesim/state", self._state_response)
-        s.route("GET", "/api/turtlesim/events", self._events)
         s.route("GET", "/api/turtlesim/snapshot.png", self._snapshot)
-
-    def attach(self) -> None:
-        """Create the event hub (the app must be started)."""
-        self.hub = self.app.hub()
+        self.channel = gateway.app_channel(CHANNEL, "ninjemys/TurtlesimView", self._full_state, lock)
 
     def _full_state(self) -> dict:
-        """Everything a freshly connected page needs (call with the lock held)."""
+        """Everything a freshly subscribed page needs (call with the lock held)."""
         w = self.world
         return {
+            "kind": "state",
             "node": self.node_name,
             "size": CANVAS_PIXELS,
             "scale": PIXELS_PER_METER,
@@ -82,38 +83,25 @@ class TurtlesimView:
             "turtles": [turtle_json(t) for t in w.turtles.values()],
         }
 
-    def _state_response(self, _request: Request) -> Response:
-        with self.lock:
-            state = self._full_state()
-        return Response(state)
-
-    def _events(self, _request: Request) -> EventStream:
-        assert self.hub is not None
-        with self.lock:
-            return self.hub.open([("state", self._full_state())])
-
     def _snapshot(self, _request: Request) -> Response:
         with self.lock:
             frame = compose_frame(self.world)
         return Response(png_bytes(frame), 200, "image/png", {"Cache-Control": "no-store"})
 
-    def _resync(self) -> dict:
-        with self.lock:
-            return self._full_state()
-
     def publish(self) -> None:
         """Send the turtles and new pen segments to every open page (call with the lock held)."""
-        if self.hub is None or self.hub.listeners == 0:
-            self._sent_segments = self.world.segment_total
-            self._sent_clear = self.world.clear_count
-            return
         w = self.world
+        if self.channel.listeners == 0:
+            self._sent_segments = w.segment_total
+            self._sent_clear = w.clear_count
+            self._last_poses = None
+            return
         pending = w.segment_total - self._sent_segments
         if w.clear_count != self._sent_clear or pending > len(w.segments):
             self._sent_clear = w.clear_count
             self._sent_segments = w.segment_total
             self._last_poses = None
-            self.hub.publish("state", self._full_state(), resync=self._resync)
+            self.channel.publish(self._full_state())
             return
         new = w.segments[len(w.segments) - pending :] if pending else []
         self._sent_segments = w.segment_total
@@ -121,35 +109,40 @@ class TurtlesimView:
         if not new and poses == self._last_poses:
             return
         self._last_poses = poses
-        update = {"turtles": poses, "segments": [segment_json(s) for s in new]}
-        self.hub.publish("update", update, resync=self._resync)
+        self.channel.publish({"kind": "update", "turtles": poses, "segments": [segment_json(s) for s in new]})
 
 
 def start_view(
     sim: TurtlesimNode, options: argparse.Namespace, ros_args: list[str]
 ) -> Callable[[], None] | None:
-    """Serve the turtlesim page and the node graph for a running sim; returns the stop function
-    (None when the server cannot start: the error is logged)."""
+    """Serve the turtlesim page and the node graph for a running sim, with the gateway (on the
+    turtlesim node itself: no extra node in the graph) as the pages' data path; returns the stop
+    function (None when the server cannot start: the error is logged)."""
     import rospy
-    from ninjemys.node import Node
-    from ninjemys.node.cli_args import parse_args
 
-    master_uri = parse_args([sys.argv[0], *ros_args]).master_uri
-    # the topic monitor's node is only created when someone opens a topic's details in the page
-    monitor = TopicMonitor(lambda: Node("turtlesim_webtools", anonymous=True, master_uri=master_uri))
-    app = WebApp(master_uri, rospy.get_name(), options.host, options.port, monitor=monitor)
-    view = TurtlesimView(app, sim.world, sim.lock, rospy.get_name())
+    node = rospy.core.process_node()
+    gateway = Gateway(GatewayOptions(node_name=node.name), node=node)
+    gateway.start()
+    app = WebApp(node.master_uri, rospy.get_name(), options.host, options.port)
+    app.add_gateway(gateway)
+    view = TurtlesimView(app, gateway, sim.world, sim.lock, rospy.get_name())
     try:
         url = app.start()
     except OSError as exc:
+        gateway.shutdown()
         rospy.logerr("cannot serve the turtlesim view on %s:%d: %s", options.host, options.port, exc)
         return None
-    view.attach()
     sim.view = view
     print(f"turtlesim view: {url}turtlesim   node graph: {url}", flush=True)
     if not options.no_browser:
         open_if_display(url + "turtlesim")  # where ROS would open its window
-    return app.stop
+
+    def stop() -> None:
+        sim.view = None
+        app.stop()
+        gateway.shutdown()
+
+    return stop
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -1,8 +1,8 @@
 // The browser's ROS client: the gateway's Foxglove WebSocket subprotocol (foxglove.websocket.v1),
 // the web tools' one data path.
 //
-// The server advertises channels (topics with their type and full ros1msg definition) and
-// services; we subscribe by topic name, decode the raw ROS 1 payloads with ros1msg.js, publish by
+// The server advertises channels (topics with their type and full ros1msg definition, and the
+// JSON channels of the server's own app, e.g. a simulator's view) and services; we subscribe by topic name, decode the raw ROS 1 payloads with ros1msg.js, publish by
 // advertising a client channel and sending ROS 1 bytes, and call services with ROS 1 bytes both
 // ways. The connection comes back by itself after a drop: subscriptions and advertisements are
 // re-made on the new connection, and callers keep their handles.
@@ -19,6 +19,9 @@ export { RosMsgError } from "./ros1msg.js";
 
 const SUBPROTOCOL = "foxglove.websocket.v1";
 const utf8 = new TextEncoder();
+const utf8Decoder = new TextDecoder();
+// channels with Foxglove's "json" encoding: an in-process app's own data (a simulator's view)
+const JSON_CODEC = { decode: (bytes) => JSON.parse(utf8Decoder.decode(bytes)) };
 
 /** The gateway's address for pages served by the web tools: ws(s)://<host>/ws. */
 export function defaultUrl() {
@@ -260,7 +263,8 @@ export class RosClient {
   /** The codec of a topic's advertised type, or null when nobody publishes it yet. */
   codecForTopic(topic) {
     const ch = this.byTopic.get(topic);
-    return ch ? codecFor(ch.schemaName, ch.schema) : null;
+    if (!ch) return null;
+    return ch.encoding === "json" ? JSON_CODEC : codecFor(ch.schemaName, ch.schema);
   }
 
   /** The codec of a type, from any advertised channel or service using it, else from the web app. */
@@ -306,7 +310,7 @@ export class RosClient {
     }
     if (entry.subId !== null && entry.channelId === ch.id) return;
     try {
-      entry.codec = codecFor(ch.schemaName, ch.schema);
+      entry.codec = ch.encoding === "json" ? JSON_CODEC : codecFor(ch.schemaName, ch.schema);
     } catch (err) {
       for (const h of entry.handlers) h.onError?.(`${topic}: bad definition of ${ch.schemaName}: ${err.message}`);
       return;
