@@ -69,7 +69,7 @@ class FoxgloveSession:
                 "name": g.node.name,
                 "capabilities": caps,
                 "supportedEncodings": ["ros1"],
-                "metadata": {"ROS_DISTRO": "noetic"},
+                "metadata": self._metadata(),
                 "sessionId": g.session_id,
             }
         )
@@ -77,6 +77,22 @@ class FoxgloveSession:
         services = list(g.catalog.services.values())
         if services:
             self.send({"op": "advertiseServices", "services": services})
+        if g.master_error is not None:
+            self.master_status(g.master_error)
+
+    def master_status(self, error: str | None) -> None:
+        """Tell the client the master is unreachable (a status with id ``master``), or no longer."""
+        if error is None:
+            self.send({"op": "removeStatus", "statusIds": ["master"]})
+        else:
+            self.status(2, error, "master")
+
+    def _metadata(self) -> dict[str, str]:
+        g = self.gateway
+        meta = {"ROS_DISTRO": "noetic", "ROS_MASTER_URI": g.node.master_uri}
+        if g.options.hide_own_node:
+            meta["debugNodes"] = g.node.name
+        return meta
 
     def send_time(self, ns: int) -> None:
         self.outbox.put("\0time", _TIME.pack(0x02, ns), 1)
@@ -285,7 +301,7 @@ class FoxgloveSession:
 
     def op_subscribeConnectionGraph(self, msg: dict[str, Any]) -> None:  # noqa: N802
         self.graph_subscribed = True
-        self.send(self.gateway.catalog.graph_update(full=True))
+        self.send(self.gateway.graph_update())
 
     def op_unsubscribeConnectionGraph(self, msg: dict[str, Any]) -> None:  # noqa: N802
         self.graph_subscribed = False

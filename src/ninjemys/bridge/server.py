@@ -31,6 +31,7 @@ from urllib.parse import urlsplit
 from websockets.server import ServerProtocol
 
 from ninjemys.bridge.appchannels import AppChannel
+from ninjemys.bridge.buswatch import BusWatch
 from ninjemys.bridge.foxglove import SUBPROTOCOLS, FoxgloveSession
 from ninjemys.bridge.graph import Publishers, Services, Taps
 from ninjemys.bridge.outbox import CloseRequest, Outbox
@@ -83,6 +84,9 @@ class GatewayOptions:
     #: web app's pages and scripts); None serves no files. The gateway does not know the web app:
     #: the web app sits above it and passes its folder in.
     static_dir: str | None = None
+    #: the gateway's node exists only to look at the graph (rqt_graph): the graph page counts it as
+    #: debug plumbing ("Hide debug"), so looking at a topic does not change the picture
+    hide_own_node: bool = False
 
     def secret(self) -> str | None:
         if not self.authenticate:
@@ -240,19 +244,45 @@ class Catalog:
             "old_graph": old,
         }
 
+    def node_names(self) -> set[str]:
+        """Every node the master lists as a publisher, subscriber or service provider."""
+        return {n for table in self.graph.values() for nodes in table.values() for n in nodes}
+
+    @staticmethod
+    def bus_update(state: dict[str, Any]) -> dict[str, Any]:
+        """A connectionGraphUpdate carrying only the bus state (ninjemys' ``rosBus`` extension:
+        node liveness and live connections from getBusInfo; Foxglove clients ignore it)."""
+        return {
+            "op": "connectionGraphUpdate",
+            "publishedTopics": [],
+            "subscribedTopics": [],
+            "advertisedServices": [],
+            "removedTopics": [],
+            "removedServices": [],
+            "rosBus": state,
+        }
+
     def graph_update(self, full: bool, old: dict[str, dict[str, list[str]]] | None = None) -> dict[str, Any]:
         g = self.graph
         old = old if old is not None and not full else {"pub": {}, "sub": {}, "srv": {}}
 
+        gone = (set(old["pub"]) | set(old["sub"])) - (set(g["pub"]) | set(g["sub"]))
+
         def changed(kind: str) -> list[str]:
-            return [k for k, v in g[kind].items() if old[kind].get(k) != v]
+            # a topic that lost its last publisher (or subscriber) but still exists is listed with no
+            # ids; one that left altogether is in removedTopics
+            now = [k for k, v in g[kind].items() if old[kind].get(k) != v]
+            emptied = [k for k in old[kind] if k not in g[kind] and k not in gone]
+            return now + emptied
 
         return {
             "op": "connectionGraphUpdate",
-            "publishedTopics": [{"name": t, "publisherIds": g["pub"][t]} for t in changed("pub")],
-            "subscribedTopics": [{"name": t, "subscriberIds": g["sub"][t]} for t in changed("sub")],
-            "advertisedServices": [{"name": s, "providerIds": g["srv"][s]} for s in changed("srv")],
-            "removedTopics": sorted((set(old["pub"]) | set(old["sub"])) - (set(g["pub"]) | set(g["sub"]))),
+            "publishedTopics": [{"name": t, "publisherIds": g["pub"].get(t, [])} for t in changed("pub")],
+            "subscribedTopics": [{"name": t, "subscriberIds": g["sub"].get(t, [])} for t in changed("sub")],
+            "advertisedServices": [
+                {"name": s, "providerIds": g["srv"][s]} for s in g["srv"] if old["srv"].get(s) != g["srv"][s]
+            ],
+            "removedTopics": sorted(gone),
             "removedServices": sorted(set(old["srv"]) - set(g["srv"])),
         }
 
@@ -291,6 +321,9 @@ class Gateway:
         self.publishers = Publishers(self.node)
         self.services = Services(self.node)
         self.pool = ThreadPoolExecutor(8, thread_name_prefix="gateway")
+        #: node liveness and live connections (getBusInfo), swept only while a client watches the graph
+        self.bus = BusWatch(self.node.master, self.node.name, self.pool, self._bus_changed)
+        self.master_error: str | None = None
         self.session_id = str(time.time_ns())
         self._clients: dict[int, _Client] = {}
         self._ids = itertools.count(1)
@@ -399,11 +432,17 @@ class Gateway:
                     "gateway: graph refresh failed (retrying every %g s): %s", self.options.update_period, exc
                 )
                 self._refresh_failing = True
+                self.master_error = f"cannot reach the master at {self.node.master_uri}: {exc}"
+                for fox in self._foxes():
+                    fox.master_status(self.master_error)
             return
+        foxes = self._foxes()
         if self._refresh_failing:
             log.info("gateway: graph refresh works again")
             self._refresh_failing = False
-        foxes = [c.session for c in list(self._clients.values()) if isinstance(c.session, FoxgloveSession)]
+            self.master_error = None
+            for fox in foxes:
+                fox.master_status(None)
         for fox in foxes:
             if diff["removed_channels"]:
                 fox.send({"op": "unadvertise", "channelIds": diff["removed_channels"]})
@@ -415,6 +454,25 @@ class Gateway:
                 fox.send({"op": "advertiseServices", "services": diff["services"]})
             if diff["graph_changed"] and fox.graph_subscribed:
                 fox.send(self.catalog.graph_update(full=False, old=diff["old_graph"]))
+        if any(fox.graph_subscribed for fox in foxes):
+            self.bus.poke(self.catalog.node_names())
+
+    def _foxes(self) -> list[FoxgloveSession]:
+        return [c.session for c in list(self._clients.values()) if isinstance(c.session, FoxgloveSession)]
+
+    def _bus_changed(self, state: dict[str, Any]) -> None:
+        update = self.catalog.bus_update(state)
+        for fox in self._foxes():
+            if fox.graph_subscribed:
+                fox.send(update)
+
+    def graph_update(self) -> dict[str, Any]:
+        """The full connection graph for a client that just subscribed, with the bus state so far
+        (a sweep starts at once; its result follows as an update)."""
+        self.bus.poke(self.catalog.node_names(), force=True)
+        update = self.catalog.graph_update(full=True)
+        update["rosBus"] = self.bus.state()
+        return update
 
     def watch_param(self, name: str) -> None:
         """Forward master paramUpdate for ``name`` to the Foxglove clients that subscribed it."""

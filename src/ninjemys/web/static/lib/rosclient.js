@@ -54,7 +54,8 @@ class Listeners {
 /**
  * One connection to the gateway. Events (`on(name, fn)` returns an unsubscribe function):
  * `open`, `close`, `channels` (the topic list changed), `services`, `status` ({level, message}),
- * `time` (sim time in ns, under /use_sim_time), `graph` (connectionGraphUpdate).
+ * `time` (sim time in ns, under /use_sim_time), `graph` (connectionGraphUpdate; see watchGraph),
+ * `removeStatus` (status ids the server withdrew).
  */
 export class RosClient {
   constructor(url = defaultUrl(), { reconnect = true, reconnectDelay = 500 } = {}) {
@@ -79,6 +80,7 @@ export class RosClient {
     this._paramReqs = new Map();
     this._paramIds = 1;
     this._paramWatchers = new Map(); // name -> Set(fn)
+    this._graphWatchers = 0;
     this._closedByUser = false;
     this._ready = null;
     this._connect();
@@ -134,6 +136,7 @@ export class RosClient {
     switch (msg.op) {
       case "serverInfo":
         this.serverInfo = msg;
+        if (this._graphWatchers > 0) this._send({ op: "subscribeConnectionGraph" });
         break;
       case "advertise": {
         for (const ch of msg.channels) {
@@ -204,6 +207,9 @@ export class RosClient {
       case "connectionGraphUpdate":
         this._listeners.emit("graph", msg);
         break;
+      case "removeStatus":
+        this._listeners.emit("removeStatus", msg.statusIds || []);
+        break;
       default:
         break;
     }
@@ -248,6 +254,21 @@ export class RosClient {
         call.reject(err);
       }
     }
+  }
+
+  /**
+   * Watch the connection graph: `fn(update)` gets every connectionGraphUpdate, the first one (after
+   * each connection) the full graph. Returns a stop function.
+   */
+  watchGraph(fn) {
+    const off = this.on("graph", fn);
+    this._graphWatchers += 1;
+    this._send({ op: "subscribeConnectionGraph" });
+    return () => {
+      off();
+      this._graphWatchers -= 1;
+      if (this._graphWatchers === 0) this._send({ op: "unsubscribeConnectionGraph" });
+    };
   }
 
   /** The advertised topics: [{name, type}], sorted by name. */
