@@ -21,9 +21,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
-from ninjemys.testing import run_master  # noqa: E402
 from ninjemys.bridge.server import Gateway, GatewayOptions  # noqa: E402
 from ninjemys.node import Node  # noqa: E402
+from ninjemys.testing import run_master  # noqa: E402
 from ninjemys.web.app import WebApp  # noqa: E402
 
 NODES_SCRIPT = textwrap.dedent(

@@ -17,7 +17,7 @@ The order, bottom to top (``ORDER``; docs/architecture.md draws the same table, 
     packages   ROS packages on disk: discovery, manifests, shipped executables, catkin workspaces
     wire       ROS 1 serialization, TCPROS framing and headers, XML-RPC encoding (sans-IO)
     net        the node's event loop and the XML-RPC server/client on it; addresses
-    serve      HTTP, WebSocket and Server-Sent Events on asyncio, for browsers (serve/)
+    serve      HTTP and WebSocket on asyncio, for browsers (serve/)
     master     registrations, parameter server, rosout log format
     node       the client runtime (Node and its parts)
     libs       cores built on Node: actionlib, tf2, message_filters, dynamic_reconfigure,

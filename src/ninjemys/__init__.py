@@ -11,7 +11,7 @@ tests/test_layering.py say the same)::
     packages  ROS packages on disk, manifests, shipped executables
     wire      ROS 1 serialization, TCPROS framing, XML-RPC encoding (sans-IO)
     net       the node's event loop, XML-RPC server and client, addresses
-    serve     HTTP, WebSocket and Server-Sent Events on asyncio, for browsers
+    serve     HTTP and WebSocket on asyncio, for browsers
     master    the master: registrations, parameters, rosout
     node      the client runtime: Node and its parts
     libs      actionlib, tf2, message_filters, dynamic_reconfigure, maps, launch, bag, ...
