@@ -225,9 +225,8 @@ class HttpServer:
             if handler is None:
                 result: Response = self._static_file(request)
             else:
-                result = handler(request)
-                if asyncio.iscoroutine(result):
-                    result = await result
+                outcome = handler(request)
+                result = await outcome if isinstance(outcome, Awaitable) else outcome
         except HttpError as exc:
             result = Response({"error": exc.reason}, exc.status)
         except ValueError as exc:
