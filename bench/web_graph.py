@@ -96,11 +96,15 @@ def main() -> None:
                 want = options.nodes
                 t0 = time.monotonic()
                 page.goto(url)
-                page.wait_for_function(f"document.querySelectorAll('g.node').length >= {want}", timeout=60000)
+                page.wait_for_function(
+                    f"document.querySelectorAll('g.node').length >= {want}", polling="raf", timeout=60000
+                )
                 shown = time.monotonic() - t0
                 t0 = time.monotonic()
                 page.reload()
-                page.wait_for_function(f"document.querySelectorAll('g.node').length >= {want}", timeout=60000)
+                page.wait_for_function(
+                    f"document.querySelectorAll('g.node').length >= {want}", polling="raf", timeout=60000
+                )
                 reshown = time.monotonic() - t0
                 render_ms = page.evaluate(
                     "() => { const t = performance.now(); render(); return performance.now() - t; }"
@@ -110,13 +114,22 @@ def main() -> None:
                 helper.stdin.flush()
                 helper.stdout.readline()
                 t_reg = time.monotonic() - t0
-                page.wait_for_selector('g.node[data-name="/newcomer"]', state="attached", timeout=30000)
+                # polled every frame: wait_for_selector backs off to 500 ms between checks
+                page.wait_for_function(
+                    "document.querySelector('g.node[data-name=\"/newcomer\"]') !== null",
+                    polling="raf",
+                    timeout=30000,
+                )
                 appear = time.monotonic() - t0
                 t0 = time.monotonic()
                 helper.stdin.write("remove\n")
                 helper.stdin.flush()
                 helper.stdout.readline()
-                page.wait_for_selector('g.node[data-name="/newcomer"]', state="detached", timeout=30000)
+                page.wait_for_function(
+                    "document.querySelector('g.node[data-name=\"/newcomer\"]') === null",
+                    polling="raf",
+                    timeout=30000,
+                )
                 vanish = time.monotonic() - t0
                 browser.close()
         finally:

@@ -157,7 +157,8 @@ function lookerNodes() {
 /** nodes, topics and node->node edges, as rqt_graph draws them */
 function buildGraph() {
   const types = new Map(ros.topics().map((t) => [t.name, t.type]));
-  const names = new Set(Object.keys(known.bus.nodes));
+  // the nodes are the master's (the bus sweep only annotates them, and lags behind a departure)
+  const names = new Set();
   for (const table of [known.pub, known.sub, known.srv]) for (const ids of table.values()) for (const n of ids) names.add(n);
   const lookers = lookerNodes();
   const nodes = [...names].sort().map((name) => ({
@@ -196,10 +197,10 @@ let stateQueued = false;
 function refreshState() {
   if (stateQueued) return;
   stateQueued = true;
-  requestAnimationFrame(() => {
+  setTimeout(() => { // one re-layout for a burst of updates (graph, bus, channels)
     stateQueued = false;
     showState({ graph: buildGraph(), master_uri: ((ros.serverInfo || {}).metadata || {}).ROS_MASTER_URI || "", error: known.error });
-  });
+  }, 0);
 }
 
 function showState(state) {
