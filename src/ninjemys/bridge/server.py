@@ -87,6 +87,10 @@ class GatewayOptions:
     #: the gateway's node exists only to look at the graph (rqt_graph): the graph page counts it as
     #: debug plumbing ("Hide debug"), so looking at a topic does not change the picture
     hide_own_node: bool = False
+    #: under /use_sim_time, follow /clock (the ``time`` capability, sim-time receive stamps); a gateway
+    #: inside the simulator itself sets False: its pages need no clock, and subscribing to its own
+    #: /clock would decode every tick in the simulator's process
+    sim_clock: bool = True
 
     def secret(self) -> str | None:
         if not self.authenticate:
@@ -316,7 +320,7 @@ class Gateway:
         self.node = node if node is not None else Node(self.options.node_name)
         self._own_node = node is None
         self.catalog = Catalog()
-        self.sim_time = bool(self._param("/use_sim_time", False))
+        self.sim_time = self.options.sim_clock and bool(self._param("/use_sim_time", False))
         self.taps = Taps(self.node, self._now_ns)
         self.publishers = Publishers(self.node)
         self.services = Services(self.node)

@@ -175,7 +175,7 @@ def start_view(sim_node: SimNode, options: argparse.Namespace, log: NodeLog) -> 
     simulator's own node: no extra node in the graph) as the pages' data path; returns the stop
     function (None when the server cannot start: the error is logged)."""
     node = sim_node.node
-    gateway = Gateway(GatewayOptions(node_name=node.name), node=node)
+    gateway = Gateway(GatewayOptions(node_name=node.name, sim_clock=False), node=node)
     gateway.start()
     web = WebApp(node.master_uri, node.name, options.host, options.port)
     web.add_gateway(gateway)

@@ -121,7 +121,7 @@ def start_view(
     import rospy
 
     node = rospy.core.process_node()
-    gateway = Gateway(GatewayOptions(node_name=node.name), node=node)
+    gateway = Gateway(GatewayOptions(node_name=node.name, sim_clock=False), node=node)
     gateway.start()
     app = WebApp(node.master_uri, rospy.get_name(), options.host, options.port)
     app.add_gateway(gateway)
