@@ -1,7 +1,8 @@
 """Each layer imports only from the layers below it (docs/architecture.md's layer map), checked with ``ast``.
 
 Every ``import`` and ``from ... import`` in src/ counts, wherever it sits (module top, inside a
-function, under ``if TYPE_CHECKING``): a lazy import is still a dependency. A module may import its
+function, under ``if TYPE_CHECKING``), and so does ``importlib.import_module("...")`` or
+``__import__("...")`` with a literal name: a lazy import is still a dependency. A module may import its
 own layer and any layer below; anything else fails with ``file:line``. Three more rules:
 
 - layers that share a floor (a tuple in ``ORDER``: ``sim`` and ``nav``) are peers and may not import
@@ -155,6 +156,10 @@ def _imported_names(node: ast.AST, path: Path, src: Path) -> list[str]:
     a.b when that is a module (``from ninjemys import tools``)."""
     if isinstance(node, ast.Import):
         return [alias.name for alias in node.names]
+    if isinstance(node, ast.Call) and _is_import_call(node.func) and node.args:
+        # importlib.import_module("ninjemys.x") / __import__("ninjemys.x"): an import by another name
+        first = node.args[0]
+        return [first.value] if isinstance(first, ast.Constant) and isinstance(first.value, str) else []
     if not isinstance(node, ast.ImportFrom):
         return []
     if node.level:  # relative: resolve against the importing module's package
@@ -167,6 +172,12 @@ def _imported_names(node: ast.AST, path: Path, src: Path) -> list[str]:
         module = node.module or ""
     subs = [f"{module}.{alias.name}" for alias in node.names if _is_module(f"{module}.{alias.name}", src)]
     return [module, *subs]
+
+
+def _is_import_call(func: ast.expr) -> bool:
+    if isinstance(func, ast.Name):
+        return func.id in ("__import__", "import_module")
+    return isinstance(func, ast.Attribute) and func.attr == "import_module"
 
 
 def _is_module(dotted: str, src: Path) -> bool:
@@ -346,3 +357,20 @@ def test_the_layer_map_in_docs_says_what_order_says() -> None:
             )
     missing = sorted(k for k in LAYERS if k and "." not in k and k not in named)
     assert not missing, f"docs/architecture.md's layer map does not name: {missing}"
+
+
+def test_a_literal_dynamic_import_counts(tmp_path: Path) -> None:
+    src = tmp_path / "src"
+    for pkg in ("ninjemys", "ninjemys/sim", "ninjemys/web"):
+        (src / pkg).mkdir(parents=True, exist_ok=True)
+        (src / pkg / "__init__.py").write_text("")
+    (src / "ninjemys" / "web" / "app.py").write_text("")
+    (src / "ninjemys" / "sim" / "view.py").write_text(
+        'import importlib\n\n\ndef f():\n    return importlib.import_module("ninjemys.web.app")\n'
+    )
+    (src / "ninjemys" / "sim" / "other.py").write_text('def g():\n    return __import__("ninjemys.web")\n')
+    problems = find_violations(src)
+    assert problems == [
+        "src/ninjemys/sim/other.py:2: ninjemys.sim.other (sim) imports ninjemys.web (web): a layer above",
+        "src/ninjemys/sim/view.py:5: ninjemys.sim.view (sim) imports ninjemys.web.app (web): a layer above",
+    ]
