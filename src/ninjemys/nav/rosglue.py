@@ -14,7 +14,7 @@ import numpy as np
 
 import rospy
 from ninjemys.errors import ShutdownError
-from ninjemys.sim.mapfile import GridMap
+from ninjemys.maps.mapfile import GridMap
 from ninjemys.tf2.core import BufferCore
 from ninjemys.tf2.errors import TransformException
 from ninjemys.tf2.node import TransformBroadcaster, TransformListener
