@@ -16,8 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ninjemys.maps.mapfile import load_map
 from ninjemys.nav.amcl import AMCLParams, ParticleFilter
-from ninjemys.sim.mapfile import load_map
 
 TARGET_MS = 20.0
 MAP = Path(__file__).resolve().parents[1] / "src/ninjemys/packages/share/puzzlebot_sim/maps/office.yaml"

@@ -16,8 +16,8 @@ import time
 import numpy as np
 
 from nav_amcl import MAP, cast  # the office map and its plain numpy ray march
+from ninjemys.maps.mapfile import load_map
 from ninjemys.nav.slam import ParticleMapper, SlamParams, compose
-from ninjemys.sim.mapfile import load_map
 
 
 def drive() -> list[tuple[float, float]]:

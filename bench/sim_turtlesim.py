@@ -15,7 +15,6 @@ import subprocess
 import sys
 import threading
 import time
-import urllib.request
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
@@ -83,13 +82,29 @@ def drive(uri: str, turtles: int, hz: float, stop: threading.Event) -> None:
 
 
 def stream(url: str, stop: threading.Event, counter: list[int]) -> None:
-    with urllib.request.urlopen(url, timeout=30) as resp:
+    """A browser view's data path: the gateway's view:turtlesim channel, counting messages."""
+    import json
+
+    from websockets.sync.client import connect
+
+    with connect(url, subprotocols=["foxglove.websocket.v1"]) as ws:
         while not stop.is_set():
-            line = resp.readline()
-            if not line:
-                return
-            if line.startswith(b"event:"):
+            try:
+                raw = ws.recv(timeout=0.5)
+            except TimeoutError:
+                continue
+            if isinstance(raw, bytes):
                 counter[0] += 1
+                continue
+            msg = json.loads(raw)
+            if msg["op"] == "advertise":
+                for ch in msg["channels"]:
+                    if ch["topic"] == "view:turtlesim":
+                        ws.send(
+                            json.dumps(
+                                {"op": "subscribe", "subscriptions": [{"id": 1, "channelId": ch["id"]}]}
+                            )
+                        )
 
 
 def scenario(uri: str, seconds: float, turtles: int, web: bool) -> tuple[float, int]:
@@ -102,7 +117,7 @@ def scenario(uri: str, seconds: float, turtles: int, web: bool) -> tuple[float, 
         if turtles:
             threads.append(threading.Thread(target=drive, args=(uri, turtles, 60.0, stop), daemon=True))
         if web:
-            url = f"http://localhost:{port}/api/turtlesim/events"
+            url = f"ws://localhost:{port}/ws"
             threads.append(threading.Thread(target=stream, args=(url, stop, events), daemon=True))
         for t in threads:
             t.start()

@@ -2,7 +2,8 @@
 
     .venv/bin/python bench/web_graph.py [--nodes 100]
 
-A helper process runs N ninjemys nodes (node i publishes /g<i%10>/t<i> and subscribes to the previous
+The page gets its data through the gateway on the web tools' server (the connection graph and the
+getBusInfo sweep of its rosBus extension), as the rqt_graph command runs it. A helper process runs N ninjemys nodes (node i publishes /g<i%10>/t<i> and subscribes to the previous
 node's topic, so the graph is a chain through 10 namespaces). The browser is Debian's chromium via
 Playwright. ROS 1's rqt_graph is a Qt desktop tool (not installed here), so there is nothing to run
 side by side; its refresh is manual or a 1 s auto-refresh of the same master calls.
@@ -20,6 +21,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
+from ninjemys.bridge.server import Gateway, GatewayOptions  # noqa: E402
+from ninjemys.node import Node  # noqa: E402
 from ninjemys.testing import run_master  # noqa: E402
 from ninjemys.web.app import WebApp  # noqa: E402
 
@@ -72,13 +75,16 @@ def main() -> None:
         helper.stdout.readline()
         print(f"{options.nodes} nodes registered in {time.monotonic() - t0:.1f} s (helper process)")
         t0 = time.monotonic()
-        app = WebApp(uri, caller_id="/bench_rqt_graph")
+        # as the rqt_graph command runs it: the page's data comes through a gateway on its server
+        node = Node("bench_rqt_graph", master_uri=uri)
+        gateway = Gateway(
+            GatewayOptions(node_name=node.name, hide_own_node=True, update_period=0.5), node=node
+        )
+        gateway.start()
+        app = WebApp(uri, caller_id=node.name)
+        app.add_gateway(gateway)
         url = app.start()
-        while (
-            app._poller is None
-            or app._poller.graph is None
-            or len(app._poller.graph["nodes"]) < options.nodes
-        ):
+        while len(gateway.catalog.node_names()) < options.nodes:
             time.sleep(0.01)
         first_graph = time.monotonic() - t0
         try:
@@ -90,11 +96,15 @@ def main() -> None:
                 want = options.nodes
                 t0 = time.monotonic()
                 page.goto(url)
-                page.wait_for_function(f"document.querySelectorAll('g.node').length >= {want}", timeout=60000)
+                page.wait_for_function(
+                    f"document.querySelectorAll('g.node').length >= {want}", polling="raf", timeout=60000
+                )
                 shown = time.monotonic() - t0
                 t0 = time.monotonic()
                 page.reload()
-                page.wait_for_function(f"document.querySelectorAll('g.node').length >= {want}", timeout=60000)
+                page.wait_for_function(
+                    f"document.querySelectorAll('g.node').length >= {want}", polling="raf", timeout=60000
+                )
                 reshown = time.monotonic() - t0
                 render_ms = page.evaluate(
                     "() => { const t = performance.now(); render(); return performance.now() - t; }"
@@ -104,17 +114,28 @@ def main() -> None:
                 helper.stdin.flush()
                 helper.stdout.readline()
                 t_reg = time.monotonic() - t0
-                page.wait_for_selector('g.node[data-name="/newcomer"]', state="attached", timeout=30000)
+                # polled every frame: wait_for_selector backs off to 500 ms between checks
+                page.wait_for_function(
+                    "document.querySelector('g.node[data-name=\"/newcomer\"]') !== null",
+                    polling="raf",
+                    timeout=30000,
+                )
                 appear = time.monotonic() - t0
                 t0 = time.monotonic()
                 helper.stdin.write("remove\n")
                 helper.stdin.flush()
                 helper.stdout.readline()
-                page.wait_for_selector('g.node[data-name="/newcomer"]', state="detached", timeout=30000)
+                page.wait_for_function(
+                    "document.querySelector('g.node[data-name=\"/newcomer\"]') === null",
+                    polling="raf",
+                    timeout=30000,
+                )
                 vanish = time.monotonic() - t0
                 browser.close()
         finally:
             app.stop()
+            gateway.shutdown()
+            node.shutdown("bench over")
             helper.stdin.close()
             try:
                 helper.wait(20)
@@ -123,7 +144,7 @@ def main() -> None:
                 helper.wait()
     print("graph page (machine shared, figures noisy; master polled every 0.5 s):")
     print(
-        f"  web tools start -> first {options.nodes}-node graph  {first_graph * 1000:7.0f} ms (master + lookups)"
+        f"  web tools start -> first {options.nodes}-node graph  {first_graph * 1000:7.0f} ms (gateway's master poll)"
     )
     print(f"  open page -> {options.nodes}-node graph drawn     {shown * 1000:7.0f} ms (fresh browser)")
     print(f"  reload    -> {options.nodes}-node graph drawn     {reshown * 1000:7.0f} ms")

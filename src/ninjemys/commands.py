@@ -1,4 +1,5 @@
-"""Where our console scripts are: roslaunch starts ``roscore`` this way, tests start every command.
+"""Our console scripts: where they are (roslaunch starts ``roscore`` this way, tests start every
+command) and how each one ends (:func:`entry`: one-line errors on stderr, exit codes, no tracebacks).
 
 The venv's ``bin/`` next to the running interpreter comes first, so a process started from a venv
 runs that venv's commands even when another ROS (Debian's ``/usr/bin/roscore``) is on PATH.
@@ -9,6 +10,9 @@ from __future__ import annotations
 import os
 import shutil
 import sys
+from collections.abc import Callable
+
+from ninjemys.errors import MasterUnreachable, NinjemysError
 
 
 def command_path(command: str) -> str:
@@ -20,3 +24,32 @@ def command_path(command: str) -> str:
     if found is None:
         raise FileNotFoundError(f"ninjemys command {command!r} is not installed next to {sys.executable}")
     return found
+
+
+def error(message: str) -> None:
+    """Print a user-facing error the way ROS 1 tools do (one line, stderr)."""
+    print(message if message.startswith("ERROR") else f"ERROR: {message}", file=sys.stderr)
+
+
+def entry(main: Callable[[list[str] | None], int]) -> Callable[[], None]:
+    """Wrap ``main`` for a console script: map our errors and Ctrl-C to exit codes, never a traceback."""
+
+    def console_main() -> None:
+        try:
+            code = main(sys.argv[1:])
+        except KeyboardInterrupt:
+            code = 130 if os.environ.get("NINJEMYS_SIGINT_CODE") else 0
+        except BrokenPipeError:
+            # `rostopic echo /x | head`: the reader went away; exit quietly like ROS 1 tools
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+            code = 1
+        except MasterUnreachable:
+            error("Unable to communicate with master!")
+            code = 1
+        except NinjemysError as exc:
+            error(str(exc))
+            code = 1
+        sys.exit(code)
+
+    return console_main

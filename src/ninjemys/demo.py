@@ -49,7 +49,7 @@ def _port_free(port: int) -> bool:
 
 
 def _pick_port(requested: int | None) -> int:
-    from ninjemys.testing import free_port
+    from ninjemys.net.addresses import free_port
 
     if requested:
         return requested
@@ -202,7 +202,7 @@ def run(
                 [
                     sys.executable,
                     "-m",
-                    "ninjemys.sim.turtlesim_node",
+                    "ninjemys.web.turtlesim_view",
                     "--port",
                     str(web_port),
                     "--no-browser",

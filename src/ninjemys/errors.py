@@ -20,6 +20,10 @@ Every error the library raises on purpose derives from :class:`NinjemysError`, s
     +-- LaunchError              a launch file is malformed or refers to something missing
     +-- BagError                 a bag file is malformed or cannot be written
     +-- ActionException          a class given as an action is not one (actionlib's ActionException)
+    +-- (beside their code)      TurtleError, SpawnError, PlanError, ConversionError (also ValueErrors),
+                                 OpError, HttpError, RvizConfigError, CfgError, ...
+
+tests/test_rulebook.py walks every module and checks that each exception class is in this tree.
 
 The rospy facade maps these onto rospy.ROSException, ROSInterruptException, ServiceException, ...
 """

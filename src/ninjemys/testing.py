@@ -7,49 +7,16 @@ from __future__ import annotations
 
 import contextlib
 import os
-import socket
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 from ninjemys.commands import command_path
+from ninjemys.net.addresses import free_port as free_port  # re-exported: tests and users take it from here
 
 #: Debian's real ROS 1 runs under the system interpreter, never the project's venv.
 ROS1_PYTHON = "/usr/bin/python3"
 ROS1_BIN = Path("/usr/bin")
-
-
-def _ephemeral_range() -> tuple[int, int]:
-    try:
-        low, high = Path("/proc/sys/net/ipv4/ip_local_port_range").read_text().split()
-        return int(low), int(high)
-    except (OSError, ValueError):
-        return 32768, 60999
-
-
-def free_port(host: str = "127.0.0.1") -> int:
-    """A TCP port that was free a moment ago, chosen *below* the kernel's ephemeral range.
-
-    Tests hand these ports to masters that start a moment later. A port from the ephemeral range
-    (what binding to port 0 returns) can meanwhile be given by the kernel to any node that binds
-    port 0 for its XML-RPC or TCPROS server; a test would then mistake that node for its master.
-    """
-    import random
-
-    low, _ = _ephemeral_range()
-    first, last = (20000, low - 1) if low > 21000 else (1024, low - 1)
-    rng = random.Random()
-    for _ in range(200):
-        candidate = rng.randint(first, last)
-        with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
-            try:
-                s.bind((host, candidate))
-            except OSError:
-                continue
-            return candidate
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
-        s.bind((host, 0))
-        return s.getsockname()[1]
 
 
 def have_ros1() -> bool:

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from ninjemys.sim.mapfile import GridMap
+from ninjemys.maps.mapfile import GridMap
 
 
 def room_map(size: float = 6.0, res: float = 0.05) -> GridMap:
@@ -63,7 +63,7 @@ SHARE = Path(__file__).resolve().parents[2] / "src" / "ninjemys" / "packages" / 
 
 def world_map(world: str) -> GridMap:
     """The ground-truth map of a shipped world (what the simulator rasterizes)."""
-    from ninjemys.sim.mapfile import load_map
+    from ninjemys.maps.mapfile import load_map
 
     return load_map(SHARE / "puzzlebot_sim" / "maps" / f"{world}.yaml")
 

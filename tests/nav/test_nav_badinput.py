@@ -77,7 +77,7 @@ def test_move_base_parameter_of_the_wrong_type(master, tmp_path):
 
 
 def test_map_saver_writes_what_map_server_reads(master, tmp_path):
-    from ninjemys.sim.mapfile import load_map
+    from ninjemys.maps.mapfile import load_map
 
     share = os.path.join(os.path.dirname(__file__), "..", "..", "src", "ninjemys", "packages", "share")
     maze = os.path.abspath(os.path.join(share, "puzzlebot_sim", "maps", "maze.yaml"))

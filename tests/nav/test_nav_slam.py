@@ -59,7 +59,7 @@ def test_a_featureless_corridor_does_not_pull_the_pose_along_it(laser):
     """Walls that constrain only the across-corridor position: there the motion model holds the pose.
     The matcher this filter replaced took the best score anywhere in its window: the beams that end
     past the mapped part of the walls pulled it back towards the map, 3.2 m over these 6 m."""
-    from ninjemys.sim.mapfile import GridMap
+    from ninjemys.maps.mapfile import GridMap
 
     angles, cast = laser
     data = np.zeros((40, 400), dtype=np.int8)  # 20 x 2 m, walls along its length only

@@ -61,7 +61,7 @@ def test_missing_executable_error(tmp_path: Path) -> None:
 
 
 def test_shipped_table_has_the_fixed_names() -> None:
-    assert shipped_executable("turtlesim", "turtlesim_node").target == "ninjemys.sim.turtlesim_node:main"
+    assert shipped_executable("turtlesim", "turtlesim_node").target == "ninjemys.web.turtlesim_view:main"
     assert shipped_executable("turtlesim", "turtle_teleop_key").target == "ninjemys.sim.teleop_key:main"
     assert shipped_executable("rqt_graph", "rqt_graph").target == "ninjemys.web.rqt_graph:main"
     assert shipped_executable("rospy_tutorials", "talker.py").target == "ninjemys.tutorials.talker:main"

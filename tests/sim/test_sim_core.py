@@ -281,7 +281,7 @@ def test_urdf_and_yaml_descriptions_agree():
 
 
 def test_bad_robot_description_names_field(tmp_path):
-    from ninjemys.sim.mapfile import MapFileError
+    from ninjemys.maps.mapfile import MapFileError
 
     p = tmp_path / "bad.yaml"
     p.write_text("wheel_radius: 0.05\nsensors:\n  laser:\n    frame: laser\n    range_min: 20\n")

@@ -1,4 +1,4 @@
-"""map_server's loading rules and map_saver's output (ninjemys.sim.mapfile), on small images written here."""
+"""map_server's loading rules and map_saver's output (ninjemys.maps.mapfile), on small images written here."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ninjemys.sim.mapfile import GridMap, MapFileError, load_map, map_saver_pixels, save_map
+from ninjemys.maps.mapfile import GridMap, MapFileError, load_map, map_saver_pixels, save_map
 
 
 def write_pgm(path: Path, img: np.ndarray) -> None:

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from ninjemys.sim.mapfile import MapFileError
+from ninjemys.maps.mapfile import MapFileError
 from ninjemys.sim.robot_model import load_robot_model
 from ninjemys.sim.simcore import PERSONAL_SPACE, Simulation
 from ninjemys.sim.world2d import load_world

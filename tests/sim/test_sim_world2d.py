@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ninjemys.sim.mapfile import GridMap, MapFileError, load_map, occupancy_from_pixels, save_map
+from ninjemys.maps.mapfile import GridMap, MapFileError, load_map, occupancy_from_pixels, save_map
 from ninjemys.sim.world2d import load_world, rasterize, world_from_map
 from ninjemys.sim.worlds import SHIPPED_WORLDS, map_path, resolve_world
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import os
 import signal
 import subprocess
@@ -38,12 +37,19 @@ def test_demo_drives_the_square_and_stops_cleanly(tmp_path) -> None:  # type: ig
         assert f"node graph: http://localhost:{web}/" in text
         children = _children(demo.pid)
 
-        def moved() -> bool:
-            with urllib.request.urlopen(f"http://localhost:{web}/api/turtlesim/state", timeout=5) as resp:
-                turtle = json.load(resp)["turtles"][0]
-            return turtle["x"] > 5.8
+        # the view's page is served (its data comes through the gateway), and turtle1 drives
+        with urllib.request.urlopen(f"http://localhost:{web}/turtlesim", timeout=5) as page:
+            assert b"turtlesim.js" in page.read()
+        from ninjemys.node import Node
+        from turtlesim.msg import Pose
 
-        wait_until(moved, timeout=20, what="turtle1 to drive")
+        poses: list[float] = []
+        node = Node("demo_watcher", anonymous=True, master_uri=f"http://localhost:{port}/")
+        try:
+            node.subscriber("/turtle1/pose", Pose, lambda m: poses.append(m.x), queue_size=10)
+            wait_until(lambda: poses and poses[-1] > 5.8, timeout=20, what="turtle1 to drive")
+        finally:
+            node.shutdown("test over")
         demo.send_signal(signal.SIGINT)
         assert demo.wait(20) == 0
         for pid in children:

@@ -152,9 +152,11 @@ def test_malformed_package_xml_names_file_and_line(ws: Path, monkeypatch: pytest
 
 
 def test_missing_dependency_is_named(ws: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    create(ws, monkeypatch, "needy", "rospy", "nonexistent_msgs")
-    with pytest.raises(PackageError, match="depends on 'nonexistent_msgs'"):
+    create(ws, monkeypatch, "needy", "rospy", "nonexistent_msgs")  # find_package(catkin ... COMPONENTS)
+    with pytest.raises(PackageError, match="Could not find a package configuration file provided by") as info:
         make(ws, monkeypatch)
+    assert "needy/CMakeLists.txt:" in str(info.value)
+    assert "ninjemys: 'nonexistent_msgs' (required by needy)" in str(info.value)
 
 
 def test_malformed_msg_fails_build_with_file_and_line(ws: Path, monkeypatch: pytest.MonkeyPatch) -> None:

@@ -1,26 +1,23 @@
-"""The graph page in a real headless chromium: talker -> /chatter -> listener, live updates."""
+"""The graph page in a real headless chromium: talker -> /chatter -> listener, live updates, and the
+topic details (rate and last message) watched through the gateway."""
 
 from __future__ import annotations
 
 import signal
 
 import pytest
-from web_helpers import LISTENER, ROBOT_BASE, TALKER
-
-from ninjemys.web.app import WebApp
+from web_helpers import LISTENER, ROBOT_BASE, TALKER, graph_app
 
 pytestmark = [pytest.mark.ros1, pytest.mark.browser]
 
 
 def test_graph_page_shows_chatter_and_updates_on_kill(ros1_master: str, rospy_node, browser_page) -> None:  # type: ignore[no-untyped-def]
-    app = WebApp(ros1_master, caller_id="/test_rqt_graph", poll_period=0.2)
-    url = app.start()
-    try:
+    with graph_app(ros1_master) as app:
         rospy_node(TALKER)
         listener = rospy_node(LISTENER)
         rospy_node(ROBOT_BASE)
         page = browser_page
-        page.goto(url)
+        page.goto(app.url)
         page.wait_for_selector('g.node[data-name="/talker"]', timeout=20000)
         page.wait_for_selector('g.node[data-name="/listener"]', timeout=20000)
         page.wait_for_selector('g.topic[data-name="/chatter"]', timeout=20000)
@@ -36,14 +33,25 @@ def test_graph_page_shows_chatter_and_updates_on_kill(ros1_master: str, rospy_no
         assert page.locator("g.group").count() == 0
         page.check("#group")
 
-        # clicking the topic shows its type
+        # clicking the topic shows its type, then its rate and last message (subscribed through the
+        # gateway, whose node stays hidden as debug plumbing)
         page.click('g.topic[data-name="/chatter"]')
         page.wait_for_selector('#details dd[data-key="type"]:has-text("std_msgs/String")', timeout=10000)
+        page.wait_for_selector('#details dd[data-key="rate"]:has-text("Hz")', timeout=20000)
+        page.wait_for_function(
+            "document.getElementById('details-message').textContent.includes('hello world')", timeout=10000
+        )
+        assert page.locator('g.node[data-name^="/test_rqt_graph"]').count() == 0
+        page.uncheck("#hide-debug")
+        page.wait_for_selector('g.node[data-name^="/test_rqt_graph"]', timeout=10000)
+        page.check("#hide-debug")
 
-        # nodes-only view draws talker -> listener directly
+        # nodes-only view draws talker -> listener directly, as a live connection once swept
         page.select_option("#mode", "nodes")
         page.wait_for_selector(
-            'path.edge[data-source="/talker"][data-target="/listener"]', state="attached", timeout=10000
+            'path.edge:not(.pending)[data-source="/talker"][data-target="/listener"]',
+            state="attached",
+            timeout=10000,
         )
         page.select_option("#mode", "topics")
 
@@ -51,5 +59,3 @@ def test_graph_page_shows_chatter_and_updates_on_kill(ros1_master: str, rospy_no
         listener.wait(10)
         page.wait_for_selector('g.node[data-name="/listener"]', state="detached", timeout=20000)
         assert page.locator('g.node[data-name="/talker"]').count() == 1
-    finally:
-        app.stop()

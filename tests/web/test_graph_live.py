@@ -1,98 +1,94 @@
-"""The web tools app against a real ROS 1 graph: Debian's rosmaster and rospy talker/listener."""
+"""The graph page's data against a real ROS 1 graph (Debian's rosmaster, rospy talker/listener),
+read as the page reads it: the gateway's Foxglove connection graph with its rosBus extension."""
 
 from __future__ import annotations
 
 import json
 import signal
-import urllib.request
 
 import pytest
-from web_helpers import LISTENER, TALKER, wait_until
-
-from ninjemys.web.app import WebApp
+from web_helpers import LISTENER, TALKER, graph_app, wait_until
+from websockets.sync.client import ClientConnection, connect
 
 pytestmark = pytest.mark.ros1
 
 
-def _get(url: str) -> dict:
-    with urllib.request.urlopen(url, timeout=5) as resp:
-        return json.load(resp)
+class GraphClient:
+    """A Foxglove client that keeps the connection graph as the page does (and the last status)."""
+
+    def __init__(self, ws: ClientConnection) -> None:
+        self.ws = ws
+        self.pub: dict[str, list[str]] = {}
+        self.sub: dict[str, list[str]] = {}
+        self.bus: dict = {"nodes": {}, "live": {}}
+        self.types: dict[str, str] = {}
+        self.status: dict | None = None
+        self.info: dict = {}
+        self.ws.send(json.dumps({"op": "subscribeConnectionGraph"}))
+
+    def pump(self) -> None:
+        while True:
+            try:
+                raw = self.ws.recv(timeout=0.2)
+            except TimeoutError:
+                return
+            if isinstance(raw, bytes):
+                continue
+            msg = json.loads(raw)
+            op = msg["op"]
+            if op == "serverInfo":
+                self.info = msg
+            elif op == "advertise":
+                self.types.update({c["topic"]: c["schemaName"] for c in msg["channels"]})
+            elif op == "status":
+                self.status = msg
+            elif op == "removeStatus":
+                self.status = None
+            elif op == "connectionGraphUpdate":
+                self.pub.update({t["name"]: t["publisherIds"] for t in msg["publishedTopics"]})
+                self.sub.update({t["name"]: t["subscriberIds"] for t in msg["subscribedTopics"]})
+                for name in msg["removedTopics"]:
+                    self.pub.pop(name, None)
+                    self.sub.pop(name, None)
+                self.bus = msg.get("rosBus", self.bus)
+
+    def edge_live(self, source: str, target: str, topic: str) -> bool:
+        self.pump()
+        linked = source in self.pub.get(topic, []) and target in self.sub.get(topic, [])
+        live = self.bus["live"]
+        return linked and (topic in live.get(source, []) or topic in live.get(target, []))
 
 
-@pytest.fixture
-def app(ros1_master: str):  # type: ignore[no-untyped-def]
-    web = WebApp(ros1_master, caller_id="/test_rqt_graph", poll_period=0.2)
-    web.start()
-    try:
-        yield web
-    finally:
-        web.stop()
+def _connect(url: str) -> ClientConnection:
+    return connect(url.replace("http", "ws", 1) + "ws", subprotocols=["foxglove.websocket.v1"])
 
 
-def _edge(graph: dict | None, source: str, target: str) -> bool:
-    return bool(graph) and any(e["source"] == source and e["target"] == target for e in graph["edges"])
-
-
-def test_graph_shows_real_ros1_nodes_and_follows_changes(app: WebApp, rospy_node) -> None:  # type: ignore[no-untyped-def]
-    rospy_node(TALKER)
-    listener = rospy_node(LISTENER)
-    graph = wait_until(
-        lambda: (g := _get(app.url + "api/graph")["graph"]) and _edge(g, "/talker", "/listener") and g,
-        what="talker -> listener edge",
-    )
-    chatter = next(t for t in graph["topics"] if t["name"] == "/chatter")
-    assert chatter["type"] == "std_msgs/String"
-    assert wait_until(lambda: _edge(_get(app.url + "api/graph")["graph"], "/talker", "/listener"))
-    details = _get(app.url + "api/topic?name=/chatter")
-    assert details["publishers"] == ["/talker"] and details["subscribers"] == ["/listener"]
-
-    listener.send_signal(signal.SIGINT)  # rospy unregisters on shutdown
-    listener.wait(10)
-    wait_until(
-        lambda: all(n["name"] != "/listener" for n in _get(app.url + "api/graph")["graph"]["nodes"]),
-        what="listener to leave the graph",
-    )
-
-
-def test_unknown_topic_is_a_404(app: WebApp) -> None:
-    with pytest.raises(urllib.error.HTTPError) as info:
-        urllib.request.urlopen(app.url + "api/topic?name=/nope", timeout=5)
-    assert info.value.code == 404
+def test_graph_shows_real_ros1_nodes_and_follows_changes(ros1_master: str, rospy_node) -> None:  # type: ignore[no-untyped-def]
+    with graph_app(ros1_master) as app, _connect(app.url) as ws:
+        client = GraphClient(ws)
+        rospy_node(TALKER)
+        listener = rospy_node(LISTENER)
+        wait_until(
+            lambda: client.edge_live("/talker", "/listener", "/chatter"), what="live talker -> listener"
+        )
+        assert client.types["/chatter"] == "std_msgs/String"
+        assert client.bus["nodes"]["/talker"]["reachable"] is True
+        assert client.info["metadata"]["ROS_MASTER_URI"] == ros1_master
+        # the gateway's own node is the act of looking: the page counts it as debug
+        assert client.info["metadata"]["debugNodes"].startswith("/test_rqt_graph")
+        listener.send_signal(signal.SIGINT)  # rospy unregisters on shutdown
+        listener.wait(10)
+        wait_until(
+            lambda: (client.pump(), "/listener" not in client.sub.get("/chatter", []))[1],
+            what="listener to leave the graph",
+        )
 
 
 def test_unreachable_master_is_reported() -> None:
     from ninjemys.testing import free_port
 
-    web = WebApp(f"http://localhost:{free_port()}/", poll_period=0.2)
-    web.start()
-    try:
-        state = wait_until(lambda: _get(web.url + "api/graph").get("error"), what="master error")
-        assert "cannot reach the master" in state
-    finally:
-        web.stop()
-
-
-def test_topic_details_show_rate_and_last_message(ros1_master: str, rospy_node) -> None:  # type: ignore[no-untyped-def]
-    from ninjemys.node import Node
-    from ninjemys.web.monitor import TopicMonitor
-
-    monitor = TopicMonitor(lambda: Node("test_webtools", anonymous=True, master_uri=ros1_master))
-    web = WebApp(ros1_master, caller_id="/test_rqt_graph", poll_period=0.2, monitor=monitor)
-    web.start()
-    try:
-        rospy_node(TALKER)
-        wait_until(
-            lambda: any(
-                t["name"] == "/chatter"
-                for t in (_get(web.url + "api/graph")["graph"] or {}).get("topics", [])
-            ),
-            what="/chatter in the graph",
-        )
-        details = wait_until(
-            lambda: (d := _get(web.url + "api/topic?name=/chatter"))["count"] >= 5 and d, what="messages"
-        )
-        assert details["type"] == "std_msgs/String"
-        assert details["last_message"] == 'data: "hello world"'
-        assert 2.0 < details["rate"] < 50.0  # the talker publishes at 10 Hz (loose: shared machine)
-    finally:
-        web.stop()
+    with graph_app(f"http://localhost:{free_port()}/") as app, _connect(app.url) as ws:
+        client = GraphClient(ws)
+        status = wait_until(lambda: (client.pump(), client.status)[1], what="master status")
+        assert status["id"] == "master" and status["level"] == 2
+        assert "cannot reach the master" in status["message"]

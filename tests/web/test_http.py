@@ -1,4 +1,4 @@
-"""The stdlib HTTP server: routes, static files, errors, Server-Sent Events, bad input."""
+"""The stdlib HTTP server: routes, static files, errors, bad input."""
 
 from __future__ import annotations
 
@@ -6,8 +6,7 @@ import asyncio
 import json
 from pathlib import Path
 
-from ninjemys.web.events import Hub
-from ninjemys.web.http import HttpError, HttpServer, Request, Response
+from ninjemys.serve.http import HttpError, HttpServer, Request, Response
 
 
 async def _request(port: int, raw: bytes) -> bytes:
@@ -59,31 +58,6 @@ def test_routes_static_errors(tmp_path: Path) -> None:
             # still serving after all that
             again = await _request(server.port, b"GET /json HTTP/1.1\r\nConnection: close\r\n\r\n")
             assert again.startswith(b"HTTP/1.1 200")
-        finally:
-            await server.close()
-
-    asyncio.run(scenario())
-
-
-def test_server_sent_events_fan_out() -> None:
-    async def scenario() -> None:
-        server = HttpServer("127.0.0.1", 0)
-        hub = Hub(asyncio.get_running_loop())
-        server.route("GET", "/events", lambda _r: hub.open([("state", {"n": 0})]))
-        await server.start()
-        try:
-            reader, writer = await asyncio.open_connection("127.0.0.1", server.port)
-            writer.write(b"GET /events HTTP/1.1\r\n\r\n")
-            await writer.drain()
-            head = await reader.readuntil(b"\r\n\r\n")
-            assert b"text/event-stream" in head
-            assert await reader.readuntil(b"\n\n") == b'event: state\ndata: {"n":0}\n\n'
-            assert hub.listeners == 1
-            hub.publish("pose", {"x": 1.5})
-            assert await asyncio.wait_for(reader.readuntil(b"\n\n"), 5) == b'event: pose\ndata: {"x":1.5}\n\n'
-            hub.close()
-            assert await asyncio.wait_for(reader.read(), 5) == b""
-            writer.close()
         finally:
             await server.close()
 

@@ -16,8 +16,8 @@ from ninjemys.bag.api import Bag
 from ninjemys.idl.loader import get_message_class
 from ninjemys.master.core import MasterThread
 from ninjemys.rostime import Time
+from ninjemys.serve.http import HttpError
 from ninjemys.testing import free_port, ninjemys_bin, run_master
-from ninjemys.web.http import HttpError
 from ninjemys.web.rqt import Rqt
 
 

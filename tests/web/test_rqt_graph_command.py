@@ -1,4 +1,5 @@
-"""The ``rqt_graph`` command: prints the URL, serves the graph, exits 0 on Ctrl-C; bad port -> one-line error."""
+"""The ``rqt_graph`` command: prints the URL, serves the graph page and its gateway, exits 0 on
+Ctrl-C; bad port -> one-line error."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ import subprocess
 import urllib.request
 
 from web_helpers import wait_until
+from websockets.sync.client import connect
 
 from ninjemys.testing import free_port, ninjemys_bin, run_master
 
@@ -29,13 +31,18 @@ def test_rqt_graph_serves_and_exits_cleanly() -> None:
             line = proc.stdout.readline()
             assert line.strip() == f"rqt_graph: node graph of {uri} at http://localhost:{port}/"
 
-            def graph_with_rosout() -> dict | None:
+            def rosout_published() -> bool:
                 # run_master() returns once the master answers; rosout registers a moment later
-                with urllib.request.urlopen(f"http://localhost:{port}/api/graph", timeout=5) as resp:
-                    g = json.load(resp)["graph"]
-                return g if g and any(n["name"] == "/rosout" for n in g["nodes"]) else None
+                with connect(f"ws://localhost:{port}/ws", subprotocols=["foxglove.websocket.v1"]) as ws:
+                    ws.send(json.dumps({"op": "subscribeConnectionGraph"}))
+                    while True:
+                        msg = json.loads(ws.recv(timeout=5))
+                        if msg["op"] == "connectionGraphUpdate":
+                            return any(t["name"] == "/rosout" for t in msg["publishedTopics"])
 
-            assert wait_until(graph_with_rosout, what="a graph showing our roscore's /rosout")
+            assert wait_until(rosout_published, what="the gateway's graph showing our roscore's /rosout")
+            with urllib.request.urlopen(f"http://localhost:{port}/", timeout=5) as page:
+                assert b"graph.js" in page.read()
             proc.send_signal(signal.SIGINT)
             assert proc.wait(10) == 0
         finally:

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import contextlib
 import time
 import xmlrpc.client
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import Any
 
 CHROMIUM = Path("/usr/bin/chromium")
 CHROMIUM_ARGS = [
@@ -68,3 +70,26 @@ def wait_until(predicate: Callable[[], object], timeout: float = 20.0, what: str
             return value
         time.sleep(0.1)
     raise AssertionError(f"timed out waiting for {what}")
+
+
+@contextlib.contextmanager
+def graph_app(master_uri: str, update_period: float = 0.2) -> Iterator[Any]:
+    """The web tools as rqt_graph runs them: a WebApp with a gateway (own node, counted as debug)."""
+    from ninjemys.bridge.server import Gateway, GatewayOptions
+    from ninjemys.node import Node
+    from ninjemys.web.app import WebApp
+
+    node = Node("test_rqt_graph", anonymous=True, master_uri=master_uri)
+    gateway = Gateway(
+        GatewayOptions(node_name=node.name, hide_own_node=True, update_period=update_period), node=node
+    )
+    gateway.start()
+    app = WebApp(master_uri, caller_id=node.name)
+    app.add_gateway(gateway)
+    app.start()
+    try:
+        yield app
+    finally:
+        app.stop()
+        gateway.shutdown()
+        node.shutdown("test over")

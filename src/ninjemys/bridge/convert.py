@@ -21,6 +21,7 @@ from typing import Any
 import cbor2
 import numpy
 
+from ninjemys.errors import NinjemysError
 from ninjemys.idl.loader import get_message_class
 from ninjemys.rostime import Duration, Time
 
@@ -68,7 +69,7 @@ _INT_RANGES = {
 }
 
 
-class ConversionError(ValueError):
+class ConversionError(NinjemysError, ValueError):
     """A JSON value does not fit the message field it was given for (the text names both)."""
 
 

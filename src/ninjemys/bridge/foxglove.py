@@ -1,7 +1,8 @@
 """The Foxglove WebSocket protocol (foxglove/ws-protocol ``docs/spec.md``, v1) for one client.
 
 Channels are the graph's topics with encoding ``ros1``, schema name ``pkg/Type`` and the full
-definition text (``ros1msg``) as schema; message data is the TCPROS payload as received, never
+definition text (``ros1msg``) as schema (plus the ``json`` channels of an in-process app,
+:mod:`ninjemys.bridge.appchannels`); message data is the TCPROS payload as received, never
 deserialized (the tap subscribes raw). Client publishing sends the client's bytes as they are
 (``publish_raw``), and service calls carry ROS 1 bytes both ways.
 """
@@ -68,7 +69,7 @@ class FoxgloveSession:
                 "name": g.node.name,
                 "capabilities": caps,
                 "supportedEncodings": ["ros1"],
-                "metadata": {"ROS_DISTRO": "noetic"},
+                "metadata": self._metadata(),
                 "sessionId": g.session_id,
             }
         )
@@ -76,6 +77,22 @@ class FoxgloveSession:
         services = list(g.catalog.services.values())
         if services:
             self.send({"op": "advertiseServices", "services": services})
+        if g.master_error is not None:
+            self.master_status(g.master_error)
+
+    def master_status(self, error: str | None) -> None:
+        """Tell the client the master is unreachable (a status with id ``master``), or no longer."""
+        if error is None:
+            self.send({"op": "removeStatus", "statusIds": ["master"]})
+        else:
+            self.status(2, error, "master")
+
+    def _metadata(self) -> dict[str, str]:
+        g = self.gateway
+        meta = {"ROS_DISTRO": "noetic", "ROS_MASTER_URI": g.node.master_uri}
+        if g.options.hide_own_node:
+            meta["debugNodes"] = g.node.name
+        return meta
 
     def send_time(self, ns: int) -> None:
         self.outbox.put("\0time", _TIME.pack(0x02, ns), 1)
@@ -151,6 +168,10 @@ class FoxgloveSession:
                     continue
                 self._subs[sub_id] = channel_id
             topic = channel["topic"]
+            app = self.gateway.catalog.app.get(channel_id)
+            if app is not None:  # a channel of this process's own app (a simulator's view)
+                app.add((self, sub_id), self._sink(sub_id, topic))
+                continue
             try:
                 # published_as: a channel of a type learned from a publisher's definition is taken raw
                 self.gateway.taps.add(
@@ -171,8 +192,15 @@ class FoxgloveSession:
                 channel_id = self._subs.pop(int(sub_id), None)
             channel = self.gateway.catalog.channel(channel_id) if channel_id is not None else None
             if channel is not None:
-                self.gateway.taps.remove(channel["topic"], (self, int(sub_id)))
+                self._drop(int(sub_id), channel)
                 self.outbox.discard(f"{channel['topic']}#{sub_id}")
+
+    def _drop(self, sub_id: int, channel: dict[str, Any]) -> None:
+        app = self.gateway.catalog.app.get(channel["id"])
+        if app is not None:
+            app.remove((self, sub_id))
+        else:
+            self.gateway.taps.remove(channel["topic"], (self, sub_id))
 
     def _sink(self, sub_id: int, topic: str) -> Callable[[Delivery], None]:
         lane = f"{topic}#{sub_id}"
@@ -273,7 +301,7 @@ class FoxgloveSession:
 
     def op_subscribeConnectionGraph(self, msg: dict[str, Any]) -> None:  # noqa: N802
         self.graph_subscribed = True
-        self.send(self.gateway.catalog.graph_update(full=True))
+        self.send(self.gateway.graph_update())
 
     def op_unsubscribeConnectionGraph(self, msg: dict[str, Any]) -> None:  # noqa: N802
         self.graph_subscribed = False
@@ -329,7 +357,7 @@ class FoxgloveSession:
             for sub_id, channel_id in list(self._subs.items()):
                 channel = self.gateway.catalog.channel(channel_id)
                 if channel is not None:
-                    self.gateway.taps.remove(channel["topic"], (self, sub_id))
+                    self._drop(sub_id, channel)
             self._subs.clear()
             for channel_id, (topic, _pub) in list(self._client_channels.items()):
                 self.gateway.publishers.unadvertise(topic, (self, channel_id))

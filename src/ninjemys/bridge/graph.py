@@ -26,8 +26,8 @@ from typing import Any
 from ninjemys.errors import NinjemysError, ServiceError
 from ninjemys.idl.loader import get_message_class, get_service_class, message_class_from_definition
 from ninjemys.node import Node
+from ninjemys.node.services import probe
 from ninjemys.node.subscriber import RawMessage
-from ninjemys.tools.rosservice import probe
 
 log = logging.getLogger(__name__)
 

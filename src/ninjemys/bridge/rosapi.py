@@ -20,8 +20,8 @@ from ninjemys.idl.loader import get_message_class, get_message_spec, get_service
 from ninjemys.net.addresses import split_uri
 from ninjemys.node import Node
 from ninjemys.node.clock import for_node
+from ninjemys.node.services import probe
 from ninjemys.rostime import Time
-from ninjemys.tools.rosservice import probe
 
 log = logging.getLogger(__name__)
 

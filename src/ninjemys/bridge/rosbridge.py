@@ -42,7 +42,7 @@ DEFAULT_QUEUE_LENGTH = 100
 MAX_PENDING_FRAGMENTED = 8
 
 
-class OpError(Exception):
+class OpError(NinjemysError):
     """A client message the session refuses; the text goes back in a ``status`` op."""
 
 

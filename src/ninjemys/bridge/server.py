@@ -3,11 +3,11 @@
 A client that offers a Foxglove subprotocol (``foxglove.websocket.v1``, ``foxglove.sdk.v1``) gets
 the Foxglove protocol; any other client (roslibjs, roslibpy: no subprotocol) gets rosbridge. So one
 port serves both, and the same server serves the static web app (:class:`Gateway.mount` puts the
-endpoint on any :class:`ninjemys.web.http.HttpServer`).
+endpoint on any :class:`ninjemys.serve.http.HttpServer`).
 
 Per client: a :class:`~ninjemys.bridge.outbox.Outbox` (bounded, per-topic lanes, fair) filled by
 ROS threads, and one sender task on the event loop that moves it into the socket only as fast as
-the client reads (the transport buffer is capped; see :mod:`ninjemys.web.websocket`). A client that
+the client reads (the transport buffer is capped; see :mod:`ninjemys.serve.websocket`). A client that
 stops reading costs at most its budget; the ROS side and the other clients never wait for it.
 """
 
@@ -30,6 +30,8 @@ from urllib.parse import urlsplit
 
 from websockets.server import ServerProtocol
 
+from ninjemys.bridge.appchannels import AppChannel
+from ninjemys.bridge.buswatch import BusWatch
 from ninjemys.bridge.foxglove import SUBPROTOCOLS, FoxgloveSession
 from ninjemys.bridge.graph import Publishers, Services, Taps
 from ninjemys.bridge.outbox import CloseRequest, Outbox
@@ -37,8 +39,8 @@ from ninjemys.bridge.rosbridge import RosbridgeSession
 from ninjemys.errors import NinjemysError
 from ninjemys.idl.loader import get_message_class, get_service_class
 from ninjemys.node import Node
-from ninjemys.web.http import HttpServer, Request, Response
-from ninjemys.web.websocket import WRITE_HIGH_WATER, WebSocket
+from ninjemys.serve.http import HttpServer, Request, Response
+from ninjemys.serve.websocket import WRITE_HIGH_WATER, WebSocket
 
 log = logging.getLogger(__name__)
 
@@ -78,6 +80,17 @@ class GatewayOptions:
     #: a service call not answered within this many seconds gets a failed reply (rosbridge's
     #: ``default_call_service_timeout``; a rosbridge call's own ``timeout`` field overrides it)
     call_service_timeout: float = 5.0
+    #: a folder the standalone server (:meth:`Gateway.run_in_thread`) serves at ``/static`` (e.g. the
+    #: web app's pages and scripts); None serves no files. The gateway does not know the web app:
+    #: the web app sits above it and passes its folder in.
+    static_dir: str | None = None
+    #: the gateway's node exists only to look at the graph (rqt_graph): the graph page counts it as
+    #: debug plumbing ("Hide debug"), so looking at a topic does not change the picture
+    hide_own_node: bool = False
+    #: under /use_sim_time, follow /clock (the ``time`` capability, sim-time receive stamps); a gateway
+    #: inside the simulator itself sets False: its pages need no clock, and subscribing to its own
+    #: /clock would decode every tick in the simulator's process
+    sim_clock: bool = True
 
     def secret(self) -> str | None:
         if not self.authenticate:
@@ -112,10 +125,21 @@ class Catalog:
         self._service_types: dict[str, str] = {}
         self.graph: dict[str, dict[str, list[str]]] = {"pub": {}, "sub": {}, "srv": {}}
         self.topic_types: dict[str, str] = {}
+        #: channels an in-process app publishes (not ROS topics): id -> channel; never refreshed away
+        self.app: dict[int, AppChannel] = {}
         self._lock = threading.Lock()
 
     def channel(self, channel_id: int) -> dict[str, Any] | None:
         return self.channels.get(channel_id)
+
+    def add_app_channel(
+        self, topic: str, schema_name: str, snapshot: Callable[[], Any] | None, lock: Any
+    ) -> AppChannel:
+        app = AppChannel(next(self._ids), topic, schema_name, snapshot, lock)
+        with self._lock:
+            self.app[app.id] = app
+            self.channels[app.id] = app.channel
+        return app
 
     def refresh(
         self, node: Node, services: Services, learn: Callable[[str, str], str | None] = lambda t, n: None
@@ -224,19 +248,45 @@ class Catalog:
             "old_graph": old,
         }
 
+    def node_names(self) -> set[str]:
+        """Every node the master lists as a publisher, subscriber or service provider."""
+        return {n for table in self.graph.values() for nodes in table.values() for n in nodes}
+
+    @staticmethod
+    def bus_update(state: dict[str, Any]) -> dict[str, Any]:
+        """A connectionGraphUpdate carrying only the bus state (ninjemys' ``rosBus`` extension:
+        node liveness and live connections from getBusInfo; Foxglove clients ignore it)."""
+        return {
+            "op": "connectionGraphUpdate",
+            "publishedTopics": [],
+            "subscribedTopics": [],
+            "advertisedServices": [],
+            "removedTopics": [],
+            "removedServices": [],
+            "rosBus": state,
+        }
+
     def graph_update(self, full: bool, old: dict[str, dict[str, list[str]]] | None = None) -> dict[str, Any]:
         g = self.graph
         old = old if old is not None and not full else {"pub": {}, "sub": {}, "srv": {}}
 
+        gone = (set(old["pub"]) | set(old["sub"])) - (set(g["pub"]) | set(g["sub"]))
+
         def changed(kind: str) -> list[str]:
-            return [k for k, v in g[kind].items() if old[kind].get(k) != v]
+            # a topic that lost its last publisher (or subscriber) but still exists is listed with no
+            # ids; one that left altogether is in removedTopics
+            now = [k for k, v in g[kind].items() if old[kind].get(k) != v]
+            emptied = [k for k in old[kind] if k not in g[kind] and k not in gone]
+            return now + emptied
 
         return {
             "op": "connectionGraphUpdate",
-            "publishedTopics": [{"name": t, "publisherIds": g["pub"][t]} for t in changed("pub")],
-            "subscribedTopics": [{"name": t, "subscriberIds": g["sub"][t]} for t in changed("sub")],
-            "advertisedServices": [{"name": s, "providerIds": g["srv"][s]} for s in changed("srv")],
-            "removedTopics": sorted((set(old["pub"]) | set(old["sub"])) - (set(g["pub"]) | set(g["sub"]))),
+            "publishedTopics": [{"name": t, "publisherIds": g["pub"].get(t, [])} for t in changed("pub")],
+            "subscribedTopics": [{"name": t, "subscriberIds": g["sub"].get(t, [])} for t in changed("sub")],
+            "advertisedServices": [
+                {"name": s, "providerIds": g["srv"][s]} for s in g["srv"] if old["srv"].get(s) != g["srv"][s]
+            ],
+            "removedTopics": sorted(gone),
             "removedServices": sorted(set(old["srv"]) - set(g["srv"])),
         }
 
@@ -270,11 +320,14 @@ class Gateway:
         self.node = node if node is not None else Node(self.options.node_name)
         self._own_node = node is None
         self.catalog = Catalog()
-        self.sim_time = bool(self._param("/use_sim_time", False))
+        self.sim_time = self.options.sim_clock and bool(self._param("/use_sim_time", False))
         self.taps = Taps(self.node, self._now_ns)
         self.publishers = Publishers(self.node)
         self.services = Services(self.node)
         self.pool = ThreadPoolExecutor(8, thread_name_prefix="gateway")
+        #: node liveness and live connections (getBusInfo), swept only while a client watches the graph
+        self.bus = BusWatch(self.node.master, self.node.name, self.pool, self._bus_changed)
+        self.master_error: str | None = None
         self.session_id = str(time.time_ns())
         self._clients: dict[int, _Client] = {}
         self._ids = itertools.count(1)
@@ -310,6 +363,17 @@ class Gateway:
             return dict(self.node.master.get_topic_types()).get(topic)
         except NinjemysError:
             return None
+
+    def app_channel(
+        self, topic: str, schema_name: str, snapshot: Callable[[], Any] | None = None, lock: Any = None
+    ) -> AppChannel:
+        """A JSON channel this process publishes on the gateway (not a ROS topic; see
+        :mod:`ninjemys.bridge.appchannels`), advertised to the Foxglove clients at once."""
+        app = self.catalog.add_app_channel(topic, schema_name, snapshot, lock)
+        for client in list(self._clients.values()):
+            if isinstance(client.session, FoxgloveSession):
+                client.session.send({"op": "advertise", "channels": [app.channel]})
+        return app
 
     # -- graph polling ----------------------------------------------------------------------
     def start(self) -> None:
@@ -372,11 +436,17 @@ class Gateway:
                     "gateway: graph refresh failed (retrying every %g s): %s", self.options.update_period, exc
                 )
                 self._refresh_failing = True
+                self.master_error = f"cannot reach the master at {self.node.master_uri}: {exc}"
+                for fox in self._foxes():
+                    fox.master_status(self.master_error)
             return
+        foxes = self._foxes()
         if self._refresh_failing:
             log.info("gateway: graph refresh works again")
             self._refresh_failing = False
-        foxes = [c.session for c in list(self._clients.values()) if isinstance(c.session, FoxgloveSession)]
+            self.master_error = None
+            for fox in foxes:
+                fox.master_status(None)
         for fox in foxes:
             if diff["removed_channels"]:
                 fox.send({"op": "unadvertise", "channelIds": diff["removed_channels"]})
@@ -388,6 +458,25 @@ class Gateway:
                 fox.send({"op": "advertiseServices", "services": diff["services"]})
             if diff["graph_changed"] and fox.graph_subscribed:
                 fox.send(self.catalog.graph_update(full=False, old=diff["old_graph"]))
+        if any(fox.graph_subscribed for fox in foxes):
+            self.bus.poke(self.catalog.node_names())
+
+    def _foxes(self) -> list[FoxgloveSession]:
+        return [c.session for c in list(self._clients.values()) if isinstance(c.session, FoxgloveSession)]
+
+    def _bus_changed(self, state: dict[str, Any]) -> None:
+        update = self.catalog.bus_update(state)
+        for fox in self._foxes():
+            if fox.graph_subscribed:
+                fox.send(update)
+
+    def graph_update(self) -> dict[str, Any]:
+        """The full connection graph for a client that just subscribed, with the bus state so far
+        (a sweep starts at once; its result follows as an update)."""
+        self.bus.poke(self.catalog.node_names(), force=True)
+        update = self.catalog.graph_update(full=True)
+        update["rosBus"] = self.bus.state()
+        return update
 
     def watch_param(self, name: str) -> None:
         """Forward master paramUpdate for ``name`` to the Foxglove clients that subscribed it."""
@@ -568,11 +657,10 @@ class Gateway:
     # -- standalone server --------------------------------------------------------------------
     def run_in_thread(self) -> str:
         """Start the gateway and its own HTTP server on a loop thread; returns the ws:// URL."""
-        from ninjemys.web.app import STATIC_DIR
-
         self.start()
         self._http = HttpServer(self.options.address, self.options.port, self.options.ssl_context())
-        self._http.static("/static", STATIC_DIR)
+        if self.options.static_dir is not None:
+            self._http.static("/static", Path(self.options.static_dir))
         self.mount(self._http)
         started = threading.Event()
         errors: list[BaseException] = []

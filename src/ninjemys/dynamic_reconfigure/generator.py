@@ -20,7 +20,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from ninjemys.errors import DefinitionError
+from ninjemys.errors import DefinitionError, NinjemysError
 
 str_t = "str"
 bool_t = "bool"
@@ -37,7 +37,7 @@ _NAME = re.compile(r"^[a-zA-Z][a-zA-Z0-9_]*$")
 _HERE = os.path.normcase(os.path.abspath(__file__))
 
 
-class CfgError(Exception):
+class CfgError(NinjemysError):
     """A mistake in a .cfg file; ``run_cfg`` turns it into ``file:line: reason``."""
 
 

@@ -20,6 +20,7 @@ from ninjemys.errors import LaunchError, MasterError, NinjemysError
 from ninjemys.launch.plan import LaunchPlan
 from ninjemys.launch.runner import DEATH_WRAPPER
 from ninjemys.master.client import MasterClient
+from ninjemys.net.addresses import is_local_address
 
 CALLER_ID = "/roslaunch"
 
@@ -29,26 +30,6 @@ def master_uri_for(port: int | None, env: dict[str, str]) -> str:
     if port:
         return f"http://localhost:{port}/"
     return env.get("ROS_MASTER_URI") or "http://localhost:11311/"
-
-
-def is_local_address(host: str) -> bool:
-    """True when ``host`` names this machine (loopback, its host name, or one of its addresses)."""
-    import socket
-
-    if host in ("localhost", "127.0.0.1", "::1", "0.0.0.0", ""):
-        return True
-    try:
-        if host in (socket.gethostname(), socket.getfqdn()):
-            return True
-        address = socket.gethostbyname(host)
-    except OSError:
-        return False
-    if address.startswith("127."):
-        return True
-    try:
-        return address in {info[4][0] for info in socket.getaddrinfo(socket.gethostname(), None)}
-    except OSError:
-        return False
 
 
 def is_local_uri(uri: str) -> bool:

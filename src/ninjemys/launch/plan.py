@@ -29,7 +29,7 @@ class Machine:
         """This machine: the implicit local machine, or an address that resolves to this host."""
         if self.name == "":
             return True
-        from ninjemys.launch.master_link import is_local_address
+        from ninjemys.net.addresses import is_local_address
 
         return is_local_address(self.address)
 

@@ -26,8 +26,8 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from ninjemys.maps.mapfile import GridMap
 from ninjemys.nav.costmap import distance_transform
-from ninjemys.sim.mapfile import GridMap
 
 BIN_XY = 0.5
 BIN_TH = math.radians(10.0)

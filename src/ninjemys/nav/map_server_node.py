@@ -16,8 +16,8 @@ import threading
 from pathlib import Path
 
 import rospy
+from ninjemys.maps.mapfile import MapFileError, load_map, save_map
 from ninjemys.nav.rosglue import grid_from_msg, grid_to_msg, param, run_node, start_node
-from ninjemys.sim.mapfile import MapFileError, load_map, save_map
 
 USAGE = "USAGE: map_server <map.yaml>\n  map.yaml: map description file"
 SAVER_USAGE = "Usage: \n  map_saver -h\n  map_saver [--occ <threshold_occupied>] [--free <threshold_free>] [-f <mapname>] [ROS remapping args]"

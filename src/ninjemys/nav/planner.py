@@ -20,6 +20,8 @@ import math
 
 import numpy as np
 
+from ninjemys.errors import NinjemysError
+
 SQRT2 = math.sqrt(2.0)
 
 #: "not reached yet"; every real cost, and every sum formed below, stays under 2**63
@@ -39,7 +41,7 @@ _WALK_STEPS = 1500
 _TABLE_CELLS = 32
 
 
-class PlanError(ValueError):
+class PlanError(NinjemysError, ValueError):
     """No plan: the text says why (start or goal blocked or off the map, goal unreachable)."""
 
 

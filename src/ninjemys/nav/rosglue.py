@@ -18,8 +18,8 @@ import numpy as np
 
 import rospy
 from ninjemys.errors import NinjemysError, ShutdownError
+from ninjemys.maps.mapfile import GridMap
 from ninjemys.node.timers import TimeMovedBackwardsError
-from ninjemys.sim.mapfile import GridMap
 from ninjemys.tf2.core import BufferCore
 from ninjemys.tf2.errors import TransformException
 from ninjemys.tf2.math import Pose2D, quaternion_from_yaw, yaw_from_quaternion

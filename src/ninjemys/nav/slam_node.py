@@ -22,9 +22,9 @@ from typing import Any
 import numpy as np
 
 import rospy
+from ninjemys.maps.mapfile import GridMap
 from ninjemys.nav.rosglue import Tf2D, grid_to_msg, param, run_node, scan_arrays, sleep, tf_item
 from ninjemys.nav.slam import ParticleMapper, SlamParams
-from ninjemys.sim.mapfile import GridMap
 
 
 class SlamNode:

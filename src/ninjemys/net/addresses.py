@@ -52,3 +52,57 @@ def lookup_host(host: str) -> str | bytes:
     spent on host names that are plain ASCII (``localhost``) in practice.
     """
     return host.encode("ascii") if host.isascii() else host
+
+
+def is_local_address(host: str) -> bool:
+    """True when ``host`` names this machine (loopback, its host name, or one of its addresses)."""
+    if host in ("localhost", "127.0.0.1", "::1", "0.0.0.0", ""):
+        return True
+    try:
+        if host in (socket.gethostname(), socket.getfqdn()):
+            return True
+        address = socket.gethostbyname(host)
+    except OSError:
+        return False
+    if address.startswith("127."):
+        return True
+    try:
+        return address in {info[4][0] for info in socket.getaddrinfo(socket.gethostname(), None)}
+    except OSError:
+        return False
+
+
+def _ephemeral_range() -> tuple[int, int]:
+    try:
+        with open("/proc/sys/net/ipv4/ip_local_port_range", encoding="ascii") as f:
+            low, high = f.read().split()
+        return int(low), int(high)
+    except (OSError, ValueError):
+        return 32768, 60999
+
+
+def free_port(host: str = "127.0.0.1") -> int:
+    """A TCP port that was free a moment ago, chosen *below* the kernel's ephemeral range.
+
+    For any master started a moment later: the tests (:mod:`ninjemys.testing` re-exports it) and the demo.
+
+    Tests hand these ports to masters that start a moment later. A port from the ephemeral range
+    (what binding to port 0 returns) can meanwhile be given by the kernel to any node that binds
+    port 0 for its XML-RPC or TCPROS server; a test would then mistake that node for its master.
+    """
+    import random
+
+    low, _ = _ephemeral_range()
+    first, last = (20000, low - 1) if low > 21000 else (1024, low - 1)
+    rng = random.Random()
+    for _ in range(200):
+        candidate = rng.randint(first, last)
+        with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+            try:
+                s.bind((host, candidate))
+            except OSError:
+                continue
+            return candidate
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind((host, 0))
+        return s.getsockname()[1]

@@ -52,6 +52,40 @@ _unpack_len = _U32.unpack_from
 _unpack_response_head = SERVICE_RESPONSE_HEAD.unpack_from
 
 
+def probe(service: str, uri: str, timeout: float = 5.0, caller_id: str = "/rosservice") -> dict[str, str]:
+    """The provider's connection header for ``service`` (its ``type``, ``md5sum``, ...), learned the
+    way ROS 1 learns a service's type: a TCPROS probe (``probe=1``, md5 ``*``) that the provider
+    answers with its header before closing. One home for the tools, the gateway and rosapi.
+
+    Raises :class:`ServiceError` naming the service and its URI when it cannot be reached.
+    """
+    try:
+        host, port = split_uri(uri)
+    except ValueError:
+        raise ServiceError(f"service [{service}] has an invalid RPC URI [{uri}]") from None
+    try:
+        with socket.create_connection((host, port), timeout=timeout) as sock:
+            fields = {"probe": "1", "md5sum": "*", "callerid": caller_id, "service": service}
+            sock.sendall(headers.encode_header(fields))
+            prefix = _recv_exact(sock, 4)
+            return headers.decode_header(_recv_exact(sock, headers.header_length(prefix)))
+    except (OSError, NinjemysError) as exc:
+        raise ServiceError(
+            f"Unable to communicate with service [{service}], address [{uri}]: {exc}"
+        ) from None
+
+
+def _recv_exact(sock: socket.socket, n: int) -> bytes:
+    chunks, have = [], 0
+    while have < n:
+        chunk = sock.recv(n - have)
+        if not chunk:
+            raise ConnectionError("service closed the connection during the handshake")
+        chunks.append(chunk)
+        have += len(chunk)
+    return b"".join(chunks)
+
+
 class _Link:
     """The receive side of one service connection: records (a fixed head whose last field is the
     body length, then the body) read through one preallocated buffer.

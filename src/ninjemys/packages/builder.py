@@ -162,7 +162,8 @@ def build_workspace(
     env = os.environ if env is None else env
     report = BuildReport()
     ws.load()
-    ws.check_dependencies(env)
+    for note in ws.check_dependencies(env):
+        log(note)
     ordered = ws.ordered()
     writer = _Writer(report)
     cache_path = ws.build / "ninjemys_cache.json"
@@ -217,13 +218,14 @@ def build_workspace(
             writer.write(dist / pkg.name / "msg" / "__init__.py", STUB)
         if "srv" in defs:
             writer.write(dist / pkg.name / "srv" / "__init__.py", STUB)
-        for program in hints.install_programs:
+        for program, destination in hints.install_programs:
             script = (pkg.path / program).resolve()
             if not script.is_file():
                 raise PackageError(
                     f"{pkg.path / 'CMakeLists.txt'}: catkin_install_python(PROGRAMS {program}) names a missing file"
                 )
-            writer.write(ws.devel / "lib" / pkg.name / script.name, _relay_script(script), executable=True)
+            target = ws.devel / destination.format(pkg=pkg.name) / script.name
+            writer.write(target, _relay_script(script), executable=True)
 
     wsenv = WorkspaceEnv(source=ws.source, devel=ws.devel)
     underlays = underlay_workspaces(ws.devel, env)

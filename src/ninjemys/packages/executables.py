@@ -63,12 +63,15 @@ def is_python_script(path: Path) -> bool:
 
 
 def devel_lib_dirs(package: str, env: Mapping[str, str] | None = None) -> list[Path]:
-    """``<devel>/lib/<package>`` for every prefix on CMAKE_PREFIX_PATH that has one."""
+    """``<devel>/lib/<package>`` and ``<devel>/share/<package>`` for every prefix on
+    CMAKE_PREFIX_PATH that has them (rosrun's ``catkin_find --libexec --share``: a script installed
+    with ``DESTINATION ${CATKIN_PACKAGE_SHARE_DESTINATION}/dir`` runs too)."""
     env = os.environ if env is None else env
     dirs = []
     for prefix in env.get("CMAKE_PREFIX_PATH", "").split(os.pathsep):
-        if prefix and (Path(prefix) / "lib" / package).is_dir():
-            dirs.append(Path(prefix) / "lib" / package)
+        for space in ("lib", "share"):
+            if prefix and (Path(prefix) / space / package).is_dir():
+                dirs.append(Path(prefix) / space / package)
     return dirs
 
 
@@ -96,8 +99,10 @@ def candidates(manifest: PackageManifest, name: str, env: Mapping[str, str] | No
     """Every file called ``name`` that rosrun would consider, best first."""
     found: list[Path] = []
     for lib in devel_lib_dirs(manifest.name, env):
-        if (lib / name).is_file():
-            found.append(lib / name)
+        for dirpath, dirnames, filenames in os.walk(lib, followlinks=True):
+            dirnames.sort()
+            if name in filenames:
+                found.append(Path(dirpath) / name)
     for path in _walk_named(manifest.path, name):
         if path not in found:
             found.append(path)

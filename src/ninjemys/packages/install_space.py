@@ -237,13 +237,13 @@ def _install_package(pkg: PackageManifest, out: _Installer) -> None:
     share = out.prefix / "share" / pkg.name
     out.copy(pkg.path / MANIFEST, share / MANIFEST)
     hints = read_cmake_hints(pkg.path)
-    for program in hints.install_programs:
+    for program, destination in hints.install_programs:
         script = pkg.path / program
         if not script.is_file():
             raise PackageError(
                 f"{pkg.path / 'CMakeLists.txt'}: catkin_install_python(PROGRAMS {program}) names a missing file"
             )
-        out.copy(script, out.prefix / "lib" / pkg.name / script.name, executable=True)
+        out.copy(script, out.prefix / destination.format(pkg=pkg.name) / script.name, executable=True)
     if hints.python_setup and (pkg.path / "setup.py").is_file():
         dist = out.prefix / "lib" / "python3" / "dist-packages"
         for module, source in python_packages(pkg.path).items():

@@ -1,7 +1,7 @@
 """Executables that ship inside ninjemys as Python modules, by ROS package name.
 
 ``rosrun turtlesim turtlesim_node`` and ``<node pkg="turtlesim" type="turtlesim_node"/>`` have no
-file to execute: the node is ``ninjemys.sim.turtlesim_node:main``. This table maps
+file to execute: the node is ``ninjemys.web.turtlesim_view:main``. This table maps
 package -> executable -> :class:`ShippedExecutable`; :mod:`ninjemys.packages.run_shipped` is the
 process entry point that imports the module and calls the function with the user's arguments.
 """
@@ -37,7 +37,7 @@ class ShippedExecutable:
 def _table() -> dict[str, dict[str, ShippedExecutable]]:
     entries: dict[str, dict[str, tuple[str, tuple[str, ...]]]] = {
         "turtlesim": {
-            "turtlesim_node": ("ninjemys.sim.turtlesim_node:main", ()),
+            "turtlesim_node": ("ninjemys.web.turtlesim_view:main", ()),
             "turtle_teleop_key": ("ninjemys.sim.teleop_key:main", ()),
             "draw_square": ("ninjemys.sim.draw_square:main", ()),
             "mimic": ("ninjemys.sim.mimic:main", ()),
@@ -57,7 +57,7 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
         "rqt_service_caller": {"rqt_service_caller": ("ninjemys.web.rqt:service_caller_main", ())},
         "actionlib": {"axclient.py": ("ninjemys.web.rqt:axclient_main", ())},
         "puzzlebot_sim": {
-            "sim_node": ("ninjemys.sim.puzzlebot_node:main", ()),
+            "sim_node": ("ninjemys.web.puzzlebot_view:main", ()),
             "world_to_map": ("ninjemys.sim.world_to_map:main", ()),
         },
         "teleop_twist_keyboard": {

@@ -1,20 +1,26 @@
 """A catkin workspace: its spaces, its packages in dependency order, and what it depends on.
 
 Validation happens here, before anything is written: malformed package.xml (file:line), two
-packages with one name, a dependency that is neither in the workspace, nor visible on
-ROS_PACKAGE_PATH / in ninjemys, nor a tool ninjemys provides itself (catkin, rospy, ...), and
-dependency cycles. Each is a PackageError that names the package and the file.
+packages with one name, dependency cycles, and a package that CMakeLists.txt requires with
+``find_package(... REQUIRED ...)`` and that is found nowhere: not in the workspace, not on
+ROS_PACKAGE_PATH or in an underlay, not shipped with ninjemys, not a role ninjemys plays itself
+(catkin, rospy, ...), and not a CMake package installed on the system. That is exactly where real
+catkin fails; a dependency named only in package.xml (a ``<test_depend>`` on a C++ tutorial, an
+``<exec_depend>`` installed later) never fails a catkin build, so it does not fail ours. Each error is
+a PackageError in CMake's words plus one line of ours saying where the name could come from.
 """
 
 from __future__ import annotations
 
 import os
 import re
+import textwrap
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from ninjemys.errors import PackageError
+from ninjemys.packages.cmake_hints import Requirement, read_cmake_hints
 from ninjemys.packages.discovery import PackageIndex, crawl, package_path_dirs, underlay_dirs
 from ninjemys.packages.manifest import MANIFEST, PackageManifest, parse_manifest
 from ninjemys.packages.setup_scripts import underlay_workspaces
@@ -62,11 +68,6 @@ PROVIDED = frozenset(
 )
 
 
-def is_system_dependency(name: str) -> bool:
-    """rosdep keys (python3-numpy, libopencv-dev, boost, eigen) are system packages, not ROS ones."""
-    return bool(re.search(r"[-.]", name)) or name.startswith(("python", "lib")) or name in {"boost", "eigen"}
-
-
 @dataclass
 class Workspace:
     """``root`` holds ``src`` (sources), ``build`` and ``devel`` (outputs)."""
@@ -103,20 +104,32 @@ class Workspace:
             packages.append(manifest)
         self.packages = packages
 
-    def check_dependencies(self, env: Mapping[str, str] | None = None) -> None:
-        """Every build/run dependency must be resolvable; the first missing one is reported."""
+    def check_dependencies(self, env: Mapping[str, str] | None = None) -> list[str]:
+        """Every package a ``find_package(... REQUIRED ...)`` names must be found; the first missing
+        one raises CMake's error. Returns notes for system libraries (Boost, OpenCV ...) that a
+        C++ part would need and that are not installed: a Python build does not need them."""
         env = os.environ if env is None else env
         local = {p.name for p in self.packages}
         underlay_sources = [u.source for u in underlay_workspaces(self.devel, env) if u.source.is_dir()]
         index = PackageIndex.scan(package_path_dirs(env) + underlay_sources + underlay_dirs())
+        notes: list[str] = []
         for pkg in self.packages:
-            for dep in pkg.all_depends:
-                if dep in local or dep in PROVIDED or dep in index.packages or is_system_dependency(dep):
+            for req in read_cmake_hints(pkg.path).required:
+                name = req.name
+                if (
+                    name in local
+                    or name in PROVIDED
+                    or name in index.packages
+                    or cmake_config_found(name, env)
+                ):
                     continue
-                raise PackageError(
-                    f"{pkg.path / MANIFEST}: package '{pkg.name}' depends on '{dep}', which is neither in "
-                    f"the workspace ({self.source}) nor on ROS_PACKAGE_PATH nor shipped with ninjemys"
+                if req.catkin or _ROS_NAME.fullmatch(name):
+                    raise PackageError(_missing_package_text(self.source, pkg, req))
+                notes.append(
+                    f"-- ninjemys: {pkg.path.name}/CMakeLists.txt:{req.line}: find_package({name} REQUIRED) "
+                    "names a system library that is not installed; only C++ targets would need it"
                 )
+        return notes
 
     def ordered(self) -> list[PackageManifest]:
         """Packages in dependency order (dependencies first; ties by name); cycles are an error."""
@@ -140,3 +153,74 @@ class Workspace:
         for name in sorted(by_name):
             visit(name, [])
         return order
+
+
+_ROS_NAME = re.compile(r"[a-z][a-z0-9_]*")
+
+
+def _system_prefixes(env: Mapping[str, str]) -> list[Path]:
+    prefixes = [Path(p) for p in env.get("CMAKE_PREFIX_PATH", "").split(os.pathsep) if p]
+    prefixes += [Path("/usr/local"), Path("/usr")]
+    opt_ros = Path("/opt/ros")
+    if opt_ros.is_dir():
+        prefixes += sorted(opt_ros.iterdir())
+    return prefixes
+
+
+def cmake_config_found(name: str, env: Mapping[str, str] | None = None) -> bool:
+    """Whether CMake's find_package would find ``name`` on this system: a ``<name>Config.cmake`` /
+    ``<name>-config.cmake`` in the usual places under each prefix, or a ``Find<name>.cmake`` module
+    shipped with CMake (Boost, PythonInterp ...)."""
+    env = os.environ if env is None else env
+    files = {f"{name}Config.cmake".lower(), f"{name}-config.cmake".lower()}
+    lowered = name.lower()
+    for prefix in _system_prefixes(env):
+        roots = [prefix / "share", prefix / "lib" / "cmake", prefix / "lib"]
+        roots += [d / "cmake" for d in (prefix / "lib").glob("*-linux-gnu*")]
+        for root in roots:
+            for directory in (root / name / "cmake", root / name):
+                if _holds_config(directory, files):
+                    return True
+            if root.name == "cmake" and root.is_dir():
+                for directory in root.iterdir():
+                    if directory.name.lower().startswith(lowered) and _holds_config(directory, files):
+                        return True
+    return any(Path("/usr/share").glob(f"cmake*/Modules/Find{name}.cmake"))
+
+
+def _holds_config(directory: Path, files: set[str]) -> bool:
+    try:
+        return any(entry.name.lower() in files for entry in directory.iterdir())
+    except OSError:
+        return False
+
+
+def _missing_package_text(source: Path, pkg: PackageManifest, req: Requirement) -> str:
+    """CMake's error for a package find_package cannot find, as catkin_make prints it, and a hint."""
+    name = req.name
+    where = f"{pkg.path.relative_to(source) if pkg.path.is_relative_to(source) else pkg.path}/CMakeLists.txt"
+    body = (
+        f'Could not find a package configuration file provided by "{name}" with any of the following '
+        f"names:\n\n    {name}Config.cmake\n    {name}-config.cmake\n\n"
+        f'Add the installation prefix of "{name}" to CMAKE_PREFIX_PATH or set "{name}_DIR" to a directory '
+        f'containing one of the above files.  If "{name}" provides a separate development package or SDK, '
+        "be sure it has been installed."
+    )
+    lines = []
+    for paragraph in body.split("\n\n"):
+        if paragraph.startswith("    "):
+            lines.append(paragraph)
+        else:
+            lines.append("\n".join(textwrap.wrap(paragraph, 74, initial_indent="  ", subsequent_indent="  ")))
+    if req.catkin:
+        head = "CMake Error at /usr/share/catkin/cmake/catkinConfig.cmake:82 (find_package):"
+        tail = f"\nCall Stack (most recent call first):\n  {where}:{req.line} (find_package)"
+    else:
+        head = f"CMake Error at {where}:{req.line} (find_package):"
+        tail = ""
+    hint = (
+        f"ninjemys: '{name}' (required by {pkg.name}) is not in this workspace, on ROS_PACKAGE_PATH, "
+        "in a sourced underlay or shipped with ninjemys: put its source into src/ or source the "
+        "setup.bash of a workspace that has it"
+    )
+    return head + "\n" + "\n\n".join(lines) + tail + "\n\n" + hint

@@ -11,7 +11,7 @@ import sys
 import threading
 from enum import Enum
 
-from ninjemys.tools.cli import entry
+from ninjemys.commands import entry
 
 SIDE = 2.0
 FORWARD_SPEED = 1.0

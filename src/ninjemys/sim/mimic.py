@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import sys
 
-from ninjemys.tools.cli import entry
+from ninjemys.commands import entry
 
 
 def twist_from_pose(pose, twist_class):  # type: ignore[no-untyped-def]

@@ -34,24 +34,25 @@ import sys
 import threading
 import time
 import xml.etree.ElementTree as ET
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+from ninjemys.commands import entry
 from ninjemys.errors import NinjemysError, ShutdownError
 from ninjemys.idl.loader import get_message_class, get_service_class
+from ninjemys.maps.mapfile import MapFileError
 from ninjemys.node import Node
 from ninjemys.node.cli_args import parse_args
 from ninjemys.node.log import NodeLog
 from ninjemys.rostime import Time
-from ninjemys.sim.mapfile import MapFileError
 from ninjemys.sim.robot_model import RobotModel, load_robot_model
 from ninjemys.sim.simcore import Robot, Simulation, SpawnError
 from ninjemys.sim.world2d import World, load_world, world_from_map
 from ninjemys.sim.worlds import world_path
 from ninjemys.tf2.math import quaternion_from_rpy, quaternion_from_yaw, yaw_from_quaternion
-from ninjemys.tools.cli import entry
 
 Twist = get_message_class("geometry_msgs/Twist")
 TransformStamped = get_message_class("geometry_msgs/TransformStamped")
@@ -495,7 +496,7 @@ class SimNode:
                 want = any(
                     pubs[k].get_num_connections() for k in ("image", "depth", "color_info", "depth_info")
                 )
-                if want or (self.view is not None and self.view.wants_camera(r.name)):
+                if want:  # a browser view watches the cameras as ROS topics too (through its gateway)
                     self._camera(io, stamp)
         if tfs:
             self.tf_pub.publish(TFMessage(transforms=tfs))
@@ -632,8 +633,6 @@ class SimNode:
         r = io.robot
         spec = r.model.camera
         rgb, depth = self.sim.render(r)
-        if self.view is not None:
-            self.view.camera_frame(r.name, rgb, depth)
         pubs = io.pubs
         frame = io.frame("camera_color_optical_frame")
         depth_frame = io.frame("camera_depth_optical_frame")
@@ -767,7 +766,14 @@ def load_sim_world(log: NodeLog, world_arg: str, map_arg: str) -> World:
     return load_world(world_path(world_arg))
 
 
-def main(argv: list[str] | None = None) -> int:
+#: starts a browser view of a running sim: ``(sim, options, log) -> stop`` (None: it failed, logged)
+ViewStarter = Callable[["SimNode", argparse.Namespace, NodeLog], "Callable[[], None] | None"]
+
+
+def main(argv: list[str] | None = None, view: ViewStarter | None = None) -> int:
+    """Run the simulator. Its browser view is not the simulator's business: the ``sim_node``
+    command (:mod:`ninjemys.web.puzzlebot_view`) passes ``view``; without it, with ``~gui:=false``
+    or ``--headless``, the simulator runs the same with no web server."""
     argv = sys.argv[1:] if argv is None else argv
     ros_args = [a for a in argv if ":=" in a]
     options = _parser().parse_args([a for a in argv if ":=" not in a])
@@ -856,32 +862,19 @@ def main(argv: list[str] | None = None) -> int:
             f"{rate:g}" if rate > 0 else "unlimited",
             update_rate,
         )
-        web = None
+        stop_view = None
         gui = _param(node, log, "gui", True, bool) and not options.headless
-        if gui:
-            from ninjemys.sim.puzzlebot_view import PuzzlebotView
-            from ninjemys.web.app import WebApp
-            from ninjemys.web.browser import open_if_display
-
-            web = WebApp(node.master_uri, node.name, options.host, options.port)
-            view = PuzzlebotView(web, app)
-            try:
-                url = web.start()
-            except OSError as exc:
-                log.error("cannot serve the simulator view on %s:%d: %s", options.host, options.port, exc)
+        if gui and view is not None:
+            stop_view = view(app, options, log)
+            if stop_view is None:
                 return 1
-            view.attach()
-            app.view = view
-            print(f"puzzlebot_sim view: {url}puzzlebot   node graph: {url}", flush=True)
-            if not options.no_browser:
-                open_if_display(url + "puzzlebot")
         app.start()
         try:
             node.spin()
         finally:
             app.stop()
-            if web is not None:
-                web.stop()
+            if stop_view is not None:
+                stop_view()
         return 0
     finally:
         node.shutdown("exit")

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import yaml
 
-from ninjemys.sim.mapfile import Fields, MapFileError, yaml_lines
+from ninjemys.maps.mapfile import Fields, MapFileError, yaml_lines
 from ninjemys.sim.worlds import ROBOTS_DIR
 
 

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ninjemys.errors import NinjemysError
 from ninjemys.sim.raycast import grid_edges
 from ninjemys.sim.robot_model import RobotModel
 from ninjemys.sim.sensors import Camera, FloorPaint, Scene, imu_reading, lidar_ranges
@@ -29,7 +30,7 @@ PERSONAL_SPACE = 0.2  # m: the gap a person who gives way keeps from a robot's b
 LOOK_AHEAD = 2.0  # m: how far ahead on its route such a person starts to step aside
 
 
-class SpawnError(ValueError):
+class SpawnError(NinjemysError, ValueError):
     """A spawn or delete the simulation refuses; the text says why (shown to the service caller)."""
 
 

@@ -17,7 +17,7 @@ import math
 import sys
 from dataclasses import dataclass
 
-from ninjemys.tools.cli import entry
+from ninjemys.commands import entry
 
 WHEEL_RADIUS = 0.05
 WHEEL_SEPARATION = 0.18

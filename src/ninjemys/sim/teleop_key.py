@@ -14,7 +14,7 @@ import os
 import sys
 from collections.abc import Iterator
 
-from ninjemys.tools.cli import entry
+from ninjemys.commands import entry
 
 BANNER = "Reading from keyboard\n---------------------------\nUse arrow keys to move the turtle. 'q' to quit."
 

@@ -16,8 +16,8 @@ import select
 import sys
 import time
 
+from ninjemys.commands import entry
 from ninjemys.sim.teleop_key import raw_terminal
-from ninjemys.tools.cli import entry
 
 BANNER = """
 Reading from the keyboard  and Publishing to Twist!

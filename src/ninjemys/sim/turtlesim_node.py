@@ -3,8 +3,8 @@
 Topics per turtle ``<name>/cmd_vel`` (in), ``<name>/pose`` and ``<name>/color_sensor`` (out); services
 ``clear``, ``reset``, ``spawn``, ``kill`` and per turtle ``set_pen``, ``teleport_absolute``,
 ``teleport_relative``; parameters ``~background_r/g/b``. Instead of a Qt window the view is a page of
-the web tools app whose URL the node prints; ``--headless`` skips the web server and changes nothing
-else.
+the web tools app (:mod:`ninjemys.web.turtlesim_view`, which the ``turtlesim_node`` command wires in)
+whose URL the node prints; ``--headless`` skips the web server and changes nothing else.
 
 The world is stepped every 16 ms on one thread; service handlers and velocity callbacks run on the
 runtime's threads and take the same lock, so every change is atomic with respect to a step.
@@ -16,13 +16,14 @@ import argparse
 import sys
 import threading
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 import rospy
 from geometry_msgs.msg import Twist
+from ninjemys.commands import entry
 from ninjemys.sim.world import CENTER, DEFAULT_BACKGROUND, UPDATE_PERIOD, TurtleError, World
-from ninjemys.tools.cli import entry
 from std_srvs.srv import Empty, EmptyResponse
 from turtlesim.msg import Color, Pose
 from turtlesim.srv import (
@@ -237,44 +238,32 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
-def main(argv: list[str] | None = None) -> int:
+#: starts a browser view of a running sim: ``(sim, options, ros_args) -> stop`` (None: it failed, logged)
+ViewStarter = Callable[[TurtlesimNode, argparse.Namespace, list[str]], "Callable[[], None] | None"]
+
+
+def main(argv: list[str] | None = None, view: ViewStarter | None = None) -> int:
+    """Run the node. The browser view is not the simulator's business: the command that wants one
+    (``turtlesim_node``, :mod:`ninjemys.web.turtlesim_view`) passes ``view``; without it, or with
+    ``--headless``, the node runs the same with no web server."""
     argv = sys.argv[1:] if argv is None else argv
     ros_args = [a for a in argv if ":=" in a]
     options = _parser().parse_args([a for a in argv if ":=" not in a])
     rospy.init_node("turtlesim", argv=[sys.argv[0], *ros_args])
     sim = TurtlesimNode()
-    app = None
-    if not options.headless:
-        from ninjemys.node import Node
-        from ninjemys.node.cli_args import parse_args
-        from ninjemys.sim.view import TurtlesimView
-        from ninjemys.web.app import WebApp
-        from ninjemys.web.browser import open_if_display
-        from ninjemys.web.monitor import TopicMonitor
-
-        master_uri = parse_args([sys.argv[0], *ros_args]).master_uri
-        # the topic monitor's node is only created when someone opens a topic's details in the page
-        monitor = TopicMonitor(lambda: Node("turtlesim_webtools", anonymous=True, master_uri=master_uri))
-        app = WebApp(master_uri, rospy.get_name(), options.host, options.port, monitor=monitor)
-        view = TurtlesimView(app, sim.world, sim.lock, rospy.get_name())
-        try:
-            url = app.start()
-        except OSError as exc:
-            rospy.logerr("cannot serve the turtlesim view on %s:%d: %s", options.host, options.port, exc)
+    stop_view = None
+    if view is not None and not options.headless:
+        stop_view = view(sim, options, ros_args)
+        if stop_view is None:
             rospy.signal_shutdown("web view failed")
             return 1
-        view.attach()
-        sim.view = view
-        print(f"turtlesim view: {url}turtlesim   node graph: {url}", flush=True)
-        if not options.no_browser:
-            open_if_display(url + "turtlesim")  # where ROS would open its window
     sim.start()
     try:
         rospy.spin()
     finally:
         sim.stop()
-        if app is not None:
-            app.stop()
+        if stop_view is not None:
+            stop_view()
     return 0
 
 

@@ -22,6 +22,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ninjemys.errors import NinjemysError
+
 #: Canvas size in pixels and the scale ROS derives from its turtle images (45 px tall).
 CANVAS_PIXELS = 500
 PIXELS_PER_METER = 45.0
@@ -40,7 +42,7 @@ DEFAULT_PEN = (179, 184, 255)
 DEFAULT_PEN_WIDTH = 3
 
 
-class TurtleError(ValueError):
+class TurtleError(NinjemysError, ValueError):
     """A request the world refuses (taken name, unknown turtle, non-finite number).
 
     The text is ROS turtlesim's error log line, so the node can log and return it unchanged.

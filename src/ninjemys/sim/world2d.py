@@ -11,7 +11,7 @@ No ROS in here. Everything solid is reduced to what the ray caster and the colli
 
 Worlds come from our YAML format (:func:`load_world`, described in docs/sim.md) or from a
 map_server map (:func:`world_from_map`); :func:`rasterize` turns any world into an
-:class:`~ninjemys.sim.mapfile.GridMap` (what the navigation stack uses as its map).
+:class:`~ninjemys.maps.mapfile.GridMap` (what the navigation stack uses as its map).
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ninjemys.sim.mapfile import Fields, GridMap, MapFileError, load_map, yaml_lines
+from ninjemys.maps.mapfile import Fields, GridMap, MapFileError, load_map, yaml_lines
 
 CYLINDER_SIDES = 24
 DEFAULT_WALL_HEIGHT = 1.0

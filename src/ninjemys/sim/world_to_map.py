@@ -11,10 +11,10 @@ import argparse
 import sys
 from pathlib import Path
 
-from ninjemys.sim.mapfile import MapFileError, save_map
+from ninjemys.commands import entry
+from ninjemys.maps.mapfile import MapFileError, save_map
 from ninjemys.sim.world2d import rasterize
 from ninjemys.sim.worlds import resolve_world
-from ninjemys.tools.cli import entry
 
 
 def main(argv: list[str] | None = None) -> int:

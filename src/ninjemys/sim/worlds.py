@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ninjemys.sim.mapfile import MapFileError
+from ninjemys.maps.mapfile import MapFileError
 from ninjemys.sim.world2d import World, load_world
 
 #: share/puzzlebot_sim inside the installed package (package.xml, launch/, worlds/, maps/, robots/)

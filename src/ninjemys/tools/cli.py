@@ -1,51 +1,24 @@
 """What every command-line tool shares: one-line errors on stderr, exit codes, no tracebacks.
 
+``entry`` and ``error`` live in :mod:`ninjemys.commands` (the base layer) so the apps (sim, web, the
+gateway) wrap their commands the same way without importing the tools; they are re-exported here.
+
 Each tool module defines ``main(argv: list[str] | None = None) -> int`` and exposes
 ``console_main = entry(main)`` for the console-script entry point in pyproject.
 """
 
 from __future__ import annotations
 
-import os
-import sys
 from collections.abc import Callable
 
-from ninjemys.errors import MasterUnreachable, NinjemysError
+from ninjemys.commands import entry as entry  # re-exported: every tool takes it from here
+from ninjemys.commands import error as error
 
 TYPE_CHECKING = False  # importing typing costs ~7 ms of every tool's start-up
 if TYPE_CHECKING:
     from typing import Any
 
     from ninjemys.master.client import MasterClient
-
-
-def error(message: str) -> None:
-    """Print a user-facing error the way ROS 1 tools do (one line, stderr)."""
-    print(message if message.startswith("ERROR") else f"ERROR: {message}", file=sys.stderr)
-
-
-def entry(main: Callable[[list[str] | None], int]) -> Callable[[], None]:
-    """Wrap ``main`` for a console script: map our errors and Ctrl-C to exit codes, never a traceback."""
-
-    def console_main() -> None:
-        try:
-            code = main(sys.argv[1:])
-        except KeyboardInterrupt:
-            code = 130 if os.environ.get("NINJEMYS_SIGINT_CODE") else 0
-        except BrokenPipeError:
-            # `rostopic echo /x | head`: the reader went away; exit quietly like ROS 1 tools
-            devnull = os.open(os.devnull, os.O_WRONLY)
-            os.dup2(devnull, sys.stdout.fileno())
-            code = 1
-        except MasterUnreachable:
-            error("Unable to communicate with master!")
-            code = 1
-        except NinjemysError as exc:
-            error(str(exc))
-            code = 1
-        sys.exit(code)
-
-    return console_main
 
 
 def master(caller_id: str = "/ninjemys_tool") -> MasterClient:

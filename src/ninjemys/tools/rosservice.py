@@ -7,16 +7,13 @@ provider, which answers with its header and closes.
 from __future__ import annotations
 
 import argparse
-import socket
 import sys
 from typing import Any
 
 from ninjemys import names
 from ninjemys.errors import MasterError, NinjemysError, ServiceError, TypeNotFoundError
-from ninjemys.net.addresses import split_uri
 from ninjemys.tools.cli import Subcommands, entry, master, run_subcommand
 from ninjemys.tools.graph import GraphState
-from ninjemys.wire import headers
 
 NAME = "rosservice"
 ID = "/rosservice"
@@ -51,33 +48,13 @@ def service_uri(client: Any, service: str) -> str | None:
 
 
 def probe(service: str, uri: str, timeout: float = 5.0) -> dict[str, str]:
-    """The provider's connection header for ``service`` (its ``type``, ``md5sum``, ...)."""
-    try:
-        host, port = split_uri(uri)
-    except ValueError:
-        raise ServiceToolError(f"service [{service}] has an invalid RPC URI [{uri}]") from None
-    try:
-        with socket.create_connection((host, port), timeout=timeout) as sock:
-            sock.sendall(
-                headers.encode_header({"probe": "1", "md5sum": "*", "callerid": ID, "service": service})
-            )
-            prefix = _recv_exact(sock, 4)
-            return headers.decode_header(_recv_exact(sock, headers.header_length(prefix)))
-    except (OSError, NinjemysError) as exc:
-        raise ServiceToolError(
-            f"Unable to communicate with service [{service}], address [{uri}]: {exc}"
-        ) from None
+    """The provider's connection header (:func:`ninjemys.node.services.probe`), as a rosservice error."""
+    from ninjemys.node.services import probe as probe_service  # the node runtime only when probing
 
-
-def _recv_exact(sock: socket.socket, n: int) -> bytes:
-    chunks, have = [], 0
-    while have < n:
-        chunk = sock.recv(n - have)
-        if not chunk:
-            raise ConnectionError("service closed the connection during the handshake")
-        chunks.append(chunk)
-        have += len(chunk)
-    return b"".join(chunks)
+    try:
+        return probe_service(service, uri, timeout, caller_id=ID)
+    except ServiceError as exc:
+        raise ServiceToolError(str(exc)) from None
 
 
 def service_type(client: Any, service: str) -> str | None:

@@ -26,12 +26,12 @@ from urllib.parse import urlencode
 from ninjemys.bag.play import stand_in_class
 from ninjemys.bag.reader import BagReader
 from ninjemys.bridge.server import Gateway, GatewayOptions
+from ninjemys.commands import entry
 from ninjemys.errors import NinjemysError
 from ninjemys.node import Node
-from ninjemys.tools.cli import entry
+from ninjemys.serve.http import HttpError, Request, Response
 from ninjemys.web.app import STATIC_DIR, WebApp
 from ninjemys.web.browser import serve_until_stopped, stop_signals
-from ninjemys.web.http import HttpError, Request, Response
 
 DEFAULT_MASTER = "http://localhost:11311"
 NSEC = 1_000_000_000

@@ -1,6 +1,8 @@
 """``rqt_graph``: start the web tools and show the node graph of the current ROS master.
 
-Prints the URL (and opens a browser when there is a display), then serves until Ctrl-C.
+Prints the URL (and opens a browser when there is a display), then serves until Ctrl-C. The page's
+data comes through a gateway on the same server (its connection graph, and a subscription for the
+topic whose details are open); the gateway's node counts as debug plumbing on the page.
 """
 
 from __future__ import annotations
@@ -9,11 +11,11 @@ import argparse
 import os
 import sys
 
+from ninjemys.bridge.server import Gateway, GatewayOptions
+from ninjemys.commands import entry
 from ninjemys.node import Node
-from ninjemys.tools.cli import entry
 from ninjemys.web.app import WebApp
 from ninjemys.web.browser import serve_until_stopped, stop_signals
-from ninjemys.web.monitor import TopicMonitor
 
 DEFAULT_MASTER = "http://localhost:11311"
 
@@ -32,19 +34,28 @@ def main(argv: list[str] | None = None) -> int:
     # ROS passes remappings (name:=value) and __name/__log args; they do not apply to this tool
     args = _parser().parse_args([a for a in (argv or []) if ":=" not in a])
     master_uri = os.environ.get("ROS_MASTER_URI", DEFAULT_MASTER)
-    monitor = TopicMonitor(lambda: Node("rqt_graph", anonymous=True, master_uri=master_uri))
-    app = WebApp(master_uri, caller_id="/rqt_graph", host=args.host, port=args.port, monitor=monitor)
+    app = WebApp(master_uri, caller_id="/rqt_graph", host=args.host, port=args.port)
     stopped = stop_signals()
     try:
-        url = app.start()
+        url = app.start()  # the port first: a busy one is a one-line error before any ROS traffic
     except OSError as exc:
         print(
             f"ERROR: cannot serve the web tools on {args.host}:{args.port}: {exc.strerror or exc}",
             file=sys.stderr,
         )
         return 1
+    node = Node("rqt_graph", anonymous=True, master_uri=master_uri)
+    gateway = Gateway(GatewayOptions(node_name=node.name, hide_own_node=True, update_period=0.5), node=node)
+    gateway.start()
+    app.add_gateway(gateway)
+
+    def stop() -> None:
+        app.stop()
+        gateway.shutdown()
+        node.shutdown("rqt_graph closed")
+
     print(f"rqt_graph: node graph of {master_uri} at {url}", flush=True)
-    return serve_until_stopped(url, not args.no_browser, app.stop, stopped)
+    return serve_until_stopped(url, not args.no_browser, stop, stopped)
 
 
 console_main = entry(main)

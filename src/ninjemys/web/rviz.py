@@ -17,13 +17,13 @@ from pathlib import Path
 from typing import Any
 
 from ninjemys.bridge.server import Gateway, GatewayOptions
+from ninjemys.commands import entry
 from ninjemys.errors import NinjemysError
 from ninjemys.node import Node
-from ninjemys.tools.cli import entry
+from ninjemys.serve.http import HttpError, Request, Response
 from ninjemys.web import rvizconfig
 from ninjemys.web.app import STATIC_DIR, WebApp
 from ninjemys.web.browser import serve_until_stopped, stop_signals
-from ninjemys.web.http import HttpError, Request, Response
 
 DEFAULT_MASTER = "http://localhost:11311"
 #: where rviz saves when it was not started with -d

@@ -17,6 +17,8 @@ from typing import Any
 
 import yaml
 
+from ninjemys.errors import NinjemysError
+
 #: rviz display classes the page draws -> the key that holds their topic
 SUPPORTED: dict[str, str | None] = {
     "rviz/Grid": None,
@@ -44,7 +46,7 @@ DEFAULT_TOOLS = {
 }
 
 
-class RvizConfigError(Exception):
+class RvizConfigError(NinjemysError):
     """A .rviz file that cannot be read; the message starts with ``file:line:``."""
 
 

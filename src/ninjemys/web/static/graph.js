@@ -1,5 +1,14 @@
-// The node graph page (rqt_graph in the browser): live from /api/graph/events (Server-Sent Events).
-"use strict";
+// The node graph page (rqt_graph in the browser), live through the gateway like every page: the
+// Foxglove connection graph (who publishes, subscribes, provides), the channels (topic types), the
+// gateway's rosBus extension (which nodes answer, which connections are up, from getBusInfo), and
+// for the selected topic a subscription that measures its rate and shows its last message.
+import { RosClient } from "/static/lib/rosclient.js";
+import { toJson } from "/static/rqt/common.js";
+
+// what rqt_graph hides with "Hide Debug": the logging plumbing every node is wired to
+const DEBUG_TOPICS = new Set(["/rosout", "/rosout_agg", "/statistics"]);
+const DEBUG_NODES = new Set(["/rosout"]);
+const RATE_WINDOW = 10; // seconds over which a topic's rate is averaged
 
 const SVGNS = "http://www.w3.org/2000/svg";
 const ui = {
@@ -16,6 +25,7 @@ const ui = {
 let current = null; // last {graph, master_uri, error}
 let selectedTopic = null;
 let detailsTimer = null;
+let watch = null; // the selected topic's subscription: {sub, stamps, count, last, type}
 
 function el(tag, attrs, parent) {
   const e = document.createElementNS(SVGNS, tag);
@@ -130,42 +140,121 @@ function render() {
   ui.status.className = "";
 }
 
+// -- the graph model, from the gateway's connection graph -------------------------------------
+const ros = new RosClient();
+const known = { pub: new Map(), sub: new Map(), srv: new Map(), bus: { nodes: {}, live: {} }, error: null };
+
+function namespaceOf(name) {
+  const head = name.replace(/\/+$/, "").split("/").slice(0, -1).join("/");
+  return head || "/";
+}
+
+function lookerNodes() {
+  const meta = (ros.serverInfo && ros.serverInfo.metadata) || {};
+  return new Set((meta.debugNodes || "").split(",").filter(Boolean));
+}
+
+/** nodes, topics and node->node edges, as rqt_graph draws them */
+function buildGraph() {
+  const types = new Map(ros.topics().map((t) => [t.name, t.type]));
+  // the nodes are the master's (the bus sweep only annotates them, and lags behind a departure)
+  const names = new Set();
+  for (const table of [known.pub, known.sub, known.srv]) for (const ids of table.values()) for (const n of ids) names.add(n);
+  const lookers = lookerNodes();
+  const nodes = [...names].sort().map((name) => ({
+    name,
+    namespace: namespaceOf(name),
+    uri: (known.bus.nodes[name] || {}).uri || "",
+    reachable: (known.bus.nodes[name] || { reachable: true }).reachable,
+    debug: DEBUG_NODES.has(name) || lookers.has(name),
+  }));
+  const live = (node, topic) => (known.bus.live[node] || []).includes(topic);
+  const topics = [];
+  const edges = [];
+  const topicNames = new Set([...known.pub.keys(), ...known.sub.keys(), ...types.keys()]);
+  for (const name of [...topicNames].sort()) {
+    const publishers = [...(known.pub.get(name) || [])].sort();
+    const subscribers = [...(known.sub.get(name) || [])].sort();
+    topics.push({ name, namespace: namespaceOf(name), type: types.get(name) || "", publishers, subscribers, debug: DEBUG_TOPICS.has(name) });
+    for (const a of publishers) for (const b of subscribers) edges.push({ source: a, target: b, topic: name, connected: live(a, name) || live(b, name) });
+  }
+  return { nodes, topics, edges };
+}
+
+function onGraph(update) {
+  for (const t of update.publishedTopics || []) known.pub.set(t.name, t.publisherIds);
+  for (const t of update.subscribedTopics || []) known.sub.set(t.name, t.subscriberIds);
+  for (const sv of update.advertisedServices || []) known.srv.set(sv.name, sv.providerIds);
+  for (const name of update.removedTopics || []) { known.pub.delete(name); known.sub.delete(name); }
+  for (const name of update.removedServices || []) known.srv.delete(name);
+  // a topic keeps its entry in one table while the other side changes: drop the emptied ones
+  for (const table of [known.pub, known.sub]) for (const [name, ids] of table) if (!ids.length) table.delete(name);
+  if (update.rosBus) known.bus = update.rosBus;
+  refreshState();
+}
+
+let stateQueued = false;
+function refreshState() {
+  if (stateQueued) return;
+  stateQueued = true;
+  setTimeout(() => { // one re-layout for a burst of updates (graph, bus, channels)
+    stateQueued = false;
+    showState({ graph: buildGraph(), master_uri: ((ros.serverInfo || {}).metadata || {}).ROS_MASTER_URI || "", error: known.error });
+  }, 0);
+}
+
 function showState(state) {
   current = state;
   if (state.error) {
     ui.status.textContent = state.error;
     ui.status.className = "error";
   }
-  if (state.graph) render();
-  document.body.dataset.version = state.graph ? state.graph.version : "";
+  if (state.graph && !state.error) render();
+  else if (state.graph) { const keep = ui.status.textContent; render(); ui.status.textContent = keep; ui.status.className = "error"; }
+  document.body.dataset.nodes = String(state.graph ? state.graph.nodes.length : 0);
 }
+window.render = render; // for bench/web_graph.py's timing of one re-layout
 
-// topic details panel: type, publishers, subscribers, rate and last message, refreshed each second
-async function selectTopic(name) {
+// topic details panel: type, publishers, subscribers, and (watched through the gateway while the
+// panel is open) rate and last message, refreshed each second
+function selectTopic(name) {
   selectedTopic = name;
   ui.details.hidden = false;
   document.getElementById("details-title").textContent = name;
   render();
   clearInterval(detailsTimer);
-  await loadDetails();
+  watchTopic(name);
+  loadDetails();
   detailsTimer = setInterval(loadDetails, 1000);
 }
 
-async function loadDetails() {
-  if (!selectedTopic) return;
-  const name = selectedTopic;
-  let info;
-  try {
-    const resp = await fetch("/api/topic?name=" + encodeURIComponent(name));
-    info = await resp.json();
-    if (!resp.ok) throw new Error(info.error || resp.statusText);
-  } catch (err) {
-    document.getElementById("details-body").textContent = String(err.message || err);
-    return;
-  }
-  if (name !== selectedTopic) return;
+function watchTopic(name) {
+  if (watch) watch.sub.unsubscribe();
+  watch = { stamps: [], count: 0, last: null, error: null };
+  const w = watch;
+  w.sub = ros.subscribe(name, (msg) => {
+    const now = performance.now() / 1000;
+    w.count += 1;
+    w.last = msg;
+    w.stamps.push(now);
+    while (w.stamps.length && now - w.stamps[0] > RATE_WINDOW) w.stamps.shift();
+  }, { onError: (text) => { w.error = text; } });
+}
+
+function rateOf(w) {
+  const now = performance.now() / 1000;
+  while (w.stamps.length && now - w.stamps[0] > RATE_WINDOW) w.stamps.shift();
+  if (w.stamps.length < 2) return null;
+  const span = w.stamps[w.stamps.length - 1] - w.stamps[0];
+  return span > 0 ? (w.stamps.length - 1) / span : null;
+}
+
+function loadDetails() {
+  if (!selectedTopic || !current || !current.graph) return;
+  const info = current.graph.topics.find((t) => t.name === selectedTopic);
   const body = document.getElementById("details-body");
   body.textContent = "";
+  if (!info) { body.textContent = `topic ${selectedTopic} is not in the graph`; return; }
   const row = (label, value, key) => {
     const dt = document.createElement("dt"); dt.textContent = label;
     const dd = document.createElement("dd"); dd.textContent = value; dd.dataset.key = key;
@@ -174,21 +263,36 @@ async function loadDetails() {
   row("Type", info.type || "(unknown)", "type");
   row("Publishers", info.publishers.join(", ") || "none", "publishers");
   row("Subscribers", info.subscribers.join(", ") || "none", "subscribers");
-  if (info.rate !== undefined) row("Rate", info.rate === null ? "no messages yet" : `${info.rate.toFixed(2)} Hz (${info.count} messages)`, "rate");
-  if (info.monitor_error) row("Monitor", info.monitor_error, "monitor");
-  document.getElementById("details-message").textContent = info.last_message || "";
+  if (watch) {
+    const rate = rateOf(watch);
+    row("Rate", rate === null ? "no messages yet" : `${rate.toFixed(2)} Hz (${watch.count} messages)`, "rate");
+    if (watch.error) row("Monitor", watch.error, "monitor");
+  }
+  document.getElementById("details-message").textContent = watch && watch.last ? toJson(watch.last) : "";
 }
 
 document.getElementById("close-details").addEventListener("click", () => {
   selectedTopic = null;
   clearInterval(detailsTimer);
+  if (watch) { watch.sub.unsubscribe(); watch = null; }
   ui.details.hidden = true;
   render();
 });
 for (const input of [ui.mode, ui.group, ui.hideDebug, ui.hideDead, ui.hideLeaf]) input.addEventListener("change", render);
 ui.filter.addEventListener("input", render);
-document.getElementById("refresh").addEventListener("click", () => fetch("/api/graph/refresh", { method: "POST" }));
 
-const events = new EventSource("/api/graph/events");
-events.addEventListener("state", (ev) => showState(JSON.parse(ev.data)));
-events.onerror = () => { ui.status.textContent = "connection to the web tools server lost, retrying…"; ui.status.className = "error"; };
+let stopGraph = ros.watchGraph(onGraph);
+document.getElementById("refresh").addEventListener("click", () => {
+  // a fresh subscription brings the full graph and an immediate bus sweep
+  stopGraph();
+  known.pub.clear(); known.sub.clear(); known.srv.clear();
+  stopGraph = ros.watchGraph(onGraph);
+});
+ros.on("channels", refreshState);
+ros.on("status", (st) => { if (st.id === "master") { known.error = st.message; refreshState(); } });
+ros.on("removeStatus", (ids) => { if (ids.includes("master")) { known.error = null; ui.status.className = ""; refreshState(); } });
+ros.on("close", () => {
+  known.pub.clear(); known.sub.clear(); known.srv.clear();
+  ui.status.textContent = "connection to the gateway lost, retrying…";
+  ui.status.className = "error";
+});

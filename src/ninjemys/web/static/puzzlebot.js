@@ -1,13 +1,18 @@
 // The PuzzleBot simulator seen from above: world, robots, trails, lidar rays, cameras, keyboard teleop.
-"use strict";
+// One data path, the gateway: the "view:puzzlebot" JSON channel (world, then updates), the robots'
+// camera topics, cmd_vel publications and the /gazebo/* services.
+import { RosClient } from "/static/lib/rosclient.js";
+
+const VIEW_CHANNEL = "view:puzzlebot";
+const ros = new RosClient();
 
 const canvas = document.getElementById("pb-world");
 const ctx = canvas.getContext("2d");
 const statusLine = document.getElementById("status");
 const robotSelect = document.getElementById("pb-robot");
 const robotList = document.getElementById("pb-robots");
-const colorImg = document.getElementById("pb-color");
-const depthImg = document.getElementById("pb-depth");
+const colorCanvas = document.getElementById("pb-color");
+const depthCanvas = document.getElementById("pb-depth");
 let world = null;
 let update = { robots: [], movers: [], time: 0, paused: false };
 const trails = new Map();
@@ -82,6 +87,7 @@ function queueDraw() { if (!frameQueued) { frameQueued = true; requestAnimationF
 
 function applyUpdate(u) {
   update = u;
+  window.puzzlebot = { world, update, trails };
   for (const r of u.robots) {
     if (r.trail_reset || !trails.has(r.name)) trails.set(r.name, []);
     const t = trails.get(r.name);
@@ -112,29 +118,47 @@ function loadState(state) {
   applyUpdate(state.update);
 }
 
-const events = new EventSource("/api/puzzlebot/events");
-events.addEventListener("state", (ev) => loadState(JSON.parse(ev.data)));
-events.addEventListener("update", (ev) => applyUpdate(JSON.parse(ev.data)));
-events.onerror = () => { statusLine.textContent = "disconnected (retrying)"; statusLine.className = "error"; };
+ros.subscribe(VIEW_CHANNEL, (m) => (m.kind === "state" ? loadState(m) : applyUpdate(m)));
+ros.on("close", () => { statusLine.textContent = "disconnected (retrying)"; statusLine.className = "error"; });
 
-// camera images: fetched while the page is visible, for the selected robot
-let cameraBusy = false;
-async function refreshCamera() {
-  const r = update.robots.find((x) => x.name === robotSelect.value);
-  if (cameraBusy || document.hidden || !r || !r.camera) return;
-  cameraBusy = true;
-  try {
-    for (const [img, kind] of [[colorImg, "color"], [depthImg, "depth"]]) {
-      const res = await fetch(`/api/puzzlebot/camera.png?robot=${encodeURIComponent(r.name)}&kind=${kind}&t=${Date.now()}`);
-      if (res.ok) {
-        const url = URL.createObjectURL(await res.blob());
-        const old = img.src; img.src = url; if (old.startsWith("blob:")) URL.revokeObjectURL(old);
-        img.dataset.loaded = String(Number(img.dataset.loaded || 0) + 1);
-      }
+// camera images: the selected robot's colour (rgb8) and depth (16UC1, mm) topics, drawn as they come
+let cameraSubs = [];
+let cameraRobot = null;
+function drawImage(target, msg) {
+  const { width, height } = msg;
+  if (target.width !== width || target.height !== height) { target.width = width; target.height = height; }
+  const c = target.getContext("2d");
+  const img = c.createImageData(width, height);
+  const out = img.data, data = msg.data;
+  if (msg.encoding === "rgb8") {
+    for (let i = 0, j = 0; i < width * height; i++, j += 3) {
+      out[4 * i] = data[j]; out[4 * i + 1] = data[j + 1]; out[4 * i + 2] = data[j + 2]; out[4 * i + 3] = 255;
     }
-  } finally { cameraBusy = false; }
+  } else if (msg.encoding === "16UC1") {
+    const view = new DataView(data.buffer, data.byteOffset, data.byteLength);
+    for (let i = 0; i < width * height; i++) {
+      const d = view.getUint16(2 * i, !msg.is_bigendian);
+      const v = d > 0 ? 255 - Math.min(Math.max(d / 40, 0), 235) : 0; // near bright, 10 m dark
+      out[4 * i] = out[4 * i + 1] = out[4 * i + 2] = v; out[4 * i + 3] = 255;
+    }
+  } else return;
+  c.putImageData(img, 0, 0);
+  target.dataset.loaded = String(Number(target.dataset.loaded || 0) + 1);
 }
-setInterval(refreshCamera, 200);
+function followCameras() {
+  const r = update.robots.find((x) => x.name === robotSelect.value);
+  const name = r && r.camera ? r.name : null;
+  if (name === cameraRobot) return;
+  for (const sub of cameraSubs) sub.unsubscribe();
+  cameraSubs = [];
+  cameraRobot = name;
+  if (!r || !name) return;
+  cameraSubs = [
+    ros.subscribe(r.topics.color, (msg) => drawImage(colorCanvas, msg), { type: "sensor_msgs/Image" }),
+    ros.subscribe(r.topics.depth, (msg) => drawImage(depthCanvas, msg), { type: "sensor_msgs/Image" }),
+  ];
+}
+setInterval(followCameras, 200);
 
 // keyboard teleop: held keys set the velocity, sent 10 times a second while any is held
 const keys = new Set();
@@ -148,14 +172,17 @@ function command() {
   if (keys.has("ArrowRight") || keys.has("d")) w -= ANGULAR;
   return [v, w];
 }
-async function send(force) {
+const drivers = new Map(); // cmd_vel topic -> publisher (through the gateway)
+function send(force) {
   const [v, w] = command();
   const key = `${v},${w}`;
   if (!force && key === lastSent && v === 0 && w === 0) return;
   lastSent = key;
-  if (!robotSelect.value) return;
-  await fetch("/api/puzzlebot/cmd_vel", { method: "POST", headers: { "Content-Type": "application/json" },
-    body: JSON.stringify({ robot: robotSelect.value, linear: v, angular: w }) });
+  const r = update.robots.find((x) => x.name === robotSelect.value);
+  if (!r) return;
+  let pub = drivers.get(r.topics.cmd_vel);
+  if (!pub) { pub = ros.advertise(r.topics.cmd_vel, "geometry_msgs/Twist"); drivers.set(r.topics.cmd_vel, pub); }
+  pub.publish({ linear: { x: v, y: 0, z: 0 }, angular: { x: 0, y: 0, z: w } });
   document.body.dataset.lastCommand = key;
 }
 const DRIVE_KEYS = ["ArrowUp", "ArrowDown", "ArrowLeft", "ArrowRight", "w", "a", "s", "d", " "];
@@ -170,8 +197,10 @@ setInterval(() => { if (keys.size) send(true); }, 100);
 window.addEventListener("blur", () => { if (keys.size) { keys.clear(); send(true); } });
 
 for (const b of document.querySelectorAll(".pb-buttons button")) {
-  b.addEventListener("click", () => fetch("/api/puzzlebot/control", { method: "POST", headers: { "Content-Type": "application/json" },
-    body: JSON.stringify({ action: b.dataset.action }) }));
+  const service = { pause: "pause_physics", unpause: "unpause_physics" }[b.dataset.action] || b.dataset.action;
+  b.addEventListener("click", () => ros.callService(`/gazebo/${service}`, {}).catch((err) => {
+    statusLine.textContent = String(err.message || err); statusLine.className = "error";
+  }));
 }
 robotSelect.addEventListener("change", queueDraw);
 window.addEventListener("resize", queueDraw);

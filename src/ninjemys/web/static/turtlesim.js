@@ -1,5 +1,6 @@
-// The turtlesim window: a path canvas (pen trails) with the turtles drawn on top, live over SSE.
-"use strict";
+// The turtlesim window: a path canvas (pen trails) with the turtles drawn on top, live through the
+// gateway (the node's "view:turtlesim" JSON channel: a full state first, then updates).
+import { RosClient } from "/static/lib/rosclient.js";
 
 const view = document.getElementById("turtlesim");
 const ctx = view.getContext("2d");
@@ -10,6 +11,7 @@ const statusLine = document.getElementById("status");
 let geo = { size: 500, scale: 45, world: 499 / 45 };
 let turtles = [];
 let frameQueued = false;
+const VIEW_CHANNEL = "view:turtlesim";
 const SHELLS = ["#2e8b57", "#3b7d3b", "#4a6b2a", "#1f7a6d", "#6b8e23", "#2f6f4f"];
 
 function px(x, y) { return [x * geo.scale, (geo.world - y) * geo.scale]; }
@@ -72,13 +74,12 @@ function loadState(state) {
 }
 loadState.pending = drawSegment;
 
-const events = new EventSource("/api/turtlesim/events");
-events.addEventListener("state", (ev) => loadState(JSON.parse(ev.data)));
-events.addEventListener("update", (ev) => {
-  const u = JSON.parse(ev.data);
-  for (const s of u.segments) loadState.pending(s);
-  showTurtles(u.turtles);
+const ros = new RosClient();
+ros.subscribe(VIEW_CHANNEL, (m) => {
+  if (m.kind === "state") { loadState(m); return; }
+  for (const seg of m.segments) loadState.pending(seg);
+  showTurtles(m.turtles);
   queueFrame();
   document.body.dataset.updates = String(Number(document.body.dataset.updates || 0) + 1);
 });
-events.onerror = () => { statusLine.textContent = "turtlesim is not reachable, retrying…"; statusLine.className = "error"; };
+ros.on("close", () => { statusLine.textContent = "turtlesim is not reachable, retrying…"; statusLine.className = "error"; });

@@ -1,8 +1,8 @@
 // The browser's ROS client: the gateway's Foxglove WebSocket subprotocol (foxglove.websocket.v1),
 // the web tools' one data path.
 //
-// The server advertises channels (topics with their type and full ros1msg definition) and
-// services; we subscribe by topic name, decode the raw ROS 1 payloads with ros1msg.js, publish by
+// The server advertises channels (topics with their type and full ros1msg definition, and the
+// JSON channels of the server's own app, e.g. a simulator's view) and services; we subscribe by topic name, decode the raw ROS 1 payloads with ros1msg.js, publish by
 // advertising a client channel and sending ROS 1 bytes, and call services with ROS 1 bytes both
 // ways. The connection comes back by itself after a drop: subscriptions and advertisements are
 // re-made on the new connection, and callers keep their handles.
@@ -19,6 +19,9 @@ export { RosMsgError } from "./ros1msg.js";
 
 const SUBPROTOCOL = "foxglove.websocket.v1";
 const utf8 = new TextEncoder();
+const utf8Decoder = new TextDecoder();
+// channels with Foxglove's "json" encoding: an in-process app's own data (a simulator's view)
+const JSON_CODEC = { decode: (bytes) => JSON.parse(utf8Decoder.decode(bytes)) };
 
 /** The gateway's address for pages served by the web tools: ws(s)://<host>/ws. */
 export function defaultUrl() {
@@ -51,7 +54,8 @@ class Listeners {
 /**
  * One connection to the gateway. Events (`on(name, fn)` returns an unsubscribe function):
  * `open`, `close`, `channels` (the topic list changed), `services`, `status` ({level, message}),
- * `time` (sim time in ns, under /use_sim_time), `graph` (connectionGraphUpdate).
+ * `time` (sim time in ns, under /use_sim_time), `graph` (connectionGraphUpdate; see watchGraph),
+ * `removeStatus` (status ids the server withdrew).
  */
 export class RosClient {
   constructor(url = defaultUrl(), { reconnect = true, reconnectDelay = 500 } = {}) {
@@ -76,6 +80,7 @@ export class RosClient {
     this._paramReqs = new Map();
     this._paramIds = 1;
     this._paramWatchers = new Map(); // name -> Set(fn)
+    this._graphWatchers = 0;
     this._closedByUser = false;
     this._ready = null;
     this._connect();
@@ -131,6 +136,7 @@ export class RosClient {
     switch (msg.op) {
       case "serverInfo":
         this.serverInfo = msg;
+        if (this._graphWatchers > 0) this._send({ op: "subscribeConnectionGraph" });
         break;
       case "advertise": {
         for (const ch of msg.channels) {
@@ -201,6 +207,9 @@ export class RosClient {
       case "connectionGraphUpdate":
         this._listeners.emit("graph", msg);
         break;
+      case "removeStatus":
+        this._listeners.emit("removeStatus", msg.statusIds || []);
+        break;
       default:
         break;
     }
@@ -247,6 +256,21 @@ export class RosClient {
     }
   }
 
+  /**
+   * Watch the connection graph: `fn(update)` gets every connectionGraphUpdate, the first one (after
+   * each connection) the full graph. Returns a stop function.
+   */
+  watchGraph(fn) {
+    const off = this.on("graph", fn);
+    this._graphWatchers += 1;
+    this._send({ op: "subscribeConnectionGraph" });
+    return () => {
+      off();
+      this._graphWatchers -= 1;
+      if (this._graphWatchers === 0) this._send({ op: "unsubscribeConnectionGraph" });
+    };
+  }
+
   /** The advertised topics: [{name, type}], sorted by name. */
   topics() {
     return [...this.byTopic.values()].map((c) => ({ name: c.topic, type: c.schemaName })).sort((a, b) => a.name.localeCompare(b.name));
@@ -260,7 +284,8 @@ export class RosClient {
   /** The codec of a topic's advertised type, or null when nobody publishes it yet. */
   codecForTopic(topic) {
     const ch = this.byTopic.get(topic);
-    return ch ? codecFor(ch.schemaName, ch.schema) : null;
+    if (!ch) return null;
+    return ch.encoding === "json" ? JSON_CODEC : codecFor(ch.schemaName, ch.schema);
   }
 
   /** The codec of a type, from any advertised channel or service using it, else from the web app. */
@@ -306,7 +331,7 @@ export class RosClient {
     }
     if (entry.subId !== null && entry.channelId === ch.id) return;
     try {
-      entry.codec = codecFor(ch.schemaName, ch.schema);
+      entry.codec = ch.encoding === "json" ? JSON_CODEC : codecFor(ch.schemaName, ch.schema);
     } catch (err) {
       for (const h of entry.handlers) h.onError?.(`${topic}: bad definition of ${ch.schemaName}: ${err.message}`);
       return;

@@ -1,6 +1,6 @@
 """WebSocket connections on the web tools' asyncio HTTP server, over the ``websockets`` sans-I/O core.
 
-The HTTP server (:mod:`ninjemys.web.http`) parses the upgrade request like any other request and
+The HTTP server (:mod:`ninjemys.serve.http`) parses the upgrade request like any other request and
 hands it to a :class:`WebSocketEndpoint`; the endpoint decides (subprotocol, Origin, token) and the
 connection then runs over the same asyncio streams. ``websockets``' sans-I/O ``ServerProtocol`` does
 the RFC 6455 work (handshake validation, framing, masking, ping/pong, close handshake, UTF-8
@@ -25,7 +25,7 @@ from websockets.http11 import Request as WsRequest
 from websockets.http11 import Response as WsResponse
 from websockets.server import ServerProtocol
 
-from ninjemys.web.http import Request
+from ninjemys.serve.http import Request
 
 log = logging.getLogger(__name__)
 

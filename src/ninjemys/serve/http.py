@@ -1,11 +1,10 @@
-"""A small asyncio HTTP/1.1 server for the web tools: routes, static files, JSON and Server-Sent Events.
+"""A small asyncio HTTP/1.1 server for the web tools: routes, static files, JSON, and WebSocket upgrades.
 
-Stdlib only. Server-Sent Events carry every live update the pages need (graph changes, turtle poses,
-trail segments) in one direction, server -> browser; the few browser -> server actions are plain
-POSTs, so a WebSocket library would add a dependency without buying anything.
-
-The server runs on whatever event loop calls :meth:`HttpServer.start`, so it can share a node's I/O
-loop, or run on its own thread via :class:`ninjemys.web.app.WebApp`.
+Stdlib only here; the WebSocket connections (:mod:`ninjemys.serve.websocket`, on ``websockets``'
+sans-I/O protocol) carry every live update the pages need, through the gateway mounted on the
+server: there are no server-push HTTP responses (Server-Sent Events went with the in-process
+pollers that used them). The server runs on whatever event loop calls :meth:`HttpServer.start`, so
+it can share a loop, or run on its own thread via the web app or the standalone gateway.
 """
 
 from __future__ import annotations
@@ -21,12 +20,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 from urllib.parse import parse_qs, unquote, urlsplit
 
+from ninjemys.errors import NinjemysError
+
 log = logging.getLogger(__name__)
 
 MAX_HEADER_BYTES = 64 * 1024
 MAX_BODY_BYTES = 1024 * 1024
-#: An idle SSE stream sends a comment this often so proxies and dead peers are noticed.
-SSE_KEEPALIVE = 15.0
 
 _REASONS = {
     200: "OK",
@@ -79,27 +78,15 @@ class Response:
         return json.dumps(self.body).encode("utf-8"), self.content_type or "application/json"
 
 
-@dataclass(eq=False)
-class EventStream:
-    """A Server-Sent Events response: the server writes each (event, data) put on ``queue``.
-
-    ``None`` on the queue ends the stream; ``on_close`` runs when the browser goes away, so the
-    producer can stop feeding the queue.
-    """
-
-    queue: asyncio.Queue[tuple[str, object] | None]
-    on_close: Callable[[], None] = lambda: None
-
-
-Handler = Callable[[Request], Awaitable[Response | EventStream] | Response | EventStream]
+Handler = Callable[[Request], Awaitable[Response] | Response]
 
 if TYPE_CHECKING:
     import ssl
 
-    from ninjemys.web.websocket import WebSocketEndpoint
+    from ninjemys.serve.websocket import WebSocketEndpoint
 
 
-class HttpError(Exception):
+class HttpError(NinjemysError):
     """Raised by a handler to answer with an error status and a one-line reason."""
 
     def __init__(self, status: int, reason: str) -> None:
@@ -123,13 +110,12 @@ class HttpServer:
         self._server: asyncio.base_events.Server | None = None
         self._writers: set[asyncio.StreamWriter] = set()
         self._tasks: set[asyncio.Task[None]] = set()  # the connections' handlers (closed in order)
-        self._streams: set[EventStream] = set()
 
     def route(self, method: str, path: str, handler: Handler) -> None:
         self._routes[(method.upper(), path)] = handler
 
     def websocket(self, path: str, endpoint: WebSocketEndpoint) -> None:
-        """Accept WebSocket upgrades on ``path`` (see :mod:`ninjemys.web.websocket`); a plain GET of
+        """Accept WebSocket upgrades on ``path`` (see :mod:`ninjemys.serve.websocket`); a plain GET of
         the same path still goes to the HTTP route, if there is one."""
         self._websockets[path] = endpoint
 
@@ -151,8 +137,6 @@ class HttpServer:
         if self._server is None:
             return
         self._server.close()
-        for stream in list(self._streams):
-            stream.queue.put_nowait(None)
         # every connection's handler is cancelled and awaited: a WebSocket sends its close frame and
         # its endpoint stops its own tasks, so the loop can close with nothing left pending
         # (otherwise "Task was destroyed but it is pending" at exit while a page is still open)
@@ -182,7 +166,7 @@ class HttpServer:
                 keep_alive = request.headers.get("connection", "").lower() != "close"
                 endpoint = self._websockets.get(request.path)
                 if endpoint is not None and request.headers.get("upgrade", "").lower() == "websocket":
-                    from ninjemys.web.websocket import serve_upgrade  # only WebSocket users load it
+                    from ninjemys.serve.websocket import serve_upgrade  # only WebSocket users load it
 
                     await serve_upgrade(endpoint, request, reader, writer)
                     return
@@ -239,11 +223,10 @@ class HttpServer:
         handler = self._routes.get((method, request.path))
         try:
             if handler is None:
-                result: Response | EventStream = self._static_file(request)
+                result: Response = self._static_file(request)
             else:
-                result = handler(request)
-                if asyncio.iscoroutine(result):
-                    result = await result
+                outcome = handler(request)
+                result = await outcome if isinstance(outcome, Awaitable) else outcome
         except HttpError as exc:
             result = Response({"error": exc.reason}, exc.status)
         except ValueError as exc:
@@ -251,9 +234,6 @@ class HttpServer:
         except Exception as exc:  # a handler bug must not take the server down
             log.exception("web handler for %s %s failed", request.method, request.path)
             result = Response({"error": f"{type(exc).__name__}: {exc}"}, 500)
-        if isinstance(result, EventStream):
-            await self._stream(result, writer)
-            return False
         await self._send(writer, result, head_only=request.method == "HEAD")
         return True
 
@@ -282,28 +262,3 @@ class HttpServer:
         if not head_only:
             writer.write(body)
         await writer.drain()
-
-    async def _stream(self, stream: EventStream, writer: asyncio.StreamWriter) -> None:
-        writer.write(
-            b"HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\nCache-Control: no-cache\r\n"
-            b"Connection: close\r\n\r\n"
-        )
-        self._streams.add(stream)
-        try:
-            while True:
-                try:
-                    item = await asyncio.wait_for(stream.queue.get(), SSE_KEEPALIVE)
-                except TimeoutError:
-                    writer.write(b": keepalive\n\n")
-                else:
-                    if item is None:
-                        return
-                    event, data = item
-                    payload = json.dumps(data, separators=(",", ":"))
-                    writer.write(f"event: {event}\ndata: {payload}\n\n".encode())
-                await writer.drain()
-        except (ConnectionError, asyncio.CancelledError):
-            return
-        finally:
-            self._streams.discard(stream)
-            stream.on_close()

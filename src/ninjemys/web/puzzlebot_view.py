@@ -1,0 +1,213 @@
+"""The PuzzleBot simulator's browser view, a page of the web tools app (as turtlesim's window is),
+and the ``sim_node`` command that shows it.
+
+``/puzzlebot`` draws the world from above (walls, furniture, floor markings), the robots with their
+trails and lidar rays, and the selected robot's colour and depth images; the keyboard (arrows or
+WASD, space to stop) drives the selected robot. Everything goes through the gateway mounted on the
+page's server, the browser's one data path: the page subscribes to the ``view:puzzlebot`` JSON
+channel (the static world once, then updates at most 20 times a wall-clock second) and to the
+robots' camera topics (rendered only while someone subscribes, as for any ROS client); it publishes
+``cmd_vel`` like any teleop node and calls ``/gazebo/pause_physics``, ``unpause_physics``,
+``reset_world`` and ``reset_simulation`` to pause, resume and reset.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from collections.abc import Callable
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ninjemys.bridge.server import Gateway, GatewayOptions
+from ninjemys.commands import entry
+from ninjemys.web.app import WebApp
+from ninjemys.web.browser import open_if_display
+
+if TYPE_CHECKING:
+    from ninjemys.node.log import NodeLog
+    from ninjemys.sim.puzzlebot_node import SimNode
+
+UPDATE_PERIOD = 0.05  # wall seconds between updates sent to the pages
+#: the gateway channel the page subscribes to (JSON; not a ROS topic, see ninjemys.bridge.appchannels)
+CHANNEL = "view:puzzlebot"
+
+
+class PuzzlebotView:
+    """The ``/puzzlebot`` page of a :class:`WebApp`, fed through the gateway mounted on it.
+
+    The page subscribes to the gateway's :data:`CHANNEL` (the static world once, then robots,
+    trails, scans and movers) and to the robots' camera topics; it drives by publishing ``cmd_vel``
+    and pauses or resets through the ``/gazebo/*`` services, all through the gateway. The simulator
+    calls :meth:`wants_scans` and :meth:`publish` (on its thread, with its lock held).
+    """
+
+    def __init__(self, app: WebApp, gateway: Gateway, sim_node: SimNode) -> None:
+        self.sim_node = sim_node
+        self._last_sent = 0.0
+        self._trail_sent: dict[str, int] = {}
+        app.add_page("PuzzleBot", "/puzzlebot")
+        app.server.route("GET", "/puzzlebot", lambda _r: app._static_page("puzzlebot.html"))
+        self.channel = gateway.app_channel(CHANNEL, "ninjemys/PuzzlebotView", self._full_state, sim_node.lock)
+
+    # -- what the sim thread asks -----------------------------------------------------------------
+    def wants_scans(self) -> bool:
+        return self.channel.listeners > 0
+
+    # -- state ----------------------------------------------------------------------------------
+    def _full_state(self) -> dict:
+        """The static world and the robots (call with the sim lock held)."""
+        sim = self.sim_node.sim
+        w = sim.world
+        obstacles = [
+            {
+                "name": o.name,
+                "kind": o.kind,
+                "outline": np.round(o.outline, 4).tolist(),
+                "color": list(o.color),
+                "height": o.height,
+            }
+            for o in w.obstacles
+        ]
+        grid_edges = np.round(sim.map_edges(), 4).tolist()
+        markings = [
+            {
+                "points": np.round(m.points, 4).tolist(),
+                "closed": m.closed,
+                "width": m.width,
+                "color": list(m.color),
+            }
+            for m in w.markings
+        ]
+        self._trail_sent = {}
+        return {
+            "kind": "state",
+            "node": self.sim_node.node.name,
+            "world": w.name,
+            "bounds": list(w.extent()),
+            "obstacles": obstacles,
+            "grid_edges": grid_edges,
+            "markings": markings,
+            "update": self._update(full_trails=True),
+        }
+
+    def _update(self, full_trails: bool = False) -> dict:
+        sim = self.sim_node.sim
+        robots = []
+        for name, io in self.sim_node.io.items():
+            r = io.robot
+            total = r.trail_count
+            sent = 0 if full_trails else self._trail_sent.get(name, 0)
+            restart = full_trails or sent > total  # a reset cleared the trail
+            if restart:
+                sent = 0
+            fresh = min(total - sent, len(r.trail))
+            self._trail_sent[name] = total
+            scan = None
+            if io.last_scan is not None and r.model.laser is not None:
+                ranges = io.last_scan
+                scan = {
+                    "ranges": [round(float(v), 3) if math.isfinite(v) else None for v in ranges],
+                    "angle_min": -math.pi,
+                    "increment": 2.0 * math.pi / len(ranges),
+                    "offset": list(r.model.laser.pose.xyz[:2]),
+                }
+            robots.append(
+                {
+                    "name": name,
+                    "namespace": "/" + io.prefix.rstrip("/") if io.prefix else "",
+                    # resolved names the page publishes to and subscribes to through the gateway
+                    "topics": self._topics(io.prefix),
+                    "x": round(r.x, 4),
+                    "y": round(r.y, 4),
+                    "yaw": round(r.yaw, 4),
+                    "v": round(r.v, 3),
+                    "w": round(r.w, 3),
+                    "radius": r.model.body_radius,
+                    "color": list(r.model.color),
+                    "contact": r.contact,
+                    "contact_with": r.contact_with,
+                    "camera": r.model.camera is not None,
+                    "trail": list(r.trail)[len(r.trail) - fresh :] if fresh > 0 else [],
+                    "trail_reset": restart,
+                    "scan": scan,
+                }
+            )
+        movers = [
+            {
+                "name": m.name,
+                "outline": np.round(m.outline_at(sim.world_time), 3).tolist(),
+                "color": list(m.color),
+            }
+            for m in sim.world.moving
+        ]
+        return {
+            "kind": "update",
+            "time": round(sim.time, 3),
+            "paused": self.sim_node.paused,
+            "robots": robots,
+            "movers": movers,
+        }
+
+    def _topics(self, prefix: str) -> dict[str, str]:
+        resolve = self.sim_node.node.resolve_name
+        return {
+            "cmd_vel": resolve(prefix + "cmd_vel"),
+            "color": resolve(prefix + "camera/color/image_raw"),
+            "depth": resolve(prefix + "camera/depth/image_rect_raw"),
+        }
+
+    def publish(self, _sim_time: float) -> None:
+        """Send robots, trails, scans and movers to the open pages (sim lock held; throttled)."""
+        if self.channel.listeners == 0:
+            return
+        now = time.monotonic()
+        if now - self._last_sent < UPDATE_PERIOD:
+            return
+        self._last_sent = now
+        self.channel.publish(self._update())
+
+
+def start_view(sim_node: SimNode, options: argparse.Namespace, log: NodeLog) -> Callable[[], None] | None:
+    """Serve the PuzzleBot page and the node graph for a running simulator, with the gateway (on the
+    simulator's own node: no extra node in the graph) as the pages' data path; returns the stop
+    function (None when the server cannot start: the error is logged)."""
+    node = sim_node.node
+    gateway = Gateway(GatewayOptions(node_name=node.name, sim_clock=False), node=node)
+    gateway.start()
+    web = WebApp(node.master_uri, node.name, options.host, options.port)
+    web.add_gateway(gateway)
+    view = PuzzlebotView(web, gateway, sim_node)
+    try:
+        url = web.start()
+    except OSError as exc:
+        gateway.shutdown()
+        log.error("cannot serve the simulator view on %s:%d: %s", options.host, options.port, exc)
+        return None
+    sim_node.view = view
+    print(f"puzzlebot_sim view: {url}puzzlebot   node graph: {url}", flush=True)
+    if not options.no_browser:
+        open_if_display(url + "puzzlebot")
+
+    def stop() -> None:
+        sim_node.view = None
+        web.stop()
+        gateway.shutdown()
+
+    return stop
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``rosrun puzzlebot_sim sim_node``: the simulator (:mod:`ninjemys.sim.puzzlebot_node`) with its view."""
+    from ninjemys.sim import puzzlebot_node
+
+    return puzzlebot_node.main(argv, view=start_view)
+
+
+console_main = entry(main)
+
+
+if __name__ == "__main__":
+    console_main()
