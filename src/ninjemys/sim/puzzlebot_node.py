@@ -569,7 +569,9 @@ class SimNode:
             gt.child_frame_id = io.frame("base_link")
             gp = gt.pose.pose
             gp.position.x, gp.position.y = r.x, r.y
-            gp.orientation.x, gp.orientation.y, gp.orientation.z, gp.orientation.w = quaternion_from_yaw(r.yaw)
+            gp.orientation.x, gp.orientation.y, gp.orientation.z, gp.orientation.w = quaternion_from_yaw(
+                r.yaw
+            )
             gt.twist.twist.linear.x = r.v
             gt.twist.twist.angular.z = r.w
             pubs["ground_truth"].publish(gt)
