@@ -201,3 +201,20 @@ def test_final_turn_is_progress_only_while_the_heading_error_shrinks():
         t += 0.05
         fsm.cycle(t, (0.0, 0.0, yaw), (0.0, 0.0, yaw), (0.0, 0.0))
     assert fsm.state == CLEARING and 1.8 < t - stalled < 2.2  # from the last 0.05 rad of progress
+
+
+def test_the_state_machine_imports_no_ros_socket_or_thread():
+    """The brain stays testable without a process: no node, rospy, socket or thread below it."""
+    import ast
+    import importlib.util
+
+    path = importlib.util.find_spec("ninjemys.nav.move_base").origin
+    tree = ast.parse(open(path, encoding="utf-8").read())
+    names = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            names.update(a.name for a in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module:
+            names.add(node.module)
+    banned = ("rospy", "ninjemys.node", "socket", "threading", "ninjemys.net", "_thread", "asyncio")
+    assert not [n for n in names if n.startswith(banned)], names
