@@ -112,6 +112,9 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
             "robot_state_publisher": ("ninjemys.robot.state_publisher:main", ()),
             "state_publisher": ("ninjemys.robot.state_publisher:legacy_main", ()),
         },
+        "joint_state_publisher": {
+            "joint_state_publisher": ("ninjemys.robot.joint_state_publisher:main", ()),
+        },
         "xacro": {
             "xacro": ("ninjemys.tools.xacro:main", ()),
             "xacro.py": ("ninjemys.tools.xacro:main", ()),

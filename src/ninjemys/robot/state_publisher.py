@@ -14,15 +14,13 @@ have, with one warning per new set of unknown names (ROS 1 ignores them silently
 
 from __future__ import annotations
 
-import sys
 import threading
 from collections.abc import Callable
 from typing import Any
 
-from ninjemys.errors import NinjemysError, ShutdownError
+from ninjemys.errors import NinjemysError
 from ninjemys.idl.loader import get_message_class
-from ninjemys.node import Node
-from ninjemys.node.cli_args import parse_args
+from ninjemys.node.run import run_node
 from ninjemys.robot.kinematics import Joint, RobotModel, URDFError, parse_urdf
 from ninjemys.rostime import Duration, Time
 
@@ -147,30 +145,8 @@ def load_model(node: Any) -> RobotModel:
 
 def main(argv: list[str] | None = None, legacy: bool = False) -> int:
     """``rosrun robot_state_publisher robot_state_publisher`` (and the legacy ``state_publisher``)."""
-    import signal
 
-    argv = sys.argv[1:] if argv is None else argv
-    args = parse_args([sys.argv[0], *argv])
-    try:
-        node = Node(
-            args.node_name("robot_state_publisher"),
-            namespace=args.namespace,
-            remappings=args.remappings,
-            master_uri=args.master_uri,
-            params=args.private_params,
-            log_file=args.log_file,
-        )
-    except NinjemysError as exc:
-        print(f"robot_state_publisher: {exc}", file=sys.stderr)
-        return 1
-
-    def on_signal(_signum: int, _frame: Any) -> None:
-        threading.Thread(target=node.shutdown, args=("signal",), name="shutdown", daemon=True).start()
-
-    if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGINT, on_signal)
-        signal.signal(signal.SIGTERM, on_signal)
-    try:
+    def build(node: Any) -> int:
         if legacy:
             node.log.warn(
                 "The 'state_publisher' executable is deprecated. Please use 'robot_state_publisher' instead"
@@ -181,12 +157,9 @@ def main(argv: list[str] | None = None, legacy: bool = False) -> int:
             node.log.error("%s", exc)
             return 1
         StatePublisher(node, model, lambda text: node.log.warn("%s", text)).start()
-        node.spin()
-    except ShutdownError:
-        pass
-    finally:
-        node.shutdown("exit")
-    return 0
+        return 0
+
+    return run_node("robot_state_publisher", argv, build)
 
 
 def legacy_main(argv: list[str] | None = None) -> int:
