@@ -138,7 +138,7 @@ def test_same_joint_states_as_debians_with_a_source(master) -> None:
         _run(["/usr/bin/python3", str(DEBIAN_JSP), "__ns:=/debian", "__name:=jsp"], ros1),
     ]
     try:
-        for ns, pub in sources.items():
+        for pub in sources.values():
             msg = JointState(
                 name=["finger", "spin", "nope"], position=[0.03, 1.25, 5.0], velocity=[0.5, 0.1, 0.0]
             )
