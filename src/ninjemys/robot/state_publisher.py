@@ -21,7 +21,8 @@ from typing import Any
 from ninjemys.errors import NinjemysError
 from ninjemys.idl.loader import get_message_class
 from ninjemys.node.run import run_node
-from ninjemys.robot.kinematics import Joint, RobotModel, URDFError, parse_urdf
+from ninjemys.robot.kinematics import MOVING, Joint, RobotModel, URDFError, parse_urdf
+from ninjemys.robot.tf_wire import Layout, WireJoint
 from ninjemys.rostime import Duration, Time
 
 
@@ -51,8 +52,14 @@ class StatePublisher:
         for joint in model.joints.values():
             if joint.mimic:
                 self.mimics.setdefault(joint.mimic.joint, []).append(joint)
-        self.last_published: dict[str, Time] = {}
-        self.last_stamp: Time | None = None
+        self.interval_ns = self.interval.to_nsec()
+        self.wire = {
+            j.name: WireJoint(j, resolve_frame(self.prefix, j.parent), resolve_frame(self.prefix, j.child))
+            for j in model.joints.values()
+        }
+        self.plans: dict[tuple[str, ...], tuple[tuple[str, ...], Layout | None, tuple[Any, ...]]] = {}
+        self.last_published: dict[str, int] = {}
+        self.last_stamp: int | None = None
         self.unknown_seen: set[frozenset[str]] = set()
         self.lock = threading.Lock()
         self.tf = node.publisher("/tf", self.TFMessage, queue_size=100)
@@ -72,7 +79,7 @@ class StatePublisher:
         self.tf.publish(self._message(self.model.fixed, {}, stamp))
 
     def on_joint_state(self, msg: Any) -> None:
-        names, positions = list(msg.name), list(msg.position)
+        names, positions = msg.name, msg.position
         if len(names) != len(positions):
             if not positions:
                 self.warn(
@@ -82,6 +89,38 @@ class StatePublisher:
             else:
                 self.warn("Robot state publisher ignored an invalid JointState message")
             return
+        key = tuple(names)
+        plan = self.plans.get(key)
+        if plan is None:
+            plan = self._plan(key)
+        known, layout, mimics = plan
+        stamp = msg.header.stamp
+        secs, nsecs = stamp.secs, stamp.nsecs
+        now = secs * 1_000_000_000 + nsecs
+        with self.lock:
+            if self.last_stamp is not None and now < self.last_stamp:
+                self.warn(
+                    "Moved backwards in time (probably because ROS clock was reset), re-publishing joint transforms!"
+                )
+                self.last_published.clear()
+            self.last_stamp = now
+            if not known:
+                return
+            last = self.last_published
+            oldest = min([last.get(n, 0) for n in known])
+            if not (self.ignore_timestamp or now > oldest + self.interval_ns):
+                return
+            for name in known:
+                last[name] = now
+        if layout is None:
+            return
+        values = dict(zip(names, positions, strict=True))
+        for source, name, multiplier, offset in mimics:
+            values[name] = values[source] * multiplier + offset
+        self.tf.publish_raw(layout.pack(values, secs, nsecs))
+
+    def _plan(self, names: tuple[str, ...]) -> tuple[tuple[str, ...], Layout | None, tuple[Any, ...]]:
+        """What a message naming ``names`` publishes: worked out once per list of names."""
         joints = self.model.joints
         unknown = frozenset(n for n in names if n not in joints)
         if unknown and unknown not in self.unknown_seen:
@@ -89,32 +128,19 @@ class StatePublisher:
             self.warn(
                 f"joint_states names joint(s) the robot does not have, ignored: {', '.join(sorted(unknown))}"
             )
-        stamp = msg.header.stamp
-        with self.lock:
-            if self.last_stamp is not None and stamp < self.last_stamp:
-                self.warn(
-                    "Moved backwards in time (probably because ROS clock was reset), re-publishing joint transforms!"
-                )
-                self.last_published.clear()
-            self.last_stamp = stamp
-            known = [n for n in names if n in joints]
-            if not known:
-                return
-            oldest = min((self.last_published.get(n, Time(0)) for n in known), default=Time(0))
-            if not (self.ignore_timestamp or stamp > oldest + self.interval):
-                return
-            for name in known:
-                self.last_published[name] = stamp
-        values = {n: float(p) for n, p in zip(names, positions, strict=True) if n in joints}
-        moving = [joints[n] for n in values if joints[n].type in ("revolute", "continuous", "prismatic")]
-        for name in list(values):
+        known = tuple(dict.fromkeys(n for n in names if n in joints))
+        moving = [self.wire[n] for n in known if joints[n].type in MOVING]
+        mimics = []
+        for name in known:
             for mimic in self.mimics.get(name, ()):
                 assert mimic.mimic is not None
-                values[mimic.name] = values[name] * mimic.mimic.multiplier + mimic.mimic.offset
+                mimics.append((name, mimic.name, mimic.mimic.multiplier, mimic.mimic.offset))
                 if mimic.type != "fixed":
-                    moving.append(mimic)
-        if moving:
-            self.tf.publish(self._message(moving, values, stamp))
+                    moving.append(self.wire[mimic.name])
+        plan = (known, Layout(moving) if moving else None, tuple(mimics))
+        if len(self.plans) < 64:  # a stream keeps one list of names; a bounded cache for odd ones
+            self.plans[names] = plan
+        return plan
 
     def _message(self, joints: list[Joint], values: dict[str, float], stamp: Time) -> Any:
         transforms = []
