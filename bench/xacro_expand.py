@@ -52,7 +52,7 @@ def description(links: int) -> str:
     return (
         '<?xml version="1.0"?>\n<robot name="bench" xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
         '  <xacro:arg name="gripper" default="true"/>\n'
-        "  <xacro:property name=\"dims\" value=\"${xacro.load_yaml('$(find bench_robot)/urdf/dims.yaml')}\"/>\n"
+        '  <xacro:property name="dims" value="${xacro.load_yaml(\'$(find bench_robot)/urdf/dims.yaml\')}"/>\n'
         '  <xacro:include filename="$(find bench_robot)/urdf/segment.xacro"/>\n'
         '  <link name="link_0"/>\n'
         f"{body}"

@@ -24,14 +24,20 @@ GOOD = """<robot name="arm">
 </robot>
 """
 BAD = {
-    "no_limits": ('<robot name="x">\n<link name="a"/><link name="b"/>\n'
-                  '<joint name="j" type="revolute"><parent link="a"/><child link="b"/></joint>\n</robot>\n',
-                  "Joint [j] is of type REVOLUTE but it does not specify limits", 3),
+    "no_limits": (
+        '<robot name="x">\n<link name="a"/><link name="b"/>\n'
+        '<joint name="j" type="revolute"><parent link="a"/><child link="b"/></joint>\n</robot>\n',
+        "Joint [j] is of type REVOLUTE but it does not specify limits",
+        3,
+    ),
     "no_links": ('<robot name="x">\n</robot>\n', "No link elements found in urdf file", 1),
     "malformed": ('<robot name="x">\n<link name="a">\n</robot>\n', "malformed XML", 3),
-    "unknown_link": ('<robot name="x">\n<link name="a"/>\n<link name="c"/>\n'
-                     '<joint name="j" type="fixed"><parent link="a"/><child link="b"/></joint>\n</robot>\n',
-                     "child link [b] of joint [j] not found", 4),
+    "unknown_link": (
+        '<robot name="x">\n<link name="a"/>\n<link name="c"/>\n'
+        '<joint name="j" type="fixed"><parent link="a"/><child link="b"/></joint>\n</robot>\n',
+        "child link [b] of joint [j] not found",
+        4,
+    ),
 }
 
 

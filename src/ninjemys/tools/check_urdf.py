@@ -15,12 +15,14 @@ import xml.etree.ElementTree as ET
 import xml.parsers.expat
 from dataclasses import dataclass, field
 
+from ninjemys.errors import NinjemysError
+
 USAGE = "Expect URDF xml file to parse"
 FAILED = "ERROR: Model Parsing the xml failed"
 JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 
 
-class CheckFailed(Exception):
+class CheckFailed(NinjemysError):
     """One urdfdom-style error: the reason and the URDF line it is about."""
 
     def __init__(self, reason: str, line: int) -> None:
@@ -81,7 +83,9 @@ def check(text: str) -> Tree:
     roots = [link for link in links if link not in parent_of]
     if len(roots) != 1:
         names = ", ".join(roots) if roots else "none"
-        raise CheckFailed(f"Failed to find root link: {len(roots)} links have no parent ({names})", lines[id(root)])
+        raise CheckFailed(
+            f"Failed to find root link: {len(roots)} links have no parent ({names})", lines[id(root)]
+        )
     return Tree(name=name, root=roots[0], children=children)
 
 
