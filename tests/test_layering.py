@@ -100,6 +100,7 @@ LAYERS: dict[str, str] = {
     "dynamic_reconfigure.generator": "packages",
     "laser_geometry": "libs",
     "cv_bridge": "libs",
+    "robot": "libs",
     "maps": "libs",
     "launch": "libs",
     "bag": "libs",

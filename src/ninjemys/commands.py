@@ -10,7 +10,7 @@ from __future__ import annotations
 import os
 import shutil
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 
 from ninjemys.errors import MasterUnreachable, NinjemysError
 
@@ -24,6 +24,18 @@ def command_path(command: str) -> str:
     if found is None:
         raise FileNotFoundError(f"ninjemys command {command!r} is not installed next to {sys.executable}")
     return found
+
+
+def with_our_commands(env: Mapping[str, str]) -> dict[str, str]:
+    """``env`` with the directory of our console scripts first on PATH: what rosrun and roslaunch
+    start (``$(find xacro)/xacro``, a shell script calling ``rostopic``) finds ninjemys' commands even
+    when the venv is not activated, as ROS 1's are on PATH after its setup.bash."""
+    out = dict(env)
+    bindir = os.path.dirname(sys.executable)
+    path = out.get("PATH", "")
+    if bindir not in path.split(os.pathsep):
+        out["PATH"] = os.pathsep.join([bindir, path]) if path else bindir
+    return out
 
 
 def error(message: str) -> None:

@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ninjemys.commands import with_our_commands
 from ninjemys.errors import LaunchError, NinjemysError
 from ninjemys.launch.dom import Element, parse_xml
 from ninjemys.launch.plan import LaunchPlan, Machine, NodeSpec, SetupCommand
@@ -397,7 +398,13 @@ class _Loader:
                     raise LaunchError(f"cannot read binfile [{binfile}]: {exc.strerror}") from None
             assert command is not None
             try:
-                proc = subprocess.run(shlex.split(command), stdout=subprocess.PIPE, check=False, timeout=60)
+                proc = subprocess.run(
+                    shlex.split(command),
+                    stdout=subprocess.PIPE,
+                    check=False,
+                    timeout=60,
+                    env=with_our_commands(self.env),
+                )
             except FileNotFoundError:
                 raise LaunchError(
                     f"Cannot load command parameter [{name}]: no such command [{command}]"

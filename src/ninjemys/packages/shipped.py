@@ -108,6 +108,17 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
             "view_frames": ("ninjemys.tools.view_frames:tf_main", ()),
         },
         "tf2_tools": {"view_frames.py": ("ninjemys.tools.view_frames:main", ())},
+        "robot_state_publisher": {
+            "robot_state_publisher": ("ninjemys.robot.state_publisher:main", ()),
+            "state_publisher": ("ninjemys.robot.state_publisher:legacy_main", ()),
+        },
+        "joint_state_publisher": {
+            "joint_state_publisher": ("ninjemys.robot.joint_state_publisher:main", ()),
+        },
+        "xacro": {
+            "xacro": ("ninjemys.tools.xacro:main", ()),
+            "xacro.py": ("ninjemys.tools.xacro:main", ()),
+        },
         "rosbag": {
             sub: ("ninjemys.tools.rosbag:main", (sub,))
             for sub in (

@@ -11,6 +11,7 @@ import os
 import shlex
 import sys
 
+from ninjemys.commands import with_our_commands
 from ninjemys.errors import PackageError
 from ninjemys.packages.discovery import PackageIndex
 from ninjemys.packages.executables import find_executable
@@ -54,7 +55,7 @@ def main(argv: list[str] | None = None) -> int:
     sys.stdout.flush()
     sys.stderr.flush()
     try:
-        os.execvp(command[0], command)
+        os.execvpe(command[0], command, with_our_commands(os.environ))
     except OSError as exc:
         print(f"[rosrun] cannot execute {command[0]}: {exc.strerror}", file=sys.stderr)
         return 1

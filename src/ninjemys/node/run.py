@@ -1,0 +1,60 @@
+"""Running an in-house node as a process: name and remappings from the command line, Ctrl-C and
+SIGTERM, spin until shutdown. One place for what every ``main()`` of a shipped node does."""
+
+from __future__ import annotations
+
+import signal
+import sys
+import threading
+from collections.abc import Callable
+from typing import Any
+
+from ninjemys.errors import NinjemysError, ShutdownError
+from ninjemys.node.cli_args import parse_args
+from ninjemys.node.node import Node
+
+
+def start_node(default_name: str, argv: list[str] | None = None) -> Node:
+    """A core Node named as ROS 1 names it from ``argv`` (``__name:=``, ``__ns:=``, remappings,
+    ``_private:=value`` parameters, ``__log:=``)."""
+    argv = sys.argv[1:] if argv is None else argv
+    args = parse_args([sys.argv[0], *argv])
+    return Node(
+        args.node_name(default_name),
+        namespace=args.namespace,
+        remappings=args.remappings,
+        master_uri=args.master_uri,
+        params=args.private_params,
+        log_file=args.log_file,
+    )
+
+
+def run_node(default_name: str, argv: list[str] | None, build: Callable[[Node], Any]) -> int:
+    """Start the node, ``build(node)`` its parts, spin until Ctrl-C, SIGTERM or ``rosnode kill``.
+
+    ``build`` returns a non-zero int to stop at once with that exit code (a required parameter that
+    is missing). A signal shuts the node down from a ``shutdown`` thread, not from the interrupted
+    main thread, which may hold locks the shutdown needs.
+    """
+    try:
+        node = start_node(default_name, argv)
+    except NinjemysError as exc:
+        print(f"{default_name}: {exc}", file=sys.stderr)
+        return 1
+
+    def on_signal(_signum: int, _frame: Any) -> None:
+        threading.Thread(target=node.shutdown, args=("signal",), name="shutdown", daemon=True).start()
+
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, on_signal)
+        signal.signal(signal.SIGTERM, on_signal)
+    try:
+        code = build(node)
+        if isinstance(code, int) and code:
+            return code
+        node.spin()
+    except ShutdownError:
+        pass
+    finally:
+        node.shutdown("exit")
+    return 0

@@ -1,0 +1,271 @@
+"""robot_state_publisher: a moving 6-joint arm with a mimic joint gives the transforms Debian's C++
+robot_state_publisher gives (to 1e-9, quaternion signs included), fixed joints latched on
+/tf_static, tf_prefix, unknown joints ignored with one warning, a bad URDF named; and the URDF
+reader's errors say which element and why."""
+
+from __future__ import annotations
+
+import math
+import os
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from ninjemys import testing
+from ninjemys.idl.loader import get_message_class
+from ninjemys.node import Node
+from ninjemys.robot.kinematics import URDFError, parse_urdf, quaternion, rpy_matrix
+from ninjemys.rostime import Time
+
+DEBIAN_RSP = Path("/usr/lib/robot_state_publisher/robot_state_publisher")
+
+ARM = """<?xml version="1.0"?>
+<robot name="arm">
+  <link name="base_link"/><link name="shoulder"/><link name="upper"/><link name="fore"/>
+  <link name="wrist"/><link name="slider"/><link name="hand"/><link name="finger_l"/><link name="finger_r"/>
+  <link name="camera"/>
+  <joint name="j1" type="continuous"><parent link="base_link"/><child link="shoulder"/>
+    <origin xyz="0 0 0.1" rpy="0 0 0.3"/><axis xyz="0 0 1"/></joint>
+  <joint name="j2" type="revolute"><parent link="shoulder"/><child link="upper"/>
+    <origin xyz="0.05 0 0.2" rpy="1.2 -0.4 2.9"/><axis xyz="0 1 1"/><limit lower="-2" upper="2" effort="1" velocity="1"/></joint>
+  <joint name="j3" type="revolute"><parent link="upper"/><child link="fore"/>
+    <origin xyz="0 0.3 0" rpy="3.14159 0 0"/><axis xyz="1 0 0"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+  <joint name="j4" type="continuous"><parent link="fore"/><child link="wrist"/>
+    <origin xyz="0.25 0 0" rpy="0 1.5707963 0"/><axis xyz="0.3 -0.5 0.8"/></joint>
+  <joint name="j5" type="prismatic"><parent link="wrist"/><child link="slider"/>
+    <origin xyz="0 0 0.05" rpy="0.1 0.2 0.3"/><axis xyz="0 0 1"/><limit lower="0" upper="0.2" effort="1" velocity="1"/></joint>
+  <joint name="j6" type="revolute"><parent link="slider"/><child link="hand"/>
+    <origin xyz="0 0 0.02" rpy="-2.5 0.7 -1.1"/><axis xyz="0 1 0"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+  <joint name="finger_l_joint" type="prismatic"><parent link="hand"/><child link="finger_l"/>
+    <origin xyz="0 0.02 0.05"/><axis xyz="0 1 0"/><limit lower="0" upper="0.04" effort="1" velocity="1"/></joint>
+  <joint name="finger_r_joint" type="prismatic"><parent link="hand"/><child link="finger_r"/>
+    <origin xyz="0 -0.02 0.05"/><axis xyz="0 1 0"/><limit lower="-0.04" upper="0" effort="1" velocity="1"/>
+    <mimic joint="finger_l_joint" multiplier="-1.0" offset="0.001"/></joint>
+  <joint name="camera_joint" type="fixed"><parent link="hand"/><child link="camera"/>
+    <origin xyz="0.01 0 0.03" rpy="-1.5707963 0 -1.5707963"/></joint>
+</robot>
+"""
+MOVING = ["j1", "j2", "j3", "j4", "j5", "j6", "finger_l_joint"]
+
+
+def test_quaternion_follows_kdls_branches() -> None:
+    for rpy in [
+        (0, 0, 0),
+        (math.pi, 0, 0),
+        (0, math.pi, 0),
+        (0, 0, math.pi),
+        (3.0, -1.2, 0.4),
+        (-2.9, 0.1, 3.1),
+    ]:
+        x, y, z, w = quaternion(rpy_matrix(*rpy))
+        assert abs(x * x + y * y + z * z + w * w - 1.0) < 1e-12
+    assert quaternion(rpy_matrix(0, 0, math.pi))[2] == pytest.approx(1.0)
+
+
+def test_urdf_errors_name_the_element_and_reason() -> None:
+    with pytest.raises(URDFError, match=r"robot.urdf:3:\d+: malformed XML"):
+        parse_urdf('<robot name="r">\n<link name="a"/>\n<joint </robot>', source="robot.urdf")
+    with pytest.raises(URDFError, match="joint 'j' names link 'nowhere'"):
+        parse_urdf(
+            '<robot name="r"><link name="a"/><joint name="j" type="fixed"><parent link="a"/>'
+            '<child link="nowhere"/></joint></robot>'
+        )
+    with pytest.raises(URDFError, match=r"joint 'j' <origin xyz>: '1 2' is not 3"):
+        parse_urdf(
+            '<robot name="r"><link name="a"/><link name="b"/><joint name="j" type="fixed"><parent link="a"/>'
+            '<child link="b"/><origin xyz="1 2"/></joint></robot>'
+        )
+    with pytest.raises(URDFError, match="unknown type 'hinge'"):
+        parse_urdf(
+            '<robot name="r"><link name="a"/><link name="b"/><joint name="j" type="hinge"><parent link="a"/>'
+            '<child link="b"/></joint></robot>'
+        )
+
+
+class _Collector:
+    """Every transform seen on a tf topic, by (child, stamp)."""
+
+    def __init__(self) -> None:
+        self.seen: dict[tuple[str, int], tuple[str, tuple[float, ...]]] = {}
+        self.lock = threading.Lock()
+
+    def __call__(self, msg) -> None:  # noqa: ANN001
+        with self.lock:
+            for t in msg.transforms:
+                tr, q = t.transform.translation, t.transform.rotation
+                key = (t.child_frame_id, t.header.stamp.to_nsec())
+                self.seen[key] = (t.header.frame_id, (tr.x, tr.y, tr.z, q.x, q.y, q.z, q.w))
+
+    def wait(self, count: int, timeout: float = 30.0) -> None:
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            with self.lock:
+                if len(self.seen) >= count:
+                    return
+            time.sleep(0.05)
+        raise AssertionError(f"only {len(self.seen)} of {count} transforms arrived")
+
+
+def _start(argv: list[str], env: dict[str, str]) -> subprocess.Popen[bytes]:
+    return subprocess.Popen(argv, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+
+
+def _positions(k: int) -> list[float]:
+    return [0.3 * k - 1.0, 0.2 * k - 0.9, -0.25 * k + 1.1, 0.4 * k, 0.01 * k, -0.15 * k + 0.5, 0.003 * k]
+
+
+@pytest.fixture
+def master(tmp_path: Path):
+    env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_LOG_DIR=str(tmp_path / "log"))
+    with testing.run_master(env=env) as uri:
+        yield uri, dict(env, ROS_MASTER_URI=uri, ROS_HOSTNAME="localhost")
+
+
+def _run_arm(master, extra_nodes: list[list[str]], topics: list[str], messages: int, static: bool = True):
+    uri, env = master
+    node = Node("rsp_check", master_uri=uri)
+    procs: list[subprocess.Popen[bytes]] = []
+    try:
+        node.set_param("/robot_description", ARM)
+        node.set_param("/tf_prefix_test/tf_prefix", "")
+        TFMessage = get_message_class("tf2_msgs/TFMessage")
+        JointState = get_message_class("sensor_msgs/JointState")
+        collectors = {t: _Collector() for t in topics}
+        for topic, collector in collectors.items():
+            node.subscriber(topic, TFMessage, collector, queue_size=1000)
+        pub = node.publisher("/joint_states", JointState, queue_size=100)
+        procs = [_start(argv, env) for argv in extra_nodes]
+        deadline = time.monotonic() + 30
+        while pub.get_num_connections() < len(extra_nodes):
+            assert time.monotonic() < deadline, "the state publishers did not subscribe"
+            time.sleep(0.05)
+        time.sleep(0.5)
+        for k in range(messages):
+            msg = JointState()
+            msg.header.stamp = Time(100 + k, 0)  # 1 s apart: never throttled by publish_frequency
+            msg.name = MOVING + (["not_a_joint"] if k % 2 else [])
+            msg.position = _positions(k) + ([9.0] if k % 2 else [])
+            pub.publish(msg)
+            time.sleep(0.02)
+        return collectors, procs
+    finally:
+        node.shutdown("test done")
+        for proc in procs:
+            proc.terminate()
+        for proc in procs:
+            try:
+                proc.wait(10)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()
+
+
+def _ours(*args: str) -> list[str]:
+    return [sys.executable, "-m", "ninjemys.packages.run_shipped", "robot_state_publisher", *args]
+
+
+def test_ours_publishes_every_moving_joint_mimic_and_fixed(master) -> None:
+    collectors, procs = _run_arm(
+        master, [_ours("robot_state_publisher", "__name:=rsp")], ["/tf", "/tf_static"], 5
+    )
+    tf, static = collectors["/tf"], collectors["/tf_static"]
+    tf.wait(5 * 8)
+    static.wait(1)
+    children = {child for child, _ in tf.seen}
+    assert children == {"shoulder", "upper", "fore", "wrist", "slider", "hand", "finger_l", "finger_r"}
+    assert {child for child, _ in static.seen} == {"camera"}
+    _, left = tf.seen[("finger_l", 103 * 10**9)]
+    _, right = tf.seen[("finger_r", 103 * 10**9)]
+    assert left[1] == pytest.approx(0.02 + 0.009) and right[1] == pytest.approx(-0.02 - 0.009 + 0.001)
+    output = procs[0].stdout.read().decode() if procs[0].stdout else ""
+    assert output.count("not_a_joint") == 1, output
+
+
+def test_tf_prefix_and_missing_description(master, tmp_path: Path) -> None:
+    uri, env = master
+    node = Node("rsp_prefix_check", master_uri=uri)
+    try:
+        node.set_param("/robot_description", ARM)
+        node.set_param("/robo1/tf_prefix", "robo1")
+        TFMessage = get_message_class("tf2_msgs/TFMessage")
+        static = _Collector()
+        node.subscriber("/tf_static", TFMessage, static, queue_size=10)
+        proc = _start(_ours("robot_state_publisher", "__ns:=/robo1", "__name:=rsp"), env)
+        try:
+            static.wait(1)
+            assert list(static.seen.values())[0][0] == "robo1/hand"
+            assert list(static.seen)[0][0] == "robo1/camera"
+        finally:
+            proc.terminate()
+            proc.wait(10)
+        node.delete_param("/robot_description")
+        bad = subprocess.run(
+            _ours("robot_state_publisher", "__name:=rsp2"),
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
+        assert bad.returncode == 1
+        assert "Could not find parameter robot_description" in bad.stdout + bad.stderr
+    finally:
+        node.shutdown("test done")
+
+
+@pytest.mark.ros1
+@pytest.mark.skipif(not DEBIAN_RSP.exists(), reason="Debian's ros-robot-state-publisher is not installed")
+def test_same_transforms_as_debians_robot_state_publisher(master) -> None:
+    debian_env_args = ["/tf:=/tf_debian", "/tf_static:=/tf_static_debian", "__name:=rsp_debian"]
+    ours_args = ["/tf:=/tf_ours", "/tf_static:=/tf_static_ours", "__name:=rsp_ours"]
+    nodes = [[str(DEBIAN_RSP), *debian_env_args], _ours("robot_state_publisher", *ours_args)]
+    topics = ["/tf_debian", "/tf_ours", "/tf_static_debian", "/tf_static_ours"]
+    messages = 12
+    collectors, _ = _run_arm(master, nodes, topics, messages)
+    collectors["/tf_debian"].wait(messages * 8)
+    collectors["/tf_ours"].wait(messages * 8)
+    theirs, ours = collectors["/tf_debian"].seen, collectors["/tf_ours"].seen
+    assert set(theirs) == set(ours)
+    for key, (parent, values) in theirs.items():
+        assert ours[key][0] == parent
+        assert max(abs(a - b) for a, b in zip(values, ours[key][1], strict=True)) < 1e-9, key
+    collectors["/tf_static_debian"].wait(1)
+    ((key, (parent, values)),) = collectors["/tf_static_debian"].seen.items()
+    ((okey, (oparent, ovalues)),) = collectors["/tf_static_ours"].seen.items()
+    assert (key[0], parent) == (okey[0], oparent)
+    assert max(abs(a - b) for a, b in zip(values, ovalues, strict=True)) < 1e-9
+
+
+def test_a_malformed_joint_state_is_reported_and_the_node_goes_on(master) -> None:
+    uri, env = master
+    node = Node("rsp_bad_input", master_uri=uri)
+    try:
+        node.set_param("/robot_description", ARM)
+        TFMessage, JointState = (
+            get_message_class("tf2_msgs/TFMessage"),
+            get_message_class("sensor_msgs/JointState"),
+        )
+        tf = _Collector()
+        node.subscriber("/tf", TFMessage, tf, queue_size=100)
+        pub = node.publisher("/joint_states", JointState, queue_size=10)
+        proc = _start(_ours("robot_state_publisher", "__name:=rsp"), env)
+        try:
+            deadline = time.monotonic() + 30
+            while pub.get_num_connections() < 1:
+                assert time.monotonic() < deadline
+                time.sleep(0.05)
+            pub.publish_raw(b"\x00\x01\x02")  # not a JointState
+            pub.publish_raw(b"\x00" * 12 + b"\xff\xff\xff\x7f")  # a frame_id longer than the message
+            good = JointState(name=MOVING, position=_positions(1))
+            good.header.stamp = Time(7, 0)
+            pub.publish(good)
+            tf.wait(8)
+        finally:
+            proc.terminate()
+            out = proc.communicate(timeout=10)[0].decode()
+        assert out.count("ignored a malformed JointState message") == 2, out
+    finally:
+        node.shutdown("test done")
