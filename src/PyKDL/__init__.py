@@ -21,6 +21,8 @@ __all__ = [
     "Vector",
     "Wrench",
     "addDelta",
+    "changeBase",
+    "changeRefPoint",
     "diff",
     "dot",
 ]
@@ -784,3 +786,13 @@ def SetToZero(v: Any) -> None:
         SetToZero(v._b)
     else:
         raise TypeError("SetToZero(): argument did not match any overloaded call")
+
+
+def changeRefPoint(screw: Any, v_base_AB: Vector) -> Any:
+    """A Twist or Wrench with its reference point moved by ``v_base_AB``."""
+    return screw.RefPoint(v_base_AB)
+
+
+def changeBase(arg: Any, rotation: Rotation) -> Any:
+    """A Vector, Twist or Wrench expressed in another base: ``rotation * arg``."""
+    return rotation * arg
