@@ -10,7 +10,8 @@ PyKDL.
 from __future__ import annotations
 
 import math
-from typing import Any, Iterator
+from collections.abc import Iterator
+from typing import Any
 
 __all__ = [
     "Equal",
@@ -254,7 +255,17 @@ class Rotation:
         s0, s1, s2 = a0 * st, a1 * st, a2 * st
         v01, v02, v12 = v0 * a1, v0 * a2, v1 * a2
         return Rotation._raw(
-            [ct + v0 * a0, -s2 + v01, s1 + v02, s2 + v01, ct + v1 * a1, -s0 + v12, -s1 + v02, s0 + v12, ct + v2 * a2]
+            [
+                ct + v0 * a0,
+                -s2 + v01,
+                s1 + v02,
+                s2 + v01,
+                ct + v1 * a1,
+                -s0 + v12,
+                -s1 + v02,
+                s0 + v12,
+                ct + v2 * a2,
+            ]
         )
 
     @staticmethod
@@ -477,6 +488,8 @@ class Frame:
     """A rotation ``M`` and a position ``p``: the pose of a frame in another."""
 
     __slots__ = ("M", "p")
+    M: Rotation
+    p: Vector
 
     def __init__(self, *args: Any) -> None:
         M, p = Rotation(), Vector()
@@ -582,6 +595,8 @@ class _Screw:
     """A pair of vectors indexed 0..5 (Twist: vel, rot; Wrench: force, torque)."""
 
     __slots__ = ("_a", "_b")
+    _a: Vector
+    _b: Vector
     _names = ("", "")
 
     def __init__(self, *args: Any) -> None:
@@ -734,9 +749,9 @@ def Equal(a: Any, b: Any, eps: float = epsilon) -> bool:
     if isinstance(a, (int, float)) and isinstance(b, (int, float)):
         return abs(a - b) < eps
     if isinstance(a, Vector) and isinstance(b, Vector):
-        return all(abs(x - y) < eps for x, y in zip(a._d, b._d))
+        return all(abs(x - y) < eps for x, y in zip(a._d, b._d, strict=True))
     if isinstance(a, Rotation) and isinstance(b, Rotation):
-        return all(abs(x - y) < eps for x, y in zip(a._d, b._d))
+        return all(abs(x - y) < eps for x, y in zip(a._d, b._d, strict=True))
     if isinstance(a, Frame) and isinstance(b, Frame):
         return Equal(a.M, b.M, eps) and Equal(a.p, b.p, eps)
     if isinstance(a, _Screw) and type(a) is type(b):

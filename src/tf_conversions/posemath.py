@@ -9,8 +9,8 @@ from __future__ import annotations
 from typing import Any
 
 import numpy
+
 import rospy  # noqa: F401 - posemath's namespace in ROS 1 carries it
-import tf  # noqa: F401 - likewise
 from geometry_msgs.msg import Point, Pose, Quaternion  # noqa: F401 - likewise
 from PyKDL import *  # noqa: F403 - ROS 1's posemath re-exports PyKDL
 from PyKDL import Frame, Rotation, Vector

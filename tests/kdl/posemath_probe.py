@@ -4,9 +4,9 @@ import json
 import random
 
 import numpy
-from geometry_msgs.msg import Pose
 
 import tf_conversions.posemath as pm
+from geometry_msgs.msg import Pose
 
 
 class FakeCv:
@@ -49,7 +49,9 @@ def main():
                 "type": type(back).__name__ + type(m).__name__,
             }
         )
-    names = sorted(n for n in ("Frame", "Vector", "Rotation", "Twist", "Pose", "Point", "Quaternion") if hasattr(pm, n))
+    names = sorted(
+        n for n in ("Frame", "Vector", "Rotation", "Twist", "Pose", "Point", "Quaternion") if hasattr(pm, n)
+    )
     print(json.dumps({"rows": rows, "names": names}))
 
 

@@ -100,7 +100,8 @@ def main():
         "ident": repr(K.Frame.Identity()),
         "zero": repr(K.Twist.Zero()) + repr(K.Wrench.Zero()) + repr(K.Vector.Zero()),
         "rot180": list(K.Rotation.RotX(math.pi).GetQuaternion()),
-        "rot180b": [K.Rotation.RotY(math.pi).GetRotAngle()[0]] + vec(K.Rotation.RotY(math.pi).GetRotAngle()[1]),
+        "rot180b": [K.Rotation.RotY(math.pi).GetRotAngle()[0]]
+        + vec(K.Rotation.RotY(math.pi).GetRotAngle()[1]),
         "gimbal": list(K.Rotation.RPY(0.3, math.pi / 2, 0.2).GetRPY()),
         "xyz": [K.Vector(4, 5, 6).x(), K.Vector(4, 5, 6).y(), K.Vector(4, 5, 6).z()],
     }

@@ -34,7 +34,7 @@ def _close(path: str, a: object, b: object, problems: list[str]) -> None:
             _close(f"{path}.{key}", a[key], b[key], problems)
     elif isinstance(a, list):
         assert isinstance(b, list) and len(a) == len(b), f"{path}: {len(b)} items vs {len(a)}"
-        for i, (x, y) in enumerate(zip(a, b)):
+        for i, (x, y) in enumerate(zip(a, b, strict=True)):
             _close(f"{path}[{i}]", x, y, problems)
     elif isinstance(a, float) or isinstance(b, float):
         if abs(float(a) - float(b)) > 1e-12:  # type: ignore[arg-type]
