@@ -204,12 +204,7 @@ def main(argv: list[str] | None = None) -> int:
 
     def build(node: Any) -> int:
         params = _param_reader(node)
-        if params("use_gui", False):
-            node.log.error(
-                "The 'use_gui' parameter was specified, which is deprecated.  We'll attempt to find and run "
-                "the GUI, but if this fails you should install the 'joint_state_publisher_gui' package "
-                "instead and run that.  This backwards compatibility option will be removed in Noetic."
-            )
+        # ``~use_gui`` (Melodic's deprecated way to get the GUI) is ignored, as Noetic's 1.15 ignores it
         description = params("robot_description")
         if not isinstance(description, str):
             node.log.fatal("The robot_description parameter is required and not set.")
