@@ -51,7 +51,9 @@ class JointStatePublisherGui:
 
     def start(self) -> str:
         base = self.app.start()
-        query = urlencode([("description", self.description), ("input", self.input)])
+        query = urlencode(
+            [("description", self.description), ("input", self.input), ("ns", self.node.name + "/")]
+        )
         return f"{base}{PAGE.lstrip('/')}?{query}"
 
     def stop(self) -> None:

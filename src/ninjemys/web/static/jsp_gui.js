@@ -5,6 +5,7 @@ import { RosClient } from "/static/lib/rosclient.js";
 const params = new URLSearchParams(location.search);
 const descriptionParam = params.get("description") || "/robot_description";
 const inputTopic = params.get("input") || "/joint_state_publisher_gui/slider_input";
+const privateNs = params.get("ns") || "/joint_state_publisher_gui/";
 const ros = new RosClient();
 const msg = document.getElementById("jsp-msg");
 const box = document.getElementById("jsp-joints");
@@ -12,7 +13,7 @@ const sliders = new Map();
 window.jspGui = { sliders, ready: false };
 
 /** The free joints of a URDF: movable, with limits (continuous: -pi..pi), not mimicking another. */
-function freeJoints(xml) {
+function freeJoints(xml, { zeros = {}, dependent = {}, useMimic = true } = {}) {
   const doc = new DOMParser().parseFromString(xml, "application/xml");
   if (doc.querySelector("parsererror")) throw new Error(`${descriptionParam} is not well-formed XML`);
   const out = [];
@@ -20,7 +21,8 @@ function freeJoints(xml) {
     if (j.tagName !== "joint") continue;
     const type = j.getAttribute("type");
     if (!["revolute", "continuous", "prismatic"].includes(type)) continue;
-    if ([...j.children].some((c) => c.tagName === "mimic")) continue;
+    if (useMimic && [...j.children].some((c) => c.tagName === "mimic")) continue;
+    if (Object.prototype.hasOwnProperty.call(dependent, j.getAttribute("name"))) continue;
     const limit = [...j.children].find((c) => c.tagName === "limit");
     let lo = -Math.PI, hi = Math.PI;
     if (type !== "continuous") {
@@ -28,7 +30,8 @@ function freeJoints(xml) {
       lo = Number(limit.getAttribute("lower"));
       hi = Number(limit.getAttribute("upper"));
     }
-    const zero = lo > 0 || hi < 0 ? (lo + hi) / 2 : 0;
+    const given = Number(zeros[j.getAttribute("name")]);
+    const zero = given ? given : lo > 0 || hi < 0 ? (lo + hi) / 2 : 0;
     out.push({ name: j.getAttribute("name"), lo, hi, zero });
   }
   return out;
@@ -41,12 +44,21 @@ function publishAll(pub) {
 
 async function main() {
   await ros.ready();
-  const description = (await ros.getParameters([descriptionParam]))[descriptionParam];
+  // the node reads each of these as ~name, then name in its namespace: so does the page
+  const nodeNs = privateNs.replace(/[^/]+\/$/, "");
+  const names = ["dependent_joints", "zeros", "use_mimic_tags"].flatMap((n) => [privateNs + n, nodeNs + n]);
+  const got = await ros.getParameters([descriptionParam, ...names]);
+  const pick = (n, fallback) => got[privateNs + n] ?? got[nodeNs + n] ?? fallback;
+  const description = got[descriptionParam];
   if (typeof description !== "string") {
     msg.textContent = `parameter ${descriptionParam} is not set`;
     return;
   }
-  const joints = freeJoints(description);
+  const joints = freeJoints(description, {
+    zeros: pick("zeros", {}) || {},
+    dependent: pick("dependent_joints", {}) || {},
+    useMimic: pick("use_mimic_tags", true) !== false,
+  });
   const pub = ros.advertise(inputTopic, "sensor_msgs/JointState");
   for (const j of joints) {
     const row = document.createElement("label");
