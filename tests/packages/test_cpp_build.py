@@ -126,7 +126,13 @@ def workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
     env = {k: v for k, v in os.environ.items() if k not in ("ROS_PACKAGE_PATH", "CMAKE_PREFIX_PATH")}
     env.pop("NINJEMYS_CATKIN_CPP", None)
     result = subprocess.run(
-        [ninjemys_bin("catkin_make")], cwd=ws, env=env, capture_output=True, text=True, timeout=600, check=False
+        [ninjemys_bin("catkin_make")],
+        cwd=ws,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
     )
     assert result.returncode == 0, result.stdout + result.stderr
     assert "cpp_chat: C++ program(s) built by catkin's CMake: chatter cpp_chat_echo" in result.stdout
@@ -188,7 +194,9 @@ def test_cpp_talker_custom_message_to_python_listener(workspace: Path, master: s
 def test_python_talker_to_cpp_listener(workspace: Path, master: str) -> None:
     env = _env(workspace, master)
     echo = _start([ninjemys_bin("rosrun"), "cpp_chat", "cpp_chat_echo"], env)
-    pub = _start([ninjemys_bin("rostopic"), "pub", "-r", "10", "/chatter", "std_msgs/String", "data: from python"], env)
+    pub = _start(
+        [ninjemys_bin("rostopic"), "pub", "-r", "10", "/chatter", "std_msgs/String", "data: from python"], env
+    )
     try:
         heard = subprocess.run(
             [ninjemys_bin("rostopic"), "echo", "-n", "1", "/echo"],

@@ -74,7 +74,9 @@ def find_toolchain(env: Mapping[str, str]) -> tuple[Toolchain | None, str]:
     if missing:
         return None, "no " + ", no ".join(missing)
     # catkin's CMake runs catkin_pkg, which lives with the system Python, not necessarily ours
-    python = "/usr/bin/python3" if Path("/usr/bin/python3").is_file() else (shutil.which("python3") or "python3")
+    python = (
+        "/usr/bin/python3" if Path("/usr/bin/python3").is_file() else (shutil.which("python3") or "python3")
+    )
     assert cmake and compiler and toplevel
     return Toolchain(cmake, compiler, toplevel, python), ""
 
@@ -133,7 +135,7 @@ def build_cpp(
         f"-DCMAKE_CXX_COMPILER={toolchain.compiler}",
         "-DCATKIN_ENABLE_TESTING=OFF",
     ]
-    log(f'-- ~~  C++ packages through catkin\'s CMake: {" ".join(p.name for p in packages)}')
+    log(f"-- ~~  C++ packages through catkin's CMake: {' '.join(p.name for p in packages)}")
     _run(configure, build, env, 'Invoking "cmake" failed', log)
     jobs = jobs or max(1, os.cpu_count() or 1)
     _run(["make", f"-j{jobs}"], build, env, f'Invoking "make -j{jobs}" failed', log)
@@ -142,7 +144,9 @@ def build_cpp(
         directory = devel / "lib" / pkg.name
         if directory.is_dir():
             programs = [
-                p for p in sorted(directory.iterdir()) if p.is_file() and os.access(p, os.X_OK) and not p.suffix
+                p
+                for p in sorted(directory.iterdir())
+                if p.is_file() and os.access(p, os.X_OK) and not p.suffix
             ]
             if programs:
                 built[pkg.name] = programs
