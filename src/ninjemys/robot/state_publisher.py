@@ -19,6 +19,7 @@ import threading
 from collections.abc import Callable
 from typing import Any
 
+from ninjemys import names
 from ninjemys.errors import NinjemysError
 from ninjemys.idl.loader import get_message_class
 from ninjemys.node.run import run_node
@@ -192,11 +193,16 @@ class _JointEncoder:
 
 def load_model(node: Any) -> RobotModel:
     """The URDF on the parameter server (``robot_description``, searched up the namespace)."""
-    key = node.search_param("robot_description") or "robot_description"
+    plain = names.resolve_name("robot_description", node.name, {})
+    remapped = node.resolve_name("robot_description")  # roscpp's searchParam remaps the key first
+    if remapped != plain or node.has_param(plain):
+        key = remapped
+    else:
+        key = node.search_param("robot_description") or plain
     try:
         text = node.get_param(key)
     except NinjemysError:
-        raise URDFError(f"Could not find parameter {key} on parameter server") from None
+        raise URDFError("Could not find parameter robot_description on parameter server") from None
     if not isinstance(text, str):
         raise URDFError(f"parameter {key} is not a string (a URDF document)")
     return parse_urdf(text, source=f"parameter {node.resolve_name(key)}")
