@@ -212,3 +212,41 @@ def test_without_a_toolchain_the_reason_is_given(monkeypatch: pytest.MonkeyPatch
     assert find_toolchain({"PATH": "/nonexistent"})[1].startswith("no cmake, no a C++ compiler")
     tool, why = find_toolchain({"PATH": os.environ.get("PATH", ""), "NINJEMYS_CATKIN_CPP": "0"})
     assert tool is None and "Python-only" in why
+
+
+@pytest.mark.ros1
+@needs_toolchain
+@pytest.mark.skipif(not Path("/usr/bin/catkin_make").exists(), reason="no Debian catkin")
+def test_a_compile_error_fails_like_debians_catkin_make(tmp_path: Path) -> None:
+    results = {}
+    for who, command, env in (
+        (
+            "debian",
+            "/usr/bin/catkin_make",
+            {"PATH": "/usr/bin:/bin", "HOME": str(tmp_path), "LANG": "C.UTF-8"},
+        ),
+        (
+            "ours",
+            ninjemys_bin("catkin_make"),
+            {k: v for k, v in os.environ.items() if k != "ROS_PACKAGE_PATH"},
+        ),
+    ):
+        pkg = tmp_path / who / "src" / "broken_cpp"
+        (pkg / "src").mkdir(parents=True)
+        (pkg / "package.xml").write_text(PACKAGE_XML.replace("cpp_chat", "broken_cpp"))
+        (pkg / "CMakeLists.txt").write_text(
+            "cmake_minimum_required(VERSION 3.0.2)\nproject(broken_cpp)\n"
+            "find_package(catkin REQUIRED COMPONENTS roscpp)\ncatkin_package()\n"
+            "include_directories(${catkin_INCLUDE_DIRS})\nadd_executable(node src/node.cpp)\n"
+        )
+        (pkg / "src" / "node.cpp").write_text(
+            "#include <ros/ros.h>\nint main() { return undeclared_name; }\n"
+        )
+        env.pop("NINJEMYS_CATKIN_CPP", None)
+        results[who] = subprocess.run(
+            [command], cwd=tmp_path / who, env=env, capture_output=True, text=True, timeout=600, check=False
+        )
+    for who, result in results.items():
+        assert result.returncode != 0, who
+        assert "undeclared_name" in result.stdout + result.stderr, who
+    assert 'Invoking "make -j' in results["ours"].stdout + results["ours"].stderr
