@@ -20,6 +20,8 @@ ROS1_DEBS := ros-core python3-rospy python3-rosbag python3-genpy python3-rosmsg 
 ROS1_DEBS += ros-robot-state-publisher liburdfdom-tools
 # PyKDL, tf_conversions and joint_state_publisher: the references for ours
 ROS1_DEBS += python3-pykdl python3-tf-conversions joint-state-publisher
+# C++ nodes through catkin's CMake: the build tool, gencpp and std_msgs' .msg files for C++ messages
+ROS1_DEBS += cmake python3-gencpp ros-std-msgs libstd-msgs-dev
 BROWSER_DEBS := chromium chromium-driver fonts-dejavu-core
 SYSTEM_DEBS  := $(ROS1_DEBS) $(BROWSER_DEBS) tmux
 

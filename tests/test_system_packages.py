@@ -19,10 +19,10 @@ ROS_HOMEPAGE = re.compile(r"ros\.org|github\.com/(ros|ros-planning|ros-perceptio
 
 
 def makefile_debs() -> set[str]:
-    """The names in the Makefile's *_DEBS variables (continuation lines joined)."""
+    """The names in the Makefile's *_DEBS variables, `=`, `:=` and `+=` alike (continuation lines joined)."""
     text = MAKEFILE.read_text(encoding="utf-8").replace("\\\n", " ")
     names: set[str] = set()
-    for match in re.finditer(r"^[A-Z0-9_]*DEBS\s*:?=(.*)$", text, re.M):
+    for match in re.finditer(r"^[A-Z0-9_]*DEBS\s*[+:]?=(.*)$", text, re.M):
         names.update(word for word in match.group(1).split() if not word.startswith("$("))
     return names
 

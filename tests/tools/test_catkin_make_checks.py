@@ -89,6 +89,7 @@ def test_unknown_package_in_a_field_type(ws: Path, monkeypatch: pytest.MonkeyPat
 
 
 def test_cpp_targets_are_named_as_not_built(ws: Path, monkeypatch: pytest.MonkeyPatch, capsys) -> None:
+    monkeypatch.setenv("NINJEMYS_CATKIN_CPP", "0")  # as on a machine without the C++ toolchain
     pkg = create(ws, monkeypatch, "mixed_pkg", "roscpp", "rospy", "std_msgs")
     cmake = pkg / "CMakeLists.txt"
     text = cmake.read_text()  # catkin_create_pkg's template: its add_executable lines are comments
@@ -102,6 +103,7 @@ def test_cpp_targets_are_named_as_not_built(ws: Path, monkeypatch: pytest.Monkey
     assert make(ws, monkeypatch) == 0
     out = capsys.readouterr().out
     assert "-- ~~  - mixed_pkg: 2 C++ target(s) not built" in out
+    assert "[NINJEMYS_CATKIN_CPP=0 asks for the Python-only build]" in out
     assert (
         f"{cmake}:{lines_before + 1}: add_executable(mixed_pkg_talker) (src/talker.cpp, src/util.cpp)" in out
     )

@@ -27,6 +27,7 @@ from typing import Any
 from ninjemys.errors import DefinitionError, PackageError
 from ninjemys.packages import cfg_gen, idl_check, msg_types
 from ninjemys.packages.cmake_hints import read_cmake_hints
+from ninjemys.packages.cpp_build import Toolchain, build_cpp, cpp_closure, find_toolchain
 from ninjemys.packages.cpp_targets import CppTarget, cpp_targets, skipped_message
 from ninjemys.packages.discovery import PackageIndex, package_path_dirs, underlay_dirs
 from ninjemys.packages.manifest import PackageManifest
@@ -64,6 +65,8 @@ class BuildReport:
     validated: int = 0
     #: C++ targets declared in CMakeLists.txt files and not built (no compiler here)
     cpp_skipped: list[CppTarget] = field(default_factory=list)
+    #: the programs catkin's CMake built, per package (where a C++ toolchain exists)
+    cpp_built: dict[str, list[Path]] = field(default_factory=dict)
 
 
 class _Writer:
@@ -129,12 +132,41 @@ def _definitions(pkg: PackageManifest) -> dict[str, list[Path]]:
     return found
 
 
-def _report_cpp_targets(pkg: PackageManifest, report: BuildReport, log: Callable[[str], None]) -> None:
+def _report_cpp_targets(
+    pkg: PackageManifest, report: BuildReport, log: Callable[[str], None], why: str
+) -> None:
     """Name the package's C++ targets, which this build skips, instead of ignoring them."""
     targets = cpp_targets(pkg.path, pkg.name)
-    for line in skipped_message(pkg.name, targets):
+    lines = skipped_message(pkg.name, targets)
+    if lines:
+        lines[0] += f" [{why}]"
+    for line in lines:
         log(line)
     report.cpp_skipped.extend(targets)
+
+
+def _build_cpp_packages(
+    ws: Workspace,
+    ordered: list[PackageManifest],
+    wanted: set[str],
+    toolchain: Toolchain,
+    writer: _Writer,
+    report: BuildReport,
+    log: Callable[[str], None],
+) -> None:
+    """Build the C++ packages with catkin's CMake and link their programs into devel/lib/<pkg>/."""
+    chosen = cpp_closure(ordered, wanted)
+    built = build_cpp(chosen, ws.build / "ninjemys_cpp", ws.root / "install", toolchain, log)
+    for package, programs in built.items():
+        for program in programs:
+            link = ws.devel / "lib" / package / program.name
+            link.parent.mkdir(parents=True, exist_ok=True)
+            if link.is_symlink() or link.exists():
+                link.unlink()
+            link.symlink_to(program)
+            writer.outputs.add(str(link))
+            log(f"-- ~~  - {package}: built {program.name}")
+    report.cpp_built = built
 
 
 def _package_finder(ws: Workspace, env: Mapping[str, str]) -> Callable[[str], Path | None]:
@@ -195,10 +227,13 @@ def build_workspace(
         writer.write(toplevel, TOPLEVEL_CMAKE)
     ws.build.mkdir(parents=True, exist_ok=True)
     dist = ws.devel / "lib" / "python3" / "dist-packages"
+    toolchain, no_toolchain = find_toolchain(env)
+    cpp_packages = {pkg.name for pkg in ordered if cpp_targets(pkg.path, pkg.name)}
     for pkg in ordered:
         log(f"-- ~~  - {pkg.name}")
         report.packages.append(pkg.name)
-        _report_cpp_targets(pkg, report, log)
+        if toolchain is None:
+            _report_cpp_targets(pkg, report, log, no_toolchain)
         defs = _definitions(pkg)
         hints = read_cmake_hints(pkg.path)
         py_packages = (
@@ -226,6 +261,9 @@ def build_workspace(
                 )
             target = ws.devel / destination.format(pkg=pkg.name) / script.name
             writer.write(target, _relay_script(script), executable=True)
+
+    if toolchain is not None and cpp_packages:
+        _build_cpp_packages(ws, ordered, cpp_packages, toolchain, writer, report, log)
 
     wsenv = WorkspaceEnv(source=ws.source, devel=ws.devel)
     underlays = underlay_workspaces(ws.devel, env)

@@ -63,6 +63,8 @@ def main(argv: list[str] | None = None) -> int:
         f"[100%] Built target(s) {' '.join(report.packages) or '(none)'}: "
         f"{len(report.written)} file(s) updated, {report.validated} definition(s) checked, {elapsed:.2f}s"
     )
+    for package, programs in report.cpp_built.items():
+        print(f"-- {package}: C++ program(s) built by catkin's CMake: {' '.join(p.name for p in programs)}")
     if report.cpp_skipped:
         names = ", ".join(t.name for t in report.cpp_skipped)
         print(f"-- {len(report.cpp_skipped)} C++ target(s) not built (see above): {names}")

@@ -1,0 +1,166 @@
+"""Build a workspace's C++ packages through real CMake with catkin's own macros, where a toolchain exists.
+
+ninjemys' catkin_make writes Python relays itself, but compiling roscpp nodes needs what ROS 1 has:
+a C++ compiler, CMake, catkin's CMake (``toplevel.cmake``) and roscpp's development files (Debian's
+``catkin``, ``g++``, ``libroscpp-dev``). When they are all present, the packages that declare C++
+targets, with the workspace packages they depend on (so their messages get C++ headers too), are
+configured and built by catkin itself in ``build/ninjemys_cpp`` (its own devel space, so it never
+overwrites ours), and each built program is linked into ``devel/lib/<pkg>/`` where rosrun and
+roslaunch look. Without the toolchain, :func:`find_toolchain` says what is missing and the targets
+are named as not built. ``NINJEMYS_CATKIN_CPP=0`` asks for the Python-only build on purpose.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+from ninjemys.errors import PackageError
+from ninjemys.packages.manifest import PackageManifest
+
+#: where catkin's top-level CMake file lives: Debian's ``catkin``, then ROS 1 binary installs
+_TOPLEVEL = (Path("/usr/share/catkin/cmake/toplevel.cmake"),)
+_ROSCPP_CONFIGS = ("/usr/lib/*/cmake/roscpp/roscppConfig.cmake", "/usr/share/roscpp/cmake/roscppConfig.cmake")
+_OPT_ROS = Path("/opt/ros")
+
+
+@dataclass(frozen=True)
+class Toolchain:
+    """The programs and catkin files a C++ build needs."""
+
+    cmake: str
+    compiler: str
+    toplevel: Path
+    python: str
+
+
+def _toplevel_candidates() -> list[Path]:
+    found = list(_TOPLEVEL)
+    if _OPT_ROS.is_dir():
+        found += sorted(_OPT_ROS.glob("*/share/catkin/cmake/toplevel.cmake"))
+    return found
+
+
+def _roscpp_found() -> bool:
+    for pattern in _ROSCPP_CONFIGS:
+        root = Path("/")
+        if any(root.glob(pattern.lstrip("/"))):
+            return True
+    return _OPT_ROS.is_dir() and any(_OPT_ROS.glob("*/share/roscpp/cmake/roscppConfig.cmake"))
+
+
+def find_toolchain(env: Mapping[str, str]) -> tuple[Toolchain | None, str]:
+    """The toolchain, or None and the reason (shown with the targets it leaves unbuilt)."""
+    if env.get("NINJEMYS_CATKIN_CPP", "1") == "0":
+        return None, "NINJEMYS_CATKIN_CPP=0 asks for the Python-only build"
+    path = env.get("PATH", os.defpath)
+    cmake = shutil.which("cmake", path=path)
+    compiler = shutil.which("c++", path=path) or shutil.which("g++", path=path)
+    toplevel = next((p for p in _toplevel_candidates() if p.is_file()), None)
+    missing = [
+        what
+        for what, ok in (
+            ("cmake", cmake),
+            ("a C++ compiler (g++)", compiler),
+            ("catkin's CMake (Debian package catkin)", toplevel),
+            ("roscpp's development files (Debian package libroscpp-dev)", _roscpp_found()),
+        )
+        if not ok
+    ]
+    if missing:
+        return None, "no " + ", no ".join(missing)
+    # catkin's CMake runs catkin_pkg, which lives with the system Python, not necessarily ours
+    python = (
+        "/usr/bin/python3" if Path("/usr/bin/python3").is_file() else (shutil.which("python3") or "python3")
+    )
+    assert cmake and compiler and toplevel
+    return Toolchain(cmake, compiler, toplevel, python), ""
+
+
+def cpp_closure(packages: list[PackageManifest], wanted: set[str]) -> list[PackageManifest]:
+    """The wanted packages and every workspace package they depend on, transitively."""
+    by_name = {p.name: p for p in packages}
+    todo = [n for n in wanted if n in by_name]
+    chosen: set[str] = set()
+    while todo:
+        name = todo.pop()
+        if name in chosen:
+            continue
+        chosen.add(name)
+        manifest = by_name[name]
+        deps = manifest.buildtool_depends + manifest.build_depends + manifest.build_export_depends
+        todo += [d for d in deps + manifest.exec_depends if d in by_name and d not in chosen]
+    return [p for p in packages if p.name in chosen]
+
+
+def _link_sources(src: Path, packages: list[PackageManifest], toplevel: Path) -> None:
+    """A source space of links to the chosen packages (re-made each run: the set may change)."""
+    src.mkdir(parents=True, exist_ok=True)
+    for entry in src.iterdir():
+        if entry.is_symlink():
+            entry.unlink()
+    for pkg in packages:
+        (src / pkg.name).symlink_to(pkg.path.resolve(), target_is_directory=True)
+    (src / "CMakeLists.txt").symlink_to(toplevel)
+
+
+def build_cpp(
+    packages: list[PackageManifest],
+    build_root: Path,
+    install_prefix: Path,
+    toolchain: Toolchain,
+    log: Callable[[str], None],
+    jobs: int = 0,
+) -> dict[str, list[Path]]:
+    """Configure and build the packages with catkin's CMake; the programs built, per package.
+
+    Raises PackageError with CMake's or the compiler's output (as catkin_make prints it) on failure.
+    """
+    src = build_root / "src"
+    build = build_root / "build"
+    devel = build_root / "devel"
+    _link_sources(src, packages, toolchain.toplevel)
+    build.mkdir(parents=True, exist_ok=True)
+    env = dict(os.environ)
+    configure = [
+        toolchain.cmake,
+        str(src),
+        f"-DCATKIN_DEVEL_PREFIX={devel}",
+        f"-DCMAKE_INSTALL_PREFIX={install_prefix}",
+        f"-DPYTHON_EXECUTABLE={toolchain.python}",
+        f"-DCMAKE_CXX_COMPILER={toolchain.compiler}",
+        "-DCATKIN_ENABLE_TESTING=OFF",
+    ]
+    log(f"-- ~~  C++ packages through catkin's CMake: {' '.join(p.name for p in packages)}")
+    _run(configure, build, env, 'Invoking "cmake" failed', log)
+    jobs = jobs or max(1, os.cpu_count() or 1)
+    _run(["make", f"-j{jobs}"], build, env, f'Invoking "make -j{jobs}" failed', log)
+    built: dict[str, list[Path]] = {}
+    for pkg in packages:
+        directory = devel / "lib" / pkg.name
+        if directory.is_dir():
+            programs = [
+                p
+                for p in sorted(directory.iterdir())
+                if p.is_file() and os.access(p, os.X_OK) and not p.suffix
+            ]
+            if programs:
+                built[pkg.name] = programs
+    return built
+
+
+def _run(cmd: list[str], cwd: Path, env: dict[str, str], failure: str, log: Callable[[str], None]) -> None:
+    proc = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True, check=False)
+    if proc.returncode != 0:
+        output = (proc.stdout + proc.stderr).rstrip()
+        raise PackageError(f"{output}\n{failure}")
+    for line in proc.stdout.splitlines():
+        if line.startswith("[") and "Built target" in line:
+            log(line)
+
+
+__all__ = ["Toolchain", "build_cpp", "cpp_closure", "find_toolchain"]

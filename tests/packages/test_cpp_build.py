@@ -1,0 +1,252 @@
+"""C++ nodes build where a toolchain exists: catkin_make hands the packages with C++ targets to catkin's
+own CMake (Debian's catkin, g++, libroscpp-dev, gencpp), links the programs into devel/lib/<pkg>/, and
+they talk to Python nodes through ninjemys' master both ways, custom message included."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from ninjemys.packages.cpp_build import find_toolchain
+from ninjemys.testing import kill_tree, ninjemys_bin, run_master
+
+PACKAGE_XML = """<?xml version="1.0"?>
+<package format="2">
+  <name>cpp_chat</name>
+  <version>0.1.0</version>
+  <description>C++ chat nodes for the toolchain test</description>
+  <maintainer email="t@example.com">t</maintainer>
+  <license>BSD</license>
+  <buildtool_depend>catkin</buildtool_depend>
+  <depend>roscpp</depend>
+  <depend>std_msgs</depend>
+  <build_depend>message_generation</build_depend>
+  <exec_depend>message_runtime</exec_depend>
+</package>
+"""
+
+CMAKE = """cmake_minimum_required(VERSION 3.0.2)
+project(cpp_chat)
+find_package(catkin REQUIRED COMPONENTS roscpp std_msgs message_generation)
+add_message_files(FILES Reading.msg)
+generate_messages(DEPENDENCIES std_msgs)
+catkin_package(CATKIN_DEPENDS roscpp std_msgs message_runtime)
+include_directories(${catkin_INCLUDE_DIRS})
+add_executable(chatter src/chatter.cpp)
+target_link_libraries(chatter ${catkin_LIBRARIES})
+add_dependencies(chatter ${PROJECT_NAME}_generate_messages_cpp)
+add_executable(${PROJECT_NAME}_echo src/echo.cpp)
+target_link_libraries(${PROJECT_NAME}_echo ${catkin_LIBRARIES})
+catkin_install_python(PROGRAMS scripts/py_listener.py DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+"""
+
+CHATTER = r"""// Publishes "hello N" on /chatter and a cpp_chat/Reading on /reading.
+#include <ros/ros.h>
+#include <std_msgs/String.h>
+#include <cpp_chat/Reading.h>
+#include <sstream>
+
+int main(int argc, char **argv) {
+  ros::init(argc, argv, "cpp_chatter");
+  ros::NodeHandle nh;
+  ros::Publisher text = nh.advertise<std_msgs::String>("chatter", 10);
+  ros::Publisher reading = nh.advertise<cpp_chat::Reading>("reading", 10);
+  ros::Rate rate(20);
+  for (int count = 0; ros::ok(); ++count) {
+    std_msgs::String msg;
+    std::ostringstream out;
+    out << "hello " << count;
+    msg.data = out.str();
+    text.publish(msg);
+    cpp_chat::Reading r;
+    r.header.stamp = ros::Time::now();
+    r.label = "temperature";
+    r.value = 20.5 + count;
+    reading.publish(r);
+    ros::spinOnce();
+    rate.sleep();
+  }
+  return 0;
+}
+"""
+
+ECHO = r"""// Listens on /chatter and republishes each string, prefixed, on /echo.
+#include <ros/ros.h>
+#include <std_msgs/String.h>
+
+static ros::Publisher echo;
+
+static void heard(const std_msgs::String::ConstPtr &msg) {
+  std_msgs::String out;
+  out.data = "cpp heard: " + msg->data;
+  echo.publish(out);
+}
+
+int main(int argc, char **argv) {
+  ros::init(argc, argv, "cpp_echo");
+  ros::NodeHandle nh;
+  echo = nh.advertise<std_msgs::String>("echo", 10);
+  ros::Subscriber sub = nh.subscribe("chatter", 10, heard);
+  ros::spin();
+  return 0;
+}
+"""
+
+PY_LISTENER = """#!/usr/bin/env python3
+# Waits for one cpp_chat/Reading from the C++ node and prints its fields.
+import rospy
+from cpp_chat.msg import Reading
+
+rospy.init_node("py_reading_listener")
+msg = rospy.wait_for_message("reading", Reading, timeout=60)
+print("reading", msg.label, msg.value, msg.header.stamp.secs > 0, flush=True)
+"""
+
+needs_toolchain = pytest.mark.skipif(find_toolchain(os.environ)[0] is None, reason="no C++ toolchain")
+
+
+@pytest.fixture(scope="module")
+def workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    ws = tmp_path_factory.mktemp("cpp_ws")
+    pkg = ws / "src" / "cpp_chat"
+    (pkg / "src").mkdir(parents=True)
+    (pkg / "msg").mkdir()
+    (pkg / "scripts").mkdir()
+    (pkg / "package.xml").write_text(PACKAGE_XML)
+    (pkg / "CMakeLists.txt").write_text(CMAKE)
+    (pkg / "msg" / "Reading.msg").write_text("std_msgs/Header header\nstring label\nfloat64 value\n")
+    (pkg / "src" / "chatter.cpp").write_text(CHATTER)
+    (pkg / "src" / "echo.cpp").write_text(ECHO)
+    (pkg / "scripts" / "py_listener.py").write_text(PY_LISTENER)
+    (pkg / "scripts" / "py_listener.py").chmod(0o755)
+    env = {k: v for k, v in os.environ.items() if k not in ("ROS_PACKAGE_PATH", "CMAKE_PREFIX_PATH")}
+    env.pop("NINJEMYS_CATKIN_CPP", None)
+    result = subprocess.run(
+        [ninjemys_bin("catkin_make")],
+        cwd=ws,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "cpp_chat: C++ program(s) built by catkin's CMake: chatter cpp_chat_echo" in result.stdout
+    return ws
+
+
+def _env(ws: Path, master: str) -> dict[str, str]:
+    env = dict(os.environ, ROS_MASTER_URI=master, ROS_PACKAGE_PATH=str(ws / "src"), ROS_HOSTNAME="localhost")
+    env["PYTHONPATH"] = str(ws / "devel" / "lib" / "python3" / "dist-packages")
+    env["CMAKE_PREFIX_PATH"] = str(ws / "devel")
+    env["ROS_HOME"] = str(ws / "ros_home")
+    return env
+
+
+@pytest.fixture
+def master() -> Iterator[str]:
+    with run_master() as uri:
+        yield uri
+
+
+def _start(cmd: list[str], env: dict[str, str]) -> subprocess.Popen[str]:
+    return subprocess.Popen(
+        cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, start_new_session=True
+    )
+
+
+@pytest.mark.ros1
+@needs_toolchain
+def test_programs_are_linked_where_rosrun_looks(workspace: Path) -> None:
+    for name in ("chatter", "cpp_chat_echo"):
+        program = workspace / "devel" / "lib" / "cpp_chat" / name
+        assert program.is_symlink() and os.access(program.resolve(), os.X_OK)
+    assert (workspace / "build" / "ninjemys_cpp" / "devel" / "include" / "cpp_chat" / "Reading.h").is_file()
+
+
+@pytest.mark.ros1
+@needs_toolchain
+def test_cpp_talker_custom_message_to_python_listener(workspace: Path, master: str) -> None:
+    env = _env(workspace, master)
+    talker = _start([ninjemys_bin("rosrun"), "cpp_chat", "chatter"], env)
+    try:
+        heard = subprocess.run(
+            [ninjemys_bin("rosrun"), "cpp_chat", "py_listener.py"],
+            env=env, capture_output=True, text=True, timeout=90, check=False,
+        )  # fmt: skip
+        assert heard.returncode == 0, heard.stdout + heard.stderr
+        assert "reading temperature" in heard.stdout and "True" in heard.stdout
+        text = subprocess.run(
+            [ninjemys_bin("rostopic"), "echo", "-n", "1", "/chatter"],
+            env=env, capture_output=True, text=True, timeout=60, check=False,
+        )  # fmt: skip
+        assert 'data: "hello ' in text.stdout, text.stdout + text.stderr
+    finally:
+        kill_tree(talker)
+
+
+@pytest.mark.ros1
+@needs_toolchain
+def test_python_talker_to_cpp_listener(workspace: Path, master: str) -> None:
+    env = _env(workspace, master)
+    echo = _start([ninjemys_bin("rosrun"), "cpp_chat", "cpp_chat_echo"], env)
+    pub = _start(
+        [ninjemys_bin("rostopic"), "pub", "-r", "10", "/chatter", "std_msgs/String", "data: from python"], env
+    )
+    try:
+        heard = subprocess.run(
+            [ninjemys_bin("rostopic"), "echo", "-n", "1", "/echo"],
+            env=env, capture_output=True, text=True, timeout=60, check=False,
+        )  # fmt: skip
+        assert 'data: "cpp heard: from python"' in heard.stdout, heard.stdout + heard.stderr
+    finally:
+        kill_tree(pub)
+        kill_tree(echo)
+
+
+def test_without_a_toolchain_the_reason_is_given(monkeypatch: pytest.MonkeyPatch) -> None:
+    assert find_toolchain({"PATH": "/nonexistent"})[1].startswith("no cmake, no a C++ compiler")
+    tool, why = find_toolchain({"PATH": os.environ.get("PATH", ""), "NINJEMYS_CATKIN_CPP": "0"})
+    assert tool is None and "Python-only" in why
+
+
+@pytest.mark.ros1
+@needs_toolchain
+@pytest.mark.skipif(not Path("/usr/bin/catkin_make").exists(), reason="no Debian catkin")
+def test_a_compile_error_fails_like_debians_catkin_make(tmp_path: Path) -> None:
+    results = {}
+    for who, command, env in (
+        (
+            "debian",
+            "/usr/bin/catkin_make",
+            {"PATH": "/usr/bin:/bin", "HOME": str(tmp_path), "LANG": "C.UTF-8"},
+        ),
+        (
+            "ours",
+            ninjemys_bin("catkin_make"),
+            {k: v for k, v in os.environ.items() if k != "ROS_PACKAGE_PATH"},
+        ),
+    ):
+        pkg = tmp_path / who / "src" / "broken_cpp"
+        (pkg / "src").mkdir(parents=True)
+        (pkg / "package.xml").write_text(PACKAGE_XML.replace("cpp_chat", "broken_cpp"))
+        (pkg / "CMakeLists.txt").write_text(
+            "cmake_minimum_required(VERSION 3.0.2)\nproject(broken_cpp)\n"
+            "find_package(catkin REQUIRED COMPONENTS roscpp)\ncatkin_package()\n"
+            "include_directories(${catkin_INCLUDE_DIRS})\nadd_executable(node src/node.cpp)\n"
+        )
+        (pkg / "src" / "node.cpp").write_text(
+            "#include <ros/ros.h>\nint main() { return undeclared_name; }\n"
+        )
+        env.pop("NINJEMYS_CATKIN_CPP", None)
+        results[who] = subprocess.run(
+            [command], cwd=tmp_path / who, env=env, capture_output=True, text=True, timeout=600, check=False
+        )
+    for who, result in results.items():
+        assert result.returncode != 0, who
+        assert "undeclared_name" in result.stdout + result.stderr, who
+    assert 'Invoking "make -j' in results["ours"].stdout + results["ours"].stderr
