@@ -115,3 +115,61 @@ def test_debian_cv_bridge_decodes_ours_to_the_same_arrays() -> None:
         mine = bridge.cv2_to_compressed_imgmsg(ours, "png")
         assert mine.format == fmt == "png"
         assert base64.b64decode(png_pixels) == bridge.compressed_imgmsg_to_cv2(mine).tobytes()
+
+
+class _FakePub:
+    def __init__(self) -> None:
+        self.connections = 0
+        self.sent: list = []
+
+    def get_num_connections(self) -> int:
+        return self.connections
+
+    def publish(self, msg: object) -> None:
+        self.sent.append(msg)
+
+
+class _FakeNode:
+    """Enough of a Node for CompressedPublisher: names, one publisher, parameters, a log."""
+
+    def __init__(self, params: dict) -> None:
+        self.pub = _FakePub()
+        self.params = params
+        self.warnings: list[str] = []
+        self.log = type("L", (), {"warn": lambda _s, text: self.warnings.append(text)})()
+
+    def resolve_name(self, name: str) -> str:
+        return "/" + name.lstrip("/")
+
+    def publisher(self, topic: str, cls: object, queue_size: int) -> _FakePub:
+        return self.pub
+
+    def get_param(self, key: str, default: object) -> object:
+        return self.params.get(key, default)
+
+
+def test_publisher_encodes_only_when_subscribed(monkeypatch: pytest.MonkeyPatch) -> None:
+    import ninjemys.image_transport.compressed as mod
+
+    calls: list = []
+    real = mod.encode
+    monkeypatch.setattr(mod, "encode", lambda m, p: calls.append(p) or real(m, p))
+    node = _FakeNode({"/cam/compressed/format": "png", "/cam/compressed/png_level": 1})
+    pub = mod.CompressedPublisher(node, "cam")
+    assert pub.topic == "/cam/compressed"
+    img = bridge.cv2_to_imgmsg(_pattern(), "rgb8")
+    pub.publish(img)
+    assert calls == [] and node.pub.sent == []  # nobody listens: no CPU spent
+    node.pub.connections = 1
+    pub.publish(img)
+    assert calls == [CompressionParams("png", 80, 1)]
+    assert node.pub.sent[0].format == "rgb8; png compressed bgr8"
+
+
+def test_bad_parameters_warn_and_fall_back() -> None:
+    import ninjemys.image_transport.compressed as mod
+
+    node = _FakeNode({"/cam/compressed/format": "gif", "/cam/compressed/jpeg_quality": "high"})
+    pub = mod.CompressedPublisher(node, "cam")
+    assert pub.params() == CompressionParams()
+    assert any("gif" in w for w in node.warnings) and any("jpeg_quality" in w for w in node.warnings)
