@@ -71,7 +71,11 @@ def encode(img_msg: Any, params: CompressionParams = CompressionParams()) -> Any
 def decode(cmsg: Any) -> Any:
     """The sensor_msgs/Image a CompressedImage came from (its encoding restored from ``format``)."""
     cv2 = _cv2()
-    im = cv2.imdecode(np.frombuffer(bytes(cmsg.data), np.uint8), cv2.IMREAD_UNCHANGED)
+    data = bytes(cmsg.data)
+    try:
+        im = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_UNCHANGED) if data else None
+    except cv2.error:
+        im = None
     if im is None:
         raise CvBridgeError(f"compressed transport: cannot decode the image data (format '{cmsg.format}')")
     fmt = cmsg.format or ""
