@@ -16,6 +16,8 @@ ROS1_DEBS := ros-core python3-rospy python3-rosbag python3-genpy python3-rosmsg 
 	python3-tf2-ros python3-tf python3-tf2-geometry-msgs python3-dynamic-reconfigure \
 	python3-message-filters python3-move-base-msgs python3-map-msgs python3-laser-geometry \
 	python3-cv-bridge libdynamic-reconfigure-config-init-mutex-dev
+# robot descriptions: Debian's C++ robot_state_publisher and urdfdom's check_urdf, the references
+ROS1_DEBS += ros-robot-state-publisher liburdfdom-tools
 BROWSER_DEBS := chromium chromium-driver fonts-dejavu-core
 SYSTEM_DEBS  := $(ROS1_DEBS) $(BROWSER_DEBS) tmux
 

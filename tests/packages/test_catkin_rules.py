@@ -226,3 +226,13 @@ def test_same_pass_and_fail_as_debians_catkin_make(
         assert str(info.value).splitlines()[0] == first
         flat = " ".join((debian.stdout + debian.stderr).split())
         assert " ".join(str(info.value).split("\nninjemys:")[0].split()) in flat
+
+
+def test_catkin_ignore_beside_a_package_xml_hides_the_package(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, clean_env: None
+) -> None:
+    pkg = _package(tmp_path, "cpp_only", "", MISSING_CMAKE)
+    _package(tmp_path, "fine", "", LOOSE_CMAKE)
+    (pkg / "CATKIN_IGNORE").touch()
+    assert _make(tmp_path, monkeypatch) == 0
+    assert (tmp_path / "devel" / "setup.bash").is_file()

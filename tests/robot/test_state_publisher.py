@@ -237,3 +237,35 @@ def test_same_transforms_as_debians_robot_state_publisher(master) -> None:
     ((okey, (oparent, ovalues)),) = collectors["/tf_static_ours"].seen.items()
     assert (key[0], parent) == (okey[0], oparent)
     assert max(abs(a - b) for a, b in zip(values, ovalues, strict=True)) < 1e-9
+
+
+def test_a_malformed_joint_state_is_reported_and_the_node_goes_on(master) -> None:
+    uri, env = master
+    node = Node("rsp_bad_input", master_uri=uri)
+    try:
+        node.set_param("/robot_description", ARM)
+        TFMessage, JointState = (
+            get_message_class("tf2_msgs/TFMessage"),
+            get_message_class("sensor_msgs/JointState"),
+        )
+        tf = _Collector()
+        node.subscriber("/tf", TFMessage, tf, queue_size=100)
+        pub = node.publisher("/joint_states", JointState, queue_size=10)
+        proc = _start(_ours("robot_state_publisher", "__name:=rsp"), env)
+        try:
+            deadline = time.monotonic() + 30
+            while pub.get_num_connections() < 1:
+                assert time.monotonic() < deadline
+                time.sleep(0.05)
+            pub.publish_raw(b"\x00\x01\x02")  # not a JointState
+            pub.publish_raw(b"\x00" * 12 + b"\xff\xff\xff\x7f")  # a frame_id longer than the message
+            good = JointState(name=MOVING, position=_positions(1))
+            good.header.stamp = Time(7, 0)
+            pub.publish(good)
+            tf.wait(8)
+        finally:
+            proc.terminate()
+            out = proc.communicate(timeout=10)[0].decode()
+        assert out.count("ignored a malformed JointState message") == 2, out
+    finally:
+        node.shutdown("test done")

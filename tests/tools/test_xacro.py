@@ -138,3 +138,60 @@ def test_errors_name_the_file_and_the_package(workspace, tmp_path: Path) -> None
     undefined.write_text('<robot xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="${nope}"/></robot>')
     result = _expand([str(undefined)], env)
     assert result.returncode != 0 and "nope" in result.stderr and "undefined.xacro" in result.stderr
+
+
+SUBST = """<?xml version="1.0"?>
+<robot name="subst" xmlns:xacro="http://www.ros.org/wiki/xacro">
+  <xacro:arg name="scale" default="2"/>
+  <xacro:property name="r" value="${radians(90)}"/>
+  <link name="$(env MYBOT_NAME)"/>
+  <link name="$(optenv MYBOT_UNSET fallback)"/>
+  <link name="l$(eval 2 * 4 + 1)"/>
+  <joint name="j" type="fixed"><parent link="fallback"/><child link="$(env MYBOT_NAME)"/>
+    <origin xyz="${sin(r)} ${cos(pi)} ${$(arg scale) ** 2}" rpy="0 0 0"/></joint>
+  <xacro:include filename="$(find mybot)/urdf/wheel.xacro"/>
+  <xacro:wheel side="s" y="0"><axis xyz="1 0 0"/></xacro:wheel>
+</robot>
+"""
+
+
+def test_process_file_in_a_script_resolves_find_env_optenv_eval_and_math(workspace) -> None:
+    pkg, env = workspace
+    (pkg / "urdf" / "subst.xacro").write_text(SUBST)
+    env["MYBOT_NAME"] = "from_env"
+    script = (
+        "import sys, xacro\n"
+        "doc = xacro.process_file(sys.argv[1], mappings={'scale': '3'})\n"
+        "print(doc.toprettyxml(indent='  '))\n"
+    )
+    result = subprocess.run(
+        [sys.executable, "-c", script, str(pkg / "urdf" / "subst.xacro")],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert result.returncode == 0, result.stderr
+    root = ET.fromstring(result.stdout)
+    assert [link.get("name") for link in root.findall("link")] == ["from_env", "fallback", "l9", "s_wheel"]
+    assert root.find("joint[@name='j']/origin").get("xyz") == "1.0 -1.0 9"
+    # the command, with Noetic's --inorder flag (processing in order is the default), gives the same robot
+    command = _expand([str(pkg / "urdf" / "subst.xacro"), "--inorder", "scale:=3"], env)
+    assert command.returncode == 0, command.stderr
+    assert ET.canonicalize(command.stdout, strip_text=True) == ET.canonicalize(
+        result.stdout.split("?>", 1)[1], strip_text=True
+    )
+
+
+def test_same_xml_as_the_reference_xacro(workspace) -> None:
+    """Ours (``xacro``, ``rosrun xacro xacro``) and upstream xacro's own ``main`` print the same bytes."""
+    pkg, env = workspace
+    reference = _expand(
+        [str(pkg / "urdf" / "mybot.urdf.xacro"), "with_lidar:=false"],
+        env,
+        [sys.executable, "-c", "import sys, xacro; sys.argv[0] = 'xacro'; sys.exit(xacro.main())"],
+    )
+    ours = _expand([str(pkg / "urdf" / "mybot.urdf.xacro"), "with_lidar:=false"], env)
+    assert reference.returncode == ours.returncode == 0, reference.stderr + ours.stderr
+    assert ours.stdout == reference.stdout
+    _check_robot(ours.stdout, lidar=False)

@@ -44,10 +44,13 @@ def crawl(root: Path) -> Iterator[Path]:
     stack: list[tuple[Path, int]] = [(root, 0)]
     while stack:
         directory, depth = stack.pop()
+        # the markers come first, as in catkin_pkg: CATKIN_IGNORE beside a package.xml hides it
+        if any((directory / m).exists() for m in _IGNORE_MARKERS[:2]):
+            continue
         if (directory / MANIFEST).is_file():
             yield directory
             continue
-        if depth >= _MAX_DEPTH or any((directory / m).exists() for m in _IGNORE_MARKERS):
+        if depth >= _MAX_DEPTH or (directory / _IGNORE_MARKERS[2]).exists():
             continue
         try:
             children = sorted(

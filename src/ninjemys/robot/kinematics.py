@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from ninjemys.errors import NinjemysError
@@ -48,13 +49,60 @@ class Joint:
 
     def transform(self, position: float = 0.0) -> Pose:
         """parent -> child at ``position`` (radians or metres)."""
-        rotation, xyz = self.rotation, self.xyz
-        if self.type in ("revolute", "continuous"):
-            rotation = _matmul(rotation, _axis_angle(self.axis, position))
-        elif self.type == "prismatic":
-            moved = _apply(rotation, tuple(a * position for a in self.axis))  # type: ignore[arg-type]
-            xyz = (xyz[0] + moved[0], xyz[1] + moved[1], xyz[2] + moved[2])
-        return (*xyz, *quaternion(rotation))
+        return _pose_function(self)(position)
+
+    def pose_function(self) -> Callable[[float], Pose]:
+        """:meth:`transform` with what does not move computed once (for a stream of positions)."""
+        return _pose_function(self)
+
+
+def _pose_function(joint: Joint) -> Callable[[float], Pose]:
+    """``position -> pose`` for one joint, with everything that does not move computed once.
+
+    A revolute joint's rotation is the origin's quaternion times the axis-angle one (16 products
+    instead of two matrices), with the sign KDL's GetQuaternion would give the same rotation:
+    the branch that KDL picks from the matrix diagonal is picked here from the squared components
+    (trace = 4w^2 - 1, R00 > R11 <=> x^2 > y^2 ...), and that component is made positive.
+    """
+    x0, y0, z0 = joint.xyz
+    ox, oy, oz, ow = quaternion(joint.rotation)
+    if joint.type in ("revolute", "continuous"):
+        ax, ay, az = joint.axis
+
+        def revolute(position: float) -> Pose:
+            half = 0.5 * position
+            s, c = math.sin(half), math.cos(half)
+            bx, by, bz = ax * s, ay * s, az * s
+            qx = ow * bx + ox * c + oy * bz - oz * by
+            qy = ow * by - ox * bz + oy * c + oz * bx
+            qz = ow * bz + ox * by - oy * bx + oz * c
+            qw = ow * c - ox * bx - oy * by - oz * bz
+            return (x0, y0, z0, *_kdl_sign(qx, qy, qz, qw))
+
+        return revolute
+    if joint.type == "prismatic":
+        dx, dy, dz = _apply(joint.rotation, joint.axis)
+        rotation = (ox, oy, oz, ow)
+
+        def prismatic(position: float) -> Pose:
+            return (x0 + dx * position, y0 + dy * position, z0 + dz * position, *rotation)
+
+        return prismatic
+    fixed = (x0, y0, z0, ox, oy, oz, ow)
+    return lambda _position: fixed
+
+
+def _kdl_sign(x: float, y: float, z: float, w: float) -> tuple[float, float, float, float]:
+    xx, yy, zz, ww = x * x, y * y, z * z, w * w
+    if 4.0 * ww - (xx + yy + zz + ww) > 1e-12:
+        key = w
+    elif xx > yy and xx > zz:
+        key = x
+    elif yy > zz:
+        key = y
+    else:
+        key = z
+    return (x, y, z, w) if key >= 0.0 else (-x, -y, -z, -w)
 
 
 @dataclass(frozen=True)

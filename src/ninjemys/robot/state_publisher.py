@@ -14,14 +14,16 @@ have, with one warning per new set of unknown names (ROS 1 ignores them silently
 
 from __future__ import annotations
 
+import struct
 import threading
 from collections.abc import Callable
 from typing import Any
 
+from ninjemys import names
 from ninjemys.errors import NinjemysError
 from ninjemys.idl.loader import get_message_class
 from ninjemys.node.run import run_node
-from ninjemys.robot.kinematics import Joint, RobotModel, URDFError, parse_urdf
+from ninjemys.robot.kinematics import Joint, Pose, RobotModel, URDFError, parse_urdf
 from ninjemys.rostime import Duration, Time
 
 
@@ -39,7 +41,6 @@ class StatePublisher:
 
     def __init__(self, node: Any, model: RobotModel, log: Callable[[str], None]) -> None:
         self.node, self.model, self.warn = node, model, log
-        self.TransformStamped = get_message_class("geometry_msgs/TransformStamped")
         self.TFMessage = get_message_class("tf2_msgs/TFMessage")
         self.frequency = float(node.get_param("~publish_frequency", 50.0))
         self.interval = Duration.from_sec(1.0 / self.frequency) if self.frequency > 0 else Duration(0)
@@ -47,32 +48,66 @@ class StatePublisher:
         self.use_tf_static = bool(node.get_param("~use_tf_static", True))
         prefix_key = node.search_param("tf_prefix")
         self.prefix = str(node.get_param(prefix_key, "")) if prefix_key else ""
+        self.encoded = {name: _JointEncoder(joint, self.prefix) for name, joint in model.joints.items()}
         self.mimics: dict[str, list[Joint]] = {}
         for joint in model.joints.values():
             if joint.mimic:
                 self.mimics.setdefault(joint.mimic.joint, []).append(joint)
-        self.last_published: dict[str, Time] = {}
-        self.last_stamp: Time | None = None
+        self.interval_ns = int(self.interval.to_nsec())
+        self.last_published: dict[str, int] = {}  # joint -> stamp (ns) of its last transform
+        self.last_stamp_ns = 0
         self.unknown_seen: set[frozenset[str]] = set()
         self.lock = threading.Lock()
         self.tf = node.publisher("/tf", self.TFMessage, queue_size=100)
         self.tf_static = node.publisher("/tf_static", self.TFMessage, queue_size=100, latch=True)
         JointState = get_message_class("sensor_msgs/JointState")
-        self.sub = node.subscriber("joint_states", JointState, self.on_joint_state, queue_size=100)
+        self.names_cache: dict[bytes, tuple[str, ...]] = {}
+        self.sub = node.subscriber("joint_states", JointState, self.on_raw, queue_size=100, raw=True)
 
     def start(self) -> None:
         """Fixed joints: once, latched (use_tf_static), or on a timer on /tf."""
         if self.use_tf_static:
-            self.tf_static.publish(self._message(self.model.fixed, {}, self.node.now()))
+            self.tf_static.publish_raw(self._message(self.model.fixed, {}, self.node.now()))
         elif self.model.fixed and self.frequency > 0:
             self.node.timer(self.interval, lambda _e: self._publish_fixed_on_tf())
 
     def _publish_fixed_on_tf(self) -> None:
         stamp = self.node.now() + Duration.from_sec(0.5)
-        self.tf.publish(self._message(self.model.fixed, {}, stamp))
+        self.tf.publish_raw(self._message(self.model.fixed, {}, stamp))
 
-    def on_joint_state(self, msg: Any) -> None:
-        names, positions = list(msg.name), list(msg.position)
+    def on_raw(self, raw: Any) -> None:
+        """A JointState as bytes: only the stamp, the names and the positions are read (the names,
+        the same in every message of a stream, are decoded once per distinct list)."""
+        try:
+            secs, nsecs, names, positions = self._parse(raw.data)
+        except (struct.error, UnicodeDecodeError, IndexError):
+            self.warn("Robot state publisher ignored a malformed JointState message")
+            return
+        self.on_joint_state(names, positions, secs, nsecs)
+
+    def _parse(self, data: bytes | bytearray) -> tuple[int, int, tuple[str, ...], tuple[float, ...]]:
+        _seq, secs, nsecs, frame_len = _HEADER.unpack_from(data, 0)
+        start = 16 + frame_len
+        (count,) = _COUNT.unpack_from(data, start)
+        offset = start + 4
+        for _ in range(count):
+            (length,) = _COUNT.unpack_from(data, offset)
+            offset += 4 + length
+        key = bytes(data[start:offset])
+        names = self.names_cache.get(key)
+        if names is None:
+            names = _names(key, count)
+            if len(self.names_cache) < 64:
+                self.names_cache[key] = names
+        (n,) = _COUNT.unpack_from(data, offset)
+        if offset + 4 + 8 * n > len(data):
+            raise struct.error("positions run past the end")
+        positions = struct.unpack_from(f"<{n}d", data, offset + 4)
+        return secs, nsecs, names, positions
+
+    def on_joint_state(
+        self, names: tuple[str, ...], positions: tuple[float, ...], secs: int, nsecs: int
+    ) -> None:
         if len(names) != len(positions):
             if not positions:
                 self.warn(
@@ -83,61 +118,91 @@ class StatePublisher:
                 self.warn("Robot state publisher ignored an invalid JointState message")
             return
         joints = self.model.joints
-        unknown = frozenset(n for n in names if n not in joints)
-        if unknown and unknown not in self.unknown_seen:
-            self.unknown_seen.add(unknown)
-            self.warn(
-                f"joint_states names joint(s) the robot does not have, ignored: {', '.join(sorted(unknown))}"
-            )
-        stamp = msg.header.stamp
+        known = [n for n in names if n in joints]
+        if len(known) != len(names):
+            unknown = frozenset(n for n in names if n not in joints)
+            if unknown not in self.unknown_seen:
+                self.unknown_seen.add(unknown)
+                self.warn(
+                    f"joint_states names joint(s) the robot does not have, ignored: {', '.join(sorted(unknown))}"
+                )
+        now_ns = secs * 1_000_000_000 + nsecs
         with self.lock:
-            if self.last_stamp is not None and stamp < self.last_stamp:
+            if now_ns < self.last_stamp_ns:
                 self.warn(
                     "Moved backwards in time (probably because ROS clock was reset), re-publishing joint transforms!"
                 )
                 self.last_published.clear()
-            self.last_stamp = stamp
-            known = [n for n in names if n in joints]
+            self.last_stamp_ns = now_ns
             if not known:
                 return
-            oldest = min((self.last_published.get(n, Time(0)) for n in known), default=Time(0))
-            if not (self.ignore_timestamp or stamp > oldest + self.interval):
+            last = self.last_published
+            if not self.ignore_timestamp and now_ns <= min(last.get(n, 0) for n in known) + self.interval_ns:
                 return
             for name in known:
-                self.last_published[name] = stamp
-        values = {n: float(p) for n, p in zip(names, positions, strict=True) if n in joints}
-        moving = [joints[n] for n in values if joints[n].type in ("revolute", "continuous", "prismatic")]
-        for name in list(values):
-            for mimic in self.mimics.get(name, ()):
+                last[name] = now_ns
+        values = {n: p for n, p in zip(names, positions, strict=True) if n in joints}
+        moving = [joints[n] for n in values if joints[n].type in _MOVING]
+        mimics = self.mimics
+        for name in list(values) if mimics else ():
+            for mimic in mimics.get(name, ()):
                 assert mimic.mimic is not None
                 values[mimic.name] = values[name] * mimic.mimic.multiplier + mimic.mimic.offset
                 if mimic.type != "fixed":
                     moving.append(mimic)
         if moving:
-            self.tf.publish(self._message(moving, values, stamp))
+            self.tf.publish_raw(self._message(moving, values, Time(secs, nsecs)))
 
-    def _message(self, joints: list[Joint], values: dict[str, float], stamp: Time) -> Any:
-        transforms = []
+    def _message(self, joints: list[Joint], values: dict[str, float], stamp: Time) -> bytes:
+        """The serialized TFMessage: one TransformStamped per joint (header seq 0, as tf2 sends)."""
+        stamp_bytes = _STAMP.pack(0, stamp.secs, stamp.nsecs)
+        parts = [_COUNT.pack(len(joints))]
         for joint in joints:
-            x, y, z, qx, qy, qz, qw = joint.transform(values.get(joint.name, 0.0))
-            t = self.TransformStamped()
-            t.header.stamp = stamp
-            t.header.frame_id = resolve_frame(self.prefix, joint.parent)
-            t.child_frame_id = resolve_frame(self.prefix, joint.child)
-            tr, rot = t.transform.translation, t.transform.rotation
-            tr.x, tr.y, tr.z = x, y, z
-            rot.x, rot.y, rot.z, rot.w = qx, qy, qz, qw
-            transforms.append(t)
-        return self.TFMessage(transforms=transforms)
+            parts.append(self.encoded[joint.name].encode(stamp_bytes, values.get(joint.name, 0.0)))
+        return b"".join(parts)
+
+
+_MOVING = frozenset(("revolute", "continuous", "prismatic"))
+_COUNT = struct.Struct("<I")
+_HEADER = struct.Struct("<4I")  # seq, stamp secs, stamp nsecs, frame_id length
+_STAMP = struct.Struct("<3I")
+_POSE = struct.Struct("<7d")
+
+
+def _names(section: bytes, count: int) -> tuple[str, ...]:
+    names, offset = [], 4
+    for _ in range(count):
+        (length,) = _COUNT.unpack_from(section, offset)
+        names.append(section[offset + 4 : offset + 4 + length].decode("utf-8"))
+        offset += 4 + length
+    return tuple(names)
+
+
+class _JointEncoder:
+    """One joint's part of a TFMessage: its frame names serialized once, its pose per message."""
+
+    def __init__(self, joint: Joint, prefix: str) -> None:
+        parent = resolve_frame(prefix, joint.parent).encode()
+        child = resolve_frame(prefix, joint.child).encode()
+        self.frames = _COUNT.pack(len(parent)) + parent + _COUNT.pack(len(child)) + child
+        self.pose: Callable[[float], Pose] = joint.pose_function()
+
+    def encode(self, stamp: bytes, position: float) -> bytes:
+        return stamp + self.frames + _POSE.pack(*self.pose(position))
 
 
 def load_model(node: Any) -> RobotModel:
     """The URDF on the parameter server (``robot_description``, searched up the namespace)."""
-    key = node.search_param("robot_description") or "robot_description"
+    plain = names.resolve_name("robot_description", node.name, {})
+    remapped = node.resolve_name("robot_description")  # roscpp's searchParam remaps the key first
+    if remapped != plain or node.has_param(plain):
+        key = remapped
+    else:
+        key = node.search_param("robot_description") or plain
     try:
         text = node.get_param(key)
     except NinjemysError:
-        raise URDFError(f"Could not find parameter {key} on parameter server") from None
+        raise URDFError("Could not find parameter robot_description on parameter server") from None
     if not isinstance(text, str):
         raise URDFError(f"parameter {key} is not a string (a URDF document)")
     return parse_urdf(text, source=f"parameter {node.resolve_name(key)}")

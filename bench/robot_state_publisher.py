@@ -1,0 +1,138 @@
+"""CPU of robot_state_publisher at 50 Hz joint states for a 20-joint robot: ninjemys vs Debian's C++.
+
+Run: ``.venv/bin/python bench/robot_state_publisher.py`` (``--seconds N``, default 20).
+
+One master (ours), one description (a chain of 20 revolute joints with odd origins and axes, and
+two fixed joints), one JointState stream at 50 Hz from this process with a new stamp every message.
+Both state publishers run at once, ours and Debian's ``/usr/lib/robot_state_publisher``, each on
+its own remapped /tf, and each one's CPU time (user + system from /proc) is taken over the same
+window; the transforms each published in that window are counted so a silent node cannot win.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "src"))
+
+JOINTS = 20
+DEBIAN = Path("/usr/lib/robot_state_publisher/robot_state_publisher")
+
+
+def description() -> str:
+    links = "".join(f'<link name="l{i}"/>' for i in range(JOINTS + 3))
+    joints = "".join(
+        f'<joint name="j{i}" type="revolute"><parent link="l{i}"/><child link="l{i + 1}"/>'
+        f'<origin xyz="0.{i % 7} 0.1 0.2" rpy="0.{i % 5} -0.3 1.{i % 3}"/><axis xyz="0 {i % 2} 1"/>'
+        '<limit lower="-3" upper="3" effort="1" velocity="1"/></joint>'
+        for i in range(JOINTS)
+    )
+    fixed = "".join(
+        f'<joint name="f{k}" type="fixed"><parent link="l{JOINTS}"/><child link="l{JOINTS + 1 + k}"/></joint>'
+        for k in range(2)
+    )
+    return f'<robot name="bench">{links}{joints}{fixed}</robot>'
+
+
+def cpu_seconds(pid: int) -> float:
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seconds", type=float, default=20.0)
+    opts = parser.parse_args()
+    from ninjemys import testing
+    from ninjemys.idl.loader import get_message_class
+    from ninjemys.node import Node
+    from ninjemys.rostime import Time
+
+    home = tempfile.mkdtemp(prefix="bench_rsp_")
+    env = dict(os.environ, ROS_HOME=home, ROS_LOG_DIR=home)
+    with testing.run_master(env=env) as uri:
+        env.update(ROS_MASTER_URI=uri, ROS_HOSTNAME="localhost")
+        node = Node("rsp_bench", master_uri=uri)
+        node.set_param("/robot_description", description())
+        TFMessage, JointState = (
+            get_message_class("tf2_msgs/TFMessage"),
+            get_message_class("sensor_msgs/JointState"),
+        )
+        counts = {"ours": 0, "debian": 0}
+        lock = threading.Lock()
+
+        def counter(name: str):  # noqa: ANN202
+            def count(msg) -> None:  # noqa: ANN001
+                with lock:
+                    counts[name] += len(msg.transforms)
+
+            return count
+
+        commands = {
+            "ours": [
+                sys.executable,
+                "-m",
+                "ninjemys.packages.run_shipped",
+                "robot_state_publisher",
+                "robot_state_publisher",
+                "/tf:=/tf_ours",
+                "__name:=rsp_ours",
+            ],
+        }
+        if DEBIAN.exists():
+            commands["debian"] = [str(DEBIAN), "/tf:=/tf_debian", "__name:=rsp_debian"]
+        for name in commands:
+            node.subscriber(f"/tf_{name}", TFMessage, counter(name), queue_size=1000)
+        pub = node.publisher("/joint_states", JointState, queue_size=100)
+        procs = {
+            name: subprocess.Popen(argv, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            for name, argv in commands.items()
+        }
+        try:
+            while pub.get_num_connections() < len(procs):
+                time.sleep(0.05)
+            time.sleep(1.0)
+            names = [f"j{i}" for i in range(JOINTS)]
+            period, k = 1.0 / 50.0, 0
+            start_cpu = {name: cpu_seconds(p.pid) for name, p in procs.items()}
+            with lock:
+                start_counts = dict(counts)
+            start = time.monotonic()
+            next_t = start
+            while time.monotonic() - start < opts.seconds:
+                stamp = time.time()
+                msg = JointState(name=names, position=[0.01 * k + 0.1 * i for i in range(JOINTS)])
+                msg.header.stamp = Time.from_sec(stamp)
+                pub.publish(msg)
+                k += 1
+                next_t += period
+                time.sleep(max(0.0, next_t - time.monotonic()))
+            wall = time.monotonic() - start
+            time.sleep(0.5)
+            cpu = {name: cpu_seconds(p.pid) - start_cpu[name] for name, p in procs.items()}
+            with lock:
+                sent = {name: counts[name] - start_counts[name] for name in procs}
+        finally:
+            for p in procs.values():
+                p.terminate()
+            for p in procs.values():
+                p.wait(10)
+            node.shutdown("bench done")
+    print(
+        f"robot_state_publisher, {JOINTS} joints at 50 Hz for {wall:.0f} s (load {os.getloadavg()[0]:.1f}):"
+    )
+    for name in procs:
+        print(f"  {name:7s} CPU {100 * cpu[name] / wall:5.2f} % of a core, {sent[name]} transforms published")
+    if "debian" in cpu and cpu["debian"] > 0:
+        print(f"  ratio ours/debian: {cpu['ours'] / cpu['debian']:.2f}")
+
+
+if __name__ == "__main__":
+    main()
