@@ -80,7 +80,9 @@ def publisher_cost(repeat: int) -> None:
                 t = time.process_time()
                 encode(msg, params)
                 best = min(best, time.process_time() - t)
-            print(f"  {w}x{h} {params.format:5s} {best * 1e3:8.2f} ms/frame  {best * 30 * 100:6.1f} % of a core at 30 fps")
+            print(
+                f"  {w}x{h} {params.format:5s} {best * 1e3:8.2f} ms/frame  {best * 30 * 100:6.1f} % of a core at 30 fps"
+            )
 
 
 def main(argv: list[str] | None = None) -> int:
