@@ -26,7 +26,6 @@ NODE = '''#!/usr/bin/env python3
 """Red-object mask, as the course texts write it."""
 import cv2
 import numpy as np
-import pytest
 import rospy
 from cv_bridge import CvBridge
 from sensor_msgs.msg import Image
