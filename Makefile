@@ -18,8 +18,8 @@ ROS1_DEBS := ros-core python3-rospy python3-rosbag python3-genpy python3-rosmsg 
 	python3-cv-bridge libdynamic-reconfigure-config-init-mutex-dev
 # robot descriptions: Debian's C++ robot_state_publisher and urdfdom's check_urdf, the references
 ROS1_DEBS += ros-robot-state-publisher liburdfdom-tools
-# vision: Debian's OpenCV under /usr/bin/python3 (cv_bridge and image_transport side-by-side tests)
-ROS1_DEBS += python3-opencv
+# vision: Debian's OpenCV under /usr/bin/python3 and its C++ image_transport republish (side-by-side tests)
+ROS1_DEBS += python3-opencv image-transport-tools
 BROWSER_DEBS := chromium chromium-driver fonts-dejavu-core
 SYSTEM_DEBS  := $(ROS1_DEBS) $(BROWSER_DEBS) tmux
 

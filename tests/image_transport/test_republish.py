@@ -85,3 +85,46 @@ def test_bad_arguments_give_usage(args: list[str]) -> None:
     )
     assert res.returncode != 0
     assert "republish" in res.stderr and "Traceback" not in res.stderr
+
+
+DEBIAN_REPUBLISH = "/usr/lib/image_transport/republish"
+
+
+@pytest.mark.ros1
+@pytest.mark.skipif(not os.path.exists(DEBIAN_REPUBLISH), reason="needs Debian's image-transport-tools")
+def test_raw_republish_side_by_side_with_debian() -> None:
+    """Debian's C++ republish (its only plugin is raw) and ours, same arguments: the same Image out.
+    Debian's lists no compressed transport (no compressed_image_transport package in Debian)."""
+    from ninjemys.testing import ros1_env
+
+    arr = np.arange(20 * 10 * 3, dtype=np.uint8).reshape(10, 20, 3)
+    bridge = CvBridge()
+    with run_master() as uri:
+        node = Node("republish_pair", master_uri=uri, rosout=False, logger_services=False)
+        procs = [_start(uri, "raw", "in:=/cam/image_raw", "raw", "out:=/ours/out")]
+        procs.append(
+            subprocess.Popen(
+                [DEBIAN_REPUBLISH, "raw", "in:=/cam/image_raw", "raw", "out:=/deb/out"],
+                env=ros1_env(uri),
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.PIPE,
+                start_new_session=True,
+            )
+        )
+        try:
+            ours: queue.Queue[Any] = queue.Queue()
+            theirs: queue.Queue[Any] = queue.Queue()
+            node.subscriber("/ours/out", Image, ours.put)
+            node.subscriber("/deb/out", Image, theirs.put)
+            pub = node.publisher("/cam/image_raw", Image, queue_size=2)
+            img = bridge.cv2_to_imgmsg(arr, "bgr8")
+            img.header.frame_id = "cam"
+            a = _wait(ours, pub, img)
+            b = _wait(theirs, pub, img)
+        finally:
+            for p in procs:
+                kill_tree(p)
+            node.shutdown("test over")
+    for m in (a, b):
+        assert (m.encoding, m.height, m.width, m.step, m.header.frame_id) == ("bgr8", 10, 20, 60, "cam")
+        assert bytes(m.data) == arr.tobytes()
