@@ -18,6 +18,8 @@ ROS1_DEBS := ros-core python3-rospy python3-rosbag python3-genpy python3-rosmsg 
 	python3-cv-bridge libdynamic-reconfigure-config-init-mutex-dev
 # robot descriptions: Debian's C++ robot_state_publisher and urdfdom's check_urdf, the references
 ROS1_DEBS += ros-robot-state-publisher liburdfdom-tools
+# PyKDL, tf_conversions and joint_state_publisher: the references for ours
+ROS1_DEBS += python3-pykdl python3-tf-conversions joint-state-publisher
 # vision: Debian's OpenCV under /usr/bin/python3 and its C++ image_transport republish (side-by-side tests)
 ROS1_DEBS += python3-opencv image-transport-tools
 BROWSER_DEBS := chromium chromium-driver fonts-dejavu-core

@@ -63,6 +63,8 @@ PACKAGES = {
     "laser_geometry": ["laser_geometry", "laser_geometry.laser_geometry"],
     "cv_bridge": ["cv_bridge", "cv_bridge.core", "cv_bridge.boost.cv_bridge_boost"],
     "sensor_msgs": ["sensor_msgs.point_cloud2"],
+    "PyKDL": ["PyKDL"],
+    "tf_conversions": ["tf_conversions", "tf_conversions.posemath"],
 }
 
 _GENERATOR_INTERNALS = "the C++/Python/doc file writers behind generate(); ours generates differently"
@@ -70,6 +72,26 @@ _CSM = "CommStateMachine internals: ours is driven by the client with one status
 
 #: what Debian has and we deliberately do not (or differently): path -> one-line reason
 ALLOWED = {
+    **{
+        f"{mod}.{name}": "PyKDL: orocos-kdl's chains, trees, solvers, joint arrays and *Vel types are not"
+        " provided; only the frames that tf_conversions and scripts use (docs/libs.md)"
+        for mod in ("PyKDL", "tf_conversions", "tf_conversions.posemath")
+        for name in (
+            *("Add", "Subtract", "Multiply", "Divide", "MultiplyJacobian", "SolverI", "doubleVel"),
+            *("Chain", "ChainDynParam", "ChainFkSolverPos", "ChainFkSolverPos_recursive", "ChainFkSolverVel"),
+            *("ChainFkSolverVel_recursive", "ChainIdSolver", "ChainIdSolver_RNE", "ChainIkSolverPos"),
+            *("ChainIkSolverPos_LMA", "ChainIkSolverPos_NR", "ChainIkSolverPos_NR_JL", "ChainIkSolverVel"),
+            *("ChainIkSolverVel_pinv", "ChainIkSolverVel_pinv_givens", "ChainIkSolverVel_pinv_nso"),
+            *("ChainIkSolverVel_wdls", "ChainJntToJacDotSolver", "ChainJntToJacSolver", "FrameVel"),
+            *("Jacobian", "JntArray", "JntArrayVel", "JntSpaceInertiaMatrix", "Joint", "RigidBodyInertia"),
+            *("RotationVel", "RotationalInertia", "Segment", "Tree", "TwistVel", "VectorVel"),
+        )
+    },
+    **{
+        f"{mod}.{cls}": "PyKDL's classes are pybind11 objects there, plain Python classes here"
+        for mod in ("PyKDL", "tf_conversions", "tf_conversions.posemath")
+        for cls in ("Frame", "Rotation", "Vector", "Twist", "Wrench")
+    },
     "actionlib.g_goal_id": "a module-level counter of ROS 1's client; our ids come from GoalIDGenerator",
     "actionlib.action_client.g_goal_id": "same counter as actionlib.g_goal_id",
     "actionlib.goal_id_generator.s_goalcount": "ROS 1's module-level goal counter; ours lives in the generator",

@@ -19,11 +19,13 @@ THREAD_SOURCES = [
     SRC / "ninjemys" / "net",
     SRC / "ninjemys" / "master",
     SRC / "rospy",
+    SRC / "ninjemys" / "nav" / "move_base_node.py",
 ]
 LOCK_SOURCES = [
     SRC / "ninjemys" / "node",
     SRC / "ninjemys" / "net",
     SRC / "ninjemys" / "master" / "client.py",
+    SRC / "ninjemys" / "nav" / "move_base_node.py",
 ]
 _SYNC = {"Lock", "RLock", "Condition", "Event", "local", "deque"}
 

@@ -27,6 +27,8 @@ PROVIDED_LIBRARIES = (
     "tf2",
     "tf2_ros",
     "tf2_py",
+    "tf_conversions",
+    "python_orocos_kdl",
     "tf2_geometry_msgs",
     "tf2_msgs",
     "tf",

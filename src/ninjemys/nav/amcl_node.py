@@ -38,7 +38,7 @@ from ninjemys.nav.rosglue import (
     scan_arrays,
     tf_item,
 )
-from ninjemys.nav.slam import compose, inverse
+from ninjemys.tf2.math import se2_compose, se2_inverse
 
 
 class AmclNode:
@@ -224,7 +224,7 @@ class AmclNode:
                 )
             update = self.force_update
             if self.last_odom is not None:
-                d = compose(inverse(self.last_odom), odom)
+                d = se2_compose(se2_inverse(self.last_odom), odom)
                 moved = (
                     abs(odom[0] - self.last_odom[0]) > self.params.update_min_d
                     or abs(odom[1] - self.last_odom[1]) > self.params.update_min_d
@@ -249,7 +249,7 @@ class AmclNode:
                 self.force_update = injected > 0
                 est = (float(mean[0]), float(mean[1]), float(mean[2]))
                 self._publish_pose(scan, est, cov)
-                self.map_to_odom = compose(est, inverse(odom))
+                self.map_to_odom = se2_compose(est, se2_inverse(odom))
             if self.map_to_odom is not None and self.tf_broadcast:
                 self.tf.send(
                     [tf_item(self.global_frame, self.odom_frame, t + self.tolerance, self.map_to_odom)]

@@ -15,9 +15,8 @@ from typing import Any
 
 import numpy as np
 
-import rospy
 from ninjemys.nav.costmap import Costmap, CostmapParams, parse_footprint, to_occupancy
-from ninjemys.nav.rosglue import fill_info, stamp
+from ninjemys.nav.rosglue import fill_info
 
 
 class CostmapROS:
@@ -52,7 +51,7 @@ class CostmapROS:
             try:
                 p.footprint = parse_footprint(footprint)
             except ValueError as exc:
-                rospy.logerr("%s/footprint: %s; using robot_radius %.3f", self.ns, exc, p.robot_radius)
+                self.node.log.error("%s/footprint: %s; using robot_radius %.3f", self.ns, exc, p.robot_radius)
         plugins = self.node.get_param(self.ns + "/plugins", None)
         if isinstance(plugins, list):
             kinds = {str(pl.get("type", "")) for pl in plugins if isinstance(pl, dict)}
@@ -97,7 +96,7 @@ class CostmapROS:
                     raise ValueError
                 return out
         except (TypeError, ValueError):
-            rospy.logerr(
+            self.node.log.error(
                 "move_base: parameter %s: expected a %s, got %r; using %r",
                 self.node.resolve_name(where),
                 type(default).__name__,
@@ -119,11 +118,11 @@ class CostmapROS:
                     base = self.node.get_param(cand)
                     break
             if not isinstance(base, dict):
-                rospy.logerr("%s: observation source '%s' has no parameters; ignored", self.ns, name)
+                self.node.log.error("%s: observation source '%s' has no parameters; ignored", self.ns, name)
                 continue
             kind = str(base.get("data_type", "LaserScan"))
             if kind != "LaserScan":
-                rospy.logerr(
+                self.node.log.error(
                     "%s: observation source '%s' has data_type %s; only LaserScan is supported",
                     self.ns,
                     name,
@@ -151,8 +150,15 @@ class CostmapROS:
         if self._published != key or self._last_costs is None:
             msg = self._grid_cls()
             msg.header.frame_id = self.global_frame
-            msg.header.stamp = stamp()
-            fill_info(msg.info, cm.size_x, cm.size_y, cm.resolution, (cm.origin_x, cm.origin_y, 0.0))
+            msg.header.stamp = self.node.now()
+            fill_info(
+                msg.info,
+                cm.size_x,
+                cm.size_y,
+                cm.resolution,
+                (cm.origin_x, cm.origin_y, 0.0),
+                self.node.get_time(),
+            )
             msg.data = occ.ravel()
             self.pub.publish(msg)
             self._published = key
@@ -164,7 +170,7 @@ class CostmapROS:
             y1, x1 = changed.max(axis=0) + 1
             up = self._update_cls()
             up.header.frame_id = self.global_frame
-            up.header.stamp = stamp()
+            up.header.stamp = self.node.now()
             up.x, up.y, up.width, up.height = int(x0), int(y0), int(x1 - x0), int(y1 - y0)
             up.data = np.ascontiguousarray(occ[y0:y1, x0:x1]).ravel()
             self.update_pub.publish(up)

@@ -12,7 +12,9 @@ the rest as dwa_local_planner does (all distances in cells of the local costmap)
            left out near the goal
 
 Within ``xy_goal_tolerance`` of the goal the robot stops and turns in place to the goal's yaw
-(``yaw_goal_tolerance``), like dwa's LatchedStopRotateController (``latch_xy_goal_tolerance``).
+(``yaw_goal_tolerance``), like dwa's LatchedStopRotateController (``latch_xy_goal_tolerance``). In
+a narrow spot the last centimetres may have no safe arc at all; within ``NEAR_GOAL`` tolerances of
+the goal, standing, that also ends the approach with the turn in place (ours; dwa fails the cycle).
 Everything for one cycle is a handful of numpy operations over all samples at once.
 """
 
@@ -24,11 +26,11 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from ninjemys.nav.costmap import INSCRIBED, NO_INFORMATION, Costmap
+from ninjemys.tf2.math import angle_diff
 
-
-def angle_diff(a: float, b: float) -> float:
-    """a - b wrapped into [-pi, pi)."""
-    return (a - b + math.pi) % (2 * math.pi) - math.pi
+#: within this many xy_goal_tolerance of the goal, a standing robot with no safe arc ends the approach:
+#: it turns in place to the goal's yaw
+NEAR_GOAL = 1.5
 
 
 @dataclass
@@ -77,12 +79,14 @@ class DWAParams:
 
 @dataclass
 class Command:
-    """One cycle's answer: a velocity, and whether the goal is reached or no arc was safe."""
+    """One cycle's answer: a velocity, and whether the goal is reached or no arc was safe.
+    ``turning``: the final turn in place to the goal's yaw (the goal's position is reached)."""
 
     v: float
     w: float
     reached: bool = False
     valid: bool = True
+    turning: bool = False
 
 
 class DWAPlanner:
@@ -134,7 +138,17 @@ class DWAPlanner:
         if self.goal_reached_xy(x, y) or (self.xy_latched and p.latch_xy_goal_tolerance):
             self.xy_latched = True
             return self._rotate_to(th, gyaw, vel, period)
-        return self._sample(x, y, th, vel, costmap)
+        cmd = self._sample(x, y, th, vel, costmap)
+        stopped = abs(vel[0]) <= p.acc_lim_x / p.controller_frequency  # turning in place was sampled
+        if not cmd.valid and stopped and math.hypot(gx - x, gy - y) <= NEAR_GOAL * p.xy_goal_tolerance:
+            # the last centimetres of a narrow spot: standing next to the goal, even the turns in
+            # place touch an inscribed cell (the robot's own cell reads inscribed), but the goal is
+            # practically reached and a turn in place sweeps nothing new for a round robot. Without
+            # this the robot stood there until controller_patience ran out, and the recoveries and
+            # the abort left it at any heading. (A robot still moving first stops: no arc is safe.)
+            self.xy_latched = True
+            return self._rotate_to(th, gyaw, vel, period)
+        return cmd
 
     def _rotate_to(
         self, th: float, goal_yaw: float, vel: tuple[float, float], period: float | None = None
@@ -143,7 +157,7 @@ class DWAPlanner:
         dt = 1.0 / p.controller_frequency
         if abs(vel[0]) > 0.02:  # stop first, then turn
             v = math.copysign(max(0.0, abs(vel[0]) - p.acc_lim_x * dt), vel[0])
-            return Command(v, 0.0)
+            return Command(v, 0.0, turning=True)
         err = angle_diff(goal_yaw, th)
         if abs(err) <= p.yaw_goal_tolerance:
             return Command(0.0, 0.0, reached=True)
@@ -156,7 +170,7 @@ class DWAPlanner:
         # the tolerance window, else a late cycle swings past it and the robot hunts back and forth
         hold = max(dt, period or 0.0)
         w = min(w, (abs(err) + 0.5 * p.yaw_goal_tolerance) / hold)
-        return Command(0.0, math.copysign(w, err))
+        return Command(0.0, math.copysign(w, err), turning=True)
 
     def _sample(self, x: float, y: float, th: float, vel: tuple[float, float], cm: Costmap) -> Command:
         p = self.params

@@ -21,35 +21,52 @@ goal status text (ROS 1 accepts them and aborts after ``planner_patience``); whe
 finds no safe arc for ``controller_patience`` seconds, or the robot oscillates, the recovery
 behaviours run in ROS 1's order (conservative reset, rotate in place, aggressive reset, rotate), then
 the goal is aborted.
+
+Those rules are :class:`~ninjemys.nav.move_base.MoveBaseFsm`'s, which has no ROS inside; this module
+keeps the I/O and three threads (control, planner, costmaps), plugs DWA, the grid planner and the
+costmap-clearing recoveries into its seams, and feeds it from one goal inbox (action goals,
+``move_base_simple`` goals and cancels, in arrival order). The node is a core
+:class:`~ninjemys.node.Node` made from the command line (no rospy).
 """
 
 from __future__ import annotations
 
 import math
 import threading
-from collections import deque
 from dataclasses import fields
 from typing import Any
 
 import numpy as np
 
-import rospy
+from ninjemys.actionlib import states
+from ninjemys.errors import ShutdownError
 from ninjemys.nav.costmap import INSCRIBED
 from ninjemys.nav.costmap_ros import CostmapROS
-from ninjemys.nav.dwa import DWAParams, DWAPlanner, angle_diff
+from ninjemys.nav.dwa import DWAParams, DWAPlanner
+from ninjemys.nav.move_base import (
+    CANCELABLE,
+    ClearCostmaps,
+    Command,
+    MoveBaseFsm,
+    MoveBaseParams,
+    Outcome,
+    RotateRecovery,
+    Step,
+)
 from ninjemys.nav.planner import PlanError, plan_path
 from ninjemys.nav.rosglue import (
     Pose2D,
     Tf2D,
     fill_pose,
     grid_from_msg,
+    node_sleep,
     param,
     pose_msg_to_2d,
-    run_node,
+    run_core_node,
     scan_arrays,
-    sleep,
 )
-from ninjemys.nav.slam import compose, inverse
+from ninjemys.node.log import WARN
+from ninjemys.tf2.math import se2_compose
 
 #: dwa_local_planner's names for the base_local_planner (TrajectoryPlannerROS) parameters we map
 TRAJECTORY_ALIASES = {
@@ -62,7 +79,50 @@ TRAJECTORY_ALIASES = {
     "goal_distance_bias": "gdist_scale",
 }
 
-RECOVERIES = ("conservative_reset", "rotate_recovery", "aggressive_reset", "rotate_recovery")
+
+def move_base_params(node: Any) -> MoveBaseParams:
+    """MoveBaseParams from move_base's private parameters."""
+    p = MoveBaseParams()
+    for f in fields(p):
+        setattr(p, f.name, param(node, f.name, getattr(p, f.name)))
+    p.controller_frequency = max(1.0, p.controller_frequency)
+    return p
+
+
+class DwaController:
+    """The controller seam over :class:`DWAPlanner` and the local costmap, which is brought up to date
+    (new marks, the window moved) just before each command."""
+
+    def __init__(self, dwa: DWAPlanner, local_cm: CostmapROS, refresh: Any) -> None:
+        self.dwa = dwa
+        self.local_cm = local_cm
+        self._refresh = refresh
+
+    def new_goal(self) -> None:
+        self.dwa.xy_latched = False
+
+    def set_plan(self, plan: np.ndarray) -> None:
+        latched = self.dwa.xy_latched
+        self.dwa.set_plan(plan)
+        self.dwa.xy_latched = latched  # a replan for the same goal keeps the goal latch
+
+    def compute(self, pose: Pose2D, velocity: tuple[float, float], period: float | None) -> Command:
+        self._refresh(self.local_cm, pose)
+        return self.dwa.compute(pose, velocity, self.local_cm.costmap, period)
+
+    def remaining(self) -> int:
+        return len(self.dwa.plan)
+
+
+class GridPlanner:
+    """The planner seam over :func:`plan_path` on the global costmap (a copy of its costs, taken under
+    move_base's lock, so the search itself runs unlocked)."""
+
+    def __init__(self, owner: MoveBase) -> None:
+        self.owner = owner
+
+    def make_plan(self, start: Pose2D, goal: Pose2D) -> np.ndarray:
+        return self.owner._make_plan(start, goal)
 
 
 def dwa_params(node: Any) -> DWAParams:
@@ -91,16 +151,9 @@ class MoveBase:
         from std_srvs.srv import Empty
 
         self.node = node
+        self.log = node.log
         self.lock = threading.RLock()
-        self.frequency = max(1.0, param(node, "controller_frequency", 20.0))
-        self.planner_frequency = param(node, "planner_frequency", 0.0)
-        self.controller_patience = param(node, "controller_patience", 15.0)
-        self.planner_patience = param(node, "planner_patience", 5.0)
-        self.oscillation_timeout = param(node, "oscillation_timeout", 0.0)
-        self.oscillation_distance = param(node, "oscillation_distance", 0.5)
-        self.recovery_enabled = param(node, "recovery_behavior_enabled", True)
-        self.rotation_allowed = param(node, "clearing_rotation_allowed", True)
-        self.conservative_dist = param(node, "conservative_reset_dist", 3.0)
+        self.params = move_base_params(node)
         planner_ns = "GlobalPlanner" if node.has_param("~GlobalPlanner") else "NavfnROS"
         self.allow_unknown = param(node, f"{planner_ns}/allow_unknown", True)
         self.neutral_cost = param(node, f"{planner_ns}/neutral_cost", 50.0)
@@ -111,28 +164,27 @@ class MoveBase:
         self.dwa = DWAPlanner(dwa_params(node))
         self.tf = Tf2D(node)
         self.velocity = (0.0, 0.0)
-        self.goal: Pose2D | None = None  # in the global frame
-        self.handle: Any = None  # the action goal handle being executed (None: a simple goal or idle)
-        self.plan: np.ndarray | None = None
-        self.state = "idle"
-        self.last_valid = 0.0
-        self.last_plan_time = 0.0
-        self.plan_requested = False
-        self.inbox: list[tuple[str, Any, Any]] = []  # goals and cancels from the action server
+        self.fsm = MoveBaseFsm(
+            self.params,
+            GridPlanner(self),
+            DwaController(self.dwa, self.local_cm, self._refresh),
+            [
+                ClearCostmaps(
+                    "conservative_reset", self._clear_outside, lambda: self.params.conservative_reset_dist
+                ),
+                RotateRecovery(
+                    lambda: self.dwa.params.max_vel_theta, lambda: self.params.clearing_rotation_allowed
+                ),
+                ClearCostmaps("aggressive_reset", self._clear_outside, lambda: 0.0),
+                RotateRecovery(
+                    lambda: self.dwa.params.max_vel_theta, lambda: self.params.clearing_rotation_allowed
+                ),
+            ],
+        )
+        # the one goal inbox: action goals, move_base_simple goals and cancels, taken by the control loop
+        self.inbox: list[tuple[str, Any, Any]] = []
         self.inbox_lock = threading.Lock()
-        self.goal_seq = 0  # bumped by every new goal: a plan computed for an older goal is dropped
         self.plan_event = threading.Event()
-        self.planner_busy = False
-        self.last_request = -1e9
-        self.planning_since = 0.0
-        self.recovery_index = 0
-        self.osc_pose: Pose2D | None = None
-        self.osc_time = 0.0
-        self.rotate_start: float | None = None
-        self.rotate_turned = 0.0
-        self.rotate_last_yaw = 0.0
-        self.last_cycle: float | None = None
-        self.periods: deque[float] = deque(maxlen=20)  # measured control periods (ROS time)
         self._path_cls, self._pose_stamped = Path, PoseStamped
         self.cmd_pub = node.publisher("cmd_vel", Twist, queue_size=1)
         self._twist = Twist
@@ -200,27 +252,12 @@ class MoveBase:
 
     def on_mb_reconfigure(self, config: Any, _level: int) -> Any:
         with self.lock:
-            for key in (
-                "planner_frequency",
-                "controller_patience",
-                "planner_patience",
-                "oscillation_timeout",
-                "oscillation_distance",
-                "conservative_reset_dist",
-            ):
-                if key in config:
-                    setattr(
-                        self,
-                        {"conservative_reset_dist": "conservative_dist"}.get(key, key),
-                        float(config[key]),
-                    )
-            if "controller_frequency" in config:
-                self.frequency = max(1.0, float(config["controller_frequency"]))
-                self.dwa.params.controller_frequency = self.frequency
-            if "recovery_behavior_enabled" in config:
-                self.recovery_enabled = bool(config["recovery_behavior_enabled"])
-            if "clearing_rotation_allowed" in config:
-                self.rotation_allowed = bool(config["clearing_rotation_allowed"])
+            for f in fields(self.params):
+                if f.name in config:
+                    kind = type(getattr(self.params, f.name))
+                    setattr(self.params, f.name, kind(config[f.name]))
+            self.params.controller_frequency = max(1.0, self.params.controller_frequency)
+            self.dwa.params.controller_frequency = self.params.controller_frequency
         return config
 
     # -- inputs -------------------------------------------------------------------------------------
@@ -233,7 +270,7 @@ class MoveBase:
                     cm.costmap.set_static_map(grid.data, grid.resolution, grid.origin[0], grid.origin[1])
             if self.global_cm.costmap.params.use_static:
                 self.global_cm.costmap.update()
-        rospy.loginfo(
+        self.log.info(
             "move_base: received a %d X %d map at %.3f m/pix", grid.width, grid.height, grid.resolution
         )
 
@@ -256,7 +293,7 @@ class MoveBase:
         ranges, angles = scan_arrays(scan)
         if not self.bad_scan_reported and not np.isfinite(ranges).all():
             self.bad_scan_reported = True
-            rospy.logwarn(
+            self.log.warn(
                 "move_base: scan on %s has NaN/inf ranges (%d of %d): NaN is dropped, inf clears without marking",
                 scan.header.frame_id,
                 int((~np.isfinite(ranges)).sum()),
@@ -311,7 +348,7 @@ class MoveBase:
             tr = self.tf.lookup(self.global_cm.global_frame, frame, 0.0)
             if tr is None:
                 return None, f"cannot transform the goal from frame {frame} to {self.global_cm.global_frame}"
-            p = compose(tr, p)
+            p = se2_compose(tr, p)
         # read without move_base's lock: the action server calls this with its own lock held, and the
         # control loop takes the two in the other order (the grid and its costs are replaced, not edited)
         cm = self.global_cm.costmap
@@ -339,69 +376,47 @@ class MoveBase:
         """Runs with the action server's lock held: decide here, hand the goal to the control loop."""
         goal, reason = self._goal_in_global(handle.get_goal().target_pose)
         if goal is None:
-            rospy.logerr("move_base: %s", reason)
+            self.log.error("move_base: %s", reason)
             handle.set_rejected(None, reason)
             return
         handle.set_accepted("This goal has been accepted by the simple action server")
-        with self.inbox_lock:
-            self.inbox.append(("goal", goal, handle))
+        self._post("goal", goal, handle)
 
     def on_cancel(self, handle: Any) -> None:
         """Runs with the action server's lock held: the control loop cancels."""
-        with self.inbox_lock:
-            self.inbox.append(("cancel", None, handle))
-
-    def _take_inbox(self) -> None:
-        """Apply goals and cancels from the action server (control loop, move_base's lock held)."""
-        with self.inbox_lock:
-            items, self.inbox = self.inbox, []
-        for kind, goal, handle in items:
-            if kind == "goal":
-                if self.handle is not None:
-                    self.handle.set_canceled(
-                        None,
-                        "This goal was canceled because another goal was received by the simple action server",
-                    )
-                self._begin(goal, handle)
-            elif self.handle is not None and handle == self.handle:
-                self._stop()
-                handle.set_canceled(None, "")
-                self.handle = None
-                self.goal = None
-                self.state = "idle"
-            elif handle.get_goal_status().status in (0, 1, 6, 7):  # pending, active, preempting, recalling
-                handle.set_canceled(None, "")
+        self._post("cancel", None, handle)
 
     def on_simple_goal(self, msg: Any) -> None:
+        """A ``move_base_simple/goal``: through the same inbox as action goals, with no handle."""
         goal, reason = self._goal_in_global(msg)
         if goal is None:
-            rospy.logerr("move_base: %s", reason)
+            self.log.error("move_base: %s", reason)
             return
-        with self.lock:
-            if self.handle is not None:
-                self.handle.set_canceled(
-                    None,
-                    "This goal was canceled because another goal was received by the simple action server",
-                )
-            self._begin(goal, None)
+        self._post("goal", goal, None)
 
-    def _begin(self, goal: Pose2D, handle: Any) -> None:
-        self.goal = goal
-        self.handle = handle
-        self.dwa.xy_latched = False
-        self.plan = None
-        self.goal_seq += 1
-        self.last_request = -1e9
-        self.state = "planning"
-        self.plan_requested = True
-        self.planning_since = rospy.get_time()
-        self.last_valid = rospy.get_time()
-        self.recovery_index = 0
-        self.osc_pose = None
-        self.osc_time = rospy.get_time()
+    def _post(self, kind: str, goal: Pose2D | None, handle: Any) -> None:
+        with self.inbox_lock:
+            self.inbox.append((kind, goal, handle))
+
+    def _take_inbox(self) -> list[Step]:
+        """Apply goals and cancels in arrival order (control loop, move_base's lock held)."""
+        with self.inbox_lock:
+            items, self.inbox = self.inbox, []
+        steps = []
+        for kind, goal, handle in items:
+            if kind == "goal":
+                steps.append(self.fsm.accept(goal, handle, self.node.get_time()))
+                self._publish_goal(goal)
+            elif self.fsm.is_current(handle):
+                steps.append(self.fsm.cancel(handle))
+            elif handle.get_goal_status().status in CANCELABLE:
+                handle.set_canceled(None, "")
+        return steps
+
+    def _publish_goal(self, goal: Pose2D) -> None:
         msg = self._pose_stamped()
         msg.header.frame_id = self.global_cm.global_frame
-        msg.header.stamp = rospy.Time.from_sec(rospy.get_time())
+        msg.header.stamp = self.node.now()
         fill_pose(msg.pose, goal)
         self.goal_pub.publish(msg)
 
@@ -414,19 +429,18 @@ class MoveBase:
         resp.plan.header.frame_id = self.global_cm.global_frame
         goal, reason = self._goal_in_global(req.goal)
         if goal is None:
-            rospy.logerr("move_base: make_plan: %s", reason)
+            self.log.error("move_base: make_plan: %s", reason)
             return resp
-        if req.start.header.frame_id:
-            start = pose_msg_to_2d(req.start.pose)
-        else:
+        start: Pose2D | None = pose_msg_to_2d(req.start.pose) if req.start.header.frame_id else None
+        if start is None:
             start = self.tf.lookup(self.global_cm.global_frame, self.global_cm.robot_base_frame)
-            if start is None:
-                rospy.logerr("move_base: make_plan: no robot pose in %s", self.global_cm.global_frame)
-                return resp
+        if start is None:
+            self.log.error("move_base: make_plan: no robot pose in %s", self.global_cm.global_frame)
+            return resp
         try:
             plan = self._make_plan(start, goal)
         except PlanError as exc:
-            rospy.logerr("move_base: make_plan: %s", exc)
+            self.log.error("move_base: make_plan: %s", exc)
             return resp
         resp.plan = self._path_msg(plan, self.global_cm.global_frame)
         return resp
@@ -466,7 +480,7 @@ class MoveBase:
 
         path = self._path_cls()
         path.header.frame_id = frame
-        path.header.stamp = rospy.Time.from_sec(rospy.get_time())
+        path.header.stamp = self.node.now()
         out = []
         for x, y, yaw in plan:
             ps = PoseStamped()
@@ -485,21 +499,37 @@ class MoveBase:
         msg.angular.z = float(w)
         self.cmd_pub.publish(msg)
 
-    def _finish(self, ok: bool, text: str) -> None:
-        self._stop()
-        if self.handle is not None:
-            if ok:
-                self.handle.set_succeeded(None, text)
-            else:
-                self.handle.set_aborted(None, text)
-        if ok:
-            rospy.loginfo("move_base: %s", text or "goal reached")
-        else:
-            rospy.logerr("move_base: %s", text)
-        self.handle = None
-        self.goal = None
-        self.state = "idle"
-        self.plan = None
+    def _apply(self, step: Step) -> None:
+        """Carry out what the state machine asked (move_base's lock not held)."""
+        for level, text in step.log:
+            (self.log.warn if level == "warn" else self.log.info)("move_base: %s", text)
+        if step.cmd is not None:
+            self._send(*step.cmd)
+        for outcome in step.ended:
+            self._end(outcome)
+        if step.plan is not None:
+            self.plan_pub.publish(self._path_msg(step.plan, self.global_cm.global_frame))
+        if step.plan_wanted:
+            self.plan_event.set()
+
+    def _end(self, outcome: Outcome) -> None:
+        handle = outcome.token
+        if outcome.goal is not None and outcome.pose is not None:
+            (gx, gy, gyaw), (x, y, yaw) = outcome.goal, outcome.pose
+            self.log.info(
+                "move_base: goal (%.2f, %.2f, %.2f) %s at (%.2f, %.2f, %.2f)",
+                gx, gy, gyaw, outcome.name, x, y, yaw,
+            )  # fmt: skip
+        if outcome.status == states.SUCCEEDED:
+            self.log.info("move_base: %s", outcome.text or "goal reached")
+            if handle is not None:
+                handle.set_succeeded(None, outcome.text)
+        elif outcome.status == states.ABORTED:
+            self.log.error("move_base: %s", outcome.text)
+            if handle is not None:
+                handle.set_aborted(None, outcome.text)
+        elif handle is not None:  # PREEMPTED: a cancel, or a newer goal
+            handle.set_canceled(None, outcome.text)
 
     def costmap_loop(self) -> None:
         """Update each costmap at its update_frequency and publish it at its publish_frequency (as
@@ -509,8 +539,8 @@ class MoveBase:
         period = 1.0 / max(freqs) if freqs else 0.5
         updated = {id(cm): -math.inf for cm in cms}
         published = dict(updated)
-        while sleep(period):
-            t = rospy.get_time()
+        while node_sleep(self.node, period):
+            t = self.node.get_time()
             for cm in cms:
                 if cm.update_frequency > 0 and t - updated[id(cm)] >= 1.0 / cm.update_frequency - 1e-6:
                     updated[id(cm)] = t
@@ -521,15 +551,15 @@ class MoveBase:
                         cm.publish()
 
     def control_loop(self) -> None:
-        rate = rospy.Rate(self.frequency)
-        while not rospy.is_shutdown():
+        rate = self.node.rate(self.params.controller_frequency)
+        while not self.node.is_shutdown:
             try:
                 self.cycle()
             except Exception as exc:  # one cycle failing must not kill the controller thread
-                rospy.logerr("move_base: control cycle failed: %s: %s", type(exc).__name__, exc)
+                self.log.error("move_base: control cycle failed: %s: %s", type(exc).__name__, exc)
             try:
                 rate.sleep()
-            except rospy.ROSInterruptException:
+            except ShutdownError:
                 return
 
     def _robot_poses(self) -> tuple[Pose2D | None, Pose2D | None]:
@@ -539,204 +569,70 @@ class MoveBase:
         return g, self.tf.lookup(self.local_cm.global_frame, self.local_cm.robot_base_frame)
 
     def cycle(self) -> None:
+        """One control cycle: goals from the inbox, then the state machine on the robot's poses."""
         with self.lock:
-            if self.inbox:
-                self._take_inbox()
-            if self.goal is None:
-                return
+            steps = self._take_inbox() if self.inbox else []
+            idle = self.fsm.goal is None
+        for step in steps:
+            self._apply(step)
+        if idle:
+            return
         gpose, lpose = self._robot_poses()
         if gpose is None or lpose is None:
-            rospy.logwarn_throttle(
+            self.log.log_throttle(
                 5.0,
+                WARN,
                 "move_base: no robot pose yet (waiting for TF %s -> %s)",
                 self.global_cm.global_frame,
                 self.global_cm.robot_base_frame,
             )
             return
-        now = rospy.get_time()
-        if self.last_cycle is not None and now > self.last_cycle:
-            self.periods.append(now - self.last_cycle)
-        self.last_cycle = now
         with self.lock:
-            goal = self.goal
-            if goal is None:
-                return
-            self._feedback(gpose)
-            replan_due = (
-                self.planner_frequency > 0 and now - self.last_plan_time >= 1.0 / self.planner_frequency
-            )
-            if self.state == "planning" or (self.state == "controlling" and replan_due):
-                self._request_plan(now)
-            if self.state == "planning":
-                self._stop()  # standing still until there is a plan, as ROS 1's move_base
-                return
-            if self.state == "clearing":
-                self._recovery_step(gpose, lpose, now)
-                return
-            if self.state != "controlling" or self.plan is None:
-                return
-            # the plan in the local costmap's frame
-            to_local = compose(lpose, inverse(gpose))
-            c, s = math.cos(to_local[2]), math.sin(to_local[2])
-            plan = self.plan
-            local_plan = np.column_stack(
-                [
-                    to_local[0] + c * plan[:, 0] - s * plan[:, 1],
-                    to_local[1] + s * plan[:, 0] + c * plan[:, 1],
-                    plan[:, 2] + to_local[2],
-                ]
-            )
-            lcm = self.local_cm.costmap
-            self._refresh(self.local_cm, lpose)  # new marks since the last cycle, or the window moved
-            keep_latch = self.dwa.xy_latched
-            self.dwa.set_plan(local_plan)
-            self.dwa.xy_latched = keep_latch
-            # the longest recent cycle: how long this command may stand before the next one
-            cmd = self.dwa.compute(lpose, self.velocity, lcm, max(self.periods, default=None))
-            # prune the global plan as the local planner did
-            self.plan = plan[len(plan) - len(self.dwa.plan) :]
-        if cmd.reached:
-            with self.lock:
-                self._finish(True, "Goal reached")
-            return
-        if cmd.valid:
-            self.last_valid = now
-            self._send(cmd.v, cmd.w)
-            self._check_oscillation(gpose, now)
-            return
-        self._stop()
-        with self.lock:
-            if now - self.last_valid > self.controller_patience:
-                self._start_recovery(now, "Aborting because a valid control could not be found")
-            elif now - self.last_plan_time > 1.0:
-                self.state = "planning"  # ROS 1 replans when the local planner fails
-                self.planning_since = min(self.planning_since, now) if self.plan_requested else now
-                self.plan_requested = True
+            handle = self.fsm.token
+            step = self.fsm.cycle(self.node.get_time(), gpose, lpose, self.velocity)
+        if step.feedback is not None and handle is not None:
+            self._feedback(handle, step.feedback)
+        self._apply(step)
 
-    def _feedback(self, gpose: Pose2D) -> None:
-        if self.handle is None:
-            return
+    def _feedback(self, handle: Any, gpose: Pose2D) -> None:
         from move_base_msgs.msg import MoveBaseFeedback
 
         fb = MoveBaseFeedback()
         fb.base_position.header.frame_id = self.global_cm.global_frame
-        fb.base_position.header.stamp = rospy.Time.from_sec(rospy.get_time())
+        fb.base_position.header.stamp = self.node.now()
         fill_pose(fb.base_position.pose, gpose)
-        self.handle.publish_feedback(fb)
-
-    def _request_plan(self, now: float) -> None:
-        """Ask the planner thread for a plan (at most every half second while one is being made)."""
-        if self.planner_busy or now - self.last_request < 0.5:
-            return
-        self.last_request = now
-        self.plan_event.set()
+        handle.publish_feedback(fb)
 
     def planner_loop(self) -> None:
         """The global planner's own thread (as in ROS 1): the control loop keeps its rate meanwhile."""
-        while not rospy.is_shutdown():
+        while not self.node.is_shutdown:
             if not self.plan_event.wait(0.5):
                 continue
             self.plan_event.clear()
-            with self.lock:
-                goal, seq = self.goal, self.goal_seq
-                wanted = goal is not None and self.state in ("planning", "controlling")
-                self.planner_busy = wanted
-            if not wanted or goal is None:
-                continue
             try:
-                self._plan_once(goal, seq)
+                self._plan_once()
             except Exception as exc:  # the planner thread must survive anything one plan does
-                rospy.logerr("move_base: planning failed: %s: %s", type(exc).__name__, exc)
-            finally:
-                self.planner_busy = False
+                self.log.error("move_base: planning failed: %s: %s", type(exc).__name__, exc)
+                with self.lock:
+                    self.fsm.planner_busy = False
 
-    def _plan_once(self, goal: Pose2D, seq: int) -> None:
+    def _plan_once(self) -> None:
         gpose = self.tf.lookup(self.global_cm.global_frame, self.global_cm.robot_base_frame)
         if gpose is None:
             return
-        now = rospy.get_time()
-        try:
-            plan = self._make_plan(gpose, goal)
-        except PlanError as exc:
-            with self.lock:
-                if seq != self.goal_seq:
-                    return
-                self.last_plan_time = now
-                if self.state == "controlling":
-                    rospy.logwarn_throttle(
-                        5.0, "move_base: replanning failed (%s); keeping the current plan", exc
-                    )
-                elif self.state == "planning" and now - self.planning_since > self.planner_patience:
-                    self._start_recovery(
-                        now, f"Failed to find a valid plan. Even after executing recovery behaviors. ({exc})"
-                    )
-            return
+        now = self.node.get_time()
         with self.lock:
-            if seq != self.goal_seq or self.goal is None:
-                return
-            self.plan = plan
-            self.last_plan_time = now
-            self.plan_requested = False
-            if self.state == "planning":
-                # controller_patience keeps counting from the last valid command (as ROS 1's
-                # last_valid_control_): a new plan the local planner cannot follow either must not
-                # restart it, or the robot stands replanning forever and no recovery ever runs
-                self.state = "controlling"
-        self.plan_pub.publish(self._path_msg(plan, self.global_cm.global_frame))
-
-    def _check_oscillation(self, gpose: Pose2D, now: float) -> None:
-        if self.oscillation_timeout <= 0:
+            job = self.fsm.take_plan_job(now)
+        if job is None:
             return
-        if self.osc_pose is None:
-            self.osc_pose, self.osc_time = gpose, now
-            return
-        if math.hypot(gpose[0] - self.osc_pose[0], gpose[1] - self.osc_pose[1]) >= self.oscillation_distance:
-            self.osc_pose, self.osc_time = gpose, now
-            self.recovery_index = 0  # real progress: the recovery sequence starts over, as in ROS 1
-            return
-        if now - self.osc_time > self.oscillation_timeout:
-            with self.lock:
-                self._start_recovery(
-                    now, "Aborting because the robot appears to be oscillating over and over"
-                )
-
-    def _start_recovery(self, now: float, failure: str) -> None:
-        if not self.recovery_enabled or self.recovery_index >= len(RECOVERIES):
-            self._finish(False, failure)
-            return
-        self.failure = failure
-        self.state = "clearing"
-        self.rotate_start = None
-        rospy.logwarn(
-            "move_base: %s; running recovery behavior %s",
-            failure.split(".")[0],
-            RECOVERIES[self.recovery_index],
-        )
-
-    def _recovery_step(self, gpose: Pose2D, lpose: Pose2D, now: float) -> None:
-        name = RECOVERIES[self.recovery_index]
-        if name == "rotate_recovery" and self.rotation_allowed:
-            if self.rotate_start is None:
-                self.rotate_start = now
-                self.rotate_turned = 0.0
-                self.rotate_last_yaw = lpose[2]
-            self.rotate_turned += abs(angle_diff(lpose[2], self.rotate_last_yaw))
-            self.rotate_last_yaw = lpose[2]
-            if self.rotate_turned < 2 * math.pi - 0.1 and now - self.rotate_start < 30.0:
-                self._send(0.0, min(1.0, self.dwa.params.max_vel_theta))
-                return
-            self._stop()
-        elif name == "conservative_reset":
-            self._clear_outside(gpose, lpose, self.conservative_dist)
-        elif name == "aggressive_reset":
-            self._clear_outside(gpose, lpose, 0.0)
-        self.recovery_index += 1
-        self.state = "planning"
-        self.plan_requested = True
-        self.planning_since = now
-        self.last_valid = now
-        self.osc_time = now
-        self.osc_pose = None
+        goal, seq = job
+        try:
+            plan, error = self._make_plan(gpose, goal), ""
+        except PlanError as exc:
+            plan, error = None, str(exc)
+        with self.lock:
+            step = self.fsm.plan_done(seq, now, plan, error)
+        self._apply(step)
 
     def _clear_outside(self, gpose: Pose2D, lpose: Pose2D, size: float) -> None:
         """Forget obstacle marks outside a ``size`` x ``size`` square around the robot (0: all), in both
@@ -755,4 +651,4 @@ class MoveBase:
 
 
 def main(argv: list[str] | None = None) -> int:
-    return run_node("move_base", argv, MoveBase)
+    return run_core_node("move_base", argv, MoveBase)

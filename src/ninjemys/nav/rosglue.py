@@ -1,25 +1,29 @@
 """What every navigation node shares: start-up, parameters, message conversions and 2D TF lookups.
 
-A node starts through ``rospy.init_node`` (the process's command line, logging, /rosout and sim
-clock), then works on the core :class:`~ninjemys.node.Node` it made (``rospy.core.process_node``).
+A node starts either as a core :class:`~ninjemys.node.Node` made from the process's command line
+(:func:`run_core_node`, the in-house idiom: move_base) or through ``rospy.init_node``, then works on
+the core Node it made (:func:`run_node`, ``rospy.core.process_node``). Everything below takes the
+Node and uses its log and clock, so it serves both.
 """
 
 from __future__ import annotations
 
-import math
+import os
+import signal
 import sys
+import threading
 from typing import Any
 
 import numpy as np
 
 import rospy
-from ninjemys.errors import ShutdownError
+from ninjemys.errors import NinjemysError, ShutdownError
 from ninjemys.maps.mapfile import GridMap
+from ninjemys.node.timers import TimeMovedBackwardsError
 from ninjemys.tf2.core import BufferCore
 from ninjemys.tf2.errors import TransformException
+from ninjemys.tf2.math import Pose2D, quaternion_from_yaw, yaw_from_quaternion
 from ninjemys.tf2.node import TransformBroadcaster, TransformListener
-
-Pose2D = tuple[float, float, float]
 
 #: how long (wall seconds) a scan waits for the transform at its stamp before it is dropped; ROS 1's
 #: message filters hold up to their queue size of scans, about a second of a 40 Hz (4x sim) laser
@@ -53,6 +57,66 @@ def run_node(name: str, argv: list[str] | None, build: Any) -> int:
     return 0
 
 
+def start_core_node(name: str, argv: list[str] | None) -> tuple[Any, list[str]]:
+    """A core Node named ``name`` from the process's ROS arguments (``__name``, ``__ns``, ``__log``,
+    ``__ip``, remappings, ``_param:=value``) on its clock (sim time under /use_sim_time), with /rosout
+    and the logger services, as ``rospy.init_node`` would make it; returns it and the other arguments."""
+    from ninjemys.node import Node
+    from ninjemys.node.cli_args import network_env, parse_args
+
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = parse_args([sys.argv[0], *argv])
+    os.environ.update(network_env(args))
+    node = Node(
+        args.node_name(name),
+        namespace=args.namespace,
+        remappings=args.remappings,
+        master_uri=args.master_uri,
+        params=args.private_params,
+        log_file=args.log_file,
+        default_clock=True,
+    )
+    return node, [a for a in argv if ":=" not in a]
+
+
+def run_core_node(name: str, argv: list[str] | None, build: Any) -> int:
+    """Start core node ``name``, build its object with ``build(node)``, wait for shutdown (Ctrl-C,
+    SIGTERM, ``rosnode kill``). A signal shuts the node down from a ``shutdown`` thread, not from the
+    interrupted main thread, which may hold locks the shutdown needs."""
+    try:
+        node, _ = start_core_node(name, argv)
+    except NinjemysError as exc:
+        print(f"{name}: {exc}", file=sys.stderr)
+        return 1
+
+    def on_signal(_signum: int, _frame: Any) -> None:
+        threading.Thread(target=node.shutdown, args=("signal",), name="shutdown", daemon=True).start()
+
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, on_signal)
+        signal.signal(signal.SIGTERM, on_signal)
+    try:
+        build(node)
+        node.spin()
+    except ShutdownError:
+        pass
+    finally:
+        node.shutdown("exit")
+    return 0
+
+
+def node_sleep(node: Any, seconds: float) -> bool:
+    """Sleep ``seconds`` of the node's ROS time; False once it is shutting down (for background loops).
+    ROS time moving backwards (a simulation reset) ends the sleep early but not the loop."""
+    try:
+        node.sleep(seconds)
+    except TimeMovedBackwardsError:
+        pass
+    except ShutdownError:
+        return False
+    return not node.is_shutdown
+
+
 def now() -> float:
     """ROS time in seconds (sim time when /use_sim_time is set)."""
     return rospy.get_time()
@@ -62,23 +126,17 @@ def stamp(t: float | None = None) -> Any:
     return rospy.Time.from_sec(now() if t is None else t)
 
 
-def yaw_to_quat(yaw: float) -> tuple[float, float, float, float]:
-    return (0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0))
-
-
-def quat_to_yaw(x: float, y: float, z: float, w: float) -> float:
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-
-
 def pose_msg_to_2d(pose: Any) -> Pose2D:
     """geometry_msgs/Pose -> (x, y, yaw)."""
     q = pose.orientation
-    return float(pose.position.x), float(pose.position.y), quat_to_yaw(q.x, q.y, q.z, q.w)
+    return float(pose.position.x), float(pose.position.y), yaw_from_quaternion(q.x, q.y, q.z, q.w)
 
 
 def fill_pose(pose: Any, p: Pose2D) -> Any:
     pose.position.x, pose.position.y, pose.position.z = float(p[0]), float(p[1]), 0.0
-    (pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w) = yaw_to_quat(p[2])
+    (pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w) = quaternion_from_yaw(
+        p[2]
+    )
     return pose
 
 
@@ -113,12 +171,12 @@ def fill_info(
 
 def tf_to_2d(t: tuple) -> Pose2D:
     """The buffer's 7-float transform (x, y, z, qx, qy, qz, qw) as (x, y, yaw)."""
-    return float(t[0]), float(t[1]), quat_to_yaw(t[3], t[4], t[5], t[6])
+    return float(t[0]), float(t[1]), yaw_from_quaternion(t[3], t[4], t[5], t[6])
 
 
 def tf_item(parent: str, child: str, t: float, p: Pose2D) -> tuple:
     """A broadcaster item for a planar transform at ROS time ``t``."""
-    q = yaw_to_quat(p[2])
+    q = quaternion_from_yaw(p[2])
     return (parent, child, int(round(t * 1e9)), float(p[0]), float(p[1]), 0.0, *q)
 
 
@@ -126,8 +184,8 @@ class Tf2D:
     """A tf2 buffer fed from /tf and /tf_static, answering planar lookups, plus a broadcaster."""
 
     def __init__(self, node: Any, cache_time: float = 10.0) -> None:
-        self.buffer = BufferCore(cache_time=cache_time, report=lambda text: rospy.logwarn(text))
-        self.listener = TransformListener(node, self.buffer, now=now)
+        self.buffer = BufferCore(cache_time=cache_time, report=lambda text: node.log.warn("%s", text))
+        self.listener = TransformListener(node, self.buffer, now=node.get_time)
         self._broadcaster: TransformBroadcaster | None = None
         self._node = node
 
@@ -197,7 +255,7 @@ def param(node: Any, key: str, default: Any) -> Any:
         if isinstance(default, float):
             return float(value)
     except (TypeError, ValueError):
-        rospy.logerr(
+        node.log.error(
             "%s: parameter %s: expected a %s, got %r; using %r",
             node.name,
             node.resolve_name("~" + key),

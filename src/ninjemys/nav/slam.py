@@ -38,20 +38,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-
-def compose(a: tuple[float, float, float], b: tuple[float, float, float]) -> tuple[float, float, float]:
-    """Pose ``a`` then pose ``b`` expressed in ``a``'s frame."""
-    c, s = math.cos(a[2]), math.sin(a[2])
-    return a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], _wrap(a[2] + b[2])
-
-
-def inverse(a: tuple[float, float, float]) -> tuple[float, float, float]:
-    c, s = math.cos(a[2]), math.sin(a[2])
-    return -c * a[0] - s * a[1], s * a[0] - c * a[1], _wrap(-a[2])
-
-
-def _wrap(a: float) -> float:
-    return (a + math.pi) % (2 * math.pi) - math.pi
+from ninjemys.tf2.math import se2_compose, se2_inverse, wrap_angle
 
 
 @dataclass
@@ -189,14 +176,14 @@ class ParticleMapper:
         b = self.best()
         if b is None or self.odom is None:
             return (0.0, 0.0, 0.0)
-        return compose(b.pose, inverse(self.odom))
+        return se2_compose(b.pose, se2_inverse(self.odom))
 
     # -- processing -------------------------------------------------------------------------------
 
     def should_process(self, odom_pose: tuple[float, float, float]) -> bool:
         if self.odom is None:
             return True
-        step = compose(inverse(self.odom), odom_pose)
+        step = se2_compose(se2_inverse(self.odom), odom_pose)
         return (
             math.hypot(step[0], step[1]) >= self.params.linearUpdate
             or abs(step[2]) >= self.params.angularUpdate
@@ -237,14 +224,14 @@ class ParticleMapper:
                 for _ in range(max(1, p.particles))
             ]
         elif self.odom is not None:
-            step = compose(inverse(self.odom), odom_pose)
+            step = se2_compose(se2_inverse(self.odom), odom_pose)
             for q in self.particles:
                 q.pose, log_eta = self._propose(q, step, bx, by)
                 q.logw += log_eta
             self._normalize_and_resample()
         self._give_own_maps()
         for q in self.particles:
-            self._integrate(q, compose(q.pose, laser_pose), ranges, angles, hit)
+            self._integrate(q, se2_compose(q.pose, laser_pose), ranges, angles, hit)
         self.odom = odom_pose
         self.scans += 1
         b = self.best()
@@ -256,13 +243,13 @@ class ParticleMapper:
     ) -> tuple[tuple[float, float, float], float]:
         """The particle's new pose drawn from the improved proposal, and the log of its mass."""
         p = self.params
-        predicted = compose(q.pose, step)
+        predicted = se2_compose(q.pose, step)
         dist, turn = math.hypot(step[0], step[1]), abs(step[2])
         s_xy = max(p.srr * dist + p.srt * turn, 0.25 * p.lstep)
         s_th = max(p.stt * turn + p.str * dist, 0.25 * p.astep)
         if bx.size < 10:  # nothing to match: the motion model alone
             noise = self.rng.normal(0.0, 1.0, 3) * (s_xy, s_xy, s_th)
-            return compose(predicted, (float(noise[0]), float(noise[1]), float(noise[2]))), 0.0
+            return se2_compose(predicted, (float(noise[0]), float(noise[1]), float(noise[2]))), 0.0
         field, ox, oy = self._field(q, predicted)
         center = np.array(predicted)
         # coarse to fine: a 7x7x7 grid over +-3 sigma of the motion model, then twice around the
@@ -293,7 +280,7 @@ class ParticleMapper:
         cov = (w[:, None, None] * dev[:, :, None] * dev[:, None, :]).sum(axis=0) / total
         cov += np.diag([1e-6, 1e-6, 1e-6])
         draw = self.rng.multivariate_normal(mean, cov)
-        pose = (float(draw[0]), float(draw[1]), _wrap(float(draw[2])))
+        pose = (float(draw[0]), float(draw[1]), wrap_angle(float(draw[2])))
         return pose, float(score[i]) + math.log(total)
 
     def _normalize_and_resample(self) -> None:

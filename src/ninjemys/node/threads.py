@@ -124,6 +124,23 @@ THREADS: tuple[Thread, ...] = (
         "tools.roscore (starts the rosout node in roscore's process)",
         "creates the rosout Node; the node's own threads do the rest",
     ),
+    # -- apps: move_base (nav.move_base_node.MoveBase) --------------------------------------------
+    Thread(
+        "move_base-control",
+        "nav.move_base_node.MoveBase",
+        "takes the goal inbox, runs the state machine's cycle at controller_frequency, publishes cmd_vel, "
+        "feedback and goal results",
+    ),
+    Thread(
+        "move_base-planner",
+        "nav.move_base_node.MoveBase",
+        "the global planner: woken by plan_event, plans on a copy of the global costmap",
+    ),
+    Thread(
+        "move_base-costmaps",
+        "nav.move_base_node.MoveBase",
+        "updates and publishes both costmaps at their update_frequency and publish_frequency",
+    ),
 )
 
 #: user threads: the caller's own threads (the main thread, publishing threads, service callers)
@@ -207,4 +224,12 @@ RESOURCES: tuple[Resource, ...] = (
     Resource("queue", "ninjemys.net.xmlrpc_server:_Connection.queue", LOOP, "none (requests in order)"),
     Resource("queue", "ninjemys.net.xmlrpc_server:_Connection.out", LOOP, "none (response bytes not yet sent)"),
     Resource("lock", "ninjemys.master.client:MasterClient._lock", USER + " (caller)", "one call at a time"),
+    Resource("lock", "ninjemys.nav.move_base_node:MoveBase.lock", "move_base-control",
+             "the planner, costmap and scan threads and the services: the state machine and the costmaps; "
+             "the action server's callbacks never take it (they hold the server's lock, which the control "
+             "thread takes inside this one)"),
+    Resource("lock", "ninjemys.nav.move_base_node:MoveBase.inbox_lock", "move_base-control",
+             "the action server's callbacks and the move_base_simple subscriber append goals and cancels"),
+    Resource("event", "ninjemys.nav.move_base_node:MoveBase.plan_event", "move_base-planner",
+             "set by whichever thread's state-machine step wants a plan"),
 )  # fmt: skip

@@ -116,6 +116,9 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
         "joint_state_publisher": {
             "joint_state_publisher": ("ninjemys.robot.joint_state_publisher:main", ()),
         },
+        "joint_state_publisher_gui": {
+            "joint_state_publisher_gui": ("ninjemys.web.jsp_gui:main", ()),
+        },
         "xacro": {
             "xacro": ("ninjemys.tools.xacro:main", ()),
             "xacro.py": ("ninjemys.tools.xacro:main", ()),

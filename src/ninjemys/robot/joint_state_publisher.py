@@ -199,41 +199,38 @@ def _param_reader(node: Any) -> Any:
     return read
 
 
+def start(node: Any, extra_sources: tuple[str, ...] = ()) -> int:
+    """Read the parameters, subscribe the sources (``~source_list`` and ``extra_sources``) and publish
+    ``joint_states`` on a timer; non-zero when the node cannot run (no or bad robot_description)."""
+    params = _param_reader(node)
+    # ``~use_gui`` (Melodic's deprecated way to get the GUI) is ignored, as Noetic's 1.15 ignores it
+    description = params("robot_description")
+    if not isinstance(description, str):
+        node.log.fatal("The robot_description parameter is required and not set.")
+        return 1
+    try:
+        jsp = JointStatePublisher(description, params, lambda text: node.log.warn("%s", text))
+    except URDFError as exc:
+        node.log.fatal("%s", exc)
+        return 1
+    JointState = get_message_class("sensor_msgs/JointState")
+    for source in [*(params("source_list", []) or []), *extra_sources]:
+        node.subscriber(str(source), JointState, jsp.on_source, queue_size=10)
+    pub = node.publisher("joint_states", JointState, queue_size=5)
+    delta = float(params("delta", 0.0) or 0.0)
+
+    def cycle(_event: Any) -> None:
+        if delta > 0:
+            jsp.sweep(delta)
+        msg = JointState()
+        msg.header.stamp = node.now()
+        if jsp.fill(msg):
+            pub.publish(msg)
+
+    node.timer(1.0 / float(params("rate", 10)), cycle)
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     """``rosrun joint_state_publisher joint_state_publisher``."""
-
-    def build(node: Any) -> int:
-        params = _param_reader(node)
-        if params("use_gui", False):
-            node.log.error(
-                "The 'use_gui' parameter was specified, which is deprecated.  We'll attempt to find and run "
-                "the GUI, but if this fails you should install the 'joint_state_publisher_gui' package "
-                "instead and run that.  This backwards compatibility option will be removed in Noetic."
-            )
-        description = params("robot_description")
-        if not isinstance(description, str):
-            node.log.fatal("The robot_description parameter is required and not set.")
-            return 1
-        try:
-            jsp = JointStatePublisher(description, params, lambda text: node.log.warn("%s", text))
-        except URDFError as exc:
-            node.log.fatal("%s", exc)
-            return 1
-        JointState = get_message_class("sensor_msgs/JointState")
-        for source in params("source_list", []) or []:
-            node.subscriber(str(source), JointState, jsp.on_source, queue_size=10)
-        pub = node.publisher("joint_states", JointState, queue_size=5)
-        delta = float(params("delta", 0.0) or 0.0)
-
-        def cycle(_event: Any) -> None:
-            if delta > 0:
-                jsp.sweep(delta)
-            msg = JointState()
-            msg.header.stamp = node.now()
-            if jsp.fill(msg):
-                pub.publish(msg)
-
-        node.timer(1.0 / float(params("rate", 10)), cycle)
-        return 0
-
-    return run_node("joint_state_publisher", argv, build)
+    return run_node("joint_state_publisher", argv, start)

@@ -53,6 +53,7 @@ from ninjemys.sim.robot_model import RobotModel, load_robot_model
 from ninjemys.sim.simcore import Robot, Simulation, SpawnError
 from ninjemys.sim.world2d import World, load_world, world_from_map
 from ninjemys.sim.worlds import world_path
+from ninjemys.tf2.math import quaternion_from_rpy, quaternion_from_yaw, yaw_from_quaternion
 
 Twist = get_message_class("geometry_msgs/Twist")
 TransformStamped = get_message_class("geometry_msgs/TransformStamped")
@@ -72,26 +73,6 @@ SpawnModel = get_service_class("gazebo_msgs/SpawnModel")
 DeleteModel = get_service_class("gazebo_msgs/DeleteModel")
 
 WORLD_FRAME = "map"  # ground truth frame: the shipped maps are rasterized in world coordinates
-
-
-def quaternion(yaw: float) -> tuple[float, float, float, float]:
-    return 0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0)
-
-
-def quaternion_rpy(roll: float, pitch: float, yaw: float) -> tuple[float, float, float, float]:
-    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
-    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
-    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
-    return (
-        sr * cp * cy - cr * sp * sy,
-        cr * sp * cy + sr * cp * sy,
-        cr * cp * sy - sr * sp * cy,
-        cr * cp * cy + sr * sp * sy,
-    )
-
-
-def yaw_of(q: Any) -> float:
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
 
 
 class StepLock:
@@ -308,7 +289,7 @@ class SimNode:
             t.child_frame_id = io.frame(child)
             t.transform.translation.x, t.transform.translation.y, t.transform.translation.z = xyz
             q = t.transform.rotation
-            q.x, q.y, q.z, q.w = quaternion_rpy(*rpy)
+            q.x, q.y, q.z, q.w = quaternion_from_rpy(*rpy)
             out.append(t)
         return out
 
@@ -384,7 +365,8 @@ class SimNode:
         resp = SpawnModel._response_class()
         name = req.model_name.strip()
         x, y = req.initial_pose.position.x, req.initial_pose.position.y
-        yaw = yaw_of(req.initial_pose.orientation)
+        q = req.initial_pose.orientation
+        yaw = yaw_from_quaternion(q.x, q.y, q.z, q.w)
         try:
             if not name or not name.replace("_", "a").isalnum() or not name[0].isalpha():
                 raise SpawnError(f"model_name [{req.model_name}] is not a valid ROS name")
@@ -538,7 +520,7 @@ class SimNode:
             msg.child_frame_id = io.frame("base_link")
             p = msg.pose.pose
             p.position.x, p.position.y = ox, oy
-            p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w = quaternion(oyaw)
+            p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w = quaternion_from_yaw(oyaw)
             msg.twist.twist.linear.x = r.v
             msg.twist.twist.angular.z = r.w
             a1, a2, a3, a4 = r.model.odom_alpha
@@ -591,7 +573,9 @@ class SimNode:
             gt.child_frame_id = io.frame("base_link")
             gp = gt.pose.pose
             gp.position.x, gp.position.y = r.x, r.y
-            gp.orientation.x, gp.orientation.y, gp.orientation.z, gp.orientation.w = quaternion(r.yaw)
+            gp.orientation.x, gp.orientation.y, gp.orientation.z, gp.orientation.w = quaternion_from_yaw(
+                r.yaw
+            )
             gt.twist.twist.linear.x = r.v
             gt.twist.twist.angular.z = r.w
             pubs["ground_truth"].publish(gt)
@@ -614,7 +598,7 @@ class SimNode:
         t.child_frame_id = io.frame("base_link")
         t.transform.translation.x, t.transform.translation.y = ox, oy
         q = t.transform.rotation
-        q.x, q.y, q.z, q.w = quaternion(oyaw)
+        q.x, q.y, q.z, q.w = quaternion_from_yaw(oyaw)
         tfs.append(t)
 
     def _imu(self, io: RobotIO, stamp: Time) -> None:
@@ -625,7 +609,7 @@ class SimNode:
         msg.header.stamp = stamp
         msg.header.frame_id = io.frame(spec.pose.frame)
         o = msg.orientation
-        o.x, o.y, o.z, o.w = quaternion(yaw)
+        o.x, o.y, o.z, o.w = quaternion_from_yaw(yaw)
         msg.angular_velocity.z = wz
         msg.linear_acceleration.x, msg.linear_acceleration.y, msg.linear_acceleration.z = ax, ay, 9.80665
         g, a = max(spec.gyro_noise**2, 1e-9), max(spec.accel_noise**2, 1e-9)

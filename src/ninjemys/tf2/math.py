@@ -4,11 +4,13 @@ The buffer composes a handful of transforms per lookup; for 4-vectors numpy's pe
 (about a microsecond an operation) costs more than the arithmetic, so these are straight-line
 float code on tuples. Quaternions are (x, y, z, w), ROS's order, and are assumed unit length
 (the buffer refuses others on input). ``compose(a, b)`` is ``a * b``: apply ``b`` first, then ``a``.
+The planar helpers at the end (yaw <-> quaternion, SE(2) compose and inverse) are the one copy that
+the simulator, the navigation stack and the tools share.
 """
 
 from __future__ import annotations
 
-from math import acos, sin, sqrt
+from math import acos, atan2, cos, pi, sin, sqrt
 
 Transform7 = tuple[float, float, float, float, float, float, float]
 
@@ -148,3 +150,55 @@ def slerp(
     w = s0 * aw + s1 * bw
     n = sqrt(x * x + y * y + z * z + w * w)
     return x / n, y / n, z / n, w / n
+
+
+# -- planar helpers: the one home of yaw, quaternion and SE(2) math for sim, nav and the tools ---------
+
+#: a planar pose or transform (x, y, yaw)
+Pose2D = tuple[float, float, float]
+Quaternion = tuple[float, float, float, float]
+
+
+def wrap_angle(a: float) -> float:
+    """``a`` wrapped into [-pi, pi)."""
+    return (a + pi) % (2.0 * pi) - pi
+
+
+def angle_diff(a: float, b: float) -> float:
+    """``a - b`` wrapped into [-pi, pi)."""
+    return (a - b + pi) % (2.0 * pi) - pi
+
+
+def quaternion_from_yaw(yaw: float) -> Quaternion:
+    """The (x, y, z, w) quaternion of a turn by ``yaw`` about z."""
+    return 0.0, 0.0, sin(yaw / 2.0), cos(yaw / 2.0)
+
+
+def quaternion_from_rpy(roll: float, pitch: float, yaw: float) -> Quaternion:
+    """tf2's ``Quaternion::setRPY``: roll about x, then pitch about y, then yaw about z (fixed axes)."""
+    cr, sr = cos(roll / 2.0), sin(roll / 2.0)
+    cp, sp = cos(pitch / 2.0), sin(pitch / 2.0)
+    cy, sy = cos(yaw / 2.0), sin(yaw / 2.0)
+    return (
+        sr * cp * cy - cr * sp * sy,
+        cr * sp * cy + sr * cp * sy,
+        cr * cp * sy - sr * sp * cy,
+        cr * cp * cy + sr * sp * sy,
+    )
+
+
+def yaw_from_quaternion(x: float, y: float, z: float, w: float) -> float:
+    """The yaw (rotation about z) of an (x, y, z, w) quaternion, as tf2's ``getYaw``."""
+    return atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+def se2_compose(a: Pose2D, b: Pose2D) -> Pose2D:
+    """Pose ``a`` then pose ``b`` expressed in ``a``'s frame (yaw wrapped)."""
+    c, s = cos(a[2]), sin(a[2])
+    return a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], wrap_angle(a[2] + b[2])
+
+
+def se2_inverse(a: Pose2D) -> Pose2D:
+    """The planar transform that undoes ``a``."""
+    c, s = cos(a[2]), sin(a[2])
+    return -c * a[0] - s * a[1], s * a[0] - c * a[1], wrap_angle(-a[2])

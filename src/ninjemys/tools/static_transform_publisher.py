@@ -16,6 +16,7 @@ import math
 import sys
 from typing import Any
 
+from ninjemys.tf2.math import quaternion_from_rpy
 from ninjemys.tools.cli import entry
 from ninjemys.tools.tf_echo import atof
 
@@ -39,19 +40,6 @@ TF_USAGE = (
     "\nThis transform is the transform of the coordinate frame from frame_id into the coordinate frame \n"
     "of the child_frame_id.  \n"
 )
-
-
-def quaternion_from_rpy(roll: float, pitch: float, yaw: float) -> tuple[float, float, float, float]:
-    """tf2's ``Quaternion::setRPY``: roll about x, then pitch about y, then yaw about z (fixed axes)."""
-    cr, sr = math.cos(roll / 2.0), math.sin(roll / 2.0)
-    cp, sp = math.cos(pitch / 2.0), math.sin(pitch / 2.0)
-    cy, sy = math.cos(yaw / 2.0), math.sin(yaw / 2.0)
-    return (
-        sr * cp * cy - cr * sp * sy,
-        cr * sp * cy + sr * cp * sy,
-        cr * cp * sy - sr * sp * cy,
-        cr * cp * cy + sr * sp * sy,
-    )
 
 
 def parse_numbers(nums: list[str]) -> tuple[float, ...] | None:
