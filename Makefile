@@ -22,6 +22,8 @@ ROS1_DEBS += ros-robot-state-publisher liburdfdom-tools
 ROS1_DEBS += python3-pykdl python3-tf-conversions joint-state-publisher
 # C++ nodes through catkin's CMake: the build tool, gencpp and std_msgs' .msg files for C++ messages
 ROS1_DEBS += cmake python3-gencpp ros-std-msgs libstd-msgs-dev
+# vision: Debian's OpenCV under /usr/bin/python3 and its C++ image_transport republish (side-by-side tests)
+ROS1_DEBS += python3-opencv image-transport-tools
 BROWSER_DEBS := chromium chromium-driver fonts-dejavu-core
 SYSTEM_DEBS  := $(ROS1_DEBS) $(BROWSER_DEBS) tmux
 

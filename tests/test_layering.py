@@ -93,6 +93,7 @@ LAYERS: dict[str, str] = {
     "node": "node",
     "actionlib": "libs",
     "tf2": "libs",
+    "image_transport": "libs",
     "message_filters": "libs",
     "dynamic_reconfigure": "libs",
     # the .cfg -> Config.py generator is pure code generation (errors only, like idl's codegen) that

@@ -72,12 +72,42 @@ def test_color_conversions() -> None:
         bridge.imgmsg_to_cv2(msg, "yuv422")
     with pytest.raises(CvBridgeError, match=r"Unrecognized image encoding \[bogus\]"):
         bridge.imgmsg_to_cv2(msg, "bogus")
+    assert bridge.imgmsg_to_cv2(image("bayer_rggb8", 1), "bgr8").shape[-1] == 3  # OpenCV demosaics
+
+
+def _hide_cv2(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A Python without OpenCV: the numpy and Pillow paths (cv2 is a dependency, but optional here)."""
+    import builtins
+
+    real_import = builtins.__import__
+
+    def no_cv2(name, *args, **kwargs):  # type: ignore[no-untyped-def]
+        if name == "cv2":
+            raise ImportError(name)
+        return real_import(name, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "__import__", no_cv2)
+
+
+def test_without_opencv_numpy_conversions_and_bayer_error(monkeypatch: pytest.MonkeyPatch) -> None:
+    _hide_cv2(monkeypatch)
+    bridge = CvBridge()
+    rgb = np.array([[[255, 0, 0], [0, 255, 0], [0, 0, 255], [10, 20, 30]]], dtype=np.uint8)
+    msg = bridge.cv2_to_imgmsg(rgb, "rgb8")
+    assert bridge.imgmsg_to_cv2(msg, "mono8")[0].tolist() == [76, 150, 29, 18]
+    assert bridge.imgmsg_to_cv2(msg, "bgra8")[0, 3].tolist() == [30, 20, 10, 255]
     with pytest.raises(CvBridgeError, match="needs OpenCV"):
         bridge.imgmsg_to_cv2(image("bayer_rggb8", 1), "bgr8")
 
 
-def test_compressed_with_pillow() -> None:
+def test_compressed_bad_format_is_one_clear_error() -> None:
+    with pytest.raises(CvBridgeError, match="cannot encode .* as xyz"):
+        CvBridge().cv2_to_compressed_imgmsg(np.zeros((2, 2, 3), np.uint8), "xyz")
+
+
+def test_compressed_with_pillow(monkeypatch: pytest.MonkeyPatch) -> None:
     pytest.importorskip("PIL")
+    _hide_cv2(monkeypatch)
     bridge = CvBridge()
     bgr = np.zeros((8, 8, 3), dtype=np.uint8)
     bgr[..., 0] = 200  # blue in OpenCV order

@@ -398,3 +398,41 @@ def test_scan_topic_matches_a_wall_in_a_generated_map(sims, client, tmp_path):
         elif math.cos(world_angle) < -0.05:
             assert math.isinf(measured) and measured > 0  # nothing behind within 12 m: +inf (REP 117)
     assert checked > 100
+
+
+def test_camera_offers_compressed_subtopic(sims, client):
+    """image_transport's ``camera/color/image_raw/compressed``: JPEG by default, PNG by parameter,
+    the same pixels as the raw image (PNG exactly)."""
+    import numpy as np
+
+    from ninjemys.cv_bridge import CvBridge
+    from sensor_msgs.msg import CompressedImage, Image
+
+    client.set_param("/camera/color/image_raw/compressed/format", "png")
+    sims("_world:=office", "_rate:=2.0")
+    comp = Latest(client, "/camera/color/image_raw/compressed", CompressedImage)
+    c = comp.wait(what="a compressed camera frame")
+    assert c.format == "rgb8; png compressed bgr8" and c.header.frame_id.endswith(
+        "camera_color_optical_frame"
+    )
+    raw = Latest(client, "/camera/color/image_raw", Image)
+    r = raw.wait(what="a raw camera frame")
+    bridge = CvBridge()
+    decoded = bridge.compressed_imgmsg_to_cv2(c, "rgb8")
+    assert decoded.shape == (r.height, r.width, 3) and decoded.std() > 0  # a real scene, not blank
+    # the same frame on both topics (matched by stamp) has the same pixels
+    by_stamp: dict = {}
+    client.subscriber(
+        "/camera/color/image_raw",
+        Image,
+        lambda m: by_stamp.setdefault(m.header.stamp, [None, None]).__setitem__(0, m),
+    )
+    client.subscriber(
+        "/camera/color/image_raw/compressed",
+        CompressedImage,
+        lambda m: by_stamp.setdefault(m.header.stamp, [None, None]).__setitem__(1, m),
+    )
+    pair = wait_until(
+        lambda: next((p for p in list(by_stamp.values()) if None not in p), None), what="one frame on both"
+    )
+    assert np.array_equal(bridge.compressed_imgmsg_to_cv2(pair[1], "rgb8"), bridge.imgmsg_to_cv2(pair[0]))

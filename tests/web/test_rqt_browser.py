@@ -301,6 +301,24 @@ def test_image_view_shows_the_published_pixels(graph: Graph, browser_page: Any) 
         "() => Array.from(document.getElementById('iv-canvas').getContext('2d').getImageData(3, 0, 1, 1).data)"
     )
     assert pixels == [10, 200, 30, 255]
+    # a JPEG as image_transport's compressed publisher writes it ("rgb8; jpeg compressed bgr8")
+    import numpy as np
+
+    from ninjemys.cv_bridge import CvBridge
+    from ninjemys.image_transport import encode
+
+    flat = np.zeros((8, 16, 3), np.uint8)
+    flat[:] = (200, 40, 60)
+    jpeg = graph.peer.publisher("/camera/jpeg", M("sensor_msgs/CompressedImage"), queue_size=1, latch=True)
+    jpeg.publish(encode(CvBridge().cv2_to_imgmsg(flat, "rgb8")))
+    page.wait_for_selector('.iv-topic option[value="/camera/jpeg"]', state="attached", timeout=10000)
+    page.select_option(".iv-topic", "/camera/jpeg")
+    page.wait_for_function("document.getElementById('iv-canvas').width === 16", timeout=10000)
+    pixels = page.evaluate(
+        "() => Array.from(document.getElementById('iv-canvas').getContext('2d').getImageData(5, 4, 1, 1).data)"
+    )
+    assert max(abs(a - b) for a, b in zip(pixels, [200, 40, 60, 255], strict=True)) <= 6, pixels
+    assert "rgb8; jpeg compressed bgr8" in page.inner_text(".iv-info")
 
 
 def _png_rgb(width: int, height: int, rgb: tuple[int, int, int]) -> bytes:

@@ -1,8 +1,9 @@
 """cv_bridge: sensor_msgs/Image and CompressedImage <-> numpy arrays (what OpenCV calls images).
 
-ROS 1's ``CvBridge`` needs OpenCV even for raw images; this one needs only numpy for them (the
-arrays are exactly what ``cv2`` functions take). Compressed images use OpenCV when it is installed,
-else Pillow; with neither, the error says which to install. Differences from ROS 1, on purpose:
+Like ROS 1's, it converts with OpenCV (``opencv-python-headless``, a dependency of ninjemys):
+``cv2.cvtColor`` for color changes, ``cv2.imencode``/``imdecode`` for compressed images. Without
+cv2 (a Python where it was removed) raw images still convert with numpy and compressed ones with
+Pillow; with neither, the error says which to install. Differences from ROS 1, on purpose:
 ``step`` is honoured (row padding), a too-short ``data`` is an error naming the sizes instead of a
 numpy traceback, and decoded compressed images are treated as mono/bgr/bgra by their channel count
 (ROS 1 assumes bgr8 and fails on grayscale JPEGs).
@@ -196,7 +197,13 @@ class CvBridge:
         msg = get_message_class("sensor_msgs/CompressedImage")()
         msg.format = dst_format
         if kind == "cv2":
-            ok, buf = codec.imencode("." + dst_format, cvim)
+            try:
+                ok, buf = codec.imencode("." + dst_format, cvim)
+            except codec.error as exc:  # an unknown extension, or a type the format cannot hold
+                raise CvBridgeError(
+                    f"OpenCV cannot encode a {cvim.dtype} {cvim.shape} image as {dst_format}: "
+                    f"{str(exc).strip().splitlines()[-1]}"
+                ) from None
             if not ok:
                 raise CvBridgeError(
                     f"OpenCV could not encode a {cvim.dtype} {cvim.shape} image as {dst_format}"

@@ -4,7 +4,9 @@ The conversion rules are cv_bridge's (C++ ``getConversionCode``): between color 
 rgb, bgr, rgba, bgra, yuv422, bayer) any listed pair converts; a generic encoding (``8UC3``, ``32FC1``)
 only converts to one with the same number of channels, changing depth; 8 <-> 16 bit depth changes
 scale the values (x 65535/255 or 255/65535). Pixel arithmetic follows OpenCV's (fixed-point gray
-weights, rounding to nearest), so results match ROS 1's cv_bridge; Bayer demosaicing needs OpenCV.
+weights, rounding to nearest), so results match ROS 1's cv_bridge. With OpenCV installed (a runtime
+dependency) color changes go through ``cv2.cvtColor`` as ROS 1's do; the numpy path stays for
+byte-swapped arrays and a Python without cv2. Bayer demosaicing needs OpenCV.
 """
 
 from __future__ import annotations
@@ -184,6 +186,26 @@ def _bayer(img: np.ndarray, encoding: str, kind: str) -> np.ndarray:
     return cv2.cvtColor(img, getattr(cv2, f"COLOR_{_BAYER_CODES[pattern]}2{target}"))
 
 
+_CV_NATIVE = (np.dtype(np.uint8), np.dtype(np.uint16), np.dtype(np.float32))
+
+
+def _cvt_color(img: np.ndarray, src_kind: str, dst_kind: str) -> np.ndarray | None:
+    """OpenCV's ``cvtColor`` between GRAY/RGB/BGR/RGBA/BGRA, as ROS 1's cv_bridge converts (and 5-60x
+    faster than the numpy path); None when OpenCV is absent or the array is not one it takes."""
+    if img.dtype not in _CV_NATIVE or not img.dtype.isnative:
+        return None
+    try:
+        import cv2
+    except ImportError:
+        return None
+    code = getattr(cv2, f"COLOR_{src_kind}2{dst_kind}", None)
+    if code is None:
+        return None
+    if src_kind == GRAY and img.ndim == 3:
+        img = img[..., 0]
+    return np.asarray(cv2.cvtColor(img, code))
+
+
 def convert(img: np.ndarray, src: str, dst: str) -> np.ndarray:
     """``img`` (in encoding ``src``) as encoding ``dst``; a new array. CvBridgeError if impossible."""
     if src == dst:
@@ -221,7 +243,9 @@ def convert(img: np.ndarray, src: str, dst: str) -> np.ndarray:
     elif src_kind == dst_kind:
         out = img
     else:
-        out = _from_rgba(_to_rgba(img, src_kind), dst_kind, src_kind)
+        out = _cvt_color(img, src_kind, dst_kind)
+        if out is None:
+            out = _from_rgba(_to_rgba(img, src_kind), dst_kind, src_kind)
     if src_bits != dst_bits or out.dtype != dst_dtype:
         out = _convert_depth(out, src_bits, dst_bits, dst_dtype)
     elif out is img:

@@ -108,6 +108,7 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
             "view_frames": ("ninjemys.tools.view_frames:tf_main", ()),
         },
         "tf2_tools": {"view_frames.py": ("ninjemys.tools.view_frames:main", ())},
+        "image_transport": {"republish": ("ninjemys.image_transport.republish:main", ())},
         "robot_state_publisher": {
             "robot_state_publisher": ("ninjemys.robot.state_publisher:main", ()),
             "state_publisher": ("ninjemys.robot.state_publisher:legacy_main", ()),

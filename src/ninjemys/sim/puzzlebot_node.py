@@ -43,6 +43,7 @@ import numpy as np
 from ninjemys.commands import entry
 from ninjemys.errors import NinjemysError, ShutdownError
 from ninjemys.idl.loader import get_message_class, get_service_class
+from ninjemys.image_transport import CompressedPublisher
 from ninjemys.maps.mapfile import MapFileError
 from ninjemys.node import Node
 from ninjemys.node.cli_args import parse_args
@@ -221,6 +222,8 @@ class SimNode:
                 pubs["scan"] = n.publisher(prefix + "scan", LaserScan, queue_size=10)
             if model.camera is not None:
                 pubs["image"] = n.publisher(prefix + "camera/color/image_raw", Image, queue_size=2)
+                # image_transport's <base>/compressed, encoded only while subscribed
+                pubs["image_compressed"] = CompressedPublisher(n, prefix + "camera/color/image_raw")
                 pubs["depth"] = n.publisher(prefix + "camera/depth/image_rect_raw", Image, queue_size=2)
                 pubs["color_info"] = n.publisher(
                     prefix + "camera/color/camera_info", CameraInfo, queue_size=2
@@ -494,7 +497,8 @@ class SimNode:
                         self._scan(io, stamp, ranges)
             if io.camera_due is not None and io.camera_due.fire(now):
                 want = any(
-                    pubs[k].get_num_connections() for k in ("image", "depth", "color_info", "depth_info")
+                    pubs[k].get_num_connections()
+                    for k in ("image", "image_compressed", "depth", "color_info", "depth_info")
                 )
                 if want:  # a browser view watches the cameras as ROS topics too (through its gateway)
                     self._camera(io, stamp)
@@ -638,7 +642,8 @@ class SimNode:
         pubs = io.pubs
         frame = io.frame("camera_color_optical_frame")
         depth_frame = io.frame("camera_depth_optical_frame")
-        if pubs["image"].get_num_connections():
+        want_raw = pubs["image"].get_num_connections()
+        if want_raw or pubs["image_compressed"].get_num_connections():
             img = Image()
             img.header.stamp = stamp
             img.header.frame_id = frame
@@ -647,7 +652,9 @@ class SimNode:
             img.is_bigendian = 0
             img.step = rgb.shape[1] * 3
             img.data = rgb.reshape(-1)  # a view: uint8[] fields take numpy arrays without a copy
-            pubs["image"].publish(img)
+            if want_raw:
+                pubs["image"].publish(img)
+            pubs["image_compressed"].publish(img)
         if pubs["depth"].get_num_connections():
             d = Image()
             d.header.stamp = stamp

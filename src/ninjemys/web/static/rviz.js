@@ -231,6 +231,8 @@ class Display {
     this.received = 0;
   }
   get msgType() { return MSG_TYPE[this.cfg.cls] || null; }
+  /** The topic subscribed to (a display with a transport, like Image, may add a suffix). */
+  subscribedTopic() { return this.cfg.topic; }
   get color() { return rvizColor(this.cfg.color, DEFAULT_COLOR[this.cfg.cls] || "255; 255; 255"); }
   option(name, fallback) { const v = this.cfg.options?.[name]; return v === undefined ? fallback : v; }
 
@@ -248,7 +250,7 @@ class Display {
     this.group.visible = this.cfg.enabled;
     if (!this.cfg.enabled) { this.statuses.clear(); renderStatus(this); return; }
     if (this.msgType) {
-      const topic = this.cfg.topic;
+      const topic = this.subscribedTopic();
       if (!topic) { this.setStatus("Topic", "error", "No topic set"); return; }
       this.setStatus("Topic", "warn", `No messages received on ${topic}`);
       this.sub = ros.subscribe(topic, (msg, info) => {
@@ -891,9 +893,49 @@ class ImageDisplay extends Display {
     this.figure.append(this.caption, this.canvas);
     $("rv-images").appendChild(this.figure);
   }
-  start() { super.start(); this.figure.style.display = this.cfg.enabled ? "" : "none"; this.caption.textContent = `${this.cfg.name}: ${this.cfg.topic}`; }
+  // rviz's "Transport Hint": compressed subscribes to <Image Topic>/compressed (sensor_msgs/CompressedImage);
+  // an Image Topic that itself ends in /compressed is taken as that transport too
+  get compressed() { return this.option("Transport Hint", "raw") === "compressed" || /\/compressed$/.test(this.cfg.topic || ""); }
+  get msgType() { return this.compressed ? "sensor_msgs/CompressedImage" : "sensor_msgs/Image"; }
+  subscribedTopic() {
+    const t = this.cfg.topic;
+    return t && this.compressed && !/\/compressed$/.test(t) ? `${t}/compressed` : t;
+  }
+  start() { this.pending = null; this.decoding = false; super.start(); this.figure.style.display = this.cfg.enabled ? "" : "none"; this.caption.textContent = `${this.cfg.name}: ${this.subscribedTopic()}`; }
   destroy() { super.destroy(); this.figure.remove(); }
-  onMessage(m) {
+  onMessage(m, info) {
+    if (info?.type === "sensor_msgs/CompressedImage" || m.format !== undefined) { this.onCompressed(m); return; }
+    this.onRaw(m);
+  }
+  /** Decode jpeg/png in the browser; while one frame decodes, only the newest waiting frame is kept. */
+  onCompressed(m) {
+    this.pending = m;
+    if (this.decoding) return;
+    this.decoding = true;
+    const next = async () => {
+      while (this.pending) {
+        const msg = this.pending;
+        this.pending = null;
+        const mime = /png/i.test(msg.format) ? "image/png" : "image/jpeg";
+        let bitmap;
+        try {
+          bitmap = await createImageBitmap(new Blob([msg.data], { type: mime }));
+        } catch {
+          this.setStatus("Message", "error", `cannot decode a CompressedImage of format '${msg.format}' (${msg.data.length} bytes)`);
+          continue;
+        }
+        if (this.canvas.width !== bitmap.width || this.canvas.height !== bitmap.height) { this.canvas.width = bitmap.width; this.canvas.height = bitmap.height; }
+        this.canvas.getContext("2d").drawImage(bitmap, 0, 0);
+        this.setStatus("Message", null);
+        this.setStatus("Image", "ok", `${bitmap.width}×${bitmap.height} ${msg.format}`);
+        bitmap.close();
+        dirty = true;
+      }
+      this.decoding = false;
+    };
+    next();
+  }
+  onRaw(m) {
     const { width: w, height: h, encoding, step, data } = m;
     if (!w || !h) throw new Error("empty image");
     if (step * h > data.length) throw new Error(`image data holds ${data.length} bytes; ${h} rows of ${step} need ${step * h}`);
