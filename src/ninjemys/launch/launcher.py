@@ -13,11 +13,11 @@ import signal
 import socket
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
-from ninjemys.errors import LaunchError
+from ninjemys.errors import LaunchError, NinjemysError
 from ninjemys.launch import master_link
 from ninjemys.launch.plan import LaunchPlan, NodeSpec
 from ninjemys.launch.queries import node_command, node_environment, node_executable
@@ -30,7 +30,8 @@ from ninjemys.launch.runner import (
     remote_command,
 )
 from ninjemys.master.client import MasterClient
-from ninjemys.packages.discovery import PackageIndex
+from ninjemys.packages.discovery import PackageIndex, package_path_dirs, underlay_dirs
+from ninjemys.packages.executables import find_executable
 from ninjemys.roshome import log_directory
 
 
@@ -79,8 +80,15 @@ def summary(plan: LaunchPlan, extra_params: dict[str, object]) -> str:
 
 
 def _process_specs(
-    plan: LaunchPlan, opts: LaunchOptions, master_uri: str, log_dir: Path, env: dict[str, str]
+    plan: LaunchPlan,
+    opts: LaunchOptions,
+    master_uri: str,
+    log_dir: Path,
+    env: dict[str, str],
+    failures: list[str] | None = None,
 ) -> list[ProcessSpec]:
+    """The processes to start. With ``failures``, a local node whose package or executable cannot
+    be found is left out and its ROS 1 line goes there (the others still start, as in ROS 1)."""
     index = PackageIndex.from_environment(env)
     specs = []
     ros_home = env.get("ROS_HOME") or os.path.join(os.path.expanduser("~"), ".ros")
@@ -94,6 +102,11 @@ def _process_specs(
         local = machine.is_local
         if opts.local_only and not local:
             continue
+        if local and failures is not None:
+            reason = launch_failure(node, index, env)
+            if reason is not None:
+                failures.append(f"ERROR: cannot launch node of type [{node.package}/{node.type}]: {reason}")
+                continue
         counter += 1
         name = node_process_name(node, counter)
         proc_env = node_environment(node, master_uri, env)
@@ -138,6 +151,23 @@ def _process_specs(
     return specs
 
 
+def launch_failure(node: NodeSpec, index: PackageIndex, env: Mapping[str, str]) -> str | None:
+    """Why ROS 1's roslaunch could not start ``node`` (its words), or None when it can."""
+    try:
+        manifest = index.find(node.package)
+    except NinjemysError:
+        paths = [*package_path_dirs(env), *underlay_dirs()]
+        return node.package + "".join(f"\nROS path [{i}]={path}" for i, path in enumerate(paths))
+    try:
+        find_executable(manifest, node.type)
+    except NinjemysError:
+        return (
+            f"Cannot locate node of type [{node.type}] in package [{node.package}]. Make sure file exists in "
+            "package path and permission is set to executable (chmod +x)"
+        )
+    return None
+
+
 def process_specs(
     plan: LaunchPlan, opts: LaunchOptions, master_uri: str, log_dir: Path, env: dict[str, str]
 ) -> list[ProcessSpec]:
@@ -171,7 +201,7 @@ class LaunchSession:
         self.env["ROS_MASTER_URI"] = uri
         log_root = log_directory(self.env)
         # validate everything user-provided before starting anything
-        probe_specs = _process_specs(self.plan, self.opts, uri, log_root / "pending", self.env)
+        probe_specs = _process_specs(self.plan, self.opts, uri, log_root / "pending", self.env, [])
         del probe_specs
         try:
             return self._run_with_master(uri, log_root)
@@ -206,7 +236,10 @@ class LaunchSession:
             self._say(summary(self.plan, {}))
         master_link.load_parameters(client, self.plan)
         client.close()
-        specs = _process_specs(self.plan, self.opts, uri, log_dir, self.env)
+        failures: list[str] = []
+        specs = _process_specs(self.plan, self.opts, uri, log_dir, self.env, failures)
+        for line in failures:
+            print(line, file=sys.stderr, flush=True)
         if core_proc is not None:
             specs.insert(
                 0,
