@@ -79,3 +79,24 @@ def test_same_lines_as_debians_roslaunch(tmp_path: Path) -> None:
     for out in (ours, theirs):
         assert "ERROR: cannot launch node of type [nosuch_pkg/nosuch_node]: nosuch_pkg\nROS path [0]=" in out
         assert out.count(MISSING_EXE) == 1, out
+
+
+def test_a_file_that_is_not_executable_gets_the_same_line(tmp_path: Path) -> None:
+    pkg = tmp_path / "src" / "noexec_pkg"
+    pkg.mkdir(parents=True)
+    (pkg / "package.xml").write_text(
+        '<package format="2"><name>noexec_pkg</name><version>0.0.1</version><description>d</description>'
+        '<maintainer email="dev@example.com">d</maintainer><license>BSD</license></package>'
+    )
+    (pkg / "node.py").write_text("print('never run')\n")
+    (tmp_path / "m.launch").write_text(
+        '<launch><node pkg="noexec_pkg" type="node.py" name="a"/>'
+        '<node pkg="rosout" type="rosout" name="extra_rosout"/></launch>'
+    )
+    env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_PACKAGE_PATH=str(tmp_path / "src"))
+    out, nodes = _run([str(Path(sys.executable).parent / "roslaunch")], tmp_path, env)
+    assert "/extra_rosout" in nodes
+    assert (
+        "ERROR: cannot launch node of type [noexec_pkg/node.py]: Cannot locate node of type [node.py]" in out
+    )
+    assert "chmod +x" in out

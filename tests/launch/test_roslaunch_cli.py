@@ -89,12 +89,6 @@ BAD = {
         "test.launch:3: Invalid roslaunch XML syntax",
     ),
     "missing_arg": ('<param name="p" value="$(arg x)"/>', "arg 'x' is not set"),
-    "unknown_package": ('<node name="a" pkg="no_such_pkg" type="x"/>', "package 'no_such_pkg' not found"),
-    "unknown_executable": (
-        '<node name="a" pkg="corpus_run" type="nope.py"/>',
-        "Cannot locate node of type [nope.py]",
-    ),
-    "not_executable": ('<node name="a" pkg="corpus_run" type="noexec.py"/>', "chmod +x"),
     "find_missing": ('<param name="p" value="$(find missing_pkg)/x"/>', "$(find missing_pkg)"),
     "unknown_machine": (
         '<node name="a" pkg="corpus_run" type="sleeper.py" machine="mars"/>',
@@ -103,6 +97,8 @@ BAD = {
 }
 
 
+# A node whose package or executable is missing is not among these: ROS 1 reports it and starts the
+# rest (tests/launch/test_launch_missing_nodes.py).
 @pytest.mark.parametrize("case", sorted(BAD))
 def test_bad_input_is_one_clear_error_and_starts_nothing(case: str, tmp_path: Path, env: dict) -> None:
     body, expected = BAD[case]
