@@ -102,7 +102,7 @@ class PackageIndex:
 
     def depends(self, name: str, recursive: bool = True) -> list[str]:
         """Run and build dependencies of ``name`` (known packages only), depth-first like rospack."""
-        direct = [d for d in self.find(name).all_depends if d in self.packages]
+        direct = [d for d in self.find(name).rospack_depends if d in self.packages]
         if not recursive:
             return direct
         order: list[str] = []
@@ -112,7 +112,7 @@ class PackageIndex:
             if pkg in visiting or pkg in order:
                 return
             visiting.add(pkg)
-            for dep in self.packages[pkg].all_depends:
+            for dep in self.packages[pkg].rospack_depends:
                 if dep in self.packages:
                     visit(dep)
             visiting.discard(pkg)

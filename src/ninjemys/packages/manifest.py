@@ -55,6 +55,12 @@ class PackageManifest:
         return tuple(dict.fromkeys(self.exec_depends + self.build_export_depends))
 
     @property
+    def rospack_depends(self) -> tuple[str, ...]:
+        """What ``rospack depends1`` lists: every dependency but the buildtool ones (catkin), as the
+        tutorials show (``rospack depends1 beginner_tutorials``: roscpp rospy std_msgs)."""
+        return tuple(d for d in self.all_depends if d not in self.buildtool_depends)
+
+    @property
     def all_depends(self) -> tuple[str, ...]:
         """Every declared dependency except docs, in declaration order, no repeats."""
         return tuple(
