@@ -8,16 +8,13 @@ Node and uses its log and clock, so it serves both.
 
 from __future__ import annotations
 
-import os
-import signal
 import sys
-import threading
 from typing import Any
 
 import numpy as np
 
 import rospy
-from ninjemys.errors import NinjemysError, ShutdownError
+from ninjemys.errors import ShutdownError
 from ninjemys.maps.mapfile import GridMap
 from ninjemys.node.timers import TimeMovedBackwardsError
 from ninjemys.tf2.core import BufferCore
@@ -57,52 +54,12 @@ def run_node(name: str, argv: list[str] | None, build: Any) -> int:
     return 0
 
 
-def start_core_node(name: str, argv: list[str] | None) -> tuple[Any, list[str]]:
-    """A core Node named ``name`` from the process's ROS arguments (``__name``, ``__ns``, ``__log``,
-    ``__ip``, remappings, ``_param:=value``) on its clock (sim time under /use_sim_time), with /rosout
-    and the logger services, as ``rospy.init_node`` would make it; returns it and the other arguments."""
-    from ninjemys.node import Node
-    from ninjemys.node.cli_args import network_env, parse_args
-
-    argv = sys.argv[1:] if argv is None else list(argv)
-    args = parse_args([sys.argv[0], *argv])
-    os.environ.update(network_env(args))
-    node = Node(
-        args.node_name(name),
-        namespace=args.namespace,
-        remappings=args.remappings,
-        master_uri=args.master_uri,
-        params=args.private_params,
-        log_file=args.log_file,
-        default_clock=True,
-    )
-    return node, [a for a in argv if ":=" not in a]
-
-
 def run_core_node(name: str, argv: list[str] | None, build: Any) -> int:
     """Start core node ``name``, build its object with ``build(node)``, wait for shutdown (Ctrl-C,
-    SIGTERM, ``rosnode kill``). A signal shuts the node down from a ``shutdown`` thread, not from the
-    interrupted main thread, which may hold locks the shutdown needs."""
-    try:
-        node, _ = start_core_node(name, argv)
-    except NinjemysError as exc:
-        print(f"{name}: {exc}", file=sys.stderr)
-        return 1
+    SIGTERM, ``rosnode kill``): :func:`ninjemys.node.run.run_node`, the one way in-house nodes run."""
+    from ninjemys.node.run import run_node
 
-    def on_signal(_signum: int, _frame: Any) -> None:
-        threading.Thread(target=node.shutdown, args=("signal",), name="shutdown", daemon=True).start()
-
-    if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGINT, on_signal)
-        signal.signal(signal.SIGTERM, on_signal)
-    try:
-        build(node)
-        node.spin()
-    except ShutdownError:
-        pass
-    finally:
-        node.shutdown("exit")
-    return 0
+    return run_node(name, argv, build)
 
 
 def node_sleep(node: Any, seconds: float) -> bool:

@@ -3,6 +3,7 @@ SIGTERM, spin until shutdown. One place for what every ``main()`` of a shipped n
 
 from __future__ import annotations
 
+import os
 import signal
 import sys
 import threading
@@ -10,15 +11,17 @@ from collections.abc import Callable
 from typing import Any
 
 from ninjemys.errors import NinjemysError, ShutdownError
-from ninjemys.node.cli_args import parse_args
+from ninjemys.node.cli_args import network_env, parse_args
 from ninjemys.node.node import Node
 
 
 def start_node(default_name: str, argv: list[str] | None = None) -> Node:
-    """A core Node named as ROS 1 names it from ``argv`` (``__name:=``, ``__ns:=``, remappings,
-    ``_private:=value`` parameters, ``__log:=``)."""
+    """A core Node named as ROS 1 names it from ``argv`` (``__name:=``, ``__ns:=``, ``__ip:=``,
+    remappings, ``_private:=value`` parameters, ``__log:=``), on the process's default clock (sim
+    time under /use_sim_time), with /rosout and the logger services, as ``rospy.init_node`` makes it."""
     argv = sys.argv[1:] if argv is None else argv
     args = parse_args([sys.argv[0], *argv])
+    os.environ.update(network_env(args))
     return Node(
         args.node_name(default_name),
         namespace=args.namespace,
@@ -26,6 +29,7 @@ def start_node(default_name: str, argv: list[str] | None = None) -> Node:
         master_uri=args.master_uri,
         params=args.private_params,
         log_file=args.log_file,
+        default_clock=True,
     )
 
 
