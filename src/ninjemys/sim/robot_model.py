@@ -36,6 +36,10 @@ class LaserSpec:
     range_min: float = 0.15
     range_max: float = 12.0
     noise: float = 0.01
+    topic: str = "scan"
+    # first beam's angle and the last one's; None for the last: a full turn less one increment
+    angle_min: float = -math.pi
+    angle_max: float | None = None
 
 
 @dataclass
@@ -46,6 +50,13 @@ class CameraSpec:
     height: int = 240
     hfov: float = 69.0
     depth_max: float = 10.0
+    image_topic: str = "camera/color/image_raw"
+    info_topic: str = "camera/color/camera_info"
+    frame: str = "camera_color_optical_frame"
+    # the depth stream (None: a colour-only camera, as Gazebo's plain camera plugin)
+    depth_topic: str | None = "camera/depth/image_rect_raw"
+    depth_info_topic: str | None = "camera/depth/camera_info"
+    depth_frame: str = "camera_depth_optical_frame"
 
 
 @dataclass
@@ -54,6 +65,26 @@ class ImuSpec:
     rate: float = 100.0
     gyro_noise: float = 0.001
     accel_noise: float = 0.01
+    topic: str = "imu"
+
+
+@dataclass
+class DriveSpec:
+    """How the robot is driven and what its drive publishes: our PuzzleBot's defaults, or what a
+    description's drive plugin (gazebo_ros_diff_drive, ros_control's DiffDriveController...) says."""
+
+    kind: str = "puzzlebot"  # "puzzlebot", "diff_drive", "skid_steer", "ros_control" or "none" (passive)
+    command_topic: str = "cmd_vel"
+    odom_topic: str = "odom"
+    odom_frame: str = "odom"
+    base_frame: str = "base_link"
+    publish_odom: bool = True
+    publish_odom_tf: bool = True
+    publish_wheel_tf: bool = False
+    publish_wheel_joint_state: bool = True
+    publish_wheel_speeds: bool = True  # the PuzzleBot's wl/wr encoder topics
+    odometry_source: str = "encoder"  # or "world" (ground truth), as gazebo_ros_diff_drive's odometrySource
+    update_rate: float | None = None  # None: RobotModel.odom_rate
 
 
 @dataclass
@@ -74,6 +105,8 @@ class RobotModel:
     odom_rate: float = 100.0
     odom_alpha: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
     source: str = field(default="")
+    drive: DriveSpec = field(default_factory=DriveSpec)
+    ignored_plugins: list[str] = field(default_factory=list)  # named once in a warning at spawn
 
 
 def _merge(base: dict, over: dict) -> dict:
