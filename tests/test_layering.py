@@ -5,7 +5,7 @@ function, under ``if TYPE_CHECKING``), and so does ``importlib.import_module("..
 ``__import__("...")`` with a literal name: a lazy import is still a dependency. A module may import its
 own layer and any layer below; anything else fails with ``file:line``. Three more rules:
 
-- layers that share a floor (a tuple in ``ORDER``: ``sim`` and ``nav``) are peers and may not import
+- layers that share a floor (a tuple in ``ORDER``: ``sim``, ``nav`` and ``drivers``) are peers and may not import
   each other: the navigation stack ships without the simulator and the simulator without it;
 - no app (the floors from ``gateway`` up) imports ``tools``: the commands are a front end, not a
   library; what apps share with them (``commands.entry``, the service probe) lives below;
@@ -27,7 +27,8 @@ The order, bottom to top (``ORDER``; docs/architecture.md draws the same table, 
     compat     the ROS 1 Python facades: every top-level package of src/ other than ninjemys
     tools      the commands (roscore, rostopic, ..., rosout), ninjemys.testing
     gateway    the WebSocket gateway (bridge/): rosbridge v2 and Foxglove for browsers
-    sim | nav  the simulators and the navigation stack: peers, neither imports the other
+    sim | nav | drivers
+               the simulators, the navigation stack and the device drivers: peers, none imports another
     web        the browser apps (rviz, rqt, the graph page, the simulators' views)
     apps       the demo and the tutorials
 
@@ -62,7 +63,7 @@ ORDER: list[str | tuple[str, ...]] = [
     "compat",
     "tools",
     "gateway",
-    ("sim", "nav"),
+    ("sim", "nav", "drivers"),
     "web",
     "apps",
 ]
@@ -110,6 +111,7 @@ LAYERS: dict[str, str] = {
     "bridge": "gateway",
     "sim": "sim",
     "nav": "nav",
+    "drivers": "drivers",
     "web": "web",
     "demo": "apps",
     "tutorials": "apps",

@@ -119,6 +119,9 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
         "joint_state_publisher_gui": {
             "joint_state_publisher_gui": ("ninjemys.web.jsp_gui:main", ()),
         },
+        # -- drivers (docs/drivers.md) --
+        "joy": {"joy_node": ("ninjemys.drivers.joy_node:main", ())},
+        "teleop_twist_joy": {"teleop_node": ("ninjemys.drivers.teleop_twist_joy:main", ())},
         "xacro": {
             "xacro": ("ninjemys.tools.xacro:main", ()),
             "xacro.py": ("ninjemys.tools.xacro:main", ()),
