@@ -119,6 +119,7 @@ class Node:
         try:
             self._tcpros = transport.TcprosServer(self._on_topic_connection, self._on_service_connection)
             self.tcpros_port = self._tcpros.port
+            self.unix_address: str | None = self._tcpros.unix_address
             self._slave = XmlRpcServer(SlaveApi(self), "0.0.0.0", 0, advertise=self.tcpros_host)
             self.runtime.run(self._start_servers(), timeout=10.0)
         except BaseException:
@@ -506,10 +507,10 @@ class Node:
                         c.id,
                         c.subscriber,
                         "o",
-                        "TCPROS",
+                        transport.transport_of(c.sock),
                         topic,
                         not c.closed,
-                        f"TCPROS connection to [{c.subscriber}]",
+                        f"{transport.transport_of(c.sock)} connection to [{c.subscriber}]",
                     ]
                 )
         for topic, sub in list(self._subscriptions.items()):
@@ -519,10 +520,10 @@ class Node:
                         s.id,
                         s.uri,
                         "i",
-                        "TCPROS",
+                        transport.transport_of(s.sock),
                         topic,
                         not s.closed,
-                        f"TCPROS connection from [{s.publisher}]",
+                        f"{transport.transport_of(s.sock)} connection from [{s.publisher}]",
                     ]
                 )
         return info
