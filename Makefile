@@ -31,7 +31,7 @@ SYSTEM_DEBS  := $(ROS1_DEBS) $(BROWSER_DEBS) tmux
 NPM_DIR   := .cache/npm
 NPM_STAMP := $(NPM_DIR)/node_modules/.installed
 
-.PHONY: all venv system npm lint format typecheck test test-fast demo bench clean
+.PHONY: all venv system npm lint format typecheck test test-fast demo bench fuzz clean
 
 all: venv
 
@@ -88,6 +88,10 @@ demo: venv
 
 bench: venv system
 	$(PY) bench/run_all.py
+
+# every parser of untrusted input, 100,000 mutated inputs each (make test runs 2,000: tests/fuzz)
+fuzz: venv
+	$(PY) tests/fuzz/run_fuzz.py --count 100000
 
 clean:
 	rm -rf $(VENV) build dist src/*.egg-info .pytest_cache .ruff_cache $(NPM_DIR)
