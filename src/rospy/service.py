@@ -14,7 +14,8 @@ from ninjemys import names
 from ninjemys.errors import NinjemysError, ServiceError
 from ninjemys.interrupt import wait_event
 from ninjemys.node.log import ERROR
-from rospy.core import _process
+from ninjemys.node.params import ParamAccess
+from rospy.core import _process, warn_illegal_name
 from rospy.exceptions import ServiceException, mapped, translate
 from rospy.msg import AnyMsg
 
@@ -39,9 +40,10 @@ class _AnyService:
     _response_class = AnyMsg
 
 
-class _Unnamed:
-    """The surface a core ServiceProxy needs from a node, for calls made before init_node (as rospy's
-    ``/unnamed`` caller): a master client, a caller id, and interruptible waits."""
+class _Unnamed(ParamAccess):
+    """The surface a core ServiceProxy and the parameter calls need from a node, for calls made
+    before init_node (as rospy's ``/unnamed`` caller): a master client, a caller id, name
+    resolution (``~x`` is ``/unnamed/x``, as in rospy), and interruptible waits."""
 
     def __init__(self) -> None:
         from ninjemys.master.client import MasterClient
@@ -64,18 +66,16 @@ class _Unnamed:
         return names.resolve_name(name, self.name, self.remappings)
 
 
-_unnamed: _Unnamed | None = None
-
-
 def _client_context() -> Any:
-    """The node to call services from: the initialized node, else the shared ``/unnamed`` context."""
-    global _unnamed
+    """The node to call the master and services from: the initialized node, else the process's
+    ``/unnamed`` context (made on first use, forgotten by ``reset_rospy``)."""
     node = _process.node
     if node is not None:
         return node
-    if _unnamed is None:
-        _unnamed = _Unnamed()
-    return _unnamed
+    with _process.lock:
+        if _process.unnamed is None:
+            _process.unnamed = _Unnamed()
+        return _process.unnamed
 
 
 def _core_proxy(name: str, service_class: Any, persistent: bool, headers: Mapping[str, str] | None) -> Any:
@@ -166,7 +166,10 @@ class Service:
         buff_size: int = 65536,
         error_handler: Callable[..., Any] | None = None,
     ) -> None:
+        if not isinstance(name, str) or not name:
+            raise ValueError("service name is not a non-empty string")
         _check_service_class(service_class, name)
+        warn_illegal_name(name)
         self.service_class = service_class
         self.request_class = service_class._request_class
         self.response_class = service_class._response_class

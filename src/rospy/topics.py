@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 
 from ninjemys.errors import NinjemysError, SerializationError, ShutdownError
-from rospy.core import _process
+from rospy.core import _process, warn_illegal_name
 from rospy.exceptions import (
     ROSException,
     ROSInterruptException,
@@ -60,6 +60,7 @@ class Topic:
         if not isinstance(name, str) or not name:
             raise ValueError(f"topic name must be a non-empty string, not {name!r}")
         _check_class(data_class, f"topic [{name}]")
+        warn_illegal_name(name, stacklevel=4)  # the user's Publisher(...)/Subscriber(...) line
         self._requested = name
         self.data_class = data_class
         self.type = data_class._type
@@ -115,6 +116,16 @@ class Publisher(Topic):
         queue_size: int | None = None,
     ) -> None:
         super().__init__(name, data_class)
+        if queue_size is None:
+            import warnings
+
+            warnings.warn(
+                "The publisher should be created with an explicit keyword argument 'queue_size'. "
+                "Please see http://wiki.ros.org/rospy/Overview/Publishers%20and%20Subscribers for more "
+                "information.",
+                SyntaxWarning,
+                stacklevel=2,
+            )
         self.subscriber_listener = subscriber_listener
         self.tcp_nodelay = tcp_nodelay
         self.latch = latch

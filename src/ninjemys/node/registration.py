@@ -73,6 +73,25 @@ class Registrar:
                 _log.warning("%s: master unreachable, will register when it is back (%s)", what, exc)
             self._master_down = True
             return None
+        except MasterError as exc:
+            if getattr(self.node, "strict_names", True) or getattr(exc, "status", None) is None:
+                raise
+            # rospy's leniency (a node named "a b" registers its ~get_loggers as "/a b/get_loggers"):
+            # the master refuses, rospy logs FATAL in its own words and the node runs on without it.
+            self._refused(what, str(getattr(exc, "status", exc)))
+            return None
+
+    def _refused(self, what: str, status: str) -> None:
+        kind, _, name = what.partition(" ")
+        noun = {"publisher": "publication", "subscriber": "subscription"}.get(kind, kind)
+        log = getattr(self.node, "log", None)
+        text = f"unable to register {noun} [{name}] with master: {status}"
+        if log is None:
+            _log.critical("%s", text)
+        else:
+            from ninjemys.node.log import FATAL
+
+            log.log(FATAL, "%s", text)
 
     def add_publisher(self, topic: str, type_name: str) -> None:
         with self._lock:
