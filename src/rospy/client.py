@@ -315,8 +315,14 @@ def resolve_name(name: str, caller_id: str | None = None) -> str:
 
 
 def remap_name(name: str, caller_id: str | None = None, resolved: bool = True) -> str:
-    """The remapped form of ``name`` (itself when no remapping applies)."""
-    return resolve_name(name, caller_id)
+    """The remapped form of ``name``, resolved; ``name`` itself, unresolved, when the command line
+    does not remap it (rospy's contract: resolve only what is remapped)."""
+    from ninjemys import names
+
+    mappings = names.load_mappings(sys.argv)
+    if name not in mappings:
+        return name
+    return names.resolve_name(mappings[name], caller_id or get_name())
 
 
 # -- parameters -----------------------------------------------------------------------------------------
@@ -403,6 +409,7 @@ def wait_for_message(topic: str, topic_type: Any, timeout: float | None = None) 
             box.append(msg)
             got.set()
 
+    timeout = _seconds(timeout)
     sub = Subscriber(topic, topic_type, take, queue_size=1)
     with _process.lock:
         _process.waiters.add(got)
@@ -418,7 +425,15 @@ def wait_for_message(topic: str, topic_type: Any, timeout: float | None = None) 
         return box[0]
     if is_shutdown():
         raise ROSInterruptException("rospy shutdown")
-    raise ROSException(f"timeout exceeded while waiting for message on topic {sub.resolved_name}")
+    raise ROSException(f"timeout exceeded while waiting for message on topic {topic}")  # rospy's words
+
+
+def _seconds(timeout: Any) -> float | None:
+    """A timeout in seconds from rospy's accepted forms: None, a number or a rospy.Duration."""
+    if timeout is None:
+        return None
+    to_sec = getattr(timeout, "to_sec", None)
+    return float(to_sec() if to_sec is not None else timeout)
 
 
 def get_published_topics(namespace: str = "/") -> list[list[str]]:

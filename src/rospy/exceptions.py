@@ -20,6 +20,15 @@ class ROSSerializationException(ROSException):
     """A message could not be serialized (wrong field type or value)."""
 
 
+class PublishArgumentError(ROSSerializationException, TypeError):
+    """``publish()`` arguments that do not make a message of the topic's type.
+
+    rospy raises a plain TypeError here (``pub.publish(Int32(3))`` on a String topic, or too many
+    arguments); ninjemys used to raise ROSSerializationException. This is both, so code written
+    against either catches it.
+    """
+
+
 class ROSInitException(ROSException):
     """The node could not be initialized (bad arguments, master unreachable, ...)."""
 

@@ -89,8 +89,10 @@ def _core_proxy(name: str, service_class: Any, persistent: bool, headers: Mappin
 
 def wait_for_service(service: str, timeout: float | None = None) -> None:
     """Block until ``service`` is available; ROSException after ``timeout`` seconds."""
+    from rospy.client import _seconds
+
     with mapped():
-        _core_proxy(service, _AnyService, False, None).wait_for_service(timeout)
+        _core_proxy(service, _AnyService, False, None).wait_for_service(_seconds(timeout))
 
 
 class ServiceProxy:
@@ -125,8 +127,10 @@ class ServiceProxy:
         return impl
 
     def wait_for_service(self, timeout: float | None = None) -> None:
+        from rospy.client import _seconds
+
         with mapped():
-            self._core().wait_for_service(timeout)
+            self._core().wait_for_service(_seconds(timeout))
 
     def call(self, *args: Any, **kwds: Any) -> Any:
         """Send a request (an instance, or its fields) and return the response."""

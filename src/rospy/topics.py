@@ -12,6 +12,7 @@ from collections.abc import Callable, Mapping
 from ninjemys.errors import NinjemysError, SerializationError, ShutdownError
 from rospy.core import _process, warn_illegal_name
 from rospy.exceptions import (
+    PublishArgumentError,
     ROSException,
     ROSInterruptException,
     ROSSerializationException,
@@ -154,8 +155,12 @@ class Publisher(Topic):
         else:
             try:
                 msg = args_kwds_to_message(self.data_class, args, kwds)
-            except (TypeError, ValueError) as exc:
+            except TypeError as exc:
+                raise PublishArgumentError(str(exc)) from None
+            except ValueError as exc:
                 raise ROSSerializationException(str(exc)) from None
+        if not self.latch and not impl.get_num_connections():
+            return  # as rospy: nobody listens, so nothing is serialized (a bad field is not an error yet)
         try:
             if self._raw:
                 impl.publish_raw(msg._buff)
