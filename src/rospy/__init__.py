@@ -92,10 +92,13 @@ from rospy.topics import Publisher, SubscribeListener, Subscriber
 
 
 def _install_import_hook() -> None:
-    """``from my_pkg.msg import MyMsg`` for packages on ROS_PACKAGE_PATH, without a build step."""
+    """``from my_pkg.msg import MyMsg`` for packages on ROS_PACKAGE_PATH, without a build step; and
+    Noetic's ``URDF.from_parameter_server()`` on the PyPI urdf_parser_py (see rospy._urdf)."""
     from ninjemys.idl.hook import install
+    from rospy import _urdf
 
     install()
+    _urdf.install()
 
 
 _install_import_hook()
