@@ -29,7 +29,7 @@ pytestmark = [
     pytest.mark.skipif(not testing.have_ros1(), reason="Debian's ROS 1 is not installed"),
 ]
 
-PRELUDE = r'''
+PRELUDE = r"""
 import sys, warnings
 warnings.simplefilter("default")
 import rospy
@@ -52,15 +52,15 @@ def my_services():
     state = rosgraph.Master("/parity").getSystemState()
     me = rospy.get_name()
     return sorted(s for s, providers in state[2] if me in providers)
-'''
+"""
 
-NODE_NAME = r'''
+NODE_NAME = r"""
 rospy.init_node(NAME, disable_signals=True)
 print("name", rospy.get_name(), "namespace", rospy.get_namespace(), flush=True)
 print("services", my_services(), flush=True)
 rospy.loginfo("running")
 rospy.signal_shutdown("done")
-'''
+"""
 
 CASES: dict[str, tuple[str, list[str]]] = {
     # 1. illegal node names: a UserWarning at the user's line, the node runs; the master refuses
@@ -73,23 +73,23 @@ CASES: dict[str, tuple[str, list[str]]] = {
     "node_name_tilde": ('NAME = "~x"' + NODE_NAME, []),
     "node_name_from_argv": ('NAME = "wheel"' + NODE_NAME, ["__name:=a/b"]),
     "node_name_anonymous_dash": (
-        r'''
+        r"""
 rospy.init_node("my-node", anonymous=True, disable_signals=True)
 print("prefix", rospy.get_name().startswith("/my-node_"), flush=True)
 rospy.signal_shutdown("done")
-''',
+""",
         [],
     ),
     "node_name_refused": (
-        r'''
+        r"""
 show("empty", lambda: rospy.init_node("", disable_signals=True))
 show("namespace", lambda: rospy.init_node("a/b", disable_signals=True))
-''',
+""",
         [],
     ),
     # 2. the parameter server and the graph before init_node, as /unnamed
     "params_before_init": (
-        r'''
+        r"""
 show("set", lambda: rospy.set_param("/parity_pre/a", 1))
 show("set private", lambda: rospy.set_param("~parity_priv", 2))
 show("get", lambda: rospy.get_param("/parity_pre/a"))
@@ -106,20 +106,20 @@ show("delete missing", lambda: rospy.delete_param("/parity_pre/a"))
 show("delete private", lambda: rospy.delete_param("~parity_priv"))
 show("topics", lambda: [t for t in rospy.get_published_topics() if t[0] == "/rosout_agg"])
 show("name", rospy.get_name)
-''',
+""",
         [],
     ),
     "params_before_init_in_namespace": (
-        r'''
+        r"""
 show("set private", lambda: rospy.set_param("~parity_ns_priv", "v"))
 show("names", lambda: sorted(n for n in rospy.get_param_names() if "parity_ns" in n))
 show("delete", lambda: rospy.delete_param("~parity_ns_priv"))
-''',
+""",
         ["__ns:=/parity_ns"],
     ),
     # 3. illegal graph names after init: warnings, never errors
     "illegal_graph_names": (
-        r'''
+        r"""
 from std_msgs.msg import String
 from std_srvs.srv import Empty
 rospy.init_node("parity_names", disable_signals=True)
@@ -137,12 +137,12 @@ show("resolve space", lambda: rospy.resolve_name("a b"))
 show("remap unmapped", lambda: rospy.remap_name("foo"))
 show("remap mapped", lambda: rospy.remap_name("chatter"))
 rospy.signal_shutdown("done")
-''',
+""",
         ["chatter:=other"],
     ),
     # 4. time, rates and timeouts
     "rates_and_timeouts": (
-        r'''
+        r"""
 from std_msgs.msg import String
 rospy.init_node("parity_time", disable_signals=True)
 show("rate zero", lambda: rospy.Rate(0), text=False)
@@ -154,12 +154,12 @@ show("wait_for_service Duration", lambda: rospy.wait_for_service("nosrv", timeou
 show("sleep negative", lambda: rospy.sleep(-1))
 show("sleep Duration", lambda: rospy.sleep(rospy.Duration(0.01)))
 rospy.signal_shutdown("done")
-''',
+""",
         [],
     ),
     # 5. publish(): arguments that make no message are TypeErrors; nothing is serialized unheard
     "publish_arguments": (
-        r'''
+        r"""
 from std_msgs.msg import String, Int32
 rospy.init_node("parity_pub", disable_signals=True)
 pub = rospy.Publisher("parity_chatter", String, queue_size=1)
@@ -168,16 +168,16 @@ show("too many", lambda: pub.publish("a", "b"), text=False)
 show("bad field, nobody listening", lambda: pub.publish(5))
 rospy.Publisher("parity_noqs", String)
 rospy.signal_shutdown("done")
-''',
+""",
         [],
     ),
     "init_twice": (
-        r'''
+        r"""
 rospy.init_node("parity_twice", disable_signals=True)
 show("same", lambda: rospy.init_node("parity_twice", disable_signals=True))
 show("different", lambda: rospy.init_node("other"))
 rospy.signal_shutdown("done")
-''',
+""",
         [],
     ),
 }

@@ -70,7 +70,12 @@ class Registrar:
             return fn()
         except MasterUnreachable as exc:
             if not self._master_down:
-                _log.warning("%s: master unreachable, will register when it is back (%s)", what, exc)
+                # rospy's words (ours re-registers by itself when the master comes back)
+                _log.warning(
+                    "Unable to register with master node [%s]: master may not be running yet. Will keep trying.",
+                    self.node.master_uri,
+                )
+                _log.debug("%s: %s", what, exc)
             self._master_down = True
             return None
         except MasterError as exc:
