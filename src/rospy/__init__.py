@@ -187,8 +187,12 @@ def __getattr__(name: str) -> object:
         from std_msgs.msg import Header
 
         return Header
-    if name == "numpy_msg":
-        from rospy import numpy_msg as module
+    if name == "names":  # rospy imports rospy.names eagerly; code reads rospy.names.get_namespace()
+        import importlib
 
-        return module
+        return importlib.import_module("rospy.names")
+    if name == "numpy_msg":
+        import importlib  # not "from rospy import numpy_msg": that asks this __getattr__ again
+
+        return importlib.import_module("rospy.numpy_msg")
     raise AttributeError(f"module 'rospy' has no attribute {name!r}")

@@ -56,7 +56,7 @@ class UrdfFinder:
             return None
         from importlib.machinery import PathFinder
 
-        spec = PathFinder.find_spec(fullname, path)
+        spec: Any = PathFinder.find_spec(fullname, path)
         if spec is None or spec.loader is None or not hasattr(spec.loader, "exec_module"):
             return spec
         spec.loader = _Loader(spec.loader)

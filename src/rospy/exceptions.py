@@ -65,6 +65,15 @@ class ServiceException(ROSException):
     """A service call failed, or a service handler reported an error."""
 
 
+class ServiceArgumentError(ServiceException, TypeError):
+    """A ServiceProxy called with arguments that make no request: rospy raises TypeError, ninjemys
+    raised ServiceException; this is both."""
+
+
+class NotAServiceClassError(AttributeError):
+    """A class given as a service type is not one (rospy fails with the same AttributeError type)."""
+
+
 def translate(exc: BaseException) -> BaseException:
     """The rospy exception that stands for ``exc`` (``exc`` itself when it is not a ninjemys error)."""
     from ninjemys import errors
@@ -77,7 +86,7 @@ def translate(exc: BaseException) -> BaseException:
     if isinstance(exc, errors.ShutdownError):
         return ROSInterruptException(text)
     if isinstance(exc, errors.ServiceError):
-        return ServiceException(text)
+        return ServiceArgumentError(text) if isinstance(exc, TypeError) else ServiceException(text)
     if isinstance(exc, errors.SerializationError):
         return ROSSerializationException(text)
     if isinstance(exc, errors.NameError_):

@@ -16,7 +16,7 @@ from ninjemys.interrupt import wait_event
 from ninjemys.node.log import ERROR
 from ninjemys.node.params import ParamAccess
 from rospy.core import _process, warn_illegal_name
-from rospy.exceptions import ServiceException, mapped, translate
+from rospy.exceptions import NotAServiceClassError, ServiceException, mapped, translate
 from rospy.msg import AnyMsg
 
 TYPE_CHECKING = False  # importing typing costs ~7 ms of every node's start-up; checkers set it
@@ -28,7 +28,7 @@ __all__ = ["Service", "ServiceProxy", "ServiceException", "wait_for_service"]
 
 def _check_service_class(service_class: Any, name: str) -> None:
     if not all(hasattr(service_class, a) for a in ("_type", "_md5sum", "_request_class", "_response_class")):
-        raise ValueError(f"service [{name}]: [{service_class}] is not a service class")
+        raise NotAServiceClassError(f"service [{name}]: [{service_class}] is not a service class")
 
 
 class _AnyService:

@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 
 from ninjemys.errors import NinjemysError, SerializationError, ShutdownError
-from rospy.core import _process, warn_illegal_name
+from rospy.core import _process, is_shutdown, warn_illegal_name
 from rospy.exceptions import (
     PublishArgumentError,
     ROSException,
@@ -94,6 +94,11 @@ class Topic:
             return
         try:
             self._impl = self._create(node)
+        except ShutdownError:
+            if not is_shutdown():
+                raise ROSInterruptException(f"topic [{self.resolved_name}]: the node is shut down") from None
+            # as rospy: a handle made while the node shuts down exists, and sends or receives nothing
+            return
         except NinjemysError as exc:
             raise translate(exc) from None
         self.resolved_name = self.name = self._impl.resolved_name
@@ -149,7 +154,8 @@ class Publisher(Topic):
         """Publish a message, or build one from the arguments: ``pub.publish("hello")`` for a String."""
         impl = self._impl
         if impl is None:
-            self._not_ready()
+            self._not_ready()  # raises, unless the node is shutting down (then nothing is sent)
+            return
         if len(args) == 1 and not kwds and isinstance(args[0], self.data_class):
             msg = args[0]
         else:
@@ -167,6 +173,8 @@ class Publisher(Topic):
             else:
                 impl.publish(msg)
         except ShutdownError:
+            if is_shutdown():
+                return  # as rospy: publishing while the node shuts down is quietly dropped
             raise ROSInterruptException(f"publish() to a closed topic [{self.resolved_name}]") from None
         except SerializationError as exc:
             raise ROSSerializationException(str(exc)) from None
@@ -178,6 +186,8 @@ class Publisher(Topic):
             raise ROSException(f"publish() to an unregistered() handle [{self.resolved_name}]")
         if _process.node is None:
             raise ROSException("ROS node has not been initialized yet. Please call init_node() first")
+        if is_shutdown():
+            return  # as rospy: publishing while the node shuts down is quietly dropped
         raise ROSInterruptException(f"publish() to a closed topic [{self.resolved_name}]")
 
 

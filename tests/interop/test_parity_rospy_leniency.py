@@ -171,6 +171,52 @@ rospy.signal_shutdown("done")
 """,
         [],
     ),
+    # 6. services, logging and shutdown
+    "service_call_forms": (
+        r'''
+from std_msgs.msg import String
+from std_srvs.srv import SetBool, SetBoolRequest
+rospy.init_node("parity_srv", disable_signals=True)
+rospy.Service("parity_setb", SetBool, lambda r: (r.data, "got %s" % r.data))
+rospy.wait_for_service("parity_setb", timeout=10)
+proxy = rospy.ServiceProxy("parity_setb", SetBool)
+show("keywords", lambda: proxy(data=True).message)
+show("positional", lambda: proxy(True).message)
+show("request", lambda: proxy(SetBoolRequest(False)).message)
+show("call()", lambda: proxy.call(True).success)
+show("too many arguments", lambda: proxy(1, 2), text=False)
+show("proxy of a message class", lambda: rospy.ServiceProxy("x", String), text=False)
+show("service of a message class", lambda: rospy.Service("y", String, lambda r: None), text=False)
+rospy.signal_shutdown("done")
+''',
+        [],
+    ),
+    "logging_forms": (
+        r'''
+rospy.init_node("parity_log", disable_signals=True)
+show("mapping argument", lambda: rospy.loginfo("%(a)s and %(b)s", {"a": 1, "b": 2}))
+show("percent, no arguments", lambda: rospy.loginfo("100%"))
+show("logger_name", lambda: rospy.logwarn("kw %s", 1, logger_name="x"))
+show("throttle logger_name", lambda: rospy.logwarn_throttle(1, "thr", logger_name="x"))
+show("once logger_name", lambda: rospy.logerr_once("once", logger_name="x"))
+show("names module", lambda: rospy.names.get_namespace())
+rospy.signal_shutdown("done")
+''',
+        [],
+    ),
+    "after_shutdown": (
+        r'''
+from std_msgs.msg import String
+rospy.init_node("parity_after", disable_signals=True)
+pub = rospy.Publisher("parity_after", String, queue_size=1)
+rospy.signal_shutdown("done")
+show("publish", lambda: pub.publish("x"))
+show("new publisher publishes", lambda: rospy.Publisher("parity_after2", String, queue_size=1).publish("x"))
+show("wait_for_message", lambda: rospy.wait_for_message("t", String, timeout=0.1), text=False)
+show("is_shutdown", rospy.is_shutdown)
+''',
+        [],
+    ),
     "init_twice": (
         r"""
 rospy.init_node("parity_twice", disable_signals=True)

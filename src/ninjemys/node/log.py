@@ -216,6 +216,8 @@ class NodeLog:
         """Log ``msg % args`` at ``level``; ``depth`` frames up is the call site recorded in /rosout."""
         if self._closed and level < WARN:
             return
+        if len(args) == 1 and isinstance(args[0], dict) and args[0]:
+            args = args[0]  # type: ignore[assignment]  # "%(a)s", {"a": 1}: the logging module's rule, as rospy
         text = str(msg) % args if args else str(msg)
         if exc_info:
             import traceback
