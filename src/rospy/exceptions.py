@@ -70,8 +70,9 @@ class ServiceArgumentError(ServiceException, TypeError):
     raised ServiceException; this is both."""
 
 
-class NotAServiceClassError(AttributeError):
-    """A class given as a service type is not one (rospy fails with the same AttributeError type)."""
+class NotAServiceClassError(ValueError, AttributeError):
+    """A class given as a service type is not one: rospy fails with an AttributeError, ninjemys
+    raised ValueError; this is both."""
 
 
 def translate(exc: BaseException) -> BaseException:
