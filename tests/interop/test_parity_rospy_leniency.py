@@ -132,6 +132,8 @@ show("publisher space", lambda: rospy.Publisher("a b", String, queue_size=1).res
 show("publisher digit", lambda: rospy.Publisher("1topic", String, queue_size=1).resolved_name)
 show("subscriber dash", lambda: rospy.Subscriber("a-c", String, lambda m: None).resolved_name)
 show("service dash", lambda: rospy.Service("s-b", Empty, lambda r: None).resolved_name)
+show("subscriber space", lambda: rospy.Subscriber("c d", String, lambda m: None).resolved_name)
+show("service space", lambda: rospy.Service("s d", Empty, lambda r: None).resolved_name)
 show("proxy dash", lambda: rospy.ServiceProxy("s-c", Empty).resolved_name)
 show("resolve space", lambda: rospy.resolve_name("a b"))
 show("remap unmapped", lambda: rospy.remap_name("foo"))
