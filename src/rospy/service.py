@@ -204,6 +204,7 @@ class Service:
                 self.error_handler(exc, *sys.exc_info())
             else:
                 _process.log.log(ERROR, "Error processing request: %s", exc, exc_info=True)
+            exc.ninjemys_reported = True  # type: ignore[attr-defined]  # the core need not log it again
             raise
 
     def shutdown(self, reason: str = "") -> None:

@@ -335,7 +335,10 @@ class ServiceServer:
         if isinstance(exc, ServiceError):
             _log.debug("service %s: handler refused the request: %s", self.name, exc)
             return encode_service_response(False, f"service cannot process request: {exc}")
-        _log.error("service %s: error processing request: %s", self.name, exc)
+        if getattr(exc, "ninjemys_reported", False):  # the handler's owner (rospy) logged it already
+            _log.debug("service %s: error processing request: %s", self.name, exc)
+        else:
+            _log.error("service %s: error processing request: %s", self.name, exc)
         return encode_service_response(False, f"error processing request: {exc}")
 
     @property
