@@ -175,7 +175,7 @@ rospy.signal_shutdown("done")
     ),
     # 6. services, logging and shutdown
     "service_call_forms": (
-        r'''
+        r"""
 from std_msgs.msg import String
 from std_srvs.srv import SetBool, SetBoolRequest
 rospy.init_node("parity_srv", disable_signals=True)
@@ -190,11 +190,11 @@ show("too many arguments", lambda: proxy(1, 2), text=False)
 show("proxy of a message class", lambda: rospy.ServiceProxy("x", String), text=False)
 show("service of a message class", lambda: rospy.Service("y", String, lambda r: None), text=False)
 rospy.signal_shutdown("done")
-''',
+""",
         [],
     ),
     "logging_forms": (
-        r'''
+        r"""
 rospy.init_node("parity_log", disable_signals=True)
 show("mapping argument", lambda: rospy.loginfo("%(a)s and %(b)s", {"a": 1, "b": 2}))
 show("percent, no arguments", lambda: rospy.loginfo("100%"))
@@ -203,11 +203,11 @@ show("throttle logger_name", lambda: rospy.logwarn_throttle(1, "thr", logger_nam
 show("once logger_name", lambda: rospy.logerr_once("once", logger_name="x"))
 show("names module", lambda: rospy.names.get_namespace())
 rospy.signal_shutdown("done")
-''',
+""",
         [],
     ),
     "after_shutdown": (
-        r'''
+        r"""
 from std_msgs.msg import String
 rospy.init_node("parity_after", disable_signals=True)
 pub = rospy.Publisher("parity_after", String, queue_size=1)
@@ -216,8 +216,35 @@ show("publish", lambda: pub.publish("x"))
 show("new publisher publishes", lambda: rospy.Publisher("parity_after2", String, queue_size=1).publish("x"))
 show("wait_for_message", lambda: rospy.wait_for_message("t", String, timeout=0.1), text=False)
 show("is_shutdown", rospy.is_shutdown)
-''',
+""",
         [],
+    ),
+    # 7. the command line: remappings, private parameters as YAML, __ns, myargv
+    "command_line": (
+        r"""
+show("myargv", rospy.myargv)
+show("myargv given", lambda: rospy.myargv(["p", "a-b:=c", "x:=y", "_p:=1", "__ns:=/n", "k"]))
+rospy.init_node("argv_node", disable_signals=True)
+for label, fn in [("name", rospy.get_name), ("namespace", rospy.get_namespace),
+                  ("resolve a", lambda: rospy.resolve_name("a")), ("resolve b", lambda: rospy.resolve_name("b")),
+                  ("resolve ~c", lambda: rospy.resolve_name("~c")), ("remap a", lambda: rospy.remap_name("a")),
+                  ("mappings", lambda: sorted(rospy.names.get_mappings().items()))]:
+    show(label, fn)
+for key in "pqsl":
+    show("param " + key, lambda: rospy.get_param("~" + key))
+rospy.signal_shutdown("done")
+""",
+        [
+            "a:=/remapped",
+            "b:=rel",
+            "~c:=d",
+            "_p:=5",
+            "_q:=hello",
+            "_s:=[1, 2]",
+            "_l:=true",
+            "-v",
+            "__ns:=/myns",
+        ],
     ),
     "init_twice": (
         r"""

@@ -86,10 +86,10 @@ def _recv_exact(sock: socket.socket, n: int) -> bytes:
     return b"".join(chunks)
 
 
-
 class RequestArgumentError(ServiceError, TypeError):
     """Call arguments that do not make a request of the service's type. Also a TypeError, which is
     what rospy raises for them (code written for rospy may catch it)."""
+
 
 class _Link:
     """The receive side of one service connection: records (a fixed head whose last field is the
