@@ -265,7 +265,9 @@ def _make_handler(previous: Any) -> Any:
 
 def spin() -> None:
     """Block until the node shuts down (Ctrl-C, rosnode kill, a name collision, signal_shutdown)."""
-    node = _process.require_node()
+    node = _process.node
+    if node is None:
+        raise ROSInitException("client code must call rospy.init_node() first")  # rospy's words
     try:
         node.wait_for_shutdown()
     except KeyboardInterrupt:
@@ -400,7 +402,7 @@ def wait_for_message(topic: str, topic_type: Any, timeout: float | None = None) 
     """Receive one message on ``topic``; ROSException after ``timeout`` seconds, ROSInterruptException on shutdown."""
     from rospy.topics import Subscriber
 
-    node = _process.require_node()
+    node = _process.node  # None before init_node: rospy waits all the same (init_node may come)
     box: list[Any] = []
     got = threading.Event()
 
@@ -413,7 +415,7 @@ def wait_for_message(topic: str, topic_type: Any, timeout: float | None = None) 
     sub = Subscriber(topic, topic_type, take, queue_size=1)
     with _process.lock:
         _process.waiters.add(got)
-    if node.is_shutdown:
+    if node is not None and node.is_shutdown:
         got.set()
     try:
         wait_event(got, timeout)

@@ -170,7 +170,12 @@ def _reset() -> None:
 
 
 def on_shutdown(hook: Callable[[], Any]) -> None:
-    """Call ``hook()`` (no arguments) when the node shuts down, before its connections close."""
+    """Call ``hook()`` (no arguments) when the node shuts down, before its connections close.
+
+    TypeError at once for a hook that cannot be called, as rospy (not an error logged at shutdown).
+    """
+    if not callable(hook):
+        raise TypeError(f"shutdown hook [{hook}] must be a function or callable object: {type(hook)}")
     with _process.lock:
         if not _process.hooks_ran:
             _process.hooks.append(hook)

@@ -246,6 +246,19 @@ rospy.signal_shutdown("done")
             "__ns:=/myns",
         ],
     ),
+    "before_init_misc": (
+        r"""
+from std_msgs.msg import String
+show("spin", rospy.spin)
+show("wait_for_message", lambda: rospy.wait_for_message("parity_none", String, timeout=0.2))
+show("on_shutdown of a non-callable", lambda: rospy.on_shutdown(5))
+show("on_shutdown", lambda: rospy.on_shutdown(lambda: print("hook ran", flush=True)))
+rospy.init_node("parity_misc", disable_signals=True)
+rospy.signal_shutdown("done")
+show("is_shutdown", rospy.is_shutdown)
+""",
+        [],
+    ),
     "init_twice": (
         r"""
 rospy.init_node("parity_twice", disable_signals=True)

@@ -4,7 +4,7 @@
 overview)::
 
               Debug  Info  Warn  Error  Fatal
-    stdout            X
+    stdout     (X)    X
     stderr                  X     X      X
     log file    X     X     X     X      X
     /rosout     (X)   X     X     X      X      (debug only when the level is DEBUG)
@@ -228,8 +228,7 @@ class NodeLog:
         if level < self.level:
             return
         sim = self._ros_time() if self._ros_time is not None else None
-        if level != DEBUG:
-            self._write_console(level, format_console(level, text, wall, sim))
+        self._write_console(level, format_console(level, text, wall, sim))  # debug too, once enabled (rospy)
         if self._rosout is not None or self._held is not None:
             code = sys._getframe(depth)
             record = (
@@ -355,7 +354,7 @@ class NodeLog:
         return self._ros_time() if self._ros_time is not None else time.time()
 
     def _write_console(self, level: int, line: str) -> None:
-        stream = (self._stdout or sys.stdout) if level == INFO else (self._stderr or sys.stderr)
+        stream = (self._stdout or sys.stdout) if level <= INFO else (self._stderr or sys.stderr)
         color = _COLORS.get(level)
         if self._colorize and color and stream.isatty():
             line = color + line + _COLOR_RESET
