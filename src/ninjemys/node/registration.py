@@ -21,6 +21,7 @@ import logging
 import socket
 import threading
 from collections.abc import Callable
+from functools import partial
 
 from ninjemys.errors import MasterError, MasterUnreachable, ShutdownError
 from ninjemys.master.client import MasterClient
@@ -242,16 +243,27 @@ class Registrar:
                 "master at %s does not know %s: registering again", self.node.master_uri, self.node.name
             )
         master, uri = self._probe, self.node.uri
+
+        def again(fn: Callable[[], object]) -> object | None:
+            try:
+                return fn()
+            except MasterUnreachable:
+                raise
+            except MasterError as exc:  # a name this master refuses (rospy's leniency): skip it
+                _log.debug("re-registration: %s", exc)
+                return None
+
         try:
             for topic, type_name in pubs.items():
-                master.register_publisher(topic, type_name, uri)
+                again(partial(master.register_publisher, topic, type_name, uri))
             for topic, type_name in subs.items():
-                publishers = master.register_subscriber(topic, type_name, uri)
-                self.node.publisher_update(topic, list(publishers))
+                publishers = again(partial(master.register_subscriber, topic, type_name, uri))
+                if isinstance(publishers, list):
+                    self.node.publisher_update(topic, list(publishers))
             for name, service_uri in srvs.items():
-                master.register_service(name, service_uri, uri)
+                again(partial(master.register_service, name, service_uri, uri))
             for key in keys:
-                master.subscribe_param(uri, key)
+                again(partial(master.subscribe_param, uri, key))
         except MasterError as exc:
             _log.info("re-registration interrupted: %s", exc)
             self._master_down = True
