@@ -34,7 +34,22 @@ print(json.dumps(out))
 def _calls() -> list[tuple[str, list[float]]]:
     rng = random.Random(21)
     pi = math.pi
-    specials = [0.0, pi, -pi, 2 * pi, -2 * pi, pi / 2, -pi / 2, 0.25, -0.25, 0.5, -0.5, 3 * pi, -7.5, 10.5 * pi]
+    specials = [
+        0.0,
+        pi,
+        -pi,
+        2 * pi,
+        -2 * pi,
+        pi / 2,
+        -pi / 2,
+        0.25,
+        -0.25,
+        0.5,
+        -0.5,
+        3 * pi,
+        -7.5,
+        10.5 * pi,
+    ]
     singles = specials + [rng.uniform(-20, 20) for _ in range(60)]
     pairs = [(a, b) for a in specials for b in specials] + [
         (rng.uniform(-10, 10), rng.uniform(-10, 10)) for _ in range(100)
