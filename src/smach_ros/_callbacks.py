@@ -15,7 +15,9 @@ def interface_of(
     A callback without a smach interface sees the state's ``input_keys``/``output_keys``.
     """
     if cb is not None and not callable(cb):
-        raise smach.InvalidStateError(f"Callback object given to {type(state).__name__} that IS NOT a function object")
+        raise smach.InvalidStateError(
+            f"Callback object given to {type(state).__name__} that IS NOT a function object"
+        )
     if smach.has_smach_interface(cb):
         ins, outs = list(cb.get_registered_input_keys()), list(cb.get_registered_output_keys())
         state.register_input_keys(ins)

@@ -57,7 +57,9 @@ class ActionServerWrapper:
         self.userdata[feedback_key] = copy.copy(spec.action_feedback.feedback)
         self._server_name = server_name
         self._action_spec = action_spec
-        self._action_server = SimpleActionServer(server_name, action_spec, execute_cb=self.execute_cb, auto_start=False)
+        self._action_server = SimpleActionServer(
+            server_name, action_spec, execute_cb=self.execute_cb, auto_start=False
+        )
         self._succeeded_outcomes = set(succeeded_outcomes)
         self._aborted_outcomes = set(aborted_outcomes)
         self._preempted_outcomes = set(preempted_outcomes)
@@ -105,7 +107,10 @@ class ActionServerWrapper:
         try:
             outcome = container.execute(
                 smach.Remapper(
-                    self.userdata, container.get_registered_input_keys(), container.get_registered_output_keys(), {}
+                    self.userdata,
+                    container.get_registered_input_keys(),
+                    container.get_registered_output_keys(),
+                    {},
                 )
             )
         except smach.InvalidUserCodeError:

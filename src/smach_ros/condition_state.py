@@ -60,7 +60,8 @@ class ConditionState(smach.State):
                     return "true"
             except Exception as exc:
                 raise smach.InvalidUserCodeError(
-                    f"Error thrown while executing condition callback {self._cond_cb}: " + traceback.format_exc()
+                    f"Error thrown while executing condition callback {self._cond_cb}: "
+                    + traceback.format_exc()
                 ) from exc
             checks += 1
             if rospy.is_shutdown():

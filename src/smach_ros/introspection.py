@@ -90,19 +90,27 @@ class IntrospectionClient:
 class ContainerProxy:
     """Publishes one container's structure and status and applies init commands addressed to it."""
 
-    def __init__(self, server_name: str, container: smach.Container, path: str, update_rate: float = 2.0) -> None:
+    def __init__(
+        self, server_name: str, container: smach.Container, path: str, update_rate: float = 2.0
+    ) -> None:
         self._path = path
         self._container = container
         self._update_rate = update_rate.to_sec() if hasattr(update_rate, "to_sec") else float(update_rate)
         self._status_lock = threading.Lock()
         self._stop = threading.Event()
-        self._init_sub = rospy.Subscriber(server_name + INIT_TOPIC, SmachContainerInitialStatusCmd, self._init_cmd_cb)
-        self._structure_pub = rospy.Publisher(server_name + STRUCTURE_TOPIC, SmachContainerStructure, queue_size=1)
+        self._init_sub = rospy.Subscriber(
+            server_name + INIT_TOPIC, SmachContainerInitialStatusCmd, self._init_cmd_cb
+        )
+        self._structure_pub = rospy.Publisher(
+            server_name + STRUCTURE_TOPIC, SmachContainerStructure, queue_size=1
+        )
         self._status_pub = rospy.Publisher(server_name + STATUS_TOPIC, SmachContainerStatus, queue_size=1)
         container.register_transition_cb(self._transition_cb)
         container.register_start_cb(self._transition_cb)
         container.register_termination_cb(self._transition_cb)
-        self._thread = threading.Thread(name=f"{server_name}:{path}:heartbeat", target=self._heartbeat, daemon=True)
+        self._thread = threading.Thread(
+            name=f"{server_name}:{path}:heartbeat", target=self._heartbeat, daemon=True
+        )
 
     def start(self) -> None:
         self._thread.start()

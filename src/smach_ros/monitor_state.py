@@ -27,7 +27,9 @@ class MonitorState(smach.State):
         input_keys: list[str] | tuple[str, ...] = (),
         output_keys: list[str] | tuple[str, ...] = (),
     ) -> None:
-        super().__init__(outcomes=["valid", "invalid", "preempted"], input_keys=input_keys, output_keys=output_keys)
+        super().__init__(
+            outcomes=["valid", "invalid", "preempted"], input_keys=input_keys, output_keys=output_keys
+        )
         self._topic = topic
         self._msg_type = msg_type
         self._cond_cb = cond_cb

@@ -174,7 +174,9 @@ class SimpleActionState(smach.State):
         self._done = False
         self._goal_result = None
         self._status = SimpleActionState.ACTIVE
-        self._action_client.send_goal(self._goal, self._goal_done_cb, self._goal_active_cb, self._goal_feedback_cb)
+        self._action_client.send_goal(
+            self._goal, self._goal_done_cb, self._goal_active_cb, self._goal_feedback_cb
+        )
         if self.preempt_requested():  # a preempt that arrived while the goal was being sent
             self._action_client.cancel_goal()
         self._wait_for_result()
@@ -190,7 +192,9 @@ class SimpleActionState(smach.State):
             while not self._done and not rospy.is_shutdown():
                 now = time.monotonic()
                 if exec_deadline is not None and now >= exec_deadline:
-                    rospy.logwarn(f"Action {self._action_name} timed out after {int(self._exec_timeout or 0)} seconds.")
+                    rospy.logwarn(
+                        f"Action {self._action_name} timed out after {int(self._exec_timeout or 0)} seconds."
+                    )
                     self._action_client.cancel_goal()
                     exec_deadline = None
                 if self.preempt_requested() and self._preempt_timeout and preempt_deadline is None:
@@ -255,7 +259,11 @@ class SimpleActionState(smach.State):
         rospy.logdebug(f"Action {self._action_name} sent feedback.")
 
     def _goal_done_cb(self, result_state: int, result: Any) -> None:
-        name = _STATUS_NAMES[result_state] if 0 <= result_state < len(_STATUS_NAMES) else f"UNKNOWN ({result_state})"
+        name = (
+            _STATUS_NAMES[result_state]
+            if 0 <= result_state < len(_STATUS_NAMES)
+            else f"UNKNOWN ({result_state})"
+        )
         rospy.logdebug(f"Action {self._action_name} terminated with result {name}.")
         self._goal_status = result_state
         self._goal_result = result

@@ -15,6 +15,8 @@ def set_preempt_handler(sc: Any) -> None:
         sc.request_preempt()
         stopped = threading.Event()
         while sc.is_running() and not stopped.wait(1.0):
-            rospy.loginfo("Received shutdown request... sent preempt... waiting for state machine to terminate.")
+            rospy.loginfo(
+                "Received shutdown request... sent preempt... waiting for state machine to terminate."
+            )
 
     rospy.on_shutdown(handler)
