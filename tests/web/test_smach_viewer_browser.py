@@ -59,17 +59,33 @@ def test_viewer_draws_the_machine_and_follows_the_active_state(browser_page: Any
         env["ROS_MASTER_URI"] = uri
         (tmp_path / "machine.py").write_text(MACHINE)
         machine = subprocess.Popen(
-            [sys.executable, str(tmp_path / "machine.py")], env=env, stdin=subprocess.PIPE,
-            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+            [sys.executable, str(tmp_path / "machine.py")],
+            env=env,
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
         )
         viewer = subprocess.Popen(
-            [ninjemys_bin("rosrun"), "smach_viewer", "smach_viewer.py", "--no-browser", "--port", str(free_port())],
-            env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+            [
+                ninjemys_bin("rosrun"),
+                "smach_viewer",
+                "smach_viewer.py",
+                "--no-browser",
+                "--port",
+                str(free_port()),
+            ],
+            env=env,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
         )
         try:
             assert viewer.stdout is not None
             line = viewer.stdout.readline().strip()
-            assert line.startswith("smach_viewer: http://"), line + (viewer.stderr.read() if viewer.stderr else "")
+            assert line.startswith("smach_viewer: http://"), line + (
+                viewer.stderr.read() if viewer.stderr else ""
+            )
             page = browser_page
             page.goto(line.split(": ", 1)[1])
             page.wait_for_function("window.smachViewer && window.smachViewer.ready", timeout=30000)
@@ -82,11 +98,21 @@ def test_viewer_draws_the_machine_and_follows_the_active_state(browser_page: Any
             root = next(c for c in drawn["containers"] if c["path"] == "/SM_ROOT")
             assert sorted(root["children"]) == ["INNER", "ONE"]
             assert sorted(root["outcomes"]) == ["finished", "preempted"]
-            assert ["open", "ONE", "INNER"] in root["edges"] and ["inner_done", "INNER", "finished"] in root["edges"]
+            assert ["open", "ONE", "INNER"] in root["edges"] and ["inner_done", "INNER", "finished"] in root[
+                "edges"
+            ]
             # the drawing itself: the nested container's box holds its state, the active state is marked
-            assert page.locator("g.sv-container[data-path='/SM_ROOT/INNER'] g.sv-state[data-state='TWO']").count() == 1
+            assert (
+                page.locator(
+                    "g.sv-container[data-path='/SM_ROOT/INNER'] g.sv-state[data-state='TWO']"
+                ).count()
+                == 1
+            )
             assert page.locator("g.sv-state.active[data-state='ONE']").count() == 1
-            assert page.locator("path.sv-edge[data-outcome='open'][data-from='ONE'][data-to='INNER']").count() == 1
+            assert (
+                page.locator("path.sv-edge[data-outcome='open'][data-from='ONE'][data-to='INNER']").count()
+                == 1
+            )
             assert machine.stdin is not None
             machine.stdin.write("ONE\n")
             machine.stdin.flush()

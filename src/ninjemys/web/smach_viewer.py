@@ -36,7 +36,9 @@ class SmachViewer:
         self.app.server.route(
             "GET",
             PAGE,
-            lambda _r: Response((STATIC_DIR / "smach_viewer.html").read_bytes(), 200, "text/html; charset=utf-8"),
+            lambda _r: Response(
+                (STATIC_DIR / "smach_viewer.html").read_bytes(), 200, "text/html; charset=utf-8"
+            ),
         )
 
     def start(self) -> str:
@@ -52,7 +54,9 @@ def main(argv: list[str] | None = None) -> int:
     """``rosrun smach_viewer smach_viewer.py [--port N] [--no-browser]`` (ROS remappings accepted)."""
     argv = sys.argv[1:] if argv is None else argv
     p = argparse.ArgumentParser(prog="smach_viewer.py", description=__doc__.splitlines()[0])
-    p.add_argument("--port", type=int, default=int(os.environ.get("NINJEMYS_WEB_PORT", "0")), help="HTTP port")
+    p.add_argument(
+        "--port", type=int, default=int(os.environ.get("NINJEMYS_WEB_PORT", "0")), help="HTTP port"
+    )
     p.add_argument("--host", default="127.0.0.1", help="address to serve on (default: localhost only)")
     p.add_argument("--no-browser", action="store_true", help="only print the URL")
     args, _unknown = p.parse_known_args([a for a in argv if ":=" not in a])
