@@ -293,3 +293,84 @@ def test_introspection_topics_read_by_debian_rostopic_echo(master: str, tmp_path
     assert status["/SM_ROOT/SUB"]["active_states"] == ["WAIT"]
     data = pickle.loads(base64.b64decode(status["/SM_ROOT/SUB"]["local_data"]))
     assert data == {"count": 7}
+
+
+WRAPPED = r"""
+import threading, rospy, smach, smach_ros, actionlib
+from actionlib.msg import TwoIntsAction, TwoIntsGoal, TwoIntsResult
+from actionlib_msgs.msg import GoalStatus
+
+rospy.init_node("wrapper")
+
+@smach.cb_interface(input_keys=["a", "b"], output_keys=["sum"], outcomes=["done"])
+def add(ud):
+    ud.sum = ud.a + ud.b
+    return "done"
+
+class Wait(smach.State):
+    def __init__(self):
+        smach.State.__init__(self, outcomes=["done", "preempted"], input_keys=["a"])
+        self.started = threading.Event()
+    def execute(self, ud):
+        if ud.a >= 0:
+            return "done"
+        self.started.set()
+        while not rospy.is_shutdown():
+            if self.preempt_requested():
+                self.service_preempt()
+                return "preempted"
+            rospy.sleep(0.02)
+        return "done"
+
+wait = Wait()
+sm = smach.StateMachine(outcomes=["ok", "preempted"], input_keys=["a", "b"], output_keys=["sum"])
+with sm:
+    smach.StateMachine.add("WAIT", wait, transitions={"done": "ADD"})
+    smach.StateMachine.add("ADD", smach.CBState(add), transitions={"done": "ok"})
+wrapper = smach_ros.ActionServerWrapper("wrapped", TwoIntsAction, sm, succeeded_outcomes=["ok"],
+    preempted_outcomes=["preempted"], goal_slots_map={"a": "a", "b": "b"}, result_slots_map={"sum": "sum"})
+wrapper.run_server()
+
+client = actionlib.SimpleActionClient("wrapped", TwoIntsAction)
+assert client.wait_for_server(rospy.Duration(10))
+client.send_goal_and_wait(TwoIntsGoal(a=20, b=22), rospy.Duration(10))
+print("result", GoalStatus.to_string(client.get_state()), client.get_result().sum, flush=True)
+client.send_goal(TwoIntsGoal(a=-1, b=0))
+assert wait.started.wait(10)
+client.cancel_goal()
+client.wait_for_result(rospy.Duration(10))
+print("cancelled", GoalStatus.to_string(client.get_state()), flush=True)
+
+# the classic monitor pattern: a Concurrence whose MonitorState ends the other child
+watch = smach.Concurrence(outcomes=["stopped", "finished"], default_outcome="finished",
+    outcome_map={"stopped": {"MONITOR": "invalid"}}, child_termination_cb=lambda outcomes: True)
+from std_msgs.msg import Bool
+flag = rospy.Publisher("stop_flag", Bool, queue_size=1)
+with watch:
+    smach.Concurrence.add("MONITOR", smach_ros.MonitorState("stop_flag", Bool, lambda ud, msg: not msg.data))
+    smach.Concurrence.add("WORK", smach_ros.ConditionState(lambda ud: False, max_checks=-1, poll_rate=rospy.Duration(0.02)))
+def stop_soon():
+    while flag.get_num_connections() == 0:
+        rospy.sleep(0.05)
+    flag.publish(Bool(data=True))
+threading.Thread(target=stop_soon, daemon=True).start()
+print("concurrence", watch.execute(), flush=True)
+"""
+
+
+def test_action_server_wrapper_and_monitor_concurrence(master: str, tmp_path: Path) -> None:
+    (tmp_path / "wrapped.py").write_text(WRAPPED)
+    done = subprocess.run(
+        [sys.executable, str(tmp_path / "wrapped.py")],
+        env=_our_env(master, tmp_path),
+        capture_output=True,
+        text=True,
+        timeout=90,
+    )
+    assert done.returncode == 0, done.stderr
+    lines = dict(
+        line.split(" ", 1) for line in done.stdout.splitlines() if " " in line and not line.startswith("[")
+    )
+    assert lines["result"] == "SUCCEEDED 42"
+    assert lines["cancelled"] == "PREEMPTED"
+    assert lines["concurrence"] == "stopped"
