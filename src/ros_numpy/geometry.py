@@ -6,8 +6,8 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from geometry_msgs.msg import Point, Pose, Quaternion, Transform, Vector3
 
+from geometry_msgs.msg import Point, Pose, Quaternion, Transform, Vector3
 from ros_numpy.registry import converts_from_numpy, converts_to_numpy
 
 

@@ -6,9 +6,9 @@ import re
 from typing import Any
 
 import numpy as np
-from sensor_msgs.msg import Image
 
 from ros_numpy.registry import converts_from_numpy, converts_to_numpy
+from sensor_msgs.msg import Image
 
 #: encoding -> (numpy dtype, channels)
 NAMED = {

@@ -5,8 +5,8 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from nav_msgs.msg import MapMetaData, OccupancyGrid
 
+from nav_msgs.msg import MapMetaData, OccupancyGrid
 from ros_numpy.registry import converts_from_numpy, converts_to_numpy
 
 

@@ -5,9 +5,9 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from sensor_msgs.msg import PointCloud2, PointField
 
 from ros_numpy.registry import converts_from_numpy, converts_to_numpy
+from sensor_msgs.msg import PointCloud2, PointField
 
 DUMMY_FIELD_PREFIX = "__"
 _TYPES = {
