@@ -374,3 +374,48 @@ def test_action_server_wrapper_and_monitor_concurrence(master: str, tmp_path: Pa
     assert lines["result"] == "SUCCEEDED 42"
     assert lines["cancelled"] == "PREEMPTED"
     assert lines["concurrence"] == "stopped"
+
+
+REMOTE_INIT = r"""
+import rospy, smach, smach_ros
+
+rospy.init_node("remote_init")
+
+@smach.cb_interface(outcomes=["done"], input_keys=["start"], output_keys=["seen"])
+def record(ud, name):
+    ud.seen = "%s:%s" % (name, ud.start)
+    return "done"
+
+sm = smach.StateMachine(outcomes=["done"])
+sm.userdata.start = "default"
+with sm:
+    smach.StateMachine.add("A", smach.CBState(record, cb_args=["A"]), transitions={"done": "done"})
+    smach.StateMachine.add("B", smach.CBState(record, cb_args=["B"]), transitions={"done": "done"})
+sis = smach_ros.IntrospectionServer("init_sis", sm, "/SM_ROOT")
+sis.start()
+ud = smach.UserData()
+ud.start = "remote"
+client = smach_ros.IntrospectionClient()
+print("servers", client.get_servers(), flush=True)
+print("set", client.set_initial_state("/init_sis", "/SM_ROOT", ["B"], ud, timeout=rospy.Duration(15)), flush=True)
+print("outcome", sm.execute(), sm.userdata.seen, flush=True)
+sis.stop()
+"""
+
+
+def test_container_init_sets_the_initial_state_and_userdata_remotely(master: str, tmp_path: Path) -> None:
+    (tmp_path / "init.py").write_text(REMOTE_INIT)
+    done = subprocess.run(
+        [sys.executable, str(tmp_path / "init.py")],
+        env=_our_env(master, tmp_path),
+        capture_output=True,
+        text=True,
+        timeout=90,
+    )
+    assert done.returncode == 0, done.stderr
+    lines = dict(
+        line.split(" ", 1) for line in done.stdout.splitlines() if " " in line and not line.startswith("[")
+    )
+    assert lines["servers"] == "['/init_sis']"
+    assert lines["set"] == "True"
+    assert lines["outcome"] == "done B:remote"

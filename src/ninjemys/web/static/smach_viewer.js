@@ -102,6 +102,7 @@ function render(box, x, y, parent, model) {
   el("rect", { x: 0, y: 0, width: box.width, height: box.height, rx: 8 }, g);
   el("text", { x: 10, y: 14, class: "sv-title" }, g).textContent = box.path;
   const inner = el("g", { transform: "translate(0,18)" }, g);
+  const edgeLayer = el("g", { class: "sv-edges" });
   const pos = box.laid.pos;
   const defs = svg.querySelector("defs");
   for (const e of box.edges) {
@@ -117,10 +118,10 @@ function render(box, x, y, parent, model) {
         ? `M${a.x + a.w / 2},${a.y + a.h} C${a.x + a.w / 2},${a.y + a.h + 40} ${b.x + b.w / 2},${b.y + b.h + 40} ${b.x + b.w / 2},${b.y + b.h}`
         : `M${x1},${y1} C${(x1 + x2) / 2},${y1} ${(x1 + x2) / 2},${y2} ${x2},${y2}`;
     }
-    el("path", { d, class: "sv-edge", "marker-end": defs ? "url(#sv-arrow)" : "", "data-from": e.source.slice(2), "data-to": e.target.slice(2), "data-outcome": e.label }, inner);
+    el("path", { d, class: "sv-edge", "marker-end": defs ? "url(#sv-arrow)" : "", "data-from": e.source.slice(2), "data-to": e.target.slice(2), "data-outcome": e.label }, edgeLayer);
     const lx = e.source === e.target ? a.x + a.w / 2 : (a.x + a.w + b.x) / 2;
     const ly = e.source === e.target ? a.y - 24 : (a.y + a.h / 2 + b.y + b.h / 2) / 2 - 4;
-    el("text", { x: lx, y: ly, class: "sv-edge-label" }, inner).textContent = e.label;
+    el("text", { x: lx, y: ly, class: "sv-edge-label" }, edgeLayer).textContent = e.label;
   }
   for (const child of box.children) {
     const p = pos.get(`s:${child}`);
@@ -146,6 +147,7 @@ function render(box, x, y, parent, model) {
     el("rect", { x: p.x, y: p.y, width: p.w, height: p.h, rx: 14 }, og);
     el("text", { x: p.x + p.w / 2, y: p.y + p.h / 2 }, og).textContent = o;
   }
+  inner.append(edgeLayer); // on top of nested containers' boxes
   model.containers.push({ path: box.path, children: box.children, outcomes: box.outcomes, edges: box.edges.map((e) => [e.label, e.source.slice(2), e.target.slice(2)]) });
   return g;
 }
