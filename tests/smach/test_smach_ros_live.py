@@ -419,3 +419,69 @@ def test_container_init_sets_the_initial_state_and_userdata_remotely(master: str
     assert lines["servers"] == "['/init_sis']"
     assert lines["set"] == "True"
     assert lines["outcome"] == "done B:remote"
+
+
+WRAPPER_SERVER = r"""
+import rospy, smach, smach_ros
+from actionlib.msg import TwoIntsAction
+
+rospy.init_node("wrapper_server")
+
+@smach.cb_interface(input_keys=["a", "b"], output_keys=["sum"], outcomes=["done", "negative"])
+def add(ud):
+    total = ud.a + ud.b
+    ud.sum = total  # output only: reading ud.sum back would be an InvalidUserCodeError, as in smach
+    return "negative" if total < 0 else "done"
+
+sm = smach.StateMachine(outcomes=["ok", "bad"], input_keys=["a", "b"], output_keys=["sum"])
+with sm:
+    smach.StateMachine.add("ADD", smach.CBState(add), transitions={"done": "ok", "negative": "bad"})
+wrapper = smach_ros.ActionServerWrapper("wrapped", TwoIntsAction, sm, succeeded_outcomes=["ok"],
+    aborted_outcomes=["bad"], goal_slots_map={"a": "a", "b": "b"}, result_slots_map={"sum": "sum"})
+wrapper.run_server()
+print("ready", flush=True)
+rospy.spin()
+"""
+
+DEBIAN_CLIENT = r"""
+import rospy, actionlib
+from actionlib.msg import TwoIntsAction, TwoIntsGoal
+from actionlib_msgs.msg import GoalStatus
+rospy.init_node("debian_client")
+client = actionlib.SimpleActionClient("wrapped", TwoIntsAction)
+assert client.wait_for_server(rospy.Duration(20))
+for a, b in ((20, 22), (-5, 1)):
+    client.send_goal_and_wait(TwoIntsGoal(a=a, b=b), rospy.Duration(20))
+    print("goal", a, b, GoalStatus.to_string(client.get_state()), client.get_result().sum)
+"""
+
+
+@pytest.mark.ros1
+@pytest.mark.skipif(not have_ros1(), reason="needs Debian's ROS 1")
+def test_debian_actionlib_client_drives_our_action_server_wrapper(master: str, tmp_path: Path) -> None:
+    (tmp_path / "server.py").write_text(WRAPPER_SERVER)
+    (tmp_path / "client.py").write_text(DEBIAN_CLIENT)
+    server = subprocess.Popen(
+        [sys.executable, str(tmp_path / "server.py")],
+        env=_our_env(master, tmp_path),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert server.stdout is not None
+        while (line := server.stdout.readline()) and line.strip() != "ready":
+            pass
+        done = subprocess.run(
+            [ROS1_PYTHON, str(tmp_path / "client.py")],
+            env=ros1_env(master, ROS_HOME=str(tmp_path)),
+            capture_output=True,
+            text=True,
+            timeout=90,
+        )
+    finally:
+        kill_tree(server)
+        server_log = server.communicate()[1] if server.stderr else ""
+    assert done.returncode == 0, done.stderr
+    goals = [line for line in done.stdout.splitlines() if line.startswith("goal ")]
+    assert goals == ["goal 20 22 SUCCEEDED 42", "goal -5 1 ABORTED -4"], server_log
