@@ -76,10 +76,10 @@ class RosserialHost:
         self.sync_timeout = sync_timeout
         self.reader = proto.FrameReader()
         self._write_lock = threading.Lock()
-        self.TopicInfo = _topic_info_class()
-        self.Log = get_message_class("rosserial_msgs/Log")
-        self.Time = get_message_class("std_msgs/Time")
-        self.RequestParam = get_service_class("rosserial_msgs/RequestParam")
+        self.TopicInfo: Any = _topic_info_class()
+        self.Log: Any = get_message_class("rosserial_msgs/Log")
+        self.Time: Any = get_message_class("std_msgs/Time")
+        self.RequestParam: Any = get_service_class("rosserial_msgs/RequestParam")
         self.publishers: dict[int, Any] = {}  # topic id -> Publisher
         self.subscribers: dict[int, Any] = {}  # topic id -> Subscriber
         self._pub_by_name: dict[str, tuple[str, Any]] = {}
@@ -254,7 +254,7 @@ class RosserialHost:
 
     def _service_class(self, kind: str, info: Any) -> Any:
         try:
-            cls = get_service_class(info.message_type)
+            cls: Any = get_service_class(info.message_type)
         except NinjemysError as exc:
             raise RosserialError(f"Creation of {kind} failed: {exc}") from None
         if cls._md5sum != info.md5sum:
@@ -355,7 +355,7 @@ class RosserialHost:
 
     def _handle_log(self, payload: bytes) -> None:
         msg = self.Log().deserialize(payload)
-        emit = {
+        emit: Any = {
             0: self.log.debug,
             1: self.log.info,
             2: self.log.warn,

@@ -58,7 +58,7 @@ class SocketLink:
 
 def open_serial(port: str, baud: int) -> Any:
     """pyserial's port in raw mode, reads timing out after 0.1 s so shutdown is seen promptly."""
-    import serial  # pyserial: imported here so that `import ninjemys.drivers` costs nothing
+    import serial  # type: ignore[import-untyped]  # pyserial: imported here so that `import ninjemys.drivers` costs nothing
 
     return serial.Serial(port, baud, timeout=0.1, write_timeout=5.0)
 

@@ -159,7 +159,7 @@ class RplidarNode:
         self.log = node.log
         self.port = port
         self.dev = dev
-        self.LaserScan = get_message_class("sensor_msgs/LaserScan")
+        self.LaserScan: Any = get_message_class("sensor_msgs/LaserScan")
         self.frame_id = str(node.get_param("~frame_id", "laser_frame"))
         self.inverted = bool(node.get_param("~inverted", False))
         self.angle_compensate = bool(node.get_param("~angle_compensate", False))
@@ -172,7 +172,7 @@ class RplidarNode:
         self.published = 0
 
     def _service(self, action: str) -> Any:
-        Empty = get_service_class("std_srvs/Empty")
+        Empty: Any = get_service_class("std_srvs/Empty")
 
         def handle(_req: Any) -> Any:
             done = threading.Event()
@@ -324,7 +324,7 @@ class RplidarNode:
 
 
 def open_port(path: str, baud: int) -> Any:
-    import serial  # pyserial, imported when a node starts (no work at import)
+    import serial  # type: ignore[import-untyped]  # pyserial, imported when a node starts (no work at import)
 
     return serial.Serial(path, baud, timeout=READ_TIMEOUT, write_timeout=2.0)
 
