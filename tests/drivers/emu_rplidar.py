@@ -66,6 +66,7 @@ class EmulatedA1:
         self.pwm: list[int] = []
         self.mode: int | None = None  # CMD_SCAN or CMD_EXPRESS_SCAN while streaming
         self.sent_samples = 0
+        self.rev_marks: list[float] = []  # wall time of writing each revolution-closing capsule (express)
         self._stop = threading.Event()
         self._rx = bytearray()
         self.std_angles = [(k + 0.3) for k in range(360)]  # one revolution of standard samples, degrees
@@ -185,13 +186,16 @@ class EmulatedA1:
         tick = 0.01
         due = 0.0
         last_mode = None
+        last = time.monotonic()
         while not self._stop.wait(tick):
+            now = time.monotonic()
+            elapsed, last = min(now - last, 0.2), now  # the rate holds even when the wait oversleeps
             mode = self.mode
             if mode != last_mode:
                 k, first, due, last_mode = 0, True, 0.0, mode
             if mode is None:
                 continue
-            due += self.samples_per_s * tick
+            due += self.samples_per_s * elapsed
             if mode == rp.CMD_SCAN:
                 rev = self.standard_samples()
                 out = bytearray()
@@ -206,6 +210,8 @@ class EmulatedA1:
                 rev = self.express_samples()
                 out = bytearray()
                 while due >= 32:
+                    if k == 0 and not first:
+                        self.rev_marks.append(time.time())  # it gives the last capsule its end angle
                     start_deg = k * 360.0 / self.express_per_rev
                     dists = [rev[(k + i) % len(rev)][1] for i in range(32)]
                     out += rp.pack_capsule(start_deg, dists, [self.express_offset_q3] * 32, start=first)

@@ -29,6 +29,9 @@ SDK_VERSION = "1.12.0"
 LEGACY_MAX_DISTANCE = 16.0
 READ_TIMEOUT = 0.05
 ANSWER_TIMEOUT = 1.0
+#: reads of a scan stream wait until this much is there, or BATCH_WAIT has passed (CPU per sample)
+BATCH_BYTES = 4 * rp.CAPSULE_SIZE
+BATCH_WAIT = 0.01
 
 
 class ScanMode:
@@ -298,6 +301,10 @@ class RplidarNode:
                 assembler.reset()
                 rev_start, rev_stamp = time.monotonic(), self.node.now()
             waiting = self.port.in_waiting
+            if 0 < waiting < BATCH_BYTES:
+                # let a few measurements gather: one wake-up per 10 ms, not one per capsule
+                self.node.wait_for_shutdown(BATCH_WAIT)
+                waiting = self.port.in_waiting
             data = self.port.read(waiting if waiting else 1)  # blocks up to READ_TIMEOUT when idle
             if not data:
                 continue

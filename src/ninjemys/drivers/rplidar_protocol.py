@@ -196,7 +196,8 @@ class NodeDecoder:
         self._buf = bytearray()
         self.discarded = 0
 
-    def feed(self, data: bytes) -> list[tuple[float, float, int, bool]]:
+    def feed(self, data: bytes) -> np.ndarray:
+        """Rows of (angle deg, distance mm, quality, start flag)."""
         buf = self._buf
         buf += data
         out: list[tuple[float, float, int, bool]] = []
@@ -214,7 +215,7 @@ class NodeDecoder:
             out.append((angle_q6 / 64.0, dist_q2 / 4.0, b0 >> 2, bool(b0 & 1)))
             pos += NODE_SIZE
         del buf[:pos]
-        return out
+        return np.array(out, dtype=np.float64).reshape(-1, 4)
 
 
 def pack_capsule(start_angle_deg: float, dists_mm: list[float], offsets_q3: list[int], start: bool) -> bytes:
@@ -239,6 +240,7 @@ class CapsuleDecoder:
     Angles follow Slamtec's SDK: the 32 samples of a capsule are spread evenly from its start angle to
     the next capsule's, minus each sample's compensation (6 bits, 1/8 degree). A capsule whose sync
     nibbles or checksum are wrong is dropped (and the one before it, whose end angle it would give).
+    The capsules of one read are decoded together, in one pass of array arithmetic.
     """
 
     def __init__(self) -> None:
@@ -246,10 +248,12 @@ class CapsuleDecoder:
         self._prev: bytes | None = None
         self.bad = 0
 
-    def feed(self, data: bytes) -> list[tuple[float, float, int, bool]]:
+    def feed(self, data: bytes) -> np.ndarray:
+        """Rows of (angle deg, distance mm, quality, start flag)."""
         buf = self._buf
         buf += data
-        out: list[tuple[float, float, int, bool]] = []
+        prevs: list[bytes] = []
+        curs: list[bytes] = []
         pos = 0
         while len(buf) - pos >= CAPSULE_SIZE:
             if (buf[pos] >> 4) != 0xA or (buf[pos + 1] >> 4) != 0x5:
@@ -258,43 +262,55 @@ class CapsuleDecoder:
                 self._prev = None
                 continue
             cap = bytes(buf[pos : pos + CAPSULE_SIZE])
-            cs = 0
-            for b in cap[2:]:
-                cs ^= b
+            cs = int(np.bitwise_xor.reduce(np.frombuffer(cap, dtype=np.uint8, offset=2)))
             if cs != ((cap[0] & 0xF) | (cap[1] & 0xF) << 4):
                 pos += 1
                 self.bad += 1
                 self._prev = None
                 continue
             pos += CAPSULE_SIZE
-            start_word = cap[2] | cap[3] << 8
-            if start_word & 0x8000:  # a new scan starts: nothing before it pairs with it
+            if cap[3] & 0x80:  # a new scan starts: nothing before it pairs with it
                 self._prev = cap
                 continue
             if self._prev is not None:
-                out += _capsule_samples(self._prev, cap)
+                prevs.append(self._prev)
+                curs.append(cap)
             self._prev = cap
         del buf[:pos]
-        return out
+        if not prevs:
+            return np.empty((0, 4))
+        return _capsule_samples(prevs, curs)
 
 
-def _capsule_samples(prev: bytes, cur: bytes) -> list[tuple[float, float, int, bool]]:
-    prev_q8 = ((prev[2] | prev[3] << 8) & 0x7FFF) << 2
-    cur_q8 = ((cur[2] | cur[3] << 8) & 0x7FFF) << 2
-    diff_q8 = cur_q8 - prev_q8
-    if prev_q8 > cur_q8:
-        diff_q8 += 360 << 8
-    inc_q16 = diff_q8 << 3
-    angle_q16 = prev_q8 << 8
-    full = 360 << 16
-    out: list[tuple[float, float, int, bool]] = []
-    for i in range(CABINS):
-        d1, d2, offs = struct.unpack_from("<HHB", prev, 4 + 5 * i)
-        for dist_word, off_q3 in ((d1, (offs & 0xF) | (d1 & 0x3) << 4), (d2, (offs >> 4) | (d2 & 0x3) << 4)):
-            angle_q6 = (angle_q16 - (off_q3 << 13)) >> 10
-            start = ((angle_q16 + inc_q16) % full) < inc_q16
-            angle_q16 += inc_q16
-            angle_q6 %= 360 << 6
-            dist_q2 = dist_word & 0xFFFC
-            out.append((angle_q6 / 64.0, dist_q2 / 4.0, 0x2F if dist_q2 else 0, start))
+_SAMPLE_INDEX = np.arange(2 * CABINS, dtype=np.int64)
+
+
+def _capsule_samples(prevs: list[bytes], curs: list[bytes]) -> np.ndarray:
+    """The 32 samples of each of ``prevs``, spread up to the start angle of the matching ``curs``
+    (the SDK's integer arithmetic, on arrays: one row per capsule)."""
+    n = len(prevs)
+    p = np.frombuffer(b"".join(prevs), dtype=np.uint8).reshape(n, CAPSULE_SIZE).astype(np.int64)
+    c = np.frombuffer(b"".join(curs), dtype=np.uint8).reshape(n, CAPSULE_SIZE).astype(np.int64)
+    prev_q8 = ((p[:, 2] | p[:, 3] << 8) & 0x7FFF) << 2
+    cur_q8 = ((c[:, 2] | c[:, 3] << 8) & 0x7FFF) << 2
+    diff_q8 = cur_q8 - prev_q8 + np.where(prev_q8 > cur_q8, 360 << 8, 0)
+    inc_q16 = (diff_q8 << 3)[:, None]
+    cab = p[:, 4:].reshape(n, CABINS, 5)
+    d1 = cab[:, :, 0] | cab[:, :, 1] << 8
+    d2 = cab[:, :, 2] | cab[:, :, 3] << 8
+    offs = cab[:, :, 4]
+    dist = np.empty((n, 2 * CABINS), dtype=np.int64)
+    off_q3 = np.empty((n, 2 * CABINS), dtype=np.int64)
+    dist[:, 0::2], dist[:, 1::2] = d1, d2
+    off_q3[:, 0::2] = (offs & 0xF) | (d1 & 0x3) << 4
+    off_q3[:, 1::2] = (offs >> 4) | (d2 & 0x3) << 4
+    angle_q16 = (prev_q8 << 8)[:, None] + _SAMPLE_INDEX[None, :] * inc_q16
+    angle_q6 = ((angle_q16 - (off_q3 << 13)) >> 10) % (360 << 6)
+    start = ((angle_q16 + inc_q16) % (360 << 16)) < inc_q16
+    dist_q2 = dist & 0xFFFC
+    out = np.empty((n * 2 * CABINS, 4), dtype=np.float64)
+    out[:, 0] = (angle_q6 / 64.0).ravel()
+    out[:, 1] = (dist_q2 / 4.0).ravel()
+    out[:, 2] = np.where(dist_q2 != 0, 0x2F, 0).ravel()
+    out[:, 3] = start.ravel()
     return out

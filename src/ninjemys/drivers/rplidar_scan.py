@@ -39,27 +39,35 @@ class RevolutionAssembler:
     """Samples in, whole revolutions out: a sample with the start flag closes the one before it.
 
     Samples before the first start flag belong to a revolution seen in part and are dropped, as the
-    SDK's grabScanData drops them.
+    SDK's grabScanData drops them. Rows are (angle deg, distance mm, quality, start flag); revolutions
+    come out as rows of the first three.
     """
 
     def __init__(self) -> None:
-        self._rows: list[tuple[float, float, int, bool]] = []
+        self._parts: list[np.ndarray] = []
         self._started = False
 
     def reset(self) -> None:
-        self._rows = []
+        self._parts = []
         self._started = False
 
-    def feed(self, rows: list[tuple[float, float, int, bool]]) -> list[np.ndarray]:
+    def feed(self, rows: np.ndarray) -> list[np.ndarray]:
         out: list[np.ndarray] = []
-        for row in rows:
-            if row[3]:
-                if self._started and self._rows:
-                    out.append(np.array([r[:3] for r in self._rows], dtype=np.float64))
-                self._rows = []
-                self._started = True
+        if not len(rows):
+            return out
+        starts = np.nonzero(rows[:, 3] != 0)[0]
+        prev = 0
+        for s in starts:
             if self._started:
-                self._rows.append(row)
+                self._parts.append(rows[prev:s])
+                rev = np.concatenate(self._parts)
+                if len(rev):
+                    out.append(rev[:, :3])
+            self._parts = []
+            self._started = True
+            prev = s
+        if self._started:
+            self._parts.append(rows[prev:])
         return out
 
 
@@ -94,16 +102,18 @@ def compensated(rev: np.ndarray, multiple: int) -> np.ndarray:
     count = 360 * multiple
     out = np.zeros((count, 3), dtype=np.float64)
     out[:, 0] = np.arange(count) / multiple
-    offset = 0
-    for angle, dist, quality in rev:
-        if dist == 0:
-            continue
-        value = int(angle * multiple)
-        if value - offset < 0:
-            offset = value
-        for j in range(multiple):
-            idx = min(value - offset + j, count - 1)
-            out[idx] = (angle, dist, quality)
+    valid = rev[rev[:, 1] != 0]
+    if not len(valid):
+        return out
+    # angles are >= 0, so rplidar_ros' running offset stays 0; each sample fills `multiple` bins from
+    # int(angle * multiple) and, where samples share a bin, the later one (in angle order) wins
+    values = (valid[:, 0] * multiple).astype(np.int64)
+    winner = np.full(count, -1, dtype=np.int64)
+    order = np.arange(len(valid), dtype=np.int64)
+    for j in range(multiple):
+        np.maximum.at(winner, np.minimum(values + j, count - 1), order)
+    filled = winner >= 0
+    out[filled] = valid[winner[filled]]
     return out
 
 
