@@ -114,7 +114,10 @@ class RosserialHost:
         self.last_sync = time.monotonic()
         try:
             while not self.node.is_shutdown:
-                data = self.link.read(4096)
+                # what is there, or wait (up to the link's timeout) for one byte: a read of a fixed size
+                # would hold a short packet back until the timeout
+                waiting = getattr(self.link, "in_waiting", 0)
+                data = self.link.read(waiting if waiting else 1)
                 if data:
                     for item in self.reader.feed(data):
                         if isinstance(item, proto.Drop):

@@ -42,7 +42,7 @@ class SocketLink:
 
     def read(self, size: int) -> bytes:
         try:
-            data = self.sock.recv(size)
+            data = self.sock.recv(max(size, 4096))
         except TimeoutError:
             return b""
         if not data:

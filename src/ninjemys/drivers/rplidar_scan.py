@@ -57,7 +57,7 @@ class RevolutionAssembler:
             return out
         starts = np.nonzero(rows[:, 3] != 0)[0]
         prev = 0
-        for s in starts:
+        for s in starts.tolist():
             if self._started:
                 self._parts.append(rows[prev:s])
                 rev = np.concatenate(self._parts)
