@@ -5,7 +5,8 @@ request, answers with one ``rosserial_msgs/TopicInfo`` per endpoint, asks for th
 ``sync_period`` seconds), requests the ``wheel_radius`` parameter and logs a line once configured. It
 publishes the wheel speeds ``wl`` and ``wr`` (std_msgs/Float32, rad/s) computed from the last
 ``cmd_vel`` (geometry_msgs/Twist) by differential-drive kinematics, subscribes the LED ring topic
-``led`` (std_msgs/ColorRGBA) and provides the service ``reset_encoders`` (std_srvs/Trigger).
+``led`` (std_msgs/ColorRGBA), provides the service ``reset_encoders`` (std_srvs/Trigger) and calls the
+ROS service ``board_config`` (std_srvs/Trigger) when ``call_config()`` is used.
 
 The board sits on the master side of a pseudo-terminal (``os.openpty``): the host opens ``path`` as it
 would open /dev/ttyACM0. ``connect_tcp(port)`` puts it on a TCP connection instead (rosserial over
@@ -35,8 +36,8 @@ RequestParam = get_service_class("rosserial_msgs/RequestParam")
 Trigger = get_service_class("std_srvs/Trigger")
 
 # ros_lib numbers subscribers from 100 and publishers from 100 + MAX_SUBSCRIBERS (25 on an Uno)
-SUB_CMD_VEL, SUB_LED, SUB_RESET = 100, 101, 102
-PUB_WL, PUB_WR, PUB_RESET = 125, 126, 127
+SUB_CMD_VEL, SUB_LED, SUB_RESET, SUB_CONFIG = 100, 101, 102, 103
+PUB_WL, PUB_WR, PUB_RESET, PUB_CONFIG = 125, 126, 127, 128
 WHEEL_BASE = 0.19  # m, the PuzzleBot's track
 BUFFER = 280  # bytes, an Uno's default buffers
 
@@ -72,6 +73,7 @@ class EmulatedArduino:
         self.cmd_vels: list[Any] = []
         self.leds: list[Any] = []
         self.resets = 0
+        self.config_answers: list[Any] = []
         self.stopped_by_host = False
         self.drops = 0
         self.sync_enabled = True  # False: stop asking for the time (a hung sketch), the host must notice
@@ -152,6 +154,14 @@ class EmulatedArduino:
             proto.ID_SERVICE_SERVER + proto.ID_SUBSCRIBER,
             _info(SUB_RESET, "reset_encoders", "std_srvs/Trigger", trig),
         )
+        self.send(
+            proto.ID_SERVICE_CLIENT + proto.ID_PUBLISHER,
+            _info(PUB_CONFIG, "board_config", "std_srvs/Trigger", trig),
+        )
+        self.send(
+            proto.ID_SERVICE_CLIENT + proto.ID_SUBSCRIBER,
+            _info(SUB_CONFIG, "board_config", "std_srvs/Trigger", trig),
+        )
         req = RequestParam._request_class()
         req.name = "wheel_radius"
         self.send(proto.ID_PARAMETER_REQUEST, req.serialize_to_bytes())
@@ -188,6 +198,8 @@ class EmulatedArduino:
                 self.leds.append(ColorRGBA().deserialize(f.payload))
             elif tid == SUB_RESET:
                 self.resets += 1
+            elif tid == SUB_CONFIG:
+                self.config_answers.append(Trigger._response_class().deserialize(f.payload))
             self.cond.notify_all()
         if tid == proto.ID_PUBLISHER:
             self._negotiate()
@@ -224,6 +236,10 @@ class EmulatedArduino:
                     self.send(proto.ID_TIME, Time().serialize_to_bytes())
             except OSError:
                 continue
+
+    def call_config(self) -> None:
+        """The sketch calls the ROS service ``board_config``; the answer lands in ``config_answers``."""
+        self.send(PUB_CONFIG, Trigger._request_class().serialize_to_bytes())
 
     def wait(self, pred: Any, timeout: float = 20.0) -> None:
         with self.cond:

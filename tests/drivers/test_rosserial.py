@@ -20,7 +20,7 @@ import pytest
 from ninjemys import testing
 from ninjemys.drivers import rosserial_protocol as proto
 from ninjemys.drivers.rosserial_host import RosserialError, param_response_lists
-from ninjemys.idl.loader import get_message_class
+from ninjemys.idl.loader import get_message_class, get_service_class
 from ninjemys.node import Node
 
 from .emu_arduino import WHEEL_BASE, EmulatedArduino
@@ -280,7 +280,9 @@ def test_a_device_with_an_unknown_md5_gets_one_clear_error_and_the_rest_works(tm
         assert "Traceback" not in out, out
 
 
-def test_tcp_mode_serves_a_wifi_board(board: EmulatedArduino, tmp_path: Path) -> None:
+def test_tcp_mode_serves_a_wifi_board_whose_sketch_calls_a_ros_service(
+    board: EmulatedArduino, tmp_path: Path
+) -> None:
     env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_LOG_DIR=str(tmp_path))
     port = testing.free_port()
     with testing.run_master(env=env) as uri:
@@ -289,12 +291,21 @@ def test_tcp_mode_serves_a_wifi_board(board: EmulatedArduino, tmp_path: Path) ->
         node.set_param("/wheel_radius", 0.1)
         wr = Collect()
         node.subscriber("/wr", Float32, wr)
+        Trigger = get_service_class("std_srvs/Trigger")
+        node.service(
+            "/board_config",
+            Trigger,
+            lambda _req: Trigger._response_class(success=True, message="gains 1.5 0.2"),
+        )
         proc = serial_node(env, "tcp", str(port))
         try:
             board.connect_tcp(port)
             board.wait(lambda: board.configured and board.wheel_radius is not None)
             assert board.wheel_radius == pytest.approx(0.1)
             wr.wait_for(lambda m: m.data == 0.0)
+            board.call_config()
+            board.wait(lambda: bool(board.config_answers))
+            assert board.config_answers[0].success and board.config_answers[0].message == "gains 1.5 0.2"
         finally:
             out = stop(proc)
             node.shutdown()
