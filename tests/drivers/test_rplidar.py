@@ -252,6 +252,44 @@ def stop_after_exit(proc: subprocess.Popen) -> str:
     return out
 
 
+def test_rplidar_a1_launch_brings_up_the_node_on_the_emulated_device(tmp_path: Path) -> None:
+    a1 = EmulatedA1()
+    env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_LOG_DIR=str(tmp_path))
+    with testing.run_master(env=env) as uri:
+        env["ROS_MASTER_URI"] = uri
+        node = Node("rplidar_launch_test", master_uri=uri)
+        scans = Collect()
+        node.subscriber("/scan", LaserScan, scans)
+        launch = subprocess.Popen(
+            [
+                testing.ninjemys_bin("roslaunch"),
+                "rplidar_ros",
+                "rplidar_a1.launch",
+                f"serial_port:={a1.path}",
+            ],
+            env=env,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+            start_new_session=True,
+        )
+        try:
+            scans.wait_count(2, timeout=40)
+            scan = scans.items[-1]
+            assert (
+                scan.header.frame_id == "laser" and len(scan.ranges) == 360
+            )  # angle_compensate from the file
+            assert node.get_param("/rplidarNode/serial_baudrate") == 115200
+        finally:
+            os.killpg(launch.pid, signal.SIGINT)
+            try:
+                launch.communicate(timeout=20)
+            except subprocess.TimeoutExpired:
+                testing.kill_tree(launch)
+            node.shutdown()
+            a1.close()
+
+
 def test_launch_files_name_the_node_and_its_parameters() -> None:
     from ninjemys.packages.shipped import shipped_executable
 
