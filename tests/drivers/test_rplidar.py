@@ -227,6 +227,8 @@ def test_health_error_and_unknown_scan_mode_stop_the_node_as_rplidar_ros_does(tm
         sick = EmulatedA1(health=(2, 0x8001))
         try:
             out = stop_after_exit(rplidar(env, f"_serial_port:={sick.path}"))
+            sick.wait(lambda: rp.CMD_RESET in sick.commands, timeout=5)  # the protection stop is reset
+            assert rp.CMD_SCAN not in sick.commands and rp.CMD_EXPRESS_SCAN not in sick.commands
         finally:
             sick.close()
         assert "RPLidar health status : 2" in out, out

@@ -129,6 +129,10 @@ class RplidarDevice:
         else:
             self._set_dtr(True)
 
+    def reset(self) -> None:
+        self.port.write(rp.request(rp.CMD_RESET))
+        time.sleep(0.002)
+
     def stop(self) -> None:
         self.port.write(rp.request(rp.CMD_STOP))
         time.sleep(0.002)  # the protocol asks for 1 ms before the next request
@@ -206,6 +210,8 @@ class RplidarNode:
         self.log.info("RPLidar health status : %d", health.status)
         if health.status == rp.STATUS_ERROR:
             self.log.error("Error, rplidar internal error detected. Please reboot the device to retry.")
+            # the protocol's way out of the protection stop: a core reset, so the next start may work
+            self.dev.reset()
             return 1
         if health.status == rp.STATUS_WARNING:
             self.log.warn("RPLidar health warning, error code: %d", health.error_code)
