@@ -45,6 +45,8 @@ SHIPPED_PACKAGES = (
     "tf2_web_republisher",
     # wave 3: device drivers (issue 24)
     "realsense2_camera",
+    # wave 3: ros_control's controller_manager (issue 23)
+    "controller_manager_msgs",
 )
 
 #: packages Debian's ROS 1 lacks; their facts are checked against published md5sums instead
@@ -58,6 +60,7 @@ NOT_IN_DEBIAN = frozenset(
         "rosapi",
         "tf2_web_republisher",
         "realsense2_camera",
+        "controller_manager_msgs",
     }
 )
 
