@@ -123,6 +123,12 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
         "joy": {"joy_node": ("ninjemys.drivers.joy_node:main", ())},
         "teleop_twist_joy": {"teleop_node": ("ninjemys.drivers.teleop_twist_joy:main", ())},
         "realsense2_camera": {"realsense2_camera_node": ("ninjemys.drivers.realsense_node:main", ())},
+        # -- ros_control (docs/sim.md): the manager runs inside the simulator --
+        "controller_manager": {
+            "spawner": ("ninjemys.sim.ros_control.spawner:main", ()),
+            "unspawner": ("ninjemys.sim.ros_control.spawner:unspawner_main", ()),
+            "controller_manager": ("ninjemys.sim.ros_control.cm_command:main", ()),
+        },
         "xacro": {
             "xacro": ("ninjemys.tools.xacro:main", ()),
             "xacro.py": ("ninjemys.tools.xacro:main", ()),

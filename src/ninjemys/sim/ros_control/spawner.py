@@ -81,7 +81,7 @@ def _spawn(node: Any, args: argparse.Namespace) -> int:
                 node.wait_for_service(service, timeout)
             break
         except NinjemysError:
-            if node.is_shutdown():
+            if node.is_shutdown:
                 return 0
             use_sim = node.has_param("/use_sim_time") and node.get_param("/use_sim_time")
             if use_sim and node.get_time() == 0.0:
@@ -129,7 +129,7 @@ def _spawn(node: Any, args: argparse.Namespace) -> int:
             time.sleep(1)  # spawner gives the manager's error line a chance to get out first
             log.error(f"Failed to load {name}")
     log.info(f"Controller Spawner: Loaded controllers: {', '.join(loaded)}")
-    if node.is_shutdown():
+    if node.is_shutdown:
         return 0
     if not args.stopped:
         resp = switch(
@@ -154,10 +154,10 @@ def _wait_for_true(node: Any, topic: str, timeout: float | None) -> bool:
 
     sub = node.subscriber(topic, bool_cls, on_msg)
     try:
-        if not heard.wait(timeout) and not node.is_shutdown():
+        if not heard.wait(timeout) and not node.is_shutdown:
             node.log.warn(f'Controller Spawner hasn\'t heard anything from its "wait for" topic ({topic})')
         while not true.wait(0.1):
-            if node.is_shutdown():
+            if node.is_shutdown:
                 return False
         return True
     finally:
@@ -175,3 +175,48 @@ def _load_yaml(node: Any, path: str) -> list[str]:
     for key, value in doc.items():
         node.set_param(key, value)
     return list(doc)
+
+
+def unspawner_main(argv: list[str] | None = None) -> int:
+    """``unspawner name ...``: stop the named controllers (again every 3 s) until killed, then restart them."""
+    import sys
+
+    raw = sys.argv[1:] if argv is None else argv
+    names = [a for a in raw if ":=" not in a]
+    if not names or names[0] in ("-h", "--help"):
+        print("./unspawner name1 name2 name3\n\n\tStops a set of controllers until killed.")
+        print("\tUseful in roslaunch files to temporarily stop controllers")
+        return 1
+    name = f"unspawner_{os.getpid()}_{int(time.time() * 1000) % 10**9}"
+    return run_node(name, [a for a in raw if ":=" in a], lambda node: _unspawn(node, set(names)))
+
+
+def _unspawn(node: Any, to_inhibit: set[str]) -> int:
+    switch_cls = get_service_class("controller_manager_msgs/SwitchController")
+    list_cls = get_service_class("controller_manager_msgs/ListControllers")
+    node.wait_for_service("controller_manager/switch_controller")
+    node.wait_for_service("controller_manager/list_controllers")
+    switch = node.service_proxy("controller_manager/switch_controller", switch_cls)
+    listing = node.service_proxy("controller_manager/list_controllers", list_cls)
+    inhibited: set[str] = set()
+
+    def stop(*_: Any) -> None:
+        running = {c.name for c in listing(list_cls._request_class()).controller if c.state == "running"}
+        to_stop = to_inhibit & running
+        if to_stop:
+            node.log.info(f"Inhibiting controllers: {', '.join(sorted(to_stop))}")
+            switch(switch_cls._request_class(stop_controllers=sorted(to_stop), strictness=1))
+            inhibited.update(to_stop)
+
+    stop()
+    timer = node.timer(3.0, stop)
+
+    def restart() -> None:
+        timer.shutdown()
+        try:
+            switch(switch_cls._request_class(start_controllers=sorted(inhibited), strictness=1))
+        except NinjemysError as exc:
+            node.log.warn(f"unspawner could not restart {sorted(inhibited)}: {exc}")
+
+    node.on_shutdown(restart)
+    return 0
