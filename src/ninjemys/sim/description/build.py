@@ -164,7 +164,7 @@ def _colour(doc: Document, geo: Geometry, cfg: GazeboConfig) -> tuple[int, int, 
 
 def expand_xacro(path: str, mappings: dict[str, str] | None = None) -> str:
     """A xacro file expanded as ``xacro path key:=value ...`` would print it."""
-    import xacro
+    import xacro  # type: ignore[import-untyped]
 
     try:
         return str(xacro.process_file(path, mappings=dict(mappings or {})).toprettyxml(indent="  "))

@@ -102,7 +102,8 @@ class Geometry:
         children: dict[str, list[Joint]] = {}
         for j in self.joints.values():
             children.setdefault(j.parent, []).append(j)
-        out, todo = [], [self.root]
+        out: list[str] = []
+        todo = [self.root]
         while todo:
             link = todo.pop()
             out.append(link)
@@ -118,7 +119,7 @@ class Geometry:
         return min(pts) if pts else 0.0
 
     def _body_points(self) -> list[tuple[str, Vector]]:
-        out = []
+        out: list[tuple[str, Vector]] = []
         for link in self.body_links():
             pose = self.pose_of(link)
             for shape in self.shapes.get(link, []):

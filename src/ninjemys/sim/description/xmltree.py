@@ -25,16 +25,17 @@ class Document:
     source: str
     lines: dict[int, int] = field(default_factory=dict)
 
-    def line(self, el: ET.Element) -> int:
-        return self.lines.get(id(el), 0)
+    def line(self, el: ET.Element | None) -> int:
+        return self.lines.get(id(el if el is not None else self.root), 0)
 
-    def where(self, el: ET.Element, path: str = "") -> str:
+    def where(self, el: ET.Element | None, path: str = "") -> str:
         """``file:line: <path>`` for an error message."""
         line = self.line(el)
         loc = f"{self.source}:{line}" if line else self.source
-        return f"{loc}: <{path or el.tag}>"
+        return f"{loc}: <{path or (el if el is not None else self.root).tag}>"
 
-    def error(self, el: ET.Element, reason: str, path: str = "") -> DescriptionError:
+    def error(self, el: ET.Element | None, reason: str, path: str = "") -> DescriptionError:
+        """The error for ``el`` (the root when the element is absent)."""
         return DescriptionError(f"{self.where(el, path)}: {reason}")
 
 

@@ -37,7 +37,7 @@ class _Client:
     def call(self, service: str, kind: str, **fields: Any) -> Any:
         name = f"controller_manager/{service}"
         self.node.wait_for_service(name)
-        cls = get_service_class(f"controller_manager_msgs/{kind}")
+        cls: Any = get_service_class(f"controller_manager_msgs/{kind}")
         return self.node.service_proxy(name, cls)(cls._request_class(**fields))
 
     def load(self, name: str) -> bool:

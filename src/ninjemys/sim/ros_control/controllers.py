@@ -90,7 +90,7 @@ class JointStateController(Controller):
                         float(item.get("effort", 0.0)),
                     )
                 )
-        self._msg = get_message_class("sensor_msgs/JointState")
+        self._msg: Any = get_message_class("sensor_msgs/JointState")
         self.pub = node.publisher(_join(root_ns, "joint_states"), self._msg, queue_size=4)
         self.last: float | None = None
 
@@ -201,10 +201,10 @@ class DiffDriveController(Controller):
         self.twist_cov = _covariance(params, "twist_covariance_diagonal", w) or [0.0] * 6
         self.linear_limiter = _limiter(params, "linear/x", w)
         self.angular_limiter = _limiter(params, "angular/z", w)
-        self._twist = get_message_class("geometry_msgs/Twist")
-        self._odom_msg = get_message_class("nav_msgs/Odometry")
-        self._tf_msg = get_message_class("tf2_msgs/TFMessage")
-        self._tf_stamped = get_message_class("geometry_msgs/TransformStamped")
+        self._twist: Any = get_message_class("geometry_msgs/Twist")
+        self._odom_msg: Any = get_message_class("nav_msgs/Odometry")
+        self._tf_msg: Any = get_message_class("tf2_msgs/TFMessage")
+        self._tf_stamped: Any = get_message_class("geometry_msgs/TransformStamped")
         self._lock = threading.Lock()
         self._cmd: tuple[float, float, float | None] = (0.0, 0.0, None)  # linear, angular, stamp
         self._last = [(0.0, 0.0), (0.0, 0.0)]  # the last two limited commands (linear, angular)

@@ -41,7 +41,7 @@ class ControllerManager:
         self._lock = threading.RLock()
         self.now = 0.0
         base = _join(self.ns, "controller_manager")
-        srv = {
+        srv: dict[str, Any] = {
             n: get_service_class(f"controller_manager_msgs/{n}")
             for n in (
                 "LoadController",
@@ -52,9 +52,9 @@ class ControllerManager:
                 "ReloadControllerLibraries",
             )
         }
-        self._state_msg = get_message_class("controller_manager_msgs/ControllerState")
-        self._res_msg = get_message_class("controller_manager_msgs/HardwareInterfaceResources")
-        self._srv_classes = srv
+        self._state_msg: Any = get_message_class("controller_manager_msgs/ControllerState")
+        self._res_msg: Any = get_message_class("controller_manager_msgs/HardwareInterfaceResources")
+        self._srv_classes: dict[str, Any] = srv
         self.services = [
             node.service(_join(base, "load_controller"), srv["LoadController"], self._on_load),
             node.service(_join(base, "unload_controller"), srv["UnloadController"], self._on_unload),

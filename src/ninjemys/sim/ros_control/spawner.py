@@ -71,9 +71,9 @@ def _spawn(node: Any, args: argparse.Namespace) -> int:
     load_name = ns + "controller_manager/load_controller"
     switch_name = ns + "controller_manager/switch_controller"
     unload_name = ns + "controller_manager/unload_controller"
-    load_cls = get_service_class("controller_manager_msgs/LoadController")
-    switch_cls = get_service_class("controller_manager_msgs/SwitchController")
-    unload_cls = get_service_class("controller_manager_msgs/UnloadController")
+    load_cls: Any = get_service_class("controller_manager_msgs/LoadController")
+    switch_cls: Any = get_service_class("controller_manager_msgs/SwitchController")
+    unload_cls: Any = get_service_class("controller_manager_msgs/UnloadController")
     while True:
         try:
             for service in (load_name, switch_name, unload_name):
@@ -143,7 +143,7 @@ def _spawn(node: Any, args: argparse.Namespace) -> int:
 
 
 def _wait_for_true(node: Any, topic: str, timeout: float | None) -> bool:
-    bool_cls = get_message_class("std_msgs/Bool")
+    bool_cls: Any = get_message_class("std_msgs/Bool")
     heard = threading.Event()
     true = threading.Event()
 
@@ -192,8 +192,8 @@ def unspawner_main(argv: list[str] | None = None) -> int:
 
 
 def _unspawn(node: Any, to_inhibit: set[str]) -> int:
-    switch_cls = get_service_class("controller_manager_msgs/SwitchController")
-    list_cls = get_service_class("controller_manager_msgs/ListControllers")
+    switch_cls: Any = get_service_class("controller_manager_msgs/SwitchController")
+    list_cls: Any = get_service_class("controller_manager_msgs/ListControllers")
     node.wait_for_service("controller_manager/switch_controller")
     node.wait_for_service("controller_manager/list_controllers")
     switch = node.service_proxy("controller_manager/switch_controller", switch_cls)
