@@ -8,6 +8,7 @@ VelocityJointInterface (a command in rad/s). :class:`SimRobotHW` is that for a w
     loop = ControlLoop(node, model)                       # advertises <ns>/controller_manager/*
     commands = loop.step(sim_time, dt, {joint: (position, velocity), ...})   # every step
     # commands: {joint: rad/s} for each joint a running controller commands
+    loop.step_robot(robot, sim_time, dt)   # the same for a simcore Robot (angles/speeds in, target out)
 """
 
 from __future__ import annotations
@@ -72,6 +73,17 @@ class ControlLoop:
         """Read the joints, update the running controllers, return the commanded joint velocities."""
         self.hw.read(joints)
         return self.manager.update(now, period)
+
+    def step_robot(self, robot: Any, now: float, period: float) -> None:
+        """:meth:`step` for a :class:`ninjemys.sim.simcore.Robot`: its wheel angles and speeds in, its
+        wheel targets out (a wheel no running controller commands is held at 0, as an idle joint)."""
+        m = robot.model
+        commands = self.step(
+            now,
+            period,
+            {m.left_joint: (robot.left_angle, robot.wl), m.right_joint: (robot.right_angle, robot.wr)},
+        )
+        robot.target = (commands.get(m.left_joint, 0.0), commands.get(m.right_joint, 0.0))
 
     def close(self) -> None:
         self.manager.close()
