@@ -267,3 +267,22 @@ def test_mutated_descriptions_give_description_errors_and_nothing_else():
             model_from_description("".join(s), "f.urdf")
         except DescriptionError:
             pass
+
+
+@pytest.mark.ros1
+@pytest.mark.parametrize("control", ["gazebo", "ros_control"])
+def test_debians_urdfdom_reads_the_expanded_test_package(tmp_path: Path, control: str):
+    """The description is a real URDF: Debian's check_urdf (liburdfdom) parses it, with the tree we read."""
+    import shutil
+    import subprocess
+
+    if shutil.which("check_urdf", path="/usr/bin") is None:
+        pytest.skip("needs Debian's liburdfdom-tools")
+    urdf = tmp_path / "puzzlebot.urdf"
+    urdf.write_text(expand_xacro(str(XACRO), {"control": control}))
+    out = subprocess.run(["/usr/bin/check_urdf", str(urdf)], capture_output=True, text=True, timeout=30)
+    assert out.returncode == 0, out.stdout + out.stderr
+    assert "robot name is: puzzlebot" in out.stdout
+    assert "root Link: base_footprint has 1 child(ren)" in out.stdout
+    for link in ("wheel_left_link", "wheel_right_link", "laser_frame", "camera_link_optical", "caster_link"):
+        assert f"child(1):  {link}" in out.stdout or f"  {link}" in out.stdout
