@@ -146,6 +146,18 @@ def test_spawner_reports_a_controller_without_configuration(graph):
     assert "Controller Spawner: Loaded controllers: joint_state_controller" in out
 
 
+def test_spawner_stopped_loads_without_starting(graph):
+    uri, node, _ = graph
+    proc = _spawner(uri, "--stopped", "puzzlebot_controller")
+    try:
+        _wait(lambda: _states(node) == {"puzzlebot_controller": "initialized"}, what="loaded, not started")
+    finally:
+        proc.send_signal(signal.SIGINT)
+        out, _ = proc.communicate(timeout=20)
+    assert "Started controllers" not in out
+    _wait(lambda: _states(node) == {}, what="controllers unloaded")
+
+
 def test_controller_manager_command(graph):
     uri, node, _ = graph
     env = dict(os.environ, ROS_MASTER_URI=uri, ROS_HOSTNAME="localhost")
