@@ -95,6 +95,10 @@ def test_load_robot_model_expands_xacro_and_takes_a_robot_namespace():
     m = load_robot_model(str(XACRO), robot_namespace="pb1")
     assert m.drive.command_topic == "/pb1/cmd_vel" and m.laser.topic == "/pb1/scan"
     assert m.camera.image_topic == "/pb1/camera/image_raw" and m.imu.topic == "/pb1/imu"
+    # the plugins resolve their frames with the namespace as tf_prefix, as Gazebo's do
+    assert (m.drive.odom_frame, m.drive.base_frame) == ("pb1/odom", "pb1/base_footprint")
+    assert m.laser.pose.frame == "pb1/laser_frame" and m.camera.frame == "pb1/camera_link_optical"
+    assert m.imu.pose.frame == "base_link"  # gazebo_ros_imu_sensor publishes frameName as given
 
 
 def _urdf(gazebo: str, extra_links: str = "") -> str:
@@ -160,7 +164,7 @@ def test_skid_steer_gpu_laser_kinect_and_imu_model_plugin():
     d = m.drive
     assert d.kind == "skid_steer" and d.command_topic == "/husky/cmd_vel" and d.odom_topic == "/husky/odom"
     assert not d.publish_odom_tf  # broadcastTF defaults to false in the skid steer plugin
-    assert d.base_frame == "base_link" and m.odom_rate == 20.0
+    assert d.base_frame == "husky/base_link" and d.odom_frame == "husky/odom" and m.odom_rate == 20.0
     laser = m.laser
     assert laser.beams == 720 and laser.topic == "/front/scan" and laser.pose.frame == "front_laser"
     assert laser.rate == 40.0 and laser.range_max == 30.0

@@ -70,9 +70,13 @@ def topic(namespace: str, name: str) -> str:
     return f"/{ns}/{name}" if ns else f"/{name}"
 
 
-def frame(name: str) -> str:
-    """A frame id as tf2 wants it (Gazebo's plugins resolve ``/name`` with an empty tf_prefix)."""
-    return name.lstrip("/")
+def frame(name: str, namespace: str = "") -> str:
+    """A frame id as the plugins publish it: tf::resolve with the robot namespace as tf_prefix
+    (``odom`` under robotNamespace ``/pb1`` is ``pb1/odom``); an absolute ``/name`` is kept, less its slash."""
+    if name.startswith("/"):
+        return name.lstrip("/")
+    prefix = namespace.strip("/")
+    return f"{prefix}/{name}" if prefix else name
 
 
 def _namespace(r: Reader, override: str | None) -> str:
@@ -117,8 +121,8 @@ def _model_plugin(
             kind="diff_drive",
             command_topic=topic(ns, r.text("commandTopic", "cmd_vel")),
             odom_topic=topic(ns, r.text("odometryTopic", "odom")),
-            odom_frame=frame(r.text("odometryFrame", "odom")),
-            base_frame=frame(r.text("robotBaseFrame", "base_footprint")),
+            odom_frame=frame(r.text("odometryFrame", "odom"), ns),
+            base_frame=frame(r.text("robotBaseFrame", "base_footprint"), ns),
             # publishTf is the plugin's switch for the odometry topic (its name is historical)
             publish_odom=r.boolean("publishTf", r.boolean("publishOdom", True)),
             publish_odom_tf=r.boolean("publishOdomTF", True),
@@ -141,8 +145,8 @@ def _model_plugin(
             kind="skid_steer",
             command_topic=topic(ns, r.text("commandTopic", "cmd_vel")),
             odom_topic=topic(ns, r.text("odometryTopic", "odom")),
-            odom_frame=frame(r.text("odometryFrame", "odom")),
-            base_frame=frame(r.text("robotBaseFrame", "base_footprint")),
+            odom_frame=frame(r.text("odometryFrame", "odom"), ns),
+            base_frame=frame(r.text("robotBaseFrame", "base_footprint"), ns),
             publish_odom=True,
             publish_odom_tf=r.boolean("broadcastTF", False),
             publish_wheel_tf=False,
@@ -266,7 +270,7 @@ def _sensor(
                 "ray/range/min",
             )
         beams = max(1, round(samples * resolution))
-        frame_id = frame(p.text("frameName", "/world"))
+        frame_id = frame(p.text("frameName", "/world"), ns)
         if not p.has("frameName"):
             cfg.warnings.append(f"{label}: missing <frameName>, defaults to /world")
         cfg.laser = LaserSpec(
@@ -304,7 +308,7 @@ def _sensor(
             )
         cam_ns = topic(ns, p.text("cameraName", "")).rstrip("/")
         plugin_rate = p.number("updateRate", 0.0, minimum=0)
-        frame_id = frame(p.text("frameName", "/camera"))
+        frame_id = frame(p.text("frameName", "/world"), ns)
         depth = filename == KINECT
         if depth:
             far = min(far, p.number("pointCloudCutoffMax", 5.0, positive=True))
