@@ -75,3 +75,55 @@ def test_ros_control_drives_the_simulated_robot_through_step_robot():
         t += sim.dt
     assert r.yaw == pytest.approx(math.pi / 2, abs=0.03)
     assert odom.heading == pytest.approx(r.yaw, abs=0.02)  # odometry reads the wheels one step behind
+
+
+FOUR_WHEELS = """<?xml version="1.0"?>
+<robot name="rover">
+  <link name="base_link"><collision><origin xyz="0 0 0.05"/><geometry><box size="0.4 0.3 0.1"/></geometry></collision></link>
+  {wheels}
+  <gazebo><plugin name="gazebo_ros_control" filename="libgazebo_ros_control.so">
+    <robotNamespace>/rover</robotNamespace></plugin></gazebo>
+</robot>"""
+WHEEL = """<link name="{n}_link"><collision><geometry><cylinder radius="0.06" length="0.03"/></geometry></collision></link>
+  <joint name="{n}" type="continuous"><parent link="base_link"/><child link="{n}_link"/>
+    <origin xyz="{x} {y} 0" rpy="-1.5708 0 0"/><axis xyz="0 0 1"/></joint>
+  <transmission name="{n}_tr"><type>transmission_interface/SimpleTransmission</type>
+    <joint name="{n}"><hardwareInterface>hardware_interface/VelocityJointInterface</hardwareInterface></joint>
+    <actuator name="{n}_motor"><mechanicalReduction>1</mechanicalReduction></actuator></transmission>"""
+
+
+def test_four_wheel_ros_control_base_with_wheel_lists():
+    from test_ros_control_core import DIFF, FakeNode, _twist
+
+    wheels = "\n  ".join(
+        WHEEL.format(n=n, x=x, y=y)
+        for n, x, y in (("fl", 0.15, 0.2), ("fr", 0.15, -0.2), ("rl", -0.15, 0.2), ("rr", -0.15, -0.2))
+    )
+    model = model_from_description(FOUR_WHEELS.format(wheels=wheels), "rover.urdf")
+    assert model.drive.kind == "ros_control" and model.drive.controller_namespace == "/rover"
+    assert model.control_joints == {
+        model.left_joint: "left",
+        model.right_joint: "right",
+        **{j: s for j, s in (("fl", "left"), ("fr", "right"), ("rl", "left"), ("rr", "right"))},
+    }
+    assert model.wheel_separation == pytest.approx(0.4) and model.wheel_radius == pytest.approx(0.06)
+    params = dict(
+        DIFF, left_wheel=["fl", "rl"], right_wheel=["fr", "rr"], wheel_separation=0.4, wheel_radius=0.06
+    )
+    params["linear"], params["angular"] = {}, {}
+    node = FakeNode({"rover": {"base": params}})
+    loop = ControlLoop(node, model)
+    assert "/rover/controller_manager/load_controller" in node.services
+    assert loop.manager.load("base") and loop.manager.switch(["base"], [], STRICT)
+    sim = Simulation(World("empty", bounds=(-5, -5, 5, 5)))
+    r = sim.add_robot("rover", model, 0.0, 0.0, 0.0)
+    cmd_vel = node.subs["/rover/base/cmd_vel"]
+    t = 0.0
+    for _ in range(round(1.0 / sim.dt)):
+        cmd_vel(_twist(0.0, 1.0))
+        loop.step_robot(r, t, sim.dt)
+        sim.step()
+        t += sim.dt
+    assert r.yaw == pytest.approx(1.0, abs=0.03)
+    odom = loop.manager.controllers["base"].controller.odometry
+    assert odom.heading == pytest.approx(r.yaw, abs=0.03)

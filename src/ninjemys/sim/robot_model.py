@@ -120,6 +120,9 @@ class RobotModel:
     warnings: list[str] = field(default_factory=list)  # what the description lacks, logged once at spawn
     # False for a Gazebo description: robot_state_publisher publishes the link frames, the simulator does not
     sensor_tf: bool = True
+    # ros_control: the joints with a <transmission> and their side ("left", "right"; "" for a joint that
+    # is not a wheel): every wheel of a side turns as that side's wheel of the simulated body
+    control_joints: dict[str, str] = field(default_factory=dict)
 
 
 def _merge(base: dict, over: dict) -> dict:

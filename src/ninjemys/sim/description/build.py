@@ -85,7 +85,29 @@ def model_from_description(text: str, source: str, *, robot_namespace: str | Non
         ignored_plugins=list(dict.fromkeys(cfg.ignored)),
         warnings=warnings,
         sensor_tf=False,
+        control_joints=_control_joints(doc, geo, left, right) if drive.kind == "ros_control" else {},
     )
+
+
+def _control_joints(doc: Document, geo: Geometry, left: Wheel, right: Wheel) -> dict[str, str]:
+    """The joints gazebo_ros_control exposes (those named by a <transmission>), each with its side."""
+    named = [j.get("name", "") for t in doc.root.findall("transmission") for j in t.findall("joint")]
+    mid = (left.pose[1][1] + right.pose[1][1]) / 2.0
+    sides: dict[str, str] = {left.joint: "left", right.joint: "right"} if left is not right else {}
+    wheel_joints = {w.joint: w for w in geo.wheels}
+    for name in named:
+        if name not in geo.joints:
+            for t in doc.root.findall("transmission"):
+                for j in t.findall("joint"):
+                    if j.get("name") == name:
+                        raise doc.error(
+                            j, f"transmission '{t.get('name', '')}' names joint '{name}', not in the robot"
+                        )
+        if name in sides:
+            continue
+        w = wheel_joints.get(name)
+        sides[name] = ("left" if w.pose[1][1] > mid else "right") if w is not None else ""
+    return sides
 
 
 def _wheels(doc: Document, geo: Geometry, cfg: GazeboConfig, drive: DriveSpec) -> tuple[Wheel, Wheel]:

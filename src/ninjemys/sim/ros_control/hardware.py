@@ -64,8 +64,12 @@ class ControlLoop:
     def __init__(self, node: Any, model: RobotModel, namespace: str | None = None) -> None:
         from ninjemys.sim.ros_control.manager import ControllerManager
 
-        joints = [j for j in (model.left_joint, model.right_joint) if j]
+        named = [j for j in (model.left_joint, model.right_joint) if j]
+        joints = list(dict.fromkeys(named + list(model.control_joints)))
         self.hw = SimRobotHW(joints, model.wheel_separation, model.wheel_radius)
+        sides = dict(model.control_joints) or {model.left_joint: "left", model.right_joint: "right"}
+        self.left = [j for j, side in sides.items() if side == "left"]
+        self.right = [j for j, side in sides.items() if side == "right"]
         ns = namespace if namespace is not None else model.drive.controller_namespace
         self.manager = ControllerManager(node, self.hw, ns)
 
@@ -76,14 +80,14 @@ class ControlLoop:
 
     def step_robot(self, robot: Any, now: float, period: float) -> None:
         """:meth:`step` for a :class:`ninjemys.sim.simcore.Robot`: its wheel angles and speeds in, its
-        wheel targets out (a wheel no running controller commands is held at 0, as an idle joint)."""
-        m = robot.model
-        commands = self.step(
-            now,
-            period,
-            {m.left_joint: (robot.left_angle, robot.wl), m.right_joint: (robot.right_angle, robot.wr)},
-        )
-        robot.target = (commands.get(m.left_joint, 0.0), commands.get(m.right_joint, 0.0))
+        wheel targets out. Every joint of a side (a four-wheel base) reads that side's wheel; the side's
+        target is the mean of its commanded joints (0 when no running controller commands them)."""
+        states = {j: (robot.left_angle, robot.wl) for j in self.left}
+        states.update({j: (robot.right_angle, robot.wr) for j in self.right})
+        commands = self.step(now, period, states)
+        left = [commands[j] for j in self.left if j in commands]
+        right = [commands[j] for j in self.right if j in commands]
+        robot.target = (sum(left) / len(left) if left else 0.0, sum(right) / len(right) if right else 0.0)
 
     def close(self) -> None:
         self.manager.close()
