@@ -206,6 +206,11 @@ def test_skid_steer_gpu_laser_kinect_and_imu_model_plugin():
             r"<ray/range/min>: sensor s \(ray\): range min 5 is not below max 2",
         ),
         (
+            '<gazebo><plugin name="dd" filename="libgazebo_ros_diff_drive.so"><left_joint>jl</left_joint>'
+            "</plugin></gazebo>",
+            r"<leftJoint>: .*joint 'left_joint' is not in the robot \(<left_joint> is the ROS 2 plugin's parameter",
+        ),
+        (
             '<gazebo reference="nolink"><material>Gazebo/Red</material></gazebo>',
             r"<gazebo>: reference 'nolink' names no link",
         ),

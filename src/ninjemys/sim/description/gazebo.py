@@ -200,12 +200,25 @@ def _model_plugin(
         cfg.ignored.append(filename or plugin.get("name", "<plugin>"))
 
 
+#: the ROS 2 plugins' names of the ROS 1 parameters, often copied into ROS 1 descriptions by mistake
+ROS2_NAMES = {
+    "leftJoint": "left_joint",
+    "rightJoint": "right_joint",
+    "leftFrontJoint": "left_joint",
+    "rightFrontJoint": "right_joint",
+}
+
+
 def _joint(r: Reader, geo: Geometry, path: str, default: str) -> str:
     name = r.text(path, default)
     if name not in geo.joints:
         child = r.el.find(path)
+        hint = ""
+        ros2 = ROS2_NAMES.get(path)
+        if child is None and ros2 and r.el.find(ros2) is not None:
+            hint = f" (<{ros2}> is the ROS 2 plugin's parameter; ROS 1's gazebo_ros reads <{path}>)"
         raise r.doc.error(
-            child if child is not None else r.el, f"{r.label}: joint '{name}' is not in the robot", path
+            child if child is not None else r.el, f"{r.label}: joint '{name}' is not in the robot{hint}", path
         )
     return name
 
