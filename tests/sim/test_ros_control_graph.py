@@ -232,3 +232,75 @@ def test_real_rospy_drives_the_diff_drive_controller_and_rosservice_sees_the_man
     finally:
         proc.send_signal(signal.SIGINT)
         proc.communicate(timeout=20)
+
+
+_ROSPY_SERVICES = r"""
+import json, sys, rospy, genpy.dynamic
+spec = json.loads(sys.argv[1])
+
+def service_class(name):
+    s = spec[name]
+    req = genpy.dynamic.generate_dynamic(s["req_type"], s["req_text"])[s["req_type"]]
+    resp = genpy.dynamic.generate_dynamic(s["resp_type"], s["resp_text"])[s["resp_type"]]
+    return type(name, (object,), {"_type": s["type"], "_md5sum": s["md5"], "_request_class": req, "_response_class": resp})
+
+rospy.init_node("rospy_cm_client")
+ListControllers = service_class("ListControllers")
+SwitchController = service_class("SwitchController")
+listing = rospy.ServiceProxy("/controller_manager/list_controllers", ListControllers)
+switch = rospy.ServiceProxy("/controller_manager/switch_controller", SwitchController)
+before = listing(ListControllers._request_class())
+print("BEFORE", sorted((c.name, c.state, c.claimed_resources[0].hardware_interface) for c in before.controller))
+r = switch(SwitchController._request_class(stop_controllers=["puzzlebot_controller"], strictness=2))
+print("SWITCH", r.ok)
+after = listing(ListControllers._request_class())
+print("AFTER", sorted((c.name, c.state) for c in after.controller))
+"""
+
+
+@pytest.mark.ros1
+@pytest.mark.skipif(not testing.have_ros1(), reason="needs Debian's ROS 1")
+def test_real_rospy_calls_the_controller_manager_services(graph):
+    """Debian has no controller_manager_msgs: genpy generates the classes from our full texts, and
+    rospy's handshake checks our md5sums against them (the md5s themselves are checked by genmsg)."""
+    import json
+
+    from ninjemys.idl.loader import get_service_class
+
+    uri, node, _ = graph
+    spec = {}
+    for name in ("ListControllers", "SwitchController"):
+        cls = get_service_class(f"controller_manager_msgs/{name}")
+        spec[name] = {
+            "type": cls._type,
+            "md5": cls._md5sum,
+            "req_type": cls._request_class._type,
+            "req_text": cls._request_class._full_text,
+            "resp_type": cls._response_class._type,
+            "resp_text": cls._response_class._full_text,
+        }
+    proc = _spawner(uri, "joint_state_controller", "puzzlebot_controller")
+    try:
+        _wait(lambda: _states(node).get("puzzlebot_controller") == "running", what="controller running")
+        out = subprocess.run(
+            [testing.ROS1_PYTHON, "-c", _ROSPY_SERVICES, json.dumps(spec)],
+            env=testing.ros1_env(uri),
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
+        assert out.returncode == 0, out.stderr
+        lines = dict(line.split(" ", 1) for line in out.stdout.splitlines())
+        assert lines["BEFORE"] == str(
+            [
+                ("joint_state_controller", "running", "hardware_interface::JointStateInterface"),
+                ("puzzlebot_controller", "running", "hardware_interface::VelocityJointInterface"),
+            ]
+        )
+        assert lines["SWITCH"] == "True"
+        assert lines["AFTER"] == str(
+            [("joint_state_controller", "running"), ("puzzlebot_controller", "stopped")]
+        )
+    finally:
+        proc.send_signal(signal.SIGINT)
+        proc.communicate(timeout=20)
