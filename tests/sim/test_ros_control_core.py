@@ -135,6 +135,15 @@ def test_diff_drive_turns_cmd_vel_into_wheel_velocities_with_limits_and_timeout(
     assert cmds["wl"] == pytest.approx(0.0, abs=1e-9) and cmds["wr"] == pytest.approx(0.0, abs=1e-9)
 
 
+def test_publish_cmd_publishes_the_limited_command():
+    node, cm, _ = _manager({"base": dict(DIFF, publish_cmd=True)})
+    assert cm.load("base") and cm.switch(["base"], [], STRICT)
+    node.subs["/base/cmd_vel"](_twist(2.0, 0.0))
+    cm.update(0.01, 0.01)
+    out = node.pubs["/base/cmd_vel_out"].sent
+    assert len(out) == 1 and out[0].twist.linear.x == 0.5  # max_velocity
+
+
 def test_odometry_follows_the_wheels_and_publishes_at_publish_rate():
     node, cm, hw = _manager({"base": DIFF})
     cm.load("base")

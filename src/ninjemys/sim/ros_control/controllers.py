@@ -212,6 +212,16 @@ class DiffDriveController(Controller):
         self.odom_pub = node.publisher(_join(self.ns, "odom"), self._odom_msg, queue_size=100)
         self.tf_pub = node.publisher("/tf", self._tf_msg, queue_size=100) if self.enable_odom_tf else None
         self.sub = node.subscriber(_join(self.ns, "cmd_vel"), self._twist, self._on_cmd, queue_size=1)
+        # publish_cmd: the limited command, as TwistStamped on <name>/cmd_vel_out
+        self._twist_stamped: Any = get_message_class("geometry_msgs/TwistStamped")
+        self.cmd_pub = (
+            node.publisher(_join(self.ns, "cmd_vel_out"), self._twist_stamped, queue_size=100)
+            if _flag(params, "publish_cmd", False, w)
+            else None
+        )
+        for unsupported in ("publish_wheel_joint_controller_state",):
+            if params.get(unsupported):
+                node.log.warn(f"{w}: parameter '{unsupported}' is not supported here and is ignored")
         self.now = 0.0
 
     @property
@@ -261,6 +271,11 @@ class DiffDriveController(Controller):
         lin = self.linear_limiter.limit(lin, l0, l1, period)
         ang = self.angular_limiter.limit(ang, a0, a1, period)
         self._last = [(lin, ang), (l0, a0)]
+        if self.cmd_pub is not None:
+            out = self._twist_stamped()
+            out.header.stamp = _stamp(now)
+            out.twist.linear.x, out.twist.angular.z = lin, ang
+            self.cmd_pub.publish(out)
         left = (lin - ang * self.separation / 2.0) / self.left_radius
         right = (lin + ang * self.separation / 2.0) / self.right_radius
         for j in self.left:
@@ -299,6 +314,8 @@ class DiffDriveController(Controller):
 
     def close(self) -> None:
         self.sub.unregister()
+        if self.cmd_pub is not None:
+            self.cmd_pub.unregister()
         self.odom_pub.unregister()
         if self.tf_pub is not None:
             self.tf_pub.unregister()
