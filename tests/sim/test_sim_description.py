@@ -176,6 +176,10 @@ def test_skid_steer_gpu_laser_kinect_and_imu_model_plugin():
     assert cam.image_topic == "/kinect/rgb/image_raw" and cam.depth_topic == "/kinect/depth/image_raw"
     assert cam.depth_info_topic == "/kinect/depth/camera_info" and cam.frame == "kinect_optical"
     assert m.imu.topic == "/imu/data" and m.imu.rate == 50.0 and m.imu.gyro_noise == 0.02
+    depth_camera = model_from_description(
+        _urdf(g.replace("libgazebo_ros_openni_kinect", "libgazebo_ros_depth_camera")), "b"
+    )
+    assert depth_camera.camera.depth_topic == "/kinect/depth/image_raw"
 
 
 @pytest.mark.parametrize(

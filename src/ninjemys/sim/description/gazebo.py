@@ -24,6 +24,7 @@ ROS_CONTROL = "libgazebo_ros_control.so"
 LASERS = ("libgazebo_ros_laser.so", "libgazebo_ros_gpu_laser.so")
 CAMERA = "libgazebo_ros_camera.so"
 KINECT = "libgazebo_ros_openni_kinect.so"
+DEPTH_CAMERA = "libgazebo_ros_depth_camera.so"  # the same depth parameters as the kinect plugin
 IMU_SENSOR = "libgazebo_ros_imu_sensor.so"
 IMU_MODEL = "libgazebo_ros_imu.so"
 DRIVES = (DIFF_DRIVE, SKID_STEER, ROS_CONTROL)
@@ -298,7 +299,7 @@ def _sensor(
             hi,
             range_resolution=s.number("ray/range/resolution", 0.0, minimum=0),
         )
-    elif kind in ("camera", "depth") and filename in (CAMERA, KINECT):
+    elif kind in ("camera", "depth") and filename in (CAMERA, KINECT, DEPTH_CAMERA):
         if cfg.camera is not None:
             cfg.warnings.append(f"{label}: only the first camera is simulated")
             return
@@ -322,7 +323,7 @@ def _sensor(
         cam_ns = topic(ns, p.text("cameraName", "")).rstrip("/")
         plugin_rate = p.number("updateRate", 0.0, minimum=0)
         frame_id = frame(p.text("frameName", "/world"), ns)
-        depth = filename == KINECT
+        depth = filename in (KINECT, DEPTH_CAMERA)
         if depth:
             far = min(far, p.number("pointCloudCutoffMax", 5.0, positive=True))
         cfg.camera = CameraSpec(
