@@ -362,7 +362,7 @@ def _sensor(
                     compose(local, _offset(p, "xyzOffset", "rpyOffset")),
                     frame(p.text("frameName", "")),
                 ),
-                p.number("updateRateHZ", 1.0, positive=True),
+                p.number("updateRateHZ", 1.0, minimum=0) or rate or 100.0,
                 noise,
                 noise,
                 f"{prefix}/{p.text('topicName', '/imu_data').lstrip('/')}",
