@@ -82,6 +82,16 @@ def test_publish_odom_tf_and_plugin_wheel_separation_come_from_the_xacro_args():
     assert m.drive.wheel_separation == pytest.approx(0.38) and m.wheel_separation == pytest.approx(0.19)
 
 
+def test_publish_tf_false_silences_odometry_and_its_tf():
+    g = (
+        '<gazebo><plugin name="dd" filename="libgazebo_ros_diff_drive.so"><leftJoint>jl</leftJoint>'
+        "<rightJoint>jr</rightJoint><publishTf>0</publishTf><publishOdomTF>true</publishOdomTF></plugin></gazebo>"
+    )
+    d = model_from_description(_urdf(g), "bot.urdf").drive
+    assert not d.publish_odom and not d.publish_odom_tf
+    assert d.odometry_source == "world" and d.wheel_separation == 0.34  # the plugin's defaults
+
+
 def test_ros_control_variant():
     m = _model(control="ros_control")
     assert m.drive.kind == "ros_control"

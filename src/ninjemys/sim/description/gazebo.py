@@ -124,9 +124,9 @@ def _model_plugin(
             odom_topic=topic(ns, r.text("odometryTopic", "odom")),
             odom_frame=frame(r.text("odometryFrame", "odom"), ns),
             base_frame=frame(r.text("robotBaseFrame", "base_footprint"), ns),
-            # publishTf is the plugin's switch for the odometry topic (its name is historical)
+            # publishTf is the plugin's switch for the odometry topic and its TF (its name is historical)
             publish_odom=r.boolean("publishTf", r.boolean("publishOdom", True)),
-            publish_odom_tf=r.boolean("publishOdomTF", True),
+            publish_odom_tf=r.boolean("publishOdomTF", True) and r.boolean("publishTf", True),
             publish_wheel_tf=r.boolean("publishWheelTF", False),
             publish_wheel_joint_state=r.boolean("publishWheelJointState", False),
             publish_wheel_speeds=False,
