@@ -99,6 +99,10 @@ def test_ros_control_variant():
     assert not m.drive.publish_odom and not m.drive.publish_odom_tf
     assert (m.left_joint, m.right_joint) == ("wheel_left_joint", "wheel_right_joint")
     assert m.laser is not None and m.camera is not None
+    assert m.control_joints == {"wheel_left_joint": "left", "wheel_right_joint": "right"}
+    text = expand_xacro(str(XACRO), {"control": "ros_control"})
+    # spawn_model -robot_namespace pb2 moves the controller_manager (and every plugin) under /pb2
+    assert model_from_description(text, "x", robot_namespace="pb2").drive.controller_namespace == "/pb2"
 
 
 def test_load_robot_model_expands_xacro_and_takes_a_robot_namespace():
