@@ -261,3 +261,24 @@ def test_stl_ascii_and_binary_and_connected_parts(tmp_path):
 def test_malformed_sdf_names_file_line_element_and_reason(tmp_path, text, pattern):
     with pytest.raises(SdfError, match=pattern):
         load_sdf_world(write(tmp_path, text), env=NO_ENV)
+
+
+def test_mesh_uris_by_package_and_model(tmp_path):
+    pkg = tmp_path / "src" / "course_worlds"
+    (pkg / "meshes").mkdir(parents=True)
+    (pkg / "package.xml").write_text(
+        '<package format="2"><name>course_worlds</name><version>0.0.1</version><description>d</description>'
+        "<maintainer email='a@b.c'>a</maintainer><license>BSD</license></package>"
+    )
+    tri = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0.3]]], dtype=float)
+    write_binary_stl(pkg / "meshes" / "t.stl", tri)
+    text = (
+        '<sdf version="1.6"><world name="w"><model name="m"><link name="l"><collision name="c"><geometry>'
+        "<mesh><uri>package://course_worlds/meshes/t.stl</uri></mesh></geometry></collision></link></model>"
+        "</world></sdf>"
+    )
+    env = {"ROS_PACKAGE_PATH": str(tmp_path / "src"), "HOME": "/nonexistent"}
+    (ob,) = load_sdf_world(write(tmp_path, text), env=env).obstacles
+    assert ob.height == pytest.approx(0.3) and len(ob.outline) == 3
+    with pytest.raises(SdfError, match=r"package 'other' of package://other/t.stl not found"):
+        load_sdf_world(write(tmp_path, text.replace("course_worlds/meshes", "other")), env=env)

@@ -34,7 +34,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ninjemys.errors import PackageError
 from ninjemys.maps.mapfile import MapFileError
+from ninjemys.packages.discovery import find_package
 from ninjemys.sim.meshes import load_mesh_parts
 from ninjemys.sim.world2d import Obstacle, World
 
@@ -289,18 +291,6 @@ def model_dirs(env: Mapping[str, str] | None = None) -> list[Path]:
     return dirs
 
 
-def _package_dir(name: str, env: Mapping[str, str]) -> Path | None:
-    for root in (Path(r) for r in env.get("ROS_PACKAGE_PATH", "").split(":") if r):
-        if (root / "package.xml").is_file() and root.name == name:
-            return root
-        if not root.is_dir():
-            continue
-        for manifest in sorted(root.glob("**/package.xml")):
-            if manifest.parent.name == name:
-                return manifest.parent
-    return None
-
-
 def resolve_uri(uri: str, el: Element, env: Mapping[str, str]) -> Path:
     """A file or model directory for ``model://``, ``package://``, ``file://`` or a relative path."""
     text = uri.strip()
@@ -317,9 +307,10 @@ def resolve_uri(uri: str, el: Element, env: Mapping[str, str]) -> Path:
         )
     if text.startswith("package://"):
         pkg, _, tail = text[len("package://") :].partition("/")
-        pdir = _package_dir(pkg, env)
-        if pdir is None:
-            raise el.error(f"package '{pkg}' of {text} not found on ROS_PACKAGE_PATH")
+        try:
+            pdir = find_package(pkg, env)
+        except PackageError:
+            raise el.error(f"package '{pkg}' of {text} not found on ROS_PACKAGE_PATH") from None
         return pdir / tail
     if text.startswith("file://"):
         return Path(text[len("file://") :])

@@ -8,6 +8,7 @@ import * as THREE from "three";
 import { OrbitControls } from "/static/vendor/three/OrbitControls.js";
 import { RosClient } from "/static/lib/rosclient.js";
 import { TfBuffer, fromPose, compose, stripSlash, yawOf } from "/static/lib/tf.js";
+import { loadMesh } from "/static/rviz/meshes.js";
 
 const params = new URLSearchParams(location.search);
 const $ = (id) => document.getElementById(id);
@@ -825,6 +826,13 @@ class RobotModelDisplay extends Display {
       return { t: xyz(o, "xyz"), q: [q.x, q.y, q.z, q.w] };
     };
     const alpha = Number(this.option("Alpha", 1));
+    // materials named at the top level, used by name in visuals (<material name="blue"/>)
+    const named = new Map();
+    for (const m of doc.querySelectorAll("robot > material")) {
+      const rgba = m.querySelector("color")?.getAttribute("rgba");
+      if (rgba) named.set(m.getAttribute("name"), rgba);
+    }
+    const meshes = [];
     for (const link of doc.querySelectorAll("robot > link")) {
       const g = new THREE.Group();
       const shapes = link.querySelectorAll(":scope > visual");
@@ -832,7 +840,8 @@ class RobotModelDisplay extends Display {
       for (const v of list) {
         const geo = v.querySelector("geometry");
         let mesh = null;
-        const rgba = v.querySelector("material > color")?.getAttribute("rgba");
+        const matEl = v.querySelector(":scope > material");
+        const rgba = matEl?.querySelector("color")?.getAttribute("rgba") || named.get(matEl?.getAttribute("name"));
         const col = rgba ? rgba.trim().split(/\s+/).map(Number) : [0.8, 0.8, 0.8, 1];
         const mat = new THREE.MeshLambertMaterial({ color: new THREE.Color(col[0], col[1], col[2]), transparent: alpha < 1, opacity: alpha });
         const box = geo?.querySelector("box"), cyl = geo?.querySelector("cylinder"), sph = geo?.querySelector("sphere");
@@ -843,7 +852,14 @@ class RobotModelDisplay extends Display {
           c.rotation.x = Math.PI / 2; // URDF cylinders run along z, three's along y
           mesh = new THREE.Group(); mesh.add(c);
         } else if (sph) mesh = new THREE.Mesh(new THREE.SphereGeometry(Number(sph.getAttribute("radius")), 20, 14), mat);
-        if (!mesh) continue; // meshes (STL/DAE) are not loaded: boxes, cylinders and spheres only
+        else if (geo?.querySelector("mesh")) {
+          // filled in when the file arrives; the link is placed meanwhile
+          const m = geo.querySelector("mesh");
+          mesh = new THREE.Group();
+          mesh.scale.set(...xyz(m, "scale", [1, 1, 1]));
+          meshes.push({ uri: (m.getAttribute("filename") || "").trim(), holder: mesh, mat });
+        }
+        if (!mesh) continue;
         const wrap = new THREE.Group();
         setPose(wrap, originOf(v));
         wrap.add(mesh);
@@ -857,6 +873,25 @@ class RobotModelDisplay extends Display {
       const parent = j.querySelector("parent")?.getAttribute("link");
       if (child && parent) this.joints.set(child, { parent, origin: originOf(j) });
     }
+    this.loadMeshes(meshes);
+  }
+  /** Fetch the visuals' mesh files; the status says how many are drawn and names the first failure. */
+  async loadMeshes(meshes) {
+    this.setStatus("Meshes", null);
+    if (!meshes.length) return;
+    const generation = (this.generation = (this.generation || 0) + 1);
+    this.setStatus("Meshes", "warn", `loading ${meshes.length} meshes`);
+    const results = await Promise.allSettled(meshes.map(async ({ uri, holder, mat }) => {
+      if (!uri) throw new Error("a <mesh> without a filename");
+      holder.add(await loadMesh(uri, mat));
+      dirty = true;
+    }));
+    if (generation !== this.generation) return; // reloaded meanwhile
+    const failed = results.map((r, i) => [r, meshes[i].uri]).filter(([r]) => r.status === "rejected");
+    if (failed.length) {
+      const [r, uri] = failed[0];
+      this.setStatus("Meshes", "error", `${failed.length} of ${meshes.length} meshes not drawn: ${uri}: ${r.reason.message}`);
+    } else this.setStatus("Meshes", "ok", `${meshes.length} meshes`);
   }
   /** A link's pose in the fixed frame: from tf, else through its joint from its parent's. */
   linkPose(name, depth = 0) {
