@@ -282,3 +282,43 @@ def test_mesh_uris_by_package_and_model(tmp_path):
     assert ob.height == pytest.approx(0.3) and len(ob.outline) == 3
     with pytest.raises(SdfError, match=r"package 'other' of package://other/t.stl not found"):
         load_sdf_world(write(tmp_path, text.replace("course_worlds/meshes", "other")), env=env)
+
+
+def test_the_camera_sees_models_at_their_heights_and_colours(tmp_path):
+    """A short red box before a tall green wall: red up to the box's top, the wall above it."""
+
+    def model(name: str, x: float, size: str, z: float, colour: str) -> str:
+        geometry = f"<geometry><box><size>{size}</size></box></geometry>"
+        return (
+            f'<model name="{name}"><static>true</static><pose>{x} 0 {z} 0 0 0</pose><link name="l">'
+            f'<collision name="c">{geometry}</collision><visual name="v">{geometry}'
+            f"<material><script><name>{colour}</name></script></material></visual></link></model>"
+        )
+
+    text = (
+        '<sdf version="1.6"><world name="w"><include><uri>model://ground_plane</uri></include>'
+        + model("crate", 1.5, "0.4 0.4 0.3", 0.15, "Gazebo/Red")
+        + model("wall", 6.0, "0.2 8 2", 1.0, "Gazebo/Green")
+        + "</world></sdf>"
+    )
+    sim = Simulation(load_sdf_world(write(tmp_path, text), env=NO_ENV))
+    r = sim.add_robot("pb", load_robot_model("puzzlebot"), 0.0, 0.0, 0.0)
+    rgb, depth = sim.render(r)
+    cam = r.camera
+    u = cam.width // 2
+    cam_x = r.model.camera.pose.xyz[0]
+
+    def row_at(z: float, d: float) -> int:  # the image row whose ray is at height z at depth d
+        return int(round(cam.cy - (z - cam.cam_z) / d * cam.fy))
+
+    near, far = 1.3 - cam_x, 5.9 - cam_x
+    rows = [row_at(0.25, near), row_at(0.05, near), row_at(0.4, near), row_at(1.5, far), row_at(2.3, far)]
+    assert all(0 <= v < cam.height for v in rows) and len(set(rows)) == 5
+    for v in (row_at(0.25, near), row_at(0.05, near)):  # the crate
+        r_, g, b = rgb[v, u]
+        assert r_ > 200 and g < 30 and b < 30 and depth[v, u] == round(near * 1000), (v, rgb[v, u])
+    for v in (row_at(0.4, near), row_at(1.5, far)):  # above the crate: the wall behind it
+        r_, g, b = rgb[v, u]
+        assert g > 150 and r_ < 30 and b < 30 and depth[v, u] == round(far * 1000), (v, rgb[v, u])
+    v = row_at(2.3, far)  # above the wall: sky, no depth
+    assert depth[v, u] == 0 and tuple(rgb[v, u]) not in {(255, 0, 0), (0, 255, 0)}
