@@ -168,8 +168,8 @@ class Camera:
             if not visible.any():
                 cut[cols] = np.minimum(cut[cols], top_c)
                 continue
-            top_k = np.full(self.width, self.height, dtype=self._row_type)
-            bottom_k = np.zeros(self.width, dtype=self._row_type)
+            top_k: np.ndarray = np.full(self.width, self.height, dtype=self._row_type)
+            bottom_k: np.ndarray = np.zeros(self.width, dtype=self._row_type)
             top_k[cols[visible]] = top_c[visible]
             bottom_k[cols[visible]] = bottom_c[visible]
             depth_k = np.zeros(self.width)
