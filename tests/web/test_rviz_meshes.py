@@ -73,6 +73,7 @@ def live(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[dict[str, 
     config.write_text(
         "Visualization Manager:\n  Displays:\n    - Class: rviz/RobotModel\n      Name: Robot\n"
         "      Enabled: true\n      Robot Description: robot_description\n"
+        "    - Class: rviz/Marker\n      Name: Mesh marker\n      Enabled: true\n      Marker Topic: /marker\n"
         "  Global Options:\n    Fixed Frame: map\n    Background Color: 48; 48; 48\n"
     )
     with MasterThread() as uri:
@@ -80,16 +81,25 @@ def live(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[dict[str, 
         peer.set_param("/robot_description", urdf)
         pub = peer.publisher("/tf_static", M("tf2_msgs/TFMessage"), queue_size=1, latch=True)
         pub.publish(tf_message(transform("map", "base_link", 0.0, 0.0)))
+        marker = M("visualization_msgs/Marker")(ns="mesh", id=1, type=10, action=0)
+        marker.header.frame_id = "map"
+        marker.pose.position.y = 3.0
+        marker.pose.orientation.w = 1.0
+        marker.scale.x = marker.scale.y = marker.scale.z = 1.0
+        marker.color.g = marker.color.a = 1.0
+        marker.mesh_resource = "package://mesh_bot/meshes/base.stl"
+        mpub = peer.publisher("/marker", M("visualization_msgs/Marker"), queue_size=1, latch=True)
+        mpub.publish(marker)
         rviz = Rviz(uri, str(config), update_period=0.2)
         try:
-            yield {"url": rviz.start(), "keep": pub}
+            yield {"url": rviz.start(), "keep": (pub, mpub)}
         finally:
             rviz.stop()
             peer.shutdown("test over")
 
 
-BOUNDS = """(uri) => {
-  const d = rviz.displays.find((d) => d.cfg.name === 'Robot');
+BOUNDS = """(uri, display = 'Robot') => {
+  const d = rviz.displays.find((d) => d.cfg.name === display);
   let found = null;
   d.group.traverse((o) => { if (o.userData.meshUri === uri) found = o; });
   if (!found) return null;
@@ -137,6 +147,16 @@ def test_robot_model_draws_stl_dae_and_obj_meshes(live: dict[str, Any], browser_
         "hi": [-2.9, 0.1, 0.3],
         "colours": ["00ff00"],
     }
+    # a MESH_RESOURCE marker draws the same file, in the marker's colour, at its pose
+    wait_until(
+        lambda: (
+            page.evaluate(f"() => ({BOUNDS})('package://mesh_bot/meshes/base.stl', 'Mesh marker')")
+            is not None
+        ),
+        what="the mesh marker's file",
+    )
+    mk = page.evaluate(f"() => ({BOUNDS})('package://mesh_bot/meshes/base.stl', 'Mesh marker')")
+    assert mk == {"lo": [-0.3, 2.8, -0.1], "hi": [0.3, 3.2, 0.1], "colours": ["00ff00"]}
     # and the pixels: the top view shows the red box where base_link is, 1.2 m long and 0.4 m wide
     page.wait_for_timeout(300)
     rgb = screenshot_rgb(page).astype(int)

@@ -4,13 +4,16 @@ import * as THREE from "three";
 import { fromPose, stripSlash } from "/static/lib/tf.js";
 import { setPose, disposeTree, arrowMesh } from "/static/rviz/util.js";
 import { label } from "/static/rviz/labels.js";
+import { markDirty } from "/static/rviz/context.js";
+import { loadMesh } from "/static/rviz/meshes.js";
 import { Display } from "/static/rviz/display.js";
 
 // -- markers
 
 export const MARKER_TYPES = ["ARROW", "CUBE", "SPHERE", "CYLINDER", "LINE_STRIP", "LINE_LIST", "CUBE_LIST", "SPHERE_LIST", "POINTS", "TEXT_VIEW_FACING", "MESH_RESOURCE", "TRIANGLE_LIST"];
 
-export function markerObject(m) {
+/** The three.js object of a marker; a MESH_RESOURCE's file arrives later (``onError`` if it cannot). */
+export function markerObject(m, onError = () => {}) {
   const c = m.color;
   const color = new THREE.Color(c.r, c.g, c.b);
   const opacity = c.a;
@@ -63,6 +66,19 @@ export function markerObject(m) {
     }
     case 8: return new THREE.Points(pointsGeom(), new THREE.PointsMaterial({ color: perPoint ? 0xffffff : color, vertexColors: perPoint, size: s.x, transparent, opacity }));
     case 9: { const g = new THREE.Group(); g.userData.text = m.text; return g; }
+    case 10: { // MESH_RESOURCE: the file through the web app, scaled; the marker's colour unless
+      // a COLLADA file's own materials are asked for (mesh_use_embedded_materials)
+      if (!m.mesh_resource) throw new Error("MESH_RESOURCE marker without a mesh_resource");
+      const g = new THREE.Group();
+      g.scale.set(s.x, s.y, s.z);
+      const embedded = m.mesh_use_embedded_materials && /\.dae$/i.test(m.mesh_resource);
+      loadMesh(m.mesh_resource, lambert()).then((o) => {
+        if (!embedded) o.traverse((x) => { if (x.isMesh) x.material = lambert(); });
+        g.add(o);
+        markDirty();
+      }).catch((err) => onError(err));
+      return g;
+    }
     case 11: {
       const g = pointsGeom();
       g.computeVertexNormals();
@@ -90,7 +106,9 @@ export class MarkerDisplay extends Display {
     if (m.action === 2) return;
     let obj;
     try {
-      obj = markerObject(m);
+      obj = markerObject(m, (err) => {
+        if (this.markers.get(key)?.holder.children[0]?.children[0] === obj) this.setStatus(`Marker ${key}`, "error", `${m.mesh_resource}: ${err.message}`);
+      });
     } catch (err) {
       this.setStatus(`Marker ${key}`, "error", err.message);
       return;
