@@ -25,7 +25,9 @@ ROS1_DEBS += cmake python3-gencpp ros-std-msgs libstd-msgs-dev
 # vision: Debian's OpenCV under /usr/bin/python3 and its C++ image_transport republish (side-by-side tests)
 ROS1_DEBS += python3-opencv image-transport-tools
 BROWSER_DEBS := chromium chromium-driver fonts-dejavu-core
-SYSTEM_DEBS  := $(ROS1_DEBS) $(BROWSER_DEBS) tmux
+# multi-host tests: network namespaces (iproute2), roslaunch <machine> over ssh (openssh-server)
+NET_DEBS     := iproute2 openssh-server openssh-client
+SYSTEM_DEBS  := $(ROS1_DEBS) $(BROWSER_DEBS) $(NET_DEBS) tmux
 
 # npm packages the tests run with Node.js (Foxglove's own WebSocket client), in a git-ignored directory.
 NPM_DIR   := .cache/npm
