@@ -322,3 +322,23 @@ def test_the_camera_sees_models_at_their_heights_and_colours(tmp_path):
         assert g > 150 and r_ < 30 and b < 30 and depth[v, u] == round(far * 1000), (v, rgb[v, u])
     v = row_at(2.3, far)  # above the wall: sky, no depth
     assert depth[v, u] == 0 and tuple(rgb[v, u]) not in {(255, 0, 0), (0, 255, 0)}
+
+
+def test_model_documents_as_spawn_sdf_model_receives_them():
+    from ninjemys.sim.sdf import parse_sdf_world, sdf_model_obstacles
+
+    model = (
+        '<sdf version="1.6"><model name="crate"><pose>0 0 0.25 0 0 0.5</pose><link name="l">'
+        '<collision name="c"><geometry><box><size>1 0.5 0.5</size></box></geometry></collision></link>'
+        "</model></sdf>"
+    )
+    (ob,) = sdf_model_obstacles(model, env=NO_ENV)
+    assert ob.name == "crate" and ob.height == pytest.approx(0.5)
+    assert ob.outline.mean(axis=0) == pytest.approx([0, 0], abs=1e-9)
+    # spawn_model -database NAME sends a world of one include
+    include = '<sdf version="1.4"><world name="default"><include><uri>model://cardboard_box</uri></include></world></sdf>'
+    (box,) = sdf_model_obstacles(include, env=NO_ENV)
+    assert box.name == "cardboard_box" and box.height == pytest.approx(0.3)
+    assert parse_sdf_world(include, "<text>", env=NO_ENV).obstacles[0].name == "cardboard_box"
+    with pytest.raises(SdfError, match=r"<spawn_sdf_model>:1: <sdf>: no <model> in this SDF document"):
+        sdf_model_obstacles('<sdf version="1.6"><light name="l"/></sdf>', env=NO_ENV)

@@ -349,7 +349,11 @@ def _read_sdf(path: Path, ctx: _Context, where: Element | None = None) -> Elemen
     except OSError as exc:
         msg = f"cannot read {path}: {exc.strerror or exc}"
         raise (where.error(msg) if where is not None else SdfError(f"{path}: {msg}")) from None
-    root = parse_xml(data, str(path))
+    return _sdf_root(data, str(path), ctx)
+
+
+def _sdf_root(data: bytes, source: str, ctx: _Context) -> Element:
+    root = parse_xml(data, source)
     if root.tag != "sdf":
         raise root.error("the root element of an SDF file is <sdf>")
     version = root.attrib.get("version")
@@ -576,11 +580,54 @@ def load_sdf_world(
 ) -> World:
     """The simulator's World for a Gazebo ``.world`` file (SdfError naming file, line, element, reason)."""
     p = Path(path)
+    try:
+        data = p.read_bytes()
+    except OSError as exc:
+        raise SdfError(f"{p}: cannot read world: {exc.strerror or exc}") from None
+    return parse_sdf_world(data, str(p), env, warn)
+
+
+def parse_sdf_world(
+    data: bytes | str,
+    source: str,
+    env: Mapping[str, str] | None = None,
+    warn: Callable[[str], None] | None = None,
+) -> World:
+    """A World from SDF text (``source`` names it in errors; relative mesh paths start at its folder)."""
     ctx = _Context(os.environ if env is None else env)
-    root = _read_sdf(p, ctx)
+    root = _sdf_root(data.encode() if isinstance(data, str) else data, source, ctx)
     world_el = root.find("world")
     if world_el is None:
         raise root.error("no <world> in this file (a model file? spawn it with spawn_model -sdf)")
+    solids = _world_solids(world_el, ctx)
+    world = World(world_el.attrib.get("name", Path(source).stem), _obstacles(solids), source=source)
+    _report(ctx, source, warn)
+    return world
+
+
+def sdf_model_obstacles(
+    data: bytes | str,
+    source: str = "<spawn_sdf_model>",
+    env: Mapping[str, str] | None = None,
+    warn: Callable[[str], None] | None = None,
+) -> list[Obstacle]:
+    """The obstacles of an SDF model document (``<sdf><model>``, as spawn_sdf_model receives it, or a
+    ``<world>`` of includes), in the model's frame: place them at the spawn pose."""
+    ctx = _Context(os.environ if env is None else env)
+    root = _sdf_root(data.encode() if isinstance(data, str) else data, source, ctx)
+    solids: list[_Solid] = []
+    world_el = root.find("world")
+    if world_el is not None:
+        solids = _world_solids(world_el, ctx)
+    for model in root.findall("model"):
+        _model(model, np.eye(4), ctx, solids, [], 0)
+    if world_el is None and root.find("model") is None:
+        raise root.error("no <model> in this SDF document")
+    _report(ctx, source, warn)
+    return _obstacles(solids)
+
+
+def _world_solids(world_el: Element, ctx: _Context) -> list[_Solid]:
     saved = _state_poses(world_el, ctx)
     solids: list[_Solid] = []
     for child in world_el.children:
@@ -593,12 +640,13 @@ def load_sdf_world(
             ctx.skip(f"world plugin {child.attrib.get('filename', '?')}", child)
         elif child.tag != "state" and child.tag not in _QUIET_WORLD:
             ctx.skip(f"<{child.tag}>", child)
-    obstacles = _obstacles(solids)
-    world = World(world_el.attrib.get("name", p.stem), obstacles, source=str(p))
+    return solids
+
+
+def _report(ctx: _Context, source: str, warn: Callable[[str], None] | None) -> None:
     if ctx.unsupported:
         listed = "; ".join(f"{what} ({where})" for what, where in ctx.unsupported.items())
-        (warn or log.warning)(f"{p}: not simulated, ignored: {listed}")
-    return world
+        (warn or log.warning)(f"{source}: not simulated, ignored: {listed}")
 
 
 def _obstacles(solids: list[_Solid]) -> list[Obstacle]:
