@@ -23,6 +23,8 @@ from ninjemys.maps.mapfile import MapFileError
 
 #: vertices closer than this (metres) are the same vertex when finding an STL's connected parts
 WELD = 1e-6
+#: vertices farther than this from the mesh origin (metres) are a broken file, not a world
+MAX_COORDINATE = 1e6
 #: a mesh with more triangles than this is one part (finding components would cost more than it helps)
 MAX_COMPONENT_TRIANGLES = 200_000
 
@@ -40,12 +42,19 @@ def load_mesh_parts(path: str | Path) -> list[np.ndarray]:
         raise MeshError(f"{p}: cannot read mesh: {exc.strerror or exc}") from None
     suffix = p.suffix.lower()
     if suffix == ".stl":
-        return _components(_stl_triangles(data, p))
-    if suffix == ".dae":
-        return _collada_parts(data, p)
-    if suffix == ".obj":
-        return _components(_obj_triangles(data, p))
-    raise MeshError(f"{p}: unsupported mesh format '{suffix}' (STL, DAE and OBJ are read)")
+        parts = [_stl_triangles(data, p)]
+    elif suffix == ".dae":
+        parts = _collada_parts(data, p)
+    elif suffix == ".obj":
+        parts = [_obj_triangles(data, p)]
+    else:
+        raise MeshError(f"{p}: unsupported mesh format '{suffix}' (STL, DAE and OBJ are read)")
+    for part in parts:
+        if not np.isfinite(part).all():
+            raise MeshError(f"{p}: a vertex is not a finite number (nan or inf)")
+        if len(part) and np.abs(part).max() > MAX_COORDINATE:
+            raise MeshError(f"{p}: a vertex lies more than {MAX_COORDINATE:g} m from the origin")
+    return _components(parts[0]) if suffix in (".stl", ".obj") else parts
 
 
 # -- STL -------------------------------------------------------------------------------------------
@@ -109,7 +118,9 @@ def _obj_triangles(data: bytes, p: Path) -> np.ndarray:
     if not verts or not faces:
         raise MeshError(f"{p}: OBJ with no vertices or no faces")
     v = np.array(verts)
-    idx = np.array([(f[0], f[i], f[i + 1]) for f in faces for i in range(1, len(f) - 1)])
+    idx = np.array([(f[0], f[i], f[i + 1]) for f in faces for i in range(1, len(f) - 1)], dtype=np.int64)
+    if not len(idx):
+        raise MeshError(f"{p}: OBJ with no face of three or more vertices")
     if idx.min() < 0 or idx.max() >= len(v):
         raise MeshError(f"{p}: a face refers to a vertex that does not exist")
     return v[idx]
@@ -166,21 +177,21 @@ def _node_matrix(node: ET.Element, p: Path) -> np.ndarray:
     m = np.eye(4)
     for child in node:
         tag = _local(child.tag)
+        count = {"matrix": 16, "translate": 3, "scale": 3, "rotate": 4}.get(tag)
+        if count is None:
+            continue
+        v = _floats(child.text, p, tag)
+        if len(v) != count:
+            raise MeshError(f"{p}: <{tag}> needs {count} numbers, got {len(v)}")
         if tag == "matrix":
-            v = _floats(child.text, p, "matrix")
-            if len(v) != 16:
-                raise MeshError(f"{p}: <matrix> needs 16 numbers, got {len(v)}")
             m = m @ v.reshape(4, 4)
         elif tag == "translate":
-            v = _floats(child.text, p, "translate")
             t = np.eye(4)
-            t[:3, 3] = v[:3]
+            t[:3, 3] = v
             m = m @ t
         elif tag == "scale":
-            v = _floats(child.text, p, "scale")
             m = m @ np.diag([v[0], v[1], v[2], 1.0])
-        elif tag == "rotate":
-            v = _floats(child.text, p, "rotate")
+        else:
             m = m @ _axis_angle(v[:3], math.radians(v[3]))
     return m
 
@@ -233,7 +244,10 @@ def _collada_parts(data: bytes, p: Path) -> list[np.ndarray]:
     for asset in (c for c in root if _local(c.tag) == "asset"):
         for c in asset:
             if _local(c.tag) == "unit":
-                unit = float(c.get("meter", "1") or 1)
+                try:
+                    unit = float(c.get("meter", "1") or 1)
+                except ValueError:
+                    raise MeshError(f"{p}: <unit meter={c.get('meter')!r}>: expected a number") from None
             elif _local(c.tag) == "up_axis":
                 up = (c.text or "Y_UP").strip()
     geometries = {g.get("id"): g for g in root.iter() if _local(g.tag) == "geometry"}
