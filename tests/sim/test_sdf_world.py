@@ -342,3 +342,15 @@ def test_model_documents_as_spawn_sdf_model_receives_them():
     assert parse_sdf_world(include, "<text>", env=NO_ENV).obstacles[0].name == "cardboard_box"
     with pytest.raises(SdfError, match=r"<spawn_sdf_model>:1: <sdf>: no <model> in this SDF document"):
         sdf_model_obstacles('<sdf version="1.6"><light name="l"/></sdf>', env=NO_ENV)
+
+
+def test_a_floating_shape_stands_on_the_floor_and_is_reported(tmp_path):
+    text = (
+        '<sdf version="1.6"><world name="w"><model name="table"><static>1</static><link name="top">'
+        '<pose>0 0 0.75 0 0 0</pose><collision name="c">\n<geometry><box><size>1 1 0.05</size></box>'
+        "</geometry></collision></link></model></world></sdf>"
+    )
+    warnings: list[str] = []
+    (ob,) = load_sdf_world(write(tmp_path, text), env=NO_ENV, warn=warnings.append).obstacles
+    assert ob.height == pytest.approx(0.775)
+    assert len(warnings) == 1 and "float above the floor" in warnings[0] and "w.world:1" in warnings[0]

@@ -50,6 +50,8 @@ ROUND_SIDES = 24
 #: shapes whose top is lower than this (metres) lie on the floor: nothing for a sensor to hit
 MIN_TOP = 1e-3
 DEFAULT_COLOUR = (180, 180, 180)
+#: a shape whose lowest point is higher than this (metres) floats: reported, as it stands on the floor here
+FLOATING = 0.05
 MAX_INCLUDE_DEPTH = 16
 
 #: Gazebo's material scripts (gazebo.material) by name, as the RGB they render roughly as
@@ -266,6 +268,7 @@ class Footprint:
     outline: np.ndarray
     top: float
     kind: str
+    bottom: float = 0.0
 
 
 # -- the reader ----------------------------------------------------------------------------------
@@ -423,7 +426,7 @@ def _geometry(geom: Element, m: np.ndarray, ctx: _Context) -> list[Footprint]:
         centre = m[:3, 3]
         a = np.arange(ROUND_SIDES) * (2 * math.pi / ROUND_SIDES)
         outline = np.column_stack([centre[0] + r * np.cos(a), centre[1] + r * np.sin(a)])
-        return [Footprint(outline, float(centre[2] + r), "sphere")]
+        return [Footprint(outline, float(centre[2] + r), "sphere", float(centre[2] - r))]
     if kind == "polyline":
         height = _number(shape, "height", positive=True)
         pts = []
@@ -462,7 +465,8 @@ def _geometry(geom: Element, m: np.ndarray, ctx: _Context) -> list[Footprint]:
 
 
 def _piece(points: np.ndarray, kind: str) -> Footprint:
-    return Footprint(convex_hull(points[:, :2]), float(points[:, 2].max()), kind)
+    z = points[:, 2]
+    return Footprint(convex_hull(points[:, :2]), float(z.max()), kind, float(z.min()))
 
 
 @dataclass
@@ -517,6 +521,11 @@ def _link(el: Element, model: np.ndarray, ctx: _Context, out: list[_Solid], scop
             for fp in _geometry(geom, m @ _pose(child, ctx), ctx):
                 if fp.top > MIN_TOP and len(fp.outline) >= 2:
                     out.append(_Solid([*scope, name, cname], fp, colour))
+                    if fp.bottom > FLOATING:
+                        # a table top, a shelf: the floor plan has no space under things
+                        ctx.skip(
+                            "space under shapes that float above the floor (they stand on it here)", child
+                        )
             for sub in child.children:
                 if sub.tag not in _QUIET_COLLISION and sub.tag != "geometry":
                     ctx.skip(f"<{sub.tag}> in a collision", sub)
