@@ -152,7 +152,9 @@ class Camera:
         wall_mm = np.rint(np.where(found, depth, 0.0) * 1000.0).astype(np.uint16)
         np.copyto(self._lanes1, wall)
         depth_mm = _select(self._lanes1, wall_mm[None, :], self._floor_depth_image)
-        cut = top  # rows at or below a nearer layer's top are that layer's (or the floor in front of it)
+        cut = (
+            top.copy()
+        )  # rows at or below a nearer layer's top are that layer's (or the floor in front of it)
         seen_height = np.where(found, heights, np.inf)  # the first layer's obstacle, per column
         for threshold in layer_thresholds(scene, self.cam_z):
             # only columns whose nearest obstacle is shorter than the class can show a farther one
@@ -168,28 +170,23 @@ class Camera:
             if not visible.any():
                 cut[cols] = np.minimum(cut[cols], top_c)
                 continue
-            top_k: np.ndarray = np.full(self.width, self.height, dtype=self._row_type)
-            bottom_k: np.ndarray = np.zeros(self.width, dtype=self._row_type)
-            top_k[cols[visible]] = top_c[visible]
-            bottom_k[cols[visible]] = bottom_c[visible]
-            depth_k = np.zeros(self.width)
-            depth_k[cols] = depth_c
-            colors_k = np.zeros((self.width, 3), dtype=np.uint8)
-            colors_k[cols] = colors_c
-            light_k = np.clip(1.1 - depth_k / 15.0, 0.45, 1.0)
-            col_k = (colors_k * light_k[:, None]).astype(np.uint8).reshape(1, 3 * self.width)
-            np.greater_equal(rows, np.repeat(top_k, 3), out=wall3)
-            np.less(rows, np.repeat(bottom_k, 3), out=self._below3)
-            wall3 &= self._below3
-            rgb = _select(self._lanes3, col_k, rgb.reshape(self.height, 3 * self.width)).reshape(
-                self.height, self.width, 3
-            )
-            mask_k = (rows >= top_k) & (rows < bottom_k)
-            wall |= mask_k
-            np.copyto(self._lanes1, mask_k)
-            mm_k = np.rint(depth_k * 1000.0).astype(np.uint16)
-            depth_mm = _select(self._lanes1, mm_k[None, :], depth_mm)
-            cut = cut.copy() if cut is top else cut
+            # the farther layer's visible rows lie in one band: masked copies over that band only
+            vis = cols[visible]
+            top_v, bottom_v = top_c[visible], bottom_c[visible]
+            r0, r1 = int(top_v.min()), int(bottom_v.max())
+            band = rows[r0:r1]
+            mask = (band >= top_v[None, :]) & (band < bottom_v[None, :])  # (rows of the band, visible cols)
+            depth_v = depth_c[visible]
+            light_v = np.clip(1.1 - depth_v / 15.0, 0.45, 1.0)
+            colour_v = (colors_c[visible] * light_v[:, None]).astype(np.uint8)
+            sub = rgb[r0:r1, vis]
+            np.copyto(sub, np.broadcast_to(colour_v[None, :, :], sub.shape), where=mask[:, :, None])
+            rgb[r0:r1, vis] = sub
+            mm_v = np.rint(depth_v * 1000.0).astype(np.uint16)
+            dsub = depth_mm[r0:r1, vis]
+            np.copyto(dsub, np.broadcast_to(mm_v[None, :], dsub.shape), where=mask)
+            depth_mm[r0:r1, vis] = dsub
+            wall[r0:r1, vis] |= mask
             cut[cols] = np.minimum(cut[cols], top_c)
         if scene.floor is not None:
             self._paint_floor(rgb, wall, scene.floor, x, y, yaw)
