@@ -148,4 +148,11 @@ PUBLISHED_MD5: dict[str, str] = {
     "controller_manager_msgs/ControllerState": "aeb6b261d97793ab74099a3740245272",
     "controller_manager_msgs/ListControllers": "1341feb2e63fa791f855565d0da950d8",
     "controller_manager_msgs/SwitchController": "b29a7abc673b2c54c14b54e50f8d06a5",
+    "controller_manager_msgs/ControllerStatistics": "697780c372c8d8597a1436d0e2ad3ba8",
+    "controller_manager_msgs/ControllersStatistics": "a154c347736773e3700d1719105df29d",
+    "controller_manager_msgs/HardwareInterfaceResources": "f25b55cbf1d1f76e82e5ec9e83f76258",
+    "controller_manager_msgs/ListControllerTypes": "c1d4cd11aefa9f97ba4aeb5b33987f4e",
+    "controller_manager_msgs/LoadController": "647e5c54b8d6468952d8d31f1efe96c0",
+    "controller_manager_msgs/UnloadController": "647e5c54b8d6468952d8d31f1efe96c0",
+    "controller_manager_msgs/ReloadControllerLibraries": "40e8c411fd1797d2e2c486018f846040",
 }
