@@ -228,9 +228,9 @@ def rosnode_ping_all(verbose: bool = False, skip_cache: bool = False) -> tuple[l
     return pinged, unpinged
 
 
-def _unregister(master: rosgraph.Master, state: Any, keep: Any) -> None:
+def _unregister(master: rosgraph.Master, graph: GraphSnapshot, keep: Any) -> None:
     """Unregister, as each node itself, every registration of a node for which ``keep`` is False."""
-    pubs, subs, srvs = state
+    pubs, subs, srvs = (t.items() for t in (graph.publishers, graph.subscribers, graph.services))
     for topic, nodes in pubs:
         for n in nodes:
             if not keep(n) and (api := get_api_uri(master, n)):
@@ -247,17 +247,17 @@ def _unregister(master: rosgraph.Master, state: Any, keep: Any) -> None:
 
 def cleanup_master_blacklist(master: rosgraph.Master, blacklist: list[str]) -> None:
     """Remove every registration of the nodes in ``blacklist`` from the master (and our URI cache)."""
-    state = master.getSystemState()
+    graph = _snapshot(master)
     for n in blacklist:
         print("Unregistering", n)
-    _unregister(master, state, lambda n: n not in blacklist)
+    _unregister(master, graph, lambda n: n not in blacklist)
     for n in blacklist:
         _caller_apis.pop(n, None)
 
 
 def cleanup_master_whitelist(master: rosgraph.Master, whitelist: list[str]) -> None:
     """Remove every registration of the nodes not in ``whitelist`` from the master."""
-    _unregister(master, master.getSystemState(), lambda n: n in whitelist)
+    _unregister(master, _snapshot(master), lambda n: n in whitelist)
 
 
 def rosnode_cleanup() -> None:

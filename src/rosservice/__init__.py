@@ -18,6 +18,7 @@ import rosgraph.names
 import rosmsg
 import rospy
 from ninjemys.errors import ServiceError
+from ninjemys.master.snapshot import GraphSnapshot
 from ninjemys.node.services import probe
 from roslib.message import get_service_class
 
@@ -59,6 +60,14 @@ def _succeed(args: Any) -> Any:
     if code != 1:
         raise ROSServiceException(f"remote call failed: {msg}")
     return val
+
+
+def _graph() -> GraphSnapshot:
+    """The registrations now, indexed as every graph reader indexes them (ninjemys.master.snapshot)."""
+    try:
+        return GraphSnapshot.from_system_state(_get_master().getSystemState())
+    except OSError:
+        raise ROSServiceIOException(_IO_ERROR) from None
 
 
 def _parse_rosrpc_uri(uri: str) -> tuple[str, int]:
@@ -113,10 +122,7 @@ def get_service_list(
     node: str | None = None, namespace: str | None = None, include_nodes: bool = False
 ) -> list[Any]:
     """The service names (of ``node``, under ``namespace``), or ``[name, [node, ...]]`` pairs."""
-    try:
-        srvs = _get_master().getSystemState()[2]
-    except OSError:
-        raise ROSServiceIOException(_IO_ERROR) from None
+    srvs = [[name, list(nodes)] for name, nodes in _graph().services.items()]
     if namespace:
         g_ns = rosgraph.names.make_global_ns(namespace)
         srvs = [x for x in srvs if x[0] == namespace or x[0].startswith(g_ns)]
@@ -137,12 +143,8 @@ def get_service_node(service_name: str) -> str | None:
 
 def rosservice_find(service_type: str) -> list[str]:
     """The services of type ``service_type`` (each probed; unreachable ones are skipped)."""
-    try:
-        services = _get_master().getSystemState()[2]
-    except OSError:
-        raise ROSServiceIOException(_IO_ERROR) from None
     found = []
-    for s, _nodes in services:
+    for s in _graph().services:
         try:
             if get_service_type(s) == service_type:
                 found.append(s)

@@ -19,6 +19,7 @@ from typing import Any
 import rosgraph
 import rosgraph.names
 import rospy
+from ninjemys.master.snapshot import GraphSnapshot
 from ninjemys.node.rates import (
     BandwidthWindow,
     DelayWindow,
@@ -204,9 +205,12 @@ def get_topic_class(
 def get_topic_list(master: rosgraph.Master | None = None) -> tuple[list[tuple[str, str, list[str]]], ...]:
     """``(publications, subscriptions)``, each ``[(topic, type, [node, ...]), ...]``."""
     master = master or _master()
-    pubs, subs, _srvs = master.getSystemState()
-    types: dict[str, str] = {t: tt for t, tt in _topic_types(master)}
-    return tuple([(t, types.get(t, "unknown type"), nodes) for t, nodes in part] for part in (pubs, subs))
+    state = master.getSystemState()
+    graph = GraphSnapshot.from_system_state(state, topic_types=_topic_types(master))
+    return tuple(
+        [(t, graph.topic_types.get(t, "unknown type"), list(nodes)) for t, nodes in table.items()]
+        for table in (graph.publishers, graph.subscribers)
+    )
 
 
 _caller_apis: dict[str, str] = {}

@@ -80,13 +80,22 @@ class GraphSnapshot:
         return cls(pubs, subs, srvs, topic_types, published_types)
 
     @classmethod
-    def fetch(cls, master: Any, with_types: bool = True) -> GraphSnapshot:
-        """Ask ``master`` (a :class:`~ninjemys.master.client.MasterClient`) now; ``with_types=False``
-        skips the two type queries."""
+    def fetch(cls, master: Any, with_types: bool = True, published: bool = True) -> GraphSnapshot:
+        """Ask ``master`` (a :class:`~ninjemys.master.client.MasterClient`) now. ``with_types=False``
+        skips both type queries, ``published=False`` only getPublishedTopics (a poller that needs
+        getTopicTypes alone saves a round trip)."""
         state = master.get_system_state()
         if not with_types:
             return cls.from_system_state(state)
-        return cls.from_system_state(state, master.get_topic_types(), master.get_published_topics("/"))
+        published_types = master.get_published_topics("/") if published else ()
+        return cls.from_system_state(state, master.get_topic_types(), published_types)
+
+    def same_graph(self, other: GraphSnapshot) -> bool:
+        """Whether ``other`` has the same registrations (types aside)."""
+        return all(
+            dict(getattr(self, a)) == dict(getattr(other, a))
+            for a in ("publishers", "subscribers", "services")
+        )
 
     def system_state(self) -> list[list[list[Any]]]:
         """The getSystemState form again (``[[name, [node, ...]], ...]`` three times), for ROS 1 APIs."""
