@@ -135,7 +135,7 @@ def _teleop(node: Node) -> int:
 
     def param(name: str, default: float | bool | str) -> float | bool | str:
         try:
-            return node.get_param("~" + name, default)  # type: ignore[no-any-return]
+            return node.get_param("~" + name, default)
         except NinjemysError as exc:
             node.log.warn("~%s: %s; using %r", name, exc, default)
             return default

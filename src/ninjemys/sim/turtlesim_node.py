@@ -18,6 +18,7 @@ import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 from typing import Any
 
 from geometry_msgs.msg import Twist
@@ -102,13 +103,9 @@ class TurtlesimNode:
         color = node.publisher(f"{name}/color_sensor", Color, queue_size=1)
         cmd = node.subscriber(f"{name}/cmd_vel", Twist, self._on_cmd_vel, callback_args=name, queue_size=1)
         services = [
-            node.service(f"{name}/set_pen", SetPen, lambda req, n=name: self._set_pen(n, req)),
-            node.service(
-                f"{name}/teleport_absolute", TeleportAbsolute, lambda req, n=name: self._teleport_abs(n, req)
-            ),
-            node.service(
-                f"{name}/teleport_relative", TeleportRelative, lambda req, n=name: self._teleport_rel(n, req)
-            ),
+            node.service(f"{name}/set_pen", SetPen, partial(self._set_pen, name)),
+            node.service(f"{name}/teleport_absolute", TeleportAbsolute, partial(self._teleport_abs, name)),
+            node.service(f"{name}/teleport_relative", TeleportRelative, partial(self._teleport_rel, name)),
         ]
         self.io[name] = _TurtleIO(pose, color, cmd, services)
 
