@@ -12,12 +12,13 @@ import socket
 import sys
 from typing import Any
 from urllib.parse import urlparse
+from xmlrpc.client import ServerProxy  # noqa: F401  (ROS 1's rosnode has it; calls go through _server_proxy)
 
 import rosgraph
 import rosgraph.names
 import rostopic
 from ninjemys.master.graph import CONNECTION_INFO, GraphSnapshot, ping_node
-from ninjemys.net.auth import server_proxy as ServerProxy  # noqa: N812 - signs when NINJEMYS_SECRET is set
+from ninjemys.net.auth import server_proxy as _server_proxy  # signs when NINJEMYS_SECRET is set
 
 __all__ = [
     "NAME",
@@ -169,7 +170,7 @@ def kill_nodes(node_names: list[str]) -> tuple[list[str], list[str]]:
             fail.append(n)
     for n, uri in tocall:
         try:
-            _succeed(ServerProxy(uri).shutdown(ID, "user request"))
+            _succeed(_server_proxy(uri).shutdown(ID, "user request"))
         except Exception:  # noqa: BLE001, S110  (the node may exit before answering)
             pass
         success.append(n)
@@ -304,7 +305,7 @@ def get_node_info_description(node_name: str) -> str:
 def get_node_connection_info_description(node_api: str, master: rosgraph.Master) -> str:
     """The second part of ``rosnode info``: the node's pid and its connections (getBusInfo)."""
     socket.setdefaulttimeout(5.0)
-    node = ServerProxy(node_api)
+    node = _server_proxy(node_api)
     state = master.getSystemState()
     try:
         buff = f"Pid: {_succeed(node.getPid(ID))}\n"
