@@ -8,18 +8,17 @@ ninjemys.tools.rosnode; the layering keeps facades below the tools.)
 
 from __future__ import annotations
 
-import errno
-import re
 import socket
 import sys
-import time
 from typing import Any
 from urllib.parse import urlparse
+from xmlrpc.client import ServerProxy  # noqa: F401  (ROS 1's rosnode has it; calls go through _server_proxy)
 
 import rosgraph
 import rosgraph.names
 import rostopic
-from ninjemys.net.auth import server_proxy as ServerProxy  # noqa: N812 - signs when NINJEMYS_SECRET is set
+from ninjemys.master.graph import CONNECTION_INFO, GraphSnapshot, ping_node
+from ninjemys.net.auth import server_proxy as _server_proxy  # signs when NINJEMYS_SECRET is set
 
 __all__ = [
     "NAME",
@@ -47,7 +46,7 @@ __all__ = [
 
 NAME = "rosnode"
 ID = "/rosnode"
-CONNECTION_PATTERN = re.compile(r"\w+ connection on port (\d+) to \[(.*) on socket (\d+)\]")
+CONNECTION_PATTERN = CONNECTION_INFO
 _IO_ERROR = "Unable to communicate with master!"
 
 
@@ -94,25 +93,23 @@ def lookup_uri(master: rosgraph.Master, system_state: Any, topic: str, uri: str)
     return uri
 
 
-def _state(master: rosgraph.Master) -> Any:
+def _snapshot(master: rosgraph.Master, with_types: bool = False) -> GraphSnapshot:
+    """The graph now, as the ``rosnode`` command indexes it (ninjemys.master.graph)."""
     try:
-        return master.getSystemState()
+        state = master.getSystemState()
+        published = master.getPublishedTopics("/") if with_types else ()
     except OSError:
         raise ROSNodeIOException(_IO_ERROR) from None
+    return GraphSnapshot.from_system_state(state, published_types=published)
 
 
 def get_node_names(namespace: str | None = None) -> list[str]:
     """Every node with a registration, or those in ``namespace`` (already resolved)."""
-    state = _state(rosgraph.Master(ID))
-    prefix = rosgraph.names.make_global_ns(namespace) if namespace else None
-    nodes = {
-        n
-        for part in state
-        for _name, registered in part
-        for n in registered
-        if prefix is None or n.startswith(prefix) or n == namespace
-    }
-    return list(nodes)
+    nodes = _snapshot(rosgraph.Master(ID)).node_names()
+    if not namespace:
+        return nodes
+    prefix = rosgraph.names.make_global_ns(namespace)
+    return [n for n in nodes if n.startswith(prefix) or n == namespace]
 
 
 def _host(uri: str) -> str | None:
@@ -173,7 +170,7 @@ def kill_nodes(node_names: list[str]) -> tuple[list[str], list[str]]:
             fail.append(n)
     for n, uri in tocall:
         try:
-            _succeed(ServerProxy(uri).shutdown(ID, "user request"))
+            _succeed(_server_proxy(uri).shutdown(ID, "user request"))
         except Exception:  # noqa: BLE001, S110  (the node may exit before answering)
             pass
         success.append(n)
@@ -201,65 +198,26 @@ def rosnode_ping(
     node_name: str, max_count: int | None = None, verbose: bool = False, skip_cache: bool = False
 ) -> bool:
     """Call the node's getPid ``max_count`` times (forever if None), a second apart; True if it
-    answered. Failures print ROS 1's messages on stderr and return False."""
+    answered. Failures print ROS 1's messages on stderr and return False (the loop is
+    :func:`ninjemys.master.graph.ping_node`, which the ``rosnode`` command runs too)."""
     master = rosgraph.Master(ID)
-    node_api = get_api_uri(master, node_name, skip_cache=skip_cache)
-    if not node_api:
-        print(f"cannot ping [{node_name}]: unknown node", file=sys.stderr)
-        return False
-    timeout = 3.0
-    if verbose:
-        print(f"pinging {node_name} with a timeout of {timeout}s")
-    socket.setdefaulttimeout(timeout)
-    node = ServerProxy(node_api)
-    count = 0
-    acc = 0.0
-    try:
-        while True:
-            try:
-                start = time.time()
-                _succeed(node.getPid(ID))
-                dur = (time.time() - start) * 1000.0
-                acc += dur
-                count += 1
-                if verbose:
-                    print(f"xmlrpc reply from {node_api}\ttime={dur:f}ms")
-            except TimeoutError:
-                print(f"connection to [{node_name}] timed out", file=sys.stderr)
-                return False
-            except OSError as e:
-                if e.errno == -2 or (isinstance(e, socket.gaierror) and e.errno == socket.EAI_NONAME):
-                    print(f"ERROR: Unknown host [{_host(node_api)}] for node [{node_name}]", file=sys.stderr)
-                elif e.errno == errno.ECONNREFUSED:
-                    new_api = get_api_uri(master, node_name, skip_cache=True)
-                    if not new_api:
-                        print(f"cannot ping [{node_name}]: unknown node", file=sys.stderr)
-                        return False
-                    if new_api != node_api:
-                        if verbose:
-                            print(f"node url has changed from [{node_api}] to [{new_api}], retrying to ping")
-                        node_api = new_api
-                        node = ServerProxy(node_api)
-                        continue
-                    print(f"ERROR: connection refused to [{node_api}]", file=sys.stderr)
-                else:
-                    print(f"connection to [{node_name}] failed", file=sys.stderr)
-                return False
-            if max_count and count >= max_count:
-                break
-            time.sleep(1.0)
-    except KeyboardInterrupt:
-        pass
-    if verbose and count > 1:
-        print(f"ping average: {acc / count:f}ms")
-    return True
+
+    def lookup(node: str, refresh: bool) -> str | None:
+        return get_api_uri(master, node, skip_cache=skip_cache or refresh)
+
+    return ping_node(
+        node_name,
+        lookup,
+        ID,
+        max_count=max_count,
+        verbose=verbose,
+        err=lambda line: print(line, file=sys.stderr),
+    )
 
 
 def rosnode_ping_all(verbose: bool = False, skip_cache: bool = False) -> tuple[list[str], list[str]]:
     """Ping every registered node once: ``(answered, silent)``."""
-    nodes = list(
-        {n for part in _state(rosgraph.Master(ID)) for _name, registered in part for n in registered}
-    )
+    nodes = _snapshot(rosgraph.Master(ID)).node_names()
     if verbose:
         print("Will ping the following nodes: \n" + "".join(f" * {n}\n" for n in nodes))
     pinged: list[str] = []
@@ -271,9 +229,9 @@ def rosnode_ping_all(verbose: bool = False, skip_cache: bool = False) -> tuple[l
     return pinged, unpinged
 
 
-def _unregister(master: rosgraph.Master, state: Any, keep: Any) -> None:
+def _unregister(master: rosgraph.Master, graph: GraphSnapshot, keep: Any) -> None:
     """Unregister, as each node itself, every registration of a node for which ``keep`` is False."""
-    pubs, subs, srvs = state
+    pubs, subs, srvs = (t.items() for t in (graph.publishers, graph.subscribers, graph.services))
     for topic, nodes in pubs:
         for n in nodes:
             if not keep(n) and (api := get_api_uri(master, n)):
@@ -290,17 +248,17 @@ def _unregister(master: rosgraph.Master, state: Any, keep: Any) -> None:
 
 def cleanup_master_blacklist(master: rosgraph.Master, blacklist: list[str]) -> None:
     """Remove every registration of the nodes in ``blacklist`` from the master (and our URI cache)."""
-    state = master.getSystemState()
+    graph = _snapshot(master)
     for n in blacklist:
         print("Unregistering", n)
-    _unregister(master, state, lambda n: n not in blacklist)
+    _unregister(master, graph, lambda n: n not in blacklist)
     for n in blacklist:
         _caller_apis.pop(n, None)
 
 
 def cleanup_master_whitelist(master: rosgraph.Master, whitelist: list[str]) -> None:
     """Remove every registration of the nodes not in ``whitelist`` from the master."""
-    _unregister(master, master.getSystemState(), lambda n: n in whitelist)
+    _unregister(master, _snapshot(master), lambda n: n in whitelist)
 
 
 def rosnode_cleanup() -> None:
@@ -326,13 +284,9 @@ def rosnode_cleanup() -> None:
 
 def get_node_info_description(node_name: str) -> str:
     """The first part of ``rosnode info``: the node's publications, subscriptions and services."""
-    master = rosgraph.Master(ID)
-    try:
-        state = master.getSystemState()
-        types = dict((t, tt) for t, tt in master.getPublishedTopics("/"))
-    except OSError:
-        raise ROSNodeIOException(_IO_ERROR) from None
-    pubs, subs, srvs = (sorted(t for t, nodes in part if node_name in nodes) for part in state)
+    snapshot = _snapshot(rosgraph.Master(ID), with_types=True)
+    pubs, subs, srvs = snapshot.topics_of(node_name)
+    types = snapshot.published_types
     buff = f"Node [{node_name}]"
     for title, names in (("Publications", pubs), ("Subscriptions", subs)):
         if names:
@@ -351,7 +305,7 @@ def get_node_info_description(node_name: str) -> str:
 def get_node_connection_info_description(node_api: str, master: rosgraph.Master) -> str:
     """The second part of ``rosnode info``: the node's pid and its connections (getBusInfo)."""
     socket.setdefaulttimeout(5.0)
-    node = ServerProxy(node_api)
+    node = _server_proxy(node_api)
     state = master.getSystemState()
     try:
         buff = f"Pid: {_succeed(node.getPid(ID))}\n"

@@ -8,18 +8,18 @@ ninjemys.tools.rosservice (the layering keeps facades below the tools).
 
 from __future__ import annotations
 
-import socket
 import sys
-from io import BytesIO
 from typing import Any
 
 import genpy
 import genpy.message
 import rosgraph
 import rosgraph.names
-import rosgraph.network
 import rosmsg
 import rospy
+from ninjemys.errors import ServiceError
+from ninjemys.master.snapshot import GraphSnapshot
+from ninjemys.node.services import probe
 from roslib.message import get_service_class
 
 __all__ = [
@@ -62,6 +62,14 @@ def _succeed(args: Any) -> Any:
     return val
 
 
+def _graph() -> GraphSnapshot:
+    """The registrations now, indexed as every graph reader indexes them (ninjemys.master.snapshot)."""
+    try:
+        return GraphSnapshot.from_system_state(_get_master().getSystemState())
+    except OSError:
+        raise ROSServiceIOException(_IO_ERROR) from None
+
+
 def _parse_rosrpc_uri(uri: str) -> tuple[str, int]:
     if not uri.startswith("rosrpc://"):
         raise ValueError(uri)
@@ -72,25 +80,21 @@ def _parse_rosrpc_uri(uri: str) -> tuple[str, int]:
 
 
 def get_service_headers(service_name: str, service_uri: str) -> dict[str, str]:
-    """The TCPROS header service ``service_name`` answers a probe with (its type, md5sum ...)."""
+    """The TCPROS header service ``service_name`` answers a probe with (its type, md5sum ...): the
+    probe is :func:`ninjemys.node.services.probe` (the rosservice command's, the gateway's), with
+    ROS 1's exceptions."""
     try:
-        addr, port = _parse_rosrpc_uri(service_uri)
+        _parse_rosrpc_uri(service_uri)
     except ValueError:
         raise ROSServiceException(
             f"service [{service_name}] has an invalid RPC URI [{service_uri}]"
         ) from None
-    family = socket.AF_INET6 if rosgraph.network.use_ipv6() else socket.AF_INET
-    with socket.socket(family, socket.SOCK_STREAM) as s:
-        try:
-            s.settimeout(5.0)
-            s.connect((addr, port))
-            header = {"probe": "1", "md5sum": "*", "callerid": "/rosservice", "service": service_name}
-            rosgraph.network.write_ros_handshake_header(s, header)
-            return rosgraph.network.read_ros_handshake_header(s, BytesIO(), 2048)
-        except OSError:
-            raise ROSServiceIOException(
-                f"Unable to communicate with service [{service_name}], address [{service_uri}]"
-            ) from None
+    try:
+        return probe(service_name, service_uri, 5.0, caller_id="/rosservice")
+    except ServiceError:
+        raise ROSServiceIOException(
+            f"Unable to communicate with service [{service_name}], address [{service_uri}]"
+        ) from None
 
 
 def get_service_type(service_name: str) -> str | None:
@@ -118,10 +122,7 @@ def get_service_list(
     node: str | None = None, namespace: str | None = None, include_nodes: bool = False
 ) -> list[Any]:
     """The service names (of ``node``, under ``namespace``), or ``[name, [node, ...]]`` pairs."""
-    try:
-        srvs = _get_master().getSystemState()[2]
-    except OSError:
-        raise ROSServiceIOException(_IO_ERROR) from None
+    srvs = [[name, list(nodes)] for name, nodes in _graph().services.items()]
     if namespace:
         g_ns = rosgraph.names.make_global_ns(namespace)
         srvs = [x for x in srvs if x[0] == namespace or x[0].startswith(g_ns)]
@@ -142,12 +143,8 @@ def get_service_node(service_name: str) -> str | None:
 
 def rosservice_find(service_type: str) -> list[str]:
     """The services of type ``service_type`` (each probed; unreachable ones are skipped)."""
-    try:
-        services = _get_master().getSystemState()[2]
-    except OSError:
-        raise ROSServiceIOException(_IO_ERROR) from None
     found = []
-    for s, _nodes in services:
+    for s in _graph().services:
         try:
             if get_service_type(s) == service_type:
                 found.append(s)

@@ -9,11 +9,9 @@ layering keeps facades below the tools, so the two share the master API, not cod
 from __future__ import annotations
 
 import itertools
-import math
 import sys
 import threading
 import time
-from collections import defaultdict
 from collections.abc import Callable, Sequence
 from io import StringIO
 from typing import Any
@@ -21,6 +19,16 @@ from typing import Any
 import rosgraph
 import rosgraph.names
 import rospy
+from ninjemys.master.snapshot import GraphSnapshot
+from ninjemys.node.rates import (
+    BandwidthWindow,
+    DelayWindow,
+    RateWindow,
+    bw_text,
+    delay_text,
+    hz_table,
+    hz_text,
+)
 from roslib.message import get_message_class
 
 __all__ = [
@@ -197,9 +205,12 @@ def get_topic_class(
 def get_topic_list(master: rosgraph.Master | None = None) -> tuple[list[tuple[str, str, list[str]]], ...]:
     """``(publications, subscriptions)``, each ``[(topic, type, [node, ...]), ...]``."""
     master = master or _master()
-    pubs, subs, _srvs = master.getSystemState()
-    types: dict[str, str] = {t: tt for t, tt in _topic_types(master)}
-    return tuple([(t, types.get(t, "unknown type"), nodes) for t, nodes in part] for part in (pubs, subs))
+    state = master.getSystemState()
+    graph = GraphSnapshot.from_system_state(state, topic_types=_topic_types(master))
+    return tuple(
+        [(t, graph.topic_types.get(t, "unknown type"), list(nodes)) for t, nodes in table.items()]
+        for table in (graph.publishers, graph.subscribers)
+    )
 
 
 _caller_apis: dict[str, str] = {}
@@ -249,209 +260,160 @@ def find_by_type(topic_type: str) -> list[str]:
 
 
 class ROSTopicHz:
-    """Receives messages (``callback_hz``) and computes their rate statistics, per topic."""
+    """Receives messages (``callback_hz``) and computes their rate statistics, per topic.
+
+    ROS 1's class shape over :class:`ninjemys.node.rates.RateWindow` (one per topic; topic None is
+    the single-topic state ROS 1 kept in plain attributes): the window, formulas and printed lines
+    are the ``rostopic hz`` command's."""
 
     def __init__(
         self, window_size: int, filter_expr: Callable[[Any], bool] | None = None, use_wtime: bool = False
     ):
         self.lock = threading.Lock()
-        self.last_printed_tn: float = 0
-        self.msg_t0: float = -1
-        self.msg_tn: float = 0
-        self.times: list[float] = []
-        self._last_printed_tn: dict[Any, float] = defaultdict(int)
-        self._msg_t0: dict[Any, float] = defaultdict(lambda: -1)
-        self._msg_tn: dict[Any, float] = defaultdict(int)
-        self._times: dict[Any, list[float]] = defaultdict(list)
         self.filter_expr = filter_expr
         self.use_wtime = use_wtime
         self.window_size = 50000 if window_size < 0 else window_size
+        self._windows: dict[Any, RateWindow] = {}
 
-    # the per-topic state; topic None is the single-topic state ROS 1 kept in plain attributes
+    def _window(self, topic: str | None) -> RateWindow:
+        window = self._windows.get(topic)
+        if window is None:
+            window = self._windows[topic] = RateWindow(self.window_size)
+        return window
+
+    # ROS 1's accessors of the per-topic state
     def get_last_printed_tn(self, topic: str | None = None) -> float:
-        return self.last_printed_tn if topic is None else self._last_printed_tn[topic]
+        return self._window(topic).last_reported or 0
 
     def set_last_printed_tn(self, value: float, topic: str | None = None) -> None:
-        if topic is None:
-            self.last_printed_tn = value
-        self._last_printed_tn[topic] = value
+        self._window(topic).last_reported = value
 
     def get_msg_t0(self, topic: str | None = None) -> float:
-        return self.msg_t0 if topic is None else self._msg_t0[topic]
+        first = self._window(topic).first
+        return -1 if first is None else first
 
     def set_msg_t0(self, value: float, topic: str | None = None) -> None:
-        if topic is None:
-            self.msg_t0 = value
-        self._msg_t0[topic] = value
+        self._window(topic).first = None if value < 0 else value
 
     def get_msg_tn(self, topic: str | None = None) -> float:
-        return self.msg_tn if topic is None else self._msg_tn[topic]
+        return self._window(topic).last or 0
 
     def set_msg_tn(self, value: float, topic: str | None = None) -> None:
-        if topic is None:
-            self.msg_tn = value
-        self._msg_tn[topic] = value
+        self._window(topic).last = value
 
     def get_times(self, topic: str | None = None) -> list[float]:
-        return self.times if topic is None else self._times[topic]
+        return list(self._window(topic).gaps)
 
     def set_times(self, value: list[float], topic: str | None = None) -> None:
-        if topic is None:
-            self.times = value
-        self._times[topic] = value
+        gaps = self._window(topic).gaps
+        gaps.clear()
+        gaps.extend(value)
+
+    last_printed_tn = property(get_last_printed_tn, set_last_printed_tn)
+    msg_t0 = property(get_msg_t0, set_msg_t0)
+    msg_tn = property(get_msg_tn, set_msg_tn)
+    times = property(get_times, set_times)
 
     def callback_hz(self, m: Any, topic: str | None = None) -> None:
         """Subscriber callback: record the arrival time (ROS time, or wall time with use_wtime)."""
         if self.filter_expr is not None and not self.filter_expr(m):
             return
-        with self.lock:
-            now = rospy.Time.from_sec(time.time()) if self.use_wtime else rospy.get_rostime()
-            if now.is_zero():
-                if self.get_times(topic):
-                    print("time has reset, resetting counters")
-                    self.set_times([], topic)
-                return
-            curr = now.to_sec()
-            t0 = self.get_msg_t0(topic)
-            if t0 < 0 or t0 > curr:
-                self.set_msg_t0(curr, topic)
-                self.set_msg_tn(curr, topic)
-                self.set_times([], topic)
-            else:
-                self.get_times(topic).append(curr - self.get_msg_tn(topic))
-                self.set_msg_tn(curr, topic)
-            if len(self.get_times(topic)) > self.window_size - 1:
-                self.get_times(topic).pop(0)
+        now = rospy.Time.from_sec(time.time()) if self.use_wtime else rospy.get_rostime()
+        window = self._window(topic)
+        if now.is_zero():
+            if window.gaps:
+                print("time has reset, resetting counters")
+                window.reset()
+            return
+        window.arrived(now.to_sec())
 
     def get_hz(self, topic: str | None = None) -> tuple[float, float, float, float, int] | None:
         """``(rate, min_delta, max_delta, std_dev, window)``, or None without new messages."""
-        times = self.get_times(topic)
-        if not times or self.get_msg_tn(topic) == self.get_last_printed_tn(topic):
-            return None
-        with self.lock:
-            n = len(times)
-            mean = sum(times) / n
-            rate = 1.0 / mean if mean > 0.0 else 0
-            std_dev = math.sqrt(sum((x - mean) ** 2 for x in times) / n)
-            self.set_last_printed_tn(self.get_msg_tn(topic), topic)
-            return rate, min(times), max(times), std_dev, n + 1
+        return self._window(topic).report()
 
     def print_hz(self, topics: Sequence[str | None] = (None,)) -> None:
         """Print the rate of one topic, or a table of several, as ``rostopic hz`` does."""
         if len(topics) == 1:
-            ret = self.get_hz(topics[0])
-            if ret is None:
-                print("no new messages")
-                return
-            rate, lo, hi, std, window = ret
-            print(
-                f"average rate: {rate:.3f}\n\tmin: {lo:.3f}s max: {hi:.3f}s std dev: {std:.5f}s window: {window}"
-            )
+            print(hz_text(self.get_hz(topics[0])))
             return
-        header = ["topic", "rate", "min_delta", "max_delta", "std_dev", "window"]
-        rows = [(t, s) for t in topics if (s := self.get_hz(t)) is not None]
-        if not rows:
-            print("no new messages")
-            return
-        cells = [[str(t), *(f"{v:.4}" for v in s[:4]), str(s[4])] for t, s in rows]
-        widths = [max(len(h), *(len(c[i]) for c in cells)) for i, h in enumerate(header)]
-        head = "   ".join(h.center(w) for h, w in zip(header, widths, strict=True))
-        body = "\n".join("   ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)) for row in cells)
-        print(f"{head}\n{'=' * (sum(widths) + 3 * (len(header) - 1))}\n{body}\n")
+        print(hz_table([(str(t), self.get_hz(t)) for t in topics]))
 
 
 class ROSTopicDelay:
-    """Receives stamped messages (``callback_delay``) and computes the delay of their stamps."""
+    """Receives stamped messages (``callback_delay``) and computes the delay of their stamps
+    (ROS 1's class shape over :class:`ninjemys.node.rates.DelayWindow`)."""
 
     def __init__(self, window_size: int):
         self.lock = threading.Lock()
-        self.last_msg_tn: float = 0
-        self.msg_t0: float = -1.0
-        self.msg_tn: float = 0
-        self.delays: list[float] = []
         self.window_size = 50000 if window_size < 0 else window_size
+        self._window = DelayWindow(self.window_size)
+
+    @property
+    def delays(self) -> list[float]:
+        return list(self._window.delays)
+
+    @property
+    def msg_t0(self) -> float:
+        return -1.0 if self._window.first is None else self._window.first
+
+    @property
+    def msg_tn(self) -> float:
+        return self._window.last or 0
 
     def callback_delay(self, msg: Any) -> None:
         """Subscriber callback: record now minus the message's header stamp."""
         if not msg._has_header:
             rospy.logerr("msg does not have header")
             return
-        with self.lock:
-            now = rospy.get_rostime()
-            if now.is_zero():
-                if self.delays:
-                    print("time has reset, resetting counters")
-                    self.delays = []
-                return
-            curr = now.to_sec()
-            if self.msg_t0 < 0 or self.msg_t0 > curr:
-                self.msg_t0 = self.msg_tn = curr
-                self.delays = []
-            else:
-                self.delays.append(curr - msg.header.stamp.to_sec())
-                self.msg_tn = curr
-            if len(self.delays) > self.window_size - 1:
-                self.delays.pop(0)
+        now = rospy.get_rostime()
+        if now.is_zero():
+            if self._window.delays:
+                print("time has reset, resetting counters")
+                self._window.reset()
+            return
+        self._window.arrived(now.to_sec(), msg.header.stamp.to_sec())
 
     def get_delay(self) -> tuple[float, float, float, float, int] | None:
         """``(mean, min, max, std_dev, window)`` of the delays, or None without new messages."""
-        if self.msg_tn == self.last_msg_tn:
-            return None
-        with self.lock:
-            if not self.delays:
-                return None
-            n = len(self.delays)
-            mean = sum(self.delays) / n
-            std_dev = math.sqrt(sum((x - mean) ** 2 for x in self.delays) / n)
-            self.last_msg_tn = self.msg_tn
-            return mean, min(self.delays), max(self.delays), std_dev, n + 1
+        return self._window.report()
 
     def print_delay(self) -> None:
         """Print the delay statistics as ``rostopic delay`` does."""
-        if not self.delays:
+        if not self._window.delays:
             return
-        ret = self.get_delay()
-        if ret is None:
-            print("no new messages")
-            return
-        mean, lo, hi, std, window = ret
-        print(
-            f"average delay: {mean:.3f}\n\tmin: {lo:.3f}s max: {hi:.3f}s std dev: {std:.5f}s window: {window}"
-        )
+        print(delay_text(self.get_delay()))
 
 
 class ROSTopicBandwidth:
-    """Receives raw messages (``rospy.AnyMsg``, ``callback``) and computes the bandwidth they use."""
+    """Receives raw messages (``rospy.AnyMsg``, ``callback``) and computes the bandwidth they use
+    (ROS 1's class shape over :class:`ninjemys.node.rates.BandwidthWindow`)."""
 
     def __init__(self, window_size: int = 100):
         self.lock = threading.Lock()
-        self.last_printed_tn: float = 0
-        self.sizes: list[int] = []
-        self.times: list[float] = []
         self.window_size = window_size or 100
+        self._window = BandwidthWindow(self.window_size)
+
+    @property
+    def times(self) -> list[float]:
+        return [t for t, _ in list(self._window.samples)]
+
+    @property
+    def sizes(self) -> list[int]:
+        return [s for _, s in list(self._window.samples)]
+
+    @property
+    def last_printed_tn(self) -> float:
+        return 0
 
     def callback(self, data: Any) -> None:
         """Subscriber callback: record the message's wire size and arrival (wall) time."""
-        with self.lock:
-            self.times.append(time.time())
-            self.sizes.append(len(data._buff))
-            if len(self.times) > self.window_size:
-                self.times.pop(0)
-                self.sizes.pop(0)
+        self._window.arrived(time.time(), len(data._buff))
 
     def print_bw(self) -> None:
         """Print average bandwidth and message sizes as ``rostopic bw`` does (nothing before 2 messages)."""
-        if len(self.times) < 2:
-            return
-        with self.lock:
-            n = len(self.times)
-            total = sum(self.sizes)
-            values = [total / (time.time() - self.times[0]), total / n, min(self.sizes), max(self.sizes)]
-        scale, unit = (
-            (1, "B") if values[0] < 1000 else (1000, "KB") if values[0] < 1000000 else (1000000, "MB")
-        )
-        bw, mean, lo, hi = (f"{v / scale:.2f}{unit}" for v in values)
-        print(f"average: {bw}/s\n\tmean: {mean} min: {lo} max: {hi} window: {n}")
+        stats = self._window.report(time.time())
+        if stats is not None:
+            print(bw_text(stats))
 
 
 def create_publisher(

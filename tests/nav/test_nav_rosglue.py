@@ -1,46 +1,34 @@
-"""The nav nodes' background loops survive ROS time moving backwards (a /gazebo/reset_simulation)."""
+"""The nav nodes run on the core Node (one idiom from core to apps): their background loops survive ROS
+time moving backwards (a /gazebo/reset_simulation) and end on shutdown (tests/test_node_idiom.py
+checks that no app module imports rospy)."""
 
 from __future__ import annotations
 
-import pytest
-
-import rospy
+from ninjemys.errors import ShutdownError
 from ninjemys.nav import rosglue
+from ninjemys.node.run import run_node
+from ninjemys.node.timers import TimeMovedBackwardsError
 
 
-def test_sleep_goes_on_when_ros_time_moves_backwards(monkeypatch: pytest.MonkeyPatch) -> None:
-    def jumped(_seconds: float) -> None:
-        raise rospy.ROSTimeMovedBackwardsException(1.0)
+class _Node:
+    def __init__(self, raises: BaseException | None, shut: bool = False) -> None:
+        self.raises = raises
+        self.is_shutdown = shut
 
-    monkeypatch.setattr(rospy, "sleep", jumped)
-    monkeypatch.setattr(rospy, "is_shutdown", lambda: False)
-    assert rosglue.sleep(0.1) is True  # the loop goes on
-
-
-def test_sleep_ends_the_loop_on_shutdown(monkeypatch: pytest.MonkeyPatch) -> None:
-    def interrupted(_seconds: float) -> None:
-        raise rospy.ROSInterruptException("shutdown")
-
-    monkeypatch.setattr(rospy, "sleep", interrupted)
-    assert rosglue.sleep(0.1) is False
+    def sleep(self, _seconds: float) -> None:
+        if self.raises is not None:
+            raise self.raises
 
 
-def test_ctrl_c_during_init_node_ends_the_node_quietly(monkeypatch: pytest.MonkeyPatch) -> None:
-    def interrupted(*_args, **_kwargs) -> None:
-        raise rospy.ROSInitException("init_node interrupted before it could complete")
-
-    monkeypatch.setattr(rospy, "init_node", interrupted)
-    monkeypatch.setattr(rospy, "is_shutdown", lambda: True)
-    built = []
-    assert rosglue.run_node("move_base", [], built.append) == 0
-    assert built == []
+def test_sleep_goes_on_when_ros_time_moves_backwards() -> None:
+    assert rosglue.node_sleep(_Node(TimeMovedBackwardsError(5.0, 1.0)), 0.1) is True
+    assert rosglue.node_sleep(_Node(None), 0.1) is True
 
 
-def test_a_failed_init_node_is_not_hidden(monkeypatch: pytest.MonkeyPatch) -> None:
-    def failed(*_args, **_kwargs) -> None:
-        raise rospy.ROSInitException("Unable to register with master node")
+def test_sleep_ends_the_loop_on_shutdown() -> None:
+    assert rosglue.node_sleep(_Node(ShutdownError("bye")), 0.1) is False
+    assert rosglue.node_sleep(_Node(None, shut=True), 0.1) is False
 
-    monkeypatch.setattr(rospy, "init_node", failed)
-    monkeypatch.setattr(rospy, "is_shutdown", lambda: False)
-    with pytest.raises(rospy.ROSInitException):
-        rosglue.run_node("move_base", [], lambda node: None)
+
+def test_nav_nodes_run_on_the_one_runner() -> None:
+    assert rosglue.run_node is run_node  # ninjemys.node.run's: the one runner of in-house nodes

@@ -59,9 +59,9 @@ def test_hz_reports_100hz(master_uri, tmp_path):
 
 
 def test_hz_statistics_are_ros1s_formulas():
-    from ninjemys.tools.topic_rates import RateStats
+    from ninjemys.node.rates import RateWindow
 
-    stats = RateStats(window=5)
+    stats = RateWindow(window=5)
     for t in (10.0, 10.01, 10.03, 10.04, 10.05, 10.07):  # 6 arrivals, window keeps the last 4 gaps
         stats.arrived(t)
     rate, lo, hi, std, window = stats.report()

@@ -26,6 +26,7 @@ from ninjemys.bag.format import DEFAULT_CHUNK_THRESHOLD
 from ninjemys.bag.writer import BagWriter
 from ninjemys.errors import BagError, NinjemysError
 from ninjemys.interrupt import wait_event
+from ninjemys.master.snapshot import GraphSnapshot
 
 
 @dataclass
@@ -209,8 +210,7 @@ class Recorder:
         try:
             if self.options.node:
                 node_name = self.node.resolve_name(self.options.node)
-                state = self.node.master.get_system_state()
-                topics = [t for t, nodes in state[1] if node_name in nodes]
+                topics = GraphSnapshot.fetch(self.node.master, with_types=False).topics_of(node_name)[1]
             else:
                 topics = [t for t, _type in self.node.master.get_published_topics()]
         except NinjemysError as exc:

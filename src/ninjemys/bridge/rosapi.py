@@ -17,6 +17,7 @@ from typing import Any
 
 from ninjemys.errors import NinjemysError
 from ninjemys.idl.loader import get_message_class, get_message_spec, get_service_class
+from ninjemys.master.snapshot import GraphSnapshot
 from ninjemys.net.addresses import split_uri
 from ninjemys.node import Node
 from ninjemys.node.clock import for_node
@@ -141,10 +142,11 @@ class RosApi:
 
     # -- graph --------------------------------------------------------------------------------
     def _types(self) -> list[tuple[str, str]]:
-        return [tuple(p) for p in self.master.get_topic_types()]
+        return list(GraphSnapshot.fetch(self.master, published=False).topic_types.items())
 
-    def _state(self) -> Any:
-        return self.master.get_system_state()
+    def _graph(self) -> GraphSnapshot:
+        """The registrations now (one getSystemState, indexed as every graph reader indexes it)."""
+        return GraphSnapshot.fetch(self.master, with_types=False)
 
     def topics(self, _req: Any) -> Any:
         pairs = self._types()
@@ -168,7 +170,7 @@ class RosApi:
         }
 
     def services(self, _req: Any) -> Any:
-        return {"services": [s for s, _ in self._state()[2]]}
+        return {"services": list(self._graph().services)}
 
     def _service_type(self, service: str) -> str:
         try:
@@ -177,22 +179,14 @@ class RosApi:
             return ""
 
     def services_for_type(self, req: Any) -> Any:
-        return {"services": [s for s, _ in self._state()[2] if self._service_type(s) == req.type]}
+        return {"services": [s for s in self._graph().services if self._service_type(s) == req.type]}
 
     def nodes(self, _req: Any) -> Any:
-        names: set[str] = set()
-        for group in self._state():
-            for _, nodes in group:
-                names.update(nodes)
-        return {"nodes": sorted(names)}
+        return {"nodes": self._graph().node_names()}
 
     def node_details(self, req: Any) -> Any:
-        pubs, subs, srvs = self._state()
-        return {
-            "subscribing": [t for t, n in subs if req.node in n],
-            "publishing": [t for t, n in pubs if req.node in n],
-            "services": [s for s, n in srvs if req.node in n],
-        }
+        publishing, subscribing, services = self._graph().topics_of(req.node)
+        return {"subscribing": subscribing, "publishing": publishing, "services": services}
 
     def action_servers(self, _req: Any) -> Any:
         topics = {t for t, _ in self._types()}
@@ -211,21 +205,22 @@ class RosApi:
         return {"type": self._service_type(req.service)}
 
     def publishers(self, req: Any) -> Any:
-        return {"publishers": next((n for t, n in self._state()[0] if t == req.topic), [])}
+        return {"publishers": list(self._graph().publishers.get(req.topic, ()))}
 
     def subscribers(self, req: Any) -> Any:
-        return {"subscribers": next((n for t, n in self._state()[1] if t == req.topic), [])}
+        return {"subscribers": list(self._graph().subscribers.get(req.topic, ()))}
 
     def service_providers(self, req: Any) -> Any:
         """The nodes providing a service of type ``req.service`` (rosapi's own reading of the field)."""
         providers: list[str] = []
-        for service, nodes in self._state()[2]:
+        for service, nodes in self._graph().services.items():
             if self._service_type(service) == req.service:
                 providers.extend(n for n in nodes if n not in providers)
         return {"providers": providers}
 
     def service_node(self, req: Any) -> Any:
-        return {"node": next((n[0] for s, n in self._state()[2] if s == req.service and n), "")}
+        providers = self._graph().services.get(req.service, ())
+        return {"node": providers[0] if providers else ""}
 
     def service_host(self, req: Any) -> Any:
         try:

@@ -21,7 +21,7 @@ import logging
 import ssl
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -38,6 +38,7 @@ from ninjemys.bridge.outbox import CloseRequest, Outbox
 from ninjemys.bridge.rosbridge import RosbridgeSession
 from ninjemys.errors import NinjemysError
 from ninjemys.idl.loader import get_message_class, get_service_class
+from ninjemys.master.snapshot import GraphSnapshot
 from ninjemys.net import auth
 from ninjemys.node import Node
 from ninjemys.serve.http import HttpServer, Request, Response
@@ -130,8 +131,8 @@ class Catalog:
         self._ids = itertools.count(1)
         self._unknown: set[str] = set()
         self._service_types: dict[str, str] = {}
-        self.graph: dict[str, dict[str, list[str]]] = {"pub": {}, "sub": {}, "srv": {}}
-        self.topic_types: dict[str, str] = {}
+        #: the graph as of the last refresh (the one snapshot type every graph reader uses)
+        self.snapshot = GraphSnapshot()
         #: channels an in-process app publishes (not ROS topics): id -> channel; never refreshed away
         self.app: dict[int, AppChannel] = {}
         self._lock = threading.Lock()
@@ -155,11 +156,8 @@ class Catalog:
 
         ``learn(topic, type)`` gives the definition text of a type the gateway cannot load (as a
         publisher sent it), or None while it is not known yet."""
-        state = node.master.get_system_state()
-        types = dict(node.master.get_topic_types())
-        pubs = {t: sorted(n) for t, n in state[0]}
-        subs = {t: sorted(n) for t, n in state[1]}
-        srvs = {s: sorted(n) for s, n in state[2]}
+        snapshot = GraphSnapshot.fetch(node.master, published=False)
+        types, pubs, srvs = snapshot.topic_types, snapshot.publishers, snapshot.services
         added, removed = [], []
         wanted: dict[tuple[str, str], None] = {}
         for topic in pubs:
@@ -243,21 +241,29 @@ class Catalog:
                 sid = self._service_ids.pop(key)
                 self.services.pop(sid, None)
             removed_srv.append(sid)
-        old = self.graph
-        self.graph = {"pub": pubs, "sub": subs, "srv": srvs}
-        self.topic_types = types
+        old, self.snapshot = self.snapshot, snapshot
         return {
             "channels": added,
             "removed_channels": removed,
             "services": added_srv,
             "removed_services": removed_srv,
-            "graph_changed": old != self.graph,
+            "graph_changed": not old.same_graph(snapshot),
             "old_graph": old,
         }
 
+    @property
+    def topic_types(self) -> Mapping[str, str]:
+        """getTopicTypes as of the last refresh."""
+        return self.snapshot.topic_types
+
+    @property
+    def graph(self) -> dict[str, dict[str, list[str]]]:
+        """The last snapshot as the connection graph shows it: name -> sorted node names."""
+        return _graph_view(self.snapshot)
+
     def node_names(self) -> set[str]:
         """Every node the master lists as a publisher, subscriber or service provider."""
-        return {n for table in self.graph.values() for nodes in table.values() for n in nodes}
+        return set(self.snapshot.node_names())
 
     @staticmethod
     def bus_update(state: dict[str, Any]) -> dict[str, Any]:
@@ -273,29 +279,45 @@ class Catalog:
             "rosBus": state,
         }
 
-    def graph_update(self, full: bool, old: dict[str, dict[str, list[str]]] | None = None) -> dict[str, Any]:
+    def graph_update(self, full: bool, old: GraphSnapshot | None = None) -> dict[str, Any]:
+        """A connectionGraphUpdate: everything (``full``) or what changed since ``old``."""
         g = self.graph
-        old = old if old is not None and not full else {"pub": {}, "sub": {}, "srv": {}}
+        old_view = _graph_view(old if old is not None and not full else GraphSnapshot())
+        return _graph_diff(g, old_view)
 
-        gone = (set(old["pub"]) | set(old["sub"])) - (set(g["pub"]) | set(g["sub"]))
 
-        def changed(kind: str) -> list[str]:
-            # a topic that lost its last publisher (or subscriber) but still exists is listed with no
-            # ids; one that left altogether is in removedTopics
-            now = [k for k, v in g[kind].items() if old[kind].get(k) != v]
-            emptied = [k for k in old[kind] if k not in g[kind] and k not in gone]
-            return now + emptied
+def _graph_view(snapshot: GraphSnapshot) -> dict[str, dict[str, list[str]]]:
+    return {
+        kind: {name: sorted(nodes) for name, nodes in table.items()}
+        for kind, table in (
+            ("pub", snapshot.publishers),
+            ("sub", snapshot.subscribers),
+            ("srv", snapshot.services),
+        )
+    }
 
-        return {
-            "op": "connectionGraphUpdate",
-            "publishedTopics": [{"name": t, "publisherIds": g["pub"].get(t, [])} for t in changed("pub")],
-            "subscribedTopics": [{"name": t, "subscriberIds": g["sub"].get(t, [])} for t in changed("sub")],
-            "advertisedServices": [
-                {"name": s, "providerIds": g["srv"][s]} for s in g["srv"] if old["srv"].get(s) != g["srv"][s]
-            ],
-            "removedTopics": sorted(gone),
-            "removedServices": sorted(set(old["srv"]) - set(g["srv"])),
-        }
+
+def _graph_diff(g: dict[str, dict[str, list[str]]], old: dict[str, dict[str, list[str]]]) -> dict[str, Any]:
+    """Foxglove's connectionGraphUpdate from graph view ``old`` to ``g``."""
+    gone = (set(old["pub"]) | set(old["sub"])) - (set(g["pub"]) | set(g["sub"]))
+
+    def changed(kind: str) -> list[str]:
+        # a topic that lost its last publisher (or subscriber) but still exists is listed with no
+        # ids; one that left altogether is in removedTopics
+        now = [k for k, v in g[kind].items() if old[kind].get(k) != v]
+        emptied = [k for k in old[kind] if k not in g[kind] and k not in gone]
+        return now + emptied
+
+    return {
+        "op": "connectionGraphUpdate",
+        "publishedTopics": [{"name": t, "publisherIds": g["pub"].get(t, [])} for t in changed("pub")],
+        "subscribedTopics": [{"name": t, "subscriberIds": g["sub"].get(t, [])} for t in changed("sub")],
+        "advertisedServices": [
+            {"name": s, "providerIds": g["srv"][s]} for s in g["srv"] if old["srv"].get(s) != g["srv"][s]
+        ],
+        "removedTopics": sorted(gone),
+        "removedServices": sorted(set(old["srv"]) - set(g["srv"])),
+    }
 
 
 class _Client:

@@ -30,13 +30,14 @@ from ninjemys.dynamic_reconfigure.errors import (
 from ninjemys.errors import ServiceError, TimeoutError_
 from ninjemys.idl.loader import get_message_class, get_service_class
 from ninjemys.interrupt import wait_slice
+from ninjemys.master.snapshot import GraphSnapshot
 
 
 def reconfigure_servers(node: Any) -> list[str]:
     """Every node name that offers ``<name>/set_parameters``, sorted (``dynparam list``)."""
     suffix = "/set_parameters"
-    _pubs, _subs, services = node.master.get_system_state()
-    return sorted(name[: -len(suffix)] for name, _providers in services if name.endswith(suffix))
+    services = GraphSnapshot.fetch(node.master, with_types=False).services
+    return sorted(name[: -len(suffix)] for name in services if name.endswith(suffix))
 
 
 def _param_type(name: str) -> type:

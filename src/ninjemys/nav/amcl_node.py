@@ -25,7 +25,6 @@ from typing import Any
 
 import numpy as np
 
-import rospy
 from ninjemys.nav.amcl import AMCLParams, ParticleFilter
 from ninjemys.nav.rosglue import (
     Pose2D,
@@ -34,10 +33,11 @@ from ninjemys.nav.rosglue import (
     grid_from_msg,
     param,
     pose_msg_to_2d,
-    run_node,
+    run_core_node,
     scan_arrays,
     tf_item,
 )
+from ninjemys.node.log import WARN
 from ninjemys.tf2.math import se2_compose, se2_inverse
 
 
@@ -60,10 +60,12 @@ class AmclNode:
         self.params.update(values)
         laser_model = param(node, "laser_model_type", "likelihood_field")
         if laser_model not in ("likelihood_field", "likelihood_field_prob"):
-            rospy.logwarn("amcl: ~laser_model_type %r is not available; using likelihood_field", laser_model)
+            self.node.log.warn(
+                "amcl: ~laser_model_type %r is not available; using likelihood_field", laser_model
+            )
         odom_model = param(node, "odom_model_type", "diff")
         if odom_model not in ("diff", "diff-corrected"):
-            rospy.logwarn("amcl: ~odom_model_type %r is not available; using diff", odom_model)
+            self.node.log.warn("amcl: ~odom_model_type %r is not available; using diff", odom_model)
         self.global_frame = param(node, "global_frame_id", "map")
         self.odom_frame = param(node, "odom_frame_id", "odom")
         self.base_frame = param(node, "base_frame_id", "base_link")
@@ -106,27 +108,29 @@ class AmclNode:
     def _request_map(self) -> None:
         from nav_msgs.srv import GetMap
 
-        rospy.loginfo("Requesting the map...")
-        while not rospy.is_shutdown():
+        self.node.log.info("Requesting the map...")
+        while not self.node.is_shutdown:
             try:
                 self.node.wait_for_service("static_map", timeout=2.0)
                 proxy = self.node.service_proxy("static_map", GetMap)
                 self.on_map(proxy().map)
                 return
             except Exception as exc:  # the service is not up yet: ROS 1 amcl waits and retries too
-                rospy.logwarn_throttle(10.0, "Request for map failed; trying again... (%s)", exc)
+                self.node.log.log_throttle(10.0, WARN, "Request for map failed; trying again... (%s)", exc)
 
     def on_map(self, msg: Any) -> None:
         with self.lock:
             if self.pf is not None and param(self.node, "first_map_only", False):
                 return
             grid = grid_from_msg(msg)
-            rospy.loginfo("Received a %d X %d map @ %.3f m/pix", grid.width, grid.height, grid.resolution)
+            self.node.log.info(
+                "Received a %d X %d map @ %.3f m/pix", grid.width, grid.height, grid.resolution
+            )
             seed = None if self.seed < 0 else self.seed
             self.pf = ParticleFilter(grid, self.params, seed=seed)
             x, y, a = self.init_pose
             self.pf.init_gaussian((x, y, a), *self.init_cov)
-            rospy.loginfo("Initializing with the initial pose: %.3f %.3f %.3f", x, y, a)
+            self.node.log.info("Initializing with the initial pose: %.3f %.3f %.3f", x, y, a)
             self.force_update = True
             self.last_odom = None
 
@@ -144,12 +148,12 @@ class AmclNode:
 
         with self.lock:
             if self.pf is None:
-                rospy.logwarn("amcl: global_localization before a map arrived; ignored")
+                self.node.log.warn("amcl: global_localization before a map arrived; ignored")
             else:
-                rospy.loginfo("Initializing with uniform distribution")
+                self.node.log.info("Initializing with uniform distribution")
                 self.pf.init_global()
                 self.force_update = True
-                rospy.loginfo("Global initialisation done!")
+                self.node.log.info("Global initialisation done!")
         return EmptyResponse()
 
     def on_nomotion(self, _req: Any) -> Any:
@@ -157,13 +161,13 @@ class AmclNode:
 
         with self.lock:
             self.force_update = True
-        rospy.loginfo("Requesting no-motion update")
+        self.node.log.info("Requesting no-motion update")
         return EmptyResponse()
 
     def on_initial_pose(self, msg: Any) -> None:
         frame = msg.header.frame_id.lstrip("/")
         if frame and frame != self.global_frame:
-            rospy.logwarn(
+            self.node.log.warn(
                 'Ignoring initial pose in frame "%s"; initial poses must be in the global frame, "%s"',
                 frame,
                 self.global_frame,
@@ -172,10 +176,10 @@ class AmclNode:
         x, y, a = pose_msg_to_2d(msg.pose.pose)
         cov = msg.pose.covariance
         if not all(math.isfinite(v) for v in (x, y, a, cov[0], cov[7], cov[35])):
-            rospy.logerr("amcl: initialpose has NaN or inf values; ignored")
+            self.node.log.error("amcl: initialpose has NaN or inf values; ignored")
             return
         with self.lock:
-            rospy.loginfo("Setting pose (%.6f): %.3f %.3f %.3f", rospy.get_time(), x, y, a)
+            self.node.log.info("Setting pose (%.6f): %.3f %.3f %.3f", self.node.get_time(), x, y, a)
             self.init_pose = (x, y, a)
             self.init_cov = (float(cov[0]), float(cov[7]), float(cov[35]))
             if self.pf is not None:
@@ -191,8 +195,9 @@ class AmclNode:
         # the odometry of the scan's own instant (waiting for it, as amcl's message filter does)
         odom = self.tf.lookup_at(self.odom_frame, self.base_frame, t)
         if odom is None:
-            rospy.logwarn_throttle(
+            self.node.log.log_throttle(
                 5.0,
+                WARN,
                 "amcl: no transform %s -> %s at the scan's stamp %.3f; scan dropped",
                 self.odom_frame,
                 self.base_frame,
@@ -207,8 +212,8 @@ class AmclNode:
             if laser is None:
                 laser = self.tf.lookup(self.base_frame, laser_frame, 0.0)
                 if laser is None:
-                    rospy.logwarn_throttle(
-                        5.0, "amcl: no transform %s -> %s yet", self.base_frame, laser_frame
+                    self.node.log.log_throttle(
+                        5.0, WARN, "amcl: no transform %s -> %s yet", self.base_frame, laser_frame
                     )
                     return
                 self.laser_pose[laser_frame] = laser
@@ -216,7 +221,7 @@ class AmclNode:
             bad = ~np.isfinite(ranges)
             if bad.any() and not self.bad_scan_reported:
                 self.bad_scan_reported = True
-                rospy.logwarn(
+                self.node.log.warn(
                     "amcl: scan from %s has %d NaN/inf ranges of %d; those beams are skipped",
                     laser_frame,
                     int(bad.sum()),
@@ -283,4 +288,4 @@ class AmclNode:
 
 
 def main(argv: list[str] | None = None) -> int:
-    return run_node("amcl", argv, AmclNode)
+    return run_core_node("amcl", argv, AmclNode)

@@ -15,9 +15,9 @@ import sys
 import threading
 from pathlib import Path
 
-import rospy
 from ninjemys.maps.mapfile import MapFileError, load_map, save_map
-from ninjemys.nav.rosglue import grid_from_msg, grid_to_msg, param, run_node, start_node
+from ninjemys.nav.rosglue import grid_from_msg, grid_to_msg, param, run_core_node
+from ninjemys.node.node import Node
 
 USAGE = "USAGE: map_server <map.yaml>\n  map.yaml: map description file"
 SAVER_USAGE = "Usage: \n  map_saver -h\n  map_saver [--occ <threshold_occupied>] [--free <threshold_free>] [-f <mapname>] [ROS remapping args]"
@@ -34,27 +34,27 @@ def main(argv: list[str] | None = None) -> int:
 
     path = files[0]
 
-    def serve(node: object) -> None:
+    def serve(node: Node) -> None:
         frame_id = param(node, "frame_id", "map")
         try:
             grid = load_map(path)
         except MapFileError as exc:
-            rospy.logerr("map_server: %s", exc)  # and keep running, with nothing to offer
+            node.log.error("map_server: %s", exc)  # and keep running, with nothing to offer
             return
-        msg = grid_to_msg(grid, frame_id, cls=OccupancyGrid)
-        rospy.loginfo("Read a %d X %d map @ %.3f m/cell", grid.width, grid.height, grid.resolution)
-        meta_pub = node.publisher("map_metadata", MapMetaData, latch=True, queue_size=1)  # type: ignore[attr-defined]
-        map_pub = node.publisher("map", OccupancyGrid, latch=True, queue_size=1)  # type: ignore[attr-defined]
+        msg = grid_to_msg(grid, frame_id, node.get_time(), cls=OccupancyGrid)
+        node.log.info("Read a %d X %d map @ %.3f m/cell", grid.width, grid.height, grid.resolution)
+        meta_pub = node.publisher("map_metadata", MapMetaData, latch=True, queue_size=1)
+        map_pub = node.publisher("map", OccupancyGrid, latch=True, queue_size=1)
         meta_pub.publish(msg.info)
         map_pub.publish(msg)
 
         def on_static_map(_req: object) -> object:
-            rospy.loginfo("Sending map")
+            node.log.info("Sending map")
             return GetMapResponse(map=msg)
 
-        node.service("static_map", GetMap, on_static_map)  # type: ignore[attr-defined]
+        node.service("static_map", GetMap, on_static_map)
 
-    return run_node("map_server", args, serve)
+    return run_core_node("map_server", args, serve)
 
 
 def saver_main(argv: list[str] | None = None) -> int:
@@ -89,29 +89,29 @@ def saver_main(argv: list[str] | None = None) -> int:
         return 1
     from nav_msgs.msg import OccupancyGrid
 
-    node, _ = start_node("map_saver", args)
     done = threading.Event()
 
-    def on_map(msg: object) -> None:
-        if done.is_set():
-            return
-        grid = grid_from_msg(msg)
-        rospy.loginfo("Received a %d X %d map @ %.3f m/pix", grid.width, grid.height, grid.resolution)
-        base = Path(name)
-        rospy.loginfo("Writing map occupancy data to %s.pgm", base)
-        try:
-            save_map(grid, base, occ, free)
-        except OSError as exc:
-            rospy.logerr("map_saver: cannot write %s: %s", base, exc.strerror or exc)
-        else:
-            rospy.loginfo("Writing map occupancy data to %s.yaml", base)
-            rospy.loginfo("Done\n")
-        done.set()
+    def wait_for_map(node: Node) -> None:
+        def on_map(msg: object) -> None:
+            if done.is_set():
+                return
+            grid = grid_from_msg(msg)
+            node.log.info("Received a %d X %d map @ %.3f m/pix", grid.width, grid.height, grid.resolution)
+            base = Path(name)
+            node.log.info("Writing map occupancy data to %s.pgm", base)
+            try:
+                save_map(grid, base, occ, free)
+            except OSError as exc:
+                node.log.error("map_saver: cannot write %s: %s", base, exc.strerror or exc)
+            else:
+                node.log.info("Writing map occupancy data to %s.yaml", base)
+                node.log.info("Done\n")
+            done.set()
+            # not from this subscription's own worker thread, which the shutdown joins
+            threading.Thread(target=node.shutdown, args=("map saved",), name="shutdown", daemon=True).start()
 
-    rospy.loginfo("Waiting for the map")
-    node.subscriber("map", OccupancyGrid, on_map)
-    while not done.wait(0.2):
-        if rospy.is_shutdown():
-            return 1
-    rospy.signal_shutdown("map saved")
-    return 0
+        node.log.info("Waiting for the map")
+        node.subscriber("map", OccupancyGrid, on_map)
+
+    code = run_core_node("map_saver", args, wait_for_map)
+    return code or (0 if done.is_set() else 1)

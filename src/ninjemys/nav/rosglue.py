@@ -1,22 +1,24 @@
 """What every navigation node shares: start-up, parameters, message conversions and 2D TF lookups.
 
-A node starts either as a core :class:`~ninjemys.node.Node` made from the process's command line
-(:func:`run_core_node`, the in-house idiom: move_base) or through ``rospy.init_node``, then works on
-the core Node it made (:func:`run_node`, ``rospy.core.process_node``). Everything below takes the
-Node and uses its log and clock, so it serves both.
+Every navigation node is a core :class:`~ninjemys.node.Node` made from the process's command line
+and run by :func:`ninjemys.node.run.run_node` (re-exported here as :func:`run_core_node`), the one way
+in-house nodes run; rospy stays for tutorials and users. Everything below takes the Node and uses
+its log and clock (sim time under /use_sim_time).
 """
 
 from __future__ import annotations
 
-import sys
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
-import rospy
 from ninjemys.errors import ShutdownError
 from ninjemys.maps.mapfile import GridMap
+from ninjemys.node.node import Node
+from ninjemys.node.run import run_node
 from ninjemys.node.timers import TimeMovedBackwardsError
+from ninjemys.rostime import Time
 from ninjemys.tf2.core import BufferCore
 from ninjemys.tf2.errors import TransformException
 from ninjemys.tf2.math import Pose2D, quaternion_from_yaw, yaw_from_quaternion
@@ -27,38 +29,9 @@ from ninjemys.tf2.node import TransformBroadcaster, TransformListener
 STAMP_WAIT = 1.0
 
 
-def start_node(name: str, argv: list[str] | None) -> tuple[Any, list[str]]:
-    """``rospy.init_node(name)`` with the process's ``name:=value`` arguments; returns the core node and
-    the remaining (non-ROS) arguments."""
-    argv = sys.argv[1:] if argv is None else list(argv)
-    rospy.init_node(name, argv=[sys.argv[0], *argv])
-    rest = [a for a in argv if ":=" not in a]
-    return rospy.core.process_node(), rest
-
-
-def run_node(name: str, argv: list[str] | None, build: Any) -> int:
-    """Start node ``name``, build its object with ``build(node)``, spin. A shutdown (Ctrl-C, ``rosnode
-    kill``, SIGTERM) while it is still starting or being built ends it quietly, as a spinning node ends
-    (``init_node`` reports a Ctrl-C during its registration as ROSInitException)."""
-    try:
-        node, _ = start_node(name, argv)
-    except rospy.ROSInitException:
-        if rospy.is_shutdown():
-            return 0
-        raise
-    try:
-        build(node)
-    except (ShutdownError, rospy.ROSInterruptException):
-        return 0
-    rospy.spin()
-    return 0
-
-
-def run_core_node(name: str, argv: list[str] | None, build: Any) -> int:
+def run_core_node(name: str, argv: list[str] | None, build: Callable[[Node], Any]) -> int:
     """Start core node ``name``, build its object with ``build(node)``, wait for shutdown (Ctrl-C,
     SIGTERM, ``rosnode kill``): :func:`ninjemys.node.run.run_node`, the one way in-house nodes run."""
-    from ninjemys.node.run import run_node
-
     return run_node(name, argv, build)
 
 
@@ -74,13 +47,9 @@ def node_sleep(node: Any, seconds: float) -> bool:
     return not node.is_shutdown
 
 
-def now() -> float:
-    """ROS time in seconds (sim time when /use_sim_time is set)."""
-    return rospy.get_time()
-
-
-def stamp(t: float | None = None) -> Any:
-    return rospy.Time.from_sec(now() if t is None else t)
+def stamp(t: float) -> Time:
+    """ROS time ``t`` (seconds) as a message stamp."""
+    return Time.from_sec(t)
 
 
 def pose_msg_to_2d(pose: Any) -> Pose2D:
@@ -104,8 +73,8 @@ def grid_from_msg(msg: Any) -> GridMap:
     return GridMap(data.copy(), float(info.resolution), pose_msg_to_2d(info.origin))
 
 
-def grid_to_msg(grid: GridMap, frame_id: str, t: float | None = None, cls: Any = None) -> Any:
-    """GridMap -> nav_msgs/OccupancyGrid stamped now (or ``t``)."""
+def grid_to_msg(grid: GridMap, frame_id: str, t: float, cls: Any = None) -> Any:
+    """GridMap -> nav_msgs/OccupancyGrid stamped (and loaded) at ROS time ``t``."""
     from nav_msgs.msg import OccupancyGrid
 
     msg = (cls or OccupancyGrid)()
@@ -116,9 +85,7 @@ def grid_to_msg(grid: GridMap, frame_id: str, t: float | None = None, cls: Any =
     return msg
 
 
-def fill_info(
-    info: Any, width: int, height: int, resolution: float, origin: Pose2D, t: float | None = None
-) -> Any:
+def fill_info(info: Any, width: int, height: int, resolution: float, origin: Pose2D, t: float) -> Any:
     info.map_load_time = stamp(t)
     info.resolution = float(resolution)
     info.width, info.height = int(width), int(height)
@@ -181,20 +148,6 @@ def scan_arrays(scan: Any) -> tuple[np.ndarray, np.ndarray]:
     ranges = np.asarray(scan.ranges, dtype=np.float64)
     angles = scan.angle_min + np.arange(len(ranges)) * scan.angle_increment
     return ranges, angles
-
-
-def sleep(seconds: float) -> bool:
-    """Sleep ``seconds`` of ROS time; False once the node is shutting down (for background loops).
-
-    ROS time moving backwards (a simulation reset, a looping bag) ends this sleep early but not the
-    loop: rospy raises it as a kind of ROSInterruptException, which must not stop the node's threads."""
-    try:
-        rospy.sleep(seconds)
-    except rospy.ROSTimeMovedBackwardsException:
-        pass
-    except rospy.ROSInterruptException:
-        return False
-    return not rospy.is_shutdown()
 
 
 def param(node: Any, key: str, default: Any) -> Any:

@@ -38,10 +38,12 @@ from typing import Any
 import numpy as np
 import yaml
 
-import rospy
+from ninjemys.errors import ShutdownError
 from ninjemys.nav.costmap import footprint_radii, parse_footprint
-from ninjemys.nav.rosglue import Tf2D, param, run_node, scan_arrays, sleep
+from ninjemys.nav.rosglue import Tf2D, node_sleep, param, run_core_node, scan_arrays
 from ninjemys.nav.safety import NEVER, MuxInput, MuxLock, TwistMux, blocked
+from ninjemys.node.log import ERROR, WARN
+from ninjemys.node.timers import TimeMovedBackwardsError
 
 DEFAULT_TOPICS = [
     {"name": "teleop", "topic": "teleop/cmd_vel", "timeout": 0.5, "priority": 100},
@@ -103,11 +105,11 @@ class SafetyMonitor:
         inputs, errors = parse_topics(node.get_param("~topics", DEFAULT_TOPICS))
         locks, lock_errors = parse_locks(node.get_param("~locks", []))
         for line in errors + lock_errors:
-            rospy.logerr("safety_monitor: %s", line)
+            self.node.log.error("safety_monitor: %s", line)
         self.mux = TwistMux(inputs or parse_topics(DEFAULT_TOPICS)[0], locks)
         for inp in self.mux.inputs:
             if inp.timeout <= 0.0:
-                rospy.logwarn(
+                self.node.log.warn(
                     "safety_monitor: input %s (%s) has no timeout: its last command holds until "
                     "another input takes over",
                     inp.name,
@@ -120,7 +122,7 @@ class SafetyMonitor:
                 radius = footprint_radii(parse_footprint(fp), radius)[1]
             except (ValueError, TypeError, yaml.YAMLError) as exc:
                 reason = " ".join(str(exc).split())  # a YAML error spans lines: one line here
-                rospy.logerr("safety_monitor: ~footprint: %s; using robot_radius %.3f", reason, radius)
+                self.node.log.error("safety_monitor: ~footprint: %s; using robot_radius %.3f", reason, radius)
         self.radius = radius
         self.margin = param(node, "safety_margin", 0.05)
         self.max_decel = param(node, "max_decel", 1.0)
@@ -171,7 +173,7 @@ class SafetyMonitor:
         if isinstance(value, str):
             value = [value]
         if not isinstance(value, list):
-            rospy.logerr(
+            self.node.log.error(
                 "safety_monitor: ~localization_inputs: expected a list of input names, got %r; using [navigation]",
                 value,
             )
@@ -179,7 +181,7 @@ class SafetyMonitor:
         names = {str(name) for name in value}
         known = {inp.name for inp in self.mux.inputs}
         for name in sorted(names - known):
-            rospy.logerr(
+            self.node.log.error(
                 "safety_monitor: ~localization_inputs: %s is not one of the inputs (%s)",
                 name,
                 ", ".join(sorted(known)),
@@ -191,16 +193,16 @@ class SafetyMonitor:
     def on_cmd(self, msg: Any, inp: MuxInput) -> None:
         v, w = float(msg.linear.x), float(msg.angular.z)
         if not (math.isfinite(v) and math.isfinite(w)):
-            rospy.logwarn_throttle(
-                5.0, "safety_monitor: %s: NaN/inf velocity ignored", self.node.resolve_name(inp.topic)
+            self.node.log.log_throttle(
+                5.0, WARN, "safety_monitor: %s: NaN/inf velocity ignored", self.node.resolve_name(inp.topic)
             )
             return
         with self.lock:
-            inp.v, inp.w, inp.last_time = v, w, rospy.get_time()
+            inp.v, inp.w, inp.last_time = v, w, self.node.get_time()
 
     def on_lock(self, msg: Any, lock: MuxLock) -> None:
         with self.lock:
-            lock.data, lock.last_time = bool(msg.data), rospy.get_time()
+            lock.data, lock.last_time = bool(msg.data), self.node.get_time()
 
     def on_scan(self, scan: Any) -> None:
         ranges, angles = scan_arrays(scan)
@@ -209,7 +211,7 @@ class SafetyMonitor:
         ok = np.isfinite(ranges) & (ranges >= scan.range_min) & (ranges <= scan.range_max)
         if not self.bad_scan_reported and not np.isfinite(ranges).all():
             self.bad_scan_reported = True
-            rospy.logwarn(
+            self.node.log.warn(
                 "safety_monitor: scan from %s has NaN/inf ranges (%d of %d); they are treated as no return",
                 scan.header.frame_id,
                 int((~np.isfinite(ranges)).sum()),
@@ -224,7 +226,7 @@ class SafetyMonitor:
         pts = np.column_stack([laser[0] + r * np.cos(a), laser[1] + r * np.sin(a)])
         with self.lock:
             self.points = pts
-            self.scan_time = rospy.get_time()
+            self.scan_time = self.node.get_time()
 
     def on_odom(self, msg: Any) -> None:
         self.velocity = float(msg.twist.twist.linear.x)
@@ -233,8 +235,8 @@ class SafetyMonitor:
         c = msg.pose.covariance
         self.cov = float(c[0]) + float(c[7])
         if math.isnan(self.cov):
-            rospy.logwarn_throttle(
-                5.0, "safety_monitor: amcl_pose: NaN position covariance; treated as localization lost"
+            self.node.log.log_throttle(
+                5.0, WARN, "safety_monitor: amcl_pose: NaN position covariance; treated as localization lost"
             )
 
     def localization_lost(self) -> bool:
@@ -253,7 +255,7 @@ class SafetyMonitor:
                 if on:
                     self.cmd_pub.publish(self._twist())
         if changed:
-            (rospy.logwarn if on else rospy.loginfo)(
+            (self.node.log.warn if on else self.node.log.info)(
                 "safety_monitor: e-stop %s (%s)", "ENGAGED" if on else "reset", why
             )
 
@@ -317,7 +319,7 @@ class SafetyMonitor:
     def _time_moved_backwards(self, now: float) -> None:
         """A simulation reset or a looping bag: every age measured before is meaningless now, and a
         command stamped in the old future would otherwise stay fresh until time caught up with it."""
-        rospy.loginfo(
+        self.node.log.info(
             "safety_monitor: ROS time moved backwards (%.3f -> %.3f); inputs and scan forgotten",
             self.last_now,
             now,
@@ -336,25 +338,25 @@ class SafetyMonitor:
         )
         if stale != self.scan_stale:
             if stale:
-                rospy.logwarn(
+                self.node.log.warn(
                     "safety_monitor: no scan on %s for %.2f s (~scan_timeout %.2f); linear motion stopped",
                     self.node.resolve_name("scan"),
                     now - (self.scan_time or 0.0),
                     self.scan_timeout,
                 )
             else:
-                rospy.loginfo("safety_monitor: scans again on %s", self.node.resolve_name("scan"))
+                self.node.log.info("safety_monitor: scans again on %s", self.node.resolve_name("scan"))
         self.scan_stale = stale
 
     def loop(self) -> None:
-        rate = rospy.Rate(self.rate)
-        while not rospy.is_shutdown():
+        rate = self.node.rate(self.rate)
+        while not self.node.is_shutdown:
             with self.out_lock:
                 try:
-                    v, w, publish = self.decide(rospy.get_time())
+                    v, w, publish = self.decide(self.node.get_time())
                 except Exception as exc:  # the guard must keep guarding: stop and report
-                    rospy.logerr_throttle(
-                        5.0, "safety_monitor: %s: %s; stopping the robot", type(exc).__name__, exc
+                    self.node.log.log_throttle(
+                        5.0, ERROR, "safety_monitor: %s: %s; stopping the robot", type(exc).__name__, exc
                     )
                     v, w, publish = 0.0, 0.0, True
                 if publish:
@@ -363,16 +365,16 @@ class SafetyMonitor:
                     self.cmd_pub.publish(msg)
             try:
                 rate.sleep()
-            except rospy.ROSTimeMovedBackwardsException:
+            except TimeMovedBackwardsError:
                 continue
-            except rospy.ROSInterruptException:
+            except ShutdownError:
                 return
 
     def diag_loop(self) -> None:
         from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
 
-        while sleep(self.diag_period):  # goes on across a simulation reset
-            now = rospy.get_time()
+        while node_sleep(self.node, self.diag_period):  # goes on across a simulation reset
+            now = self.node.get_time()
             with self.lock:
                 e_stop, active, is_blocked, cov = self.e_stop, self.active, self.blocked, self.cov
                 lost, scan_stale = self.localization_lost(), self.scan_stale
@@ -421,9 +423,9 @@ class SafetyMonitor:
                 KeyValue(key="current priority", value=str(floor)),
             ]
             arr = self._diag_cls(status=[status])
-            arr.header.stamp = rospy.Time.from_sec(rospy.get_time())
+            arr.header.stamp = self.node.now()
             self.diag_pub.publish(arr)
 
 
 def main(argv: list[str] | None = None) -> int:
-    return run_node("safety_monitor", argv, SafetyMonitor)
+    return run_core_node("safety_monitor", argv, SafetyMonitor)

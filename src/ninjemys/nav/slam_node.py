@@ -21,10 +21,10 @@ from typing import Any
 
 import numpy as np
 
-import rospy
 from ninjemys.maps.mapfile import GridMap
-from ninjemys.nav.rosglue import Tf2D, grid_to_msg, param, run_node, scan_arrays, sleep, tf_item
+from ninjemys.nav.rosglue import Tf2D, grid_to_msg, node_sleep, param, run_core_node, scan_arrays, tf_item
 from ninjemys.nav.slam import ParticleMapper, SlamParams
+from ninjemys.node.log import WARN
 
 
 class SlamNode:
@@ -41,7 +41,7 @@ class SlamNode:
             {name: param(node, name, getattr(params, name)) for name in SlamParams.__dataclass_fields__}
         )
         for name, reason in rejected:
-            rospy.logerr("slam_gmapping: parameter %s: %s", node.resolve_name("~" + name), reason)
+            self.node.log.error("slam_gmapping: parameter %s: %s", node.resolve_name("~" + name), reason)
         self.mapper = ParticleMapper(params)
         self.map_frame = param(node, "map_frame", "map")
         self.odom_frame = param(node, "odom_frame", "odom")
@@ -66,17 +66,20 @@ class SlamNode:
             threading.Thread(target=self.tf_loop, name="slam-tf", daemon=True).start()
 
     def tf_loop(self) -> None:
-        while sleep(self.tf_period):
+        while node_sleep(self.node, self.tf_period):
             corr = self.correction  # one tuple, swapped whole: no lock, so a long filter step never
             # holds back the transform (amcl and move_base would see map -> odom go stale)
-            self.tf.send([tf_item(self.map_frame, self.odom_frame, rospy.get_time() + self.tf_period, corr)])
+            self.tf.send(
+                [tf_item(self.map_frame, self.odom_frame, self.node.get_time() + self.tf_period, corr)]
+            )
 
     def on_scan(self, scan: Any) -> None:
         t = scan.header.stamp.to_sec()
         odom = self.tf.lookup_at(self.odom_frame, self.base_frame, t)  # gmapping's message filter
         if odom is None:
-            rospy.logwarn_throttle(
+            self.node.log.log_throttle(
                 5.0,
+                WARN,
                 "slam_gmapping: no transform %s -> %s at the scan's stamp; scan dropped",
                 self.odom_frame,
                 self.base_frame,
@@ -92,7 +95,7 @@ class SlamNode:
         ranges, angles = scan_arrays(scan)
         if not self.bad_scan_reported and not np.isfinite(ranges).all():
             self.bad_scan_reported = True
-            rospy.logwarn(
+            self.node.log.warn(
                 "slam_gmapping: scan from %s has NaN/inf ranges (%d of %d): NaN and -inf are skipped, +inf is free space up to maxUrange",
                 frame,
                 int((~np.isfinite(ranges)).sum()),
@@ -110,7 +113,7 @@ class SlamNode:
                 entropy = self.mapper.entropy()
                 p = self.mapper.params
                 grid = GridMap(self.mapper.occupancy(), p.delta, (p.xmin, p.ymin, 0.0))
-                self.map_msg = grid_to_msg(grid, self.map_frame, cls=self._grid_cls)
+                self.map_msg = grid_to_msg(grid, self.map_frame, self.node.get_time(), cls=self._grid_cls)
         if publish:
             if entropy > 0.0:  # as slam_gmapping: published with each map update, when above zero
                 self.entropy_pub.publish(self._float_cls(data=entropy))
@@ -123,8 +126,8 @@ class SlamNode:
         with self.lock:
             p = self.mapper.params
             grid = GridMap(self.mapper.occupancy(), p.delta, (p.xmin, p.ymin, 0.0))
-        return GetMapResponse(map=grid_to_msg(grid, self.map_frame, cls=self._grid_cls))
+        return GetMapResponse(map=grid_to_msg(grid, self.map_frame, self.node.get_time(), cls=self._grid_cls))
 
 
 def main(argv: list[str] | None = None) -> int:
-    return run_node("slam_gmapping", argv, SlamNode)
+    return run_core_node("slam_gmapping", argv, SlamNode)

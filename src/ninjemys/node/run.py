@@ -40,6 +40,25 @@ def run_node(default_name: str, argv: list[str] | None, build: Callable[[Node], 
     is missing). A signal shuts the node down from a ``shutdown`` thread, not from the interrupted
     main thread, which may hold locks the shutdown needs.
     """
+
+    def build_and_spin(node: Node) -> int:
+        code = build(node)
+        if isinstance(code, int) and code:
+            return code
+        node.spin()
+        return 0
+
+    return run_main(default_name, argv, build_and_spin)
+
+
+def run_main(default_name: str, argv: list[str] | None, body: Callable[[Node], int | None]) -> int:
+    """Start the node and run ``body(node)`` on this thread (a node with a loop of its own: a keyboard
+    teleop, a square driver), as :func:`run_node` does; returns its exit code (None: 0).
+
+    Ctrl-C, SIGTERM and ``rosnode kill`` shut the node down (``node.is_shutdown`` turns True, its sleeps
+    and rates raise ShutdownError, which ends ``body`` quietly); the node is shut down when ``body``
+    returns, whichever way.
+    """
     try:
         node = start_node(default_name, argv)
     except NinjemysError as exc:
@@ -53,12 +72,8 @@ def run_node(default_name: str, argv: list[str] | None, build: Callable[[Node], 
         signal.signal(signal.SIGINT, on_signal)
         signal.signal(signal.SIGTERM, on_signal)
     try:
-        code = build(node)
-        if isinstance(code, int) and code:
-            return code
-        node.spin()
+        return body(node) or 0
     except ShutdownError:
-        pass
+        return 0
     finally:
         node.shutdown("exit")
-    return 0

@@ -194,6 +194,18 @@ RESOURCES: tuple[Resource, ...] = (
              "guards the set of open client sockets; the loop adds, shutdown reads"),
     Resource("lock", "ninjemys.node.services:ServiceProxy._lock", USER + " (caller)",
              "one request/response exchange at a time on the proxy's connection"),
+    # the rostopic hz/bw/delay windows (ninjemys.node.rates): samples come from a subscription's
+    # worker thread, reports from the thread that prints; each window's lock guards its deque
+    Resource("lock", "ninjemys.node.rates:RateWindow.lock", "sub:<topic>",
+             "the printing thread takes it to copy the gaps for a report"),
+    Resource("queue", "ninjemys.node.rates:RateWindow.gaps", "sub:<topic>", "read under RateWindow.lock"),
+    Resource("lock", "ninjemys.node.rates:DelayWindow.lock", "sub:<topic>",
+             "the printing thread takes it to copy the delays for a report"),
+    Resource("queue", "ninjemys.node.rates:DelayWindow.delays", "sub:<topic>", "read under DelayWindow.lock"),
+    Resource("lock", "ninjemys.node.rates:BandwidthWindow.lock", "sub:<topic>",
+             "the printing thread takes it to copy the samples for a report"),
+    Resource("queue", "ninjemys.node.rates:BandwidthWindow.samples", "sub:<topic>",
+             "read under BandwidthWindow.lock"),
     Resource("lock", "ninjemys.node.registration:Registrar._lock", "any thread",
              "guards what the node has registered; reg:<node> copies it to re-register"),
     Resource("event", "ninjemys.node.registration:Registrar._stop", "the shutting-down thread",

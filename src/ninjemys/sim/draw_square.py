@@ -7,11 +7,14 @@ stopped, turn 90 degrees at 0.4 rad/s until within 0.01 rad, wait until stopped,
 from __future__ import annotations
 
 import math
-import sys
 import threading
 from enum import Enum
 
 from ninjemys.commands import entry
+
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from ninjemys.node.node import Node
 
 SIDE = 2.0
 FORWARD_SPEED = 1.0
@@ -79,42 +82,40 @@ class SquareController:
 
 
 def main(argv: list[str] | None = None) -> int:
-    import rospy
     from geometry_msgs.msg import Twist
+    from ninjemys.node.run import run_main
     from std_srvs.srv import Empty
     from turtlesim.msg import Pose
 
-    rospy.init_node("draw_square", argv=sys.argv if argv is None else [sys.argv[0], *argv])
-    controller = SquareController()
-    latest: list[Pose] = []
-    lock = threading.Lock()
+    def drive(node: Node) -> None:
+        controller = SquareController()
+        latest: list[Pose] = []
+        lock = threading.Lock()
 
-    def on_pose(msg: Pose) -> None:
-        with lock:
-            latest[:] = [msg]
+        def on_pose(msg: Pose) -> None:
+            with lock:
+                latest[:] = [msg]
 
-    pub = rospy.Publisher("turtle1/cmd_vel", Twist, queue_size=1)
-    rospy.Subscriber("turtle1/pose", Pose, on_pose, queue_size=1)
-    rospy.wait_for_service("reset")
-    rospy.ServiceProxy("reset", Empty)()
-    rate = rospy.Rate(1 / 0.016)
-    reported = 0
-    while not rospy.is_shutdown():
-        with lock:
-            pose = latest[0] if latest else None
-        if pose is not None:
-            linear, angular = controller.step(pose)
-            for goal in controller.goals[reported:]:
-                rospy.loginfo("New goal [%f %f, %f]", *goal)
-            reported = len(controller.goals)
-            twist = Twist()
-            twist.linear.x, twist.angular.z = linear, angular
-            pub.publish(twist)
-        try:
-            rate.sleep()
-        except rospy.ROSInterruptException:
-            break
-    return 0
+        pub = node.publisher("turtle1/cmd_vel", Twist, queue_size=1)
+        node.subscriber("turtle1/pose", Pose, on_pose, queue_size=1)
+        node.wait_for_service("reset")
+        node.service_proxy("reset", Empty)()
+        rate = node.rate(1 / 0.016)
+        reported = 0
+        while not node.is_shutdown:
+            with lock:
+                pose = latest[0] if latest else None
+            if pose is not None:
+                linear, angular = controller.step(pose)
+                for goal in controller.goals[reported:]:
+                    node.log.info("New goal [%f %f, %f]", *goal)
+                reported = len(controller.goals)
+                twist = Twist()
+                twist.linear.x, twist.angular.z = linear, angular
+                pub.publish(twist)
+            rate.sleep()  # ShutdownError ends the loop (run_main ends the node quietly)
+
+    return run_main("draw_square", argv, drive)
 
 
 console_main = entry(main)

@@ -6,9 +6,11 @@ remap both (``input:=turtle1 output:=turtle2``) to pair two turtles.
 
 from __future__ import annotations
 
-import sys
-
 from ninjemys.commands import entry
+
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from ninjemys.node.node import Node
 
 
 def twist_from_pose(pose, twist_class):  # type: ignore[no-untyped-def]
@@ -20,15 +22,17 @@ def twist_from_pose(pose, twist_class):  # type: ignore[no-untyped-def]
 
 
 def main(argv: list[str] | None = None) -> int:
-    import rospy
     from geometry_msgs.msg import Twist
+    from ninjemys.node.run import run_node
     from turtlesim.msg import Pose
 
-    rospy.init_node("turtle_mimic", argv=sys.argv if argv is None else [sys.argv[0], *argv])
-    pub = rospy.Publisher("output/cmd_vel", Twist, queue_size=1)
-    rospy.Subscriber("input/pose", Pose, lambda pose: pub.publish(twist_from_pose(pose, Twist)), queue_size=1)
-    rospy.spin()
-    return 0
+    def build(node: Node) -> None:
+        pub = node.publisher("output/cmd_vel", Twist, queue_size=1)
+        node.subscriber(
+            "input/pose", Pose, lambda pose: pub.publish(twist_from_pose(pose, Twist)), queue_size=1
+        )
+
+    return run_node("turtle_mimic", argv, build)
 
 
 console_main = entry(main)

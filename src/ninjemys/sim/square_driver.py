@@ -2,7 +2,7 @@
 
 The turtle stands in for a differential-drive robot with wheel radius r = 0.05 m and wheel separation
 l = 0.18 m. Each loop picks wheel speeds (w_r, w_l), commands the body velocity they produce, and
-integrates what that covered over the measured loop time dt (``rospy.get_time()``)::
+integrates what that covered over the measured loop time dt (the node's ROS time)::
 
     d     = r * (w_r + w_l) / 2 * dt        distance moved
     theta = r * (w_r - w_l) / l * dt        angle turned
@@ -18,6 +18,10 @@ import sys
 from dataclasses import dataclass
 
 from ninjemys.commands import entry
+
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from ninjemys.node.node import Node
 
 WHEEL_RADIUS = 0.05
 WHEEL_SEPARATION = 0.18
@@ -76,45 +80,47 @@ class SquarePlan:
 
 
 def main(argv: list[str] | None = None) -> int:
-    import rospy
     from geometry_msgs.msg import Twist
+    from ninjemys.errors import ShutdownError
+    from ninjemys.node.run import run_main
 
     argv = sys.argv[1:] if argv is None else argv
     parser = argparse.ArgumentParser(prog="square_driver", description=__doc__.split("\n")[0])
     parser.add_argument("--side", type=float, default=1.0, help="side length in metres (default 1)")
     parser.add_argument("--laps", type=int, default=0, help="squares to drive (default: until Ctrl-C)")
     options = parser.parse_args([a for a in argv if ":=" not in a])
-    rospy.init_node("square_driver", argv=[sys.argv[0], *[a for a in argv if ":=" in a]])
-    pub = rospy.Publisher("turtle1/cmd_vel", Twist, queue_size=1)
-    plan = SquarePlan(options.side)
-    rate = rospy.Rate(50)
-    # dead reckoning counts every command as driven: do not start before turtlesim is listening
-    while pub.get_num_connections() == 0 and not rospy.is_shutdown():
-        try:
-            rate.sleep()
-        except rospy.ROSInterruptException:
-            return 0
-    rospy.loginfo("Driving a %.2f m square (r=%.2f m, l=%.2f m)", plan.side, WHEEL_RADIUS, WHEEL_SEPARATION)
-    last = rospy.get_time()
-    w_r, w_l = plan.wheels()
-    while not rospy.is_shutdown():
-        now = rospy.get_time()
-        if plan.advance(w_r, w_l, now - last):
-            rospy.loginfo("%s done", "side" if plan.turning else "corner")
-            if options.laps and plan.legs >= 8 * options.laps:
-                break
-        last = now
+
+    def drive(node: Node) -> None:
+        pub = node.publisher("turtle1/cmd_vel", Twist, queue_size=1)
+        plan = SquarePlan(options.side)
+        rate = node.rate(50)
+        # dead reckoning counts every command as driven: do not start before turtlesim is listening
+        while pub.get_num_connections() == 0 and not node.is_shutdown:
+            rate.sleep()  # ShutdownError ends the node quietly (run_main)
+        node.log.info(
+            "Driving a %.2f m square (r=%.2f m, l=%.2f m)", plan.side, WHEEL_RADIUS, WHEEL_SEPARATION
+        )
+        last = node.get_time()
         w_r, w_l = plan.wheels()
-        twist = Twist()
-        twist.linear.x = plan.drive.linear(w_r, w_l)
-        twist.angular.z = plan.drive.angular(w_r, w_l)
-        pub.publish(twist)
         try:
-            rate.sleep()
-        except rospy.ROSInterruptException:
-            break
-    pub.publish(Twist())
-    return 0
+            while not node.is_shutdown:
+                now = node.get_time()
+                if plan.advance(w_r, w_l, now - last):
+                    node.log.info("%s done", "side" if plan.turning else "corner")
+                    if options.laps and plan.legs >= 8 * options.laps:
+                        break
+                last = now
+                w_r, w_l = plan.wheels()
+                twist = Twist()
+                twist.linear.x = plan.drive.linear(w_r, w_l)
+                twist.angular.z = plan.drive.angular(w_r, w_l)
+                pub.publish(twist)
+                rate.sleep()
+        except ShutdownError:
+            pass
+        pub.publish(Twist())
+
+    return run_main("square_driver", [a for a in argv if ":=" in a], drive)
 
 
 console_main = entry(main)

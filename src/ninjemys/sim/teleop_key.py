@@ -16,6 +16,10 @@ from collections.abc import Iterator
 
 from ninjemys.commands import entry
 
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from ninjemys.node.node import Node
+
 BANNER = "Reading from keyboard\n---------------------------\nUse arrow keys to move the turtle. 'q' to quit."
 
 #: final byte of the arrow keys' escape sequences (ESC [ A ... ESC [ D, or ESC O A in keypad mode)
@@ -83,47 +87,47 @@ def raw_terminal(fd: int) -> Iterator[None]:
         termios.tcsetattr(fd, termios.TCSADRAIN, saved)
 
 
-def _scale(rospy, name: str, default: float = 2.0) -> float:  # type: ignore[no-untyped-def]
+def _scale(node: Node, name: str, default: float = 2.0) -> float:
     """A speed scale parameter; the default when it is unset, unusable or the master is away."""
+    from ninjemys.errors import NinjemysError
+
     try:
-        return float(rospy.get_param(name, default))
-    except (rospy.ROSException, TypeError, ValueError) as exc:
-        rospy.logwarn("%s: %s; using %.1f", name, exc, default)
+        return float(node.get_param(name, default))
+    except (NinjemysError, TypeError, ValueError) as exc:
+        node.log.warn("%s: %s; using %.1f", name, exc, default)
         return default
 
 
 def main(argv: list[str] | None = None) -> int:
-    import rospy
     from geometry_msgs.msg import Twist
+    from ninjemys.node.run import run_main
 
-    argv = sys.argv if argv is None else [sys.argv[0], *argv]
-    rospy.init_node("teleop_turtle", argv=argv)
-    scale_linear = _scale(rospy, "~scale_linear")
-    scale_angular = _scale(rospy, "~scale_angular")
-    pub = rospy.Publisher("turtle1/cmd_vel", Twist, queue_size=1)
-    print(BANNER, flush=True)
-    fd = sys.stdin.fileno()
-    decoder = KeyDecoder()
-    with raw_terminal(fd):
-        while not rospy.is_shutdown():
-            try:
-                data = os.read(fd, 64)
-            except InterruptedError:
-                continue
-            if not data:  # end of input (stdin closed): stop like 'q'
-                break
-            for key in decoder.feed(data):
-                if key == "QUIT":
-                    rospy.signal_shutdown("quit")
-                    return 0
-                motion = twist_for(key, scale_linear, scale_angular)
-                if motion is not None:
-                    rospy.logdebug(key)
-                    twist = Twist()
-                    twist.linear.x, twist.angular.z = motion
-                    pub.publish(twist)
-    rospy.signal_shutdown("input closed")
-    return 0
+    def teleop(node: Node) -> None:
+        scale_linear = _scale(node, "~scale_linear")
+        scale_angular = _scale(node, "~scale_angular")
+        pub = node.publisher("turtle1/cmd_vel", Twist, queue_size=1)
+        print(BANNER, flush=True)
+        fd = sys.stdin.fileno()
+        decoder = KeyDecoder()
+        with raw_terminal(fd):
+            while not node.is_shutdown:
+                try:
+                    data = os.read(fd, 64)
+                except InterruptedError:
+                    continue
+                if not data:  # end of input (stdin closed): stop like 'q'
+                    return
+                for key in decoder.feed(data):
+                    if key == "QUIT":
+                        return
+                    motion = twist_for(key, scale_linear, scale_angular)
+                    if motion is not None:
+                        node.log.debug(key)
+                        twist = Twist()
+                        twist.linear.x, twist.angular.z = motion
+                        pub.publish(twist)
+
+    return run_main("teleop_turtle", argv, teleop)
 
 
 console_main = entry(main)

@@ -19,6 +19,10 @@ import time
 from ninjemys.commands import entry
 from ninjemys.sim.teleop_key import raw_terminal
 
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from ninjemys.node.node import Node
+
 BANNER = """
 Reading from the keyboard  and Publishing to Twist!
 ---------------------------
@@ -120,17 +124,20 @@ class TeleopState:
 
 
 def main(argv: list[str] | None = None) -> int:
-    import rospy
-    from geometry_msgs.msg import Twist, TwistStamped
+    from ninjemys.node.run import run_main
 
-    argv = sys.argv if argv is None else [sys.argv[0], *argv]
-    rospy.init_node("teleop_twist_keyboard", argv=argv)
+    return run_main("teleop_twist_keyboard", argv, _teleop)
+
+
+def _teleop(node: Node) -> int:
+    from geometry_msgs.msg import Twist, TwistStamped
+    from ninjemys.errors import NinjemysError
 
     def param(name: str, default: float | bool | str) -> float | bool | str:
         try:
-            return rospy.get_param("~" + name, default)
-        except rospy.ROSException as exc:
-            rospy.logwarn("~%s: %s; using %r", name, exc, default)
+            return node.get_param("~" + name, default)
+        except NinjemysError as exc:
+            node.log.warn("~%s: %s; using %r", name, exc, default)
             return default
 
     try:
@@ -147,25 +154,25 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     stamped = bool(param("stamped", False))
     frame_id = str(param("frame_id", ""))
-    pub = rospy.Publisher("cmd_vel", TwistStamped if stamped else Twist, queue_size=1)
+    pub = node.publisher("cmd_vel", TwistStamped if stamped else Twist, queue_size=1)
 
     def publish() -> None:
         lx, ly, lz, az = state.twist()
         msg = TwistStamped() if stamped else Twist()
         twist = msg.twist if stamped else msg
         if stamped:
-            msg.header.stamp = rospy.Time.now()
+            msg.header.stamp = node.now()
             msg.header.frame_id = frame_id
         twist.linear.x, twist.linear.y, twist.linear.z, twist.angular.z = lx, ly, lz, az
         pub.publish(msg)
 
     i = 0
-    while not rospy.is_shutdown() and pub.get_num_connections() == 0:
+    while not node.is_shutdown and pub.get_num_connections() == 0:
         if i == 4:
             print(f"Waiting for subscriber to connect to {pub.resolved_name}", flush=True)
         time.sleep(0.5)
         i = (i + 1) % 5
-    if rospy.is_shutdown():
+    if node.is_shutdown:
         return 1
     print(BANNER, flush=True)
     print(vels(state.speed, state.turn), flush=True)
@@ -175,7 +182,7 @@ def main(argv: list[str] | None = None) -> int:
     last_key = last_pub = time.monotonic()
     try:
         with raw_terminal(fd):
-            while not rospy.is_shutdown():
+            while not node.is_shutdown:
                 now = time.monotonic()
                 deadlines = []
                 if timeout is not None and state.twist() != (0.0, 0.0, 0.0, 0.0):
@@ -208,7 +215,7 @@ def main(argv: list[str] | None = None) -> int:
                 last_pub = now
     finally:
         state.stop()
-        if not rospy.is_shutdown():
+        if not node.is_shutdown:
             publish()
     return 0
 

@@ -18,11 +18,14 @@ import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 from typing import Any
 
-import rospy
 from geometry_msgs.msg import Twist
 from ninjemys.commands import entry
+from ninjemys.errors import NinjemysError, ServiceError, ShutdownError
+from ninjemys.node.node import Node
+from ninjemys.node.run import run_node
 from ninjemys.sim.world import CENTER, DEFAULT_BACKGROUND, UPDATE_PERIOD, TurtleError, World
 from std_srvs.srv import Empty, EmptyResponse
 from turtlesim.msg import Color, Pose
@@ -58,54 +61,51 @@ class _TurtleIO:
 
 
 class TurtlesimNode:
-    """Binds one :class:`World` to ROS topics and services (the node must be initialised)."""
+    """Binds one :class:`World` to the ROS topics and services of ``node`` (a core Node)."""
 
-    def __init__(self) -> None:
+    def __init__(self, node: Node) -> None:
+        self.node = node
         self.lock = threading.Lock()
-        self.world = World(self._background(), warn=rospy.logwarn, info=rospy.loginfo)
+        self.world = World(self._background(), warn=node.log.warn, info=node.log.info)
         self.io: dict[str, _TurtleIO] = {}
         self.view: Any = None
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
-        rospy.Service("clear", Empty, self._clear)
-        rospy.Service("reset", Empty, self._reset)
-        rospy.Service("spawn", Spawn, self._spawn)
-        rospy.Service("kill", Kill, self._kill)
-        rospy.loginfo("Starting turtlesim with node name %s", rospy.get_name())
+        node.service("clear", Empty, self._clear)
+        node.service("reset", Empty, self._reset)
+        node.service("spawn", Spawn, self._spawn)
+        node.service("kill", Kill, self._kill)
+        node.log.info("Starting turtlesim with node name %s", node.name)
         with self.lock:
             self._add(self.world.spawn("", CENTER, CENTER, 0.0).name)
 
     # -- parameters ------------------------------------------------------------------------------
-    @staticmethod
-    def _background() -> tuple[int, int, int]:
+    def _background(self) -> tuple[int, int, int]:
         values = []
         for key, default in zip(("r", "g", "b"), DEFAULT_BACKGROUND, strict=True):
             try:
-                value = rospy.get_param("~background_" + key, default)
-            except rospy.ROSException as exc:  # master away: keep simulating with the default colour
-                rospy.logwarn("~background_%s: %s; using %d", key, exc, default)
+                value = self.node.get_param("~background_" + key, default)
+            except NinjemysError as exc:  # master away: keep simulating with the default colour
+                self.node.log.warn("~background_%s: %s; using %d", key, exc, default)
                 value = default
             try:
                 values.append(int(value) & 0xFF)
             except (TypeError, ValueError):
-                rospy.logwarn("~background_%s: %r is not an integer, using %d", key, value, default)
+                self.node.log.warn("~background_%s: %r is not an integer, using %d", key, value, default)
                 values.append(default)
         return values[0], values[1], values[2]
 
     # -- turtles ---------------------------------------------------------------------------------
     def _add(self, name: str) -> None:
         """Create the topics and services of a turtle that exists in the world (lock held)."""
-        pose = rospy.Publisher(f"{name}/pose", Pose, queue_size=1)
-        color = rospy.Publisher(f"{name}/color_sensor", Color, queue_size=1)
-        cmd = rospy.Subscriber(f"{name}/cmd_vel", Twist, self._on_cmd_vel, callback_args=name, queue_size=1)
+        node = self.node
+        pose = node.publisher(f"{name}/pose", Pose, queue_size=1)
+        color = node.publisher(f"{name}/color_sensor", Color, queue_size=1)
+        cmd = node.subscriber(f"{name}/cmd_vel", Twist, self._on_cmd_vel, callback_args=name, queue_size=1)
         services = [
-            rospy.Service(f"{name}/set_pen", SetPen, lambda req, n=name: self._set_pen(n, req)),
-            rospy.Service(
-                f"{name}/teleport_absolute", TeleportAbsolute, lambda req, n=name: self._teleport_abs(n, req)
-            ),
-            rospy.Service(
-                f"{name}/teleport_relative", TeleportRelative, lambda req, n=name: self._teleport_rel(n, req)
-            ),
+            node.service(f"{name}/set_pen", SetPen, partial(self._set_pen, name)),
+            node.service(f"{name}/teleport_absolute", TeleportAbsolute, partial(self._teleport_abs, name)),
+            node.service(f"{name}/teleport_relative", TeleportRelative, partial(self._teleport_rel, name)),
         ]
         self.io[name] = _TurtleIO(pose, color, cmd, services)
 
@@ -120,20 +120,19 @@ class TurtlesimNode:
                 self.world.command(name, msg.linear.x, msg.linear.y, msg.angular.z, time.monotonic())
 
     # -- services --------------------------------------------------------------------------------
-    @staticmethod
-    def _refuse(exc: TurtleError) -> None:
-        rospy.logerr(str(exc))
-        raise rospy.ServiceException(str(exc)) from None
+    def _refuse(self, exc: TurtleError) -> None:
+        self.node.log.error("%s", exc)
+        raise ServiceError(str(exc)) from None
 
     def _clear(self, _req: Any) -> EmptyResponse:
-        rospy.loginfo("Clearing turtlesim.")
+        self.node.log.info("Clearing turtlesim.")
         background = self._background()
         with self.lock:
             self.world.clear(background)
         return EmptyResponse()
 
     def _reset(self, _req: Any) -> EmptyResponse:
-        rospy.loginfo("Resetting turtlesim.")
+        self.node.log.info("Resetting turtlesim.")
         background = self._background()
         with self.lock:
             for name in list(self.io):
@@ -196,11 +195,11 @@ class TurtlesimNode:
 
     def _run(self) -> None:
         next_tick = time.monotonic()
-        while not self._stop.is_set() and not rospy.is_shutdown():
+        while not self._stop.is_set() and not self.node.is_shutdown:
             try:
                 self.tick(time.monotonic())
             except Exception as exc:  # a bug in one tick must not freeze the simulation for good
-                rospy.logerr("turtlesim update failed: %s: %s", type(exc).__name__, exc)
+                self.node.log.error("turtlesim update failed: %s: %s", type(exc).__name__, exc)
             next_tick += UPDATE_PERIOD
             delay = next_tick - time.monotonic()
             if delay < -UPDATE_PERIOD:  # fell behind (machine busy): do not try to catch up in a burst
@@ -225,7 +224,7 @@ class TurtlesimNode:
             try:
                 io.pose.publish(pose)
                 io.color.publish(color)
-            except rospy.ROSException:
+            except ShutdownError:
                 continue  # the turtle was killed between the step and the publish
 
 
@@ -249,22 +248,26 @@ def main(argv: list[str] | None = None, view: ViewStarter | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     ros_args = [a for a in argv if ":=" in a]
     options = _parser().parse_args([a for a in argv if ":=" not in a])
-    rospy.init_node("turtlesim", argv=[sys.argv[0], *ros_args])
-    sim = TurtlesimNode()
-    stop_view = None
-    if view is not None and not options.headless:
-        stop_view = view(sim, options, ros_args)
-        if stop_view is None:
-            rospy.signal_shutdown("web view failed")
-            return 1
-    sim.start()
+    parts: list[Any] = []  # the simulator, then the view's stop function
+
+    def build(node: Node) -> int:
+        sim = TurtlesimNode(node)
+        parts.append(sim)
+        if view is not None and not options.headless:
+            stop_view = view(sim, options, ros_args)
+            if stop_view is None:
+                return 1
+            parts.append(stop_view)
+        sim.start()
+        return 0
+
     try:
-        rospy.spin()
+        return run_node("turtlesim", ros_args, build)
     finally:
-        sim.stop()
-        if stop_view is not None:
-            stop_view()
-    return 0
+        if parts:
+            parts[0].stop()
+        for stop in parts[1:]:
+            stop()
 
 
 console_main = entry(main)

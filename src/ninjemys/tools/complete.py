@@ -41,6 +41,8 @@ TYPE_CHECKING = False  # typing itself is not worth importing on every Tab press
 if TYPE_CHECKING:
     from collections.abc import Callable
 
+    from ninjemys.master.snapshot import GraphSnapshot
+
 #: a completion that waits longer than this for the master is worse than none
 MASTER_TIMEOUT = 1.0
 CALLER_ID = "/ninjemys_complete"
@@ -234,26 +236,25 @@ def master_call(method: str, *params: str) -> object | None:
 # -- the kinds ------------------------------------------------------------------------------------
 
 
-def _system_state() -> list:
+def _snapshot() -> GraphSnapshot:
+    from ninjemys.master.snapshot import GraphSnapshot
+
     state = master_call("getSystemState")
-    return state if isinstance(state, list) and len(state) == 3 else [[], [], []]
+    return GraphSnapshot.from_system_state(
+        state if isinstance(state, list) and len(state) == 3 else [[], [], []]
+    )
 
 
 def topics() -> list[str]:
-    publishers, subscribers, _ = _system_state()
-    return sorted({entry[0] for entry in publishers + subscribers})
+    return _snapshot().topic_names()
 
 
 def nodes() -> list[str]:
-    found: set[str] = set()
-    for group in _system_state():
-        for _name, members in group:
-            found.update(members)
-    return sorted(found)
+    return _snapshot().node_names()
 
 
 def services() -> list[str]:
-    return sorted(entry[0] for entry in _system_state()[2])
+    return sorted(_snapshot().services)
 
 
 def params() -> list[str]:

@@ -5,13 +5,13 @@ from __future__ import annotations
 import argparse
 import socket
 import sys
-import time
 from urllib.parse import urlparse
 
 from ninjemys import names
-from ninjemys.errors import MasterError, MasterUnreachable, NinjemysError
+from ninjemys.errors import MasterError, NinjemysError
+from ninjemys.master.client import MasterClient
+from ninjemys.master.graph import CONNECTION_INFO, GraphSnapshot, bus_info, node_api, ping, ping_node, slave
 from ninjemys.tools.cli import Subcommands, entry, error, master, run_subcommand
-from ninjemys.tools.graph import CONNECTION_INFO, GraphState, bus_info, node_api, ping, slave
 
 NAME = "rosnode"
 ID = "/rosnode"
@@ -39,7 +39,7 @@ def _resolve(name: str) -> str:
 
 def _cmd_list(args: argparse.Namespace) -> int:
     client = master(ID)
-    nodes = GraphState.fetch(client, with_types=False).node_names()
+    nodes = GraphSnapshot.fetch(client, with_types=False).node_names()
     if args.namespace:
         ns = names.make_global_ns(_resolve(args.namespace))
         nodes = [n for n in nodes if n.startswith(ns) or n == ns.rstrip("/")]
@@ -53,15 +53,13 @@ def _cmd_list(args: argparse.Namespace) -> int:
     return 0
 
 
-def _topic_type(topic: str, state: GraphState) -> str:
+def _topic_type(topic: str, state: GraphSnapshot) -> str:
     return state.published_types.get(topic, "unknown type")
 
 
-def info_text(node: str, state: GraphState) -> str:
+def info_text(node: str, state: GraphSnapshot) -> str:
     """The first block of ``rosnode info``: publications, subscriptions, services."""
-    pubs = sorted(t for t, n in state.publishers.items() if node in n)
-    subs = sorted(t for t, n in state.subscribers.items() if node in n)
-    srvs = sorted(s for s, n in state.services.items() if node in n)
+    pubs, subs, srvs = state.topics_of(node)
     buff = f"Node [{node}]"
     for title, items in (("Publications", pubs), ("Subscriptions", subs)):
         if items:
@@ -75,7 +73,7 @@ def info_text(node: str, state: GraphState) -> str:
     return buff
 
 
-def connections_text(uri: str, state: GraphState, client: object) -> str:
+def connections_text(uri: str, state: GraphSnapshot, client: object) -> str:
     """The ``Pid:`` / ``Connections:`` block, from the node's getPid and getBusInfo."""
     pid, rows = bus_info(uri, ID)
     buff = f"Pid: {pid}\n"
@@ -101,7 +99,7 @@ def connections_text(uri: str, state: GraphState, client: object) -> str:
 
 
 def _lookup_peer(
-    client: object, state: GraphState, topic: str, dest: str, cache: dict[str, str | None]
+    client: object, state: GraphSnapshot, topic: str, dest: str, cache: dict[str, str | None]
 ) -> str:
     """rosnode prints ``/node (uri)`` when the peer's URI belongs to a node on that topic."""
     for table in (state.publishers, state.subscribers):
@@ -117,7 +115,7 @@ def _cmd_info(args: argparse.Namespace) -> int:
     client = master(ID)
     for raw in args.nodes:
         node = _resolve(raw)
-        state = GraphState.fetch(client)
+        state = GraphSnapshot.fetch(client)
         print("-" * 80)
         print(info_text(node, state))
         uri = node_api(client, node)
@@ -134,52 +132,15 @@ def _cmd_info(args: argparse.Namespace) -> int:
     return 0
 
 
-def _ping_node(client: object, node: str, max_count: int | None, verbose: bool) -> bool:
-    uri = node_api(client, node)  # type: ignore[arg-type]
-    if not uri:
-        print(f"cannot ping [{node}]: unknown node", file=sys.stderr)
-        return False
-    timeout = 3.0
-    if verbose:
-        print(f"pinging {node} with a timeout of {timeout}s")
-    count, total = 0, 0.0
-    try:
-        while True:
-            try:
-                ms = ping(uri, ID, timeout)
-            except MasterUnreachable as exc:
-                if "timed out" in str(exc):
-                    print(f"connection to [{node}] timed out", file=sys.stderr)
-                elif _unknown_host(uri):
-                    print(
-                        f"ERROR: Unknown host [{urlparse(uri).hostname}] for node [{node}]", file=sys.stderr
-                    )
-                else:
-                    print(f"ERROR: connection refused to [{uri}]", file=sys.stderr)
-                return False
-            except MasterError:
-                print(f"connection to [{node}] failed", file=sys.stderr)
-                return False
-            count += 1
-            total += ms
-            if verbose:
-                print(f"xmlrpc reply from {uri}\ttime={ms:f}ms")
-            if max_count and count >= max_count:
-                break
-            time.sleep(1.0)
-    except KeyboardInterrupt:
-        pass
-    if verbose and count > 1:
-        print(f"ping average: {total / count:f}ms")
-    return True
-
-
-def _unknown_host(uri: str) -> bool:
-    try:
-        socket.getaddrinfo(urlparse(uri).hostname, 0)
-    except OSError:
-        return True
-    return False
+def _ping_node(client: MasterClient, node: str, max_count: int | None, verbose: bool) -> bool:
+    return ping_node(
+        node,
+        lambda name, _refresh: node_api(client, name),
+        ID,
+        max_count=max_count,
+        verbose=verbose,
+        err=lambda line: print(line, file=sys.stderr),
+    )
 
 
 def _cmd_ping(args: argparse.Namespace) -> int:
@@ -189,7 +150,7 @@ def _cmd_ping(args: argparse.Namespace) -> int:
             raise NodeToolError(f"Invalid arguments '{args.node}' used with --all")
         if args.count:
             raise NodeToolError("-c may not be used with --all")
-        nodes = GraphState.fetch(client, with_types=False).node_names()
+        nodes = GraphSnapshot.fetch(client, with_types=False).node_names()
         print("Will ping the following nodes: \n" + "".join(f" * {n}\n" for n in nodes))
         for node in nodes:
             _ping_node(client, node, 1, True)
@@ -203,7 +164,7 @@ def _cmd_ping(args: argparse.Namespace) -> int:
 
 def _cmd_kill(args: argparse.Namespace) -> int:
     client = master(ID)
-    known = GraphState.fetch(client, with_types=False).node_names()
+    known = GraphSnapshot.fetch(client, with_types=False).node_names()
     if args.kill_all:
         if args.nodes:
             raise NodeToolError("invalid arguments with kill all (-a) option")
@@ -266,7 +227,7 @@ def _hostname(uri: str | None) -> str | None:
 
 def _cmd_machine(args: argparse.Namespace) -> int:
     client = master(ID)
-    nodes = GraphState.fetch(client, with_types=False).node_names()
+    nodes = GraphSnapshot.fetch(client, with_types=False).node_names()
     hosts = {n: _hostname(node_api(client, n)) for n in nodes}
     if args.machine is None:
         machines: list[str] = []
@@ -298,7 +259,7 @@ def _cmd_machine(args: argparse.Namespace) -> int:
 
 def _cmd_cleanup(args: argparse.Namespace) -> int:
     client = master(ID)
-    state = GraphState.fetch(client, with_types=False)
+    state = GraphSnapshot.fetch(client, with_types=False)
     dead = []
     for node in state.node_names():
         uri = node_api(client, node)

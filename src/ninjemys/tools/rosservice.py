@@ -12,8 +12,8 @@ from typing import Any
 
 from ninjemys import names
 from ninjemys.errors import MasterError, NinjemysError, ServiceError, TypeNotFoundError
+from ninjemys.master.graph import GraphSnapshot
 from ninjemys.tools.cli import Subcommands, entry, master, run_subcommand
-from ninjemys.tools.graph import GraphState
 
 NAME = "rosservice"
 ID = "/rosservice"
@@ -90,7 +90,7 @@ def _service_class(type_name: str) -> Any:
 
 
 def _cmd_list(args: argparse.Namespace) -> int:
-    state = GraphState.fetch(master(ID), with_types=False)
+    state = GraphSnapshot.fetch(master(ID), with_types=False)
     items = sorted(state.services.items())
     if args.namespace:
         ns = names.make_global_ns(_resolve(args.namespace))
@@ -103,7 +103,7 @@ def _cmd_list(args: argparse.Namespace) -> int:
 def _cmd_info(args: argparse.Namespace) -> int:
     client = master(ID)
     service = _resolve(args.service)
-    providers = GraphState.fetch(client, with_types=False).services.get(service)
+    providers = GraphSnapshot.fetch(client, with_types=False).services.get(service)
     if not providers:
         print("ERROR: unknown service", file=sys.stderr)
         return 1
@@ -144,7 +144,7 @@ def _cmd_uri(args: argparse.Namespace) -> int:
 
 def _cmd_node(args: argparse.Namespace) -> int:
     service = _resolve(args.service)
-    providers = GraphState.fetch(master(ID), with_types=False).services.get(service)
+    providers = GraphSnapshot.fetch(master(ID), with_types=False).services.get(service)
     if not providers:
         print(f"Unknown service: {service}", file=sys.stderr)
         return 1
@@ -164,7 +164,7 @@ def _cmd_args(args: argparse.Namespace) -> int:
 def _cmd_find(args: argparse.Namespace) -> int:
     client = master(ID)
     found = []
-    for service in GraphState.fetch(client, with_types=False).services:
+    for service in GraphSnapshot.fetch(client, with_types=False).services:
         try:
             if service_type(client, service) == args.type:
                 found.append(service)

@@ -14,8 +14,8 @@ import threading
 from typing import Any
 
 from ninjemys import names
+from ninjemys.master.graph import GraphSnapshot, node_api
 from ninjemys.tools.cli import Subcommands, entry, master, run_subcommand
-from ninjemys.tools.graph import GraphState, node_api
 from ninjemys.tools.topic_common import (
     COALESCE,
     ID,
@@ -57,7 +57,7 @@ def _cmd_list(args: argparse.Namespace) -> int:
         return _list_bag(args.bag)
     if args.subscribers_only and args.publishers_only:
         raise TopicToolError("cannot specify both subscribers- and publishers-only")
-    state = GraphState.fetch(master(ID))
+    state = GraphSnapshot.fetch(master(ID))
     pubs = [(t, state.type_of(t), n) for t, n in state.publishers.items()]
     subs = [(t, state.type_of(t), n) for t, n in state.subscribers.items()]
     if args.namespace:
@@ -142,7 +142,7 @@ def _list_bag(path: str) -> int:
 
 
 def info_text(topic: str, client: Any) -> str:
-    state = GraphState.fetch(client)
+    state = GraphSnapshot.fetch(client)
     pubs = state.publishers.get(topic, [])
     subs = state.subscribers.get(topic, [])
     if not pubs and not subs:

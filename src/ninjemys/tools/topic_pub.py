@@ -10,8 +10,8 @@ from pathlib import Path
 from typing import Any
 
 from ninjemys.errors import MasterError, TypeNotFoundError
+from ninjemys.master.graph import GraphSnapshot
 from ninjemys.tools.cli import master
-from ninjemys.tools.graph import GraphState
 from ninjemys.tools.topic_common import ID, TopicToolError, make_node, resolve_topic
 
 ONCE_DELAY = 3.0
@@ -103,7 +103,7 @@ def _await_subscribers(node: Any, pub: Any, client: Any, topic: str, timeout: fl
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline and not node.is_shutdown:
         try:
-            expected = len(GraphState.fetch(client, with_types=False).subscribers.get(topic, []))
+            expected = len(GraphSnapshot.fetch(client, with_types=False).subscribers.get(topic, []))
         except MasterError:
             return
         if pub.get_num_connections() >= expected:
@@ -117,7 +117,7 @@ def _linger(node: Any, pub: Any, client: Any, topic: str) -> None:
     deadline = time.monotonic() + ONCE_DELAY
     while time.monotonic() < deadline and not node.is_shutdown:
         try:
-            expected = len(GraphState.fetch(client, with_types=False).subscribers.get(topic, []))
+            expected = len(GraphSnapshot.fetch(client, with_types=False).subscribers.get(topic, []))
         except MasterError:
             expected = 0
         if expected and pub.get_num_connections() >= expected:

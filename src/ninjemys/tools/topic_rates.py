@@ -1,50 +1,28 @@
-"""``rostopic hz``, ``bw`` and ``delay``: rates from raw arrivals (hz and bw never deserialize)."""
+"""``rostopic hz``, ``bw`` and ``delay``: rates from raw arrivals (hz and bw never deserialize).
+
+The windows and ROS 1's lines are ninjemys.node.rates (shared with the rostopic facade); this
+module subscribes and prints once a second."""
 
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 import threading
 import time
-from collections import deque
 from collections.abc import Callable
 from typing import Any
 
+from ninjemys.node.rates import (
+    BandwidthWindow,
+    DelayWindow,
+    RateWindow,
+    bw_text,
+    delay_text,
+    hz_table,
+    hz_text,
+)
 from ninjemys.tools.cli import master
 from ninjemys.tools.topic_common import ID, class_for, compile_filter, make_node, resolve_topic, wait_for_type
-
-
-class RateStats:
-    """rostopic hz's statistics over a window of inter-arrival gaps (ROS 1's formulas)."""
-
-    def __init__(self, window: int) -> None:
-        self.window = window if window > 0 else 50000
-        self.gaps: deque[float] = deque(maxlen=self.window - 1 if self.window > 1 else 1)
-        self.last: float | None = None
-        self.last_printed: float | None = None
-        self.lock = threading.Lock()
-
-    def arrived(self, now: float) -> None:
-        with self.lock:
-            if self.last is None or now < self.last:
-                self.last = now
-                self.gaps.clear()
-                return
-            self.gaps.append(now - self.last)
-            self.last = now
-
-    def report(self) -> tuple[float, float, float, float, int] | None:
-        with self.lock:
-            if not self.gaps or self.last == self.last_printed:
-                return None
-            gaps = list(self.gaps)
-            self.last_printed = self.last
-        n = len(gaps)
-        mean = sum(gaps) / n
-        rate = 1.0 / mean if mean > 0 else 0.0
-        std = math.sqrt(sum((g - mean) ** 2 for g in gaps) / n)
-        return rate, min(gaps), max(gaps), std, n + 1
 
 
 def cmd_hz(args: argparse.Namespace) -> int:
@@ -54,12 +32,12 @@ def cmd_hz(args: argparse.Namespace) -> int:
     node = make_node()
     try:
         clock = None if args.wall_time else for_node(node)
-        stats: dict[str, RateStats] = {}
+        stats: dict[str, RateWindow] = {}
         predicate = compile_filter(args.filter_expr)
         for raw_topic in args.topics:
             topic = resolve_topic(raw_topic)
             ttype, real, _ = wait_for_type(client, topic)
-            rate = stats[raw_topic] = RateStats(args.window)
+            rate = stats[raw_topic] = RateWindow(args.window)
             now = time.time if clock is None else clock.now
             node.subscriber(real, None, _hz_callback(rate, now, predicate, ttype, real), raw=True)
             print(f"subscribed to [{real}]")
@@ -74,7 +52,7 @@ def cmd_hz(args: argparse.Namespace) -> int:
 
 
 def _hz_callback(
-    stats: RateStats, now: Callable[[], float], predicate: Any, ttype: str, topic: str
+    stats: RateWindow, now: Callable[[], float], predicate: Any, ttype: str, topic: str
 ) -> Callable[[Any], None]:
     if predicate is None:
         return lambda raw: stats.arrived(now())
@@ -89,80 +67,30 @@ def _hz_callback(
     return filtered
 
 
-def _print_rates(stats: dict[str, RateStats]) -> None:
+def _print_rates(stats: dict[str, RateWindow]) -> None:
     if len(stats) == 1:
-        result = next(iter(stats.values())).report()
-        if result is None:
-            print("no new messages")
-            return
-        rate, lo, hi, std, window = result
-        print(
-            f"average rate: {rate:.3f}\n\tmin: {lo:.3f}s max: {hi:.3f}s std dev: {std:.5f}s window: {window}"
-        )
+        print(hz_text(next(iter(stats.values())).report()))
         return
-    header = ["topic", "rate", "min_delta", "max_delta", "std_dev", "window"]
-    cols: dict[str, list[str]] = {h: [] for h in header}
-    for topic, stat in stats.items():
-        result = stat.report()
-        if result is None:
-            continue
-        rate, lo, hi, std, window = result
-        for key, value in zip(
-            header, (topic, f"{rate:.4}", f"{lo:.4}", f"{hi:.4}", f"{std:.4}", str(window)), strict=True
-        ):
-            cols[key].append(value)
-    if not cols["topic"]:
-        print("no new messages")
-        return
-    widths = [max(len(h), *(len(v) for v in cols[h])) for h in header]
-    print("   ".join(h.center(w) for h, w in zip(header, widths, strict=True)))
-    print("=" * (sum(widths) + 3 * (len(header) - 1)))
-    for i in range(len(cols["topic"])):
-        print("   ".join(cols[h][i].ljust(w) for h, w in zip(header, widths, strict=True)))
-    print()
+    print(hz_table([(topic, window.report()) for topic, window in stats.items()]))
 
 
 def cmd_bw(args: argparse.Namespace) -> int:
     client = master(ID)
     topic = resolve_topic(args.topic)
     _, real, _ = wait_for_type(client, topic)
-    window = args.window if args.window and args.window > 0 else 100
-    samples: deque[tuple[float, int]] = deque(maxlen=window)
-    lock = threading.Lock()
-
-    def arrived(raw: Any) -> None:
-        with lock:
-            samples.append((time.time(), len(raw.data)))
-
+    window = BandwidthWindow(args.window or 0)
     node = make_node()
     try:
-        node.subscriber(real, None, arrived, raw=True)
+        node.subscriber(real, None, lambda raw: window.arrived(time.time(), len(raw.data)), raw=True)
         print(f"subscribed to [{real}]")
         while not node.is_shutdown:
             time.sleep(1.0)
-            with lock:
-                if len(samples) < 2:
-                    continue
-                now = time.time()
-                sizes = [s for _, s in samples]
-                span = now - samples[0][0]
-            total = sum(sizes)
-            rate = total / span if span > 0 else 0.0
-            print(
-                "average: %s/s\n\tmean: %s min: %s max: %s window: %s"
-                % (*_units(rate, total / len(sizes), min(sizes), max(sizes)), len(sizes))
-            )
+            stats = window.report(time.time())
+            if stats is not None:
+                print(bw_text(stats))
     finally:
         node.shutdown("rostopic bw done")
     return 0
-
-
-def _units(rate: float, *values: float) -> list[str]:
-    if rate < 1000:
-        return [f"{v:.2f}B" for v in (rate, *values)]
-    if rate < 1000000:
-        return [f"{v / 1000:.2f}KB" for v in (rate, *values)]
-    return [f"{v / 1000000:.2f}MB" for v in (rate, *values)]
 
 
 def cmd_delay(args: argparse.Namespace) -> int:
@@ -174,40 +102,26 @@ def cmd_delay(args: argparse.Namespace) -> int:
     node = make_node()
     try:
         clock = for_node(node)
-        delays: deque[float] = deque(maxlen=args.window if args.window and args.window > 0 else 50000)
-        lock = threading.Lock()
+        window = DelayWindow(args.window or 0)
         cls_holder: list[Any] = []
-        fresh = threading.Event()
+        warned = threading.Event()
 
         def arrived(raw: Any) -> None:
             now = clock.now()
             if not cls_holder:
                 cls_holder.append(class_for(ttype, raw.connection_header))
-                if not cls_holder[0]._has_header:
+            if not cls_holder[0]._has_header:
+                if not warned.is_set():
+                    warned.set()
                     print("msg does not have header", file=sys.stderr)
-            msg = cls_holder[0].deserialize_from(raw.data)
-            if not getattr(msg, "_has_header", False):
                 return
-            with lock:
-                delays.append(now - msg.header.stamp.to_sec())
-            fresh.set()
+            window.arrived(now, cls_holder[0].deserialize_from(raw.data).header.stamp.to_sec())
 
         node.subscriber(real, None, arrived, raw=True)
         print(f"subscribed to [{real}]")
         while not node.is_shutdown:
             time.sleep(1.0)
-            if not fresh.is_set():
-                print("no new messages")
-                continue
-            fresh.clear()
-            with lock:
-                values = list(delays)
-            n = len(values)
-            mean = sum(values) / n
-            std = math.sqrt(sum((d - mean) ** 2 for d in values) / n)
-            print(
-                f"average delay: {mean:.3f}\n\tmin: {min(values):.3f}s max: {max(values):.3f}s std dev: {std:.5f}s window: {n}"
-            )
+            print(delay_text(window.report()))
     finally:
         node.shutdown("rostopic delay done")
     return 0

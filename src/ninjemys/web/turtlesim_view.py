@@ -118,19 +118,17 @@ def start_view(
     """Serve the turtlesim page and the node graph for a running sim, with the gateway (on the
     turtlesim node itself: no extra node in the graph) as the pages' data path; returns the stop
     function (None when the server cannot start: the error is logged)."""
-    import rospy
-
-    node = rospy.core.process_node()
+    node = sim.node
     gateway = Gateway(GatewayOptions(node_name=node.name, sim_clock=False), node=node)
     gateway.start()
-    app = WebApp(node.master_uri, rospy.get_name(), options.host, options.port)
+    app = WebApp(node.master_uri, node.name, options.host, options.port)
     app.add_gateway(gateway)
-    view = TurtlesimView(app, gateway, sim.world, sim.lock, rospy.get_name())
+    view = TurtlesimView(app, gateway, sim.world, sim.lock, node.name)
     try:
         url = app.start()
     except OSError as exc:
         gateway.shutdown()
-        rospy.logerr("cannot serve the turtlesim view on %s:%d: %s", options.host, options.port, exc)
+        node.log.error("cannot serve the turtlesim view on %s:%d: %s", options.host, options.port, exc)
         return None
     sim.view = view
     print(f"turtlesim view: {url}turtlesim   node graph: {url}", flush=True)

@@ -1,0 +1,35 @@
+"""One node idiom from core to apps: the in-house nodes of the apps (the gateway, the simulators, the
+navigation stack, the drivers, the web tools) are core ``Node``s run by ``ninjemys.node.run``; none
+imports rospy, which stays for the tutorials and for users' programs (checked with ``ast``: every
+import form counts, as in test_layering)."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+SRC = Path(__file__).resolve().parents[1] / "src" / "ninjemys"
+APPS = ("bridge", "sim", "nav", "drivers", "web", "robot", "image_transport")
+
+
+def rospy_imports(root: Path) -> list[str]:
+    """``file:line`` of every import of rospy (or a submodule) under ``root``."""
+    found = []
+    for path in sorted(root.rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            names: list[str] = []
+            if isinstance(node, ast.Import):
+                names = [alias.name for alias in node.names]
+            elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+                names = [node.module]
+            found += [f"{path.relative_to(SRC)}:{node.lineno}" for n in names if n.split(".")[0] == "rospy"]
+    return found
+
+
+def test_no_in_house_app_node_goes_through_rospy():
+    offenders = [hit for app in APPS for hit in rospy_imports(SRC / app)]
+    assert offenders == [], "in-house nodes use ninjemys.node.run and the core Node: " + ", ".join(offenders)
+
+
+def test_the_check_sees_rospy_imports():
+    assert rospy_imports(SRC / "tutorials"), "the tutorials are rospy programs: the scan must find them"
