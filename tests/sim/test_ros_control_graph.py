@@ -199,8 +199,11 @@ got = []
 rospy.Subscriber("/puzzlebot_controller/odom", Odometry, got.append)
 pub = rospy.Publisher("/puzzlebot_controller/cmd_vel", Twist, queue_size=1)
 t = Twist(); t.linear.x = 0.2
-end = rospy.get_time() + 1.5
-while rospy.get_time() < end:
+# drive until the odometry shows the move (a loaded machine steps the simulation slowly), at most 20 s
+end = rospy.get_time() + 20.0
+while rospy.get_time() < end and not (got and got[-1].pose.pose.position.x > 0.15):
+    pub.publish(t); rospy.sleep(0.05)
+for _ in range(10):
     pub.publish(t); rospy.sleep(0.05)
 o = got[-1]
 print("ODOM %.3f %.3f %s" % (o.pose.pose.position.x, o.twist.twist.linear.x, o.child_frame_id))
