@@ -6,11 +6,11 @@ import ast
 import threading
 from pathlib import Path
 
-from node_harness import wait_until
 from node_msgs import String
 
 from ninjemys.idl.loader import get_service_class
 from ninjemys.node import threads
+from ninjemys.testing import wait_until
 
 SRC = Path(__file__).resolve().parents[2] / "src"
 #: where the core starts threads and creates its locks and queues

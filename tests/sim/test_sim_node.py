@@ -14,11 +14,10 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from sim_helpers import wait_until
 
 from ninjemys.packages.shipped import shipped_executable
 from ninjemys.sim.worlds import WORLDS_DIR
-from ninjemys.testing import run_master
+from ninjemys.testing import run_master, wait_until
 
 
 class SimProcess:
