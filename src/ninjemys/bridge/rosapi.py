@@ -141,7 +141,7 @@ class RosApi:
 
     # -- graph --------------------------------------------------------------------------------
     def _types(self) -> list[tuple[str, str]]:
-        return [tuple(p) for p in self.master.get_topic_types()]
+        return [(p[0], p[1]) for p in self.master.get_topic_types()]
 
     def _state(self) -> Any:
         return self.master.get_system_state()

@@ -454,7 +454,7 @@ class RealSenseCamera:
 
     def _publish_cloud(self, cloud: Any, stamp: Time, frame_id: str) -> None:
         PointCloud2 = get_message_class("sensor_msgs/PointCloud2")
-        PointField = get_message_class("sensor_msgs/PointField")
+        PointField: Any = get_message_class("sensor_msgs/PointField")  # its constants are made at run time
         msg = PointCloud2()
         msg.header.stamp = stamp
         msg.header.frame_id = frame_id

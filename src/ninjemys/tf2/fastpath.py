@@ -10,6 +10,7 @@ import logging
 from bisect import bisect_right
 from cmath import rect
 from math import cos, sin
+from typing import Any
 
 from ninjemys.tf2 import math as tfm
 from ninjemys.tf2.reference import ReferenceLookup
@@ -143,7 +144,7 @@ def _side(frame: Frame, n: int) -> list:
     path = frame.path
     links = tuple(zip(path[:n], path[1 : n + 1], strict=True))
     lead = next((f for f, _ in links if not f.static), None)
-    side = [None if links and lead is None else {}, lead, links]
+    side: list = [None if links and lead is None else {}, lead, links]
     frame.sides[path[n]] = side
     return side
 
@@ -235,13 +236,13 @@ class FastLookup(ReferenceLookup):
         per frame until the next insertion (``gen``); None when some link has no data for ``t``."""
         if frame.memo_gen == gen and frame.memo_t == t:
             return frame.memo_val
+        acc: Any
         if not frame.data:  # the top of its tree ("map", "world"): itself, at any time
             acc = (frame, (0j, 0.0, 1.0 + 0j))
             frame.memo_gen, frame.memo_t, frame.memo_val = gen, t, acc
             return acc
         path: list[tuple[Frame, Entry]] = []
         cur = frame
-        acc: tuple | None
         while True:
             if cur.memo_gen == gen and cur.memo_t == t:
                 acc = cur.memo_val
@@ -308,6 +309,11 @@ class FastLookup(ReferenceLookup):
         return acc
 
     def _lookup(self, target: Frame, source: Frame, t: int) -> tuple[int, tuple]:
+        # names reused for speed: paths (None only when i < 0), then stamps, then memos and composites
+        sp: Any
+        tp: Any
+        a: Any
+        b: Any
         topology = self._topology
         sp = source.path if source.path_topology == topology else self._path(source)
         tp = target.path if target.path_topology == topology else self._path(target)

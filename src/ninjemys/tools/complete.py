@@ -40,6 +40,7 @@ from ninjemys.share.completion import BASH_FILE
 TYPE_CHECKING = False  # typing itself is not worth importing on every Tab press
 if TYPE_CHECKING:
     from collections.abc import Callable
+    from types import ModuleType
 
 #: a completion that waits longer than this for the master is worse than none
 MASTER_TIMEOUT = 1.0
@@ -307,7 +308,7 @@ def _launch_args(*where: str) -> list[str]:
     return launch_args(path) if path else []
 
 
-def _pkgs() -> object:
+def _pkgs() -> ModuleType:
     from ninjemys.tools import complete_pkgs
 
     return complete_pkgs
