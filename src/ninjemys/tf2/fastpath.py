@@ -6,7 +6,6 @@ cannot answer, the walk does.
 
 from __future__ import annotations
 
-import logging
 from bisect import bisect_right
 from cmath import rect
 from math import cos, sin
@@ -22,8 +21,6 @@ from ninjemys.tf2.storage import (
     _nlerp,
     _raise,
 )
-
-_log = logging.getLogger("ninjemys.tf2.core")
 
 _SEEN = (-1,)  # a segment looked up once: its composite is made on the second lookup (no history is -1)
 

@@ -4,12 +4,8 @@
 
 from __future__ import annotations
 
-import logging
-
 from ninjemys.tf2.ingest import Ingest
 from ninjemys.tf2.storage import Frame, _secs
-
-_log = logging.getLogger("ninjemys.tf2.core")
 
 
 class Introspection(Ingest):

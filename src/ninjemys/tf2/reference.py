@@ -6,7 +6,6 @@ the differential tests can compare both.
 
 from __future__ import annotations
 
-import logging
 from collections.abc import Iterable
 
 from ninjemys.tf2 import math as tfm
@@ -21,8 +20,6 @@ from ninjemys.tf2.storage import (
     FrameStore,
     _raise,
 )
-
-_log = logging.getLogger("ninjemys.tf2.core")
 
 
 def _min_stamp(frames: Iterable[Frame]) -> int:
