@@ -117,7 +117,7 @@ def run_master(
     ``env`` replaces the child's environment (ROS_HOME and ROS_LOG_DIR are inherited by default,
     so logs land in the test's own directory); its output is discarded.
     """
-    import xmlrpc.client
+    from ninjemys.net import auth
 
     port = port or free_port()
     uri = f"http://localhost:{port}/"
@@ -135,7 +135,7 @@ def run_master(
         deadline = time.monotonic() + timeout
         while True:
             try:
-                xmlrpc.client.ServerProxy(uri).getPid("/run_master")
+                auth.server_proxy(uri).getPid("/run_master")
                 break
             except OSError:
                 if proc.poll() is not None:
@@ -191,7 +191,7 @@ def kill_tree(proc: Any) -> None:
 @contextlib.contextmanager
 def run_real_roscore(ros_home: str | os.PathLike[str], timeout: float = 30.0) -> Iterator[str]:
     """Debian's /usr/bin/roscore on a free port; yields its URI once /rosout is up; kills the whole tree."""
-    import xmlrpc.client
+    from ninjemys.net import auth
 
     port = free_port()
     uri = f"http://localhost:{port}/"
@@ -208,7 +208,7 @@ def run_real_roscore(ros_home: str | os.PathLike[str], timeout: float = 30.0) ->
         while True:
             try:
                 # the master's reply is XML-RPC data (typeshed's union of every wire type): a triple here
-                reply: Any = xmlrpc.client.ServerProxy(uri).getSystemState("/run_real_roscore")
+                reply: Any = auth.server_proxy(uri).getSystemState("/run_real_roscore")
                 code, _, state = reply
                 if code == 1 and any(topic == "/rosout_agg" for topic, _ in state[0]):
                     break

@@ -29,6 +29,7 @@ from ninjemys.errors import (
     ShutdownError,
     TimeoutError_,
 )
+from ninjemys.net import auth
 from ninjemys.net.addresses import is_local_address, split_uri
 from ninjemys.node import transport
 from ninjemys.wire import headers
@@ -66,9 +67,13 @@ def probe(service: str, uri: str, timeout: float = 5.0, caller_id: str = "/rosse
     try:
         with socket.create_connection((host, port), timeout=timeout) as sock:
             fields = {"probe": "1", "md5sum": "*", "callerid": caller_id, "service": service}
-            sock.sendall(headers.encode_header(fields))
+            sock.sendall(headers.encode_header(auth.sign_fields(fields)))
             prefix = _recv_exact(sock, 4)
-            return headers.decode_header(_recv_exact(sock, headers.header_length(prefix)))
+            reply = headers.decode_header(_recv_exact(sock, headers.header_length(prefix)))
+            refused = auth.check_fields(reply)
+            if refused is not None:
+                raise ServiceError(f"service [{service}] at {uri}: authentication failed: {refused}")
+            return reply
     except (OSError, NinjemysError) as exc:
         raise ServiceError(
             f"Unable to communicate with service [{service}], address [{uri}]: {exc}"
@@ -264,7 +269,7 @@ class ServiceServer:
             await transport.send_error_header(sock, error)
             transport.close_quietly(sock)
             return
-        await transport.write_all(sock, headers.encode_header(self._reply_header()))
+        await transport.write_all(sock, headers.encode_header(auth.sign_fields(self._reply_header())))
         if header.get("probe") == "1":
             transport.close_quietly(sock)
             return
@@ -477,9 +482,12 @@ class ServiceProxy:
             elif self.persistent:
                 fields["persistent"] = "1"
             fields.update(self.headers)
-            sock.sendall(headers.encode_header(fields))
+            sock.sendall(headers.encode_header(auth.sign_fields(fields)))
             link = _Link(sock, 4096 if probe else 1 << 16)
             reply = link.header()
+            refused = auth.check_fields(reply)
+            if refused is not None:
+                reply = {"error": f"authentication failed: {refused}"}
         except (OSError, NinjemysError) as exc:
             transport.close_quietly(sock)
             raise ServiceError(f"service [{self.name}]: handshake failed: {exc}") from None

@@ -227,6 +227,12 @@ THREADS: tuple[Thread, ...] = (
         "runs execute_cb for each accepted goal",
         "execute callbacks",
     ),
+    Thread(
+        "concurrent_split:<label>",
+        "smach.concurrence.Concurrence.execute (one per child state, joined before it returns)",
+        "runs one child state of the concurrence, as smach's threads of that name do",
+        "state execute callbacks",
+    ),
     Thread("rosbag-record-writer", "bag.record", "writes the recorded messages to the bag, in order"),
     Thread(
         "rosbag-record-discovery",
@@ -323,6 +329,8 @@ RESOURCES: tuple[Resource, ...] = (
     Resource("queue", "ninjemys.net.xmlrpc_server:_Connection.queue", LOOP, "none (requests in order)"),
     Resource("queue", "ninjemys.net.xmlrpc_server:_Connection.out", LOOP, "none (response bytes not yet sent)"),
     Resource("lock", "ninjemys.master.client:MasterClient._lock", USER + " (caller)", "one call at a time"),
+    Resource("lock", "ninjemys.net.auth:Signer._lock", "any thread checking a signature",
+             "held only to remember an accepted nonce and forget expired ones"),
     Resource("lock", "ninjemys.nav.move_base_node:MoveBase.lock", "move_base-control",
              "the planner, costmap and scan threads and the services: the state machine and the costmaps; "
              "the action server's callbacks never take it (they hold the server's lock, which the control "
