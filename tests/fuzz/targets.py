@@ -328,6 +328,75 @@ def _gateway(data: bytes) -> None:
     msg.serialize(io.BytesIO())
 
 
+# -- device drivers: what a serial port delivers ------------------------------------------------------
+
+
+def _rosserial(data: bytes) -> None:
+    """A rosserial byte stream cut into reads of varying sizes; each packet's TopicInfo decoded as the
+    host decodes a negotiation (the host logs a payload that does not decode and goes on)."""
+    from ninjemys.drivers.rosserial_protocol import Frame, FrameReader
+    from ninjemys.idl.loader import get_message_class
+
+    info = get_message_class("rosserial_msgs/TopicInfo")
+    reader = FrameReader()
+    pos, step = 0, 1
+    while pos < len(data):
+        for item in reader.feed(data[pos : pos + step]):
+            if isinstance(item, Frame) and item.topic_id == 0 and item.payload:
+                info().deserialize(item.payload)
+            elif not isinstance(item, Frame):
+                item.log_line()
+        pos += step
+        step = step * 3 % 97 + 1
+
+
+def _rosserial_seeds() -> list[bytes]:
+    from ninjemys.drivers.rosserial_protocol import frame
+    from ninjemys.idl.loader import get_message_class
+
+    ti = get_message_class("rosserial_msgs/TopicInfo")()
+    ti.topic_id, ti.topic_name, ti.message_type, ti.md5sum, ti.buffer_size = (
+        125,
+        "wl",
+        "std_msgs/Float32",
+        "7" * 32,
+        280,
+    )
+    return [
+        frame(0, ti.serialize_to_bytes()) + frame(125, b"\x00\x00\xc0\x3f") + frame(10, bytes(8)),
+        b"noise" + frame(7),
+    ]
+
+
+def _rplidar(data: bytes) -> None:
+    """An RPLIDAR stream as the node reads it: a descriptor, then standard nodes or express capsules,
+    assembled into revolutions and turned into LaserScan fields."""
+    from ninjemys.drivers import rplidar_protocol as rp
+    from ninjemys.drivers.rplidar_scan import RevolutionAssembler, revolution_to_scan
+
+    if len(data) >= rp.DESCRIPTOR_SIZE:
+        try:
+            rp.Descriptor.unpack(data[: rp.DESCRIPTOR_SIZE]).check(rp.CMD_SCAN)
+        except rp.RplidarError:
+            pass
+    for decoder in (rp.NodeDecoder(), rp.CapsuleDecoder()):
+        assembler = RevolutionAssembler()
+        for pos in range(0, len(data), 200):
+            for rev in assembler.feed(decoder.feed(data[pos : pos + 200])):
+                for compensate in (True, False):
+                    revolution_to_scan(rev, compensate, 2, 0.1, False, 16.0)
+
+
+def _rplidar_seeds() -> list[bytes]:
+    from ninjemys.drivers import rplidar_protocol as rp
+
+    nodes = b"".join(rp.pack_node(a * 7.5, 1000 + a, 40, a % 48 == 0) for a in range(100))
+    caps = b"".join(
+        rp.pack_capsule(c * 30.0, [500.0 + i for i in range(32)], [3] * 32, c == 0) for c in range(14)
+    )
+    return [rp.Descriptor(5, 1, 0x81).pack() + nodes, rp.Descriptor(84, 1, 0x82).pack() + caps]
+
+
 def targets() -> list[Target]:
     """Every target, with its seeds (built on first use)."""
     return [
@@ -340,6 +409,8 @@ def targets() -> list[Target]:
         Target("map", _map, _map_seeds()),
         Target("world", _world, _world_seeds()),
         Target("gateway", _gateway, _gateway_seeds()),
+        Target("rosserial", _rosserial, _rosserial_seeds()),
+        Target("rplidar", _rplidar, _rplidar_seeds()),
     ]
 
 

@@ -48,6 +48,7 @@ SHIPPED_PACKAGES = (
     # issue 21 item 7: the long tail course code imports (smach's introspection, aruco_detect's fiducials)
     "smach_msgs",
     "fiducial_msgs",
+    "rosserial_msgs",
 )
 
 #: packages Debian's ROS 1 lacks; their facts are checked against published md5sums instead
@@ -63,6 +64,7 @@ NOT_IN_DEBIAN = frozenset(
         "realsense2_camera",
         "smach_msgs",
         "fiducial_msgs",
+        "rosserial_msgs",
     }
 )
 

@@ -138,4 +138,10 @@ PUBLISHED_MD5: dict[str, str] = {
     "realsense2_camera/IMUInfo": "a02adb3a99530b11ba18a16f40f9512a",
     "realsense2_camera/Metadata": "4966ca002be16ee67fe4dbfb2f354787",
     "realsense2_camera/DeviceInfo": "914e9cfa74a4f66f08c3fe1016943c1b",
+    # rosserial_msgs 0.9.2 (Noetic): rosserial's generated ros_lib headers, roslisp and rosnodejs code
+    "rosserial_msgs/TopicInfo": "0ad51f88fc44892f8c10684077646005",
+    "rosserial_msgs/Log": "11abd731c25933261cd6183bd12d6295",
+    "rosserial_msgs/RequestParam": "d7a0c2be00c9fd03cc69f2863de9c4d9",
+    "rosserial_msgs/RequestParamRequest": "c1f3d28f1b044c871e6eff2e9fc3c667",
+    "rosserial_msgs/RequestParamResponse": "9f0e98bda65981986ddf53afa7a40e49",
 }
