@@ -214,6 +214,12 @@ THREADS: tuple[Thread, ...] = (
     # -- apps: the web tools (web) ---------------------------------------------------------------
     Thread("web-tools", "web.app.WebApp.start", "the web tools' asyncio loop: their HTTP server and pages"),
     Thread("rqt_bag-play", "web.rqt (bag playback)", "publishes the bag's messages at their times and speed"),
+    # -- drivers ---------------------------------------------------------------------------------
+    Thread(
+        "rosserial-call",
+        "drivers.rosserial_host (one per service request from the device)",
+        "calls the ROS service the device asked for and sends the response back down the link; ends",
+    ),
     # -- libraries and commands ------------------------------------------------------------------
     Thread(
         "action-status:<ns>",
