@@ -13,7 +13,6 @@ ROOT = Path(__file__).resolve().parents[1]
 RELAXED_AT_MOST = {
     "ninjemys.sim.puzzlebot_node",
     "ninjemys.sim.robot_model",
-    "ninjemys.sim.sensors",
     "ninjemys.sim.simcore",
     "ninjemys.sim.turtlesim_node",
 }

@@ -282,6 +282,70 @@ def _world(data: bytes) -> None:
         load_world(path)
 
 
+# -- Gazebo worlds (SDF) and mesh files ---------------------------------------------------------------
+
+
+_SDF_WORLD = b"""<?xml version="1.0"?>
+<sdf version="1.6">
+  <world name="course">
+    <include><uri>model://ground_plane</uri></include>
+    <include><uri>model://sun</uri></include>
+    <include><uri>model://construction_cone</uri><name>cone</name><pose>1 2 0 0 0 0.3</pose></include>
+    <model name="box"><static>true</static><pose>2 0 0.25 0 0 0</pose>
+      <link name="link"><pose>0 0 0 0.1 0 0</pose>
+        <collision name="c"><geometry><box><size>0.5 1 0.5</size></box></geometry></collision>
+        <visual name="v"><geometry><box><size>0.5 1 0.5</size></box></geometry>
+          <material><script><name>Gazebo/Red</name></script><diffuse>1 0 0 1</diffuse></material></visual>
+      </link>
+      <model name="inner"><link name="l"><collision name="c"><geometry><cylinder><radius>0.2</radius>
+        <length>1</length></cylinder></geometry></collision></link></model>
+    </model>
+    <model name="shapes"><link name="l">
+      <collision name="s"><geometry><sphere><radius>0.3</radius></sphere></geometry></collision>
+      <collision name="p"><geometry><polyline><point>0 0</point><point>1 0</point><point>0 1</point>
+        <height>0.5</height></polyline></geometry></collision>
+    </link></model>
+    <state world_name="course"><model name="box"><pose>3 0 0.25 0 0 0</pose></model></state>
+    <actor name="walker"/>
+  </world>
+</sdf>
+"""
+
+
+def _sdf_world(data: bytes) -> None:
+    from ninjemys.sim.sdf import parse_sdf_world
+
+    parse_sdf_world(data, "fuzz.world", env={"HOME": "/nonexistent"}, warn=lambda _m: None)
+
+
+def _mesh_seeds() -> list[bytes]:
+    from ninjemys.sim.sdf import SHIPPED_MODELS
+
+    stl = (SHIPPED_MODELS / "construction_cone" / "meshes" / "cone.stl").read_bytes()
+    ascii_stl = b"solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 1\nendloop\nendfacet\nendsolid t\n"
+    dae = (
+        b'<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1"><asset>'
+        b'<unit meter="0.01"/><up_axis>Y_UP</up_axis></asset><library_geometries><geometry id="g"><mesh>'
+        b'<source id="p"><float_array id="a" count="9">0 0 0 1 0 0 0 1 1</float_array></source>'
+        b'<vertices id="v"><input semantic="POSITION" source="#p"/></vertices></mesh></geometry>'
+        b'</library_geometries><library_visual_scenes><visual_scene id="s"><node><translate>1 2 3</translate>'
+        b'<rotate>0 0 1 90</rotate><scale>1 2 1</scale><instance_geometry url="#g"/></node></visual_scene>'
+        b"</library_visual_scenes></COLLADA>"
+    )
+    obj = b"v 0 0 0\nv 1 0 0\nv 0 1 1\nf 1 2 3\nf -1 -2 -3\n"
+    return [b"stl" + stl, b"stl" + ascii_stl, b"dae" + dae, b"obj" + obj]
+
+
+def _mesh(data: bytes) -> None:
+    from ninjemys.sim.meshes import load_mesh_parts
+
+    kind = {b"stl": ".stl", b"dae": ".dae", b"obj": ".obj"}.get(data[:3], ".stl")
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / f"fuzz{kind}"
+        path.write_bytes(data[3:])
+        load_mesh_parts(path)
+
+
 # -- the gateway -------------------------------------------------------------------------------------
 
 
@@ -409,6 +473,8 @@ def targets() -> list[Target]:
         Target("map", _map, _map_seeds()),
         Target("world", _world, _world_seeds()),
         Target("gateway", _gateway, _gateway_seeds()),
+        Target("sdf_world", _sdf_world, [_SDF_WORLD]),
+        Target("mesh", _mesh, _mesh_seeds()),
         Target("rosserial", _rosserial, _rosserial_seeds()),
         Target("rplidar", _rplidar, _rplidar_seeds()),
     ]

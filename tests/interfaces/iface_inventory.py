@@ -49,6 +49,8 @@ SHIPPED_PACKAGES = (
     "smach_msgs",
     "fiducial_msgs",
     "rosserial_msgs",
+    # wave 3: ros_control's controller_manager (issue 23)
+    "controller_manager_msgs",
 )
 
 #: packages Debian's ROS 1 lacks; their facts are checked against published md5sums instead
@@ -65,6 +67,7 @@ NOT_IN_DEBIAN = frozenset(
         "smach_msgs",
         "fiducial_msgs",
         "rosserial_msgs",
+        "controller_manager_msgs",
     }
 )
 

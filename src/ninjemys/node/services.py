@@ -91,6 +91,11 @@ def _recv_exact(sock: socket.socket, n: int) -> bytes:
     return b"".join(chunks)
 
 
+class RequestArgumentError(ServiceError, TypeError):
+    """Call arguments that do not make a request of the service's type. Also a TypeError, which is
+    what rospy raises for them (code written for rospy may catch it)."""
+
+
 class _Link:
     """The receive side of one service connection: records (a fixed head whose last field is the
     body length, then the body) read through one preallocated buffer.
@@ -335,7 +340,10 @@ class ServiceServer:
         if isinstance(exc, ServiceError):
             _log.debug("service %s: handler refused the request: %s", self.name, exc)
             return encode_service_response(False, f"service cannot process request: {exc}")
-        _log.error("service %s: error processing request: %s", self.name, exc)
+        if getattr(exc, "ninjemys_reported", False):  # the handler's owner (rospy) logged it already
+            _log.debug("service %s: error processing request: %s", self.name, exc)
+        else:
+            _log.error("service %s: error processing request: %s", self.name, exc)
         return encode_service_response(False, f"error processing request: {exc}")
 
     @property
@@ -440,7 +448,7 @@ class ServiceProxy:
             try:
                 request = self.request_class(*args, **kwargs)
             except TypeError as exc:
-                raise ServiceError(f"service [{self.name}]: bad request arguments: {exc}") from None
+                raise RequestArgumentError(f"service [{self.name}]: bad request arguments: {exc}") from None
         payload = request.serialize_to_bytes()
         frame = _U32.pack(len(payload)) + payload
         if not args and not kwargs:

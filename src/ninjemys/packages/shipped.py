@@ -130,6 +130,12 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
             "socket_node": ("ninjemys.drivers.rosserial_node:socket_main", ()),
         },
         "rplidar_ros": {"rplidarNode": ("ninjemys.drivers.rplidar_node:main", ())},
+        # -- ros_control (docs/sim.md): the manager runs inside the simulator --
+        "controller_manager": {
+            "spawner": ("ninjemys.sim.ros_control.spawner:main", ()),
+            "unspawner": ("ninjemys.sim.ros_control.spawner:unspawner_main", ()),
+            "controller_manager": ("ninjemys.sim.ros_control.cm_command:main", ()),
+        },
         "xacro": {
             "xacro": ("ninjemys.tools.xacro:main", ()),
             "xacro.py": ("ninjemys.tools.xacro:main", ()),

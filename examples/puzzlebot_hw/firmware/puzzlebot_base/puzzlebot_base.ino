@@ -2,9 +2,9 @@
 //
 // The interface the host (ninjemys' rosserial_python serial_node.py, at 115200 baud) sees:
 //   subscribes  cmd_vel   geometry_msgs/Twist    linear.x (m/s), angular.z (rad/s)
-//               led_ring  std_msgs/ColorRGBA     the ring's colour (r, g, b in 0..1; a = brightness)
+//               led       std_msgs/ColorRGBA     the LED ring's colour (r, g, b in 0..1; a = brightness)
 //   publishes   wl, wr    std_msgs/Float32       left and right wheel speeds (rad/s) at 50 Hz
-//   parameters  ~wheel_radius (m), ~wheel_base (m)  asked of the host at start-up (RequestParam)
+//   parameters  wheel_radius (m), wheel_base (m)    asked of the host at start-up (RequestParam)
 //   logs        "puzzlebot_base ready" on /rosout once the parameters are in
 // The wheel speed loop runs on the board: encoder counts -> rad/s, a PI controller per wheel
 // driving the H-bridge PWM towards the speeds cmd_vel asks for. A command older than 0.5 s stops
@@ -40,7 +40,7 @@ void on_led_ring(const std_msgs::ColorRGBA& c) {
 }
 
 ros::Subscriber<geometry_msgs::Twist> cmd_sub("cmd_vel", &on_cmd_vel);
-ros::Subscriber<std_msgs::ColorRGBA> led_sub("led_ring", &on_led_ring);
+ros::Subscriber<std_msgs::ColorRGBA> led_sub("led", &on_led_ring);
 
 void isr_left() { counts_l += digitalRead(ENC_L_B) ? -1 : 1; }
 void isr_right() { counts_r += digitalRead(ENC_R_B) ? 1 : -1; }
@@ -60,8 +60,8 @@ void setup() {
   nh.advertise(wl_pub); nh.advertise(wr_pub);
   nh.subscribe(cmd_sub); nh.subscribe(led_sub);
   while (!nh.connected()) nh.spinOnce();
-  nh.getParam("~wheel_radius", &wheel_radius);
-  nh.getParam("~wheel_base", &wheel_base);
+  nh.getParam("wheel_radius", &wheel_radius);
+  nh.getParam("wheel_base", &wheel_base);
   nh.loginfo("puzzlebot_base ready");
 }
 
