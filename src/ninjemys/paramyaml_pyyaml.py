@@ -40,11 +40,11 @@ class _Loader(yaml.SafeLoader):
     """SafeLoader with rosparam's angle tags and binary values."""
 
 
-def _radians(loader: yaml.SafeLoader, node: yaml.Node) -> float:
+def _radians(loader: yaml.SafeLoader, node: yaml.ScalarNode) -> float:
     return _angle(_strip_call(str(loader.construct_scalar(node)), "rad("))
 
 
-def _degrees(loader: yaml.SafeLoader, node: yaml.Node) -> float:
+def _degrees(loader: yaml.SafeLoader, node: yaml.ScalarNode) -> float:
     return math.radians(_angle(_strip_call(str(loader.construct_scalar(node)), "deg(")))
 
 

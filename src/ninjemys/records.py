@@ -8,7 +8,7 @@ from __future__ import annotations
 class SlotRecord:
     """Compared and shown by the values of ``__slots__`` (mutable, so not hashable)."""
 
-    __slots__ = ()
+    __slots__: tuple[str, ...] = ()
 
     def __eq__(self, other: object) -> bool:
         if other.__class__ is not self.__class__:

@@ -19,6 +19,10 @@ import time as _time
 from collections.abc import Callable
 from numbers import Integral, Real
 
+TYPE_CHECKING = False  # importing typing costs start-up time; checkers set it
+if TYPE_CHECKING:
+    from typing import Self
+
 _NS = 1_000_000_000
 
 #: returns (secs, nsecs) of "now" for Time.now(); None is the wall clock (the fast path)
@@ -82,7 +86,7 @@ class TVal:
         self.secs = secs + carry
 
     @classmethod
-    def _raw(cls, secs: int, nsecs: int):  # noqa: ANN206 - generated code's fast constructor
+    def _raw(cls, secs: int, nsecs: int) -> Self:  # generated code's fast constructor
         """Build a value from wire integers without re-validating (normalizes if needed)."""
         obj = cls.__new__(cls)
         if 0 <= nsecs < _NS:
@@ -112,7 +116,7 @@ class TVal:
         return self.secs * _NS + self.nsecs
 
     @classmethod
-    def from_sec(cls, float_secs: float):  # noqa: ANN206
+    def from_sec(cls, float_secs: float) -> Self:
         secs = int(float_secs)
         return cls(secs, int((float_secs - secs) * 1e9))
 
@@ -131,16 +135,16 @@ class TVal:
     def __setstate__(self, state: list[int]) -> None:
         self.secs, self.nsecs = state
 
-    def __copy__(self):  # noqa: ANN204
+    def __copy__(self) -> Self:
         return type(self)._raw(self.secs, self.nsecs)
 
-    def __deepcopy__(self, memo: dict):  # noqa: ANN204
+    def __deepcopy__(self, memo: dict) -> Self:
         return type(self)._raw(self.secs, self.nsecs)
 
     def _cmp_check(self, other: object) -> int:
         if type(other) is not type(self) and not isinstance(other, type(self)):
             raise TypeError(f"cannot compare {type(self).__name__} to {type(other).__name__}")
-        return other.to_nsec()  # type: ignore[attr-defined]
+        return other.to_nsec()
 
     def __lt__(self, other: object) -> bool:
         return self.to_nsec() < self._cmp_check(other)
@@ -263,7 +267,7 @@ class Duration(TVal):
 
     def __truediv__(self, val: object) -> Duration | float:
         if isinstance(val, Integral | Real):
-            return Duration.from_sec(self.to_sec() / val)
+            return Duration.from_sec(self.to_sec() / float(val))
         if isinstance(val, Duration):
             return self.to_sec() / val.to_sec()
         return NotImplemented

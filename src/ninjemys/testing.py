@@ -1,4 +1,5 @@
-"""Public test helpers: free ports, and locating Debian's real ROS 1 for comparison tests.
+"""Public test helpers: free ports, locating Debian's real ROS 1 for comparison tests, a master or a node
+in a child process (:func:`run_master`, :class:`NodeProcess`) and polling waits (:func:`wait_until`).
 
 Kept dependency-free so user test suites (and ours) can import it without starting anything.
 """
@@ -7,11 +8,17 @@ from __future__ import annotations
 
 import contextlib
 import os
-from collections.abc import Iterator
+import re
+import signal
+import subprocess
+import threading
+import time
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 from ninjemys.commands import command_path
+from ninjemys.errors import NinjemysError
 from ninjemys.net.addresses import free_port as free_port  # re-exported: tests and users take it from here
 
 #: Debian's real ROS 1 runs under the system interpreter, never the project's venv.
@@ -43,7 +50,6 @@ def ros1_built_interfaces(dest: str | os.PathLike[str]) -> Path:
     installation holds. Returns the directory to put on ``ROS_PACKAGE_PATH``.
     """
     import shutil
-    import subprocess
 
     from ninjemys.idl.search import SHIPPED_ROOT
 
@@ -71,7 +77,7 @@ def ninjemys_bin(command: str) -> str:
     return command_path(command)
 
 
-def FakeClock(start: float = 0.0):  # noqa: N802 - reads as a class at call sites
+def FakeClock(start: float = 0.0) -> Any:  # noqa: N802 - reads as a class at call sites
     """A simulated ROS clock that a test drives by hand (``clock.advance(0.5)``, ``clock.set(3.0)``).
 
     Returns a :class:`ninjemys.node.clock.FakeClock`; imported on call so this module stays light.
@@ -111,9 +117,6 @@ def run_master(
     ``env`` replaces the child's environment (ROS_HOME and ROS_LOG_DIR are inherited by default,
     so logs land in the test's own directory); its output is discarded.
     """
-    import subprocess
-    import time
-
     from ninjemys.net import auth
 
     port = port or free_port()
@@ -176,7 +179,6 @@ def descendants(pid: int) -> list[int]:
 
 def kill_tree(proc: Any) -> None:
     """SIGKILL a Popen'd process and all of its descendants, then reap it."""
-    import signal
 
     for pid in [*descendants(proc.pid), proc.pid]:
         try:
@@ -189,9 +191,6 @@ def kill_tree(proc: Any) -> None:
 @contextlib.contextmanager
 def run_real_roscore(ros_home: str | os.PathLike[str], timeout: float = 30.0) -> Iterator[str]:
     """Debian's /usr/bin/roscore on a free port; yields its URI once /rosout is up; kills the whole tree."""
-    import subprocess
-    import time
-
     from ninjemys.net import auth
 
     port = free_port()
@@ -208,7 +207,9 @@ def run_real_roscore(ros_home: str | os.PathLike[str], timeout: float = 30.0) ->
         deadline = time.monotonic() + timeout
         while True:
             try:
-                code, _, state = auth.server_proxy(uri).getSystemState("/run_real_roscore")
+                # the master's reply is XML-RPC data (typeshed's union of every wire type): a triple here
+                reply: Any = auth.server_proxy(uri).getSystemState("/run_real_roscore")
+                code, _, state = reply
                 if code == 1 and any(topic == "/rosout_agg" for topic, _ in state[0]):
                     break
             except OSError:
@@ -221,3 +222,162 @@ def run_real_roscore(ros_home: str | os.PathLike[str], timeout: float = 30.0) ->
         yield uri
     finally:
         kill_tree(proc)
+
+
+class WaitTimeout(NinjemysError, AssertionError):
+    """A test's wait ran out: an AssertionError, so pytest reports it as the test's failure."""
+
+
+def wait_until(
+    predicate: Callable[[], Any], timeout: float = 20.0, what: str = "condition", step: float = 0.05
+) -> Any:
+    """Poll ``predicate`` every ``step`` seconds until it returns something truthy, and return that.
+
+    For tests only, where the code under test offers no event to wait on (another process, the
+    master's state). Raises :class:`WaitTimeout` naming ``what`` after ``timeout`` seconds; the
+    predicate is asked once more at the deadline, so a slow machine that got there late still passes.
+    """
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        value = predicate()
+        if value:
+            return value
+        time.sleep(step)
+    value = predicate()
+    if value:
+        return value
+    raise WaitTimeout(f"timed out after {timeout:g} s waiting for {what}")
+
+
+Match = Callable[[str], Any]
+
+
+class NodeProcess:
+    """A node (ours, real ROS 1's, any command) in a child process, its output collected line by line.
+
+    Reader threads collect stdout and stderr (``stderr=None``: merged into stdout), so the child never
+    blocks on a full pipe and a test can wait for a line without reading. Use it as a context manager
+    or call :meth:`stop`; both leave no process behind (:meth:`stop` asks with SIGTERM, then kills the
+    whole tree, as roslaunch's children live in their own sessions).
+    """
+
+    def __init__(
+        self,
+        cmd: Sequence[str],
+        env: dict[str, str] | None = None,
+        cwd: str | os.PathLike[str] | None = None,
+        merge_stderr: bool = False,
+    ) -> None:
+        self.cmd = list(cmd)
+        self.proc = subprocess.Popen(
+            self.cmd,
+            env=env,
+            cwd=cwd,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT if merge_stderr else subprocess.PIPE,
+            stdin=subprocess.DEVNULL,
+        )
+        self.out: list[str] = []
+        self.err: list[str] = []
+        self._cond = threading.Condition()
+        streams: list[tuple[IO[bytes] | None, list[str]]] = [(self.proc.stdout, self.out)]
+        if not merge_stderr:
+            streams.append((self.proc.stderr, self.err))
+        self._readers = [
+            threading.Thread(target=self._read, args=(stream, sink), daemon=True, name="NodeProcess reader")
+            for stream, sink in streams
+        ]
+        for reader in self._readers:
+            reader.start()
+
+    @property
+    def pid(self) -> int:
+        return self.proc.pid
+
+    def _read(self, stream: IO[bytes] | None, sink: list[str]) -> None:
+        if stream is None:
+            return
+        for raw in iter(stream.readline, b""):
+            with self._cond:
+                sink.append(raw.decode("utf-8", "replace").rstrip("\n"))
+                self._cond.notify_all()
+        stream.close()
+        with self._cond:
+            self._cond.notify_all()
+
+    def text(self) -> str:
+        """Everything printed on stdout so far (with stderr when merged), one line per line."""
+        with self._cond:
+            return "\n".join(self.out)
+
+    def wait_for(self, pattern: str | Match, timeout: float = 15.0, stream: str = "out") -> Any:
+        """The first line of stdout (``stream="err"``: stderr) that matches: a regex ``pattern`` gives its
+        ``re.Match``, a callable gives its truthy result. Fails the test (:class:`WaitTimeout`, with the
+        last lines of both streams) after ``timeout`` seconds or once the child has exited and its output
+        is read."""
+        match: Match = re.compile(pattern).search if isinstance(pattern, str) else pattern
+        sink = self.out if stream == "out" else self.err
+        deadline = time.monotonic() + timeout
+        seen = 0
+        with self._cond:
+            while True:
+                for line in sink[seen:]:
+                    found = match(line)
+                    if found:
+                        return found
+                seen = len(sink)
+                left = deadline - time.monotonic()
+                ended = self.proc.poll() is not None and not any(r.is_alive() for r in self._readers)
+                if left <= 0 or ended:
+                    why = f"exited with {self.proc.returncode}" if ended else f"nothing within {timeout:g} s"
+                    raise WaitTimeout(
+                        f"{self.cmd}: no line matching {pattern!r} on std{stream} ({why})\n"
+                        f"stdout: {self.out[-20:]}\nstderr: {self.err[-20:]}"
+                    )
+                self._cond.wait(min(left, 0.5))
+
+    def describe(self) -> str:
+        """The last lines of both streams: what an assertion about this child should show."""
+        with self._cond:
+            return f"{self.cmd[:3]} stdout={self.out[-5:]} stderr={self.err[-10:]}"
+
+    def interrupt(self) -> None:
+        """Ctrl-C: SIGINT, as a terminal sends it."""
+        self.proc.send_signal(signal.SIGINT)
+
+    def wait(self, timeout: float = 10.0) -> int:
+        """The exit code once the child ends (and its output is read)."""
+        code = self.proc.wait(timeout)
+        for reader in self._readers:
+            reader.join(2.0)
+        return code
+
+    def stop(self, grace: float = 10.0) -> int | None:
+        """SIGTERM, up to ``grace`` seconds to exit, then SIGKILL to it and its descendants; returns the
+        exit code (None when it had to be killed)."""
+        code: int | None = None
+        if self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                code = self.proc.wait(grace)
+            except subprocess.TimeoutExpired:
+                pass
+        else:
+            code = self.proc.returncode
+        if code is None:
+            kill_tree(self.proc)
+        for reader in self._readers:
+            reader.join(2.0)
+        return code
+
+    def kill(self) -> None:
+        """SIGKILL to it and its descendants at once (no shutdown hooks run)."""
+        kill_tree(self.proc)
+        for reader in self._readers:
+            reader.join(2.0)
+
+    def __enter__(self) -> NodeProcess:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.kill()

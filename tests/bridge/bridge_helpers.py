@@ -4,20 +4,7 @@ from __future__ import annotations
 
 import base64
 import struct
-import time
 import zlib
-from collections.abc import Callable
-
-
-def wait_for(predicate: Callable[[], object], timeout: float = 10.0, what: str = "condition") -> object:
-    """Poll ``predicate`` until it is truthy (tests only: the gateway has no event to wait on here)."""
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        value = predicate()
-        if value:
-            return value
-        time.sleep(0.02)
-    raise AssertionError(f"timed out waiting for {what}")
 
 
 def png_pixels(encoded: str) -> bytes:

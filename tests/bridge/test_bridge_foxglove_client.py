@@ -13,11 +13,11 @@ from collections.abc import Callable
 from pathlib import Path
 
 import pytest
-from bridge_helpers import wait_for
 
 from ninjemys.bridge.server import Gateway
 from ninjemys.idl.loader import get_message_class, get_service_class
 from ninjemys.node import Node
+from ninjemys.testing import wait_until
 
 NODE = shutil.which("node") or ("/usr/bin/node" if Path("/usr/bin/node").exists() else None)
 ROOT = Path(__file__).resolve().parents[2]
@@ -80,7 +80,7 @@ def run_client(
     reader.start()
     try:
         done.wait(timeout)
-        wait_for(also, timeout=timeout, what="the ROS side's condition")
+        wait_until(also, timeout=timeout, what="the ROS side's condition")
     finally:
         proc.kill()
         proc.wait(10)
@@ -97,8 +97,10 @@ def test_foxglove_client(gateway: Gateway, node: Node, node_modules: Path, subpr
     got: list[str] = []
     node.subscriber("/fox_in", String, lambda m: got.append(m.data))
     pub = node.publisher("/fox_out", PoseStamped)
-    wait_for(lambda: any(c["topic"] == "/fox_out" for c in gateway.catalog.channels.values()), what="channel")
-    wait_for(lambda: gateway.catalog.services, what="service catalogue")
+    wait_until(
+        lambda: any(c["topic"] == "/fox_out" for c in gateway.catalog.channels.values()), what="channel"
+    )
+    wait_until(lambda: gateway.catalog.services, what="service catalogue")
     stop = threading.Event()
 
     def publish() -> None:

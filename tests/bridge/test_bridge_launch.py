@@ -10,10 +10,9 @@ import subprocess
 from collections.abc import Iterator
 
 import pytest
-from bridge_helpers import wait_for
 from websockets.sync.client import connect
 
-from ninjemys.testing import free_port, ninjemys_bin
+from ninjemys.testing import free_port, ninjemys_bin, wait_until
 
 roslibpy = pytest.importorskip("roslibpy")
 
@@ -51,7 +50,7 @@ def _connect_when_up(url: str, **kwargs: object) -> object:
         except OSError:
             return None
 
-    return wait_for(attempt, timeout=60, what=f"the gateway at {url}")
+    return wait_until(attempt, timeout=60, what=f"the gateway at {url}")
 
 
 def test_rosbridge_websocket_launch(launch, master_uri: str) -> None:
@@ -65,7 +64,7 @@ def test_rosbridge_websocket_launch(launch, master_uri: str) -> None:
             reply = json.loads(ws.recv(timeout=10))
             return reply["values"]["nodes"] if reply.get("result") else None
 
-        names = wait_for(nodes, timeout=30, what="rosapi")
+        names = wait_until(nodes, timeout=30, what="rosapi")
         assert {"/rosbridge_websocket", "/rosapi"} <= set(names)
         ws.send(json.dumps({"op": "subscribe", "topic": "/client_count", "type": "std_msgs/Int32"}))
         count = json.loads(ws.recv(timeout=10))

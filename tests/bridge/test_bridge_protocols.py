@@ -13,14 +13,14 @@ from collections.abc import Callable
 
 import cbor2
 import pytest
-from bridge_helpers import png_pixels, wait_for
+from bridge_helpers import png_pixels
 from websockets.sync.client import ClientConnection, connect
 
 from ninjemys.bridge.server import Gateway
 from ninjemys.idl.loader import get_message_class
 from ninjemys.node import Node
 from ninjemys.rostime import Time
-from ninjemys.testing import ros1_env
+from ninjemys.testing import ros1_env, wait_until
 
 String = get_message_class("std_msgs/String")
 Clock = get_message_class("rosgraph_msgs/Clock")
@@ -91,7 +91,7 @@ def test_rosbridge_cbor_input_and_incoming_fragments(gateway: Gateway, node: Nod
                 )
             return bool(got)
 
-        wait_for(sent, what="a fragmented publish")
+        wait_until(sent, what="a fragmented publish")
     assert got[0] == "pieced together"
 
 
@@ -122,7 +122,7 @@ def test_foxglove_time_under_sim_time(make_gateway: Callable[..., Gateway], node
 def test_foxglove_connection_graph_and_parameter_updates(gateway: Gateway, node: Node) -> None:
     node.set_param("/fox/gain", 1)
     node.publisher("/graph_seed", String)
-    wait_for(lambda: "/graph_seed" in gateway.catalog.graph["pub"], what="the graph poll")
+    wait_until(lambda: "/graph_seed" in gateway.catalog.graph["pub"], what="the graph poll")
     with connect(f"ws://127.0.0.1:{gateway.port}/", subprotocols=["foxglove.websocket.v1"]) as ws:
         ws.send(json.dumps({"op": "subscribeConnectionGraph"}))
         graph = first(ws, lambda m: isinstance(m, dict) and m.get("op") == "connectionGraphUpdate")
@@ -138,7 +138,7 @@ def test_foxglove_connection_graph_and_parameter_updates(gateway: Gateway, node:
         )
         assert {"name": "/fresh_topic", "publisherIds": [node.name]} in update["publishedTopics"]
         ws.send(json.dumps({"op": "subscribeParameterUpdates", "parameterNames": ["/fox/gain"]}))
-        wait_for(lambda: "/fox/gain" in gateway._watched, what="the parameter subscription")
+        wait_until(lambda: "/fox/gain" in gateway._watched, what="the parameter subscription")
         node.set_param("/fox/gain", 2.5)
         values = first(ws, lambda m: isinstance(m, dict) and m.get("op") == "parameterValues")
         assert values["parameters"] == [{"name": "/fox/gain", "value": 2.5, "type": "float64"}]
@@ -159,7 +159,7 @@ def test_foxglove_connection_graph_and_parameter_updates(gateway: Gateway, node:
                 }
             )
         )
-        wait_for(lambda: node.has_param("/fox/blob"), what="a byte_array parameter")
+        wait_until(lambda: node.has_param("/fox/blob"), what="a byte_array parameter")
 
 
 def test_foxglove_client_publishes_a_type_we_do_not_ship(gateway: Gateway, node: Node) -> None:
@@ -181,7 +181,7 @@ def test_foxglove_client_publishes_a_type_we_do_not_ship(gateway: Gateway, node:
             ws.send(struct.pack("<BI", 1, 4) + payload)
             return bool(got)
 
-        wait_for(sent, what="the client's custom-type message")
+        wait_until(sent, what="the client's custom-type message")
     assert got[0] == payload
     assert ["/custom", "my_robot/Thing"] in node.master.get_topic_types()
 
@@ -192,7 +192,7 @@ def test_a_flood_of_ops_is_absorbed(gateway: Gateway, node: Node) -> None:
     node.subscriber("/flood", String, lambda m: got.append(m.data), queue_size=10000)
     with connect(f"ws://127.0.0.1:{gateway.port}/") as ws:
         ws.send(json.dumps({"op": "advertise", "topic": "/flood", "type": "std_msgs/String"}))
-        wait_for(
+        wait_until(
             lambda: (
                 gateway.publishers.get("/flood") and gateway.publishers.get("/flood")[0].get_num_connections()
             ),
@@ -200,7 +200,7 @@ def test_a_flood_of_ops_is_absorbed(gateway: Gateway, node: Node) -> None:
         )
         for i in range(3000):
             ws.send(json.dumps({"op": "publish", "topic": "/flood", "msg": {"data": str(i)}}))
-        wait_for(lambda: len(got) == 3000, timeout=60, what="every published message")
+        wait_until(lambda: len(got) == 3000, timeout=60, what="every published message")
     assert got[-1] == "2999"
 
 
@@ -210,7 +210,7 @@ def test_throttle_rate_and_cleanup_on_disconnect(gateway: Gateway, node: Node) -
         ws.send(
             json.dumps({"op": "subscribe", "topic": "/fast", "type": "std_msgs/String", "throttle_rate": 400})
         )
-        wait_for(lambda: pub.get_num_connections(), what="the gateway's subscription")
+        wait_until(lambda: pub.get_num_connections(), what="the gateway's subscription")
         received = 0
         end = time.monotonic() + 1.5
         while time.monotonic() < end:  # 50 Hz for 1.5 s; at most one message per 400 ms gets through
@@ -222,12 +222,12 @@ def test_throttle_rate_and_cleanup_on_disconnect(gateway: Gateway, node: Node) -
                 pass
         assert 2 <= received <= 5
         ws.send(json.dumps({"op": "advertise", "topic": "/from_client", "type": "std_msgs/String"}))
-        wait_for(lambda: gateway.publishers.get("/from_client"), what="the client's publisher")
+        wait_until(lambda: gateway.publishers.get("/from_client"), what="the client's publisher")
     # the client left: its subscription and publisher are gone from the graph
-    wait_for(
+    wait_until(
         lambda: not gateway.taps.topics() and gateway.publishers.get("/from_client") is None, what="cleanup"
     )
-    wait_for(lambda: pub.get_num_connections() == 0, what="the tap's connection closed")
+    wait_until(lambda: pub.get_num_connections() == 0, what="the tap's connection closed")
 
 
 @pytest.mark.ros1
@@ -240,7 +240,7 @@ def test_real_ros1_publisher_to_foxglove_and_rosbridge(gateway: Gateway, master_
         stderr=subprocess.DEVNULL,
     )
     try:
-        wait_for(
+        wait_until(
             lambda: any(c["topic"] == "/real_chatter" for c in gateway.catalog.channels.values()),
             timeout=30,
             what="channel",
@@ -291,7 +291,7 @@ def test_foxglove_channel_for_a_type_only_the_publisher_knows(gateway: Gateway, 
 
     threading.Thread(target=publish, daemon=True).start()
     try:
-        channel = wait_for(
+        channel = wait_until(
             lambda: next((c for c in gateway.catalog.channels.values() if c["topic"] == "/their_pose"), None),
             timeout=20,
             what="a channel for the unknown type",

@@ -9,13 +9,12 @@ import time
 from collections.abc import Iterator
 
 import pytest
-from bridge_helpers import wait_for
 
 from ninjemys.bridge.rosapi import RosApi
 from ninjemys.bridge.server import Gateway
 from ninjemys.idl.loader import get_message_class, get_service_class
 from ninjemys.node import Node
-from ninjemys.testing import ros1_env
+from ninjemys.testing import ros1_env, wait_until
 
 roslibpy = pytest.importorskip("roslibpy")
 
@@ -49,8 +48,8 @@ def test_topics_both_ways(ros: object, node: Node) -> None:
     roslibpy.Topic(ros, "/to_browser", "sensor_msgs/Image").subscribe(received.append)
     out = roslibpy.Topic(ros, "/from_browser", "std_msgs/String")
     out.advertise()
-    wait_for(lambda: pub.get_num_connections() > 0, what="the gateway subscribing")
-    wait_for(
+    wait_until(lambda: pub.get_num_connections() > 0, what="the gateway subscribing")
+    wait_until(
         lambda: node.get_subscriptions() and len(node.master.get_system_state()[0]) >= 2, what="advertise"
     )
     image = Image(height=1, width=2, encoding="rgb8", step=6, data=bytes(range(6)))
@@ -62,8 +61,8 @@ def test_topics_both_ways(ros: object, node: Node) -> None:
         out.publish(roslibpy.Message({"data": "hello from roslibpy"}))
         return bool(got)
 
-    wait_for(sent, what="roslibpy -> ROS")
-    wait_for(lambda: received, what="ROS -> roslibpy")
+    wait_until(sent, what="roslibpy -> ROS")
+    wait_until(lambda: received, what="ROS -> roslibpy")
     msg = received[0]
     # rosbridge's JSON: uint8[] as base64, time as {secs, nsecs}
     assert msg["data"] == "AAECAwQF"
@@ -102,7 +101,7 @@ def test_parameters_and_rosapi(ros: object, node: Node, rosapi: RosApi) -> None:
     assert node.get_param("/robot/gains") == [1, 2, 3]
     assert "/robot/name" in ros.get_params()
     node.publisher("/chatter", String)
-    wait_for(lambda: "/chatter" in ros.get_topics(), what="rosapi topics")
+    wait_until(lambda: "/chatter" in ros.get_topics(), what="rosapi topics")
     assert ros.get_topic_type("/chatter") == "std_msgs/String"
     assert "/chatter" in ros.get_topics_for_type("std_msgs/String")
     assert node.name in ros.get_nodes()
@@ -143,7 +142,7 @@ def test_tf_through_tfclient(ros: object, master_uri: str) -> None:
             broadcaster.sendTransform(t)
             return bool(frames)
 
-        wait_for(broadcast, timeout=20, what="a transform through the TFClient")
+        wait_until(broadcast, timeout=20, what="a transform through the TFClient")
         assert frames[0]["translation"]["x"] == pytest.approx(1.25)
 
         # the action interface (TFSubscription): transforms come as the goal's feedback
@@ -171,18 +170,18 @@ def test_tf_through_tfclient(ros: object, master_uri: str) -> None:
             broadcast()
             return bool(feedback)
 
-        wait_for(subscribed, timeout=30, what="TFSubscription feedback")
+        wait_until(subscribed, timeout=30, what="TFSubscription feedback")
         goal = goals[-1][0]
         transform = feedback[0]["transforms"][0]
         assert transform["header"]["frame_id"] == "world" and transform["child_frame_id"] == "base_link"
         goal.cancel()
-        wait_for(
+        wait_until(
             lambda: goal.status and goal.status["status"] == 2,
             timeout=20,
             what="the goal cancelled (PREEMPTED)",
         )
         # the service's subscription keeps flowing after the goal ended
-        wait_for(
+        wait_until(
             lambda: broadcast(2.5) and frames[-1]["translation"]["x"] == pytest.approx(2.5),
             timeout=20,
             what="TFClient updates after the goal's end",
@@ -218,7 +217,7 @@ def test_actionlib_goal_through_roslibpy(ros: object, master_uri: str, rosapi: R
     script.write_text(ACTION_SERVER)
     proc = subprocess.Popen(["/usr/bin/python3", str(script)], env=ros1_env(master_uri))
     try:
-        wait_for(lambda: "/lookup/goal" in ros.get_topics(), timeout=30, what="the actionlib server")
+        wait_until(lambda: "/lookup/goal" in ros.get_topics(), timeout=30, what="the actionlib server")
         client = ActionClient(ros, "/lookup", "tf2_msgs/LookupTransformAction")
         done = threading.Event()
         results: list[dict] = []
@@ -229,7 +228,7 @@ def test_actionlib_goal_through_roslibpy(ros: object, master_uri: str, rosapi: R
             goal.send()
             return done.wait(2.0)
 
-        wait_for(attempt, timeout=30, what="the goal's result")
+        wait_until(attempt, timeout=30, what="the goal's result")
         assert results[0]["transform"]["header"]["frame_id"] == "map"
         assert results[0]["transform"]["child_frame_id"] == "base_link"
     finally:
@@ -261,7 +260,7 @@ def test_actionlib_goal_with_feedback_against_ninjemys_actionlib(
     server = SimpleActionServer(server_node, "/fibonacci", Fibonacci, execute)
     server.start()
     try:
-        wait_for(lambda: "/fibonacci/goal" in ros.get_topics(), timeout=30, what="the action server")
+        wait_until(lambda: "/fibonacci/goal" in ros.get_topics(), timeout=30, what="the action server")
         client = ActionClient(ros, "/fibonacci", "actionlib_tutorials/FibonacciAction")
         done = threading.Event()
         results: list[dict] = []
@@ -278,7 +277,7 @@ def test_actionlib_goal_with_feedback_against_ninjemys_actionlib(
             goal.send()
             return done.wait(3.0) and len(feedback) == 5
 
-        wait_for(attempt, timeout=30, what="the goal's result")
+        wait_until(attempt, timeout=30, what="the goal's result")
         assert results[0]["sequence"] == [0, 1, 1, 2, 3, 5, 8]
         assert feedback and feedback[-1]["sequence"][:3] == [0, 1, 1]
     finally:

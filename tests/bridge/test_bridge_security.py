@@ -11,7 +11,6 @@ from collections.abc import Callable
 from pathlib import Path
 
 import pytest
-from bridge_helpers import wait_for
 from websockets.exceptions import ConnectionClosed, InvalidStatus
 from websockets.sync.client import ClientConnection, connect
 
@@ -19,6 +18,7 @@ from ninjemys.bridge.rosbridge import rosauth_mac
 from ninjemys.bridge.server import Gateway
 from ninjemys.idl.loader import get_message_class
 from ninjemys.node import Node
+from ninjemys.testing import wait_until
 
 String = get_message_class("std_msgs/String")
 SECRET = "relatively_long_secret"
@@ -77,7 +77,7 @@ def test_rosbridge_auth(make_gateway: Callable[..., Gateway], node: Node, secret
     with connect(url) as friend:
         friend.send(auth_op(SECRET))
         friend.send(subscribe)
-        wait_for(lambda: "/chatter" in gateway.taps.topics(), what="the authenticated subscription")
+        wait_until(lambda: "/chatter" in gateway.taps.topics(), what="the authenticated subscription")
 
         def heard() -> bool:
             publish()
@@ -86,7 +86,7 @@ def test_rosbridge_auth(make_gateway: Callable[..., Gateway], node: Node, secret
             except TimeoutError:
                 return False
 
-        wait_for(heard, what="data for the authenticated client")
+        wait_until(heard, what="data for the authenticated client")
 
 
 def test_foxglove_token(make_gateway: Callable[..., Gateway], secret_file: Path) -> None:
@@ -154,7 +154,7 @@ def test_tls(make_gateway: Callable[..., Gateway], node: Node, tmp_path: Path) -
             ws.send(json.dumps({"op": "publish", "topic": "/over_tls", "msg": {"data": "encrypted"}}))
             return bool(got)
 
-        wait_for(sent, what="a publication over TLS")
+        wait_until(sent, what="a publication over TLS")
     assert got[0] == "encrypted"
     with pytest.raises((ssl.SSLError, OSError)):  # a client that does not trust the certificate is refused
         connect(f"wss://localhost:{gateway.port}/", ssl=ssl.create_default_context(), open_timeout=5).close()
@@ -206,7 +206,7 @@ def test_bad_input_gets_status_errors_and_the_server_keeps_serving(
                 assert expected in status["msg"], (text, status)
         # the same connection still works after every error
         ws.send(json.dumps({"op": "subscribe", "topic": "/chatter", "type": "std_msgs/String"}))
-        wait_for(lambda: "/chatter" in gateway.taps.topics(), what="subscription after errors")
+        wait_until(lambda: "/chatter" in gateway.taps.topics(), what="subscription after errors")
 
         def heard() -> bool:
             publish()
@@ -215,7 +215,7 @@ def test_bad_input_gets_status_errors_and_the_server_keeps_serving(
             except TimeoutError:
                 return False
 
-        wait_for(heard, what="data after errors")
+        wait_until(heard, what="data after errors")
     with connect(url) as big:
         big.send("x" * (100 * 1024))  # over max_message_size: a status error, then a 1009 close
         status = recv_json(big)

@@ -11,12 +11,12 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from bridge_helpers import wait_for
 from websockets.sync.client import connect
 
 from ninjemys.bridge.server import Gateway
 from ninjemys.idl.loader import get_message_class
 from ninjemys.node import Node
+from ninjemys.testing import wait_until
 
 Image = get_message_class("sensor_msgs/Image")
 String = get_message_class("std_msgs/String")
@@ -32,7 +32,7 @@ def test_stalled_client_is_bounded_and_does_not_starve_others(
     images = node.publisher("/camera/image_raw", Image, queue_size=None)
     beats = node.publisher("/heartbeat", String)
     wanted = {"/camera/image_raw", "/heartbeat"}
-    wait_for(lambda: wanted <= {c["topic"] for c in gateway.catalog.channels.values()}, what="channels")
+    wait_until(lambda: wanted <= {c["topic"] for c in gateway.catalog.channels.values()}, what="channels")
     channels = {c["topic"]: c["id"] for c in gateway.catalog.channels.values()}
 
     # client 1: Foxglove, subscribes to both, then never reads again (max_queue=1: its socket fills)
@@ -90,7 +90,7 @@ def _flood(gateway: Gateway, stalled: Any, healthy: Any, channels: dict, images:
 
     reader = threading.Thread(target=read_healthy, daemon=True)
     reader.start()
-    wait_for(lambda: images.get_num_connections() and beats.get_num_connections() >= 1, what="taps")
+    wait_until(lambda: images.get_num_connections() and beats.get_num_connections() >= 1, what="taps")
     frame = Image(height=480, width=640, encoding="rgb8", step=1920, data=bytes(640 * 480 * 3))
     rss_before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     sent_beats: list[float] = []
@@ -129,11 +129,13 @@ def test_rosbridge_client_is_told_about_its_drops(make_gateway: Callable[..., Ga
                 {"op": "subscribe", "topic": "/camera/small", "type": "sensor_msgs/Image", "queue_length": 2}
             )
         )
-        wait_for(lambda: images.get_num_connections(), what="the tap")
+        wait_until(lambda: images.get_num_connections(), what="the tap")
         for _ in range(60):  # 18 MB while the client reads nothing
             images.publish(frame)
             time.sleep(0.01)
-        wait_for(lambda: gateway.status()["clients"][0]["dropped"].get("/camera/small"), what="drops counted")
+        wait_until(
+            lambda: gateway.status()["clients"][0]["dropped"].get("/camera/small"), what="drops counted"
+        )
         deadline = time.monotonic() + 20
         while time.monotonic() < deadline:
             msg = json.loads(ws.recv(timeout=10))

@@ -12,9 +12,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "node"))
 
-from node_harness import Child  # noqa: E402
 
 from ninjemys import testing  # noqa: E402
+from ninjemys.testing import NodeProcess  # noqa: E402
 
 ROSPY_TALKER = """
 import sys, rospy
@@ -183,9 +183,9 @@ def roscpp_binary() -> str:
     return str(binary)
 
 
-def rospy(script: str, master_uri: str, *args: str) -> Child:
-    return Child([testing.ROS1_PYTHON, "-c", script, *args], env=testing.ros1_env(master_uri))
+def rospy(script: str, master_uri: str, *args: str) -> NodeProcess:
+    return NodeProcess([testing.ROS1_PYTHON, "-c", script, *args], env=testing.ros1_env(master_uri))
 
 
-def roscpp(master_uri: str, mode: str) -> Child:
-    return Child([roscpp_binary(), mode], env=testing.ros1_env(master_uri))
+def roscpp(master_uri: str, mode: str) -> NodeProcess:
+    return NodeProcess([roscpp_binary(), mode], env=testing.ros1_env(master_uri))

@@ -14,12 +14,13 @@ import pytest
 
 sys.path[:0] = [str(Path(__file__).parent), str(Path(__file__).parents[1] / "node")]
 
-from node_harness import Child, MasterProcess, wait_until  # noqa: E402
+from node_harness import MasterProcess  # noqa: E402
 from node_msgs import String  # noqa: E402
 from ros1_peers import rospy  # noqa: E402
 
 from ninjemys import testing  # noqa: E402
 from ninjemys.node import Node  # noqa: E402
+from ninjemys.testing import NodeProcess, wait_until  # noqa: E402
 
 pytestmark = pytest.mark.ros1
 
@@ -49,11 +50,11 @@ def master() -> Iterator[MasterProcess]:
 
 def test_small_messages_to_a_default_rospy_subscriber_skip_nagle(master) -> None:
     node = Node("status_pub", master_uri=master.uri)
-    child: Child | None = None
+    child: NodeProcess | None = None
     try:
         pub = node.publisher("status", String, queue_size=10)
         child = rospy(_LATENCY_LISTENER, master.uri)
-        assert child.wait_line(lambda line: line == "ready", timeout=30), child.describe()
+        assert child.wait_for(lambda line: line == "ready", timeout=30), child.describe()
         assert wait_until(lambda: pub.get_num_connections() == 1, timeout=15), child.describe()
         # rospy's header asked for "tcp_nodelay: 0"; the option is ours to set, and it is set
         (conn,) = pub._pub.connections
@@ -68,11 +69,11 @@ def test_small_messages_to_a_default_rospy_subscriber_skip_nagle(master) -> None
                 seq += 1
                 time.sleep(0.002)
             time.sleep(0.1)
-        assert wait_until(lambda: sum(line.startswith("lat ") for line in child.lines) == seq, timeout=10), (
+        assert wait_until(lambda: sum(line.startswith("lat ") for line in child.out) == seq, timeout=10), (
             child.describe()
         )
         latency = {
-            int(s): float(t) for _, s, t in (line.split() for line in child.lines if line.startswith("lat "))
+            int(s): float(t) for _, s, t in (line.split() for line in child.out if line.startswith("lat "))
         }
         seconds = [latency[i] for i in range(1, seq, 2)]
         assert statistics.median(seconds) < 0.005, sorted(seconds)

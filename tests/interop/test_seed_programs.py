@@ -17,11 +17,7 @@ from pathlib import Path
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "rospy"))
-
-from nodeproc import NodeProc  # noqa: E402
-
-from ninjemys.testing import ROS1_PYTHON, ros1_env, run_master, run_real_roscore  # noqa: E402
+from ninjemys.testing import ROS1_PYTHON, NodeProcess, ros1_env, run_master, run_real_roscore
 
 SEEDS = Path(os.environ.get("NINJEMYS_SEEDS", Path(__file__).resolve().parents[3] / "shared" / "seeds"))
 SEED = SEEDS / "000_7aec5b1f38a66cac.txt"
@@ -58,8 +54,8 @@ def listener_code() -> str:
 
 
 @pytest.fixture
-def procs() -> Iterator[list[NodeProc]]:
-    started: list[NodeProc] = []
+def procs() -> Iterator[list[NodeProcess]]:
+    started: list[NodeProcess] = []
     try:
         yield started
     finally:
@@ -68,11 +64,11 @@ def procs() -> Iterator[list[NodeProc]]:
 
 
 def _run(
-    procs: list[NodeProc], tmp_path: Path, code: str, env: dict[str, str], python: str = sys.executable
-) -> NodeProc:
+    procs: list[NodeProcess], tmp_path: Path, code: str, env: dict[str, str], python: str = sys.executable
+) -> NodeProcess:
     path = tmp_path / f"seed_{len(procs)}.py"
     path.write_text(code)
-    proc = NodeProc([python, str(path)], env, tmp_path)
+    proc = NodeProcess([python, str(path)], env, tmp_path)
     procs.append(proc)
     return proc
 
@@ -106,7 +102,7 @@ def test_seed_blocks_are_found() -> None:
     assert 'rospy.Subscriber("chatter", String, callback)' in listener_code()
 
 
-def _check_pair(talker: NodeProc, listener: NodeProc) -> None:
+def _check_pair(talker: NodeProcess, listener: NodeProcess) -> None:
     sent = talker.wait_for(INFO_LINE + r"hello world (\d+\.\d+)$").group(1)
     heard = listener.wait_for(INFO_LINE + r"(/listener_\d+_\d+)I heard hello world (\d+\.\d+)$")
     assert float(heard.group(2)) >= float(sent) - 60

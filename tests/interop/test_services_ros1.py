@@ -10,12 +10,13 @@ import pytest
 
 sys.path[:0] = [str(Path(__file__).parent), str(Path(__file__).parents[1] / "node")]
 
-from node_harness import Child, MasterProcess  # noqa: E402
+from node_harness import MasterProcess  # noqa: E402
 from node_msgs import Trigger  # noqa: E402
 from ros1_peers import ROSPY_CLIENT, ROSPY_SERVICE, roscpp, rospy  # noqa: E402
 
 from ninjemys import testing  # noqa: E402
 from ninjemys.node import Node  # noqa: E402
+from ninjemys.testing import NodeProcess  # noqa: E402
 
 pytestmark = pytest.mark.ros1
 
@@ -40,8 +41,8 @@ def node(master: MasterProcess) -> Iterator[Node]:
 
 
 @pytest.fixture
-def peers() -> Iterator[list[Child]]:
-    started: list[Child] = []
+def peers() -> Iterator[list[NodeProcess]]:
+    started: list[NodeProcess] = []
     try:
         yield started
     finally:
@@ -65,8 +66,8 @@ def test_rospy_client_calls_our_service(master, node, peers, mode: str) -> None:
     child = rospy(ROSPY_CLIENT, master.uri, mode)
     peers.append(child)
     assert child.proc.wait(30) == 0, child.describe()
-    assert child.lines[:3] == [f"response True ninjemys answer {i}" for i in (1, 2, 3)]
-    assert child.lines[3].startswith("error ") and "this service always fails" in child.lines[3]
+    assert child.out[:3] == [f"response True ninjemys answer {i}" for i in (1, 2, 3)]
+    assert child.out[3].startswith("error ") and "this service always fails" in child.out[3]
 
 
 @pytest.mark.parametrize("impl", ["rospy", "roscpp"])
@@ -74,7 +75,7 @@ def test_rospy_client_calls_our_service(master, node, peers, mode: str) -> None:
 def test_our_proxy_calls_ros1_service(master, node, peers, impl: str, persistent: bool) -> None:
     child = rospy(ROSPY_SERVICE, master.uri) if impl == "rospy" else roscpp(master.uri, "service")
     peers.append(child)
-    assert child.wait_line(lambda line: line == "ready", timeout=30), child.describe()
+    assert child.wait_for(lambda line: line == "ready", timeout=30), child.describe()
     name = "/rospy_trigger" if impl == "rospy" else "/cpp_trigger"
     node.wait_for_service(name, timeout=15)
     proxy = node.service_proxy(name, Trigger, persistent=persistent)
@@ -99,4 +100,4 @@ def test_roscpp_client_calls_our_service(master, node, peers) -> None:
     child = roscpp(master.uri, "client")
     peers.append(child)
     assert child.proc.wait(30) == 0, child.describe()
-    assert child.lines == [f"response True ninjemys answer {i}" for i in (1, 2, 3)] + ["failing call failed"]
+    assert child.out == [f"response True ninjemys answer {i}" for i in (1, 2, 3)] + ["failing call failed"]

@@ -12,7 +12,7 @@ import pytest
 
 sys.path[:0] = [str(Path(__file__).parent), str(Path(__file__).parents[1] / "node")]
 
-from node_harness import Child, MasterProcess, wait_until  # noqa: E402
+from node_harness import MasterProcess  # noqa: E402
 from node_msgs import Image, String  # noqa: E402
 from ros1_peers import (  # noqa: E402
     ROSPY_IMAGE_PUB,
@@ -25,6 +25,7 @@ from ros1_peers import (  # noqa: E402
 
 from ninjemys import testing  # noqa: E402
 from ninjemys.node import Node  # noqa: E402
+from ninjemys.testing import NodeProcess, wait_until  # noqa: E402
 
 pytestmark = pytest.mark.ros1
 
@@ -40,8 +41,8 @@ def master(request: pytest.FixtureRequest) -> Iterator[MasterProcess]:
 
 
 @pytest.fixture
-def peers() -> Iterator[list[Child]]:
-    started: list[Child] = []
+def peers() -> Iterator[list[NodeProcess]]:
+    started: list[NodeProcess] = []
     try:
         yield started
     finally:
@@ -65,9 +66,9 @@ def node(master: MasterProcess) -> Iterator[Callable[[str], Node]]:
             n.shutdown("test over")
 
 
-def _start(peers: list[Child], child: Child) -> Child:
+def _start(peers: list[NodeProcess], child: NodeProcess) -> NodeProcess:
     peers.append(child)
-    assert child.wait_line(lambda line: line == "ready", timeout=30), child.describe()
+    assert child.wait_for(lambda line: line == "ready", timeout=30), child.describe()
     return child
 
 
@@ -105,7 +106,7 @@ def test_our_talker_to_ros1_listener(master, node, peers, impl: str) -> None:
     child = _start(
         peers, rospy(ROSPY_LISTENER, master.uri) if impl == "rospy" else roscpp(master.uri, "listener")
     )
-    assert _publish_until(pub, lambda: sum(line.startswith("got ninjemys") for line in child.lines) >= 5), (
+    assert _publish_until(pub, lambda: sum(line.startswith("got ninjemys") for line in child.out) >= 5), (
         child.describe()
     )
 
@@ -128,7 +129,7 @@ def test_our_latched_to_ros1_late_subscriber(master, node, peers, impl: str) -> 
     child = _start(
         peers, rospy(ROSPY_LISTENER, master.uri) if impl == "rospy" else roscpp(master.uri, "listener")
     )
-    assert child.wait_line(lambda line: line == "got ninjemys latched"), child.describe()
+    assert child.wait_for(lambda line: line == "got ninjemys latched"), child.describe()
 
 
 def test_rospy_image_to_us_intact(master, node, peers) -> None:
@@ -147,7 +148,7 @@ def test_our_image_to_rospy_intact(master, node, peers) -> None:
     pub.publish(Image(1080, 1920, "rgb8", 5760, data))
     child = _start(peers, rospy(ROSPY_IMAGE_SUB, master.uri))
     expected = f"image 1920x1080 rgb8 {len(data)} {hashlib.md5(data).hexdigest()}"
-    assert child.wait_line(lambda line: line == expected, timeout=20), child.describe()
+    assert child.wait_for(lambda line: line == expected, timeout=20), child.describe()
 
 
 def _rolling_hash(data: bytes) -> int:
@@ -177,4 +178,4 @@ def test_our_6mb_message_to_roscpp_intact(master, node, peers) -> None:
     pub.publish(String(text))
     child = _start(peers, roscpp(master.uri, "biglistener"))
     expected = f"big {len(text)} {_rolling_hash(text.encode())}"
-    assert child.wait_line(lambda line: line == expected, timeout=20), (expected, child.describe())
+    assert child.wait_for(lambda line: line == expected, timeout=20), (expected, child.describe())

@@ -3,18 +3,15 @@
 from __future__ import annotations
 
 import os
-import queue
 import re
 import signal
 import subprocess
-import threading
-import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
 
-from ninjemys.testing import ninjemys_bin
+from ninjemys.testing import NodeProcess, WaitTimeout, ninjemys_bin
 
 DATA = Path(__file__).parent / "data"
 PKGS = DATA / "pkgs"
@@ -49,54 +46,35 @@ def env(tmp_path: Path, port: int) -> dict[str, str]:
 
 
 class Launch:
-    """A running roslaunch whose stdout lines are collected by a reader thread."""
+    """A running roslaunch (a :class:`ninjemys.testing.NodeProcess`, stderr merged into stdout), waited on
+    through predicates over all its output lines so far."""
 
     def __init__(self, args: list[str], env: dict[str, str]) -> None:
-        self.proc = subprocess.Popen(
-            [ninjemys_bin("roslaunch"), *args],
-            env=env,
-            stdin=subprocess.DEVNULL,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-            text=True,
-        )
-        self.lines: list[str] = []
-        self._queue: queue.Queue[str | None] = queue.Queue()
-        threading.Thread(target=self._read, daemon=True).start()
+        self.child = NodeProcess([ninjemys_bin("roslaunch"), *args], env=env, merge_stderr=True)
+        self.proc = self.child.proc
 
-    def _read(self) -> None:
-        assert self.proc.stdout is not None
-        for line in self.proc.stdout:
-            self._queue.put(line)
-        self._queue.put(None)
+    @property
+    def lines(self) -> list[str]:
+        """Every line printed so far, each with its newline (as the launch printed it)."""
+        return [line + "\n" for line in list(self.child.out)]
 
     def wait_for(self, predicate: Callable[[list[str]], bool], timeout: float = 60.0) -> bool:
-        deadline = time.monotonic() + timeout
-        while not predicate(self.lines):
-            remaining = deadline - time.monotonic()
-            if remaining <= 0:
-                return False
-            try:
-                line = self._queue.get(timeout=remaining)
-            except queue.Empty:
-                return False
-            if line is None:
-                return predicate(self.lines)
-            self.lines.append(line)
-        return True
+        """True once ``predicate(lines)`` holds; False after ``timeout`` or once roslaunch has ended
+        without it."""
+        try:
+            self.child.wait_for(lambda _line: predicate(self.lines), timeout)
+            return True
+        except WaitTimeout:
+            return predicate(self.lines)
 
     def finish(self, timeout: float = 30.0) -> int:
-        code = self.proc.wait(timeout)
-        self.wait_for(lambda _: False, timeout=2.0)
-        return code
+        return self.child.wait(timeout)
 
     def pids(self) -> list[int]:
         return [int(m) for line in self.lines for m in re.findall(r"started with pid \[(\d+)\]", line)]
 
     def kill(self) -> None:
-        if self.proc.poll() is None:
-            self.proc.kill()
-        self.proc.wait()
+        self.child.kill()
 
 
 @pytest.fixture

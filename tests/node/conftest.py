@@ -10,10 +10,11 @@ import pytest
 
 from ninjemys import testing
 from ninjemys.node import Node
+from ninjemys.testing import wait_until  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-from node_harness import MasterProcess, wait_until  # noqa: E402
+from node_harness import MasterProcess  # noqa: E402
 
 __all__ = ["MasterProcess", "wait_until"]
 

@@ -12,9 +12,9 @@ import xmlrpc.server
 from collections.abc import Iterator
 
 import pytest
-from node_harness import wait_until
 from node_msgs import String
 
+from ninjemys.testing import wait_until
 from ninjemys.wire import headers
 from ninjemys.wire.tcpros import frame
 

@@ -5,8 +5,7 @@ from __future__ import annotations
 
 import time
 
-from node_harness import wait_until
-
+from ninjemys.testing import wait_until
 from std_msgs.msg import Int64
 
 

@@ -6,12 +6,11 @@ import threading
 import xmlrpc.client
 
 import pytest
-from node_harness import wait_until
 
 from ninjemys import rostime
 from ninjemys.idl.loader import get_message_class, get_service_class
 from ninjemys.node import Node
-from ninjemys.testing import FakeClock
+from ninjemys.testing import FakeClock, wait_until
 
 ClockMsg = get_message_class("rosgraph_msgs/Clock")
 Log = get_message_class("rosgraph_msgs/Log")

@@ -6,8 +6,7 @@ from __future__ import annotations
 import socket
 import struct
 
-from node_harness import wait_until
-
+from ninjemys.testing import wait_until
 from ninjemys.wire import headers
 from std_msgs.msg import Int64, String
 

@@ -4,22 +4,12 @@
 from __future__ import annotations
 
 import threading
-import time
 
 from ninjemys.idl.loader import get_message_class
 from ninjemys.node import Node
-from ninjemys.testing import run_master
+from ninjemys.testing import run_master, wait_until
 
 String = get_message_class("std_msgs/String")
-
-
-def _wait(cond, timeout: float = 10.0) -> bool:  # type: ignore[no-untyped-def]
-    deadline = time.monotonic() + timeout
-    while not cond():
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(0.01)
-    return True
 
 
 def test_shared_thread_serves_every_topic_and_hands_streams_on() -> None:
@@ -42,26 +32,26 @@ def test_shared_thread_serves_every_topic_and_hands_streams_on() -> None:
             guest = sub_node.subscriber("/share_b", String, on("b"), share_thread=host)
             assert guest._thread is host._thread  # one worker for both
             assert "sub:/share_b" not in {t.name for t in threading.enumerate()}
-            assert _wait(lambda: all(p.get_num_connections() for p in pubs.values()))
+            assert wait_until(lambda: all(p.get_num_connections() for p in pubs.values()))
             pubs["/share_a"].publish(String("a1"))
             pubs["/share_b"].publish(String("b1"))
-            assert _wait(lambda: got["a"] == ["a1"] and got["b"] == ["b1"])
+            assert wait_until(lambda: got["a"] == ["a1"] and got["b"] == ["b1"])
             assert threads == {"sub:/share_a"}
 
             # the host closes: its thread goes on delivering the guest's topic
             host.unregister()
             pubs["/share_b"].publish(String("b2"))
-            assert _wait(lambda: got["b"] == ["b1", "b2"])
+            assert wait_until(lambda: got["b"] == ["b1", "b2"])
 
             # a second handle of /b (its own thread); when the guest closes, /b's stream goes to it
             second = sub_node.subscriber("/share_b", String, on("b2"))
-            assert _wait(lambda: second.get_num_connections() == 1)
+            assert wait_until(lambda: second.get_num_connections() == 1)
             pubs["/share_b"].publish(String("b3"))
-            assert _wait(lambda: got["b2"] == ["b3"] and got["b"] == ["b1", "b2", "b3"])
+            assert wait_until(lambda: got["b2"] == ["b3"] and got["b"] == ["b1", "b2", "b3"])
             guest.unregister()
             assert not host._thread.is_alive()  # the last handle it served closed: it ended
             pubs["/share_b"].publish(String("b4"))
-            assert _wait(lambda: got["b2"] == ["b3", "b4"])
+            assert wait_until(lambda: got["b2"] == ["b3", "b4"])
             assert got["b"] == ["b1", "b2", "b3"]
             assert got["a"] == ["a1"]
         finally:
@@ -80,17 +70,17 @@ def test_guest_closing_first_leaves_the_host_serving_and_a_closed_host_is_not_jo
             guest = sub_node.subscriber("/share_c", String, lambda m: None, share_thread=host)
             guest.unregister()
             assert host._thread.is_alive()
-            assert _wait(lambda: pub_a.get_num_connections() == 1)
+            assert wait_until(lambda: pub_a.get_num_connections() == 1)
             pub_a.publish(String("x"))
-            assert _wait(lambda: got == ["x"])
+            assert wait_until(lambda: got == ["x"])
             host.unregister()
             assert not host._thread.is_alive()
             # a handle asked to share a finished thread gets a thread of its own
             late = sub_node.subscriber("/share_a", String, lambda m: got.append(m.data), share_thread=host)
             assert late._thread is not host._thread and late._thread.is_alive()
-            assert _wait(lambda: late.get_num_connections() == 1)
+            assert wait_until(lambda: late.get_num_connections() == 1)
             pub_a.publish(String("y"))
-            assert _wait(lambda: got == ["x", "y"])
+            assert wait_until(lambda: got == ["x", "y"])
         finally:
             sub_node.shutdown("test over")
             pub_node.shutdown("test over")

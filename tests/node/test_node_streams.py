@@ -16,10 +16,10 @@ from pathlib import Path
 from types import SimpleNamespace
 
 import pytest
-from node_harness import Child, wait_until
 
 from ninjemys import testing
 from ninjemys.node.subscriber import SubConnection
+from ninjemys.testing import NodeProcess, wait_until
 from ninjemys.wire.tcpros import frame
 from sensor_msgs.msg import Image, PointCloud2
 from std_msgs.msg import Header
@@ -44,9 +44,9 @@ def _starved_gaps(arrivals: list[tuple[float, int]]) -> list[str]:
     ]
 
 
-def _publisher(master_uri: str, kind: str, rate: float, seconds: float) -> Child:
+def _publisher(master_uri: str, kind: str, rate: float, seconds: float) -> NodeProcess:
     cmd = [sys.executable, STREAM_PROC, master_uri, kind, str(rate), str(seconds)]
-    return Child(["taskset", "-c", "0", *cmd])
+    return NodeProcess(["taskset", "-c", "0", *cmd])
 
 
 def _stamp(msg: object) -> float:
@@ -123,7 +123,7 @@ def test_saturated_1mb_stream_keeps_calling_back(master, make_node) -> None:
     )
     pub = _publisher(master.uri, "cloud", 0, 2.5)
     try:
-        assert pub.wait_line(lambda line: line.startswith("done"), timeout=30), pub.describe()
+        assert pub.wait_for(lambda line: line.startswith("done"), timeout=30), pub.describe()
         assert wait_until(lambda: arrivals and time.perf_counter() - arrivals[-1][0] > 0.3, timeout=10)
     finally:
         pub.kill()
@@ -162,9 +162,9 @@ def test_saturated_stream_from_real_rospy_keeps_calling_back(master, make_node) 
         "/cloud", PointCloud2, lambda m: arrivals.append((time.perf_counter(), m.header.seq)), queue_size=10
     )
     cmd = ["taskset", "-c", "0", testing.ROS1_PYTHON, "-c", ROSPY_CLOUD_PUBLISHER, "2.5"]
-    pub = Child(cmd, env=testing.ros1_env(master.uri))
+    pub = NodeProcess(cmd, env=testing.ros1_env(master.uri))
     try:
-        assert pub.wait_line(lambda line: line == "done", timeout=60), pub.describe()
+        assert pub.wait_for(lambda line: line == "done", timeout=60), pub.describe()
     finally:
         pub.kill()
     assert len(arrivals) >= 25, f"only {len(arrivals)} callbacks in 2.5 s of a saturated rospy stream"
@@ -184,7 +184,7 @@ def test_image_stream_does_not_delay_a_small_subscription(master, make_node) -> 
     small_pub = _publisher(master.uri, "small", 100, 3.0)
     try:
         for child in (image_pub, small_pub):
-            assert child.wait_line(lambda line: line.startswith("done"), timeout=30), child.describe()
+            assert child.wait_for(lambda line: line.startswith("done"), timeout=30), child.describe()
     finally:
         image_pub.kill()
         small_pub.kill()

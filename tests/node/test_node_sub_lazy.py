@@ -8,8 +8,7 @@ import socket
 import threading
 import time
 
-from node_harness import wait_until
-
+from ninjemys.testing import wait_until
 from std_msgs.msg import Int64, String
 
 LONG = 300.0  # a lazy period far beyond every timeout here

@@ -6,21 +6,16 @@ import ast
 import threading
 from pathlib import Path
 
-from node_harness import wait_until
 from node_msgs import String
 
 from ninjemys.idl.loader import get_service_class
 from ninjemys.node import threads
+from ninjemys.testing import wait_until
 
 SRC = Path(__file__).resolve().parents[2] / "src"
-#: where the core starts threads and creates its locks and queues
-THREAD_SOURCES = [
-    SRC / "ninjemys" / "node",
-    SRC / "ninjemys" / "net",
-    SRC / "ninjemys" / "master",
-    SRC / "rospy",
-    SRC / "ninjemys" / "nav" / "move_base_node.py",
-]
+#: where threads are started: everywhere, the core and the apps (bridge, serve, sim, nav, web) alike
+THREAD_SOURCES = [SRC]
+DOCS = SRC.parent / "docs" / "node.md"
 LOCK_SOURCES = [
     SRC / "ninjemys" / "node",
     SRC / "ninjemys" / "net",
@@ -61,6 +56,12 @@ def started_thread_names() -> list[tuple[str, str]]:
                 names: list[ast.expr] = []
                 if _callee(node) in ("Thread", "Timer"):
                     names = [kw.value for kw in node.keywords if kw.arg == "name"]
+                elif _callee(node) == "ThreadPoolExecutor":  # its workers are named <prefix>_<n>
+                    for kw in node.keywords:
+                        prefix = _name_prefix(kw.value) if kw.arg == "thread_name_prefix" else None
+                        if prefix is not None:
+                            complete = isinstance(kw.value, ast.Constant)
+                            found.append((f"{path.relative_to(SRC)}:{node.lineno}", prefix + "_" * complete))
                 elif _callee(node) == "start_thread" and len(node.args) >= 2:
                     names = [node.args[1]]
                 for expr in names:
@@ -122,6 +123,18 @@ def test_every_thread_the_core_starts_is_in_the_table() -> None:
     }
     missing = [f"{where}: thread {name!r}" for where, name in started if name not in prefixes]
     assert not missing, "threads missing from ninjemys.node.threads.THREADS:\n" + "\n".join(missing)
+    # the apps' threads are found too (the wing's were missing from the table once)
+    assert {name for _, name in started} >= {"gateway-loop", "gateway_", "puzzlebot-sim", "move_base-control"}
+
+
+def test_the_docs_show_every_thread_of_the_table() -> None:
+    rows = {
+        line.split("|")[1].strip().strip("`")
+        for line in DOCS.read_text().splitlines()
+        if line.startswith("| `")
+    }
+    missing = [t.name for t in threads.THREADS if t.name not in rows]
+    assert not missing, f"docs/node.md's threads table lacks: {missing}"
 
 
 def test_every_lock_and_queue_has_a_row_and_every_row_exists() -> None:

@@ -9,9 +9,8 @@ import struct
 import threading
 import time
 
-from node_harness import wait_until
-
 from ninjemys.node import topics
+from ninjemys.testing import wait_until
 from ninjemys.wire import headers
 from sensor_msgs.msg import Image
 from std_msgs.msg import Int64

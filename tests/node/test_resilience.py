@@ -9,12 +9,12 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from node_harness import MasterProcess, wait_until
+from node_harness import MasterProcess
 from node_msgs import String
 
 from ninjemys.master.client import MasterClient
 from ninjemys.node import Node
-from ninjemys.testing import free_port
+from ninjemys.testing import free_port, wait_until
 
 TALKER = str(Path(__file__).parent / "talker_proc.py")
 

@@ -5,10 +5,10 @@ from __future__ import annotations
 import os
 import xmlrpc.client
 
-from node_harness import wait_until
 from node_msgs import String
 
 from ninjemys.node import transport
+from ninjemys.testing import wait_until
 
 
 def test_slave_api_shapes(make_node, master) -> None:

@@ -9,10 +9,11 @@ import subprocess
 import sys
 
 import pytest
-from node_harness import MasterProcess, wait_until
+from node_harness import MasterProcess
 
 from ninjemys.idl.spec import Constant, Field, FieldType, MsgSpec
 from ninjemys.master.client import MasterClient
+from ninjemys.testing import wait_until
 
 #: imported by nothing on the `import rospy; rospy.init_node()` path (each costs milliseconds)
 NEVER_IMPORTED = ("asyncio", "concurrent.futures", "ssl", "subprocess", "encodings.idna")

@@ -5,8 +5,9 @@ from __future__ import annotations
 import threading
 import time
 
-from node_harness import wait_until
 from node_msgs import Image, Int64, String
+
+from ninjemys.testing import wait_until
 
 
 def _connected(pub, n: int = 1) -> bool:

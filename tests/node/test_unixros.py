@@ -10,11 +10,11 @@ import sys
 from pathlib import Path
 
 import pytest
-from node_harness import wait_until
 from node_msgs import String
 
 from ninjemys.idl.loader import get_message_class, get_service_class
 from ninjemys.node import transport
+from ninjemys.testing import wait_until
 
 pytestmark = pytest.mark.skipif(not transport.local_transport_enabled(), reason="UNIXROS needs Linux")
 

@@ -8,9 +8,8 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from nodeproc import NodeProc
 
-from ninjemys.testing import run_master
+from ninjemys.testing import NodeProcess, run_master
 
 
 @pytest.fixture(scope="module")
@@ -39,17 +38,17 @@ def node_env(master: str, tmp_path: Path) -> dict[str, str]:
 @pytest.fixture
 def run_node(node_env: dict[str, str], tmp_path: Path) -> Iterator:
     """``run_node(code_or_path, *args, env=None)`` starts a node process; all are killed at teardown."""
-    started: list[NodeProc] = []
+    started: list[NodeProcess] = []
     counter = [0]
 
-    def start(script: str | Path, *args: str, env: dict[str, str] | None = None) -> NodeProc:
+    def start(script: str | Path, *args: str, env: dict[str, str] | None = None) -> NodeProcess:
         if isinstance(script, Path):
             path = script
         else:
             counter[0] += 1
             path = tmp_path / f"node_{counter[0]}.py"
             path.write_text(script)
-        proc = NodeProc([sys.executable, str(path), *args], env or node_env, tmp_path)
+        proc = NodeProcess([sys.executable, str(path), *args], env or node_env, tmp_path)
         started.append(proc)
         return proc
 

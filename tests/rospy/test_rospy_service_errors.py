@@ -13,9 +13,9 @@ import sys
 from pathlib import Path
 
 import pytest
-from nodeproc import NodeProc
 
 from ninjemys import testing
+from ninjemys.testing import NodeProcess
 
 pytestmark = pytest.mark.ros1
 
@@ -69,13 +69,13 @@ def _as_noetic_prints(line: str) -> str:
     return f"{head}{sep}{text.encode()!r}"
 
 
-def _start(impl: str, script: str, master: str, node_env: dict[str, str], tmp_path: Path) -> NodeProc:
+def _start(impl: str, script: str, master: str, node_env: dict[str, str], tmp_path: Path) -> NodeProcess:
     path = tmp_path / f"{impl}_{abs(hash(script))}.py"
     path.write_text(script)
     if impl == "rospy":
         env = testing.ros1_env(master, ROS_HOME=str(tmp_path / "ros1_home"), PYTHONUNBUFFERED="1")
-        return NodeProc([testing.ROS1_PYTHON, str(path)], env, tmp_path)
-    return NodeProc([sys.executable, str(path)], node_env, tmp_path)
+        return NodeProcess([testing.ROS1_PYTHON, str(path)], env, tmp_path)
+    return NodeProcess([sys.executable, str(path)], node_env, tmp_path)
 
 
 @pytest.mark.skipif(not testing.have_ros1(), reason="needs Debian's ROS 1")

@@ -3,14 +3,12 @@
 from __future__ import annotations
 
 import os
-import subprocess
-import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
 
-from ninjemys.testing import free_port, ninjemys_bin, run_master
+from ninjemys.testing import NodeProcess, free_port, ninjemys_bin, run_master
 
 
 @pytest.fixture
@@ -19,45 +17,33 @@ def master() -> Iterator[str]:
         yield uri
 
 
-class TurtlesimProcess:
-    """A running turtlesim_node; ``log()`` is everything it printed so far."""
+class TurtlesimProcess(NodeProcess):
+    """A running turtlesim_node (stderr merged into stdout); ``log()`` is everything it printed so far."""
 
-    def __init__(self, proc: subprocess.Popen, log_path: Path, web_port: int | None) -> None:
-        self.proc = proc
-        self.log_path = log_path
-        self.web_port = web_port
+    web_port: int | None = None
 
     def log(self) -> str:
-        return self.log_path.read_text(errors="replace")
+        return self.text()
 
     def wait_for_log(self, text: str, timeout: float = 20.0) -> str:
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            out = self.log()
-            if text in out:
-                return out
-            if self.proc.poll() is not None:
-                raise AssertionError(f"turtlesim_node exited ({self.proc.returncode}):\n{out}")
-            time.sleep(0.05)
-        raise AssertionError(f"turtlesim_node never printed {text!r}:\n{self.log()}")
+        """The output so far, once it contains ``text`` (fails the test if it never does)."""
+        self.wait_for(lambda _line: text in self.text(), timeout)
+        return self.text()
 
 
 def start_turtlesim(master_uri: str, tmp_path: Path, *args: str, web: bool = False) -> TurtlesimProcess:
     env = dict(os.environ, ROS_MASTER_URI=master_uri, PYTHONUNBUFFERED="1")
-    log_path = tmp_path / f"turtlesim-{free_port()}.log"
     port = free_port() if web else None
     cmd = [ninjemys_bin("turtlesim_node"), *args]
     cmd += ["--port", str(port)] if web else ["--headless"]
-    with open(log_path, "wb") as out:
-        proc = subprocess.Popen(cmd, env=env, stdout=out, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
-    sim = TurtlesimProcess(proc, log_path, port)
+    sim = TurtlesimProcess(cmd, env=env, cwd=tmp_path, merge_stderr=True)
+    sim.web_port = port
     try:
         sim.wait_for_log("Spawning turtle [turtle1]")
         if web:
             sim.wait_for_log("turtlesim view:")
     except BaseException:
-        proc.kill()
-        proc.wait()
+        sim.kill()
         raise
     return sim
 
@@ -75,12 +61,7 @@ def turtlesim(master: str, tmp_path: Path) -> Iterator[Callable[..., TurtlesimPr
         yield start
     finally:
         for sim in started:
-            sim.proc.terminate()
-            try:
-                sim.proc.wait(5)
-            except subprocess.TimeoutExpired:
-                sim.proc.kill()
-                sim.proc.wait()
+            sim.stop(grace=5.0)
 
 
 @pytest.fixture

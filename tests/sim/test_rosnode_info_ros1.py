@@ -5,9 +5,8 @@ from __future__ import annotations
 import subprocess
 
 import pytest
-from sim_helpers import wait_until
 
-from ninjemys.testing import ROS1_PYTHON, ros1_env
+from ninjemys.testing import ROS1_PYTHON, ros1_env, wait_until
 
 pytestmark = pytest.mark.ros1
 

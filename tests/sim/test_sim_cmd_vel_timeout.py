@@ -9,10 +9,9 @@ import subprocess
 from pathlib import Path
 
 import pytest
-from sim_helpers import wait_until
 
 from ninjemys.packages.shipped import shipped_executable
-from ninjemys.testing import run_master
+from ninjemys.testing import run_master, wait_until
 
 
 def drive_once_then_watch(tmp_path: Path, *params: str) -> tuple[float, float]:

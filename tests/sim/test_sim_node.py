@@ -14,49 +14,28 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from sim_helpers import wait_until
 
 from ninjemys.packages.shipped import shipped_executable
 from ninjemys.sim.worlds import WORLDS_DIR
-from ninjemys.testing import run_master
+from ninjemys.testing import NodeProcess, run_master, wait_until
 
 
-class SimProcess:
-    def __init__(self, proc: subprocess.Popen, log_path: Path) -> None:
-        self.proc = proc
-        self.log_path = log_path
+class SimProcess(NodeProcess):
+    """A running sim_node (stderr merged into stdout); ``log()`` is everything it printed so far."""
 
     def log(self) -> str:
-        return self.log_path.read_text(errors="replace")
+        return self.text()
 
     def wait_for_log(self, text: str, timeout: float = 20.0) -> str:
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            out = self.log()
-            if text in out:
-                return out
-            if self.proc.poll() is not None:
-                raise AssertionError(f"sim_node exited ({self.proc.returncode}):\n{out}")
-            time.sleep(0.05)
-        raise AssertionError(f"sim_node never printed {text!r}:\n{self.log()}")
-
-    def stop(self) -> None:
-        if self.proc.poll() is None:
-            self.proc.terminate()
-            try:
-                self.proc.wait(10)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait()
+        """The output so far, once it contains ``text`` (fails the test if it never does)."""
+        self.wait_for(lambda _line: text in self.text(), timeout)
+        return self.text()
 
 
 def start_sim(master: str, tmp_path: Path, *params: str, wait: bool = True) -> SimProcess:
     env = dict(os.environ, ROS_MASTER_URI=master, PYTHONUNBUFFERED="1")
-    log_path = tmp_path / f"sim-{len(list(tmp_path.glob('sim-*.log')))}.log"
     cmd = shipped_executable("puzzlebot_sim", "sim_node").command([*params, "_gui:=false"])
-    with open(log_path, "wb") as out:
-        proc = subprocess.Popen(cmd, env=env, stdout=out, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
-    sim = SimProcess(proc, log_path)
+    sim = SimProcess(cmd, env=env, cwd=tmp_path, merge_stderr=True)
     if wait:
         try:
             sim.wait_for_log("PuzzleBot simulator:")
@@ -292,7 +271,7 @@ def test_malformed_world_fails_with_file_line_field(sims, tmp_path, content, exp
     bad = tmp_path / "bad.yaml"
     bad.write_text(content)
     sim = sims(f"_world:={bad}", wait=False)
-    assert sim.proc.wait(30) == 1
+    assert sim.wait(30) == 1
     assert expected in sim.log()
     assert "Traceback" not in sim.log()
 

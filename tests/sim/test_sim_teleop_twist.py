@@ -6,11 +6,11 @@ import os
 import threading
 
 import pexpect
-from sim_helpers import wait_until
 
 from geometry_msgs.msg import Twist
 from ninjemys.packages.shipped import shipped_executable
 from ninjemys.sim.teleop_twist_keyboard import TeleopState
+from ninjemys.testing import wait_until
 
 
 def test_key_logic_matches_the_ros_package() -> None:

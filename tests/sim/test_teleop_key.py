@@ -7,11 +7,10 @@ import threading
 
 import pexpect
 import pytest
-from sim_helpers import wait_until
 
 from geometry_msgs.msg import Twist
 from ninjemys.sim.teleop_key import KeyDecoder
-from ninjemys.testing import ninjemys_bin
+from ninjemys.testing import ninjemys_bin, wait_until
 
 UP, DOWN, RIGHT, LEFT = "\x1b[A", "\x1b[B", "\x1b[C", "\x1b[D"
 

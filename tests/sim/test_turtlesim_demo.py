@@ -8,9 +8,7 @@ import subprocess
 import sys
 import urllib.request
 
-from sim_helpers import wait_until
-
-from ninjemys.testing import free_port
+from ninjemys.testing import free_port, wait_until
 
 
 def _children(pid: int) -> set[int]:

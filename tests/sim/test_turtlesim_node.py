@@ -6,12 +6,12 @@ import math
 import threading
 
 import pytest
-from sim_helpers import wait_until
 
 from geometry_msgs.msg import Twist
 from ninjemys.errors import ServiceError
 from ninjemys.master.client import MasterClient
 from ninjemys.sim.world import CENTER, WORLD_SIZE
+from ninjemys.testing import wait_until
 from std_srvs.srv import Empty
 from turtlesim.msg import Pose
 from turtlesim.srv import Kill, SetPen, Spawn, TeleportAbsolute

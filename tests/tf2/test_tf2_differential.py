@@ -1,10 +1,12 @@
 """Our tf2 buffer core against Debian's (C++ tf2 behind tf2_py) on the same random operations: inserts in
 and out of order, statics, new parents, pruning, lookups at stored, interpolated and latest times, and
-every error text. Results must agree to 1e-9."""
+every error text. Results must agree to 1e-9, for our fast path and for our reference path (tf2's walk
+alone, ``BufferCore(fast=False)``)."""
 
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -25,8 +27,9 @@ def outcomes(cmd: list[str], env: dict[str, str] | None) -> list:
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
-def test_same_answers_as_ros1_tf2():
-    ours = outcomes([sys.executable], None)
+@pytest.mark.parametrize("path", ["fast", "reference"])
+def test_same_answers_as_ros1_tf2(path):
+    ours = outcomes([sys.executable], {**os.environ, "TF2_PATH": path})
     theirs = outcomes([testing.ROS1_PYTHON], testing.ros1_env("http://localhost:11311"))
     for seed, a_run, b_run in zip(SEEDS, ours, theirs, strict=True):
         assert len(a_run) == len(b_run)

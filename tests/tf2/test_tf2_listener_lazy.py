@@ -8,25 +8,17 @@ from __future__ import annotations
 import socket
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 
 import pytest
 
 from ninjemys import testing
 from ninjemys.node import Node
+from ninjemys.testing import wait_until
 from ninjemys.tf2 import node as tfnode
 from ninjemys.tf2.core import BufferCore
 
 S = 1_000_000_000
-
-
-def _wait(predicate: Callable[[], object], timeout: float = 10.0) -> bool:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if predicate():
-            return True
-        time.sleep(0.01)
-    return bool(predicate())
 
 
 @pytest.fixture
@@ -40,7 +32,7 @@ def pair(
         try:
             br = tfnode.TransformBroadcaster(talker)
             listener = tfnode.TransformListener(listener_node, BufferCore())
-            assert _wait(
+            assert wait_until(
                 lambda: br.pub_tf.get_num_connections() == 1 and listener.tf_sub.get_num_connections() == 1
             )
             time.sleep(0.2)  # the listener's thread takes the connection over (and reads it once)
@@ -81,7 +73,7 @@ def test_a_waiter_wakes_when_its_data_arrives(pair) -> None:
     _send(br, 5.0, child="late")
     waiter.join(30.0)
     assert got and got[0][0]  # within the wait's 20 s, while the lazy period is 300 s
-    assert _wait(lambda: not listener.tf_sub._host._eager)  # lazy again once nobody waits
+    assert wait_until(lambda: not listener.tf_sub._host._eager)  # lazy again once nobody waits
 
 
 def test_the_sockets_wake_the_thread_before_they_fill(pair) -> None:
@@ -91,9 +83,9 @@ def test_the_sockets_wake_the_thread_before_they_fill(pair) -> None:
     mark = conn.sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVLOWAT)
     assert mark == max(1, conn.sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF) // 4)
     sub.set_eager(True)
-    assert _wait(lambda: conn.sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVLOWAT) == 1)
+    assert wait_until(lambda: conn.sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVLOWAT) == 1)
     sub.set_eager(False)
-    assert _wait(lambda: conn.sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVLOWAT) == mark)
+    assert wait_until(lambda: conn.sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVLOWAT) == mark)
 
 
 def test_unregister_ends_the_lazy_thread(pair) -> None:

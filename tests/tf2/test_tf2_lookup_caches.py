@@ -360,6 +360,7 @@ def test_a_repeated_lookup_from_the_root_is_memoized(monkeypatch):
     so asking again for a deep frame in the root at the same time composes no link (it walked all
     99 links on every call before)."""
     import ninjemys.tf2.core as core
+    import ninjemys.tf2.fastpath as fastpath
 
     def fail(*_args):
         raise AssertionError("a memoized lookup composed links")
@@ -371,7 +372,7 @@ def test_a_repeated_lookup_from_the_root_is_memoized(monkeypatch):
         first = b.lookup(target, source, t)
         b.lookup(target, source, t)  # the repeat fills the memos
         with monkeypatch.context() as patch:
-            patch.setattr(core, "_relative_at", fail)
+            patch.setattr(fastpath, "_relative_at", fail)
             patch.setattr(core.Frame, "at", fail)
             for _ in range(3):
                 again = b.lookup(target, source, t)

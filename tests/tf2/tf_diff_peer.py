@@ -1,10 +1,12 @@
 """Random tf2 BufferCore operations, printed as JSON: run under Debian's ROS 1 and under ninjemys (both offer
 ``tf2_py.BufferCore``) and compare. Half the rotations are about z only, so chains mix planar and general
 links. Stamps never repeat per frame: a repeated stamp is where we differ on
-purpose (the newest data wins; tf2 keeps the first)."""
+purpose (the newest data wins; tf2 keeps the first). With TF2_PATH=reference in the environment (ours
+only) the buffer answers with tf2's walk alone (``BufferCore(fast=False)``)."""
 
 import json
 import math
+import os
 import random
 import sys
 
@@ -67,4 +69,8 @@ def run(seed):
 
 
 if __name__ == "__main__":
+    if os.environ.get("TF2_PATH") == "reference":
+        import ninjemys.tf2.core
+
+        ninjemys.tf2.core.FAST = False
     print(json.dumps([run(int(seed)) for seed in sys.argv[1:]]))

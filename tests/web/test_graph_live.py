@@ -7,8 +7,10 @@ import json
 import signal
 
 import pytest
-from web_helpers import LISTENER, TALKER, graph_app, wait_until
+from web_helpers import LISTENER, TALKER, graph_app
 from websockets.sync.client import ClientConnection, connect
+
+from ninjemys.testing import wait_until
 
 pytestmark = pytest.mark.ros1
 

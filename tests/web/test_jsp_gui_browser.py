@@ -12,11 +12,10 @@ import xmlrpc.client
 from typing import Any
 
 import pytest
-from web_helpers import wait_until
 
 from ninjemys.idl.loader import get_message_class
 from ninjemys.node import Node
-from ninjemys.testing import free_port, ninjemys_bin, run_master
+from ninjemys.testing import free_port, ninjemys_bin, run_master, wait_until
 
 pytestmark = pytest.mark.browser
 

@@ -11,7 +11,6 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from web_helpers import wait_until
 
 from ninjemys.actionlib.simple_server import SimpleActionServer
 from ninjemys.bag.api import Bag
@@ -22,7 +21,7 @@ from ninjemys.idl.loader import get_service_class as get_message_class_srv
 from ninjemys.master.core import MasterThread
 from ninjemys.node import Node
 from ninjemys.rostime import Time
-from ninjemys.testing import ROS1_PYTHON, ros1_env
+from ninjemys.testing import ROS1_PYTHON, ros1_env, wait_until
 from ninjemys.tools.rosout import Rosout
 from ninjemys.web.rqt import Rqt, tool_url
 

@@ -10,10 +10,9 @@ import socket
 import subprocess
 import urllib.request
 
-from web_helpers import wait_until
 from websockets.sync.client import connect
 
-from ninjemys.testing import free_port, ninjemys_bin, run_master
+from ninjemys.testing import free_port, ninjemys_bin, run_master, wait_until
 
 
 def test_rqt_graph_serves_and_exits_cleanly() -> None:

@@ -13,10 +13,10 @@ from typing import Any
 import pytest
 import yaml
 from rviz_helpers import M, grid, scan, screenshot_rgb, tf_message, top_view_url, transform
-from web_helpers import wait_until
 
 from ninjemys.master.core import MasterThread
 from ninjemys.node import Node
+from ninjemys.testing import wait_until
 from ninjemys.web.rviz import Rviz
 
 pytestmark = pytest.mark.browser

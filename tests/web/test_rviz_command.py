@@ -11,11 +11,10 @@ from typing import Any
 
 import pytest
 import yaml
-from web_helpers import wait_until
 
 from ninjemys.master.core import MasterThread
 from ninjemys.packages.discovery import PackageIndex
-from ninjemys.testing import ninjemys_bin
+from ninjemys.testing import ninjemys_bin, wait_until
 from ninjemys.web import rvizconfig
 
 NAV_RVIZ = PackageIndex.from_environment().find("puzzlebot_navigation").path / "rviz" / "navigation.rviz"

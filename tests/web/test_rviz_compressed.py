@@ -11,12 +11,12 @@ from typing import Any
 import numpy as np
 import pytest
 from rviz_helpers import M
-from web_helpers import wait_until
 
 from ninjemys.cv_bridge import CvBridge
 from ninjemys.image_transport import CompressionParams, encode
 from ninjemys.master.core import MasterThread
 from ninjemys.node import Node
+from ninjemys.testing import wait_until
 from ninjemys.web.rviz import Rviz
 
 pytestmark = pytest.mark.browser

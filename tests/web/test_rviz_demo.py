@@ -12,11 +12,10 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from web_helpers import wait_until
 
 from ninjemys.idl.loader import get_message_class
 from ninjemys.node import Node
-from ninjemys.testing import free_port
+from ninjemys.testing import free_port, wait_until
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow]
 

@@ -9,11 +9,11 @@ from typing import Any
 import numpy as np
 import pytest
 from rviz_helpers import M, tf_message, transform
-from web_helpers import wait_until
 
 from ninjemys.master.core import MasterThread
 from ninjemys.node import Node
 from ninjemys.rostime import Duration
+from ninjemys.testing import wait_until
 from ninjemys.web.rviz import Rviz
 
 pytestmark = pytest.mark.browser

@@ -11,12 +11,11 @@ import subprocess
 
 import pytest
 from pngdecode import decode_png
-from web_helpers import wait_until
 
 from ninjemys.idl.loader import get_message_class
 from ninjemys.node import Node
 from ninjemys.packages.shipped import shipped_executable
-from ninjemys.testing import free_port, run_master
+from ninjemys.testing import free_port, run_master, wait_until
 
 pytestmark = pytest.mark.browser
 

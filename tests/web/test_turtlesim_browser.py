@@ -10,11 +10,10 @@ import urllib.request
 import numpy as np
 import pytest
 from pngdecode import decode_png
-from web_helpers import wait_until
 
 from ninjemys.sim.render import png_bytes
 from ninjemys.sim.world import CENTER, DEFAULT_BACKGROUND, DEFAULT_PEN, PIXELS_PER_METER, WORLD_SIZE
-from ninjemys.testing import free_port, ninjemys_bin, run_master
+from ninjemys.testing import free_port, ninjemys_bin, run_master, wait_until
 
 pytestmark = pytest.mark.browser
 

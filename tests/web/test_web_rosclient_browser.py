@@ -7,12 +7,12 @@ from collections.abc import Iterator
 from typing import Any
 
 import pytest
-from web_helpers import wait_until
 
 from ninjemys.bridge.server import Gateway, GatewayOptions
 from ninjemys.idl.loader import get_message_class, get_service_class
 from ninjemys.master.core import MasterThread
 from ninjemys.node import Node
+from ninjemys.testing import wait_until
 from ninjemys.web.app import WebApp
 
 pytestmark = pytest.mark.browser

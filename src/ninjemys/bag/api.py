@@ -267,7 +267,7 @@ class Bag:
                 header = {
                     "type": datatype.encode(),
                     "md5sum": md5sum.encode(),
-                    "message_definition": definition.encode(),
+                    "message_definition": (definition or "").encode(),
                 }
             conn_id = writer.connection(topic, header)
         try:
@@ -319,6 +319,7 @@ class Bag:
         new_tuple = tuple.__new__  # namedtuple construction without its Python-level __new__
         # per-connection work (class lookup, header text) is done once, not per message
         per_conn: dict[int, Any] = {}
+        cls: Any  # None only for a raw read of a type that cannot be loaded (never deserialized)
         try:
             for conn, ns, data, chunk_pos in source:
                 cached = per_conn.get(conn.id)

@@ -23,6 +23,7 @@ import numpy
 
 from ninjemys.errors import NinjemysError
 from ninjemys.idl.loader import get_message_class
+from ninjemys.idl.message import Message
 from ninjemys.rostime import Duration, Time
 
 _INTS = {"byte", "char", "int8", "uint8", "int16", "uint16", "int32", "uint32", "int64", "uint64"}
@@ -136,7 +137,7 @@ def _field_encoder(slot_type: str, cbor: bool) -> Callable[[Any], Any] | None:
     return lambda v: [to_value(x, cbor) for x in v]
 
 
-def _build_encoder(cls: type, cbor: bool) -> Callable[[Any], dict]:
+def _build_encoder(cls: type[Message], cbor: bool) -> Callable[[Any], dict]:
     fields = [(name, _field_encoder(t, cbor)) for name, t in zip(cls.__slots__, cls._slot_types, strict=True)]
 
     def encode(msg: Any) -> dict:
@@ -152,7 +153,7 @@ def _build_encoder(cls: type, cbor: bool) -> Callable[[Any], dict]:
 # -- from JSON ------------------------------------------------------------------------------------
 
 
-def from_value(cls: type, value: Any, where: str = "") -> Any:
+def from_value(cls: type[Message], value: Any, where: str = "") -> Any:
     """A ``cls`` instance from rosbridge's JSON object (``where`` prefixes error texts: the field path)."""
     if value is None:
         value = {}

@@ -35,9 +35,10 @@ class CloseRequest:
         return 0
 
 
-Frame = str | bytes | bytearray | memoryview | CloseRequest
-#: one message, or several frames that must go together (rosbridge fragments of one message)
-Item = Frame | tuple[Frame, ...]
+Frame = str | bytes | bytearray | memoryview
+#: one message, or several frames that must go together (rosbridge fragments of one message), or the
+#: request to close the connection
+Item = Frame | tuple[Frame, ...] | CloseRequest
 
 
 def _size(item: Item) -> int:

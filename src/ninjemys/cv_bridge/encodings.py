@@ -243,9 +243,8 @@ def convert(img: np.ndarray, src: str, dst: str) -> np.ndarray:
     elif src_kind == dst_kind:
         out = img
     else:
-        out = _cvt_color(img, src_kind, dst_kind)
-        if out is None:
-            out = _from_rgba(_to_rgba(img, src_kind), dst_kind, src_kind)
+        converted = _cvt_color(img, src_kind, dst_kind)
+        out = converted if converted is not None else _from_rgba(_to_rgba(img, src_kind), dst_kind, src_kind)
     if src_bits != dst_bits or out.dtype != dst_dtype:
         out = _convert_depth(out, src_bits, dst_bits, dst_dtype)
     elif out is img:

@@ -485,7 +485,7 @@ class RealSenseCamera:
 def main(argv: list[str] | None = None) -> int:
     """``rosrun realsense2_camera realsense2_camera_node`` (and the node of rs_camera.launch)."""
     try:
-        import pyrealsense2 as rs  # type: ignore[import-untyped]  # noqa: PLC0415 - optional, untyped
+        import pyrealsense2 as rs  # noqa: PLC0415 - optional (untyped: pyproject lets mypy see it as Any)
     except ImportError:
         print(NOT_INSTALLED, file=sys.stderr)
         return 1

@@ -16,6 +16,7 @@ import os
 import re
 import sys
 import traceback
+import types
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -27,7 +28,7 @@ bool_t = "bool"
 int_t = "int"
 double_t = "double"
 
-_PYTYPES: dict[str, type] = {"str": str, "int": int, "double": float, "bool": bool}
+_PYTYPES: dict[str, Callable[[Any], object]] = {"str": str, "int": int, "double": float, "bool": bool}
 _CTYPES = {"str": "std::string", "int": "int", "double": "double", "bool": "bool"}
 _CCONST = {"str": "const char * const", "int": "const int", "double": "const double", "bool": "const bool"}
 _MIN: dict[str, Any] = {"int": -0x80000000, "double": -math.inf, "str": "", "bool": False}
@@ -43,7 +44,7 @@ class CfgError(NinjemysError):
 
 def _caller() -> tuple[str, int]:
     """File (base name) and line of the first frame outside this module: the .cfg line being run."""
-    frame = sys._getframe(1)
+    frame: types.FrameType | None = sys._getframe(1)
     while frame is not None and os.path.normcase(os.path.abspath(frame.f_code.co_filename)) == _HERE:
         frame = frame.f_back
     if frame is None:
@@ -84,7 +85,7 @@ class Group:
         self.srcfile, self.srcline = _caller()
         gen._groups[id] = self
 
-    def add_group(self, name: str, type: str = "", state: bool = True) -> Group:
+    def add_group(self, name: str, type: str = "", state: bool = True) -> _Group:
         group = Group(self.gen, name, type, state, self.gen._next_id, self.id)
         self.gen._next_id += 1
         self.groups.append(group)
@@ -172,6 +173,9 @@ class Group:
 _sink: Callable[[ParameterGenerator], None] | None = None
 
 
+_Group = Group  # the class, under a name ParameterGenerator's class attribute ``Group`` does not hide
+
+
 class ParameterGenerator:
     """``parameter_generator_catkin.ParameterGenerator``: the API every .cfg file is written against."""
 
@@ -227,7 +231,7 @@ class ParameterGenerator:
     ) -> None:
         self.group.add(name, paramtype, level, description, default, min, max, edit_method)
 
-    def add_group(self, name: str, type: str = "", state: bool = True) -> Group:
+    def add_group(self, name: str, type: str = "", state: bool = True) -> _Group:
         return self.group.add_group(name, type=type, state=state)
 
     def generate(self, pkgname: str, nodename: str, name: str) -> int:

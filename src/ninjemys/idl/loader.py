@@ -35,6 +35,7 @@ from ninjemys.idl.message import (
     DESER_ERRORS,
     SER_ERRORS,
     Message,
+    ServiceClass,
     as_view,
     bad_args,
     deser_failed,
@@ -65,7 +66,7 @@ _msg_specs: dict[str, MsgSpec] = {}
 _srv_specs: dict[str, SrvSpec] = {}
 _md5s: dict[str, str] = {}
 _classes: dict[str, type[Message]] = {}
-_srv_classes: dict[str, type] = {}
+_srv_classes: dict[str, type[ServiceClass]] = {}
 _from_definition: dict[tuple[str, str], type[Message]] = {}
 
 _RUNTIME: dict[str, Any] = {
@@ -220,7 +221,7 @@ def get_message_class(type_name: str) -> type[Message]:
     return cls
 
 
-def get_service_class(type_name: str) -> type:
+def get_service_class(type_name: str) -> type[ServiceClass]:
     """The service class (``_type``, ``_md5sum``, ``_request_class``, ``_response_class``)."""
     cls = _srv_classes.get(type_name)
     if cls is not None:
@@ -237,7 +238,7 @@ def get_service_class(type_name: str) -> type:
             md5sum = compute_srv_md5(spec, get_message_spec, _md5s)
             cls = type(
                 spec.short_name,
-                (),
+                (ServiceClass,),
                 {
                     "__slots__": (),
                     "__module__": f"{spec.package}.srv",

@@ -26,6 +26,17 @@ _pack_len = struct.Struct("<I").pack
 _DESER_ERRORS = (struct.error, ValueError, IndexError, TypeError, UnicodeError, MemoryError, OverflowError)
 
 
+class ServiceClass:
+    """Base of every generated service class: its type, checksum and the request and response classes
+    (genpy's service classes carry the same four attributes)."""
+
+    __slots__ = ()
+    _type = ""
+    _md5sum = ""
+    _request_class: type[Message]
+    _response_class: type[Message]
+
+
 class Message:
     """Base of every generated message class (genpy.Message's surface)."""
 
@@ -38,6 +49,15 @@ class Message:
     _slot_types: tuple[str, ...] = ()
     #: the spec's fields as (name, FieldType), for diagnosis and generic walkers
     _fields: tuple[Any, ...] = ()
+
+    if TYPE_CHECKING:
+        # generated classes add their fields (and services their _request_class, ...) at run time, so
+        # to a type checker every field of a message is Any: code reads and writes them freely
+        def __init__(self, *args: Any, **kwds: Any) -> None: ...
+
+        def __getattr__(self, name: str) -> Any: ...
+
+        def __setattr__(self, name: str, value: Any) -> None: ...
 
     # --- serialization -------------------------------------------------------------------------
     def _ser(self, w: Any) -> None:  # generated per class

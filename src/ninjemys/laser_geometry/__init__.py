@@ -124,8 +124,8 @@ class LaserProjection:
         PointCloud2 = get_message_class("sensor_msgs/PointCloud2")
         PointField = get_message_class("sensor_msgs/PointField")
         fields = [
-            PointField(name, dtype.fields[name][1], _INT32 if name == "index" else _FLOAT32, 1)
-            for name in dtype.names or ()
+            PointField(name, offset, _INT32 if name == "index" else _FLOAT32, 1)
+            for name, (_, offset, *_) in (dtype.fields or {}).items()
         ]
         return PointCloud2(
             header=scan_in.header,

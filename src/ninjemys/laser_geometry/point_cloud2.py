@@ -73,7 +73,9 @@ def _as_array(cloud: Any, fmt: str) -> np.ndarray | None:
     """All points as a flat structured array, or None when numpy cannot view the layout (a point
     wider than ``point_step``, data shorter than the rows claim)."""
     order = fmt[0]
-    names, formats, offsets = [], [], []
+    names: list[str] = []
+    formats: list[str] = []
+    offsets: list[int] = []
     position = 0
     for code in fmt[1:]:
         if code == "x":
@@ -123,7 +125,7 @@ def read_points(
                     yield point
         return
     if skip_nans:
-        floats = [name for name in points.dtype.names if points.dtype[name].kind == "f"]
+        floats = [name for name in points.dtype.names or () if points.dtype[name].kind == "f"]
         if floats:
             keep = ~np.logical_or.reduce([np.isnan(points[name]) for name in floats])
             points = points[keep]

@@ -16,6 +16,7 @@ import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ninjemys.errors import LaunchError, NinjemysError
 from ninjemys.launch import master_link
@@ -33,6 +34,10 @@ from ninjemys.master.client import MasterClient
 from ninjemys.packages.discovery import PackageIndex, package_path_dirs, underlay_dirs
 from ninjemys.packages.executables import find_executable
 from ninjemys.roshome import log_directory
+
+if TYPE_CHECKING:
+    import subprocess
+    from typing import Any
 
 
 @dataclass
@@ -196,7 +201,7 @@ class LaunchSession:
         self.opts = opts
         self.env = dict(os.environ if env is None else env)
         self.supervisor: Supervisor | None = None
-        self._core = None
+        self._core: subprocess.Popen[Any] | None = None
 
     def _say(self, text: str) -> None:
         sys.stdout.write(text + "\n")
@@ -249,11 +254,12 @@ class LaunchSession:
         for line in failures:
             print(line, file=sys.stderr, flush=True)
         if core_proc is not None:
+            core_args: Any = core_proc.args  # the argv list start_core passed to Popen
             specs.insert(
                 0,
                 ProcessSpec(
                     name="master",
-                    argv=[str(a) for a in core_proc.args],
+                    argv=[str(a) for a in core_args],
                     env=self.env,
                     popen=core_proc,
                     is_core=True,

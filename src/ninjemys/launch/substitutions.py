@@ -50,7 +50,7 @@ class SubstitutionContext:
 
 def collect(text: str) -> list[str]:
     """The bodies of every ``$(...)`` in ``text`` (no nesting: the first ``)`` closes)."""
-    bodies = []
+    bodies: list[str] = []
     i = 0
     while True:
         start = text.find("$(", i)

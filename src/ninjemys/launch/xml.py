@@ -18,10 +18,10 @@ import copy
 import os
 import shlex
 import subprocess
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ninjemys.commands import with_our_commands
 from ninjemys.errors import LaunchError, NinjemysError
@@ -39,6 +39,9 @@ from ninjemys.names import (
     ns_join,
 )
 from ninjemys.paramyaml import ParamYamlError, load_yaml
+
+if TYPE_CHECKING:
+    from ninjemys.packages.discovery import PackageIndex
 
 NODE_ATTRS = (
     "pkg",
@@ -149,7 +152,7 @@ class _Loader:
         self.args_only = args_only
         self.env = env
         self.anons: dict[str, str] = {}
-        self._index = None
+        self._index: PackageIndex | None = None
 
     # -- helpers ---------------------------------------------------------------------------------
     def _find(self, pkg: str) -> str:
@@ -699,7 +702,7 @@ def command_line_args(argv: list[str]) -> dict[str, str]:
 
 
 def load_launch(
-    files: list[str | Path],
+    files: Sequence[str | Path],
     argv: list[str] | None = None,
     env: Mapping[str, str] | None = None,
     xml_text: str | None = None,

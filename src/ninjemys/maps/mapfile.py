@@ -284,26 +284,26 @@ def _read_png(blob: bytes) -> np.ndarray:
     out = np.zeros((height, stride), dtype=np.int32)
     prev = np.zeros(stride, dtype=np.int32)
     for r in range(height):
-        kind, line = int(rows[r, 0]), rows[r, 1:].astype(np.int32)
-        if kind == 0:
-            cur = line
-        elif kind == 2:
-            cur = (line + prev) & 255
+        filt, row = int(rows[r, 0]), rows[r, 1:].astype(np.int32)
+        if filt == 0:
+            cur = row
+        elif filt == 2:
+            cur = (row + prev) & 255
         else:
             cur = np.zeros(stride, dtype=np.int32)
             for i in range(stride):
                 left = int(cur[i - channels]) if i >= channels else 0
                 up = int(prev[i])
                 ul = int(prev[i - channels]) if i >= channels else 0
-                if kind == 1:
+                if filt == 1:
                     pred = left
-                elif kind == 3:
+                elif filt == 3:
                     pred = (left + up) // 2
                 else:
                     p = left + up - ul
                     pa, pb, pc = abs(p - left), abs(p - up), abs(p - ul)
                     pred = left if pa <= pb and pa <= pc else up if pb <= pc else ul
-                cur[i] = (int(line[i]) + pred) & 255
+                cur[i] = (int(row[i]) + pred) & 255
         out[r] = cur
         prev = cur
     return out.reshape(height, width, channels).astype(np.float64)

@@ -23,7 +23,8 @@ if TYPE_CHECKING:
     from typing import Any
 
 TopicTypes = list[list[str]]
-SystemState = list[list[list[object]]]
+# [publishers, subscribers, services], each a list of [name, [node, ...]] (XML-RPC lists, so Any inside)
+SystemState = list[list[list["Any"]]]
 
 
 class MasterClient:

@@ -66,7 +66,7 @@ class AMCLParams:
         for f in fields(self):
             if f.name in values:
                 kind = type(getattr(self, f.name))
-                setattr(self, f.name, kind(values[f.name]))  # type: ignore[call-arg]
+                setattr(self, f.name, kind(values[f.name]))
 
 
 def wrap(a: np.ndarray | float) -> np.ndarray | float:

@@ -324,7 +324,8 @@ class SafetyMonitor:
             self.last_now,
             now,
         )
-        for handle in [*self.mux.inputs, *self.mux.locks]:
+        handles: list[Any] = [*self.mux.inputs, *self.mux.locks]  # inputs and locks: both keep last_time
+        for handle in handles:
             handle.last_time = NEVER
         self.scan_time = None
         self.stale_since = None

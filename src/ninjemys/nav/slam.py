@@ -33,6 +33,7 @@ milliseconds per particle.
 
 from __future__ import annotations
 
+import builtins
 import math
 from dataclasses import dataclass, fields
 
@@ -67,7 +68,8 @@ class SlamParams:
     particles: int = 30
     resampleThreshold: float = 0.5  # noqa: N815
 
-    def update(self, values: dict[str, object]) -> list[tuple[str, str]]:
+    # ``str`` is a field here (gmapping's rotation-from-translation error), so the type is spelled in full
+    def update(self, values: dict[builtins.str, object]) -> list[tuple[builtins.str, builtins.str]]:
         """Take ``values`` by name; a value out of its range keeps the current one. Returns (name,
         reason) for each rejected value: the node logs them and goes on."""
         rejected = []
@@ -75,7 +77,7 @@ class SlamParams:
             if f.name not in values:
                 continue
             old = getattr(self, f.name)
-            value = type(old)(values[f.name])  # type: ignore[call-arg]
+            value = type(old)(values[f.name])
             problem = _out_of_range(f.name, value)
             if problem:
                 rejected.append((f.name, f"{problem}, got {values[f.name]!r}; using {old!r}"))

@@ -8,7 +8,7 @@ The rule that keeps this sane: **nothing touches a socket it does not own**; own
 the hand-offs named here (``Runtime.call_soon``/``run``/``start_thread``, ``Subscriber.post``,
 ``PubConnection`` under its lock).
 
-:data:`THREADS` names every thread the runtime starts (its ``threading.Thread`` name) and what runs
+:data:`THREADS` names every thread started anywhere in ``src/``, the apps' included (its ``threading.Thread`` name) and what runs
 on it; :data:`RESOURCES` lists each socket, lock and queue with its owner and who else may touch it,
 and how. ``tests/node/test_node_threads.py`` checks the code against both: every thread started in
 the core has a row here, every lock/queue attribute of ``ninjemys.node`` and ``ninjemys.net`` has one
@@ -140,6 +140,117 @@ THREADS: tuple[Thread, ...] = (
         "move_base-costmaps",
         "nav.move_base_node.MoveBase",
         "updates and publishes both costmaps at their update_frequency and publish_frequency",
+    ),
+    # -- apps: the rest of navigation (nav) ------------------------------------------------------
+    Thread(
+        "amcl-static-map",
+        "nav.amcl_node.AmclNode (use_map_topic false)",
+        "calls static_map until the map server answers, then hands the map to the filter; ends",
+    ),
+    Thread("slam-tf", "nav.slam_node (transform_publish_period > 0)", "publishes map->odom at that period"),
+    Thread(
+        "safety-loop",
+        "nav.safety_node",
+        "at the node's rate: decides the command (mux inputs and locks, the scan's zones, e-stop) and publishes cmd_vel",
+    ),
+    Thread("safety-diagnostics", "nav.safety_node", "publishes /diagnostics every diagnostic period"),
+    # -- apps: the simulators (sim) --------------------------------------------------------------
+    Thread(
+        "puzzlebot-sim",
+        "sim.puzzlebot_node (start)",
+        "the physics stepper: steps the world at its rate, publishes odometry, tf, scans, IMU, camera and "
+        "/clock; the Gazebo services change the world under its lock",
+    ),
+    Thread(
+        "turtlesim-update",
+        "sim.turtlesim_node (start)",
+        "turtlesim's 16 ms update: moves the turtles, publishes each one's pose and colour sensor",
+    ),
+    # -- apps: the web gateway (bridge) ----------------------------------------------------------
+    Thread(
+        "gateway-loop",
+        "bridge.server.Gateway.start",
+        "the gateway's asyncio loop: HTTP, WebSocket and SSE clients, each client's sender; ROS data "
+        "reaches it with call_soon_threadsafe",
+    ),
+    Thread(
+        "gateway-graph",
+        "bridge.server.Gateway",
+        "polls the master every update_period: channels, services and the connection graph that changed",
+    ),
+    Thread(
+        "gateway_<n>",
+        "bridge.server.Gateway.pool (8 workers)",
+        "blocking work off the loop: the getBusInfo sweeps of the connection graph, dropping a topic's tap, and rosbridge's call_service",
+    ),
+    Thread(
+        "gateway-call <service>_<n>",
+        "bridge.graph (one pool per service, LANE_WORKERS each)",
+        "service calls clients asked for, in order per service",
+    ),
+    Thread(
+        "gateway-deadlines", "bridge.graph._Deadlines", "runs callbacks at their deadlines (call timeouts)"
+    ),
+    Thread(
+        "gateway-proxies-close",
+        "bridge.graph (shutdown)",
+        "closes the service proxies without holding up shutdown; ends",
+    ),
+    Thread(
+        "foxglove-<client>_<n>",
+        "bridge.foxglove (one worker per Foxglove client)",
+        "that client's requests that block (service calls, parameters), in order",
+    ),
+    Thread(
+        "rosbridge-<client>_<n>",
+        "bridge.rosbridge (one worker per rosbridge client)",
+        "that client's operations that block (advertise, call_service, parameters), in order",
+    ),
+    Thread(
+        "tf2_web_republisher",
+        "bridge.tf_republisher",
+        "publishes each client's throttled transforms at its rate",
+    ),
+    # -- apps: the web tools (web) ---------------------------------------------------------------
+    Thread("web-tools", "web.app.WebApp.start", "the web tools' asyncio loop: their HTTP server and pages"),
+    Thread("rqt_bag-play", "web.rqt (bag playback)", "publishes the bag's messages at their times and speed"),
+    # -- drivers ---------------------------------------------------------------------------------
+    Thread(
+        "rosserial-call",
+        "drivers.rosserial_host (one per service request from the device)",
+        "calls the ROS service the device asked for and sends the response back down the link; ends",
+    ),
+    # -- libraries and commands ------------------------------------------------------------------
+    Thread(
+        "action-status:<ns>",
+        "actionlib.server.ActionServer",
+        "publishes the status list at status_frequency and drops finished goals after status_list_timeout",
+    ),
+    Thread("action-timer:<ns>", "actionlib.server.ActionServer (status_frequency > 0)", "the status timer"),
+    Thread(
+        "action-execute:<ns>",
+        "actionlib.simple_server.SimpleActionServer (with execute_cb)",
+        "runs execute_cb for each accepted goal",
+        "execute callbacks",
+    ),
+    Thread(
+        "concurrent_split:<label>",
+        "smach.concurrence.Concurrence.execute (one per child state, joined before it returns)",
+        "runs one child state of the concurrence, as smach's threads of that name do",
+        "state execute callbacks",
+    ),
+    Thread("rosbag-record-writer", "bag.record", "writes the recorded messages to the bag, in order"),
+    Thread(
+        "rosbag-record-discovery",
+        "bag.record (--all, --regex or --node)",
+        "polls the master and subscribes to topics that match",
+    ),
+    Thread("roslaunch", "roslaunch.parent.ROSLaunchParent.start", "the launch's supervisor"),
+    Thread("roslaunch-<name>", "roslaunch.scriptapi", "a scripted launch's supervisor"),
+    Thread(
+        "NodeProcess reader",
+        "testing.NodeProcess (two per child: stdout, stderr)",
+        "collects the child's output lines for the test",
     ),
 )
 

@@ -272,8 +272,8 @@ def build_workspace(
     writer.write(ws.devel / "setup.zsh", render_setup_zsh(wsenv))
     writer.write(ws.devel / MARKER, json.dumps({"source": str(ws.source), "devel": str(ws.devel)}) + "\n")
     for name in ("local_setup.sh", "local_setup.bash"):
-        target = "setup.sh" if name.endswith(".sh") else "setup.bash"
-        writer.write(ws.devel / name, f". {str(ws.devel / target)!r}\n".replace("'", '"'))
+        full = "setup.sh" if name.endswith(".sh") else "setup.bash"
+        writer.write(ws.devel / name, f". {str(ws.devel / full)!r}\n".replace("'", '"'))
 
     manifest_path = ws.build / "ninjemys_outputs.json"
     try:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import importlib
 import inspect
 import sys
+from collections.abc import Mapping
 
 from ninjemys.packages.shipped import shipped_executable
 
@@ -47,6 +48,7 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     full_args = [*exe.prefix_args, *args]
     sys.argv = [name, *full_args]
+    params: Mapping[str, inspect.Parameter]
     try:
         params = inspect.signature(function).parameters
     except (TypeError, ValueError):

@@ -174,7 +174,7 @@ def _joint(el: ET.Element, source: str) -> Joint:
     if kind in MOVING and norm == 0.0:
         raise URDFError(f"{where}: <axis xyz> has zero length")
     if norm:
-        axis = tuple(a / norm for a in axis)  # type: ignore[assignment]
+        axis = tuple(a / norm for a in axis)
     mimic = None
     mimic_el = el.find("mimic")
     if mimic_el is not None:

@@ -112,7 +112,7 @@ class WebSocket:
 
     async def messages(self) -> AsyncIterator[str | bytes]:
         """Each complete message the client sends (text as str, binary as bytes), until it closes."""
-        parts: list[bytes] = []
+        parts: list[bytes | bytearray | memoryview] = []
         text = False
         protocol = self.protocol
         while True:

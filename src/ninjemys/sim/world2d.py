@@ -337,7 +337,9 @@ def parse_world(doc: dict, f: Fields, path: Path) -> World:
         t = f.number(w.get("thickness", DEFAULT_WALL_THICKNESS), f"{where}.thickness", minimum=0)
         h = f.number(w.get("height", DEFAULT_WALL_HEIGHT), f"{where}.height", positive=True)
         c = _colour(f, w.get("color"), f"{where}.color", COLOURS["white"])
-        obstacles.append(Obstacle(str(w.get("name", f"wall_{i}")), "wall", wall_outline(*a, *b, t), h, c))
+        obstacles.append(
+            Obstacle(str(w.get("name", f"wall_{i}")), "wall", wall_outline(a[0], a[1], b[0], b[1], t), h, c)
+        )
     for i, b in enumerate(items("boxes")):
         where = f"boxes[{i}]"
         _check_keys(f, b, where, {"center", "size", "yaw", "height", "color", "name"}, {"center", "size"})
@@ -518,10 +520,10 @@ def rasterize(
             occ[ri[ok], ci[ok]] = True
     if world.grid is not None:
         g = world.grid
-        cx = xmin + (np.arange(cols) + 0.5) * resolution
-        cy = ymin + (np.arange(rows) + 0.5) * resolution
-        gc = np.floor((cx - g.origin_x) / g.resolution).astype(int)
-        gr = np.floor((cy - g.origin_y) / g.resolution).astype(int)
+        col_x = xmin + (np.arange(cols) + 0.5) * resolution
+        row_y = ymin + (np.arange(rows) + 0.5) * resolution
+        gc = np.floor((col_x - g.origin_x) / g.resolution).astype(int)
+        gr = np.floor((row_y - g.origin_y) / g.resolution).astype(int)
         okc = (gc >= 0) & (gc < g.occupied.shape[1])
         okr = (gr >= 0) & (gr < g.occupied.shape[0])
         sub = np.zeros((rows, cols), dtype=bool)

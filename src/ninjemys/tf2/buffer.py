@@ -322,7 +322,7 @@ class Buffer(BufferCore):
             target_frame, target_time, source_frame, source_time, fixed_frame
         )
 
-    def can_transform(  # type: ignore[override]
+    def can_transform(
         self,
         target_frame: str,
         source_frame: str,
@@ -338,7 +338,7 @@ class Buffer(BufferCore):
             result = self._wait(lambda: self.can_transform_ns(target_frame, source_frame, t), timeout)
         return result if return_debug_tuple else result[0]
 
-    def can_transform_full(  # type: ignore[override]
+    def can_transform_full(
         self,
         target_frame: str,
         target_time: Any,

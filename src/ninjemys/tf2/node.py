@@ -159,7 +159,7 @@ class TransformListener:
     def unregister(self) -> None:
         """Stop listening (both subscriptions)."""
         if self._source:
-            self.buffer.remove_source(self)  # type: ignore[attr-defined]
+            self.buffer.remove_source(self)
         self.tf_sub.unregister()
         self.tf_static_sub.unregister()
 

@@ -52,7 +52,7 @@ _AXES2TUPLE = {
 _TUPLE2AXES = {v: k for k, v in _AXES2TUPLE.items()}
 
 
-def _axes(axes: Any) -> tuple[int, int, int, int, int, int, int]:
+def _axes(axes: Any) -> tuple[int, int, int, int, int, int]:
     """(i, j, k, parity, repetition, frame) for an axes string or tuple."""
     try:
         first, parity, repetition, frame = _AXES2TUPLE[axes.lower()]
@@ -360,7 +360,7 @@ def shear_from_matrix(matrix: Any) -> tuple[float, Any, Any, Any]:
         raise ValueError(f"no two linear independent eigenvectors found {w}")
     vecs = numpy.real(v[:, idx]).squeeze().T
     best = -1.0
-    normal = None
+    normal: Any = None
     for a, b in ((0, 1), (0, 2), (1, 2)):
         if b >= len(vecs):
             continue

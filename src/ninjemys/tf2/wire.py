@@ -27,7 +27,7 @@ def decode_tf_message(buf: bytes | bytearray | memoryview) -> list[tuple]:
     try:
         (count,) = _U32.unpack_from(buf, 0)
         pos = 4
-        out = []
+        out: list[tuple] = []
         append = out.append
         names: dict[bytes, str] = {}
         stamp_len = _STAMP_LEN.unpack_from

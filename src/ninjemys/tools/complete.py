@@ -40,6 +40,7 @@ from ninjemys.share.completion import BASH_FILE
 TYPE_CHECKING = False  # typing itself is not worth importing on every Tab press
 if TYPE_CHECKING:
     from collections.abc import Callable
+    from types import ModuleType
 
     from ninjemys.master.snapshot import GraphSnapshot
 
@@ -313,7 +314,7 @@ def _launch_args(*where: str) -> list[str]:
     return launch_args(path) if path else []
 
 
-def _pkgs() -> object:
+def _pkgs() -> ModuleType:
     from ninjemys.tools import complete_pkgs
 
     return complete_pkgs

@@ -39,7 +39,7 @@ class _ProtoDumper(yaml.SafeDumper):
 
 def _represent_fields(dumper: _ProtoDumper, fields: _Fields) -> yaml.Node:
     if fields.switches_style:
-        dumper.default_flow_style = None
+        dumper.default_flow_style = None  # type: ignore[assignment]  # PyYAML's heuristic; typeshed says bool
     return dumper.represent_mapping("tag:yaml.org,2002:map", fields.items)
 
 

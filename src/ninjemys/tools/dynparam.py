@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import optparse
 import sys
+from collections.abc import Iterator
 from typing import Any
 
 from ninjemys.dynamic_reconfigure.client import ReconfigureClient, reconfigure_servers
@@ -240,7 +241,7 @@ def _dump_loader() -> type:
     class Loader(yaml.SafeLoader):
         pass
 
-    def config(loader: yaml.SafeLoader, suffix: str, node: yaml.Node) -> Config:
+    def config(loader: yaml.SafeLoader, suffix: str, node: yaml.Node) -> Iterator[Config]:
         if suffix != "dynamic_reconfigure.encoding.Config" or not isinstance(node, yaml.MappingNode):
             raise yaml.constructor.ConstructorError(None, None, f"unexpected tag {suffix}", node.start_mark)
         result = Config()

@@ -14,6 +14,10 @@ import shutil
 import sys
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from typing import Any
 
 from ninjemys.bag.format import DEFAULT_CHUNK_THRESHOLD, NSEC
 from ninjemys.bag.info import info_key, info_text, info_yaml
@@ -190,7 +194,7 @@ def filter_cmd(argv: list[str]) -> int:
         opts.verbose_pattern is not None and _uses_name(opts.verbose_pattern, "m")
     )
 
-    def keep(msg) -> bool:  # noqa: ANN001
+    def keep(msg: Any) -> bool:
         conn = msg.connection
         m = None
         if needs_m:

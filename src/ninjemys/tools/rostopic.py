@@ -82,13 +82,14 @@ def _cmd_list(args: argparse.Namespace) -> int:
 def _hosts(client: Any, entries: list[Any], cache: dict[str, str | None]) -> set[str]:
     from urllib.parse import urlparse
 
-    hosts = set()
+    hosts: set[str] = set()
     for _, _, nodes in entries:
         for node in nodes:
             if node not in cache:
                 cache[node] = node_api(client, node)
-            if cache[node]:
-                hosts.add(urlparse(cache[node]).hostname or "")
+            uri = cache[node]
+            if uri:
+                hosts.add(urlparse(uri).hostname or "")
     return hosts
 
 

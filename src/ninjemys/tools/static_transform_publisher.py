@@ -52,7 +52,11 @@ def parse_numbers(nums: list[str]) -> tuple[float, ...] | None:
     return None
 
 
-def _normalized(t: tuple[float, ...], log: Any) -> tuple[float, ...] | None:
+def _normalized(t: tuple[float, ...] | None, log: Any) -> tuple[float, ...] | None:
+    """``t`` with a unit quaternion; None (after one line) when it has none. ``t`` is None only when
+    the numbers were not 6 or 7, which the argument count already ruled out."""
+    if t is None:
+        return None
     qx, qy, qz, qw = t[3:]
     n = math.sqrt(qx * qx + qy * qy + qz * qz + qw * qw)
     if not n or not math.isfinite(n):
@@ -105,6 +109,7 @@ def main(argv: list[str] | None = None) -> int:
     rospy.init_node("static_transform_publisher", argv=full, anonymous=True)
     if not wait_for_master_like_roscpp(rospy.core.process_node()):
         return 0  # Ctrl-C while waiting for the master, as roscpp: a quiet exit
+    values: tuple[float, ...] | None
     if len(args) == 1:
         got = _from_param(rospy, args[0])
         if got is None:
@@ -155,7 +160,7 @@ def tf_main(argv: list[str] | None = None) -> int:
     if parent == child:
         rospy.logfatal(f"target_frame and source frame are the same ({parent}, {child}) this cannot work")
         return 1
-    values = _normalized(parse_numbers(args[:-3]), _report(rospy))  # type: ignore[arg-type]
+    values = _normalized(parse_numbers(args[:-3]), _report(rospy))
     if values is None:
         return 1
     if period <= 0.0:

@@ -25,7 +25,7 @@ class Monitor:
         self.authority_delays: dict[str, deque[float]] = {}
         self.authority_times: dict[str, deque[float]] = {}
 
-    def record(self, frames: list[tuple[str, float]], authority: str, now: float) -> None:
+    def record(self, frames: list[tuple[str, float | None]], authority: str, now: float) -> None:
         """One message: ``(child_frame_id, stamp seconds or None for static)`` pairs from ``authority``."""
         with self.lock:
             total = 0.0

@@ -10,9 +10,18 @@ from __future__ import annotations
 import functools
 import sys
 from collections.abc import Callable
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from typing import Protocol
+
+    class Main(Protocol):
+        """A tutorial's ``main``: called with no arguments by its console script, with argv by rosrun."""
+
+        def __call__(self, argv: list[str] | None = None) -> int: ...
 
 
-def node_main(body: Callable[[list[str] | None], int]) -> Callable[[list[str] | None], int]:
+def node_main(body: Callable[[list[str] | None], int]) -> Main:
     """Wrap a tutorial's ``main``: a start-up problem (bad ``_param:=``, bad ``__name:=``, no master for a
     client) is one ``ERROR:`` line on stderr and exit code 1, never a traceback."""
 

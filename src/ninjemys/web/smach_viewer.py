@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from typing import TYPE_CHECKING
 
 from ninjemys.bridge.server import Gateway, GatewayOptions
 from ninjemys.commands import entry
@@ -20,17 +21,20 @@ from ninjemys.serve.http import Response
 from ninjemys.web.app import STATIC_DIR, WebApp
 from ninjemys.web.browser import serve_until_stopped, stop_signals
 
+if TYPE_CHECKING:
+    from ninjemys.node import Node
+
 PAGE = "/smach_viewer"
 
 
 class SmachViewer:
     """The viewer's node, gateway and web app; ``start()`` returns the page URL."""
 
-    def __init__(self, node: object, host: str = "127.0.0.1", port: int = 0) -> None:
+    def __init__(self, node: Node, host: str = "127.0.0.1", port: int = 0) -> None:
         self.node = node
-        self.gateway = Gateway(GatewayOptions(node_name=node.name, update_period=0.5), node=node)  # type: ignore[attr-defined]
+        self.gateway = Gateway(GatewayOptions(node_name=node.name, update_period=0.5), node=node)
         self.gateway.start()
-        self.app = WebApp(node.master_uri, caller_id=node.name, host=host, port=port)  # type: ignore[attr-defined]
+        self.app = WebApp(node.master_uri, caller_id=node.name, host=host, port=port)
         self.app.add_gateway(self.gateway, "/ws")
         self.app.add_page("SMACH viewer", PAGE)
         self.app.server.route(
@@ -47,7 +51,7 @@ class SmachViewer:
     def stop(self) -> None:
         self.gateway.shutdown()
         self.app.stop()
-        self.node.shutdown("smach_viewer closed")  # type: ignore[attr-defined]
+        self.node.shutdown("smach_viewer closed")
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -186,7 +186,7 @@ def _colour(doc: Document, geo: Geometry, cfg: GazeboConfig) -> tuple[int, int, 
 
 def expand_xacro(path: str, mappings: dict[str, str] | None = None) -> str:
     """A xacro file expanded as ``xacro path key:=value ...`` would print it."""
-    import xacro  # type: ignore[import-untyped]
+    import xacro  # untyped: pyproject lets mypy see it as Any
 
     try:
         return str(xacro.process_file(path, mappings=dict(mappings or {})).toprettyxml(indent="  "))

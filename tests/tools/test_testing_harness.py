@@ -1,0 +1,101 @@
+"""``ninjemys.testing``'s polling wait and node-process harness, which every process test relies on."""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+
+import pytest
+
+from ninjemys.errors import NinjemysError
+from ninjemys.testing import NodeProcess, WaitTimeout, wait_until
+
+
+def test_wait_until_returns_the_first_truthy_value():
+    calls = []
+
+    def ready():
+        calls.append(1)
+        return len(calls) >= 3 and "value"
+
+    assert wait_until(ready, timeout=5, step=0.001) == "value"
+    assert len(calls) == 3
+
+
+def test_wait_until_fails_the_test_naming_what_it_waited_for():
+    with pytest.raises(WaitTimeout, match=r"timed out after 0.05 s waiting for the moon") as caught:
+        wait_until(lambda: None, timeout=0.05, what="the moon", step=0.01)
+    assert isinstance(caught.value, AssertionError) and isinstance(caught.value, NinjemysError)
+
+
+def test_wait_until_asks_once_more_at_the_deadline():
+    start = time.monotonic()
+    assert wait_until(lambda: time.monotonic() - start > 0.05, timeout=0.05, step=1.0)
+
+
+SCRIPT = """
+import signal, subprocess, sys, time
+if sys.argv[1] == "term":
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(7))
+print("hello 42", flush=True)
+print("to stderr", file=sys.stderr, flush=True)
+if sys.argv[1] == "exit":
+    sys.exit(3)
+if sys.argv[1] == "grandchild":
+    print("pid", subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"]).pid, flush=True)
+time.sleep(60)
+"""
+
+
+def _start(mode: str, **kw) -> NodeProcess:
+    return NodeProcess([sys.executable, "-c", SCRIPT, mode], **kw)
+
+
+def test_lines_are_matched_by_regex_or_predicate_on_either_stream():
+    with _start("sleep") as child:
+        assert child.wait_for(r"hello (\d+)").group(1) == "42"
+        assert child.wait_for(lambda line: line.endswith("42") and line) == "hello 42"
+        assert child.wait_for("^to stderr$", stream="err")
+        assert "hello 42" in child.text() and "to stderr" in child.describe()
+    assert child.proc.poll() is not None  # the context manager kills it
+
+
+def test_merged_stderr_lands_in_stdout():
+    with _start("sleep", merge_stderr=True) as child:
+        child.wait_for("^to stderr$")
+        assert child.err == []
+
+
+def test_a_child_that_exits_fails_the_wait_at_once_with_its_output():
+    with _start("exit") as child:
+        start = time.monotonic()
+        with pytest.raises(WaitTimeout, match=r"exited with 3(.|\n)*hello 42"):
+            child.wait_for("never printed", timeout=30)
+        assert time.monotonic() - start < 20
+        assert child.wait() == 3
+
+
+def test_stop_asks_with_sigterm_first():
+    child = _start("term")
+    child.wait_for("hello")
+    assert child.stop() == 7
+
+
+def test_kill_takes_the_descendants_too():
+    child = _start("grandchild")
+    pid = int(child.wait_for(r"^pid (\d+)").group(1))
+    child.kill()
+    wait_until(
+        lambda: not os.path.exists(f"/proc/{pid}") or "Z" in _state(pid),
+        timeout=5,
+        what="the grandchild gone",
+    )
+
+
+def _state(pid: int) -> str:
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return "Z"
