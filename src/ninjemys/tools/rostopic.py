@@ -144,8 +144,8 @@ def _list_bag(path: str) -> int:
 
 def info_text(topic: str, client: Any) -> str:
     state = GraphSnapshot.fetch(client)
-    pubs = state.publishers.get(topic, [])
-    subs = state.subscribers.get(topic, [])
+    pubs: list[str] = list(state.publishers.get(topic, ()))
+    subs: list[str] = list(state.subscribers.get(topic, ()))
     if not pubs and not subs:
         raise TopicToolError(f"Unknown topic {topic}")
     out = [f"Type: {state.type_of(topic) or 'unknown type'}\n\n"]
