@@ -20,6 +20,8 @@ THREAD_SOURCES = [
     SRC / "ninjemys" / "master",
     SRC / "rospy",
     SRC / "ninjemys" / "nav" / "move_base_node.py",
+    SRC / "ninjemys" / "sim",
+    SRC / "ninjemys" / "web" / "gazebo_ros.py",
 ]
 LOCK_SOURCES = [
     SRC / "ninjemys" / "node",

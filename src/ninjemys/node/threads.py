@@ -141,6 +141,24 @@ THREADS: tuple[Thread, ...] = (
         "nav.move_base_node.MoveBase",
         "updates and publishes both costmaps at their update_frequency and publish_frequency",
     ),
+    # -- apps: the simulators (sim.stepper.Stepper, sim.turtlesim_node, web.gazebo_ros) -----------
+    Thread(
+        "puzzlebot-sim",
+        "sim.stepper.Stepper (the PuzzleBot simulator node, gzserver, gazebo)",
+        "steps the physics under the simulation's StepLock, paced against the wall clock, and publishes "
+        "/clock, sensors, odometry, /tf and /gazebo/model_states; services and cmd_vel callbacks run on "
+        "their own srv:/sub: threads and take the same lock (cmd_vel: one atomic assignment, no lock)",
+    ),
+    Thread(
+        "turtlesim-update",
+        "sim.turtlesim_node",
+        "moves the turtles and publishes their poses at turtlesim's update rate",
+    ),
+    Thread(
+        "gzclient-attach",
+        "web.gazebo_ros.gzclient_main",
+        "waits for gzserver's /gazebo/gui_url parameter, then opens the browser view",
+    ),
 )
 
 #: user threads: the caller's own threads (the main thread, publishing threads, service callers)

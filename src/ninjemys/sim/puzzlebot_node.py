@@ -20,7 +20,7 @@ path), ``~update_rate`` (physics steps per simulated second, default 100), ``~se
 ``~cmd_vel_timeout`` (simulated seconds without a command after which the wheels are stopped, as
 diff_drive_controller's ``cmd_vel_timeout`` does; default 0: off, the last command holds, as with
 Gazebo's diff drive plugin), ``~no_robot`` (start with an empty world: robots come from
-``spawn_model``, as in Gazebo).
+``spawn_model``, as in Gazebo), ``~paused`` (start with physics paused, Gazebo's ``-u``).
 
 The first robot's names and sensors, as a student's launch file sets them (defaults: the model's):
 ``~cmd_vel_topic``, ``~publish_odom``, ``~publish_odom_tf``, ``~odom_topic``, ``~odom_frame``,
@@ -56,6 +56,7 @@ from ninjemys.node.log import NodeLog
 from ninjemys.rostime import Time
 from ninjemys.sim import messages
 from ninjemys.sim.gazebo_api import GazeboApi, parse_model_xml
+from ninjemys.sim.gazebo_worlds import load_gazebo_world
 from ninjemys.sim.robot_model import RobotModel, load_robot_model
 from ninjemys.sim.simcore import Robot, Simulation, SpawnError
 from ninjemys.sim.stepper import Due, StepLock, Stepper
@@ -530,6 +531,9 @@ def load_sim_world(log: NodeLog, world_arg: str, map_arg: str) -> World:
     if map_arg:
         log.info("world from map_server map %s", map_arg)
         return world_from_map(map_arg)
+    if world_arg.endswith(".world"):  # Gazebo's world_name (gzserver, empty_world.launch)
+        log.info("world from Gazebo world file %s", world_arg)
+        return load_gazebo_world(world_arg)
     return load_world(world_path(world_arg))
 
 
@@ -579,7 +583,7 @@ def main(argv: list[str] | None = None, view: ViewStarter | None = None) -> int:
         try:
             world = load_sim_world(log, world_arg, map_arg)
             model = load_robot_model(_param(node, log, "model", "puzzlebot", str))
-        except MapFileError as exc:
+        except NinjemysError as exc:  # MapFileError, or the SDF reader's errors
             log.fatal("%s", exc)
             return 1
         update_rate = _param(node, log, "update_rate", 100.0, float)
@@ -640,6 +644,9 @@ def main(argv: list[str] | None = None, view: ViewStarter | None = None) -> int:
             stop_view = view(app, options, log)
             if stop_view is None:
                 return 1
+        if _param(node, log, "paused", False, bool):
+            app.stepper.paused = True  # Gazebo's -u: physics waits for unpause_physics
+            log.info("physics paused (call /gazebo/unpause_physics to start)")
         app.start()
         try:
             node.spin()

@@ -45,6 +45,8 @@ class PuzzlebotView:
     calls :meth:`wants_scans` and :meth:`publish` (on its thread, with its lock held).
     """
 
+    url = ""  # the page's address once served
+
     def __init__(self, app: WebApp, gateway: Gateway, sim_node: SimNode) -> None:
         self.sim_node = sim_node
         self._last_sent = 0.0
@@ -185,6 +187,7 @@ def start_view(sim_node: SimNode, options: argparse.Namespace, log: NodeLog) -> 
         gateway.shutdown()
         log.error("cannot serve the simulator view on %s:%d: %s", options.host, options.port, exc)
         return None
+    view.url = url + "puzzlebot"
     sim_node.view = view
     print(f"puzzlebot_sim view: {url}puzzlebot   node graph: {url}", flush=True)
     if not options.no_browser:
