@@ -141,7 +141,7 @@ def wait_for_model(node: Node, topic: str, model: str) -> bool:
     node.log.info("Waiting for model %s before proceeding.", model)
     try:
         while not seen.wait(0.1):
-            if node.is_shutdown():
+            if node.is_shutdown:
                 return False
         return True
     finally:
@@ -233,7 +233,7 @@ def run(node: Node, args: argparse.Namespace) -> int:
         if threading.current_thread() is threading.main_thread():
             signal.signal(signal.SIGINT, lambda *_: interrupted.set())
             signal.signal(signal.SIGTERM, lambda *_: interrupted.set())
-        while not interrupted.wait(0.2) and not node.is_shutdown():
+        while not interrupted.wait(0.2) and not node.is_shutdown:
             pass
     return 0
 

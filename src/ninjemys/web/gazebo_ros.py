@@ -106,7 +106,7 @@ def gzclient_main(argv: list[str] | None = None) -> int:
     def build(node: Node) -> None:
         def attach() -> None:
             waited = 0.0
-            while not node.is_shutdown():
+            while not node.is_shutdown:
                 try:
                     url: Any = node.get_param(GUI_URL_PARAM, None)
                 except NinjemysError:
