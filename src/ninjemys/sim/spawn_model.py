@@ -20,7 +20,7 @@ from typing import Any
 from urllib.parse import SplitResult, urlsplit
 
 from ninjemys.commands import entry
-from ninjemys.errors import NinjemysError, ShutdownError
+from ninjemys.errors import NinjemysError, ShutdownError, TimeoutError_
 from ninjemys.idl.loader import get_message_class, get_service_class
 from ninjemys.names import rospy_anonymous_name
 from ninjemys.node import Node
@@ -148,8 +148,20 @@ def wait_for_model(node: Node, topic: str, model: str) -> bool:
         sub.unregister()
 
 
+def wait_for_service(node: Node, name: str) -> None:
+    """Until ``name`` answers, asking every 50 ms at most: a launch file starts spawn_model beside
+    gzserver, and the model should go in as soon as the server offers the service (the core's
+    wait backs off to 200 ms between tries)."""
+    while True:
+        try:
+            node.wait_for_service(name, 0.05)
+            return
+        except TimeoutError_:
+            continue
+
+
 def call(node: Node, name: str, cls: Any, **fields: Any) -> Any:
-    node.wait_for_service(name)
+    wait_for_service(node, name)
     req = cls._request_class()
     for key, value in fields.items():
         setattr(req, key, value)
@@ -184,7 +196,7 @@ def run(node: Node, args: argparse.Namespace) -> int:
     service = f"{ns}/spawn_urdf_model" if args.urdf else f"{ns}/spawn_sdf_model"
     log.info("Waiting for service %s", service)
     try:
-        node.wait_for_service(service)
+        wait_for_service(node, service)
         log.info("Calling service %s", service)
         resp = call(node, service, SpawnModel, **fields)
         log.info("Spawn status: %s", resp.status_message)
