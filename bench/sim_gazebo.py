@@ -22,7 +22,6 @@ import re
 import statistics
 import subprocess
 import sys
-import tarfile
 import tempfile
 import threading
 import time
@@ -91,10 +90,7 @@ def extract_tree(rev: str, dest: Path) -> Path:
     data = subprocess.run(
         ["git", "-C", str(ROOT), "archive", rev, "src"], capture_output=True, check=True
     ).stdout
-    archive = dest / "src.tar"
-    archive.write_bytes(data)
-    with tarfile.open(archive) as tar:
-        tar.extractall(dest, filter="data")
+    subprocess.run(["tar", "-x", "-C", str(dest)], input=data, check=True)
     return dest / "src"
 
 

@@ -24,30 +24,30 @@ from typing import TYPE_CHECKING, Any
 from ninjemys.idl.loader import get_message_class, get_service_class
 from ninjemys.maps.mapfile import MapFileError
 from ninjemys.rostime import Time
-from ninjemys.sim.robot_model import load_robot_model
+from ninjemys.sim.robot_model import load_robot_model, model_from_urdf
 from ninjemys.sim.simcore import Robot, SpawnError, wrap_angle
 from ninjemys.tf2.math import quaternion_from_yaw, yaw_from_quaternion
 
 if TYPE_CHECKING:
     from ninjemys.sim.puzzlebot_node import SimNode
 
-Empty = get_service_class("std_srvs/Empty")
-SpawnModel = get_service_class("gazebo_msgs/SpawnModel")
-DeleteModel = get_service_class("gazebo_msgs/DeleteModel")
-GetModelState = get_service_class("gazebo_msgs/GetModelState")
-SetModelState = get_service_class("gazebo_msgs/SetModelState")
-GetWorldProperties = get_service_class("gazebo_msgs/GetWorldProperties")
-GetModelProperties = get_service_class("gazebo_msgs/GetModelProperties")
-GetLinkState = get_service_class("gazebo_msgs/GetLinkState")
-GetPhysicsProperties = get_service_class("gazebo_msgs/GetPhysicsProperties")
-ApplyBodyWrench = get_service_class("gazebo_msgs/ApplyBodyWrench")
-BodyRequest = get_service_class("gazebo_msgs/BodyRequest")
-SetModelConfiguration = get_service_class("gazebo_msgs/SetModelConfiguration")
-ModelState = get_message_class("gazebo_msgs/ModelState")
-ModelStates = get_message_class("gazebo_msgs/ModelStates")
-LinkStates = get_message_class("gazebo_msgs/LinkStates")
-Pose = get_message_class("geometry_msgs/Pose")
-Twist = get_message_class("geometry_msgs/Twist")
+Empty: Any = get_service_class("std_srvs/Empty")
+SpawnModel: Any = get_service_class("gazebo_msgs/SpawnModel")
+DeleteModel: Any = get_service_class("gazebo_msgs/DeleteModel")
+GetModelState: Any = get_service_class("gazebo_msgs/GetModelState")
+SetModelState: Any = get_service_class("gazebo_msgs/SetModelState")
+GetWorldProperties: Any = get_service_class("gazebo_msgs/GetWorldProperties")
+GetModelProperties: Any = get_service_class("gazebo_msgs/GetModelProperties")
+GetLinkState: Any = get_service_class("gazebo_msgs/GetLinkState")
+GetPhysicsProperties: Any = get_service_class("gazebo_msgs/GetPhysicsProperties")
+ApplyBodyWrench: Any = get_service_class("gazebo_msgs/ApplyBodyWrench")
+BodyRequest: Any = get_service_class("gazebo_msgs/BodyRequest")
+SetModelConfiguration: Any = get_service_class("gazebo_msgs/SetModelConfiguration")
+ModelState: Any = get_message_class("gazebo_msgs/ModelState")
+ModelStates: Any = get_message_class("gazebo_msgs/ModelStates")
+LinkStates: Any = get_message_class("gazebo_msgs/LinkStates")
+Pose: Any = get_message_class("geometry_msgs/Pose")
+Twist: Any = get_message_class("geometry_msgs/Twist")
 
 WORLD_FRAMES = ("", "world", "map")
 PUSH_MASS = 1.0  # kg: what apply_body_wrench pushes (the flat world has no inertia of its own)
@@ -534,8 +534,9 @@ def parse_model_xml(text: str) -> tuple[str, Any]:
         root = ET.fromstring(body)
     except ET.ParseError as exc:
         raise SpawnError(f"model_xml is not valid XML: {exc}") from None
-    if root.tag == "robot" and len([j for j in root.iter("joint") if j.get("type") == "continuous"]) == 2:
-        return "robot", load_robot_model(body)
+    if root.tag == "robot" and any(j.get("type") == "continuous" for j in root.iter("joint")):
+        # a robot with wheels: the URDF reader says what it is, or why it cannot be simulated
+        return "robot", model_from_urdf(body, "model_xml")
     for geom in root.iter("geometry"):
         box = geom.find("box")
         cyl = geom.find("cylinder")

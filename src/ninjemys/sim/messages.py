@@ -20,13 +20,13 @@ from ninjemys.sim.robot_model import CameraSpec, ImuSpec, LaserSpec, RobotModel
 from ninjemys.sim.simcore import scan_angles
 from ninjemys.tf2.math import quaternion_from_rpy, quaternion_from_yaw
 
-TransformStamped = get_message_class("geometry_msgs/TransformStamped")
-JointState = get_message_class("sensor_msgs/JointState")
-Odometry = get_message_class("nav_msgs/Odometry")
-LaserScan = get_message_class("sensor_msgs/LaserScan")
-Image = get_message_class("sensor_msgs/Image")
-CameraInfo = get_message_class("sensor_msgs/CameraInfo")
-Imu = get_message_class("sensor_msgs/Imu")
+TransformStamped: Any = get_message_class("geometry_msgs/TransformStamped")
+JointState: Any = get_message_class("sensor_msgs/JointState")
+Odometry: Any = get_message_class("nav_msgs/Odometry")
+LaserScan: Any = get_message_class("sensor_msgs/LaserScan")
+Image: Any = get_message_class("sensor_msgs/Image")
+CameraInfo: Any = get_message_class("sensor_msgs/CameraInfo")
+Imu: Any = get_message_class("sensor_msgs/Imu")
 
 #: camera_link -> optical frame: z forward, x right, y down (rpy -pi/2, 0, -pi/2, as camera drivers publish)
 OPTICAL_RPY = (-math.pi / 2, 0.0, -math.pi / 2)

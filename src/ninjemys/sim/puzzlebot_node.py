@@ -64,18 +64,18 @@ from ninjemys.sim.world2d import World, load_world, world_from_map
 from ninjemys.sim.worlds import world_path
 from ninjemys.tf2.math import quaternion_from_yaw
 
-Twist = get_message_class("geometry_msgs/Twist")
-Float32 = get_message_class("std_msgs/Float32")
-Bool = get_message_class("std_msgs/Bool")
-JointState = get_message_class("sensor_msgs/JointState")
-Odometry = get_message_class("nav_msgs/Odometry")
-LaserScan = get_message_class("sensor_msgs/LaserScan")
-Image = get_message_class("sensor_msgs/Image")
-CameraInfo = get_message_class("sensor_msgs/CameraInfo")
-Imu = get_message_class("sensor_msgs/Imu")
-TFMessage = get_message_class("tf2_msgs/TFMessage")
-Clock = get_message_class("rosgraph_msgs/Clock")
-Log = get_message_class("rosgraph_msgs/Log")
+Twist: Any = get_message_class("geometry_msgs/Twist")
+Float32: Any = get_message_class("std_msgs/Float32")
+Bool: Any = get_message_class("std_msgs/Bool")
+JointState: Any = get_message_class("sensor_msgs/JointState")
+Odometry: Any = get_message_class("nav_msgs/Odometry")
+LaserScan: Any = get_message_class("sensor_msgs/LaserScan")
+Image: Any = get_message_class("sensor_msgs/Image")
+CameraInfo: Any = get_message_class("sensor_msgs/CameraInfo")
+Imu: Any = get_message_class("sensor_msgs/Imu")
+TFMessage: Any = get_message_class("tf2_msgs/TFMessage")
+Clock: Any = get_message_class("rosgraph_msgs/Clock")
+Log: Any = get_message_class("rosgraph_msgs/Log")
 
 WORLD_FRAME = "map"  # ground truth frame: the shipped maps are rasterized in world coordinates
 
@@ -353,19 +353,19 @@ class SimNode:
             pubs = io.pubs
             if io.odom_due is not None and io.odom_due.fire(now):
                 self._odometry(io, stamp, tfs)
-            imu = pubs.get("imu")
-            if io.imu_due is not None and io.imu_due.fire(now) and imu.get_num_connections():
-                spec = r.model.imu
-                imu.publish(messages.imu(stamp, io.frame(spec.pose.frame), spec, sim.imu(r)))
-            if io.scan_due is not None and io.scan_due.fire(now):
+            imu, imu_spec = pubs.get("imu"), r.model.imu
+            if io.imu_due is not None and io.imu_due.fire(now) and imu is not None and imu_spec is not None:
+                if imu.get_num_connections():
+                    imu.publish(messages.imu(stamp, io.frame(imu_spec.pose.frame), imu_spec, sim.imu(r)))
+            laser = r.model.laser
+            if io.scan_due is not None and io.scan_due.fire(now) and laser is not None:
                 want_view = self.view is not None and self.view.wants_scans()
                 scan = pubs["scan"]
                 if scan.get_num_connections() or want_view:
                     ranges = sim.scan(r)
                     io.last_scan = ranges
                     if scan.get_num_connections():
-                        spec = r.model.laser
-                        scan.publish(messages.laser_scan(stamp, io.frame(spec.pose.frame), spec, ranges))
+                        scan.publish(messages.laser_scan(stamp, io.frame(laser.pose.frame), laser, ranges))
             if io.camera_due is not None and io.camera_due.fire(now):
                 want = any(
                     pubs[k].get_num_connections()
@@ -427,6 +427,8 @@ class SimNode:
     def _camera(self, io: RobotIO, stamp: Time) -> None:
         r = io.robot
         spec = r.model.camera
+        if spec is None or r.camera is None:
+            return
         rgb, depth = self.sim.render(r)
         pubs = io.pubs
         frame = io.frame(spec.frame)
@@ -627,7 +629,7 @@ def main(argv: list[str] | None = None, view: ViewStarter | None = None) -> int:
             pose = (x, y, yaw) if i == 0 else (s.x, s.y, s.yaw)
             try:
                 robot_model = model if s.model == "puzzlebot" else load_robot_model(s.model)
-                app.add_robot(s.name, robot_model, *pose, namespaced)
+                app.add_robot(s.name, robot_model, pose[0], pose[1], pose[2], namespaced)
             except (SpawnError, MapFileError) as exc:
                 log.fatal("%s", exc)
                 return 1

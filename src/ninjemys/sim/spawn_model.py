@@ -27,11 +27,11 @@ from ninjemys.node import Node
 from ninjemys.node.run import start_node
 from ninjemys.tf2.math import quaternion_from_rpy
 
-Empty = get_service_class("std_srvs/Empty")
-SpawnModel = get_service_class("gazebo_msgs/SpawnModel")
-DeleteModel = get_service_class("gazebo_msgs/DeleteModel")
-SetModelConfiguration = get_service_class("gazebo_msgs/SetModelConfiguration")
-ModelStates = get_message_class("gazebo_msgs/ModelStates")
+Empty: Any = get_service_class("std_srvs/Empty")
+SpawnModel: Any = get_service_class("gazebo_msgs/SpawnModel")
+DeleteModel: Any = get_service_class("gazebo_msgs/DeleteModel")
+SetModelConfiguration: Any = get_service_class("gazebo_msgs/SetModelConfiguration")
+ModelStates: Any = get_message_class("gazebo_msgs/ModelStates")
 
 DATABASE_TEMPLATE = (
     '<sdf version="1.4"><world name="default"><include><uri>model://{}</uri></include></world></sdf>'
