@@ -25,13 +25,15 @@ ROS1_DEBS += cmake python3-gencpp ros-std-msgs libstd-msgs-dev
 # vision: Debian's OpenCV under /usr/bin/python3 and its C++ image_transport republish (side-by-side tests)
 ROS1_DEBS += python3-opencv image-transport-tools
 BROWSER_DEBS := chromium chromium-driver fonts-dejavu-core
-SYSTEM_DEBS  := $(ROS1_DEBS) $(BROWSER_DEBS) tmux
+# multi-host tests: network namespaces (iproute2), roslaunch <machine> over ssh (openssh-server)
+NET_DEBS     := iproute2 openssh-server openssh-client
+SYSTEM_DEBS  := $(ROS1_DEBS) $(BROWSER_DEBS) $(NET_DEBS) tmux
 
 # npm packages the tests run with Node.js (Foxglove's own WebSocket client), in a git-ignored directory.
 NPM_DIR   := .cache/npm
 NPM_STAMP := $(NPM_DIR)/node_modules/.installed
 
-.PHONY: all venv system npm lint format typecheck test test-fast demo bench clean
+.PHONY: all venv system npm lint format typecheck test test-fast demo bench fuzz clean
 
 all: venv
 
@@ -88,6 +90,10 @@ demo: venv
 
 bench: venv system
 	$(PY) bench/run_all.py
+
+# every parser of untrusted input, 100,000 mutated inputs each (make test runs 2,000: tests/fuzz)
+fuzz: venv
+	$(PY) tests/fuzz/run_fuzz.py --count 100000
 
 clean:
 	rm -rf $(VENV) build dist src/*.egg-info .pytest_cache .ruff_cache $(NPM_DIR)

@@ -43,6 +43,8 @@ SHIPPED_PACKAGES = (
     # wave 2 (issue 16): the WebSocket gateway's rosapi and tf2_web_republisher
     "rosapi",
     "tf2_web_republisher",
+    # wave 3: device drivers (issue 24)
+    "realsense2_camera",
 )
 
 #: packages Debian's ROS 1 lacks; their facts are checked against published md5sums instead
@@ -55,6 +57,7 @@ NOT_IN_DEBIAN = frozenset(
         "gazebo_msgs",
         "rosapi",
         "tf2_web_republisher",
+        "realsense2_camera",
     }
 )
 

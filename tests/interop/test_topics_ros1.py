@@ -86,11 +86,14 @@ def _publish_until(pub, stop: Callable[[], bool], text: str = "ninjemys", timeou
 @pytest.mark.parametrize("impl", ["rospy", "roscpp"])
 def test_ros1_talker_to_our_listener(master, node, peers, impl: str) -> None:
     got: list[str] = []
-    node("listener").subscriber("chatter", String, lambda m: got.append(m.data))
+    listener = node("listener")
+    listener.subscriber("chatter", String, lambda m: got.append(m.data))
     _start(
         peers, rospy(ROSPY_TALKER, master.uri, "stream") if impl == "rospy" else roscpp(master.uri, "talker")
     )
     assert wait_until(lambda: len(got) >= 5, timeout=15), peers[0].describe()
+    # we offered UNIXROS first; a ROS 1 publisher skips what it does not know and gives TCPROS
+    assert [e[3] for e in listener.bus_info() if e[4] == "/chatter"] == ["TCPROS"]
     assert all(g.startswith(impl + " ") for g in got)
     numbers = [int(g.split()[1]) for g in got]
     assert numbers == sorted(numbers)

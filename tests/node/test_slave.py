@@ -8,6 +8,8 @@ import xmlrpc.client
 from node_harness import wait_until
 from node_msgs import String
 
+from ninjemys.node import transport
+
 
 def test_slave_api_shapes(make_node, master) -> None:
     talker, listener = make_node("talker"), make_node("listener")
@@ -26,13 +28,25 @@ def test_slave_api_shapes(make_node, master) -> None:
     ]
     code, _, info = api.getBusInfo("/t")
     chatter_info = [entry for entry in info if entry[4] == "/chatter"]
-    assert code == 1 and chatter_info[0][1:6] == ["/listener", "o", "TCPROS", "/chatter", True]
+    # two ninjemys nodes of one host talk over a Unix socket (UNIXROS); getBusInfo names the transport
+    local = "UNIXROS" if transport.local_transport_enabled() else "TCPROS"
+    assert code == 1 and chatter_info[0][1:6] == ["/listener", "o", local, "/chatter", True]
+    assert chatter_info[0][6] == f"{local} connection to [/listener]"
     code, _, (pubstats, substats, _srv) = api.getBusStats("/t")
     chatter = {stat[0]: stat for stat in pubstats}["/chatter"]  # next to the node's own /rosout
     assert chatter[1] > 0
     code, msg, proto = api.requestTopic("/t", "/chatter", [["UDPROS"], ["TCPROS"]])
     assert code == 1 and proto[0] == "TCPROS" and proto[2] == talker.tcpros_port
     assert api.requestTopic("/t", "/nothing", [["TCPROS"]])[0] == -1
+    # UNIXROS only for this host (boot id and network namespace); anyone else falls through to TCPROS
+    if transport.local_transport_enabled():
+        code, _, proto = api.requestTopic(
+            "/t", "/chatter", [["UNIXROS", transport.host_identity()], ["TCPROS"]]
+        )
+        assert code == 1 and proto == ["UNIXROS", f"@ninjemys-tcpros-{talker.tcpros_port}"]
+        code, _, proto = api.requestTopic("/t", "/chatter", [["UNIXROS", "another-host/1"], ["TCPROS"]])
+        assert code == 1 and proto[0] == "TCPROS"
+        assert api.requestTopic("/t", "/chatter", [["UNIXROS"]])[0] == 0
     assert api.requestTopic("/t", "/chatter", [["UDPROS"]])[0] == 0
     assert api.paramUpdate("/master", "/not/subscribed/", 1)[0] == -1
     assert api.getPid(42)[0] == -1

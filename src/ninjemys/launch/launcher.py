@@ -127,7 +127,15 @@ def _process_specs(
                     "set ROS_MASTER_URI to this machine's name or address to launch remote nodes"
                 )
             # the remote machine runs its own ninjemys: rosrun there finds the package and executable
-            argv = remote_command(machine, ["rosrun", node.package, node.type, *_user_args(node)], proc_env)
+            # what the launch decides travels (master, namespace, <env>s); the remote machine's own
+            # set-up (ROS_IP, ROS_HOSTNAME, ROS_PACKAGE_PATH...) comes from its env-loader, as in ROS 1:
+            # this machine's ROS_IP there would advertise the wrong address
+            remote_env = {"ROS_MASTER_URI": master_uri, **dict(node.env_args), **dict(machine.env_args)}
+            if "ROS_NAMESPACE" in proc_env:
+                remote_env["ROS_NAMESPACE"] = proc_env["ROS_NAMESPACE"]
+            if "PYTHONUNBUFFERED" in proc_env:
+                remote_env["PYTHONUNBUFFERED"] = proc_env["PYTHONUNBUFFERED"]
+            argv = remote_command(machine, ["rosrun", node.package, node.type, *_user_args(node)], remote_env)
             cwd = None
         Path(ros_home).mkdir(parents=True, exist_ok=True)
         output = "screen" if opts.screen else "log" if opts.log else (node.output or "log")

@@ -418,7 +418,8 @@ DEATH_WRAPPER: list[str] = (
 def remote_command(
     machine: Machine, argv: list[str], env: dict[str, str], timeout: float = 10.0
 ) -> list[str]:
-    """ssh argv running ``argv`` on ``machine`` with ``env``; LaunchError naming the machine if unreachable."""
+    """ssh argv running ``argv`` on ``machine`` with ``env`` (every variable of it, set before the
+    machine's env-loader runs); LaunchError naming the machine if unreachable."""
     target = f"{machine.user}@{machine.address}" if machine.user else machine.address
     base = [
         "ssh",
@@ -449,9 +450,7 @@ def remote_command(
             f"cannot reach machine [{machine.name}] at {target} over ssh (port {machine.ssh_port}): "
             f"{reason[-1] if reason else f'exit code {probe.returncode}'}"
         )
-    assignments = [
-        f"{k}={shlex.quote(v)}" for k, v in env.items() if k.startswith("ROS_") or k == "PYTHONUNBUFFERED"
-    ]
+    assignments = [f"{k}={shlex.quote(v)}" for k, v in env.items()]
     loader = shlex.split(machine.env_loader) if machine.env_loader else []
     remote = " ".join(
         ["env", *assignments, *(shlex.quote(a) for a in loader), *(shlex.quote(a) for a in argv)]

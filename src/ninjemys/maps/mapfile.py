@@ -158,6 +158,11 @@ class Fields:
         return [self.number(v, f"{where}[{i}]") for i, v in enumerate(value)]
 
 
+def text_byte(exc: UnicodeDecodeError) -> int:
+    """The byte a UTF-8 decode stopped at (for messages that say where a file is not text)."""
+    return exc.object[exc.start]
+
+
 def load_map(yaml_path: str | Path) -> GridMap:
     """Read a map_server map (YAML naming its image). Raises MapFileError naming file, line and field."""
     path = Path(yaml_path)
@@ -165,6 +170,10 @@ def load_map(yaml_path: str | Path) -> GridMap:
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise MapFileError(f"{path}: cannot read map: {exc.strerror or exc}") from None
+    except UnicodeDecodeError as exc:
+        raise MapFileError(
+            f"{path}: not a text (UTF-8) file: byte {exc.start} is 0x{text_byte(exc):02x}"
+        ) from None
     doc, lines = yaml_lines(text, str(path))
     f = Fields(str(path), lines)
     if not isinstance(doc, dict):

@@ -25,6 +25,27 @@ def advertised_host(env: Mapping[str, str] | None = None) -> str:
     return socket.gethostname() or "localhost"
 
 
+def advertised_host_problem(host: str, env: Mapping[str, str] | None = None) -> str | None:
+    """Why peers will not reach a node advertising ``host`` (it does not resolve here), or None.
+
+    Blocking (a name lookup): call it off the I/O loop. A numeric address needs no lookup.
+    """
+    from ninjemys.net.loop import is_numeric_host  # the loop imports this module
+
+    if is_numeric_host(host):
+        return None
+    try:
+        socket.getaddrinfo(host, None)
+    except (OSError, UnicodeError):
+        env = os.environ if env is None else env
+        source = "ROS_HOSTNAME" if env.get("ROS_HOSTNAME", "").strip() == host else "this machine's host name"
+        return (
+            f"{source} [{host}] does not resolve on this machine, so other nodes cannot connect to this "
+            "node: set ROS_HOSTNAME to a name they can resolve, or ROS_IP to this machine's address"
+        )
+    return None
+
+
 def master_uri(env: Mapping[str, str] | None = None) -> str:
     """ROS_MASTER_URI, or ROS 1's default ``http://localhost:11311/``."""
     env = os.environ if env is None else env

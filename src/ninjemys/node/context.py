@@ -39,6 +39,7 @@ class NodeContext(Protocol):
     #: where the node's TCPROS server listens, as advertised to peers
     tcpros_host: str
     tcpros_port: int
+    unix_address: str | None  # the UNIXROS listener (node.transport), None without one
 
     @property
     def is_shutdown(self) -> bool: ...

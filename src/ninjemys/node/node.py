@@ -31,7 +31,7 @@ from ninjemys import names, rostime
 from ninjemys.errors import MasterError, NinjemysError, ParameterError, ShutdownError
 from ninjemys.interrupt import wait_event
 from ninjemys.master.client import MasterClient
-from ninjemys.net.addresses import advertised_host
+from ninjemys.net.addresses import advertised_host, advertised_host_problem
 from ninjemys.net.addresses import master_uri as env_master_uri
 from ninjemys.net.xmlrpc_server import XmlRpcServer
 from ninjemys.node import runtime as _runtime
@@ -119,6 +119,7 @@ class Node:
         try:
             self._tcpros = transport.TcprosServer(self._on_topic_connection, self._on_service_connection)
             self.tcpros_port = self._tcpros.port
+            self.unix_address: str | None = self._tcpros.unix_address
             self._slave = XmlRpcServer(SlaveApi(self), "0.0.0.0", 0, advertise=self.tcpros_host)
             self.runtime.run(self._start_servers(), timeout=10.0)
         except BaseException:
@@ -130,6 +131,9 @@ class Node:
         # the clock and the log exist before anything below can fail, so shutdown always finds them
         self.clock: Clock = clock if clock is not None else Clock()
         self.log: NodeLog = NodeLog(self.name, level=log_level, log_file=log_file)
+        # a name peers cannot resolve: say so once, now, not as each peer's failed connection later
+        # (the lookup may wait on DNS: the loop's helper thread does it)
+        self.runtime.loop.call_soon_threadsafe(self._check_advertised_host)
         try:
             for key, value in (params or {}).items():
                 try:
@@ -214,6 +218,16 @@ class Node:
     def _check_alive(self) -> None:
         if self._shutdown_event.is_set():
             raise ShutdownError(f"node {self.name} is shut down ({self.shutdown_reason})")
+
+    def _check_advertised_host(self) -> None:
+        """On the loop: look the advertised host up on a helper thread; log why peers cannot reach us."""
+
+        def check() -> None:
+            problem = advertised_host_problem(self.tcpros_host)
+            if problem is not None:
+                self.log.error("%s", problem)
+
+        self.runtime.loop.run_in_thread(check)
 
     # -- topics ----------------------------------------------------------------------------------
 
@@ -506,10 +520,10 @@ class Node:
                         c.id,
                         c.subscriber,
                         "o",
-                        "TCPROS",
+                        transport.transport_of(c.sock),
                         topic,
                         not c.closed,
-                        f"TCPROS connection to [{c.subscriber}]",
+                        f"{transport.transport_of(c.sock)} connection to [{c.subscriber}]",
                     ]
                 )
         for topic, sub in list(self._subscriptions.items()):
@@ -519,10 +533,10 @@ class Node:
                         s.id,
                         s.uri,
                         "i",
-                        "TCPROS",
+                        transport.transport_of(s.sock),
                         topic,
                         not s.closed,
-                        f"TCPROS connection from [{s.publisher}]",
+                        f"{transport.transport_of(s.sock)} connection from [{s.publisher}]",
                     ]
                 )
         return info

@@ -29,7 +29,7 @@ from ninjemys.errors import (
     ShutdownError,
     TimeoutError_,
 )
-from ninjemys.net.addresses import split_uri
+from ninjemys.net.addresses import is_local_address, split_uri
 from ninjemys.node import transport
 from ninjemys.wire import headers
 from ninjemys.wire.headers import MAX_HEADER_LEN
@@ -455,14 +455,17 @@ class ServiceProxy:
     def _connect(self, probe: bool = False, timeout: float | None = 10.0) -> _Link:
         """Look the service up, connect and exchange headers; the link then carries the calls."""
         host, port = self._lookup()
+        sock = _local_connection(host, port, timeout)
         try:
-            sock = socket.create_connection((host, port), timeout=timeout)
+            if sock is None:
+                sock = socket.create_connection((host, port), timeout=timeout)
         except OSError as exc:
             raise ServiceError(
                 f"unable to connect to service [{self.name}] at {host}:{port}: {exc}"
             ) from None
         try:
-            sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            if sock.family != socket.AF_UNIX:
+                sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
             fields = {
                 "callerid": self.node.name,
                 "service": self.name,
@@ -513,3 +516,31 @@ class ServiceProxy:
         with self._lock:
             self._closed = True
             self._drop()
+
+
+def _local_connection(host: str, port: int, timeout: float | None) -> socket.socket | None:
+    """A Unix-socket connection to the ninjemys node behind a local ``rosrpc://host:port``
+    (``transport.unix_address``), or None: another host, not Linux, or a server that has none
+    (rospy, roscpp), which then gets TCP as before."""
+    if not transport.local_transport_enabled() or not _is_local(host):
+        return None
+    sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    sock.settimeout(timeout)
+    try:
+        sock.connect(transport.unix_sockaddr(transport.unix_address(port)))
+    except OSError:
+        sock.close()
+        return None
+    return sock
+
+
+_LOCAL_HOSTS: dict[str, bool] = {}
+
+
+def _is_local(host: str) -> bool:
+    """``is_local_address``, remembered: a service call may connect anew each time, and naming a
+    host may cost a resolver round trip."""
+    known = _LOCAL_HOSTS.get(host)
+    if known is None:
+        known = _LOCAL_HOSTS[host] = is_local_address(host)
+    return known

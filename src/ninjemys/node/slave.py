@@ -11,6 +11,7 @@ from __future__ import annotations
 import logging
 import os
 
+from ninjemys.node import transport
 from ninjemys.wire import xmlrpc as wire
 
 TYPE_CHECKING = False  # importing typing costs ~7 ms of every node's start-up; checkers set it
@@ -94,7 +95,12 @@ class SlaveApi:
         if not self._node.publishes(topic):
             return wire.error(f"Not a publisher of [{topic}]", [])
         for proto in protocols if isinstance(protocols, list) else []:
-            if isinstance(proto, list) and proto and proto[0] == "TCPROS":
+            if not isinstance(proto, list) or not proto:
+                continue
+            unix = self._node.unix_address
+            if proto[0] == transport.UNIXROS and unix and proto[1:2] == [transport.host_identity()]:
+                return wire.ok(f"ready on {unix}", [transport.UNIXROS, unix])
+            if proto[0] == "TCPROS":
                 host, port = self._node.tcpros_host, self._node.tcpros_port
                 return wire.ok(f"ready on {host}:{port}", ["TCPROS", host, port])
         return wire.failure("no supported protocol implementations", [])

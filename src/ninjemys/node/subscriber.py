@@ -278,18 +278,27 @@ class Subscription:
     async def _connect(self, uri: str, attempt: int = 0) -> None:
         sock: socket.socket | None = None
         try:
+            offer: list[list[str]] = [["TCPROS"]]
+            # a lazy handle waits on SO_RCVLOWAT, which Linux honours for TCP only: it keeps TCPROS
+            lazy = any(h._host._lazy for h in self.handles)
+            if transport.local_transport_enabled() and transport.host_identity() and not lazy:
+                offer.insert(0, [transport.UNIXROS, transport.host_identity()])
             reply = await xmlrpc_client.call(
-                uri, "requestTopic", (self.node.name, self.topic, [["TCPROS"]]), timeout=5.0
+                uri, "requestTopic", (self.node.name, self.topic, offer), timeout=5.0
             )
             code, status, proto = reply
-            if code != 1 or not proto or proto[0] != "TCPROS":
+            if code != 1 or not proto or proto[0] not in ("TCPROS", transport.UNIXROS):
                 _log.info("topic %s: publisher %s declined: %s", self.topic, uri, status)
                 self._retry_later(uri, attempt)
                 return
-            host, port = proto[1], int(proto[2])
-            sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+            if proto[0] == transport.UNIXROS:
+                sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+                address: Any = transport.unix_sockaddr(str(proto[1]))
+            else:
+                sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+                address = (proto[1], int(proto[2]))
             transport.tune(sock, self.tcp_nodelay)
-            await transport.connect(sock, (host, port), timeout=5.0)
+            await transport.connect(sock, address, timeout=5.0)
             await transport.write_all(sock, headers.encode_header(self._header()))
             header = await transport.read_header(sock)
             error = headers.check_publisher_header(header, self.type_name, self.md5sum)

@@ -429,7 +429,8 @@ class Publication:
         # for "0" by default): this publisher joins a burst's frames into one send itself, so Nagle
         # would only hold back a small message behind the peer's delayed ACK (up to 40 ms); the
         # option is ours and leaves the bytes on the wire unchanged
-        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        if sock.family != socket.AF_UNIX:
+            sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         conn = PubConnection(self.node, sock, self.topic, who)
         with self.lock:
             reply = headers.encode_header(self.reply_header({}))

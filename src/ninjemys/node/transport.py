@@ -1,5 +1,12 @@
 """Socket plumbing shared by topics and services: header exchange and the node's TCPROS server.
 
+Between processes on one host the same TCPROS streams run over a Unix-domain socket (``UNIXROS``):
+the node's server also listens on the abstract name ``@ninjemys-tcpros-<port>`` (Linux; abstract
+names vanish with the socket, so a crashed node leaves nothing behind). Subscribers ask for it in
+``requestTopic`` before TCPROS, with this host's identity (boot id and network namespace), and the
+publisher grants it only to the same host; service clients whose URI is a local address try the
+name of the URI's port first. Peers that do not know it (rospy, roscpp) get plain TCPROS.
+
 All coroutines here run on the runtime loop. Every read has a deadline and every length is checked
 before anything is allocated, so a silent, slow or lying peer costs one log line and one closed
 socket, never a hung or crashed node.
@@ -8,7 +15,9 @@ socket, never a hung or crashed node.
 from __future__ import annotations
 
 import logging
+import os
 import socket
+import sys
 from collections.abc import Callable
 
 from ninjemys.errors import ProtocolError
@@ -25,10 +34,52 @@ _log = logging.getLogger(__name__)
 #: How long a peer may take to send its connection header.
 HEADER_TIMEOUT = 10.0
 
+#: the transport names getBusInfo reports (ROS 1's is "TCPROS")
+TCPROS, UNIXROS = "TCPROS", "UNIXROS"
+
+_identity: str | None = None
+
+
+def local_transport_enabled() -> bool:
+    """Unix-domain sockets between processes of one host: Linux (abstract names), unless
+    ``NINJEMYS_UNIXROS=0`` asks for TCP everywhere (to compare, or to debug with tcpdump)."""
+    return sys.platform.startswith("linux") and os.environ.get("NINJEMYS_UNIXROS", "1") != "0"
+
+
+def host_identity() -> str:
+    """This host as a Unix socket sees it: the boot id and the network namespace (abstract socket
+    names are per namespace, like TCP ports). Two processes may use UNIXROS iff these are equal."""
+    global _identity
+    if _identity is None:
+        try:
+            with open("/proc/sys/kernel/random/boot_id") as f:
+                boot = f.read().strip()
+            netns = os.stat("/proc/self/ns/net").st_ino
+            _identity = f"{boot}/{netns}"
+        except OSError:
+            _identity = ""
+    return _identity
+
+
+def unix_address(port: int) -> str:
+    """The abstract socket name of the node whose TCPROS port is ``port`` (``@`` as ``ss`` shows it)."""
+    return f"@ninjemys-tcpros-{port}"
+
+
+def unix_sockaddr(address: str) -> str | bytes:
+    """``@name`` (abstract) or a filesystem path, as ``socket.connect`` takes it."""
+    return b"\0" + address[1:].encode() if address.startswith("@") else address
+
+
+def transport_of(sock: socket.socket) -> str:
+    return UNIXROS if sock.family == socket.AF_UNIX else TCPROS
+
 
 def tune(sock: socket.socket, nodelay: bool = True) -> None:
     """Non-blocking, TCP_NODELAY as asked, keepalive on (a vanished peer is eventually noticed)."""
     sock.setblocking(False)
+    if sock.family == socket.AF_UNIX:
+        return  # no Nagle and no keepalive on a Unix socket: the kernel ends it with the peer
     try:
         sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1 if nodelay else 0)
         sock.setsockopt(socket.SOL_SOCKET, socket.SO_KEEPALIVE, 1)
@@ -91,6 +142,8 @@ async def send_error_header(sock: socket.socket, text: str) -> None:
 
 
 def peer_name(sock: socket.socket) -> str:
+    if sock.family == socket.AF_UNIX:
+        return "a local process (UNIXROS)"
     try:
         host, port = sock.getpeername()[:2]
         return f"{host}:{port}"
@@ -114,20 +167,36 @@ class TcprosServer:
         self._sock.listen(128)
         self._sock.setblocking(False)
         self.port: int = self._sock.getsockname()[1]
-        self._task: Any = None
+        self._tasks: list[Any] = []
         self._conns: set[Any] = set()
+        #: the UNIXROS listener's address, or None (not Linux, disabled, or the name was taken)
+        self.unix_address: str | None = None
+        self._unix: socket.socket | None = None
+        if local_transport_enabled():
+            unix = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+            try:
+                unix.bind(unix_sockaddr(unix_address(self.port)))
+                unix.listen(128)
+                unix.setblocking(False)
+                self._unix, self.unix_address = unix, unix_address(self.port)
+            except OSError as exc:
+                _log.info("UNIXROS unavailable (%s): TCPROS only", exc)
+                close_quietly(unix)
 
     def start(self) -> None:
         """Begin accepting (call on the loop)."""
-        self._task = get_running_loop().create_task(self._accept_loop())
+        loop = get_running_loop()
+        self._tasks = [loop.create_task(self._accept_loop(self._sock))]
+        if self._unix is not None:
+            self._tasks.append(loop.create_task(self._accept_loop(self._unix)))
 
-    async def _accept_loop(self) -> None:
+    async def _accept_loop(self, listener: socket.socket) -> None:
         loop = get_running_loop()
         while True:
             try:
-                conn, _ = await loop.sock_accept(self._sock)
+                conn, _ = await loop.sock_accept(listener)
             except OSError as exc:
-                if self._sock.fileno() < 0:
+                if listener.fileno() < 0:
                     return
                 _log.warning("TCPROS accept failed: %s", exc)
                 await sleep(0.05)
@@ -160,8 +229,10 @@ class TcprosServer:
 
     def close(self) -> None:
         """Stop accepting (call on the loop)."""
-        if self._task is not None:
-            self._task.cancel()
+        for task in self._tasks:
+            task.cancel()
         for task in list(self._conns):
             task.cancel()
         close_quietly(self._sock)
+        if self._unix is not None:
+            close_quietly(self._unix)

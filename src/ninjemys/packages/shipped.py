@@ -130,6 +130,7 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
         # -- drivers (docs/drivers.md) --
         "joy": {"joy_node": ("ninjemys.drivers.joy_node:main", ())},
         "teleop_twist_joy": {"teleop_node": ("ninjemys.drivers.teleop_twist_joy:main", ())},
+        "realsense2_camera": {"realsense2_camera_node": ("ninjemys.drivers.realsense_node:main", ())},
         "xacro": {
             "xacro": ("ninjemys.tools.xacro:main", ()),
             "xacro.py": ("ninjemys.tools.xacro:main", ()),

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ninjemys.maps.mapfile import Fields, GridMap, MapFileError, load_map, yaml_lines
+from ninjemys.maps.mapfile import Fields, GridMap, MapFileError, load_map, text_byte, yaml_lines
 
 CYLINDER_SIDES = 24
 DEFAULT_WALL_HEIGHT = 1.0
@@ -301,6 +301,10 @@ def load_world(path: str | Path) -> World:
         text = p.read_text(encoding="utf-8")
     except OSError as exc:
         raise MapFileError(f"{p}: cannot read world: {exc.strerror or exc}") from None
+    except UnicodeDecodeError as exc:
+        raise MapFileError(
+            f"{p}: not a text (UTF-8) file: byte {exc.start} is 0x{text_byte(exc):02x}"
+        ) from None
     doc, lines = yaml_lines(text, str(p))
     f = Fields(str(p), lines)
     if isinstance(doc, dict) and "image" in doc:

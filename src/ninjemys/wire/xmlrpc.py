@@ -442,7 +442,8 @@ class _HttpParser:
         raw = headers.get("content-length")
         if raw is None:
             return 0
-        if not raw.isdigit():
+        # ASCII digits only: str.isdigit() also accepts '²' and other digits int() refuses
+        if not (raw.isascii() and raw.isdigit()):
             raise ProtocolError(f"HTTP: bad Content-Length {raw[:40]!r}")
         length = int(raw)
         if length > self._max_body:

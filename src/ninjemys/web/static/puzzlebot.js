@@ -2,6 +2,7 @@
 // One data path, the gateway: the "view:puzzlebot" JSON channel (world, then updates), the robots'
 // camera topics, cmd_vel publications and the /gazebo/* services.
 import { RosClient } from "/static/lib/rosclient.js";
+import { startGamepad } from "/static/lib/gamepad.js";
 
 const VIEW_CHANNEL = "view:puzzlebot";
 const ros = new RosClient();
@@ -202,5 +203,11 @@ for (const b of document.querySelectorAll(".pb-buttons button")) {
     statusLine.textContent = String(err.message || err); statusLine.className = "error";
   }));
 }
+// a game controller publishes sensor_msgs/Joy on /joy, as joy_node would: run teleop_twist_joy to drive
+const gamepadLine = document.getElementById("pb-gamepad");
+const gamepad = startGamepad(ros, {
+  status: (id) => { gamepadLine.textContent = id ? `gamepad: ${id} → /joy` : ""; document.body.dataset.gamepad = id || ""; },
+});
+window.puzzlebotGamepad = gamepad.state;
 robotSelect.addEventListener("change", queueDraw);
 window.addEventListener("resize", queueDraw);
