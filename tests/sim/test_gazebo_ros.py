@@ -269,3 +269,28 @@ def test_gzclient_attaches_to_the_servers_view(gazebo: Gazebo) -> None:
         assert "/puzzlebot" in out
     finally:
         client.stop()
+
+
+def test_spawn_model_wait_and_bond(gazebo: Gazebo) -> None:
+    """-wait MODEL spawns once MODEL is in model_states; -b deletes the model again on Ctrl-C."""
+    box = gazebo.tmp / "bonded.sdf"
+    box.write_text(BOX_SDF)
+    out = gazebo.spawn_model(
+        "-sdf", "-file", str(box), "-model", "early", "-x", "4", "-y", "-4", "-wait", "puzzlebot"
+    )
+    assert out.returncode == 0, out.stdout + out.stderr
+    assert "Waiting for model puzzlebot before proceeding." in out.stdout
+    assert gazebo.call("/gazebo/delete_model", DeleteModel, model_name="early").success
+    bonded = Launched(
+        [ninjemys_bin("rosrun"), "gazebo_ros", "spawn_model", "-sdf", "-file", str(box), "-model", "bonded",
+         "-x", "-4", "-y", "4", "-b"],
+        gazebo.env(),
+        gazebo.tmp / "bonded.log",
+    )  # fmt: skip
+    try:
+        bonded.wait_for("Waiting for shutdown to delete model bonded")
+        assert "bonded" in gazebo.model_states()
+    finally:
+        bonded.stop()
+    assert "Deleting model bonded" in bonded.log()
+    assert "bonded" not in gazebo.model_states()
