@@ -343,6 +343,7 @@ class SimNode:
                 "robot [%s] hit '%s' at (%.3f, %.3f): stopped at contact", r.name, r.contact_with, r.x, r.y
             )
         tfs: list[Any] | None = [] if self.tf_pub.get_num_connections() else None
+        view = self.view  # one read: the browser view attaches while the simulation runs
         for io in self.io.values():
             r = io.robot
             last = io.last_cmd
@@ -359,7 +360,7 @@ class SimNode:
                     imu.publish(messages.imu(stamp, io.frame(imu_spec.pose.frame), imu_spec, sim.imu(r)))
             laser = r.model.laser
             if io.scan_due is not None and io.scan_due.fire(now) and laser is not None:
-                want_view = self.view is not None and self.view.wants_scans()
+                want_view = view is not None and view.wants_scans()
                 scan = pubs["scan"]
                 if scan.get_num_connections() or want_view:
                     ranges = sim.scan(r)
@@ -377,8 +378,8 @@ class SimNode:
         if tfs:
             self.tf_pub.publish(TFMessage(transforms=tfs))
         self.gazebo.after_step(stamp)
-        if self.view is not None:
-            self.view.publish(now)
+        if view is not None:
+            view.publish(now)
 
     def _odometry(self, io: RobotIO, stamp: Time, tfs: list[Any] | None) -> None:
         """Advance the robot's odometry; publish odom, ground truth, wl/wr and joint_states to whoever
@@ -642,15 +643,15 @@ def main(argv: list[str] | None = None, view: ViewStarter | None = None) -> int:
         )
         stop_view = None
         gui = _param(node, log, "gui", True, bool) and not options.headless
-        if gui and view is not None:
-            stop_view = view(app, options, log)
-            if stop_view is None:
-                return 1
         if _param(node, log, "paused", False, bool):
             app.stepper.paused = True  # Gazebo's -u: physics waits for unpause_physics
             log.info("physics paused (call /gazebo/unpause_physics to start)")
-        app.start()
+        app.start()  # the physics and the sensors first: the view's server starts beside them
         try:
+            if gui and view is not None:
+                stop_view = view(app, options, log)
+                if stop_view is None:
+                    return 1
             node.spin()
         finally:
             app.stop()
