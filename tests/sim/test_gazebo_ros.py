@@ -294,3 +294,21 @@ def test_spawn_model_wait_and_bond(gazebo: Gazebo) -> None:
         bonded.stop()
     assert "Deleting model bonded" in bonded.log()
     assert "bonded" not in gazebo.model_states()
+
+
+@pytest.mark.parametrize("args", [(), ("gui:=false",), ("use_clock_frequency:=true", "paused:=true")])
+def test_debian_roslaunch_reads_empty_world_launch_as_ours_does(args: tuple[str, ...]) -> None:
+    """The same nodes and parameters from Debian's roslaunch and ours (the file is plain roslaunch XML)."""
+    from ninjemys.sim.gazebo_worlds import GAZEBO_ROS_SHARE
+
+    launch = str(GAZEBO_ROS_SHARE / "launch" / "empty_world.launch")
+    env = ros1_env("http://localhost:1", ROS_PACKAGE_PATH=str(GAZEBO_ROS_SHARE.parent))
+    for flag in ("--nodes", "--dump-params"):
+        real = subprocess.run(
+            ["/usr/bin/roslaunch", flag, launch, *args], env=env, capture_output=True, text=True
+        )
+        ours = subprocess.run(
+            [ninjemys_bin("roslaunch"), flag, launch, *args], capture_output=True, text=True
+        )
+        assert real.returncode == 0 and ours.returncode == 0, real.stderr + ours.stderr
+        assert sorted(ours.stdout.splitlines()) == sorted(real.stdout.splitlines()), flag
