@@ -3,6 +3,7 @@
 Services (gazebo_msgs and std_srvs types, Noetic's names and status texts): ``spawn_urdf_model``,
 ``spawn_sdf_model``, ``delete_model``, ``get_model_state``, ``set_model_state``,
 ``get_world_properties``, ``get_model_properties``, ``get_link_state``, ``get_physics_properties``,
+``set_physics_properties`` (its ``max_update_rate``: the pace),
 ``set_model_configuration``, ``apply_body_wrench`` and ``clear_body_wrenches`` (a push: the body
 gains the velocity the force gives a 1 kg body over the duration, and its wheels stop it when the
 push ends), ``pause_physics``, ``unpause_physics``, ``reset_simulation``, ``reset_world``. Topics:
@@ -40,6 +41,7 @@ GetWorldProperties: Any = get_service_class("gazebo_msgs/GetWorldProperties")
 GetModelProperties: Any = get_service_class("gazebo_msgs/GetModelProperties")
 GetLinkState: Any = get_service_class("gazebo_msgs/GetLinkState")
 GetPhysicsProperties: Any = get_service_class("gazebo_msgs/GetPhysicsProperties")
+SetPhysicsProperties: Any = get_service_class("gazebo_msgs/SetPhysicsProperties")
 ApplyBodyWrench: Any = get_service_class("gazebo_msgs/ApplyBodyWrench")
 BodyRequest: Any = get_service_class("gazebo_msgs/BodyRequest")
 SetModelConfiguration: Any = get_service_class("gazebo_msgs/SetModelConfiguration")
@@ -132,6 +134,7 @@ class GazeboApi:
             ("get_model_properties", GetModelProperties, self._get_model_properties),
             ("get_link_state", GetLinkState, self._get_link_state),
             ("get_physics_properties", GetPhysicsProperties, self._get_physics_properties),
+            ("set_physics_properties", SetPhysicsProperties, self._set_physics_properties),
             ("apply_body_wrench", ApplyBodyWrench, self._apply_body_wrench),
             ("clear_body_wrenches", BodyRequest, self._clear_body_wrenches),
             ("set_model_configuration", SetModelConfiguration, self._set_model_configuration),
@@ -413,6 +416,34 @@ class GazeboApi:
         resp.max_update_rate = rate / self.sn.sim.dt if rate > 0 else 0.0
         resp.gravity.z = -9.8
         resp.success, resp.status_message = True, "GetPhysicsProperties: got properties"
+        return resp
+
+    def _set_physics_properties(self, req: Any) -> Any:
+        """Gazebo's pacing knob: ``max_update_rate`` steps per wall second (0: as fast as possible),
+        so the real-time factor is max_update_rate x step. The step itself stays (the sensors'
+        schedules are built on it); a different ``time_step`` is refused, as are gravity and ODE."""
+        resp = SetPhysicsProperties._response_class()
+        sn = self.sn
+        rate = req.max_update_rate
+        if not math.isfinite(rate) or rate < 0:
+            resp.success, resp.status_message = (
+                False,
+                f"SetPhysicsProperties: max_update_rate {rate} must be >= 0",
+            )
+            return resp
+        if req.time_step and abs(req.time_step - sn.sim.dt) > 1e-12:
+            resp.success = False
+            resp.status_message = (
+                f"SetPhysicsProperties: time_step is {sn.sim.dt} here (the node's ~update_rate sets it)"
+            )
+            return resp
+        sn.stepper.set_rate(rate * sn.sim.dt)
+        sn.log.info(
+            "physics: max_update_rate %g (real-time factor %s)",
+            rate,
+            f"{rate * sn.sim.dt:g}" if rate else "unlimited",
+        )
+        resp.success, resp.status_message = True, "physics engine updated"
         return resp
 
     def _apply_body_wrench(self, req: Any) -> Any:

@@ -110,6 +110,7 @@ class Stepper:
         self._thread: threading.Thread | None = None
         self._started = (time.monotonic(), time.process_time())
         self.stepped = 0.0  # simulated seconds stepped (resets of time do not undo them)
+        self._rebase = False  # the rate changed: pace from the current instant
 
     def start(self) -> None:
         self._thread = threading.Thread(target=self._run, name=self._name, daemon=True)
@@ -126,6 +127,13 @@ class Stepper:
 
     def wake(self) -> None:
         """Re-read the pause flag and the clock now (after unpause or a reset)."""
+        self._wake.set()
+
+    def set_rate(self, rate: float) -> None:
+        """A new real-time factor (0: as fast as possible), paced from now on."""
+        with self.lock:
+            self.rate = rate
+            self._rebase = True
         self._wake.set()
 
     def set_paused(self, paused: bool) -> None:
@@ -157,7 +165,8 @@ class Stepper:
                 continue
             try:
                 with self.lock.stepping:
-                    if self._sim_time() < sim0:  # reset_simulation: time went back
+                    if self._rebase or self._sim_time() < sim0:  # a new rate, or reset_simulation
+                        self._rebase = False
                         wall0, sim0 = time.monotonic(), self._sim_time()
                     self._step()
                     self.stepped += self.dt
