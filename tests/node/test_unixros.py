@@ -33,6 +33,7 @@ def test_the_same_stream_is_byte_identical_over_unixros_and_tcpros(make_node, mo
     make_node("unix_listener").subscriber(
         "stream", Image, lambda m: over_unix.append(bytes(m.data)), raw=True
     )
+    assert wait_until(lambda: pub.get_num_connections() == 1)  # connected before the switch below
     monkeypatch.setenv("NINJEMYS_UNIXROS", "0")
     over_tcp: list[bytes] = []
     make_node("tcp_listener").subscriber("stream", Image, lambda m: over_tcp.append(bytes(m.data)), raw=True)

@@ -35,7 +35,8 @@ def advertised_host_problem(host: str, env: Mapping[str, str] | None = None) -> 
     if is_numeric_host(host):
         return None
     try:
-        socket.getaddrinfo(host, None)
+        # an ASCII name goes as bytes: a str would load the idna codec into every node (start-up cost)
+        socket.getaddrinfo(host.encode("ascii") if host.isascii() else host, None)
     except (OSError, UnicodeError):
         env = os.environ if env is None else env
         source = "ROS_HOSTNAME" if env.get("ROS_HOSTNAME", "").strip() == host else "this machine's host name"
