@@ -359,13 +359,15 @@ class SimNode:
                 if imu.get_num_connections():
                     imu.publish(messages.imu(stamp, io.frame(imu_spec.pose.frame), imu_spec, sim.imu(r)))
             laser = r.model.laser
-            if io.scan_due is not None and io.scan_due.fire(now) and laser is not None:
-                want_view = view is not None and view.wants_scans()
+            if io.scan_due is not None and laser is not None:
                 scan = pubs["scan"]
-                if scan.get_num_connections() or want_view:
+                subscribed = scan.get_num_connections()
+                if not subscribed and not (view is not None and view.wants_scans()):
+                    io.scan_due.next = now  # idle: a new subscriber's first scan goes out at once
+                elif io.scan_due.fire(now):
                     ranges = sim.scan(r)
                     io.last_scan = ranges
-                    if scan.get_num_connections():
+                    if subscribed:
                         scan.publish(messages.laser_scan(stamp, io.frame(laser.pose.frame), laser, ranges))
             if io.camera_due is not None and io.camera_due.fire(now):
                 want = any(
