@@ -363,7 +363,12 @@ def test_a_real_rospy_controller_drives_a_square_checked_against_model_states(ga
     SetPhysicsProperties = get_service_class("gazebo_msgs/SetPhysicsProperties")
     state = SetModelState._request_class().model_state
     state.model_name, state.pose.orientation.w = "puzzlebot", 1.0
-    assert gazebo.call("/gazebo/set_model_state", SetModelState, model_state=state).success
+    if "puzzlebot" not in gazebo.model_states():  # run alone: spawn it (the first test does otherwise)
+        gazebo.client.set_param("/robot_description", URDF)
+        out = gazebo.spawn_model("-urdf", "-param", "robot_description", "-model", "puzzlebot", "-unpause")
+        assert out.returncode == 0, out.stdout + out.stderr
+    resp = gazebo.call("/gazebo/set_model_state", SetModelState, model_state=state)
+    assert resp.success, resp.status_message
     resp = gazebo.call("/gazebo/set_physics_properties", SetPhysicsProperties, max_update_rate=200.0)
     assert (resp.success, resp.status_message) == (True, "physics engine updated")
     GetPhysicsProperties = get_service_class("gazebo_msgs/GetPhysicsProperties")
