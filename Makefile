@@ -24,6 +24,8 @@ ROS1_DEBS += python3-pykdl python3-tf-conversions joint-state-publisher
 ROS1_DEBS += cmake python3-gencpp ros-std-msgs libstd-msgs-dev
 # vision: Debian's OpenCV under /usr/bin/python3 and its C++ image_transport republish (side-by-side tests)
 ROS1_DEBS += python3-opencv image-transport-tools
+# the long tail (issue 21 item 7): Debian's python3-angles, the reference for ours
+ROS1_DEBS += python3-angles
 BROWSER_DEBS := chromium chromium-driver fonts-dejavu-core
 # multi-host tests: network namespaces (iproute2), roslaunch <machine> over ssh (openssh-server)
 NET_DEBS     := iproute2 openssh-server openssh-client

@@ -106,6 +106,7 @@ LAYERS: dict[str, str] = {
     "maps": "libs",
     "launch": "libs",
     "bag": "libs",
+    "smach": "libs",
     "tools": "tools",
     "testing": "tools",
     "bridge": "gateway",

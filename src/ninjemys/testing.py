@@ -113,7 +113,8 @@ def run_master(
     """
     import subprocess
     import time
-    import xmlrpc.client
+
+    from ninjemys.net import auth
 
     port = port or free_port()
     uri = f"http://localhost:{port}/"
@@ -131,7 +132,7 @@ def run_master(
         deadline = time.monotonic() + timeout
         while True:
             try:
-                xmlrpc.client.ServerProxy(uri).getPid("/run_master")
+                auth.server_proxy(uri).getPid("/run_master")
                 break
             except OSError:
                 if proc.poll() is not None:
@@ -190,7 +191,8 @@ def run_real_roscore(ros_home: str | os.PathLike[str], timeout: float = 30.0) ->
     """Debian's /usr/bin/roscore on a free port; yields its URI once /rosout is up; kills the whole tree."""
     import subprocess
     import time
-    import xmlrpc.client
+
+    from ninjemys.net import auth
 
     port = free_port()
     uri = f"http://localhost:{port}/"
@@ -206,7 +208,7 @@ def run_real_roscore(ros_home: str | os.PathLike[str], timeout: float = 30.0) ->
         deadline = time.monotonic() + timeout
         while True:
             try:
-                code, _, state = xmlrpc.client.ServerProxy(uri).getSystemState("/run_real_roscore")
+                code, _, state = auth.server_proxy(uri).getSystemState("/run_real_roscore")
                 if code == 1 and any(topic == "/rosout_agg" for topic, _ in state[0]):
                     break
             except OSError:

@@ -15,11 +15,11 @@ import sys
 import time
 from typing import Any
 from urllib.parse import urlparse
-from xmlrpc.client import ServerProxy
 
 import rosgraph
 import rosgraph.names
 import rostopic
+from ninjemys.net.auth import server_proxy as ServerProxy  # noqa: N812 - signs when NINJEMYS_SECRET is set
 
 __all__ = [
     "NAME",

@@ -92,10 +92,13 @@ from rospy.topics import Publisher, SubscribeListener, Subscriber
 
 
 def _install_import_hook() -> None:
-    """``from my_pkg.msg import MyMsg`` for packages on ROS_PACKAGE_PATH, without a build step."""
+    """``from my_pkg.msg import MyMsg`` for packages on ROS_PACKAGE_PATH, without a build step; and
+    Noetic's ``URDF.from_parameter_server()`` on the PyPI urdf_parser_py (see rospy._urdf)."""
     from ninjemys.idl.hook import install
+    from rospy import _urdf
 
     install()
+    _urdf.install()
 
 
 _install_import_hook()
@@ -184,8 +187,12 @@ def __getattr__(name: str) -> object:
         from std_msgs.msg import Header
 
         return Header
-    if name == "numpy_msg":
-        from rospy import numpy_msg as module
+    if name == "names":  # rospy imports rospy.names eagerly; code reads rospy.names.get_namespace()
+        import importlib
 
-        return module
+        return importlib.import_module("rospy.names")
+    if name == "numpy_msg":
+        import importlib  # not "from rospy import numpy_msg": that asks this __getattr__ again
+
+        return importlib.import_module("rospy.numpy_msg")
     raise AttributeError(f"module 'rospy' has no attribute {name!r}")

@@ -18,7 +18,7 @@ import time
 from ninjemys.errors import MasterError, NameError_, NinjemysError, ParameterError
 from ninjemys.interrupt import wait_event
 from ninjemys.node.log import INFO
-from rospy.core import _process, is_shutdown, signal_shutdown
+from rospy.core import _process, is_shutdown, signal_shutdown, warn_illegal_name
 from rospy.exceptions import ROSException, ROSInitException, ROSInterruptException, mapped, translate
 
 TYPE_CHECKING = False  # importing typing costs ~7 ms of every node's start-up; checkers set it
@@ -75,14 +75,13 @@ def init_node(
     threshold. Unless ``disable_signals``, Ctrl-C (SIGINT) and SIGTERM shut the node down: sleeps
     raise ROSInterruptException and spin() returns. Calling it again with the same arguments is a no-op.
     """
-    key = (
-        name,
-        None if argv is None else tuple(argv),
-        anonymous,
-        log_level,
-        disable_rostime,
-        disable_signals,
-    )
+    if argv is None:
+        argv = sys.argv
+    key = (name, argv, anonymous, log_level, disable_rostime, disable_signals)
+    if not name:
+        raise ValueError("name must not be empty")
+    if "/" in name:
+        raise ValueError("namespaces are not allowed in node names")
     with _process.lock:
         if _process.init_args is not None:
             if _process.init_args != key:
@@ -90,15 +89,9 @@ def init_node(
                     f"rospy.init_node() has already been called with different arguments: {_process.init_args}"
                 )
             return
-        if not name:
-            raise ValueError("name must not be empty")
-        if "/" in name:
-            raise ValueError("namespaces are not allowed in node names")
-        args = _parse(sys.argv if argv is None else argv)
-        try:
-            base = args.node_name(name, anonymous)
-        except NameError_ as exc:
-            raise ValueError(str(exc)) from None
+        args = _parse(argv)
+        base = args.node_name(name, anonymous)
+        full = _node_name(base, args.namespace)
         from ninjemys.node.cli_args import network_env
 
         os.environ.update(network_env(args))
@@ -109,7 +102,7 @@ def init_node(
         ):
             _install_signal_handlers()
         _install_process_hooks()
-        node = _start_node(base, args, log_level or INFO, not disable_rostime, not disable_rosout)
+        node = _start_node(full, args, log_level or INFO, not disable_rostime, not disable_rosout)
         _process.node = node
         _process.init_args = key
         node.on_shutdown(_on_node_shutdown)
@@ -121,11 +114,30 @@ def init_node(
         raise ROSInitException("init_node interrupted before it could complete")
 
 
+def _node_name(base: str, namespace: str) -> str:
+    """The node's global name for ``base``, with rospy's warning (not an error) for an illegal one.
+
+    rospy lets ``init_node("Wheel's velocity")`` (or ``__name:=a/b``) through with a UserWarning at
+    the caller's line, and names the node by resolving ``base`` as ``<ns>/unnamed`` would
+    (``~x`` -> ``/unnamed/x``); the master then refuses what it refuses (spaces, colons).
+    """
+    from ninjemys import names
+
+    if not names.is_legal_base_name(base):
+        import warnings
+
+        warnings.warn(
+            f"'{base}' is not a legal ROS base name. This may cause problems with other ROS tools.",
+            stacklevel=3,  # warn in _node_name, called by init_node, called on the user's line
+        )
+    return names.resolve_name(base, names.canonicalize_name(namespace + "unnamed"))
+
+
 def _parse(argv: list[str]) -> Any:
     from ninjemys.node.cli_args import parse_args
 
     try:
-        return parse_args(argv)
+        return parse_args(argv, strict_names=False)
     except ParameterError as exc:
         raise ROSInitException(str(exc)) from None
     except NameError_ as exc:
@@ -150,6 +162,7 @@ def _start_node(base: str, args: Any, log_level: int, rostime: bool, rosout: boo
             log_level=log_level,
             log_file=args.log_file,
             default_clock=True,
+            strict_names=False,
         )
     except NameError_ as exc:
         raise ValueError(str(exc)) from None
@@ -252,7 +265,9 @@ def _make_handler(previous: Any) -> Any:
 
 def spin() -> None:
     """Block until the node shuts down (Ctrl-C, rosnode kill, a name collision, signal_shutdown)."""
-    node = _process.require_node()
+    node = _process.node
+    if node is None:
+        raise ROSInitException("client code must call rospy.init_node() first")  # rospy's words
     try:
         node.wait_for_shutdown()
     except KeyboardInterrupt:
@@ -302,20 +317,36 @@ def resolve_name(name: str, caller_id: str | None = None) -> str:
 
 
 def remap_name(name: str, caller_id: str | None = None, resolved: bool = True) -> str:
-    """The remapped form of ``name`` (itself when no remapping applies)."""
-    return resolve_name(name, caller_id)
+    """The remapped form of ``name``, resolved; ``name`` itself, unresolved, when the command line
+    does not remap it (rospy's contract: resolve only what is remapped)."""
+    from ninjemys import names
+
+    mappings = names.load_mappings(sys.argv)
+    if name not in mappings:
+        return name
+    return names.resolve_name(mappings[name], caller_id or get_name())
 
 
 # -- parameters -----------------------------------------------------------------------------------------
 
 
+def _params() -> Any:
+    """Who asks the parameter server: the node, or before init_node rospy's ``/unnamed`` caller."""
+    from rospy.service import _client_context
+
+    return _client_context()
+
+
 def get_param(param_name: str, default: Any = _UNSPECIFIED) -> Any:
-    """A parameter's value (``~name`` is private to the node); KeyError when unset and no default."""
-    node = _process.require_node()
+    """A parameter's value (``~name`` is private to the node); KeyError when unset and no default.
+
+    As in rospy, this works before ``init_node`` too (as ``/unnamed``: ``~x`` is ``/unnamed/x``).
+    """
+    ctx = _params()
     try:
         if default is _UNSPECIFIED:
-            return node.get_param(param_name)
-        return node.get_param(param_name, default)
+            return ctx.get_param(param_name)
+        return ctx.get_param(param_name, default)
     except ParameterError:
         raise KeyError(param_name) from None
     except NinjemysError as exc:
@@ -326,23 +357,24 @@ get_param_cached = get_param
 
 
 def set_param(param_name: str, param_value: Any) -> None:
-    """Set a parameter (dicts set a whole namespace)."""
-    node = _process.require_node()
+    """Set a parameter (dicts set a whole namespace); an illegal name only warns, as in rospy."""
+    warn_illegal_name(param_name)
+    ctx = _params()
     with mapped():
-        node.set_param(param_name, param_value)
+        ctx.set_param(param_name, param_value)
 
 
 def has_param(param_name: str) -> bool:
-    node = _process.require_node()
+    ctx = _params()
     with mapped():
-        return node.has_param(param_name)
+        return bool(ctx.has_param(param_name))
 
 
 def delete_param(param_name: str) -> None:
     """Delete a parameter; KeyError when it is not set."""
-    node = _process.require_node()
+    ctx = _params()
     try:
-        node.delete_param(param_name)
+        ctx.delete_param(param_name)
     except ParameterError:
         raise KeyError(param_name) from None
     except NinjemysError as exc:
@@ -351,15 +383,16 @@ def delete_param(param_name: str) -> None:
 
 def search_param(param_name: str) -> str | None:
     """The closest parameter named ``param_name`` up the namespace tree, or None."""
-    node = _process.require_node()
+    ctx = _params()
     with mapped():
-        return node.search_param(param_name)
+        found: str | None = ctx.search_param(param_name)
+        return found
 
 
 def get_param_names() -> list[str]:
-    node = _process.require_node()
+    ctx = _params()
     with mapped():
-        return node.get_param_names()
+        return list(ctx.get_param_names())
 
 
 # -- graph ----------------------------------------------------------------------------------------------
@@ -369,7 +402,7 @@ def wait_for_message(topic: str, topic_type: Any, timeout: float | None = None) 
     """Receive one message on ``topic``; ROSException after ``timeout`` seconds, ROSInterruptException on shutdown."""
     from rospy.topics import Subscriber
 
-    node = _process.require_node()
+    node = _process.node  # None before init_node: rospy waits all the same (init_node may come)
     box: list[Any] = []
     got = threading.Event()
 
@@ -378,10 +411,11 @@ def wait_for_message(topic: str, topic_type: Any, timeout: float | None = None) 
             box.append(msg)
             got.set()
 
+    timeout = _seconds(timeout)
     sub = Subscriber(topic, topic_type, take, queue_size=1)
     with _process.lock:
         _process.waiters.add(got)
-    if node.is_shutdown:
+    if node is not None and node.is_shutdown:
         got.set()
     try:
         wait_event(got, timeout)
@@ -393,14 +427,22 @@ def wait_for_message(topic: str, topic_type: Any, timeout: float | None = None) 
         return box[0]
     if is_shutdown():
         raise ROSInterruptException("rospy shutdown")
-    raise ROSException(f"timeout exceeded while waiting for message on topic {sub.resolved_name}")
+    raise ROSException(f"timeout exceeded while waiting for message on topic {topic}")  # rospy's words
+
+
+def _seconds(timeout: Any) -> float | None:
+    """A timeout in seconds from rospy's accepted forms: None, a number or a rospy.Duration."""
+    if timeout is None:
+        return None
+    to_sec = getattr(timeout, "to_sec", None)
+    return float(to_sec() if to_sec is not None else timeout)
 
 
 def get_published_topics(namespace: str = "/") -> list[list[str]]:
     """[[topic, type], ...] of every published topic under ``namespace``."""
-    node = _process.require_node()
+    ctx = _params()  # works before init_node, as rospy's /unnamed
     try:
-        return [list(x) for x in node.master.get_published_topics(namespace)]
+        return [list(x) for x in ctx.master.get_published_topics(namespace)]
     except MasterError as exc:
         raise ROSException(f"unable to get published topics: {exc}") from None
 

@@ -58,6 +58,8 @@ class _Process:
             self.hooks_ran = False
             self.shutdown_requested = False
             self.init_args: tuple[Any, ...] | None = None
+            #: rospy.service's ``/unnamed`` stand-in for master calls made before init_node
+            self.unnamed: Any = None
 
     @property
     def clock(self) -> Clock:
@@ -100,6 +102,23 @@ class _Process:
 
 
 _process = _Process()
+
+
+def warn_illegal_name(name: str, stacklevel: int = 3) -> None:
+    """rospy's warning (never an error) for a graph name ROS 1 calls illegal (``a b``, ``1x``, ``a-b``).
+
+    rospy warns and carries on, and so do we: the master decides what it registers (it refuses
+    names with a space or a colon, which the node then logs at FATAL, as rospy does).
+    """
+    from ninjemys.names import is_legal_name
+
+    if not is_legal_name(name):
+        import warnings
+
+        warnings.warn(
+            f"'{name}' is not a legal ROS graph resource name. This may cause problems with other ROS tools",
+            stacklevel=stacklevel,
+        )
 
 
 def process_node() -> Any:
@@ -151,7 +170,12 @@ def _reset() -> None:
 
 
 def on_shutdown(hook: Callable[[], Any]) -> None:
-    """Call ``hook()`` (no arguments) when the node shuts down, before its connections close."""
+    """Call ``hook()`` (no arguments) when the node shuts down, before its connections close.
+
+    TypeError at once for a hook that cannot be called, as rospy (not an error logged at shutdown).
+    """
+    if not callable(hook):
+        raise TypeError(f"shutdown hook [{hook}] must be a function or callable object: {type(hook)}")
     with _process.lock:
         if not _process.hooks_ran:
             _process.hooks.append(hook)

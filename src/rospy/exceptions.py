@@ -20,6 +20,15 @@ class ROSSerializationException(ROSException):
     """A message could not be serialized (wrong field type or value)."""
 
 
+class PublishArgumentError(ROSSerializationException, TypeError):
+    """``publish()`` arguments that do not make a message of the topic's type.
+
+    rospy raises a plain TypeError here (``pub.publish(Int32(3))`` on a String topic, or too many
+    arguments); ninjemys used to raise ROSSerializationException. This is both, so code written
+    against either catches it.
+    """
+
+
 class ROSInitException(ROSException):
     """The node could not be initialized (bad arguments, master unreachable, ...)."""
 
@@ -56,6 +65,16 @@ class ServiceException(ROSException):
     """A service call failed, or a service handler reported an error."""
 
 
+class ServiceArgumentError(ServiceException, TypeError):
+    """A ServiceProxy called with arguments that make no request: rospy raises TypeError, ninjemys
+    raised ServiceException; this is both."""
+
+
+class NotAServiceClassError(ValueError, AttributeError):
+    """A class given as a service type is not one: rospy fails with an AttributeError, ninjemys
+    raised ValueError; this is both."""
+
+
 def translate(exc: BaseException) -> BaseException:
     """The rospy exception that stands for ``exc`` (``exc`` itself when it is not a ninjemys error)."""
     from ninjemys import errors
@@ -68,7 +87,7 @@ def translate(exc: BaseException) -> BaseException:
     if isinstance(exc, errors.ShutdownError):
         return ROSInterruptException(text)
     if isinstance(exc, errors.ServiceError):
-        return ServiceException(text)
+        return ServiceArgumentError(text) if isinstance(exc, TypeError) else ServiceException(text)
     if isinstance(exc, errors.SerializationError):
         return ROSSerializationException(text)
     if isinstance(exc, errors.NameError_):

@@ -14,8 +14,9 @@ from ninjemys import names
 from ninjemys.errors import NinjemysError, ServiceError
 from ninjemys.interrupt import wait_event
 from ninjemys.node.log import ERROR
-from rospy.core import _process
-from rospy.exceptions import ServiceException, mapped, translate
+from ninjemys.node.params import ParamAccess
+from rospy.core import _process, warn_illegal_name
+from rospy.exceptions import NotAServiceClassError, ServiceException, mapped, translate
 from rospy.msg import AnyMsg
 
 TYPE_CHECKING = False  # importing typing costs ~7 ms of every node's start-up; checkers set it
@@ -27,7 +28,7 @@ __all__ = ["Service", "ServiceProxy", "ServiceException", "wait_for_service"]
 
 def _check_service_class(service_class: Any, name: str) -> None:
     if not all(hasattr(service_class, a) for a in ("_type", "_md5sum", "_request_class", "_response_class")):
-        raise ValueError(f"service [{name}]: [{service_class}] is not a service class")
+        raise NotAServiceClassError(f"service [{name}]: [{service_class}] is not a service class")
 
 
 class _AnyService:
@@ -39,9 +40,10 @@ class _AnyService:
     _response_class = AnyMsg
 
 
-class _Unnamed:
-    """The surface a core ServiceProxy needs from a node, for calls made before init_node (as rospy's
-    ``/unnamed`` caller): a master client, a caller id, and interruptible waits."""
+class _Unnamed(ParamAccess):
+    """The surface a core ServiceProxy and the parameter calls need from a node, for calls made
+    before init_node (as rospy's ``/unnamed`` caller): a master client, a caller id, name
+    resolution (``~x`` is ``/unnamed/x``, as in rospy), and interruptible waits."""
 
     def __init__(self) -> None:
         from ninjemys.master.client import MasterClient
@@ -64,18 +66,16 @@ class _Unnamed:
         return names.resolve_name(name, self.name, self.remappings)
 
 
-_unnamed: _Unnamed | None = None
-
-
 def _client_context() -> Any:
-    """The node to call services from: the initialized node, else the shared ``/unnamed`` context."""
-    global _unnamed
+    """The node to call the master and services from: the initialized node, else the process's
+    ``/unnamed`` context (made on first use, forgotten by ``reset_rospy``)."""
     node = _process.node
     if node is not None:
         return node
-    if _unnamed is None:
-        _unnamed = _Unnamed()
-    return _unnamed
+    with _process.lock:
+        if _process.unnamed is None:
+            _process.unnamed = _Unnamed()
+        return _process.unnamed
 
 
 def _core_proxy(name: str, service_class: Any, persistent: bool, headers: Mapping[str, str] | None) -> Any:
@@ -89,8 +89,10 @@ def _core_proxy(name: str, service_class: Any, persistent: bool, headers: Mappin
 
 def wait_for_service(service: str, timeout: float | None = None) -> None:
     """Block until ``service`` is available; ROSException after ``timeout`` seconds."""
+    from rospy.client import _seconds
+
     with mapped():
-        _core_proxy(service, _AnyService, False, None).wait_for_service(timeout)
+        _core_proxy(service, _AnyService, False, None).wait_for_service(_seconds(timeout))
 
 
 class ServiceProxy:
@@ -125,8 +127,10 @@ class ServiceProxy:
         return impl
 
     def wait_for_service(self, timeout: float | None = None) -> None:
+        from rospy.client import _seconds
+
         with mapped():
-            self._core().wait_for_service(timeout)
+            self._core().wait_for_service(_seconds(timeout))
 
     def call(self, *args: Any, **kwds: Any) -> Any:
         """Send a request (an instance, or its fields) and return the response."""
@@ -166,7 +170,10 @@ class Service:
         buff_size: int = 65536,
         error_handler: Callable[..., Any] | None = None,
     ) -> None:
+        if not isinstance(name, str) or not name:
+            raise ValueError("service name is not a non-empty string")
         _check_service_class(service_class, name)
+        warn_illegal_name(name)
         self.service_class = service_class
         self.request_class = service_class._request_class
         self.response_class = service_class._response_class
@@ -197,6 +204,7 @@ class Service:
                 self.error_handler(exc, *sys.exc_info())
             else:
                 _process.log.log(ERROR, "Error processing request: %s", exc, exc_info=True)
+            exc.ninjemys_reported = True  # type: ignore[attr-defined]  # the core need not log it again
             raise
 
     def shutdown(self, reason: str = "") -> None:

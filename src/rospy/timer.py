@@ -11,7 +11,7 @@ from collections.abc import Callable
 
 from ninjemys.node import timers as _timers
 from ninjemys.rostime import Duration, Time
-from rospy.core import _process
+from rospy.core import _process, is_shutdown
 from rospy.exceptions import ROSInterruptException, mapped
 
 TYPE_CHECKING = False  # importing typing costs ~7 ms of every node's start-up; checkers set it
@@ -33,19 +33,28 @@ class Rate:
     """Loop at ``hz``: call ``sleep()`` once per iteration (``rate.sleep()`` in the seeds' talker)."""
 
     def __init__(self, hz: float, reset: bool = True) -> None:
-        self._rate = _timers.Rate(hz, _process.clock, reset=reset)
-        self.sleep_dur = Duration.from_sec(self._rate.period)
+        # rospy.Rate(0) raises ZeroDivisionError (the core's RateError is one); a negative rate is
+        # accepted by rospy and never waits (its period is negative), so it is accepted here too.
+        self._rate = None if hz < 0 else _timers.Rate(hz, _process.clock, reset=reset)
+        self.sleep_dur = Duration.from_sec(1.0 / hz)
+        self._created = _process.clock.now()
 
     @property
     def last_time(self) -> Time:
-        return Time.from_sec(self._rate.last_time)
+        return Time.from_sec(self._created if self._rate is None else self._rate.last_time)
 
     def remaining(self) -> Duration:
         """Time left until the next deadline."""
+        if self._rate is None:
+            return self.sleep_dur
         return Duration.from_sec(self._rate.remaining())
 
     def sleep(self) -> None:
         """Sleep until the next period; ROSInterruptException on shutdown."""
+        if self._rate is None:
+            if is_shutdown():
+                raise ROSInterruptException("ROS shutdown request")
+            return
         with mapped():
             self._rate.sleep()
 

@@ -10,8 +10,9 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 
 from ninjemys.errors import NinjemysError, SerializationError, ShutdownError
-from rospy.core import _process
+from rospy.core import _process, is_shutdown, warn_illegal_name
 from rospy.exceptions import (
+    PublishArgumentError,
     ROSException,
     ROSInterruptException,
     ROSSerializationException,
@@ -60,6 +61,7 @@ class Topic:
         if not isinstance(name, str) or not name:
             raise ValueError(f"topic name must be a non-empty string, not {name!r}")
         _check_class(data_class, f"topic [{name}]")
+        warn_illegal_name(name, stacklevel=4)  # the user's Publisher(...)/Subscriber(...) line
         self._requested = name
         self.data_class = data_class
         self.type = data_class._type
@@ -92,6 +94,11 @@ class Topic:
             return
         try:
             self._impl = self._create(node)
+        except ShutdownError:
+            if not is_shutdown():
+                raise ROSInterruptException(f"topic [{self.resolved_name}]: the node is shut down") from None
+            # as rospy: a handle made while the node shuts down exists, and sends or receives nothing
+            return
         except NinjemysError as exc:
             raise translate(exc) from None
         self.resolved_name = self.name = self._impl.resolved_name
@@ -115,6 +122,16 @@ class Publisher(Topic):
         queue_size: int | None = None,
     ) -> None:
         super().__init__(name, data_class)
+        if queue_size is None:
+            import warnings
+
+            warnings.warn(
+                "The publisher should be created with an explicit keyword argument 'queue_size'. "
+                "Please see http://wiki.ros.org/rospy/Overview/Publishers%20and%20Subscribers for more "
+                "information.",
+                SyntaxWarning,
+                stacklevel=2,
+            )
         self.subscriber_listener = subscriber_listener
         self.tcp_nodelay = tcp_nodelay
         self.latch = latch
@@ -137,20 +154,27 @@ class Publisher(Topic):
         """Publish a message, or build one from the arguments: ``pub.publish("hello")`` for a String."""
         impl = self._impl
         if impl is None:
-            self._not_ready()
+            self._not_ready()  # raises, unless the node is shutting down (then nothing is sent)
+            return
         if len(args) == 1 and not kwds and isinstance(args[0], self.data_class):
             msg = args[0]
         else:
             try:
                 msg = args_kwds_to_message(self.data_class, args, kwds)
-            except (TypeError, ValueError) as exc:
+            except TypeError as exc:
+                raise PublishArgumentError(str(exc)) from None
+            except ValueError as exc:
                 raise ROSSerializationException(str(exc)) from None
+        if not self.latch and not impl.get_num_connections():
+            return  # as rospy: nobody listens, so nothing is serialized (a bad field is not an error yet)
         try:
             if self._raw:
                 impl.publish_raw(msg._buff)
             else:
                 impl.publish(msg)
         except ShutdownError:
+            if is_shutdown():
+                return  # as rospy: publishing while the node shuts down is quietly dropped
             raise ROSInterruptException(f"publish() to a closed topic [{self.resolved_name}]") from None
         except SerializationError as exc:
             raise ROSSerializationException(str(exc)) from None
@@ -162,6 +186,8 @@ class Publisher(Topic):
             raise ROSException(f"publish() to an unregistered() handle [{self.resolved_name}]")
         if _process.node is None:
             raise ROSException("ROS node has not been initialized yet. Please call init_node() first")
+        if is_shutdown():
+            return  # as rospy: publishing while the node shuts down is quietly dropped
         raise ROSInterruptException(f"publish() to a closed topic [{self.resolved_name}]")
 
 

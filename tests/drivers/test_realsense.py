@@ -169,7 +169,8 @@ def test_rs_from_file_launch_publishes_the_recording(recording: Path, tmp_path: 
         assert [f.name for f in cloud.fields] == ["x", "y", "z", "rgb"] and cloud.point_step == 20
         xyz = np.frombuffer(bytes(cloud.data), np.uint8).reshape(-1, 20)[:, :12].copy().view(np.float32)
         assert cloud.width > 0.9 * W * H and cloud.height == 1
-        assert set(np.round(xyz[:, 2], 2)) <= {1.0, *(round(2.0 + k / 1000, 2) for k in range(0, 160))}
+        depths_mm = set(np.round(xyz[:, 2].astype(np.float64) * 1000).astype(int).tolist())
+        assert depths_mm <= {BOX_MM, *range(WALL_MM, WALL_MM + 160)}, sorted(depths_mm)[:10]
 
         frames = {
             (t.header.frame_id, t.child_frame_id): t for m in got.msgs["tf_static"] for t in m.transforms

@@ -282,6 +282,70 @@ def _world(data: bytes) -> None:
         load_world(path)
 
 
+# -- Gazebo worlds (SDF) and mesh files ---------------------------------------------------------------
+
+
+_SDF_WORLD = b"""<?xml version="1.0"?>
+<sdf version="1.6">
+  <world name="course">
+    <include><uri>model://ground_plane</uri></include>
+    <include><uri>model://sun</uri></include>
+    <include><uri>model://construction_cone</uri><name>cone</name><pose>1 2 0 0 0 0.3</pose></include>
+    <model name="box"><static>true</static><pose>2 0 0.25 0 0 0</pose>
+      <link name="link"><pose>0 0 0 0.1 0 0</pose>
+        <collision name="c"><geometry><box><size>0.5 1 0.5</size></box></geometry></collision>
+        <visual name="v"><geometry><box><size>0.5 1 0.5</size></box></geometry>
+          <material><script><name>Gazebo/Red</name></script><diffuse>1 0 0 1</diffuse></material></visual>
+      </link>
+      <model name="inner"><link name="l"><collision name="c"><geometry><cylinder><radius>0.2</radius>
+        <length>1</length></cylinder></geometry></collision></link></model>
+    </model>
+    <model name="shapes"><link name="l">
+      <collision name="s"><geometry><sphere><radius>0.3</radius></sphere></geometry></collision>
+      <collision name="p"><geometry><polyline><point>0 0</point><point>1 0</point><point>0 1</point>
+        <height>0.5</height></polyline></geometry></collision>
+    </link></model>
+    <state world_name="course"><model name="box"><pose>3 0 0.25 0 0 0</pose></model></state>
+    <actor name="walker"/>
+  </world>
+</sdf>
+"""
+
+
+def _sdf_world(data: bytes) -> None:
+    from ninjemys.sim.sdf import parse_sdf_world
+
+    parse_sdf_world(data, "fuzz.world", env={"HOME": "/nonexistent"}, warn=lambda _m: None)
+
+
+def _mesh_seeds() -> list[bytes]:
+    from ninjemys.sim.sdf import SHIPPED_MODELS
+
+    stl = (SHIPPED_MODELS / "construction_cone" / "meshes" / "cone.stl").read_bytes()
+    ascii_stl = b"solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 1\nendloop\nendfacet\nendsolid t\n"
+    dae = (
+        b'<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1"><asset>'
+        b'<unit meter="0.01"/><up_axis>Y_UP</up_axis></asset><library_geometries><geometry id="g"><mesh>'
+        b'<source id="p"><float_array id="a" count="9">0 0 0 1 0 0 0 1 1</float_array></source>'
+        b'<vertices id="v"><input semantic="POSITION" source="#p"/></vertices></mesh></geometry>'
+        b'</library_geometries><library_visual_scenes><visual_scene id="s"><node><translate>1 2 3</translate>'
+        b'<rotate>0 0 1 90</rotate><scale>1 2 1</scale><instance_geometry url="#g"/></node></visual_scene>'
+        b"</library_visual_scenes></COLLADA>"
+    )
+    obj = b"v 0 0 0\nv 1 0 0\nv 0 1 1\nf 1 2 3\nf -1 -2 -3\n"
+    return [b"stl" + stl, b"stl" + ascii_stl, b"dae" + dae, b"obj" + obj]
+
+
+def _mesh(data: bytes) -> None:
+    from ninjemys.sim.meshes import load_mesh_parts
+
+    kind = {b"stl": ".stl", b"dae": ".dae", b"obj": ".obj"}.get(data[:3], ".stl")
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / f"fuzz{kind}"
+        path.write_bytes(data[3:])
+        load_mesh_parts(path)
+
+
 # -- the gateway -------------------------------------------------------------------------------------
 
 
@@ -328,6 +392,75 @@ def _gateway(data: bytes) -> None:
     msg.serialize(io.BytesIO())
 
 
+# -- device drivers: what a serial port delivers ------------------------------------------------------
+
+
+def _rosserial(data: bytes) -> None:
+    """A rosserial byte stream cut into reads of varying sizes; each packet's TopicInfo decoded as the
+    host decodes a negotiation (the host logs a payload that does not decode and goes on)."""
+    from ninjemys.drivers.rosserial_protocol import Frame, FrameReader
+    from ninjemys.idl.loader import get_message_class
+
+    info = get_message_class("rosserial_msgs/TopicInfo")
+    reader = FrameReader()
+    pos, step = 0, 1
+    while pos < len(data):
+        for item in reader.feed(data[pos : pos + step]):
+            if isinstance(item, Frame) and item.topic_id == 0 and item.payload:
+                info().deserialize(item.payload)
+            elif not isinstance(item, Frame):
+                item.log_line()
+        pos += step
+        step = step * 3 % 97 + 1
+
+
+def _rosserial_seeds() -> list[bytes]:
+    from ninjemys.drivers.rosserial_protocol import frame
+    from ninjemys.idl.loader import get_message_class
+
+    ti = get_message_class("rosserial_msgs/TopicInfo")()
+    ti.topic_id, ti.topic_name, ti.message_type, ti.md5sum, ti.buffer_size = (
+        125,
+        "wl",
+        "std_msgs/Float32",
+        "7" * 32,
+        280,
+    )
+    return [
+        frame(0, ti.serialize_to_bytes()) + frame(125, b"\x00\x00\xc0\x3f") + frame(10, bytes(8)),
+        b"noise" + frame(7),
+    ]
+
+
+def _rplidar(data: bytes) -> None:
+    """An RPLIDAR stream as the node reads it: a descriptor, then standard nodes or express capsules,
+    assembled into revolutions and turned into LaserScan fields."""
+    from ninjemys.drivers import rplidar_protocol as rp
+    from ninjemys.drivers.rplidar_scan import RevolutionAssembler, revolution_to_scan
+
+    if len(data) >= rp.DESCRIPTOR_SIZE:
+        try:
+            rp.Descriptor.unpack(data[: rp.DESCRIPTOR_SIZE]).check(rp.CMD_SCAN)
+        except rp.RplidarError:
+            pass
+    for decoder in (rp.NodeDecoder(), rp.CapsuleDecoder()):
+        assembler = RevolutionAssembler()
+        for pos in range(0, len(data), 200):
+            for rev in assembler.feed(decoder.feed(data[pos : pos + 200])):
+                for compensate in (True, False):
+                    revolution_to_scan(rev, compensate, 2, 0.1, False, 16.0)
+
+
+def _rplidar_seeds() -> list[bytes]:
+    from ninjemys.drivers import rplidar_protocol as rp
+
+    nodes = b"".join(rp.pack_node(a * 7.5, 1000 + a, 40, a % 48 == 0) for a in range(100))
+    caps = b"".join(
+        rp.pack_capsule(c * 30.0, [500.0 + i for i in range(32)], [3] * 32, c == 0) for c in range(14)
+    )
+    return [rp.Descriptor(5, 1, 0x81).pack() + nodes, rp.Descriptor(84, 1, 0x82).pack() + caps]
+
+
 def targets() -> list[Target]:
     """Every target, with its seeds (built on first use)."""
     return [
@@ -340,6 +473,10 @@ def targets() -> list[Target]:
         Target("map", _map, _map_seeds()),
         Target("world", _world, _world_seeds()),
         Target("gateway", _gateway, _gateway_seeds()),
+        Target("sdf_world", _sdf_world, [_SDF_WORLD]),
+        Target("mesh", _mesh, _mesh_seeds()),
+        Target("rosserial", _rosserial, _rosserial_seeds()),
+        Target("rplidar", _rplidar, _rplidar_seeds()),
     ]
 
 

@@ -24,7 +24,7 @@ class _Hang(Exception):
 
 
 def _alarm(_signum: int, _frame: object) -> None:
-    raise _Hang("no result within 2 s")
+    raise _Hang("no result within 10 s")
 
 
 @pytest.mark.parametrize("target", ALL, ids=[t.name for t in ALL])
@@ -36,7 +36,7 @@ def test_parser_takes_mutated_input_without_an_unexpected_exception(target: Targ
     try:
         for i in range(COUNT):
             data = mutator.next()
-            signal.alarm(2)
+            signal.alarm(10)  # a hang never ends; a loaded CI machine can be slow
             try:
                 exc = check(target, data)
             except _Hang as hang:

@@ -45,6 +45,12 @@ SHIPPED_PACKAGES = (
     "tf2_web_republisher",
     # wave 3: device drivers (issue 24)
     "realsense2_camera",
+    # issue 21 item 7: the long tail course code imports (smach's introspection, aruco_detect's fiducials)
+    "smach_msgs",
+    "fiducial_msgs",
+    "rosserial_msgs",
+    # wave 3: ros_control's controller_manager (issue 23)
+    "controller_manager_msgs",
 )
 
 #: packages Debian's ROS 1 lacks; their facts are checked against published md5sums instead
@@ -58,6 +64,10 @@ NOT_IN_DEBIAN = frozenset(
         "rosapi",
         "tf2_web_republisher",
         "realsense2_camera",
+        "smach_msgs",
+        "fiducial_msgs",
+        "rosserial_msgs",
+        "controller_manager_msgs",
     }
 )
 

@@ -83,10 +83,12 @@ def test_routing_follows_the_ros1_table(tmp_path: Path) -> None:
         assert piece in text
 
 
-def test_debug_enabled_goes_to_rosout_not_console(tmp_path: Path) -> None:
+def test_debug_enabled_goes_to_stdout_and_rosout(tmp_path: Path) -> None:
+    # Debian's rospy under init_node(log_level=rospy.DEBUG) prints "[DEBUG] [...]: dbg" on stdout
     logger, out, err, pub = make(tmp_path, level=DEBUG)
     logger.debug("dbg")
-    assert out.getvalue() == "" and err.getvalue() == ""
+    assert [LINE.match(x).groups() for x in out.getvalue().splitlines()] == [("DEBUG", "dbg")]
+    assert err.getvalue() == ""
     assert [(m.level, m.msg) for m in pub.sent] == [(DEBUG, "dbg")]
 
 

@@ -138,3 +138,29 @@ def test_shutdown_is_prompt_without_a_master(master) -> None:
     node.shutdown("bye")
     assert time.monotonic() - started < 2.0
     assert node.is_shutdown
+
+
+def test_a_node_with_names_the_master_refuses_still_reregisters_the_rest() -> None:
+    """rospy's leniency (a node named "a b": the master refuses its "/a b/get_loggers"): after a
+    master restart, the refused names are skipped and everything else is registered again."""
+    master = MasterProcess(free_port(), kind="ninjemys")
+    master.start()
+    node = None
+    try:
+        node = Node("a b", master_uri=master.uri, strict_names=False)
+        node.publisher("bad topic", String)  # refused first: must not stop what comes after
+        node.publisher("/ok_topic", String)
+        client = MasterClient(master.uri, "/check", timeout=2)
+        try:
+            pubs, _, srvs = client.get_system_state()
+            assert ["/ok_topic", ["/a b"]] in pubs
+            assert not any(name.startswith("/a b/") for name, _ in srvs)  # refused, logged FATAL
+            master.kill()
+            master.start()
+            assert wait_until(lambda: ["/ok_topic", ["/a b"]] in client.get_system_state()[0], timeout=5)
+        finally:
+            client.close()
+    finally:
+        if node is not None:
+            node.shutdown("test over")
+        master.kill()

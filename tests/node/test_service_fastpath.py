@@ -514,7 +514,7 @@ def test_rospy_proxy_call_is_direct_and_subclass_overrides_still_apply(make_node
     server.service("add", AddTwoInts, lambda r: r.a + r.b)
     # no init_node: the proxies talk to this test's master as /unnamed, from a fresh context
     monkeypatch.setenv("ROS_MASTER_URI", server.master_uri)
-    monkeypatch.setattr(rospy.service, "_unnamed", None)
+    monkeypatch.setattr(rospy.core._process, "unnamed", None)
 
     class Doubling(rospy.ServiceProxy):
         def call(self, *args, **kwds):

@@ -143,7 +143,7 @@ def _publish_everything(peer: Node) -> list[Any]:
             M("visualization_msgs/MarkerArray")(markers=markers),
         )
     )
-    bad = M("visualization_msgs/Marker")(ns="bad", id=1, type=10, action=0)  # a mesh: not shown, and said so
+    bad = M("visualization_msgs/Marker")(ns="bad", id=1, type=10, action=0)  # a mesh without a file: said so
     bad.header.frame_id = "map"
     bad.pose.orientation.w = 1.0
     bad.lifetime = Duration(0, 0)
@@ -181,11 +181,11 @@ def test_every_display_shows_its_topic(live: dict[str, Any], browser_page: Any) 
         "Image": "4×3 rgb8",
         "Footprint": "receiving geometry_msgs/PolygonStamped",
         "Pose": "receiving geometry_msgs/PoseStamped",
-        "Marker": "marker type MESH_RESOURCE is not shown",
+        "Marker": "MESH_RESOURCE marker without a mesh_resource",
     }
     for name, text in expected.items():
         wait_until(lambda n=name, t=text: t in status(n), what=f"{name}: {text!r} (has {status(name)!r})")
-    # no display is in error except the mesh marker, which says why
+    # no display is in error except the mesh marker without a file, which says why
     errors = page.locator('.rv-display[data-level="error"]').evaluate_all(
         "els => els.map(e => e.dataset.name)"
     )

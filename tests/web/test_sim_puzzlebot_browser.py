@@ -75,6 +75,16 @@ def test_page_shows_the_world_and_drives_the_robot(web_sim, browser_page) -> Non
     page.wait_for_function(
         "Number(document.getElementById('pb-depth').dataset.loaded || 0) >= 1", timeout=20000
     )
+    # the colour image the page drew from the camera topic is a real render: floor at the bottom,
+    # something else above (looked at before driving: a robot that drove on under load may face a wall)
+    width, height, top, bottom = page.evaluate(
+        """(() => {
+          const c = document.getElementById("pb-color"), g = c.getContext("2d");
+          const px = (y) => Array.from(g.getImageData(2, y, 1, 1).data);
+          return [c.width, c.height, px(2), px(c.height - 3)];
+        })()"""
+    )
+    assert (width, height) == (320, 240) and top != bottom and top[3] == 255
     start = _robot(page)
     assert start["x"] == 0.0 and start["scan"] is not None
     # drive forward with the keyboard for a moment
@@ -92,16 +102,6 @@ def test_page_shows_the_world_and_drives_the_robot(web_sim, browser_page) -> Non
     )
     yellow = (shot[:, :, 0] > 200) & (shot[:, :, 1] > 170) & (shot[:, :, 2] < 90)
     assert yellow.sum() > 50
-    # the colour image the page drew from the camera topic is a real render: floor at the bottom,
-    # something else above
-    width, height, top, bottom = page.evaluate(
-        """(() => {
-          const c = document.getElementById("pb-color"), g = c.getContext("2d");
-          const px = (y) => Array.from(g.getImageData(2, y, 1, 1).data);
-          return [c.width, c.height, px(2), px(c.height - 3)];
-        })()"""
-    )
-    assert (width, height) == (320, 240) and top != bottom and top[3] == 255
     # page buttons reach the Gazebo-style controls
     page.get_by_role("button", name="reset world").click()
     wait_until(lambda: _robot(page)["x"] == 0.0, what="reset world from the page")

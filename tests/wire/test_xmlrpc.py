@@ -95,7 +95,10 @@ def test_connection_close_and_http10_keep_alive_rules() -> None:
     [
         (b"POST / HTTP/1.1\r\nContent-Length: 99999999999\r\n\r\n", "exceeds"),
         (b"POST / HTTP/1.1\r\nContent-Length: -1\r\n\r\n", "Content-Length"),
-        ("POST / HTTP/1.1\r\nContent-Length: 35\u00b2\r\n\r\n".encode(), "Content-Length"),  # found by fuzzing
+        (
+            "POST / HTTP/1.1\r\nContent-Length: 35\u00b2\r\n\r\n".encode(),
+            "Content-Length",
+        ),  # found by fuzzing
         (b"POST / HTTP/1.1\r\nTransfer-Encoding: chunked\r\n\r\n", "chunked"),
         (b"\x16\x03\x01\x02\x00\x01\x00\x01\xfc\x03\x03\r\n\r\n", "start line|method|version"),
         (b"POST / HTTP/9.9\r\n\r\n", "version"),

@@ -38,6 +38,7 @@ from ninjemys.bridge.outbox import CloseRequest, Outbox
 from ninjemys.bridge.rosbridge import RosbridgeSession
 from ninjemys.errors import NinjemysError
 from ninjemys.idl.loader import get_message_class, get_service_class
+from ninjemys.net import auth
 from ninjemys.node import Node
 from ninjemys.serve.http import HttpServer, Request, Response
 from ninjemys.serve.websocket import WRITE_HIGH_WATER, WebSocket
@@ -96,7 +97,13 @@ class GatewayOptions:
         if not self.authenticate:
             return None
         if self.secret_file is None:
-            raise NinjemysError("authentication is on but no secret file is set (secret_file)")
+            # the graph's own secret (NINJEMYS_SECRET / NINJEMYS_SECRET_FILE, ninjemys.net.auth)
+            shared = auth.load_secret()
+            if shared is None:
+                raise NinjemysError(
+                    "authentication is on but no secret is set (secret_file, or NINJEMYS_SECRET for the graph's)"
+                )
+            return shared.decode("utf-8", "replace")
         return Path(self.secret_file).read_text().strip()
 
     def foxglove_token(self) -> str | None:

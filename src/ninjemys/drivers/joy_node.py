@@ -34,6 +34,12 @@ from ninjemys.drivers.joystick import (
 from ninjemys.idl.loader import get_message_class
 from ninjemys.node.run import run_node
 
+
+def _msg(type_name: str) -> Any:
+    """A message class, typed loosely: its fields are generated at run time."""
+    return get_message_class(type_name)
+
+
 #: how long a wait may last before the loop looks at shutdown (joy_node spins between selects)
 _POLL = 0.1
 
@@ -44,11 +50,11 @@ class JoyNode:
     def __init__(self, node: Any) -> None:
         self.node = node
         self.log = node.log
-        self.Joy = get_message_class("sensor_msgs/Joy")
+        self.Joy = _msg("sensor_msgs/Joy")
         self.pub = node.publisher("joy", self.Joy, queue_size=1)
         self.feedback = node.subscriber(
             "joy/set_feedback",
-            get_message_class("sensor_msgs/JoyFeedbackArray"),
+            _msg("sensor_msgs/JoyFeedbackArray"),
             lambda _m: None,
             queue_size=10,
         )

@@ -39,6 +39,17 @@ from ninjemys.idl.loader import get_message_class, get_service_class
 from ninjemys.node.run import run_node
 from ninjemys.rostime import Time
 
+
+def _msg(type_name: str) -> Any:
+    """A message class, typed loosely: its fields are generated at run time."""
+    return get_message_class(type_name)
+
+
+def _srv(type_name: str) -> Any:
+    """A service class, typed loosely: its parts are generated at run time."""
+    return get_service_class(type_name)
+
+
 NOT_INSTALLED = "realsense2_camera: pyrealsense2 is not installed (pip install pyrealsense2): no RealSense camera can be read"
 KNOWN_FILTERS = (
     "colorizer",
@@ -104,8 +115,8 @@ class RealSenseCamera:
         self.aligned_frame_id = str(
             p("aligned_depth_to_color_frame_id", "camera_aligned_depth_to_color_frame")
         )
-        self.Image = get_message_class("sensor_msgs/Image")
-        self.CameraInfo = get_message_class("sensor_msgs/CameraInfo")
+        self.Image = _msg("sensor_msgs/Image")
+        self.CameraInfo = _msg("sensor_msgs/CameraInfo")
         self.seq: dict[str, int] = {}
         self.streaming = True
         self.pipeline: Any = None
@@ -211,20 +222,20 @@ class RealSenseCamera:
             )
         if self.pointcloud and "depth" in present:
             self.pubs["points"] = n.publisher(
-                "depth/color/points", get_message_class("sensor_msgs/PointCloud2"), queue_size=1
+                "depth/color/points", _msg("sensor_msgs/PointCloud2"), queue_size=1
             )
-        SetBool = get_service_class("std_srvs/SetBool")
+        SetBool = _srv("std_srvs/SetBool")
         n.service("enable", SetBool, self._enable)
-        n.service("~device_info", get_service_class("realsense2_camera/DeviceInfo"), self._device_info)
+        n.service("~device_info", _srv("realsense2_camera/DeviceInfo"), self._device_info)
 
     def _enable(self, req: Any) -> Any:
         self.streaming = bool(req.data)
         self.log.info("toggling sensor : %s", "ON" if self.streaming else "OFF")
-        return get_service_class("std_srvs/SetBool")._response_class(success=True, message="")
+        return _srv("std_srvs/SetBool")._response_class(success=True, message="")
 
     def _device_info(self, _req: Any) -> Any:
         rs, d = self.rs, self.device
-        resp = get_service_class("realsense2_camera/DeviceInfo")._response_class()
+        resp = _srv("realsense2_camera/DeviceInfo")._response_class()
 
         def info(key: Any) -> str:
             return str(d.get_info(key)) if d.supports(key) else ""
@@ -254,7 +265,7 @@ class RealSenseCamera:
                 self.base_frame_id, s.frame_id, s.optical_frame_id, rotation, translation, aligned
             )
         if "depth" in profiles and "color" in profiles:
-            Extrinsics = get_message_class("realsense2_camera/Extrinsics")
+            Extrinsics = _msg("realsense2_camera/Extrinsics")
             pub = self.node.publisher("extrinsics/depth_to_color", Extrinsics, queue_size=1, latch=True)
             msg = Extrinsics()
             msg.header.frame_id = "depth_to_color_extrinsics"
@@ -266,8 +277,8 @@ class RealSenseCamera:
             pub.publish(msg)
         if not self.publish_tf or not transforms:
             return
-        TFMessage = get_message_class("tf2_msgs/TFMessage")
-        TransformStamped = get_message_class("geometry_msgs/TransformStamped")
+        TFMessage = _msg("tf2_msgs/TFMessage")
+        TransformStamped = _msg("geometry_msgs/TransformStamped")
         msgs = []
         for t in transforms:
             m = TransformStamped()
@@ -453,8 +464,8 @@ class RealSenseCamera:
         self.pubs[f"{key}_info"].publish(info)
 
     def _publish_cloud(self, cloud: Any, stamp: Time, frame_id: str) -> None:
-        PointCloud2 = get_message_class("sensor_msgs/PointCloud2")
-        PointField = get_message_class("sensor_msgs/PointField")
+        PointCloud2 = _msg("sensor_msgs/PointCloud2")
+        PointField = _msg("sensor_msgs/PointField")
         msg = PointCloud2()
         msg.header.stamp = stamp
         msg.header.frame_id = frame_id
@@ -474,7 +485,7 @@ class RealSenseCamera:
 def main(argv: list[str] | None = None) -> int:
     """``rosrun realsense2_camera realsense2_camera_node`` (and the node of rs_camera.launch)."""
     try:
-        import pyrealsense2 as rs  # noqa: PLC0415 - optional: only this node needs it
+        import pyrealsense2 as rs  # type: ignore[import-untyped]  # noqa: PLC0415 - optional, untyped
     except ImportError:
         print(NOT_INSTALLED, file=sys.stderr)
         return 1

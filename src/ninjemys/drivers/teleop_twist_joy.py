@@ -20,6 +20,12 @@ from typing import Any
 from ninjemys.idl.loader import get_message_class
 from ninjemys.node.run import run_node
 
+
+def _msg(type_name: str) -> Any:
+    """A message class, typed loosely: its fields are generated at run time."""
+    return get_message_class(type_name)
+
+
 LINEAR = ("x", "y", "z")
 ANGULAR = ("yaw", "pitch", "roll")
 
@@ -117,7 +123,7 @@ def _value(axes: Any, axis_map: dict[str, int], scale_map: dict[str, float], nam
 def start(node: Any) -> Teleop:
     """The node's publisher, subscriber and log lines (as the C++ node prints them)."""
     config = read_config(node.get_param)
-    teleop = Teleop(config, get_message_class("geometry_msgs/Twist"))
+    teleop = Teleop(config, _msg("geometry_msgs/Twist"))
     pub = node.publisher("cmd_vel", teleop.Twist, queue_size=1, latch=True)
     log = node.log
     log.info("Teleop enable button %i.", config.enable_button)
@@ -141,7 +147,7 @@ def start(node: Any) -> Teleop:
         if twist is not None:
             pub.publish(twist)
 
-    node.subscriber("joy", get_message_class("sensor_msgs/Joy"), on_joy, queue_size=1)
+    node.subscriber("joy", _msg("sensor_msgs/Joy"), on_joy, queue_size=1)
     return teleop
 
 

@@ -13,6 +13,7 @@ import socket
 import threading
 
 from ninjemys.errors import MasterError, MasterUnreachable, ProtocolError
+from ninjemys.net import auth
 from ninjemys.net.addresses import lookup_host, split_uri
 from ninjemys.net.addresses import master_uri as default_master_uri
 from ninjemys.wire import xmlrpc as wire
@@ -45,7 +46,8 @@ class MasterClient:
 
     def call_raw(self, method: str, *args: Any) -> Any:
         """One XML-RPC call with ``args`` exactly as given (no caller_id added); returns the raw value."""
-        request = wire.http_request(self._host, self._port, wire.dump_call(method, args))
+        body = wire.dump_call(method, args)
+        request = wire.http_request(self._host, self._port, body, extra_headers=auth.http_header_line(body))
         with self._lock:
             for attempt in (0, 1):
                 fresh = self._sock is None

@@ -18,6 +18,7 @@ import socket
 import time
 
 from ninjemys.errors import ProtocolError, TimeoutError_
+from ninjemys.net import auth
 from ninjemys.net.addresses import split_uri
 from ninjemys.net.loop import get_running_loop
 from ninjemys.net.loop import timeout as deadline
@@ -44,7 +45,8 @@ async def call(uri: str, method: str, params: tuple[Any, ...] | list[Any], timeo
         host, port = split_uri(uri)
     except ValueError as exc:
         raise ProtocolError(str(exc)) from None
-    request = wire.http_request(host, port, wire.dump_call(method, params), keep_alive=False)
+    body = wire.dump_call(method, params)
+    request = wire.http_request(host, port, body, keep_alive=False, extra_headers=auth.http_header_line(body))
     try:
         async with deadline(timeout):
             return await _exchange(host, port, request)

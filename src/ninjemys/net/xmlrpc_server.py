@@ -27,6 +27,7 @@ import socket
 from collections import deque
 
 from ninjemys.errors import ProtocolError
+from ninjemys.net import auth
 from ninjemys.net.addresses import advertised_host, lookup_host
 from ninjemys.net.loop import get_running_loop, is_numeric_host
 from ninjemys.wire import xmlrpc as wire
@@ -285,6 +286,13 @@ class _Connection:
             method, params = wire.parse_call(request.body)
         except ProtocolError as exc:
             self._write(wire.dump_fault(FAULT_PARSE, str(exc)), keep_alive)
+            return
+        refused = auth.check_http(request.headers, request.body)
+        if refused is not None:
+            log.warning(
+                "XML-RPC %s from %s refused: authentication failed: %s", method, self._peer(), refused
+            )
+            self._write(wire.dump_response([-1, f"authentication failed: {refused}", 0]), keep_alive)
             return
         try:
             result = self.server.call(method, params)

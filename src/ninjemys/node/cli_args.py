@@ -146,16 +146,19 @@ def user_remappings(argv: Sequence[str]) -> dict[str, str]:
     return {src: dst for src, dst in names.load_mappings(argv).items() if not src.startswith("__")}
 
 
-def parse_args(argv: Sequence[str], env: Mapping[str, str] | None = None) -> NodeArgs:
+def parse_args(
+    argv: Sequence[str], env: Mapping[str, str] | None = None, strict_names: bool = True
+) -> NodeArgs:
     """Read a node's command line and environment the way ROS 1 does.
 
     ``argv`` is the full command line including the program name (``sys.argv``); the returned
     ``argv`` is what ``rospy.myargv()`` gives: the same list without any ``x:=y`` argument.
+    ``strict_names=False`` takes any non-empty ``__name:=`` as given (rospy only warns about it).
     """
     env = os.environ if env is None else env
     argv = list(argv)
     name = _special_value(argv, "__name")
-    if name is not None and not names.is_legal_base_name(name):
+    if name is not None and strict_names and not names.is_legal_base_name(name):
         raise NameError_(
             f"__name:={name}: the node name must be a legal base name (a letter, then [A-Za-z0-9_])"
         )

@@ -4,7 +4,7 @@
 overview)::
 
               Debug  Info  Warn  Error  Fatal
-    stdout            X
+    stdout     (X)    X
     stderr                  X     X      X
     log file    X     X     X     X      X
     /rosout     (X)   X     X     X      X      (debug only when the level is DEBUG)
@@ -216,6 +216,8 @@ class NodeLog:
         """Log ``msg % args`` at ``level``; ``depth`` frames up is the call site recorded in /rosout."""
         if self._closed and level < WARN:
             return
+        if len(args) == 1 and isinstance(args[0], dict) and args[0]:
+            args = args[0]  # type: ignore[assignment]  # "%(a)s", {"a": 1}: the logging module's rule, as rospy
         text = str(msg) % args if args else str(msg)
         if exc_info:
             import traceback
@@ -226,8 +228,7 @@ class NodeLog:
         if level < self.level:
             return
         sim = self._ros_time() if self._ros_time is not None else None
-        if level != DEBUG:
-            self._write_console(level, format_console(level, text, wall, sim))
+        self._write_console(level, format_console(level, text, wall, sim))  # debug too, once enabled (rospy)
         if self._rosout is not None or self._held is not None:
             code = sys._getframe(depth)
             record = (
@@ -353,7 +354,7 @@ class NodeLog:
         return self._ros_time() if self._ros_time is not None else time.time()
 
     def _write_console(self, level: int, line: str) -> None:
-        stream = (self._stdout or sys.stdout) if level == INFO else (self._stderr or sys.stderr)
+        stream = (self._stdout or sys.stdout) if level <= INFO else (self._stderr or sys.stderr)
         color = _COLORS.get(level)
         if self._colorize and color and stream.isatty():
             line = color + line + _COLOR_RESET

@@ -28,7 +28,7 @@ import threading
 from collections.abc import Callable, Mapping
 
 from ninjemys import names, rostime
-from ninjemys.errors import MasterError, NinjemysError, ParameterError, ShutdownError
+from ninjemys.errors import MasterError, NinjemysError, ShutdownError
 from ninjemys.interrupt import wait_event
 from ninjemys.master.client import MasterClient
 from ninjemys.net.addresses import advertised_host, advertised_host_problem
@@ -38,6 +38,7 @@ from ninjemys.node import runtime as _runtime
 from ninjemys.node import timers, transport
 from ninjemys.node.clock import CLOCK_TOPIC, USE_SIM_TIME, Clock
 from ninjemys.node.log import INFO, NodeLog
+from ninjemys.node.params import ParamAccess
 from ninjemys.node.registration import Registrar
 from ninjemys.node.services import ServiceProxy, ServiceServer
 from ninjemys.node.slave import SlaveApi
@@ -49,10 +50,9 @@ if TYPE_CHECKING:
     from typing import Any
 
 _log = logging.getLogger(__name__)
-_UNSET = object()
 
 
-class Node:
+class Node(ParamAccess):
     """A ROS node: ``Node("talker")``, then ``publisher``, ``subscriber``, ``service``, ``service_proxy``."""
 
     def __init__(
@@ -71,6 +71,7 @@ class Node:
         log_level: int = INFO,
         log_file: str | None = None,
         default_clock: bool | None = None,
+        strict_names: bool = True,
     ) -> None:
         """Register node ``name`` with the master and start its servers, clock and logging.
 
@@ -90,11 +91,15 @@ class Node:
             log_file: the log file's path (``__log:=``), else ``<log dir>/<node>-<pid>.log``.
             default_clock: make this node's clock the one ``rostime.Time.now()`` reads. None
                 (default) takes the place when no live node holds it; True takes it anyway; False never.
+            strict_names: refuse names that ROS 1 calls illegal (``a b``, ``1x``, ``a-b``) for the
+                node and for what it resolves. False is rospy's leniency: such names are used as
+                given (rospy only warns) and the master decides what it registers.
         """
         if sim_time not in ("auto", True, False):
             raise ValueError(f"Node: sim_time must be 'auto', True or False, not {sim_time!r}")
-        if not name or not names.is_legal_name(name.lstrip("/")) or "~" in name:
+        if not name or "~" in name or (strict_names and not names.is_legal_name(name.lstrip("/"))):
             raise names.NameError_(f"node name [{name}] is not a legal ROS name")
+        self.strict_names = strict_names
         if anonymous:
             name = names.rospy_anonymous_name(name)
         ns = names.make_global_ns(namespace or "/")
@@ -207,7 +212,7 @@ class Node:
 
     def resolve_name(self, name: str) -> str:
         """Resolve ``name`` (relative, ``~private`` or global) in this node's namespace, then remap it."""
-        if not names.is_legal_name(name):
+        if not isinstance(name, str) or (self.strict_names and not names.is_legal_name(name)):
             raise names.NameError_(f"[{name}] is not a legal ROS graph name")
         return names.resolve_name(name, self.name, self.remappings)
 
@@ -427,45 +432,7 @@ class Node:
             return
         await server.accept(sock, header)
 
-    # -- parameters ------------------------------------------------------------------------------
-
-    def get_param(self, key: str, default: Any = _UNSET) -> Any:
-        """The value of ``key`` (resolved like a topic name); ``default`` if unset, else ParameterError."""
-        resolved = self.resolve_name(key)
-        try:
-            return self.master.get_param(resolved)
-        except MasterError as exc:
-            if getattr(exc, "code", None) not in (-1, 0):
-                raise  # unreachable master, protocol trouble: not "unset"
-            if default is not _UNSET:
-                return default
-            raise ParameterError(f"parameter [{resolved}] is not set") from None
-
-    def set_param(self, key: str, value: Any) -> None:
-        self.master.set_param(self.resolve_name(key), value)
-
-    def has_param(self, key: str) -> bool:
-        return bool(self.master.has_param(self.resolve_name(key)))
-
-    def delete_param(self, key: str) -> None:
-        resolved = self.resolve_name(key)
-        try:
-            self.master.delete_param(resolved)
-        except MasterError as exc:
-            if getattr(exc, "code", None) in (-1, 0):
-                raise ParameterError(f"parameter [{resolved}] is not set") from None
-            raise
-
-    def search_param(self, key: str) -> str | None:
-        try:
-            return self.master.search_param(key)
-        except MasterError as exc:
-            if getattr(exc, "code", None) in (-1, 0):
-                return None
-            raise
-
-    def get_param_names(self) -> list[str]:
-        return list(self.master.get_param_names())
+    # -- parameters (get/set/has/delete/search/get_param_names: ParamAccess) ----------------------
 
     def subscribe_param(self, key: str, callback: Callable[[str, Any], None]) -> Any:
         """Call ``callback(key, value)`` (on a helper thread) whenever ``key`` changes; returns the value now."""

@@ -21,6 +21,7 @@ import logging
 import socket
 import threading
 from collections.abc import Callable
+from functools import partial
 
 from ninjemys.errors import MasterError, MasterUnreachable, ShutdownError
 from ninjemys.master.client import MasterClient
@@ -70,9 +71,33 @@ class Registrar:
             return fn()
         except MasterUnreachable as exc:
             if not self._master_down:
-                _log.warning("%s: master unreachable, will register when it is back (%s)", what, exc)
+                # rospy's words (ours re-registers by itself when the master comes back)
+                _log.warning(
+                    "Unable to register with master node [%s]: master may not be running yet. Will keep trying.",
+                    self.node.master_uri,
+                )
+                _log.debug("%s: %s", what, exc)
             self._master_down = True
             return None
+        except MasterError as exc:
+            if getattr(self.node, "strict_names", True) or getattr(exc, "status", None) is None:
+                raise
+            # rospy's leniency (a node named "a b" registers its ~get_loggers as "/a b/get_loggers"):
+            # the master refuses, rospy logs FATAL in its own words and the node runs on without it.
+            self._refused(what, str(getattr(exc, "status", exc)))
+            return None
+
+    def _refused(self, what: str, status: str) -> None:
+        kind, _, name = what.partition(" ")
+        noun = {"publisher": "publication", "subscriber": "subscription"}.get(kind, kind)
+        log = getattr(self.node, "log", None)
+        text = f"unable to register {noun} [{name}] with master: {status}"
+        if log is None:
+            _log.critical("%s", text)
+        else:
+            from ninjemys.node.log import FATAL
+
+            log.log(FATAL, "%s", text)
 
     def add_publisher(self, topic: str, type_name: str) -> None:
         with self._lock:
@@ -218,16 +243,27 @@ class Registrar:
                 "master at %s does not know %s: registering again", self.node.master_uri, self.node.name
             )
         master, uri = self._probe, self.node.uri
+
+        def again(fn: Callable[[], object]) -> object | None:
+            try:
+                return fn()
+            except MasterUnreachable:
+                raise
+            except MasterError as exc:  # a name this master refuses (rospy's leniency): skip it
+                _log.debug("re-registration: %s", exc)
+                return None
+
         try:
             for topic, type_name in pubs.items():
-                master.register_publisher(topic, type_name, uri)
+                again(partial(master.register_publisher, topic, type_name, uri))
             for topic, type_name in subs.items():
-                publishers = master.register_subscriber(topic, type_name, uri)
-                self.node.publisher_update(topic, list(publishers))
+                publishers = again(partial(master.register_subscriber, topic, type_name, uri))
+                if isinstance(publishers, list):
+                    self.node.publisher_update(topic, list(publishers))
             for name, service_uri in srvs.items():
-                master.register_service(name, service_uri, uri)
+                again(partial(master.register_service, name, service_uri, uri))
             for key in keys:
-                master.subscribe_param(uri, key)
+                again(partial(master.subscribe_param, uri, key))
         except MasterError as exc:
             _log.info("re-registration interrupted: %s", exc)
             self._master_down = True

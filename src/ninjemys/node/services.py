@@ -29,6 +29,7 @@ from ninjemys.errors import (
     ShutdownError,
     TimeoutError_,
 )
+from ninjemys.net import auth
 from ninjemys.net.addresses import is_local_address, split_uri
 from ninjemys.node import transport
 from ninjemys.wire import headers
@@ -66,9 +67,13 @@ def probe(service: str, uri: str, timeout: float = 5.0, caller_id: str = "/rosse
     try:
         with socket.create_connection((host, port), timeout=timeout) as sock:
             fields = {"probe": "1", "md5sum": "*", "callerid": caller_id, "service": service}
-            sock.sendall(headers.encode_header(fields))
+            sock.sendall(headers.encode_header(auth.sign_fields(fields)))
             prefix = _recv_exact(sock, 4)
-            return headers.decode_header(_recv_exact(sock, headers.header_length(prefix)))
+            reply = headers.decode_header(_recv_exact(sock, headers.header_length(prefix)))
+            refused = auth.check_fields(reply)
+            if refused is not None:
+                raise ServiceError(f"service [{service}] at {uri}: authentication failed: {refused}")
+            return reply
     except (OSError, NinjemysError) as exc:
         raise ServiceError(
             f"Unable to communicate with service [{service}], address [{uri}]: {exc}"
@@ -84,6 +89,11 @@ def _recv_exact(sock: socket.socket, n: int) -> bytes:
         chunks.append(chunk)
         have += len(chunk)
     return b"".join(chunks)
+
+
+class RequestArgumentError(ServiceError, TypeError):
+    """Call arguments that do not make a request of the service's type. Also a TypeError, which is
+    what rospy raises for them (code written for rospy may catch it)."""
 
 
 class _Link:
@@ -264,7 +274,7 @@ class ServiceServer:
             await transport.send_error_header(sock, error)
             transport.close_quietly(sock)
             return
-        await transport.write_all(sock, headers.encode_header(self._reply_header()))
+        await transport.write_all(sock, headers.encode_header(auth.sign_fields(self._reply_header())))
         if header.get("probe") == "1":
             transport.close_quietly(sock)
             return
@@ -330,7 +340,10 @@ class ServiceServer:
         if isinstance(exc, ServiceError):
             _log.debug("service %s: handler refused the request: %s", self.name, exc)
             return encode_service_response(False, f"service cannot process request: {exc}")
-        _log.error("service %s: error processing request: %s", self.name, exc)
+        if getattr(exc, "ninjemys_reported", False):  # the handler's owner (rospy) logged it already
+            _log.debug("service %s: error processing request: %s", self.name, exc)
+        else:
+            _log.error("service %s: error processing request: %s", self.name, exc)
         return encode_service_response(False, f"error processing request: {exc}")
 
     @property
@@ -435,7 +448,7 @@ class ServiceProxy:
             try:
                 request = self.request_class(*args, **kwargs)
             except TypeError as exc:
-                raise ServiceError(f"service [{self.name}]: bad request arguments: {exc}") from None
+                raise RequestArgumentError(f"service [{self.name}]: bad request arguments: {exc}") from None
         payload = request.serialize_to_bytes()
         frame = _U32.pack(len(payload)) + payload
         if not args and not kwargs:
@@ -477,9 +490,12 @@ class ServiceProxy:
             elif self.persistent:
                 fields["persistent"] = "1"
             fields.update(self.headers)
-            sock.sendall(headers.encode_header(fields))
+            sock.sendall(headers.encode_header(auth.sign_fields(fields)))
             link = _Link(sock, 4096 if probe else 1 << 16)
             reply = link.header()
+            refused = auth.check_fields(reply)
+            if refused is not None:
+                reply = {"error": f"authentication failed: {refused}"}
         except (OSError, NinjemysError) as exc:
             transport.close_quietly(sock)
             raise ServiceError(f"service [{self.name}]: handshake failed: {exc}") from None

@@ -44,7 +44,7 @@ from collections import deque
 from collections.abc import Callable, Mapping
 
 from ninjemys.errors import NinjemysError, ProtocolError
-from ninjemys.net import xmlrpc_client
+from ninjemys.net import auth, xmlrpc_client
 from ninjemys.node import transport
 from ninjemys.node.topics import connection_ids
 from ninjemys.records import SlotRecord
@@ -301,7 +301,12 @@ class Subscription:
             await transport.connect(sock, address, timeout=5.0)
             await transport.write_all(sock, headers.encode_header(self._header()))
             header = await transport.read_header(sock)
-            error = headers.check_publisher_header(header, self.type_name, self.md5sum)
+            refused = auth.check_fields(header)
+            error = (
+                f"authentication failed: {refused}"
+                if refused is not None
+                else headers.check_publisher_header(header, self.type_name, self.md5sum)
+            )
             if error is not None:
                 _log.warning("topic %s: cannot subscribe to %s: %s", self.topic, uri, error)
                 transport.close_quietly(sock)
@@ -329,14 +334,16 @@ class Subscription:
             self._connecting.discard(uri)
 
     def _header(self) -> dict[str, str]:
-        return {
-            "callerid": self.node.name,
-            "topic": self.topic,
-            "md5sum": self.md5sum,
-            "type": self.type_name,
-            "message_definition": self.definition,
-            "tcp_nodelay": "1" if self.tcp_nodelay else "0",
-        }
+        return auth.sign_fields(
+            {
+                "callerid": self.node.name,
+                "topic": self.topic,
+                "md5sum": self.md5sum,
+                "type": self.type_name,
+                "message_definition": self.definition,
+                "tcp_nodelay": "1" if self.tcp_nodelay else "0",
+            }
+        )
 
     def _hand(self, op: tuple[str, SubConnection]) -> None:
         """Give a connection to (or take it from) the reader's worker thread."""

@@ -242,6 +242,8 @@ RESOURCES: tuple[Resource, ...] = (
     Resource("queue", "ninjemys.net.xmlrpc_server:_Connection.queue", LOOP, "none (requests in order)"),
     Resource("queue", "ninjemys.net.xmlrpc_server:_Connection.out", LOOP, "none (response bytes not yet sent)"),
     Resource("lock", "ninjemys.master.client:MasterClient._lock", USER + " (caller)", "one call at a time"),
+    Resource("lock", "ninjemys.net.auth:Signer._lock", "any thread checking a signature",
+             "held only to remember an accepted nonce and forget expired ones"),
     Resource("lock", "ninjemys.nav.move_base_node:MoveBase.lock", "move_base-control",
              "the planner, costmap and scan threads and the services: the state machine and the costmaps; "
              "the action server's callbacks never take it (they hold the server's lock, which the control "

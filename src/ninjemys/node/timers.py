@@ -70,6 +70,11 @@ def sleep(clock: Clock, duration: Any) -> None:
         raise TimeMovedBackwardsError(start, clock.now())
 
 
+class RateError(NinjemysError, ValueError, ZeroDivisionError):
+    """A Rate with no usable frequency. Also a ZeroDivisionError, because ``rospy.Rate(0)`` raises
+    one (it divides by the frequency), and code written for rospy may catch that."""
+
+
 class Rate:
     """Loop at a fixed frequency: call :meth:`sleep` once per iteration.
 
@@ -82,7 +87,7 @@ class Rate:
 
     def __init__(self, hz: float, clock: Clock, reset: bool = True) -> None:
         if hz <= 0:
-            raise ValueError(f"Rate: frequency must be positive, got {hz}")
+            raise RateError(f"Rate: frequency must be positive, got {hz}")
         self.period = 1.0 / hz
         self._clock = clock
         self._reset = reset

@@ -30,6 +30,7 @@ from collections import deque
 from collections.abc import Callable, Mapping
 
 from ninjemys.errors import SerializationError, ShutdownError
+from ninjemys.net import auth
 from ninjemys.node import transport
 from ninjemys.wire import headers
 from ninjemys.wire.tcpros import pack_len
@@ -433,7 +434,7 @@ class Publication:
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         conn = PubConnection(self.node, sock, self.topic, who)
         with self.lock:
-            reply = headers.encode_header(self.reply_header({}))
+            reply = headers.encode_header(auth.sign_fields(self.reply_header({})))
             latched = b"".join(h.latched for h in self.handles if h.latch and h.latched is not None)
             conn.send(reply + latched, queue_size=0)
             conn.num_sent = 1 if latched else 0

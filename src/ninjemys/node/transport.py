@@ -21,6 +21,7 @@ import sys
 from collections.abc import Callable
 
 from ninjemys.errors import ProtocolError
+from ninjemys.net import auth
 from ninjemys.net.loop import get_running_loop, sleep
 from ninjemys.net.loop import timeout as deadline
 from ninjemys.wire import headers
@@ -212,6 +213,14 @@ class TcprosServer:
         except (ProtocolError, OSError, TimeoutError) as exc:
             why = "no connection header within the deadline" if isinstance(exc, TimeoutError) else exc
             _log.warning("TCPROS: dropped inbound connection from %s: %s", peer_name(sock), why)
+            close_quietly(sock)
+            return
+        refused = auth.check_fields(header)
+        if refused is not None:
+            who = header.get("callerid", peer_name(sock))
+            _log.warning("TCPROS: refused %s (%s): authentication failed: %s", who,
+                         header.get("topic") or header.get("service") or "?", refused)  # fmt: skip
+            await send_error_header(sock, f"authentication failed: {refused}")
             close_quietly(sock)
             return
         try:

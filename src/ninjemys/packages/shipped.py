@@ -43,6 +43,7 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
             "mimic": ("ninjemys.sim.mimic:main", ()),
         },
         "rqt_graph": {"rqt_graph": ("ninjemys.web.rqt_graph:main", ())},
+        "smach_viewer": {"smach_viewer.py": ("ninjemys.web.smach_viewer:main", ())},
         "rviz": {"rviz": ("ninjemys.web.rviz:main", ())},
         "rqt_gui": {"rqt_gui": ("ninjemys.web.rqt:rqt_main", ())},
         "rqt_plot": {"rqt_plot": ("ninjemys.web.rqt:plot_main", ())},
@@ -131,6 +132,18 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
         "joy": {"joy_node": ("ninjemys.drivers.joy_node:main", ())},
         "teleop_twist_joy": {"teleop_node": ("ninjemys.drivers.teleop_twist_joy:main", ())},
         "realsense2_camera": {"realsense2_camera_node": ("ninjemys.drivers.realsense_node:main", ())},
+        "rosserial_python": {"serial_node.py": ("ninjemys.drivers.rosserial_node:main", ())},
+        "rosserial_server": {
+            "serial_node": ("ninjemys.drivers.rosserial_node:main", ()),
+            "socket_node": ("ninjemys.drivers.rosserial_node:socket_main", ()),
+        },
+        "rplidar_ros": {"rplidarNode": ("ninjemys.drivers.rplidar_node:main", ())},
+        # -- ros_control (docs/sim.md): the manager runs inside the simulator --
+        "controller_manager": {
+            "spawner": ("ninjemys.sim.ros_control.spawner:main", ()),
+            "unspawner": ("ninjemys.sim.ros_control.spawner:unspawner_main", ()),
+            "controller_manager": ("ninjemys.sim.ros_control.cm_command:main", ()),
+        },
         "xacro": {
             "xacro": ("ninjemys.tools.xacro:main", ()),
             "xacro.py": ("ninjemys.tools.xacro:main", ()),

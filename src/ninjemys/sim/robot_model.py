@@ -40,6 +40,7 @@ class LaserSpec:
     # first beam's angle and the last one's; None for the last: a full turn less one increment
     angle_min: float = -math.pi
     angle_max: float | None = None
+    range_resolution: float = 0.0  # ranges rounded to this step (Gazebo's <range><resolution>); 0: none
 
 
 @dataclass
@@ -85,6 +86,15 @@ class DriveSpec:
     publish_wheel_speeds: bool = True  # the PuzzleBot's wl/wr encoder topics
     odometry_source: str = "encoder"  # or "world" (ground truth), as gazebo_ros_diff_drive's odometrySource
     update_rate: float | None = None  # None: RobotModel.odom_rate
+    # the drive's own kinematics (gazebo_ros_diff_drive's wheelSeparation and wheelDiameter/2): the
+    # wheel speeds for a cmd_vel are computed with these, the motion follows the URDF's wheels, so a
+    # plugin value that differs from the geometry turns the robot at the rate Gazebo would. None: the model's.
+    wheel_separation: float | None = None
+    wheel_radius: float | None = None
+    joint_states_topic: str = "joint_states"  # publishWheelJointState's topic
+    # ros_control: the namespace of gazebo_ros_control's controller_manager and the description parameter
+    controller_namespace: str = "/"
+    robot_param: str = "robot_description"
 
 
 @dataclass
@@ -107,6 +117,12 @@ class RobotModel:
     source: str = field(default="")
     drive: DriveSpec = field(default_factory=DriveSpec)
     ignored_plugins: list[str] = field(default_factory=list)  # named once in a warning at spawn
+    warnings: list[str] = field(default_factory=list)  # what the description lacks, logged once at spawn
+    # False for a Gazebo description: robot_state_publisher publishes the link frames, the simulator does not
+    sensor_tf: bool = True
+    # ros_control: the joints with a <transmission> and their side ("left", "right"; "" for a joint that
+    # is not a wheel): every wheel of a side turns as that side's wheel of the simulated body
+    control_joints: dict[str, str] = field(default_factory=dict)
 
 
 def _merge(base: dict, over: dict) -> dict:
@@ -208,12 +224,24 @@ def model_from_doc(doc: dict, f: Fields) -> RobotModel:
     )
 
 
-def load_robot_model(spec: str = "puzzlebot") -> RobotModel:
-    """``puzzlebot`` (or another shipped name), a YAML description path, or a URDF path / text."""
+def load_robot_model(
+    spec: str = "puzzlebot", *, robot_namespace: str | None = None, gazebo: bool | None = None
+) -> RobotModel:
+    """``puzzlebot`` (or another shipped name), a YAML description path, or a URDF/xacro path or text.
+
+    ``gazebo`` picks the rules a URDF is read by: Gazebo's (``<gazebo>`` plugins say what drives and
+    publishes; none: passive) or ours (the PuzzleBot's topics, with the URDF's geometry). ``None``
+    decides by the presence of ``<gazebo>`` blocks; spawn_model passes True.
+    """
     text_is_urdf = spec.lstrip().startswith("<")
     if text_is_urdf:
-        return model_from_urdf(spec, "<robot_description>")
+        return model_from_urdf(spec, "<robot_description>", robot_namespace=robot_namespace, gazebo=gazebo)
     path = Path(spec).expanduser()
+    if path.suffix == ".xacro":
+        from ninjemys.sim.description.build import expand_xacro
+
+        text = expand_xacro(str(path))
+        return model_from_urdf(text, str(path), robot_namespace=robot_namespace, gazebo=gazebo)
     if "/" not in spec and not spec.endswith((".yaml", ".yml", ".urdf")):
         path = ROBOTS_DIR / f"{spec}.yaml"
         if not path.is_file():
@@ -226,7 +254,7 @@ def load_robot_model(spec: str = "puzzlebot") -> RobotModel:
     except OSError as exc:
         raise MapFileError(f"{path}: cannot read robot description: {exc.strerror or exc}") from None
     if path.suffix == ".urdf" or text.lstrip().startswith("<"):
-        return model_from_urdf(text, str(path))
+        return model_from_urdf(text, str(path), robot_namespace=robot_namespace, gazebo=gazebo)
     doc, lines = yaml_lines(text, str(path))
     f = Fields(str(path), lines)
     if not isinstance(doc, dict):
@@ -244,8 +272,15 @@ def _floats(text: str | None, n: int, where: str, source: str) -> list[float]:
     return values
 
 
-def model_from_urdf(text: str, source: str) -> RobotModel:
-    """The URDF subset: base link cylinder, continuous wheel joints, fixed sensor joints."""
+def model_from_urdf(
+    text: str, source: str, *, robot_namespace: str | None = None, gazebo: bool | None = None
+) -> RobotModel:
+    """A URDF under Gazebo's rules (see :mod:`ninjemys.sim.description`) or, without ``<gazebo>``
+    blocks, our subset: base link cylinder, continuous wheel joints, fixed sensor joints."""
+    from ninjemys.sim.description.build import has_gazebo_blocks, model_from_description
+
+    if gazebo or (gazebo is None and has_gazebo_blocks(text)):
+        return model_from_description(text, source, robot_namespace=robot_namespace)
     try:
         root = ET.fromstring(text)
     except ET.ParseError as exc:

@@ -127,33 +127,16 @@ class Camera:
         self._lanes1 = _padded_empty((height, width), np.uint16)
 
     def render(self, scene: Scene, x: float, y: float, yaw: float) -> tuple[np.ndarray, np.ndarray]:
-        """(rgb8 image (H, W, 3), depth in mm uint16 (H, W)) from a camera at (x, y, cam_z) facing ``yaw``."""
+        """(rgb8 image (H, W, 3), depth in mm uint16 (H, W)) from a camera at (x, y, cam_z) facing ``yaw``.
+
+        Each column shows the nearest obstacle its rays meet between floor and top, and above that
+        obstacle whatever taller one stands behind it (a wall behind a cone): the nearest obstacle of
+        each height class (at least as tall as a threshold, :func:`layer_thresholds`) is one layer,
+        and a farther layer shows only above the nearer layers' tops.
+        """
         angles = yaw + self.col_angles
         far = self.depth_max / float(self.col_cos.min())
-        dist, seg = cast_segments(x, y, angles, scene.segments, far)
-        found = seg >= 0
-        if len(scene.heights):
-            # a column with no hit (-1) reads the last segment's: never drawn, ``found`` masks it out
-            heights, colors = scene.heights[seg], scene.colors[seg]
-        else:
-            heights, colors = np.zeros(self.width), np.zeros((self.width, 3), dtype=np.uint8)
-        if len(scene.circles):
-            cd, ci = cast_circles(x, y, angles, scene.circles, scene.radii, far)
-            nearer = cd < dist
-            dist = np.where(nearer, cd, dist)
-            heights[nearer] = scene.circle_heights[ci[nearer]]
-            colors[nearer] = scene.circle_colors[ci[nearer]]
-            found |= nearer
-        depth = dist * self.col_cos  # along the optical axis
-        found &= depth <= self.depth_max
-        # rows v whose ray meets the column's obstacle between its foot and its top:
-        # 0 <= cam_z + slope_v * depth <= height, i.e. slope_v in [-cam_z / depth, (height - cam_z) / depth]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            lo_slope = np.where(found, -self.cam_z / depth, np.inf)
-            hi_slope = np.where(found, (heights - self.cam_z) / depth, -np.inf)
-        # row_slope decreases with v: searchsorted on its negation
-        top = np.searchsorted(self._neg_slope, -hi_slope, "left").astype(self._row_type)
-        bottom = np.searchsorted(self._neg_slope, -lo_slope, "right").astype(self._row_type)
+        found, depth, top, bottom, colors, heights = self._layer(scene, x, y, angles, far, None)
         rows = self._rows
         wall = rows >= top
         wall &= rows < bottom
@@ -166,12 +149,101 @@ class Camera:
         np.less(rows, np.repeat(bottom, 3), out=self._below3)
         wall3 &= self._below3
         rgb = _select(self._lanes3, col, self._background).reshape(self.height, self.width, 3)
-        if scene.floor is not None:
-            self._paint_floor(rgb, wall, scene.floor, x, y, yaw)
         wall_mm = np.rint(np.where(found, depth, 0.0) * 1000.0).astype(np.uint16)
         np.copyto(self._lanes1, wall)
         depth_mm = _select(self._lanes1, wall_mm[None, :], self._floor_depth_image)
+        cut = (
+            top.copy()
+        )  # rows at or below a nearer layer's top are that layer's (or the floor in front of it)
+        seen_height = np.where(found, heights, np.inf)  # the first layer's obstacle, per column
+        for threshold in layer_thresholds(scene, self.cam_z):
+            # only columns whose nearest obstacle is shorter than the class can show a farther one
+            cols = np.flatnonzero(seen_height < threshold)
+            if not len(cols):
+                continue
+            found_c, depth_c, top_c, bottom_c, colors_c, heights_c = self._layer(
+                scene, x, y, angles[cols], far, threshold, cols
+            )
+            bottom_c = np.minimum(bottom_c, cut[cols])
+            visible = found_c & (top_c < bottom_c)
+            seen_height[cols] = np.where(found_c, np.maximum(seen_height[cols], heights_c), np.inf)
+            if not visible.any():
+                cut[cols] = np.minimum(cut[cols], top_c)
+                continue
+            # the farther layer's visible rows lie in one band: masked copies over that band only
+            vis = cols[visible]
+            top_v, bottom_v = top_c[visible], bottom_c[visible]
+            r0, r1 = int(top_v.min()), int(bottom_v.max())
+            band = rows[r0:r1]
+            mask = (band >= top_v[None, :]) & (band < bottom_v[None, :])  # (rows of the band, visible cols)
+            depth_v = depth_c[visible]
+            light_v = np.clip(1.1 - depth_v / 15.0, 0.45, 1.0)
+            colour_v = (colors_c[visible] * light_v[:, None]).astype(np.uint8)
+            sub = rgb[r0:r1, vis]
+            np.copyto(sub, np.broadcast_to(colour_v[None, :, :], sub.shape), where=mask[:, :, None])
+            rgb[r0:r1, vis] = sub
+            mm_v = np.rint(depth_v * 1000.0).astype(np.uint16)
+            dsub = depth_mm[r0:r1, vis]
+            np.copyto(dsub, np.broadcast_to(mm_v[None, :], dsub.shape), where=mask)
+            depth_mm[r0:r1, vis] = dsub
+            wall[r0:r1, vis] |= mask
+            cut[cols] = np.minimum(cut[cols], top_c)
+        if scene.floor is not None:
+            self._paint_floor(rgb, wall, scene.floor, x, y, yaw)
         return rgb, depth_mm
+
+    def _layer(
+        self,
+        scene: Scene,
+        x: float,
+        y: float,
+        angles: np.ndarray,
+        far: float,
+        threshold: float | None,
+        cols: np.ndarray | None = None,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Per column (all, or the ``cols`` whose ``angles`` are given): whether an obstacle (at least
+        ``threshold`` tall) is seen, its depth along the optical axis, its top and foot rows
+        (``top <= v < bottom``), its colour and its height."""
+        segs, heights_all, colours_all = scene.segments, scene.heights, scene.colors
+        circles, radii, c_heights, c_colours = (
+            scene.circles,
+            scene.radii,
+            scene.circle_heights,
+            scene.circle_colors,
+        )
+        if threshold is not None:
+            tall = heights_all >= threshold
+            segs, heights_all, colours_all = segs[tall], heights_all[tall], colours_all[tall]
+            if len(circles):
+                tall_c = c_heights >= threshold
+                circles, radii = circles[tall_c], radii[tall_c]
+                c_heights, c_colours = c_heights[tall_c], c_colours[tall_c]
+        dist, seg = cast_segments(x, y, angles, segs, far)
+        found = seg >= 0
+        if len(heights_all):
+            # a column with no hit (-1) reads the last segment's: never drawn, ``found`` masks it out
+            heights, colors = heights_all[seg], colours_all[seg]
+        else:
+            heights, colors = np.zeros(len(angles)), np.zeros((len(angles), 3), dtype=np.uint8)
+        if len(circles):
+            cd, ci = cast_circles(x, y, angles, circles, radii, far)
+            nearer = cd < dist
+            dist = np.where(nearer, cd, dist)
+            heights[nearer] = c_heights[ci[nearer]]
+            colors[nearer] = c_colours[ci[nearer]]
+            found |= nearer
+        depth = dist * (self.col_cos if cols is None else self.col_cos[cols])  # along the optical axis
+        found &= depth <= self.depth_max
+        # rows v whose ray meets the column's obstacle between its foot and its top:
+        # 0 <= cam_z + slope_v * depth <= height, i.e. slope_v in [-cam_z / depth, (height - cam_z) / depth]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            lo_slope = np.where(found, -self.cam_z / depth, np.inf)
+            hi_slope = np.where(found, (heights - self.cam_z) / depth, -np.inf)
+        # row_slope decreases with v: searchsorted on its negation
+        top = np.searchsorted(self._neg_slope, -hi_slope, "left").astype(self._row_type)
+        bottom = np.searchsorted(self._neg_slope, -lo_slope, "right").astype(self._row_type)
+        return found, depth, top, bottom, colors, heights
 
     def _paint_floor(
         self, rgb: np.ndarray, wall: np.ndarray, paint: FloorPaint, x: float, y: float, yaw: float
@@ -198,6 +270,27 @@ class Camera:
 
     def intrinsics(self) -> tuple[float, float, float, float]:
         return self.fx, self.fy, self.cx, self.cy
+
+
+#: at most this many extra layers (height classes) per frame: a scene with many distinct heights
+#: gets the tallest ones and evenly spaced ones between (exact for the classes kept)
+MAX_EXTRA_LAYERS = 3
+
+
+def layer_thresholds(scene: Scene, cam_z: float) -> list[float]:
+    """Heights above which a farther obstacle can show over a nearer, shorter one: the scene's
+    distinct obstacle heights but the lowest (that class is everything: the first layer), thinned
+    to :data:`MAX_EXTRA_LAYERS`. None when all obstacles are equally tall (the common case)."""
+    heights = (
+        scene.heights if not len(scene.circles) else np.concatenate([scene.heights, scene.circle_heights])
+    )
+    if not len(heights):
+        return []
+    distinct = np.unique(heights)[1:]
+    if len(distinct) > MAX_EXTRA_LAYERS:
+        picks = np.linspace(0, len(distinct) - 1, MAX_EXTRA_LAYERS).round().astype(int)
+        distinct = distinct[np.unique(picks)]
+    return [float(h) for h in distinct]
 
 
 def _padded_empty(shape: tuple[int, ...], dtype: type) -> np.ndarray:

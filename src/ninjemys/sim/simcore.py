@@ -95,8 +95,11 @@ class Robot:
     def command(self, linear: float, angular: float) -> None:
         """Set the body velocity to reach (cmd_vel): wheel targets, scaled together to the speed limit."""
         m = self.model
-        wr = (linear + angular * m.wheel_separation / 2.0) / m.wheel_radius
-        wl = (linear - angular * m.wheel_separation / 2.0) / m.wheel_radius
+        # the drive's own kinematics (a Gazebo plugin's wheelSeparation/wheelDiameter), the body's otherwise
+        sep = m.drive.wheel_separation or m.wheel_separation
+        rad = m.drive.wheel_radius or m.wheel_radius
+        wr = (linear + angular * sep / 2.0) / rad
+        wl = (linear - angular * sep / 2.0) / rad
         peak = max(abs(wl), abs(wr))
         if peak > m.max_wheel_speed:
             wl *= m.max_wheel_speed / peak

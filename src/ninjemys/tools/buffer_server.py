@@ -18,7 +18,7 @@ import actionlib
 import rospy
 import tf2_ros
 from ninjemys.tf2 import errors
-from ninjemys.tools.cli import entry
+from ninjemys.tools.cli import entry, wait_for_master_like_roscpp
 from tf2_msgs.msg import LookupTransformAction, LookupTransformResult, TF2Error
 
 #: tf2's exceptions -> the error code the result carries (checked in order: the most specific first)
@@ -115,6 +115,8 @@ class BufferServer:
 def main(argv: list[str] | None = None) -> int:
     full = [sys.argv[0] if argv is None else "buffer_server", *(sys.argv[1:] if argv is None else argv)]
     rospy.init_node("tf_buffer", argv=full)
+    if not wait_for_master_like_roscpp(rospy.core.process_node()):
+        return 0  # Ctrl-C while waiting for the master, as roscpp: a quiet exit
     buffer_size = float(rospy.get_param("~buffer_size", 120.0))
     buffer = tf2_ros.Buffer(rospy.Duration.from_sec(buffer_size), debug=False)
     tf2_ros.TransformListener(buffer)

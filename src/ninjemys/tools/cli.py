@@ -29,6 +29,42 @@ def master(caller_id: str = "/ninjemys_tool") -> MasterClient:
     return MasterClient(caller_id=caller_id, timeout=10.0)
 
 
+def wait_for_master_like_roscpp(node: Any) -> bool:
+    """Wait for the master as a roscpp node does (tf_echo, tf_monitor, static_transform_publisher,
+    buffer_server are roscpp programs in ROS 1): with no master, roscpp prints one ERROR line and
+    retries until it answers, then says it connected. False if the node shut down meanwhile (Ctrl-C).
+
+    This is a poll by nature (a master that is not running sends no event); roscpp retries every
+    quarter second too, and the wait ends at once on shutdown.
+    """
+    import sys
+    import time
+
+    from ninjemys.errors import MasterUnreachable
+    from ninjemys.net.addresses import split_uri
+
+    host, port = split_uri(node.master_uri)
+    failed = False
+    while True:
+        try:
+            node.master.get_pid()
+        except MasterUnreachable:
+            if not failed:
+                sys.stderr.write(
+                    f"[ERROR] [{time.time():.9f}]: [registerPublisher] Failed to contact master at "
+                    f"[{host}:{port}].  Retrying...\n"
+                )
+                sys.stderr.flush()
+                failed = True
+            if node.wait_for_shutdown(0.25):
+                return False
+            continue
+        if failed:
+            sys.stdout.write(f"[ INFO] [{time.time():.9f}]: Connected to master at [{host}:{port}]\n")
+            sys.stdout.flush()
+        return True
+
+
 class _Unused:
     """Stands in for the parser of a subcommand that was not invoked (nothing to build)."""
 

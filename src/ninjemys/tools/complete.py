@@ -59,9 +59,14 @@ def _request(method: str, params: tuple[str, ...], host: str) -> bytes:
         f"<?xml version='1.0'?><methodCall><methodName>{method}</methodName>"
         f"<params>{body}</params></methodCall>"
     ).encode()
+    signature = ""
+    if os.environ.get("NINJEMYS_SECRET") or os.environ.get("NINJEMYS_SECRET_FILE"):
+        from ninjemys.net import auth  # only a graph with a secret pays for signing
+
+        signature = auth.http_header_line(payload)
     head = (
         f"POST /RPC2 HTTP/1.1\r\nHost: {host}\r\nContent-Type: text/xml\r\n"
-        f"Content-Length: {len(payload)}\r\nConnection: close\r\n\r\n"
+        f"Content-Length: {len(payload)}\r\n{signature}Connection: close\r\n\r\n"
     ).encode()
     return head + payload
 

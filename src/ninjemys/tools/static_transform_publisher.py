@@ -17,7 +17,7 @@ import sys
 from typing import Any
 
 from ninjemys.tf2.math import quaternion_from_rpy
-from ninjemys.tools.cli import entry
+from ninjemys.tools.cli import entry, wait_for_master_like_roscpp
 from ninjemys.tools.tf_echo import atof
 
 TF2_USAGE = (
@@ -103,6 +103,8 @@ def main(argv: list[str] | None = None) -> int:
         )
         return 255
     rospy.init_node("static_transform_publisher", argv=full, anonymous=True)
+    if not wait_for_master_like_roscpp(rospy.core.process_node()):
+        return 0  # Ctrl-C while waiting for the master, as roscpp: a quiet exit
     if len(args) == 1:
         got = _from_param(rospy, args[0])
         if got is None:
@@ -146,6 +148,8 @@ def tf_main(argv: list[str] | None = None) -> int:
         )
         return 255
     rospy.init_node("static_transform_publisher", argv=full, anonymous=True)
+    if not wait_for_master_like_roscpp(rospy.core.process_node()):
+        return 0  # Ctrl-C while waiting for the master, as roscpp: a quiet exit
     period = atof(args[-1]) / 1000.0
     parent, child = args[-3], args[-2]
     if parent == child:

@@ -11,7 +11,7 @@ import math
 import re
 import sys
 
-from ninjemys.tools.cli import entry
+from ninjemys.tools.cli import entry, wait_for_master_like_roscpp
 
 USAGE = (
     "Usage: tf_echo source_frame target_frame [echo_rate]\n\n"
@@ -68,6 +68,8 @@ def main(argv: list[str] | None = None) -> int:
         sys.stdout.write(USAGE)
         return 255
     rospy.init_node("tf_echo", argv=full, anonymous=True)
+    if not wait_for_master_like_roscpp(rospy.core.process_node()):
+        return 0  # Ctrl-C while waiting for the master, as roscpp: a quiet exit
     rate_hz = atof(args[3]) if len(args) == 4 else float(rospy.get_param("~rate", 1.0))
     if rate_hz <= 0.0:
         sys.stderr.write("Echo rate must be > 0.0\n")

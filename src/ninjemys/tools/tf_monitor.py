@@ -12,7 +12,7 @@ import sys
 import threading
 from collections import deque
 
-from ninjemys.tools.cli import entry
+from ninjemys.tools.cli import entry, wait_for_master_like_roscpp
 
 
 class Monitor:
@@ -77,6 +77,8 @@ def main(argv: list[str] | None = None) -> int:
         return 255
     rospy.init_node("tf_monitor", argv=full, anonymous=True)
     node = rospy.core.process_node()
+    if not wait_for_master_like_roscpp(rospy.core.process_node()):
+        return 0  # Ctrl-C while waiting for the master, as roscpp: a quiet exit
     buffer = tf2_ros.Buffer(debug=False)
     tf2_ros.TransformListener(buffer)
     monitor = Monitor()

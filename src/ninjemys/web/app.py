@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING
 from ninjemys.errors import NinjemysError
 from ninjemys.idl.loader import get_message_class
 from ninjemys.serve.http import HttpError, HttpServer, Request, Response
+from ninjemys.web import resources
 
 if TYPE_CHECKING:
     from ninjemys.bridge.server import Gateway
@@ -89,6 +90,8 @@ class WebApp:
         s.route("GET", "/", lambda _r: self._static_page("graph.html"))
         s.route("GET", "/graph", lambda _r: self._static_page("graph.html"))
         s.route("GET", "/api/pages", lambda _r: Response([p.__dict__ for p in self.pages]))
+        # mesh files of robot descriptions (package://, file://), for rviz's RobotModel
+        s.route("GET", resources.ROUTE, resources.Resources().handle)
 
     def _static_page(self, name: str) -> Response:
         return Response((STATIC_DIR / name).read_bytes(), 200, "text/html; charset=utf-8")

@@ -496,14 +496,17 @@ def http_response(body: bytes, status: int = 200, keep_alive: bool = True) -> by
     return head.encode("latin-1") + body
 
 
-def http_request(host: str, port: int, body: bytes, path: str = "/RPC2", keep_alive: bool = True) -> bytes:
-    """A complete HTTP/1.1 POST carrying an XML-RPC call."""
+def http_request(
+    host: str, port: int, body: bytes, path: str = "/RPC2", keep_alive: bool = True, extra_headers: str = ""
+) -> bytes:
+    """A complete HTTP/1.1 POST carrying an XML-RPC call (``extra_headers``: whole ``Name: value\\r\\n`` lines)."""
     head = (
         f"POST {path} HTTP/1.1\r\n"
         f"Host: {host}:{port}\r\n"
         "User-Agent: ninjemys\r\n"
         "Content-Type: text/xml\r\n"
         f"Content-Length: {len(body)}\r\n"
+        f"{extra_headers}"
         f"Connection: {'keep-alive' if keep_alive else 'close'}\r\n\r\n"
     )
     return head.encode("latin-1") + body

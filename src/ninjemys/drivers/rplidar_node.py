@@ -1,0 +1,377 @@
+"""``rosrun rplidar_ros rplidarNode``: a Slamtec RPLIDAR on ``sensor_msgs/LaserScan``, as rplidar_ros 1.10.
+
+Parameters (private): ``serial_port`` (/dev/ttyUSB0), ``serial_baudrate`` (115200; A3: 256000),
+``frame_id`` (laser_frame), ``inverted`` (false), ``angle_compensate`` (false; the launch files set
+true), ``scan_mode`` ("" = the device's typical mode: Express when the firmware has it, else Standard).
+Publishes ``scan`` (queue 1000, as rplidar_ros); services ``stop_motor`` and ``start_motor``
+(std_srvs/Empty). Start-up follows rplidar_ros: device info (S/N, firmware, hardware), health (an
+error status stops the node with rplidar_ros' message), motor on, scan; each step's failure is one
+clear line. Scan modes are those of the legacy protocol (Standard and Express capsules); a mode the
+device does not list is refused with rplidar_ros' list of supported modes.
+
+The node owns the port: the services hand their work to the read loop, which does it between reads.
+"""
+
+from __future__ import annotations
+
+import queue
+import threading
+import time
+from typing import Any
+
+from ninjemys.drivers import rplidar_protocol as rp
+from ninjemys.drivers.rplidar_scan import RevolutionAssembler, compensate_multiple, revolution_to_scan
+from ninjemys.idl.loader import get_message_class, get_service_class
+from ninjemys.node.run import run_node
+
+SDK_VERSION = "1.12.0"
+#: legacy scan modes' range (the SDK's value when the device cannot be asked)
+LEGACY_MAX_DISTANCE = 16.0
+READ_TIMEOUT = 0.05
+ANSWER_TIMEOUT = 1.0
+#: reads of a scan stream wait until this much is there, or BATCH_WAIT has passed (CPU per sample)
+BATCH_BYTES = 4 * rp.CAPSULE_SIZE
+BATCH_WAIT = 0.01
+
+
+class ScanMode:
+    def __init__(self, ident: int, name: str, us_per_sample: float, max_distance: float, cmd: int) -> None:
+        self.id = ident
+        self.name = name
+        self.us_per_sample = us_per_sample
+        self.max_distance = max_distance
+        self.cmd = cmd
+
+
+class RplidarDevice:
+    """Requests and answers on an open port (pyserial-like: ``read(n)`` with a timeout, ``write``)."""
+
+    def __init__(self, port: Any) -> None:
+        self.port = port
+        self.motor_ctrl = False
+
+    def _read_exact(self, size: int, timeout: float) -> bytes:
+        deadline = time.monotonic() + timeout
+        data = b""
+        while len(data) < size:
+            chunk = self.port.read(size - len(data))
+            if chunk:
+                data += chunk
+            elif time.monotonic() > deadline:
+                break
+        return data
+
+    def _descriptor(self, cmd: int, timeout: float) -> rp.Descriptor:
+        """Skip to ``0xA5 0x5A`` and read the descriptor; check it is ``cmd``'s."""
+        deadline = time.monotonic() + timeout
+        prev = b""
+        while True:
+            b = self.port.read(1)
+            if not b:
+                if time.monotonic() > deadline:
+                    raise TimeoutError(f"no answer to {rp.COMMAND_NAMES[cmd]} within {timeout:.1f} s")
+                continue
+            if prev == b"\xa5" and b == b"\x5a":
+                rest = self._read_exact(5, timeout)
+                if len(rest) < 5:
+                    raise TimeoutError(f"the answer to {rp.COMMAND_NAMES[cmd]} stopped in its descriptor")
+                d = rp.Descriptor.unpack(b"\xa5\x5a" + rest)
+                d.check(cmd)
+                return d
+            prev = b
+
+    def ask(self, cmd: int, payload_request: bytes | None = None, timeout: float = ANSWER_TIMEOUT) -> bytes:
+        """Send ``cmd`` and return its single answer's data."""
+        self.port.reset_input_buffer()
+        self.port.write(payload_request if payload_request is not None else rp.request(cmd))
+        d = self._descriptor(cmd, timeout)
+        data = self._read_exact(d.length, timeout)
+        if len(data) < d.length:
+            raise TimeoutError(
+                f"the answer to {rp.COMMAND_NAMES[cmd]} stopped after {len(data)} of {d.length} bytes"
+            )
+        return data
+
+    def device_info(self) -> rp.DeviceInfo:
+        return rp.DeviceInfo.unpack(self.ask(rp.CMD_GET_INFO))
+
+    def health(self) -> rp.Health:
+        return rp.Health.unpack(self.ask(rp.CMD_GET_HEALTH))
+
+    def sample_rates(self) -> tuple[int, int]:
+        std, express = rp.struct.unpack("<HH", self.ask(rp.CMD_GET_SAMPLERATE))
+        return std, express
+
+    def check_motor_ctrl(self) -> bool:
+        """GET_ACC_BOARD_FLAG: A2/A3 (and A1 on an accessory board) take SET_MOTOR_PWM; others use DTR."""
+        try:
+            data = self.ask(rp.CMD_GET_ACC_BOARD_FLAG, rp.acc_board_flag_request(), timeout=0.3)
+        except (TimeoutError, rp.RplidarError):
+            data = b"\x00\x00\x00\x00"
+        self.motor_ctrl = bool(rp.struct.unpack("<I", data)[0] & 1)
+        return self.motor_ctrl
+
+    def _set_dtr(self, value: bool) -> None:
+        try:
+            self.port.dtr = value
+        except (OSError, ValueError, AttributeError):
+            pass  # a pseudo-terminal or a USB bridge without modem lines: nothing to switch
+
+    def start_motor(self) -> None:
+        if self.motor_ctrl:
+            self.port.write(rp.motor_pwm_request(rp.DEFAULT_MOTOR_PWM))
+        else:
+            self._set_dtr(False)  # A1: DTR low powers the motor
+
+    def stop_motor(self) -> None:
+        if self.motor_ctrl:
+            self.port.write(rp.motor_pwm_request(0))
+        else:
+            self._set_dtr(True)
+
+    def reset(self) -> None:
+        self.port.write(rp.request(rp.CMD_RESET))
+        time.sleep(0.002)
+
+    def stop(self) -> None:
+        self.port.write(rp.request(rp.CMD_STOP))
+        time.sleep(0.002)  # the protocol asks for 1 ms before the next request
+        self.port.reset_input_buffer()
+
+    def start_scan(self, mode: ScanMode) -> None:
+        self.stop()
+        self.port.reset_input_buffer()
+        if mode.cmd == rp.CMD_EXPRESS_SCAN:
+            self.port.write(rp.express_scan_request())
+        else:
+            self.port.write(rp.request(rp.CMD_SCAN))
+        self._descriptor(mode.cmd, ANSWER_TIMEOUT)
+
+
+def supported_modes(dev: RplidarDevice, info: rp.DeviceInfo) -> list[ScanMode]:
+    """The legacy protocol's modes: Standard, and Express on firmware 1.17 and later."""
+    try:
+        std_us, express_us = dev.sample_rates()
+    except (TimeoutError, rp.RplidarError):
+        std_us, express_us = 500, 0  # early A1 firmware: 2 kHz standard scans only
+    modes = [ScanMode(0, "Standard", float(std_us), LEGACY_MAX_DISTANCE, rp.CMD_SCAN)]
+    if info.firmware_version >= (1 << 8 | 17) and express_us:
+        modes.append(ScanMode(1, "Express", float(express_us), LEGACY_MAX_DISTANCE, rp.CMD_EXPRESS_SCAN))
+    return modes
+
+
+class RplidarNode:
+    def __init__(self, node: Any, port: Any, dev: RplidarDevice) -> None:
+        self.node = node
+        self.log = node.log
+        self.port = port
+        self.dev = dev
+        self.LaserScan: Any = get_message_class("sensor_msgs/LaserScan")
+        self.frame_id = str(node.get_param("~frame_id", "laser_frame"))
+        self.inverted = bool(node.get_param("~inverted", False))
+        self.angle_compensate = bool(node.get_param("~angle_compensate", False))
+        self.scan_mode_name = str(node.get_param("~scan_mode", ""))
+        self.pub = node.publisher("scan", self.LaserScan, queue_size=1000)
+        self.actions: queue.Queue[tuple[str, threading.Event]] = queue.Queue()
+        self.scanning = False
+        self.stopped = False  # by stop_motor: no scan until start_motor
+        self.mode: ScanMode | None = None
+        self.published = 0
+
+    def _service(self, action: str) -> Any:
+        Empty: Any = get_service_class("std_srvs/Empty")
+
+        def handle(_req: Any) -> Any:
+            done = threading.Event()
+            self.actions.put((action, done))
+            done.wait(5.0)
+            return Empty._response_class()
+
+        return self.node.service(action, Empty, handle)
+
+    def setup(self) -> int:
+        self.log.info("RPLIDAR running on ROS package rplidar_ros. SDK Version:%s", SDK_VERSION)
+        try:
+            info = self.dev.device_info()
+        except TimeoutError:
+            self.log.error("Error, operation time out. RESULT_OPERATION_TIMEOUT! ")
+            return 1
+        except rp.RplidarError as exc:
+            self.log.error("Error, unexpected answer to GET_INFO: %s", exc)
+            return 1
+        self.log.info("RPLIDAR S/N: %s", info.serialnum.hex().upper())
+        self.log.info("Firmware Ver: %d.%02d", info.firmware_version >> 8, info.firmware_version & 0xFF)
+        self.log.info("Hardware Rev: %d", info.hardware_version)
+        try:
+            health = self.dev.health()
+        except (TimeoutError, rp.RplidarError) as exc:
+            self.log.error("Error, cannot retrieve rplidar health code: %s", exc)
+            return 1
+        self.log.info("RPLidar health status : %d", health.status)
+        if health.status == rp.STATUS_ERROR:
+            self.log.error("Error, rplidar internal error detected. Please reboot the device to retry.")
+            # the protocol's way out of the protection stop: a core reset, so the next start may work
+            self.dev.reset()
+            return 1
+        if health.status == rp.STATUS_WARNING:
+            self.log.warn("RPLidar health warning, error code: %d", health.error_code)
+        self._service("stop_motor")
+        self._service("start_motor")
+        self.dev.check_motor_ctrl()
+        self.dev.start_motor()
+        modes = supported_modes(self.dev, info)
+        if self.scan_mode_name:
+            chosen = [m for m in modes if m.name == self.scan_mode_name]
+            if not chosen:
+                self.log.error(
+                    "scan mode `%s' is not supported by lidar, supported modes:", self.scan_mode_name
+                )
+                for m in modes:
+                    self.log.error(
+                        "\t%s: max_distance: %.1f m, Point number: %.1fK",
+                        m.name,
+                        m.max_distance,
+                        1000.0 / m.us_per_sample,
+                    )
+                return 1
+            self.mode = chosen[0]
+        else:
+            self.mode = modes[-1]  # the typical mode: Express when the device has it
+        self.multiple = compensate_multiple(self.mode.us_per_sample)
+        return 0
+
+    def _start_scan(self, quiet: bool) -> bool:
+        assert self.mode is not None
+        try:
+            self.dev.start_scan(self.mode)
+        except (TimeoutError, rp.RplidarError) as exc:
+            if not quiet:
+                self.log.error("Can not start scan: %s", exc)
+            return False
+        self.log.info(
+            "current scan mode: %s, max_distance: %.1f m, Point number: %.1fK , angle_compensate: %d",
+            self.mode.name,
+            self.mode.max_distance,
+            1000.0 / self.mode.us_per_sample,
+            self.multiple,
+        )
+        self.scanning = True
+        return True
+
+    def _do(self, action: str) -> None:
+        if action == "stop_motor":
+            self.log.debug("Stop motor")
+            self.dev.stop()
+            self.dev.stop_motor()
+            self.scanning = False
+            self.stopped = True
+        else:
+            self.log.debug("Start motor")
+            self.stopped = False
+            self.dev.start_motor()
+            self._start_scan(quiet=False)
+
+    def _decoder(self) -> Any:
+        assert self.mode is not None
+        return rp.CapsuleDecoder() if self.mode.cmd == rp.CMD_EXPRESS_SCAN else rp.NodeDecoder()
+
+    def run(self) -> None:
+        assert self.mode is not None
+        decoder = self._decoder()
+        assembler = RevolutionAssembler()
+        failed_once = False
+        next_try = 0.0
+        rev_start = time.monotonic()
+        rev_stamp = self.node.now()
+        while not self.node.is_shutdown:
+            try:
+                action, done = self.actions.get_nowait()
+            except queue.Empty:
+                pass
+            else:
+                self._do(action)
+                decoder = self._decoder()
+                assembler.reset()
+                rev_start, rev_stamp = time.monotonic(), self.node.now()
+                done.set()
+                continue
+            if not self.scanning:
+                if self.stopped or time.monotonic() < next_try:
+                    self.node.wait_for_shutdown(0.05)
+                    continue
+                if not self._start_scan(quiet=failed_once):
+                    failed_once = True
+                    next_try = time.monotonic() + 1.0
+                    continue
+                decoder = self._decoder()
+                assembler.reset()
+                rev_start, rev_stamp = time.monotonic(), self.node.now()
+            waiting = self.port.in_waiting
+            if 0 < waiting < BATCH_BYTES:
+                # let a few measurements gather: one wake-up per 10 ms, not one per capsule
+                self.node.wait_for_shutdown(BATCH_WAIT)
+                waiting = self.port.in_waiting
+            data = self.port.read(waiting if waiting else 1)  # blocks up to READ_TIMEOUT when idle
+            if not data:
+                continue
+            for rev in assembler.feed(decoder.feed(data)):
+                now = time.monotonic()
+                self._publish(rev, rev_stamp, now - rev_start)
+                rev_start, rev_stamp = now, self.node.now()
+
+    def _publish(self, rev: Any, stamp: Any, duration: float) -> None:
+        assert self.mode is not None
+        f = revolution_to_scan(
+            rev, self.angle_compensate, self.multiple, duration, self.inverted, self.mode.max_distance
+        )
+        msg = self.LaserScan()
+        msg.header.stamp = stamp
+        msg.header.frame_id = self.frame_id
+        msg.angle_min, msg.angle_max, msg.angle_increment = f.angle_min, f.angle_max, f.angle_increment
+        msg.time_increment, msg.scan_time = f.time_increment, f.scan_time
+        msg.range_min, msg.range_max = f.range_min, f.range_max
+        msg.ranges = f.ranges
+        msg.intensities = f.intensities
+        self.pub.publish(msg)
+        self.published += 1
+
+
+def open_port(path: str, baud: int) -> Any:
+    import serial  # type: ignore[import-untyped]  # pyserial, imported when a node starts (no work at import)
+
+    return serial.Serial(path, baud, timeout=READ_TIMEOUT, write_timeout=2.0)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``rosrun rplidar_ros rplidarNode``."""
+
+    def build(node: Any) -> int:
+        path = str(node.get_param("~serial_port", "/dev/ttyUSB0"))
+        baud = int(node.get_param("~serial_baudrate", 115200))
+        try:
+            port = open_port(path, baud)
+        except (OSError, ValueError):
+            node.log.info("RPLIDAR running on ROS package rplidar_ros. SDK Version:%s", SDK_VERSION)
+            node.log.error("Error, cannot bind to the specified serial port %s.", path)
+            return 1
+        dev = RplidarDevice(port)
+        lidar = RplidarNode(node, port, dev)
+        try:
+            code = lidar.setup()
+            if code:
+                return code
+            lidar.run()
+        except OSError as exc:
+            if not node.is_shutdown:
+                node.log.error("RPLIDAR: the serial port failed: %s", exc)
+                return 1
+        finally:
+            try:
+                dev.stop()
+                dev.stop_motor()
+            except OSError:
+                pass
+            port.close()
+        return 0
+
+    return run_node("rplidarNode", argv, build)

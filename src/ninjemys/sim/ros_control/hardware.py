@@ -1,0 +1,93 @@
+"""The seam between the simulator and ros_control: joint handles, and one call per physics step.
+
+gazebo_ros_control's DefaultRobotHWSim exposes every joint with a transmission through a
+JointStateInterface (position, velocity, effort) and, for velocity transmissions, a
+VelocityJointInterface (a command in rad/s). :class:`SimRobotHW` is that for a wheeled base;
+:class:`ControlLoop` is what the simulator node owns::
+
+    loop = ControlLoop(node, model)                       # advertises <ns>/controller_manager/*
+    commands = loop.step(sim_time, dt, {joint: (position, velocity), ...})   # every step
+    # commands: {joint: rad/s} for each joint a running controller commands
+    loop.step_robot(robot, sim_time, dt)   # the same for a simcore Robot (angles/speeds in, target out)
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from ninjemys.sim.robot_model import RobotModel
+
+JOINT_STATE_INTERFACE = "hardware_interface::JointStateInterface"
+VELOCITY_INTERFACE = "hardware_interface::VelocityJointInterface"
+
+
+@dataclass
+class JointHandle:
+    name: str
+    position: float = 0.0
+    velocity: float = 0.0
+    effort: float = 0.0
+    command: float = 0.0
+
+
+class SimRobotHW:
+    """The robot's joints as ros_control sees them, with the description's wheel geometry.
+
+    ``wheel_separation`` and ``wheel_radius`` stand in for what diff_drive_controller reads from the
+    URDF when its own parameters are absent.
+    """
+
+    def __init__(self, joints: Iterable[str], wheel_separation: float, wheel_radius: float) -> None:
+        self.joints = {name: JointHandle(name) for name in joints}
+        self.wheel_separation = wheel_separation
+        self.wheel_radius = wheel_radius
+        self.lock = threading.Lock()
+
+    def read(self, states: Mapping[str, tuple[float, float]]) -> None:
+        """Copy the simulator's joint (position, velocity) into the handles."""
+        for name, (position, velocity) in states.items():
+            handle = self.joints.get(name)
+            if handle is not None:
+                handle.position, handle.velocity = position, velocity
+
+    def commands(self, claimed: Iterable[str]) -> dict[str, float]:
+        return {name: self.joints[name].command for name in claimed if name in self.joints}
+
+
+class ControlLoop:
+    """gazebo_ros_control for one robot: a controller_manager over the robot's wheel joints."""
+
+    def __init__(self, node: Any, model: RobotModel, namespace: str | None = None) -> None:
+        from ninjemys.sim.ros_control.manager import ControllerManager
+
+        named = [j for j in (model.left_joint, model.right_joint) if j]
+        joints = list(dict.fromkeys(named + list(model.control_joints)))
+        self.hw = SimRobotHW(joints, model.wheel_separation, model.wheel_radius)
+        sides = dict(model.control_joints) or {model.left_joint: "left", model.right_joint: "right"}
+        self.left = [j for j, side in sides.items() if side == "left"]
+        self.right = [j for j, side in sides.items() if side == "right"]
+        ns = namespace if namespace is not None else model.drive.controller_namespace
+        self.manager = ControllerManager(node, self.hw, ns)
+
+    def step(self, now: float, period: float, joints: Mapping[str, tuple[float, float]]) -> dict[str, float]:
+        """Read the joints, update the running controllers, return the commanded joint velocities."""
+        self.hw.read(joints)
+        return self.manager.update(now, period)
+
+    def step_robot(self, robot: Any, now: float, period: float) -> None:
+        """:meth:`step` for a :class:`ninjemys.sim.simcore.Robot`: its wheel angles and speeds in, its
+        wheel targets out. Every joint of a side (a four-wheel base) reads that side's wheel; the side's
+        target is the mean of its commanded joints (0 when no running controller commands them)."""
+        states = {j: (robot.left_angle, robot.wl) for j in self.left}
+        states.update({j: (robot.right_angle, robot.wr) for j in self.right})
+        commands = self.step(now, period, states)
+        left = [commands[j] for j in self.left if j in commands]
+        right = [commands[j] for j in self.right if j in commands]
+        robot.target = (sum(left) / len(left) if left else 0.0, sum(right) / len(right) if right else 0.0)
+
+    def close(self) -> None:
+        self.manager.close()

@@ -1,0 +1,676 @@
+"""Gazebo worlds (SDF 1.4-1.7 ``.world`` files) read into the simulator's floor-plan :class:`World`.
+
+No ROS in here. A lidar in Gazebo hits collision geometry, so every ``<collision>`` of every model
+becomes one obstacle: its footprint on the floor (the outline of the shape's projection) and its top
+(the highest point), coloured by its link's ``<visual>`` material. Poses compose down the tree
+(world, nested models, link, collision; x y z roll pitch yaw, fixed axes as SDF says), so a tilted
+box or a lying cylinder gets the footprint it really has.
+
+* Shapes: ``box``, ``cylinder``, ``sphere``, ``polyline`` (an extruded outline) and ``mesh`` (STL,
+  COLLADA, OBJ, with ``<scale>``): a mesh becomes the convex hull of each connected part's projected
+  vertices (:mod:`ninjemys.sim.meshes`), as tall as its highest vertex. ``plane`` is the floor.
+* ``<include>`` of ``model://NAME`` is found as Gazebo finds it: ``GAZEBO_MODEL_PATH``, then
+  ``~/.gazebo/models``, then the models that ship with us (``ground_plane``, ``sun`` and a few simple
+  obstacles, share/gazebo_models). The include's ``<name>``, ``<pose>`` and ``<static>`` override
+  the model's. Mesh URIs may be ``model://``, ``package://`` (ROS_PACKAGE_PATH), ``file://`` or a
+  path relative to the file.
+* A saved world's ``<state>`` moves its models to the poses saved there, as Gazebo does on load.
+* Materials: ``<diffuse>``, else ``<ambient>``, else a ``Gazebo/Red``-style script name.
+* What has no place in a floor plan (lights, physics, plugins, actors, joints ...) is skipped; the
+  elements that would have changed what sensors see are reported once, in one warning.
+
+Malformed SDF raises :class:`SdfError` with ``file:line: <element>: reason``.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import os
+import xml.parsers.expat
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ninjemys.errors import PackageError
+from ninjemys.maps.mapfile import MapFileError
+from ninjemys.packages.discovery import find_package
+from ninjemys.sim.meshes import load_mesh_parts
+from ninjemys.sim.world2d import Obstacle, World
+
+log = logging.getLogger(__name__)
+
+#: the models that ship with ninjemys (ground_plane, sun, unit shapes ...), last on the model path
+SHIPPED_MODELS = Path(__file__).resolve().parent.parent / "packages" / "share" / "gazebo_models" / "models"
+SUPPORTED_VERSIONS = ("1.4", "1.5", "1.6", "1.7")
+#: sides of the polygon that stands for a round outline (as world2d's cylinders)
+ROUND_SIDES = 24
+#: shapes whose top is lower than this (metres) lie on the floor: nothing for a sensor to hit
+MIN_TOP = 1e-3
+DEFAULT_COLOUR = (180, 180, 180)
+#: a shape whose lowest point is higher than this (metres) floats: reported, as it stands on the floor here
+FLOATING = 0.05
+MAX_INCLUDE_DEPTH = 16
+
+#: Gazebo's material scripts (gazebo.material) by name, as the RGB they render roughly as
+GAZEBO_MATERIALS: dict[str, tuple[int, int, int]] = {
+    "gazebo/grey": (178, 178, 178),
+    "gazebo/gray": (178, 178, 178),
+    "gazebo/darkgrey": (89, 89, 89),
+    "gazebo/darkgray": (89, 89, 89),
+    "gazebo/lightgrey": (204, 204, 204),
+    "gazebo/white": (255, 255, 255),
+    "gazebo/flatblack": (26, 26, 26),
+    "gazebo/black": (0, 0, 0),
+    "gazebo/red": (255, 0, 0),
+    "gazebo/redbright": (222, 33, 33),
+    "gazebo/redglow": (255, 0, 0),
+    "gazebo/green": (0, 255, 0),
+    "gazebo/greenglow": (0, 255, 0),
+    "gazebo/blue": (0, 0, 255),
+    "gazebo/blueglow": (0, 0, 255),
+    "gazebo/skyblue": (33, 150, 243),
+    "gazebo/yellow": (255, 255, 0),
+    "gazebo/zincyellow": (231, 214, 36),
+    "gazebo/darkyellow": (178, 178, 0),
+    "gazebo/yellowglow": (255, 255, 0),
+    "gazebo/purple": (255, 0, 255),
+    "gazebo/purpleglow": (255, 0, 255),
+    "gazebo/turquoise": (0, 255, 255),
+    "gazebo/turquoiseglow": (0, 255, 255),
+    "gazebo/orange": (255, 128, 0),
+    "gazebo/indigo": (51, 0, 128),
+    "gazebo/wood": (156, 112, 74),
+    "gazebo/woodfloor": (173, 133, 92),
+    "gazebo/woodpallet": (166, 128, 84),
+    "gazebo/bricks": (160, 82, 62),
+    "gazebo/residential": (196, 186, 170),
+    "gazebo/ceilingtiled": (230, 230, 225),
+    "gazebo/paintedwall": (235, 230, 220),
+    "gazebo/asphalt": (60, 60, 60),
+    "gazebo/grass": (80, 140, 50),
+}
+
+#: elements that change nothing a sensor of the floor plan sees: skipped without a word
+_QUIET_WORLD = {
+    "light", "physics", "scene", "gui", "gravity", "magnetic_field", "atmosphere",
+    "spherical_coordinates", "wind", "audio", "frame",
+}  # fmt: skip
+_QUIET_MODEL = {
+    "static", "pose", "joint", "allow_auto_disable", "enable_wind", "self_collide", "frame", "gripper",
+}  # fmt: skip
+_QUIET_LINK = {
+    "pose", "inertial", "gravity", "kinematic", "self_collide", "velocity_decay", "must_be_base_link",
+    "enable_wind", "audio_sink", "audio_source", "battery", "light", "frame", "projector",
+}  # fmt: skip
+_QUIET_COLLISION = {"pose", "surface", "max_contacts", "laser_retro", "frame"}
+
+
+class SdfError(MapFileError):
+    """A world or model file that cannot be read: ``file:line: <element>: reason``."""
+
+
+# -- a small XML tree with line numbers ---------------------------------------------------------
+
+
+@dataclass
+class Element:
+    """One XML element: tag, attributes, children, text, and the line it starts on."""
+
+    tag: str
+    attrib: dict[str, str]
+    line: int
+    source: str
+    children: list[Element] = field(default_factory=list)
+    text: str = ""
+
+    def find(self, tag: str) -> Element | None:
+        return next((c for c in self.children if c.tag == tag), None)
+
+    def findall(self, tag: str) -> list[Element]:
+        return [c for c in self.children if c.tag == tag]
+
+    def value(self, tag: str) -> str | None:
+        child = self.find(tag)
+        return None if child is None else child.text.strip()
+
+    def error(self, reason: str) -> SdfError:
+        return SdfError(f"{self.source}:{self.line}: <{self.tag}>: {reason}")
+
+
+def parse_xml(data: bytes, source: str) -> Element:
+    """The document's root element, each element knowing its line (expat; errors name file and line)."""
+    parser = xml.parsers.expat.ParserCreate()
+    stack: list[Element] = []
+    root: list[Element] = []
+
+    def start(tag: str, attrs: dict[str, str]) -> None:
+        el = Element(tag, dict(attrs), parser.CurrentLineNumber, source)
+        if stack:
+            stack[-1].children.append(el)
+        else:
+            root.append(el)
+        stack.append(el)
+
+    def end(_tag: str) -> None:
+        stack.pop()
+
+    def chars(text: str) -> None:
+        if stack:
+            stack[-1].text += text
+
+    parser.StartElementHandler = start
+    parser.EndElementHandler = end
+    parser.CharacterDataHandler = chars
+    try:
+        parser.Parse(data, True)
+    except xml.parsers.expat.ExpatError as exc:
+        raise SdfError(
+            f"{source}:{exc.lineno}: not well-formed XML: {xml.parsers.expat.ErrorString(exc.code)}"
+        ) from None
+    return root[0]
+
+
+# -- numbers and poses ---------------------------------------------------------------------------
+
+
+def _numbers(el: Element, count: int, what: str) -> list[float]:
+    words = el.text.split()
+    if len(words) != count:
+        raise el.error(f"expected {count} numbers ({what}), got {el.text.strip()!r}")
+    try:
+        values = [float(w) for w in words]
+    except ValueError:
+        raise el.error(f"expected {count} numbers ({what}), got {el.text.strip()!r}") from None
+    if not all(math.isfinite(v) for v in values):
+        raise el.error(f"expected finite numbers, got {el.text.strip()!r}")
+    return values
+
+
+def _number(parent: Element, tag: str, default: float | None = None, positive: bool = False) -> float:
+    el = parent.find(tag)
+    if el is None:
+        if default is None:
+            raise parent.error(f"missing <{tag}>")
+        return default
+    (value,) = _numbers(el, 1, tag)
+    if positive and value <= 0:
+        raise el.error(f"expected a number > 0, got {el.text.strip()!r}")
+    return value
+
+
+def _bool(el: Element) -> bool:
+    text = el.text.strip().lower()
+    if text in ("1", "true"):
+        return True
+    if text in ("0", "false"):
+        return False
+    raise el.error(f"expected true or false, got {el.text.strip()!r}")
+
+
+def pose_matrix(x: float, y: float, z: float, roll: float, pitch: float, yaw: float) -> np.ndarray:
+    """4x4 transform of an SDF pose: translation, then rotation R = Rz(yaw) Ry(pitch) Rx(roll)."""
+    cr, sr = math.cos(roll), math.sin(roll)
+    cp, sp = math.cos(pitch), math.sin(pitch)
+    cy, sy = math.cos(yaw), math.sin(yaw)
+    m = np.eye(4)
+    m[:3, :3] = [
+        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+        [-sp, cp * sr, cp * cr],
+    ]
+    m[:3, 3] = (x, y, z)
+    return m
+
+
+# -- footprints ----------------------------------------------------------------------------------
+
+
+def convex_hull(points: np.ndarray) -> np.ndarray:
+    """Counter-clockwise convex hull of (N, 2) points (Andrew's monotone chain)."""
+    pts = np.unique(np.round(np.asarray(points, dtype=np.float64), 9), axis=0)
+    if len(pts) < 3:
+        return pts
+
+    def half(seq: np.ndarray) -> list[np.ndarray]:
+        chain: list[np.ndarray] = []
+        for p in seq:
+            while len(chain) >= 2:
+                (ax, ay), (bx, by) = chain[-2], chain[-1]
+                if (bx - ax) * (p[1] - ay) - (by - ay) * (p[0] - ax) > 1e-12:
+                    break
+                chain.pop()
+            chain.append(p)
+        return chain
+
+    lower, upper = half(pts), half(pts[::-1])
+    return np.array(lower[:-1] + upper[:-1])
+
+
+def _round_points(radius: float, z0: float, z1: float) -> np.ndarray:
+    a = np.arange(ROUND_SIDES) * (2 * math.pi / ROUND_SIDES)
+    ring = np.column_stack([radius * np.cos(a), radius * np.sin(a)])
+    return np.vstack(
+        [np.column_stack([ring, np.full(ROUND_SIDES, z0)]), np.column_stack([ring, np.full(ROUND_SIDES, z1)])]
+    )
+
+
+def _transform(m: np.ndarray, pts: np.ndarray) -> np.ndarray:
+    return pts @ m[:3, :3].T + m[:3, 3]
+
+
+@dataclass
+class Footprint:
+    """One solid piece: outline on the floor (counter-clockwise), top height, shape kind."""
+
+    outline: np.ndarray
+    top: float
+    kind: str
+    bottom: float = 0.0
+
+
+# -- the reader ----------------------------------------------------------------------------------
+
+
+@dataclass
+class _Context:
+    env: Mapping[str, str]
+    unsupported: dict[str, str] = field(default_factory=dict)  # what -> first place
+
+    def skip(self, what: str, el: Element) -> None:
+        self.unsupported.setdefault(what, f"{el.source}:{el.line}")
+
+
+def model_dirs(env: Mapping[str, str] | None = None) -> list[Path]:
+    """Where ``model://`` URIs are looked up, in Gazebo's order, ending with our shipped models."""
+    environ = os.environ if env is None else env
+    dirs = [Path(d) for d in environ.get("GAZEBO_MODEL_PATH", "").split(":") if d]
+    home = environ.get("HOME")
+    if home:
+        dirs.append(Path(home) / ".gazebo" / "models")
+    dirs.append(SHIPPED_MODELS)
+    return dirs
+
+
+def resolve_uri(uri: str, el: Element, env: Mapping[str, str]) -> Path:
+    """A file or model directory for ``model://``, ``package://``, ``file://`` or a relative path."""
+    text = uri.strip()
+    if text.startswith("model://"):
+        rest = text[len("model://") :]
+        name, _, tail = rest.partition("/")
+        looked = model_dirs(env)
+        for d in looked:
+            if (d / name).is_dir():
+                return d / name / tail if tail else d / name
+        raise el.error(
+            f"model '{name}' of {text} not found (looked in GAZEBO_MODEL_PATH, ~/.gazebo/models and "
+            f"ninjemys' models: {', '.join(str(d) for d in looked)})"
+        )
+    if text.startswith("package://"):
+        pkg, _, tail = text[len("package://") :].partition("/")
+        try:
+            pdir = find_package(pkg, env)
+        except PackageError:
+            raise el.error(f"package '{pkg}' of {text} not found on ROS_PACKAGE_PATH") from None
+        return pdir / tail
+    if text.startswith("file://"):
+        return Path(text[len("file://") :])
+    if "://" in text:
+        raise el.error(f"cannot fetch {text}: only model://, package://, file:// and paths are read")
+    path = Path(text)
+    return path if path.is_absolute() else Path(el.source).parent / path
+
+
+def _model_file(model_dir: Path, el: Element) -> Path:
+    """The SDF of a model directory: model.config's newest <sdf> we read, else model.sdf."""
+    config = model_dir / "model.config"
+    if config.is_file():
+        root = parse_xml(config.read_bytes(), str(config))
+        best: tuple[tuple[int, ...], str] | None = None
+        for sdf in root.findall("sdf"):
+            version = sdf.attrib.get("version", "1.4")
+            try:
+                key = tuple(int(p) for p in version.split("."))
+            except ValueError:
+                key = (0,)
+            if version in SUPPORTED_VERSIONS and (best is None or key > best[0]):
+                best = (key, sdf.text.strip())
+        if best is None and root.find("sdf") is not None:
+            best = ((0,), root.findall("sdf")[0].text.strip())
+        if best is not None:
+            return model_dir / best[1]
+    if (model_dir / "model.sdf").is_file():
+        return model_dir / "model.sdf"
+    raise el.error(f"{model_dir} has neither model.config nor model.sdf")
+
+
+def _read_sdf(path: Path, ctx: _Context, where: Element | None = None) -> Element:
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        msg = f"cannot read {path}: {exc.strerror or exc}"
+        raise (where.error(msg) if where is not None else SdfError(f"{path}: {msg}")) from None
+    return _sdf_root(data, str(path), ctx)
+
+
+def _sdf_root(data: bytes, source: str, ctx: _Context) -> Element:
+    root = parse_xml(data, source)
+    if root.tag != "sdf":
+        raise root.error("the root element of an SDF file is <sdf>")
+    version = root.attrib.get("version")
+    if version is None:
+        raise root.error("missing attribute 'version'")
+    if version not in SUPPORTED_VERSIONS:
+        ctx.skip(f"SDF version {version} (read as 1.7)", root)
+    return root
+
+
+def _colour(link: Element, ctx: _Context) -> tuple[int, int, int]:
+    """The colour of a link's first visual material: diffuse, ambient, then the script's name."""
+    for visual in link.findall("visual"):
+        mat = visual.find("material")
+        if mat is None:
+            continue
+        for tag in ("diffuse", "ambient"):
+            el = mat.find(tag)
+            if el is not None:
+                words = el.text.split()
+                if len(words) not in (3, 4):
+                    raise el.error(f"expected r g b [a] in 0-1, got {el.text.strip()!r}")
+                rgb = _numbers(el, len(words), "r g b a")[:3]
+                if any(v < 0 or v > 1 for v in rgb):
+                    raise el.error(f"colour components are 0-1, got {el.text.strip()!r}")
+                return (round(rgb[0] * 255), round(rgb[1] * 255), round(rgb[2] * 255))
+        script = mat.find("script")
+        if script is not None:
+            name = (script.value("name") or "").strip()
+            if name.lower() in GAZEBO_MATERIALS:
+                return GAZEBO_MATERIALS[name.lower()]
+            ctx.skip(f"material script {name!r} (drawn grey)", script)
+    return DEFAULT_COLOUR
+
+
+def _pose(el: Element, ctx: _Context) -> np.ndarray:
+    pose = el.find("pose")
+    if pose is None or not pose.text.strip():
+        return np.eye(4)
+    frame = pose.attrib.get("relative_to") or pose.attrib.get("frame")
+    if frame:
+        ctx.skip(f"pose relative to '{frame}' (taken relative to the parent)", pose)
+    return pose_matrix(*_numbers(pose, 6, "x y z roll pitch yaw"))
+
+
+def _geometry(geom: Element, m: np.ndarray, ctx: _Context) -> list[Footprint]:
+    shapes = [c for c in geom.children if c.tag != "empty"]
+    if not shapes:
+        return []
+    shape = shapes[0]
+    kind = shape.tag
+    if kind == "box":
+        size_el = shape.find("size")
+        if size_el is None:
+            raise shape.error("missing <size>")
+        sx, sy, sz = _numbers(size_el, 3, "x y z")
+        if min(sx, sy, sz) <= 0:
+            raise size_el.error(f"sizes must be > 0, got {size_el.text.strip()!r}")
+        corners = np.array([[x, y, z] for x in (-sx, sx) for y in (-sy, sy) for z in (-sz, sz)]) / 2.0
+        return [_piece(_transform(m, corners), "box")]
+    if kind == "cylinder":
+        r = _number(shape, "radius", positive=True)
+        length = _number(shape, "length", positive=True)
+        return [_piece(_transform(m, _round_points(r, -length / 2, length / 2)), "cylinder")]
+    if kind == "sphere":
+        r = _number(shape, "radius", positive=True)
+        centre = m[:3, 3]
+        a = np.arange(ROUND_SIDES) * (2 * math.pi / ROUND_SIDES)
+        outline = np.column_stack([centre[0] + r * np.cos(a), centre[1] + r * np.sin(a)])
+        return [Footprint(outline, float(centre[2] + r), "sphere", float(centre[2] - r))]
+    if kind == "polyline":
+        height = _number(shape, "height", positive=True)
+        pts = []
+        for point in shape.findall("point"):
+            pts.append(_numbers(point, 2, "x y"))
+        if len(pts) < 3:
+            raise shape.error("a polyline needs at least three <point>s")
+        flat = np.array(pts)
+        solid = np.vstack(
+            [
+                np.column_stack([flat, np.zeros(len(flat))]),
+                np.column_stack([flat, np.full(len(flat), height)]),
+            ]
+        )
+        return [_piece(_transform(m, solid), "polyline")]
+    if kind == "mesh":
+        uri = shape.value("uri")
+        if not uri:
+            raise shape.error("missing <uri>")
+        if shape.find("submesh") is not None:
+            ctx.skip("mesh <submesh> (the whole mesh is used)", shape)
+        scale = np.ones(3)
+        scale_el = shape.find("scale")
+        if scale_el is not None:
+            scale = np.array(_numbers(scale_el, 3, "x y z"))
+        path = resolve_uri(uri, shape, ctx.env)
+        try:
+            parts = load_mesh_parts(path)
+        except MapFileError as exc:
+            raise shape.error(str(exc)) from None
+        return [_piece(_transform(m, part * scale), "mesh") for part in parts if len(part)]
+    if kind == "plane":
+        return []  # the floor
+    ctx.skip(f"<{kind}> geometry", shape)
+    return []
+
+
+def _piece(points: np.ndarray, kind: str) -> Footprint:
+    z = points[:, 2]
+    return Footprint(convex_hull(points[:, :2]), float(z.max()), kind, float(z.min()))
+
+
+@dataclass
+class _Solid:
+    path: list[str]  # model names from the top, then link, then collision
+    footprint: Footprint
+    colour: tuple[int, int, int]
+
+
+def _model(
+    el: Element,
+    parent: np.ndarray,
+    ctx: _Context,
+    out: list[_Solid],
+    scope: list[str],
+    depth: int,
+    pose_override: np.ndarray | None = None,
+) -> None:
+    name = el.attrib.get("name")
+    if not name:
+        raise el.error("missing attribute 'name'")
+    m = parent @ (pose_override if pose_override is not None else _pose(el, ctx))
+    here = [*scope, name]
+    for child in el.children:
+        tag = child.tag
+        if tag == "link":
+            _link(child, m, ctx, out, here)
+        elif tag == "model":
+            _model(child, m, ctx, out, here, depth + 1)
+        elif tag == "include":
+            _include(child, m, ctx, out, here, depth + 1)
+        elif tag == "plugin":
+            ctx.skip(f"model plugin {child.attrib.get('filename', '?')}", child)
+        elif tag not in _QUIET_MODEL:
+            ctx.skip(f"<{tag}> in a model", child)
+
+
+def _link(el: Element, model: np.ndarray, ctx: _Context, out: list[_Solid], scope: list[str]) -> None:
+    name = el.attrib.get("name")
+    if not name:
+        raise el.error("missing attribute 'name'")
+    m = model @ _pose(el, ctx)
+    colour = _colour(el, ctx)
+    for child in el.children:
+        if child.tag == "collision":
+            cname = child.attrib.get("name")
+            if not cname:
+                raise child.error("missing attribute 'name'")
+            geom = child.find("geometry")
+            if geom is None:
+                raise child.error("missing <geometry>")
+            for fp in _geometry(geom, m @ _pose(child, ctx), ctx):
+                if fp.top > MIN_TOP and len(fp.outline) >= 2:
+                    out.append(_Solid([*scope, name, cname], fp, colour))
+                    if fp.bottom > FLOATING:
+                        # a table top, a shelf: the floor plan has no space under things
+                        ctx.skip(
+                            "space under shapes that float above the floor (they stand on it here)", child
+                        )
+            for sub in child.children:
+                if sub.tag not in _QUIET_COLLISION and sub.tag != "geometry":
+                    ctx.skip(f"<{sub.tag}> in a collision", sub)
+        elif child.tag == "sensor":
+            ctx.skip(f"<sensor type='{child.attrib.get('type', '?')}'> in a world model", child)
+        elif child.tag != "visual" and child.tag not in _QUIET_LINK:
+            ctx.skip(f"<{child.tag}> in a link", child)
+
+
+def _include(
+    el: Element,
+    parent: np.ndarray,
+    ctx: _Context,
+    out: list[_Solid],
+    scope: list[str],
+    depth: int,
+    saved: dict[str, np.ndarray] | None = None,
+) -> None:
+    if depth > MAX_INCLUDE_DEPTH:
+        raise el.error(f"includes nested more than {MAX_INCLUDE_DEPTH} deep (a model including itself?)")
+    uri = el.value("uri")
+    if not uri:
+        raise el.error("missing <uri>")
+    target = resolve_uri(uri, el, ctx.env)
+    path = _model_file(target, el) if target.is_dir() else target
+    root = _read_sdf(path, ctx, el)
+    model = root.find("model")
+    if model is None:
+        if root.find("light") is not None:
+            return  # a light (Gazebo's sun is one): nothing solid
+        raise root.error(f"{uri}: no <model> in {path}")
+    name = el.value("name")
+    if name:
+        model.attrib["name"] = name
+    static = el.find("static")
+    if static is not None:
+        _bool(static)
+    pose = el.find("pose")
+    override = pose_matrix(*_numbers(pose, 6, "x y z roll pitch yaw")) if pose is not None else None
+    if saved and model.attrib.get("name") in saved:
+        override = saved[model.attrib["name"]]
+    _model(model, parent, ctx, out, scope, depth, override)
+
+
+def _state_poses(world: Element, ctx: _Context) -> dict[str, np.ndarray]:
+    """Model poses saved in the world's ``<state>`` (a world saved from Gazebo's GUI)."""
+    poses: dict[str, np.ndarray] = {}
+    for state in world.findall("state"):
+        for model in state.findall("model"):
+            pose = model.find("pose")
+            name = model.attrib.get("name")
+            if name and pose is not None and pose.text.strip():
+                poses[name] = pose_matrix(*_numbers(pose, 6, "x y z roll pitch yaw"))
+    return poses
+
+
+def load_sdf_world(
+    path: str | Path,
+    env: Mapping[str, str] | None = None,
+    warn: Callable[[str], None] | None = None,
+) -> World:
+    """The simulator's World for a Gazebo ``.world`` file (SdfError naming file, line, element, reason)."""
+    p = Path(path)
+    try:
+        data = p.read_bytes()
+    except OSError as exc:
+        raise SdfError(f"{p}: cannot read world: {exc.strerror or exc}") from None
+    return parse_sdf_world(data, str(p), env, warn)
+
+
+def parse_sdf_world(
+    data: bytes | str,
+    source: str,
+    env: Mapping[str, str] | None = None,
+    warn: Callable[[str], None] | None = None,
+) -> World:
+    """A World from SDF text (``source`` names it in errors; relative mesh paths start at its folder)."""
+    ctx = _Context(os.environ if env is None else env)
+    root = _sdf_root(data.encode() if isinstance(data, str) else data, source, ctx)
+    world_el = root.find("world")
+    if world_el is None:
+        raise root.error("no <world> in this file (a model file? spawn it with spawn_model -sdf)")
+    solids = _world_solids(world_el, ctx)
+    world = World(world_el.attrib.get("name", Path(source).stem), _obstacles(solids), source=source)
+    _report(ctx, source, warn)
+    return world
+
+
+def sdf_model_obstacles(
+    data: bytes | str,
+    source: str = "<spawn_sdf_model>",
+    env: Mapping[str, str] | None = None,
+    warn: Callable[[str], None] | None = None,
+) -> list[Obstacle]:
+    """The obstacles of an SDF model document (``<sdf><model>``, as spawn_sdf_model receives it, or a
+    ``<world>`` of includes), in the model's frame: place them at the spawn pose."""
+    ctx = _Context(os.environ if env is None else env)
+    root = _sdf_root(data.encode() if isinstance(data, str) else data, source, ctx)
+    solids: list[_Solid] = []
+    world_el = root.find("world")
+    if world_el is not None:
+        solids = _world_solids(world_el, ctx)
+    for model in root.findall("model"):
+        _model(model, np.eye(4), ctx, solids, [], 0)
+    if world_el is None and root.find("model") is None:
+        raise root.error("no <model> in this SDF document")
+    _report(ctx, source, warn)
+    return _obstacles(solids)
+
+
+def _world_solids(world_el: Element, ctx: _Context) -> list[_Solid]:
+    saved = _state_poses(world_el, ctx)
+    solids: list[_Solid] = []
+    for child in world_el.children:
+        if child.tag == "model":
+            name = child.attrib.get("name", "")
+            _model(child, np.eye(4), ctx, solids, [], 0, saved.get(name))
+        elif child.tag == "include":
+            _include(child, np.eye(4), ctx, solids, [], 1, saved)
+        elif child.tag == "plugin":
+            ctx.skip(f"world plugin {child.attrib.get('filename', '?')}", child)
+        elif child.tag != "state" and child.tag not in _QUIET_WORLD:
+            ctx.skip(f"<{child.tag}>", child)
+    return solids
+
+
+def _report(ctx: _Context, source: str, warn: Callable[[str], None] | None) -> None:
+    if ctx.unsupported:
+        listed = "; ".join(f"{what} ({where})" for what, where in ctx.unsupported.items())
+        (warn or log.warning)(f"{source}: not simulated, ignored: {listed}")
+
+
+def _obstacles(solids: list[_Solid]) -> list[Obstacle]:
+    """One obstacle per collision piece, named by its top-level model when that model has one piece,
+    else ``model::link::collision`` (``#n`` for the parts of one mesh), as Gazebo scopes names."""
+    per_model: dict[str, int] = {}
+    for s in solids:
+        per_model[s.path[0]] = per_model.get(s.path[0], 0) + 1
+    seen: dict[str, int] = {}
+    obstacles = []
+    for s in solids:
+        name = s.path[0] if per_model[s.path[0]] == 1 else "::".join(s.path)
+        n = seen.get(name, 0)
+        seen[name] = n + 1
+        if n:
+            name = f"{name}#{n}"
+        obstacles.append(Obstacle(name, s.footprint.kind, s.footprint.outline, s.footprint.top, s.colour))
+    return obstacles

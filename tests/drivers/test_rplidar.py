@@ -1,0 +1,302 @@
+"""rplidar_ros' rplidarNode on an emulated A1: Slamtec's protocol, the known room on /scan within 1 cm in
+rplidar_ros' angle convention, a bad descriptor and a health error as clear errors, stop_motor seen by the
+device."""
+
+from __future__ import annotations
+
+import math
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ninjemys import testing
+from ninjemys.drivers import rplidar_protocol as rp
+from ninjemys.drivers.rplidar_scan import ascend, compensate_multiple, revolution_to_scan
+from ninjemys.idl.loader import get_message_class, get_service_class
+from ninjemys.node import Node
+
+from .emu_rplidar import EmulatedA1, room_range
+
+LaserScan = get_message_class("sensor_msgs/LaserScan")
+Empty = get_service_class("std_srvs/Empty")
+
+
+# -- the protocol ------------------------------------------------------------------------------------------
+
+
+def test_requests_descriptors_and_answers_as_the_protocol_document_lays_them_out() -> None:
+    assert rp.request(rp.CMD_SCAN) == b"\xa5\x20"
+    assert rp.express_scan_request() == bytes.fromhex("a5 82 05 00 00 00 00 00 22")
+    assert rp.motor_pwm_request(660) == bytes.fromhex("a5 f0 02 94 02") + bytes(
+        (0xA5 ^ 0xF0 ^ 0x02 ^ 0x94 ^ 0x02,)
+    )
+    d = rp.Descriptor(5, rp.SEND_MODE_MULTIPLE, rp.ANS_TYPE_MEASUREMENT)
+    assert d.pack() == bytes.fromhex("a5 5a 05 00 00 40 81")
+    assert rp.Descriptor.unpack(d.pack()) == d
+    d.check(rp.CMD_SCAN)
+    with pytest.raises(
+        rp.RplidarError, match=r"answered SCAN \(0x20\) with a response descriptor of length 84"
+    ):
+        rp.Descriptor(84, 1, 0x82).check(rp.CMD_SCAN)
+    info = rp.DeviceInfo(0x18, 0x011D, 7, bytes(16))
+    assert len(info.pack()) == 20 and rp.DeviceInfo.unpack(info.pack()) == info
+
+
+def test_standard_nodes_decode_and_resynchronise_after_noise() -> None:
+    stream = rp.pack_node(10.5, 1234.25, 47, True) + b"\x00\x02" + rp.pack_node(11.0, 0, 0, False)
+    dec = rp.NodeDecoder()
+    rows = [tuple(r) for i in range(len(stream)) for r in dec.feed(stream[i : i + 1])]
+    assert rows[0] == (10.5, 1234.25, 47, 1)
+    assert rows[-1] == (11.0, 0.0, 0, 0)
+    assert dec.discarded >= 2
+
+
+def test_express_capsules_interpolate_angles_between_capsules_with_compensation() -> None:
+    dists = [1000.0 + i for i in range(32)]
+    caps = rp.pack_capsule(0.0, dists, [0] * 32, start=True) + rp.pack_capsule(30.0, dists, [8] * 32, False)
+    caps += rp.pack_capsule(60.0, dists, [0] * 32, False)
+    dec = rp.CapsuleDecoder()
+    rows = dec.feed(caps)
+    # a capsule's samples come out when the next one gives their end angle: the second capsule's are
+    # 30 + i * 30/32 degrees, minus 8/8 = 1 degree of compensation
+    assert len(rows) == 64
+    assert tuple(rows[0][:2]) == (0.0, 1000.0)
+    for i, (angle, dist, quality, _) in enumerate(rows[32:]):
+        assert angle == pytest.approx(30.0 + i * 30.0 / 32 - 1.0)
+        assert dist == 1000.0 + i and quality == 0x2F
+    bad = bytearray(rp.pack_capsule(90.0, dists, [0] * 32, False))
+    bad[10] ^= 0xFF
+    assert len(dec.feed(bytes(bad))) == 0 and dec.bad >= 1
+
+
+def test_angle_convention_is_pi_minus_the_device_angle_with_reversed_ranges() -> None:
+    rev = np.array([[a + 0.5, 1000.0 + a, 10] for a in range(360)], dtype=np.float64)
+    f = revolution_to_scan(rev, True, 1, 0.1, False, 12.0)
+    assert f.angle_min == pytest.approx(math.pi - math.radians(359))
+    assert f.angle_max == pytest.approx(math.pi)
+    assert f.angle_increment == pytest.approx(math.radians(1))
+    # beam j is at pi - 359 deg + j deg, i.e. device angle 359 - j
+    assert f.ranges[0] == pytest.approx(1.359) and f.ranges[-1] == pytest.approx(1.0)
+    inv = revolution_to_scan(rev, True, 1, 0.1, True, 12.0)
+    assert inv.ranges[0] == pytest.approx(1.0)
+    rev[3, 1] = 0.0
+    assert np.isinf(revolution_to_scan(rev, True, 1, 0.1, False, 12.0).ranges[359 - 3])
+    assert compensate_multiple(500) == 1 and compensate_multiple(125) == 2
+    # empty samples get angles from their neighbours and the revolution is sorted
+    jumbled = np.array([[200.0, 0, 0], [10.0, 5.0, 1], [5.0, 5.0, 1]])
+    assert list(ascend(jumbled)[:, 0]) == sorted(ascend(jumbled)[:, 0])
+
+
+# -- the node on the emulated device -----------------------------------------------------------------------
+
+
+class Collect:
+    def __init__(self) -> None:
+        self.items: list = []
+        self.cond = threading.Condition()
+
+    def __call__(self, msg) -> None:  # noqa: ANN001
+        with self.cond:
+            self.items.append(msg)
+            self.cond.notify_all()
+
+    def wait_count(self, n: int, timeout: float = 20.0) -> None:
+        with self.cond:
+            if not self.cond.wait_for(lambda: len(self.items) >= n, timeout):
+                raise AssertionError(f"{len(self.items)} scans received, wanted {n}")
+
+
+def rplidar(env: dict[str, str], *args: str) -> subprocess.Popen:
+    return subprocess.Popen(
+        [sys.executable, "-m", "ninjemys.packages.run_shipped", "rplidar_ros", "rplidarNode", *args],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+
+
+def stop(proc: subprocess.Popen) -> str:
+    if proc.poll() is None:
+        proc.send_signal(signal.SIGINT)
+    try:
+        out, _ = proc.communicate(timeout=20)
+    except subprocess.TimeoutExpired:
+        testing.kill_tree(proc)
+        out, _ = proc.communicate()
+    return out
+
+
+def check_room(scan, samples: list[tuple[float, float]]) -> None:  # noqa: ANN001
+    """Every beam of a compensated scan against the emulator's samples: the last sample of each 1-degree
+    bin lands there (rplidar_ros' compensation), at laser angle pi - device angle, within 1 cm."""
+    assert len(scan.ranges) == 360
+    by_bin: dict[int, tuple[float, float]] = {}
+    for a, d in sorted(samples):
+        if d:
+            by_bin[int(a)] = (a, d)
+    checked = 0
+    for j, r in enumerate(scan.ranges):
+        phi = scan.angle_min + j * scan.angle_increment
+        device_bin = 359 - j
+        if device_bin not in by_bin:
+            assert math.isinf(r), (j, r)
+            continue
+        a, _ = by_bin[device_bin]
+        assert phi == pytest.approx(math.pi - math.radians(device_bin), abs=1e-6)
+        assert abs(r - room_range(math.pi - math.radians(a))) < 0.01, (j, r, a)
+        checked += 1
+    assert checked > 300
+
+
+@pytest.mark.parametrize("mode", ["Standard", "Express"])
+def test_scan_of_the_known_room_within_1cm_and_stop_motor_reaches_the_device(
+    mode: str, tmp_path: Path
+) -> None:
+    a1 = EmulatedA1(samples_per_s=2000.0 if mode == "Standard" else 4000.0)
+    env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_LOG_DIR=str(tmp_path))
+    with testing.run_master(env=env) as uri:
+        env["ROS_MASTER_URI"] = uri
+        node = Node("rplidar_test", master_uri=uri)
+        scans = Collect()
+        node.subscriber("/scan", LaserScan, scans)
+        args = [f"_serial_port:={a1.path}", "_frame_id:=laser", "_angle_compensate:=true"]
+        proc = rplidar(env, *args, *([] if mode == "Express" else ["_scan_mode:=Standard"]))
+        try:
+            scans.wait_count(3, timeout=30)
+            scan = scans.items[-1]
+            assert scan.header.frame_id == "laser"
+            assert scan.range_min == pytest.approx(0.15) and scan.range_max == pytest.approx(16.0)
+            assert scan.scan_time > 0 and scan.time_increment == pytest.approx(scan.scan_time / 359)
+            samples = a1.standard_samples() if mode == "Standard" else a1.express_samples()
+            check_room(scan, samples)
+            assert rp.CMD_GET_INFO in a1.commands and rp.CMD_GET_HEALTH in a1.commands
+
+            before = len(a1.commands)
+            node.service_proxy("/stop_motor", Empty)(Empty._request_class())
+            a1.wait(lambda: rp.CMD_STOP in a1.commands[before:])
+            assert a1.mode is None  # the device stopped streaming
+            time.sleep(0.5)
+            count = len(scans.items)
+            time.sleep(0.5)
+            assert len(scans.items) == count  # no scans while stopped
+            node.service_proxy("/start_motor", Empty)(Empty._request_class())
+            scans.wait_count(count + 2)
+        finally:
+            out = stop(proc)
+            node.shutdown()
+            a1.close()
+        assert "RPLIDAR S/N: A0A1A2A3A4A5A6A7A8A9AAABACADAEAF" in out, out
+        assert "Firmware Ver: 1.29" in out and "Hardware Rev: 7" in out, out
+        assert "RPLidar health status : 0" in out, out
+        assert f"current scan mode: {mode}, max_distance: 16.0 m" in out, out
+        assert "Traceback" not in out, out
+
+
+def test_a_bad_descriptor_is_one_clear_error_and_the_node_stays_up(tmp_path: Path) -> None:
+    a1 = EmulatedA1(bad_scan_descriptor=True)
+    env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_LOG_DIR=str(tmp_path))
+    with testing.run_master(env=env) as uri:
+        env["ROS_MASTER_URI"] = uri
+        proc = rplidar(env, f"_serial_port:={a1.path}", "_scan_mode:=Standard")
+        try:
+            a1.wait(lambda: a1.commands.count(rp.CMD_SCAN) >= 3)  # retried, once a second
+            assert proc.poll() is None
+        finally:
+            out = stop(proc)
+            a1.close()
+        line = (
+            "Can not start scan: the device answered SCAN (0x20) with a response descriptor of length 84, "
+            "send mode 1, type 0x82; expected length 5, send mode 1, type 0x81"
+        )
+        assert out.count(line) == 1, out
+        assert "Traceback" not in out, out
+
+
+def test_health_error_and_unknown_scan_mode_stop_the_node_as_rplidar_ros_does(tmp_path: Path) -> None:
+    env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_LOG_DIR=str(tmp_path))
+    with testing.run_master(env=env) as uri:
+        env["ROS_MASTER_URI"] = uri
+        sick = EmulatedA1(health=(2, 0x8001))
+        try:
+            out = stop_after_exit(rplidar(env, f"_serial_port:={sick.path}"))
+            sick.wait(lambda: rp.CMD_RESET in sick.commands, timeout=5)  # the protection stop is reset
+            assert rp.CMD_SCAN not in sick.commands and rp.CMD_EXPRESS_SCAN not in sick.commands
+        finally:
+            sick.close()
+        assert "RPLidar health status : 2" in out, out
+        assert "Error, rplidar internal error detected. Please reboot the device to retry." in out, out
+        a1 = EmulatedA1()
+        try:
+            out = stop_after_exit(rplidar(env, f"_serial_port:={a1.path}", "_scan_mode:=Sensitivity"))
+        finally:
+            a1.close()
+        assert "scan mode `Sensitivity' is not supported by lidar, supported modes:" in out, out
+        assert "\tStandard: max_distance: 16.0 m, Point number: 2.0K" in out, out
+        out = stop_after_exit(rplidar(env, f"_serial_port:={tmp_path / 'nothing'}"))
+        assert f"Error, cannot bind to the specified serial port {tmp_path / 'nothing'}." in out, out
+
+
+def stop_after_exit(proc: subprocess.Popen) -> str:
+    try:
+        out, _ = proc.communicate(timeout=30)
+    except subprocess.TimeoutExpired:
+        return stop(proc) + "\n(did not exit)"
+    assert proc.returncode != 0
+    assert "Traceback" not in out, out
+    return out
+
+
+def test_rplidar_a1_launch_brings_up_the_node_on_the_emulated_device(tmp_path: Path) -> None:
+    a1 = EmulatedA1()
+    env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_LOG_DIR=str(tmp_path))
+    with testing.run_master(env=env) as uri:
+        env["ROS_MASTER_URI"] = uri
+        node = Node("rplidar_launch_test", master_uri=uri)
+        scans = Collect()
+        node.subscriber("/scan", LaserScan, scans)
+        launch = subprocess.Popen(
+            [
+                testing.ninjemys_bin("roslaunch"),
+                "rplidar_ros",
+                "rplidar_a1.launch",
+                f"serial_port:={a1.path}",
+            ],
+            env=env,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+            start_new_session=True,
+        )
+        try:
+            scans.wait_count(2, timeout=40)
+            scan = scans.items[-1]
+            assert (
+                scan.header.frame_id == "laser" and len(scan.ranges) == 360
+            )  # angle_compensate from the file
+            assert node.get_param("/rplidarNode/serial_baudrate") == 115200
+        finally:
+            os.killpg(launch.pid, signal.SIGINT)
+            try:
+                launch.communicate(timeout=20)
+            except subprocess.TimeoutExpired:
+                testing.kill_tree(launch)
+            node.shutdown()
+            a1.close()
+
+
+def test_launch_files_name_the_node_and_its_parameters() -> None:
+    from ninjemys.packages.shipped import shipped_executable
+
+    assert shipped_executable("rplidar_ros", "rplidarNode") is not None
+    share = Path(__file__).resolve().parents[2] / "src/ninjemys/packages/share/rplidar_ros/launch"
+    for name in ("rplidar", "rplidar_a1", "rplidar_a2", "rplidar_a3"):
+        text = (share / f"{name}.launch").read_text()
+        assert 'type="rplidarNode"' in text and 'name="angle_compensate"' in text
