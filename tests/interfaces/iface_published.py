@@ -96,6 +96,14 @@ PUBLISHED_MD5: dict[str, str] = {
     # roslisp/gennodejs/ROS.NET code generated from gazebo_ros_pkgs' Noetic gazebo_msgs
     "gazebo_msgs/SpawnModel": "9ed9c82c96abe1a00c3e8cdaeee24413",
     "gazebo_msgs/DeleteModel": "9ce56b4e9e54616de25d796dc972a262",
+    # `rosbag info` listings of Gazebo bags, rosserial headers, roslisp/gennodejs/ROS.NET code and a
+    # ROS Answers handshake error for the Noetic change of GetModelState (the others: test_gazebo_msgs.py)
+    "gazebo_msgs/ModelStates": "48c080191eb15c41858319b4d8a609c2",
+    "gazebo_msgs/LinkStates": "48c080191eb15c41858319b4d8a609c2",
+    "gazebo_msgs/LinkState": "0818ebbf28ce3a08d48ab1eaa7309ebe",
+    "gazebo_msgs/PerformanceMetrics": "884f71fd5037b886ec5e126b83c4425a",
+    "gazebo_msgs/GetModelState": "4c515e936d3319c9610c559c60bfc3d4",
+    "gazebo_msgs/SetModelState": "5b3ab0281d4f5445def017e3a2e4a07b",
     # rosapi (rosbridge_suite 0.11, Noetic) and tf2_web_republisher: rosserial, roslisp, gennodejs and
     # ROS.NET code generated from their definitions
     "rosapi/TypeDef": "80597571d79bbeef6c9c4d98f30116a0",

@@ -90,6 +90,9 @@ def test_published_table_covers_every_type_of_packages_debian_lacks() -> None:
     from iface_inventory import NOT_IN_DEBIAN
 
     ours = {t for t in INV.messages + INV.services if package_of(t) in NOT_IN_DEBIAN}
+    # gazebo_msgs' 34 types: Debian's genmsg computes each from our text (test_gazebo_msgs.py);
+    # the published figures below anchor a sample of them
+    ours = {t for t in ours if package_of(t) != "gazebo_msgs"}
     assert ours - set(PUBLISHED_MD5) == set()
 
 

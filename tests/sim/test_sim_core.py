@@ -324,7 +324,7 @@ def test_camera_sees_the_square_painted_on_the_floor():
 
 
 def test_spawn_model_xml_kinds():
-    from ninjemys.sim.puzzlebot_node import parse_model_xml
+    from ninjemys.sim.gazebo_api import parse_model_xml
 
     urdf = (ROBOTS_DIR / "puzzlebot.urdf").read_text()
     kind, model = parse_model_xml(urdf)

@@ -13,11 +13,12 @@ import numpy as np
 import pytest
 
 from ninjemys.sim import sensors
-from ninjemys.sim.puzzlebot_node import StepLock, keep_freed_memory
+from ninjemys.sim.puzzlebot_node import keep_freed_memory
 from ninjemys.sim.raycast import cast_segments
 from ninjemys.sim.robot_model import load_robot_model
 from ninjemys.sim.sensors import FLOOR_RGB, SKY_RGB, _padded_copy, _padded_empty, _select
 from ninjemys.sim.simcore import Simulation
+from ninjemys.sim.stepper import StepLock
 from ninjemys.sim.world2d import load_world
 from ninjemys.sim.worlds import world_path
 

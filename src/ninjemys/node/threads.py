@@ -157,7 +157,7 @@ THREADS: tuple[Thread, ...] = (
     # -- apps: the simulators (sim) --------------------------------------------------------------
     Thread(
         "puzzlebot-sim",
-        "sim.puzzlebot_node (start)",
+        "sim.stepper.Stepper (the PuzzleBot simulator node, gzserver, gazebo)",
         "the physics stepper: steps the world at its rate, publishes odometry, tf, scans, IMU, camera and "
         "/clock; the Gazebo services change the world under its lock",
     ),
@@ -251,6 +251,11 @@ THREADS: tuple[Thread, ...] = (
         "NodeProcess reader",
         "testing.NodeProcess (two per child: stdout, stderr)",
         "collects the child's output lines for the test",
+    ),
+    Thread(
+        "gzclient-attach",
+        "web.gazebo_ros.gzclient_main",
+        "waits for gzserver's /gazebo/gui_url parameter, then opens the browser view",
     ),
 )
 

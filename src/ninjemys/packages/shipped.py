@@ -61,6 +61,14 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
             "sim_node": ("ninjemys.web.puzzlebot_view:main", ()),
             "world_to_map": ("ninjemys.sim.world_to_map:main", ()),
         },
+        # -- Gazebo's names (docs/sim.md, "Gazebo's names") --
+        "gazebo_ros": {
+            "gzserver": ("ninjemys.web.gazebo_ros:gzserver_main", ()),
+            "gzclient": ("ninjemys.web.gazebo_ros:gzclient_main", ()),
+            "gazebo": ("ninjemys.web.gazebo_ros:gazebo_main", ()),
+            "debug": ("ninjemys.web.gazebo_ros:gzserver_main", ()),
+            "spawn_model": ("ninjemys.sim.spawn_model:main", ()),
+        },
         "teleop_twist_keyboard": {
             "teleop_twist_keyboard.py": ("ninjemys.sim.teleop_twist_keyboard:main", ()),
         },

@@ -1,15 +1,16 @@
 """``rosrun puzzlebot_sim sim_node``: the PuzzleBot simulator as a ROS node (the role Gazebo plays).
 
-It binds one :class:`~ninjemys.sim.simcore.Simulation` to ROS names. Per robot (relative names, under
-``<robot>/`` when the world has several robots or the robot was spawned later): ``cmd_vel`` in;
-``wl``, ``wr`` (std_msgs/Float32, rad/s), ``joint_states``, ``odom``, ``base_pose_ground_truth``,
-``scan``, ``imu``, ``camera/color/image_raw`` (rgb8), ``camera/depth/image_rect_raw`` (16UC1, mm),
+It binds one :class:`~ninjemys.sim.simcore.Simulation` to ROS names; the pacing is
+:mod:`~ninjemys.sim.stepper`'s, the messages are built by :mod:`~ninjemys.sim.messages` and the
+``/gazebo/*`` services and topics live in :mod:`~ninjemys.sim.gazebo_api`. Per robot (relative names,
+under ``<robot>/`` when the world has several robots or a spawned robot would clash with one, or under
+a spawn's ``robot_namespace``), with our PuzzleBot's names by default and a description's drive and
+sensor plugins' names otherwise: ``cmd_vel`` in; ``wl``, ``wr`` (std_msgs/Float32, rad/s),
+``joint_states``, ``odom``, ``base_pose_ground_truth``, ``scan``, ``imu``, ``camera/color/image_raw``
+(rgb8, and its ``/compressed``), ``camera/depth/image_rect_raw`` (16UC1, mm),
 ``camera/color/camera_info``, ``camera/depth/camera_info`` and ``contact`` (std_msgs/Bool, latched)
-out. Global: ``/clock``, ``/tf`` (odom -> base_link), ``/tf_static`` (base_link -> sensors), and the
-Gazebo services ``/gazebo/reset_simulation``, ``/gazebo/reset_world``, ``/gazebo/pause_physics``,
-``/gazebo/unpause_physics`` (std_srvs/Empty), ``/gazebo/spawn_urdf_model``,
-``/gazebo/spawn_sdf_model`` (gazebo_msgs/SpawnModel) and ``/gazebo/delete_model``
-(gazebo_msgs/DeleteModel).
+out. Global: ``/clock``, ``/tf`` (odom -> base_link), ``/tf_static`` (base_link -> sensors, for our
+own descriptions; a URDF robot's come from robot_state_publisher, as in Gazebo).
 
 Private parameters: ``~world`` (a shipped world name or a path; default ``square``), ``~map`` (a
 map_server YAML used as the world instead), ``~rate`` (real-time factor; 0 runs as fast as
@@ -18,7 +19,13 @@ path), ``~update_rate`` (physics steps per simulated second, default 100), ``~se
 ``~odom_alpha`` (amcl's α1-α4), ``~laser_noise``, ``~gui`` (serve the browser view),
 ``~cmd_vel_timeout`` (simulated seconds without a command after which the wheels are stopped, as
 diff_drive_controller's ``cmd_vel_timeout`` does; default 0: off, the last command holds, as with
-Gazebo's diff drive plugin).
+Gazebo's diff drive plugin), ``~no_robot`` (start with an empty world: robots come from
+``spawn_model``, as in Gazebo), ``~paused`` (start with physics paused, Gazebo's ``-u``).
+
+The first robot's names and sensors, as a student's launch file sets them (defaults: the model's):
+``~cmd_vel_topic``, ``~publish_odom``, ``~publish_odom_tf``, ``~odom_topic``, ``~odom_frame``,
+``~base_frame``, ``~scan_topic``, ``~scan_beams``, ``~scan_angle_min``, ``~scan_angle_max``,
+``~image_topic``, ``~camera_info_topic``, ``~camera_frame``, ``~imu_topic``.
 
 One thread steps the simulation and publishes; callbacks and services take the same lock. A topic
 nobody subscribes to costs nothing: its sensor is not even computed (Gazebo's sensors behave alike).
@@ -32,8 +39,6 @@ import math
 import signal
 import sys
 import threading
-import time
-import xml.etree.ElementTree as ET
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -41,101 +46,40 @@ from typing import Any
 import numpy as np
 
 from ninjemys.commands import entry
-from ninjemys.errors import NinjemysError, ShutdownError
-from ninjemys.idl.loader import get_message_class, get_service_class
+from ninjemys.errors import NinjemysError
+from ninjemys.idl.loader import get_message_class
 from ninjemys.image_transport import CompressedPublisher
 from ninjemys.maps.mapfile import MapFileError
 from ninjemys.node import Node
 from ninjemys.node.cli_args import parse_args
 from ninjemys.node.log import NodeLog
 from ninjemys.rostime import Time
+from ninjemys.sim import messages
+from ninjemys.sim.gazebo_api import GazeboApi, parse_model_xml
+from ninjemys.sim.gazebo_worlds import load_gazebo_world
 from ninjemys.sim.robot_model import RobotModel, load_robot_model
 from ninjemys.sim.simcore import Robot, Simulation, SpawnError
+from ninjemys.sim.stepper import Due, StepLock, Stepper
 from ninjemys.sim.world2d import World, load_world, world_from_map
 from ninjemys.sim.worlds import world_path
-from ninjemys.tf2.math import quaternion_from_rpy, quaternion_from_yaw, yaw_from_quaternion
+from ninjemys.tf2.math import quaternion_from_yaw
 
-Twist = get_message_class("geometry_msgs/Twist")
-TransformStamped = get_message_class("geometry_msgs/TransformStamped")
-Float32 = get_message_class("std_msgs/Float32")
-Bool = get_message_class("std_msgs/Bool")
-JointState = get_message_class("sensor_msgs/JointState")
-Odometry = get_message_class("nav_msgs/Odometry")
-LaserScan = get_message_class("sensor_msgs/LaserScan")
-Image = get_message_class("sensor_msgs/Image")
-CameraInfo = get_message_class("sensor_msgs/CameraInfo")
-Imu = get_message_class("sensor_msgs/Imu")
-TFMessage = get_message_class("tf2_msgs/TFMessage")
-Clock = get_message_class("rosgraph_msgs/Clock")
-Log = get_message_class("rosgraph_msgs/Log")
-Empty = get_service_class("std_srvs/Empty")
-SpawnModel = get_service_class("gazebo_msgs/SpawnModel")
-DeleteModel = get_service_class("gazebo_msgs/DeleteModel")
+Twist: Any = get_message_class("geometry_msgs/Twist")
+Float32: Any = get_message_class("std_msgs/Float32")
+Bool: Any = get_message_class("std_msgs/Bool")
+JointState: Any = get_message_class("sensor_msgs/JointState")
+Odometry: Any = get_message_class("nav_msgs/Odometry")
+LaserScan: Any = get_message_class("sensor_msgs/LaserScan")
+Image: Any = get_message_class("sensor_msgs/Image")
+CameraInfo: Any = get_message_class("sensor_msgs/CameraInfo")
+Imu: Any = get_message_class("sensor_msgs/Imu")
+TFMessage: Any = get_message_class("tf2_msgs/TFMessage")
+Clock: Any = get_message_class("rosgraph_msgs/Clock")
+Log: Any = get_message_class("rosgraph_msgs/Log")
 
 WORLD_FRAME = "map"  # ground truth frame: the shipped maps are rasterized in world coordinates
 
-
-class StepLock:
-    """The simulation's lock: the stepping thread steps with it, services, the browser view and
-    spawns take it with ``with lock:`` (reentrant).
-
-    Running as fast as possible, the stepping thread would take a plain lock again right after
-    releasing it (it holds the GIL) and starve everyone else. Yielding the CPU after every step
-    (``time.sleep(0)``) fixed that at a price: on a loaded machine each yield let other processes
-    run, ~90 us per 10 ms step. Here the others announce that they wait, and the stepping thread
-    steps aside (:meth:`give_way`) only then."""
-
-    def __init__(self) -> None:
-        self._lock = threading.RLock()
-        self._count_lock = threading.Lock()
-        self._waiting = 0
-        self._nobody_waits = threading.Event()
-        self._nobody_waits.set()
-
-    def __enter__(self) -> StepLock:
-        with self._count_lock:
-            self._waiting += 1
-            self._nobody_waits.clear()
-        try:
-            self._lock.acquire()
-        except BaseException:  # interrupted while waiting (KeyboardInterrupt): no longer a waiter
-            self._done_waiting()
-            raise
-        return self
-
-    def __exit__(self, *_exc: object) -> None:
-        self._lock.release()
-        self._done_waiting()
-
-    def _done_waiting(self) -> None:
-        with self._count_lock:
-            self._waiting -= 1
-            if not self._waiting:
-                self._nobody_waits.set()
-
-    @property
-    def stepping(self) -> threading.RLock:
-        """The lock itself, for the stepping thread (which does not announce itself)."""
-        return self._lock
-
-    def give_way(self, timeout: float) -> None:
-        """Between two steps: return once nobody waits for the lock (at most ``timeout`` s)."""
-        if self._waiting:
-            self._nobody_waits.wait(timeout)
-
-
-@dataclass
-class Due:
-    """A periodic output in simulated time: fires at the first step at or after ``next``."""
-
-    period: float
-    next: float = 0.0
-
-    def fire(self, now: float) -> bool:
-        if now + 1e-9 < self.next:
-            return False
-        self.next = max(self.next + self.period, now - self.period)  # no burst after a pause or reset
-        return True
+__all__ = ["SimNode", "RobotIO", "StepLock", "Due", "parse_model_xml", "keep_freed_memory", "main"]
 
 
 @dataclass
@@ -147,7 +91,7 @@ class RobotIO:
     frame_prefix: str  # "" or "name/": tf_prefix-style frame names
     pubs: dict[str, Any]
     cmd_sub: Any
-    odom_due: Due
+    odom_due: Due | None
     scan_due: Due | None
     camera_due: Due | None
     imu_due: Due | None
@@ -156,14 +100,22 @@ class RobotIO:
     last_contact: bool | None = None
     last_scan: np.ndarray | None = None
     static_tfs: list[Any] = field(default_factory=list)
+    topics: dict[str, str] = field(default_factory=dict)  # role -> relative topic name (the view's)
 
     def frame(self, name: str) -> str:
         return self.frame_prefix + name
 
     def close(self) -> None:
-        self.cmd_sub.unregister()
+        if self.cmd_sub is not None:
+            self.cmd_sub.unregister()
         for pub in self.pubs.values():
             pub.unregister()
+
+
+def _period(rate: float | None, default: float, dt: float) -> float:
+    """A sensor's period in sim seconds; rate <= 0 means every physics step (Gazebo's updateRate 0)."""
+    value = default if rate is None else rate
+    return dt if value <= 0 else 1.0 / value
 
 
 class SimNode:
@@ -175,79 +127,52 @@ class SimNode:
         self.node = node
         self.log = log
         self.sim = sim
-        self.rate = rate
         self.laser_noise = laser_noise
         self.lock = StepLock()
         self.io: dict[str, RobotIO] = {}
-        self.paused = False
-        self._wake = threading.Event()
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
-        self._started = (time.monotonic(), time.process_time())
-        self._stepped = 0.0  # simulated seconds stepped (resets of time do not undo them)
+        self.stepper = Stepper(
+            self._step_and_publish, lambda: sim.time, sim.dt, rate, self.lock, self._step_failed
+        )
         self.cmd_timeout = 0.0  # ~cmd_vel_timeout (0: off)
         self.view: Any = None
         self.clock_pub = node.publisher("/clock", Clock, queue_size=10)
         self.tf_pub = node.publisher("/tf", TFMessage, queue_size=100)
         self.tf_static_pub = node.publisher("/tf_static", TFMessage, queue_size=100, latch=True)
-        self.namespaced = False
-        node.service("/gazebo/reset_simulation", Empty, self._reset_simulation)
-        node.service("/gazebo/reset_world", Empty, self._reset_world)
-        node.service("/gazebo/pause_physics", Empty, self._pause)
-        node.service("/gazebo/unpause_physics", Empty, self._unpause)
-        node.service("/gazebo/spawn_urdf_model", SpawnModel, self._spawn)
-        node.service("/gazebo/spawn_sdf_model", SpawnModel, self._spawn)
-        node.service("/gazebo/delete_model", DeleteModel, self._delete)
+        self.gazebo = GazeboApi(self)
+
+    @property
+    def rate(self) -> float:
+        return self.stepper.rate
+
+    @property
+    def paused(self) -> bool:
+        return self.stepper.paused
 
     # -- robots ---------------------------------------------------------------------------------
     def add_robot(
-        self, name: str, model: RobotModel, x: float, y: float, yaw: float, namespaced: bool
+        self,
+        name: str,
+        model: RobotModel,
+        x: float,
+        y: float,
+        yaw: float,
+        namespaced: bool,
+        namespace: str | None = None,
     ) -> RobotIO:
-        """Place a robot and create its topics (raises SpawnError when the place is taken)."""
+        """Place a robot and create its topics (raises SpawnError when the place is taken).
+
+        ``namespace`` (a spawn's robot_namespace) puts the topics under it and leaves the frames as
+        the description names them, as Gazebo's plugins do; ``namespaced`` puts topics and frames
+        under ``<name>/`` (our multi-robot worlds)."""
         with self.lock:
             robot = self.sim.add_robot(name, model, x, y, yaw)
             if self.laser_noise is not None and model.laser is not None:
                 model.laser.noise = self.laser_noise
-            prefix = f"{name}/" if namespaced else ""
-            n = self.node
-            pubs = {
-                "wl": n.publisher(prefix + "wl", Float32, queue_size=10),
-                "wr": n.publisher(prefix + "wr", Float32, queue_size=10),
-                "joint_states": n.publisher(prefix + "joint_states", JointState, queue_size=10),
-                "odom": n.publisher(prefix + "odom", Odometry, queue_size=10),
-                "ground_truth": n.publisher(prefix + "base_pose_ground_truth", Odometry, queue_size=10),
-                "contact": n.publisher(prefix + "contact", Bool, queue_size=1, latch=True),
-            }
-            if model.laser is not None:
-                pubs["scan"] = n.publisher(prefix + "scan", LaserScan, queue_size=10)
-            if model.camera is not None:
-                pubs["image"] = n.publisher(prefix + "camera/color/image_raw", Image, queue_size=2)
-                # image_transport's <base>/compressed, encoded only while subscribed
-                pubs["image_compressed"] = CompressedPublisher(n, prefix + "camera/color/image_raw")
-                pubs["depth"] = n.publisher(prefix + "camera/depth/image_rect_raw", Image, queue_size=2)
-                pubs["color_info"] = n.publisher(
-                    prefix + "camera/color/camera_info", CameraInfo, queue_size=2
-                )
-                pubs["depth_info"] = n.publisher(
-                    prefix + "camera/depth/camera_info", CameraInfo, queue_size=2
-                )
-            if model.imu is not None:
-                pubs["imu"] = n.publisher(prefix + "imu", Imu, queue_size=10)
-            io = RobotIO(
-                robot,
-                prefix,
-                prefix,
-                pubs,
-                None,
-                Due(1.0 / model.odom_rate, self.sim.time),
-                Due(1.0 / model.laser.rate, self.sim.time) if model.laser else None,
-                Due(1.0 / model.camera.rate, self.sim.time) if model.camera else None,
-                Due(1.0 / model.imu.rate, self.sim.time) if model.imu else None,
-            )
-            io.cmd_sub = n.subscriber(
-                prefix + "cmd_vel", Twist, self._on_cmd_vel, callback_args=name, queue_size=1
-            )
-            io.static_tfs = self._static_transforms(io)
+            if namespace:
+                prefix, frame_prefix = namespace.strip("/") + "/", ""
+            else:
+                prefix = frame_prefix = f"{name}/" if namespaced else ""
+            io = self._endpoints(robot, prefix, frame_prefix)
             self.io[name] = io
             self._publish_static()
             self._publish_contact(io)
@@ -258,8 +183,81 @@ class SimNode:
             x,
             y,
             yaw,
-            f" in namespace /{name}" if namespaced else "",
+            f" in namespace /{prefix.rstrip('/')}" if prefix else "",
         )
+        drive = model.drive
+        if drive.kind == "none":
+            self.log.warn(
+                "robot [%s] has no drive plugin (gazebo_ros_diff_drive, gazebo_ros_skid_steer_drive or "
+                "gazebo_ros_control): it is passive (no %s, no odometry)",
+                name,
+                drive.command_topic,
+            )
+        if model.ignored_plugins:
+            self.log.warn(
+                "robot [%s]: ignoring plugins this simulator does not provide: %s",
+                name,
+                ", ".join(model.ignored_plugins),
+            )
+        return io
+
+    def _endpoints(self, robot: Robot, prefix: str, frame_prefix: str) -> RobotIO:
+        """The publishers and the command subscriber the model's drive and sensors name."""
+        n, model, dt, now = self.node, robot.model, self.sim.dt, self.sim.time
+        drive = model.drive
+        driven = drive.kind != "none"
+        pubs: dict[str, Any] = {
+            "ground_truth": n.publisher(prefix + "base_pose_ground_truth", Odometry, queue_size=10),
+            "contact": n.publisher(prefix + "contact", Bool, queue_size=1, latch=True),
+        }
+        topics = {  # what the browser view subscribes to (the camera's defaults when it has none)
+            "cmd_vel": prefix + drive.command_topic,
+            "color": prefix + "camera/color/image_raw",
+            "depth": prefix + "camera/depth/image_rect_raw",
+        }
+        if driven and drive.publish_wheel_speeds:
+            pubs["wl"] = n.publisher(prefix + "wl", Float32, queue_size=10)
+            pubs["wr"] = n.publisher(prefix + "wr", Float32, queue_size=10)
+        if driven and drive.publish_wheel_joint_state:
+            pubs["joint_states"] = n.publisher(prefix + "joint_states", JointState, queue_size=10)
+        if driven and drive.publish_odom:
+            pubs["odom"] = n.publisher(prefix + drive.odom_topic, Odometry, queue_size=10)
+        laser, camera, imu = model.laser, model.camera, model.imu
+        if laser is not None:
+            pubs["scan"] = n.publisher(prefix + laser.topic, LaserScan, queue_size=10)
+        if camera is not None:
+            topics["color"] = prefix + camera.image_topic
+            pubs["image"] = n.publisher(prefix + camera.image_topic, Image, queue_size=2)
+            # image_transport's <base>/compressed, encoded only while subscribed
+            pubs["image_compressed"] = CompressedPublisher(n, prefix + camera.image_topic)
+            pubs["color_info"] = n.publisher(prefix + camera.info_topic, CameraInfo, queue_size=2)
+            if camera.depth_topic:
+                topics["depth"] = prefix + camera.depth_topic
+                pubs["depth"] = n.publisher(prefix + camera.depth_topic, Image, queue_size=2)
+                if camera.depth_info_topic:
+                    pubs["depth_info"] = n.publisher(
+                        prefix + camera.depth_info_topic, CameraInfo, queue_size=2
+                    )
+        if imu is not None:
+            pubs["imu"] = n.publisher(prefix + imu.topic, Imu, queue_size=10)
+        io = RobotIO(
+            robot,
+            prefix,
+            frame_prefix,
+            pubs,
+            None,
+            Due(_period(drive.update_rate, model.odom_rate, dt), now),
+            Due(_period(laser.rate, 10.0, dt), now) if laser else None,
+            Due(_period(camera.rate, 30.0, dt), now) if camera else None,
+            Due(_period(imu.rate, 100.0, dt), now) if imu else None,
+            topics=topics,
+        )
+        if driven:
+            io.cmd_sub = n.subscriber(
+                prefix + drive.command_topic, Twist, self._on_cmd_vel, callback_args=robot.name, queue_size=1
+            )
+        if drive.kind == "puzzlebot":  # a URDF robot's sensor frames come from robot_state_publisher
+            io.static_tfs = messages.static_transforms(model, frame_prefix, self._stamp())
         return io
 
     def remove_robot(self, name: str) -> None:
@@ -268,30 +266,6 @@ class SimNode:
             io = self.io.pop(name)
             self._publish_static()
         io.close()
-
-    def _static_transforms(self, io: RobotIO) -> list[Any]:
-        """base_link -> each sensor's frame, and camera_link -> the optical frames the images name
-        (z forward, x right, y down: rpy -pi/2, 0, -pi/2, as the RealSense driver publishes)."""
-        m = io.robot.model
-        pairs: list[tuple[str, str, tuple[float, float, float], tuple[float, float, float]]] = []
-        for spec in (m.laser, m.camera, m.imu):
-            if spec is not None:
-                pairs.append(("base_link", spec.pose.frame, spec.pose.xyz, spec.pose.rpy))
-        if m.camera is not None:
-            optical = (-math.pi / 2, 0.0, -math.pi / 2)
-            for child in ("camera_color_optical_frame", "camera_depth_optical_frame"):
-                pairs.append((m.camera.pose.frame, child, (0.0, 0.0, 0.0), optical))
-        out = []
-        for parent, child, xyz, rpy in pairs:
-            t = TransformStamped()
-            t.header.stamp = self._stamp()
-            t.header.frame_id = io.frame(parent)
-            t.child_frame_id = io.frame(child)
-            t.transform.translation.x, t.transform.translation.y, t.transform.translation.z = xyz
-            q = t.transform.rotation
-            q.x, q.y, q.z, q.w = quaternion_from_rpy(*rpy)
-            out.append(t)
-        return out
 
     def _publish_static(self) -> None:
         """/tf_static is latched: one message holds every robot's static transforms."""
@@ -315,9 +289,10 @@ class SimNode:
             if not io.bad_cmd_warned:
                 io.bad_cmd_warned = True
                 self.log.warn(
-                    "%scmd_vel: ignoring a command with a non-finite value (linear.x=%s, angular.z=%s); "
+                    "%s%s: ignoring a command with a non-finite value (linear.x=%s, angular.z=%s); "
                     "further ones are ignored silently until a valid command arrives",
                     "/" + io.prefix if io.prefix else "",
+                    io.robot.model.drive.command_topic,
                     lin.x,
                     ang.z,
                 )
@@ -326,147 +301,39 @@ class SimNode:
         io.robot.command(lin.x, ang.z)
         io.last_cmd = self.sim.time
 
-    # -- services -------------------------------------------------------------------------------
-    def _reset_simulation(self, _req: Any) -> Any:
-        with self.lock:
-            self.sim.reset_simulation()
-            self._after_reset()
-        self.log.info("simulation reset: time and robots back to the start")
-        return Empty._response_class()
-
-    def _reset_world(self, _req: Any) -> Any:
-        with self.lock:
-            self.sim.reset_world()
-            self._after_reset()
-        self.log.info("world reset: robots back to their start poses")
-        return Empty._response_class()
-
-    def _after_reset(self) -> None:
+    # -- after the Gazebo services changed the world ----------------------------------------------
+    def after_reset(self) -> None:
+        """Outputs due now, contact re-announced, the stepping thread re-reads the clock."""
         now = self.sim.time
         for io in self.io.values():
             for due in (io.odom_due, io.scan_due, io.camera_due, io.imu_due):
                 if due is not None:
                     due.next = now
             self._publish_contact(io)
-        self._wake.set()
-
-    def _pause(self, _req: Any) -> Any:
-        with self.lock:
-            self.paused = True
-        return Empty._response_class()
-
-    def _unpause(self, _req: Any) -> Any:
-        with self.lock:
-            self.paused = False
-        self._wake.set()
-        return Empty._response_class()
-
-    def _spawn(self, req: Any) -> Any:
-        resp = SpawnModel._response_class()
-        name = req.model_name.strip()
-        x, y = req.initial_pose.position.x, req.initial_pose.position.y
-        q = req.initial_pose.orientation
-        yaw = yaw_from_quaternion(q.x, q.y, q.z, q.w)
-        try:
-            if not name or not name.replace("_", "a").isalnum() or not name[0].isalpha():
-                raise SpawnError(f"model_name [{req.model_name}] is not a valid ROS name")
-            if req.reference_frame not in ("", "world", "map"):
-                raise SpawnError(
-                    f"reference_frame [{req.reference_frame}] is not supported (use '' or 'world')"
-                )
-            kind, spec = parse_model_xml(req.model_xml)
-            if kind == "robot":
-                self.add_robot(name, spec, x, y, yaw, True)
-            else:
-                shape, size, height, colour = spec
-                with self.lock:
-                    self.sim.add_obstacle(name, shape, size, x, y, yaw, height, colour)
-                self.log.info("spawned %s [%s] at (%.3f, %.3f)", shape, name, x, y)
-        except (SpawnError, MapFileError) as exc:
-            self.log.error("spawn refused: %s", exc)
-            resp.success, resp.status_message = False, f"SpawnModel: Failure - {exc}"
-            return resp
-        resp.success, resp.status_message = True, f"SpawnModel: Successfully spawned entity [{name}]"
-        return resp
-
-    def _delete(self, req: Any) -> Any:
-        resp = DeleteModel._response_class()
-        name = req.model_name
-        try:
-            if name in self.sim.robots:
-                self.remove_robot(name)
-            else:
-                with self.lock:
-                    self.sim.remove_obstacle(name)
-        except SpawnError as exc:
-            resp.success, resp.status_message = False, f"DeleteModel: {exc}"
-            return resp
-        self.log.info("deleted model [%s]", name)
-        resp.success, resp.status_message = True, f"DeleteModel: successfully deleted model [{name}]"
-        return resp
+        self.stepper.wake()
 
     # -- the stepping thread --------------------------------------------------------------------
     def start(self) -> None:
-        self._thread = threading.Thread(target=self._run, name="puzzlebot-sim", daemon=True)
-        self._thread.start()
+        self.stepper.start()
 
     def stop(self) -> None:
-        self._stop.set()
-        self._wake.set()
-        if self._thread is not None:
-            self._thread.join(5.0)
+        if self.stepper.stop():
             self.log.info("%s", self.summary())
 
     def summary(self) -> str:
         """How fast the simulation ran: simulated seconds per wall second and per CPU second."""
-        wall = max(time.monotonic() - self._started[0], 1e-9)
-        cpu = max(time.process_time() - self._started[1], 1e-9)
-        stepped = self._stepped
-        return (
-            f"simulated {stepped:.2f} s in {wall:.2f} s of wall time ({stepped / wall:.1f}x real time), "
-            f"{cpu:.2f} s of CPU ({stepped / cpu:.1f} simulated s per CPU s)"
-        )
+        return self.stepper.summary()
+
+    def _step_failed(self, exc: Exception) -> None:
+        self.log.error("simulation step failed: %s: %s", type(exc).__name__, exc)
 
     def _stamp(self) -> Time:
-        ns = round(self.sim.steps * self.sim.dt * 1e9)
-        return Time(ns // 1_000_000_000, ns % 1_000_000_000)
-
-    def _run(self) -> None:
-        self._started = (time.monotonic(), time.process_time())
-        wall0 = time.monotonic()
-        sim0 = self.sim.time
-        while not self._stop.is_set():
-            with self.lock.stepping:
-                paused = self.paused
-            if paused:
-                self._wake.wait(0.5)
-                self._wake.clear()
-                wall0, sim0 = time.monotonic(), self.sim.time
-                continue
-            try:
-                with self.lock.stepping:
-                    if self.sim.time < sim0:  # reset_simulation: time went back
-                        wall0, sim0 = time.monotonic(), self.sim.time
-                    self._step_and_publish()
-            except ShutdownError:
-                return  # the node shut down under the stepping thread
-            except Exception as exc:  # a bug in one step must not freeze the simulation for good
-                self.log.error("simulation step failed: %s: %s", type(exc).__name__, exc)
-            if self.rate <= 0:
-                self.lock.give_way(0.5)  # as fast as possible, yet services and the view get the lock
-            else:
-                target = wall0 + (self.sim.time - sim0) / self.rate
-                delay = target - time.monotonic()
-                if delay > 0:
-                    self._wake.wait(delay)
-                    self._wake.clear()
-                elif delay < -0.25:  # far behind (machine busy): run on from now, no burst to catch up
-                    wall0, sim0 = time.monotonic(), self.sim.time
+        return messages.stamp_of(self.sim.steps, self.sim.dt)
 
     def _step_and_publish(self) -> None:
         sim = self.sim
+        self.gazebo.before_step()
         touched = sim.step()
-        self._stepped += sim.dt
         now = sim.time
         stamp = self._stamp()
         if self.clock_pub.get_num_connections():  # nobody listening costs nothing (checked every step)
@@ -476,6 +343,7 @@ class SimNode:
                 "robot [%s] hit '%s' at (%.3f, %.3f): stopped at contact", r.name, r.contact_with, r.x, r.y
             )
         tfs: list[Any] | None = [] if self.tf_pub.get_num_connections() else None
+        view = self.view  # one read: the browser view attaches while the simulation runs
         for io in self.io.values():
             r = io.robot
             last = io.last_cmd
@@ -484,236 +352,102 @@ class SimNode:
                 r.command(0.0, 0.0)
             self._publish_contact(io)
             pubs = io.pubs
-            if io.odom_due.fire(now):
+            if io.odom_due is not None and io.odom_due.fire(now):
                 self._odometry(io, stamp, tfs)
-            if io.imu_due is not None and io.imu_due.fire(now) and pubs["imu"].get_num_connections():
-                self._imu(io, stamp)
-            if io.scan_due is not None and io.scan_due.fire(now):
-                want_view = self.view is not None and self.view.wants_scans()
-                if pubs["scan"].get_num_connections() or want_view:
+            imu, imu_spec = pubs.get("imu"), r.model.imu
+            if io.imu_due is not None and io.imu_due.fire(now) and imu is not None and imu_spec is not None:
+                if imu.get_num_connections():
+                    imu.publish(messages.imu(stamp, io.frame(imu_spec.pose.frame), imu_spec, sim.imu(r)))
+            laser = r.model.laser
+            if io.scan_due is not None and laser is not None:
+                scan = pubs["scan"]
+                subscribed = scan.get_num_connections()
+                if not subscribed and not (view is not None and view.wants_scans()):
+                    io.scan_due.next = now  # idle: a new subscriber's first scan goes out at once
+                elif io.scan_due.fire(now):
                     ranges = sim.scan(r)
                     io.last_scan = ranges
-                    if pubs["scan"].get_num_connections():
-                        self._scan(io, stamp, ranges)
+                    if subscribed:
+                        scan.publish(messages.laser_scan(stamp, io.frame(laser.pose.frame), laser, ranges))
             if io.camera_due is not None and io.camera_due.fire(now):
                 want = any(
                     pubs[k].get_num_connections()
                     for k in ("image", "image_compressed", "depth", "color_info", "depth_info")
+                    if k in pubs
                 )
                 if want:  # a browser view watches the cameras as ROS topics too (through its gateway)
                     self._camera(io, stamp)
         if tfs:
             self.tf_pub.publish(TFMessage(transforms=tfs))
-        if self.view is not None:
-            self.view.publish(now)
+        self.gazebo.after_step(stamp)
+        if view is not None:
+            view.publish(now)
 
     def _odometry(self, io: RobotIO, stamp: Time, tfs: list[Any] | None) -> None:
         """Advance the robot's odometry; publish odom, ground truth, wl/wr and joint_states to whoever
-        listens, and append odom -> base_link to ``tfs`` (None: nobody listens to /tf)."""
+        listens, and append odom -> base to ``tfs`` (None: nobody listens to /tf)."""
         r = io.robot
         pubs = io.pubs
-        ox, oy, oyaw = self.sim.odometry(r)
-        if pubs["odom"].get_num_connections():
-            msg = Odometry()
-            msg.header.stamp = stamp
-            msg.header.frame_id = io.frame("odom")
-            msg.child_frame_id = io.frame("base_link")
-            p = msg.pose.pose
-            p.position.x, p.position.y = ox, oy
-            p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w = quaternion_from_yaw(oyaw)
-            msg.twist.twist.linear.x = r.v
-            msg.twist.twist.angular.z = r.w
-            a1, a2, a3, a4 = r.model.odom_alpha
-            var_xy = 1e-4 + a3 * 0.01
-            var_yaw = 1e-4 + a1 * 0.01
-            msg.pose.covariance = [
-                var_xy,
-                0,
-                0,
-                0,
-                0,
-                0,
-                0,
-                var_xy,
-                0,
-                0,
-                0,
-                0,
-                0,
-                0,
-                1e6,
-                0,
-                0,
-                0,
-                0,
-                0,
-                0,
-                1e6,
-                0,
-                0,
-                0,
-                0,
-                0,
-                0,
-                1e6,
-                0,
-                0,
-                0,
-                0,
-                0,
-                0,
-                var_yaw,
-            ]
-            msg.twist.covariance = msg.pose.covariance
-            pubs["odom"].publish(msg)
-        if pubs["ground_truth"].get_num_connections():
-            gt = Odometry()
-            gt.header.stamp = stamp
-            gt.header.frame_id = WORLD_FRAME
-            gt.child_frame_id = io.frame("base_link")
-            gp = gt.pose.pose
-            gp.position.x, gp.position.y = r.x, r.y
-            gp.orientation.x, gp.orientation.y, gp.orientation.z, gp.orientation.w = quaternion_from_yaw(
-                r.yaw
+        drive = r.model.drive
+        driven = drive.kind != "none"
+        if drive.odometry_source == "world":
+            pose = (r.x, r.y, r.yaw)  # gazebo_ros_diff_drive's odometrySource world: the true pose
+        else:
+            pose = self.sim.odometry(r)
+        odom_frame, base_frame = io.frame(drive.odom_frame), io.frame(drive.base_frame)
+        odom = pubs.get("odom")
+        if odom is not None and odom.get_num_connections():
+            odom.publish(
+                messages.odometry(stamp, odom_frame, base_frame, pose, (r.v, r.w), r.model.odom_alpha)
             )
-            gt.twist.twist.linear.x = r.v
-            gt.twist.twist.angular.z = r.w
-            pubs["ground_truth"].publish(gt)
-        if pubs["wl"].get_num_connections():
-            pubs["wl"].publish(Float32(data=r.wl))
-        if pubs["wr"].get_num_connections():
-            pubs["wr"].publish(Float32(data=r.wr))
-        if pubs["joint_states"].get_num_connections():
-            js = JointState()
-            js.header.stamp = stamp
-            js.name = [r.model.left_joint, r.model.right_joint]
-            js.position = [r.left_angle, r.right_angle]
-            js.velocity = [r.wl, r.wr]
-            pubs["joint_states"].publish(js)
-        if tfs is None:
+        if pubs["ground_truth"].get_num_connections():
+            pubs["ground_truth"].publish(
+                messages.odometry(stamp, WORLD_FRAME, io.frame("base_link"), (r.x, r.y, r.yaw), (r.v, r.w))
+            )
+        wl, wr = pubs.get("wl"), pubs.get("wr")
+        if wl is not None and wl.get_num_connections():
+            wl.publish(Float32(data=r.wl))
+        if wr is not None and wr.get_num_connections():
+            wr.publish(Float32(data=r.wr))
+        js = pubs.get("joint_states")
+        if js is not None and js.get_num_connections():
+            js.publish(
+                messages.joint_state(
+                    stamp,
+                    [r.model.left_joint, r.model.right_joint],
+                    [r.left_angle, r.right_angle],
+                    [r.wl, r.wr],
+                )
+            )
+        if tfs is None or not driven or not drive.publish_odom_tf:
             return
-        t = TransformStamped()
-        t.header.stamp = stamp
-        t.header.frame_id = io.frame("odom")
-        t.child_frame_id = io.frame("base_link")
-        t.transform.translation.x, t.transform.translation.y = ox, oy
-        q = t.transform.rotation
-        q.x, q.y, q.z, q.w = quaternion_from_yaw(oyaw)
-        tfs.append(t)
-
-    def _imu(self, io: RobotIO, stamp: Time) -> None:
-        r = io.robot
-        spec = r.model.imu
-        yaw, wz, ax, ay = self.sim.imu(r)
-        msg = Imu()
-        msg.header.stamp = stamp
-        msg.header.frame_id = io.frame(spec.pose.frame)
-        o = msg.orientation
-        o.x, o.y, o.z, o.w = quaternion_from_yaw(yaw)
-        msg.angular_velocity.z = wz
-        msg.linear_acceleration.x, msg.linear_acceleration.y, msg.linear_acceleration.z = ax, ay, 9.80665
-        g, a = max(spec.gyro_noise**2, 1e-9), max(spec.accel_noise**2, 1e-9)
-        msg.orientation_covariance = [1e-4, 0, 0, 0, 1e-4, 0, 0, 0, 1e-4]
-        msg.angular_velocity_covariance = [g, 0, 0, 0, g, 0, 0, 0, g]
-        msg.linear_acceleration_covariance = [a, 0, 0, 0, a, 0, 0, 0, a]
-        io.pubs["imu"].publish(msg)
-
-    def _scan(self, io: RobotIO, stamp: Time, ranges: np.ndarray) -> None:
-        spec = io.robot.model.laser
-        msg = LaserScan()
-        msg.header.stamp = stamp
-        msg.header.frame_id = io.frame(spec.pose.frame)
-        inc = 2.0 * math.pi / spec.beams
-        msg.angle_min = -math.pi
-        msg.angle_max = -math.pi + inc * (spec.beams - 1)
-        msg.angle_increment = inc
-        msg.time_increment = 0.0
-        msg.scan_time = 1.0 / spec.rate
-        msg.range_min = spec.range_min
-        msg.range_max = spec.range_max
-        msg.ranges = ranges
-        msg.intensities = []
-        io.pubs["scan"].publish(msg)
+        tfs.append(
+            messages.transform(
+                stamp, odom_frame, base_frame, (pose[0], pose[1], 0.0), quaternion_from_yaw(pose[2])
+            )
+        )
 
     def _camera(self, io: RobotIO, stamp: Time) -> None:
         r = io.robot
         spec = r.model.camera
+        if spec is None or r.camera is None:
+            return
         rgb, depth = self.sim.render(r)
         pubs = io.pubs
-        frame = io.frame("camera_color_optical_frame")
-        depth_frame = io.frame("camera_depth_optical_frame")
+        frame = io.frame(spec.frame)
+        depth_frame = io.frame(spec.depth_frame)
         want_raw = pubs["image"].get_num_connections()
         if want_raw or pubs["image_compressed"].get_num_connections():
-            img = Image()
-            img.header.stamp = stamp
-            img.header.frame_id = frame
-            img.height, img.width = rgb.shape[0], rgb.shape[1]
-            img.encoding = "rgb8"
-            img.is_bigendian = 0
-            img.step = rgb.shape[1] * 3
-            img.data = rgb.reshape(-1)  # a view: uint8[] fields take numpy arrays without a copy
+            img = messages.rgb_image(stamp, frame, rgb)
             if want_raw:
                 pubs["image"].publish(img)
             pubs["image_compressed"].publish(img)
-        if pubs["depth"].get_num_connections():
-            d = Image()
-            d.header.stamp = stamp
-            d.header.frame_id = depth_frame
-            d.height, d.width = depth.shape[0], depth.shape[1]
-            d.encoding = "16UC1"
-            d.is_bigendian = 0
-            d.step = depth.shape[1] * 2
-            d.data = depth.astype("<u2", copy=False).view(np.uint8).reshape(-1)
-            pubs["depth"].publish(d)
-        fx, fy, cx, cy = r.camera.intrinsics()
+        if "depth" in pubs and pubs["depth"].get_num_connections():
+            pubs["depth"].publish(messages.depth_image(stamp, depth_frame, depth))
+        intrinsics = r.camera.intrinsics()
         for key, frame_id in (("color_info", frame), ("depth_info", depth_frame)):
-            if pubs[key].get_num_connections():
-                info = CameraInfo()
-                info.header.stamp = stamp
-                info.header.frame_id = frame_id
-                info.height, info.width = spec.height, spec.width
-                info.distortion_model = "plumb_bob"
-                info.D = [0.0, 0.0, 0.0, 0.0, 0.0]
-                info.K = [fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0]
-                info.R = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
-                info.P = [fx, 0.0, cx, 0.0, 0.0, fy, cy, 0.0, 0.0, 0.0, 1.0, 0.0]
-                pubs[key].publish(info)
-
-
-def parse_model_xml(text: str) -> tuple[str, Any]:
-    """What a SpawnModel request's ``model_xml`` describes: ("robot", RobotModel) or
-    ("obstacle", (shape, size, height, colour)). Empty text or ``puzzlebot`` is the PuzzleBot."""
-    body = text.strip()
-    if not body:
-        return "robot", load_robot_model("puzzlebot")
-    if not body.startswith("<"):
-        return "robot", load_robot_model(body)
-    try:
-        root = ET.fromstring(body)
-    except ET.ParseError as exc:
-        raise SpawnError(f"model_xml is not valid XML: {exc}") from None
-    if root.tag == "robot" and len([j for j in root.iter("joint") if j.get("type") == "continuous"]) == 2:
-        return "robot", load_robot_model(body)
-    for geom in root.iter("geometry"):
-        box = geom.find("box")
-        cyl = geom.find("cylinder")
-        if box is not None:
-            size_text = box.get("size") or (box.findtext("size") or "")
-            try:
-                sx, sy, sz = (float(v) for v in size_text.split())
-            except ValueError:
-                raise SpawnError(f"box size {size_text!r} is not three numbers") from None
-            return "obstacle", ("box", (sx, sy), sz, (180, 130, 80))
-        if cyl is not None:
-            try:
-                radius = float(cyl.get("radius") or cyl.findtext("radius") or "")
-                length = float(cyl.get("length") or cyl.findtext("length") or "")
-            except ValueError:
-                raise SpawnError("cylinder needs numeric radius and length") from None
-            return "obstacle", ("cylinder", (radius, radius), length, (60, 90, 200))
-    raise SpawnError(
-        "model_xml describes neither a differential-drive robot (URDF with 2 continuous joints) nor a box or cylinder"
-    )
+            if key in pubs and pubs[key].get_num_connections():
+                pubs[key].publish(messages.camera_info(stamp, frame_id, spec, intrinsics))
 
 
 # -- process entry point -------------------------------------------------------------------------
@@ -768,10 +502,43 @@ def keep_freed_memory() -> bool:
     return bool(mallopt(m_mmap_threshold, 16 << 20)) and bool(mallopt(m_trim_threshold, 64 << 20))
 
 
+def configure_model(
+    model: RobotModel, param: Callable[[str, Any, type], Any], has_param: Callable[[str], bool]
+) -> None:
+    """Apply the node's private parameters that rename or reshape the first robot's outputs (item 5
+    of the Gazebo issue: what a student's launch file sets where the maker's plugins would)."""
+    drive = model.drive
+    drive.command_topic = param("cmd_vel_topic", drive.command_topic, str)
+    drive.publish_odom = param("publish_odom", drive.publish_odom, bool)
+    drive.publish_odom_tf = param("publish_odom_tf", drive.publish_odom_tf, bool)
+    drive.odom_topic = param("odom_topic", drive.odom_topic, str)
+    drive.odom_frame = param("odom_frame", drive.odom_frame, str)
+    drive.base_frame = param("base_frame", drive.base_frame, str)
+    laser = model.laser
+    if laser is not None:
+        laser.topic = param("scan_topic", laser.topic, str)
+        beams = int(param("scan_beams", laser.beams, float))
+        laser.beams = beams if beams >= 1 else laser.beams
+        laser.angle_min = param("scan_angle_min", laser.angle_min, float)
+        if has_param("~scan_angle_max"):
+            top = param("scan_angle_max", laser.angle_max if laser.angle_max is not None else math.pi, float)
+            laser.angle_max = top if top > laser.angle_min else None
+    camera = model.camera
+    if camera is not None:
+        camera.image_topic = param("image_topic", camera.image_topic, str)
+        camera.info_topic = param("camera_info_topic", camera.info_topic, str)
+        camera.frame = param("camera_frame", camera.frame, str)
+    if model.imu is not None:
+        model.imu.topic = param("imu_topic", model.imu.topic, str)
+
+
 def load_sim_world(log: NodeLog, world_arg: str, map_arg: str) -> World:
     if map_arg:
         log.info("world from map_server map %s", map_arg)
         return world_from_map(map_arg)
+    if world_arg.endswith(".world"):  # Gazebo's world_name (gzserver, empty_world.launch)
+        log.info("world from Gazebo world file %s", world_arg)
+        return load_gazebo_world(world_arg)
     return load_world(world_path(world_arg))
 
 
@@ -821,7 +588,7 @@ def main(argv: list[str] | None = None, view: ViewStarter | None = None) -> int:
         try:
             world = load_sim_world(log, world_arg, map_arg)
             model = load_robot_model(_param(node, log, "model", "puzzlebot", str))
-        except MapFileError as exc:
+        except NinjemysError as exc:  # MapFileError, or the SDF reader's errors
             log.fatal("%s", exc)
             return 1
         update_rate = _param(node, log, "update_rate", 100.0, float)
@@ -844,6 +611,9 @@ def main(argv: list[str] | None = None, view: ViewStarter | None = None) -> int:
         laser_noise = node.get_param("~laser_noise", None) if node.has_param("~laser_noise") else None
         keep_freed_memory()
         sim = Simulation(world, 1.0 / update_rate, int(_param(node, log, "seed", 0, float)))
+        configure_model(
+            model, lambda key, default, kind: _param(node, log, key, default, kind), node.has_param
+        )
         app = SimNode(node, log, sim, rate, float(laser_noise) if laser_noise is not None else None)
         app.cmd_timeout = max(0.0, _param(node, log, "cmd_vel_timeout", 0.0, float))
         starts = list(world.robots) or []
@@ -851,16 +621,18 @@ def main(argv: list[str] | None = None, view: ViewStarter | None = None) -> int:
             from ninjemys.sim.world2d import RobotStart
 
             starts = [RobotStart("puzzlebot", 0.0, 0.0, 0.0)]
-        first = starts[0]
-        x = _param(node, log, "x", first.x, float)
-        y = _param(node, log, "y", first.y, float)
-        yaw = _param(node, log, "yaw", first.yaw, float)
+        if _param(node, log, "no_robot", False, bool):
+            starts = []  # Gazebo's way: an empty world, robots come from spawn_model
+        first = starts[0] if starts else None
+        x = _param(node, log, "x", first.x if first else 0.0, float)
+        y = _param(node, log, "y", first.y if first else 0.0, float)
+        yaw = _param(node, log, "yaw", first.yaw if first else 0.0, float)
         namespaced = len(starts) > 1
         for i, s in enumerate(starts):
             pose = (x, y, yaw) if i == 0 else (s.x, s.y, s.yaw)
             try:
                 robot_model = model if s.model == "puzzlebot" else load_robot_model(s.model)
-                app.add_robot(s.name, robot_model, *pose, namespaced)
+                app.add_robot(s.name, robot_model, pose[0], pose[1], pose[2], namespaced)
             except (SpawnError, MapFileError) as exc:
                 log.fatal("%s", exc)
                 return 1
@@ -873,12 +645,15 @@ def main(argv: list[str] | None = None, view: ViewStarter | None = None) -> int:
         )
         stop_view = None
         gui = _param(node, log, "gui", True, bool) and not options.headless
-        if gui and view is not None:
-            stop_view = view(app, options, log)
-            if stop_view is None:
-                return 1
-        app.start()
+        if _param(node, log, "paused", False, bool):
+            app.stepper.paused = True  # Gazebo's -u: physics waits for unpause_physics
+            log.info("physics paused (call /gazebo/unpause_physics to start)")
+        app.start()  # the physics and the sensors first: the view's server starts beside them
         try:
+            if gui and view is not None:
+                stop_view = view(app, options, log)
+                if stop_view is None:
+                    return 1
             node.spin()
         finally:
             app.stop()

@@ -21,7 +21,7 @@ import numpy as np
 
 from ninjemys.errors import NinjemysError
 from ninjemys.sim.raycast import grid_edges
-from ninjemys.sim.robot_model import RobotModel
+from ninjemys.sim.robot_model import LaserSpec, RobotModel
 from ninjemys.sim.sensors import Camera, FloorPaint, Scene, imu_reading, lidar_ranges
 from ninjemys.sim.world2d import MovingObstacle, Obstacle, World, box_outline, circle_outline
 
@@ -32,6 +32,17 @@ LOOK_AHEAD = 2.0  # m: how far ahead on its route such a person starts to step a
 
 class SpawnError(NinjemysError, ValueError):
     """A spawn or delete the simulation refuses; the text says why (shown to the service caller)."""
+
+
+def scan_angles(spec: LaserSpec) -> tuple[float, float, float]:
+    """(angle_min, angle_max, increment) of a laser. ``angle_max`` None is a full turn less one
+    increment (our PuzzleBot's 360 beams from the back); otherwise the beams span
+    [angle_min, angle_max] inclusive, as Gazebo's ray sensor spreads its samples; one beam: increment 0."""
+    if spec.angle_max is None:
+        inc = 2.0 * math.pi / spec.beams
+        return spec.angle_min, spec.angle_min + inc * (spec.beams - 1), inc
+    inc = (spec.angle_max - spec.angle_min) / (spec.beams - 1) if spec.beams > 1 else 0.0
+    return spec.angle_min, spec.angle_max, inc
 
 
 def wrap_angle(a: float) -> float:
@@ -120,6 +131,7 @@ class Simulation:
         self.steps = 0
         self.world_time = 0.0  # moving obstacles' clock (reset_world restarts it, time goes on)
         self.robots: dict[str, Robot] = {}
+        self.obstacle_yaw: dict[str, float] = {}  # yaw of spawned or moved obstacles (outlines have none)
         self._spawned = 0
         self._static: np.ndarray
         self.static_names: list[str] = []
@@ -372,6 +384,61 @@ class Simulation:
         self.robots[name] = robot
         return robot
 
+    def place_robot(self, name: str, x: float, y: float, yaw: float) -> Robot:
+        """Teleport a robot (Gazebo's set_model_state): refused (SpawnError) when the pose is not finite
+        or the body would overlap anything; wheels and odometry keep running from the new pose."""
+        r = self.robots.get(name)
+        if r is None:
+            raise SpawnError(f"no robot named [{name}]")
+        if not all(math.isfinite(v) for v in (x, y, yaw)):
+            raise SpawnError(f"pose of [{name}] is not finite: ({x}, {y}, {yaw})")
+        gap, what = self.clearance(x, y, exclude=name)
+        solid = self.solid_at(x, y)
+        if solid:
+            gap, what = 0.0, solid
+        if gap < r.model.body_radius:
+            raise SpawnError(
+                f"cannot move [{name}] to ({x:.3f}, {y:.3f}): it would be inside '{what}' "
+                f"(clearance {max(gap, 0.0):.3f} m, body radius {r.model.body_radius:.3f} m)"
+            )
+        r.x, r.y, r.yaw = x, y, wrap_angle(yaw)
+        r.odom_ref = (r.x, r.y, r.yaw)  # wheel odometry does not see a teleport (the wheels did not turn)
+        r.free = None
+        r.contact, r.contact_with = False, ""
+        return r
+
+    def obstacle_pose(self, name: str) -> tuple[float, float, float]:
+        """An obstacle's (x, y, yaw): the centre of its outline, and the yaw it was spawned or moved
+        with (0 for the world's own)."""
+        o = next((o for o in self.world.obstacles if o.name == name), None)
+        if o is None:
+            raise SpawnError(f"no model named [{name}]")
+        cx, cy = (float(v) for v in o.outline.mean(axis=0))
+        return cx, cy, self.obstacle_yaw.get(name, 0.0)
+
+    def move_obstacle(self, name: str, x: float, y: float, yaw: float) -> None:
+        """Move a static obstacle so its centre is at (x, y), turned by ``yaw`` from its first pose
+        (Gazebo's set_model_state on a model); refused when it would overlap a robot."""
+        index = next((i for i, o in enumerate(self.world.obstacles) if o.name == name), None)
+        if index is None:
+            raise SpawnError(f"no model named [{name}]")
+        o = self.world.obstacles[index]
+        if not all(math.isfinite(v) for v in (x, y, yaw)):
+            raise SpawnError(f"pose of [{name}] is not finite: ({x}, {y}, {yaw})")
+        cx, cy, cyaw = self.obstacle_pose(name)
+        c, s = math.cos(yaw - cyaw), math.sin(yaw - cyaw)
+        rel = o.outline - np.array([cx, cy])
+        outline = np.column_stack([c * rel[:, 0] - s * rel[:, 1] + x, s * rel[:, 0] + c * rel[:, 1] + y])
+        for r in self.robots.values():
+            d = point_segment_distance(
+                np.array([r.x]), np.array([r.y]), np.hstack([outline, np.roll(outline, -1, axis=0)])
+            )
+            if (len(outline) > 2 and _inside(r.x, r.y, outline)) or float(d.min()) < r.model.body_radius:
+                raise SpawnError(f"cannot move [{name}]: it would overlap robot [{r.name}]")
+        self.world.obstacles[index] = Obstacle(o.name, o.kind, outline, o.height, o.color)
+        self.obstacle_yaw[name] = yaw
+        self._rebuild_static()
+
     def remove_robot(self, name: str) -> None:
         if self.robots.pop(name, None) is None:
             raise SpawnError(f"no robot named [{name}]")
@@ -401,6 +468,7 @@ class Simulation:
             if inside or float(d.min()) < r.model.body_radius:
                 raise SpawnError(f"cannot spawn [{name}]: it would overlap robot [{r.name}]")
         self.world.obstacles.append(Obstacle(name, kind, outline, height, color))
+        self.obstacle_yaw[name] = yaw
         self._rebuild_static()
 
     def remove_obstacle(self, name: str) -> None:
@@ -605,14 +673,14 @@ class Simulation:
         spec = r.model.laser
         assert spec is not None
         lx, ly = self.sensor_pose(r, spec.pose.xyz)
-        inc = 2.0 * math.pi / spec.beams
+        angle_min, _angle_max, inc = scan_angles(spec)
         return lidar_ranges(
             scene or self.scene(r.name),
             lx,
             ly,
             spec.pose.xyz[2],
             r.yaw + spec.pose.rpy[2],
-            -math.pi,
+            angle_min,
             inc,
             spec.beams,
             spec.range_min,

@@ -23,6 +23,7 @@ import numpy as np
 
 from ninjemys.bridge.server import Gateway, GatewayOptions
 from ninjemys.commands import entry
+from ninjemys.sim.simcore import scan_angles
 from ninjemys.web.app import WebApp
 from ninjemys.web.browser import open_if_display
 
@@ -43,6 +44,8 @@ class PuzzlebotView:
     and pauses or resets through the ``/gazebo/*`` services, all through the gateway. The simulator
     calls :meth:`wants_scans` and :meth:`publish` (on its thread, with its lock held).
     """
+
+    url = ""  # the page's address once served
 
     def __init__(self, app: WebApp, gateway: Gateway, sim_node: SimNode) -> None:
         self.sim_node = sim_node
@@ -108,10 +111,11 @@ class PuzzlebotView:
             scan = None
             if io.last_scan is not None and r.model.laser is not None:
                 ranges = io.last_scan
+                angle_min, _angle_max, increment = scan_angles(r.model.laser)
                 scan = {
                     "ranges": [round(float(v), 3) if math.isfinite(v) else None for v in ranges],
-                    "angle_min": -math.pi,
-                    "increment": 2.0 * math.pi / len(ranges),
+                    "angle_min": angle_min,
+                    "increment": increment,
                     "offset": list(r.model.laser.pose.xyz[:2]),
                 }
             robots.append(
@@ -119,7 +123,7 @@ class PuzzlebotView:
                     "name": name,
                     "namespace": "/" + io.prefix.rstrip("/") if io.prefix else "",
                     # resolved names the page publishes to and subscribes to through the gateway
-                    "topics": self._topics(io.prefix),
+                    "topics": self._topics(io.topics),
                     "x": round(r.x, 4),
                     "y": round(r.y, 4),
                     "yaw": round(r.yaw, 4),
@@ -151,13 +155,10 @@ class PuzzlebotView:
             "movers": movers,
         }
 
-    def _topics(self, prefix: str) -> dict[str, str]:
+    def _topics(self, topics: dict[str, str]) -> dict[str, str]:
+        """The robot's command and camera topics, resolved (its model names them)."""
         resolve = self.sim_node.node.resolve_name
-        return {
-            "cmd_vel": resolve(prefix + "cmd_vel"),
-            "color": resolve(prefix + "camera/color/image_raw"),
-            "depth": resolve(prefix + "camera/depth/image_rect_raw"),
-        }
+        return {role: resolve(name) for role, name in topics.items()}
 
     def publish(self, _sim_time: float) -> None:
         """Send robots, trails, scans and movers to the open pages (sim lock held; throttled)."""
@@ -186,6 +187,7 @@ def start_view(sim_node: SimNode, options: argparse.Namespace, log: NodeLog) -> 
         gateway.shutdown()
         log.error("cannot serve the simulator view on %s:%d: %s", options.host, options.port, exc)
         return None
+    view.url = url + "puzzlebot"
     sim_node.view = view
     print(f"puzzlebot_sim view: {url}puzzlebot   node graph: {url}", flush=True)
     if not options.no_browser:

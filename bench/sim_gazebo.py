@@ -1,0 +1,185 @@
+"""The simulator under Gazebo's names, and the simulator node split, measured in one run.
+
+1. ``empty_world.launch`` + ``spawn_model`` -> first ``/scan``: a launch file written the way the
+   course packages are (robot_description from the URDF, ``$(find gazebo_ros)/launch/empty_world.launch``
+   included with gui:=false, ``spawn_model -urdf -param robot_description``) is started with our
+   ``roslaunch`` on a running master; the time until a subscriber (already waiting) gets the first
+   LaserScan. The issue's target: at most 1 s. Gazebo itself is not installed here: its gzserver
+   alone takes several seconds to load a world (the figure to compare with is from Gazebo users).
+2. A/B of the simulator node split (issue 22, item 5): the same PuzzleBot run headless as fast as
+   possible, with subscribers on scan, camera and odometry and with none, by the tree before the split
+   (``--before``, default: where this branch left main) and by this tree, alternating, in one run.
+   Speeds come from the simulator's own exit summary (simulated s per CPU s: the machine is shared).
+
+Run alone: ``.venv/bin/python bench/sim_gazebo.py [--quick] [--before REV] [--only launch|ab]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+from ninjemys.testing import ninjemys_bin, run_master
+
+ROOT = Path(__file__).resolve().parent.parent
+
+LAUNCH = """<launch>
+  <param name="robot_description" textfile="$(find puzzlebot_sim)/robots/puzzlebot.urdf"/>
+  <include file="$(find gazebo_ros)/launch/empty_world.launch">
+    <arg name="gui" value="false"/>
+    <arg name="headless" value="{headless}"/>
+  </include>
+  <node name="spawn_urdf" pkg="gazebo_ros" type="spawn_model" args="-urdf -param robot_description -model puzzlebot"/>
+</launch>
+"""
+
+
+def first_scan_seconds(headless: bool, tmp: Path) -> float:
+    from ninjemys.idl.loader import get_message_class
+    from ninjemys.node import Node
+
+    launch = tmp / f"gazebo_bench_{headless}.launch"
+    launch.write_text(LAUNCH.format(headless=str(headless).lower()))
+    with run_master() as master:
+        node = Node("bench_first_scan", anonymous=True, master_uri=master)
+        got = threading.Event()
+        node.subscriber("/scan", get_message_class("sensor_msgs/LaserScan"), lambda _m: got.set(), raw=True)
+        t0 = time.monotonic()
+        proc = subprocess.Popen(
+            [ninjemys_bin("roslaunch"), str(launch)],
+            env=dict(os.environ, ROS_MASTER_URI=master),
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            start_new_session=True,
+        )
+        try:
+            if not got.wait(60):
+                raise RuntimeError("no /scan within 60 s")
+            return time.monotonic() - t0
+        finally:
+            node.shutdown("bench over")
+            os.killpg(proc.pid, 2)
+            try:
+                proc.wait(15)
+            except subprocess.TimeoutExpired:
+                os.killpg(proc.pid, 9)
+                proc.wait()
+
+
+def bench_launch(repeat: int) -> None:
+    print("\n## empty_world.launch + spawn_model -> first /scan (our roslaunch, master already up)")
+    print("| gzserver | first /scan (median of %d) | best |" % repeat)
+    print("|---|---:|---:|")
+    with tempfile.TemporaryDirectory() as tmp:
+        for headless, label in ((False, "with its browser view served"), (True, "headless:=true")):
+            times = [first_scan_seconds(headless, Path(tmp)) for _ in range(repeat)]
+            print(f"| {label} | {statistics.median(times):.2f} s | {min(times):.2f} s |")
+    print("target: at most 1 s (Gazebo's gzserver alone needs several seconds to load a world)")
+
+
+def extract_tree(rev: str, dest: Path) -> Path:
+    """``src/`` of ``rev`` (git archive), for running the simulator as it was."""
+    data = subprocess.run(
+        ["git", "-C", str(ROOT), "archive", rev, "src"], capture_output=True, check=True
+    ).stdout
+    subprocess.run(["tar", "-x", "-C", str(dest)], input=data, check=True)
+    return dest / "src"
+
+
+def sim_run(src: Path | None, subscribe: bool, duration: float) -> float:
+    """Simulated s per CPU s of one headless run (``src``: that tree on PYTHONPATH; None: this tree)."""
+    from ninjemys.idl.loader import get_message_class
+    from ninjemys.node import Node
+
+    env = dict(os.environ)
+    if src is not None:
+        env["PYTHONPATH"] = str(src)
+    with run_master() as master:
+        env["ROS_MASTER_URI"] = master
+        cmd = [sys.executable, "-m", "ninjemys.packages.run_shipped", "puzzlebot_sim", "sim_node"]
+        cmd += ["_world:=office", "_rate:=0", "_gui:=false"]
+        proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        lines: list[str] = []
+        for line in proc.stdout:  # type: ignore[union-attr]
+            lines.append(line)
+            if "PuzzleBot simulator:" in line:
+                break
+        drain = threading.Thread(target=lambda: lines.extend(proc.stdout), daemon=True)  # type: ignore[arg-type]
+        drain.start()
+        node = Node("bench_ab", anonymous=True, master_uri=master)
+        if subscribe:
+            for topic, kind in (
+                ("/scan", "sensor_msgs/LaserScan"),
+                ("/camera/color/image_raw", "sensor_msgs/Image"),
+                ("/camera/depth/image_rect_raw", "sensor_msgs/Image"),
+                ("/odom", "nav_msgs/Odometry"),
+            ):
+                node.subscriber(topic, get_message_class(kind), lambda _m: None, queue_size=100, raw=True)
+        twist_cls = get_message_class("geometry_msgs/Twist")
+        twist = twist_cls()
+        twist.linear.x, twist.angular.z = 0.05, 0.5
+        node.publisher("/cmd_vel", twist_cls, queue_size=1, latch=True).publish(twist)
+        time.sleep(duration)
+        node.shutdown("bench over")
+        proc.terminate()
+        proc.wait(15)
+        drain.join(5)
+    for line in lines:
+        m = re.search(r"\(([\d.]+) simulated s per CPU s\)", line)
+        if m:
+            return float(m.group(1))
+    raise RuntimeError("no summary from the simulator:\n" + "".join(lines[-10:]))
+
+
+def bench_ab(before: str, duration: float, rounds: int) -> None:
+    rev = subprocess.run(
+        ["git", "-C", str(ROOT), "rev-parse", "--short", before], capture_output=True, text=True, check=True
+    ).stdout.strip()
+    print(f"\n## the simulator node split, A/B: {rev} (before) and this tree (after), alternating")
+    print(f"simulated s per CPU s of the simulator, office world, as fast as possible, {duration:.0f} s runs")
+    print("| subscribers | before | after | after / before |")
+    print("|---|---:|---:|---:|")
+    with tempfile.TemporaryDirectory() as tmp:
+        old = extract_tree(before, Path(tmp))
+        for subscribe, label in ((True, "scan + camera + odom"), (False, "none")):
+            a: list[float] = []
+            b: list[float] = []
+            for _ in range(rounds):
+                a.append(sim_run(old, subscribe, duration))
+                b.append(sim_run(None, subscribe, duration))
+            ma, mb = statistics.median(a), statistics.median(b)
+            print(f"| {label} | {ma:.1f}x | {mb:.1f}x | {mb / ma:.2f} |")
+
+
+def default_before() -> str:
+    out = subprocess.run(
+        ["git", "-C", str(ROOT), "merge-base", "HEAD", "main"], capture_output=True, text=True
+    ).stdout.strip()
+    return out or "HEAD~1"
+
+
+def main() -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--quick", action="store_true", help="fewer repetitions and shorter runs")
+    p.add_argument("--before", default=None, help="the tree before the split (default: merge-base with main)")
+    p.add_argument("--only", choices=("launch", "ab"), help="run one part")
+    args = p.parse_args()
+    print(f"load average: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
+    if args.only in (None, "launch"):
+        bench_launch(2 if args.quick else 5)
+    if args.only in (None, "ab"):
+        bench_ab(args.before or default_before(), 5.0 if args.quick else 10.0, 1 if args.quick else 2)
+    print(f"load average: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

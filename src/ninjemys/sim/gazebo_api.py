@@ -1,0 +1,590 @@
+"""Gazebo's ROS API on the simulator: the ``/gazebo/*`` services and topics gazebo_ros offers.
+
+Services (gazebo_msgs and std_srvs types, Noetic's names and status texts): ``spawn_urdf_model``,
+``spawn_sdf_model``, ``delete_model``, ``get_model_state``, ``set_model_state``,
+``get_world_properties``, ``get_model_properties``, ``get_link_state``, ``get_physics_properties``,
+``set_physics_properties`` (its ``max_update_rate``: the pace),
+``set_model_configuration``, ``apply_body_wrench`` and ``clear_body_wrenches`` (a push: the body
+gains the velocity the force gives a 1 kg body over the duration, and its wheels stop it when the
+push ends), ``pause_physics``, ``unpause_physics``, ``reset_simulation``, ``reset_world``. Topics:
+``/gazebo/model_states`` and ``/gazebo/link_states`` out (every physics step, while subscribed),
+``/gazebo/set_model_state`` in.
+
+The world is flat: a model's pose has the height it was spawned with and no roll or pitch. Models
+are the robots (links: the base, the wheels and the sensors) and the static obstacles (one link,
+``link``). Everything here runs under the simulation's lock; nothing here publishes per robot.
+"""
+
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from ninjemys.idl.loader import get_message_class, get_service_class
+from ninjemys.maps.mapfile import MapFileError
+from ninjemys.rostime import Time
+from ninjemys.sim.robot_model import load_robot_model, model_from_urdf
+from ninjemys.sim.simcore import Robot, SpawnError, wrap_angle
+from ninjemys.tf2.math import quaternion_from_yaw, yaw_from_quaternion
+
+if TYPE_CHECKING:
+    from ninjemys.sim.puzzlebot_node import SimNode
+
+Empty: Any = get_service_class("std_srvs/Empty")
+SpawnModel: Any = get_service_class("gazebo_msgs/SpawnModel")
+DeleteModel: Any = get_service_class("gazebo_msgs/DeleteModel")
+GetModelState: Any = get_service_class("gazebo_msgs/GetModelState")
+SetModelState: Any = get_service_class("gazebo_msgs/SetModelState")
+GetWorldProperties: Any = get_service_class("gazebo_msgs/GetWorldProperties")
+GetModelProperties: Any = get_service_class("gazebo_msgs/GetModelProperties")
+GetLinkState: Any = get_service_class("gazebo_msgs/GetLinkState")
+GetPhysicsProperties: Any = get_service_class("gazebo_msgs/GetPhysicsProperties")
+SetPhysicsProperties: Any = get_service_class("gazebo_msgs/SetPhysicsProperties")
+ApplyBodyWrench: Any = get_service_class("gazebo_msgs/ApplyBodyWrench")
+BodyRequest: Any = get_service_class("gazebo_msgs/BodyRequest")
+SetModelConfiguration: Any = get_service_class("gazebo_msgs/SetModelConfiguration")
+ModelState: Any = get_message_class("gazebo_msgs/ModelState")
+ModelStates: Any = get_message_class("gazebo_msgs/ModelStates")
+LinkStates: Any = get_message_class("gazebo_msgs/LinkStates")
+Pose: Any = get_message_class("geometry_msgs/Pose")
+Twist: Any = get_message_class("geometry_msgs/Twist")
+
+WORLD_FRAMES = ("", "world", "map")
+PUSH_MASS = 1.0  # kg: what apply_body_wrench pushes (the flat world has no inertia of its own)
+
+#: a planar pose: x, y, z (the height it was spawned at), yaw
+Planar = tuple[float, float, float, float]
+
+
+@dataclass
+class Push:
+    """An apply_body_wrench in progress: a force (world frame) and torque about z, from ``start``
+    to ``end`` in sim seconds (``end`` None: until cleared or reset); ``velocity`` is what it gave."""
+
+    fx: float
+    fy: float
+    tz: float
+    start: float
+    end: float | None
+    vx: float = 0.0
+    vy: float = 0.0
+    w: float = 0.0
+
+
+def _pose_msg(p: Planar) -> Any:
+    msg = Pose()
+    msg.position.x, msg.position.y, msg.position.z = p[0], p[1], p[2]
+    q = msg.orientation
+    q.x, q.y, q.z, q.w = quaternion_from_yaw(p[3])
+    return msg
+
+
+def _twist_msg(vx: float, vy: float, w: float) -> Any:
+    msg = Twist()
+    msg.linear.x, msg.linear.y = vx, vy
+    msg.angular.z = w
+    return msg
+
+
+def _planar(pose: Any) -> Planar:
+    q = pose.orientation
+    yaw = yaw_from_quaternion(q.x, q.y, q.z, q.w) if (q.x, q.y, q.z, q.w) != (0, 0, 0, 0) else 0.0
+    return pose.position.x, pose.position.y, pose.position.z, yaw
+
+
+def relative(pose: Planar, ref: Planar) -> Planar:
+    """``pose`` seen from ``ref`` (both in the world frame)."""
+    c, s = math.cos(ref[3]), math.sin(ref[3])
+    dx, dy = pose[0] - ref[0], pose[1] - ref[1]
+    return c * dx + s * dy, -s * dx + c * dy, pose[2] - ref[2], wrap_angle(pose[3] - ref[3])
+
+
+def compose(ref: Planar, pose: Planar) -> Planar:
+    """``pose`` given in ``ref``'s frame, in the world frame."""
+    c, s = math.cos(ref[3]), math.sin(ref[3])
+    return (
+        ref[0] + c * pose[0] - s * pose[1],
+        ref[1] + s * pose[0] + c * pose[1],
+        ref[2] + pose[2],
+        wrap_angle(ref[3] + pose[3]),
+    )
+
+
+class GazeboApi:
+    """The ``/gazebo`` services and topics of one simulator node."""
+
+    def __init__(self, sim_node: SimNode) -> None:
+        self.sn = sim_node
+        self.heights: dict[str, float] = {}  # model -> the z it was spawned at
+        self.pushes: dict[str, Push] = {}
+        n = sim_node.node
+        for name, cls, handler in (
+            ("reset_simulation", Empty, self._reset_simulation),
+            ("reset_world", Empty, self._reset_world),
+            ("pause_physics", Empty, self._pause),
+            ("unpause_physics", Empty, self._unpause),
+            ("spawn_urdf_model", SpawnModel, self._spawn),
+            ("spawn_sdf_model", SpawnModel, self._spawn),
+            ("delete_model", DeleteModel, self._delete),
+            ("get_model_state", GetModelState, self._get_model_state),
+            ("set_model_state", SetModelState, self._set_model_state),
+            ("get_world_properties", GetWorldProperties, self._get_world_properties),
+            ("get_model_properties", GetModelProperties, self._get_model_properties),
+            ("get_link_state", GetLinkState, self._get_link_state),
+            ("get_physics_properties", GetPhysicsProperties, self._get_physics_properties),
+            ("set_physics_properties", SetPhysicsProperties, self._set_physics_properties),
+            ("apply_body_wrench", ApplyBodyWrench, self._apply_body_wrench),
+            ("clear_body_wrenches", BodyRequest, self._clear_body_wrenches),
+            ("set_model_configuration", SetModelConfiguration, self._set_model_configuration),
+        ):
+            n.service("/gazebo/" + name, cls, handler)
+        self.model_states_pub = n.publisher("/gazebo/model_states", ModelStates, queue_size=1)
+        self.link_states_pub = n.publisher("/gazebo/link_states", LinkStates, queue_size=1)
+        self.set_state_sub = n.subscriber("/gazebo/set_model_state", ModelState, self._on_set_model_state)
+
+    # -- the model tree ----------------------------------------------------------------------------
+    def model_names(self) -> list[str]:
+        sim = self.sn.sim
+        return [o.name for o in sim.world.obstacles] + list(sim.robots)
+
+    def model_pose(self, name: str) -> Planar | None:
+        sim = self.sn.sim
+        r = sim.robots.get(name)
+        if r is not None:
+            return r.x, r.y, self.heights.get(name, 0.0), r.yaw
+        try:
+            x, y, yaw = sim.obstacle_pose(name)
+        except SpawnError:
+            return None
+        return x, y, self.heights.get(name, 0.0), yaw
+
+    def model_twist(self, name: str) -> tuple[float, float, float]:
+        r = self.sn.sim.robots.get(name)
+        if r is None:
+            return 0.0, 0.0, 0.0
+        push = self.pushes.get(name)
+        vx, vy, w = r.v * math.cos(r.yaw), r.v * math.sin(r.yaw), r.w
+        if push is not None:
+            vx, vy, w = vx + push.vx, vy + push.vy, w + push.w
+        return vx, vy, w
+
+    @staticmethod
+    def robot_links(r: Robot) -> dict[str, Planar]:
+        """A robot's links in its own frame: the base, the wheels and the sensors."""
+        m = r.model
+        links: dict[str, Planar] = {m.drive.base_frame: (0.0, 0.0, 0.0, 0.0)}
+        half = m.wheel_separation / 2.0
+        for joint, side in ((m.left_joint, half), (m.right_joint, -half)):
+            links[joint.removesuffix("_joint")] = (0.0, side, m.wheel_radius, 0.0)
+        for spec in (m.laser, m.camera, m.imu):
+            if spec is not None:
+                xyz, rpy = spec.pose.xyz, spec.pose.rpy
+                links[spec.pose.frame] = (xyz[0], xyz[1], xyz[2], rpy[2])
+        return links
+
+    def links(self, model: str) -> dict[str, Planar] | None:
+        """A model's links, in the world frame (None: no such model)."""
+        pose = self.model_pose(model)
+        if pose is None:
+            return None
+        r = self.sn.sim.robots.get(model)
+        if r is None:
+            return {"link": pose}
+        return {name: compose(pose, rel) for name, rel in self.robot_links(r).items()}
+
+    def entity_pose(self, name: str) -> Planar | None:
+        """A model (``name``) or a link (``model::link``), in the world frame."""
+        model, _, link = name.partition("::")
+        if not link:
+            return self.model_pose(model)
+        links = self.links(model)
+        return None if links is None else links.get(link)
+
+    # -- services ----------------------------------------------------------------------------------
+    def _reset_simulation(self, _req: Any) -> Any:
+        with self.sn.lock:
+            self.sn.sim.reset_simulation()
+            self.pushes.clear()
+            self.sn.after_reset()
+        self.sn.log.info("simulation reset: time and robots back to the start")
+        return Empty._response_class()
+
+    def _reset_world(self, _req: Any) -> Any:
+        with self.sn.lock:
+            self.sn.sim.reset_world()
+            self.pushes.clear()
+            self.sn.after_reset()
+        self.sn.log.info("world reset: robots back to their start poses")
+        return Empty._response_class()
+
+    def _pause(self, _req: Any) -> Any:
+        self.sn.stepper.set_paused(True)
+        return Empty._response_class()
+
+    def _unpause(self, _req: Any) -> Any:
+        self.sn.stepper.set_paused(False)
+        return Empty._response_class()
+
+    def _spawn(self, req: Any) -> Any:
+        resp = SpawnModel._response_class()
+        name = req.model_name.strip()
+        sn = self.sn
+        try:
+            if not name or not name.replace("_", "a").isalnum() or not name[0].isalpha():
+                raise SpawnError(f"model_name [{req.model_name}] is not a valid ROS name")
+            if name in self.model_names():
+                resp.success, resp.status_message = False, "SpawnModel: Failure - entity already exists."
+                sn.log.error("SpawnModel: Failure - model name %s already exist.", name)
+                return resp
+            pose = _planar(req.initial_pose)
+            if req.reference_frame not in WORLD_FRAMES:
+                ref = self.entity_pose(req.reference_frame)
+                if ref is None:
+                    resp.success = False
+                    resp.status_message = "SpawnModel: reference reference_frame not found, did you forget to scope the link by model name?"
+                    return resp
+                pose = compose(ref, pose)
+            x, y, z, yaw = pose
+            kind, spec = parse_model_xml(req.model_xml)
+            if kind == "robot":
+                namespace = req.robot_namespace.strip("/")
+                clash = any(io.prefix == "" for io in sn.io.values())
+                sn.add_robot(name, spec, x, y, yaw, clash and not namespace, namespace or None)
+            else:
+                shape, size, height, colour = spec
+                with sn.lock:
+                    sn.sim.add_obstacle(name, shape, size, x, y, yaw, height, colour)
+                sn.log.info("spawned %s [%s] at (%.3f, %.3f)", shape, name, x, y)
+            self.heights[name] = z
+        except (SpawnError, MapFileError) as exc:
+            sn.log.error("spawn refused: %s", exc)
+            resp.success, resp.status_message = False, f"SpawnModel: Failure - {exc}"
+            return resp
+        resp.success, resp.status_message = True, "SpawnModel: Successfully spawned entity"
+        return resp
+
+    def _delete(self, req: Any) -> Any:
+        resp = DeleteModel._response_class()
+        name = req.model_name
+        sn = self.sn
+        try:
+            if name in sn.sim.robots:
+                sn.remove_robot(name)
+            else:
+                with sn.lock:
+                    sn.sim.remove_obstacle(name)
+        except SpawnError as exc:
+            sn.log.error("DeleteModel: model [%s] does not exist", name)
+            resp.success, resp.status_message = False, f"DeleteModel: model does not exist ({exc})"
+            return resp
+        self.heights.pop(name, None)
+        self.pushes.pop(name, None)
+        sn.log.info("deleted model [%s]", name)
+        resp.success, resp.status_message = True, "DeleteModel: successfully deleted model"
+        return resp
+
+    def _get_model_state(self, req: Any) -> Any:
+        resp = GetModelState._response_class()
+        with self.sn.lock:
+            pose = self.model_pose(req.model_name)
+            if pose is None:
+                self.sn.log.error("GetModelState: model [%s] does not exist", req.model_name)
+                resp.success, resp.status_message = False, "GetModelState: model does not exist"
+                return resp
+            vx, vy, w = self.model_twist(req.model_name)
+            frame = req.relative_entity_name
+            if frame not in WORLD_FRAMES:
+                ref = self.entity_pose(frame)
+                if ref is None:
+                    resp.success = False
+                    resp.status_message = "GetModelState: reference relative_entity_name not found, did you forget to scope the body by model name?"
+                    return resp
+                pose = relative(pose, ref)
+                c, s = math.cos(ref[3]), math.sin(ref[3])
+                vx, vy = c * vx + s * vy, -s * vx + c * vy
+            resp.header.stamp = self.sn._stamp()
+            resp.header.frame_id = frame
+            resp.pose = _pose_msg(pose)
+            resp.twist = _twist_msg(vx, vy, w)
+        resp.success, resp.status_message = True, "GetModelState: got properties"
+        return resp
+
+    def set_model_state(self, state: Any) -> tuple[bool, str]:
+        """Move a model (Gazebo's set_model_state): (success, status_message)."""
+        sn = self.sn
+        name = state.model_name
+        with sn.lock:
+            if self.model_pose(name) is None:
+                sn.log.error("Updating ModelState: model [%s] does not exist", name)
+                return False, "SetModelState: model does not exist"
+            pose = _planar(state.pose)
+            if state.reference_frame not in WORLD_FRAMES:
+                ref = self.entity_pose(state.reference_frame)
+                if ref is None:
+                    return False, "SetModelState: specified reference frame entity does not exist"
+                pose = compose(ref, pose)
+            x, y, z, yaw = pose
+            try:
+                if name in sn.sim.robots:
+                    r = sn.sim.place_robot(name, x, y, yaw)
+                    lin, ang = state.twist.linear, state.twist.angular
+                    if all(math.isfinite(v) for v in (lin.x, lin.y, ang.z)):
+                        # the twist, in the robot's own terms: forward speed and turn rate
+                        forward = lin.x * math.cos(yaw) + lin.y * math.sin(yaw)
+                        r.command(forward, ang.z)
+                else:
+                    sn.sim.move_obstacle(name, x, y, yaw)
+            except SpawnError as exc:
+                sn.log.error("SetModelState refused: %s", exc)
+                return False, f"SetModelState: {exc}"
+            self.heights[name] = z
+            self.pushes.pop(name, None)
+        return True, "SetModelState: set model state done"
+
+    def _set_model_state(self, req: Any) -> Any:
+        resp = SetModelState._response_class()
+        resp.success, resp.status_message = self.set_model_state(req.model_state)
+        return resp
+
+    def _on_set_model_state(self, msg: Any) -> None:
+        ok, status = self.set_model_state(msg)
+        if not ok:
+            self.sn.log.warn("/gazebo/set_model_state: %s", status)
+
+    def _get_world_properties(self, _req: Any) -> Any:
+        resp = GetWorldProperties._response_class()
+        with self.sn.lock:
+            resp.sim_time = self.sn.sim.time
+            resp.model_names = self.model_names()
+        resp.rendering_enabled = True
+        resp.success, resp.status_message = True, "GetWorldProperties: got properties"
+        return resp
+
+    def _get_model_properties(self, req: Any) -> Any:
+        resp = GetModelProperties._response_class()
+        with self.sn.lock:
+            name = req.model_name
+            if self.model_pose(name) is None:
+                self.sn.log.error("GetModelProperties: model [%s] does not exist", name)
+                resp.success, resp.status_message = False, "GetModelProperties: model does not exist"
+                return resp
+            r = self.sn.sim.robots.get(name)
+            bodies = list(self.robot_links(r)) if r is not None else ["link"]
+            resp.parent_model_name = ""
+            resp.canonical_body_name = bodies[0]
+            resp.body_names = bodies
+            resp.geom_names = [f"{b}_collision" for b in bodies]
+            resp.joint_names = [r.model.left_joint, r.model.right_joint] if r is not None else []
+            resp.child_model_names = []
+            resp.is_static = r is None
+        resp.success, resp.status_message = True, "GetModelProperties: got properties"
+        return resp
+
+    def _get_link_state(self, req: Any) -> Any:
+        resp = GetLinkState._response_class()
+        not_found = "GetLinkState: link not found, did you forget to scope the link by model name?"
+        with self.sn.lock:
+            model, _, link = req.link_name.partition("::")
+            links = self.links(model) if link else None
+            pose = links.get(link) if links is not None else None
+            if pose is None:
+                resp.success, resp.status_message = False, not_found
+                return resp
+            vx, vy, w = self.model_twist(model)
+            if req.reference_frame not in WORLD_FRAMES:
+                ref = self.entity_pose(req.reference_frame)
+                if ref is None:
+                    resp.success = False
+                    resp.status_message = "GetLinkState: reference reference_frame not found, did you forget to scope the link by model name?"
+                    return resp
+                pose = relative(pose, ref)
+            state = resp.link_state
+            state.link_name = req.link_name
+            state.pose = _pose_msg(pose)
+            state.twist = _twist_msg(vx, vy, w)
+            state.reference_frame = req.reference_frame
+        resp.success, resp.status_message = True, "GetLinkState: got state"
+        return resp
+
+    def _get_physics_properties(self, _req: Any) -> Any:
+        resp = GetPhysicsProperties._response_class()
+        resp.time_step = self.sn.sim.dt
+        resp.pause = self.sn.paused
+        rate = self.sn.rate
+        resp.max_update_rate = rate / self.sn.sim.dt if rate > 0 else 0.0
+        resp.gravity.z = -9.8
+        resp.success, resp.status_message = True, "GetPhysicsProperties: got properties"
+        return resp
+
+    def _set_physics_properties(self, req: Any) -> Any:
+        """Gazebo's pacing knob: ``max_update_rate`` steps per wall second (0: as fast as possible),
+        so the real-time factor is max_update_rate x step. The step itself stays (the sensors'
+        schedules are built on it); a different ``time_step`` is refused, as are gravity and ODE."""
+        resp = SetPhysicsProperties._response_class()
+        sn = self.sn
+        rate = req.max_update_rate
+        if not math.isfinite(rate) or rate < 0:
+            resp.success, resp.status_message = (
+                False,
+                f"SetPhysicsProperties: max_update_rate {rate} must be >= 0",
+            )
+            return resp
+        if req.time_step and abs(req.time_step - sn.sim.dt) > 1e-12:
+            resp.success = False
+            resp.status_message = (
+                f"SetPhysicsProperties: time_step is {sn.sim.dt} here (the node's ~update_rate sets it)"
+            )
+            return resp
+        sn.stepper.set_rate(rate * sn.sim.dt)
+        sn.log.info(
+            "physics: max_update_rate %g (real-time factor %s)",
+            rate,
+            f"{rate * sn.sim.dt:g}" if rate else "unlimited",
+        )
+        resp.success, resp.status_message = True, "physics engine updated"
+        return resp
+
+    def _apply_body_wrench(self, req: Any) -> Any:
+        resp = ApplyBodyWrench._response_class()
+        sn = self.sn
+        model = req.body_name.partition("::")[0]
+        with sn.lock:
+            pose = self.entity_pose(req.body_name)
+            if pose is None:
+                sn.log.error("ApplyBodyWrench: body [%s] does not exist", req.body_name)
+                resp.success, resp.status_message = False, "ApplyBodyWrench: body does not exist"
+                return resp
+            f, t = req.wrench.force, req.wrench.torque
+            fx, fy = f.x, f.y
+            if req.reference_frame not in WORLD_FRAMES:
+                ref = self.entity_pose(req.reference_frame)
+                if ref is None:
+                    sn.log.error("ApplyBodyWrench: reference_frame is not a valid entity name")
+                    resp.success, resp.status_message = False, "ApplyBodyWrench: reference_frame not found"
+                    return resp
+                c, s = math.cos(ref[3]), math.sin(ref[3])
+                fx, fy = c * f.x - s * f.y, s * f.x + c * f.y
+            if not all(math.isfinite(v) for v in (fx, fy, t.z)):
+                resp.success, resp.status_message = False, "ApplyBodyWrench: the wrench is not finite"
+                return resp
+            now = sn.sim.time
+            start = max(req.start_time.to_sec(), now) if req.start_time.to_sec() > 0 else now
+            duration = req.duration.to_sec()
+            end = None if duration < 0 else start + duration
+            if model in sn.sim.robots:  # static obstacles do not move, as Gazebo's static models
+                self.pushes[model] = Push(fx, fy, t.z, start, end)
+        resp.success, resp.status_message = True, ""
+        return resp
+
+    def _clear_body_wrenches(self, req: Any) -> Any:
+        with self.sn.lock:
+            self.pushes.pop(req.body_name.partition("::")[0], None)
+        return BodyRequest._response_class()
+
+    def _set_model_configuration(self, req: Any) -> Any:
+        resp = SetModelConfiguration._response_class()
+        with self.sn.lock:
+            r = self.sn.sim.robots.get(req.model_name)
+            if r is None:
+                self.sn.log.error("SetModelConfiguration: model [%s] does not exist", req.model_name)
+                resp.success, resp.status_message = False, "SetModelConfiguration: model does not exist"
+                return resp
+            if len(req.joint_names) != len(req.joint_positions):
+                resp.success = False
+                resp.status_message = (
+                    "SetModelConfiguration: joint name and position list have different lengths"
+                )
+                return resp
+            for joint, position in zip(req.joint_names, req.joint_positions, strict=True):
+                if joint == r.model.left_joint:
+                    r.left_angle = position
+                elif joint == r.model.right_joint:
+                    r.right_angle = position
+        resp.success, resp.status_message = True, "SetModelConfiguration: success"
+        return resp
+
+    # -- every step ----------------------------------------------------------------------------------
+    def before_step(self) -> None:
+        """Apply the pushes due now (the stepping thread, under the lock)."""
+        if not self.pushes:
+            return
+        sim = self.sn.sim
+        now, dt = sim.time, sim.dt
+        for name, push in list(self.pushes.items()):
+            r = sim.robots.get(name)
+            if r is None or (push.end is not None and now >= push.end):
+                del self.pushes[name]  # the push is over: the wheels' grip stops the slide
+                continue
+            if now < push.start:
+                continue
+            push.vx += push.fx / PUSH_MASS * dt
+            push.vy += push.fy / PUSH_MASS * dt
+            push.w += push.tz / PUSH_MASS * dt
+            try:
+                sim.place_robot(name, r.x + push.vx * dt, r.y + push.vy * dt, r.yaw + push.w * dt)
+            except SpawnError:
+                del self.pushes[name]  # pushed against something: it stops there
+                r.contact = True
+                self.sn.log.warn("robot [%s] pushed into an obstacle: stopped", name)
+
+    def after_step(self, stamp: Time) -> None:
+        """Publish /gazebo/model_states and /gazebo/link_states to whoever listens."""
+        if self.model_states_pub.get_num_connections():
+            names = self.model_names()
+            poses = [self.model_pose(n) for n in names]
+            self.model_states_pub.publish(
+                ModelStates(
+                    name=names,
+                    pose=[_pose_msg(p) for p in poses if p is not None],
+                    twist=[_twist_msg(*self.model_twist(n)) for n in names],
+                )
+            )
+        if self.link_states_pub.get_num_connections():
+            names, poses, twists = [], [], []
+            for model in self.model_names():
+                links = self.links(model) or {}
+                twist = _twist_msg(*self.model_twist(model))
+                for link, pose in links.items():
+                    names.append(f"{model}::{link}")
+                    poses.append(_pose_msg(pose))
+                    twists.append(twist)
+            self.link_states_pub.publish(LinkStates(name=names, pose=poses, twist=twists))
+
+
+def parse_model_xml(text: str) -> tuple[str, Any]:
+    """What a SpawnModel request's ``model_xml`` describes: ("robot", RobotModel) or
+    ("obstacle", (shape, size, height, colour)). Empty text or ``puzzlebot`` is the PuzzleBot."""
+    body = text.strip()
+    if not body:
+        return "robot", load_robot_model("puzzlebot")
+    if not body.startswith("<"):
+        return "robot", load_robot_model(body)
+    try:
+        root = ET.fromstring(body)
+    except ET.ParseError as exc:
+        raise SpawnError(f"model_xml is not valid XML: {exc}") from None
+    if root.tag == "robot" and any(j.get("type") == "continuous" for j in root.iter("joint")):
+        # a robot with wheels: the URDF reader says what it is, or why it cannot be simulated
+        return "robot", model_from_urdf(body, "model_xml")
+    for geom in root.iter("geometry"):
+        box = geom.find("box")
+        cyl = geom.find("cylinder")
+        if box is not None:
+            size_text = box.get("size") or (box.findtext("size") or "")
+            try:
+                sx, sy, sz = (float(v) for v in size_text.split())
+            except ValueError:
+                raise SpawnError(f"box size {size_text!r} is not three numbers") from None
+            return "obstacle", ("box", (sx, sy), sz, (180, 130, 80))
+        if cyl is not None:
+            try:
+                radius = float(cyl.get("radius") or cyl.findtext("radius") or "")
+                length = float(cyl.get("length") or cyl.findtext("length") or "")
+            except ValueError:
+                raise SpawnError("cylinder needs numeric radius and length") from None
+            return "obstacle", ("cylinder", (radius, radius), length, (60, 90, 200))
+    raise SpawnError(
+        "model_xml describes neither a differential-drive robot (URDF with 2 continuous joints) nor a box or cylinder"
+    )

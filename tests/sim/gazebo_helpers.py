@@ -1,0 +1,88 @@
+"""Helpers for the Gazebo-names tests: genpy classes of our gazebo_msgs for Debian's tools (Debian
+packages no gazebo_msgs), and a roslaunch process with its log."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import time
+from pathlib import Path
+
+from ninjemys.idl.search import SHIPPED_ROOT as _SHIPPED
+from ninjemys.testing import ROS1_PYTHON, kill_tree
+
+SHIPPED_ROOT = Path(_SHIPPED)
+
+
+def genpy_gazebo_msgs(dest: Path) -> Path:
+    """Debian's genpy generates Python classes from our gazebo_msgs definitions (what catkin_make of
+    gazebo_msgs leaves on a ROS 1 machine); returns the directory to put on PYTHONPATH."""
+    out = dest / "gazebo_msgs"
+    include = [
+        f"-I{pkg}:{SHIPPED_ROOT / pkg / 'msg'}"
+        for pkg in ("gazebo_msgs", "geometry_msgs", "std_msgs", "trajectory_msgs", "sensor_msgs")
+    ]
+    script = (
+        "import subprocess, sys\n"
+        "gen, kind, out, inc, files = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4].split(), sys.argv[5:]\n"
+        "for f in files:\n"
+        "    subprocess.run([sys.executable, gen, '-p', 'gazebo_msgs', *inc, '-o', out, f], check=True)\n"
+        "subprocess.run([sys.executable, gen, '--initpy', '-p', 'gazebo_msgs', '-o', out], check=True)\n"
+    )
+    for kind, gen in (("msg", "genmsg_py.py"), ("srv", "gensrv_py.py")):
+        files = sorted(str(p) for p in (SHIPPED_ROOT / "gazebo_msgs" / kind).iterdir())
+        subprocess.run(
+            [
+                ROS1_PYTHON,
+                "-c",
+                script,
+                f"/usr/lib/genpy/{gen}",
+                kind,
+                str(out / kind),
+                " ".join(include),
+                *files,
+            ],
+            check=True,
+            capture_output=True,
+            timeout=120,
+        )
+    (out / "__init__.py").write_text("")
+    return dest
+
+
+class Launched:
+    """A process whose output goes to a log file; ``wait_for`` a line of it."""
+
+    def __init__(self, cmd: list[str], env: dict[str, str], log: Path) -> None:
+        self.log_path = log
+        with open(log, "wb") as out:
+            self.proc = subprocess.Popen(
+                cmd,
+                env=env,
+                stdout=out,
+                stderr=subprocess.STDOUT,
+                stdin=subprocess.DEVNULL,
+                start_new_session=True,
+            )
+
+    def log(self) -> str:
+        return self.log_path.read_text(errors="replace")
+
+    def wait_for(self, text: str, timeout: float = 30.0) -> str:
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            out = self.log()
+            if text in out:
+                return out
+            if self.proc.poll() is not None:
+                raise AssertionError(f"process exited ({self.proc.returncode}):\n{out}")
+            time.sleep(0.05)
+        raise AssertionError(f"never printed {text!r}:\n{self.log()}")
+
+    def stop(self) -> None:
+        if self.proc.poll() is None:
+            try:
+                os.killpg(self.proc.pid, 2)
+                self.proc.wait(10)
+            except (subprocess.TimeoutExpired, ProcessLookupError):
+                kill_tree(self.proc)

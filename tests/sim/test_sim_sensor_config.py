@@ -1,0 +1,123 @@
+"""Item 5 of the Gazebo issue: the sensors, topics and frames are configurable, as node parameters
+and from the RobotModel a description gives (odometry and its TF off, the lidar's beams and angle
+range, the camera's topic, a passive robot without a drive)."""
+
+from __future__ import annotations
+
+import math
+import os
+import threading
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from gazebo_helpers import Launched
+from sim_helpers import wait_until
+
+from ninjemys.idl.loader import get_message_class
+from ninjemys.node import Node
+from ninjemys.node.log import NodeLog
+from ninjemys.packages.shipped import shipped_executable
+from ninjemys.sim.puzzlebot_node import SimNode
+from ninjemys.sim.robot_model import DriveSpec, load_robot_model
+from ninjemys.sim.simcore import Simulation
+from ninjemys.sim.world2d import World
+from ninjemys.testing import run_master
+
+LaserScan = get_message_class("sensor_msgs/LaserScan")
+Image = get_message_class("sensor_msgs/Image")
+TFMessage = get_message_class("tf2_msgs/TFMessage")
+Odometry = get_message_class("nav_msgs/Odometry")
+
+
+@pytest.fixture
+def master() -> Iterator[str]:
+    with run_master() as uri:
+        yield uri
+
+
+@pytest.fixture
+def client(master: str) -> Iterator[Node]:
+    node = Node("sensor_config_client", anonymous=True, master_uri=master)
+    try:
+        yield node
+    finally:
+        node.shutdown("test over")
+
+
+def collect(node: Node, topic: str, cls, seconds: float) -> list:  # type: ignore[no-untyped-def]
+    got: list = []
+    sub = node.subscriber(topic, cls, got.append, queue_size=100)
+    try:
+        threading.Event().wait(seconds)
+    finally:
+        sub.unregister()
+    return got
+
+
+def test_node_parameters_set_beams_angles_topics_and_turn_the_odom_tf_off(
+    master: str, client: Node, tmp_path: Path
+) -> None:
+    cmd = shipped_executable("puzzlebot_sim", "sim_node").command(
+        [
+            "_world:=square", "_rate:=2.0", "_gui:=false", "_publish_odom_tf:=false",
+            "_scan_beams:=720", f"_scan_angle_min:={-math.pi / 2}", f"_scan_angle_max:={math.pi / 2}",
+            "_image_topic:=camera/image_raw", "_camera_info_topic:=camera/camera_info", "_odom_topic:=wheel_odom",
+        ]
+    )  # fmt: skip
+    sim = Launched(cmd, dict(os.environ, ROS_MASTER_URI=master, PYTHONUNBUFFERED="1"), tmp_path / "sim.log")
+    try:
+        sim.wait_for("PuzzleBot simulator:")
+        got: list = []
+        sub = client.subscriber("/scan", LaserScan, got.append, queue_size=1)
+        wait_until(lambda: got, 15, "a scan")
+        sub.unregister()
+        scan = got[0]
+        assert len(scan.ranges) == 720
+        assert (scan.angle_min, scan.angle_max) == pytest.approx((-math.pi / 2, math.pi / 2))
+        assert scan.angle_increment == pytest.approx(math.pi / 719)
+        topics = {t for t, _ in client.master.get_published_topics("/")}
+        assert {"/camera/image_raw", "/camera/camera_info", "/wheel_odom"} <= topics
+        assert "/camera/color/image_raw" not in topics and "/odom" not in topics
+        images: list = []
+        sub = client.subscriber("/camera/image_raw", Image, images.append, queue_size=1)
+        wait_until(lambda: images, 15, "an image on camera/image_raw")
+        sub.unregister()
+        assert (images[0].width, images[0].height) == (320, 240)
+        odom = collect(client, "/wheel_odom", Odometry, 1.0)
+        assert odom, "odometry still published on its new topic"
+        tfs = collect(client, "/tf", TFMessage, 1.0)
+        pairs = {(t.header.frame_id, t.child_frame_id) for m in tfs for t in m.transforms}
+        assert ("odom", "base_link") not in pairs  # publishOdomTF false: the students' own node publishes it
+    finally:
+        sim.stop()
+
+
+def test_a_model_without_a_drive_is_passive_and_says_so(master: str, client: Node) -> None:
+    """A RobotModel as a description without a drive plugin gives it (GZDESC fills it from URDFs)."""
+    node = Node("passive_sim", master_uri=master)
+    lines: list[str] = []
+    log = NodeLog(node.name)
+    log.warn = lambda msg, *args: lines.append(msg % args)  # type: ignore[method-assign]
+    log.info = lambda msg, *args: None  # type: ignore[method-assign]
+    try:
+        sim = SimNode(node, log, Simulation(World("empty")), 0.0, None)
+        model = load_robot_model("puzzlebot")
+        model.drive = DriveSpec(kind="none")
+        model.ignored_plugins = ["libgazebo_ros_p3d.so"]
+        model.laser.topic = "base_scan"
+        sim.add_robot("statue", model, 0.0, 0.0, 0.0, False)
+        topics = {t for t, _ in client.master.get_published_topics("/")}
+        assert "/base_scan" in topics and "/odom" not in topics and "/wl" not in topics
+        subscribed = {t for t, _ in client.master.get_system_state()[1] if t == "/cmd_vel"}
+        assert not subscribed
+        assert any("no drive plugin" in line and "passive" in line for line in lines), lines
+        assert any("libgazebo_ros_p3d.so" in line for line in lines), lines
+        sim.start()
+        got: list = []
+        sub = client.subscriber("/base_scan", LaserScan, got.append, queue_size=1)
+        wait_until(lambda: got, 15, "a scan from the passive robot")
+        sub.unregister()
+        sim.stop()
+    finally:
+        node.shutdown("test over")
