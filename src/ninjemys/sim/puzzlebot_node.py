@@ -58,6 +58,7 @@ from ninjemys.sim import messages
 from ninjemys.sim.gazebo_api import GazeboApi, parse_model_xml
 from ninjemys.sim.gazebo_worlds import load_gazebo_world
 from ninjemys.sim.robot_model import RobotModel, load_robot_model
+from ninjemys.sim.ros_control.hardware import ControlLoop
 from ninjemys.sim.simcore import Robot, Simulation, SpawnError
 from ninjemys.sim.stepper import Due, StepLock, Stepper
 from ninjemys.sim.world2d import World, load_world, world_from_map
@@ -101,11 +102,15 @@ class RobotIO:
     last_scan: np.ndarray | None = None
     static_tfs: list[Any] = field(default_factory=list)
     topics: dict[str, str] = field(default_factory=dict)  # role -> relative topic name (the view's)
+    #: gazebo_ros_control's controller_manager for this robot (a ros_control description), else None
+    control: ControlLoop | None = None
 
     def frame(self, name: str) -> str:
         return self.frame_prefix + name
 
     def close(self) -> None:
+        if self.control is not None:
+            self.control.close()
         if self.cmd_sub is not None:
             self.cmd_sub.unregister()
         for pub in self.pubs.values():
@@ -173,6 +178,9 @@ class SimNode:
             else:
                 prefix = frame_prefix = f"{name}/" if namespaced else ""
             io = self._endpoints(robot, prefix, frame_prefix)
+            if model.drive.kind == "ros_control":
+                # the controllers drive the wheels; their manager's services live in the robot's namespace
+                io.control = ControlLoop(self.node, model, namespace or None)
             self.io[name] = io
             self._publish_static()
             self._publish_contact(io)
@@ -252,7 +260,7 @@ class SimNode:
             Due(_period(imu.rate, 100.0, dt), now) if imu else None,
             topics=topics,
         )
-        if driven:
+        if driven and drive.command_topic:  # ros_control: the controllers subscribe their own cmd_vel
             io.cmd_sub = n.subscriber(
                 prefix + drive.command_topic, Twist, self._on_cmd_vel, callback_args=robot.name, queue_size=1
             )
@@ -333,6 +341,9 @@ class SimNode:
     def _step_and_publish(self) -> None:
         sim = self.sim
         self.gazebo.before_step()
+        for io in self.io.values():
+            if io.control is not None:
+                io.control.step_robot(io.robot, sim.time, sim.dt)
         touched = sim.step()
         now = sim.time
         stamp = self._stamp()
