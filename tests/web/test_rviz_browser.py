@@ -14,6 +14,7 @@ import pytest
 import yaml
 from rviz_helpers import M, grid, scan, screenshot_rgb, tf_message, top_view_url, transform
 
+from ninjemys.idl.loader import get_message_class
 from ninjemys.master.core import MasterThread
 from ninjemys.node import Node
 from ninjemys.testing import wait_until
@@ -334,3 +335,19 @@ def test_pose_estimate_and_publish_point_tools(graph: dict[str, Any], browser_pa
     page.select_option("#rv-viewmode", "top")
     page.wait_for_timeout(300)
     assert errors == []
+
+
+def test_a_game_controller_in_rviz_publishes_joy(graph: dict[str, Any], browser_page: Any) -> None:
+    page = browser_page
+    page.add_init_script(
+        "(() => { const pad = { id: 'Fake Pad', index: 0, connected: true, mapping: 'standard',"
+        " axes: [0, -1, 0, 0], buttons: Array.from({ length: 4 }, (_, i) => ({ pressed: i === 1, value: i === 1 ? 1 : 0 })),"
+        " timestamp: 0 }; navigator.getGamepads = () => [pad]; })();"
+    )
+    joys: list[Any] = []
+    graph["peer"].subscriber("/joy", get_message_class("sensor_msgs/Joy"), joys.append)
+    _open(page, graph["url"])
+    page.wait_for_function("document.body.dataset.gamepad === 'Fake Pad'", timeout=10000)
+    msg = wait_until(lambda: next((m for m in list(joys) if len(m.axes) == 4), None), what="a Joy from rviz")
+    assert list(msg.buttons) == [0, 1, 0, 0] and msg.axes[1] == pytest.approx(1.0)  # up is +1, as joy_node
+    assert msg.header.frame_id == "browser_gamepad"

@@ -15,6 +15,7 @@ import { view, setView, groundPoint, project } from "/static/rviz/view.js";
 import { addDisplay, refreshTopicLists, setFixedFrame, pageState } from "/static/rviz/panel.js";
 import { setTool } from "/static/rviz/tools.js";
 import { frame, stats, frameHooks } from "/static/rviz/loop.js";
+import { startGamepad } from "/static/lib/gamepad.js";
 
 ros.on("open", () => { $("rv-conn").textContent = "connected"; });
 ros.on("close", () => { $("rv-conn").textContent = "disconnected: reconnecting…"; });
@@ -60,9 +61,15 @@ if (!params.has("cy") && fileView.y !== undefined) view.centre[1] = Number(fileV
 setView(params.get("view") || fileView.mode || "orbit");
 requestAnimationFrame(frame);
 
+// a game controller publishes sensor_msgs/Joy on /joy, as joy_node would (run teleop_twist_joy to drive)
+const gamepad = startGamepad(ros, {
+  status: (id) => { $("rv-gamepad").textContent = id ? `gamepad: ${id} → /joy` : ""; document.body.dataset.gamepad = id || ""; },
+});
+
 /** For tests and benchmarks: the page's state, and the page pixel of a fixed-frame point. */
 window.rviz = {
   ros, tf, displays, stats, frameHooks, groundPoint, setFixedFrame, addDisplay, pageState, setTool, project,
+  gamepad: gamepad.state,
   get fixedFrame() { return state.fixedFrame; },
   ready: true,
 };
