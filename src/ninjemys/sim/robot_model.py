@@ -323,23 +323,18 @@ def model_from_urdf(
     left, right = (wheels[0], wheels[1]) if ys[0] > ys[1] else (wheels[1], wheels[0])
     doc["wheel_separation"] = abs(ys[0] - ys[1])
     doc["joints"] = {"left": left.get("name"), "right": right.get("name")}
-    root_link = next(
-        (
-            n
-            for n in links
-            if n not in {j.find("child").get("link") for j in joints if j.find("child") is not None}
-        ),
-        None,
-    )
+    children = {c.get("link") for c in (j.find("child") for j in joints) if c is not None}
+    root_link = next((n for n in links if n not in children), None)
     body = cylinder(root_link)
     if body is not None:
         doc["body_radius"], doc["body_height"] = body
     sensors: dict = {}
     for j in joints:
-        if j.get("type") != "fixed" or j.find("child") is None:
+        child_element = j.find("child")
+        if j.get("type") != "fixed" or child_element is None:
             continue
-        child = j.find("child").get("link")
-        kind = {"laser": "laser", "camera_link": "camera", "imu_link": "imu"}.get(child)
+        child_link = child_element.get("link") or ""
+        kind = {"laser": "laser", "camera_link": "camera", "imu_link": "imu"}.get(child_link)
         if kind is None:
             continue
         origin = j.find("origin")
@@ -349,6 +344,6 @@ def model_from_urdf(
         rpy = _floats(
             origin.get("rpy") if origin is not None else None, 3, f"joint {j.get('name')} origin rpy", source
         )
-        sensors[kind] = dict(doc["sensors"][kind], frame=child, xyz=xyz, rpy=rpy)
+        sensors[kind] = dict(doc["sensors"][kind], frame=child_link, xyz=xyz, rpy=rpy)
     doc["sensors"] = sensors
     return model_from_doc(doc, Fields(source, {}))

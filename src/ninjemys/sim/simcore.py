@@ -541,7 +541,7 @@ class Simulation:
                 dist, who = self._clearances(r.x + f * ddx, r.y + f * ddy, r.name, geometry)
                 blocked = np.flatnonzero((dist[1:] < radius) & (dist[1:] < dist[0] - 1e-12))
             else:
-                blocked = f[:0]  # nothing within reach: the move is free
+                blocked = np.flatnonzero(f[:0])  # nothing within reach: the move is free
             if len(blocked):
                 k = int(blocked[0]) + 1
                 lo, hi = f[k - 1], f[k]
@@ -715,7 +715,7 @@ def floor_paint(world: World, resolution: float = 0.01, max_cells: int = 2000) -
     cy = lo[1] + (np.arange(rows) + 0.5) * res
     gx, gy = np.meshgrid(cx, cy)
     texture = np.zeros((rows, cols), dtype=np.uint8)
-    palette = []
+    palette: list[tuple[int, int, int]] = []
     for m in world.markings:
         ink = len(palette) + 1
         palette.append(m.color)
