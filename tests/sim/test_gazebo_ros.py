@@ -16,12 +16,11 @@ from pathlib import Path
 
 import pytest
 from gazebo_helpers import Launched, genpy_gazebo_msgs
-from sim_helpers import wait_until
 
 from ninjemys.idl.loader import get_message_class, get_service_class
 from ninjemys.node import Node
 from ninjemys.sim.worlds import ROBOTS_DIR
-from ninjemys.testing import have_ros1, ninjemys_bin, ros1_env, run_master
+from ninjemys.testing import have_ros1, ninjemys_bin, ros1_env, run_master, wait_until
 
 pytestmark = [pytest.mark.ros1, pytest.mark.skipif(not have_ros1(), reason="needs Debian's ROS 1")]
 

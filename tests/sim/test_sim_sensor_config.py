@@ -12,7 +12,6 @@ from pathlib import Path
 
 import pytest
 from gazebo_helpers import Launched
-from sim_helpers import wait_until
 
 from ninjemys.idl.loader import get_message_class
 from ninjemys.node import Node
@@ -22,7 +21,7 @@ from ninjemys.sim.puzzlebot_node import SimNode
 from ninjemys.sim.robot_model import DriveSpec, load_robot_model
 from ninjemys.sim.simcore import Simulation
 from ninjemys.sim.world2d import World
-from ninjemys.testing import run_master
+from ninjemys.testing import run_master, wait_until
 
 LaserScan = get_message_class("sensor_msgs/LaserScan")
 Image = get_message_class("sensor_msgs/Image")

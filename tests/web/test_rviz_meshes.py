@@ -9,11 +9,11 @@ from typing import Any
 import numpy as np
 import pytest
 from rviz_helpers import M, screenshot_rgb, tf_message, transform
-from web_helpers import wait_until
 
 from ninjemys.master.core import MasterThread
 from ninjemys.node import Node
 from ninjemys.sim.meshes import write_binary_stl
+from ninjemys.testing import wait_until
 from ninjemys.web.rviz import Rviz
 
 pytestmark = pytest.mark.browser
