@@ -1,4 +1,4 @@
-"""UNIXROS: ninjemys nodes of one host stream TCPROS over a Unix-domain socket, negotiated in
+"""UNIXROS (opt-in, NINJEMYS_UNIXROS=1): ninjemys nodes of one host stream TCPROS over a Unix-domain socket, negotiated in
 requestTopic (topics) or found from a local service URI (services); the bytes are the same as over
 TCP, getBusInfo names the transport, and NINJEMYS_UNIXROS=0 keeps everything on TCP."""
 
@@ -13,10 +13,16 @@ import pytest
 from node_msgs import String
 
 from ninjemys.idl.loader import get_message_class, get_service_class
-from ninjemys.node import transport
 from ninjemys.testing import wait_until
 
-pytestmark = pytest.mark.skipif(not transport.local_transport_enabled(), reason="UNIXROS needs Linux")
+pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="UNIXROS needs Linux")
+
+
+@pytest.fixture(autouse=True)
+def unixros_on(monkeypatch) -> None:  # noqa: ANN001
+    """UNIXROS is opt-in (NINJEMYS_UNIXROS=1); these tests turn it on for this process."""
+    monkeypatch.setenv("NINJEMYS_UNIXROS", "1")
+
 
 Image = get_message_class("sensor_msgs/Image")
 AddTwoInts = get_service_class("rospy_tutorials/AddTwoInts")
@@ -95,7 +101,7 @@ def test_services_use_the_unix_socket_of_a_local_server(make_node, monkeypatch) 
     assert tcp(5, 6).sum == 11
     assert tcp._link.sock.family == socket.AF_INET
     # a non-persistent proxy connects per call, locally too
-    monkeypatch.delenv("NINJEMYS_UNIXROS")
+    monkeypatch.setenv("NINJEMYS_UNIXROS", "1")
     assert client.service_proxy("add_two_ints", AddTwoInts)(1, 1).sum == 2
 
 

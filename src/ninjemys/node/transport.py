@@ -1,6 +1,7 @@
 """Socket plumbing shared by topics and services: header exchange and the node's TCPROS server.
 
-Between processes on one host the same TCPROS streams run over a Unix-domain socket (``UNIXROS``):
+With ``NINJEMYS_UNIXROS=1``, between processes on one host the same TCPROS streams run over a
+Unix-domain socket (``UNIXROS``):
 the node's server also listens on the abstract name ``@ninjemys-tcpros-<port>`` (Linux; abstract
 names vanish with the socket, so a crashed node leaves nothing behind). Subscribers ask for it in
 ``requestTopic`` before TCPROS, with this host's identity (boot id and network namespace), and the
@@ -42,9 +43,11 @@ _identity: str | None = None
 
 
 def local_transport_enabled() -> bool:
-    """Unix-domain sockets between processes of one host: Linux (abstract names), unless
-    ``NINJEMYS_UNIXROS=0`` asks for TCP everywhere (to compare, or to debug with tcpdump)."""
-    return sys.platform.startswith("linux") and os.environ.get("NINJEMYS_UNIXROS", "1") != "0"
+    """Unix-domain sockets between processes of one host: Linux (abstract names), when
+    ``NINJEMYS_UNIXROS=1`` asks for them. Opt-in for now: under a flat-out publisher a second
+    subscriber handle was seen to stall once and such runs took 2-3x longer than over TCP, while the
+    gain measured at the node level was within noise (README, UNIXROS row)."""
+    return sys.platform.startswith("linux") and os.environ.get("NINJEMYS_UNIXROS", "0") == "1"
 
 
 def host_identity() -> str:
