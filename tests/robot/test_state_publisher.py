@@ -227,7 +227,12 @@ def test_same_transforms_as_debians_robot_state_publisher(master) -> None:
     ours_args = ["/tf:=/tf_ours", "/tf_static:=/tf_static_ours", "__name:=rsp_ours"]
     nodes = [[str(DEBIAN_RSP), *debian_env_args], _ours("robot_state_publisher", *ours_args)]
     messages = 12
-    expect = {"/tf_debian": messages * 8, "/tf_ours": messages * 8, "/tf_static_debian": 1, "/tf_static_ours": 1}
+    expect = {
+        "/tf_debian": messages * 8,
+        "/tf_ours": messages * 8,
+        "/tf_static_debian": 1,
+        "/tf_static_ours": 1,
+    }
     collectors, _ = _run_arm(master, nodes, expect, messages)
     theirs, ours = collectors["/tf_debian"].seen, collectors["/tf_ours"].seen
     assert set(theirs) == set(ours)
