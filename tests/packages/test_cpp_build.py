@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from ninjemys.packages.cpp_build import find_toolchain
+from ninjemys.packages.cpp_build import find_toolchain, missing_definitions_hint, noetic_compat_flags
 from ninjemys.testing import kill_tree, ninjemys_bin, run_master
 
 PACKAGE_XML = """<?xml version="1.0"?>
@@ -74,23 +74,31 @@ int main(int argc, char **argv) {
 }
 """
 
-ECHO = r"""// Listens on /chatter and republishes each string, prefixed, on /echo.
+ECHO = r"""// Listens on /chatter and republishes each string, prefixed, on /echo. Written as the Noetic-era
+// books and tutorials write class-based nodes: boost::bind(&Class::method, this, _1) with the global
+// _1 that Boost 1.71 had (catkin_make must make that compile on newer Boost too).
 #include <ros/ros.h>
 #include <std_msgs/String.h>
 
-static ros::Publisher echo;
+class Echo {
+ public:
+  Echo() : echo_(nh_.advertise<std_msgs::String>("echo", 10)),
+           sub_(nh_.subscribe<std_msgs::String>("chatter", 10, boost::bind(&Echo::heard, this, _1))) {}
 
-static void heard(const std_msgs::String::ConstPtr &msg) {
-  std_msgs::String out;
-  out.data = "cpp heard: " + msg->data;
-  echo.publish(out);
-}
+ private:
+  void heard(const std_msgs::String::ConstPtr &msg) {
+    std_msgs::String out;
+    out.data = "cpp heard: " + msg->data;
+    echo_.publish(out);
+  }
+  ros::NodeHandle nh_;
+  ros::Publisher echo_;
+  ros::Subscriber sub_;
+};
 
 int main(int argc, char **argv) {
   ros::init(argc, argv, "cpp_echo");
-  ros::NodeHandle nh;
-  echo = nh.advertise<std_msgs::String>("echo", 10);
-  ros::Subscriber sub = nh.subscribe("chatter", 10, heard);
+  Echo echo;
   ros::spin();
   return 0;
 }
@@ -250,3 +258,25 @@ def test_a_compile_error_fails_like_debians_catkin_make(tmp_path: Path) -> None:
         assert result.returncode != 0, who
         assert "undeclared_name" in result.stdout + result.stderr, who
     assert 'Invoking "make -j' in results["ours"].stdout + results["ours"].stderr
+
+
+def test_newer_boost_gets_noetics_global_placeholders(tmp_path: Path) -> None:
+    header = tmp_path / "version.hpp"
+    header.write_text("#define BOOST_VERSION 107400\n")
+    assert noetic_compat_flags(header) == "-DBOOST_BIND_GLOBAL_PLACEHOLDERS -include boost/bind.hpp"
+    header.write_text("#define BOOST_VERSION 107100\n")
+    assert noetic_compat_flags(header) == ""
+    assert noetic_compat_flags(tmp_path / "absent.hpp") == ""
+
+
+def test_message_definitions_missing_for_cpp_generation_get_one_hint(tmp_path: Path) -> None:
+    genmsg = (
+        "CMake Error at build/demo/cmake/demo-genmsg.cmake:3 (message):\n  Could not find messages which\n"
+        "  '/ws/devel/share/demo/msg/MoveAction.msg' depends on.\n\n  Cannot locate message [GoalID] in "
+        f"package [actionlib_msgs] with paths\n  [['{tmp_path / 'nowhere'}']]\n"
+    )
+    hint = missing_definitions_hint(genmsg)
+    assert hint.startswith("ninjemys: ") and "ros-actionlib-msgs" in hint and "\n" not in hint
+    (tmp_path / "nowhere").mkdir()
+    assert missing_definitions_hint(genmsg) == ""  # the files are there: the error is something else
+    assert missing_definitions_hint("undeclared_name") == ""

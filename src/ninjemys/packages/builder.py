@@ -194,6 +194,8 @@ def build_workspace(
     env = os.environ if env is None else env
     report = BuildReport()
     ws.load()
+    for note in ws.check_layout():
+        log(note)
     for note in ws.check_dependencies(env):
         log(note)
     ordered = ws.ordered()
