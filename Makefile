@@ -26,6 +26,10 @@ ROS1_DEBS += cmake python3-gencpp ros-std-msgs libstd-msgs-dev
 ROS1_DEBS += python3-opencv image-transport-tools
 # the long tail (issue 21 item 7): Debian's python3-angles, the reference for ours
 ROS1_DEBS += python3-angles
+# rostest: Debian's rostest, the reference for ours (tests/rostest)
+ROS1_DEBS += python3-rostest
+# C++ packages with .action files (the books' C++ action servers): actionlib_msgs' .msg definitions
+ROS1_DEBS += ros-actionlib-msgs
 BROWSER_DEBS := chromium chromium-driver fonts-dejavu-core
 # multi-host tests: network namespaces (iproute2), roslaunch <machine> over ssh (openssh-server)
 NET_DEBS     := iproute2 openssh-server openssh-client
