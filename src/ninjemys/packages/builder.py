@@ -27,7 +27,13 @@ from typing import Any
 from ninjemys.errors import DefinitionError, PackageError
 from ninjemys.packages import cfg_gen, idl_check, msg_types
 from ninjemys.packages.cmake_hints import read_cmake_hints
-from ninjemys.packages.cpp_build import Toolchain, build_cpp, cpp_closure, find_toolchain
+from ninjemys.packages.cpp_build import (
+    Toolchain,
+    build_cpp,
+    cpp_closure,
+    find_toolchain,
+    missing_cpp_dependency,
+)
 from ninjemys.packages.cpp_targets import CppTarget, cpp_targets, skipped_message
 from ninjemys.packages.discovery import PackageIndex, package_path_dirs, underlay_dirs
 from ninjemys.packages.manifest import PackageManifest
@@ -156,7 +162,27 @@ def _build_cpp_packages(
 ) -> None:
     """Build the C++ packages with catkin's CMake and link their programs into devel/lib/<pkg>/."""
     chosen = cpp_closure(ordered, wanted)
-    built = build_cpp(chosen, ws.build / "ninjemys_cpp", ws.root / "install", toolchain, log)
+    try:
+        built = build_cpp(chosen, ws.build / "ninjemys_cpp", ws.root / "install", toolchain, log)
+    except PackageError as exc:
+        # a dependency's C++ side missing on this machine (nav_msgs' headers, OpenCV ...): the
+        # Python side of the workspace is still built and the C++ targets are named, with why
+        missing = missing_cpp_dependency(str(exc))
+        if missing is None:
+            raise
+        debian = f"lib{missing.lower().replace('_', '-')}-dev"
+        why = f"the C++ side of '{missing}' is not installed (Debian: {debian} or ros-{debian[3:-4]})"
+        for line in str(exc).splitlines():
+            if (
+                line.startswith("CMake Error")
+                or "Could not find a package" in line
+                or "Cannot locate" in line
+            ):
+                log(f"--   {line.strip()}")
+        for pkg in chosen:
+            if pkg.name in wanted:
+                _report_cpp_targets(pkg, report, log, why)
+        return
     for package, programs in built.items():
         for program in programs:
             link = ws.devel / "lib" / package / program.name

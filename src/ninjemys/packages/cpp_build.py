@@ -181,6 +181,22 @@ def build_cpp(
 _NO_MSG = re.compile(r"Cannot locate message \[(\w+)\] in package \[(\w+)\] with paths\s+\[\['([^']+)'\]\]")
 
 
+_NO_CONFIG = re.compile(r'Could not find a package configuration file provided by "([^"]+)"')
+
+
+def missing_cpp_dependency(output: str) -> str | None:
+    """The package whose C++ files stopped CMake's configure step (its CMake config, or the .msg
+    files message generation reads), or None when the failure is another one (a compile error, a
+    CMakeLists.txt mistake): those fail the build, as with catkin."""
+    if 'Invoking "cmake" failed' not in output:
+        return None
+    flat = " ".join(output.split())
+    match = _NO_CONFIG.search(flat) or _NO_MSG.search(flat)
+    if match is None:
+        return None
+    return match.group(1) if match.re is _NO_CONFIG else match.group(2)
+
+
 def missing_definitions_hint(output: str) -> str:
     """One line for genmsg's "Cannot locate message" when the package's msg directory is absent:
     Debian ships a message package's CMake config (with its C++ headers) apart from its ``.msg``

@@ -67,6 +67,23 @@ PROVIDED = frozenset(
     }
 )
 
+#: C++ libraries outside ROS whose CMake names look like ROS package names (lower case):
+#: find_package(gazebo REQUIRED) in a robot's world package is for Gazebo plugins in C++, which a
+#: Python build does not need, so a missing one is a note like Boost's, not a failure
+SYSTEM_LIBRARIES = frozenset(
+    {
+        "gazebo",
+        "orocos_kdl",
+        "urdfdom",
+        "urdfdom_headers",
+        "console_bridge",
+        "octomap",
+        "fcl",
+        "ompl",
+        "sdformat",
+    }
+)
+
 
 @dataclass
 class Workspace:
@@ -158,7 +175,7 @@ class Workspace:
                     or cmake_config_found(name, env)
                 ):
                     continue
-                if req.catkin or _ROS_NAME.fullmatch(name):
+                if req.catkin or (_ROS_NAME.fullmatch(name) and name not in SYSTEM_LIBRARIES):
                     raise PackageError(_missing_package_text(self.source, pkg, req))
                 notes.append(
                     f"-- ninjemys: {pkg.path.name}/CMakeLists.txt:{req.line}: find_package({name} REQUIRED) "
