@@ -11,7 +11,12 @@ from pathlib import Path
 
 import pytest
 
-from ninjemys.packages.cpp_build import find_toolchain, missing_definitions_hint, noetic_compat_flags
+from ninjemys.packages.cpp_build import (
+    find_toolchain,
+    missing_cpp_dependency,
+    missing_definitions_hint,
+    noetic_compat_flags,
+)
 from ninjemys.testing import kill_tree, ninjemys_bin, run_master
 
 PACKAGE_XML = """<?xml version="1.0"?>
@@ -327,3 +332,12 @@ def test_a_dependency_without_its_cpp_side_leaves_the_python_side_built(tmp_path
     assert "aruco_follow: 1 C++ target(s) not built" in out
     assert "[the C++ side of 'fiducial_msgs' is not installed" in out
     assert (tmp_path / "devel" / "lib" / "aruco_follow" / "follow.py").is_file()
+
+
+def test_which_failures_mean_a_missing_cpp_side() -> None:
+    configure = 'CMake Error ...\n  Could not find a package configuration file provided by "nav_msgs" with\n'
+    assert missing_cpp_dependency(configure + 'Invoking "cmake" failed') == ("nav_msgs", False)
+    header = "node.cpp:2:10: fatal error: control_msgs/JointControllerState.h: No such file or directory\n"
+    assert missing_cpp_dependency(header + 'Invoking "make -j2" failed') == ("control_msgs", True)
+    own = "node.cpp:2:19: error: 'undeclared_name' was not declared in this scope\n"
+    assert missing_cpp_dependency(own + 'Invoking "make -j2" failed') is None

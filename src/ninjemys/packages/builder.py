@@ -159,6 +159,7 @@ def _build_cpp_packages(
     writer: _Writer,
     report: BuildReport,
     log: Callable[[str], None],
+    finder: Callable[[str], Path | None],
 ) -> None:
     """Build the C++ packages with catkin's CMake and link their programs into devel/lib/<pkg>/."""
     chosen = cpp_closure(ordered, wanted)
@@ -167,9 +168,12 @@ def _build_cpp_packages(
     except PackageError as exc:
         # a dependency's C++ side missing on this machine (nav_msgs' headers, OpenCV ...): the
         # Python side of the workspace is still built and the C++ targets are named, with why
-        missing = missing_cpp_dependency(str(exc))
-        if missing is None:
+        found = missing_cpp_dependency(str(exc))
+        if found is None:
             raise
+        missing, from_header = found
+        if from_header and (missing in {p.name for p in ws.packages} or finder(missing) is None):
+            raise  # a header of the workspace's own, or of no ROS package: the code's own error
         debian = f"lib{missing.lower().replace('_', '-')}-dev"
         why = f"the C++ side of '{missing}' is not installed (Debian: {debian} or ros-{debian[3:-4]})"
         for line in str(exc).splitlines():
@@ -177,6 +181,7 @@ def _build_cpp_packages(
                 line.startswith("CMake Error")
                 or "Could not find a package" in line
                 or "Cannot locate" in line
+                or "fatal error:" in line
             ):
                 log(f"--   {line.strip()}")
         for pkg in chosen:
@@ -291,7 +296,8 @@ def build_workspace(
             writer.write(target, _relay_script(script), executable=True)
 
     if toolchain is not None and cpp_packages:
-        _build_cpp_packages(ws, ordered, cpp_packages, toolchain, writer, report, log)
+        finder = _package_finder(ws, env)
+        _build_cpp_packages(ws, ordered, cpp_packages, toolchain, writer, report, log, finder)
 
     wsenv = WorkspaceEnv(source=ws.source, devel=ws.devel)
     underlays = underlay_workspaces(ws.devel, env)

@@ -184,17 +184,24 @@ _NO_MSG = re.compile(r"Cannot locate message \[(\w+)\] in package \[(\w+)\] with
 _NO_CONFIG = re.compile(r'Could not find a package configuration file provided by "([^"]+)"')
 
 
-def missing_cpp_dependency(output: str) -> str | None:
-    """The package whose C++ files stopped CMake's configure step (its CMake config, or the .msg
-    files message generation reads), or None when the failure is another one (a compile error, a
-    CMakeLists.txt mistake): those fail the build, as with catkin."""
-    if 'Invoking "cmake" failed' not in output:
-        return None
+_NO_HEADER = re.compile(r"fatal error: ([A-Za-z][A-Za-z0-9_]*)/[\w./]+\.h(?:pp)?: No such file or directory")
+
+
+def missing_cpp_dependency(output: str) -> tuple[str, bool] | None:
+    """(package, from_header) when the build stopped for want of a package's C++ side: its CMake
+    config or the .msg files message generation reads (configure step), or one of its headers
+    (``fatal error: control_msgs/JointControllerState.h: No such file``; ``from_header`` True: the
+    caller checks it names a ROS package). None for any other failure (a compile error in the
+    package's own code, a CMakeLists.txt mistake): those fail the build, as with catkin."""
     flat = " ".join(output.split())
-    match = _NO_CONFIG.search(flat) or _NO_MSG.search(flat)
-    if match is None:
-        return None
-    return match.group(1) if match.re is _NO_CONFIG else match.group(2)
+    if 'Invoking "cmake" failed' in output:
+        match = _NO_CONFIG.search(flat)
+        if match is not None:
+            return match.group(1), False
+        match = _NO_MSG.search(flat)
+        return (match.group(2), False) if match is not None else None
+    match = _NO_HEADER.search(flat)
+    return (match.group(1), True) if match is not None else None
 
 
 def missing_definitions_hint(output: str) -> str:
