@@ -303,3 +303,21 @@ def test_same_report_as_debians_rostest(workspace: Path, tmp_path: Path, test_fi
     ours = _rostest(workspace, "probe_tests", test_file)
     assert (debian.returncode, ours.returncode) == (code, code), debian.stdout + debian.stderr
     assert _report_lines(ours.stdout) == _report_lines(debian.stdout)
+
+
+def test_catkin_make_run_tests_runs_the_add_rostest_files(workspace: Path) -> None:
+    combined = workspace / "ros_home" / "test_results" / "probe_tests" / "rostest-test_talker.xml"
+    combined.unlink(missing_ok=True)
+    made = subprocess.run(
+        [ninjemys_bin("catkin_make"), "run_tests"],
+        cwd=workspace,
+        env={k: v for k, v in _env(workspace).items() if k != "PYTHONPATH"},
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
+    assert made.returncode == 0, made.stdout + made.stderr
+    assert "-- run_tests_probe_tests_rostest_test_talker.test" in made.stdout
+    assert "[probe_tests.rosunit-talker_test/test_hears_hello][passed]" in made.stdout
+    assert read_xml(combined).ok
