@@ -139,11 +139,11 @@ def _definitions(pkg: PackageManifest) -> dict[str, list[Path]]:
 
 
 def _report_cpp_targets(
-    pkg: PackageManifest, report: BuildReport, log: Callable[[str], None], why: str
+    pkg: PackageManifest, report: BuildReport, log: Callable[[str], None], why: str, toolchain: bool = False
 ) -> None:
     """Name the package's C++ targets, which this build skips, instead of ignoring them."""
     targets = cpp_targets(pkg.path, pkg.name)
-    lines = skipped_message(pkg.name, targets)
+    lines = skipped_message(pkg.name, targets, toolchain)
     if lines:
         lines[0] += f" [{why}]"
     for line in lines:
@@ -186,7 +186,7 @@ def _build_cpp_packages(
                 log(f"--   {line.strip()}")
         for pkg in chosen:
             if pkg.name in wanted:
-                _report_cpp_targets(pkg, report, log, why)
+                _report_cpp_targets(pkg, report, log, why, toolchain=True)
         return
     for package, programs in built.items():
         for program in programs:
