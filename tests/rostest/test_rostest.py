@@ -124,6 +124,24 @@ SLOW_TEST = """<launch>
 
 SLEEPER = "#!/usr/bin/env python3\nimport time\ntime.sleep(60)\n"
 
+#: rostest's stock hztest on the talker (20 Hz), and one that expects a rate it cannot have
+HZ_TEST = """<launch>
+  <node name="talker" pkg="probe_tests" type="talker.py"/>
+  <test test-name="talker_hz" pkg="rostest" type="hztest" name="hz">
+    <param name="topic" value="chatter"/>
+    <param name="hz" value="20.0"/>
+    <param name="hzerror" value="6.0"/>
+    <param name="test_duration" value="2.0"/>
+  </test>
+  <test test-name="talker_too_slow" pkg="rostest" type="hztest" name="hz_fast">
+    <param name="topic" value="chatter"/>
+    <param name="hz" value="100.0"/>
+    <param name="hzerror" value="10.0"/>
+    <param name="test_duration" value="2.0"/>
+  </test>
+</launch>
+"""
+
 
 def _workspace(root: Path) -> Path:
     pkg = root / "src" / "probe_tests"
@@ -142,6 +160,7 @@ def _workspace(root: Path) -> Path:
     (pkg / "test" / "talker.test").write_text(TALKER_TEST)
     (pkg / "test" / "failing.test").write_text(FAILING_TEST)
     (pkg / "test" / "slow.test").write_text(SLOW_TEST)
+    (pkg / "test" / "hz.test").write_text(HZ_TEST)
     return root
 
 
@@ -218,6 +237,15 @@ def test_a_test_over_its_time_limit_fails(workspace: Path) -> None:
     assert "\x1b[1;31m * ERRORS: 1\x1b[0m" in result.stdout
 
 
+def test_hztest_checks_a_topics_rate(workspace: Path) -> None:
+    result = _rostest(workspace, "probe_tests", "hz.test")
+    out = result.stdout
+    assert result.returncode == 2, out + result.stderr
+    assert "[probe_tests.rosunit-talker_hz/test_hz][passed]" in out
+    assert "[probe_tests.rosunit-talker_too_slow/test_hz][FAILURE]" in out
+    assert "exceeded minimum (90.000Hz)" in out
+
+
 def test_find_package_rostest_is_known_to_catkin_make(workspace: Path) -> None:
     listed = subprocess.run(
         [ninjemys_bin("rospack"), "find", "rostest"],
@@ -281,7 +309,9 @@ def _report_lines(text: str) -> list[str]:
 @pytest.mark.skipif(
     not Path("/usr/bin/rostest").exists(), reason="Debian's rostest (python3-rostest) not installed"
 )
-@pytest.mark.parametrize(("test_file", "code"), [("talker.test", 0), ("failing.test", 2), ("slow.test", 1)])
+@pytest.mark.parametrize(
+    ("test_file", "code"), [("talker.test", 0), ("failing.test", 2), ("slow.test", 1), ("hz.test", 2)]
+)
 def test_same_report_as_debians_rostest(workspace: Path, tmp_path: Path, test_file: str, code: int) -> None:
     theirs = _workspace(tmp_path / "debian")
     env = {
