@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 
 from ninjemys.packages.cpp_build import (
+    failing_package,
     find_toolchain,
     missing_cpp_dependency,
     missing_definitions_hint,
@@ -314,6 +315,19 @@ def test_a_dependency_without_its_cpp_side_leaves_the_python_side_built(tmp_path
         "#!/usr/bin/env python3\nfrom fiducial_msgs.msg import Fiducial\n"
     )
     (pkg / "scripts" / "follow.py").chmod(0o755)
+    # a second C++ package that has all it needs: built all the same
+    plain = tmp_path / "src" / "plain_node"
+    (plain / "src").mkdir(parents=True)
+    (plain / "package.xml").write_text(PACKAGE_XML.replace("cpp_chat", "plain_node"))
+    (plain / "CMakeLists.txt").write_text(
+        "cmake_minimum_required(VERSION 3.0.2)\nproject(plain_node)\n"
+        "find_package(catkin REQUIRED COMPONENTS roscpp)\ncatkin_package()\n"
+        "include_directories(${catkin_INCLUDE_DIRS})\nadd_executable(plain src/plain.cpp)\n"
+        "target_link_libraries(plain ${catkin_LIBRARIES})\n"
+    )
+    (plain / "src" / "plain.cpp").write_text(
+        '#include <ros/ros.h>\nint main(int argc, char **argv) { ros::init(argc, argv, "plain"); return 0; }\n'
+    )
     env = {k: v for k, v in os.environ.items() if k not in ("ROS_PACKAGE_PATH", "CMAKE_PREFIX_PATH")}
     env.pop("NINJEMYS_CATKIN_CPP", None)
     result = subprocess.run(
@@ -332,6 +346,17 @@ def test_a_dependency_without_its_cpp_side_leaves_the_python_side_built(tmp_path
     assert "aruco_follow: 1 C++ target(s) not built" in out
     assert "[the C++ side of 'fiducial_msgs' is not installed" in out
     assert (tmp_path / "devel" / "lib" / "aruco_follow" / "follow.py").is_file()
+    assert "plain_node: C++ program(s) built by catkin's CMake: plain" in out
+    assert (tmp_path / "devel" / "lib" / "plain_node" / "plain").is_file()
+
+
+def test_the_failing_package_is_told_from_cmakes_call_stack_or_the_compiler() -> None:
+    stack = "CMake Error at /usr/share/catkin/cmake/catkinConfig.cmake:82 (find_package):\n"
+    stack += "Call Stack (most recent call first):\n  aruco_follow/CMakeLists.txt:3 (find_package)\n"
+    assert failing_package(stack, {"aruco_follow", "plain_node"}) == "aruco_follow"
+    compiler = "/ws/build/ninjemys_cpp/src/plain_node/src/x.cpp:2:10: fatal error: a/b.h: No such file\n"
+    assert failing_package(compiler, {"aruco_follow", "plain_node"}) == "plain_node"
+    assert failing_package("something else", {"plain_node"}) is None
 
 
 def test_which_failures_mean_a_missing_cpp_side() -> None:

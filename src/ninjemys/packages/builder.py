@@ -31,6 +31,7 @@ from ninjemys.packages.cpp_build import (
     Toolchain,
     build_cpp,
     cpp_closure,
+    failing_package,
     find_toolchain,
     missing_cpp_dependency,
 )
@@ -161,33 +162,44 @@ def _build_cpp_packages(
     log: Callable[[str], None],
     finder: Callable[[str], Path | None],
 ) -> None:
-    """Build the C++ packages with catkin's CMake and link their programs into devel/lib/<pkg>/."""
-    chosen = cpp_closure(ordered, wanted)
-    try:
-        built = build_cpp(chosen, ws.build / "ninjemys_cpp", ws.root / "install", toolchain, log)
-    except PackageError as exc:
-        # a dependency's C++ side missing on this machine (nav_msgs' headers, OpenCV ...): the
-        # Python side of the workspace is still built and the C++ targets are named, with why
-        found = missing_cpp_dependency(str(exc))
-        if found is None:
-            raise
-        missing, from_header = found
-        if from_header and (missing in {p.name for p in ws.packages} or finder(missing) is None):
-            raise  # a header of the workspace's own, or of no ROS package: the code's own error
-        debian = f"lib{missing.lower().replace('_', '-')}-dev"
-        why = f"the C++ side of '{missing}' is not installed (Debian: {debian} or ros-{debian[3:-4]})"
-        for line in str(exc).splitlines():
-            if (
-                line.startswith("CMake Error")
-                or "Could not find a package" in line
-                or "Cannot locate" in line
-                or "fatal error:" in line
-            ):
-                log(f"--   {line.strip()}")
-        for pkg in chosen:
-            if pkg.name in wanted:
-                _report_cpp_targets(pkg, report, log, why, toolchain=True)
-        return
+    """Build the C++ packages with catkin's CMake and link their programs into devel/lib/<pkg>/.
+
+    When what stops the build is a dependency's missing C++ side (nav_msgs' headers, OpenCV ...),
+    the package that needs it is named as not built, with why, and the others are built without
+    it; the Python side of the workspace is built in any case."""
+    remaining = set(wanted)
+    built: dict[str, list[Path]] = {}
+    while remaining:
+        chosen = cpp_closure(ordered, remaining)
+        try:
+            built = build_cpp(chosen, ws.build / "ninjemys_cpp", ws.root / "install", toolchain, log)
+            break
+        except PackageError as exc:
+            text = str(exc)
+            found = missing_cpp_dependency(text)
+            if found is None:
+                raise
+            missing, from_header = found
+            if from_header and (missing in {p.name for p in ws.packages} or finder(missing) is None):
+                raise  # a header of the workspace's own, or of no ROS package: the code's own error
+            names = {p.name for p in chosen}
+            culprit = failing_package(text, names)
+            skip = set(remaining)
+            if culprit is not None:  # it, and what needs it, wait for the missing C++ side
+                skip = {w for w in remaining if culprit in {p.name for p in cpp_closure(ordered, {w})}}
+                skip = skip or set(remaining)
+            debian = f"lib{missing.lower().replace('_', '-')}-dev"
+            why = f"the C++ side of '{missing}' is not installed (Debian: {debian} or ros-{debian[3:-4]})"
+            for line in text.splitlines():
+                if any(
+                    marker in line
+                    for marker in ("CMake Error", "Could not find a package", "Cannot locate", "fatal error:")
+                ):
+                    log(f"--   {line.strip()}")
+            for pkg in ordered:
+                if pkg.name in skip:
+                    _report_cpp_targets(pkg, report, log, why, toolchain=True)
+            remaining -= skip
     for package, programs in built.items():
         for program in programs:
             link = ws.devel / "lib" / package / program.name

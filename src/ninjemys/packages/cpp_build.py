@@ -204,6 +204,16 @@ def missing_cpp_dependency(output: str) -> tuple[str, bool] | None:
     return (match.group(1), True) if match is not None else None
 
 
+def failing_package(output: str, packages: set[str]) -> str | None:
+    """Which of ``packages`` the failure is in: the first ``<pkg>/CMakeLists.txt:<line>`` of CMake's
+    call stack, or the first compiler diagnostic under ``src/<pkg>/`` of the C++ source space."""
+    for pattern in (r"(?:^|\s)([A-Za-z][\w]*)/CMakeLists\.txt:\d+", r"ninjemys_cpp/src/([A-Za-z][\w]*)/"):
+        for match in re.finditer(pattern, output, re.M):
+            if match.group(1) in packages:
+                return match.group(1)
+    return None
+
+
 def missing_definitions_hint(output: str) -> str:
     """One line for genmsg's "Cannot locate message" when the package's msg directory is absent:
     Debian ships a message package's CMake config (with its C++ headers) apart from its ``.msg``
@@ -235,7 +245,9 @@ __all__ = [
     "Toolchain",
     "build_cpp",
     "cpp_closure",
+    "failing_package",
     "find_toolchain",
+    "missing_cpp_dependency",
     "missing_definitions_hint",
     "noetic_compat_flags",
 ]
