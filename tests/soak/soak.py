@@ -17,8 +17,9 @@ After every fault the soak waits for the graph to heal, polling from outside ove
 Heal time runs from the fault's repair (the respawned process started; the new master answering)
 to the first poll that sees all of that. Polls take ~0.1-0.4 s, the resolution of the figures.
 
-Resources (RSS, open fds, threads) of the surviving processes and of the master are sampled after
-the first heal (plus a warm-up) and at the end; the bounds are in :data:`TOLERANCE`.
+Resources (RSS, open fds, threads) of the surviving processes are sampled after the first heal
+(plus a warm-up) and at the end; each master's after its heal (plus the same warm-up) and just before
+it is killed (or at the end). The bounds are in :data:`TOLERANCE`.
 
 Acknowledged messages: the recorder stopped with SIGINT closes its bag and prints ``Recorded N
 messages``; the bag must be readable and hold exactly N, and each publisher incarnation's messages
@@ -35,7 +36,6 @@ import json
 import os
 import random
 import re
-import signal
 import statistics
 import subprocess
 import sys
@@ -91,7 +91,7 @@ def make_plan(
         # half the topics from killable singles, half from survivors
         owner = single_idx[k % len(single_idx)] if k % 2 else host_idx[k % len(host_idx)]
         plans[owner].pub.append(list(topic))
-    for i, plan in enumerate(plans):
+    for plan in plans:
         mine = {t for t, _ in plan.pub}
         choices = [t for t in topic_list if t[0] not in mine]
         plan.sub = [list(t) for t in rng.sample(choices, 2)]
@@ -414,7 +414,8 @@ def run_soak(
         time.sleep(3.0)  # warm-up: every connection made, caches filled
         survivors = {f"worker {w.tag}": w.pid for w in workers[:hosts]} | {"recorder": recorders[0].pid}
         start_res = {name: proc_stats(pid) for name, pid in survivors.items()}
-        start_res["master"] = proc_stats(master.pid)
+        start_res["master 1"] = proc_stats(master.pid)
+        end_res: dict[str, dict[str, float]] = {}
         log(f"healed at start in {report['initial_heal_s']:.2f} s; resources {start_res}")
 
         begin = time.monotonic()
@@ -426,6 +427,8 @@ def run_soak(
             now = time.monotonic()
             if restarts_at and now >= restarts_at[0]:
                 restarts_at.pop(0)
+                incarnation = 3 - len(restarts_at)
+                end_res[f"master {incarnation - 1}"] = proc_stats(master.pid)
                 down = time.monotonic()
                 master.sigkill()
                 time.sleep(rng.uniform(0.5, 2.0))  # the graph runs master-less for a while
@@ -436,6 +439,8 @@ def run_soak(
                 log(
                     f"master restart: healed {took:.2f} s after it answered ({back + took - down:.2f} s after the kill)"
                 )
+                time.sleep(2.0)  # the same warm-up as the first master's
+                start_res[f"master {incarnation}"] = proc_stats(master.pid)
                 continue
             if recorders[1].proc.poll() is None and now >= kill_recorder_at:
                 recorder_ack = _stats_before(recorders[1], time.time() - 2.0)
@@ -456,8 +461,8 @@ def run_soak(
         report["kills"] = kills
         report["master_restarts"] = len(heal["master_restart"])
         time.sleep(2.0)
-        end_res = {name: proc_stats(pid) for name, pid in survivors.items()}
-        end_res["master"] = proc_stats(master.pid)
+        end_res |= {name: proc_stats(pid) for name, pid in survivors.items()}
+        end_res[f"master {1 + len(heal['master_restart'])}"] = proc_stats(master.pid)
         report["resources"] = {"start": start_res, "end": end_res}
         report["leaks"] = leaks(start_res, end_res)
         stats = [w.last_stats() for w in workers]
@@ -511,6 +516,61 @@ def killed_bag(path: Path, acknowledged: int) -> dict[str, Any]:
             "holes": check_streams(found)}  # fmt: skip
 
 
+def cut_link_heals(rounds: int = 5, cut_s: float = 2.0) -> list[float] | str:
+    """Seconds from restoring a cut link until the stream across it resumes, ``rounds`` times; or why
+    it cannot be measured here (network namespaces need root: tests/multihost/netns.py).
+
+    Three hosts as in tests/multihost: the master on hosta, a talker (20 Hz) on hostb, a listener on
+    hostc; hostb's link is cut for ``cut_s`` seconds, then restored. What comes back is TCP's
+    retransmission (its back-off after a silence of ``cut_s``) plus nothing of ours: the connection
+    was never torn down.
+    """
+    sys.path.insert(0, str(HERE.parent))
+    from multihost.netns import Network, unavailable
+
+    why = unavailable()
+    if why is not None:
+        return why
+    node = [sys.executable, str(HERE.parent / "multihost" / "node_proc.py")]
+    venv_bin = Path(sys.executable).parent
+    net = Network()
+    healed: list[float] = []
+    try:
+
+        def env(host: str) -> dict[str, str]:
+            out = {k: v for k, v in os.environ.items() if not k.startswith("ROS_")}
+            out.update(ROS_MASTER_URI=f"http://{net.ip['hosta']}:11311/", ROS_IP=net.ip[host], PYTHONUNBUFFERED="1",
+                       ROS_HOME=f"/tmp/nj_soak_cut_{os.getpid()}_{host}")  # fmt: skip
+            return out
+
+        master = net.run("hosta", [str(venv_bin / "roscore"), "-p", "11311"], env("hosta"), "roscore")
+        if (
+            master.wait_line(lambda line: "started core service" in line or "master" in line.lower(), 30)
+            is None
+        ):
+            raise SoakFailure(f"the namespaced master did not start: {master.text()[-500:]}")
+        net.run("hostb", [*node, "talker", "/soak_cut", "b"], env("hostb"), "talker")
+        listener = net.run("hostc", [*node, "listener", "/soak_cut", "c"], env("hostc"), "listener")
+        if listener.wait_line(lambda line: line.startswith("got b "), timeout=30) is None:
+            raise SoakFailure(f"no stream across the namespaces: {listener.text()[-500:]}")
+        for _ in range(rounds):
+            net.cut("hostb")
+            time.sleep(cut_s)
+            mark = len(listener.lines)
+            net.restore("hostb")
+            restored = time.time()
+            line = listener.wait_line(lambda text: text.startswith("got b "), timeout=30, start=mark)
+            if line is None:
+                raise SoakFailure(
+                    f"the stream did not resume within 30 s of the link's restore: {listener.text()[-300:]}"
+                )
+            healed.append(float(line.split()[3]) - restored)
+            time.sleep(1.0)
+    finally:
+        net.close()
+    return healed
+
+
 def leaks(start: dict[str, dict[str, float]], end: dict[str, dict[str, float]]) -> list[str]:
     """Each survivor's growth beyond :data:`TOLERANCE`, in words."""
     out = []
@@ -550,6 +610,8 @@ def format_report(report: dict[str, Any]) -> str:
             lines.append(
                 f"  heal after {kind:26s} n={s['n']:3d}  p50 {s['p50']:.2f} s  p95 {s['p95']:.2f} s  max {s['max']:.2f} s"
             )
+    if report.get("cut_link_skipped"):
+        lines.append(f"  heal after a cut link: not measured ({report['cut_link_skipped']})")
     for name, first in report["resources"]["start"].items():
         last = report["resources"]["end"][name]
         lines.append(f"  {name:14s} RSS {first['rss']:6.1f} -> {last['rss']:6.1f} MB  fds {first['fds']:.0f} -> "
@@ -573,10 +635,19 @@ def main() -> int:
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--port", type=int, default=None, help="master port (default: a free one)")
     parser.add_argument("--json", help="also write the report here")
+    parser.add_argument("--cut-rounds", type=int, default=20, help="cut-link rounds in namespaces (0: none)")
     opts = parser.parse_args()
     report = run_soak(
         duration=opts.duration, nodes=opts.nodes, rate=opts.rate, seed=opts.seed, port=opts.port
     )
+    if opts.cut_rounds:
+        cut = cut_link_heals(opts.cut_rounds)
+        if isinstance(cut, str):
+            report["heal"]["cut_link"] = {}
+            report["cut_link_skipped"] = cut
+        else:
+            report["heal"]["cut_link"] = summarize(cut)
+            report["heal_raw"]["cut_link"] = cut
     print(format_report(report))
     if opts.json:
         Path(opts.json).write_text(json.dumps(report, indent=1))
