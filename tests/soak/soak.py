@@ -36,6 +36,7 @@ import json
 import os
 import random
 import re
+import signal
 import statistics
 import subprocess
 import sys
@@ -471,6 +472,11 @@ def run_soak(
                 )
             time.sleep(rng.uniform(0.5, 2.0))
         report["kills"] = kills
+        if os.environ.get("SOAK_TRACE_MEMORY"):
+            os.kill(workers[0].pid, signal.SIGUSR1)
+            time.sleep(3.0)
+            assert workers[0].proc is not None
+            log("\n".join(line for line in workers[0].proc.text().splitlines() if line.startswith("TM")))
         report["master_restarts"] = len(heal["master_restart"])
         time.sleep(2.0)
         end_res |= {name: proc_stats(pid) for name, pid in survivors.items()}
@@ -659,8 +665,15 @@ def main() -> int:
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--port", type=int, default=None, help="master port (default: a free one)")
     parser.add_argument("--json", help="also write the report here")
+    parser.add_argument(
+        "--trace-memory",
+        action="store_true",
+        help="diagnosis: print where worker w0's Python allocations grew (tracemalloc)",
+    )
     parser.add_argument("--cut-rounds", type=int, default=20, help="cut-link rounds in namespaces (0: none)")
     opts = parser.parse_args()
+    if opts.trace_memory:
+        os.environ["SOAK_TRACE_MEMORY"] = "1"
     report = run_soak(
         duration=opts.duration, nodes=opts.nodes, rate=opts.rate, seed=opts.seed, port=opts.port
     )

@@ -64,6 +64,42 @@ class Counters:
         self.calls_failed = 0
 
 
+def _trace_memory(stop: threading.Event) -> None:
+    """Diagnosis (``soak.py --trace-memory``): snapshot Python's allocations 20 s after start; on
+    SIGUSR1 print the 15 lines of code whose allocations grew most since (lines ``TM ...``)."""
+    import tracemalloc
+
+    tracemalloc.start(5)
+    first: list[Any] = []
+
+    def take() -> None:
+        if not stop.wait(20.0):
+            first.append(tracemalloc.take_snapshot())
+
+    def dump(*_: object) -> None:
+        import gc
+
+        from ninjemys.node.subscriber import SubConnection
+
+        conns = [o for o in gc.get_objects() if isinstance(o, SubConnection)]
+        closed = [c for c in conns if c.closed]
+        print(f"TM SubConnection objects: {len(conns)}, closed {len(closed)}", flush=True)
+        for c in closed[:3]:
+            for ref in gc.get_referrers(c):
+                if ref is not conns and ref is not closed:
+                    print(
+                        f"TM   closed {c.sub.topic} held by {type(ref).__name__} {str(ref)[:160]}", flush=True
+                    )
+        if first:
+            for stat in tracemalloc.take_snapshot().compare_to(first[0], "traceback")[:15]:
+                print(f"TM {stat.size_diff / 1024:+.1f} KiB {stat.count_diff:+d} blocks", flush=True)
+                for frame in stat.traceback.format()[-6:]:
+                    print(f"TM    {frame.strip()}", flush=True)
+
+    threading.Thread(target=take, daemon=True).start()
+    signal.signal(signal.SIGUSR1, dump)
+
+
 def main() -> None:
     spec = json.loads(open(sys.argv[1]).read())
     period = 1.0 / float(spec["rate"])
@@ -99,6 +135,8 @@ def main() -> None:
             proxies.append(node.service_proxy(name, trigger))
         print(f"ready {node.name} {node.uri}", flush=True)
     print("up", flush=True)
+    if os.environ.get("SOAK_TRACE_MEMORY"):
+        _trace_memory(stop)
 
     def call_loop() -> None:
         while not stop.wait(0.5):
