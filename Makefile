@@ -39,7 +39,7 @@ SYSTEM_DEBS  := $(ROS1_DEBS) $(BROWSER_DEBS) $(NET_DEBS) tmux
 NPM_DIR   := .cache/npm
 NPM_STAMP := $(NPM_DIR)/node_modules/.installed
 
-.PHONY: all venv system npm lint format typecheck test test-fast demo bench fuzz clean
+.PHONY: all venv system npm lint format typecheck test test-fast demo bench fuzz soak clean
 
 all: venv
 
@@ -100,6 +100,13 @@ bench: venv system
 # every parser of untrusted input, 100,000 mutated inputs each (make test runs 2,000: tests/fuzz)
 fuzz: venv
 	$(PY) tests/fuzz/run_fuzz.py --count 100000
+
+# the soak: 50 nodes under load, random SIGKILLs, two master restarts, a bag throughout, then a cut
+# link 20 times (network namespaces, as root); prints heal times p50/p95 and resources start vs end.
+# make test runs a ~70 s form (tests/soak/test_soak.py). SOAK_DURATION=seconds of faults.
+SOAK_DURATION ?= 600
+soak: venv
+	$(PY) tests/soak/soak.py --duration $(SOAK_DURATION) --json soak-report.json
 
 clean:
 	rm -rf $(VENV) build dist src/*.egg-info .pytest_cache .ruff_cache $(NPM_DIR)
