@@ -20,6 +20,7 @@ per capsule, so a read of many capsules is a few numpy passes. ``pack_*`` build 
 
 from __future__ import annotations
 
+import functools
 import math
 import struct
 
@@ -33,14 +34,22 @@ _VBS = ((3328, 4, 1 << 14), (1792, 3, 1 << 12), (1280, 2, 1 << 11), (512, 1, 1 <
 #: the ultra angle compensation's constants (radians in 1/65536, as the SDK truncates them)
 _OFFSET_NEAR_Q16 = int(7.5 * 3.1415926535 * (1 << 16) / 180.0)
 _OFFSET_BASE_Q16 = int(8 * 3.1415926535 * (1 << 16) / 180)
-_NO_ECHO = (-512, 0x1FF)
+#: predictions that mean "no echo": -512 and 511 (0xFFFFFE00 and 0x1FF in the SDK's 32-bit ints)
 
 
 def varbitscale_decode(scaled: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Millimetres and shift of 12-bit scaled majors (arrays)."""
-    value = np.zeros_like(scaled)
-    shift = np.zeros_like(scaled)
-    done = np.zeros(scaled.shape, dtype=bool)
+    """Millimetres and shift of 12-bit scaled majors (arrays), looked up in a 4096-entry table."""
+    values, shifts = _vbs_tables()
+    return values[scaled], shifts[scaled]
+
+
+@functools.cache
+def _vbs_tables() -> tuple[np.ndarray, np.ndarray]:
+    """Every 12-bit scaled major's millimetres and shift (built on first use: no work at import)."""
+    scaled = np.arange(4096, dtype=np.int64)
+    value = np.zeros(4096, dtype=np.int64)
+    shift = np.zeros(4096, dtype=np.int64)
+    done = np.zeros(4096, dtype=bool)
     for base, level, target in _VBS:
         hit = ~done & (scaled >= base)
         value[hit] = target + ((scaled[hit] - base) << level)
@@ -57,10 +66,15 @@ def varbitscale_encode(mm: int) -> int:
     return 0
 
 
-def _angles(p: np.ndarray, c: np.ndarray, per_capsule: int) -> tuple[np.ndarray, np.ndarray]:
+def _start_q8(capsules: list[bytes]) -> np.ndarray:
+    """Each capsule's start angle in 1/256 degree (its 15-bit q6 field, shifted)."""
+    words = np.frombuffer(b"".join(c[2:4] for c in capsules), dtype="<u2").astype(np.int64)
+    return (words & 0x7FFF) << 2
+
+
+def _angles(prevs: list[bytes], curs: list[bytes], per_capsule: int) -> tuple[np.ndarray, np.ndarray]:
     """Each sample's raw angle (degrees in 1/65536 << 6, the SDK's q16) and the angle step per sample."""
-    prev_q8 = ((p[:, 2] | p[:, 3] << 8) & 0x7FFF) << 2
-    cur_q8 = ((c[:, 2] | c[:, 3] << 8) & 0x7FFF) << 2
+    prev_q8, cur_q8 = _start_q8(prevs), _start_q8(curs)
     diff_q8 = cur_q8 - prev_q8 + np.where(prev_q8 > cur_q8, 360 << 8, 0)
     inc_q16 = ((diff_q8 << 8) // per_capsule)[:, None]
     raw_q16 = (prev_q8 << 8)[:, None] + np.arange(per_capsule, dtype=np.int64)[None, :] * inc_q16
@@ -79,26 +93,21 @@ def _rows(angle_q6: np.ndarray, raw_q16: np.ndarray, inc_q16: np.ndarray, dist_q
     return out
 
 
-def _matrix(capsules: list[bytes], size: int) -> np.ndarray:
-    return np.frombuffer(b"".join(capsules), dtype=np.uint8).reshape(len(capsules), size).astype(np.int64)
-
-
 def dense_samples(prevs: list[bytes], curs: list[bytes]) -> np.ndarray:
     """Rows (angle deg, distance mm, quality, start) of each dense capsule in ``prevs``."""
-    p, c = _matrix(prevs, 84), _matrix(curs, 84)
-    raw_q16, inc_q16 = _angles(p, c, DENSE_SAMPLES)
-    dist = p[:, 4::2] | p[:, 5::2] << 8
+    raw_q16, inc_q16 = _angles(prevs, curs, DENSE_SAMPLES)
+    body = b"".join(c[4:] for c in prevs)
+    dist = np.frombuffer(body, dtype="<u2").reshape(len(prevs), DENSE_SAMPLES).astype(np.int64)
     return _rows(raw_q16 >> 10, raw_q16, inc_q16, dist << 2)
 
 
 def ultra_samples(prevs: list[bytes], curs: list[bytes]) -> np.ndarray:
     """Rows (angle deg, distance mm, quality, start) of each ultra capsule in ``prevs``."""
     n = len(prevs)
-    p, c = _matrix(prevs, 132), _matrix(curs, 132)
-    raw_q16, inc_q16 = _angles(p, c, ULTRA_SAMPLES)
-    words = np.frombuffer(b"".join(prevs), dtype=np.uint8).reshape(n, 132)[:, 4:].copy()
-    combined = words.view("<u4").reshape(n, ULTRA_CABINS).astype(np.int64)
-    next_first = np.frombuffer(b"".join(c_[4:8] for c_ in curs), dtype="<u4").astype(np.int64)
+    raw_q16, inc_q16 = _angles(prevs, curs, ULTRA_SAMPLES)
+    body = b"".join(c[4:] for c in prevs)
+    combined = np.frombuffer(body, dtype="<u4").reshape(n, ULTRA_CABINS).astype(np.int64)
+    next_first = np.frombuffer(b"".join(c[4:8] for c in curs), dtype="<u4").astype(np.int64)
     major_raw = combined & 0xFFF
     major2_raw = np.concatenate([major_raw[:, 1:], (next_first & 0xFFF)[:, None]], axis=1)
     predict1 = (combined >> 12) & 0x3FF
@@ -111,8 +120,8 @@ def ultra_samples(prevs: list[bytes], curs: list[bytes]) -> np.ndarray:
     base1 = np.where(borrow, major2, major)
     scale1 = np.where(borrow, scale2, scale1)
     d0 = major << 2
-    d1 = np.where(np.isin(predict1, _NO_ECHO), 0, ((predict1 << scale1) + base1) << 2)
-    d2 = np.where(np.isin(predict2, _NO_ECHO), 0, ((predict2 << scale2) + major2) << 2)
+    d1 = np.where((predict1 == -512) | (predict1 == 0x1FF), 0, ((predict1 << scale1) + base1) << 2)
+    d2 = np.where((predict2 == -512) | (predict2 == 0x1FF), 0, ((predict2 << scale2) + major2) << 2)
     dist_q2 = np.stack([d0, d1, d2], axis=2).reshape(n, ULTRA_SAMPLES)
     dist_q2 = np.maximum(dist_q2, 0)  # a negative prediction sum is no echo, not a 4-billion-mm one
     offset_q16 = np.full(dist_q2.shape, _OFFSET_NEAR_Q16, dtype=np.int64)
