@@ -323,8 +323,16 @@ class EmulatedA3(EmulatedA1):
     ``corrupt_every``: every n-th capsule goes out with a flipped byte (a bad checksum).
     """
 
-    def __init__(self, corrupt_every: int = 0, **kwargs) -> None:  # noqa: ANN003
+    def __init__(
+        self,
+        corrupt_every: int = 0,
+        modes: tuple[ModeInfo, ...] = A3_MODES,
+        bad_conf: bool = False,
+        **kwargs,  # noqa: ANN003
+    ) -> None:
         self.corrupt_every = corrupt_every
+        self.modes = modes
+        self.bad_conf = bad_conf  # GET_LIDAR_CONF answers echo the wrong entry type
         self.corrupted = 0
         self._revs: dict[int, tuple[list[bytes], list[bytes], list[tuple[float, float]]]] = {}
         kwargs.setdefault("firmware", (1, 29))
@@ -337,7 +345,7 @@ class EmulatedA3(EmulatedA1):
             with self.cond:
                 self.commands.append(cmd)
                 self.cond.notify_all()
-            mode = A3_MODES[payload[0]]
+            mode = self.modes[payload[0]]
             size = rp.ULTRA_CAPSULE_SIZE if mode.ans_type == rp.ANS_TYPE_MEASUREMENT_CAPSULED_ULTRA else 84
             self.samples_per_s = 256e6 / mode.us_q8
             self._answer(rp.Descriptor(size, 1, mode.ans_type))
@@ -345,13 +353,18 @@ class EmulatedA3(EmulatedA1):
             self.mode = mode.ans_type
             return
         if cmd in (rp.CMD_SCAN, rp.CMD_EXPRESS_SCAN):
-            self.samples_per_s = 256e6 / A3_MODES[0 if cmd == rp.CMD_SCAN else 1].us_q8
+            self.samples_per_s = 256e6 / self.modes[0 if cmd == rp.CMD_SCAN else 1].us_q8
+        if cmd == rp.CMD_GET_LIDAR_CONF and self.bad_conf:
+            conf_type = rp.struct.unpack_from("<I", payload)[0]
+            data = rp.struct.pack("<I", conf_type + 1) + b"\x00\x00"
+            self._answer(rp.Descriptor(len(data), 0, rp.ANS_TYPE_GET_LIDAR_CONF), data)
+            return
         super()._command(cmd, payload)
 
     typical_mode = TYPICAL_A3_MODE
 
     def scan_modes(self) -> tuple[ModeInfo, ...]:
-        return A3_MODES
+        return self.modes
 
     # -- the capsule streams -------------------------------------------------------------------------------
 

@@ -19,7 +19,7 @@ from ninjemys.drivers.rplidar_scan import compensate_multiple
 from ninjemys.idl.loader import get_message_class
 from ninjemys.node import Node
 
-from .emu_rplidar import A3_MODES, EmulatedA3
+from .emu_rplidar import A3_MODES, EmulatedA3, ModeInfo
 from .test_rplidar import Collect, check_room, rplidar, stop, stop_after_exit
 
 LaserScan = get_message_class("sensor_msgs/LaserScan")
@@ -199,3 +199,28 @@ def test_the_a3_lists_its_modes_when_asked_for_one_it_lacks(tmp_path: Path) -> N
     ):
         assert line in out, out
     assert (rp.CONF_SCAN_MODE_COUNT, 0) in a3.conf_queries
+
+
+def test_an_hq_mode_and_a_garbled_mode_list_are_one_clear_line_each(tmp_path: Path) -> None:
+    env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_LOG_DIR=str(tmp_path))
+    hq = (*A3_MODES[:2], ModeInfo(2, "HighQuality", 16000, 25, rp.ANS_TYPE_MEASUREMENT_HQ))
+    with testing.run_master(env=env) as uri:
+        env["ROS_MASTER_URI"] = uri
+        a3 = EmulatedA3(modes=hq)
+        try:
+            out = stop_after_exit(rplidar(env, f"_serial_port:={a3.path}", "_scan_mode:=HighQuality"))
+        finally:
+            a3.close()
+        assert (
+            "scan mode `HighQuality' streams answers of type 0x83, which this driver does not decode "
+            "(it decodes 0x81, 0x82, 0x84 and 0x85)"
+        ) in out, out
+        garbled = EmulatedA3(bad_conf=True)
+        try:
+            out = stop_after_exit(rplidar(env, f"_serial_port:={garbled.path}"))
+        finally:
+            garbled.close()
+        assert (
+            "Error, cannot get the scan modes of the lidar: GET_LIDAR_CONF asked for entry 0x70 "
+            "and was answered 0x71"
+        ) in out, out
