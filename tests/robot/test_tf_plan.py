@@ -140,3 +140,26 @@ def test_malformed_messages_are_ignored_with_one_line_each() -> None:
     fast.on_raw(_Raw(good[:30]))  # cut inside the names
     assert len(fast.tf.sent) == 1
     assert warnings == ["Robot state publisher ignored a malformed JointState message"] * 2
+
+
+def test_a_floating_mimic_joint_stays_at_its_origin_as_on_the_general_path() -> None:
+    urdf = ARM.replace(
+        "</robot>",
+        '<link name="float"/><joint name="f" type="floating"><parent link="hand"/><child link="float"/>'
+        '<origin xyz="0.1 0.2 0.3" rpy="0.3 0.2 0.1"/><mimic joint="j1" multiplier="2"/></joint></robot>',
+    )
+    fast, _ = _publisher({})
+    general, _ = _publisher({})
+    fast.model = general.model = parse_urdf(urdf)
+    for sp in (fast, general):
+        sp.mimics = {"j1": [sp.model.joints["f"]]}
+        sp.encoded = {n: type(sp.encoded["j1"])(j, "") for n, j in sp.model.joints.items()}
+    for k in range(3):
+        fast.on_raw(_Raw(_encode(["j1"], [0.5 * k], 10 + k, 0)))
+        general.on_joint_state(("j1",), (0.5 * k,), 10 + k, 0)
+    assert len(fast.tf.sent) == 3
+    for ours, theirs in zip(fast.tf.sent, general.tf.sent, strict=True):
+        a, b = _transforms(ours), _transforms(theirs)
+        assert [t[:4] for t in a] == [t[:4] for t in b] and a[1][1] == "float"
+        for ta, tb in zip(a, b, strict=True):
+            assert max(abs(x - y) for x, y in zip(ta[4], tb[4], strict=True)) < 1e-12

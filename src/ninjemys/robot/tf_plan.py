@@ -68,6 +68,8 @@ class TfPlan:
                 dx, dy, dz = apply_rotation(joint.rotation, joint.axis)
                 self.rows.append((False, src, a, b, frame, x0, y0, z0, dx, dy, dz, ox, oy, oz, ow))
                 continue
+            if joint.type not in _MOVING:  # a floating or planar mimic joint stays at its origin, as in KDL
+                a = b = 0.0
             ax, ay, az = joint.axis
             self.rows.append(
                 (
