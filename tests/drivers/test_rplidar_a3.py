@@ -76,10 +76,10 @@ def test_ultra_capsule_decodes_majors_predictions_and_angle_compensation() -> No
     # 90 degrees over 96 samples; a 1000 mm echo is compensated by
     # (8 deg in rad q16 = 9150) - (98361 // 4000 = 24) << 6 = 7614 -> 7614 * 180 / pi = 436250 (q16 deg)
     assert rc.ultra_offset_deg(1000) == pytest.approx(436250 / 65536)
-    assert rows[0, 0] == ((((90 * 64) << 10) - 436250) >> 10) / 64.0
+    assert rows[0, 0] == rp.q14_degrees((((90 * 64) << 10) - 436250) >> 10)
     # no echo: 7.5 degrees (8578 rad q16)
     raw_q16 = ((90 * 64) << 10) + 4 * (90 << 16) // 96
-    assert rows[4, 0] == ((raw_q16 - int(8578 * 180 / 3.14159265)) >> 10) / 64.0
+    assert rows[4, 0] == rp.q14_degrees((raw_q16 - int(8578 * 180 / 3.14159265)) >> 10)
     assert rows[4, 2] == 0 and rows[0, 2] == 0x2F
 
 
@@ -89,7 +89,7 @@ def test_dense_capsule_spreads_40_samples_without_compensation() -> None:
     rows = dec.feed(b"".join(caps))
     assert len(rows) == 80
     rows = rows[40:]
-    assert rows[:, 0].tolist() == [15.0 + i * 15.0 / 40 for i in range(40)]
+    assert rows[:, 0].tolist() == [rp.q14_degrees(int((15.0 + i * 15.0 / 40) * 64)) for i in range(40)]
     assert rows[:, 1].tolist() == [500.0 + i for i in range(40)]
 
 
@@ -102,7 +102,7 @@ def test_bad_capsules_are_dropped_and_the_stream_resynchronises() -> None:
     rows = dec.feed(caps[0] + caps[1] + bytes(broken) + b"\x13\x37" + caps[3] + caps[4] + caps[5])
     # 0 -> 1 decodes; capsule 1 loses its end angle with capsule 2; 3 -> 4 and 4 -> 5 decode
     assert dec.bad > 0 and len(rows) == 3 * 96
-    assert rows[96, 0] == pytest.approx(3 * 22.5 - rc.ultra_offset_deg(1500), abs=1 / 64)
+    assert rows[96, 0] == pytest.approx(3 * 22.5 - rc.ultra_offset_deg(1500), abs=1 / 64 + 90 / 16384)
 
 
 # -- the node on an emulated A3 ----------------------------------------------------------------------------

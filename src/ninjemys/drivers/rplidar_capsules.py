@@ -26,6 +26,8 @@ import struct
 
 import numpy as np
 
+from ninjemys.drivers import rplidar_protocol as rp
+
 DENSE_SAMPLES = 40
 ULTRA_CABINS = 32
 ULTRA_SAMPLES = 3 * ULTRA_CABINS
@@ -86,7 +88,7 @@ def _rows(angle_q6: np.ndarray, raw_q16: np.ndarray, inc_q16: np.ndarray, dist_q
     angle_q6 = np.where(angle_q6 >= (360 << 6), angle_q6 - (360 << 6), angle_q6)
     start = ((raw_q16 + inc_q16) % (360 << 16)) < inc_q16
     out = np.empty((angle_q6.size, 4), dtype=np.float64)
-    out[:, 0] = (angle_q6 / 64.0).ravel()
+    out[:, 0] = rp.q14_degrees(angle_q6).ravel()
     out[:, 1] = (dist_q2 / 4.0).ravel()
     out[:, 2] = np.where(dist_q2 != 0, 0x2F, 0).ravel()
     out[:, 3] = start.ravel()

@@ -31,6 +31,7 @@ from __future__ import annotations
 import struct
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -249,6 +250,15 @@ class Health:
 
 # -- measurements -----------------------------------------------------------------------------------------
 
+
+def q14_degrees(angle_q6: Any) -> Any:
+    """Degrees as rplidar_ros sees an angle the device sent in 1/64 degree: Slamtec's SDK 1.12 hands
+    every measurement on as a 1/16384-of-90-degrees ``angle_z_q14 = (q6 << 8) / 90`` (integer
+    division) and the node reads ``q14 * 90 / 16384``, so 10.0 degrees arrives as 9.9976 (and lands
+    in compensation bin 9). Works on ints and integer arrays; exact in float32 and float64 alike."""
+    return ((angle_q6 << 8) // 90) * (90.0 / 16384.0)
+
+
 #: one revolution's samples: angle in degrees (device convention), distance in mm, quality 0..63
 Samples = tuple[np.ndarray, np.ndarray, np.ndarray]
 
@@ -295,7 +305,9 @@ class NodeDecoder:
                     run = 0
                     continue
                 angle_q6 = (b1 | snap[pos + 2] << 8) >> 1
-                single.append((angle_q6 / 64.0, (snap[pos + 3] | snap[pos + 4] << 8) / 4.0, b0 >> 2, b0 & 1))
+                single.append(
+                    (q14_degrees(angle_q6), (snap[pos + 3] | snap[pos + 4] << 8) / 4.0, b0 >> 2, b0 & 1)
+                )
                 pos += NODE_SIZE
                 run += 1
                 continue
@@ -310,7 +322,7 @@ class NodeDecoder:
             if good:
                 ok = arr[:good].astype(np.int64)
                 rows = np.empty((good, 4), dtype=np.float64)
-                rows[:, 0] = ((ok[:, 1] | ok[:, 2] << 8) >> 1) / 64.0
+                rows[:, 0] = q14_degrees((ok[:, 1] | ok[:, 2] << 8) >> 1)
                 rows[:, 1] = (ok[:, 3] | ok[:, 4] << 8) / 4.0
                 rows[:, 2] = ok[:, 0] >> 2
                 rows[:, 3] = ok[:, 0] & 1
@@ -428,7 +440,7 @@ def _capsule_samples(prevs: list[bytes], curs: list[bytes]) -> np.ndarray:
     start = ((angle_q16 + inc_q16) % (360 << 16)) < inc_q16
     dist_q2 = dist & 0xFFFC
     out = np.empty((n * 2 * CABINS, 4), dtype=np.float64)
-    out[:, 0] = (angle_q6 / 64.0).ravel()
+    out[:, 0] = q14_degrees(angle_q6).ravel()
     out[:, 1] = (dist_q2 / 4.0).ravel()
     out[:, 2] = np.where(dist_q2 != 0, 0x2F, 0).ravel()
     out[:, 3] = start.ravel()
