@@ -149,7 +149,6 @@ class RplidarDevice:
 
     def lidar_conf(self, conf_type: int, mode_id: int | None = None) -> bytes:
         """GET_LIDAR_CONF: the value of one entry (RplidarError if the answer is not that entry's)."""
-
         data = self.ask(
             rp.CMD_GET_LIDAR_CONF,
             rp.lidar_conf_request(conf_type, mode_id),
