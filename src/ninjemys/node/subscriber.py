@@ -176,13 +176,17 @@ class SubConnection:
         self.latching = header.get("latching", "0") == "1"
         self.last: bytes | bytearray | None = None
         self.id = next(connection_ids)
-        self.transport = transport.transport_of(sock)
         #: the handle whose callbacks this stream feeds (set when handed to a worker)
         self.reader: Subscriber | None = None
         self.bytes_recv = 0
         self.num_recv = 0
         self.closed = False
         self._reader = FrameReader()
+
+    @property
+    def transport(self) -> str:
+        """The transport name getBusInfo reports (TCPROS or UNIXROS)."""
+        return transport.transport_of(self.sock)
 
     def read(self, budget: int | None = None) -> list[bytes | bytearray] | None:
         """Read frames from the kernel (worker thread): about ``budget`` bytes at most when given, else

@@ -344,6 +344,9 @@ RESOURCES: tuple[Resource, ...] = (
              "throttle/once state per call site"),
     Resource("event", "ninjemys.node.runtime:Runtime._ready", LOOP, "the starting thread waits for the loop"),
     Resource("lock", "ninjemys.node.runtime:_lock", "any thread", "the process's runtime and its user count"),
+    Resource("lock", "ninjemys.node.intraprocess:_nodes_lock", "any thread",
+             "the process's table of Nodes by slave URI: a Node adds itself at start and leaves at "
+             "shutdown; the loop looks a publisher up there before connecting (in-process delivery)"),
     Resource("lock", "ninjemys.net.loop:Loop._wake_lock", "any thread", "call_soon_threadsafe's wake-up pipe write"),
     Resource("queue", "ninjemys.net.loop:Loop._ready", LOOP,
              "other threads append only through call_soon_threadsafe (then a wake-up)"),

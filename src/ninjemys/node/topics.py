@@ -108,7 +108,6 @@ class PubConnection:
         self.subscriber = subscriber
         self.uri = uri
         self.id = next(connection_ids)
-        self.transport = transport.transport_of(sock)
         self.bytes_sent = 0
         self.num_sent = 0
         self.dropped = 0
@@ -125,6 +124,11 @@ class PubConnection:
         self._armed = False  # the loop waits for the socket to become writable
         self._checking = False  # a check of the queue is scheduled on the loop
         self._refused = False  # the kernel refused a burst's batch: the publisher yields once
+
+    @property
+    def transport(self) -> str:
+        """The transport name getBusInfo reports (TCPROS or UNIXROS)."""
+        return transport.transport_of(self.sock)
 
     def send(self, data: bytes, queue_size: int | None) -> None:
         """Send ``data`` (one or more frames) to this subscriber; blocks only when ``queue_size`` is
