@@ -4,15 +4,17 @@ behaves as over TCPROS (latching, queue_size, mixed subscribers, unregister) and
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 import threading
 import time
 
+import pytest
 from node_msgs import String
 
 from ninjemys.idl.loader import get_message_class
-from ninjemys.testing import wait_until
+from ninjemys.testing import have_ros1, ninjemys_bin, ros1_env, wait_until
 
 Image = get_message_class("sensor_msgs/Image")
 Header = get_message_class("std_msgs/Header")
@@ -220,3 +222,23 @@ def test_raw_subscribers_get_the_bytes(make_node) -> None:  # noqa: ANN001
     pub.publish(img)
     assert wait_until(lambda: len(raw) == 1)
     assert raw[0] == img.serialize_to_bytes()
+
+
+@pytest.mark.parametrize("rosnode", ["ninjemys", pytest.param("ros1", marks=pytest.mark.ros1)])
+def test_rosnode_info_names_the_in_process_transport(make_node, master, rosnode) -> None:  # noqa: ANN001
+    """ROS 1 prints a connection's transport in ``rosnode info`` (from getBusInfo), and only there:
+    ``rostopic info`` lists nodes, not connections, in ROS 1 and here alike."""
+    if rosnode == "ros1" and not have_ros1():
+        pytest.skip("Debian's ROS 1 is not installed")
+    talker = make_node("talker")
+    pub = talker.publisher("chatter", String, intraprocess=True)
+    make_node("listener").subscriber("chatter", String, lambda m: None, intraprocess=True)
+    assert wait_until(lambda: pub.get_num_connections() == 1)
+    if rosnode == "ros1":
+        cmd, env = ["/usr/bin/rosnode", "info", "/talker"], ros1_env(master.uri)
+    else:
+        cmd, env = [ninjemys_bin("rosnode"), "info", "/talker"], dict(os.environ, ROS_MASTER_URI=master.uri)
+    out = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=60).stdout
+    block = out[out.index(" * topic: /chatter") :]
+    assert " * topic: /chatter\n    * to: /listener" in block
+    assert "    * direction: outbound" in block and "    * transport: INTRAPROCESS" in block
