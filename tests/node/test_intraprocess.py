@@ -135,6 +135,46 @@ def test_queue_size_keeps_the_newest_while_the_callback_is_busy(make_node) -> No
     assert sub.dropped == 8
 
 
+def test_an_unbounded_subscriber_gets_the_publishers_queue_size(make_node) -> None:  # noqa: ANN001
+    """As over TCPROS: a bounded publisher drops the oldest messages waiting for a lagging subscriber,
+    a queue_size=None publisher waits for it and loses nothing."""
+    talker = make_node("talker")
+    bounded = talker.publisher("bounded", Header, intraprocess=True, queue_size=3)
+    lossless = talker.publisher("lossless", Header, intraprocess=True, queue_size=None)
+    release = threading.Event()
+    got: dict[str, list[str]] = {"bounded": [], "lossless": []}
+
+    def slow(msg, topic) -> None:  # noqa: ANN001
+        got[topic].append(msg.frame_id)
+        release.wait(20)
+
+    listener = make_node("slow")
+    for topic in got:
+        listener.subscriber(topic, Header, slow, callback_args=topic, intraprocess=True)  # queue_size=None
+    assert wait_until(lambda: bounded.get_num_connections() == 1 and lossless.get_num_connections() == 1)
+    bounded.publish(Header(frame_id="first"))
+    lossless.publish(Header(frame_id="first"))
+    assert wait_until(lambda: got["bounded"] == ["first"] and got["lossless"] == ["first"])
+    for i in range(10):
+        bounded.publish(Header(frame_id=str(i)))
+    done = threading.Event()
+
+    def flood() -> None:
+        for i in range(400):
+            lossless.publish(Header(frame_id=str(i)))
+        done.set()
+
+    threading.Thread(target=flood, daemon=True).start()
+    assert not done.wait(0.5)  # the publisher waits for its lagging subscriber
+    release.set()
+    assert done.wait(20)
+    assert wait_until(lambda: len(got["lossless"]) == 401 and len(got["bounded"]) == 4)
+    assert got["lossless"] == ["first", *map(str, range(400))]
+    assert got["bounded"] == ["first", "7", "8", "9"]
+    stats = {t: conns for t, _, conns in talker.bus_stats()[0]}
+    assert stats["/bounded"][0][2] == 11 and stats["/lossless"][0][2] == 401
+
+
 def test_several_subscribers_mixed_in_process_and_remote(make_node, master) -> None:  # noqa: ANN001
     talker = make_node("talker")
     pub = talker.publisher("chatter", String, intraprocess=True)

@@ -126,8 +126,9 @@ class IntraLink:
         self.dropped = 0
         self.closed = False
 
-    def deliver(self, item: Handoff) -> None:
-        """Put ``item`` in the queue of every open handle of the subscription (publisher's thread)."""
+    def deliver(self, item: Handoff, queue_size: int | None = 0) -> None:
+        """Put ``item`` in the queue of every open handle of the subscription (publisher's thread).
+        ``queue_size`` is the publishing handle's, as over TCPROS (0: a latched replay, never waits)."""
         if self.closed:
             return
         self.num_sent += 1
@@ -136,7 +137,7 @@ class IntraLink:
             self.last = item  # a handle added later replays it, as a socket's last frame
         for handle in self.sub.handles:
             if not handle.closed:
-                handle.enqueue([item], self.header)  # type: ignore[list-item]
+                self.dropped += handle.push_local(item, self.header, queue_size)
 
     def close(self) -> None:
         """Either end went away (any thread; idempotent): forget the link on both sides."""

@@ -63,6 +63,12 @@ _log = logging.getLogger(__name__)
 
 #: Bytes an unbounded subscription reads from one connection before delivering what it has.
 _READ_BUDGET = 256 * 1024
+#: An in-process publisher with queue_size=None waits while this many messages wait for an unbounded
+#: handle, until no more than the low mark are left, looking every _LOCAL_WAIT seconds (TCPROS's
+#: synchronous publishing, where the kernel's buffer is the bound).
+_LOCAL_HIGH_WATER = 256
+_LOCAL_LOW_WATER = 128
+_LOCAL_WAIT = 100e-6
 
 
 def _kernel_pending(sock: socket.socket) -> int:
@@ -532,6 +538,31 @@ class Subscriber:
         """Frames read by another thread (the reader handle, or a latched replay)."""
         self._push(frames, header)
         self._wakeup()
+
+    def push_local(self, item: Handoff, header: Mapping[str, str], pub_queue_size: int | None) -> int:
+        """A message from a publisher of this process (its thread); returns how many it dropped.
+
+        This handle's own ``queue_size`` drops the oldest, as for a socket. An unbounded handle gets
+        the publisher's ``queue_size`` semantics instead, as over TCPROS: a bounded publisher drops
+        the oldest messages waiting for this lagging subscriber beyond its bound, and
+        ``queue_size=None`` makes the publisher wait (lossless, synchronous) while more than
+        :data:`_LOCAL_HIGH_WATER` wait, unless it publishes from this handle's own thread.
+        """
+        queue = self._queue
+        dropped = 0
+        if queue.maxlen is None and pub_queue_size != 0:
+            if pub_queue_size is not None:
+                while len(queue) >= pub_queue_size:
+                    try:
+                        queue.popleft()
+                    except IndexError:
+                        break
+                    dropped += 1
+            elif len(queue) >= _LOCAL_HIGH_WATER and threading.current_thread() is not self._host._thread:
+                while len(queue) > _LOCAL_LOW_WATER and not self._closed:
+                    time.sleep(_LOCAL_WAIT)
+        self.enqueue([item], header)  # type: ignore[list-item]
+        return dropped
 
     def _keep_newest(self, frames: list[bytes | bytearray], queued: int) -> list[bytes | bytearray]:
         """``queue_size`` semantics for ``frames`` arriving behind ``queued`` waiting ones: count what

@@ -501,8 +501,9 @@ class Publication:
                 links = self.intra
         else:
             links = self.intra
+        queue_size = handle.queue_size
         for link in links:
-            link.deliver(item)
+            link.deliver(item, queue_size)
 
     def add_intra(self, link: IntraLink) -> None:
         """An in-process subscriber joined: it gets the latched messages first, as over a socket."""
