@@ -300,7 +300,9 @@ RESOURCES: tuple[Resource, ...] = (
              "the loop takes it to add a subscriber, so a latched frame is sent either latched or live"),
     Resource("queue", "ninjemys.node.subscriber:Subscriber._queue", "sub:<topic>",
              "the reader appends frames for other handles of the topic, the loop appends latched "
-             "replays (both through enqueue/post, then a wake-up); bounded by queue_size"),
+             "replays, an in-process publisher's thread appends its messages (and drops the oldest "
+             "beyond its queue_size for an unbounded handle); all through enqueue, then a wake-up; "
+             "bounded by queue_size"),
     Resource("lock", "ninjemys.node.subscriber:Subscriber._ops_lock", "sub:<topic>",
              "connection hand-offs (post) from the loop and enqueue from other threads"),
     Resource("lock", "ninjemys.node.subscriber:Subscriber._read_lock", "sub:<topic>",
