@@ -55,6 +55,14 @@ def unregister_node(uri: str, node: Any) -> None:
             del _nodes[uri]
 
 
+def is_local_node(name: str) -> bool:
+    """True when a live Node of this process has caller id ``name`` (a publisher whose subscriber
+    shares its GIL: see ``topics._LAG_YIELD``)."""
+    with _nodes_lock:
+        nodes = list(_nodes.values())
+    return any(node.name == name and not node.is_shutdown for node in nodes)
+
+
 def local_publication(uri: str, topic: str) -> Publication | None:
     """The Publication of ``topic`` of the Node of this process at ``uri``, or None."""
     with _nodes_lock:

@@ -32,7 +32,7 @@ from collections.abc import Callable, Mapping
 from ninjemys.errors import SerializationError, ShutdownError
 from ninjemys.net import auth
 from ninjemys.node import transport
-from ninjemys.node.intraprocess import Handoff, IntraLink
+from ninjemys.node.intraprocess import Handoff, IntraLink, is_local_node
 from ninjemys.wire import headers
 from ninjemys.wire.tcpros import pack_len
 
@@ -68,11 +68,12 @@ _SYNC_LOW_WATER_BYTES = 4 << 20
 _LARGE = 1 << 16
 #: A big frame in more pieces than this is joined before sending (sendmsg takes at most IOV_MAX).
 _MAX_PARTS = 64
-#: A bounded publisher in a burst whose subscriber lags (the kernel refused a batch) sleeps this long
-#: once per refused batch, outside every lock: long enough (with the kernel's timer slack, ~50 us) for
-#: a thread waiting for the GIL to take it. Without it a flat-out publisher in the subscriber's own
-#: process holds the GIL between system calls too short for a waiter to win (a Unix socket's send is
-#: ~2 us; loopback TCP's ~10 us hid this), and the reader starved for tenths of a second.
+#: A bounded publisher in a burst whose subscriber lags (the kernel refused a batch) and lives in this
+#: same process sleeps this long once per refused batch, outside every lock: long enough (with the
+#: kernel's timer slack, ~50 us) for a thread waiting for the GIL to take it. Without it a flat-out
+#: publisher in the subscriber's own process holds the GIL between system calls too short for a
+#: waiter to win (a Unix socket's send is ~2 us; loopback TCP's ~10 us hid this), and the reader
+#: starved for tenths of a second. A subscriber in another process has its own GIL: no pause.
 _LAG_YIELD = 20e-6
 _clock = time.perf_counter
 
@@ -124,6 +125,8 @@ class PubConnection:
         self._armed = False  # the loop waits for the socket to become writable
         self._checking = False  # a check of the queue is scheduled on the loop
         self._refused = False  # the kernel refused a burst's batch: the publisher yields once
+        #: the subscriber is a Node of this process (shares our GIL): yield to it when it lags
+        self._same_process = is_local_node(subscriber)
 
     @property
     def transport(self) -> str:
@@ -226,7 +229,8 @@ class PubConnection:
             # what the kernel refuses stays queued: this thread tries again a batch later, and the
             # loop's check takes over once the burst ends (handing it to the loop now would have two
             # threads contend for the GIL and this lock for the rest of the burst)
-            self._refused = not self._write_locked() and self._partial is not None
+            written = self._write_locked()
+            self._refused = self._same_process and not written and self._partial is not None
         if over and len(queue) > limit:
             self._trim(limit)
         if (queue or self._partial is not None) and not self._checking and not self._armed:
