@@ -1,0 +1,170 @@
+"""Two roscores bridged by two ``zenoh-bridge-ros1`` processes over TCP on localhost, no multicast.
+
+One bridge listens, the other connects (mode peer). Real rospy programs on one graph, ninjemys nodes
+on the other, in both directions; a service call across; a latched topic seen by a late subscriber
+across; a bridge killed and restarted; bad endpoints. Ten robots with identical names: test_fleet.py.
+"""
+
+from __future__ import annotations
+
+import queue
+import subprocess
+
+import pytest
+
+pytest.importorskip("zenoh", reason="eclipse-zenoh (the zenoh extra) is not installed")
+
+from ninjemys.node import Node  # noqa: E402
+from ninjemys.testing import free_port, have_ros1, ninjemys_bin, run_master, wait_until  # noqa: E402
+from tests.zenoh.bridges import SET_BOOL_SERVER, TALKER, bridged, rospy, start_bridge  # noqa: E402
+
+needs_ros1 = pytest.mark.skipif(not have_ros1(), reason="Debian's ROS 1 (rospy) is not installed")
+
+
+@pytest.fixture
+def two_graphs(tmp_path, monkeypatch):
+    """(uri_a, uri_b, zenoh port): two masters; bridges are started by each test."""
+    monkeypatch.setenv("ROS_HOME", str(tmp_path))
+    monkeypatch.setenv("ROS_HOSTNAME", "localhost")
+    with run_master() as uri_a, run_master() as uri_b:
+        yield uri_a, uri_b, free_port()
+
+
+@pytest.fixture
+def bridges(two_graphs):
+    uri_a, uri_b, port = two_graphs
+    with start_bridge(uri_a, "-l", f"tcp/127.0.0.1:{port}") as a, start_bridge(
+        uri_b, "-e", f"tcp/127.0.0.1:{port}", "--client_bridging_mode", "auto"
+    ) as b:
+        yield uri_a, uri_b, a, b
+
+
+def listen(uri: str, topic: str) -> tuple[Node, queue.Queue[str]]:
+    from std_msgs.msg import String
+
+    got: queue.Queue[str] = queue.Queue()
+    node = Node("listener", master_uri=uri, anonymous=True, rosout=False)
+    node.subscriber(topic, String, lambda m: got.put(m.data))
+    return node, got
+
+
+def first(got: queue.Queue[str], timeout: float = 30.0) -> str:
+    try:
+        return got.get(timeout=timeout)
+    except queue.Empty:
+        raise AssertionError(f"nothing arrived across the bridge within {timeout} s") from None
+
+
+@pytest.mark.ros1
+@needs_ros1
+@pytest.mark.parametrize("direction", ["a_to_b", "b_to_a"])
+def test_rospy_talker_to_ninjemys_listener_across(bridges, direction):
+    uri_a, uri_b, _, _ = bridges
+    talk_uri, listen_uri = (uri_a, uri_b) if direction == "a_to_b" else (uri_b, uri_a)
+    with rospy(talk_uri, TALKER, "/chatter", direction):
+        node, got = listen(listen_uri, "/chatter")
+        try:
+            text = first(got)
+            assert text.startswith(f"{direction} ")
+            # a stream, not one message: the numbers keep rising
+            later = [first(got) for _ in range(5)]
+            numbers = [int(t.split()[1]) for t in [text, *later]]
+            assert numbers == sorted(numbers) and numbers[-1] > numbers[0]
+        finally:
+            node.shutdown()
+
+
+@pytest.mark.ros1
+@needs_ros1
+def test_service_call_across(bridges):
+    from std_srvs.srv import SetBool
+
+    uri_a, uri_b, _, _ = bridges
+    with rospy(uri_a, SET_BOOL_SERVER) as server:
+        server.wait_for("ready", timeout=30)
+        node = Node("caller", master_uri=uri_b, rosout=False)
+        try:
+            node.wait_for_service("/arm", timeout=30)
+            proxy = node.service_proxy("/arm", SetBool)
+            assert (proxy(True).success, proxy(True).message) == (True, "armed")
+            assert proxy(False).message == "disarmed"
+        finally:
+            node.shutdown()
+
+
+def test_latched_topic_reaches_a_late_subscriber_across(bridges):
+    from std_msgs.msg import String
+
+    uri_a, uri_b, _, _ = bridges
+    talker = Node("mapper", master_uri=uri_a, rosout=False)
+    try:
+        pub = talker.publisher("/map_version", String, latch=True)
+        pub.publish(String("map v1"))
+        bridged(uri_b, "/map_version", "pub")  # the far side knows the topic ...
+        node, got = listen(uri_b, "/map_version")  # ... and a subscriber comes after the only message
+        try:
+            assert first(got) == "map v1"
+        finally:
+            node.shutdown()
+    finally:
+        talker.shutdown()
+
+
+def test_bridge_killed_and_restarted_graph_recovers(two_graphs):
+    from std_msgs.msg import String
+
+    uri_a, uri_b, port = two_graphs
+    talker = Node("talker", master_uri=uri_a, rosout=False)
+    pub = talker.publisher("/chatter", String)
+    node, got = listen(uri_b, "/chatter")
+    try:
+        with start_bridge(uri_b, "-l", f"tcp/127.0.0.1:{port}"):
+            for round_ in ("first", "second"):
+                with start_bridge(uri_a, "-e", f"tcp/127.0.0.1:{port}") as a:
+                    wait_until(lambda r=round_: pub.publish(String(r)) or _drain_has(got, r), timeout=30,
+                               what=f"{round_} bridge to relay", step=0.1)  # fmt: skip
+                    a.kill()  # SIGKILL: no goodbye, the far side notices the silence
+                # the far side drops the dead bridge's topic within the beacon timeout
+                wait_until(lambda: not _published_by_bridge(uri_b, "/chatter"), timeout=30, what="unbridging")
+    finally:
+        node.shutdown()
+        talker.shutdown()
+
+
+def _drain_has(got: queue.Queue[str], text: str) -> bool:
+    found = False
+    while not got.empty():
+        found |= got.get_nowait() == text
+    return found
+
+
+def _published_by_bridge(uri: str, topic: str) -> bool:
+    from ninjemys.master.client import MasterClient
+
+    with MasterClient(uri, "/test_probe") as m:
+        return any(t == topic and "/ros1_to_zenoh_bridge" in n for t, n in m.get_system_state()[0])
+
+
+@pytest.mark.parametrize(
+    ("argv", "named"),
+    [
+        (["-e", "127.0.0.1:7447"], "--connect: bad endpoint '127.0.0.1:7447'"),
+        (["-l", "tcp/127.0.0.1"], "--listen: bad endpoint 'tcp/127.0.0.1'"),
+    ],
+)
+def test_bad_endpoint_one_clear_error(argv, named):
+    r = subprocess.run([ninjemys_bin("zenoh-bridge-ros1"), *argv], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2
+    assert r.stderr.splitlines() == [r.stderr.strip()], r.stderr  # one line, no traceback
+    assert named in r.stderr
+
+
+def test_unreachable_endpoint_one_clear_error():
+    port = free_port()
+    r = subprocess.run(
+        [ninjemys_bin("zenoh-bridge-ros1"), "-m", "client", "-e", f"tcp/127.0.0.1:{port}"],
+        capture_output=True, text=True, timeout=60,
+    )  # fmt: skip
+    assert r.returncode == 1
+    assert len(r.stderr.strip().splitlines()) == 1, r.stderr
+    assert f"cannot open the Zenoh session (connect tcp/127.0.0.1:{port})" in r.stderr
