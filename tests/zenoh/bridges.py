@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import textwrap
+
 from ninjemys.master.client import MasterClient
 from ninjemys.testing import ROS1_PYTHON, NodeProcess, ninjemys_bin, ros1_env, wait_until
 

@@ -28,7 +28,12 @@ def test_discovery_key_round_trips():
 
 @pytest.mark.parametrize(
     "key",
-    ["ros1_discovery_info/*/pub/zz/md5/ns/t", "ros1_discovery_info/*/bogus/61/md5/ns/t", "other/*/pub/61/m/ns/t", "x"],
+    [
+        "ros1_discovery_info/*/pub/zz/md5/ns/t",
+        "ros1_discovery_info/*/bogus/61/md5/ns/t",
+        "other/*/pub/61/m/ns/t",
+        "x",
+    ],
 )
 def test_bad_discovery_keys_are_named(key):
     with pytest.raises(keys.KeyError_, match="discovery key"):
@@ -79,11 +84,17 @@ def test_environment_fills_master_and_namespace():
         (["-e", "127.0.0.1:7447"], "--connect: bad endpoint '127.0.0.1:7447'"),
         (["-l", "tcp/127.0.0.1"], "--listen: bad endpoint 'tcp/127.0.0.1'"),
         (["-e", "carrier-pigeon/x:1"], "--connect: bad endpoint"),
-        (["--subscriber_bridging_mode", "eager"], "--subscriber_bridging_mode: unknown bridging mode 'eager'"),
+        (
+            ["--subscriber_bridging_mode", "eager"],
+            "--subscriber_bridging_mode: unknown bridging mode 'eager'",
+        ),
         (["--client_bridging_mode", "lazy_auto"], "--client_bridging_mode: unknown bridging mode"),
         (["--service_topic_custom_bridging_mode", "[1]"], "expected a JSON object"),
         (["--service_topic_custom_bridging_mode", "{"], "not JSON"),
-        (["--ros_master_polling_interval", "fast"], "--ros_master_polling_interval: 'fast' is not a duration"),
+        (
+            ["--ros_master_polling_interval", "fast"],
+            "--ros_master_polling_interval: 'fast' is not a duration",
+        ),
         (["--bridge_namespace", "a/b"], "--bridge_namespace"),
         (["--ros_master_uri", "localhost:11311"], "--ros_master_uri"),
         (["--with_rosmaster", "yes"], "--with_rosmaster"),
