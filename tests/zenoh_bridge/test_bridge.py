@@ -167,3 +167,32 @@ def test_unreachable_endpoint_one_clear_error():
     assert r.returncode == 1
     assert len(r.stderr.strip().splitlines()) == 1, r.stderr
     assert f"cannot open the Zenoh session (connect tcp/127.0.0.1:{port})" in r.stderr
+
+
+def test_unknown_type_relayed_raw_with_its_definition(bridges):
+    """A type no definition on this machine describes: bytes, md5 and definition still cross."""
+    from ninjemys.bag.play import stand_in_class
+
+    uri_a, uri_b, _, _ = bridges
+    battery = stand_in_class("fleet_msgs/Battery", "0123456789abcdef0123456789abcdef", "float32 voltage\n")
+    talker = Node("battery", master_uri=uri_a, rosout=False)
+    node = Node("monitor", master_uri=uri_b, rosout=False)
+    got: queue.Queue = queue.Queue()
+    try:
+        pub = talker.publisher("/battery", battery)
+        bridged(uri_b, "/battery", "pub")
+        node.subscriber("/battery", None, got.put, raw=True)
+        wait_until(
+            lambda: pub.publish_raw(b"\x00\x00\x40\x41") or not got.empty(), timeout=30, what="a message"
+        )
+        raw = got.get_nowait()
+        assert bytes(raw.data) == b"\x00\x00\x40\x41"
+        header = raw.connection_header
+        assert (header["type"], header["md5sum"]) == (
+            "fleet_msgs/Battery",
+            "0123456789abcdef0123456789abcdef",
+        )
+        assert header["message_definition"] == "float32 voltage\n"
+    finally:
+        node.shutdown()
+        talker.shutdown()

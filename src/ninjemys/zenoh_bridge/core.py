@@ -136,7 +136,7 @@ class ZenohBridge:
                     wanted[(kind, res)] = lambda r=res: make(r)
 
         consider(keys.PUB, "publisher", state.publishers, set(self.remote.snapshot(keys.SUB)),
-                 lambda r: RosToZenoh(node, session, r, ns))  # fmt: skip
+                 lambda r: RosToZenoh(node, session, r, ns, self._definition(r)))  # fmt: skip
         consider(keys.SUB, "subscriber", state.subscribers, set(self.remote.snapshot(keys.PUB)),
                  lambda r: ZenohToRos(node, session, r, ns))  # fmt: skip
         # a service is bridged only where it exists: a queryable for a service nobody provides answers nothing
@@ -153,6 +153,10 @@ class ZenohBridge:
                 announced.add((keys.CL, res))
                 wanted[(keys.CL, res)] = lambda r=res: ZenohToService(node, session, r, ns)
         return wanted, announced
+
+    def _definition(self, res: Resource) -> str:
+        header = self.graph.publisher_headers.get(res.name, {})
+        return header.get("message_definition", "") if header.get("md5sum") == res.md5 else ""
 
     def _reconcile(self, wanted: dict[Key, Callable[[], Any]], announced: set[Key]) -> bool:
         changed = False

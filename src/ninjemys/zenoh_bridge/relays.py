@@ -68,11 +68,12 @@ def raw_service_class(datatype: str, md5: str) -> type:
 class RosToZenoh:
     """A local publisher's messages, put on Zenoh."""
 
-    def __init__(self, node: Node, session: Any, res: Resource, bridge_ns: str) -> None:
+    def __init__(self, node: Node, session: Any, res: Resource, bridge_ns: str, definition: str = "") -> None:
         self.node, self.res = node, res
         self.key = keys.data_key(res, bridge_ns)
         self._latched: bytes | None = None
-        self._definition = ""
+        #: from the probe's header, else from the first message's
+        self._definition = definition
         self._pub = session.declare_publisher(self.key)
         self._queryable = session.declare_queryable(self.key, self._on_query, complete=False)
         self._sub = node.subscriber(res.name, None, self._on_message, raw=True)
