@@ -8,6 +8,7 @@ does) and the next successful read rebuilds them: a restarted master or bridge h
 
 from __future__ import annotations
 
+import functools
 import logging
 import threading
 from collections.abc import Callable
@@ -133,7 +134,7 @@ class ZenohBridge:
                 if here:
                     announced.add((kind, res))
                 if (here and there) or (mode == AUTO and (here or there)):
-                    wanted[(kind, res)] = lambda r=res: make(r)
+                    wanted[(kind, res)] = functools.partial(make, res)
 
         consider(keys.PUB, "publisher", state.publishers, set(self.remote.snapshot(keys.SUB)),
                  lambda r: RosToZenoh(node, session, r, ns, self._definition(r)))  # fmt: skip
@@ -151,7 +152,7 @@ class ZenohBridge:
         for res in self.remote.snapshot(keys.SRV):
             if res.name not in local_services and o.mode_for("client", res.name) == AUTO:
                 announced.add((keys.CL, res))
-                wanted[(keys.CL, res)] = lambda r=res: ZenohToService(node, session, r, ns)
+                wanted[(keys.CL, res)] = functools.partial(ZenohToService, node, session, res, ns)
         return wanted, announced
 
     def _definition(self, res: Resource) -> str:

@@ -33,7 +33,7 @@ QUERY_TIMEOUT = 10.0
 DEFINITION_TIMEOUT = 1.0
 
 
-def raw_service_class(datatype: str, md5: str) -> type:
+def raw_service_class(datatype: str, md5: str) -> Any:
     """A service class whose request and response are the serialized bytes, both ways."""
 
     class RawPart:
