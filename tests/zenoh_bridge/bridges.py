@@ -50,10 +50,11 @@ SET_BOOL_SERVER = """
     from std_srvs.srv import SetBool, SetBoolResponse
     rospy.init_node("arm_server")
     def handle(req):
-        if req.data is None:
-            raise rospy.ServiceException("no data")
         return SetBoolResponse(success=req.data, message="armed" if req.data else "disarmed")
     rospy.Service("/arm", SetBool, handle)
+    def jammed(req):
+        raise rospy.ServiceException("arm jammed")
+    rospy.Service("/brake", SetBool, jammed)
     print("ready", flush=True)
     rospy.spin()
 """

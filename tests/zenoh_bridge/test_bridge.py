@@ -15,6 +15,7 @@ import pytest
 
 pytest.importorskip("zenoh", reason="eclipse-zenoh (the zenoh extra) is not installed")
 
+from ninjemys.errors import ServiceError  # noqa: E402
 from ninjemys.node import Node  # noqa: E402
 from ninjemys.testing import free_port, have_ros1, ninjemys_bin, run_master, wait_until  # noqa: E402
 from ninjemys.zenoh_bridge.discovery import LOST_AFTER  # noqa: E402
@@ -92,6 +93,10 @@ def test_service_call_across(bridges):
             proxy = node.service_proxy("/arm", SetBool)
             assert (proxy(True).success, proxy(True).message) == (True, "armed")
             assert proxy(False).message == "disarmed"
+            # the server's refusal comes back across as the caller's error, with its text
+            node.wait_for_service("/brake", timeout=30)
+            with pytest.raises(ServiceError, match="arm jammed"):
+                node.service_proxy("/brake", SetBool)(True)
         finally:
             node.shutdown()
 
