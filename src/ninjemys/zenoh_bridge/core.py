@@ -82,13 +82,18 @@ class ZenohBridge:
             raise
         self._ros_ok: bool | None = None
         self._announced: set[Key] = set()
+        self._refused: set[Key] = set()
+        self._step_lock = threading.Lock()
 
     # -- the loop -------------------------------------------------------------------------------
 
     def run(self) -> None:
         """Poll and reconcile until :meth:`close` is called."""
         while not self._stop.is_set():
-            changed = self.step()
+            with self._step_lock:
+                if self._stop.is_set():
+                    break
+                changed = self.step()
             interval = self.options.polling_interval / (2 if changed else 1)
             self._wake.wait(interval)
             self._wake.clear()
@@ -160,7 +165,10 @@ class ZenohBridge:
         return header.get("message_definition", "") if header.get("md5sum") == res.md5 else ""
 
     def _reconcile(self, wanted: dict[Key, Callable[[], Any]], announced: set[Key]) -> bool:
+        import zenoh
+
         changed = False
+        self._refused &= set(wanted)
         for key in list(self.bridges):
             if key not in wanted:
                 self._close_bridge(key)
@@ -171,9 +179,13 @@ class ZenohBridge:
             kind, res = key
             try:
                 self.bridges[key] = make()
-            except (OSError, NinjemysError) as exc:
-                self._status(f"cannot bridge {kind} {res.name} [{res.datatype}]: {exc}")
+            except (OSError, NinjemysError, zenoh.ZError) as exc:
+                # tried again each poll (the conflict may clear), said once
+                if key not in self._refused:
+                    self._refused.add(key)
+                    self._status(f"cannot bridge {kind} {res.name} [{res.datatype}]: {exc}")
                 continue
+            self._refused.discard(key)
             changed = True
             self._status(
                 f"bridged {kind} {res.name} [{res.datatype}] as {keys.data_key(res, self.options.bridge_namespace)}"
@@ -189,7 +201,7 @@ class ZenohBridge:
         bridge = self.bridges.pop(key)
         try:
             bridge.close()
-        except (OSError, NinjemysError) as exc:
+        except Exception as exc:  # a half-closed session or node: closing goes on with the rest
             _log.debug("closing %s: %s", key, exc)
         self._status(f"unbridged {key[0]} {key[1].name}")
 
@@ -197,6 +209,10 @@ class ZenohBridge:
         """Stop the loop, close the bridges, the node and the session."""
         self._stop.set()
         self._wake.set()
+        with self._step_lock:  # a poll under way finishes first: nothing opens on a closing session
+            self._teardown()
+
+    def _teardown(self) -> None:
         for key in list(self.bridges):
             self._close_bridge(key)
         self.beacons.close()
