@@ -90,7 +90,6 @@ class LocalGraph:
         self.own_name = own_name
         self._pub_cache: dict[tuple[str, str], dict[str, str]] = {}
         self._srv_cache: dict[tuple[str, str], dict[str, str]] = {}
-        self._node_uris: dict[str, str] = {}
         #: the last header seen from a publisher of each topic (definition, latching)
         self.publisher_headers: dict[str, dict[str, str]] = {}
 
@@ -109,6 +108,9 @@ class LocalGraph:
                     self.publisher_headers[topic] = header
         for stale in set(self._pub_cache) - live_pub_keys:
             del self._pub_cache[stale]
+        live_topics = {topic for topic, _ in live_pub_keys}
+        for topic in set(self.publisher_headers) - live_topics:
+            del self.publisher_headers[topic]
         for topic, nodes in subs:
             if not list(self._others(nodes)):
                 continue
@@ -118,12 +120,15 @@ class LocalGraph:
                 state.subscribers.add(Resource(topic, datatype, md5))
         live_srv = set()
         for service, nodes in srvs:
-            if not list(self._others(nodes)):
+            provider = next(iter(self._others(nodes)), None)
+            if provider is None:
                 continue
-            header = self._service_header(service)
+            live_srv.add((service, provider))
+            header = self._service_header(service, provider)
             if header is not None:
-                live_srv.add(service)
                 state.services.add(Resource(service, header.get("type", ""), header.get("md5sum", "")))
+        for stale in [k for k in self._srv_cache if k not in live_srv]:
+            del self._srv_cache[stale]
         return state
 
     def _others(self, nodes: Iterable[str]) -> Iterable[str]:
@@ -142,27 +147,18 @@ class LocalGraph:
         self._pub_cache[(topic, node)] = header
         return header
 
-    def _service_header(self, service: str) -> dict[str, str] | None:
-        try:
-            uri = self.master.lookup_service(service)
-        except (OSError, NinjemysError):
-            return None
-        cached = self._srv_cache.get((service, uri))
+    def _service_header(self, service: str, node: str) -> dict[str, str] | None:
+        """Probed once per (service, provider node): a poll costs no master call per service."""
+        cached = self._srv_cache.get((service, node))
         if cached is not None:
             return cached
         try:
+            uri = self.master.lookup_service(service)
             header = probe_service(service, uri, timeout=PROBE_TIMEOUT, caller_id=self.own_name)
         except (OSError, NinjemysError) as exc:
             _log.info("cannot learn the type of service %s: %s", service, exc)
             return None
         if "error" in header:
             return None
-        self._srv_cache[(service, uri)] = header
+        self._srv_cache[(service, node)] = header
         return header
-
-    def is_local_service(self, service: str) -> str | None:
-        """The URI of ``service`` if some node on this master provides it, else None."""
-        try:
-            return self.master.lookup_service(service)
-        except (OSError, NinjemysError):
-            return None
