@@ -24,7 +24,7 @@ from ninjemys.errors import NinjemysError, ServiceError
 from ninjemys.node import Node
 from ninjemys.zenoh_bridge import keys
 from ninjemys.zenoh_bridge.keys import Resource
-from ninjemys.zenoh_bridge.rosside import local_definition
+from ninjemys.zenoh_bridge.rosside import local_definition, local_md5
 
 _log = logging.getLogger("ninjemys.zenoh_bridge")
 
@@ -118,7 +118,9 @@ class ZenohToRos:
 
         self.node, self.res, self.session = node, res, session
         self.key = keys.data_key(res, bridge_ns)
-        definition = local_definition(res.datatype) or self._remote_definition() or "*"
+        # the local definition only when it is the same message (md5); else the remote publisher's
+        local = local_definition(res.datatype) if local_md5(res.datatype) == res.md5 else None
+        definition = local or self._remote_definition() or "*"
         self._cls = stand_in_class(res.datatype, res.md5, definition)
         self._queue_size = queue_size
         self._live = node.publisher(res.name, self._cls, queue_size=queue_size)
