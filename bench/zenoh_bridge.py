@@ -13,6 +13,7 @@ from __future__ import annotations
 import contextlib
 import os
 import statistics
+import subprocess
 import sys
 import threading
 import time
@@ -78,31 +79,63 @@ def round_trips(uri_ping: str, uri_pong: str, count: int) -> list[float]:
         pong.shutdown()
 
 
+SINK = """
+import sys, threading, time
+from ninjemys.node import Node
+node = Node("sink", master_uri=sys.argv[1], rosout=False)
+count, first = [0], threading.Event()
+def got(raw):
+    count[0] += 1
+    first.set()
+node.subscriber(sys.argv[2], None, got, raw=True)
+print("ready", flush=True)
+first.wait()
+print("first", flush=True)
+sys.stdin.readline()  # the source starts its timed run: count from here
+start = count[0]
+sys.stdin.readline()  # the source is done
+print("count", count[0] - start, flush=True)
+node.shutdown()
+"""
+
+
 def throughput(uri_pub: str, uri_sub: str, type_name: str, payload: bytes, topic: str) -> tuple[float, float]:
-    """(messages/s, MB/s) arriving at the far subscriber while the publisher sends flat out."""
+    """(messages/s, MB/s) arriving at the far subscriber (its own process) while the publisher sends
+    flat out: source and sink never share an interpreter, direct or bridged."""
     from ninjemys.idl.loader import get_message_class
 
     cls = get_message_class(type_name)
-    sub = Node("sink", master_uri=uri_sub, rosout=False)
+    sink = subprocess.Popen(
+        [sys.executable, "-c", SINK, uri_sub, topic], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True
+    )
+    assert sink.stdin is not None and sink.stdout is not None
     pub = Node("source", master_uri=uri_pub, rosout=False)
     try:
-        count = [0]
-        sub.subscriber(topic, None, lambda raw: count.__setitem__(0, count[0] + 1), raw=True)
+        assert sink.stdout.readline().strip() == "ready"
         out = pub.publisher(topic, cls, queue_size=200)
+        first = threading.Event()
+        threading.Thread(target=lambda: (sink.stdout.readline(), first.set()), daemon=True).start()
         wait_until(
-            lambda: out.publish_raw(payload) or count[0] > 0, timeout=60, what="the first message", step=0.1
+            lambda: out.publish_raw(payload) or first.is_set(), timeout=60, what="the first message", step=0.1
         )
-        start_count, t0 = count[0], time.perf_counter()
+        sink.stdin.write("go\n")
+        sink.stdin.flush()
+        t0 = time.perf_counter()
         while time.perf_counter() - t0 < SECONDS:
             out.publish_raw(payload)
             if len(payload) > 100_000:
                 time.sleep(0.001)  # images: let the queue drain rather than measure drops
         time.sleep(0.3)
-        rate = (count[0] - start_count) / (time.perf_counter() - t0)
+        elapsed = time.perf_counter() - t0
+        sink.stdin.write("done\n")
+        sink.stdin.flush()
+        line = sink.stdout.readline().split()
+        rate = int(line[1]) / elapsed
         return rate, rate * len(payload) / 1e6
     finally:
         pub.shutdown()
-        sub.shutdown()
+        sink.kill()
+        sink.wait()
 
 
 def main() -> None:
