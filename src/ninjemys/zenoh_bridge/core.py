@@ -205,10 +205,14 @@ class ZenohBridge:
             _log.debug("closing %s: %s", key, exc)
         self._status(f"unbridged {key[0]} {key[1].name}")
 
-    def close(self) -> None:
-        """Stop the loop, close the bridges, the node and the session."""
+    def stop(self) -> None:
+        """Make :meth:`run` return after the poll under way (safe from a signal handler)."""
         self._stop.set()
         self._wake.set()
+
+    def close(self) -> None:
+        """Stop the loop, close the bridges, the node and the session."""
+        self.stop()
         with self._step_lock:  # a poll under way finishes first: nothing opens on a closing session
             self._teardown()
 

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import signal
 import sys
-import threading
 from collections.abc import Sequence
 
 from ninjemys.commands import entry
@@ -39,7 +38,14 @@ def main(argv: Sequence[str] | None = None) -> int:
 
         host, port = split_uri(options.ros_master_uri)
         master = MasterThread("0.0.0.0", port, advertise=host)
-        master.start()
+        try:
+            master.start()
+        except OSError as exc:
+            print(
+                f"zenoh-bridge-ros1: error: --with_rosmaster: cannot serve on port {port}: {exc}",
+                file=sys.stderr,
+            )
+            return 1
     from ninjemys.zenoh_bridge.core import ZenohBridge
 
     def status(line: str) -> None:
@@ -50,12 +56,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except NinjemysError as exc:
         print(f"zenoh-bridge-ros1: error: {exc}", file=sys.stderr)
         return 1
-    stop = threading.Event()
 
     def on_signal(signum: int, frame: object) -> None:
-        stop.set()
-        bridge._stop.set()
-        bridge._wake.set()
+        bridge.stop()
 
     signal.signal(signal.SIGINT, on_signal)
     signal.signal(signal.SIGTERM, on_signal)
