@@ -17,7 +17,16 @@ pytest.importorskip("zenoh", reason="eclipse-zenoh (the zenoh extra) is not inst
 
 from ninjemys.errors import ServiceError  # noqa: E402
 from ninjemys.node import Node  # noqa: E402
-from ninjemys.testing import free_port, have_ros1, ninjemys_bin, run_master, wait_until  # noqa: E402
+from ninjemys.testing import (  # noqa: E402
+    NodeProcess,
+    free_port,
+    have_ros1,
+    ninjemys_bin,
+    ros1_env,
+    run_master,
+    run_real_roscore,
+    wait_until,
+)
 from ninjemys.zenoh_bridge.discovery import LOST_AFTER  # noqa: E402
 
 from .bridges import SET_BOOL_SERVER, TALKER, bridged, rospy, start_bridge  # noqa: E402
@@ -201,3 +210,24 @@ def test_unknown_type_relayed_raw_with_its_definition(bridges):
     finally:
         node.shutdown()
         talker.shutdown()
+
+
+@pytest.mark.ros1
+@needs_ros1
+def test_real_roscores_and_real_tools_on_both_sides(tmp_path):
+    """Nothing of ours but the bridges: Debian's roscore twice, rostopic pub on one, rostopic echo on the other."""
+    port = free_port()
+    with (
+        run_real_roscore(tmp_path / "a") as uri_a,
+        run_real_roscore(tmp_path / "b") as uri_b,
+        start_bridge(uri_a, "-l", f"tcp/127.0.0.1:{port}"),
+        start_bridge(uri_b, "-e", f"tcp/127.0.0.1:{port}"),
+        NodeProcess(["/usr/bin/rostopic", "pub", "-r", "10", "/chatter", "std_msgs/String", "data: real"],
+                    env=ros1_env(uri_a)),
+    ):  # fmt: skip
+        echo = subprocess.run(
+            ["/usr/bin/rostopic", "echo", "-n", "1", "/chatter"],
+            env=ros1_env(uri_b), capture_output=True, text=True, timeout=60,
+        )  # fmt: skip
+        assert echo.returncode == 0, echo.stderr
+        assert 'data: "real"' in echo.stdout
