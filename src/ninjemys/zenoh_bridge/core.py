@@ -104,11 +104,11 @@ class ZenohBridge:
         try:
             state = self.graph.read()
         except (OSError, NinjemysError) as exc:
+            changed = bool(self.bridges)
+            self._reconcile({}, set())
             if self._ros_ok is not False:
                 self._status(f"ROS master {self.options.ros_master_uri} unreachable: {exc}; bridges closed")
             self._ros_ok = False
-            changed = bool(self.bridges)
-            self._reconcile({}, set())
             return changed
         if self._ros_ok is not True:
             self._status(f"ROS master {self.options.ros_master_uri} reached")
