@@ -439,22 +439,27 @@ class SimNode:
         )
 
     def _camera(self, io: RobotIO, stamp: Time) -> None:
+        """Render and publish the camera's images, each only when someone reads it (camera_info
+        alone needs no image at all)."""
         r = io.robot
         spec = r.model.camera
         if spec is None or r.camera is None:
             return
-        rgb, depth = self.sim.render(r)
         pubs = io.pubs
         frame = io.frame(spec.frame)
         depth_frame = io.frame(spec.depth_frame)
         want_raw = pubs["image"].get_num_connections()
-        if want_raw or pubs["image_compressed"].get_num_connections():
-            img = messages.rgb_image(stamp, frame, rgb)
-            if want_raw:
-                pubs["image"].publish(img)
-            pubs["image_compressed"].publish(img)
-        if "depth" in pubs and pubs["depth"].get_num_connections():
-            pubs["depth"].publish(messages.depth_image(stamp, depth_frame, depth))
+        want_colour = bool(want_raw or pubs["image_compressed"].get_num_connections())
+        want_depth = bool("depth" in pubs and pubs["depth"].get_num_connections())
+        if want_colour or want_depth:
+            rgb, depth = self.sim.render(r, colour=want_colour, depth=want_depth)
+            if want_colour:
+                img = messages.rgb_image(stamp, frame, rgb)
+                if want_raw:
+                    pubs["image"].publish(img)
+                pubs["image_compressed"].publish(img)
+            if want_depth:
+                pubs["depth"].publish(messages.depth_image(stamp, depth_frame, depth))
         intrinsics = r.camera.intrinsics()
         for key, frame_id in (("color_info", frame), ("depth_info", depth_frame)):
             if key in pubs and pubs[key].get_num_connections():

@@ -23,7 +23,12 @@ import numpy as np
 
 
 def cast_segments(
-    ox: float, oy: float, angles: np.ndarray, segments: np.ndarray, max_range: float
+    ox: float,
+    oy: float,
+    angles: np.ndarray,
+    segments: np.ndarray,
+    max_range: float,
+    facing: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Distance to the first segment along each ray (inf if none within ``max_range``) and its index (-1).
 
@@ -31,7 +36,7 @@ def cast_segments(
     :func:`segment_pairs`; the nearest per ray wins (on an exact tie, the pair listed last).
     """
     n = len(angles)
-    ray_of, seg_of, t = segment_pairs(ox, oy, angles, segments, max_range)
+    ray_of, seg_of, t = segment_pairs(ox, oy, angles, segments, max_range, facing)
     return nearest_hits(n, ray_of, seg_of, t)
 
 
@@ -52,7 +57,12 @@ def nearest_hits(
 
 
 def segment_pairs(
-    ox: float, oy: float, angles: np.ndarray, segments: np.ndarray, max_range: float
+    ox: float,
+    oy: float,
+    angles: np.ndarray,
+    segments: np.ndarray,
+    max_range: float,
+    facing: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Every (ray, segment) pair that can meet, and where: ``(ray_of, seg_of, t)`` with ``t`` the
     distance along the ray to the segment, ``inf`` where they do not meet within ``max_range``.
@@ -63,6 +73,11 @@ def segment_pairs(
     ``arctan2``, all span ends in two ``searchsorted``): at a few hundred segments the cost is the
     number of numpy calls. The lidar takes the nearest pair per ray (:func:`nearest_hits`); the
     camera also looks behind it for taller obstacles, from the same pairs.
+
+    ``facing`` (per segment: +1 or -1 for a side of a convex outline going counter-clockwise or
+    clockwise, 0 otherwise) leaves out the sides whose outer face looks away from the origin: a
+    ray enters a convex outline through a side facing it, so those never give a first crossing,
+    into that obstacle or into a taller one behind it (about half of a box's or a cylinder's sides).
     """
     angles = np.asarray(angles, dtype=np.float64)
     n = len(angles)
@@ -76,6 +91,10 @@ def segment_pairs(
     # broad phase: a segment whose middle is farther than max_range plus half its length cannot be
     # hit within range (a superset of the segments that come within range: same answers)
     near = np.hypot(px + qx, py + qy) - np.hypot(ex, ey) <= 2.0 * max_range + 1e-9
+    if facing is not None:
+        # the origin on a side's outer side: (origin - p) . outward normal >= 0, the outward normal
+        # being (ey, -ex) for a counter-clockwise outline and its opposite for a clockwise one
+        near &= facing * (py * ex - px * ey) >= 0
     if not near.all():
         keep = np.flatnonzero(near)
         if not len(keep):

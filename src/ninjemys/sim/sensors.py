@@ -16,6 +16,9 @@ import numpy as np
 
 from ninjemys.sim.raycast import cast_circles, cast_segments, circle_pairs, nearest_hits, segment_pairs
 
+#: what :meth:`Camera.render` returns for an image it was asked not to draw
+_EMPTY_RGB = np.zeros((0, 0, 3), dtype=np.uint8)
+_EMPTY_DEPTH = np.zeros((0, 0), dtype=np.uint16)
 FLOOR_RGB = np.array([176, 170, 160], dtype=np.float32)
 SKY_RGB = np.array([206, 220, 235], dtype=np.float32)
 
@@ -32,6 +35,9 @@ class Scene:
     circle_heights: np.ndarray  # (M,)
     circle_colors: np.ndarray  # (M, 3) uint8
     floor: FloorPaint | None = None  # markings painted on the floor
+    #: per segment: +1/-1 when it is a side of a convex outline going counter-/clockwise, 0 otherwise
+    #: (None: unknown, every side is cast); casts skip the sides facing away (see Obstacle.facing)
+    facing: np.ndarray | None = None
 
 
 @dataclass
@@ -65,9 +71,11 @@ def lidar_ranges(
     """
     angles = yaw + angle_min + increment * np.arange(beams)
     tall = scene.heights >= z
-    dist, _ = cast_segments(
-        x, y, angles, scene.segments[tall] if not tall.all() else scene.segments, range_max
-    )
+    segments, facing = scene.segments, scene.facing
+    if not tall.all():
+        segments = segments[tall]
+        facing = facing[tall] if facing is not None else None
+    dist, _ = cast_segments(x, y, angles, segments, range_max, facing)
     if len(scene.circles):
         tall_c = scene.circle_heights >= z
         cd, _ = cast_circles(x, y, angles, scene.circles[tall_c], scene.radii[tall_c], range_max)
@@ -90,7 +98,7 @@ class _Crossings:
     :func:`cast_segments` picks."""
 
     def __init__(self, scene: Scene, x: float, y: float, angles: np.ndarray, far: float) -> None:
-        ray_s, seg_s, t_s = segment_pairs(x, y, angles, scene.segments, far)
+        ray_s, seg_s, t_s = segment_pairs(x, y, angles, scene.segments, far, scene.facing)
         self.heights = scene.heights
         self.colors = scene.colors
         if len(scene.circles):
@@ -153,7 +161,15 @@ class Camera:
         self._below3 = np.empty((height, 3 * width), dtype=bool)
         self._lanes1 = _padded_empty((height, width), np.uint16)
 
-    def render(self, scene: Scene, x: float, y: float, yaw: float) -> tuple[np.ndarray, np.ndarray]:
+    def render(
+        self,
+        scene: Scene,
+        x: float,
+        y: float,
+        yaw: float,
+        colour: bool = True,
+        depth: bool = True,
+    ) -> tuple[np.ndarray, np.ndarray]:
         """(rgb8 image (H, W, 3), depth in mm uint16 (H, W)) from a camera at (x, y, cam_z) facing ``yaw``.
 
         Each column shows the nearest obstacle its rays meet between floor and top, and above that
@@ -162,31 +178,46 @@ class Camera:
         and a farther layer shows only above the nearer layers' tops. All layers come from one ray
         cast: every (column, obstacle) crossing is computed once, the first layer is the nearest
         crossing per column, each further layer the nearest crossing of a taller class.
+
+        ``colour=False`` or ``depth=False`` leaves that image out (an empty array in its place):
+        a camera whose depth stream nobody reads (or that has none) does not draw it.
         """
+        return self._render(scene, x, y, yaw, colour, depth)
+
+    def _render(
+        self, scene: Scene, x: float, y: float, yaw: float, want_rgb: bool, want_depth: bool
+    ) -> tuple[np.ndarray, np.ndarray]:
         angles = yaw + self.col_angles
         far = self.depth_max / float(self.col_cos.min())
         hits = _Crossings(scene, x, y, angles, far)
         dist, item = nearest_hits(self.width, hits.ray_of, hits.item_of, hits.t)
-        found, depth, top, bottom, colors, heights = self._layer(hits, dist, item, None)
+        found, depth, top, bottom, colors, _heights = self._layer(hits, dist, item, None)
         rows = self._rows
-        wall = rows >= top
-        wall &= rows < bottom
-        light = np.clip(1.1 - depth / 15.0, 0.45, 1.0)  # flat shading, darker with distance
-        col = (colors * light[:, None]).astype(np.uint8).reshape(1, 3 * self.width)
-        # the image as (H, 3W) bytes, each pixel's mask repeated over its three channels: selecting
-        # bytes is cheaper than any interleaving of channels or a select over 3-byte elements
+        paint = scene.floor is not None and want_rgb
         wall3 = self._lanes3.view(bool)
-        np.greater_equal(rows, np.repeat(top, 3), out=wall3)
-        np.less(rows, np.repeat(bottom, 3), out=self._below3)
-        wall3 &= self._below3
-        rgb = _select(self._lanes3, col, self._background).reshape(self.height, self.width, 3)
-        wall_mm = np.rint(np.where(found, depth, 0.0) * 1000.0).astype(np.uint16)
-        np.copyto(self._lanes1, wall)
-        depth_mm = _select(self._lanes1, wall_mm[None, :], self._floor_depth_image)
+        if want_rgb or want_depth:
+            # the image as (H, 3W) bytes, each pixel's mask repeated over its three channels: selecting
+            # bytes is cheaper than any interleaving of channels or a select over 3-byte elements
+            np.greater_equal(rows, np.repeat(top, 3), out=wall3)
+            np.less(rows, np.repeat(bottom, 3), out=self._below3)
+            wall3 &= self._below3
+        # the wall mask per pixel (the floor markings are painted elsewhere): every third lane
+        wall = wall3.reshape(self.height, self.width, 3)[:, :, 0].copy() if paint else None
+        depth_mm = _EMPTY_DEPTH
+        if want_depth:
+            wall_mm = np.rint(np.where(found, depth, 0.0) * 1000.0).astype(np.uint16)
+            np.copyto(self._lanes1, wall3.reshape(self.height, self.width, 3)[:, :, 0])
+            depth_mm = _select(self._lanes1, wall_mm[None, :], self._floor_depth_image)
+        rgb = _EMPTY_RGB
+        if want_rgb:
+            light = np.clip(1.1 - depth / 15.0, 0.45, 1.0)  # flat shading, darker with distance
+            col = (colors * light[:, None]).astype(np.uint8).reshape(1, 3 * self.width)
+            rgb = _select(self._lanes3, col, self._background).reshape(self.height, self.width, 3)
         thresholds = layer_thresholds(scene, self.cam_z)
-        if thresholds:
+        if thresholds and (want_rgb or want_depth):
             self._farther_layers(hits, thresholds, found, item, top, rgb, depth_mm, wall)
-        if scene.floor is not None:
+        if paint:
+            assert scene.floor is not None and wall is not None
             self._paint_floor(rgb, wall, scene.floor, x, y, yaw)
         return rgb, depth_mm
 
@@ -199,7 +230,7 @@ class Camera:
         top: np.ndarray,
         rgb: np.ndarray,
         depth_mm: np.ndarray,
-        wall: np.ndarray,
+        wall: np.ndarray | None,
     ) -> None:
         """Draw, above the first layer, the farther obstacles of taller classes.
 
@@ -240,15 +271,18 @@ class Camera:
                 mask = (band >= top_v[None, :]) & (band < bottom_v[None, :])  # (rows of the band, visible cols)
                 depth_v = depth_c[visible]
                 light_v = np.clip(1.1 - depth_v / 15.0, 0.45, 1.0)
-                colour_v = (colors_c[visible] * light_v[:, None]).astype(np.uint8)
-                sub = rgb[r0:r1, vis]
-                np.copyto(sub, np.broadcast_to(colour_v[None, :, :], sub.shape), where=mask[:, :, None])
-                rgb[r0:r1, vis] = sub
-                mm_v = np.rint(depth_v * 1000.0).astype(np.uint16)
-                dsub = depth_mm[r0:r1, vis]
-                np.copyto(dsub, np.broadcast_to(mm_v[None, :], dsub.shape), where=mask)
-                depth_mm[r0:r1, vis] = dsub
-                wall[r0:r1, vis] |= mask
+                if rgb.size:
+                    colour_v = (colors_c[visible] * light_v[:, None]).astype(np.uint8)
+                    sub = rgb[r0:r1, vis]
+                    np.copyto(sub, np.broadcast_to(colour_v[None, :, :], sub.shape), where=mask[:, :, None])
+                    rgb[r0:r1, vis] = sub
+                if depth_mm.size:
+                    mm_v = np.rint(depth_v * 1000.0).astype(np.uint16)
+                    dsub = depth_mm[r0:r1, vis]
+                    np.copyto(dsub, np.broadcast_to(mm_v[None, :], dsub.shape), where=mask)
+                    depth_mm[r0:r1, vis] = dsub
+                if wall is not None:
+                    wall[r0:r1, vis] |= mask
             cut[cols] = np.minimum(cut[cols], top_c)
             more = np.flatnonzero(pair_level > reached[ray_of])
             ray_of, item_of, t, pair_level = ray_of[more], item_of[more], t[more], pair_level[more]

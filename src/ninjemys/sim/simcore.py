@@ -150,17 +150,20 @@ class Simulation:
         w = self.world
         w.rebuild()
         segs, heights, colours = [w.segments], [w.seg_height], [w.seg_color]
+        facing = [w.seg_facing]
         names = [w.obstacles[i].name for i in w.seg_owner]
         if w.grid is not None:
             g = w.grid
             edges = grid_edges(g.occupied, g.resolution, g.origin_x, g.origin_y)
             segs.append(edges)
+            facing.append(np.zeros(len(edges), dtype=np.int8))
             heights.append(np.full(len(edges), g.height))
             colours.append(np.tile(np.array(g.color, dtype=np.uint8), (len(edges), 1)))
             names += ["map"] * len(edges)
         self._static = np.vstack(segs) if any(len(s) for s in segs) else np.zeros((0, 4))
         self._static_height = np.concatenate(heights)
         self._static_color = np.vstack(colours).astype(np.uint8)
+        self._static_facing = np.concatenate(facing).astype(np.int8)
         self.static_names = names
         for r in self.robots.values():
             r.free = None  # the static world changed
@@ -246,6 +249,12 @@ class Simulation:
         segs = np.vstack([self._static, ms]) if len(ms) else self._static
         heights = np.concatenate([self._static_height, mh]) if len(ms) else self._static_height
         colours = np.vstack([self._static_color, mc]) if len(ms) else self._static_color
+        # a moving obstacle may walk over a robot (the camera inside it sees its inside): both sides
+        facing = (
+            np.concatenate([self._static_facing, np.zeros(len(ms), dtype=np.int8)])
+            if len(ms)
+            else self._static_facing
+        )
         others = [r for r in self.robots.values() if r.name != exclude]
         return Scene(
             segs,
@@ -256,6 +265,7 @@ class Simulation:
             np.array([r.model.body_height for r in others]),
             np.array([r.model.color for r in others], dtype=np.uint8).reshape(-1, 3),
             self._floor,
+            facing,
         )
 
     def clearance(self, x: float, y: float, exclude: str | None = None) -> tuple[float, str]:
@@ -689,11 +699,16 @@ class Simulation:
             r.rng,
         )
 
-    def render(self, r: Robot, scene: Scene | None = None) -> tuple[np.ndarray, np.ndarray]:
+    def render(
+        self, r: Robot, scene: Scene | None = None, colour: bool = True, depth: bool = True
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """``r``'s camera images (colour, depth); one not wanted is left empty (see Camera.render)."""
         spec = r.model.camera
         assert spec is not None and r.camera is not None
         cx, cy = self.sensor_pose(r, spec.pose.xyz)
-        return r.camera.render(scene or self.scene(r.name), cx, cy, r.yaw + spec.pose.rpy[2])
+        return r.camera.render(
+            scene or self.scene(r.name), cx, cy, r.yaw + spec.pose.rpy[2], colour=colour, depth=depth
+        )
 
     def imu(self, r: Robot) -> tuple[float, float, float, float]:
         spec = r.model.imu
