@@ -336,7 +336,8 @@ class SimNode:
         self.log.error("simulation step failed: %s: %s", type(exc).__name__, exc)
 
     def _stamp(self) -> Time:
-        return messages.stamp_of(self.sim.steps, self.sim.dt)
+        ns = self.sim.time_ns
+        return Time(ns // 1_000_000_000, ns % 1_000_000_000)
 
     def _step_and_publish(self) -> None:
         sim = self.sim

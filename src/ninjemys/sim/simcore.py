@@ -28,6 +28,9 @@ from ninjemys.sim.world2d import MovingObstacle, Obstacle, World, box_outline, c
 TRAIL_LENGTH = 2000
 PERSONAL_SPACE = 0.2  # m: the gap a person who gives way keeps from a robot's body
 LOOK_AHEAD = 2.0  # m: how far ahead on its route such a person starts to step aside
+#: the longest physics step set_physics_properties accepts (s): the collision check splits a move
+#: into short pieces, but sensors fire at most once a step, so a longer one would slow a 10 Hz lidar
+MAX_TIME_STEP = 0.1
 
 
 class SpawnError(NinjemysError, ValueError):
@@ -129,6 +132,8 @@ class Simulation:
         self.dt = dt
         self.seed = seed
         self.steps = 0
+        # the step may change (Gazebo's set_physics_properties): time counts whole steps since then
+        self._since = (0, 0)  # (steps, nanoseconds) when the current step began
         self.world_time = 0.0  # moving obstacles' clock (reset_world restarts it, time goes on)
         self.robots: dict[str, Robot] = {}
         self.obstacle_yaw: dict[str, float] = {}  # yaw of spawned or moved obstacles (outlines have none)
@@ -143,7 +148,24 @@ class Simulation:
     @property
     def time(self) -> float:
         """Simulated seconds: a whole number of steps, so stamps never drift."""
-        return self.steps * self.dt
+        steps0, ns0 = self._since
+        if not ns0:
+            return self.steps * self.dt
+        return ns0 / 1e9 + (self.steps - steps0) * self.dt
+
+    @property
+    def time_ns(self) -> int:
+        """Simulated time in whole nanoseconds (message stamps), exact over any number of steps."""
+        steps0, ns0 = self._since
+        return ns0 + round((self.steps - steps0) * self.dt * 1e9)
+
+    def set_time_step(self, dt: float) -> None:
+        """Step ``dt`` seconds from now on (Gazebo's ``set_physics_properties`` time_step); time
+        goes on from where it is. Refused (SpawnError) unless 0 < dt <= MAX_TIME_STEP."""
+        if not (math.isfinite(dt) and 0.0 < dt <= MAX_TIME_STEP):
+            raise SpawnError(f"time_step {dt} must be in (0, {MAX_TIME_STEP:g}] s")
+        self._since = (self.steps, self.time_ns)
+        self.dt = dt
 
     # -- geometry -------------------------------------------------------------------------------
     def _rebuild_static(self) -> None:
@@ -502,6 +524,7 @@ class Simulation:
         """reset_world, and simulated time back to 0 (Gazebo's reset_simulation)."""
         self.reset_world()
         self.steps = 0
+        self._since = (0, 0)
 
     def step(self) -> list[Robot]:
         """Advance one physics step; returns the robots that came into contact during it."""
