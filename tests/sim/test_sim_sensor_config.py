@@ -120,3 +120,54 @@ def test_a_model_without_a_drive_is_passive_and_says_so(master: str, client: Nod
         sim.stop()
     finally:
         node.shutdown("test over")
+
+
+WHEEL_TF_URDF = """<robot name="wheelie">
+  <link name="base_link"><collision><geometry><cylinder radius="0.1" length="0.1"/></geometry></collision></link>
+  <link name="left_wheel"><collision><geometry><cylinder radius="0.05" length="0.02"/></geometry></collision></link>
+  <link name="right_wheel"><collision><geometry><cylinder radius="0.05" length="0.02"/></geometry></collision></link>
+  <joint name="left_joint" type="continuous"><parent link="base_link"/><child link="left_wheel"/>
+    <origin xyz="0 0.09 0.05" rpy="-1.5707963267948966 0 0"/><axis xyz="0 0 1"/></joint>
+  <joint name="right_joint" type="continuous"><parent link="base_link"/><child link="right_wheel"/>
+    <origin xyz="0 -0.09 0.05" rpy="-1.5707963267948966 0 0"/><axis xyz="0 0 1"/></joint>
+  <gazebo><plugin name="drive" filename="libgazebo_ros_diff_drive.so">
+    <leftJoint>left_joint</leftJoint><rightJoint>right_joint</rightJoint>
+    <wheelSeparation>0.18</wheelSeparation><wheelDiameter>0.1</wheelDiameter>
+    <robotBaseFrame>base_link</robotBaseFrame><publishWheelTF>{wheel_tf}</publishWheelTF>
+    <updateRate>50</updateRate>
+  </plugin></gazebo>
+</robot>"""
+
+
+@pytest.mark.parametrize("wheel_tf", [True, False])
+def test_publish_wheel_tf_puts_the_turning_wheels_on_tf(master: str, client: Node, wheel_tf: bool) -> None:
+    """gazebo_ros_diff_drive's publishWheelTF: base_link -> each wheel link on /tf, at the joint's
+    origin and turned about its axis by the wheel's angle (the angle joint_states reports)."""
+    node = Node("wheel_tf_sim", master_uri=master)
+    log = NodeLog(node.name)
+    try:
+        sim = SimNode(node, log, Simulation(World("empty")), 2.0, None)
+        model = load_robot_model(WHEEL_TF_URDF.format(wheel_tf=str(wheel_tf).lower()))
+        assert [j.name for j in model.wheel_tf_joints] == (["left_joint", "right_joint"] if wheel_tf else [])
+        io = sim.add_robot("wheelie", model, 0.0, 0.0, 0.0, False)
+        io.robot.command(0.2, 0.0)
+        sim.start()
+        msgs = collect(client, "/tf", TFMessage, 1.5)
+        sim.stop()
+        wheels = [t for m in msgs for t in m.transforms if t.child_frame_id in ("left_wheel", "right_wheel")]
+        assert any(t.child_frame_id == "base_link" for m in msgs for t in m.transforms)  # odom -> base
+        if not wheel_tf:
+            assert not wheels
+            return
+        assert {t.child_frame_id for t in wheels} == {"left_wheel", "right_wheel"}
+        assert {t.header.frame_id for t in wheels} == {"base_link"}
+        last = [t for t in wheels if t.child_frame_id == "left_wheel"][-1]
+        tr, q = last.transform.translation, last.transform.rotation
+        assert (tr.x, tr.y, tr.z) == pytest.approx((0.0, 0.09, 0.05))
+        # roll(-pi/2) then the joint angle about the joint's z: qz / qw gives the angle back
+        angle = 2.0 * math.atan2(q.z, q.w)  # (modulo a turn)
+        assert abs(angle) > 0.01  # the wheel turned
+        expected = model.wheel_tf_joints[0].transform(angle)
+        assert (q.x, q.y, q.z, q.w) == pytest.approx(expected[3:], abs=1e-9)
+    finally:
+        node.shutdown("test over")

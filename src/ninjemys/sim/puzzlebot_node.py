@@ -431,13 +431,22 @@ class SimNode:
                     [r.wl, r.wr],
                 )
             )
-        if tfs is None or not driven or not drive.publish_odom_tf:
+        if tfs is None or not driven:
             return
-        tfs.append(
-            messages.transform(
-                stamp, odom_frame, base_frame, (pose[0], pose[1], 0.0), quaternion_from_yaw(pose[2])
+        if drive.publish_odom_tf:
+            tfs.append(
+                messages.transform(
+                    stamp, odom_frame, base_frame, (pose[0], pose[1], 0.0), quaternion_from_yaw(pose[2])
+                )
             )
-        )
+        # gazebo_ros_diff_drive's publishWheelTF: each wheel link in its parent's frame, turned by its angle
+        for joint, angle in zip(r.model.wheel_tf_joints, (r.left_angle, r.right_angle), strict=False):
+            x, y, z, qx, qy, qz, qw = joint.transform(angle)
+            tfs.append(
+                messages.transform(
+                    stamp, io.frame(joint.parent), io.frame(joint.child), (x, y, z), (qx, qy, qz, qw)
+                )
+            )
 
     def _camera(self, io: RobotIO, stamp: Time) -> None:
         """Render and publish the camera's images, each only when someone reads it (camera_info

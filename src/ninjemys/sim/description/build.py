@@ -86,6 +86,11 @@ def model_from_description(text: str, source: str, *, robot_namespace: str | Non
         warnings=warnings,
         sensor_tf=False,
         control_joints=_control_joints(doc, geo, left, right) if drive.kind == "ros_control" else {},
+        wheel_tf_joints=(
+            [geo.joints[w.joint] for w in (left, right) if w.joint in geo.joints]
+            if drive.publish_wheel_tf and left is not right
+            else []
+        ),
     )
 
 
