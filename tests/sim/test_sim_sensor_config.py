@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 from gazebo_helpers import Launched
 
-from ninjemys.idl.loader import get_message_class
+from ninjemys.idl.loader import get_message_class, get_service_class
 from ninjemys.node import Node
 from ninjemys.node.log import NodeLog
 from ninjemys.packages.shipped import shipped_executable
@@ -169,5 +169,48 @@ def test_publish_wheel_tf_puts_the_turning_wheels_on_tf(master: str, client: Nod
         assert abs(angle) > 0.01  # the wheel turned
         expected = model.wheel_tf_joints[0].transform(angle)
         assert (q.x, q.y, q.z, q.w) == pytest.approx(expected[3:], abs=1e-9)
+    finally:
+        node.shutdown("test over")
+
+
+def test_a_push_moves_a_heavier_urdf_body_less(master: str) -> None:
+    """apply_body_wrench pushes with the body's mass from the URDF's <inertial>s (the links fixed
+    to the base: 2 kg + 2 kg here), where a description without any counts as 1 kg."""
+    heavy = (
+        WHEEL_TF_URDF.format(wheel_tf="false")
+        .replace(
+            '<link name="base_link">',
+            '<link name="base_link"><inertial><mass value="2.0"/><inertia ixx="0.01" iyy="0.01" izz="0.02"'
+            ' ixy="0" ixz="0" iyz="0"/></inertial>',
+        )
+        .replace(
+            "</robot>",
+            '<link name="deck"><inertial><origin xyz="0.1 0 0"/><mass value="2.0"/></inertial></link>'
+            '<joint name="deck_joint" type="fixed"><parent link="base_link"/><child link="deck"/></joint></robot>',
+        )
+    )
+    model = load_robot_model(heavy, robot_namespace="heavy")
+    assert model.mass == pytest.approx(4.0)
+    assert model.inertia_z == pytest.approx(0.02 + 2.0 * 0.1**2)
+    light = load_robot_model(WHEEL_TF_URDF.format(wheel_tf="false"), robot_namespace="light")
+    assert (light.mass, light.inertia_z) == (1.0, None)
+    node = Node("push_sim", master_uri=master)
+    try:
+        sim = SimNode(node, NodeLog(node.name), Simulation(World("empty")), 0.0, None)
+        sim.add_robot("heavy", model, 0.0, 0.0, 0.0, False)
+        sim.add_robot("light", light, 0.0, 3.0, 0.0, False)
+        ApplyBodyWrench = get_service_class("gazebo_msgs/ApplyBodyWrench")
+        for name in ("heavy", "light"):
+            req = ApplyBodyWrench._request_class()
+            req.body_name, req.reference_frame = name, "world"
+            req.wrench.force.x = 2.0
+            req.duration.secs = 1
+            assert sim.gazebo._apply_body_wrench(req).success
+        for _ in range(150):
+            sim._step_and_publish()
+        moved = {n: sim.sim.robots[n].x for n in ("heavy", "light")}
+        # 2 N for 1 s: a = F / m, x = a t^2 / 2 -> 0.25 m for 4 kg, 1 m for 1 kg
+        assert moved["heavy"] == pytest.approx(0.25, abs=0.02)
+        assert moved["light"] == pytest.approx(1.0, abs=0.05)
     finally:
         node.shutdown("test over")

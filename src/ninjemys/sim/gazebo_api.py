@@ -5,8 +5,8 @@ Services (gazebo_msgs and std_srvs types, Noetic's names and status texts): ``sp
 ``get_world_properties``, ``get_model_properties``, ``get_link_state``, ``get_physics_properties``,
 ``set_physics_properties`` (``max_update_rate``: the pace; ``time_step``: the physics step, as Gazebo takes it),
 ``set_model_configuration``, ``apply_body_wrench`` and ``clear_body_wrenches`` (a push: the body
-gains the velocity the force gives a 1 kg body over the duration, and its wheels stop it when the
-push ends), ``pause_physics``, ``unpause_physics``, ``reset_simulation``, ``reset_world``. Topics:
+gains the velocity the force gives its mass over the duration (the URDF's ``<inertial>`` masses of
+the links fixed to its base, 1 kg without any), and its wheels stop it when the push ends), ``pause_physics``, ``unpause_physics``, ``reset_simulation``, ``reset_world``. Topics:
 ``/gazebo/model_states`` and ``/gazebo/link_states`` out (every physics step, while subscribed),
 ``/gazebo/set_model_state`` in.
 
@@ -52,7 +52,7 @@ Pose: Any = get_message_class("geometry_msgs/Pose")
 Twist: Any = get_message_class("geometry_msgs/Twist")
 
 WORLD_FRAMES = ("", "world", "map")
-PUSH_MASS = 1.0  # kg: what apply_body_wrench pushes (the flat world has no inertia of its own)
+PUSH_INERTIA = 1.0  # kg m^2: what a torque turns when the description gives no inertia
 
 #: a planar pose: x, y, z (the height it was spawned at), yaw
 Planar = tuple[float, float, float, float]
@@ -526,9 +526,10 @@ class GazeboApi:
                 continue
             if now < push.start:
                 continue
-            push.vx += push.fx / PUSH_MASS * dt
-            push.vy += push.fy / PUSH_MASS * dt
-            push.w += push.tz / PUSH_MASS * dt
+            mass, inertia = r.model.mass, r.model.inertia_z or PUSH_INERTIA
+            push.vx += push.fx / mass * dt
+            push.vy += push.fy / mass * dt
+            push.w += push.tz / inertia * dt
             try:
                 sim.place_robot(name, r.x + push.vx * dt, r.y + push.vy * dt, r.yaw + push.w * dt)
             except SpawnError:
