@@ -214,3 +214,22 @@ def test_a_push_moves_a_heavier_urdf_body_less(master: str) -> None:
         assert moved["light"] == pytest.approx(1.0, abs=0.05)
     finally:
         node.shutdown("test over")
+
+
+@pytest.mark.parametrize(
+    ("inertial", "reason"),
+    [
+        ('<mass value="heavy"/>', "<mass value> is not a number"),
+        ('<mass value="-1"/>', "<mass value> must be a finite number >= 0"),
+        ('<mass value="1"/><inertia izz="nan"/>', "<inertia izz> must be a finite number >= 0"),
+    ],
+)
+def test_a_bad_inertial_names_the_link_and_the_reason(inertial: str, reason: str) -> None:
+    from ninjemys.errors import NinjemysError
+
+    urdf = WHEEL_TF_URDF.format(wheel_tf="false").replace(
+        '<link name="base_link">', f'<link name="base_link"><inertial>{inertial}</inertial>'
+    )
+    with pytest.raises(NinjemysError, match="base_link") as err:
+        load_robot_model(urdf)
+    assert reason in str(err.value)

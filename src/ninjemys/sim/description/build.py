@@ -127,9 +127,15 @@ def _body_mass(doc: Document, geo: Geometry) -> tuple[float, float | None]:
             i_zz = float(inertia.get("izz", "0")) if inertia is not None else 0.0
         except ValueError:
             raise doc.error(inertia, f"link '{link}': <inertia izz> is not a number") from None
+        if not (i_zz >= 0.0 and math.isfinite(i_zz)):
+            raise doc.error(inertia, f"link '{link}': <inertia izz> must be a finite number >= 0")
         origin = inertial.find("origin")
-        xyz = [float(v) for v in (origin.get("xyz", "0 0 0") if origin is not None else "0 0 0").split()]
-        cx, cy, _cz = apply(geo.pose_of(link), (xyz + [0.0, 0.0, 0.0])[:3])  # the centre of mass
+        text = origin.get("xyz", "0 0 0") if origin is not None else "0 0 0"
+        try:
+            ox, oy, oz = ([float(v) for v in text.split()] + [0.0, 0.0, 0.0])[:3]
+        except ValueError:
+            raise doc.error(origin, f"link '{link}': <inertial><origin xyz> is not three numbers") from None
+        cx, cy, _cz = apply(geo.pose_of(link), (ox, oy, oz))  # the centre of mass
         mass += m
         izz += i_zz + m * (cx * cx + cy * cy)
     if mass <= 0.0:
