@@ -6,10 +6,12 @@
    ``roslaunch`` on a running master; the time until a subscriber (already waiting) gets the first
    LaserScan. The issue's target: at most 1 s. Gazebo itself is not installed here: its gzserver
    alone takes several seconds to load a world (the figure to compare with is from Gazebo users).
-2. A/B of the simulator node split (issue 22, item 5): the same PuzzleBot run headless as fast as
-   possible, with subscribers on scan, camera and odometry and with none, by the tree before the split
-   (``--before``, default: where this branch left main) and by this tree, alternating, in one run.
-   Speeds come from the simulator's own exit summary (simulated s per CPU s: the machine is shared).
+2. A/B of the simulator: the PuzzleBot run headless as fast as possible, with subscribers on scan,
+   camera (colour and depth, 320x240 at 30 Hz) and odometry and with none, from our YAML model and
+   from its URDF (``puzzlebot_sim/robots/puzzlebot.urdf``: the issue's row, "the PuzzleBot from its
+   URDF with scan, camera and odometry"), by an older tree (``--before``, default: where this branch
+   left main) and by this tree, alternating, in one run. Speeds come from the simulator's own exit
+   summary (simulated s per CPU s: the machine is shared; the issue's target is 50x on one core).
 
 Run alone: ``.venv/bin/python bench/sim_gazebo.py [--quick] [--before REV] [--only launch|ab]``.
 """
@@ -94,7 +96,10 @@ def extract_tree(rev: str, dest: Path) -> Path:
     return dest / "src"
 
 
-def sim_run(src: Path | None, subscribe: bool, duration: float) -> float:
+URDF_MODEL = ROOT / "src/ninjemys/packages/share/puzzlebot_sim/robots/puzzlebot.urdf"
+
+
+def sim_run(src: Path | None, subscribe: bool, duration: float, model: Path | None = None) -> float:
     """Simulated s per CPU s of one headless run (``src``: that tree on PYTHONPATH; None: this tree)."""
     from ninjemys.idl.loader import get_message_class
     from ninjemys.node import Node
@@ -106,6 +111,8 @@ def sim_run(src: Path | None, subscribe: bool, duration: float) -> float:
         env["ROS_MASTER_URI"] = master
         cmd = [sys.executable, "-m", "ninjemys.packages.run_shipped", "puzzlebot_sim", "sim_node"]
         cmd += ["_world:=office", "_rate:=0", "_gui:=false"]
+        if model is not None:
+            cmd.append(f"_model:={model}")
         proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         lines: list[str] = []
         for line in proc.stdout:  # type: ignore[union-attr]
@@ -143,20 +150,25 @@ def bench_ab(before: str, duration: float, rounds: int) -> None:
     rev = subprocess.run(
         ["git", "-C", str(ROOT), "rev-parse", "--short", before], capture_output=True, text=True, check=True
     ).stdout.strip()
-    print(f"\n## the simulator node split, A/B: {rev} (before) and this tree (after), alternating")
+    print(f"\n## the simulator, A/B: {rev} (before) and this tree (after), alternating")
     print(f"simulated s per CPU s of the simulator, office world, as fast as possible, {duration:.0f} s runs")
-    print("| subscribers | before | after | after / before |")
-    print("|---|---:|---:|---:|")
+    print("| robot | subscribers | before | after | after / before |")
+    print("|---|---|---:|---:|---:|")
     with tempfile.TemporaryDirectory() as tmp:
         old = extract_tree(before, Path(tmp))
-        for subscribe, label in ((True, "scan + camera + odom"), (False, "none")):
+        for model, subscribe, robot, label in (
+            (None, True, "PuzzleBot (YAML)", "scan + camera + odom"),
+            (URDF_MODEL, True, "PuzzleBot from its URDF", "scan + camera + odom"),
+            (None, False, "PuzzleBot (YAML)", "none"),
+        ):
             a: list[float] = []
             b: list[float] = []
             for _ in range(rounds):
-                a.append(sim_run(old, subscribe, duration))
-                b.append(sim_run(None, subscribe, duration))
+                a.append(sim_run(old, subscribe, duration, model))
+                b.append(sim_run(None, subscribe, duration, model))
             ma, mb = statistics.median(a), statistics.median(b)
-            print(f"| {label} | {ma:.1f}x | {mb:.1f}x | {mb / ma:.2f} |")
+            print(f"| {robot} | {label} | {ma:.1f}x | {mb:.1f}x | {mb / ma:.2f} |")
+            print(f"load average: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
 
 
 def default_before() -> str:
@@ -169,7 +181,7 @@ def default_before() -> str:
 def main() -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--quick", action="store_true", help="fewer repetitions and shorter runs")
-    p.add_argument("--before", default=None, help="the tree before the split (default: merge-base with main)")
+    p.add_argument("--before", default=None, help="the older tree (default: merge-base with main)")
     p.add_argument("--only", choices=("launch", "ab"), help="run one part")
     args = p.parse_args()
     print(f"load average: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")

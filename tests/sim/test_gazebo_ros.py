@@ -14,6 +14,7 @@ import time
 from collections.abc import Iterator
 from pathlib import Path
 
+import numpy as np
 import pytest
 from gazebo_helpers import Launched, genpy_gazebo_msgs
 
@@ -382,3 +383,36 @@ def test_a_real_rospy_controller_drives_a_square_checked_against_model_states(ga
     print(f"1 m square: end position error {error:.3f} m, heading error {abs(yaw):.3f} rad")
     # the controller reacts in wall time: on a loaded machine a corner costs a few cm (0.125 m at load 17)
     assert error < 0.3 and abs(yaw) < 0.3
+
+
+def test_set_physics_properties_takes_another_time_step(gazebo: Gazebo) -> None:
+    """A time_step other than ours is taken, as Gazebo does: get_physics_properties reports it,
+    /clock goes on from where it was in steps of that size, and a step out of range is refused."""
+    SetPhysicsProperties = get_service_class("gazebo_msgs/SetPhysicsProperties")
+    GetPhysicsProperties = get_service_class("gazebo_msgs/GetPhysicsProperties")
+    Unpause = get_service_class("std_srvs/Empty")
+    gazebo.call("/gazebo/unpause_physics", Unpause)
+    stamps: list[int] = []
+    sub = gazebo.client.subscriber(
+        "/clock", Clock, lambda m: stamps.append(m.clock.to_nsec()), queue_size=1000
+    )
+    try:
+        resp = gazebo.call(
+            "/gazebo/set_physics_properties", SetPhysicsProperties, time_step=0.002, max_update_rate=500.0
+        )
+        assert (resp.success, resp.status_message) == (True, "physics engine updated")
+        props = gazebo.call("/gazebo/get_physics_properties", GetPhysicsProperties)
+        assert props.time_step == 0.002 and props.max_update_rate == 500.0
+        before = len(stamps)
+        wait_until(lambda: len(stamps) > before + 50, 30, "/clock in 2 ms steps")
+        steps = np.diff(np.array(stamps[before + 1 :]))
+        assert (steps > 0).all()  # time went on, never back
+        assert np.median(steps) == 2_000_000  # /clock every step: 2 ms apart
+        bad = gazebo.call("/gazebo/set_physics_properties", SetPhysicsProperties, time_step=0.5)
+        assert not bad.success and "time_step 0.5 must be in (0, 0.1]" in bad.status_message
+    finally:
+        sub.unregister()
+        gazebo.call(
+            "/gazebo/set_physics_properties", SetPhysicsProperties, time_step=0.01, max_update_rate=100.0
+        )
+    assert gazebo.call("/gazebo/get_physics_properties", GetPhysicsProperties).time_step == 0.01

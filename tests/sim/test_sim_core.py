@@ -356,3 +356,27 @@ def test_an_obstacle_spawned_ahead_stops_a_moving_robot():
         sim.step()
     assert r.contact and r.contact_with == "crate"
     assert r.x == pytest.approx(sim.world.obstacles[-1].outline[:, 0].min() - r.model.body_radius, abs=0.005)
+
+
+def test_time_step_changes_and_time_goes_on():
+    """Gazebo's set_physics_properties time_step: later steps are that long, time and stamps go on
+    from where they were (no jump), a reset brings time back to 0, bad steps are refused."""
+    from ninjemys.sim.simcore import MAX_TIME_STEP
+
+    sim = Simulation(load_world(ROBOTS_DIR.parent / "worlds" / "empty.yaml"), 0.01, 0)
+    for _ in range(150):
+        sim.step()
+    assert sim.time_ns == 1_500_000_000
+    sim.set_time_step(0.001)
+    assert sim.time_ns == 1_500_000_000 and abs(sim.time - 1.5) < 1e-12
+    for _ in range(250):
+        sim.step()
+    assert sim.time_ns == 1_750_000_000 and abs(sim.time - 1.75) < 1e-9
+    for bad in (0.0, -0.01, math.inf, math.nan, MAX_TIME_STEP * 2):
+        with pytest.raises(SpawnError, match="time_step"):
+            sim.set_time_step(bad)
+    assert sim.dt == 0.001
+    sim.reset_simulation()
+    assert sim.time == 0.0 and sim.time_ns == 0
+    sim.step()
+    assert sim.time_ns == 1_000_000

@@ -222,3 +222,63 @@ def test_cast_segments_equals_brute_force(seed):
             seen = np.isfinite(dist)
             assert np.allclose(dist[seen], expected[seen], rtol=0, atol=1e-9)
             assert (hit[seen] >= 0).all() and (hit[~seen] == -1).all()
+
+
+def valid_poses(sim: Simulation, count: int, seed: int) -> list[tuple[float, float, float]]:
+    """Poses a robot can stand at (its body clear of everything), spread over the world."""
+    rng = np.random.default_rng(seed)
+    lo, hi = sim._static.min(axis=0)[:2], sim._static.max(axis=0)[:2]
+    out: list[tuple[float, float, float]] = []
+    while len(out) < count:
+        x, y = rng.uniform(lo[0], hi[0]), rng.uniform(lo[1], hi[1])
+        if not sim.solid_at(x, y) and sim.clearance(x, y)[0] >= 0.11:
+            out.append((x, y, rng.uniform(-math.pi, math.pi)))
+    return out
+
+
+@pytest.mark.parametrize("world", ["office", "maze"])
+def test_casts_that_skip_back_faces_see_the_same(world):
+    """Leaving out the sides of convex outlines that face away from the eye changes no scan and no
+    camera image, from anywhere a robot can stand (the eye is then outside every obstacle)."""
+    sim = Simulation(load_world(world_path(world)), 0.01, 0)
+    r = sim.add_robot("pb", load_robot_model("puzzlebot"), 0.0, 0.0, 0.0)
+    assert (sim._static_facing != 0).sum() > len(sim._static_facing) // 2  # most sides are culled
+    for x, y, yaw in valid_poses(sim, 25, 3):
+        r.x, r.y, r.yaw = x, y, yaw
+        scene = sim.scene(r.name)
+        plain = sensors.Scene(**{**scene.__dict__, "facing": None})
+        angles = yaw + np.linspace(-math.pi, math.pi, 360, endpoint=False)
+        culled, _ = cast_segments(x, y, angles, scene.segments, 12.0, scene.facing)
+        full, _ = cast_segments(x, y, angles, scene.segments, 12.0)
+        assert np.array_equal(culled, full)
+        for a, b in zip(sim.render(r, scene), sim.render(r, plain), strict=True):
+            assert np.array_equal(a, b)
+
+
+def test_obstacle_facing():
+    """+1 for convex counter-clockwise outlines, -1 clockwise, 0 for thin walls and concave ones."""
+    from ninjemys.sim.world2d import Obstacle, box_outline, circle_outline
+
+    box = box_outline(1.0, 2.0, 1.0, 0.5, 0.7)
+    assert Obstacle("b", "box", box, 1.0, (0, 0, 0)).facing() == 1
+    assert Obstacle("b", "box", box[::-1], 1.0, (0, 0, 0)).facing() == -1
+    assert Obstacle("c", "cylinder", circle_outline(0, 0, 0.3), 1.0, (0, 0, 0)).facing() == 1
+    thin = np.array([[0.0, 0.0], [1.0, 0.0]])
+    assert Obstacle("w", "wall", thin, 1.0, (0, 0, 0)).facing() == 0
+    ell = np.array([[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]], dtype=float)  # an L: concave
+    assert Obstacle("l", "wall", ell, 1.0, (0, 0, 0)).facing() == 0
+
+
+@pytest.mark.parametrize("world", ["office", "square"])
+def test_camera_draws_only_the_images_asked_for(world):
+    """Colour alone and depth alone are the same images as both together (the other one empty)."""
+    sim = Simulation(load_world(world_path(world)), 0.01, 0)
+    r = sim.add_robot("pb", load_robot_model("puzzlebot"), 0.0, 0.0, 0.0)
+    for x, y, yaw in valid_poses(sim, 6, 5):
+        r.x, r.y, r.yaw = x, y, yaw
+        rgb, depth = sim.render(r)
+        rgb_only, no_depth = sim.render(r, depth=False)
+        no_rgb, depth_only = sim.render(r, colour=False)
+        assert np.array_equal(rgb, rgb_only) and np.array_equal(depth, depth_only)
+        assert no_depth.size == 0 and no_rgb.size == 0
+        assert rgb.shape == (240, 320, 3) and depth.shape == (240, 320)

@@ -3,10 +3,10 @@
 Services (gazebo_msgs and std_srvs types, Noetic's names and status texts): ``spawn_urdf_model``,
 ``spawn_sdf_model``, ``delete_model``, ``get_model_state``, ``set_model_state``,
 ``get_world_properties``, ``get_model_properties``, ``get_link_state``, ``get_physics_properties``,
-``set_physics_properties`` (its ``max_update_rate``: the pace),
+``set_physics_properties`` (``max_update_rate``: the pace; ``time_step``: the physics step, as Gazebo takes it),
 ``set_model_configuration``, ``apply_body_wrench`` and ``clear_body_wrenches`` (a push: the body
-gains the velocity the force gives a 1 kg body over the duration, and its wheels stop it when the
-push ends), ``pause_physics``, ``unpause_physics``, ``reset_simulation``, ``reset_world``. Topics:
+gains the velocity the force gives its mass over the duration (the URDF's ``<inertial>`` masses of
+the links fixed to its base, 1 kg without any), and its wheels stop it when the push ends), ``pause_physics``, ``unpause_physics``, ``reset_simulation``, ``reset_world``. Topics:
 ``/gazebo/model_states`` and ``/gazebo/link_states`` out (every physics step, while subscribed),
 ``/gazebo/set_model_state`` in.
 
@@ -52,7 +52,7 @@ Pose: Any = get_message_class("geometry_msgs/Pose")
 Twist: Any = get_message_class("geometry_msgs/Twist")
 
 WORLD_FRAMES = ("", "world", "map")
-PUSH_MASS = 1.0  # kg: what apply_body_wrench pushes (the flat world has no inertia of its own)
+PUSH_INERTIA = 1.0  # kg m^2: what a torque turns when the description gives no inertia
 
 #: a planar pose: x, y, z (the height it was spawned at), yaw
 Planar = tuple[float, float, float, float]
@@ -419,9 +419,11 @@ class GazeboApi:
         return resp
 
     def _set_physics_properties(self, req: Any) -> Any:
-        """Gazebo's pacing knob: ``max_update_rate`` steps per wall second (0: as fast as possible),
-        so the real-time factor is max_update_rate x step. The step itself stays (the sensors'
-        schedules are built on it); a different ``time_step`` is refused, as are gravity and ODE."""
+        """Gazebo's pacing knobs: ``time_step`` (the physics step, seconds; 0 keeps it) and
+        ``max_update_rate`` steps per wall second (0: as fast as possible), so the real-time factor
+        is max_update_rate x time_step, as in Gazebo. Time goes on from where it is; sensors keep
+        their rates (each fires at the first step at or after it is due). Gravity and ODE's
+        solver settings have nothing to act on in this kinematic simulator and are left alone."""
         resp = SetPhysicsProperties._response_class()
         sn = self.sn
         rate = req.max_update_rate
@@ -431,17 +433,22 @@ class GazeboApi:
                 f"SetPhysicsProperties: max_update_rate {rate} must be >= 0",
             )
             return resp
-        if req.time_step and abs(req.time_step - sn.sim.dt) > 1e-12:
-            resp.success = False
-            resp.status_message = (
-                f"SetPhysicsProperties: time_step is {sn.sim.dt} here (the node's ~update_rate sets it)"
-            )
-            return resp
-        sn.stepper.set_rate(rate * sn.sim.dt)
+        step = req.time_step
+        with sn.lock:
+            if step and abs(step - sn.sim.dt) > 1e-15:
+                try:
+                    sn.sim.set_time_step(step)
+                except SpawnError as exc:
+                    resp.success, resp.status_message = False, f"SetPhysicsProperties: {exc}"
+                    return resp
+                sn.stepper.dt = step
+                sn.log.info("physics: time_step %g s", step)
+            dt = sn.sim.dt
+        sn.stepper.set_rate(rate * dt)
         sn.log.info(
             "physics: max_update_rate %g (real-time factor %s)",
             rate,
-            f"{rate * sn.sim.dt:g}" if rate else "unlimited",
+            f"{rate * dt:g}" if rate else "unlimited",
         )
         resp.success, resp.status_message = True, "physics engine updated"
         return resp
@@ -519,9 +526,10 @@ class GazeboApi:
                 continue
             if now < push.start:
                 continue
-            push.vx += push.fx / PUSH_MASS * dt
-            push.vy += push.fy / PUSH_MASS * dt
-            push.w += push.tz / PUSH_MASS * dt
+            mass, inertia = r.model.mass, r.model.inertia_z or PUSH_INERTIA
+            push.vx += push.fx / mass * dt
+            push.vy += push.fy / mass * dt
+            push.w += push.tz / inertia * dt
             try:
                 sim.place_robot(name, r.x + push.vx * dt, r.y + push.vy * dt, r.yaw + push.w * dt)
             except SpawnError:

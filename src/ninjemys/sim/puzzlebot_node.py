@@ -336,7 +336,8 @@ class SimNode:
         self.log.error("simulation step failed: %s: %s", type(exc).__name__, exc)
 
     def _stamp(self) -> Time:
-        return messages.stamp_of(self.sim.steps, self.sim.dt)
+        ns = self.sim.time_ns
+        return Time(ns // 1_000_000_000, ns % 1_000_000_000)
 
     def _step_and_publish(self) -> None:
         sim = self.sim
@@ -430,31 +431,45 @@ class SimNode:
                     [r.wl, r.wr],
                 )
             )
-        if tfs is None or not driven or not drive.publish_odom_tf:
+        if tfs is None or not driven:
             return
-        tfs.append(
-            messages.transform(
-                stamp, odom_frame, base_frame, (pose[0], pose[1], 0.0), quaternion_from_yaw(pose[2])
+        if drive.publish_odom_tf:
+            tfs.append(
+                messages.transform(
+                    stamp, odom_frame, base_frame, (pose[0], pose[1], 0.0), quaternion_from_yaw(pose[2])
+                )
             )
-        )
+        # gazebo_ros_diff_drive's publishWheelTF: each wheel link in its parent's frame, turned by its angle
+        for joint, angle in zip(r.model.wheel_tf_joints, (r.left_angle, r.right_angle), strict=False):
+            x, y, z, qx, qy, qz, qw = joint.transform(angle)
+            tfs.append(
+                messages.transform(
+                    stamp, io.frame(joint.parent), io.frame(joint.child), (x, y, z), (qx, qy, qz, qw)
+                )
+            )
 
     def _camera(self, io: RobotIO, stamp: Time) -> None:
+        """Render and publish the camera's images, each only when someone reads it (camera_info
+        alone needs no image at all)."""
         r = io.robot
         spec = r.model.camera
         if spec is None or r.camera is None:
             return
-        rgb, depth = self.sim.render(r)
         pubs = io.pubs
         frame = io.frame(spec.frame)
         depth_frame = io.frame(spec.depth_frame)
         want_raw = pubs["image"].get_num_connections()
-        if want_raw or pubs["image_compressed"].get_num_connections():
-            img = messages.rgb_image(stamp, frame, rgb)
-            if want_raw:
-                pubs["image"].publish(img)
-            pubs["image_compressed"].publish(img)
-        if "depth" in pubs and pubs["depth"].get_num_connections():
-            pubs["depth"].publish(messages.depth_image(stamp, depth_frame, depth))
+        want_colour = bool(want_raw or pubs["image_compressed"].get_num_connections())
+        want_depth = bool("depth" in pubs and pubs["depth"].get_num_connections())
+        if want_colour or want_depth:
+            rgb, depth = self.sim.render(r, colour=want_colour, depth=want_depth)
+            if want_colour:
+                img = messages.rgb_image(stamp, frame, rgb)
+                if want_raw:
+                    pubs["image"].publish(img)
+                pubs["image_compressed"].publish(img)
+            if want_depth:
+                pubs["depth"].publish(messages.depth_image(stamp, depth_frame, depth))
         intrinsics = r.camera.intrinsics()
         for key, frame_id in (("color_info", frame), ("depth_info", depth_frame)):
             if key in pubs and pubs[key].get_num_connections():

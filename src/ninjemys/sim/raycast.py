@@ -23,22 +23,67 @@ import numpy as np
 
 
 def cast_segments(
-    ox: float, oy: float, angles: np.ndarray, segments: np.ndarray, max_range: float
+    ox: float,
+    oy: float,
+    angles: np.ndarray,
+    segments: np.ndarray,
+    max_range: float,
+    facing: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Distance to the first segment along each ray (inf if none within ``max_range``) and its index (-1).
 
-    ``angles`` are the rays' world angles in any order. Each segment is tested only against the
-    rays inside the angle it subtends from the origin (found with one ``searchsorted`` over the
-    sorted rays), so the work grows with what is visible, not with rays x segments. Every step is
-    done for all segments at once (both end points in one ``arctan2``, all span ends in two
-    ``searchsorted``): at a few hundred segments the cost is the number of numpy calls.
+    ``angles`` are the rays' world angles in any order. The candidate pairs come from
+    :func:`segment_pairs`; the nearest per ray wins (on an exact tie, the pair listed last).
+    """
+    n = len(angles)
+    ray_of, seg_of, t = segment_pairs(ox, oy, angles, segments, max_range, facing)
+    return nearest_hits(n, ray_of, seg_of, t)
+
+
+def nearest_hits(
+    n: int, ray_of: np.ndarray, seg_of: np.ndarray, t: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Per ray of ``n``: the smallest finite ``t`` among its pairs (inf if none) and the pair's
+    ``seg_of`` (-1 if none); on an exact tie the pair listed last wins."""
+    dist = np.full(n, np.inf)
+    hit = np.full(n, -1, dtype=np.intp)
+    if not len(t):
+        return dist, hit
+    np.minimum.at(dist, ray_of, t)
+    won = t == dist[ray_of]
+    won &= t != np.inf
+    hit[ray_of[won]] = seg_of[won]
+    return dist, hit
+
+
+def segment_pairs(
+    ox: float,
+    oy: float,
+    angles: np.ndarray,
+    segments: np.ndarray,
+    max_range: float,
+    facing: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every (ray, segment) pair that can meet, and where: ``(ray_of, seg_of, t)`` with ``t`` the
+    distance along the ray to the segment, ``inf`` where they do not meet within ``max_range``.
+
+    Each segment is paired only with the rays inside the angle it subtends from the origin (found
+    with one ``searchsorted`` over the sorted rays), so the work grows with what is visible, not
+    with rays x segments. Every step is done for all segments at once (both end points in one
+    ``arctan2``, all span ends in two ``searchsorted``): at a few hundred segments the cost is the
+    number of numpy calls. The lidar takes the nearest pair per ray (:func:`nearest_hits`); the
+    camera also looks behind it for taller obstacles, from the same pairs.
+
+    ``facing`` (per segment: +1 or -1 for a side of a convex outline going counter-clockwise or
+    clockwise, 0 otherwise) leaves out the sides whose outer face looks away from the origin: a
+    ray enters a convex outline through a side facing it, so those never give a first crossing,
+    into that obstacle or into a taller one behind it (about half of a box's or a cylinder's sides).
     """
     angles = np.asarray(angles, dtype=np.float64)
     n = len(angles)
-    dist = np.full(n, np.inf)
-    hit = np.full(n, -1, dtype=np.intp)
+    none = (np.zeros(0, np.intp), np.zeros(0, np.intp), np.zeros(0))
     if not n or not len(segments):
-        return dist, hit
+        return none
     # first end point relative to the origin (p), edge vector (e), second end point (q = p + e)
     px, py = segments[:, 0] - ox, segments[:, 1] - oy
     ex, ey = segments[:, 2] - segments[:, 0], segments[:, 3] - segments[:, 1]
@@ -46,10 +91,14 @@ def cast_segments(
     # broad phase: a segment whose middle is farther than max_range plus half its length cannot be
     # hit within range (a superset of the segments that come within range: same answers)
     near = np.hypot(px + qx, py + qy) - np.hypot(ex, ey) <= 2.0 * max_range + 1e-9
+    if facing is not None:
+        # the origin on a side's outer side: (origin - p) . outward normal >= 0, the outward normal
+        # being (ey, -ex) for a counter-clockwise outline and its opposite for a clockwise one
+        near &= facing * (py * ex - px * ey) >= 0
     if not near.all():
         keep = np.flatnonzero(near)
         if not len(keep):
-            return dist, hit
+            return none
         px, py, ex, ey, qx, qy = px[keep], py[keep], ex[keep], ey[keep], qx[keep], qy[keep]
     else:
         keep = None
@@ -74,7 +123,7 @@ def cast_segments(
     counts = np.maximum(stops - starts, 0)
     total = int(counts.sum())
     if not total:
-        return dist, hit
+        return none
     seg_of = np.repeat(seg_ids, counts)
     shift = np.repeat(starts - (np.cumsum(counts) - counts), counts)
     ray_of = order[np.arange(total) + shift]
@@ -84,14 +133,8 @@ def cast_segments(
     with np.errstate(divide="ignore", invalid="ignore"):
         t = (sx * gy - sy * gx) / denom
         u = (sx * dy - sy * dx) / denom
-    t[~((u >= -1e-9) & (u <= 1 + 1e-9) & (t >= 0) & np.isfinite(t))] = np.inf
-    np.minimum.at(dist, ray_of, t)
-    won = np.isfinite(t) & (t == dist[ray_of])
-    hit[ray_of[won]] = seg_of[won] if keep is None else keep[seg_of[won]]
-    far = dist > max_range
-    dist[far] = np.inf
-    hit[far] = -1
-    return dist, hit
+    t[~((u >= -1e-9) & (u <= 1 + 1e-9) & (t >= 0) & (t <= max_range))] = np.inf  # NaN fails too
+    return ray_of, (seg_of if keep is None else keep[seg_of]), t
 
 
 def grid_edges(occupied: np.ndarray, resolution: float, origin_x: float, origin_y: float) -> np.ndarray:
@@ -146,6 +189,28 @@ def cast_circles(
     hit = np.where(dist <= max_range, j, -1)
     dist = np.where(hit >= 0, dist, np.inf)
     return dist, hit
+
+
+def circle_pairs(
+    ox: float, oy: float, angles: np.ndarray, centers: np.ndarray, radii: np.ndarray, max_range: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every (ray, circle) pair that meets within ``max_range``: ``(ray_of, circle_of, t)``, by ray
+    and, within a ray, by circle index *descending* (so that, as in :func:`nearest_hits`, the
+    lowest index wins an exact tie, as :func:`cast_circles`' argmin does)."""
+    if not len(centers) or not len(angles):
+        return np.zeros(0, np.intp), np.zeros(0, np.intp), np.zeros(0)
+    dx, dy = np.cos(angles), np.sin(angles)
+    cx = centers[:, 0] - ox
+    cy = centers[:, 1] - oy
+    b = dx[:, None] * cx + dy[:, None] * cy
+    c = cx * cx + cy * cy - radii * radii
+    disc = b * b - c
+    with np.errstate(invalid="ignore"):
+        t = b - np.sqrt(disc)
+    meets = (disc >= 0) & (c > 0) & (t >= 0) & (t <= max_range)
+    ray_of, circle_of = np.nonzero(meets[:, ::-1])
+    circle_of = len(centers) - 1 - circle_of
+    return ray_of, circle_of, t[ray_of, circle_of]
 
 
 def cast_grid(

@@ -18,6 +18,7 @@ from pathlib import Path
 import yaml
 
 from ninjemys.maps.mapfile import Fields, MapFileError, yaml_lines
+from ninjemys.robot.kinematics import Joint
 from ninjemys.sim.worlds import ROBOTS_DIR
 
 
@@ -123,6 +124,13 @@ class RobotModel:
     # ros_control: the joints with a <transmission> and their side ("left", "right"; "" for a joint that
     # is not a wheel): every wheel of a side turns as that side's wheel of the simulated body
     control_joints: dict[str, str] = field(default_factory=dict)
+    #: what apply_body_wrench pushes: the body's mass (kg) and moment of inertia about the vertical
+    #: (kg m^2), from a URDF's <inertial>s; None: a torque turns it as it would a 1 kg m^2 body
+    mass: float = 1.0
+    inertia_z: float | None = None
+    #: gazebo_ros_diff_drive's publishWheelTF: the wheel joints whose parent -> child transforms go
+    #: on /tf with the wheels' angles (left, right); empty when not asked for
+    wheel_tf_joints: list[Joint] = field(default_factory=list)
 
 
 def _merge(base: dict, over: dict) -> dict:

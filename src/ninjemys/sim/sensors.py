@@ -8,13 +8,17 @@ millimetres (16UC1, as RealSense's ``depth/image_rect_raw``), 0 where there is n
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from ninjemys.sim.raycast import cast_circles, cast_segments
+from ninjemys.sim.raycast import cast_circles, cast_segments, circle_pairs, nearest_hits, segment_pairs
 
+#: what :meth:`Camera.render` returns for an image it was asked not to draw
+_EMPTY_RGB = np.zeros((0, 0, 3), dtype=np.uint8)
+_EMPTY_DEPTH = np.zeros((0, 0), dtype=np.uint16)
 FLOOR_RGB = np.array([176, 170, 160], dtype=np.float32)
 SKY_RGB = np.array([206, 220, 235], dtype=np.float32)
 
@@ -31,6 +35,9 @@ class Scene:
     circle_heights: np.ndarray  # (M,)
     circle_colors: np.ndarray  # (M, 3) uint8
     floor: FloorPaint | None = None  # markings painted on the floor
+    #: per segment: +1/-1 when it is a side of a convex outline going counter-/clockwise, 0 otherwise
+    #: (None: unknown, every side is cast); casts skip the sides facing away (see Obstacle.facing)
+    facing: np.ndarray | None = None
 
 
 @dataclass
@@ -64,9 +71,11 @@ def lidar_ranges(
     """
     angles = yaw + angle_min + increment * np.arange(beams)
     tall = scene.heights >= z
-    dist, _ = cast_segments(
-        x, y, angles, scene.segments[tall] if not tall.all() else scene.segments, range_max
-    )
+    segments, facing = scene.segments, scene.facing
+    if not tall.all():
+        segments = segments[tall]
+        facing = facing[tall] if facing is not None else None
+    dist, _ = cast_segments(x, y, angles, segments, range_max, facing)
     if len(scene.circles):
         tall_c = scene.circle_heights >= z
         cd, _ = cast_circles(x, y, angles, scene.circles[tall_c], scene.radii[tall_c], range_max)
@@ -77,6 +86,32 @@ def lidar_ranges(
     out[out > range_max] = np.inf
     out[out < range_min] = -np.inf
     return out
+
+
+class _Crossings:
+    """Every crossing of the camera's column rays with the scene's obstacles within ``far``: the
+    column (``ray_of``), the obstacle (``item_of``, an index into ``heights``/``colors``: segments
+    first, then round bodies) and the distance (``t``, inf for a pair that does not meet).
+
+    Round bodies are listed first, segments after them: :func:`nearest_hits` lets the pair listed
+    last win an exact tie, so a segment wins over a body and, among segments, the same one as
+    :func:`cast_segments` picks."""
+
+    def __init__(self, scene: Scene, x: float, y: float, angles: np.ndarray, far: float) -> None:
+        ray_s, seg_s, t_s = segment_pairs(x, y, angles, scene.segments, far, scene.facing)
+        self.heights = scene.heights
+        self.colors = scene.colors
+        if len(scene.circles):
+            ray_c, circle_c, t_c = circle_pairs(x, y, angles, scene.circles, scene.radii, far)
+            n = len(scene.segments)
+            ray_s = np.concatenate([ray_c, ray_s])
+            seg_s = np.concatenate([circle_c + n, seg_s])
+            t_s = np.concatenate([t_c, t_s])
+            self.heights = np.concatenate([scene.heights, scene.circle_heights])
+            self.colors = np.concatenate([scene.colors, scene.circle_colors])
+        if not len(self.heights):  # an empty scene: lookups of "no hit" (-1) must still work
+            self.heights, self.colors = np.zeros(1), np.zeros((1, 3), dtype=np.uint8)
+        self.ray_of, self.item_of, self.t = ray_s, seg_s, t_s
 
 
 class Camera:
@@ -125,114 +160,153 @@ class Camera:
         self._lanes3 = _padded_empty((height, 3 * width), np.uint8)
         self._below3 = np.empty((height, 3 * width), dtype=bool)
         self._lanes1 = _padded_empty((height, width), np.uint16)
+        self._wall1 = np.empty((height, width), dtype=bool)
+        self._below1 = np.empty((height, width), dtype=bool)
 
-    def render(self, scene: Scene, x: float, y: float, yaw: float) -> tuple[np.ndarray, np.ndarray]:
+    def render(
+        self,
+        scene: Scene,
+        x: float,
+        y: float,
+        yaw: float,
+        colour: bool = True,
+        depth: bool = True,
+    ) -> tuple[np.ndarray, np.ndarray]:
         """(rgb8 image (H, W, 3), depth in mm uint16 (H, W)) from a camera at (x, y, cam_z) facing ``yaw``.
 
         Each column shows the nearest obstacle its rays meet between floor and top, and above that
         obstacle whatever taller one stands behind it (a wall behind a cone): the nearest obstacle of
         each height class (at least as tall as a threshold, :func:`layer_thresholds`) is one layer,
-        and a farther layer shows only above the nearer layers' tops.
+        and a farther layer shows only above the nearer layers' tops. All layers come from one ray
+        cast: every (column, obstacle) crossing is computed once, the first layer is the nearest
+        crossing per column, each further layer the nearest crossing of a taller class.
+
+        ``colour=False`` or ``depth=False`` leaves that image out (an empty array in its place):
+        a camera whose depth stream nobody reads (or that has none) does not draw it.
         """
+        return self._render(scene, x, y, yaw, colour, depth)
+
+    def _render(
+        self, scene: Scene, x: float, y: float, yaw: float, want_rgb: bool, want_depth: bool
+    ) -> tuple[np.ndarray, np.ndarray]:
         angles = yaw + self.col_angles
         far = self.depth_max / float(self.col_cos.min())
-        found, depth, top, bottom, colors, heights = self._layer(scene, x, y, angles, far, None)
+        hits = _Crossings(scene, x, y, angles, far)
+        dist, item = nearest_hits(self.width, hits.ray_of, hits.item_of, hits.t)
+        found, depth, top, bottom, colors, _heights = self._layer(hits, dist, item, None)
         rows = self._rows
-        wall = rows >= top
-        wall &= rows < bottom
-        light = np.clip(1.1 - depth / 15.0, 0.45, 1.0)  # flat shading, darker with distance
-        col = (colors * light[:, None]).astype(np.uint8).reshape(1, 3 * self.width)
-        # the image as (H, 3W) bytes, each pixel's mask repeated over its three channels: selecting
-        # bytes is cheaper than any interleaving of channels or a select over 3-byte elements
+        paint = scene.floor is not None and want_rgb
         wall3 = self._lanes3.view(bool)
-        np.greater_equal(rows, np.repeat(top, 3), out=wall3)
-        np.less(rows, np.repeat(bottom, 3), out=self._below3)
-        wall3 &= self._below3
-        rgb = _select(self._lanes3, col, self._background).reshape(self.height, self.width, 3)
-        wall_mm = np.rint(np.where(found, depth, 0.0) * 1000.0).astype(np.uint16)
-        np.copyto(self._lanes1, wall)
-        depth_mm = _select(self._lanes1, wall_mm[None, :], self._floor_depth_image)
-        cut = (
-            top.copy()
-        )  # rows at or below a nearer layer's top are that layer's (or the floor in front of it)
-        seen_height = np.where(found, heights, np.inf)  # the first layer's obstacle, per column
-        for threshold in layer_thresholds(scene, self.cam_z):
-            # only columns whose nearest obstacle is shorter than the class can show a farther one
-            cols = np.flatnonzero(seen_height < threshold)
-            if not len(cols):
-                continue
-            found_c, depth_c, top_c, bottom_c, colors_c, heights_c = self._layer(
-                scene, x, y, angles[cols], far, threshold, cols
-            )
-            bottom_c = np.minimum(bottom_c, cut[cols])
-            visible = found_c & (top_c < bottom_c)
-            seen_height[cols] = np.where(found_c, np.maximum(seen_height[cols], heights_c), np.inf)
-            if not visible.any():
-                cut[cols] = np.minimum(cut[cols], top_c)
-                continue
-            # the farther layer's visible rows lie in one band: masked copies over that band only
-            vis = cols[visible]
-            top_v, bottom_v = top_c[visible], bottom_c[visible]
-            r0, r1 = int(top_v.min()), int(bottom_v.max())
-            band = rows[r0:r1]
-            mask = (band >= top_v[None, :]) & (band < bottom_v[None, :])  # (rows of the band, visible cols)
-            depth_v = depth_c[visible]
-            light_v = np.clip(1.1 - depth_v / 15.0, 0.45, 1.0)
-            colour_v = (colors_c[visible] * light_v[:, None]).astype(np.uint8)
-            sub = rgb[r0:r1, vis]
-            np.copyto(sub, np.broadcast_to(colour_v[None, :, :], sub.shape), where=mask[:, :, None])
-            rgb[r0:r1, vis] = sub
-            mm_v = np.rint(depth_v * 1000.0).astype(np.uint16)
-            dsub = depth_mm[r0:r1, vis]
-            np.copyto(dsub, np.broadcast_to(mm_v[None, :], dsub.shape), where=mask)
-            depth_mm[r0:r1, vis] = dsub
-            wall[r0:r1, vis] |= mask
-            cut[cols] = np.minimum(cut[cols], top_c)
-        if scene.floor is not None:
+        if want_rgb or want_depth:
+            # the image as (H, 3W) bytes, each pixel's mask repeated over its three channels: selecting
+            # bytes is cheaper than any interleaving of channels or a select over 3-byte elements
+            np.greater_equal(rows, np.repeat(top, 3), out=wall3)
+            np.less(rows, np.repeat(bottom, 3), out=self._below3)
+            wall3 &= self._below3
+        # the wall mask per pixel (the floor markings are painted elsewhere): every third lane
+        wall = wall3.reshape(self.height, self.width, 3)[:, :, 0].copy() if paint else None
+        depth_mm = _EMPTY_DEPTH
+        if want_depth:
+            wall_mm = np.rint(np.where(found, depth, 0.0) * 1000.0).astype(np.uint16)
+            # the per-pixel mask again, from byte-wide comparisons (cheaper than every third lane)
+            wall1, below1 = self._wall1, self._below1
+            np.greater_equal(rows, top, out=wall1)
+            np.less(rows, bottom, out=below1)
+            wall1 &= below1
+            np.copyto(self._lanes1, wall1)
+            depth_mm = _select(self._lanes1, wall_mm[None, :], self._floor_depth_image)
+        rgb = _EMPTY_RGB
+        if want_rgb:
+            light = np.clip(1.1 - depth / 15.0, 0.45, 1.0)  # flat shading, darker with distance
+            col = (colors * light[:, None]).astype(np.uint8).reshape(1, 3 * self.width)
+            rgb = _select(self._lanes3, col, self._background).reshape(self.height, self.width, 3)
+        thresholds = layer_thresholds(scene, self.cam_z)
+        if thresholds and (want_rgb or want_depth):
+            self._farther_layers(hits, thresholds, found, item, top, rgb, depth_mm, wall)
+        if paint:
+            assert scene.floor is not None and wall is not None
             self._paint_floor(rgb, wall, scene.floor, x, y, yaw)
         return rgb, depth_mm
 
-    def _layer(
+    def _farther_layers(
         self,
-        scene: Scene,
-        x: float,
-        y: float,
-        angles: np.ndarray,
-        far: float,
-        threshold: float | None,
-        cols: np.ndarray | None = None,
+        hits: _Crossings,
+        thresholds: list[float],
+        found: np.ndarray,
+        item: np.ndarray,
+        top: np.ndarray,
+        rgb: np.ndarray,
+        depth_mm: np.ndarray,
+        wall: np.ndarray | None,
+    ) -> None:
+        """Draw, above the first layer, the farther obstacles of taller classes.
+
+        An obstacle's class is how many thresholds its height reaches. Per column, the next layer
+        is the nearest crossing of a class above every nearer layer's (only columns whose layers so
+        far are all shorter than some threshold have one); it shows in the rows between its own top
+        and its foot, cut at the nearer layers' tops. A crossing beyond the depth range ends the
+        column, as a layer found there would (no data there)."""
+        level = np.searchsorted(np.asarray(thresholds), hits.heights, "right")  # class per obstacle
+        # the class each column has reached; a column with nothing in range takes no further layer
+        reached = np.where(found, level[np.maximum(item, 0)], len(thresholds) + 1)
+        ray_of, item_of, t = hits.ray_of, hits.item_of, hits.t
+        pair_level = level[item_of]
+        keep = pair_level > reached[ray_of]
+        keep &= t != np.inf  # pairs that do not meet
+        keep = np.flatnonzero(keep)
+        if not len(keep):
+            return
+        ray_of, item_of, t, pair_level = ray_of[keep], item_of[keep], t[keep], pair_level[keep]
+        cut = (
+            top.copy()
+        )  # rows at or below a nearer layer's top are that layer's (or the floor in front of it)
+        rows = self._rows
+        while len(t):
+            dist, nearest = nearest_hits(self.width, ray_of, item_of, t)
+            cols = np.flatnonzero(nearest >= 0)
+            found_c, depth_c, top_c, bottom_c, colors_c, _heights = self._layer(
+                hits, dist[cols], nearest[cols], cols
+            )
+            bottom_c = np.minimum(bottom_c, cut[cols])
+            visible = found_c & (top_c < bottom_c)
+            # a layer beyond the depth range ends its column (nothing farther is in range either)
+            reached[cols] = np.where(found_c, level[nearest[cols]], len(thresholds) + 1)
+            if visible.any():
+                # the layer's visible rows lie in one band: masked copies over that band only
+                vis = cols[visible]
+                top_v, bottom_v = top_c[visible], bottom_c[visible]
+                r0, r1 = int(top_v.min()), int(bottom_v.max())
+                band = rows[r0:r1]
+                mask = (band >= top_v[None, :]) & (
+                    band < bottom_v[None, :]
+                )  # (rows of the band, visible cols)
+                depth_v = depth_c[visible]
+                light_v = np.clip(1.1 - depth_v / 15.0, 0.45, 1.0)
+                if rgb.size:
+                    colour_v = (colors_c[visible] * light_v[:, None]).astype(np.uint8)
+                    sub = rgb[r0:r1, vis]
+                    np.copyto(sub, np.broadcast_to(colour_v[None, :, :], sub.shape), where=mask[:, :, None])
+                    rgb[r0:r1, vis] = sub
+                if depth_mm.size:
+                    mm_v = np.rint(depth_v * 1000.0).astype(np.uint16)
+                    dsub = depth_mm[r0:r1, vis]
+                    np.copyto(dsub, np.broadcast_to(mm_v[None, :], dsub.shape), where=mask)
+                    depth_mm[r0:r1, vis] = dsub
+                if wall is not None:
+                    wall[r0:r1, vis] |= mask
+            cut[cols] = np.minimum(cut[cols], top_c)
+            more = np.flatnonzero(pair_level > reached[ray_of])
+            ray_of, item_of, t, pair_level = ray_of[more], item_of[more], t[more], pair_level[more]
+
+    def _layer(
+        self, hits: _Crossings, dist: np.ndarray, item: np.ndarray, cols: np.ndarray | None
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Per column (all, or the ``cols`` whose ``angles`` are given): whether an obstacle (at least
-        ``threshold`` tall) is seen, its depth along the optical axis, its top and foot rows
-        (``top <= v < bottom``), its colour and its height."""
-        segs, heights_all, colours_all = scene.segments, scene.heights, scene.colors
-        circles, radii, c_heights, c_colours = (
-            scene.circles,
-            scene.radii,
-            scene.circle_heights,
-            scene.circle_colors,
-        )
-        if threshold is not None:
-            tall = heights_all >= threshold
-            segs, heights_all, colours_all = segs[tall], heights_all[tall], colours_all[tall]
-            if len(circles):
-                tall_c = c_heights >= threshold
-                circles, radii = circles[tall_c], radii[tall_c]
-                c_heights, c_colours = c_heights[tall_c], c_colours[tall_c]
-        dist, seg = cast_segments(x, y, angles, segs, far)
-        found = seg >= 0
-        if len(heights_all):
-            # a column with no hit (-1) reads the last segment's: never drawn, ``found`` masks it out
-            heights, colors = heights_all[seg], colours_all[seg]
-        else:
-            heights, colors = np.zeros(len(angles)), np.zeros((len(angles), 3), dtype=np.uint8)
-        if len(circles):
-            cd, ci = cast_circles(x, y, angles, circles, radii, far)
-            nearer = cd < dist
-            dist = np.where(nearer, cd, dist)
-            heights[nearer] = c_heights[ci[nearer]]
-            colors[nearer] = c_colours[ci[nearer]]
-            found |= nearer
+        """Per column (all, or ``cols``), from its chosen crossing (``dist`` along the ray, obstacle
+        ``item``, -1 for none): whether an obstacle is seen, its depth along the optical axis, its
+        top and foot rows (``top <= v < bottom``), its colour and its height."""
+        found = item >= 0
+        # a column with no hit (-1) reads the last obstacle's: never drawn, ``found`` masks it out
+        heights, colors = hits.heights[item], hits.colors[item]
         depth = dist * (self.col_cos if cols is None else self.col_cos[cols])  # along the optical axis
         found &= depth <= self.depth_max
         # rows v whose ray meets the column's obstacle between its foot and its top:
@@ -280,17 +354,24 @@ MAX_EXTRA_LAYERS = 3
 def layer_thresholds(scene: Scene, cam_z: float) -> list[float]:
     """Heights above which a farther obstacle can show over a nearer, shorter one: the scene's
     distinct obstacle heights but the lowest (that class is everything: the first layer), thinned
-    to :data:`MAX_EXTRA_LAYERS`. None when all obstacles are equally tall (the common case)."""
+    to :data:`MAX_EXTRA_LAYERS`. None when all obstacles are equally tall (the common case).
+
+    Remembered per set of heights: a scene is rebuilt every frame, its heights rarely change."""
     heights = (
         scene.heights if not len(scene.circles) else np.concatenate([scene.heights, scene.circle_heights])
     )
     if not len(heights):
         return []
-    distinct = np.unique(heights)[1:]
-    if len(distinct) > MAX_EXTRA_LAYERS:
-        picks = np.linspace(0, len(distinct) - 1, MAX_EXTRA_LAYERS).round().astype(int)
+    return list(_thresholds(np.ascontiguousarray(heights, dtype=np.float64).tobytes(), MAX_EXTRA_LAYERS))
+
+
+@functools.lru_cache(maxsize=16)
+def _thresholds(heights: bytes, most: int) -> tuple[float, ...]:
+    distinct = np.unique(np.frombuffer(heights, dtype=np.float64))[1:]
+    if len(distinct) > most:
+        picks = np.linspace(0, len(distinct) - 1, most).round().astype(int)
         distinct = distinct[np.unique(picks)]
-    return [float(h) for h in distinct]
+    return tuple(float(h) for h in distinct)
 
 
 def _padded_empty(shape: tuple[int, ...], dtype: type) -> np.ndarray:

@@ -28,6 +28,9 @@ from ninjemys.sim.world2d import MovingObstacle, Obstacle, World, box_outline, c
 TRAIL_LENGTH = 2000
 PERSONAL_SPACE = 0.2  # m: the gap a person who gives way keeps from a robot's body
 LOOK_AHEAD = 2.0  # m: how far ahead on its route such a person starts to step aside
+#: the longest physics step set_physics_properties accepts (s): the collision check splits a move
+#: into short pieces, but sensors fire at most once a step, so a longer one would slow a 10 Hz lidar
+MAX_TIME_STEP = 0.1
 
 
 class SpawnError(NinjemysError, ValueError):
@@ -129,6 +132,8 @@ class Simulation:
         self.dt = dt
         self.seed = seed
         self.steps = 0
+        # the step may change (Gazebo's set_physics_properties): time counts whole steps since then
+        self._since = (0, 0)  # (steps, nanoseconds) when the current step began
         self.world_time = 0.0  # moving obstacles' clock (reset_world restarts it, time goes on)
         self.robots: dict[str, Robot] = {}
         self.obstacle_yaw: dict[str, float] = {}  # yaw of spawned or moved obstacles (outlines have none)
@@ -143,24 +148,44 @@ class Simulation:
     @property
     def time(self) -> float:
         """Simulated seconds: a whole number of steps, so stamps never drift."""
-        return self.steps * self.dt
+        steps0, ns0 = self._since
+        if not ns0:
+            return self.steps * self.dt
+        return ns0 / 1e9 + (self.steps - steps0) * self.dt
+
+    @property
+    def time_ns(self) -> int:
+        """Simulated time in whole nanoseconds (message stamps), exact over any number of steps."""
+        steps0, ns0 = self._since
+        return ns0 + round((self.steps - steps0) * self.dt * 1e9)
+
+    def set_time_step(self, dt: float) -> None:
+        """Step ``dt`` seconds from now on (Gazebo's ``set_physics_properties`` time_step); time
+        goes on from where it is. Refused (SpawnError) unless 0 < dt <= MAX_TIME_STEP."""
+        if not (math.isfinite(dt) and 0.0 < dt <= MAX_TIME_STEP):
+            raise SpawnError(f"time_step {dt} must be in (0, {MAX_TIME_STEP:g}] s")
+        self._since = (self.steps, self.time_ns)
+        self.dt = dt
 
     # -- geometry -------------------------------------------------------------------------------
     def _rebuild_static(self) -> None:
         w = self.world
         w.rebuild()
         segs, heights, colours = [w.segments], [w.seg_height], [w.seg_color]
+        facing = [w.seg_facing]
         names = [w.obstacles[i].name for i in w.seg_owner]
         if w.grid is not None:
             g = w.grid
             edges = grid_edges(g.occupied, g.resolution, g.origin_x, g.origin_y)
             segs.append(edges)
+            facing.append(np.zeros(len(edges), dtype=np.int8))
             heights.append(np.full(len(edges), g.height))
             colours.append(np.tile(np.array(g.color, dtype=np.uint8), (len(edges), 1)))
             names += ["map"] * len(edges)
         self._static = np.vstack(segs) if any(len(s) for s in segs) else np.zeros((0, 4))
         self._static_height = np.concatenate(heights)
         self._static_color = np.vstack(colours).astype(np.uint8)
+        self._static_facing = np.concatenate(facing).astype(np.int8)
         self.static_names = names
         for r in self.robots.values():
             r.free = None  # the static world changed
@@ -246,6 +271,12 @@ class Simulation:
         segs = np.vstack([self._static, ms]) if len(ms) else self._static
         heights = np.concatenate([self._static_height, mh]) if len(ms) else self._static_height
         colours = np.vstack([self._static_color, mc]) if len(ms) else self._static_color
+        # a moving obstacle may walk over a robot (the camera inside it sees its inside): both sides
+        facing = (
+            np.concatenate([self._static_facing, np.zeros(len(ms), dtype=np.int8)])
+            if len(ms)
+            else self._static_facing
+        )
         others = [r for r in self.robots.values() if r.name != exclude]
         return Scene(
             segs,
@@ -256,6 +287,7 @@ class Simulation:
             np.array([r.model.body_height for r in others]),
             np.array([r.model.color for r in others], dtype=np.uint8).reshape(-1, 3),
             self._floor,
+            facing,
         )
 
     def clearance(self, x: float, y: float, exclude: str | None = None) -> tuple[float, str]:
@@ -492,6 +524,7 @@ class Simulation:
         """reset_world, and simulated time back to 0 (Gazebo's reset_simulation)."""
         self.reset_world()
         self.steps = 0
+        self._since = (0, 0)
 
     def step(self) -> list[Robot]:
         """Advance one physics step; returns the robots that came into contact during it."""
@@ -689,11 +722,16 @@ class Simulation:
             r.rng,
         )
 
-    def render(self, r: Robot, scene: Scene | None = None) -> tuple[np.ndarray, np.ndarray]:
+    def render(
+        self, r: Robot, scene: Scene | None = None, colour: bool = True, depth: bool = True
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """``r``'s camera images (colour, depth); one not wanted is left empty (see Camera.render)."""
         spec = r.model.camera
         assert spec is not None and r.camera is not None
         cx, cy = self.sensor_pose(r, spec.pose.xyz)
-        return r.camera.render(scene or self.scene(r.name), cx, cy, r.yaw + spec.pose.rpy[2])
+        return r.camera.render(
+            scene or self.scene(r.name), cx, cy, r.yaw + spec.pose.rpy[2], colour=colour, depth=depth
+        )
 
     def imu(self, r: Robot) -> tuple[float, float, float, float]:
         spec = r.model.imu

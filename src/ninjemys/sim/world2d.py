@@ -62,6 +62,21 @@ class Obstacle:
             return pts.reshape(1, 4).copy()
         return np.hstack([pts, np.roll(pts, -1, axis=0)])
 
+    def facing(self) -> int:
+        """+1 for a convex outline going counter-clockwise, -1 clockwise, 0 for anything else (a
+        thin wall, a concave or degenerate outline). Ray casts skip the sides of a convex outline
+        that face away from the eye: the crossing that enters it is always on a side facing it."""
+        pts = self.outline
+        if len(pts) < 3:
+            return 0
+        e = np.roll(pts, -1, axis=0) - pts
+        turns = e[:, 0] * np.roll(e[:, 1], -1) - e[:, 1] * np.roll(e[:, 0], -1)
+        if (turns > 1e-12).all():
+            return 1
+        if (turns < -1e-12).all():
+            return -1
+        return 0
+
 
 @dataclass
 class Marking:
@@ -177,10 +192,11 @@ class World:
 
     def rebuild(self) -> None:
         """Recompute the flat segment arrays after obstacles were added or removed."""
-        segs, heights, colours, owner = [], [], [], []
+        segs, heights, colours, owner, facing = [], [], [], [], []
         for i, ob in enumerate(self.obstacles):
             s = ob.segments()
             segs.append(s)
+            facing.append(np.full(len(s), ob.facing(), dtype=np.int8))
             heights.append(np.full(len(s), ob.height))
             colours.append(np.tile(np.array(ob.color, dtype=np.uint8), (len(s), 1)))
             owner.append(np.full(len(s), i))
@@ -188,6 +204,8 @@ class World:
         self.seg_height = np.concatenate(heights) if heights else np.zeros(0)
         self.seg_color = np.vstack(colours) if colours else np.zeros((0, 3), dtype=np.uint8)
         self.seg_owner = np.concatenate(owner) if owner else np.zeros(0, dtype=int)
+        #: per segment: its outline's :meth:`Obstacle.facing` (+1, -1, or 0: both sides seen)
+        self.seg_facing = np.concatenate(facing) if facing else np.zeros(0, dtype=np.int8)
 
     def extent(self) -> tuple[float, float, float, float]:
         """The area worth drawing and rasterizing: declared bounds, else everything plus a margin."""

@@ -12,7 +12,15 @@ from __future__ import annotations
 import math
 
 from ninjemys.sim.description.gazebo import DIFF_DRIVE, ROS_CONTROL, SKID_STEER, GazeboConfig, read_gazebo
-from ninjemys.sim.description.geometry import IDENTITY, Geometry, Wheel, compose, link_colour, read_geometry
+from ninjemys.sim.description.geometry import (
+    IDENTITY,
+    Geometry,
+    Wheel,
+    apply,
+    compose,
+    link_colour,
+    read_geometry,
+)
 from ninjemys.sim.description.xmltree import DescriptionError, Document, parse
 from ninjemys.sim.robot_model import DriveSpec, RobotModel
 
@@ -65,6 +73,7 @@ def model_from_description(text: str, source: str, *, robot_namespace: str | Non
     accel = cfg.wheel_accel
     max_accel = accel / radius if accel else UNLIMITED_ACCEL
     limit = _velocity_limit(doc, left.joint) if left.joint else None
+    mass, inertia_z = _body_mass(doc, geo)
     return RobotModel(
         name=geo.name or "robot",
         wheel_radius=radius,
@@ -86,7 +95,52 @@ def model_from_description(text: str, source: str, *, robot_namespace: str | Non
         warnings=warnings,
         sensor_tf=False,
         control_joints=_control_joints(doc, geo, left, right) if drive.kind == "ros_control" else {},
+        mass=mass,
+        inertia_z=inertia_z,
+        wheel_tf_joints=(
+            [geo.joints[w.joint] for w in (left, right) if w.joint in geo.joints]
+            if drive.publish_wheel_tf and left is not right
+            else []
+        ),
     )
+
+
+def _body_mass(doc: Document, geo: Geometry) -> tuple[float, float | None]:
+    """The body's mass (kg) and moment of inertia about the vertical through the root (kg m^2), from
+    the ``<inertial>`` of the links rigidly attached to the root (Gazebo lumps those into one body;
+    each link's izz moved to the root's axis by the parallel-axis rule). Without any: 1 kg and None."""
+    mass, izz = 0.0, 0.0
+    for link in geo.body_links():
+        el = geo.links.get(link)
+        inertial = el.find("inertial") if el is not None else None
+        mass_el = inertial.find("mass") if inertial is not None else None
+        if inertial is None or mass_el is None:
+            continue
+        try:
+            m = float(mass_el.get("value", ""))
+        except ValueError:
+            raise doc.error(mass_el, f"link '{link}': <mass value> is not a number") from None
+        if not (m >= 0.0 and math.isfinite(m)):
+            raise doc.error(mass_el, f"link '{link}': <mass value> must be a finite number >= 0")
+        inertia = inertial.find("inertia")
+        try:
+            i_zz = float(inertia.get("izz", "0")) if inertia is not None else 0.0
+        except ValueError:
+            raise doc.error(inertia, f"link '{link}': <inertia izz> is not a number") from None
+        if not (i_zz >= 0.0 and math.isfinite(i_zz)):
+            raise doc.error(inertia, f"link '{link}': <inertia izz> must be a finite number >= 0")
+        origin = inertial.find("origin")
+        text = origin.get("xyz", "0 0 0") if origin is not None else "0 0 0"
+        try:
+            ox, oy, oz = ([float(v) for v in text.split()] + [0.0, 0.0, 0.0])[:3]
+        except ValueError:
+            raise doc.error(origin, f"link '{link}': <inertial><origin xyz> is not three numbers") from None
+        cx, cy, _cz = apply(geo.pose_of(link), (ox, oy, oz))  # the centre of mass
+        mass += m
+        izz += i_zz + m * (cx * cx + cy * cy)
+    if mass <= 0.0:
+        return 1.0, None
+    return mass, (izz if izz > 0.0 else None)
 
 
 def _control_joints(doc: Document, geo: Geometry, left: Wheel, right: Wheel) -> dict[str, str]:
