@@ -137,3 +137,23 @@ def test_reapproach_count_survives_replans_of_the_same_goal():
     dwa.reapproaches = 1
     dwa.set_plan(np.array([[1.2, 1.5, 0.0], [1.5, 1.5, 0.0]]))
     assert dwa.reapproaches == 1
+
+
+def test_a_drive_back_in_that_cannot_get_there_ends_with_the_turn_not_the_recoveries():
+    """In a narrow spot the drive back in may never reach half the tolerance: after REAPPROACH_CYCLES
+    cycles the robot turns where it stands and the goal ends there (before the drive back in existed,
+    the latched approach ended there too), instead of hunting into move_base's oscillation check."""
+    from ninjemys.nav.dwa import REAPPROACH_CYCLES
+
+    cm = open_floor()
+    dwa = DWAPlanner(DWAParams(yaw_goal_tolerance=0.1))
+    dwa.set_plan(np.array([[1.2, 1.5, 0.0], [1.5, 1.5, 0.0]]))
+    dwa.compute((1.42, 1.5, 0.0), (0.0, 0.0), cm)  # latched, at the goal's yaw
+    assert not dwa.compute((1.38, 1.5, 0.0), (0.0, 0.0), cm).reached  # the estimate jumped out
+    turned = None
+    for cycle in range(REAPPROACH_CYCLES + 5):  # a robot that does not move: stuck in place
+        cmd = dwa.compute((1.38, 1.5, 0.0), (0.0, 0.0), cm)
+        if cmd.reached:
+            turned = cycle
+            break
+    assert turned is not None and REAPPROACH_CYCLES - 5 <= turned <= REAPPROACH_CYCLES + 1, turned

@@ -17,7 +17,7 @@ a narrow spot the last centimetres may have no safe arc at all; within ``NEAR_GO
 the goal, standing, that also ends the approach with the turn in place (ours; dwa fails the cycle).
 The latch holds while the robot turns, but when the turn ends with the pose estimate out of
 ``xy_goal_tolerance`` (amcl corrected ``map -> odom`` during the turn) the robot drives in again, to
-half the tolerance, at most ``MAX_REAPPROACHES`` times per goal (ours; ROS 1's latched controller reports success wherever
+half the tolerance, at most ``MAX_REAPPROACHES`` times and ``REAPPROACH_CYCLES`` cycles per goal (ours; ROS 1's latched controller reports success wherever
 the estimate has gone, which in the office left the robot 0.21 m from its goal in truth).
 Everything for one cycle is a handful of numpy operations over all samples at once.
 """
@@ -39,6 +39,10 @@ NEAR_GOAL = 1.5
 #: how many times per goal the final turn may end in a drive back in, because the pose estimate moved
 #: out of xy_goal_tolerance while the robot turned in place (ours; see DWAPlanner.compute)
 MAX_REAPPROACHES = 2
+
+#: control cycles (5 s at controller_frequency 20) that the drives back in of one goal may take in all;
+#: then the approach ends with the turn where the robot stands, as the latched approach did
+REAPPROACH_CYCLES = 100
 
 
 @dataclass
@@ -105,6 +109,7 @@ class DWAPlanner:
         self.plan = np.zeros((0, 3))
         self.xy_latched = False
         self.reapproaches = 0  # drives back in after the final turn found the estimate out of tolerance
+        self.reapproach_cycles = 0  # control cycles spent driving back in, for this goal
 
     def set_plan(self, plan: np.ndarray) -> None:
         """A new global plan (n, 3) in the local costmap's frame; resets the goal latch."""
@@ -115,6 +120,7 @@ class DWAPlanner:
         """A new goal (not a new plan for the same goal): forget the latch and the re-approaches."""
         self.xy_latched = False
         self.reapproaches = 0
+        self.reapproach_cycles = 0
 
     def _drifted(self, x: float, y: float) -> bool:
         """At the end of the final turn, the robot's estimate is out of ``xy_goal_tolerance`` again
@@ -167,6 +173,13 @@ class DWAPlanner:
             # and turned (amcl corrects map -> odom on every 0.1 rad of turn): drive in again
             self.reapproaches += 1
             self.xy_latched = False
+        if self.reapproaches and not self.xy_latched:
+            self.reapproach_cycles += 1
+            if self.reapproach_cycles > REAPPROACH_CYCLES:
+                # a drive back in that cannot get there (a narrow spot, costs near the goal) ends as the
+                # latched approach would have ended: with the turn, never with the recoveries
+                self.xy_latched = True
+                return self._rotate_to(th, gyaw, vel, period)
         cmd = self._sample(x, y, th, vel, costmap)
         stopped = abs(vel[0]) <= p.acc_lim_x / p.controller_frequency  # turning in place was sampled
         if not cmd.valid and stopped and math.hypot(gx - x, gy - y) <= NEAR_GOAL * p.xy_goal_tolerance:
