@@ -1,4 +1,5 @@
-"""A/B of any benchmark: the tree at a git revision (``--before``) and this tree, alternating, in one run.
+"""A/B of any benchmark: the tree at a git revision (``--before``) and this tree, alternating, in one run
+(a tool, not a benchmark: ``run_all.py`` does not list it, it has no ``main``).
 
 Each side runs its own copy of the benchmark (``bench/`` and ``src/`` of that revision, extracted with
 ``git archive``; this tree's for the other side) under the venv's interpreter, with ``PYTHONPATH``
@@ -50,7 +51,7 @@ def run_side(tree: Path, script: str, args: list[str], timeout: float) -> tuple[
     return out, time.monotonic() - start
 
 
-def main() -> int:
+def compare() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--before", required=True, help="the git revision to compare with")
     ap.add_argument("--rounds", type=int, default=2)
@@ -79,4 +80,4 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(compare())
