@@ -157,3 +157,18 @@ def test_a_drive_back_in_that_cannot_get_there_ends_with_the_turn_not_the_recove
             turned = cycle
             break
     assert turned is not None and REAPPROACH_CYCLES - 5 <= turned <= REAPPROACH_CYCLES + 1, turned
+
+
+def test_the_goal_is_reached_only_once_the_turn_has_stopped():
+    """ROS 1 judges the goal on a stopped robot (base_local_planner::stopped). In the maze, move_base
+    reported a goal reached at yaw -2.36 (tolerance met) while the robot was still turning; ground truth
+    later read 2.95, 1 rad on (the command that stopped it came late at 8x real time on a loaded machine)."""
+    cm = open_floor()
+    dwa = DWAPlanner(DWAParams(yaw_goal_tolerance=0.1))
+    dwa.set_plan(np.array([[1.2, 1.5, 0.0], [1.5, 1.5, 0.0]]))
+    cmd = dwa.compute((1.47, 1.5, 0.05), (0.0, 1.2), cm)  # heading within tolerance, still turning fast
+    assert not cmd.reached and cmd.turning and (cmd.v, cmd.w) == (0.0, 0.0)  # stop first
+    assert dwa.compute((1.47, 1.5, 0.05), (0.0, 0.0), cm).reached  # stopped inside the tolerance: done
+    # stopped past the tolerance instead: it turns back, it does not end there
+    cmd = dwa.compute((1.47, 1.5, -0.3), (0.0, 0.0), cm)
+    assert not cmd.reached and cmd.w > 0.0

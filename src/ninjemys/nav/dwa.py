@@ -36,6 +36,9 @@ from ninjemys.tf2.math import angle_diff
 #: it turns in place to the goal's yaw
 NEAR_GOAL = 1.5
 
+#: the robot counts as stopped below this angular speed (rad/s), base_local_planner's rot_stopped_vel
+ROT_STOPPED_VEL = 0.01
+
 #: how many times per goal the final turn may end in a drive back in, because the pose estimate moved
 #: out of xy_goal_tolerance while the robot turned in place (ours; see DWAPlanner.compute)
 MAX_REAPPROACHES = 2
@@ -202,6 +205,11 @@ class DWAPlanner:
             return Command(v, 0.0, turning=True)
         err = angle_diff(goal_yaw, th)
         if abs(err) <= p.yaw_goal_tolerance:
+            if abs(vel[1]) > ROT_STOPPED_VEL:
+                # still turning: stop, and judge the heading once stopped (ROS 1's isGoalReached asks
+                # base_local_planner::stopped too). Ended at once, a late pose or a late stop under load
+                # carried the turn on past the tolerance after the goal had been reported reached.
+                return Command(0.0, 0.0, turning=True)
             return Command(0.0, 0.0, reached=True)
         # the fastest turn that can still stop at the goal yaw within the acceleration limits, and no
         # faster than 2 rad/s per radian left: a late or missed cycle near the goal overshoots little
