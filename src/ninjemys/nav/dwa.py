@@ -36,9 +36,6 @@ from ninjemys.tf2.math import angle_diff
 #: it turns in place to the goal's yaw
 NEAR_GOAL = 1.5
 
-#: the robot counts as stopped below this angular speed (rad/s), base_local_planner's rot_stopped_vel
-ROT_STOPPED_VEL = 0.01
-
 #: how many times per goal the final turn may end in a drive back in, because the pose estimate moved
 #: out of xy_goal_tolerance while the robot turned in place (ours; see DWAPlanner.compute)
 MAX_REAPPROACHES = 2
@@ -72,6 +69,9 @@ class DWAParams:
     xy_goal_tolerance: float = 0.1
     yaw_goal_tolerance: float = 0.15
     latch_xy_goal_tolerance: bool = True
+    #: below this angular speed (rad/s, from odometry) the robot counts as stopped: the goal is judged
+    #: then (base_local_planner's ``rot_stopped_vel``, same default)
+    rot_stopped_vel: float = 0.01
     prune_plan: bool = True
 
     def update(self, values: dict[str, object]) -> list[str]:
@@ -205,7 +205,7 @@ class DWAPlanner:
             return Command(v, 0.0, turning=True)
         err = angle_diff(goal_yaw, th)
         if abs(err) <= p.yaw_goal_tolerance:
-            if abs(vel[1]) > ROT_STOPPED_VEL:
+            if abs(vel[1]) > p.rot_stopped_vel:
                 # still turning: stop, and judge the heading once stopped (ROS 1's isGoalReached asks
                 # base_local_planner::stopped too). Ended at once, a late pose or a late stop under load
                 # carried the turn on past the tolerance after the goal had been reported reached.
