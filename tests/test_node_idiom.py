@@ -29,8 +29,18 @@ def rospy_imports(root: Path) -> list[str]:
     return found
 
 
+#: modules that are rospy programs on purpose, with the reason
+EXEMPT = {
+    # rostest's stock hztest is a unittest case that rostest.rosrun runs and reports as JUnit XML: the
+    # rostest facade that runs it is built on rospy, as in ROS 1
+    "tools/hztest.py",
+}
+
+
 def test_no_in_house_app_node_goes_through_rospy():
-    offenders = [hit for app in APPS for hit in rospy_imports(SRC / app)]
+    offenders = [
+        hit for app in APPS for hit in rospy_imports(SRC / app) if hit.rsplit(":", 1)[0] not in EXEMPT
+    ]
     assert offenders == [], "in-house nodes use ninjemys.node.run and the core Node: " + ", ".join(offenders)
 
 
