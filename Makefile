@@ -79,7 +79,7 @@ format: venv
 	$(VENV)/bin/ruff format src tests bench examples
 	$(VENV)/bin/ruff check --fix src tests bench examples
 
-# Static types of the core layers (wire, idl, net, master, node); the configuration is in pyproject.toml.
+# Static types of the whole of src/ninjemys (strict, no module relaxed); the configuration is in pyproject.toml.
 typecheck: venv
 	$(VENV)/bin/mypy
 

@@ -1,5 +1,6 @@
 """Public test helpers: free ports, locating Debian's real ROS 1 for comparison tests, a master or a node
-in a child process (:func:`run_master`, :class:`NodeProcess`) and polling waits (:func:`wait_until`).
+in a child process (:func:`run_master`, :func:`run_real_master`, :func:`run_real_roscore`,
+:class:`NodeProcess`) and polling waits (:func:`wait_until`, :func:`wait_for_master`).
 
 Kept dependency-free so user test suites (and ours) can import it without starting anything.
 """
@@ -108,6 +109,42 @@ def reset_rospy() -> None:
         core._reset()
 
 
+class WaitTimeout(NinjemysError, AssertionError):
+    """A test's wait ran out: an AssertionError, so pytest reports it as the test's failure."""
+
+
+def wait_for_master(
+    uri: str,
+    proc: subprocess.Popen[bytes] | None = None,
+    timeout: float = 20.0,
+    ready: Callable[[Any], bool] | None = None,
+    what: str = "the master",
+) -> None:
+    """Return once the master at ``uri`` answers ``getSystemState`` (and ``ready(state)`` holds, e.g. a
+    topic is registered). Raises :class:`WaitTimeout` naming ``what`` when ``proc`` (the master's process,
+    if the caller started it) exits first or ``timeout`` seconds pass: one wait for every kind of master
+    a test starts (ours, Debian's rosmaster or roscore)."""
+    from ninjemys.net import auth
+
+    deadline = time.monotonic() + timeout
+    answered = False
+    while True:
+        try:
+            # the master's reply is XML-RPC data (typeshed's union of every wire type): a triple here
+            reply: Any = auth.server_proxy(uri).getSystemState("/wait_for_master")
+            answered = True
+            if reply[0] == 1 and (ready is None or ready(reply[2])):
+                return
+        except OSError:
+            pass
+        if proc is not None and proc.poll() is not None:
+            raise WaitTimeout(f"{what} at {uri} exited with {proc.returncode} before it was ready")
+        if time.monotonic() > deadline:
+            state = "answered but was not ready" if answered else "did not answer"
+            raise WaitTimeout(f"{what} at {uri} {state} within {timeout:g} s")
+        time.sleep(0.02)
+
+
 @contextlib.contextmanager
 def run_master(
     port: int | None = None, env: dict[str, str] | None = None, timeout: float = 20.0
@@ -117,8 +154,6 @@ def run_master(
     ``env`` replaces the child's environment (ROS_HOME and ROS_LOG_DIR are inherited by default,
     so logs land in the test's own directory); its output is discarded.
     """
-    from ninjemys.net import auth
-
     port = port or free_port()
     uri = f"http://localhost:{port}/"
     child_env = dict(os.environ if env is None else env)
@@ -132,17 +167,28 @@ def run_master(
         stdin=subprocess.DEVNULL,
     )
     try:
-        deadline = time.monotonic() + timeout
-        while True:
-            try:
-                auth.server_proxy(uri).getPid("/run_master")
-                break
-            except OSError:
-                if proc.poll() is not None:
-                    raise RuntimeError(f"roscore -p {port} exited with {proc.returncode}") from None
-                if time.monotonic() > deadline:
-                    raise RuntimeError(f"roscore -p {port} did not answer within {timeout} s") from None
-                time.sleep(0.02)
+        wait_for_master(uri, proc, timeout, what=f"roscore -p {port}")
+        yield uri
+    finally:
+        proc.kill()
+        proc.wait()
+
+
+@contextlib.contextmanager
+def run_real_master(host: str = "localhost", timeout: float = 20.0) -> Iterator[str]:
+    """Debian's ``rosmaster --core`` (no rosout) on a free port under the system Python; yields its URI
+    once it answers, kills it afterwards. ``host`` names it in the URI and in ``ROS_HOSTNAME``."""
+    port = free_port()
+    uri = f"http://{host}:{port}/"
+    proc = subprocess.Popen(
+        [ROS1_PYTHON, str(ROS1_BIN / "rosmaster"), "--core", "-p", str(port)],
+        env=ros1_env(uri, ROS_HOSTNAME=host),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        stdin=subprocess.DEVNULL,
+    )
+    try:
+        wait_for_master(uri, proc, timeout, what=f"/usr/bin/rosmaster -p {port}")
         yield uri
     finally:
         proc.kill()
@@ -191,7 +237,6 @@ def kill_tree(proc: Any) -> None:
 @contextlib.contextmanager
 def run_real_roscore(ros_home: str | os.PathLike[str], timeout: float = 30.0) -> Iterator[str]:
     """Debian's /usr/bin/roscore on a free port; yields its URI once /rosout is up; kills the whole tree."""
-    from ninjemys.net import auth
 
     port = free_port()
     uri = f"http://localhost:{port}/"
@@ -204,28 +249,16 @@ def run_real_roscore(ros_home: str | os.PathLike[str], timeout: float = 30.0) ->
         start_new_session=True,
     )
     try:
-        deadline = time.monotonic() + timeout
-        while True:
-            try:
-                # the master's reply is XML-RPC data (typeshed's union of every wire type): a triple here
-                reply: Any = auth.server_proxy(uri).getSystemState("/run_real_roscore")
-                code, _, state = reply
-                if code == 1 and any(topic == "/rosout_agg" for topic, _ in state[0]):
-                    break
-            except OSError:
-                pass
-            if proc.poll() is not None:
-                raise RuntimeError(f"/usr/bin/roscore -p {port} exited with {proc.returncode}")
-            if time.monotonic() > deadline:
-                raise RuntimeError(f"/usr/bin/roscore -p {port} did not bring up /rosout within {timeout} s")
-            time.sleep(0.1)
+        wait_for_master(
+            uri,
+            proc,
+            timeout,
+            ready=lambda state: any(topic == "/rosout_agg" for topic, _ in state[0]),
+            what=f"/usr/bin/roscore -p {port} (with /rosout)",
+        )
         yield uri
     finally:
         kill_tree(proc)
-
-
-class WaitTimeout(NinjemysError, AssertionError):
-    """A test's wait ran out: an AssertionError, so pytest reports it as the test's failure."""
 
 
 def wait_until(

@@ -6,7 +6,6 @@ Both masters get the same sequence of calls through ``xmlrpc.client``; the repli
 
 from __future__ import annotations
 
-import subprocess
 import time
 import xmlrpc.client
 from collections.abc import Iterator
@@ -15,7 +14,7 @@ from typing import Any
 import pytest
 
 from ninjemys.master.core import MasterThread
-from ninjemys.testing import free_port, ros1_env
+from ninjemys.testing import run_real_master
 
 pytestmark = pytest.mark.ros1
 
@@ -168,29 +167,8 @@ def _run_calls(uri: str) -> list[Any]:
 
 @pytest.fixture
 def real_master() -> Iterator[str]:
-    port = free_port()
-    uri = f"http://127.0.0.1:{port}/"
-    proc = subprocess.Popen(
-        ["/usr/bin/rosmaster", "--core", "-p", str(port)],
-        env=ros1_env(uri, ROS_HOSTNAME="127.0.0.1"),
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-    )
-    try:
-        proxy = xmlrpc.client.ServerProxy(uri)
-        deadline = time.monotonic() + 20
-        while True:
-            try:
-                proxy.getPid("/probe")
-                break
-            except OSError:
-                if time.monotonic() > deadline or proc.poll() is not None:
-                    raise RuntimeError("real rosmaster did not come up") from None
-                time.sleep(0.05)
+    with run_real_master("127.0.0.1") as uri:
         yield uri
-    finally:
-        proc.kill()
-        proc.wait()
 
 
 def test_every_call_answers_like_rosmaster(real_master: str) -> None:

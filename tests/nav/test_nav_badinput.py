@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from ninjemys.testing import ninjemys_bin, ros1_env, run_master
+from ninjemys.testing import NodeProcess, ninjemys_bin, ros1_env, run_master, wait_until
 
 
 @pytest.fixture
@@ -20,31 +20,14 @@ def master(tmp_path):
 
 
 def run_node(env: dict[str, str], args: list[str], wait_for: str, timeout: float = 30.0) -> tuple[str, bool]:
-    """Start ``rosrun <args>``, collect its output until ``wait_for`` shows up; (output, still running)."""
-    log = os.path.join(env["ROS_HOME"], f"{args[1]}.out")
-    os.makedirs(env["ROS_HOME"], exist_ok=True)
-    with open(log, "w") as sink:
-        proc = subprocess.Popen(
-            [ninjemys_bin("rosrun"), *args], env=env, stdout=sink, stderr=subprocess.STDOUT
-        )
-    deadline = time.monotonic() + timeout
-    try:
-        while time.monotonic() < deadline and proc.poll() is None:
-            with open(log) as f:
-                if wait_for in f.read():
-                    break
-            time.sleep(0.1)
-        time.sleep(1.0)
-        alive = proc.poll() is None
-    finally:
-        proc.terminate()
-        try:
-            proc.wait(10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
-    with open(log) as f:
-        return f.read(), alive
+    """Start ``rosrun <args>``, wait until ``wait_for`` shows up in its output; (output, still running
+    a second later)."""
+    with NodeProcess([ninjemys_bin("rosrun"), *args], env=env, merge_stderr=True) as proc:
+        proc.wait_for(lambda line: wait_for in line, timeout)
+        time.sleep(1.0)  # the node must outlive the bad input, not just report it
+        alive = proc.proc.poll() is None
+        proc.stop()
+        return proc.text(), alive
 
 
 def test_map_that_does_not_load(master, tmp_path):
@@ -81,8 +64,7 @@ def test_map_saver_writes_what_map_server_reads(master, tmp_path):
 
     share = os.path.join(os.path.dirname(__file__), "..", "..", "src", "ninjemys", "packages", "share")
     maze = os.path.abspath(os.path.join(share, "puzzlebot_sim", "maps", "maze.yaml"))
-    server = subprocess.Popen([ninjemys_bin("rosrun"), "map_server", "map_server", maze], env=master)
-    try:
+    with NodeProcess([ninjemys_bin("rosrun"), "map_server", "map_server", maze], env=master):
         saver = subprocess.run(
             [ninjemys_bin("rosrun"), "map_server", "map_saver", "-f", str(tmp_path / "copy")],
             env=master,
@@ -90,9 +72,6 @@ def test_map_saver_writes_what_map_server_reads(master, tmp_path):
             text=True,
             timeout=60,
         )
-    finally:
-        server.terminate()
-        server.wait(10)
     assert saver.returncode == 0, saver.stderr
     original, copy = load_map(maze), load_map(tmp_path / "copy.yaml")
     assert copy.data.shape == original.data.shape and copy.origin == original.origin
@@ -102,12 +81,7 @@ def test_map_saver_writes_what_map_server_reads(master, tmp_path):
 @pytest.mark.ros1
 def test_move_base_tunables_through_ros1_dynparam(master, tmp_path):
     """ROS 1's own dynparam client changes the DWA's max_vel_x on a running move_base."""
-    log = os.path.join(master["ROS_HOME"], "mb.out")
-    os.makedirs(master["ROS_HOME"], exist_ok=True)
-    with open(log, "w") as sink:
-        proc = subprocess.Popen(
-            [ninjemys_bin("rosrun"), "move_base", "move_base"], env=master, stdout=sink, stderr=sink
-        )
+    proc = NodeProcess([ninjemys_bin("rosrun"), "move_base", "move_base"], env=master, merge_stderr=True)
     # Debian's dynparam calls roslib.load_manifest('dynamic_reconfigure'), and Debian ships no package.xml
     share = tmp_path / "share" / "dynamic_reconfigure"
     share.mkdir(parents=True)
@@ -118,8 +92,8 @@ def test_move_base_tunables_through_ros1_dynparam(master, tmp_path):
     env = ros1_env(master["ROS_MASTER_URI"], ROS_PACKAGE_PATH=str(tmp_path / "share"))
     try:
         dynparam = ["/usr/bin/python3", "/usr/lib/dynamic_reconfigure/dynparam"]  # Debian's
-        deadline = time.monotonic() + 40
-        while time.monotonic() < deadline:
+
+        def dwa_config() -> subprocess.CompletedProcess | None:
             got = subprocess.run(
                 [*dynparam, "get", "/move_base/DWAPlannerROS"],
                 env=env,
@@ -127,9 +101,9 @@ def test_move_base_tunables_through_ros1_dynparam(master, tmp_path):
                 text=True,
                 timeout=30,
             )
-            if got.returncode == 0 and "max_vel_x" in got.stdout:
-                break
-            time.sleep(1.0)
+            return got if got.returncode == 0 and "max_vel_x" in got.stdout else None
+
+        got = wait_until(dwa_config, 40.0, "move_base's DWAPlannerROS through Debian's dynparam", step=1.0)
         assert "'max_vel_x': 0.3" in got.stdout, got.stdout + got.stderr
         subprocess.run(
             [*dynparam, "set", "/move_base/DWAPlannerROS", "max_vel_x", "0.2"],
@@ -145,7 +119,6 @@ def test_move_base_tunables_through_ros1_dynparam(master, tmp_path):
             timeout=30,
         )
         assert "'max_vel_x': 0.2" in got.stdout
-        assert proc.poll() is None
+        assert proc.proc.poll() is None, proc.describe()
     finally:
-        proc.terminate()
-        proc.wait(10)
+        proc.stop()

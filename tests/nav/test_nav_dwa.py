@@ -85,3 +85,90 @@ def test_dwa_final_turn_settles_when_cycles_run_late():
         th += w * period
     assert cmd.reached, th
     assert abs(th - 2.0) <= params.yaw_goal_tolerance
+
+
+def open_floor(cx: float = 1.5, cy: float = 1.5) -> Costmap:
+    cm = Costmap(CostmapParams(rolling_window=True, width=2.0, height=2.0, robot_radius=0.12))
+    cm.set_static_map(np.zeros((60, 60), dtype=np.int8), 0.05, 0.0, 0.0)
+    cm.update_origin(cx, cy)
+    cm.update()
+    return cm
+
+
+def test_final_turn_drives_back_in_when_the_estimate_left_the_tolerance():
+    """The office run's two misses: latched 0.09 m from the goal, the robot turned in place while amcl
+    moved its estimate (map -> odom) 0.05 m away; the latched controller then reported success 0.13 m
+    from the goal by its own estimate (0.21 m in truth). The end of the turn checks the position again."""
+    cm = open_floor()
+    dwa = DWAPlanner(DWAParams(yaw_goal_tolerance=0.1))
+    goal = (1.5, 1.5, 0.0)
+    dwa.set_plan(np.array([[1.2, 1.5, 0.0], [*goal]]))
+    cmd = dwa.compute((1.41, 1.5, 1.0), (0.0, 0.0), cm)
+    assert dwa.xy_latched and cmd.turning and not cmd.reached  # within 0.1: stop and turn
+    # the turn ends at the goal's yaw, but the estimate now stands 0.13 m from the goal
+    cmd = dwa.compute((1.37, 1.5, 0.05), (0.0, 0.0), cm)
+    assert not cmd.reached and not cmd.turning and cmd.valid and cmd.v > 0.0, cmd  # drives back in
+    assert not dwa.xy_latched and dwa.reapproaches == 1
+    # a drive back in aims for half the tolerance: 0.06 m from the goal is not there yet
+    assert not dwa.compute((1.44, 1.5, 0.05), (0.0, 0.0), cm).turning
+    # within 0.05 m it turns (here: is at the yaw already) and ends there
+    assert dwa.compute((1.46, 1.5, 0.05), (0.0, 0.0), cm).reached
+
+
+def test_final_turn_drives_back_in_at_most_max_reapproaches_times():
+    """An estimate that keeps jumping out at every turn's end cannot hold the robot for ever."""
+    from ninjemys.nav.dwa import MAX_REAPPROACHES
+
+    cm = open_floor()
+    dwa = DWAPlanner(DWAParams(yaw_goal_tolerance=0.1))
+    dwa.set_plan(np.array([[1.2, 1.5, 0.0], [1.5, 1.5, 0.0]]))
+    outcomes = []
+    for _ in range(MAX_REAPPROACHES + 1):
+        dwa.compute((1.47, 1.5, 0.0), (0.0, 0.0), cm)  # latches (and is at the yaw already)
+        outcomes.append(dwa.compute((1.36, 1.5, 0.0), (0.0, 0.0), cm).reached)  # the estimate jumped out
+    assert outcomes == [False] * MAX_REAPPROACHES + [True]
+    dwa.new_goal()  # a new goal may drive back in again
+    assert dwa.reapproaches == 0 and not dwa.xy_latched
+
+
+def test_reapproach_count_survives_replans_of_the_same_goal():
+    """move_base hands the controller the plan again every cycle (in the odom frame): that is not a new goal."""
+    dwa = DWAPlanner()
+    dwa.reapproaches = 1
+    dwa.set_plan(np.array([[1.2, 1.5, 0.0], [1.5, 1.5, 0.0]]))
+    assert dwa.reapproaches == 1
+
+
+def test_a_drive_back_in_that_cannot_get_there_ends_with_the_turn_not_the_recoveries():
+    """In a narrow spot the drive back in may never reach half the tolerance: after REAPPROACH_CYCLES
+    cycles the robot turns where it stands and the goal ends there (before the drive back in existed,
+    the latched approach ended there too), instead of hunting into move_base's oscillation check."""
+    from ninjemys.nav.dwa import REAPPROACH_CYCLES
+
+    cm = open_floor()
+    dwa = DWAPlanner(DWAParams(yaw_goal_tolerance=0.1))
+    dwa.set_plan(np.array([[1.2, 1.5, 0.0], [1.5, 1.5, 0.0]]))
+    dwa.compute((1.42, 1.5, 0.0), (0.0, 0.0), cm)  # latched, at the goal's yaw
+    assert not dwa.compute((1.38, 1.5, 0.0), (0.0, 0.0), cm).reached  # the estimate jumped out
+    turned = None
+    for cycle in range(REAPPROACH_CYCLES + 5):  # a robot that does not move: stuck in place
+        cmd = dwa.compute((1.38, 1.5, 0.0), (0.0, 0.0), cm)
+        if cmd.reached:
+            turned = cycle
+            break
+    assert turned is not None and REAPPROACH_CYCLES - 5 <= turned <= REAPPROACH_CYCLES + 1, turned
+
+
+def test_the_goal_is_reached_only_once_the_turn_has_stopped():
+    """ROS 1 judges the goal on a stopped robot (base_local_planner::stopped). In the maze, move_base
+    reported a goal reached at yaw -2.36 (tolerance met) while the robot was still turning; ground truth
+    later read 2.95, 1 rad on (the command that stopped it came late at 8x real time on a loaded machine)."""
+    cm = open_floor()
+    dwa = DWAPlanner(DWAParams(yaw_goal_tolerance=0.1))
+    dwa.set_plan(np.array([[1.2, 1.5, 0.0], [1.5, 1.5, 0.0]]))
+    cmd = dwa.compute((1.47, 1.5, 0.05), (0.0, 1.2), cm)  # heading within tolerance, still turning fast
+    assert not cmd.reached and cmd.turning and (cmd.v, cmd.w) == (0.0, 0.0)  # stop first
+    assert dwa.compute((1.47, 1.5, 0.05), (0.0, 0.0), cm).reached  # stopped inside the tolerance: done
+    # stopped past the tolerance instead: it turns back, it does not end there
+    cmd = dwa.compute((1.47, 1.5, -0.3), (0.0, 0.0), cm)
+    assert not cmd.reached and cmd.w > 0.0

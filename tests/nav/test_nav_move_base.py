@@ -203,6 +203,30 @@ def test_final_turn_is_progress_only_while_the_heading_error_shrinks():
     assert fsm.state == CLEARING and 1.8 < t - stalled < 2.2  # from the last 0.05 rad of progress
 
 
+def test_a_turn_after_a_drive_back_in_is_progress_again():
+    """The controller re-approaches after a final turn (the estimate left the xy tolerance): the next
+    turn starts from a larger heading error than the first one ended with, and must count as progress
+    from there, not from the first turn's best (else a 0.1 m re-approach, under the oscillation
+    distance, ran into the oscillation check)."""
+    fsm, _ = make(oscillation_timeout=2.0, oscillation_distance=0.2)
+    fsm.accept((0.0, 0.0, 0.0), "h1", 0.0)
+    fsm.plan_now(POSE, 0.0)
+    t, yaw = 0.0, 1.5
+    fsm.controller.answer = Command(0.0, -0.5, turning=True)
+    while yaw > 0.05:  # the first final turn, down to the goal's heading
+        t, yaw = t + 0.05, yaw - 0.025
+        fsm.cycle(t, (0.0, 0.0, yaw), (0.0, 0.0, yaw), (0.0, -0.5))
+    fsm.controller.answer = Command(0.05, 0.5)  # the drive back in turns away and creeps 0.05 m
+    for _ in range(20):
+        t, yaw = t + 0.05, yaw + 0.05
+        fsm.cycle(t, (0.0, 0.0, yaw), (0.0, 0.0, yaw), (0.05, 0.5))
+    fsm.controller.answer = Command(0.0, -0.5, turning=True)
+    while yaw > 0.05:  # the second final turn: 2 s, as long as the oscillation timeout
+        t, yaw = t + 0.05, yaw - 0.025
+        fsm.cycle(t, (0.0, 0.0, yaw), (0.0, 0.0, yaw), (0.0, -0.5))
+        assert fsm.state == CONTROLLING, t
+
+
 def test_the_state_machine_imports_no_ros_socket_or_thread():
     """The brain stays testable without a process: no node, rospy, socket or thread below it."""
     import ast

@@ -40,7 +40,7 @@ class DwaSeam:
         self.dwa, self.cm = dwa, cm
 
     def new_goal(self) -> None:
-        self.dwa.xy_latched = False
+        self.dwa.new_goal()
 
     def set_plan(self, plan) -> None:
         latched = self.dwa.xy_latched

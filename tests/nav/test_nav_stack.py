@@ -94,6 +94,7 @@ def run_ros1_goals(session: NavSession, goals: list[tuple]) -> list[dict]:
             except ValueError:
                 continue
             item["truth"] = session.probe.truth
+            item["est"] = session.probe.localized()  # amcl's pose then: its error explains a miss
             results.append(item)
         proc.wait(30)
     finally:  # an interrupted or failed run leaves no client behind
@@ -142,7 +143,11 @@ def test_office_goals_through_ros1_simple_action_client(office):
         d, a = math.hypot(tx - gx, ty - gy), yaw_err(ta, ga)
         ok = item["state"] == 3 and d <= 0.2 and a <= 0.3
         reached += ok
-        report.append(f"{item['goal']} state={item['state']} d={d:.3f} yaw={a:.3f} {item['text']!r}")
+        est = item["est"] or (math.nan, math.nan, math.nan)
+        report.append(
+            f"{item['goal']} state={item['state']} d={d:.3f} yaw={a:.3f} {item['text']!r} "
+            f"amcl-truth {math.hypot(est[0] - tx, est[1] - ty):.3f} m, amcl-goal {math.hypot(est[0] - gx, est[1] - gy):.3f} m"
+        )
         assert item["feedback"] > 0  # move_base's feedback reached the ROS 1 client
         assert item["state"] in (3, 4) and item["text"], item  # SUCCEEDED or ABORTED, with its text
     # the action interface works end to end with Debian's client: most goals are reached

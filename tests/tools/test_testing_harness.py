@@ -99,3 +99,28 @@ def _state(pid: int) -> str:
             return f.read().rsplit(")", 1)[1].split()[0]
     except OSError:
         return "Z"
+
+
+def test_wait_for_master_names_a_master_that_exited_before_it_answered():
+    import subprocess
+
+    from ninjemys.testing import free_port, wait_for_master
+
+    proc = subprocess.Popen([sys.executable, "-c", "raise SystemExit(3)"])
+    proc.wait()
+    start = time.monotonic()
+    with pytest.raises(
+        WaitTimeout, match=r"the test's master at http://localhost:\d+/ exited with 3 before it was ready"
+    ):
+        wait_for_master(f"http://localhost:{free_port()}/", proc, timeout=30.0, what="the test's master")
+    assert time.monotonic() - start < 10.0  # at once, not after the timeout
+
+
+def test_wait_for_master_waits_for_readiness_as_well_as_an_answer():
+    from ninjemys.master.core import MasterThread
+    from ninjemys.testing import wait_for_master
+
+    with MasterThread() as uri:
+        wait_for_master(uri, timeout=5.0)
+        with pytest.raises(WaitTimeout, match="answered but was not ready within 0.3 s"):
+            wait_for_master(uri, timeout=0.3, ready=lambda state: any(t == "/x" for t, _ in state[0]))

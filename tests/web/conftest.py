@@ -7,28 +7,16 @@ import subprocess
 from collections.abc import Callable, Iterator
 
 import pytest
-from web_helpers import CHROMIUM, CHROMIUM_ARGS, wait_for_master
+from web_helpers import CHROMIUM, CHROMIUM_ARGS
 
-from ninjemys.testing import ROS1_PYTHON, free_port, ros1_env
+from ninjemys.testing import ROS1_PYTHON, ros1_env, run_real_master
 
 
 @pytest.fixture
 def ros1_master() -> Iterator[str]:
     """Debian's rosmaster on a free port (no rosout: the graph tests do not need it)."""
-    port = free_port()
-    uri = f"http://localhost:{port}/"
-    proc = subprocess.Popen(
-        [ROS1_PYTHON, "/usr/bin/rosmaster", "--core", "-p", str(port)],
-        env=ros1_env(uri),
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-    )
-    try:
-        wait_for_master(uri)
+    with run_real_master() as uri:
         yield uri
-    finally:
-        proc.kill()
-        proc.wait()
 
 
 @pytest.fixture

@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import contextlib
-import time
-import xmlrpc.client
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -49,17 +47,6 @@ rospy.init_node("listener")
 rospy.Subscriber("chatter", String, lambda msg: None)
 rospy.spin()
 """
-
-
-def wait_for_master(uri: str, timeout: float = 20.0) -> None:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        try:
-            xmlrpc.client.ServerProxy(uri).getPid("/test")
-            return
-        except OSError:
-            time.sleep(0.1)
-    raise RuntimeError(f"master at {uri} did not come up")
 
 
 @contextlib.contextmanager

@@ -15,6 +15,10 @@ Within ``xy_goal_tolerance`` of the goal the robot stops and turns in place to t
 (``yaw_goal_tolerance``), like dwa's LatchedStopRotateController (``latch_xy_goal_tolerance``). In
 a narrow spot the last centimetres may have no safe arc at all; within ``NEAR_GOAL`` tolerances of
 the goal, standing, that also ends the approach with the turn in place (ours; dwa fails the cycle).
+The latch holds while the robot turns, but when the turn ends with the pose estimate out of
+``xy_goal_tolerance`` (amcl corrected ``map -> odom`` during the turn) the robot drives in again, to
+half the tolerance, at most ``MAX_REAPPROACHES`` times and ``REAPPROACH_CYCLES`` cycles per goal (ours; ROS 1's latched controller reports success wherever
+the estimate has gone, which in the office left the robot 0.21 m from its goal in truth).
 Everything for one cycle is a handful of numpy operations over all samples at once.
 """
 
@@ -31,6 +35,14 @@ from ninjemys.tf2.math import angle_diff
 #: within this many xy_goal_tolerance of the goal, a standing robot with no safe arc ends the approach:
 #: it turns in place to the goal's yaw
 NEAR_GOAL = 1.5
+
+#: how many times per goal the final turn may end in a drive back in, because the pose estimate moved
+#: out of xy_goal_tolerance while the robot turned in place (ours; see DWAPlanner.compute)
+MAX_REAPPROACHES = 2
+
+#: control cycles (5 s at controller_frequency 20) that the drives back in of one goal may take in all;
+#: then the approach ends with the turn where the robot stands, as the latched approach did
+REAPPROACH_CYCLES = 100
 
 
 @dataclass
@@ -57,6 +69,9 @@ class DWAParams:
     xy_goal_tolerance: float = 0.1
     yaw_goal_tolerance: float = 0.15
     latch_xy_goal_tolerance: bool = True
+    #: below this angular speed (rad/s, from odometry) the robot counts as stopped: the goal is judged
+    #: then (base_local_planner's ``rot_stopped_vel``, same default)
+    rot_stopped_vel: float = 0.01
     prune_plan: bool = True
 
     def update(self, values: dict[str, object]) -> list[str]:
@@ -96,17 +111,32 @@ class DWAPlanner:
         self.params = params or DWAParams()
         self.plan = np.zeros((0, 3))
         self.xy_latched = False
+        self.reapproaches = 0  # drives back in after the final turn found the estimate out of tolerance
+        self.reapproach_cycles = 0  # control cycles spent driving back in, for this goal
 
     def set_plan(self, plan: np.ndarray) -> None:
         """A new global plan (n, 3) in the local costmap's frame; resets the goal latch."""
         self.plan = np.asarray(plan, dtype=float).reshape(-1, 3)
         self.xy_latched = False
 
-    def goal_reached_xy(self, x: float, y: float) -> bool:
+    def new_goal(self) -> None:
+        """A new goal (not a new plan for the same goal): forget the latch and the re-approaches."""
+        self.xy_latched = False
+        self.reapproaches = 0
+        self.reapproach_cycles = 0
+
+    def _drifted(self, x: float, y: float) -> bool:
+        """At the end of the final turn, the robot's estimate is out of ``xy_goal_tolerance`` again
+        and there is a re-approach left (``MAX_REAPPROACHES`` per goal, so a standing robot whose
+        estimate jitters at the edge cannot hunt for ever)."""
+        return not self.goal_reached_xy(x, y) and self.reapproaches < MAX_REAPPROACHES
+
+    def goal_reached_xy(self, x: float, y: float, scale: float = 1.0) -> bool:
+        """Within ``scale`` x ``xy_goal_tolerance`` of the plan's end."""
         if len(self.plan) == 0:
             return False
         gx, gy, _ = self.plan[-1]
-        return math.hypot(gx - x, gy - y) <= self.params.xy_goal_tolerance
+        return math.hypot(gx - x, gy - y) <= scale * self.params.xy_goal_tolerance
 
     def _prune(self, x: float, y: float) -> None:
         if not self.params.prune_plan or len(self.plan) < 2:
@@ -135,9 +165,24 @@ class DWAPlanner:
             return Command(0.0, 0.0, valid=False)
         self._prune(x, y)
         gx, gy, gyaw = self.plan[-1]
-        if self.goal_reached_xy(x, y) or (self.xy_latched and p.latch_xy_goal_tolerance):
+        # a drive back in aims for half the tolerance: the next turn's corrections have room to spare
+        inner = 0.5 if self.reapproaches else 1.0
+        if self.goal_reached_xy(x, y, inner) or (self.xy_latched and p.latch_xy_goal_tolerance):
             self.xy_latched = True
-            return self._rotate_to(th, gyaw, vel, period)
+            cmd = self._rotate_to(th, gyaw, vel, period)
+            if not (cmd.reached and self._drifted(x, y)):
+                return cmd
+            # the turn is done but the pose estimate has left the xy tolerance while the robot stood
+            # and turned (amcl corrects map -> odom on every 0.1 rad of turn): drive in again
+            self.reapproaches += 1
+            self.xy_latched = False
+        if self.reapproaches and not self.xy_latched:
+            self.reapproach_cycles += 1
+            if self.reapproach_cycles > REAPPROACH_CYCLES:
+                # a drive back in that cannot get there (a narrow spot, costs near the goal) ends as the
+                # latched approach would have ended: with the turn, never with the recoveries
+                self.xy_latched = True
+                return self._rotate_to(th, gyaw, vel, period)
         cmd = self._sample(x, y, th, vel, costmap)
         stopped = abs(vel[0]) <= p.acc_lim_x / p.controller_frequency  # turning in place was sampled
         if not cmd.valid and stopped and math.hypot(gx - x, gy - y) <= NEAR_GOAL * p.xy_goal_tolerance:
@@ -160,6 +205,11 @@ class DWAPlanner:
             return Command(v, 0.0, turning=True)
         err = angle_diff(goal_yaw, th)
         if abs(err) <= p.yaw_goal_tolerance:
+            if abs(vel[1]) > p.rot_stopped_vel:
+                # still turning: stop, and judge the heading once stopped (ROS 1's isGoalReached asks
+                # base_local_planner::stopped too). Ended at once, a late pose or a late stop under load
+                # carried the turn on past the tolerance after the goal had been reported reached.
+                return Command(0.0, 0.0, turning=True)
             return Command(0.0, 0.0, reached=True)
         # the fastest turn that can still stop at the goal yaw within the acceleration limits, and no
         # faster than 2 rad/s per radian left: a late or missed cycle near the goal overshoots little

@@ -410,8 +410,10 @@ class MoveBaseFsm:
                 if err < self.turn_best - TURN_PROGRESS:
                     self.turn_best = err
                     self.progress.reset(gpose, now)
-            elif self.progress.moved(gpose, now):
-                self.recovery_index = 0  # real progress: the recovery list starts over, as in ROS 1
+            else:
+                self.turn_best = math.inf  # driving (again, after a turn the controller re-approached)
+                if self.progress.moved(gpose, now):
+                    self.recovery_index = 0  # real progress: the recovery list starts over, as in ROS 1
             if not self.progress.check(gpose, now):
                 self._start_recovery(
                     step, now, "Aborting because the robot appears to be oscillating over and over"

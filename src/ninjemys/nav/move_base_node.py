@@ -99,7 +99,7 @@ class DwaController:
         self._refresh = refresh
 
     def new_goal(self) -> None:
-        self.dwa.xy_latched = False
+        self.dwa.new_goal()
 
     def set_plan(self, plan: np.ndarray) -> None:
         latched = self.dwa.xy_latched

@@ -15,15 +15,17 @@ from ninjemys.node.cli_args import network_env, parse_args
 from ninjemys.node.node import Node
 
 
-def start_node(default_name: str, argv: list[str] | None = None) -> Node:
+def start_node(default_name: str, argv: list[str] | None = None, anonymous: bool = False) -> Node:
     """A core Node named as ROS 1 names it from ``argv`` (``__name:=``, ``__ns:=``, ``__ip:=``,
     remappings, ``_private:=value`` parameters, ``__log:=``), on the process's default clock (sim
-    time under /use_sim_time), with /rosout and the logger services, as ``rospy.init_node`` makes it."""
+    time under /use_sim_time), with /rosout and the logger services, as ``rospy.init_node`` makes it.
+    ``anonymous``: ``_<pid>_<ms>`` appended, as ROS 1's command-line tools (tf_echo, tf_monitor)
+    register, so that two of them run side by side."""
     argv = sys.argv[1:] if argv is None else argv
     args = parse_args([sys.argv[0], *argv])
     os.environ.update(network_env(args))
     return Node(
-        args.node_name(default_name),
+        args.node_name(default_name, anonymous),  # ``__name:=`` wins over anonymous, as in rospy
         namespace=args.namespace,
         remappings=args.remappings,
         master_uri=args.master_uri,
@@ -51,7 +53,9 @@ def run_node(default_name: str, argv: list[str] | None, build: Callable[[Node], 
     return run_main(default_name, argv, build_and_spin)
 
 
-def run_main(default_name: str, argv: list[str] | None, body: Callable[[Node], int | None]) -> int:
+def run_main(
+    default_name: str, argv: list[str] | None, body: Callable[[Node], int | None], anonymous: bool = False
+) -> int:
     """Start the node and run ``body(node)`` on this thread (a node with a loop of its own: a keyboard
     teleop, a square driver), as :func:`run_node` does; returns its exit code (None: 0).
 
@@ -60,7 +64,7 @@ def run_main(default_name: str, argv: list[str] | None, body: Callable[[Node], i
     returns, whichever way.
     """
     try:
-        node = start_node(default_name, argv)
+        node = start_node(default_name, argv, anonymous)
     except NinjemysError as exc:
         print(f"{default_name}: {exc}", file=sys.stderr)
         return 1

@@ -10,16 +10,16 @@ exception. A cancelled goal that is still waiting is set canceled.
 
 from __future__ import annotations
 
-import sys
 import threading
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import actionlib
-import rospy
-import tf2_ros
+from ninjemys.actionlib.server import ActionServer
 from ninjemys.tf2 import errors
 from ninjemys.tools.cli import entry, wait_for_master_like_roscpp
 from tf2_msgs.msg import LookupTransformAction, LookupTransformResult, TF2Error
+
+if TYPE_CHECKING:
+    from ninjemys.node import Node
 
 #: tf2's exceptions -> the error code the result carries (checked in order: the most specific first)
 _CODES = (
@@ -35,16 +35,17 @@ CHECK_PERIOD = 0.01
 
 
 class BufferServer:
-    """Serve lookups on ``buffer`` as the action ``ns``; call :meth:`start` when ready."""
+    """Serve lookups on ``buffer`` as the action ``ns`` of ``node``; call :meth:`start` when ready."""
 
-    def __init__(self, buffer: Any, ns: str, auto_start: bool = False) -> None:
+    def __init__(self, node: Node, buffer: Any, ns: str, auto_start: bool = False) -> None:
+        self.node = node
         self.buffer = buffer
         self._lock = threading.Lock()
         self._waiting: list[tuple[Any, float]] = []  # (goal handle, ROS time in s when it gives up)
-        self.server = actionlib.ActionServer(
-            ns, LookupTransformAction, self._on_goal, self._on_cancel, auto_start
+        self.server = ActionServer(
+            node, ns, LookupTransformAction, self._on_goal, self._on_cancel, auto_start
         )
-        self._timer = rospy.Timer(rospy.Duration.from_sec(CHECK_PERIOD), self._check)
+        self._timer = node.timer(CHECK_PERIOD, self._check)
 
     def start(self) -> None:
         self.server.start()
@@ -88,8 +89,9 @@ class BufferServer:
     def _on_goal(self, handle: Any) -> None:
         handle.set_accepted()
         goal = handle.get_goal()
-        end = rospy.get_time() + goal.timeout.to_sec()
-        if end <= rospy.get_time() or self._possible(goal):
+        now = self.node.get_time()
+        end = now + goal.timeout.to_sec()
+        if end <= now or self._possible(goal):
             self._answer(handle)
             return
         with self._lock:
@@ -104,7 +106,7 @@ class BufferServer:
             handle.set_canceled()
 
     def _check(self, _event: Any) -> None:
-        now = rospy.get_time()
+        now = self.node.get_time()
         with self._lock:
             due = [(h, end) for h, end in self._waiting if end < now or self._possible(h.get_goal())]
             self._waiting = [item for item in self._waiting if item not in due]
@@ -113,15 +115,21 @@ class BufferServer:
 
 
 def main(argv: list[str] | None = None) -> int:
-    full = [sys.argv[0] if argv is None else "buffer_server", *(sys.argv[1:] if argv is None else argv)]
-    rospy.init_node("tf_buffer", argv=full)
-    if not wait_for_master_like_roscpp(rospy.core.process_node()):
+    from ninjemys.node.run import run_node
+
+    return run_node("tf_buffer", argv, serve)
+
+
+def serve(node: Node) -> int:
+    """The buffer, its listener and the action server on a core node (a roscpp program in ROS 1)."""
+    from ninjemys.tf2.buffer import Buffer
+    from ninjemys.tf2.node import TransformListener
+
+    if not wait_for_master_like_roscpp(node):
         return 0  # Ctrl-C while waiting for the master, as roscpp: a quiet exit
-    buffer_size = float(rospy.get_param("~buffer_size", 120.0))
-    buffer = tf2_ros.Buffer(rospy.Duration.from_sec(buffer_size), debug=False)
-    tf2_ros.TransformListener(buffer)
-    BufferServer(buffer, "tf2_buffer_server").start()
-    rospy.spin()
+    buffer = Buffer(float(node.get_param("~buffer_size", 120.0)), now=node.get_time)
+    TransformListener(node, buffer, now=node.get_time, report=node.log.warn)
+    BufferServer(node, buffer, "tf2_buffer_server").start()
     return 0
 
 

@@ -14,11 +14,14 @@ from __future__ import annotations
 
 import math
 import sys
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ninjemys.tf2.math import quaternion_from_rpy
 from ninjemys.tools.cli import entry, wait_for_master_like_roscpp
 from ninjemys.tools.tf_echo import atof
+
+if TYPE_CHECKING:
+    from ninjemys.node import Node
 
 TF2_USAGE = (
     "A command line utility for manually sending a transform.\n"
@@ -68,50 +71,65 @@ def _normalized(t: tuple[float, ...] | None, log: Any) -> tuple[float, ...] | No
     return t
 
 
-def _from_param(rospy: Any, name: str) -> tuple[str, str, tuple[float, ...]] | None:
-    rospy.loginfo(f"Looking for TF in parameter: {name}")
-    if not rospy.has_param(name):
-        rospy.logfatal(f"Could not read TF from parameter server: {name}")
+def _from_param(node: Node, name: str) -> tuple[str, str, tuple[float, ...]] | None:
+    node.log.info(f"Looking for TF in parameter: {name}")
+    if not node.has_param(name):
+        node.log.fatal(f"Could not read TF from parameter server: {name}")
         return None
-    data = rospy.get_param(name)
+    data = node.get_param(name)
     try:
         tr = data["transform"]["translation"]
         rot = data["transform"]["rotation"]
         values = tuple(float(v) for v in (tr["x"], tr["y"], tr["z"], rot["x"], rot["y"], rot["z"], rot["w"]))
         return str(data["header"]["frame_id"]), str(data["child_frame_id"]), values
     except (KeyError, TypeError, ValueError):
-        rospy.logfatal(f"Could not validate XmlRpcC for TF data: {data}")
+        node.log.fatal(f"Could not validate XmlRpcC for TF data: {data}")
         return None
 
 
-def _report(rospy: Any) -> Any:
+def _report(node: Node) -> Any:
     def log(line: str, warn: bool = False) -> None:
-        (rospy.logwarn if warn else rospy.logfatal)(line)
+        (node.log.warn if warn else node.log.fatal)(line)
 
     return log
 
 
+def _arguments(argv: list[str] | None) -> tuple[list[str], list[str]]:
+    """(the command line after the program name, the same without ROS's ``name:=value`` arguments)."""
+    from ninjemys.names import strip_remap_args
+
+    argv = sys.argv[1:] if argv is None else argv
+    return argv, strip_remap_args(["static_transform_publisher", *argv])[1:]
+
+
+def _wrong_count(usage: str) -> int:
+    sys.stdout.write(usage)
+    sys.stdout.flush()
+    sys.stderr.write(
+        "[ERROR] static_transform_publisher exited due to not having the right number of arguments\n"
+    )
+    return 255
+
+
 def main(argv: list[str] | None = None) -> int:
     """tf2_ros's static_transform_publisher."""
-    import rospy
-    import tf2_ros
-    from geometry_msgs.msg import TransformStamped
+    from ninjemys.node.run import run_main
 
-    full = ["static_transform_publisher", *(sys.argv[1:] if argv is None else argv)]
-    args = rospy.myargv(full)[1:]
+    argv, args = _arguments(argv)
     if len(args) not in (1, 8, 9):
-        sys.stdout.write(TF2_USAGE)
-        sys.stdout.flush()
-        sys.stderr.write(
-            "[ERROR] static_transform_publisher exited due to not having the right number of arguments\n"
-        )
-        return 255
-    rospy.init_node("static_transform_publisher", argv=full, anonymous=True)
-    if not wait_for_master_like_roscpp(rospy.core.process_node()):
+        return _wrong_count(TF2_USAGE)
+    return run_main("static_transform_publisher", argv, lambda node: _latch(node, args), anonymous=True)
+
+
+def _latch(node: Node, args: list[str]) -> int:
+    from ninjemys.tf2.buffer import to_ns
+    from ninjemys.tf2.node import StaticTransformBroadcaster
+
+    if not wait_for_master_like_roscpp(node):
         return 0  # Ctrl-C while waiting for the master, as roscpp: a quiet exit
     values: tuple[float, ...] | None
     if len(args) == 1:
-        got = _from_param(rospy, args[0])
+        got = _from_param(node, args[0])
         if got is None:
             return 255
         parent, child, values = got
@@ -119,61 +137,50 @@ def main(argv: list[str] | None = None) -> int:
         values = parse_numbers(args[:-2])
         parent, child = args[-2], args[-1]
     if parent == child:
-        rospy.logfatal(f"target_frame and source frame are the same ({parent}, {child}) this cannot work")
+        node.log.fatal(f"target_frame and source frame are the same ({parent}, {child}) this cannot work")
         return 1
-    values = _normalized(values, _report(rospy))
+    values = _normalized(values, _report(node))
     if values is None:
         return 1
-    msg = TransformStamped()
-    msg.header.stamp = rospy.Time.now()
-    msg.header.frame_id = parent
-    msg.child_frame_id = child
-    t, q = msg.transform.translation, msg.transform.rotation
-    t.x, t.y, t.z, q.x, q.y, q.z, q.w = values
-    broadcaster = tf2_ros.StaticTransformBroadcaster()
-    broadcaster.sendTransform(msg)
-    rospy.loginfo(f"Spinning until killed publishing {parent} to {child}")
-    rospy.spin()
+    broadcaster = StaticTransformBroadcaster(node)
+    broadcaster.send_items([(parent, child, to_ns(node.now()), *values)])
+    node.log.info(f"Spinning until killed publishing {parent} to {child}")
+    node.spin()
     return 0
 
 
 def tf_main(argv: list[str] | None = None) -> int:
     """tf's legacy static_transform_publisher: re-sends on /tf every period (ms), future-dated."""
-    import rospy
-    import tf2_ros
-    from ninjemys.tf2.buffer import to_ns
+    from ninjemys.node.run import run_main
 
-    full = ["static_transform_publisher", *(sys.argv[1:] if argv is None else argv)]
-    args = rospy.myargv(full)[1:]
+    argv, args = _arguments(argv)
     if len(args) not in (9, 10):
-        sys.stdout.write(TF_USAGE)
-        sys.stdout.flush()
-        sys.stderr.write(
-            "[ERROR] static_transform_publisher exited due to not having the right number of arguments\n"
-        )
-        return 255
-    rospy.init_node("static_transform_publisher", argv=full, anonymous=True)
-    if not wait_for_master_like_roscpp(rospy.core.process_node()):
+        return _wrong_count(TF_USAGE)
+    return run_main("static_transform_publisher", argv, lambda node: _repeat(node, args), anonymous=True)
+
+
+def _repeat(node: Node, args: list[str]) -> int:
+    from ninjemys.tf2.buffer import to_ns
+    from ninjemys.tf2.node import TransformBroadcaster
+
+    if not wait_for_master_like_roscpp(node):
         return 0  # Ctrl-C while waiting for the master, as roscpp: a quiet exit
     period = atof(args[-1]) / 1000.0
     parent, child = args[-3], args[-2]
     if parent == child:
-        rospy.logfatal(f"target_frame and source frame are the same ({parent}, {child}) this cannot work")
+        node.log.fatal(f"target_frame and source frame are the same ({parent}, {child}) this cannot work")
         return 1
-    values = _normalized(parse_numbers(args[:-3]), _report(rospy))
+    values = _normalized(parse_numbers(args[:-3]), _report(node))
     if values is None:
         return 1
     if period <= 0.0:
-        rospy.logfatal(f"the period must be a positive number of milliseconds, not {args[-1]!r}")
+        node.log.fatal(f"the period must be a positive number of milliseconds, not {args[-1]!r}")
         return 1
-    broadcaster = tf2_ros.TransformBroadcaster()
+    broadcaster = TransformBroadcaster(node)
     ahead = int(period * 1e9)
-    try:
-        while not rospy.is_shutdown():
-            broadcaster.send_items([(parent, child, to_ns(rospy.Time.now()) + ahead, *values)])
-            rospy.sleep(period)
-    except rospy.ROSInterruptException:
-        pass
+    while not node.is_shutdown:
+        broadcaster.send_items([(parent, child, to_ns(node.now()) + ahead, *values)])
+        node.sleep(period)  # raises ShutdownError at Ctrl-C: run_main ends quietly
     return 0
 
 

@@ -10,8 +10,12 @@ from __future__ import annotations
 import math
 import re
 import sys
+from typing import TYPE_CHECKING
 
 from ninjemys.tools.cli import entry, wait_for_master_like_roscpp
+
+if TYPE_CHECKING:
+    from ninjemys.node import Node
 
 USAGE = (
     "Usage: tf_echo source_frame target_frame [echo_rate]\n\n"
@@ -59,48 +63,55 @@ def format_transform(stamp_ns: int, t: tuple, precision: int = 3) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    import rospy
-    import tf2_ros
+    from ninjemys.names import strip_remap_args
+    from ninjemys.node.run import run_main
 
-    full = [sys.argv[0] if argv is None else "tf_echo", *(sys.argv[1:] if argv is None else argv)]
-    args = rospy.myargv(full)
+    argv = sys.argv[1:] if argv is None else argv
+    args = strip_remap_args(["tf_echo", *argv])
     if len(args) < 3 or len(args) > 4:
         sys.stdout.write(USAGE)
         return 255
-    rospy.init_node("tf_echo", argv=full, anonymous=True)
-    if not wait_for_master_like_roscpp(rospy.core.process_node()):
+    return run_main("tf_echo", argv, lambda node: echo(node, args), anonymous=True)
+
+
+def echo(node: Node, args: list[str]) -> int:
+    """tf_echo's loop on a core node (a roscpp program in ROS 1: it waits for the master as roscpp does)."""
+    from ninjemys.tf2.core import BufferCore
+    from ninjemys.tf2.errors import TransformException
+    from ninjemys.tf2.node import TransformListener
+
+    if not wait_for_master_like_roscpp(node):
         return 0  # Ctrl-C while waiting for the master, as roscpp: a quiet exit
-    rate_hz = atof(args[3]) if len(args) == 4 else float(rospy.get_param("~rate", 1.0))
+    rate_hz = atof(args[3]) if len(args) == 4 else float(node.get_param("~rate", 1.0))
     if rate_hz <= 0.0:
         sys.stderr.write("Echo rate must be > 0.0\n")
         return 255
     precision = 3
-    if rospy.has_param("~precision"):
-        precision = int(rospy.get_param("~precision"))
+    if node.has_param("~precision"):
+        precision = int(node.get_param("~precision"))
         if precision < 1:
             sys.stderr.write("Precision must be > 0\n")
             return 255
         print(f"Precision default value was overriden, new value: {precision}")
-    buffer = tf2_ros.Buffer(debug=False)
-    tf2_ros.TransformListener(buffer)
+    buffer = BufferCore()
+    TransformListener(node, buffer, now=node.get_time, report=node.log.warn)
     source, target = args[1].lstrip("/"), args[2].lstrip("/")
-    buffer.can_transform(source, target, rospy.Time(), rospy.Duration(1.0))
-    rate = rospy.Rate(rate_hz)
-    try:
-        while not rospy.is_shutdown():
-            try:
-                stamp, t = buffer.lookup(source, target, 0)
-                sys.stdout.write(format_transform(stamp, t, precision))
-            except tf2_ros.TransformException as ex:
-                now = rospy.Time.now()
-                sys.stdout.write(
-                    f"Failure at {now.secs}.{now.nsecs:09d}\nException thrown:{ex}\n"
-                    f"The current list of frames is:\n{buffer.all_frames_as_string()}\n"
-                )
-            sys.stdout.flush()
-            rate.sleep()
-    except rospy.ROSInterruptException:
-        pass
+    buffer.wait_for_transform(
+        lambda: buffer.can_transform(source, target, 0), 1.0, node.get_time, lambda: node.is_shutdown
+    )
+    rate = node.rate(rate_hz)
+    while not node.is_shutdown:
+        try:
+            stamp, t = buffer.lookup(source, target, 0)
+            sys.stdout.write(format_transform(stamp, t, precision))
+        except TransformException as ex:
+            now = node.now()
+            sys.stdout.write(
+                f"Failure at {now.secs}.{now.nsecs:09d}\nException thrown:{ex}\n"
+                f"The current list of frames is:\n{buffer.all_frames_as_string()}\n"
+            )
+        sys.stdout.flush()
+        rate.sleep()  # raises ShutdownError at Ctrl-C: run_main ends quietly
     return 0
 
 

@@ -11,8 +11,12 @@ from __future__ import annotations
 import sys
 import threading
 from collections import deque
+from typing import TYPE_CHECKING
 
 from ninjemys.tools.cli import entry, wait_for_master_like_roscpp
+
+if TYPE_CHECKING:
+    from ninjemys.node import Node
 
 
 class Monitor:
@@ -65,29 +69,35 @@ class Monitor:
 
 
 def main(argv: list[str] | None = None) -> int:
-    import rospy
-    import tf2_ros
+    from ninjemys.names import strip_remap_args
+    from ninjemys.node.run import run_main
+
+    argv = sys.argv[1:] if argv is None else argv
+    args = strip_remap_args(["tf_monitor", *argv])[1:]
+    return run_main("tf_monitor", argv, lambda node: monitor(node, args), anonymous=True)
+
+
+def monitor(node: Node, args: list[str]) -> int:
+    """tf_monitor's loop on a core node (a roscpp program in ROS 1: it waits for the master as roscpp does)."""
+    from ninjemys.tf2.core import BufferCore
+    from ninjemys.tf2.errors import TransformException
+    from ninjemys.tf2.node import TransformListener
     from ninjemys.tf2.wire import decode_tf_message
 
-    full = ["tf_monitor", *(sys.argv[1:] if argv is None else argv)]
-    args = rospy.myargv(full)[1:]
     if len(args) not in (0, 2):
-        rospy.init_node("tf_monitor", argv=full, anonymous=True)
-        rospy.loginfo("TF_Monitor: usage: tf_monitor framea frameb")
+        node.log.info("TF_Monitor: usage: tf_monitor framea frameb")
         return 255
-    rospy.init_node("tf_monitor", argv=full, anonymous=True)
-    node = rospy.core.process_node()
-    if not wait_for_master_like_roscpp(rospy.core.process_node()):
+    if not wait_for_master_like_roscpp(node):
         return 0  # Ctrl-C while waiting for the master, as roscpp: a quiet exit
-    buffer = tf2_ros.Buffer(debug=False)
-    tf2_ros.TransformListener(buffer)
-    monitor = Monitor()
+    buffer = BufferCore()
+    TransformListener(node, buffer, now=node.get_time, report=node.log.warn)
+    books = Monitor()
 
     def on_message(raw: object, static: bool) -> None:
         who = raw.connection_header.get("callerid", "")  # type: ignore[attr-defined]
         items = decode_tf_message(raw.data)  # type: ignore[attr-defined]
         frames = [(it[1], None if static else it[2] / 1e9) for it in items]
-        monitor.record(frames, who + "(static)" if static else who, rospy.get_time())
+        books.record(frames, who + "(static)" if static else who, node.get_time())
 
     chain: list[str] | None = None
     framea = frameb = ""
@@ -95,49 +105,51 @@ def main(argv: list[str] | None = None) -> int:
         framea, frameb = args[0].lstrip("/"), args[1].lstrip("/")
         sys.stdout.write(f"Waiting for transform chain to become available between {framea} and {frameb} ")
         sys.stdout.flush()
-        while not rospy.is_shutdown() and not buffer.can_transform(framea, frameb, rospy.Time(), 1.0):
+        while (
+            not node.is_shutdown
+            and not buffer.wait_for_transform(
+                lambda: buffer.can_transform(framea, frameb, 0), 1.0, node.get_time, lambda: node.is_shutdown
+            )[0]
+        ):
             sys.stdout.write(".")
             sys.stdout.flush()
         sys.stdout.write("\n")
         try:
-            chain = buffer._chain(frameb, rospy.Time(), framea, rospy.Time(), frameb)
-        except tf2_ros.TransformException as ex:
-            rospy.logwarn(f"Transform Exception {ex}")
+            chain = buffer.chain(frameb, 0, framea, 0, frameb)
+        except TransformException as ex:
+            node.log.warn(f"Transform Exception {ex}")
             return 0
     node.subscriber("/tf", None, on_message, callback_args=False, raw=True)
     node.subscriber("/tf_static", None, on_message, callback_args=True, raw=True)
     max_diff = avg_diff = 0.0
     counter = 0
-    try:
-        while not rospy.is_shutdown():
-            counter += 1
+    while not node.is_shutdown:
+        counter += 1
+        if chain is not None:
+            try:
+                stamp, _ = buffer.lookup(framea, frameb, 0)
+                diff = node.get_time() - stamp / 1e9
+                avg_diff = 0.01 * diff + 0.99 * avg_diff
+                max_diff = max(max_diff, diff)
+            except TransformException:
+                pass
+        node.sleep(0.01)  # raises ShutdownError at Ctrl-C: run_main ends quietly
+        if counter > 20:
+            counter = 0
             if chain is not None:
-                try:
-                    stamp, _ = buffer.lookup(framea, frameb, 0)
-                    diff = rospy.get_time() - stamp / 1e9
-                    avg_diff = 0.01 * diff + 0.99 * avg_diff
-                    max_diff = max(max_diff, diff)
-                except tf2_ros.TransformException:
-                    pass
-            rospy.sleep(0.01)
-            if counter > 20:
-                counter = 0
-                if chain is not None:
-                    head = (
-                        f"\n\n\nRESULTS: for {framea} to {frameb}\nChain is: {' -> '.join(chain)}\n"
-                        f"Net delay     avg = {avg_diff:g}: max = {max_diff:g}\n"
-                    )
-                else:
-                    head = "\n\n\nRESULTS: for all Frames\n"
-                frames, heading, nodes = monitor.report(chain)
-                sys.stdout.write(head + frames)
-                sys.stdout.flush()
-                sys.stderr.write(heading)
-                sys.stderr.flush()
-                sys.stdout.write(nodes)
-                sys.stdout.flush()
-    except rospy.ROSInterruptException:
-        pass
+                head = (
+                    f"\n\n\nRESULTS: for {framea} to {frameb}\nChain is: {' -> '.join(chain)}\n"
+                    f"Net delay     avg = {avg_diff:g}: max = {max_diff:g}\n"
+                )
+            else:
+                head = "\n\n\nRESULTS: for all Frames\n"
+            frames, heading, nodes = books.report(chain)
+            sys.stdout.write(head + frames)
+            sys.stdout.flush()
+            sys.stderr.write(heading)
+            sys.stderr.flush()
+            sys.stdout.write(nodes)
+            sys.stdout.flush()
     return 0
 
 

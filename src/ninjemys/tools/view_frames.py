@@ -15,9 +15,12 @@ import sys
 import time
 from html import escape
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ninjemys.tools.cli import entry
+
+if TYPE_CHECKING:
+    from ninjemys.node import Node
 
 LISTEN_SECONDS = 5.0
 
@@ -158,24 +161,28 @@ def write_graph(
 
 
 def main(argv: list[str] | None = None) -> int:
+    """tf2_tools' ``view_frames``: listen 5 s, then write the buffer's frame graph."""
+    from ninjemys.node.run import run_main
+
+    return run_main("view_frames", sys.argv[1:] if argv is None else argv, _tf2_view)
+
+
+def _tf2_view(node: Node) -> int:
     import yaml
 
-    import rospy
-    import tf2_ros
-    from tf2_msgs.srv import FrameGraph
+    from ninjemys.tf2.core import BufferCore
+    from ninjemys.tf2.node import TransformListener
 
-    full = ["view_frames", *(sys.argv[1:] if argv is None else argv)]
-    rospy.init_node("view_frames", argv=full)
-    rospy.loginfo("Listening to tf data during 5 seconds...")
-    buffer = tf2_ros.Buffer()
-    tf2_ros.TransformListener(buffer)
-    rospy.sleep(LISTEN_SECONDS)
-    rospy.loginfo("Generating graph in frames.pdf file...")
-    rospy.wait_for_service("~tf2_frames")
-    data = yaml.safe_load(rospy.ServiceProxy("~tf2_frames", FrameGraph)().frame_yaml) or {}
-    written = write_outputs(data, rospy.Time.now().to_sec(), Path.cwd())
+    node.log.info("Listening to tf data during 5 seconds...")
+    buffer = BufferCore()
+    TransformListener(node, buffer, now=node.get_time, report=node.log.warn)
+    node.sleep(LISTEN_SECONDS)
+    node.log.info("Generating graph in frames.pdf file...")
+    # ROS 1's script asks its own ~tf2_frames service for this YAML: the same text, straight from the buffer
+    data = yaml.safe_load(buffer.all_frames_as_yaml()) or {}
+    written = write_outputs(data, node.get_time(), Path.cwd())
     if not any(p.suffix == ".pdf" for p in written):
-        rospy.loginfo(
+        node.log.info(
             "Graphviz's dot is not installed: wrote frames.gv and frames.svg (open it in a browser)"
         )
     return 0
@@ -186,34 +193,42 @@ def tf_main(argv: list[str] | None = None) -> int:
     a node's ``tf_frames`` service."""
     import argparse
 
-    import rospy
-    import tf
-    from tf.srv import FrameGraph
+    from ninjemys.names import strip_remap_args
+    from ninjemys.node.run import run_main
 
-    full = ["view_frames", *(sys.argv[1:] if argv is None else argv)]
+    argv = sys.argv[1:] if argv is None else argv
     parser = argparse.ArgumentParser(prog="view_frames", usage="usage: view_frames [options]")
     parser.add_argument("--node", metavar="node name", help="Node to get frames from")
-    options = parser.parse_args(rospy.myargv(full)[1:])
-    rospy.init_node("view_frames", argv=full, anonymous=True)
-    if options.node:
-        print("Generating graph for node: ", options.node)
-        service = f"{options.node}/tf_frames"
+    options = parser.parse_args(strip_remap_args(["view_frames", *argv])[1:])
+    return run_main("view_frames", argv, lambda node: _tf_view(node, options.node), anonymous=True)
+
+
+def _tf_view(node: Node, of_node: str | None) -> int:
+    from ninjemys.errors import NinjemysError
+    from ninjemys.idl.loader import get_service_class
+    from ninjemys.tf2.core import BufferCore
+    from ninjemys.tf2.node import TransformListener
+
+    if of_node:
+        print("Generating graph for node: ", of_node)
+        service = f"{of_node}/tf_frames"
         print(f"Waiting for service {service}")
-        rospy.wait_for_service(service)
+        node.wait_for_service(service)
         print("Polling service")
         try:
-            dot_text = rospy.ServiceProxy(service, FrameGraph)().dot_graph
-        except rospy.ServiceException as e:
+            dot_text = node.service_proxy(service, get_service_class("tf/FrameGraph"))().dot_graph
+        except (NinjemysError, OSError) as e:
             print(f"Service call failed: {e}")
             return 1
     else:
-        listener = tf.TransformListener()
+        buffer = BufferCore()
+        TransformListener(node, buffer, now=node.get_time, report=node.log.warn)
         print("WARNING: tf view_frames is deprecated. Use tf2_tools view_frames.py instead.")
         print(f"Listening to /tf for {LISTEN_SECONDS} seconds")
         time.sleep(LISTEN_SECONDS)
         print("Done Listening")
-        dot_text = listener.allFramesAsDot(rospy.Time.now())
-    written = write_graph(dot_text, edges_from_dot(dot_text), rospy.Time.now().to_sec(), Path.cwd())
+        dot_text = buffer.all_frames_as_dot(node.get_time())
+    written = write_graph(dot_text, edges_from_dot(dot_text), node.get_time(), Path.cwd())
     if written[-1].suffix == ".pdf":
         print("frames.pdf generated")
     else:
