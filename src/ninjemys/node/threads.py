@@ -257,6 +257,16 @@ THREADS: tuple[Thread, ...] = (
         "web.gazebo_ros.gzclient_main",
         "waits for gzserver's /gazebo/gui_url parameter, then opens the browser view",
     ),
+    Thread(
+        "zenoh-beacons",
+        "zenoh_bridge.discovery.Beacons",
+        "puts an empty beacon for each local resource every period, so remote bridges keep it listed",
+    ),
+    Thread(
+        "zenoh-srv_<n>",
+        "zenoh_bridge.core.ZenohBridge._pool (8 workers)",
+        "answers queries of bridged services: one ROS service call each, off Zenoh's callback thread",
+    ),
 )
 
 #: user threads: the caller's own threads (the main thread, publishing threads, service callers)
