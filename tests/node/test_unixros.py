@@ -22,6 +22,7 @@ pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="UN
 def unixros_on(monkeypatch) -> None:  # noqa: ANN001
     """UNIXROS is opt-in (NINJEMYS_UNIXROS=1); these tests turn it on for this process."""
     monkeypatch.setenv("NINJEMYS_UNIXROS", "1")
+    monkeypatch.setenv("NINJEMYS_SHM", "0")  # SHMROS is offered before UNIXROS (tests/node/test_shm.py)
 
 
 Image = get_message_class("sensor_msgs/Image")

@@ -487,10 +487,10 @@ class Node(ParamAccess):
                         c.id,
                         c.subscriber,
                         "o",
-                        transport.transport_of(c.sock),
+                        transport.transport_name(c),
                         topic,
                         not c.closed,
-                        f"{transport.transport_of(c.sock)} connection to [{c.subscriber}]",
+                        f"{transport.transport_name(c)} connection to [{c.subscriber}]",
                     ]
                 )
         for topic, sub in list(self._subscriptions.items()):
@@ -500,10 +500,10 @@ class Node(ParamAccess):
                         s.id,
                         s.uri,
                         "i",
-                        transport.transport_of(s.sock),
+                        transport.transport_name(s),
                         topic,
                         not s.closed,
-                        f"{transport.transport_of(s.sock)} connection from [{s.publisher}]",
+                        f"{transport.transport_name(s)} connection from [{s.publisher}]",
                     ]
                 )
         return info

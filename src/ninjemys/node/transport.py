@@ -79,6 +79,12 @@ def transport_of(sock: socket.socket) -> str:
     return UNIXROS if sock.family == socket.AF_UNIX else TCPROS
 
 
+def transport_name(conn: Any) -> str:
+    """What getBusInfo reports for a topic connection: its class's ``transport_name`` (SHMROS) or
+    the socket's family (TCPROS/UNIXROS)."""
+    return getattr(conn, "transport_name", None) or transport_of(conn.sock)
+
+
 def tune(sock: socket.socket, nodelay: bool = True) -> None:
     """Non-blocking, TCP_NODELAY as asked, keepalive on (a vanished peer is eventually noticed)."""
     sock.setblocking(False)

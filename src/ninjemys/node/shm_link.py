@@ -1,0 +1,198 @@
+"""``SHMROS``: TCPROS connections whose large messages travel through a shared-memory ring.
+
+Negotiation (same shape as UNIXROS): a subscriber offers ``["SHMROS", host_identity]`` first in
+``requestTopic``; a ninjemys publisher on the same host answers ``["SHMROS", host, port]``; rospy and
+roscpp, which do not know the name, answer TCPROS from the next offer. The subscriber then sends the
+usual connection header plus ``ninjemys_shm=<host identity>``; the publisher creates a ring and names
+it in its reply header (``ninjemys_shm=<segment>``). Without that field in the reply the stream is
+plain TCPROS.
+
+On an SHMROS stream every TCPROS frame starts with a tag byte: 0 = the message follows inline,
+1 = a notice ``(slot u32, generation u64, length u64)`` naming a slot of the ring. Messages of at
+least :data:`THRESHOLD` bytes go through the ring; smaller ones inline, and so does a large one when
+every slot is still held by the subscriber (a user keeping messages) or /dev/shm is full: the
+publisher never waits for a slot and never overwrites one still referenced. ``queue_size`` applies
+to notices exactly as to frames (a dropped notice frees its slot).
+
+Why 64 KiB: below it a message costs about the same either way (two system calls dominate); above
+it the socket's two copies and the kernel's wake-ups per 64 KiB grow with the size while the ring
+costs one ``memcpy`` on the publisher and none on the subscriber.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import socket
+
+from ninjemys.node import shm_ring, transport
+from ninjemys.node.subscriber import SubConnection
+from ninjemys.node.topics import PubConnection
+from ninjemys.wire.tcpros import pack_len
+
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from collections.abc import Mapping
+    from typing import Any
+
+    from ninjemys.node.context import NodeContext
+    from ninjemys.node.subscriber import Subscription
+
+_log = logging.getLogger(__name__)
+
+SHMROS = "SHMROS"
+#: the connection-header field both sides use
+FIELD = "ninjemys_shm"
+#: payloads of at least this many bytes go through the ring (see the module docstring)
+THRESHOLD = 64 * 1024
+#: slots per connection and the largest payload a slot takes (tmpfs pages are allocated per slot as
+#: it is first used, so an idle ring costs address space, not memory). 32 MiB fits a 4K rgb8 image.
+SLOTS = 4
+SLOT_SIZE = 32 << 20
+_INLINE = b"\0"
+
+
+def enabled() -> bool:
+    """On by default on Linux; ``NINJEMYS_SHM=0`` turns it off (then every stream is TCPROS/UNIXROS)."""
+    return (
+        os.environ.get("NINJEMYS_SHM", "1") != "0" and shm_ring.available() and bool(transport.host_identity())
+    )
+
+
+def offer() -> list[str] | None:
+    """What a subscriber puts first in ``requestTopic``, or None when disabled."""
+    return [SHMROS, transport.host_identity()] if enabled() else None
+
+
+def grants(proto: list[Any]) -> bool:
+    """A publisher's test of one ``requestTopic`` offer."""
+    return proto[0] == SHMROS and proto[1:2] == [transport.host_identity()] and enabled()
+
+
+def tag_inline(frame: bytes) -> bytes:
+    """A plain TCPROS frame (length prefix + payload) as an SHMROS inline frame."""
+    return pack_len(len(frame) - 3) + _INLINE + frame[4:]
+
+
+def publisher_connection(
+    node: NodeContext, sock: socket.socket, topic: str, subscriber: str, header: Mapping[str, str]
+) -> tuple[PubConnection, dict[str, str]]:
+    """The connection for an accepted subscriber and the extra reply-header fields: an SHMROS one when
+    its header asks for it from this host and a ring can be made, else plain TCPROS."""
+    if header.get(FIELD) and header.get(FIELD) == transport.host_identity() and enabled():
+        try:
+            ring = shm_ring.WriterRing(SLOTS, SLOT_SIZE)
+        except shm_ring.ShmError as exc:
+            _log.info("topic %s: shared memory unavailable for %s (%s): TCPROS", topic, subscriber, exc)
+        else:
+            return ShmPubConnection(node, sock, topic, subscriber, ring), {FIELD: ring.name}
+    return PubConnection(node, sock, topic, subscriber), {}
+
+
+class ShmPubConnection(PubConnection):
+    """A subscriber on this host: large messages into the ring, a notice on the socket."""
+
+    transport_name = SHMROS
+
+    def __init__(
+        self, node: NodeContext, sock: socket.socket, topic: str, subscriber: str, ring: shm_ring.WriterRing
+    ) -> None:
+        super().__init__(node, sock, topic, subscriber)
+        self.ring = ring
+
+    def send_hello(self, reply: bytes, latched: list[bytes]) -> None:
+        """The reply header (untagged, as in TCPROS) then latched frames, tagged inline."""
+        PubConnection.send(self, reply + b"".join(tag_inline(f) for f in latched), 0)
+
+    def send(self, data: bytes, queue_size: int | None) -> None:
+        length = len(data) - 4
+        if length >= THRESHOLD and not self.closed:
+            notice = self.ring.put([memoryview(data)[4:]], length)
+            if notice is not None:
+                PubConnection.send(self, notice, queue_size)
+                return
+        PubConnection.send(self, tag_inline(data), queue_size)
+
+    def send_parts(self, parts: list[Any], total: int, queue_size: int | None) -> None:
+        length = total - 4
+        if length >= THRESHOLD and not self.closed:
+            notice = self.ring.put(parts[1:], length)
+            if notice is not None:
+                PubConnection.send(self, notice, queue_size)
+                return
+        PubConnection.send(self, b"".join([pack_len(length + 1), _INLINE, *parts[1:]]), queue_size)
+
+    def _trim(self, queue_size: int) -> None:
+        queue = self._queue
+        while len(queue) > queue_size:
+            frame = queue.popleft()
+            self._queued_bytes -= len(frame)
+            self.dropped += 1
+            if shm_ring.is_notice(frame):
+                self.ring.reclaim(frame)
+
+    def _release_socket(self) -> None:
+        super()._release_socket()
+        self.ring.close()
+
+
+def subscriber_connection(
+    sub: Subscription, sock: socket.socket, uri: str, header: Mapping[str, str]
+) -> SubConnection:
+    """The connection for a publisher's reply header: SHMROS when it names a ring (ShmError when that
+    ring cannot be mapped: the caller retries over TCPROS), else plain TCPROS."""
+    name = header.get(FIELD)
+    if not name:
+        return SubConnection(sub, sock, uri, header)
+    return ShmSubConnection(sub, sock, uri, header, shm_ring.ReaderRing(name))
+
+
+class ShmSubConnection(SubConnection):
+    """A publisher on this host: tagged frames; notices become read-only views into the ring."""
+
+    transport_name = SHMROS
+
+    def __init__(
+        self,
+        sub: Subscription,
+        sock: socket.socket,
+        uri: str,
+        header: Mapping[str, str],
+        ring: shm_ring.ReaderRing,
+    ) -> None:
+        super().__init__(sub, sock, uri, header)
+        self.ring = ring
+
+    def read(self, budget: int | None = None) -> list[bytes | bytearray] | None:
+        frames = super().read(budget)
+        if not frames:
+            return frames
+        out: list[Any] = []
+        for frame in frames:
+            tag = frame[0] if frame else -1
+            if tag == shm_ring.INLINE_TAG:
+                out.append(frame[1:] if len(frame) < THRESHOLD else memoryview(frame)[1:])
+            elif tag == shm_ring.NOTICE_TAG:
+                try:
+                    out.append(self.ring.view(frame))
+                except shm_ring.ShmError as exc:
+                    self._malformed(str(exc))
+                    return out or None
+            else:
+                self._malformed(f"a frame with tag {tag}")
+                return out or None
+        if self.latching:
+            self.last = out[-1]
+        return out
+
+    def _malformed(self, why: str) -> None:
+        """One line, then close; the subscription reconnects over TCPROS (inline from then on)."""
+        _log.warning(
+            "topic %s: malformed shared-memory notice from %s: %s; closing, reconnecting over TCPROS",
+            self.sub.topic,
+            self.publisher,
+            why,
+        )
+        self.sub.shm_refused.add(self.uri)
+        self.close()
+        self.sub.node.runtime.call_soon(self.sub.connection_lost, self, True)
