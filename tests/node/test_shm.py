@@ -253,3 +253,36 @@ def test_a_dead_creators_segment_is_reaped_and_ours_are_never_tracked() -> None:
     )
     out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "False"  # no resource tracker can unlink a segment behind our back
+
+
+def test_shmros_is_granted_only_to_this_host_and_named_in_bus_info(make_node) -> None:  # noqa: ANN001
+    import xmlrpc.client
+
+    talker, listener = make_node("talker"), make_node("listener")
+    listener.subscriber("img", Image, lambda m: None)
+    pub = talker.publisher("img", Image)
+    assert wait_until(lambda: pub.get_num_connections() == 1)
+    api = xmlrpc.client.ServerProxy(talker.uri)
+    here = shm_link.offer()
+    assert here is not None
+    code, _, proto = api.requestTopic("/t", "/img", [here, ["TCPROS"]])
+    assert code == 1 and proto == ["SHMROS", talker.tcpros_host, talker.tcpros_port]
+    code, _, proto = api.requestTopic("/t", "/img", [["SHMROS", "another-host/1"], ["TCPROS"]])
+    assert code == 1 and proto[0] == "TCPROS"
+    # what rosnode info shows, from both ends
+    info = api.getBusInfo("/t")[2]
+    assert [e[3] for e in info if e[4] == "/img"] == ["SHMROS"]
+    assert [e[6] for e in info if e[4] == "/img"] == ["SHMROS connection to [/listener]"]
+    assert _transports(listener, "/img") == ["SHMROS"]
+
+
+def test_ninjemys_shm_0_keeps_tcpros(make_node, monkeypatch) -> None:  # noqa: ANN001
+    monkeypatch.setenv("NINJEMYS_SHM", "0")
+    talker, listener = make_node("talker"), make_node("listener")
+    got: list[Image] = []
+    listener.subscriber("img", Image, got.append)
+    pub = talker.publisher("img", Image)
+    assert wait_until(lambda: pub.get_num_connections() == 1)
+    pub.publish(_image(1, BIG))
+    assert wait_until(lambda: got)
+    assert _transports(talker, "/img") == ["TCPROS"] and type(got[0].data.obj).__name__ != "Lease"
