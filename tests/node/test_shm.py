@@ -61,7 +61,9 @@ def test_the_same_stream_is_byte_identical_over_shm_unixros_and_tcpros(make_node
     talker = make_node("talker")
     pub = talker.publisher("stream", Image, queue_size=None)
     streams: dict[str, list[bytes]] = {"shm": [], "unix": [], "tcp": []}
-    make_node("shm_listener").subscriber("stream", Image, lambda m: streams["shm"].append(bytes(m.data)), raw=True)
+    make_node("shm_listener").subscriber(
+        "stream", Image, lambda m: streams["shm"].append(bytes(m.data)), raw=True
+    )
     assert wait_until(lambda: pub.get_num_connections() == 1)
     monkeypatch.setenv("NINJEMYS_SHM", "0")
     monkeypatch.setenv("NINJEMYS_UNIXROS", "1")
@@ -69,7 +71,9 @@ def test_the_same_stream_is_byte_identical_over_shm_unixros_and_tcpros(make_node
     unix.subscriber("stream", Image, lambda m: streams["unix"].append(bytes(m.data)), raw=True)
     assert wait_until(lambda: pub.get_num_connections() == 2)
     monkeypatch.setenv("NINJEMYS_UNIXROS", "0")
-    make_node("tcp_listener").subscriber("stream", Image, lambda m: streams["tcp"].append(bytes(m.data)), raw=True)
+    make_node("tcp_listener").subscriber(
+        "stream", Image, lambda m: streams["tcp"].append(bytes(m.data)), raw=True
+    )
     assert wait_until(lambda: pub.get_num_connections() == 3)
     assert sorted(_transports(talker, "/stream")) == ["SHMROS", "TCPROS", "UNIXROS"]
     sizes = (0, 1, 1000, shm_link.THRESHOLD - 200, shm_link.THRESHOLD, 300_000, 7, 1920 * 1080 * 3)
@@ -151,7 +155,7 @@ def test_a_malformed_notice_is_rejected_with_one_line_and_falls_back_to_tcpros(m
     for bad in ({"slot": 99}, {"gen": 12345}, {"length": shm_link.SLOT_SIZE + 1}):
         caplog.clear()
 
-        def forged(parts, length, bad=bad):  # noqa: ANN001, ANN202
+        def forged(parts, length, bad=bad, good_put=good_put):  # noqa: ANN001, ANN202
             frame = good_put(parts, length)
             _, slot, gen, size = shm_ring.NOTICE.unpack_from(frame, 4)
             values = {"slot": slot, "gen": gen, "length": size, **bad}
@@ -164,9 +168,13 @@ def test_a_malformed_notice_is_rejected_with_one_line_and_falls_back_to_tcpros(m
             assert wait_until(lambda: any("malformed" in r.getMessage() for r in caplog.records))
             lines = [r.getMessage() for r in caplog.records if r.name == "ninjemys.node.shm_link"]
             assert len(lines) == 1, lines
-            assert "/img" in lines[0] and "/talker" in lines[0] and next(iter(bad)) in lines[0].replace("generation", "gen")
+            assert (
+                "/img" in lines[0]
+                and "/talker" in lines[0]
+                and next(iter(bad)) in lines[0].replace("generation", "gen")
+            )
         # the subscriber reconnects over TCPROS and gets the next messages inline
-        assert wait_until(lambda: _transports(listener, "/img") == ["TCPROS"], timeout=10)
+        assert wait_until(lambda sub=listener: _transports(sub, "/img") == ["TCPROS"], timeout=10)
         assert wait_until(lambda: _transports(talker, "/img") == ["TCPROS"], timeout=10)
         got.clear()
         pub.publish(_image(3, BIG))

@@ -49,13 +49,18 @@ THRESHOLD = 64 * 1024
 #: it is first used, so an idle ring costs address space, not memory). 32 MiB fits a 4K rgb8 image.
 SLOTS = 4
 SLOT_SIZE = 32 << 20
+#: a synchronous publisher (queue_size=None) waits this long for a slot before sending inline: its
+#: subscriber is usually just behind (messages queued for its callback hold slots), not keeping them
+SLOT_WAIT = 0.05
 _INLINE = b"\0"
 
 
 def enabled() -> bool:
     """On by default on Linux; ``NINJEMYS_SHM=0`` turns it off (then every stream is TCPROS/UNIXROS)."""
     return (
-        os.environ.get("NINJEMYS_SHM", "1") != "0" and shm_ring.available() and bool(transport.host_identity())
+        os.environ.get("NINJEMYS_SHM", "1") != "0"
+        and shm_ring.available()
+        and bool(transport.host_identity())
     )
 
 
@@ -107,7 +112,7 @@ class ShmPubConnection(PubConnection):
     def send(self, data: bytes, queue_size: int | None) -> None:
         length = len(data) - 4
         if length >= THRESHOLD and not self.closed:
-            notice = self.ring.put([memoryview(data)[4:]], length)
+            notice = self.ring.put([memoryview(data)[4:]], length, SLOT_WAIT if queue_size is None else 0.0)
             if notice is not None:
                 PubConnection.send(self, notice, queue_size)
                 return
@@ -116,7 +121,7 @@ class ShmPubConnection(PubConnection):
     def send_parts(self, parts: list[Any], total: int, queue_size: int | None) -> None:
         length = total - 4
         if length >= THRESHOLD and not self.closed:
-            notice = self.ring.put(parts[1:], length)
+            notice = self.ring.put(parts[1:], length, SLOT_WAIT if queue_size is None else 0.0)
             if notice is not None:
                 PubConnection.send(self, notice, queue_size)
                 return

@@ -30,6 +30,7 @@ import os
 import struct
 import sys
 import threading
+import time
 
 from ninjemys.errors import NinjemysError
 
@@ -42,6 +43,9 @@ _CTL = 24  # offset of the per-slot control words
 #: the notice a publisher sends instead of the payload: tag 1, slot, generation, length
 NOTICE = struct.Struct("<BIQQ")
 NOTICE_TAG, INLINE_TAG = 1, 0
+
+#: how often a waiting publisher looks for a released slot (seconds)
+_POLL = 100e-6
 
 _names = itertools.count(1)
 _reaped = False
@@ -74,7 +78,7 @@ def _pid_alive(pid: int) -> bool:
 def reap_stale() -> list[str]:
     """Unlink segments whose creating process is gone (a publisher SIGKILLed before its subscriber
     mapped the segment); returns the names removed. Done once per process, on the first ring."""
-    removed = []
+    removed: list[str] = []
     try:
         names = os.listdir(SHM_DIR)
     except OSError:
@@ -120,11 +124,10 @@ class WriterRing:
             self.unlink()
             raise ShmError(f"cannot map {self.path}: {exc}") from None
         self._fd: int | None = fd  # kept for posix_fallocate as slots grow
-        self._mm[:_HEAD.size] = _HEAD.pack(MAGIC, slots, 0, slot_size)
+        self._mm[: _HEAD.size] = _HEAD.pack(MAGIC, slots, 0, slot_size)
         self._gen = [0] * slots  # what we stamped
         self._reclaimed = [0] * slots  # notices dropped before sending (queue_size)
         self._reserved = [0] * slots  # bytes of each slot backed by tmpfs pages (no SIGBUS)
-        self._next = 0
         self._counter = 0
         self._lock = threading.Lock()
         self.closed = False
@@ -135,40 +138,56 @@ class WriterRing:
             return True
         return _WORD.unpack_from(self._mm, _CTL + 16 * slot + 8)[0] == gen
 
-    def put(self, parts: list, length: int) -> bytes | None:
+    def _free_slot(self) -> int | None:
+        """The lowest free slot (a steady stream keeps reusing the same warm pages), or None."""
+        for slot in range(self.slots):
+            if self._free(slot):
+                return slot
+        return None
+
+    def put(self, parts: list, length: int, wait: float = 0.0) -> bytes | None:
         """Copy ``parts`` (``length`` bytes) into a free slot; the notice frame (length prefix
-        included) to send, or None when every slot is still held by the subscriber or the payload
-        does not fit (the caller then sends the message inline)."""
+        included) to send, or None when the payload does not fit or every slot is still held by the
+        subscriber after ``wait`` seconds (the caller then sends the message inline). A synchronous
+        publisher waits a little: its subscriber is merely behind, and the ring is the fast path."""
         if length > self.slot_size:
             return None
-        with self._lock:
-            if self.closed:
+        deadline = 0.0
+        while True:
+            with self._lock:
+                if self.closed:
+                    return None
+                slot = self._free_slot()
+                if slot is not None:
+                    return self._fill(slot, parts, length)
+            if not wait:
                 return None
-            n = self.slots
-            for k in range(n):
-                slot = (self._next + k) % n
-                if self._free(slot):
-                    break
-            else:
+            now = time.monotonic()
+            if not deadline:
+                deadline = now + wait
+            elif now >= deadline:
                 return None
-            base = self._data + slot * self.slot_size
-            if self._reserved[slot] < length:
-                try:
-                    os.posix_fallocate(self._fd, base, length)  # type: ignore[arg-type]
-                except OSError:
-                    return None  # /dev/shm is full: inline rather than SIGBUS on the copy
-                self._reserved[slot] = length
-            mm = self._mm
-            at = base
-            for part in parts:
-                size = len(part)
-                mm[at : at + size] = part
-                at += size
-            self._counter += 1
-            gen = self._counter
-            self._gen[slot] = gen
-            _WORD.pack_into(mm, _CTL + 16 * slot, gen)
-            self._next = (slot + 1) % n
+            time.sleep(_POLL)
+
+    def _fill(self, slot: int, parts: list, length: int) -> bytes | None:
+        """Copy into ``slot`` and stamp it (lock held)."""
+        base = self._data + slot * self.slot_size
+        if self._reserved[slot] < length:
+            try:
+                os.posix_fallocate(self._fd, base, length)  # type: ignore[arg-type]
+            except OSError:
+                return None  # /dev/shm is full: inline rather than SIGBUS on the copy
+            self._reserved[slot] = length
+        mm = self._mm
+        at = base
+        for part in parts:
+            size = len(part)
+            mm[at : at + size] = part
+            at += size
+        self._counter += 1
+        gen = self._counter
+        self._gen[slot] = gen
+        _WORD.pack_into(mm, _CTL + 16 * slot, gen)
         return struct.pack("<I", NOTICE.size) + NOTICE.pack(NOTICE_TAG, slot, gen, length)
 
     def reclaim(self, notice_frame: bytes) -> None:
@@ -233,13 +252,15 @@ class ReaderRing:
         data = _data_offset(slots)
         if magic != MAGIC or slots == 0 or data + slots * slot_size > size:
             self._mm.close()
-            raise ShmError(f"{path}: not a ring this version understands ({slots} slots of {slot_size} bytes)")
+            raise ShmError(
+                f"{path}: not a ring this version understands ({slots} slots of {slot_size} bytes)"
+            )
         self.slots, self.slot_size, self._data = slots, slot_size, data
         self._seen = [0] * slots
         mm = self._mm
         release = self._release
 
-        class Lease(ctypes.c_ubyte * slot_size):  # type: ignore[misc,valid-type]
+        class Lease(ctypes.c_ubyte * slot_size):  # type: ignore[misc]
             """Exports one slot; when the last view of it goes, the slot is released."""
 
             def __del__(self) -> None:
@@ -268,7 +289,9 @@ class ReaderRing:
             raise ShmError(f"length {length} beyond the {self.slot_size}-byte slot")
         stamped = _WORD.unpack_from(self._mm, _CTL + 16 * slot)[0]
         if gen != stamped or gen <= self._seen[slot]:
-            raise ShmError(f"slot {slot}: generation {gen}, expected {stamped} (newer than {self._seen[slot]})")
+            raise ShmError(
+                f"slot {slot}: generation {gen}, expected {stamped} (newer than {self._seen[slot]})"
+            )
         self._seen[slot] = gen
         lease = self._lease.from_buffer(self._mm, self._data + slot * self.slot_size)
         lease.slot, lease.gen = slot, gen
