@@ -155,8 +155,8 @@ def test_a_malformed_notice_is_rejected_with_one_line_and_falls_back_to_tcpros(m
     for bad in ({"slot": 99}, {"gen": 12345}, {"length": shm_link.SLOT_SIZE + 1}):
         caplog.clear()
 
-        def forged(parts, length, bad=bad, good_put=good_put):  # noqa: ANN001, ANN202
-            frame = good_put(parts, length)
+        def forged(parts, length, wait=0.0, bad=bad, good_put=good_put):  # noqa: ANN001, ANN202
+            frame = good_put(parts, length, wait)
             _, slot, gen, size = shm_ring.NOTICE.unpack_from(frame, 4)
             values = {"slot": slot, "gen": gen, "length": size, **bad}
             return frame[:4] + shm_ring.NOTICE.pack(1, values["slot"], values["gen"], values["length"])
