@@ -23,7 +23,6 @@ a user keeps can never outlive its memory.
 
 from __future__ import annotations
 
-import ctypes
 import itertools
 import mmap
 import os
@@ -257,6 +256,8 @@ class ReaderRing:
             )
         self.slots, self.slot_size, self._data = slots, slot_size, data
         self._seen = [0] * slots
+        import ctypes  # only a subscriber of a ring needs it (about 2 ms of start-up otherwise)
+
         mm = self._mm
         release = self._release
 
