@@ -99,8 +99,11 @@ def role_sub(kind: str, mode: str, count: str) -> None:
 
     rospy.Subscriber("/big", cls, cb, queue_size=None, buff_size=2**27, tcp_nodelay=True)
     print("ready", flush=True)
-    seconds = float(count) * 0.05 + 3 if mode == "latency" else float(count) + 3
-    time.sleep(seconds)
+    # the window starts with the first message (a publisher under a loaded machine starts late)
+    deadline = time.monotonic() + 120
+    while not (latencies or arrivals) and time.monotonic() < deadline:
+        time.sleep(0.01)
+    time.sleep(float(count) * 0.05 + 2 if mode == "latency" else float(count) + 2)
     if mode == "latency":
         result = {"latency_ms": _pct(latencies, 0.5) * 1e3, "n": len(latencies)}
     else:
