@@ -67,7 +67,8 @@ int main(int argc, char** argv) {
       ? nh.subscribe<sensor_msgs::PointCloud2>("/big", 1000, on<sensor_msgs::PointCloud2>, ros::TransportHints().tcpNoDelay())
       : nh.subscribe<sensor_msgs::Image>("/big", 1000, on<sensor_msgs::Image>, ros::TransportHints().tcpNoDelay());
   std::printf("ready\n"); std::fflush(stdout);
-  std::this_thread::sleep_for(std::chrono::duration<double>(mode == "latency" ? n * 0.05 + 3 : n + 3));
+  for (int i = 0; i < 12000 && lat.empty() && arr.empty(); i++) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  std::this_thread::sleep_for(std::chrono::duration<double>(mode == "latency" ? n * 0.05 + 2 : n + 2));
   if (mode == "latency") {
     std::sort(lat.begin(), lat.end());
     std::printf("{\"latency_ms\": %f, \"n\": %zu}\n", lat.empty() ? 0.0 : lat[lat.size() / 2] * 1e3, lat.size());
