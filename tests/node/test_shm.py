@@ -96,8 +96,11 @@ def test_received_arrays_are_read_only_views_that_stay_valid_while_held(make_nod
         pub.publish(_image(i, BIG))
     assert wait_until(lambda: len(held) == count, timeout=15)
     in_ring = [m for m in held if type(m.data.obj).__name__ == "Lease"]
-    # every slot is held by the user: the publisher sent the rest inline rather than overwrite one
+    # every slot is held by the user: the publisher sent the rest inline rather than overwrite one,
+    # and after one wait for a slot it stopped waiting (one stall, not one per message)
     assert len(in_ring) == shm_link.SLOTS
+    ring = _pub_connection(talker, "/img").ring
+    assert ring._patient is False
     for i, msg in enumerate(held):
         assert msg.header.seq == i + 1 and msg.data[0] == i and msg.data[-1] == (i * 3) % 256
         assert len(msg.data) == BIG
@@ -120,6 +123,7 @@ def test_received_arrays_are_read_only_views_that_stay_valid_while_held(make_nod
         got.clear()
         held.clear()
     assert array[0] == first and array[1] == 0 and array[-1] == 0
+    assert ring._patient is True  # slots came free: a synchronous publisher waits for them again
 
 
 def test_queue_size_drops_keep_the_newest_and_free_their_slots(make_node) -> None:  # noqa: ANN001

@@ -128,6 +128,7 @@ class WriterRing:
         self._reclaimed = [0] * slots  # notices dropped before sending (queue_size)
         self._reserved = [0] * slots  # bytes of each slot backed by tmpfs pages (no SIGBUS)
         self._counter = 0
+        self._patient = True  # False after a wait for a slot timed out (see put)
         self._lock = threading.Lock()
         self.closed = False
 
@@ -158,13 +159,18 @@ class WriterRing:
                     return None
                 slot = self._free_slot()
                 if slot is not None:
+                    if not deadline:
+                        self._patient = True  # slots come free again: worth waiting next time
                     return self._fill(slot, parts, length)
-            if not wait:
+            if not wait or not self._patient:
                 return None
             now = time.monotonic()
             if not deadline:
                 deadline = now + wait
             elif now >= deadline:
+                # the subscriber keeps its messages (a cache, a synchronizer): stop waiting until
+                # a slot is seen free again, so one stall is all such a user ever pays
+                self._patient = False
                 return None
             time.sleep(_POLL)
 
