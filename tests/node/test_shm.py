@@ -267,7 +267,7 @@ def test_a_dead_creators_segment_is_reaped_and_ours_are_never_tracked() -> None:
     assert out.strip() == "False"  # no resource tracker can unlink a segment behind our back
 
 
-def test_shmros_is_granted_only_to_this_host_and_named_in_bus_info(make_node) -> None:  # noqa: ANN001
+def test_shmros_is_granted_only_to_this_host_and_named_in_bus_info(make_node, master) -> None:  # noqa: ANN001
     import xmlrpc.client
 
     talker, listener = make_node("talker"), make_node("listener")
@@ -286,6 +286,10 @@ def test_shmros_is_granted_only_to_this_host_and_named_in_bus_info(make_node) ->
     assert [e[3] for e in info if e[4] == "/img"] == ["SHMROS"]
     assert [e[6] for e in info if e[4] == "/img"] == ["SHMROS connection to [/listener]"]
     assert _transports(listener, "/img") == ["SHMROS"]
+    rosnode = [str(Path(sys.executable).parent / "rosnode"), "info", "/talker"]
+    env = dict(os.environ, ROS_MASTER_URI=master.uri)
+    out = subprocess.run(rosnode, env=env, capture_output=True, text=True, timeout=60).stdout
+    assert "topic: /img" in out and "transport: SHMROS" in out, out
 
 
 def test_ninjemys_shm_0_keeps_tcpros(make_node, monkeypatch) -> None:  # noqa: ANN001
