@@ -6,12 +6,14 @@ views that stay valid while held; a slot is never reused while referenced; crash
 from __future__ import annotations
 
 import gc
+import itertools
 import logging
 import os
 import signal
 import subprocess
 import sys
 import time
+from collections import deque
 from pathlib import Path
 
 import pytest
@@ -214,12 +216,20 @@ def test_a_subscriber_killed_mid_stream_leaves_nothing_behind(make_node, master)
 
 def test_a_publisher_killed_mid_write_leaves_nothing_behind(make_node, master) -> None:  # noqa: ANN001
     listener = make_node("listener")
-    held: list[Image] = []
-    listener.subscriber("/image", Image, held.append, queue_size=5)
+    held: deque[Image] = deque(maxlen=2)  # slots keep coming free: the publisher writes the ring all along
+    count = itertools.count(1)
+    seen = [0]
+
+    def on_image(msg: Image) -> None:
+        held.append(msg)
+        seen[0] = next(count)
+
+    listener.subscriber("/image", Image, on_image, queue_size=5)
     child = NodeProcess([sys.executable, str(HERE / "stream_proc.py"), master.uri, "image", "0", "60"])
     try:
-        assert wait_until(lambda: len(held) > 50, timeout=30), child.describe()
+        assert wait_until(lambda: seen[0] > 50, timeout=30), child.describe()
         assert _transports(listener, "/image") == ["SHMROS"]
+        assert all(type(m.data.obj).__name__ == "Lease" for m in list(held))  # the ring, not inline
         os.kill(child.pid, signal.SIGKILL)
         child.proc.wait()
         assert wait_until(lambda: _transports(listener, "/image") == [], timeout=10)
