@@ -312,3 +312,48 @@ def test_ninjemys_shm_0_keeps_tcpros(make_node, monkeypatch) -> None:  # noqa: A
     pub.publish(_image(1, BIG))
     assert wait_until(lambda: got)
     assert _transports(talker, "/img") == ["TCPROS"] and type(got[0].data.obj).__name__ != "Lease"
+
+
+def _mapped(name: str) -> bool:
+    return name in Path("/proc/self/maps").read_text()
+
+
+def test_the_mapping_lives_exactly_as_long_as_a_view_or_the_ring() -> None:
+    gc.disable()  # no help from the cycle collector: plain reference counts must free it
+    try:
+        ring = shm_ring.WriterRing(2, 1 << 16)
+        reader = shm_ring.ReaderRing(ring.name)
+        notice = ring.put([b"x" * 70_000], 70_000)
+        assert notice is None  # beyond the slot: the caller sends it inline
+        notice = ring.put([b"hello"], 5)
+        assert notice is not None
+        view = reader.view(notice[4:])
+        tail = view[1:]
+        del view
+        ring.close()
+        del reader
+        assert _mapped(ring.name) and bytes(tail) == b"ello"  # the last view keeps it mapped
+        del tail
+        assert not _mapped(ring.name)  # and its end unmaps it at once
+    finally:
+        gc.enable()
+
+
+def test_a_released_slot_is_written_again_and_a_held_one_never() -> None:
+    ring = shm_ring.WriterRing(2, 1 << 16)
+    reader = shm_ring.ReaderRing(ring.name)
+    try:
+        first = reader.view(ring.put([b"one"], 3)[4:])  # type: ignore[index]
+        second = reader.view(ring.put([b"two"], 3)[4:])  # type: ignore[index]
+        assert ring.put([b"three"], 5) is None  # both held
+        del second
+        third = reader.view(ring.put([b"333"], 3)[4:])  # type: ignore[index]
+        assert bytes(first) == b"one" and bytes(third) == b"333"
+        # a notice dropped before it was sent (queue_size) gives its slot back
+        del third
+        dropped = ring.put([b"lost"], 4)
+        assert dropped is not None and ring.put([b"x"], 1) is None
+        ring.reclaim(dropped)
+        assert ring.put([b"y"], 1) is not None
+    finally:
+        ring.close()

@@ -264,23 +264,18 @@ class ReaderRing:
         self._seen = [0] * slots
         import ctypes  # only a subscriber of a ring needs it (about 2 ms of start-up otherwise)
 
-        mm = self._mm
-        release = self._release
-
         class Lease(ctypes.c_ubyte * slot_size):  # type: ignore[misc]
-            """Exports one slot; when the last view of it goes, the slot is released."""
+            """Exports one slot; when the last view of it goes, the slot is released. It refers to
+            the mapping itself (``mm``), not to the ring: no reference cycle, so the mapping goes
+            the moment the connection and the last view are gone, without waiting for the GC."""
 
             def __del__(self) -> None:
                 try:
-                    release(self.slot, self.gen)
+                    _WORD.pack_into(self.mm, self.released_at, self.gen)
                 except Exception:  # interpreter shutdown: nothing left to tell
                     pass
 
         self._lease = Lease
-        self._mm_ref = mm
-
-    def _release(self, slot: int, gen: int) -> None:
-        _WORD.pack_into(self._mm, _CTL + 16 * slot + 8, gen)
 
     def view(self, frame: bytes | bytearray) -> memoryview:
         """The payload a notice frame (without its length prefix) names, as a read-only view.
@@ -301,6 +296,6 @@ class ReaderRing:
             )
         self._seen[slot] = gen
         lease = self._lease.from_buffer(self._mm, self._data + slot * self.slot_size)
-        lease.slot, lease.gen = slot, gen
+        lease.mm, lease.released_at, lease.gen = self._mm, _CTL + 16 * slot + 8, gen
         view = memoryview(lease).cast("B")[:length].toreadonly()
         return view
