@@ -26,6 +26,10 @@ ROS1_DEBS += cmake python3-gencpp ros-std-msgs libstd-msgs-dev
 ROS1_DEBS += python3-opencv image-transport-tools
 # the long tail (issue 21 item 7): Debian's python3-angles, the reference for ours
 ROS1_DEBS += python3-angles
+# rostest: Debian's rostest, the reference for ours (tests/rostest)
+ROS1_DEBS += python3-rostest
+# C++ packages with .action files (the books' C++ action servers): actionlib_msgs' .msg definitions
+ROS1_DEBS += ros-actionlib-msgs
 BROWSER_DEBS := chromium chromium-driver fonts-dejavu-core
 # multi-host tests: network namespaces (iproute2), roslaunch <machine> over ssh (openssh-server)
 NET_DEBS     := iproute2 openssh-server openssh-client
@@ -35,7 +39,7 @@ SYSTEM_DEBS  := $(ROS1_DEBS) $(BROWSER_DEBS) $(NET_DEBS) tmux
 NPM_DIR   := .cache/npm
 NPM_STAMP := $(NPM_DIR)/node_modules/.installed
 
-.PHONY: all venv system npm lint format typecheck test test-fast demo bench fuzz clean
+.PHONY: all venv system npm lint format typecheck test test-fast demo bench fuzz soak clean
 
 all: venv
 
@@ -96,6 +100,13 @@ bench: venv system
 # every parser of untrusted input, 100,000 mutated inputs each (make test runs 2,000: tests/fuzz)
 fuzz: venv
 	$(PY) tests/fuzz/run_fuzz.py --count 100000
+
+# the soak: 50 nodes under load, random SIGKILLs, two master restarts, a bag throughout, then a cut
+# link 20 times (network namespaces, as root); prints heal times p50/p95 and resources start vs end.
+# make test runs a ~70 s form (tests/soak/test_soak.py). SOAK_DURATION=seconds of faults.
+SOAK_DURATION ?= 600
+soak: venv
+	$(PY) tests/soak/soak.py --duration $(SOAK_DURATION) --json soak-report.json
 
 clean:
 	rm -rf $(VENV) build dist src/*.egg-info .pytest_cache .ruff_cache $(NPM_DIR)

@@ -107,6 +107,7 @@ LAYERS: dict[str, str] = {
     "launch": "libs",
     "bag": "libs",
     "smach": "libs",
+    "rostest": "libs",
     "tools": "tools",
     "testing": "tools",
     "bridge": "gateway",

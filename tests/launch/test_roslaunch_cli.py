@@ -89,7 +89,10 @@ BAD = {
         "test.launch:3: Invalid roslaunch XML syntax",
     ),
     "missing_arg": ('<param name="p" value="$(arg x)"/>', "arg 'x' is not set"),
-    "find_missing": ('<param name="p" value="$(find missing_pkg)/x"/>', "$(find missing_pkg)"),
+    "find_missing": (
+        '<param name="p" value="$(find missing_pkg)/x"/>',
+        "$(find missing_pkg): Resource not found: missing_pkg",  # ROS 1's words, after file:line
+    ),
     "unknown_machine": (
         '<node name="a" pkg="corpus_run" type="sleeper.py" machine="mars"/>',
         "unknown machine [mars]",

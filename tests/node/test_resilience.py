@@ -164,3 +164,58 @@ def test_a_node_with_names_the_master_refuses_still_reregisters_the_rest() -> No
         if node is not None:
             node.shutdown("test over")
         master.kill()
+
+
+def test_a_restarted_master_filling_in_does_not_cut_live_streams(monkeypatch) -> None:
+    """A new master learns the graph node by node: its first publisher lists miss the publishers that
+    have not re-registered yet. A subscriber must keep those live streams (the soak saw a message lost
+    when it did not), and apply the master's full list once the settling window is over."""
+    from ninjemys.node import registration
+
+    monkeypatch.setattr(registration, "SETTLE_PERIOD", 2.0)
+    master = MasterProcess(free_port(), kind="ninjemys")
+    master.start()
+    nodes: list[Node] = []
+    stop = threading.Event()
+    try:
+        a, b, listener = (Node(n, master_uri=master.uri) for n in ("talker_a", "talker_b", "listener"))
+        nodes += [a, b, listener]
+        got: dict[str, list[int]] = {"a": [], "b": []}
+        sub = listener.subscriber("chatter", String, lambda m: got[m.data[0]].append(int(m.data[2:])))
+        pubs = {"a": a.publisher("chatter", String), "b": b.publisher("chatter", String)}
+
+        def publish() -> None:
+            i = 0
+            while not stop.wait(0.02):
+                for tag, pub in pubs.items():
+                    pub.publish(String(f"{tag} {i}"))
+                i += 1
+
+        thread = threading.Thread(target=publish)
+        thread.start()
+        assert wait_until(lambda: sub.get_num_connections() == 2 and len(got["b"]) > 3, timeout=10)
+        master.kill()
+        master.start()
+        assert wait_until(listener.registrar.settling, timeout=5, what="the listener's re-registration")
+        # what the new master says while only talker_a has registered again
+        listener.publisher_update("/chatter", [a.uri])
+        count = len(got["b"])
+        assert wait_until(lambda: len(got["b"]) > count + 10, timeout=5)
+        assert sub.get_num_connections() == 2
+        # the window ends: the master's full list (both talkers by now) is applied; nothing is cut
+        assert wait_until(lambda: not listener.registrar.settling(), timeout=5)
+        count = len(got["b"])
+        assert wait_until(lambda: len(got["b"]) > count + 10, timeout=5)
+        assert sub.get_num_connections() == 2
+        stop.set()
+        thread.join()
+        for seqs in got.values():  # one stream each, never cut: no message missing in the middle
+            assert seqs == list(range(seqs[0], seqs[0] + len(seqs)))
+        # after the window, the master's word holds again (ROS 1 semantics): an omitted publisher is dropped
+        listener.publisher_update("/chatter", [a.uri])
+        assert wait_until(lambda: sub.get_num_connections() == 1, timeout=5)
+    finally:
+        stop.set()
+        for node in nodes:
+            node.shutdown("test over")
+        master.kill()

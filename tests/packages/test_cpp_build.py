@@ -11,7 +11,13 @@ from pathlib import Path
 
 import pytest
 
-from ninjemys.packages.cpp_build import find_toolchain
+from ninjemys.packages.cpp_build import (
+    failing_package,
+    find_toolchain,
+    missing_cpp_dependency,
+    missing_definitions_hint,
+    noetic_compat_flags,
+)
 from ninjemys.testing import kill_tree, ninjemys_bin, run_master
 
 PACKAGE_XML = """<?xml version="1.0"?>
@@ -74,23 +80,31 @@ int main(int argc, char **argv) {
 }
 """
 
-ECHO = r"""// Listens on /chatter and republishes each string, prefixed, on /echo.
+ECHO = r"""// Listens on /chatter and republishes each string, prefixed, on /echo. Written as the Noetic-era
+// books and tutorials write class-based nodes: boost::bind(&Class::method, this, _1) with the global
+// _1 that Boost 1.71 had (catkin_make must make that compile on newer Boost too).
 #include <ros/ros.h>
 #include <std_msgs/String.h>
 
-static ros::Publisher echo;
+class Echo {
+ public:
+  Echo() : echo_(nh_.advertise<std_msgs::String>("echo", 10)),
+           sub_(nh_.subscribe<std_msgs::String>("chatter", 10, boost::bind(&Echo::heard, this, _1))) {}
 
-static void heard(const std_msgs::String::ConstPtr &msg) {
-  std_msgs::String out;
-  out.data = "cpp heard: " + msg->data;
-  echo.publish(out);
-}
+ private:
+  void heard(const std_msgs::String::ConstPtr &msg) {
+    std_msgs::String out;
+    out.data = "cpp heard: " + msg->data;
+    echo_.publish(out);
+  }
+  ros::NodeHandle nh_;
+  ros::Publisher echo_;
+  ros::Subscriber sub_;
+};
 
 int main(int argc, char **argv) {
   ros::init(argc, argv, "cpp_echo");
-  ros::NodeHandle nh;
-  echo = nh.advertise<std_msgs::String>("echo", 10);
-  ros::Subscriber sub = nh.subscribe("chatter", 10, heard);
+  Echo echo;
   ros::spin();
   return 0;
 }
@@ -250,3 +264,105 @@ def test_a_compile_error_fails_like_debians_catkin_make(tmp_path: Path) -> None:
         assert result.returncode != 0, who
         assert "undeclared_name" in result.stdout + result.stderr, who
     assert 'Invoking "make -j' in results["ours"].stdout + results["ours"].stderr
+
+
+def test_newer_boost_gets_noetics_global_placeholders(tmp_path: Path) -> None:
+    header = tmp_path / "version.hpp"
+    header.write_text("#define BOOST_VERSION 107400\n")
+    assert noetic_compat_flags(header) == "-DBOOST_BIND_GLOBAL_PLACEHOLDERS -include boost/bind.hpp"
+    header.write_text("#define BOOST_VERSION 107100\n")
+    assert noetic_compat_flags(header) == ""
+    assert noetic_compat_flags(tmp_path / "absent.hpp") == ""
+
+
+def test_message_definitions_missing_for_cpp_generation_get_one_hint(tmp_path: Path) -> None:
+    genmsg = (
+        "CMake Error at build/demo/cmake/demo-genmsg.cmake:3 (message):\n  Could not find messages which\n"
+        "  '/ws/devel/share/demo/msg/MoveAction.msg' depends on.\n\n  Cannot locate message [GoalID] in "
+        f"package [actionlib_msgs] with paths\n  [['{tmp_path / 'nowhere'}']]\n"
+    )
+    hint = missing_definitions_hint(genmsg)
+    assert hint.startswith("ninjemys: ") and "ros-actionlib-msgs" in hint and "\n" not in hint
+    (tmp_path / "nowhere").mkdir()
+    assert missing_definitions_hint(genmsg) == ""  # the files are there: the error is something else
+    assert missing_definitions_hint("undeclared_name") == ""
+
+
+@needs_toolchain
+def test_a_dependency_without_its_cpp_side_leaves_the_python_side_built(tmp_path: Path) -> None:
+    """A course package with a Python node and a C++ node on fiducial_msgs, whose C++ headers this
+    machine lacks (ninjemys provides it for Python): the build succeeds, the Python node is ready,
+    and the C++ target is named as not built, saying which package's C++ side is missing."""
+    pkg = tmp_path / "src" / "aruco_follow"
+    (pkg / "src").mkdir(parents=True)
+    (pkg / "scripts").mkdir()
+    (pkg / "package.xml").write_text(
+        PACKAGE_XML.replace("cpp_chat", "aruco_follow").replace(
+            "<depend>std_msgs</depend>", "<depend>std_msgs</depend>\n  <depend>fiducial_msgs</depend>"
+        )
+    )
+    (pkg / "CMakeLists.txt").write_text(
+        "cmake_minimum_required(VERSION 3.0.2)\nproject(aruco_follow)\n"
+        "find_package(catkin REQUIRED COMPONENTS roscpp rospy fiducial_msgs)\ncatkin_package()\n"
+        "include_directories(${catkin_INCLUDE_DIRS})\nadd_executable(follow_node src/follow.cpp)\n"
+        "target_link_libraries(follow_node ${catkin_LIBRARIES})\n"
+        "catkin_install_python(PROGRAMS scripts/follow.py DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})\n"
+    )
+    (pkg / "src" / "follow.cpp").write_text(
+        "#include <ros/ros.h>\n#include <fiducial_msgs/FiducialTransformArray.h>\nint main() { return 0; }\n"
+    )
+    (pkg / "scripts" / "follow.py").write_text(
+        "#!/usr/bin/env python3\nfrom fiducial_msgs.msg import Fiducial\n"
+    )
+    (pkg / "scripts" / "follow.py").chmod(0o755)
+    # a second C++ package that has all it needs: built all the same
+    plain = tmp_path / "src" / "plain_node"
+    (plain / "src").mkdir(parents=True)
+    (plain / "package.xml").write_text(PACKAGE_XML.replace("cpp_chat", "plain_node"))
+    (plain / "CMakeLists.txt").write_text(
+        "cmake_minimum_required(VERSION 3.0.2)\nproject(plain_node)\n"
+        "find_package(catkin REQUIRED COMPONENTS roscpp)\ncatkin_package()\n"
+        "include_directories(${catkin_INCLUDE_DIRS})\nadd_executable(plain src/plain.cpp)\n"
+        "target_link_libraries(plain ${catkin_LIBRARIES})\n"
+    )
+    (plain / "src" / "plain.cpp").write_text(
+        '#include <ros/ros.h>\nint main(int argc, char **argv) { ros::init(argc, argv, "plain"); return 0; }\n'
+    )
+    env = {k: v for k, v in os.environ.items() if k not in ("ROS_PACKAGE_PATH", "CMAKE_PREFIX_PATH")}
+    env.pop("NINJEMYS_CATKIN_CPP", None)
+    result = subprocess.run(
+        [ninjemys_bin("catkin_make")],
+        cwd=tmp_path,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
+    out = result.stdout + result.stderr
+    if "C++ program(s) built by catkin's CMake: follow_node" in out:
+        pytest.skip("fiducial_msgs' C++ side is installed here")
+    assert result.returncode == 0, out
+    assert "aruco_follow: 1 C++ target(s) not built" in out
+    assert "[the C++ side of 'fiducial_msgs' is not installed" in out
+    assert (tmp_path / "devel" / "lib" / "aruco_follow" / "follow.py").is_file()
+    assert "plain_node: C++ program(s) built by catkin's CMake: plain" in out
+    assert (tmp_path / "devel" / "lib" / "plain_node" / "plain").is_file()
+
+
+def test_the_failing_package_is_told_from_cmakes_call_stack_or_the_compiler() -> None:
+    stack = "CMake Error at /usr/share/catkin/cmake/catkinConfig.cmake:82 (find_package):\n"
+    stack += "Call Stack (most recent call first):\n  aruco_follow/CMakeLists.txt:3 (find_package)\n"
+    assert failing_package(stack, {"aruco_follow", "plain_node"}) == "aruco_follow"
+    compiler = "/ws/build/ninjemys_cpp/src/plain_node/src/x.cpp:2:10: fatal error: a/b.h: No such file\n"
+    assert failing_package(compiler, {"aruco_follow", "plain_node"}) == "plain_node"
+    assert failing_package("something else", {"plain_node"}) is None
+
+
+def test_which_failures_mean_a_missing_cpp_side() -> None:
+    configure = 'CMake Error ...\n  Could not find a package configuration file provided by "nav_msgs" with\n'
+    assert missing_cpp_dependency(configure + 'Invoking "cmake" failed') == ("nav_msgs", False)
+    header = "node.cpp:2:10: fatal error: control_msgs/JointControllerState.h: No such file or directory\n"
+    assert missing_cpp_dependency(header + 'Invoking "make -j2" failed') == ("control_msgs", True)
+    own = "node.cpp:2:19: error: 'undeclared_name' was not declared in this scope\n"
+    assert missing_cpp_dependency(own + 'Invoking "make -j2" failed') is None

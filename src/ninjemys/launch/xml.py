@@ -163,7 +163,12 @@ class _Loader:
         try:
             return str(self._index.find(pkg).path)
         except NinjemysError:
-            raise LaunchError(f"$(find {pkg}): package '{pkg}' not found") from None
+            # ROS 1's words ("Resource not found" and the package path searched), after file:line
+            from ninjemys.packages.discovery import package_path_dirs, underlay_dirs
+
+            paths = [*package_path_dirs(self.env), *underlay_dirs()]
+            where = "".join(f"\nROS path [{i}]={path}" for i, path in enumerate(paths))
+            raise LaunchError(f"$(find {pkg}): Resource not found: {pkg}{where}") from None
 
     def sub(self, text: str | None, scope: _Scope, el: Element) -> str | None:
         if text is None or "$" not in text:

@@ -70,11 +70,14 @@ class Signer:
 
     def __init__(self, key: bytes) -> None:
         # imported here: only a process with a secret pays for them (node start-up stays lean)
+        import hashlib
         import hmac
         import itertools
 
-        self._digest, self._compare = hmac.digest, hmac.compare_digest
-        self._key = key
+        self._compare = hmac.compare_digest
+        # keyed once, copied per message: with OpenSSL 3, hmac.digest(key, msg, "sha256") looks the
+        # digest up on every call and costs ~4x a copy of a keyed HMAC (18 vs ~4 µs for a 340-byte call)
+        self._keyed = hmac.new(key, digestmod=hashlib.sha256)
         # nonces need only be unique: a random prefix per signer and a counter (no syscall per call)
         self._prefix = os.urandom(6).hex()
         self._count = itertools.count()
@@ -82,8 +85,10 @@ class Signer:
         self._lock = threading.Lock()
 
     def _mac(self, stamp: str, nonce: str, payload: bytes) -> str:
-        message = stamp.encode() + b"\n" + nonce.encode() + b"\n" + payload
-        return self._digest(self._key, message, "sha256").hex()
+        mac = self._keyed.copy()
+        mac.update(stamp.encode() + b"\n" + nonce.encode() + b"\n")
+        mac.update(payload)
+        return mac.hexdigest()
 
     def sign(self, payload: bytes) -> str:
         stamp, nonce = f"{time.time():.3f}", f"{self._prefix}{next(self._count):x}"

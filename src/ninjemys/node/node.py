@@ -326,10 +326,12 @@ class Node(ParamAccess):
     # -- NodeContext: calls back from the node's parts ------------------------------------------------
 
     def publisher_update(self, topic: str, publishers: list[str]) -> None:
-        """Connect to the current publishers of ``topic`` (from the master: slave API, re-registration)."""
+        """Connect to the current publishers of ``topic`` (from the master: slave API, re-registration).
+        Just after a master restart the list may be short of publishers that have not re-registered
+        yet: live connections are then kept (registration.py, ``settling``)."""
         sub = self._subscriptions.get(topic)
         if sub is not None:
-            self.runtime.call_soon(sub.update_publishers, publishers)
+            self.runtime.call_soon(sub.update_publishers, publishers, self.registrar.settling())
 
     def release_publisher(self, handle: Publisher) -> None:
         """Forget an unregistered Publisher handle; the topic's last one unregisters the topic."""

@@ -13,6 +13,14 @@ it: we do not fight (the master shuts us down, as in ROS 1).
 
 Registration calls made while the master is down are not errors: they are remembered and sent when
 it comes back.
+
+A restarted master learns the graph again one node at a time, so for a while its publisher lists
+are short of the nodes that have not re-registered yet. Taken at their word (ROS 1's
+``publisherUpdate`` semantics: drop what is not listed), they would cut live streams from healthy
+publishers and lose the messages in flight until those publishers re-register (the soak test
+found exactly that). So for :data:`SETTLE_PERIOD` seconds after a re-registration the node only
+adds publishers and keeps its live connections (:meth:`Registrar.settling`); then it asks the
+master once more for each topic's publishers and applies the full list, dropping what is really gone.
 """
 
 from __future__ import annotations
@@ -20,6 +28,7 @@ from __future__ import annotations
 import logging
 import socket
 import threading
+import time
 from collections.abc import Callable
 from functools import partial
 
@@ -39,6 +48,9 @@ _log = logging.getLogger(__name__)
 WATCH_PERIOD = 1.0
 #: Seconds between two checks while the link to the master is up (a broken link triggers one at once).
 IDLE_CHECK_PERIOD = 15.0
+#: Seconds after a re-registration during which publisher lists only add (the new master's view is
+#: still filling in); long enough for every other node to notice the restart and register again.
+SETTLE_PERIOD = 10.0
 
 
 class Registrar:
@@ -59,6 +71,7 @@ class Registrar:
         self._link: socket.socket | None = None
         self._link_up = False
         self._link_lost = threading.Event()
+        self._settle_deadline = 0.0  # monotonic end of the settling window; 0: none pending
 
     def start(self) -> None:
         self._thread = threading.Thread(target=self._watch, name=f"reg:{self.node.name}", daemon=True)
@@ -156,16 +169,26 @@ class Registrar:
 
     # -- watchdog --------------------------------------------------------------------------------
 
+    def settling(self) -> bool:
+        """True while a restarted master may still be missing other nodes' registrations: publisher
+        lists from it must not cut live connections (see the module's docstring)."""
+        return self._settle_deadline > 0.0 and time.monotonic() < self._settle_deadline
+
     def _watch(self) -> None:
         """Check the master when the link to it breaks (instantly), every WATCH_PERIOD while it is
-        down, and every IDLE_CHECK_PERIOD otherwise (in case no link could be kept)."""
+        down, and every IDLE_CHECK_PERIOD otherwise (in case no link could be kept); end a settling
+        window when it is due."""
         self._spawn_link()
         while not self._stop.is_set():
             period = WATCH_PERIOD if self._master_down or not self._link_up else IDLE_CHECK_PERIOD
+            if self._settle_deadline:
+                period = max(0.0, min(period, self._settle_deadline - time.monotonic()))
             self._link_lost.wait(period)
             self._link_lost.clear()
             if self._stop.is_set():
                 return
+            if self._settle_deadline and time.monotonic() >= self._settle_deadline and not self._master_down:
+                self._settle()
             self._check()
             if not self._master_down and not self._link_up:
                 self._spawn_link()
@@ -243,6 +266,8 @@ class Registrar:
                 "master at %s does not know %s: registering again", self.node.master_uri, self.node.name
             )
         master, uri = self._probe, self.node.uri
+        if subs:
+            self._settle_deadline = time.monotonic() + SETTLE_PERIOD
 
         def again(fn: Callable[[], object]) -> object | None:
             try:
@@ -269,6 +294,21 @@ class Registrar:
             self._master_down = True
             return
         self._master_down = False
+
+    def _settle(self) -> None:
+        """The settling window is over: the full publisher list of every topic, applied as given."""
+        self._settle_deadline = 0.0
+        with self._lock:
+            subs = dict(self.subscriptions)
+        try:
+            for topic, type_name in subs.items():
+                publishers = self._probe.register_subscriber(topic, type_name, self.node.uri)
+                if isinstance(publishers, list):
+                    self.node.publisher_update(topic, list(publishers))
+        except MasterUnreachable:
+            self._master_down = True  # the next re-registration opens a new window
+        except MasterError as exc:
+            _log.debug("settling: %s", exc)
 
     def stop(self) -> None:
         self._stop.set()

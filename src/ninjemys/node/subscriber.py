@@ -282,10 +282,15 @@ class Subscription:
 
     # -- publisher set (on the loop) -------------------------------------------------------------
 
-    def update_publishers(self, uris: list[str]) -> None:
-        """publisherUpdate semantics: connect to new URIs, drop connections to missing ones."""
+    def update_publishers(self, uris: list[str], keep_live: bool = False) -> None:
+        """publisherUpdate semantics: connect to new URIs, drop connections to missing ones
+        (``keep_live``: keep open connections the list omits, as a master still filling in may)."""
         if self.closed:
             return
+        if keep_live:
+            uris = list(uris) + [
+                uri for uri, conn in self.connections.items() if uri not in uris and not conn.closed
+            ]
         self.publishers = list(uris)
         wanted = set(uris)
         for uri, conn in list(self.connections.items()):

@@ -27,7 +27,14 @@ from typing import Any
 from ninjemys.errors import DefinitionError, PackageError
 from ninjemys.packages import cfg_gen, idl_check, msg_types
 from ninjemys.packages.cmake_hints import read_cmake_hints
-from ninjemys.packages.cpp_build import Toolchain, build_cpp, cpp_closure, find_toolchain
+from ninjemys.packages.cpp_build import (
+    Toolchain,
+    build_cpp,
+    cpp_closure,
+    failing_package,
+    find_toolchain,
+    missing_cpp_dependency,
+)
 from ninjemys.packages.cpp_targets import CppTarget, cpp_targets, skipped_message
 from ninjemys.packages.discovery import PackageIndex, package_path_dirs, underlay_dirs
 from ninjemys.packages.manifest import PackageManifest
@@ -133,11 +140,11 @@ def _definitions(pkg: PackageManifest) -> dict[str, list[Path]]:
 
 
 def _report_cpp_targets(
-    pkg: PackageManifest, report: BuildReport, log: Callable[[str], None], why: str
+    pkg: PackageManifest, report: BuildReport, log: Callable[[str], None], why: str, toolchain: bool = False
 ) -> None:
     """Name the package's C++ targets, which this build skips, instead of ignoring them."""
     targets = cpp_targets(pkg.path, pkg.name)
-    lines = skipped_message(pkg.name, targets)
+    lines = skipped_message(pkg.name, targets, toolchain)
     if lines:
         lines[0] += f" [{why}]"
     for line in lines:
@@ -153,10 +160,46 @@ def _build_cpp_packages(
     writer: _Writer,
     report: BuildReport,
     log: Callable[[str], None],
+    finder: Callable[[str], Path | None],
 ) -> None:
-    """Build the C++ packages with catkin's CMake and link their programs into devel/lib/<pkg>/."""
-    chosen = cpp_closure(ordered, wanted)
-    built = build_cpp(chosen, ws.build / "ninjemys_cpp", ws.root / "install", toolchain, log)
+    """Build the C++ packages with catkin's CMake and link their programs into devel/lib/<pkg>/.
+
+    When what stops the build is a dependency's missing C++ side (nav_msgs' headers, OpenCV ...),
+    the package that needs it is named as not built, with why, and the others are built without
+    it; the Python side of the workspace is built in any case."""
+    remaining = set(wanted)
+    built: dict[str, list[Path]] = {}
+    while remaining:
+        chosen = cpp_closure(ordered, remaining)
+        try:
+            built = build_cpp(chosen, ws.build / "ninjemys_cpp", ws.root / "install", toolchain, log)
+            break
+        except PackageError as exc:
+            text = str(exc)
+            found = missing_cpp_dependency(text)
+            if found is None:
+                raise
+            missing, from_header = found
+            if from_header and (missing in {p.name for p in ws.packages} or finder(missing) is None):
+                raise  # a header of the workspace's own, or of no ROS package: the code's own error
+            names = {p.name for p in chosen}
+            culprit = failing_package(text, names)
+            skip = set(remaining)
+            if culprit is not None:  # it, and what needs it, wait for the missing C++ side
+                skip = {w for w in remaining if culprit in {p.name for p in cpp_closure(ordered, {w})}}
+                skip = skip or set(remaining)
+            debian = f"lib{missing.lower().replace('_', '-')}-dev"
+            why = f"the C++ side of '{missing}' is not installed (Debian: {debian} or ros-{debian[3:-4]})"
+            for line in text.splitlines():
+                if any(
+                    marker in line
+                    for marker in ("CMake Error", "Could not find a package", "Cannot locate", "fatal error:")
+                ):
+                    log(f"--   {line.strip()}")
+            for pkg in ordered:
+                if pkg.name in skip:
+                    _report_cpp_targets(pkg, report, log, why, toolchain=True)
+            remaining -= skip
     for package, programs in built.items():
         for program in programs:
             link = ws.devel / "lib" / package / program.name
@@ -194,6 +237,8 @@ def build_workspace(
     env = os.environ if env is None else env
     report = BuildReport()
     ws.load()
+    for note in ws.check_layout():
+        log(note)
     for note in ws.check_dependencies(env):
         log(note)
     ordered = ws.ordered()
@@ -263,7 +308,8 @@ def build_workspace(
             writer.write(target, _relay_script(script), executable=True)
 
     if toolchain is not None and cpp_packages:
-        _build_cpp_packages(ws, ordered, cpp_packages, toolchain, writer, report, log)
+        finder = _package_finder(ws, env)
+        _build_cpp_packages(ws, ordered, cpp_packages, toolchain, writer, report, log, finder)
 
     wsenv = WorkspaceEnv(source=ws.source, devel=ws.devel)
     underlays = underlay_workspaces(ws.devel, env)

@@ -33,6 +33,8 @@ class CMakeHints:
     python_setup: bool = False
     install_programs: tuple[tuple[str, str], ...] = ()
     required: tuple[Requirement, ...] = ()
+    #: the .test files of ``add_rostest(file ...)``, relative to the package (``catkin_make run_tests``)
+    rostests: tuple[str, ...] = ()
 
     @property
     def programs(self) -> tuple[str, ...]:
@@ -49,6 +51,7 @@ def read_cmake_hints(package_dir: Path) -> CMakeHints:
     python_setup = False
     programs: list[tuple[str, str]] = []
     required: list[Requirement] = []
+    rostests: list[str] = []
     for match in _CALL.finditer(text):
         command = match.group(1).lower()
         args = [a.strip("\"'") for a in match.group(2).split()]
@@ -64,7 +67,14 @@ def read_cmake_hints(package_dir: Path) -> CMakeHints:
                     programs.append((arg, destination))
         elif command == "find_package" and args:
             required.extend(_requirements(args, line))
-    return CMakeHints(python_setup=python_setup, install_programs=tuple(programs), required=tuple(required))
+        elif command == "add_rostest" and args and "${" not in args[0]:
+            rostests.append(args[0])
+    return CMakeHints(
+        python_setup=python_setup,
+        install_programs=tuple(programs),
+        required=tuple(required),
+        rostests=tuple(rostests),
+    )
 
 
 def _destination(args: list[str]) -> str:

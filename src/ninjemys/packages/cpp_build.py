@@ -13,6 +13,7 @@ are named as not built. ``NINJEMYS_CATKIN_CPP=0`` asks for the Python-only build
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import subprocess
 from collections.abc import Callable, Mapping
@@ -81,6 +82,26 @@ def find_toolchain(env: Mapping[str, str]) -> tuple[Toolchain | None, str]:
     return Toolchain(cmake, compiler, toplevel, python), ""
 
 
+_BOOST_VERSION = Path("/usr/include/boost/version.hpp")
+
+
+def noetic_compat_flags(version_header: Path = _BOOST_VERSION) -> str:
+    """Compiler flags that give newer Boost (1.73+, as in Debian 12) the global ``_1``, ``_2`` ...
+    that Noetic's Boost 1.71 had: roscpp's headers include ``<boost/bind/bind.hpp>``, and with Boost
+    1.73+ that no longer brings the placeholders into the global namespace, so the tutorials'
+    ``boost::bind(&Server::executeCB, this, _1)`` stops compiling. Force-including ``<boost/bind.hpp>``
+    with ``BOOST_BIND_GLOBAL_PLACEHOLDERS`` is Boost's own way back to the old names (no warning).
+    Empty for Boost 1.72 and older, or when Boost is not installed."""
+    try:
+        text = version_header.read_text(encoding="utf-8", errors="replace")
+    except OSError:
+        return ""
+    match = re.search(r"#define\s+BOOST_VERSION\s+(\d+)", text)
+    if match is None or int(match.group(1)) < 107300:
+        return ""
+    return "-DBOOST_BIND_GLOBAL_PLACEHOLDERS -include boost/bind.hpp"
+
+
 def cpp_closure(packages: list[PackageManifest], wanted: set[str]) -> list[PackageManifest]:
     """The wanted packages and every workspace package they depend on, transitively."""
     by_name = {p.name: p for p in packages}
@@ -135,6 +156,9 @@ def build_cpp(
         f"-DCMAKE_CXX_COMPILER={toolchain.compiler}",
         "-DCATKIN_ENABLE_TESTING=OFF",
     ]
+    flags = noetic_compat_flags()
+    if flags:
+        configure.append(f"-DCMAKE_CXX_FLAGS={' '.join([env.get('CXXFLAGS', ''), flags]).strip()}")
     log(f"-- ~~  C++ packages through catkin's CMake: {' '.join(p.name for p in packages)}")
     _run(configure, build, env, 'Invoking "cmake" failed', log)
     jobs = jobs or max(1, os.cpu_count() or 1)
@@ -153,14 +177,77 @@ def build_cpp(
     return built
 
 
+#: genmsg's error when a dependency's .msg files are not where its CMake config says
+_NO_MSG = re.compile(r"Cannot locate message \[(\w+)\] in package \[(\w+)\] with paths\s+\[\['([^']+)'\]\]")
+
+
+_NO_CONFIG = re.compile(r'Could not find a package configuration file provided by "([^"]+)"')
+
+
+_NO_HEADER = re.compile(r"fatal error: ([A-Za-z][A-Za-z0-9_]*)/[\w./]+\.h(?:pp)?: No such file or directory")
+
+
+def missing_cpp_dependency(output: str) -> tuple[str, bool] | None:
+    """(package, from_header) when the build stopped for want of a package's C++ side: its CMake
+    config or the .msg files message generation reads (configure step), or one of its headers
+    (``fatal error: control_msgs/JointControllerState.h: No such file``; ``from_header`` True: the
+    caller checks it names a ROS package). None for any other failure (a compile error in the
+    package's own code, a CMakeLists.txt mistake): those fail the build, as with catkin."""
+    flat = " ".join(output.split())
+    if 'Invoking "cmake" failed' in output:
+        match = _NO_CONFIG.search(flat)
+        if match is not None:
+            return match.group(1), False
+        match = _NO_MSG.search(flat)
+        return (match.group(2), False) if match is not None else None
+    match = _NO_HEADER.search(flat)
+    return (match.group(1), True) if match is not None else None
+
+
+def failing_package(output: str, packages: set[str]) -> str | None:
+    """Which of ``packages`` the failure is in: the first ``<pkg>/CMakeLists.txt:<line>`` of CMake's
+    call stack, or the first compiler diagnostic under ``src/<pkg>/`` of the C++ source space."""
+    for pattern in (r"(?:^|\s)([A-Za-z][\w]*)/CMakeLists\.txt:\d+", r"ninjemys_cpp/src/([A-Za-z][\w]*)/"):
+        for match in re.finditer(pattern, output, re.M):
+            if match.group(1) in packages:
+                return match.group(1)
+    return None
+
+
+def missing_definitions_hint(output: str) -> str:
+    """One line for genmsg's "Cannot locate message" when the package's msg directory is absent:
+    Debian ships a message package's CMake config (with its C++ headers) apart from its ``.msg``
+    files, which catkin's C++ generation reads; ninjemys' own copies serve Python only. Empty when
+    the error is another one."""
+    match = _NO_MSG.search(" ".join(output.split()))
+    if match is None or Path(match.group(3)).is_dir():
+        return ""
+    package = match.group(2)
+    return (
+        f"ninjemys: {match.group(3)} does not exist: {package}'s .msg files for C++ generation come with "
+        f"Debian's package ros-{package.replace('_', '-')} (ROS 1 binary installs: ros-noetic-"
+        f"{package.replace('_', '-')}); install it and run catkin_make again"
+    )
+
+
 def _run(cmd: list[str], cwd: Path, env: dict[str, str], failure: str, log: Callable[[str], None]) -> None:
     proc = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True, check=False)
     if proc.returncode != 0:
         output = (proc.stdout + proc.stderr).rstrip()
-        raise PackageError(f"{output}\n{failure}")
+        hint = missing_definitions_hint(output)
+        raise PackageError(f"{output}\n{failure}" + (f"\n\n{hint}" if hint else ""))
     for line in proc.stdout.splitlines():
         if line.startswith("[") and "Built target" in line:
             log(line)
 
 
-__all__ = ["Toolchain", "build_cpp", "cpp_closure", "find_toolchain"]
+__all__ = [
+    "Toolchain",
+    "build_cpp",
+    "cpp_closure",
+    "failing_package",
+    "find_toolchain",
+    "missing_cpp_dependency",
+    "missing_definitions_hint",
+    "noetic_compat_flags",
+]

@@ -56,14 +56,18 @@ def cpp_targets(package_dir: Path, package: str) -> list[CppTarget]:
     return targets
 
 
-def skipped_message(package: str, targets: list[CppTarget]) -> list[str]:
-    """The lines catkin_make prints for a package's C++ targets."""
+def skipped_message(package: str, targets: list[CppTarget], toolchain: bool = False) -> list[str]:
+    """The lines catkin_make prints for a package's C++ targets; ``toolchain``: the C++ build ran
+    but could not build them (a dependency's C++ side is missing), so the advice differs."""
     if not targets:
         return []
-    lines = [
-        f"-- ~~  - {package}: {len(targets)} C++ target(s) not built (ninjemys builds Python packages, "
-        "without CMake or a compiler; port them to Python, or build them with ROS 1's catkin):"
-    ]
+    advice = (
+        "install the C++ side named below, then run catkin_make again"
+        if toolchain
+        else "ninjemys builds Python packages, without CMake or a compiler; port them to Python, "
+        "or build them with ROS 1's catkin"
+    )
+    lines = [f"-- ~~  - {package}: {len(targets)} C++ target(s) not built ({advice}):"]
     lines += [f"--        {t.describe()}" for t in targets]
     return lines
 

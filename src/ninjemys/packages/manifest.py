@@ -151,6 +151,8 @@ def parse_manifest(xml_path: str | Path) -> PackageManifest:
     export_el = root.find("export")
     if export_el is not None:
         for child in export_el:
+            if not _condition_holds(child.get("condition")):
+                continue  # e.g. <build_type condition="$ROS_VERSION == 2">ament_cmake</build_type>
             exports[child.tag] = (child.text or "").strip() or " ".join(
                 f"{k}={v}" for k, v in child.attrib.items()
             )

@@ -67,6 +67,23 @@ PROVIDED = frozenset(
     }
 )
 
+#: C++ libraries outside ROS whose CMake names look like ROS package names (lower case):
+#: find_package(gazebo REQUIRED) in a robot's world package is for Gazebo plugins in C++, which a
+#: Python build does not need, so a missing one is a note like Boost's, not a failure
+SYSTEM_LIBRARIES = frozenset(
+    {
+        "gazebo",
+        "orocos_kdl",
+        "urdfdom",
+        "urdfdom_headers",
+        "console_bridge",
+        "octomap",
+        "fcl",
+        "ompl",
+        "sdformat",
+    }
+)
+
 
 @dataclass
 class Workspace:
@@ -104,6 +121,41 @@ class Workspace:
             packages.append(manifest)
         self.packages = packages
 
+    def check_layout(self) -> list[str]:
+        """What catkin_workspace.cmake checks before it configures anything: every package is built
+        by catkin (a ``<build_type>`` of cmake or ament makes the workspace "non-homogeneous"), and
+        every catkin package has a CMakeLists.txt (add_subdirectory needs one; only a metapackage
+        gets a generated one, with a warning). Raises PackageError with CMake's text and one hint;
+        returns the metapackage warnings."""
+        notes: list[str] = []
+        for pkg in self.packages:
+            build_type = pkg.exports.get("build_type") or "catkin"
+            if build_type != "catkin" and "metapackage" not in pkg.exports:
+                raise PackageError(
+                    f"CMake Error at /usr/share/catkin/cmake/catkin_workspace.cmake:100 (message):\n"
+                    "  This workspace contains non-catkin packages in it, and catkin cannot build a\n"
+                    "  non-homogeneous workspace without isolation.  Try the\n"
+                    "  'catkin_make_isolated' command instead.\n\n"
+                    f"ninjemys: {pkg.path / MANIFEST} declares <build_type>{build_type}</build_type>; "
+                    "build it apart from this workspace, or add a CATKIN_IGNORE file beside its package.xml"
+                )
+        for pkg in self.packages:
+            if (pkg.path / "CMakeLists.txt").is_file():
+                continue
+            rel = pkg.path.relative_to(self.source) if pkg.path.is_relative_to(self.source) else pkg.path
+            if "metapackage" in pkg.exports:
+                notes.append(f"WARNING: Add a CMakeLists.txt file to the metapackage '{pkg.name}'")
+                continue
+            raise PackageError(
+                "CMake Error at /usr/share/catkin/cmake/catkin_workspace.cmake:121 (add_subdirectory):\n"
+                f"  The source directory\n\n    {pkg.path}\n\n  does not contain a CMakeLists.txt file.\n"
+                "Call Stack (most recent call first):\n"
+                f"  CMakeLists.txt:{_workspace_call_line(self.source)} (catkin_workspace)\n\n"
+                f"ninjemys: {rel}/package.xml makes '{pkg.name}' a catkin package: give it a CMakeLists.txt "
+                "(catkin_create_pkg writes one), or a CATKIN_IGNORE file if it is not meant to be built"
+            )
+        return notes
+
     def check_dependencies(self, env: Mapping[str, str] | None = None) -> list[str]:
         """Every package a ``find_package(... REQUIRED ...)`` names must be found; the first missing
         one raises CMake's error. Returns notes for system libraries (Boost, OpenCV ...) that a
@@ -123,7 +175,7 @@ class Workspace:
                     or cmake_config_found(name, env)
                 ):
                     continue
-                if req.catkin or _ROS_NAME.fullmatch(name):
+                if req.catkin or (_ROS_NAME.fullmatch(name) and name not in SYSTEM_LIBRARIES):
                     raise PackageError(_missing_package_text(self.source, pkg, req))
                 notes.append(
                     f"-- ninjemys: {pkg.path.name}/CMakeLists.txt:{req.line}: find_package({name} REQUIRED) "
@@ -156,6 +208,20 @@ class Workspace:
 
 
 _ROS_NAME = re.compile(r"[a-z][a-z0-9_]*")
+
+
+def _workspace_call_line(source: Path) -> int:
+    """The line of ``catkin_workspace()`` in the toplevel CMakeLists.txt CMake would run: the
+    workspace's own, else catkin's toplevel.cmake (what real catkin_make links there)."""
+    for candidate in (source / "CMakeLists.txt", Path("/usr/share/catkin/cmake/toplevel.cmake")):
+        try:
+            lines = candidate.read_text(encoding="utf-8", errors="replace").splitlines()
+        except OSError:
+            continue
+        for number, line in enumerate(lines, 1):
+            if line.strip().startswith("catkin_workspace("):
+                return number
+    return 7  # the line in the toplevel file ninjemys writes
 
 
 def _system_prefixes(env: Mapping[str, str]) -> list[Path]:

@@ -10,10 +10,13 @@ from __future__ import annotations
 
 import argparse
 import os
+import subprocess
 import time
 from pathlib import Path
 
+from ninjemys.commands import command_path
 from ninjemys.packages.builder import build_workspace, clean_workspace
+from ninjemys.packages.cmake_hints import read_cmake_hints
 from ninjemys.packages.install_space import install_workspace
 from ninjemys.packages.workspace import Workspace
 from ninjemys.tools.cli import entry
@@ -37,7 +40,8 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument(
         "targets",
         nargs="*",
-        help="make targets: 'clean' removes build/ and devel/; 'install' also writes the install space",
+        help="make targets: 'clean' removes build/ and devel/; 'install' also writes the install space; "
+        "'run_tests' runs the add_rostest() files with rostest",
     )
     return p
 
@@ -70,7 +74,33 @@ def main(argv: list[str] | None = None) -> int:
         print(f"-- {len(report.cpp_skipped)} C++ target(s) not built (see above): {names}")
     if "install" in args.targets:
         _install(ws, passthrough)
+    if "run_tests" in args.targets:
+        _run_tests(ws)
     return 0
+
+
+def _run_tests(ws: Workspace) -> None:
+    """``catkin_make run_tests``: every ``add_rostest(file)`` of the workspace, through ``rostest``
+    with the devel space on the paths. As with catkin, a failing test does not fail catkin_make:
+    the results are in ~/.ros/test_results (or ROS_TEST_RESULTS_DIR)."""
+    env = dict(os.environ)
+    for key, value in (
+        ("ROS_PACKAGE_PATH", str(ws.source)),
+        ("PYTHONPATH", str(ws.devel / "lib" / "python3" / "dist-packages")),
+        ("CMAKE_PREFIX_PATH", str(ws.devel)),
+    ):
+        env[key] = os.pathsep.join([value, *([env[key]] if env.get(key) else [])])
+    rostest = command_path("rostest")
+    for pkg in ws.ordered():
+        for test_file in read_cmake_hints(pkg.path).rostests:
+            path = pkg.path / test_file
+            print(f"-- run_tests_{pkg.name}_rostest_{test_file.replace('/', '_')}", flush=True)
+            if not path.is_file():
+                print(f"-- {pkg.path / 'CMakeLists.txt'}: add_rostest({test_file}) names a missing file")
+                continue
+            subprocess.run(
+                [rostest, "--pkgdir", str(pkg.path), "--package", pkg.name, str(path)], env=env, check=False
+            )
 
 
 def _install(ws: Workspace, cmake_args: list[str]) -> None:

@@ -1,0 +1,353 @@
+"""rostest as course and book packages use it: a ``.test`` file that starts a node and runs a
+unittest-based test node (``rostest.rosrun``), ``find_package(rostest)`` + ``add_rostest`` in
+CMakeLists.txt, an offline ``rosunit.unitrun`` test; JUnit XML where ROS 1 writes it, and the exit
+status. The ``ros1`` test runs Debian's rostest on the same package and compares the report."""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import pytest
+
+from ninjemys.rostest.junit import CaseResult, SuiteResult, read_xml, results_file, write_xml
+from ninjemys.rostest.pyunit import restore_removed_aliases
+from ninjemys.testing import ninjemys_bin
+
+PACKAGE_XML = """<?xml version="1.0"?>
+<package format="2">
+  <name>probe_tests</name>
+  <version>0.1.0</version>
+  <description>rostest patterns</description>
+  <maintainer email="t@example.com">t</maintainer>
+  <license>BSD</license>
+  <buildtool_depend>catkin</buildtool_depend>
+  <depend>rospy</depend>
+  <depend>std_msgs</depend>
+  <test_depend>rostest</test_depend>
+</package>
+"""
+
+CMAKE = """cmake_minimum_required(VERSION 3.0.2)
+project(probe_tests)
+find_package(catkin REQUIRED COMPONENTS rospy std_msgs)
+catkin_package()
+if(CATKIN_ENABLE_TESTING)
+  find_package(rostest REQUIRED)
+  add_rostest(test/talker.test)
+endif()
+"""
+
+TALKER = """#!/usr/bin/env python3
+# Publishes "hello world N" on chatter until shut down.
+import rospy
+from std_msgs.msg import String
+
+rospy.init_node("talker")
+pub = rospy.Publisher("chatter", String, queue_size=10)
+rate = rospy.Rate(20)
+n = 0
+while not rospy.is_shutdown():
+    pub.publish(String(data="hello world %d" % n))
+    n += 1
+    rate.sleep()
+"""
+
+#: a test node as the books write it: a TestCase with old unittest names, rostest.rosrun at the end
+HEARS = """#!/usr/bin/env python3
+import sys
+import time
+import unittest
+
+import rospy
+import rostest
+from std_msgs.msg import String
+
+
+class TestTalker(unittest.TestCase):
+    def test_hears_hello(self):
+        heard = []
+        rospy.init_node("test_talker")
+        rospy.Subscriber("chatter", String, lambda m: heard.append(m.data))
+        deadline = time.time() + 20.0
+        while not heard and time.time() < deadline:
+            time.sleep(0.05)
+        self.assert_(heard and heard[0].startswith("hello world"))
+
+    def test_param_from_test_file(self):
+        self.assertEquals(rospy.get_param("~greeting"), "hi")
+
+
+if __name__ == "__main__":
+    rostest.rosrun("probe_tests", "talker_test", TestTalker, sys.argv)
+"""
+
+FAILS = """#!/usr/bin/env python3
+import unittest
+
+import rostest
+
+
+class Arithmetic(unittest.TestCase):
+    def test_right(self):
+        self.assertEqual(1 + 1, 2)
+
+    def test_wrong(self):
+        self.assertEqual(1 + 1, 3)
+
+
+if __name__ == "__main__":
+    rostest.rosrun("probe_tests", "arith", Arithmetic)
+"""
+
+TALKER_TEST = """<launch>
+  <node name="talker" pkg="probe_tests" type="talker.py"/>
+  <test test-name="talker_test" pkg="probe_tests" type="test_hears.py" time-limit="60.0">
+    <param name="greeting" value="hi"/>
+  </test>
+</launch>
+"""
+
+FAILING_TEST = """<launch>
+  <test test-name="arith" pkg="probe_tests" type="test_fails.py"/>
+</launch>
+"""
+
+SLOW_TEST = """<launch>
+  <test test-name="sleeper" pkg="probe_tests" type="sleeper.py" time-limit="2.0"/>
+</launch>
+"""
+
+SLEEPER = "#!/usr/bin/env python3\nimport time\ntime.sleep(60)\n"
+
+#: rostest's stock hztest on the talker (20 Hz), and one that expects a rate it cannot have
+HZ_TEST = """<launch>
+  <node name="talker" pkg="probe_tests" type="talker.py"/>
+  <test test-name="talker_hz" pkg="rostest" type="hztest" name="hz">
+    <param name="topic" value="chatter"/>
+    <param name="hz" value="20.0"/>
+    <param name="hzerror" value="6.0"/>
+    <param name="test_duration" value="2.0"/>
+  </test>
+  <test test-name="talker_too_slow" pkg="rostest" type="hztest" name="hz_fast">
+    <param name="topic" value="chatter"/>
+    <param name="hz" value="100.0"/>
+    <param name="hzerror" value="10.0"/>
+    <param name="test_duration" value="2.0"/>
+  </test>
+</launch>
+"""
+
+
+def _workspace(root: Path) -> Path:
+    pkg = root / "src" / "probe_tests"
+    for sub in ("scripts", "test"):
+        (pkg / sub).mkdir(parents=True)
+    (pkg / "package.xml").write_text(PACKAGE_XML)
+    (pkg / "CMakeLists.txt").write_text(CMAKE)
+    for folder, name, text in (
+        ("scripts", "talker.py", TALKER),
+        ("test", "test_hears.py", HEARS),
+        ("test", "test_fails.py", FAILS),
+        ("test", "sleeper.py", SLEEPER),
+    ):
+        (pkg / folder / name).write_text(text)
+        (pkg / folder / name).chmod(0o755)
+    (pkg / "test" / "talker.test").write_text(TALKER_TEST)
+    (pkg / "test" / "failing.test").write_text(FAILING_TEST)
+    (pkg / "test" / "slow.test").write_text(SLOW_TEST)
+    (pkg / "test" / "hz.test").write_text(HZ_TEST)
+    return root
+
+
+def _env(ws: Path) -> dict[str, str]:
+    env = {k: v for k, v in os.environ.items() if not k.startswith("ROS_")}
+    env.update(ROS_PACKAGE_PATH=str(ws / "src"), ROS_HOME=str(ws / "ros_home"), ROS_HOSTNAME="localhost")
+    env["PYTHONPATH"] = str(ws / "devel" / "lib" / "python3" / "dist-packages")
+    return env
+
+
+@pytest.fixture(scope="module")
+def workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    ws = _workspace(tmp_path_factory.mktemp("rostest_ws"))
+    env = _env(ws)
+    made = subprocess.run(
+        [ninjemys_bin("catkin_make")],
+        cwd=ws,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
+    assert made.returncode == 0, made.stdout + made.stderr
+    return ws
+
+
+def _rostest(ws: Path, *args: str, timeout: float = 180) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [ninjemys_bin("rostest"), *args],
+        cwd=ws,
+        env=_env(ws),
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        check=False,
+    )
+
+
+def test_a_passing_test_file_runs_its_node_and_test_node(workspace: Path) -> None:
+    result = _rostest(workspace, "probe_tests", "talker.test")
+    out = result.stdout
+    assert result.returncode == 0, out + result.stderr
+    assert "[Testcase: testtalker_test] ... ok" in out
+    assert "[probe_tests.rosunit-talker_test/test_hears_hello][passed]" in out
+    assert "[probe_tests.rosunit-talker_test/test_param_from_test_file][passed]" in out
+    assert re.search(r"SUMMARY\n.* \* RESULT: SUCCESS.*\n \* TESTS: 2\n \* ERRORS: 0\n \* FAILURES: 0", out)
+    results = workspace / "ros_home" / "test_results" / "probe_tests"
+    combined = read_xml(results / "rostest-test_talker.xml")
+    assert sorted(c.name for c in combined.cases) == ["test_hears_hello", "test_param_from_test_file"]
+    assert read_xml(results / "rosunit-talker_test.xml").ok
+    # the test node's own output went to its log, not the console
+    assert "Outputting test results to" in out and "Ran 2 tests" not in out
+
+
+def test_a_failing_case_fails_the_run_and_is_named(workspace: Path) -> None:
+    """As in ROS 1: the test node ran and reported (``[Testcase: ...] ... ok``), one of its cases
+    failed: the FAILURE block with the assertion's message, and exit status 2."""
+    result = _rostest(workspace, str(workspace / "src" / "probe_tests" / "test" / "failing.test"))
+    out = result.stdout
+    assert result.returncode == 2, out + result.stderr
+    assert "[Testcase: testarith] ... ok" in out
+    assert "[probe_tests.rosunit-arith/test_right][passed]" in out
+    head = "[probe_tests.rosunit-arith/test_wrong][FAILURE]"
+    assert f"{head}{'-' * (80 - len(head))}\n2 != 3\n" in out
+    assert "\x1b[1;31m * FAILURES: 1\x1b[0m" in out
+
+
+def test_a_test_over_its_time_limit_fails(workspace: Path) -> None:
+    result = _rostest(workspace, "probe_tests", "slow.test", timeout=60)
+    assert result.returncode == 1
+    assert "[Testcase: testsleeper] ... ERROR!" in result.stdout
+    assert "max time [2.0s] allotted for test [sleeper] of type [probe_tests/sleeper.py]" in result.stdout
+    assert "\x1b[1;31m * ERRORS: 1\x1b[0m" in result.stdout
+
+
+def test_hztest_checks_a_topics_rate(workspace: Path) -> None:
+    result = _rostest(workspace, "probe_tests", "hz.test")
+    out = result.stdout
+    assert result.returncode == 2, out + result.stderr
+    assert "[probe_tests.rosunit-talker_hz/test_hz][passed]" in out
+    assert "[probe_tests.rosunit-talker_too_slow/test_hz][FAILURE]" in out
+    assert "exceeded minimum (90.000Hz)" in out
+
+
+def test_find_package_rostest_is_known_to_catkin_make(workspace: Path) -> None:
+    listed = subprocess.run(
+        [ninjemys_bin("rospack"), "find", "rostest"],
+        env=_env(workspace),
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert listed.returncode == 0 and listed.stdout.strip().endswith("rostest"), listed.stderr
+
+
+def test_rosunit_unitrun_writes_xml_and_exits_1_on_failure(tmp_path: Path) -> None:
+    script = tmp_path / "offline.py"
+    script.write_text(
+        "import unittest, rosunit\n"
+        "class T(unittest.TestCase):\n"
+        "    def test_ok(self):\n        self.failUnlessEqual(2, 2)\n"
+        "    def test_bad(self):\n        self.assertTrue(False, 'deliberately')\n"
+        "rosunit.unitrun('probe_tests', 'offline', T)\n"
+    )
+    env = dict(os.environ, ROS_HOME=str(tmp_path / "home"))
+    env.pop("ROS_TEST_RESULTS_DIR", None)
+    result = subprocess.run(
+        [sys.executable, str(script)], env=env, capture_output=True, text=True, timeout=60, check=False
+    )
+    assert result.returncode == 1, result.stdout + result.stderr
+    assert (
+        "[Testcase: test_bad] ... FAILURE!" in result.stdout and " * FAILURES: 1 [test_bad]" in result.stdout
+    )
+    suite = ET.parse(tmp_path / "home" / "test_results" / "probe_tests" / "rosunit-offline.xml").getroot()
+    assert (suite.get("tests"), suite.get("failures"), suite.get("errors")) == ("2", "1", "0")
+
+
+def test_results_round_trip_and_name_cleaning(tmp_path: Path) -> None:
+    env = {"ROS_HOME": str(tmp_path)}
+    path = results_file("pkg", "my test/one", env=env)
+    assert path == tmp_path / "test_results" / "pkg" / "rosunit-my_test_one.xml"
+    write_xml(
+        path,
+        SuiteResult("s", [CaseResult("C", "a"), CaseResult("C", "b", failure="boom\nAssertionError: x")]),
+    )
+    back = read_xml(path)
+    assert [c.name for c in back.cases] == ["a", "b"] and back.cases[1].failure is not None and not back.ok
+
+
+def test_old_unittest_names_are_there() -> None:
+    import unittest
+
+    restore_removed_aliases()
+    assert unittest.TestCase.assertEquals is not None and unittest.TestCase.assert_ is not None
+
+
+def _report_lines(text: str) -> list[str]:
+    """The [ROSTEST] block's result lines and the SUMMARY, colours and paths aside."""
+    lines = [re.sub(r"\x1b\[[0-9;]*m", "", line) for line in text.splitlines()]
+    keep = [ln for ln in lines if ln.startswith(("[probe_tests.", " * ", "[Testcase:"))]
+    return keep
+
+
+@pytest.mark.ros1
+@pytest.mark.skipif(
+    not Path("/usr/bin/rostest").exists(), reason="Debian's rostest (python3-rostest) not installed"
+)
+@pytest.mark.parametrize(
+    ("test_file", "code"), [("talker.test", 0), ("failing.test", 2), ("slow.test", 1), ("hz.test", 2)]
+)
+def test_same_report_as_debians_rostest(workspace: Path, tmp_path: Path, test_file: str, code: int) -> None:
+    theirs = _workspace(tmp_path / "debian")
+    env = {
+        "PATH": "/usr/bin:/bin",
+        "HOME": str(tmp_path / "home"),
+        "LANG": "C.UTF-8",
+        "ROS_PACKAGE_PATH": str(theirs / "src"),
+        "ROS_HOSTNAME": "localhost",
+    }
+    debian = subprocess.run(
+        ["/usr/bin/rostest", "probe_tests", test_file],
+        cwd=theirs,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=180,
+        check=False,
+    )
+    ours = _rostest(workspace, "probe_tests", test_file)
+    assert (debian.returncode, ours.returncode) == (code, code), debian.stdout + debian.stderr
+    assert _report_lines(ours.stdout) == _report_lines(debian.stdout)
+
+
+def test_catkin_make_run_tests_runs_the_add_rostest_files(workspace: Path) -> None:
+    combined = workspace / "ros_home" / "test_results" / "probe_tests" / "rostest-test_talker.xml"
+    combined.unlink(missing_ok=True)
+    made = subprocess.run(
+        [ninjemys_bin("catkin_make"), "run_tests"],
+        cwd=workspace,
+        env={k: v for k, v in _env(workspace).items() if k != "PYTHONPATH"},
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
+    assert made.returncode == 0, made.stdout + made.stderr
+    assert "-- run_tests_probe_tests_rostest_test_talker.test" in made.stdout
+    assert "[probe_tests.rosunit-talker_test/test_hears_hello][passed]" in made.stdout
+    assert read_xml(combined).ok
