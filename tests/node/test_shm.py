@@ -190,6 +190,9 @@ def test_a_malformed_notice_is_rejected_with_one_line_and_falls_back_to_tcpros(m
         listener = make_node("listener")
         listener.subscriber("img", Image, lambda m: got.append(m.data[0]))
         assert wait_until(lambda: _transports(talker, "/img") == ["SHMROS"], timeout=10)
+        got.clear()
+        pub.publish(_image(4, BIG))  # the ring is made with the first large message
+        assert wait_until(lambda: got == [4])
         good_put = _pub_connection(talker, "/img").ring.put
     assert not _segments(os.getpid()) or wait_until(lambda: len(_segments(os.getpid())) <= 1)
 
@@ -296,6 +299,8 @@ def test_shmros_is_granted_only_to_this_host_and_named_in_bus_info(make_node, ma
     assert [e[3] for e in info if e[4] == "/img"] == ["SHMROS"]
     assert [e[6] for e in info if e[4] == "/img"] == ["SHMROS connection to [/listener]"]
     assert _transports(listener, "/img") == ["SHMROS"]
+    # no large message yet: no segment, mapping or descriptor (most topics never need one)
+    assert _pub_connection(talker, "/img").ring is None and not _segments(os.getpid())
     rosnode = [str(Path(sys.executable).parent / "rosnode"), "info", "/talker"]
     env = dict(os.environ, ROS_MASTER_URI=master.uri)
     out = subprocess.run(rosnode, env=env, capture_output=True, text=True, timeout=60).stdout

@@ -3,12 +3,13 @@
 Negotiation (same shape as UNIXROS): a subscriber offers ``["SHMROS", host_identity]`` first in
 ``requestTopic``; a ninjemys publisher on the same host answers ``["SHMROS", host, port]``; rospy and
 roscpp, which do not know the name, answer TCPROS from the next offer. The subscriber then sends the
-usual connection header plus ``ninjemys_shm=<host identity>``; the publisher creates a ring and names
-it in its reply header (``ninjemys_shm=<segment>``). Without that field in the reply the stream is
-plain TCPROS.
+usual connection header plus ``ninjemys_shm=<host identity>``; the publisher agrees in its reply
+header (``ninjemys_shm=1``). Without that field in the reply the stream is plain TCPROS.
 
 On an SHMROS stream every TCPROS frame starts with a tag byte: 0 = the message follows inline,
-1 = a notice ``(slot u32, generation u64, length u64)`` naming a slot of the ring. Messages of at
+1 = a notice ``(slot u32, generation u64, length u64)`` naming a slot of the ring, 2 = the ring's
+segment name (sent once, before the first notice: the ring is made with the first large message, so
+a topic of small messages costs no segment, mapping or file descriptor). Messages of at
 least :data:`THRESHOLD` bytes go through the ring; smaller ones inline, and so does a large one when
 every slot is still held by the subscriber (a user keeping messages) or /dev/shm is full: the
 publisher never waits for a slot and never overwrites one still referenced. ``queue_size`` applies
@@ -24,6 +25,7 @@ from __future__ import annotations
 import logging
 import os
 import socket
+import threading
 
 from ninjemys.node import shm_ring, transport
 from ninjemys.node.subscriber import SubConnection
@@ -83,15 +85,17 @@ def publisher_connection(
     node: NodeContext, sock: socket.socket, topic: str, subscriber: str, header: Mapping[str, str]
 ) -> tuple[PubConnection, dict[str, str]]:
     """The connection for an accepted subscriber and the extra reply-header fields: an SHMROS one when
-    its header asks for it from this host and a ring can be made, else plain TCPROS."""
+    its header asks for it from this host, else plain TCPROS. The ring itself is made with the first
+    large message (most topics never send one, and then cost no segment, mapping or descriptor)."""
     if header.get(FIELD) and header.get(FIELD) == transport.host_identity() and enabled():
-        try:
-            ring = shm_ring.WriterRing(SLOTS, SLOT_SIZE)
-        except shm_ring.ShmError as exc:
-            _log.info("topic %s: shared memory unavailable for %s (%s): TCPROS", topic, subscriber, exc)
-        else:
-            return ShmPubConnection(node, sock, topic, subscriber, ring), {FIELD: ring.name}
+        return ShmPubConnection(node, sock, topic, subscriber), {FIELD: "1"}
     return PubConnection(node, sock, topic, subscriber), {}
+
+
+def announcement(name: str) -> bytes:
+    """The frame that names a new ring to the subscriber (tag 2, then the segment name)."""
+    body = name.encode()
+    return pack_len(len(body) + 1) + bytes([shm_ring.RING_TAG]) + body
 
 
 class ShmPubConnection(PubConnection):
@@ -99,11 +103,36 @@ class ShmPubConnection(PubConnection):
 
     transport_name = SHMROS
 
-    def __init__(
-        self, node: NodeContext, sock: socket.socket, topic: str, subscriber: str, ring: shm_ring.WriterRing
-    ) -> None:
+    def __init__(self, node: NodeContext, sock: socket.socket, topic: str, subscriber: str) -> None:
         super().__init__(node, sock, topic, subscriber)
-        self.ring = ring
+        self.ring: shm_ring.WriterRing | None = None
+        self._no_ring = False  # the ring could not be made: inline for good
+        self._ring_lock = threading.Lock()
+
+    def _ring(self) -> shm_ring.WriterRing | None:
+        """The ring, made and announced on first use (the announcement precedes every notice: the
+        ring is visible to other publishing threads only once it is queued)."""
+        ring = self.ring
+        if ring is not None or self._no_ring:
+            return ring
+        with self._ring_lock:
+            if self.ring is None and not self._no_ring and not self.closed:
+                try:
+                    ring = shm_ring.WriterRing(SLOTS, SLOT_SIZE)
+                except shm_ring.ShmError as exc:
+                    _log.info(
+                        "topic %s: shared memory unavailable for %s (%s): inline",
+                        self.topic,
+                        self.subscriber,
+                        exc,
+                    )
+                    self._no_ring = True
+                    return None
+                PubConnection.send(self, announcement(ring.name), 0)
+                self.ring = ring
+                if self.closed:  # closed meanwhile: _release_socket may have missed it
+                    ring.close()
+        return self.ring
 
     def send_hello(self, reply: bytes, latched: list[bytes]) -> None:
         """The reply header (untagged, as in TCPROS) then latched frames, tagged inline."""
@@ -111,8 +140,9 @@ class ShmPubConnection(PubConnection):
 
     def send(self, data: bytes, queue_size: int | None) -> None:
         length = len(data) - 4
-        if length >= THRESHOLD and not self.closed:
-            notice = self.ring.put([memoryview(data)[4:]], length, SLOT_WAIT if queue_size is None else 0.0)
+        ring = self._ring() if length >= THRESHOLD and not self.closed else None
+        if ring is not None:
+            notice = ring.put([memoryview(data)[4:]], length, SLOT_WAIT if queue_size is None else 0.0)
             if notice is not None:
                 PubConnection.send(self, notice, queue_size)
                 return
@@ -120,25 +150,36 @@ class ShmPubConnection(PubConnection):
 
     def send_parts(self, parts: list[Any], total: int, queue_size: int | None) -> None:
         length = total - 4
-        if length >= THRESHOLD and not self.closed:
-            notice = self.ring.put(parts[1:], length, SLOT_WAIT if queue_size is None else 0.0)
+        ring = self._ring() if length >= THRESHOLD and not self.closed else None
+        if ring is not None:
+            notice = ring.put(parts[1:], length, SLOT_WAIT if queue_size is None else 0.0)
             if notice is not None:
                 PubConnection.send(self, notice, queue_size)
                 return
         PubConnection.send(self, b"".join([pack_len(length + 1), _INLINE, *parts[1:]]), queue_size)
 
     def _trim(self, queue_size: int) -> None:
+        """queue_size drops the oldest frames as over TCPROS, and frees the slots of dropped notices;
+        a ring's announcement is never dropped (the notices after it name its slots)."""
         queue = self._queue
+        kept: list[bytes] = []
         while len(queue) > queue_size:
             frame = queue.popleft()
+            if shm_ring.is_announcement(frame):
+                kept.append(frame)
+                continue
             self._queued_bytes -= len(frame)
             self.dropped += 1
-            if shm_ring.is_notice(frame):
+            if shm_ring.is_notice(frame) and self.ring is not None:
                 self.ring.reclaim(frame)
+        queue.extendleft(reversed(kept))
 
     def _release_socket(self) -> None:
         super()._release_socket()
-        self.ring.close()
+        with self._ring_lock:
+            ring, self._no_ring = self.ring, True
+        if ring is not None:
+            ring.close()
 
 
 def subscriber_connection(
@@ -146,10 +187,9 @@ def subscriber_connection(
 ) -> SubConnection:
     """The connection for a publisher's reply header: SHMROS when it names a ring (ShmError when that
     ring cannot be mapped: the caller retries over TCPROS), else plain TCPROS."""
-    name = header.get(FIELD)
-    if not name:
+    if not header.get(FIELD):
         return SubConnection(sub, sock, uri, header)
-    return ShmSubConnection(sub, sock, uri, header, shm_ring.ReaderRing(name))
+    return ShmSubConnection(sub, sock, uri, header)
 
 
 class ShmSubConnection(SubConnection):
@@ -163,10 +203,9 @@ class ShmSubConnection(SubConnection):
         sock: socket.socket,
         uri: str,
         header: Mapping[str, str],
-        ring: shm_ring.ReaderRing,
     ) -> None:
         super().__init__(sub, sock, uri, header)
-        self.ring = ring
+        self.ring: shm_ring.ReaderRing | None = None  # mapped when the publisher announces it
 
     def read(self, budget: int | None = None) -> list[bytes | bytearray] | None:
         frames = super().read(budget)
@@ -179,7 +218,17 @@ class ShmSubConnection(SubConnection):
                 out.append(frame[1:] if len(frame) < THRESHOLD else memoryview(frame)[1:])
             elif tag == shm_ring.NOTICE_TAG:
                 try:
+                    if self.ring is None:
+                        raise shm_ring.ShmError("a notice before any ring was announced")
                     out.append(self.ring.view(frame))
+                except shm_ring.ShmError as exc:
+                    self._malformed(str(exc))
+                    return out or None
+            elif tag == shm_ring.RING_TAG:
+                try:
+                    if self.ring is not None:
+                        raise shm_ring.ShmError("a second ring announced")
+                    self.ring = shm_ring.ReaderRing(bytes(frame[1:]).decode("utf-8", "replace"))
                 except shm_ring.ShmError as exc:
                     self._malformed(str(exc))
                     return out or None

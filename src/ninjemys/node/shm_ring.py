@@ -42,6 +42,8 @@ _CTL = 24  # offset of the per-slot control words
 #: the notice a publisher sends instead of the payload: tag 1, slot, generation, length
 NOTICE = struct.Struct("<BIQQ")
 NOTICE_TAG, INLINE_TAG = 1, 0
+#: the frame that names the ring, sent once before the first notice: tag 2, then the segment name
+RING_TAG = 2
 
 #: how often a waiting publisher looks for a released slot (seconds)
 _POLL = 100e-6
@@ -226,6 +228,10 @@ class WriterRing:
 
 def is_notice(frame: bytes | bytearray) -> bool:
     return len(frame) == 4 + NOTICE.size and frame[4] == NOTICE_TAG
+
+
+def is_announcement(frame: bytes | bytearray) -> bool:
+    return len(frame) > 5 and frame[4] == RING_TAG
 
 
 class ReaderRing:

@@ -299,6 +299,9 @@ RESOURCES: tuple[Resource, ...] = (
     Resource("lock", "ninjemys.node.shm_ring:WriterRing._lock", USER + " (publishing)",
              "serializes slot choice, copy and stamp of one SHMROS ring; the loop takes it to close "
              "the ring when the connection ends"),
+    Resource("lock", "ninjemys.node.shm_link:ShmPubConnection._ring_lock", USER + " (publishing)",
+             "makes and announces the connection's ring once, with the first large message; the loop "
+             "takes it to close the ring when the connection ends"),
     Resource("shared memory", "SHMROS ring slots (node.shm_ring)", USER + " (publishing)",
              "the publisher writes a slot and its generation word, the subscriber only the released "
              "word, from whichever thread drops the last view (no lock across processes)"),
