@@ -89,7 +89,7 @@ def test_a_roscpp_publisher_gets_tcpros_from_our_shm_offer(make_node, master, pe
     got: list[String] = []
     listener.subscriber("big", String, got.append)
     _start(peers, roscpp(master.uri, "bigtalker"))
-    assert wait_until(lambda: got, timeout=20), peers[0].describe()
+    assert wait_until(lambda: got, timeout=40), (listener.bus_info(), peers[0].describe())
     assert len(got[0].data) == 6220800 and got[0].data.startswith("abcdefghijklmnopqrstuvwxyz")
     assert _transports(listener, "/big") == ["TCPROS"]
 

@@ -208,6 +208,7 @@ class ShmSubConnection(SubConnection):
         self.ring: shm_ring.ReaderRing | None = None  # mapped when the publisher announces it
 
     def read(self, budget: int | None = None) -> list[bytes | bytearray] | None:
+        last = self.last
         frames = super().read(budget)
         if not frames:
             return frames
@@ -235,8 +236,8 @@ class ShmSubConnection(SubConnection):
             else:
                 self._malformed(f"a frame with tag {tag}")
                 return out or None
-        if self.latching:
-            self.last = out[-1]
+        if self.latching:  # the latched message, not the tagged frame super() kept
+            self.last = out[-1] if out else last
         return out
 
     def _malformed(self, why: str) -> None:
