@@ -5,7 +5,9 @@ room at 8000 samples/s; our rplidarNode decodes them into /scan (angle-compensat
 the node's CPU (user+system over the window, % of one core; the issue's target is at most 5 %), the
 scan rate, and the latency from the end of a revolution as the node stamps it (header.stamp +
 scan_time) to delivery at a subscriber in another process. Debian ships no rplidar_ros, so the reference
-printed is the target. Run alone: ``.venv/bin/python bench/drivers_rplidar.py [seconds]``.
+printed is the target. Run alone: ``.venv/bin/python bench/drivers_rplidar.py [seconds] [--sensitivity]``;
+``--sensitivity`` runs an emulated A3 in its Sensitivity mode instead: ultra capsules at 16.1k
+samples/s, 1440 beams per scan.
 """
 
 from __future__ import annotations
@@ -21,7 +23,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "drivers"))
 
-from emu_rplidar import EmulatedA1  # noqa: E402
+from emu_rplidar import EmulatedA1, EmulatedA3  # noqa: E402
 
 from ninjemys.idl.loader import get_message_class  # noqa: E402
 from ninjemys.node import Node  # noqa: E402
@@ -38,9 +40,17 @@ def cpu_seconds(pid: int) -> float:
 
 
 def main() -> None:
-    window = float(sys.argv[1]) if len(sys.argv) > 1 else 20.0
-    lidar = EmulatedA1(samples_per_s=8000.0)
-    lidar.express_per_rev = 800  # 10 revolutions a second, as an A2 at 8k samples/s
+    sensitivity = "--sensitivity" in sys.argv
+    numbers = [a for a in sys.argv[1:] if not a.startswith("--")]
+    window = float(numbers[0]) if numbers else 20.0
+    lidar: EmulatedA1
+    if sensitivity:
+        lidar = EmulatedA3()
+        mode_args = ["_scan_mode:=Sensitivity"]
+    else:
+        lidar = EmulatedA1(samples_per_s=8000.0)
+        lidar.express_per_rev = 800  # 10 revolutions a second, as an A2 at 8k samples/s
+        mode_args = []
     LaserScan = get_message_class("sensor_msgs/LaserScan")
     with run_master() as uri:
         env = dict(os.environ, ROS_MASTER_URI=uri)
@@ -54,6 +64,7 @@ def main() -> None:
                 f"_serial_port:={lidar.path}",
                 "_angle_compensate:=true",
                 "_serial_baudrate:=256000",
+                *mode_args,
             ],
             env=env,
             stdout=subprocess.DEVNULL,
@@ -98,7 +109,7 @@ def main() -> None:
     rate = (s1 - s0) / (t1 - t0)
     load = os.getloadavg()
     print(
-        f"rplidarNode, express scans at {rate:.0f} samples/s, {nbeams} beams per scan, {len(got) / (t1 - t0):.1f} scans/s"
+        f"rplidarNode, {'Sensitivity (ultra capsules)' if sensitivity else 'express'} scans at {rate:.0f} samples/s, {nbeams} beams per scan, {len(got) / (t1 - t0):.1f} scans/s"
     )
     print(
         f"  CPU of the node: {cpu:.1f} % of one core (target <= {TARGET:.0f} %: {cpu / TARGET:.2f} x the target)"

@@ -1,36 +1,86 @@
-"""Ping-pong round trip of a 64-byte std_msgs/String: ninjemys vs real rospy, two placements.
+"""Ping-pong round trip of a 64-byte std_msgs/String: ninjemys vs real rospy (and roscpp), two
+placements, publishers with ``queue_size=10`` and ``queue_size=None``; plus ninjemys in one process.
 
-Run: ``.venv/bin/python bench/node_rtt.py [count]``. Targets: p50 <= 0.5x rospy on one CPU,
-<= 0.8x across CPUs, p99 <= 150 us.
+Run: ``.venv/bin/python bench/node_rtt.py [count]``. Targets: p50 <= 0.3x rospy on one CPU,
+p99 <= rospy's and <= 150 us in every placement and queue_size mode; in-process (two Nodes of one
+process, ``intraprocess=True``) p50 <= 10 us.
 """
 
 from __future__ import annotations
 
 import sys
+import threading
+import time
 
-from node_common import CROSS_CPU, IMPLS_CPP, OURS, SAME_CPU, Role, header, master, ratio, roles
+from node_common import CPP, CROSS_CPU, IMPLS_CPP, OURS, SAME_CPU, Role, header, master, ratio, roles
 
 
-def run(uri: str, impl: str, cpus: tuple[str, str], count: int) -> dict:
-    with roles(Role(impl, uri, "pong", cpu=cpus[1])) as (pong,):
-        ping = Role(impl, uri, "ping", str(count), cpu=cpus[0])
+def run(uri: str, impl: str, cpus: tuple[str, str], count: int, queue_size: str) -> dict:
+    # roscpp's program has its queue of 10 built in
+    args = () if impl == CPP else (queue_size,)
+    with roles(Role(impl, uri, "pong", *args, cpu=cpus[1])) as (pong,):
+        ping = Role(impl, uri, "ping", str(count), *args, cpu=cpus[0])
         with roles(ping):
             return ping.result()
+
+
+def in_process(uri: str, count: int) -> dict:
+    """Two Nodes of this process, both ends ``intraprocess=True``: the object is handed over, and
+    each hop is one wake-up of the receiving handle's thread."""
+    from ninjemys.node import Node
+    from std_msgs.msg import String
+
+    ping_node = Node("inproc_ping", anonymous=True, master_uri=uri, rosout=False, logger_services=False)
+    pong_node = Node("inproc_pong", anonymous=True, master_uri=uri, rosout=False, logger_services=False)
+    try:
+        back = pong_node.publisher("/inproc_pong", String, intraprocess=True)
+        pong_node.subscriber("/inproc_ping", String, back.publish, intraprocess=True)
+        got = threading.Event()
+        ping_node.subscriber("/inproc_pong", String, lambda m: got.set(), intraprocess=True)
+        pub = ping_node.publisher("/inproc_ping", String, intraprocess=True)
+        msg = String("x" * 64)
+        deadline = time.monotonic() + 20
+        while time.monotonic() < deadline:
+            got.clear()
+            pub.publish(msg)
+            if got.wait(0.2):
+                break
+        rtts = []
+        for i in range(count + 200):
+            got.clear()
+            t0 = time.perf_counter()
+            pub.publish(msg)
+            if got.wait(2.0) and i >= 200:
+                rtts.append(time.perf_counter() - t0)
+        rtts.sort()
+        return {"p50_us": rtts[len(rtts) // 2] * 1e6, "p99_us": rtts[int(len(rtts) * 0.99)] * 1e6}
+    finally:
+        pong_node.shutdown("bench over")
+        ping_node.shutdown("bench over")
 
 
 def main() -> None:
     count = int(sys.argv[1]) if len(sys.argv) > 1 else 5000
     header(f"ping-pong RTT, {count} round trips")
     with master() as uri:
-        for name, cpus in (("same CPU (taskset -c 0)", SAME_CPU), ("across CPUs (-c 0 / -c 1)", CROSS_CPU)):
-            results = {impl: run(uri, impl, cpus, count) for impl in IMPLS_CPP}
-            for impl, r in results.items():
-                print(f"{name:28s} {impl:9s} p50 {r['p50_us']:8.1f} us   p99 {r['p99_us']:8.1f} us")
-            if "rospy" in results:
-                o, t = results[OURS], results["rospy"]
-                print(
-                    f"{name:28s} ratio     p50 {ratio(o['p50_us'], t['p50_us'])}   p99 {ratio(o['p99_us'], t['p99_us'])}"
-                )
+        for queue_size in ("10", "None"):
+            for name, cpus in (
+                ("same CPU (taskset -c 0)", SAME_CPU),
+                ("across CPUs (-c 0 / -c 1)", CROSS_CPU),
+            ):
+                label = f"{name} q={queue_size}"
+                impls = [i for i in IMPLS_CPP if i != CPP or queue_size == "10"]
+                results = {impl: run(uri, impl, cpus, count, queue_size) for impl in impls}
+                for impl, r in results.items():
+                    print(f"{label:35s} {impl:9s} p50 {r['p50_us']:8.1f} us   p99 {r['p99_us']:8.1f} us")
+                if "rospy" in results:
+                    o, t = results[OURS], results["rospy"]
+                    p50, p99 = ratio(o["p50_us"], t["p50_us"]), ratio(o["p99_us"], t["p99_us"])
+                    print(f"{label:35s} ratio     p50 {p50}   p99 {p99}")
+        r = in_process(uri, count)
+        print(
+            f"{'in one process (intraprocess=True)':35s} {OURS:9s} p50 {r['p50_us']:8.1f} us   p99 {r['p99_us']:8.1f} us"
+        )
 
 
 if __name__ == "__main__":

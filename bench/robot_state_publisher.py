@@ -1,6 +1,9 @@
 """CPU of robot_state_publisher at 50 Hz joint states for a 20-joint robot: ninjemys vs Debian's C++.
 
-Run: ``.venv/bin/python bench/robot_state_publisher.py`` (``--seconds N``, default 20).
+Run: ``.venv/bin/python bench/robot_state_publisher.py`` (``--seconds N`` per round, default 20;
+``--rounds N``, default 1; ``--floor`` adds two stripped copies of ours that show where the floor is:
+``receive`` takes each JointState and does nothing with it, ``no_fk`` does everything but compute and
+serialise the transforms, publishing the first message it made again and again).
 
 One master (ours), one description (a chain of 20 revolute joints with odd origins and axes, and
 two fixed joints), one JointState stream at 50 Hz from this process with a new stamp every message.
@@ -46,9 +49,29 @@ def cpu_seconds(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
+#: Python run by the --floor variants before our node's main
+FLOOR_PATCHES = {
+    "receive": "import ninjemys.robot.state_publisher as m; m.StatePublisher.on_raw = lambda self, raw: None",
+    "no_fk": (
+        "import ninjemys.robot.tf_plan as m; made = {}; full = m.TfPlan.message\n"
+        "def once(self, p, s, n):\n"
+        "    if id(self) not in made: made[id(self)] = full(self, p, s, n)\n"
+        "    return made[id(self)]\n"
+        "m.TfPlan.message = once"
+    ),
+}
+
+
+def floor_command(name: str) -> list[str]:
+    code = f"{FLOOR_PATCHES[name]}\nimport sys\nfrom ninjemys.robot.state_publisher import main\nsys.exit(main(sys.argv[1:]))"
+    return [sys.executable, "-c", code, f"/tf:=/tf_{name}", f"__name:=rsp_{name}"]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=20.0)
+    parser.add_argument("--rounds", type=int, default=1)
+    parser.add_argument("--floor", action="store_true", help="add the receive-only and no-FK copies of ours")
     opts = parser.parse_args()
     from ninjemys import testing
     from ninjemys.idl.loader import get_message_class
@@ -65,7 +88,7 @@ def main() -> None:
             get_message_class("tf2_msgs/TFMessage"),
             get_message_class("sensor_msgs/JointState"),
         )
-        counts = {"ours": 0, "debian": 0}
+        counts: dict[str, int] = {}
         lock = threading.Lock()
 
         def counter(name: str):  # noqa: ANN202
@@ -88,6 +111,9 @@ def main() -> None:
         }
         if DEBIAN.exists():
             commands["debian"] = [str(DEBIAN), "/tf:=/tf_debian", "__name:=rsp_debian"]
+        if opts.floor:
+            commands.update({name: floor_command(name) for name in FLOOR_PATCHES})
+        counts.update(dict.fromkeys(commands, 0))
         for name in commands:
             node.subscriber(f"/tf_{name}", TFMessage, counter(name), queue_size=1000)
         pub = node.publisher("/joint_states", JointState, queue_size=100)
@@ -101,37 +127,51 @@ def main() -> None:
             time.sleep(1.0)
             names = [f"j{i}" for i in range(JOINTS)]
             period, k = 1.0 / 50.0, 0
-            start_cpu = {name: cpu_seconds(p.pid) for name, p in procs.items()}
-            with lock:
-                start_counts = dict(counts)
-            start = time.monotonic()
-            next_t = start
-            while time.monotonic() - start < opts.seconds:
-                stamp = time.time()
-                msg = JointState(name=names, position=[0.01 * k + 0.1 * i for i in range(JOINTS)])
-                msg.header.stamp = Time.from_sec(stamp)
-                pub.publish(msg)
-                k += 1
-                next_t += period
-                time.sleep(max(0.0, next_t - time.monotonic()))
-            wall = time.monotonic() - start
-            time.sleep(0.5)
-            cpu = {name: cpu_seconds(p.pid) - start_cpu[name] for name, p in procs.items()}
-            with lock:
-                sent = {name: counts[name] - start_counts[name] for name in procs}
+            ratios = []
+            for round_ in range(opts.rounds):
+                start_cpu = {name: cpu_seconds(p.pid) for name, p in procs.items()}
+                with lock:
+                    start_counts = dict(counts)
+                start = time.monotonic()
+                next_t = start
+                while time.monotonic() - start < opts.seconds:
+                    stamp = time.time()
+                    msg = JointState(name=names, position=[0.01 * k + 0.1 * i for i in range(JOINTS)])
+                    msg.header.stamp = Time.from_sec(stamp)
+                    pub.publish(msg)
+                    k += 1
+                    next_t += period
+                    time.sleep(max(0.0, next_t - time.monotonic()))
+                wall = time.monotonic() - start
+                time.sleep(0.5)
+                cpu = {name: cpu_seconds(p.pid) - start_cpu[name] for name, p in procs.items()}
+                with lock:
+                    sent = {name: counts[name] - start_counts[name] for name in procs}
+                print(
+                    f"round {round_ + 1}: robot_state_publisher, {JOINTS} joints at 50 Hz for {wall:.0f} s "
+                    f"(load {os.getloadavg()[0]:.1f}):"
+                )
+                for name in procs:
+                    print(
+                        f"  {name:7s} CPU {100 * cpu[name] / wall:5.2f} % of a core, "
+                        f"{sent[name]} transforms published"
+                    )
+                if "debian" in cpu and cpu["debian"] > 0:
+                    ratios.append(cpu["ours"] / cpu["debian"])
+                    print(f"  ratio ours/debian: {ratios[-1]:.2f}")
+                time.sleep(0.5)
+            if len(ratios) > 1:
+                ratios.sort()
+                print(
+                    f"ratio ours/debian over {len(ratios)} rounds: median {ratios[len(ratios) // 2]:.2f}, "
+                    f"range {ratios[0]:.2f}-{ratios[-1]:.2f}"
+                )
         finally:
             for p in procs.values():
                 p.terminate()
             for p in procs.values():
                 p.wait(10)
             node.shutdown("bench done")
-    print(
-        f"robot_state_publisher, {JOINTS} joints at 50 Hz for {wall:.0f} s (load {os.getloadavg()[0]:.1f}):"
-    )
-    for name in procs:
-        print(f"  {name:7s} CPU {100 * cpu[name] / wall:5.2f} % of a core, {sent[name]} transforms published")
-    if "debian" in cpu and cpu["debian"] > 0:
-        print(f"  ratio ours/debian: {cpu['ours'] / cpu['debian']:.2f}")
 
 
 if __name__ == "__main__":

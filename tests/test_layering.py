@@ -111,6 +111,7 @@ LAYERS: dict[str, str] = {
     "tools": "tools",
     "testing": "tools",
     "bridge": "gateway",
+    "zenoh_bridge": "gateway",
     "sim": "sim",
     "nav": "nav",
     "drivers": "drivers",

@@ -53,8 +53,9 @@ def test_standard_nodes_decode_and_resynchronise_after_noise() -> None:
     stream = rp.pack_node(10.5, 1234.25, 47, True) + b"\x00\x02" + rp.pack_node(11.0, 0, 0, False)
     dec = rp.NodeDecoder()
     rows = [tuple(r) for i in range(len(stream)) for r in dec.feed(stream[i : i + 1])]
-    assert rows[0] == (10.5, 1234.25, 47, 1)
-    assert rows[-1] == (11.0, 0.0, 0, 0)
+    # 10.5 degrees (672/64) reaches rplidar_ros as (672 << 8) // 90 = 1911 q14 = 10.497 degrees
+    assert rows[0] == (1911 * 90 / 16384, 1234.25, 47, 1)
+    assert rows[-1] == (rp.q14_degrees(704), 0.0, 0, 0)
     assert dec.discarded >= 2
 
 
@@ -69,7 +70,7 @@ def test_express_capsules_interpolate_angles_between_capsules_with_compensation(
     assert len(rows) == 64
     assert tuple(rows[0][:2]) == (0.0, 1000.0)
     for i, (angle, dist, quality, _) in enumerate(rows[32:]):
-        assert angle == pytest.approx(30.0 + i * 30.0 / 32 - 1.0)
+        assert angle == rp.q14_degrees(int(round((30.0 + i * 30.0 / 32 - 1.0) * 64)))
         assert dist == 1000.0 + i and quality == 0x2F
     bad = bytearray(rp.pack_capsule(90.0, dists, [0] * 32, False))
     bad[10] ^= 0xFF
@@ -134,26 +135,32 @@ def stop(proc: subprocess.Popen) -> str:
     return out
 
 
-def check_room(scan, samples: list[tuple[float, float]]) -> None:  # noqa: ANN001
-    """Every beam of a compensated scan against the emulator's samples: the last sample of each 1-degree
-    bin lands there (rplidar_ros' compensation), at laser angle pi - device angle, within 1 cm."""
-    assert len(scan.ranges) == 360
-    by_bin: dict[int, tuple[float, float]] = {}
-    for a, d in sorted(samples):
+def check_room(scan, samples: list[tuple[float, float]], multiple: int = 1) -> None:  # noqa: ANN001
+    """Every beam of a compensated scan against the emulator's samples: rplidar_ros' compensation puts
+    each sample (in angle order) into the ``multiple`` bins of 1/multiple degree from its own, the later
+    one winning (angles as the SDK hands them on: 1/64 degree made q14), and publishes bin b of n at laser angle pi - 359 b / (n - 1) degrees (for one bin a
+    degree: pi - b); the range there is the room's along the winning sample's angle, within 1 cm."""
+    count = 360 * multiple
+    assert len(scan.ranges) == count
+    winner: dict[int, float] = {}
+    for a_q6, d in sorted(samples):
+        a = rp.q14_degrees(int(round(a_q6 * 64)))  # what rplidar_ros reads (see q14_degrees)
         if d:
-            by_bin[int(a)] = (a, d)
+            for j in range(multiple):
+                winner[min(int(a * multiple) + j, count - 1)] = a
     checked = 0
     for j, r in enumerate(scan.ranges):
         phi = scan.angle_min + j * scan.angle_increment
-        device_bin = 359 - j
-        if device_bin not in by_bin:
+        device_bin = count - 1 - j
+        if device_bin not in winner:
             assert math.isinf(r), (j, r)
             continue
-        a, _ = by_bin[device_bin]
-        assert phi == pytest.approx(math.pi - math.radians(device_bin), abs=1e-6)
+        a = winner[device_bin]
+        # rplidar_ros spreads the bins evenly over [pi - 359 deg, pi] whatever their count
+        assert phi == pytest.approx(math.pi - math.radians(359.0 * device_bin / (count - 1)), abs=1e-6)
         assert abs(r - room_range(math.pi - math.radians(a))) < 0.01, (j, r, a)
         checked += 1
-    assert checked > 300
+    assert checked > 0.8 * count
 
 
 @pytest.mark.parametrize("mode", ["Standard", "Express"])

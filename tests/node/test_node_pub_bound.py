@@ -62,10 +62,13 @@ def test_a_stalled_subscriber_gets_the_newest_and_loses_the_oldest(make_node) ->
         while not received or received[-1] != total - 1:
             (length,) = struct.unpack("<I", _read_exact(sock, 4))
             received.append(int(String.deserialize_from(_read_exact(sock, length)).data[:6]))
-        # what the kernel took first (in order), then the newest queue_size: the oldest are dropped
-        head = len(received) - 10
-        assert 0 < head < total - 10
-        assert received == list(range(head)) + list(range(total - 10, total))
+        # in order, never a duplicate, and the newest queue_size last: the oldest are the ones dropped.
+        # On a quiet machine the dropped run is one block (what the kernel took, then the newest
+        # ten); when the writer thread is preempted mid-burst the queue also trims earlier, so the
+        # test does not assert a single gap
+        assert received == sorted(set(received))
+        assert received[-10:] == list(range(total - 10, total))
+        assert len(received) < total
         assert conn.dropped == total - len(received)
     finally:
         sock.close()

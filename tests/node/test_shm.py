@@ -32,7 +32,9 @@ BIG = 640 * 480 * 3  # above shm_link.THRESHOLD
 @pytest.fixture(autouse=True)
 def shm_on(monkeypatch) -> None:  # noqa: ANN001
     monkeypatch.setenv("NINJEMYS_SHM", "1")
-    monkeypatch.setenv("NINJEMYS_UNIXROS", "0")
+    monkeypatch.delenv(
+        "NINJEMYS_UNIXROS", raising=False
+    )  # the default: SHMROS streams run on the Unix socket
 
 
 def _segments(pid: int | None = None) -> list[str]:
@@ -180,8 +182,10 @@ def test_a_malformed_notice_is_rejected_with_one_line_and_falls_back_to_tcpros(m
                 and next(iter(bad)) in lines[0].replace("generation", "gen")
             )
         # the subscriber reconnects over TCPROS and gets the next messages inline
-        assert wait_until(lambda sub=listener: _transports(sub, "/img") == ["TCPROS"], timeout=10)
-        assert wait_until(lambda: _transports(talker, "/img") == ["TCPROS"], timeout=10)
+        assert wait_until(
+            lambda sub=listener: _transports(sub, "/img") in (["TCPROS"], ["UNIXROS"]), timeout=10
+        )
+        assert wait_until(lambda: _transports(talker, "/img") in (["TCPROS"], ["UNIXROS"]), timeout=10)
         got.clear()
         pub.publish(_image(3, BIG))
         assert wait_until(lambda: got == [3])
@@ -291,7 +295,13 @@ def test_shmros_is_granted_only_to_this_host_and_named_in_bus_info(make_node, ma
     here = shm_link.offer()
     assert here is not None
     code, _, proto = api.requestTopic("/t", "/img", [here, ["TCPROS"]])
-    assert code == 1 and proto == ["SHMROS", talker.tcpros_host, talker.tcpros_port]
+    # over the node's Unix socket when it has one (UNIXROS on), else its TCP port
+    expected = (
+        ["SHMROS", talker.unix_address]
+        if talker.unix_address
+        else ["SHMROS", talker.tcpros_host, talker.tcpros_port]
+    )
+    assert code == 1 and proto == expected
     code, _, proto = api.requestTopic("/t", "/img", [["SHMROS", "another-host/1"], ["TCPROS"]])
     assert code == 1 and proto[0] == "TCPROS"
     # what rosnode info shows, from both ends
@@ -316,7 +326,9 @@ def test_ninjemys_shm_0_keeps_tcpros(make_node, monkeypatch) -> None:  # noqa: A
     assert wait_until(lambda: pub.get_num_connections() == 1)
     pub.publish(_image(1, BIG))
     assert wait_until(lambda: got)
-    assert _transports(talker, "/img") == ["TCPROS"] and type(got[0].data.obj).__name__ != "Lease"
+    assert (
+        _transports(talker, "/img") in (["TCPROS"], ["UNIXROS"]) and type(got[0].data.obj).__name__ != "Lease"
+    )
 
 
 def _mapped(name: str) -> bool:

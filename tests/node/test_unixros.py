@@ -1,4 +1,4 @@
-"""UNIXROS (opt-in, NINJEMYS_UNIXROS=1): ninjemys nodes of one host stream TCPROS over a Unix-domain socket, negotiated in
+"""UNIXROS (the default between ninjemys nodes of one host): they stream TCPROS over a Unix-domain socket, negotiated in
 requestTopic (topics) or found from a local service URI (services); the bytes are the same as over
 TCP, getBusInfo names the transport, and NINJEMYS_UNIXROS=0 keeps everything on TCP."""
 
@@ -20,8 +20,8 @@ pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="UN
 
 @pytest.fixture(autouse=True)
 def unixros_on(monkeypatch) -> None:  # noqa: ANN001
-    """UNIXROS is opt-in (NINJEMYS_UNIXROS=1); these tests turn it on for this process."""
-    monkeypatch.setenv("NINJEMYS_UNIXROS", "1")
+    """UNIXROS is the default: these tests run without NINJEMYS_UNIXROS, whatever the caller set."""
+    monkeypatch.delenv("NINJEMYS_UNIXROS", raising=False)
     monkeypatch.setenv("NINJEMYS_SHM", "0")  # SHMROS is offered before UNIXROS (tests/node/test_shm.py)
 
 

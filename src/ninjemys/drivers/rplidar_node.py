@@ -2,12 +2,17 @@
 
 Parameters (private): ``serial_port`` (/dev/ttyUSB0), ``serial_baudrate`` (115200; A3: 256000),
 ``frame_id`` (laser_frame), ``inverted`` (false), ``angle_compensate`` (false; the launch files set
-true), ``scan_mode`` ("" = the device's typical mode: Express when the firmware has it, else Standard).
+true), ``scan_mode`` ("" = the device's typical mode; before firmware 1.24: Express when the firmware has it,
+else Standard).
 Publishes ``scan`` (queue 1000, as rplidar_ros); services ``stop_motor`` and ``start_motor``
 (std_srvs/Empty). Start-up follows rplidar_ros: device info (S/N, firmware, hardware), health (an
 error status stops the node with rplidar_ros' message), motor on, scan; each step's failure is one
-clear line. Scan modes are those of the legacy protocol (Standard and Express capsules); a mode the
-device does not list is refused with rplidar_ros' list of supported modes.
+clear line. Scan modes: a device with firmware 1.24 or later (A2M12, A3, S1) lists its own over
+GET_LIDAR_CONF (name, microseconds per sample, range, answer type) and names its typical one (the mode
+used when ``scan_mode`` is empty; Sensitivity on an A3); older ones have the legacy Standard and
+Express. Standard, Express, dense-capsule and ultra-capsule modes are decoded; a mode the device does
+not list is refused with rplidar_ros' list of supported modes. Capsules that fail their sync or
+checksum are dropped, with one warning line a second at most saying how many bytes went.
 
 The node owns the port: the services hand their work to the read loop, which does it between reads.
 """
@@ -19,6 +24,7 @@ import threading
 import time
 from typing import Any
 
+from ninjemys.drivers import rplidar_capsules as rc
 from ninjemys.drivers import rplidar_protocol as rp
 from ninjemys.drivers.rplidar_scan import RevolutionAssembler, compensate_multiple, revolution_to_scan
 from ninjemys.idl.loader import get_message_class, get_service_class
@@ -34,13 +40,43 @@ BATCH_BYTES = 4 * rp.CAPSULE_SIZE
 BATCH_WAIT = 0.01
 
 
+#: how each measurement stream is decoded, by answer type
+DECODERS: dict[int, Any] = {
+    rp.ANS_TYPE_MEASUREMENT: rp.NodeDecoder,
+    rp.ANS_TYPE_MEASUREMENT_CAPSULED: rp.CapsuleDecoder,
+    rp.ANS_TYPE_MEASUREMENT_DENSE_CAPSULED: lambda: rp.CapsuleDecoder(rp.CAPSULE_SIZE, rc.dense_samples),
+    rp.ANS_TYPE_MEASUREMENT_CAPSULED_ULTRA: lambda: rp.CapsuleDecoder(
+        rp.ULTRA_CAPSULE_SIZE, rc.ultra_samples
+    ),
+}
+#: a second between "bad capsule data" lines
+BAD_DATA_LOG_INTERVAL = 1.0
+
+
 class ScanMode:
-    def __init__(self, ident: int, name: str, us_per_sample: float, max_distance: float, cmd: int) -> None:
+    def __init__(
+        self,
+        ident: int,
+        name: str,
+        us_per_sample: float,
+        max_distance: float,
+        ans_type: int,
+    ) -> None:
         self.id = ident
         self.name = name
         self.us_per_sample = us_per_sample
         self.max_distance = max_distance
-        self.cmd = cmd
+        self.ans_type = ans_type
+
+    @property
+    def cmd(self) -> int:
+        """The request that starts it: SCAN for Standard, else EXPRESS_SCAN."""
+        return rp.CMD_SCAN if self.id == rp.SCAN_MODE_STANDARD else rp.CMD_EXPRESS_SCAN
+
+    @property
+    def working_mode(self) -> int:
+        """EXPRESS_SCAN's working mode byte: 0 for the legacy Express, else the mode's id."""
+        return 0 if self.id == rp.SCAN_MODE_EXPRESS else self.id
 
 
 class RplidarDevice:
@@ -61,8 +97,8 @@ class RplidarDevice:
                 break
         return data
 
-    def _descriptor(self, cmd: int, timeout: float) -> rp.Descriptor:
-        """Skip to ``0xA5 0x5A`` and read the descriptor; check it is ``cmd``'s."""
+    def _descriptor(self, cmd: int, timeout: float, check: Any = None) -> rp.Descriptor:
+        """Skip to ``0xA5 0x5A`` and read the descriptor; check it is ``cmd``'s (or with ``check``)."""
         deadline = time.monotonic() + timeout
         prev = b""
         while True:
@@ -76,15 +112,24 @@ class RplidarDevice:
                 if len(rest) < 5:
                     raise TimeoutError(f"the answer to {rp.COMMAND_NAMES[cmd]} stopped in its descriptor")
                 d = rp.Descriptor.unpack(b"\xa5\x5a" + rest)
-                d.check(cmd)
+                if check is None:
+                    d.check(cmd)
+                else:
+                    check(d, cmd)
                 return d
             prev = b
 
-    def ask(self, cmd: int, payload_request: bytes | None = None, timeout: float = ANSWER_TIMEOUT) -> bytes:
+    def ask(
+        self,
+        cmd: int,
+        payload_request: bytes | None = None,
+        timeout: float = ANSWER_TIMEOUT,
+        check: Any = None,
+    ) -> bytes:
         """Send ``cmd`` and return its single answer's data."""
         self.port.reset_input_buffer()
         self.port.write(payload_request if payload_request is not None else rp.request(cmd))
-        d = self._descriptor(cmd, timeout)
+        d = self._descriptor(cmd, timeout, check)
         data = self._read_exact(d.length, timeout)
         if len(data) < d.length:
             raise TimeoutError(
@@ -101,6 +146,15 @@ class RplidarDevice:
     def sample_rates(self) -> tuple[int, int]:
         std, express = rp.struct.unpack("<HH", self.ask(rp.CMD_GET_SAMPLERATE))
         return std, express
+
+    def lidar_conf(self, conf_type: int, mode_id: int | None = None) -> bytes:
+        """GET_LIDAR_CONF: the value of one entry (RplidarError if the answer is not that entry's)."""
+        data = self.ask(
+            rp.CMD_GET_LIDAR_CONF,
+            rp.lidar_conf_request(conf_type, mode_id),
+            check=lambda d, cmd: d.check_single(cmd, rp.ANS_TYPE_GET_LIDAR_CONF),
+        )
+        return rp.parse_lidar_conf(conf_type, data)
 
     def check_motor_ctrl(self) -> bool:
         """GET_ACC_BOARD_FLAG: A2/A3 (and A1 on an accessory board) take SET_MOTOR_PWM; others use DTR."""
@@ -142,22 +196,61 @@ class RplidarDevice:
         self.stop()
         self.port.reset_input_buffer()
         if mode.cmd == rp.CMD_EXPRESS_SCAN:
-            self.port.write(rp.express_scan_request())
+            self.port.write(rp.express_scan_request(mode.working_mode))
         else:
             self.port.write(rp.request(rp.CMD_SCAN))
-        self._descriptor(mode.cmd, ANSWER_TIMEOUT)
+        self._descriptor(mode.cmd, ANSWER_TIMEOUT, lambda d, cmd: d.check_stream(cmd, mode.ans_type))
 
 
 def supported_modes(dev: RplidarDevice, info: rp.DeviceInfo) -> list[ScanMode]:
-    """The legacy protocol's modes: Standard, and Express on firmware 1.17 and later."""
+    """The device's scan modes: listed by the device from firmware 1.24 (GET_LIDAR_CONF), else the
+    legacy protocol's Standard, and Express on firmware 1.17 and later."""
+    if info.firmware_version >= rp.CONF_FIRMWARE:
+        return conf_modes(dev)
     try:
         std_us, express_us = dev.sample_rates()
     except (TimeoutError, rp.RplidarError):
         std_us, express_us = 500, 0  # early A1 firmware: 2 kHz standard scans only
-    modes = [ScanMode(0, "Standard", float(std_us), LEGACY_MAX_DISTANCE, rp.CMD_SCAN)]
+    modes = [ScanMode(0, "Standard", float(std_us), LEGACY_MAX_DISTANCE, rp.ANS_TYPE_MEASUREMENT)]
     if info.firmware_version >= (1 << 8 | 17) and express_us:
-        modes.append(ScanMode(1, "Express", float(express_us), LEGACY_MAX_DISTANCE, rp.CMD_EXPRESS_SCAN))
+        modes.append(
+            ScanMode(1, "Express", float(express_us), LEGACY_MAX_DISTANCE, rp.ANS_TYPE_MEASUREMENT_CAPSULED)
+        )
     return modes
+
+
+def conf_modes(dev: RplidarDevice) -> list[ScanMode]:
+    """GET_LIDAR_CONF: the mode count, then each mode's microseconds per sample and range (1/256 units,
+    whole numbers kept as the SDK keeps them), answer type and name (NUL-terminated)."""
+    (count,) = rp.struct.unpack_from("<H", _sized(dev.lidar_conf(rp.CONF_SCAN_MODE_COUNT), 2, "mode count"))
+    modes = []
+    for ident in range(count):
+        us = _sized(dev.lidar_conf(rp.CONF_SCAN_MODE_US_PER_SAMPLE, ident), 4, "us per sample")
+        dist = _sized(dev.lidar_conf(rp.CONF_SCAN_MODE_MAX_DISTANCE, ident), 4, "max distance")
+        ans_type = dev.lidar_conf(rp.CONF_SCAN_MODE_ANS_TYPE, ident)[0]
+        name = dev.lidar_conf(rp.CONF_SCAN_MODE_NAME, ident).split(b"\0", 1)[0].decode("ascii", "replace")
+        us_per_sample = float(rp.struct.unpack_from("<I", us)[0] >> 8)
+        if us_per_sample <= 0:
+            raise rp.RplidarError(f"scan mode {ident} ({name}) has {us_per_sample} us per sample")
+        max_distance = float(rp.struct.unpack_from("<I", dist)[0] >> 8)
+        modes.append(ScanMode(ident, name, us_per_sample, max_distance, ans_type))
+    return modes
+
+
+def typical_mode_id(dev: RplidarDevice, info: rp.DeviceInfo) -> int:
+    """The mode rplidar_ros starts when ``scan_mode`` is empty: the device's typical one (or Express)."""
+    if info.firmware_version >= rp.CONF_FIRMWARE:
+        (ident,) = rp.struct.unpack_from(
+            "<H", _sized(dev.lidar_conf(rp.CONF_SCAN_MODE_TYPICAL), 2, "typical")
+        )
+        return int(ident)
+    return rp.SCAN_MODE_EXPRESS
+
+
+def _sized(value: bytes, size: int, what: str) -> bytes:
+    if len(value) < size:
+        raise rp.RplidarError(f"GET_LIDAR_CONF {what}: {len(value)} bytes, expected {size}")
+    return value
 
 
 class RplidarNode:
@@ -177,6 +270,7 @@ class RplidarNode:
         self.stopped = False  # by stop_motor: no scan until start_motor
         self.mode: ScanMode | None = None
         self.published = 0
+        self.bad_logged, self.bad_log_time = 0, 0.0
 
     def _service(self, action: str) -> Any:
         Empty: Any = get_service_class("std_srvs/Empty")
@@ -219,7 +313,12 @@ class RplidarNode:
         self._service("start_motor")
         self.dev.check_motor_ctrl()
         self.dev.start_motor()
-        modes = supported_modes(self.dev, info)
+        try:
+            modes = supported_modes(self.dev, info)
+            typical = typical_mode_id(self.dev, info) if not self.scan_mode_name else None
+        except (TimeoutError, rp.RplidarError) as exc:
+            self.log.error("Error, cannot get the scan modes of the lidar: %s", exc)
+            return 1
         if self.scan_mode_name:
             chosen = [m for m in modes if m.name == self.scan_mode_name]
             if not chosen:
@@ -236,7 +335,17 @@ class RplidarNode:
                 return 1
             self.mode = chosen[0]
         else:
-            self.mode = modes[-1]  # the typical mode: Express when the device has it
+            by_id = {m.id: m for m in modes}
+            # the typical mode (legacy: Express when the device has it, else Standard)
+            self.mode = by_id.get(typical if typical is not None else -1, modes[-1])
+        if self.mode.ans_type not in DECODERS:
+            self.log.error(
+                "scan mode `%s' streams answers of type 0x%02X, which this driver does not decode "
+                "(it decodes 0x81, 0x82, 0x84 and 0x85)",
+                self.mode.name,
+                self.mode.ans_type,
+            )
+            return 1
         self.multiple = compensate_multiple(self.mode.us_per_sample)
         return 0
 
@@ -273,7 +382,22 @@ class RplidarNode:
 
     def _decoder(self) -> Any:
         assert self.mode is not None
-        return rp.CapsuleDecoder() if self.mode.cmd == rp.CMD_EXPRESS_SCAN else rp.NodeDecoder()
+        self.bad_logged, self.bad_log_time = 0, 0.0
+        return DECODERS[self.mode.ans_type]()
+
+    def _report_bad(self, decoder: Any) -> None:
+        """One line (at most a second apart) for the bytes dropped since the last one."""
+        bad = getattr(decoder, "bad", None)
+        if bad is None:
+            bad = decoder.discarded
+        if bad > self.bad_logged and time.monotonic() - self.bad_log_time >= BAD_DATA_LOG_INTERVAL:
+            assert self.mode is not None
+            self.log.warn(
+                "RPLIDAR: dropped %d byte(s) of %s scan data that failed the sync or checksum check",
+                bad - self.bad_logged,
+                self.mode.name,
+            )
+            self.bad_logged, self.bad_log_time = bad, time.monotonic()
 
     def run(self) -> None:
         assert self.mode is not None
@@ -314,7 +438,9 @@ class RplidarNode:
             data = self.port.read(waiting if waiting else 1)  # blocks up to READ_TIMEOUT when idle
             if not data:
                 continue
-            for rev in assembler.feed(decoder.feed(data)):
+            rows = decoder.feed(data)
+            self._report_bad(decoder)
+            for rev in assembler.feed(rows):
                 now = time.monotonic()
                 self._publish(rev, rev_stamp, now - rev_start)
                 rev_start, rev_stamp = now, self.node.now()

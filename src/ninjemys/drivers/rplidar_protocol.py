@@ -13,7 +13,14 @@ word whose low 30 bits are the length of one response and top 2 bits the send mo
   quality, a check bit and the angle in 1/64 degree, the distance in 1/4 mm;
 * EXPRESS_SCAN (0x82 with a 5-byte payload -> stream of 84 bytes, type 0x82): capsules of 32 distances
   whose angles are interpolated between this capsule's start angle and the next one's;
-* STOP (0x25), RESET (0x40), SET_MOTOR_PWM (0xF0, uint16 payload): no answer.
+* STOP (0x25), RESET (0x40), SET_MOTOR_PWM (0xF0, uint16 payload): no answer;
+* GET_LIDAR_CONF (0x84 with a 36-byte payload: a uint32 entry type and 32 reserved bytes, the first two
+  of which carry a scan mode's id; firmware 1.24 and later -> a 4-byte echo of the type and the value,
+  type 0x20): the scan modes the device offers (count, each one's name, microseconds per sample and
+  range in 1/256 units, and the answer type its EXPRESS_SCAN stream uses) and the typical mode. A mode
+  other than Standard (0, a SCAN) and Express (1, working mode 0) starts with EXPRESS_SCAN working mode =
+  its id, answered with capsules (0x82), dense capsules (0x85) or ultra capsules (0x84), decoded in
+  :mod:`ninjemys.drivers.rplidar_capsules`.
 
 Angles are the device's: degrees clockwise seen from above, 0 at the front. The node
 (:mod:`ninjemys.drivers.rplidar_node`) owns the port; this module only encodes and decodes.
@@ -22,7 +29,9 @@ Angles are the device's: degrees clockwise seen from above, 0 at the front. The 
 from __future__ import annotations
 
 import struct
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -41,6 +50,7 @@ CMD_GET_HEALTH = 0x52
 CMD_GET_SAMPLERATE = 0x59
 CMD_SET_MOTOR_PWM = 0xF0
 CMD_GET_ACC_BOARD_FLAG = 0xFF
+CMD_GET_LIDAR_CONF = 0x84
 
 ANS_TYPE_DEVINFO = 0x04
 ANS_TYPE_DEVHEALTH = 0x06
@@ -48,6 +58,24 @@ ANS_TYPE_SAMPLE_RATE = 0x15
 ANS_TYPE_MEASUREMENT = 0x81
 ANS_TYPE_MEASUREMENT_CAPSULED = 0x82
 ANS_TYPE_ACC_BOARD_FLAG = 0xFF
+ANS_TYPE_MEASUREMENT_HQ = 0x83
+ANS_TYPE_MEASUREMENT_CAPSULED_ULTRA = 0x84
+ANS_TYPE_MEASUREMENT_DENSE_CAPSULED = 0x85
+ANS_TYPE_GET_LIDAR_CONF = 0x20
+
+#: GET_LIDAR_CONF entry types (uint32)
+CONF_SCAN_MODE_COUNT = 0x70
+CONF_SCAN_MODE_US_PER_SAMPLE = 0x71
+CONF_SCAN_MODE_MAX_DISTANCE = 0x74
+CONF_SCAN_MODE_ANS_TYPE = 0x75
+CONF_SCAN_MODE_TYPICAL = 0x7C
+CONF_SCAN_MODE_NAME = 0x7F
+#: scan mode ids with a meaning of their own: Standard is a SCAN, Express is EXPRESS_SCAN working mode 0
+SCAN_MODE_STANDARD = 0
+SCAN_MODE_EXPRESS = 1
+#: firmware from which the device answers GET_LIDAR_CONF (major << 8 | minor)
+CONF_FIRMWARE = 1 << 8 | 24
+ULTRA_CAPSULE_SIZE = 132
 
 SEND_MODE_SINGLE = 0
 SEND_MODE_MULTIPLE = 1
@@ -82,6 +110,15 @@ COMMAND_NAMES = {
     CMD_GET_SAMPLERATE: "GET_SAMPLERATE",
     CMD_SET_MOTOR_PWM: "SET_MOTOR_PWM",
     CMD_GET_ACC_BOARD_FLAG: "GET_ACC_BOARD_FLAG",
+    CMD_GET_LIDAR_CONF: "GET_LIDAR_CONF",
+}
+
+#: bytes of one element of each measurement stream, by answer type
+STREAM_ELEMENT = {
+    ANS_TYPE_MEASUREMENT: NODE_SIZE,
+    ANS_TYPE_MEASUREMENT_CAPSULED: CAPSULE_SIZE,
+    ANS_TYPE_MEASUREMENT_DENSE_CAPSULED: CAPSULE_SIZE,
+    ANS_TYPE_MEASUREMENT_CAPSULED_ULTRA: ULTRA_CAPSULE_SIZE,
 }
 
 
@@ -101,8 +138,28 @@ def request(cmd: int, payload: bytes = b"") -> bytes:
 
 
 def express_scan_request(working_mode: int = 0) -> bytes:
-    """EXPRESS_SCAN in the legacy working mode 0 (the capsules A1/A2 stream)."""
+    """EXPRESS_SCAN: working mode 0 is the legacy Express capsules; other modes are scan mode ids."""
     return request(CMD_EXPRESS_SCAN, bytes((working_mode, 0, 0, 0, 0)))
+
+
+def lidar_conf_request(conf_type: int, mode_id: int | None = None) -> bytes:
+    """GET_LIDAR_CONF for ``conf_type`` (about scan mode ``mode_id`` where the entry is per mode)."""
+    reserved = bytearray(32)
+    if mode_id is not None:
+        reserved[0:2] = struct.pack("<H", mode_id)
+    return request(CMD_GET_LIDAR_CONF, struct.pack("<I", conf_type) + bytes(reserved))
+
+
+def parse_lidar_conf(conf_type: int, data: bytes) -> bytes:
+    """The value of a GET_LIDAR_CONF answer; RplidarError when it echoes another type or carries none."""
+    if len(data) < 4:
+        raise RplidarError(f"GET_LIDAR_CONF answer of {len(data)} bytes, shorter than its type field")
+    (echoed,) = struct.unpack_from("<I", data)
+    if echoed != conf_type:
+        raise RplidarError(f"GET_LIDAR_CONF asked for entry 0x{conf_type:X} and was answered 0x{echoed:X}")
+    if len(data) == 4:
+        raise RplidarError(f"GET_LIDAR_CONF entry 0x{conf_type:X} came back without a value")
+    return data[4:]
 
 
 def motor_pwm_request(pwm: int) -> bytes:
@@ -129,6 +186,25 @@ class Descriptor:
             raise RplidarError(f"not a response descriptor: {data.hex(' ')}")
         word, data_type = struct.unpack_from("<IB", data, 2)
         return cls(word & 0x3FFFFFFF, word >> 30, data_type)
+
+    def check_single(self, cmd: int, data_type: int) -> None:
+        """Raise unless this is a single answer of ``data_type`` (any length: GET_LIDAR_CONF's vary)."""
+        if self.send_mode != SEND_MODE_SINGLE or self.data_type != data_type:
+            raise RplidarError(
+                f"the device answered {COMMAND_NAMES[cmd]} (0x{cmd:02X}) with a response descriptor of "
+                f"send mode {self.send_mode}, type 0x{self.data_type:02X}; "
+                f"expected send mode {SEND_MODE_SINGLE}, type 0x{data_type:02X}"
+            )
+
+    def check_stream(self, cmd: int, data_type: int) -> None:
+        """Raise unless this starts the measurement stream of answer type ``data_type``."""
+        size = STREAM_ELEMENT[data_type]
+        if self.send_mode != SEND_MODE_MULTIPLE or self.data_type != data_type or self.length < size:
+            raise RplidarError(
+                f"the device answered {COMMAND_NAMES[cmd]} (0x{cmd:02X}) with a response descriptor of "
+                f"length {self.length}, send mode {self.send_mode}, type 0x{self.data_type:02X}; "
+                f"expected length {size}, send mode {SEND_MODE_MULTIPLE}, type 0x{data_type:02X}"
+            )
 
     def check(self, cmd: int) -> None:
         """Raise if this is not the answer ``cmd`` has (the message names both)."""
@@ -173,6 +249,15 @@ class Health:
 
 
 # -- measurements -----------------------------------------------------------------------------------------
+
+
+def q14_degrees(angle_q6: Any) -> Any:
+    """Degrees as rplidar_ros sees an angle the device sent in 1/64 degree: Slamtec's SDK 1.12 hands
+    every measurement on as a 1/16384-of-90-degrees ``angle_z_q14 = (q6 << 8) / 90`` (integer
+    division) and the node reads ``q14 * 90 / 16384``, so 10.0 degrees arrives as 9.9976 (and lands
+    in compensation bin 9). Works on ints and integer arrays; exact in float32 and float64 alike."""
+    return ((angle_q6 << 8) // 90) * (90.0 / 16384.0)
+
 
 #: one revolution's samples: angle in degrees (device convention), distance in mm, quality 0..63
 Samples = tuple[np.ndarray, np.ndarray, np.ndarray]
@@ -220,7 +305,9 @@ class NodeDecoder:
                     run = 0
                     continue
                 angle_q6 = (b1 | snap[pos + 2] << 8) >> 1
-                single.append((angle_q6 / 64.0, (snap[pos + 3] | snap[pos + 4] << 8) / 4.0, b0 >> 2, b0 & 1))
+                single.append(
+                    (q14_degrees(angle_q6), (snap[pos + 3] | snap[pos + 4] << 8) / 4.0, b0 >> 2, b0 & 1)
+                )
                 pos += NODE_SIZE
                 run += 1
                 continue
@@ -235,7 +322,7 @@ class NodeDecoder:
             if good:
                 ok = arr[:good].astype(np.int64)
                 rows = np.empty((good, 4), dtype=np.float64)
-                rows[:, 0] = ((ok[:, 1] | ok[:, 2] << 8) >> 1) / 64.0
+                rows[:, 0] = q14_degrees((ok[:, 1] | ok[:, 2] << 8) >> 1)
                 rows[:, 1] = (ok[:, 3] | ok[:, 4] << 8) / 4.0
                 rows[:, 2] = ok[:, 0] >> 2
                 rows[:, 3] = ok[:, 0] & 1
@@ -270,13 +357,23 @@ def pack_capsule(start_angle_deg: float, dists_mm: list[float], offsets_q3: list
 class CapsuleDecoder:
     """Express scan: 84-byte capsules; each capsule's samples come out when the next one arrives.
 
+    The framing (sync nibbles 0xA and 0x5, the XOR checksum of every byte after the first two, the start
+    flag in the start angle) is the same for dense (84 bytes) and ultra (132 bytes) capsules: ``size``
+    and ``samples`` (the per-format arithmetic) make this decoder theirs.
+
     Angles follow Slamtec's SDK: the 32 samples of a capsule are spread evenly from its start angle to
     the next capsule's, minus each sample's compensation (6 bits, 1/8 degree). A capsule whose sync
     nibbles or checksum are wrong is dropped (and the one before it, whose end angle it would give).
     The capsules of one read are decoded together, in one pass of array arithmetic.
     """
 
-    def __init__(self) -> None:
+    def __init__(
+        self,
+        size: int = CAPSULE_SIZE,
+        samples: Callable[[list[bytes], list[bytes]], np.ndarray] | None = None,
+    ) -> None:
+        self.size = size
+        self.samples = samples or _capsule_samples
         self._buf = bytearray()
         self._prev: bytes | None = None
         self.bad = 0
@@ -288,20 +385,21 @@ class CapsuleDecoder:
         prevs: list[bytes] = []
         curs: list[bytes] = []
         pos = 0
-        while len(buf) - pos >= CAPSULE_SIZE:
+        size = self.size
+        while len(buf) - pos >= size:
             if (buf[pos] >> 4) != 0xA or (buf[pos + 1] >> 4) != 0x5:
                 pos += 1
                 self.bad += 1
                 self._prev = None
                 continue
-            cap = bytes(buf[pos : pos + CAPSULE_SIZE])
+            cap = bytes(buf[pos : pos + size])
             cs = int(np.bitwise_xor.reduce(np.frombuffer(cap, dtype=np.uint8, offset=2)))
             if cs != ((cap[0] & 0xF) | (cap[1] & 0xF) << 4):
                 pos += 1
                 self.bad += 1
                 self._prev = None
                 continue
-            pos += CAPSULE_SIZE
+            pos += size
             if cap[3] & 0x80:  # a new scan starts: nothing before it pairs with it
                 self._prev = cap
                 continue
@@ -312,7 +410,7 @@ class CapsuleDecoder:
         del buf[:pos]
         if not prevs:
             return np.empty((0, 4))
-        return _capsule_samples(prevs, curs)
+        return self.samples(prevs, curs)
 
 
 _SAMPLE_INDEX = np.arange(2 * CABINS, dtype=np.int64)
@@ -342,7 +440,7 @@ def _capsule_samples(prevs: list[bytes], curs: list[bytes]) -> np.ndarray:
     start = ((angle_q16 + inc_q16) % (360 << 16)) < inc_q16
     dist_q2 = dist & 0xFFFC
     out = np.empty((n * 2 * CABINS, 4), dtype=np.float64)
-    out[:, 0] = (angle_q6 / 64.0).ravel()
+    out[:, 0] = q14_degrees(angle_q6).ravel()
     out[:, 1] = (dist_q2 / 4.0).ravel()
     out[:, 2] = np.where(dist_q2 != 0, 0x2F, 0).ravel()
     out[:, 3] = start.ravel()

@@ -1,6 +1,7 @@
 """From RPLIDAR samples to ``sensor_msgs/LaserScan`` fields, with rplidar_ros' conventions.
 
-rplidar_ros (1.10, Noetic) does three things to a revolution before publishing it:
+rplidar_ros (1.10, Noetic) does three things to a revolution before publishing it (its angles as the
+SDK hands them on, in 90/16384-degree steps: :func:`ninjemys.drivers.rplidar_protocol.q14_degrees`):
 
 1. *ascend*: samples with no distance get an angle interpolated from their neighbours, then all are
    sorted by angle (the device's clockwise degrees);

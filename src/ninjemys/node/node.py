@@ -34,8 +34,8 @@ from ninjemys.master.client import MasterClient
 from ninjemys.net.addresses import advertised_host, advertised_host_problem
 from ninjemys.net.addresses import master_uri as env_master_uri
 from ninjemys.net.xmlrpc_server import XmlRpcServer
+from ninjemys.node import intraprocess, timers, transport
 from ninjemys.node import runtime as _runtime
-from ninjemys.node import timers, transport
 from ninjemys.node.clock import CLOCK_TOPIC, USE_SIM_TIME, Clock
 from ninjemys.node.log import INFO, NodeLog
 from ninjemys.node.params import ParamAccess
@@ -131,6 +131,7 @@ class Node(ParamAccess):
             _runtime.release()
             raise
         self.uri: str = self._slave.uri
+        intraprocess.register_node(self.uri, self)  # in-process subscribers find our publications
         self.registrar = Registrar(self)
         self.registrar.start()
         # the clock and the log exist before anything below can fail, so shutdown always finds them
@@ -244,9 +245,13 @@ class Node(ParamAccess):
         latch: bool = False,
         tcp_nodelay: bool = True,
         headers: Mapping[str, str] | None = None,
+        intraprocess: bool = False,
     ) -> Publisher:
         """Advertise ``topic``. ``tcp_nodelay`` is accepted for API symmetry: a publisher sets
-        TCP_NODELAY on every subscriber's socket (it batches bursts itself; docs/node.md)."""
+        TCP_NODELAY on every subscriber's socket (it batches bursts itself; docs/node.md).
+        ``intraprocess=True`` promises never to change a message after publishing it: subscriber
+        handles of this process made with ``intraprocess=True`` then get the object itself, not
+        serialized (docs/node.md, in-process delivery)."""
         self._check_alive()
         resolved = self.resolve_name(topic)
         with self._lock:
@@ -259,7 +264,7 @@ class Node(ParamAccess):
                 raise NinjemysError(
                     f"topic {resolved} is already published by {self.name} as {pub.type_name}, not {msg_class._type}"
                 )
-            handle = Publisher(pub, queue_size, latch, headers)
+            handle = Publisher(pub, queue_size, latch, headers, intraprocess)
             pub.handles.append(handle)
         if new:
             self.registrar.add_publisher(resolved, pub.type_name)
@@ -278,6 +283,7 @@ class Node(ParamAccess):
         share_thread: Subscriber | None = None,
         lazy: float = 0.0,
         batch: bool = False,
+        intraprocess: bool = False,
     ) -> Subscriber:
         """Subscribe to ``topic``; ``callback(msg[, callback_args])`` runs on this subscriber's own thread.
 
@@ -297,6 +303,11 @@ class Node(ParamAccess):
         message while something waits for the data (with ``share_thread``, the host's setting rules).
         ``batch=True`` calls back with a list: the messages read in one go, in order (a lazy reader's
         round or pull can hold many; one call saves the per-message call overhead).
+        ``intraprocess=True`` connects to publishers of this same process without a socket or
+        serialization (the transport ``INTRAPROCESS``) and promises never to change a received
+        message: from a publisher made with ``intraprocess=True`` too, the callback gets the
+        published object itself, shared with that publisher and every such subscriber; otherwise its
+        own copy (docs/node.md, in-process delivery).
         """
         self._check_alive()
         resolved = self.resolve_name(topic)
@@ -307,8 +318,9 @@ class Node(ParamAccess):
                 sub = Subscription(self, resolved, msg_class, tcp_nodelay)
                 self._subscriptions[resolved] = sub
             handle = Subscriber(
-                sub, callback, callback_args, queue_size, raw, coalesce, share_thread, lazy, batch
-            )
+                sub, callback, callback_args, queue_size, raw, coalesce, share_thread, lazy, batch,
+                intraprocess,
+            )  # fmt: skip
             sub.handles.append(handle)
         if new:
             publishers = self.registrar.add_subscriber(resolved, sub.type_name)
@@ -471,7 +483,7 @@ class Node(ParamAccess):
     def bus_stats(self) -> list[Any]:
         pubs = [
             [t, sum(c.bytes_sent for c in p.connections) + p.bytes_sent_closed,
-             [[c.id, c.bytes_sent, c.num_sent, not c.closed] for c in p.connections]]
+             [[c.id, c.bytes_sent, c.num_sent, not c.closed] for c in p.all_connections()]]
             for t, p in list(self._publications.items())
         ]  # fmt: skip
         subs = [
@@ -483,31 +495,17 @@ class Node(ParamAccess):
     def bus_info(self) -> list[Any]:
         info: list[Any] = []
         for topic, pub in list(self._publications.items()):
-            for c in pub.connections:
+            for c in pub.all_connections():
                 info.append(
-                    [
-                        c.id,
-                        c.subscriber,
-                        "o",
-                        transport.transport_name(c),
-                        topic,
-                        not c.closed,
-                        f"{transport.transport_name(c)} connection to [{c.subscriber}]",
-                    ]
-                )
+                    [c.id, c.subscriber, "o", c.transport, topic, not c.closed,
+                     f"{c.transport} connection to [{c.subscriber}]"]
+                )  # fmt: skip
         for topic, sub in list(self._subscriptions.items()):
             for s in list(sub.connections.values()):
                 info.append(
-                    [
-                        s.id,
-                        s.uri,
-                        "i",
-                        transport.transport_name(s),
-                        topic,
-                        not s.closed,
-                        f"{transport.transport_name(s)} connection from [{s.publisher}]",
-                    ]
-                )
+                    [s.id, s.uri, "i", s.transport, topic, not s.closed,
+                     f"{s.transport} connection from [{s.publisher}]"]
+                )  # fmt: skip
         return info
 
     # -- time ------------------------------------------------------------------------------------
@@ -599,6 +597,7 @@ class Node(ParamAccess):
         self.clock.shutdown()
         self.log.detach()
         rostime.release_default_clock(self)
+        intraprocess.unregister_node(self.uri, self)
         with self._lock:
             node_timers, self._timers = self._timers, []
         self.registrar.stop()

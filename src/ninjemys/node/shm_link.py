@@ -101,7 +101,10 @@ def announcement(name: str) -> bytes:
 class ShmPubConnection(PubConnection):
     """A subscriber on this host: large messages into the ring, a notice on the socket."""
 
-    transport_name = SHMROS
+    @property
+    def transport(self) -> str:
+        """What getBusInfo reports (rosnode info shows it)."""
+        return SHMROS
 
     def __init__(self, node: NodeContext, sock: socket.socket, topic: str, subscriber: str) -> None:
         super().__init__(node, sock, topic, subscriber)
@@ -195,7 +198,10 @@ def subscriber_connection(
 class ShmSubConnection(SubConnection):
     """A publisher on this host: tagged frames; notices become read-only views into the ring."""
 
-    transport_name = SHMROS
+    @property
+    def transport(self) -> str:
+        """What getBusInfo reports (rosnode info shows it)."""
+        return SHMROS
 
     def __init__(
         self,

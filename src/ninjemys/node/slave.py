@@ -97,10 +97,12 @@ class SlaveApi:
         for proto in protocols if isinstance(protocols, list) else []:
             if not isinstance(proto, list) or not proto:
                 continue
+            unix = self._node.unix_address
             if shm_link.grants(proto):  # SHMROS: large messages through shared memory (shm_link)
+                if unix:  # the notices and small messages go over the Unix socket
+                    return wire.ok(f"ready on {unix}", [shm_link.SHMROS, unix])
                 host, port = self._node.tcpros_host, self._node.tcpros_port
                 return wire.ok(f"ready on {host}:{port}", [shm_link.SHMROS, host, port])
-            unix = self._node.unix_address
             if proto[0] == transport.UNIXROS and unix and proto[1:2] == [transport.host_identity()]:
                 return wire.ok(f"ready on {unix}", [transport.UNIXROS, unix])
             if proto[0] == "TCPROS":

@@ -45,7 +45,8 @@ from collections.abc import Callable, Mapping
 
 from ninjemys.errors import NinjemysError, ProtocolError
 from ninjemys.net import auth, xmlrpc_client
-from ninjemys.node import transport
+from ninjemys.node import intraprocess, transport
+from ninjemys.node.intraprocess import Handoff
 from ninjemys.node.topics import connection_ids
 from ninjemys.records import SlotRecord
 from ninjemys.wire import headers
@@ -62,6 +63,12 @@ _log = logging.getLogger(__name__)
 
 #: Bytes an unbounded subscription reads from one connection before delivering what it has.
 _READ_BUDGET = 256 * 1024
+#: An in-process publisher with queue_size=None waits while this many messages wait for an unbounded
+#: handle, until no more than the low mark are left, looking every _LOCAL_WAIT seconds (TCPROS's
+#: synchronous publishing, where the kernel's buffer is the bound).
+_LOCAL_HIGH_WATER = 256
+_LOCAL_LOW_WATER = 128
+_LOCAL_WAIT = 100e-6
 
 
 def _kernel_pending(sock: socket.socket) -> int:
@@ -163,6 +170,8 @@ class _Poller:
 class SubConnection:
     """One publisher's stream for one topic, read on the loop."""
 
+    intra = False
+
     def __init__(self, sub: Subscription, sock: socket.socket, uri: str, header: Mapping[str, str]) -> None:
         self.sub = sub
         self.sock = sock
@@ -179,6 +188,11 @@ class SubConnection:
         self.num_recv = 0
         self.closed = False
         self._reader = FrameReader()
+
+    @property
+    def transport(self) -> str:
+        """The transport name getBusInfo reports (TCPROS or UNIXROS)."""
+        return transport.transport_of(self.sock)
 
     def read(self, budget: int | None = None) -> list[bytes | bytearray] | None:
         """Read frames from the kernel (worker thread): about ``budget`` bytes at most when given, else
@@ -273,7 +287,7 @@ class Subscription:
         self.definition: str = getattr(msg_class, "_full_text", "") if msg_class is not None else ""
         self.tcp_nodelay = tcp_nodelay
         self.handles: list[Subscriber] = []
-        self.connections: dict[str, SubConnection] = {}
+        self.connections: dict[str, SubConnection | intraprocess.IntraLink] = {}
         self.publishers: list[str] = []
         self._connecting: set[str] = set()
         #: publishers whose shared memory failed here: TCPROS only from then on
@@ -296,16 +310,43 @@ class Subscription:
         for uri, conn in list(self.connections.items()):
             if uri not in wanted:
                 del self.connections[uri]
-                self._hand(("drop", conn))
+                self._drop(conn)
         loop = self.node.runtime.loop
         for uri in uris:
             if uri not in self.connections and uri not in self._connecting:
                 self._connecting.add(uri)
                 loop.create_task(self._connect(uri))
 
+    def _drop(self, conn: SubConnection | intraprocess.IntraLink) -> None:
+        if conn.intra:
+            conn.close()
+        else:
+            self._hand(("drop", conn))  # type: ignore[arg-type]
+
+    def _connect_intra(self, uri: str) -> bool:
+        """Join a publisher of this very process without a socket, when a handle opted in (on the
+        loop); True when ``uri`` was such a publisher (joined, or refused with one line)."""
+        if not any(h.intraprocess for h in self.handles):
+            return False
+        pub = intraprocess.local_publication(uri, self.topic)
+        if pub is None:
+            return False
+        link = intraprocess.attach(pub, self, uri)
+        if link is not None:
+            if self.closed or uri not in self.publishers:
+                link.close()
+                return True
+            old = self.connections.pop(uri, None)
+            if old is not None:
+                self._drop(old)
+            self.connections[uri] = link
+        return True
+
     async def _connect(self, uri: str, attempt: int = 0) -> None:
         sock: socket.socket | None = None
         try:
+            if self._connect_intra(uri):
+                return
             offer: list[list[str]] = [["TCPROS"]]
             # a lazy handle waits on SO_RCVLOWAT, which Linux honours for TCP only: it keeps TCPROS
             lazy = any(h._host._lazy for h in self.handles)
@@ -322,7 +363,7 @@ class Subscription:
                 _log.info("topic %s: publisher %s declined: %s", self.topic, uri, status)
                 self._retry_later(uri, attempt)
                 return
-            if proto[0] == transport.UNIXROS:
+            if proto[0] == transport.UNIXROS or (proto[0] == "SHMROS" and len(proto) == 2):  # a Unix socket
                 sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
                 address: Any = transport.unix_sockaddr(str(proto[1]))
             else:
@@ -351,7 +392,7 @@ class Subscription:
             conn = _connection(self, sock, uri, header)
             old = self.connections.pop(uri, None)
             if old is not None:
-                self._hand(("drop", old))
+                self._drop(old)
             self.connections[uri] = conn
             self._hand(("add", conn))
         except (OSError, TimeoutError, NinjemysError, ValueError, TypeError) as exc:
@@ -387,7 +428,7 @@ class Subscription:
             return
         reader.post(op)
 
-    def connection_lost(self, conn: SubConnection, retry: bool) -> None:
+    def connection_lost(self, conn: SubConnection | intraprocess.IntraLink, retry: bool) -> None:
         """A stream ended (on the loop): forget it; if the publisher is still listed, try once more."""
         if self.connections.get(conn.uri) is conn:
             del self.connections[conn.uri]
@@ -408,13 +449,13 @@ class Subscription:
             delay = min(0.5 * 2**attempt, 30.0)
             self.node.runtime.loop.call_later(delay, self._retry, uri, attempt + 1)
 
-    def latched_frames(self) -> list[tuple[bytes | bytearray, Mapping[str, str]]]:
+    def latched_frames(self) -> list[tuple[Any, Mapping[str, str]]]:
         return [(c.last, c.header) for c in self.connections.values() if c.last is not None]
 
     def close(self) -> None:
         """On the loop: close every stream (the workers stop selecting closed sockets)."""
         self.closed = True
-        for conn in self.connections.values():
+        for conn in list(self.connections.values()):  # an in-process link forgets itself as it closes
             conn.close()
         self.connections.clear()
 
@@ -446,8 +487,11 @@ class Subscriber:
         share: Subscriber | None = None,
         lazy: float = 0.0,
         batch: bool = False,
+        intraprocess: bool = False,
     ) -> None:
         self._sub = subscription
+        #: an in-process publisher that opted in too hands this handle its message objects, shared
+        self.intraprocess = intraprocess
         #: seconds a message may wait so that one wake-up of the worker takes several (see Node.subscriber)
         self._coalesce = max(0.0, coalesce)
         self.name = subscription.topic
@@ -528,6 +572,31 @@ class Subscriber:
         """Frames read by another thread (the reader handle, or a latched replay)."""
         self._push(frames, header)
         self._wakeup()
+
+    def push_local(self, item: Handoff, header: Mapping[str, str], pub_queue_size: int | None) -> int:
+        """A message from a publisher of this process (its thread); returns how many it dropped.
+
+        This handle's own ``queue_size`` drops the oldest, as for a socket. An unbounded handle gets
+        the publisher's ``queue_size`` semantics instead, as over TCPROS: a bounded publisher drops
+        the oldest messages waiting for this lagging subscriber beyond its bound, and
+        ``queue_size=None`` makes the publisher wait (lossless, synchronous) while more than
+        :data:`_LOCAL_HIGH_WATER` wait, unless it publishes from this handle's own thread.
+        """
+        queue = self._queue
+        dropped = 0
+        if queue.maxlen is None and pub_queue_size != 0:
+            if pub_queue_size is not None:
+                while len(queue) >= pub_queue_size:
+                    try:
+                        queue.popleft()
+                    except IndexError:
+                        break
+                    dropped += 1
+            elif len(queue) >= _LOCAL_HIGH_WATER and threading.current_thread() is not self._host._thread:
+                while len(queue) > _LOCAL_LOW_WATER and not self._closed:
+                    time.sleep(_LOCAL_WAIT)
+        self.enqueue([item], header)  # type: ignore[list-item]
+        return dropped
 
     def _keep_newest(self, frames: list[bytes | bytearray], queued: int) -> list[bytes | bytearray]:
         """``queue_size`` semantics for ``frames`` arriving behind ``queued`` waiting ones: count what
@@ -780,11 +849,29 @@ class Subscriber:
             return None
 
     def _deliver(self, frame: bytes | bytearray, header: Mapping[str, str]) -> None:
+        if frame.__class__ is Handoff:
+            self._deliver_handoff(frame, header)
+            return
         if self._decode is None:
             msg: Any = RawMessage(frame, header)
         else:
             msg = self._decoded(frame, header)
             if msg is None:
+                return
+        self._call([msg] if self.batch else msg)
+
+    def _deliver_handoff(self, item: Handoff, header: Mapping[str, str]) -> None:
+        """A message from a publisher of this process: the object itself, a copy, or raw bytes."""
+        if self._decode is None:
+            msg: Any = RawMessage(bytes(item.body()), header)
+        else:
+            try:
+                msg = item.message_for(self.intraprocess, self.data_class)
+            except (
+                Exception
+            ) as exc:  # a publisher's object that does not serialize, or bytes that do not decode
+                _log.warning("topic %s: cannot take a message from %s in-process: %s",
+                             self.name, header.get("callerid", "?"), exc)  # fmt: skip
                 return
         self._call([msg] if self.batch else msg)
 

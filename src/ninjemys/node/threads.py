@@ -309,7 +309,9 @@ RESOURCES: tuple[Resource, ...] = (
              "the loop takes it to add a subscriber, so a latched frame is sent either latched or live"),
     Resource("queue", "ninjemys.node.subscriber:Subscriber._queue", "sub:<topic>",
              "the reader appends frames for other handles of the topic, the loop appends latched "
-             "replays (both through enqueue/post, then a wake-up); bounded by queue_size"),
+             "replays, an in-process publisher's thread appends its messages (and drops the oldest "
+             "beyond its queue_size for an unbounded handle); all through enqueue, then a wake-up; "
+             "bounded by queue_size"),
     Resource("lock", "ninjemys.node.subscriber:Subscriber._ops_lock", "sub:<topic>",
              "connection hand-offs (post) from the loop and enqueue from other threads"),
     Resource("lock", "ninjemys.node.subscriber:Subscriber._read_lock", "sub:<topic>",
@@ -353,6 +355,9 @@ RESOURCES: tuple[Resource, ...] = (
              "throttle/once state per call site"),
     Resource("event", "ninjemys.node.runtime:Runtime._ready", LOOP, "the starting thread waits for the loop"),
     Resource("lock", "ninjemys.node.runtime:_lock", "any thread", "the process's runtime and its user count"),
+    Resource("lock", "ninjemys.node.intraprocess:_nodes_lock", "any thread",
+             "the process's table of Nodes by slave URI: a Node adds itself at start and leaves at "
+             "shutdown; the loop looks a publisher up there before connecting (in-process delivery)"),
     Resource("lock", "ninjemys.net.loop:Loop._wake_lock", "any thread", "call_soon_threadsafe's wake-up pipe write"),
     Resource("queue", "ninjemys.net.loop:Loop._ready", LOOP,
              "other threads append only through call_soon_threadsafe (then a wake-up)"),

@@ -32,6 +32,7 @@ from collections.abc import Callable, Mapping
 from ninjemys.errors import SerializationError, ShutdownError
 from ninjemys.net import auth
 from ninjemys.node import transport
+from ninjemys.node.intraprocess import Handoff, IntraLink, is_local_node
 from ninjemys.wire import headers
 from ninjemys.wire.tcpros import pack_len
 
@@ -67,6 +68,13 @@ _SYNC_LOW_WATER_BYTES = 4 << 20
 _LARGE = 1 << 16
 #: A big frame in more pieces than this is joined before sending (sendmsg takes at most IOV_MAX).
 _MAX_PARTS = 64
+#: A bounded publisher in a burst whose subscriber lags (the kernel refused a batch) and lives in this
+#: same process sleeps this long once per refused batch, outside every lock: long enough (with the
+#: kernel's timer slack, ~50 us) for a thread waiting for the GIL to take it. Without it a flat-out
+#: publisher in the subscriber's own process holds the GIL between system calls too short for a
+#: waiter to win (a Unix socket's send is ~2 us; loopback TCP's ~10 us hid this), and the reader
+#: starved for tenths of a second. A subscriber in another process has its own GIL: no pause.
+_LAG_YIELD = 20e-6
 _clock = time.perf_counter
 
 
@@ -116,6 +124,14 @@ class PubConnection:
         self._since_try = 0  # publishes queued since this thread last tried to write
         self._armed = False  # the loop waits for the socket to become writable
         self._checking = False  # a check of the queue is scheduled on the loop
+        self._refused = False  # the kernel refused a burst's batch: the publisher yields once
+        #: the subscriber is a Node of this process (shares our GIL): yield to it when it lags
+        self._same_process = is_local_node(subscriber)
+
+    @property
+    def transport(self) -> str:
+        """The transport name getBusInfo reports (TCPROS or UNIXROS)."""
+        return transport.transport_of(self.sock)
 
     def send(self, data: bytes, queue_size: int | None) -> None:
         """Send ``data`` (one or more frames) to this subscriber; blocks only when ``queue_size`` is
@@ -145,6 +161,9 @@ class PubConnection:
                 must_wait = self._enqueue(data, queue_size, now)
         if must_wait:
             self._write_until_below(len(data) >= _LARGE)
+        elif self._refused:
+            self._refused = False
+            time.sleep(_LAG_YIELD)  # let the lagging reader's thread have the GIL (see _LAG_YIELD)
 
     def send_hello(self, reply: bytes, latched: list[bytes]) -> None:
         """The reply header and the latched frames, as a new subscriber first gets them."""
@@ -214,7 +233,8 @@ class PubConnection:
             # what the kernel refuses stays queued: this thread tries again a batch later, and the
             # loop's check takes over once the burst ends (handing it to the loop now would have two
             # threads contend for the GIL and this lock for the rest of the burst)
-            self._write_locked()
+            written = self._write_locked()
+            self._refused = self._same_process and not written and self._partial is not None
         if over and len(queue) > limit:
             self._trim(limit)
         if (queue or self._partial is not None) and not self._checking and not self._armed:
@@ -402,6 +422,8 @@ class Publication:
         self.md5sum: str = msg_class._md5sum
         self.definition: str = getattr(msg_class, "_full_text", "")
         self.connections: tuple[PubConnection, ...] = ()
+        #: in-process subscribers (see ninjemys.node.intraprocess); replaced whole, like connections
+        self.intra: tuple[IntraLink, ...] = ()
         self.handles: list[Publisher] = []
         self.lock = threading.Lock()
         self.bytes_sent_closed = 0
@@ -441,17 +463,18 @@ class Publication:
         conn, extra = shm_link.publisher_connection(self.node, sock, self.topic, who, header)
         with self.lock:
             reply = headers.encode_header(auth.sign_fields(self.reply_header(extra)))
-            frames = [h.latched for h in self.handles if h.latch and h.latched is not None]
+            frames = [f for f in (h.latched_frame() for h in self.handles if h.latch) if f is not None]
             conn.send_hello(reply, frames)
             conn.num_sent = 1 if frames else 0
             self.connections = (*self.connections, conn)
         conn.watch()
 
-    def publish_frame(self, data: bytes, handle: Publisher) -> None:
+    def publish_frame(self, data: bytes, handle: Publisher, item: Handoff | None = None) -> None:
         if handle.latch:
             # under the lock: a subscriber being accepted gets either this frame latched or live
             with self.lock:
                 handle.latched = data
+                handle.latched_item = item
                 conns = self.connections
         else:
             conns = self.connections  # a tuple, replaced whole when connections change
@@ -459,16 +482,51 @@ class Publication:
         for conn in conns:
             conn.send(data, queue_size)
 
-    def publish_parts(self, parts: list[Any], total: int, handle: Publisher) -> None:
+    def publish_parts(
+        self, parts: list[Any], total: int, handle: Publisher, item: Handoff | None = None
+    ) -> None:
         if handle.latch:
             with self.lock:
                 handle.latched = b"".join(parts)
+                handle.latched_item = item
                 conns = self.connections
         else:
             conns = self.connections
         queue_size = handle.queue_size
         for conn in conns:
             conn.send_parts(parts, total, queue_size)
+
+    def all_connections(self) -> list[PubConnection | IntraLink]:
+        """Socket and in-process subscribers (getBusInfo, getBusStats)."""
+        return [*self.connections, *self.intra]
+
+    def publish_intra(self, item: Handoff, handle: Publisher) -> None:
+        """Hand ``item`` to every in-process subscriber (the caller's thread, like a socket write)."""
+        if handle.latch:
+            with self.lock:
+                handle.latched_item = item
+                handle.latched = None  # serialized only if a socket subscriber comes for it
+                links = self.intra
+        else:
+            links = self.intra
+        queue_size = handle.queue_size
+        for link in links:
+            link.deliver(item, queue_size)
+
+    def add_intra(self, link: IntraLink) -> None:
+        """An in-process subscriber joined: it gets the latched messages first, as over a socket."""
+        with self.lock:
+            for h in self.handles:
+                if h.latch:
+                    item = h.latched_handoff()
+                    if item is not None:
+                        link.deliver(item)
+            self.intra = (*self.intra, link)
+
+    def remove_intra(self, link: IntraLink) -> None:
+        with self.lock:
+            if link in self.intra:
+                self.intra = tuple(c for c in self.intra if c is not link)
 
     def remove_connection(self, conn: PubConnection) -> None:
         with self.lock:
@@ -479,8 +537,11 @@ class Publication:
     def close(self) -> None:
         with self.lock:
             conns, self.connections = self.connections, ()
+            links = self.intra
         for conn in conns:
             conn.close()
+        for link in links:
+            link.close()
 
 
 class Publisher:
@@ -492,6 +553,7 @@ class Publisher:
         queue_size: int | None,
         latch: bool,
         headers: Mapping[str, str] | None,
+        intraprocess: bool = False,
     ) -> None:
         self._pub = publication
         self.name = publication.topic
@@ -503,6 +565,10 @@ class Publisher:
         self.latch = latch
         self.headers = dict(headers or {})
         self.latched: bytes | None = None
+        #: the latched message as in-process subscribers get it (with or instead of ``latched``)
+        self.latched_item: Handoff | None = None
+        #: in-process subscribers that opted in too get the published object itself (never changed after)
+        self.intraprocess = intraprocess
         self._has_header = bool(getattr(publication.msg_class, "_has_header", False))
         self._seq = 0
         self._closed = False
@@ -514,17 +580,55 @@ class Publisher:
         if self._has_header:
             self._seq += 1  # rospy counts from 1
             msg.header.seq = self._seq
+        pub = self._pub
+        if pub.intra:
+            # the object itself for a publisher that opted in; else (or for socket subscribers too)
+            # the bytes, serialized once for everyone
+            frame = self._frame(msg) if pub.connections or not self.intraprocess else None
+            body = None if frame is None else memoryview(frame)[4:]
+            handoff = Handoff(msg if self.intraprocess else None, body)
+            pub.publish_intra(handoff, self)
+            if pub.connections:
+                pub.publish_frame(self._frame(msg) if frame is None else frame, self, handoff)
+            return
+        # a latched object an in-process subscriber that comes later may share
+        item = Handoff(msg) if self.latch and self.intraprocess else None
         try:
             total, parts = msg.frame_parts()
         except AttributeError:
             if hasattr(msg, "frame_parts"):
                 raise
-            self._pub.publish_frame(self._frame_other(msg), self)
+            self._pub.publish_frame(self._frame_other(msg), self, item)
             return
         if total >= _LARGE and len(parts) <= _MAX_PARTS:
-            self._pub.publish_parts(parts, total, self)
+            self._pub.publish_parts(parts, total, self, item)
         else:
-            self._pub.publish_frame(b"".join(parts), self)
+            self._pub.publish_frame(b"".join(parts), self, item)
+
+    def _frame(self, msg: Any) -> bytes:
+        """``msg``'s whole TCPROS frame in one buffer."""
+        try:
+            _, parts = msg.frame_parts()
+        except AttributeError:
+            if hasattr(msg, "frame_parts"):
+                raise
+            return self._frame_other(msg)
+        return b"".join(parts)
+
+    def latched_frame(self) -> bytes | None:
+        """The latched message as a socket subscriber gets it (serialized now if only in-process
+        subscribers had it so far)."""
+        if self.latched is None and self.latched_item is not None:
+            self.latched = self.latched_item.frame()
+        return self.latched
+
+    def latched_handoff(self) -> Handoff | None:
+        """The latched message as an in-process subscriber gets it."""
+        if self.latched_item is not None:
+            return self.latched_item
+        if self.latched is not None:
+            return Handoff(None, memoryview(self.latched)[4:])
+        return None
 
     def _frame_other(self, msg: Any) -> bytes:
         """A message class outside the generated ones that has only ``serialize_to_bytes`` (the
@@ -540,14 +644,21 @@ class Publisher:
         """Send already-serialized bytes (relays, bag play, AnyMsg)."""
         if self._closed:
             raise ShutdownError(f"publisher of {self.name} is unregistered")
-        self._pub.publish_frame(pack_len(len(payload)) + bytes(payload), self)
+        frame = pack_len(len(payload)) + bytes(payload)
+        if self._pub.intra:
+            item = Handoff(None, memoryview(frame)[4:])
+            self._pub.publish_intra(item, self)
+            self._pub.publish_frame(frame, self, item)
+            return
+        self._pub.publish_frame(frame, self)
 
     def get_num_connections(self) -> int:
-        return len(self._pub.connections)
+        return len(self._pub.connections) + len(self._pub.intra)
 
     def subscriber_ids(self) -> frozenset[str]:
         """Caller ids of the subscribers connected now (handshake done: what is published reaches them)."""
-        return frozenset(c.subscriber for c in self._pub.connections if not c.closed)
+        conns: tuple[Any, ...] = (*self._pub.connections, *self._pub.intra)
+        return frozenset(c.subscriber for c in conns if not c.closed)
 
     def unregister(self) -> None:
         """Stop publishing; the last handle of a topic unregisters it from the master."""

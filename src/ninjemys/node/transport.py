@@ -1,6 +1,6 @@
 """Socket plumbing shared by topics and services: header exchange and the node's TCPROS server.
 
-With ``NINJEMYS_UNIXROS=1``, between processes on one host the same TCPROS streams run over a
+Between processes on one host (unless ``NINJEMYS_UNIXROS=0``) the same TCPROS streams run over a
 Unix-domain socket (``UNIXROS``):
 the node's server also listens on the abstract name ``@ninjemys-tcpros-<port>`` (Linux; abstract
 names vanish with the socket, so a crashed node leaves nothing behind). Subscribers ask for it in
@@ -43,11 +43,11 @@ _identity: str | None = None
 
 
 def local_transport_enabled() -> bool:
-    """Unix-domain sockets between processes of one host: Linux (abstract names), when
-    ``NINJEMYS_UNIXROS=1`` asks for them. Opt-in for now: under a flat-out publisher a second
-    subscriber handle was seen to stall once and such runs took 2-3x longer than over TCP, while the
-    gain measured at the node level was within noise (README, UNIXROS row)."""
-    return sys.platform.startswith("linux") and os.environ.get("NINJEMYS_UNIXROS", "0") == "1"
+    """Unix-domain sockets between processes of one host: Linux (abstract names), unless
+    ``NINJEMYS_UNIXROS=0`` asks for TCP everywhere (to compare, or to debug with tcpdump). (It was
+    opt-in while a flat-out publisher could starve a subscriber of its own process over it: see
+    ``topics._LAG_YIELD``.)"""
+    return sys.platform.startswith("linux") and os.environ.get("NINJEMYS_UNIXROS", "1") != "0"
 
 
 def host_identity() -> str:
@@ -77,12 +77,6 @@ def unix_sockaddr(address: str) -> str | bytes:
 
 def transport_of(sock: socket.socket) -> str:
     return UNIXROS if sock.family == socket.AF_UNIX else TCPROS
-
-
-def transport_name(conn: Any) -> str:
-    """What getBusInfo reports for a topic connection: its class's ``transport_name`` (SHMROS) or
-    the socket's family (TCPROS/UNIXROS)."""
-    return getattr(conn, "transport_name", None) or transport_of(conn.sock)
 
 
 def tune(sock: socket.socket, nodelay: bool = True) -> None:

@@ -81,7 +81,7 @@ def _pose_function(joint: Joint) -> Callable[[float], Pose]:
 
         return revolute
     if joint.type == "prismatic":
-        dx, dy, dz = _apply(joint.rotation, joint.axis)
+        dx, dy, dz = apply_rotation(joint.rotation, joint.axis)
         rotation = (ox, oy, oz, ow)
 
         def prismatic(position: float) -> Pose:
@@ -236,7 +236,8 @@ def _matmul(a: Matrix, b: Matrix) -> Matrix:
     )
 
 
-def _apply(m: Matrix, v: Vector) -> Vector:
+def apply_rotation(m: Matrix, v: Vector) -> Vector:
+    """``m · v``."""
     return (
         m[0][0] * v[0] + m[0][1] * v[1] + m[0][2] * v[2],
         m[1][0] * v[0] + m[1][1] * v[1] + m[1][2] * v[2],

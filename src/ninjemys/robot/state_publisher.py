@@ -24,6 +24,7 @@ from ninjemys.errors import NinjemysError
 from ninjemys.idl.loader import get_message_class
 from ninjemys.node.run import run_node
 from ninjemys.robot.kinematics import Joint, Pose, RobotModel, URDFError, parse_urdf
+from ninjemys.robot.tf_plan import TfPlan
 from ninjemys.rostime import Duration, Time
 
 
@@ -62,6 +63,9 @@ class StatePublisher:
         self.tf_static = node.publisher("/tf_static", self.TFMessage, queue_size=100, latch=True)
         JointState = get_message_class("sensor_msgs/JointState")
         self.names_cache: dict[bytes, tuple[str, ...]] = {}
+        self.plans: dict[bytes, _Entry] = {}
+        self.last_entry: _Entry | None = None
+        self.streak: tuple[_Entry, int] | None = None  # (list of names, its joints' last stamp)
         self.sub = node.subscriber("joint_states", JointState, self.on_raw, queue_size=100, raw=True)
 
     def start(self) -> None:
@@ -76,34 +80,125 @@ class StatePublisher:
         self.tf.publish_raw(self._message(self.model.fixed, {}, stamp))
 
     def on_raw(self, raw: Any) -> None:
-        """A JointState as bytes: only the stamp, the names and the positions are read (the names,
-        the same in every message of a stream, are decoded once per distinct list)."""
+        """A JointState as bytes: only the stamp, the names and the positions are read.
+
+        The names are the same in every message of a stream: each distinct list is decoded once, and
+        with it a :class:`TfPlan` is made that turns the positions into the TFMessage's bytes. The list
+        of the previous message is recognised by comparing its bytes where the names start, so a steady
+        stream costs no walk through the names either."""
+        data = raw.data
         try:
-            secs, nsecs, names, positions = self._parse(raw.data)
-        except (struct.error, UnicodeDecodeError, IndexError):
+            _seq, secs, nsecs, frame_len = _HEADER.unpack_from(data, 0)
+            start = 16 + frame_len
+            entry = self.last_entry
+            if entry is None or data[start : start + entry.size] != entry.key:
+                key, count = self._names_section(data, start)
+                entry = self.plans.get(key)
+                if entry is None:
+                    self._general(data, secs, nsecs, key, count, start + len(key))
+                    return
+                self.last_entry = entry
+            if not entry.fits(data, start):  # another number of positions: the general path says why
+                self._general(data, secs, nsecs, entry.key, entry.count, start + entry.size)
+                return
+            found = entry.positions.unpack_from(data, start + entry.size)  # the count, then positions
+        except (struct.error, UnicodeDecodeError, IndexError, ValueError):
             self.warn("Robot state publisher ignored a malformed JointState message")
             return
-        self.on_joint_state(names, positions, secs, nsecs)
+        if self._admit(entry, secs * 1_000_000_000 + nsecs) and entry.plan.count:
+            self.tf.publish_raw(entry.plan.message(found[1:], secs, nsecs))
 
-    def _parse(self, data: bytes | bytearray) -> tuple[int, int, tuple[str, ...], tuple[float, ...]]:
-        _seq, secs, nsecs, frame_len = _HEADER.unpack_from(data, 0)
-        start = 16 + frame_len
+    def _general(self, data: Any, secs: int, nsecs: int, key: bytes, count: int, offset: int) -> None:
+        """A list of names without a plan yet (or positions that do not match it): decoded in full."""
+        try:
+            names = self.names_cache.get(key) or _names(key, count)
+            (n,) = _COUNT.unpack_from(data, offset)
+            if offset + 4 + 8 * n > len(data):
+                raise struct.error("positions run past the end")
+            values = struct.unpack_from(f"<{n}d", data, offset + 4)
+        except (struct.error, UnicodeDecodeError, IndexError, ValueError):
+            self.warn("Robot state publisher ignored a malformed JointState message")
+            return
+        if len(self.names_cache) < 64:
+            self.names_cache[key] = names
+        self.on_joint_state(names, values, secs, nsecs)
+        if key not in self.plans and len(names) == n and len(set(names)) == n and len(self.plans) < 64:
+            plan = TfPlan(names, self.model.joints, self.mimics, self._frames)
+            self.plans[key] = self.last_entry = _Entry(key, n, plan)
+
+    def _frames(self, joint: Joint) -> bytes:
+        return self.encoded[joint.name].frames
+
+    @staticmethod
+    def _names_section(data: Any, start: int) -> tuple[bytes, int]:
+        """The bytes of the names array (its count and every name: a plan's key) and the name count."""
         (count,) = _COUNT.unpack_from(data, start)
         offset = start + 4
         for _ in range(count):
             (length,) = _COUNT.unpack_from(data, offset)
             offset += 4 + length
-        key = bytes(data[start:offset])
-        names = self.names_cache.get(key)
-        if names is None:
-            names = _names(key, count)
-            if len(self.names_cache) < 64:
-                self.names_cache[key] = names
-        (n,) = _COUNT.unpack_from(data, offset)
-        if offset + 4 + 8 * n > len(data):
-            raise struct.error("positions run past the end")
-        positions = struct.unpack_from(f"<{n}d", data, offset + 4)
-        return secs, nsecs, names, positions
+        if offset > len(data):
+            raise struct.error("names run past the end")
+        return bytes(data[start:offset]), count
+
+    def _admit(self, entry: _Entry, now_ns: int) -> bool:
+        """ROS 1's throttle: publish unless every joint named was published less than one interval ago
+        (``ignore_timestamp`` publishes all); a stamp older than the last one clears the record.
+
+        While one list of names follows itself, the record of its joints is one number (the streak)
+        instead of a stamp per joint; another list (or the general path) writes it out first."""
+        with self.lock:
+            if now_ns < self.last_stamp_ns:
+                self.warn(
+                    "Moved backwards in time (probably because ROS clock was reset), re-publishing joint transforms!"
+                )
+                self.last_published.clear()
+                self.streak = None
+            self.last_stamp_ns = now_ns
+            known = entry.known
+            if not known:
+                return False
+            streak = self.streak
+            if streak is not None and streak[0] is entry:
+                if not self.ignore_timestamp and now_ns <= streak[1] + self.interval_ns:
+                    return False
+                self.streak = (entry, now_ns)
+                return True
+            self._flush_streak()
+            last = self.last_published
+            if (
+                not self.ignore_timestamp
+                and now_ns <= min(map(last.get, known, entry.zeros)) + self.interval_ns
+            ):
+                return False
+            self.streak = (entry, now_ns)
+            return True
+
+    def _admit_names(self, known: list[str], now_ns: int) -> bool:
+        """:meth:`_admit` for a list of names without a plan (a stamp per joint)."""
+        with self.lock:
+            if now_ns < self.last_stamp_ns:
+                self.warn(
+                    "Moved backwards in time (probably because ROS clock was reset), re-publishing joint transforms!"
+                )
+                self.last_published.clear()
+                self.streak = None
+            self.last_stamp_ns = now_ns
+            if not known:
+                return False
+            self._flush_streak()
+            last = self.last_published
+            if not self.ignore_timestamp and now_ns <= min(last.get(n, 0) for n in known) + self.interval_ns:
+                return False
+            last.update(dict.fromkeys(known, now_ns))
+            return True
+
+    def _flush_streak(self) -> None:
+        """Write the streak's stamp to each of its joints (under the lock)."""
+        if self.streak is not None:
+            entry, stamp = self.streak
+            self.last_published.update(dict.fromkeys(entry.known, stamp))
+            self.streak = None
 
     def on_joint_state(
         self, names: tuple[str, ...], positions: tuple[float, ...], secs: int, nsecs: int
@@ -126,21 +221,8 @@ class StatePublisher:
                 self.warn(
                     f"joint_states names joint(s) the robot does not have, ignored: {', '.join(sorted(unknown))}"
                 )
-        now_ns = secs * 1_000_000_000 + nsecs
-        with self.lock:
-            if now_ns < self.last_stamp_ns:
-                self.warn(
-                    "Moved backwards in time (probably because ROS clock was reset), re-publishing joint transforms!"
-                )
-                self.last_published.clear()
-            self.last_stamp_ns = now_ns
-            if not known:
-                return
-            last = self.last_published
-            if not self.ignore_timestamp and now_ns <= min(last.get(n, 0) for n in known) + self.interval_ns:
-                return
-            for name in known:
-                last[name] = now_ns
+        if not self._admit_names(known, secs * 1_000_000_000 + nsecs):
+            return
         values = {n: p for n, p in zip(names, positions, strict=True) if n in joints}
         moving = [joints[n] for n in values if joints[n].type in _MOVING]
         mimics = self.mimics
@@ -167,6 +249,24 @@ _COUNT = struct.Struct("<I")
 _HEADER = struct.Struct("<4I")  # seq, stamp secs, stamp nsecs, frame_id length
 _STAMP = struct.Struct("<3I")
 _POSE = struct.Struct("<7d")
+
+
+class _Entry:
+    """A list of names seen before: its bytes, the joints of it the robot has, its plan, and the
+    precompiled unpacking of the position count and positions that follow it."""
+
+    __slots__ = ("count", "key", "known", "plan", "positions", "size", "zeros")
+
+    def __init__(self, key: bytes, count: int, plan: TfPlan) -> None:
+        self.key, self.size, self.count, self.plan = key, len(key), count, plan
+        self.known = plan.known
+        self.zeros = [0] * len(self.known)
+        self.positions = struct.Struct(f"<I{count}d")
+
+    def fits(self, data: Any, start: int) -> bool:
+        """The message has as many positions as names (and the bytes for them)."""
+        offset = start + self.size
+        return offset + self.positions.size <= len(data) and _COUNT.unpack_from(data, offset)[0] == self.count
 
 
 def _names(section: bytes, count: int) -> tuple[str, ...]:

@@ -1,0 +1,165 @@
+"""robot_state_publisher's fast path (a TfPlan per list of names, the previous list recognised by its
+bytes, the throttle's streak) publishes what the general path publishes, message for message: the same
+transforms in the same order to 1e-12, the same throttling, across lists that alternate, unknown
+joints, a mimic joint, prismatic joints, a clock that moves backwards and malformed messages."""
+
+from __future__ import annotations
+
+import io
+import math
+import struct
+from typing import Any
+
+import pytest
+
+from ninjemys.idl.loader import get_message_class
+from ninjemys.robot.kinematics import parse_urdf
+from ninjemys.robot.state_publisher import StatePublisher
+from ninjemys.robot.tf_plan import TfPlan
+from ninjemys.rostime import Time
+
+from .test_state_publisher import ARM, MOVING
+
+JointState = get_message_class("sensor_msgs/JointState")
+TFMessage = get_message_class("tf2_msgs/TFMessage")
+
+
+class _Pub:
+    def __init__(self) -> None:
+        self.sent: list[bytes] = []
+
+    def publish_raw(self, data: bytes) -> None:
+        self.sent.append(bytes(data))
+
+
+class _Node:
+    def __init__(self, params: dict[str, Any]) -> None:
+        self.params = params
+
+    def get_param(self, key: str, default: Any = None) -> Any:
+        return self.params.get(key, default)
+
+    def search_param(self, key: str) -> str | None:
+        return None
+
+    def publisher(self, *args: Any, **kwargs: Any) -> _Pub:
+        return _Pub()
+
+    def subscriber(self, *args: Any, **kwargs: Any) -> None:
+        return None
+
+    def now(self) -> Time:
+        return Time(1, 0)
+
+
+class _Raw:
+    def __init__(self, data: bytes) -> None:
+        self.data = data
+
+
+def _publisher(params: dict[str, Any]) -> tuple[StatePublisher, list[str]]:
+    warnings: list[str] = []
+    return StatePublisher(_Node(params), parse_urdf(ARM), warnings.append), warnings
+
+
+def _stream() -> list[tuple[list[str], list[float], int, int]]:
+    """(names, positions, secs, nsecs): two alternating lists (one naming an unknown joint), messages
+    closer than the 50 Hz throttle, a reordered list, a clock reset, a list that names only the mimic
+    leader, and the first list again."""
+    out = []
+    for k in range(40):
+        names = MOVING + (["not_a_joint"] if k % 3 == 1 else [])
+        positions = [0.37 * k - 1.1 * i for i in range(len(MOVING))] + ([5.0] if k % 3 == 1 else [])
+        out.append((names, positions, 100 + k // 4, (k % 4) * 7_000_000))  # 7 ms apart within a second
+    out.append((list(reversed(MOVING)), [0.2 * i for i in range(len(MOVING))], 200, 0))
+    out.append((MOVING, [1.0] * len(MOVING), 50, 0))  # backwards: everything republished
+    out.append((["finger_l_joint"], [0.03], 60, 0))
+    out.append((["j3", "finger_l_joint"], [2.0, 0.01], 60, 5_000_000))
+    out += [(MOVING, [0.1 * k] * len(MOVING), 61 + k, 0) for k in range(3)]
+    return out
+
+
+def _encode(names: list[str], positions: list[float], secs: int, nsecs: int) -> bytes:
+    msg = JointState(name=names, position=positions)
+    msg.header.stamp = Time(secs, nsecs)
+    buf = io.BytesIO()
+    msg.serialize(buf)
+    return buf.getvalue()
+
+
+def _transforms(data: bytes) -> list[tuple[str, str, int, int, tuple[float, ...]]]:
+    msg = TFMessage().deserialize(data)
+    out = []
+    for t in msg.transforms:
+        r, q = t.transform.translation, t.transform.rotation
+        pose = (r.x, r.y, r.z, q.x, q.y, q.z, q.w)
+        out.append((t.header.frame_id, t.child_frame_id, t.header.stamp.secs, t.header.stamp.nsecs, pose))
+    return out
+
+
+@pytest.mark.parametrize("ignore_timestamp", [False, True])
+def test_the_fast_path_publishes_what_the_general_path_publishes(ignore_timestamp: bool) -> None:
+    params = {"~ignore_timestamp": ignore_timestamp}
+    fast, fast_warnings = _publisher(params)
+    general, general_warnings = _publisher(params)
+    for names, positions, secs, nsecs in _stream():
+        fast.on_raw(_Raw(_encode(names, positions, secs, nsecs)))
+        general.on_joint_state(tuple(names), tuple(positions), secs, nsecs)
+    assert fast.plans  # the stream went through plans
+    sent, expected = fast.tf.sent, general.tf.sent
+    assert len(sent) == len(expected) and len(sent) > 10
+    for ours, theirs in zip(sent, expected, strict=True):
+        a, b = _transforms(ours), _transforms(theirs)
+        assert [t[:4] for t in a] == [t[:4] for t in b]
+        for ta, tb in zip(a, b, strict=True):
+            assert max(abs(x - y) for x, y in zip(ta[4], tb[4], strict=True)) < 1e-12, ta[1]
+    assert fast_warnings == general_warnings
+    assert sum("not_a_joint" in w for w in fast_warnings) == 1
+    assert sum("Moved backwards in time" in w for w in fast_warnings) == 1
+
+
+def test_plan_of_a_mimic_and_a_prismatic_joint_in_closed_form() -> None:
+    model = parse_urdf(ARM)
+    mimics = {"finger_l_joint": [model.joints["finger_r_joint"]]}
+    plan = TfPlan(["finger_l_joint", "j1"], model.joints, mimics, lambda joint: b"")
+    assert plan.count == 3 and plan.known == ["finger_l_joint", "j1"]
+    values = struct.unpack("<I" + "III0s7d" * 3, plan.message((0.009, math.pi / 2), 7, 8))
+    rows = [values[1 + 11 * i : 12 + 11 * i] for i in range(3)]
+    # finger_l slides along y from y = 0.02; j1 turns about z from yaw 0.3; finger_r mimics -x + 0.001
+    assert rows[0][:3] == (0, 7, 8) and rows[0][4:7] == pytest.approx((0.0, 0.029, 0.05))
+    half = (0.3 + math.pi / 2) / 2
+    assert rows[1][4:] == pytest.approx((0, 0, 0.1, 0, 0, math.sin(half), math.cos(half)), abs=1e-12)
+    assert rows[2][4:7] == pytest.approx((0.0, -0.02 - 0.009 + 0.001, 0.05))
+
+
+def test_malformed_messages_are_ignored_with_one_line_each() -> None:
+    fast, warnings = _publisher({})
+    good = _encode(MOVING, [0.1] * len(MOVING), 10, 0)
+    fast.on_raw(_Raw(good))
+    fast.on_raw(_Raw(good[:-9]))  # the same names, positions cut short
+    fast.on_raw(_Raw(good[:30]))  # cut inside the names
+    assert len(fast.tf.sent) == 1
+    assert warnings == ["Robot state publisher ignored a malformed JointState message"] * 2
+
+
+def test_a_floating_mimic_joint_stays_at_its_origin_as_on_the_general_path() -> None:
+    urdf = ARM.replace(
+        "</robot>",
+        '<link name="float"/><joint name="f" type="floating"><parent link="hand"/><child link="float"/>'
+        '<origin xyz="0.1 0.2 0.3" rpy="0.3 0.2 0.1"/><mimic joint="j1" multiplier="2"/></joint></robot>',
+    )
+    fast, _ = _publisher({})
+    general, _ = _publisher({})
+    fast.model = general.model = parse_urdf(urdf)
+    for sp in (fast, general):
+        sp.mimics = {"j1": [sp.model.joints["f"]]}
+        sp.encoded = {n: type(sp.encoded["j1"])(j, "") for n, j in sp.model.joints.items()}
+    for k in range(3):
+        fast.on_raw(_Raw(_encode(["j1"], [0.5 * k], 10 + k, 0)))
+        general.on_joint_state(("j1",), (0.5 * k,), 10 + k, 0)
+    assert len(fast.tf.sent) == 3
+    for ours, theirs in zip(fast.tf.sent, general.tf.sent, strict=True):
+        a, b = _transforms(ours), _transforms(theirs)
+        assert [t[:4] for t in a] == [t[:4] for t in b] and a[1][1] == "float"
+        for ta, tb in zip(a, b, strict=True):
+            assert max(abs(x - y) for x, y in zip(ta[4], tb[4], strict=True)) < 1e-12
