@@ -77,6 +77,7 @@ def test_a_burst_arrives_whole_and_in_order_after_the_publisher_stops(make_node)
 
 
 def test_big_frames_go_out_in_pieces_and_arrive_intact(make_node, monkeypatch) -> None:
+    monkeypatch.setenv("NINJEMYS_SHM", "0")  # the TCPROS path (SHMROS: tests/node/test_shm.py)
     sent_with_sendmsg: list[int] = []
     original = topics.PubConnection.send_parts
 

@@ -22,6 +22,7 @@ pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="UN
 def unixros_on(monkeypatch) -> None:  # noqa: ANN001
     """UNIXROS is the default: these tests run without NINJEMYS_UNIXROS, whatever the caller set."""
     monkeypatch.delenv("NINJEMYS_UNIXROS", raising=False)
+    monkeypatch.setenv("NINJEMYS_SHM", "0")  # SHMROS is offered before UNIXROS (tests/node/test_shm.py)
 
 
 Image = get_message_class("sensor_msgs/Image")

@@ -11,7 +11,7 @@ from __future__ import annotations
 import logging
 import os
 
-from ninjemys.node import transport
+from ninjemys.node import shm_link, transport
 from ninjemys.wire import xmlrpc as wire
 
 TYPE_CHECKING = False  # importing typing costs ~7 ms of every node's start-up; checkers set it
@@ -98,6 +98,11 @@ class SlaveApi:
             if not isinstance(proto, list) or not proto:
                 continue
             unix = self._node.unix_address
+            if shm_link.grants(proto):  # SHMROS: large messages through shared memory (shm_link)
+                if unix:  # the notices and small messages go over the Unix socket
+                    return wire.ok(f"ready on {unix}", [shm_link.SHMROS, unix])
+                host, port = self._node.tcpros_host, self._node.tcpros_port
+                return wire.ok(f"ready on {host}:{port}", [shm_link.SHMROS, host, port])
             if proto[0] == transport.UNIXROS and unix and proto[1:2] == [transport.host_identity()]:
                 return wire.ok(f"ready on {unix}", [transport.UNIXROS, unix])
             if proto[0] == "TCPROS":

@@ -254,6 +254,27 @@ class SubConnection:
         transport.close_quietly(self.sock)
 
 
+def shm_offer() -> list[str] | None:
+    """The SHMROS offer, or None (imported on first use: shm_link builds on this module)."""
+    from ninjemys.node import shm_link
+
+    return shm_link.offer()
+
+
+def _connection(sub: Subscription, sock: socket.socket, uri: str, header: Mapping[str, str]) -> SubConnection:
+    """SHMROS when the publisher's reply names a ring, else TCPROS/UNIXROS. A ring that cannot be
+    mapped marks the publisher TCPROS-only and raises (the caller retries)."""
+    if "ninjemys_shm" not in header:
+        return SubConnection(sub, sock, uri, header)
+    from ninjemys.node import shm_link
+
+    try:
+        return shm_link.subscriber_connection(sub, sock, uri, header)
+    except NinjemysError:
+        sub.shm_refused.add(uri)
+        raise
+
+
 class Subscription:
     """A topic this node subscribes to: the publisher connections and the handles fed by them."""
 
@@ -269,6 +290,8 @@ class Subscription:
         self.connections: dict[str, SubConnection | intraprocess.IntraLink] = {}
         self.publishers: list[str] = []
         self._connecting: set[str] = set()
+        #: publishers whose shared memory failed here: TCPROS only from then on
+        self.shm_refused: set[str] = set()
         self.closed = False
 
     # -- publisher set (on the loop) -------------------------------------------------------------
@@ -329,15 +352,18 @@ class Subscription:
             lazy = any(h._host._lazy for h in self.handles)
             if transport.local_transport_enabled() and transport.host_identity() and not lazy:
                 offer.insert(0, [transport.UNIXROS, transport.host_identity()])
+            shm = None if uri in self.shm_refused else shm_offer()
+            if shm is not None:
+                offer.insert(0, shm)
             reply = await xmlrpc_client.call(
                 uri, "requestTopic", (self.node.name, self.topic, offer), timeout=5.0
             )
             code, status, proto = reply
-            if code != 1 or not proto or proto[0] not in ("TCPROS", transport.UNIXROS):
+            if code != 1 or not proto or proto[0] not in ("TCPROS", transport.UNIXROS, "SHMROS"):
                 _log.info("topic %s: publisher %s declined: %s", self.topic, uri, status)
                 self._retry_later(uri, attempt)
                 return
-            if proto[0] == transport.UNIXROS:
+            if proto[0] == transport.UNIXROS or (proto[0] == "SHMROS" and len(proto) == 2):  # a Unix socket
                 sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
                 address: Any = transport.unix_sockaddr(str(proto[1]))
             else:
@@ -345,7 +371,10 @@ class Subscription:
                 address = (proto[1], int(proto[2]))
             transport.tune(sock, self.tcp_nodelay)
             await transport.connect(sock, address, timeout=5.0)
-            await transport.write_all(sock, headers.encode_header(self._header()))
+            fields = self._header()
+            if proto[0] == "SHMROS":
+                fields["ninjemys_shm"] = transport.host_identity()
+            await transport.write_all(sock, headers.encode_header(fields))
             header = await transport.read_header(sock)
             refused = auth.check_fields(header)
             error = (
@@ -360,7 +389,7 @@ class Subscription:
             if self.closed or uri not in self.publishers:
                 transport.close_quietly(sock)
                 return
-            conn = SubConnection(self, sock, uri, header)
+            conn = _connection(self, sock, uri, header)
             old = self.connections.pop(uri, None)
             if old is not None:
                 self._drop(old)

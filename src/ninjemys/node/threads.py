@@ -306,6 +306,15 @@ RESOURCES: tuple[Resource, ...] = (
              "the loop takes it to drain or close; serializes writes to the stream"),
     Resource("queue", "ninjemys.node.topics:PubConnection._queue", USER + " (publishing)",
              "frames of a burst and frames the kernel refused; only the refused are bounded by queue_size; drained by the loop, under _lock"),
+    Resource("lock", "ninjemys.node.shm_ring:WriterRing._lock", USER + " (publishing)",
+             "serializes slot choice, copy and stamp of one SHMROS ring; the loop takes it to close "
+             "the ring when the connection ends"),
+    Resource("lock", "ninjemys.node.shm_link:ShmPubConnection._ring_lock", USER + " (publishing)",
+             "makes and announces the connection's ring once, with the first large message; the loop "
+             "takes it to close the ring when the connection ends"),
+    Resource("shared memory", "SHMROS ring slots (node.shm_ring)", USER + " (publishing)",
+             "the publisher writes a slot and its generation word, the subscriber only the released "
+             "word, from whichever thread drops the last view (no lock across processes)"),
     Resource("lock", "ninjemys.node.topics:Publication.lock", USER + " (publishing)",
              "the loop takes it to add a subscriber, so a latched frame is sent either latched or live"),
     Resource("queue", "ninjemys.node.subscriber:Subscriber._queue", "sub:<topic>",

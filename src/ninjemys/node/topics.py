@@ -165,6 +165,10 @@ class PubConnection:
             self._refused = False
             time.sleep(_LAG_YIELD)  # let the lagging reader's thread have the GIL (see _LAG_YIELD)
 
+    def send_hello(self, reply: bytes, latched: list[bytes]) -> None:
+        """The reply header and the latched frames, as a new subscriber first gets them."""
+        self.send(reply + b"".join(latched), queue_size=0)
+
     def send_parts(self, parts: list[Any], total: int, queue_size: int | None) -> None:
         """Like :meth:`send` for a big frame still in pieces (see ``Message.frame_parts``): an idle
         connection gets them in one ``sendmsg``, so the payload is never copied in Python."""
@@ -454,14 +458,14 @@ class Publication:
         # option is ours and leaves the bytes on the wire unchanged
         if sock.family != socket.AF_UNIX:
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        conn = PubConnection(self.node, sock, self.topic, who)
+        from ninjemys.node import shm_link  # SHMROS when asked for (it builds on this module)
+
+        conn, extra = shm_link.publisher_connection(self.node, sock, self.topic, who, header)
         with self.lock:
-            reply = headers.encode_header(auth.sign_fields(self.reply_header({})))
-            latched = b"".join(
-                f for f in (h.latched_frame() for h in self.handles if h.latch) if f is not None
-            )
-            conn.send(reply + latched, queue_size=0)
-            conn.num_sent = 1 if latched else 0
+            reply = headers.encode_header(auth.sign_fields(self.reply_header(extra)))
+            frames = [f for f in (h.latched_frame() for h in self.handles if h.latch) if f is not None]
+            conn.send_hello(reply, frames)
+            conn.num_sent = 1 if frames else 0
             self.connections = (*self.connections, conn)
         conn.watch()
 
