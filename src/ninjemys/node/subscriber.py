@@ -348,11 +348,12 @@ class Subscription:
             if self._connect_intra(uri):
                 return
             offer: list[list[str]] = [["TCPROS"]]
-            # a lazy handle waits on SO_RCVLOWAT, which Linux honours for TCP only: it keeps TCPROS
+            # a lazy handle waits on SO_RCVLOWAT, which Linux honours for TCP only, and reads plain
+            # frames: it keeps TCPROS (neither a Unix socket nor shared memory)
             lazy = any(h._host._lazy for h in self.handles)
             if transport.local_transport_enabled() and transport.host_identity() and not lazy:
                 offer.insert(0, [transport.UNIXROS, transport.host_identity()])
-            shm = None if uri in self.shm_refused else shm_offer()
+            shm = None if lazy or uri in self.shm_refused else shm_offer()
             if shm is not None:
                 offer.insert(0, shm)
             reply = await xmlrpc_client.call(
