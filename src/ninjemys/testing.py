@@ -123,7 +123,8 @@ def wait_for_master(
     """Return once the master at ``uri`` answers ``getSystemState`` (and ``ready(state)`` holds, e.g. a
     topic is registered). Raises :class:`WaitTimeout` naming ``what`` when ``proc`` (the master's process,
     if the caller started it) exits first or ``timeout`` seconds pass: one wait for every kind of master
-    a test starts (ours, Debian's rosmaster or roscore)."""
+    a test starts (ours, Debian's rosmaster or roscore). A master started with a secret this process
+    does not hold is up once it refuses the call for that reason."""
     from ninjemys.net import auth
 
     deadline = time.monotonic() + timeout
@@ -135,6 +136,8 @@ def wait_for_master(
             answered = True
             if reply[0] == 1 and (ready is None or ready(reply[2])):
                 return
+            if ready is None and reply[0] == -1 and "authentication failed" in str(reply[1]):
+                return  # up, but started with a secret this process does not hold: a refusal is its answer
         except OSError:
             pass
         if proc is not None and proc.poll() is not None:

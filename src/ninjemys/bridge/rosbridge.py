@@ -509,7 +509,7 @@ class RosbridgeSession:
                 self.gateway.publishers.unadvertise(topic, self)
             self._advertised.clear()
             for server in list(self._services.values()):
-                server.shutdown()
+                server.shutdown(grace=1.0)  # the abandoned calls answer "went away" first
             self._services.clear()
 
         self._worker.submit(cleanup)

@@ -250,6 +250,8 @@ class ServiceServer:
         self.response_class = service_class._response_class
         self.handler = handler
         self._socks: set[socket.socket] = set()
+        #: connections inside a call (request read, reply not yet sent): shutdown(grace) waits for them
+        self._busy: set[socket.socket] = set()
         self._lock = threading.Lock()
         self._closed = False
 
@@ -300,6 +302,7 @@ class ServiceServer:
         response_class = self.response_class
         handler = self.handler
         ok_head = SERVICE_RESPONSE_HEAD.pack
+        busy = self._busy
         try:
             while not self._closed:
                 try:
@@ -311,6 +314,7 @@ class ServiceServer:
                 except Exception as exc:
                     send(self._bad_request(exc, who))
                     continue
+                busy.add(sock)
                 try:
                     value = handler(request)
                     if type(value) is not response_class:
@@ -319,7 +323,10 @@ class ServiceServer:
                     reply = ok_head(1, len(payload)) + payload
                 except Exception as exc:
                     reply = self._failed(exc)
-                send(reply)
+                try:
+                    send(reply)
+                finally:
+                    busy.discard(sock)
         except ProtocolError as exc:
             _log.warning("service %s: dropped client %s: %s", self.name, who, exc)
         except OSError as exc:
@@ -358,12 +365,17 @@ class ServiceServer:
         if value:
             self._end_connections()
 
-    def shutdown(self) -> None:
-        """Stop serving: unregister, and close every client connection."""
+    def shutdown(self, grace: float = 0.0) -> None:
+        """Stop serving: unregister, and close every client connection. With ``grace``, calls already
+        inside their handler get up to that many seconds to send their answer first (a provider that
+        fails its pending calls on the way out wants its callers to read why, not a closed socket)."""
         if self._closed:
             return
         self._closed = True
         self.node.release_service(self)
+        deadline = time.monotonic() + grace
+        while self._busy and time.monotonic() < deadline:
+            time.sleep(0.005)
         self._end_connections()
 
     def _end_connections(self) -> None:

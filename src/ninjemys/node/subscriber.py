@@ -372,9 +372,8 @@ class Subscription:
                 address = (proto[1], int(proto[2]))
             transport.tune(sock, self.tcp_nodelay)
             await transport.connect(sock, address, timeout=5.0)
-            fields = self._header()
-            if proto[0] == "SHMROS":
-                fields["ninjemys_shm"] = transport.host_identity()
+            shm_field = {"ninjemys_shm": transport.host_identity()} if proto[0] == "SHMROS" else None
+            fields = self._header(shm_field)
             await transport.write_all(sock, headers.encode_header(fields))
             header = await transport.read_header(sock)
             refused = auth.check_fields(header)
@@ -409,17 +408,19 @@ class Subscription:
         finally:
             self._connecting.discard(uri)
 
-    def _header(self) -> dict[str, str]:
-        return auth.sign_fields(
-            {
-                "callerid": self.node.name,
-                "topic": self.topic,
-                "md5sum": self.md5sum,
-                "type": self.type_name,
-                "message_definition": self.definition,
-                "tcp_nodelay": "1" if self.tcp_nodelay else "0",
-            }
-        )
+    def _header(self, extra: dict[str, str] | None = None) -> dict[str, str]:
+        """The connection header, signed last: every field, ``extra`` ones too, is under the signature."""
+        fields = {
+            "callerid": self.node.name,
+            "topic": self.topic,
+            "md5sum": self.md5sum,
+            "type": self.type_name,
+            "message_definition": self.definition,
+            "tcp_nodelay": "1" if self.tcp_nodelay else "0",
+        }
+        if extra:
+            fields.update(extra)
+        return auth.sign_fields(fields)
 
     def _hand(self, op: tuple[str, SubConnection]) -> None:
         """Give a connection to (or take it from) the reader's worker thread."""
