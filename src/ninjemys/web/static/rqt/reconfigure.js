@@ -111,7 +111,8 @@ export class ReconfigureTool {
         send(v);
       });
       row.append(label, input, number);
-      this.widgets.set(p.name, { set: (v) => { input.value = v; number.value = v; } });
+      // a server update never overwrites the number the user is typing (it arrives late on a busy machine)
+      this.widgets.set(p.name, { set: (v) => { input.value = v; if (document.activeElement !== number) number.value = v; } });
     }
     row.append(el("small", { style: "grid-column: 1 / 4; color: #666" }, `${p.description}${dflt !== undefined ? ` (default ${dflt})` : ""}`));
     return row;
