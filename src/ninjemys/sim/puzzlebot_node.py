@@ -80,7 +80,7 @@ Log: Any = get_message_class("rosgraph_msgs/Log")
 
 WORLD_FRAME = "map"  # ground truth frame: the shipped maps are rasterized in world coordinates
 
-__all__ = ["SimNode", "RobotIO", "StepLock", "Due", "parse_model_xml", "keep_freed_memory", "main"]
+__all__ = ["SimNode", "RobotIO", "scoped", "StepLock", "Due", "parse_model_xml", "keep_freed_memory", "main"]
 
 
 @dataclass
@@ -106,7 +106,7 @@ class RobotIO:
     control: ControlLoop | None = None
 
     def frame(self, name: str) -> str:
-        return self.frame_prefix + name
+        return scoped(self.frame_prefix, name)
 
     def close(self) -> None:
         if self.control is not None:
@@ -115,6 +115,19 @@ class RobotIO:
             self.cmd_sub.unregister()
         for pub in self.pubs.values():
             pub.unregister()
+
+
+def scoped(prefix: str, name: str) -> str:
+    """``name`` under a robot's prefix (``""`` or ``"ns/"``), never as ``ns//name``.
+
+    A description's plugin topics are absolute (gazebo_ros resolves them in the robot's namespace:
+    ``/odom``, ``/heavy/odom``) and its frames may already carry the namespace (``heavy/odom``): a
+    name already inside the prefix's namespace is kept, any other goes under the prefix, less its
+    leading slash (``/odom`` of robot ``heavy`` in a multi-robot world is ``heavy/odom``)."""
+    if not prefix:
+        return name
+    inner = name.lstrip("/")
+    return name if inner.startswith(prefix) else prefix + inner
 
 
 def _period(rate: float | None, default: float, dt: float) -> float:
@@ -215,39 +228,39 @@ class SimNode:
         drive = model.drive
         driven = drive.kind != "none"
         pubs: dict[str, Any] = {
-            "ground_truth": n.publisher(prefix + "base_pose_ground_truth", Odometry, queue_size=10),
-            "contact": n.publisher(prefix + "contact", Bool, queue_size=1, latch=True),
+            "ground_truth": n.publisher(scoped(prefix, "base_pose_ground_truth"), Odometry, queue_size=10),
+            "contact": n.publisher(scoped(prefix, "contact"), Bool, queue_size=1, latch=True),
         }
         topics = {  # what the browser view subscribes to (the camera's defaults when it has none)
-            "cmd_vel": prefix + drive.command_topic,
-            "color": prefix + "camera/color/image_raw",
-            "depth": prefix + "camera/depth/image_rect_raw",
+            "cmd_vel": scoped(prefix, drive.command_topic),
+            "color": scoped(prefix, "camera/color/image_raw"),
+            "depth": scoped(prefix, "camera/depth/image_rect_raw"),
         }
         if driven and drive.publish_wheel_speeds:
-            pubs["wl"] = n.publisher(prefix + "wl", Float32, queue_size=10)
-            pubs["wr"] = n.publisher(prefix + "wr", Float32, queue_size=10)
+            pubs["wl"] = n.publisher(scoped(prefix, "wl"), Float32, queue_size=10)
+            pubs["wr"] = n.publisher(scoped(prefix, "wr"), Float32, queue_size=10)
         if driven and drive.publish_wheel_joint_state:
-            pubs["joint_states"] = n.publisher(prefix + "joint_states", JointState, queue_size=10)
+            pubs["joint_states"] = n.publisher(scoped(prefix, "joint_states"), JointState, queue_size=10)
         if driven and drive.publish_odom:
-            pubs["odom"] = n.publisher(prefix + drive.odom_topic, Odometry, queue_size=10)
+            pubs["odom"] = n.publisher(scoped(prefix, drive.odom_topic), Odometry, queue_size=10)
         laser, camera, imu = model.laser, model.camera, model.imu
         if laser is not None:
-            pubs["scan"] = n.publisher(prefix + laser.topic, LaserScan, queue_size=10)
+            pubs["scan"] = n.publisher(scoped(prefix, laser.topic), LaserScan, queue_size=10)
         if camera is not None:
-            topics["color"] = prefix + camera.image_topic
-            pubs["image"] = n.publisher(prefix + camera.image_topic, Image, queue_size=2)
+            topics["color"] = scoped(prefix, camera.image_topic)
+            pubs["image"] = n.publisher(scoped(prefix, camera.image_topic), Image, queue_size=2)
             # image_transport's <base>/compressed, encoded only while subscribed
-            pubs["image_compressed"] = CompressedPublisher(n, prefix + camera.image_topic)
-            pubs["color_info"] = n.publisher(prefix + camera.info_topic, CameraInfo, queue_size=2)
+            pubs["image_compressed"] = CompressedPublisher(n, scoped(prefix, camera.image_topic))
+            pubs["color_info"] = n.publisher(scoped(prefix, camera.info_topic), CameraInfo, queue_size=2)
             if camera.depth_topic:
-                topics["depth"] = prefix + camera.depth_topic
-                pubs["depth"] = n.publisher(prefix + camera.depth_topic, Image, queue_size=2)
+                topics["depth"] = scoped(prefix, camera.depth_topic)
+                pubs["depth"] = n.publisher(scoped(prefix, camera.depth_topic), Image, queue_size=2)
                 if camera.depth_info_topic:
                     pubs["depth_info"] = n.publisher(
-                        prefix + camera.depth_info_topic, CameraInfo, queue_size=2
+                        scoped(prefix, camera.depth_info_topic), CameraInfo, queue_size=2
                     )
         if imu is not None:
-            pubs["imu"] = n.publisher(prefix + imu.topic, Imu, queue_size=10)
+            pubs["imu"] = n.publisher(scoped(prefix, imu.topic), Imu, queue_size=10)
         io = RobotIO(
             robot,
             prefix,
@@ -262,7 +275,11 @@ class SimNode:
         )
         if driven and drive.command_topic:  # ros_control: the controllers subscribe their own cmd_vel
             io.cmd_sub = n.subscriber(
-                prefix + drive.command_topic, Twist, self._on_cmd_vel, callback_args=robot.name, queue_size=1
+                scoped(prefix, drive.command_topic),
+                Twist,
+                self._on_cmd_vel,
+                callback_args=robot.name,
+                queue_size=1,
             )
         if drive.kind == "puzzlebot":  # a URDF robot's sensor frames come from robot_state_publisher
             io.static_tfs = messages.static_transforms(model, frame_prefix, self._stamp())
