@@ -487,11 +487,24 @@ class Simulation:
         color: tuple[int, int, int],
     ) -> None:
         """Add a static box (size = length, width) or cylinder (size[0] = radius); refused on a robot or a name clash."""
-        if any(o.name == name for o in self.world.obstacles) or name in self.robots:
-            raise SpawnError(f"a model named [{name}] already exists")
         outline = (
             circle_outline(x, y, size[0]) if kind == "cylinder" else box_outline(x, y, size[0], size[1], yaw)
         )
+        self.add_outline(name, kind, outline, yaw, height, color)
+
+    def add_outline(
+        self,
+        name: str,
+        kind: str,
+        outline: np.ndarray,
+        yaw: float,
+        height: float,
+        color: tuple[int, int, int],
+    ) -> None:
+        """Add a static obstacle of any outline (world coordinates; an SDF model's footprint, spawned);
+        refused on a robot or a name clash."""
+        if any(o.name == name for o in self.world.obstacles) or name in self.robots:
+            raise SpawnError(f"a model named [{name}] already exists")
         for r in self.robots.values():
             d = point_segment_distance(
                 np.array([r.x]), np.array([r.y]), np.hstack([outline, np.roll(outline, -1, axis=0)])
