@@ -601,7 +601,8 @@ def parse_model_xml(text: str) -> tuple[str, Any]:
     except ET.ParseError as exc:
         raise SpawnError(f"model_xml is not valid XML: {exc}") from None
     if root.tag == "sdf":
-        pieces = sdf_model_obstacles(body)  # SdfError (a MapFileError) names the element and reason
+        # SdfError (a MapFileError) names the element and the reason
+        pieces = sdf_model_obstacles(body, lift=True)
         if len(pieces) > 1:
             raise SpawnError(
                 f"the SDF model has {len(pieces)} collision pieces ({', '.join(p.name for p in pieces)}); "

@@ -57,8 +57,9 @@ from ninjemys.rostime import Time
 from ninjemys.sim import messages
 from ninjemys.sim.gazebo_api import GazeboApi, parse_model_xml
 from ninjemys.sim.gazebo_worlds import load_gazebo_world
-from ninjemys.sim.robot_model import RobotModel, load_robot_model
+from ninjemys.sim.robot_model import CameraSpec, RobotModel, load_robot_model
 from ninjemys.sim.ros_control.hardware import ControlLoop
+from ninjemys.sim.sensors import Camera
 from ninjemys.sim.simcore import Robot, Simulation, SpawnError
 from ninjemys.sim.stepper import Due, StepLock, Stepper
 from ninjemys.sim.world2d import World, load_world, world_from_map
@@ -84,6 +85,16 @@ __all__ = ["SimNode", "RobotIO", "scoped", "StepLock", "Due", "parse_model_xml",
 
 
 @dataclass
+class ExtraSensor:
+    """A description's further lidar or camera (beyond its first of each): publishers and schedule."""
+
+    kind: str  # "laser" or "camera"
+    index: int  # into the model's extra_lasers or extra_cameras
+    pubs: dict[str, Any]
+    due: Due
+
+
+@dataclass
 class RobotIO:
     """The ROS endpoints of one robot and its output schedule."""
 
@@ -104,6 +115,7 @@ class RobotIO:
     topics: dict[str, str] = field(default_factory=dict)  # role -> relative topic name (the view's)
     #: gazebo_ros_control's controller_manager for this robot (a ros_control description), else None
     control: ControlLoop | None = None
+    extras: list[ExtraSensor] = field(default_factory=list)
 
     def frame(self, name: str) -> str:
         return scoped(self.frame_prefix, name)
@@ -113,8 +125,9 @@ class RobotIO:
             self.control.close()
         if self.cmd_sub is not None:
             self.cmd_sub.unregister()
-        for pub in self.pubs.values():
-            pub.unregister()
+        for pubs in (self.pubs, *(e.pubs for e in self.extras)):
+            for pub in pubs.values():
+                pub.unregister()
 
 
 def scoped(prefix: str, name: str) -> str:
@@ -248,17 +261,9 @@ class SimNode:
             pubs["scan"] = n.publisher(scoped(prefix, laser.topic), LaserScan, queue_size=10)
         if camera is not None:
             topics["color"] = scoped(prefix, camera.image_topic)
-            pubs["image"] = n.publisher(scoped(prefix, camera.image_topic), Image, queue_size=2)
-            # image_transport's <base>/compressed, encoded only while subscribed
-            pubs["image_compressed"] = CompressedPublisher(n, scoped(prefix, camera.image_topic))
-            pubs["color_info"] = n.publisher(scoped(prefix, camera.info_topic), CameraInfo, queue_size=2)
             if camera.depth_topic:
                 topics["depth"] = scoped(prefix, camera.depth_topic)
-                pubs["depth"] = n.publisher(scoped(prefix, camera.depth_topic), Image, queue_size=2)
-                if camera.depth_info_topic:
-                    pubs["depth_info"] = n.publisher(
-                        scoped(prefix, camera.depth_info_topic), CameraInfo, queue_size=2
-                    )
+            pubs.update(self._camera_pubs(prefix, camera))
         if imu is not None:
             pubs["imu"] = n.publisher(scoped(prefix, imu.topic), Imu, queue_size=10)
         io = RobotIO(
@@ -273,6 +278,14 @@ class SimNode:
             Due(_period(imu.rate, 100.0, dt), now) if imu else None,
             topics=topics,
         )
+        for i, spec in enumerate(model.extra_lasers):
+            scan_pub = n.publisher(scoped(prefix, spec.topic), LaserScan, queue_size=10)
+            io.extras.append(
+                ExtraSensor("laser", i, {"scan": scan_pub}, Due(_period(spec.rate, 10.0, dt), now))
+            )
+        for i, cam in enumerate(model.extra_cameras):
+            due = Due(_period(cam.rate, 30.0, dt), now)
+            io.extras.append(ExtraSensor("camera", i, self._camera_pubs(prefix, cam), due))
         if driven and drive.command_topic:  # ros_control: the controllers subscribe their own cmd_vel
             io.cmd_sub = n.subscriber(
                 scoped(prefix, drive.command_topic),
@@ -284,6 +297,23 @@ class SimNode:
         if drive.kind == "puzzlebot":  # a URDF robot's sensor frames come from robot_state_publisher
             io.static_tfs = messages.static_transforms(model, frame_prefix, self._stamp())
         return io
+
+    def _camera_pubs(self, prefix: str, camera: CameraSpec) -> dict[str, Any]:
+        """A camera's publishers: image (and image_transport's <base>/compressed, encoded only while
+        subscribed), camera_info, and the depth image and its camera_info for an RGB-D camera."""
+        n = self.node
+        pubs: dict[str, Any] = {
+            "image": n.publisher(scoped(prefix, camera.image_topic), Image, queue_size=2),
+            "image_compressed": CompressedPublisher(n, scoped(prefix, camera.image_topic)),
+            "color_info": n.publisher(scoped(prefix, camera.info_topic), CameraInfo, queue_size=2),
+        }
+        if camera.depth_topic:
+            pubs["depth"] = n.publisher(scoped(prefix, camera.depth_topic), Image, queue_size=2)
+            if camera.depth_info_topic:
+                pubs["depth_info"] = n.publisher(
+                    scoped(prefix, camera.depth_info_topic), CameraInfo, queue_size=2
+                )
+        return pubs
 
     def remove_robot(self, name: str) -> None:
         with self.lock:
@@ -331,7 +361,7 @@ class SimNode:
         """Outputs due now, contact re-announced, the stepping thread re-reads the clock."""
         now = self.sim.time
         for io in self.io.values():
-            for due in (io.odom_due, io.scan_due, io.camera_due, io.imu_due):
+            for due in (io.odom_due, io.scan_due, io.camera_due, io.imu_due, *(e.due for e in io.extras)):
                 if due is not None:
                     due.next = now
             self._publish_contact(io)
@@ -406,6 +436,9 @@ class SimNode:
                 )
                 if want:  # a browser view watches the cameras as ROS topics too (through its gateway)
                     self._camera(io, stamp)
+            for extra in io.extras:
+                if extra.due.fire(now):
+                    self._extra_sensor(io, extra, stamp)
         if tfs:
             self.tf_pub.publish(TFMessage(transforms=tfs))
         self.gazebo.after_step(stamp)
@@ -465,6 +498,21 @@ class SimNode:
                 )
             )
 
+    def _extra_sensor(self, io: RobotIO, extra: ExtraSensor, stamp: Time) -> None:
+        """A further lidar's scan or camera's images, to whoever reads them (nobody: not computed)."""
+        model = io.robot.model
+        if extra.kind == "laser":
+            laser = model.extra_lasers[extra.index]
+            if extra.pubs["scan"].get_num_connections():
+                ranges = self.sim.scan(io.robot, laser=laser)
+                extra.pubs["scan"].publish(
+                    messages.laser_scan(stamp, io.frame(laser.pose.frame), laser, ranges)
+                )
+            return
+        if any(pub.get_num_connections() for pub in extra.pubs.values()):
+            spec = model.extra_cameras[extra.index]
+            self._camera_images(io, spec, io.robot.extra_cameras[extra.index], extra.pubs, stamp, extra.index)
+
     def _camera(self, io: RobotIO, stamp: Time) -> None:
         """Render and publish the camera's images, each only when someone reads it (camera_info
         alone needs no image at all)."""
@@ -472,14 +520,25 @@ class SimNode:
         spec = r.model.camera
         if spec is None or r.camera is None:
             return
-        pubs = io.pubs
+        self._camera_images(io, spec, r.camera, io.pubs, stamp, None)
+
+    def _camera_images(
+        self,
+        io: RobotIO,
+        spec: CameraSpec,
+        camera: Camera,
+        pubs: dict[str, Any],
+        stamp: Time,
+        extra: int | None,
+    ) -> None:
+        r = io.robot
         frame = io.frame(spec.frame)
         depth_frame = io.frame(spec.depth_frame)
         want_raw = pubs["image"].get_num_connections()
         want_colour = bool(want_raw or pubs["image_compressed"].get_num_connections())
         want_depth = bool("depth" in pubs and pubs["depth"].get_num_connections())
         if want_colour or want_depth:
-            rgb, depth = self.sim.render(r, colour=want_colour, depth=want_depth)
+            rgb, depth = self.sim.render(r, colour=want_colour, depth=want_depth, extra=extra)
             if want_colour:
                 img = messages.rgb_image(stamp, frame, rgb)
                 if want_raw:
@@ -487,7 +546,7 @@ class SimNode:
                 pubs["image_compressed"].publish(img)
             if want_depth:
                 pubs["depth"].publish(messages.depth_image(stamp, depth_frame, depth))
-        intrinsics = r.camera.intrinsics()
+        intrinsics = camera.intrinsics()
         for key, frame_id in (("color_info", frame), ("depth_info", depth_frame)):
             if key in pubs and pubs[key].get_num_connections():
                 pubs[key].publish(messages.camera_info(stamp, frame_id, spec, intrinsics))
