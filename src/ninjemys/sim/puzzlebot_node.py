@@ -17,6 +17,8 @@ map_server YAML used as the world instead), ``~rate`` (real-time factor; 0 runs 
 possible), ``~x ~y ~yaw`` (start pose of the first robot), ``~model`` (``puzzlebot``, a YAML or URDF
 path), ``~update_rate`` (physics steps per simulated second, default 100), ``~seed`` (noise),
 ``~odom_alpha`` (amcl's α1-α4), ``~laser_noise``, ``~gui`` (serve the browser view),
+``~pub_clock_frequency`` (/clock messages per simulated second; default
+``/gazebo/pub_clock_frequency``, else 0: every physics step, as gazebo_ros),
 ``~cmd_vel_timeout`` (simulated seconds without a command after which the wheels are stopped, as
 diff_drive_controller's ``cmd_vel_timeout`` does; default 0: off, the last command holds, as with
 Gazebo's diff drive plugin), ``~no_robot`` (start with an empty world: robots come from
@@ -165,6 +167,9 @@ class SimNode:
             self._step_and_publish, lambda: sim.time, sim.dt, rate, self.lock, self._step_failed
         )
         self.cmd_timeout = 0.0  # ~cmd_vel_timeout (0: off)
+        #: sim seconds between /clock messages (gazebo_ros' pub_clock_frequency; 0: every step)
+        self.clock_period = 0.0
+        self._last_clock: float | None = None
         self.view: Any = None
         self.clock_pub = node.publisher("/clock", Clock, queue_size=10)
         self.tf_pub = node.publisher("/tf", TFMessage, queue_size=100)
@@ -395,7 +400,7 @@ class SimNode:
         touched = sim.step()
         now = sim.time
         stamp = self._stamp()
-        if self.clock_pub.get_num_connections():  # nobody listening costs nothing (checked every step)
+        if self.clock_pub.get_num_connections() and self._clock_due(now):  # nobody listening: nothing
             self.clock_pub.publish(Clock(clock=stamp))
         for r in touched:
             self.log.warn(
@@ -444,6 +449,16 @@ class SimNode:
         self.gazebo.after_step(stamp)
         if view is not None:
             view.publish(now)
+
+    def _clock_due(self, now: float) -> bool:
+        """Whether /clock goes out this step: every step, or with ``clock_period`` set, once that much
+        simulated time has passed since the last one (gazebo_ros' publishSimTime); a clock set back
+        (reset_world) publishes at once."""
+        last = self._last_clock
+        if self.clock_period > 0 and last is not None and 0.0 <= now - last < self.clock_period - 1e-9:
+            return False
+        self._last_clock = now
+        return True
 
     def _odometry(self, io: RobotIO, stamp: Time, tfs: list[Any] | None) -> None:
         """Advance the robot's odometry; publish odom, ground truth, wl/wr and joint_states to whoever
@@ -634,6 +649,15 @@ def configure_model(
         model.imu.topic = param("imu_topic", model.imu.topic, str)
 
 
+def _gazebo_clock_frequency(node: Node) -> float:
+    """/gazebo/pub_clock_frequency when set (a number), else 0: /clock every physics step."""
+    try:
+        value = node.get_param("/gazebo/pub_clock_frequency", 0.0)
+        return float(value)
+    except (NinjemysError, TypeError, ValueError):
+        return 0.0
+
+
 def load_sim_world(log: NodeLog, world_arg: str, map_arg: str) -> World:
     if map_arg:
         log.info("world from map_server map %s", map_arg)
@@ -718,6 +742,9 @@ def main(argv: list[str] | None = None, view: ViewStarter | None = None) -> int:
         )
         app = SimNode(node, log, sim, rate, float(laser_noise) if laser_noise is not None else None)
         app.cmd_timeout = max(0.0, _param(node, log, "cmd_vel_timeout", 0.0, float))
+        # gazebo_ros reads /gazebo/pub_clock_frequency (empty_world.launch's use_clock_frequency sets it)
+        clock_hz = _param(node, log, "pub_clock_frequency", _gazebo_clock_frequency(node), float)
+        app.clock_period = 1.0 / clock_hz if clock_hz > 0 else 0.0
         starts = list(world.robots) or []
         if not starts:
             from ninjemys.sim.world2d import RobotStart
