@@ -264,7 +264,7 @@ def message_header(spec: MsgSpec, lookup: Lookup, md5sum: str, full_text: str, s
         ("HasHeader", spec.has_header),
     ):
         kind = "TrueType" if value else "FalseType"
-        for const in ("", " const"):
+        for const in (" ", " const"):
             out += [
                 "template <class ContainerAllocator>",
                 f"struct {trait}< {with_alloc}{const}>",
