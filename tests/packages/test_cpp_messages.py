@@ -196,7 +196,13 @@ def workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
     env = {k: v for k, v in os.environ.items() if k not in ("ROS_PACKAGE_PATH", "CMAKE_PREFIX_PATH")}
     env.pop("NINJEMYS_CATKIN_CPP", None)
     result = subprocess.run(
-        [ninjemys_bin("catkin_make")], cwd=ws, env=env, capture_output=True, text=True, timeout=900, check=False
+        [ninjemys_bin("catkin_make")],
+        cwd=ws,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=900,
+        check=False,
     )
     out = result.stdout + result.stderr
     assert result.returncode == 0, out
@@ -255,7 +261,7 @@ def test_cpp_traits_are_the_md5sums_and_definitions_python_uses(workspace: Path)
     python = _run([sys.executable, "-c", script, *names, *services], env)
     assert python.returncode == 0, python.stderr
     ours = json.loads(python.stdout)
-    for name, md5, datatype, fixed, header, definition in blocks:
+    for name, md5, datatype, _fixed, _header, definition in blocks:
         assert datatype == name
         assert md5 == ours[name][0], name
         if name.startswith("msg_bridge/"):
@@ -267,12 +273,16 @@ def test_cpp_traits_are_the_md5sums_and_definitions_python_uses(workspace: Path)
         assert md5 == ours[name][0], name
 
 
-def test_cpp_node_publishes_ninjemys_only_and_workspace_messages_to_python(workspace: Path, master: str) -> None:
+def test_cpp_node_publishes_ninjemys_only_and_workspace_messages_to_python(
+    workspace: Path, master: str
+) -> None:
     env = _env(workspace, master)
     bridge = _start([ninjemys_bin("rosrun"), "msg_bridge", "bridge"], env)
     try:
         state = _run([ninjemys_bin("rostopic"), "echo", "-n", "1", "/cpp_state"], env)
-        assert "set_point: 1.5" in state.stdout and "command: -2.0" in state.stdout, state.stdout + state.stderr
+        assert "set_point: 1.5" in state.stdout and "command: -2.0" in state.stdout, (
+            state.stdout + state.stderr
+        )
         report = _run([ninjemys_bin("rostopic"), "echo", "-n", "1", "/report"], env)
         assert 'frame_id: "wheel"' in report.stdout, report.stdout + report.stderr
         assert "set_point: 1.5" in report.stdout and 'note: "from cpp"' in report.stdout
@@ -310,7 +320,8 @@ def test_services_round_trip_between_cpp_and_python(workspace: Path, master: str
             calls.stdout + calls.stderr
         )
         answer = _run(
-            [ninjemys_bin("rosservice"), "call", "--wait", "/cpp/get_model_state", "{model_name: turtle}"], env
+            [ninjemys_bin("rosservice"), "call", "--wait", "/cpp/get_model_state", "{model_name: turtle}"],
+            env,
         )
         assert 'status_message: "cpp served turtle"' in answer.stdout, answer.stdout + answer.stderr
         assert "x: 4.25" in answer.stdout and "success: True" in answer.stdout

@@ -145,7 +145,9 @@ def _trait(header: str, trait: str) -> str:
 
 
 def _service_md5(header: str) -> str:
-    match = re.search(r'struct MD5Sum< ::\w+::\w+ > \{\s*static const char\* value\(\)\s*\{\s*return "(\w+)"', header)
+    match = re.search(
+        r'struct MD5Sum< ::\w+::\w+ > \{\s*static const char\* value\(\)\s*\{\s*return "(\w+)"', header
+    )
     assert match is not None
     return match.group(1)
 
@@ -224,7 +226,9 @@ def test_prefix_is_rewritten_only_where_it_changed(tmp_path: Path) -> None:
     assert (tmp_path / "p" / ".catkin").is_file()  # catkin's CMake overlays it like a workspace
     config = (tmp_path / "p" / "share" / "fiducial_msgs" / "cmake" / "fiducial_msgsConfig.cmake").read_text()
     assert "find_package(${_ninjemys_fiducial_msgs_dep} REQUIRED NO_MODULE)" in config
-    paths = (tmp_path / "p" / "share" / "fiducial_msgs" / "cmake" / "fiducial_msgs-msg-paths.cmake").read_text()
+    paths = (
+        tmp_path / "p" / "share" / "fiducial_msgs" / "cmake" / "fiducial_msgs-msg-paths.cmake"
+    ).read_text()
     assert "fiducial_msgs_MSG_DEPENDENCIES geometry_msgs;std_msgs" in paths
     assert first.written
     again = write_prefix(tmp_path / "p", ["fiducial_msgs", "smach_msgs"])
@@ -240,5 +244,7 @@ def test_actions_are_installed_as_their_seven_messages(tmp_path: Path) -> None:
     for suffix in ("Action", "ActionGoal", "ActionResult", "ActionFeedback", "Goal", "Result", "Feedback"):
         assert (msg / f"FollowJointTrajectory{suffix}.msg").is_file()
         assert (tmp_path / "p" / "include" / "control_msgs" / f"FollowJointTrajectory{suffix}.h").is_file()
-    extras = (tmp_path / "p" / "share" / "control_msgs" / "cmake" / "control_msgs-msg-extras.cmake").read_text()
+    extras = (
+        tmp_path / "p" / "share" / "control_msgs" / "cmake" / "control_msgs-msg-extras.cmake"
+    ).read_text()
     assert "msg/FollowJointTrajectoryActionGoal.msg" in extras and "srv/QueryTrajectoryState.srv" in extras

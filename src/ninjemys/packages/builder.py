@@ -194,7 +194,9 @@ def _build_cpp_packages(
                 skip = {w for w in remaining if culprit in {p.name for p in cpp_closure(ordered, {w})}}
                 skip = skip or set(remaining)
             debian = f"lib{missing.lower().replace('_', '-')}-dev"
-            why = f"the C++ side of '{missing}' is not installed (Debian: {debian} or ros-{debian[3:-4]})"
+            # a ROS package has a ros-<name> alternative; a system library's CMake name (OpenCV) does not
+            other = f" or ros-{debian[3:-4]}" if missing == missing.lower() else ""
+            why = f"the C++ side of '{missing}' is not installed (Debian: {debian}{other})"
             for line in text.splitlines():
                 if any(
                     marker in line
