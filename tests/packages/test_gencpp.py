@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 
 from ninjemys.idl import loader
+from ninjemys.packages import cpp_msgs
 from ninjemys.packages.cpp_msgs import (
     has_cpp_side,
     packages_without_cpp_side,
@@ -207,7 +208,11 @@ def test_empty_message_header_has_no_field_code() -> None:
     assert "static_value1 = 0xd41d8cd98f00b204ULL" in header
 
 
-def test_packages_with_an_installed_cpp_side_are_left_to_it(tmp_path: Path) -> None:
+def test_packages_with_an_installed_cpp_side_are_left_to_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(cpp_msgs, "_SYSTEM_PREFIXES", ())
+    monkeypatch.setattr(cpp_msgs, "_OPT_ROS", tmp_path / "no_opt_ros")
     system = tmp_path / "usr"
     (system / "share" / "nav_msgs" / "cmake").mkdir(parents=True)
     (system / "share" / "nav_msgs" / "cmake" / "nav_msgsConfig.cmake").write_text("")
@@ -217,7 +222,9 @@ def test_packages_with_an_installed_cpp_side_are_left_to_it(tmp_path: Path) -> N
     assert not has_cpp_side("gazebo_msgs", [system])
     wanted = packages_without_cpp_side({"CMAKE_PREFIX_PATH": str(system)}, exclude={"fiducial_msgs"})
     assert "nav_msgs" not in wanted and "tf" not in wanted and "fiducial_msgs" not in wanted
-    assert "gazebo_msgs" in wanted and "control_msgs" in wanted and "roscpp" not in wanted
+    assert "gazebo_msgs" in wanted and "control_msgs" in wanted and "std_msgs" in wanted
+    # never ours: roscpp, and packages whose real config brings CMake macros (add_action_files ...)
+    assert not {"roscpp", "actionlib_msgs", "dynamic_reconfigure"} & set(wanted)
 
 
 def test_prefix_is_rewritten_only_where_it_changed(tmp_path: Path) -> None:

@@ -32,8 +32,13 @@ from ninjemys.idl.parser import action_message_texts, read_definition
 from ninjemys.idl.spec import MsgSpec
 from ninjemys.packages.gencpp import message_header, service_header
 
-#: packages whose C++ side is a library, not headers: no toolchain without them (roscpp)
-_NEVER = frozenset({"roscpp"})
+#: packages whose C++ side is more than message headers, so a config of ours would mislead CMake:
+#: roscpp (no toolchain without it), and those whose config brings CMake macros
+#: (actionlib_msgs' add_action_files, dynamic_reconfigure's generate_dynamic_reconfigure_options):
+#: without their real C++ side, CMake names them as missing, and catkin_make names the targets that
+#: need them as not built. Library packages without macros (tf, actionlib) get their messages'
+#: headers: a node on their library misses its header, and is named as not built the same way.
+_NEVER = frozenset({"roscpp", "actionlib_msgs", "dynamic_reconfigure"})
 #: prefixes where an installed C++ side of a package is looked for, besides CMAKE_PREFIX_PATH
 _SYSTEM_PREFIXES = (Path("/usr"), Path("/usr/local"))
 _OPT_ROS = Path("/opt/ros")
