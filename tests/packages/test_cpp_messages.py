@@ -230,8 +230,10 @@ def _start(cmd: list[str], env: dict[str, str]) -> subprocess.Popen[str]:
     )
 
 
-def _run(cmd: list[str], env: dict[str, str], timeout: float = 90) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=timeout, check=False)
+def _run(
+    cmd: list[str], env: dict[str, str], timeout: float = 90, cwd: Path | None = None
+) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=timeout, check=False, cwd=cwd)
 
 
 def test_headers_are_where_catkin_puts_them(workspace: Path) -> None:
@@ -328,3 +330,23 @@ def test_services_round_trip_between_cpp_and_python(workspace: Path, master: str
     finally:
         kill_tree(bridge)
         kill_tree(server)
+
+
+def test_a_header_prefix_that_cannot_be_written_is_one_clear_error(tmp_path: Path) -> None:
+    pkg = tmp_path / "src" / "tiny_cpp"
+    (pkg / "src").mkdir(parents=True)
+    (pkg / "package.xml").write_text(PACKAGE_XML.replace("msg_bridge", "tiny_cpp"))
+    (pkg / "CMakeLists.txt").write_text(
+        "cmake_minimum_required(VERSION 3.0.2)\nproject(tiny_cpp)\nfind_package(catkin REQUIRED COMPONENTS roscpp)\n"
+        "catkin_package()\nadd_executable(tiny src/tiny.cpp)\n"
+    )
+    (pkg / "src" / "tiny.cpp").write_text("int main() { return 0; }\n")
+    blocker = tmp_path / "build" / "ninjemys_cpp" / "shipped"
+    blocker.parent.mkdir(parents=True)
+    blocker.write_text("a file where the prefix goes\n")
+    env = {k: v for k, v in os.environ.items() if k not in ("ROS_PACKAGE_PATH", "CMAKE_PREFIX_PATH")}
+    env.pop("NINJEMYS_CATKIN_CPP", None)
+    result = _run([ninjemys_bin("catkin_make")], env, timeout=600, cwd=tmp_path)
+    out = result.stdout + result.stderr
+    assert result.returncode != 0 and "Traceback" not in out, out
+    assert f"{blocker}: cannot write the C++ message headers" in out, out

@@ -224,7 +224,11 @@ def _shipped_messages(ws: Workspace, env: Mapping[str, str], log: Callable[[str]
     """The C++ side of every message package ninjemys ships and this machine lacks (a workspace
     package of the same name takes its place), brought up to date in build/ninjemys_cpp/shipped."""
     wanted = packages_without_cpp_side(env, exclude={p.name for p in ws.packages})
-    prefix = write_prefix(ws.build / "ninjemys_cpp" / "shipped", wanted)
+    root = ws.build / "ninjemys_cpp" / "shipped"
+    try:
+        prefix = write_prefix(root, wanted)
+    except OSError as exc:
+        raise PackageError(f"{root}: cannot write the C++ message headers: {exc.strerror or exc}") from None
     if prefix.written:
         log(
             f"-- ~~  C++ message headers of ninjemys' packages ({len(prefix.written)} file(s) written): "
