@@ -21,7 +21,8 @@ from ninjemys.packages.cpp_build import find_toolchain
 from ninjemys.testing import kill_tree, ninjemys_bin, run_master
 
 needs_toolchain = pytest.mark.skipif(find_toolchain(os.environ)[0] is None, reason="no C++ toolchain")
-pytestmark = [pytest.mark.ros1, needs_toolchain]
+# the module's one compile runs inside the first test's time: minutes on a loaded 2-core machine
+pytestmark = [pytest.mark.ros1, needs_toolchain, pytest.mark.timeout(900)]
 
 PACKAGE_XML = """<?xml version="1.0"?>
 <package format="2">
@@ -178,6 +179,79 @@ rospy.spin()
 """
 
 
+ACTION_PACKAGE_XML = PACKAGE_XML.replace("msg_bridge", "action_bridge").replace(
+    "<depend>gazebo_msgs</depend>", "<depend>actionlib</depend>\n  <depend>trajectory_msgs</depend>"
+)
+
+ACTION_CMAKE = """cmake_minimum_required(VERSION 3.0.2)
+project(action_bridge)
+find_package(catkin REQUIRED COMPONENTS roscpp actionlib control_msgs trajectory_msgs)
+catkin_package()
+include_directories(${catkin_INCLUDE_DIRS})
+add_executable(follow_client src/follow_client.cpp)
+target_link_libraries(follow_client ${catkin_LIBRARIES})
+catkin_install_python(PROGRAMS scripts/py_arm_controller.py DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+"""
+
+FOLLOW_CLIENT = r"""// A C++ actionlib client of control_msgs/FollowJointTrajectory, as arm code writes it.
+#include <ros/ros.h>
+#include <actionlib/client/simple_action_client.h>
+#include <control_msgs/FollowJointTrajectoryAction.h>
+#include <iostream>
+
+typedef actionlib::SimpleActionClient<control_msgs::FollowJointTrajectoryAction> Client;
+
+int main(int argc, char **argv) {
+  ros::init(argc, argv, "cpp_follow_client");
+  Client client("arm_controller/follow_joint_trajectory", true);
+  if (!client.waitForServer(ros::Duration(90))) {
+    std::cout << "no server" << std::endl;
+    return 1;
+  }
+  control_msgs::FollowJointTrajectoryGoal goal;
+  goal.trajectory.joint_names.push_back("shoulder");
+  goal.trajectory.joint_names.push_back("elbow");
+  trajectory_msgs::JointTrajectoryPoint point;
+  point.positions.push_back(1.0);
+  point.positions.push_back(2.0);
+  point.time_from_start = ros::Duration(0.5);
+  goal.trajectory.points.push_back(point);
+  goal.trajectory.points.push_back(point);
+  client.sendGoal(goal);
+  if (!client.waitForResult(ros::Duration(90))) {
+    std::cout << "no result" << std::endl;
+    return 1;
+  }
+  control_msgs::FollowJointTrajectoryResultConstPtr result = client.getResult();
+  std::cout << "state " << client.getState().toString() << " error_code " << result->error_code
+            << " error_string " << result->error_string << std::endl;
+  return 0;
+}
+"""
+
+PY_ARM_CONTROLLER = """#!/usr/bin/env python3
+# A Python FollowJointTrajectory action server (what a simulated arm controller offers).
+import actionlib
+import rospy
+from control_msgs.msg import FollowJointTrajectoryAction, FollowJointTrajectoryResult
+
+
+def execute(goal):
+    result = FollowJointTrajectoryResult()
+    result.error_code = FollowJointTrajectoryResult.SUCCESSFUL
+    result.error_string = "python moved %s through %d points" % (
+        "+".join(goal.trajectory.joint_names), len(goal.trajectory.points))
+    server.set_succeeded(result)
+
+
+rospy.init_node("py_arm_controller")
+server = actionlib.SimpleActionServer(
+    "arm_controller/follow_joint_trajectory", FollowJointTrajectoryAction, execute, auto_start=False)
+server.start()
+rospy.spin()
+"""
+
+
 @pytest.fixture(scope="module")
 def workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
     ws = tmp_path_factory.mktemp("cpp_msgs_ws")
@@ -193,6 +267,15 @@ def workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
     (pkg / "src" / "bridge.cpp").write_text(BRIDGE)
     (pkg / "scripts" / "py_server.py").write_text(PY_SERVER)
     (pkg / "scripts" / "py_server.py").chmod(0o755)
+    # a second package on actionlib's C++ library (Debian's libactionlib-dev) and control_msgs' actions
+    arm = ws / "src" / "action_bridge"
+    for sub in ("src", "scripts"):
+        (arm / sub).mkdir(parents=True)
+    (arm / "package.xml").write_text(ACTION_PACKAGE_XML)
+    (arm / "CMakeLists.txt").write_text(ACTION_CMAKE)
+    (arm / "src" / "follow_client.cpp").write_text(FOLLOW_CLIENT)
+    (arm / "scripts" / "py_arm_controller.py").write_text(PY_ARM_CONTROLLER)
+    (arm / "scripts" / "py_arm_controller.py").chmod(0o755)
     env = {k: v for k, v in os.environ.items() if k not in ("ROS_PACKAGE_PATH", "CMAKE_PREFIX_PATH")}
     env.pop("NINJEMYS_CATKIN_CPP", None)
     result = subprocess.run(
@@ -350,3 +433,20 @@ def test_a_header_prefix_that_cannot_be_written_is_one_clear_error(tmp_path: Pat
     out = result.stdout + result.stderr
     assert result.returncode != 0 and "Traceback" not in out, out
     assert f"{blocker}: cannot write the C++ message headers" in out, out
+
+
+def test_cpp_action_client_of_a_python_server_on_control_msgs_actions(workspace: Path, master: str) -> None:
+    """control_msgs' action messages (expanded from the .action by ninjemys) work with roscpp's
+    actionlib: a C++ SimpleActionClient gets a Python SimpleActionServer's result."""
+    client = workspace / "devel" / "lib" / "action_bridge" / "follow_client"
+    if not client.exists():
+        pytest.skip("actionlib's C++ side (Debian: libactionlib-dev) is not installed")
+    env = _env(workspace, master)
+    server = _start([ninjemys_bin("rosrun"), "action_bridge", "py_arm_controller.py"], env)
+    try:
+        result = _run([ninjemys_bin("rosrun"), "action_bridge", "follow_client"], env, timeout=200)
+        assert "state SUCCEEDED error_code 0 error_string python moved shoulder+elbow through 2 points" in (
+            result.stdout
+        ), result.stdout + result.stderr
+    finally:
+        kill_tree(server)
