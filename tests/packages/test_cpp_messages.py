@@ -320,6 +320,7 @@ def _run(
 
 
 def test_headers_are_where_catkin_puts_them(workspace: Path) -> None:
+    assert (workspace / "devel" / "include" / "msg_bridge").is_symlink()  # to catkin's generated headers
     assert (workspace / "devel" / "include" / "msg_bridge" / "Report.h").is_file()
     assert (workspace / "devel" / "include" / "msg_bridge" / "Scale.h").is_file()
     shipped = workspace / "build" / "ninjemys_cpp" / "shipped"
