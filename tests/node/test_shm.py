@@ -165,9 +165,11 @@ def test_a_malformed_notice_is_rejected_with_one_line_and_falls_back_to_tcpros(m
 
         def forged(parts, length, wait=0.0, bad=bad, good_put=good_put):  # noqa: ANN001, ANN202
             frame = good_put(parts, length, wait)
-            _, slot, gen, size = shm_ring.NOTICE.unpack_from(frame, 4)
+            _, slot, gen, offset, size = shm_ring.NOTICE.unpack_from(frame, 4)
             values = {"slot": slot, "gen": gen, "length": size, **bad}
-            return frame[:4] + shm_ring.NOTICE.pack(1, values["slot"], values["gen"], values["length"])
+            return frame[:4] + shm_ring.NOTICE.pack(
+                1, values["slot"], values["gen"], offset, values["length"]
+            )
 
         conn = _pub_connection(talker, "/img")
         conn.ring.put = forged

@@ -236,6 +236,8 @@ def u8_buffer(value: Any) -> Any:
     if isinstance(value, str):
         return value.encode("latin-1")
     if type(value).__module__ == "numpy":
+        if value.ndim and value.itemsize == 1 and value.flags.c_contiguous:
+            return memoryview(value).cast("B")  # no copy (a loaned array, cv_bridge's images)
         return value.astype("u1", copy=False).tobytes()
     return bytes(value)  # list/tuple of ints: ValueError/TypeError on bad items -> diagnosis
 
