@@ -21,7 +21,8 @@ Rules, each there so a loan can never alias a message somebody still reads:
   user kept the array itself; without ``with``, dropping the message returns it the same way;
 * after ``publish`` the loan is the subscriber's to read: take a new loan for the next message
   (publishing the same loan again while the first is unread falls back to copying);
-* no SHMROS subscriber, a message below the shared-memory threshold, every slot busy, a loan larger
+* no SHMROS subscriber, a message below the shared-memory threshold, every slot busy (a publisher
+  with ``queue_size=None`` first waits up to ``shm_link.SLOT_WAIT`` for one, as its publish does), a loan larger
   than a slot or a full /dev/shm: the array is an ordinary heap buffer instead (``loan.shared`` is
   False) and ``publish`` works exactly as for any message. The array's initial contents are undefined
   in both cases (a slot holds an earlier message).
@@ -122,10 +123,18 @@ def _shared_array(publisher: Publisher, length: int) -> Any:
     """A slot's array from the first SHMROS subscriber's ring that has one free, or None."""
     if length < shm_link.THRESHOLD:
         return None  # it would travel inline: no slot to spend on it
-    for conn in publisher._pub.connections:
-        if isinstance(conn, shm_link.ShmPubConnection) and not conn.closed:
-            ring = conn._ring()
-            array = ring.lend(length) if ring is not None else None
-            if array is not None:
-                return array
+    rings = [
+        ring
+        for conn in publisher._pub.connections
+        if isinstance(conn, shm_link.ShmPubConnection) and not conn.closed
+        for ring in (conn._ring(),)
+        if ring is not None
+    ]
+    for ring in rings:
+        array = ring.lend(length)
+        if array is not None:
+            return array
+    if rings and publisher.queue_size is None:
+        # synchronous, as its publish: the subscriber is most likely just behind (see put)
+        return rings[0].lend(length, shm_link.SLOT_WAIT)
     return None

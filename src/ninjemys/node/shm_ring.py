@@ -35,6 +35,7 @@ from ninjemys.errors import NinjemysError
 
 TYPE_CHECKING = False
 if TYPE_CHECKING:
+    from collections.abc import Callable
     from typing import Any
 
 SHM_DIR = "/dev/shm"
@@ -169,6 +170,11 @@ class WriterRing:
         publisher waits a little: its subscriber is merely behind, and the ring is the fast path."""
         if length > self.slot_size:
             return None
+        return self._with_free_slot(wait, lambda slot: self._fill(slot, parts, length))
+
+    def _with_free_slot(self, wait: float, take: Callable[[int], Any]) -> Any:
+        """``take(slot)`` under the lock for the first free slot, waiting up to ``wait`` seconds for
+        one; None when the ring is closed or no slot came free."""
         deadline = 0.0
         while True:
             with self._lock:
@@ -178,7 +184,7 @@ class WriterRing:
                 if slot is not None:
                     if not deadline:
                         self._patient = True  # slots come free again: worth waiting next time
-                    return self._fill(slot, parts, length)
+                    return take(slot)
             if not wait or not self._patient:
                 return None
             now = time.monotonic()
@@ -230,34 +236,36 @@ class WriterRing:
         """Some slot is loaned out (publish then looks for the loaned array among its parts)."""
         return True in self._lent
 
-    def lend(self, nbytes: int) -> Any:
+    def lend(self, nbytes: int, wait: float = 0.0) -> Any:
         """A writable numpy ``uint8`` array of ``nbytes`` at :data:`LOAN_OFFSET` of a free slot, or
-        None (no slot free, too big for a slot, /dev/shm full, ring closed). The slot stays busy
-        while any view of that array lives, published or not, and after that until the subscriber
-        releases what was published from it: a loan can never alias a message still being read."""
+        None (no slot free after ``wait`` seconds, too big for a slot, /dev/shm full, ring closed).
+        The slot stays busy while any view of that array lives, published or not, and after that
+        until the subscriber releases what was published from it: a loan can never alias a message
+        still being read."""
         if nbytes <= 0 or LOAN_OFFSET + nbytes > self.slot_size:
             return None
-        import ctypes  # only a lending publisher needs them
-
         import numpy
 
-        with self._lock:
-            if self.closed:
-                return None
-            slot = self._free_slot()
-            if slot is None or not self._reserve(slot, LOAN_OFFSET + nbytes):
-                return None
-            if not self._address:
-                probe = ctypes.c_char.from_buffer(self._mm)
-                self._address = ctypes.addressof(probe)
-                del probe
-            lease_type = self._lease_types.get(nbytes)
-            if lease_type is None:
-                lease_type = self._lease_types[nbytes] = _loan_type(nbytes)
-            lease = lease_type.from_buffer(self._mm, self._data + slot * self.slot_size + LOAN_OFFSET)
-            lease.lent, lease.slot = self._lent, slot
-            self._lent[slot] = True
-        return numpy.frombuffer(lease, dtype=numpy.uint8)
+        lease = self._with_free_slot(wait, lambda slot: self._lease(slot, nbytes))
+        return None if lease is None else numpy.frombuffer(lease, dtype=numpy.uint8)
+
+    def _lease(self, slot: int, nbytes: int) -> Any:
+        """Lend ``slot`` (lock held): the ctypes object exporting its array, or None."""
+        import ctypes  # only a lending publisher needs it
+
+        if not self._reserve(slot, LOAN_OFFSET + nbytes):
+            return None
+        if not self._address:
+            probe = ctypes.c_char.from_buffer(self._mm)
+            self._address = ctypes.addressof(probe)
+            del probe
+        lease_type = self._lease_types.get(nbytes)
+        if lease_type is None:
+            lease_type = self._lease_types[nbytes] = _loan_type(nbytes)
+        lease = lease_type.from_buffer(self._mm, self._data + slot * self.slot_size + LOAN_OFFSET)
+        lease.lent, lease.slot = self._lent, slot
+        self._lent[slot] = True
+        return lease
 
     def put_lent(self, parts: list, length: int) -> bytes | None:
         """Publish a message whose big array is loaned from this ring without copying it: the parts
