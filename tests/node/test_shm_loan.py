@@ -214,3 +214,19 @@ def test_a_subscriber_gone_while_loaned_leaves_the_loan_usable_and_nothing_behin
     loan.msg.data[:] = 4  # the mapping lives as long as the loan
     pub.publish(loan.msg)  # nobody to send to: fine
     assert loan.msg.data[0] == 4
+
+
+def test_an_intraprocess_publisher_leaves_the_shared_loaned_object_whole(make_node) -> None:  # noqa: ANN001
+    talker = make_node("talker")
+    pub = talker.publisher("img", Image, queue_size=None, intraprocess=True)
+    inproc: list[Image] = []
+    talker.subscriber("img", Image, inproc.append, intraprocess=True)
+    remote: list[Image] = []
+    make_node("listener").subscriber("img", Image, remote.append)
+    assert wait_until(lambda: pub.get_num_connections() == 2)
+    with pub.loan(SIZE, **_image_fields(0)) as msg:
+        msg.data[:] = 6
+        pub.publish(msg)
+    assert wait_until(lambda: inproc and remote, timeout=10)
+    assert inproc[0] is msg and len(msg.data) == SIZE and msg.data[-1] == 6  # not detached
+    assert bytes(remote[0].data) == bytes([6]) * SIZE

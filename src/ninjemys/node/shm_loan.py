@@ -18,7 +18,9 @@ Rules, each there so a loan can never alias a message somebody still reads:
 * the slot stays busy while any view of the loaned array lives (published or not) and, once
   published, until the subscriber has released the message: leaving the ``with`` block detaches the
   array from the message (its field becomes empty), so the slot comes back at once unless the
-  user kept the array itself; without ``with``, dropping the message returns it the same way;
+  user kept the array itself; without ``with``, dropping the message returns it the same way (with
+  ``intraprocess=True`` the message object itself may be an in-process subscriber's: it is left
+  whole, and the slot waits for every holder to drop it);
 * after ``publish`` the loan is the subscriber's to read: take a new loan for the next message
   (publishing the same loan again while the first is unread falls back to copying);
 * no SHMROS subscriber, a message below the shared-memory threshold, every slot busy (a publisher
@@ -51,14 +53,15 @@ class LoanedMessage:
     """A message whose big array was loaned (see the module docstring); a context manager whose
     ``with`` gives the message and whose end detaches the array, so its slot comes back."""
 
-    __slots__ = ("msg", "field", "shared")
+    __slots__ = ("msg", "field", "shared", "_detach")
 
-    def __init__(self, msg: Any, field: str, shared: bool) -> None:
+    def __init__(self, msg: Any, field: str, shared: bool, detach: bool = True) -> None:
         self.msg = msg
         #: the loaned field's name
         self.field = field
         #: True when the array lives in a shared-memory slot, False for the heap fallback
         self.shared = shared
+        self._detach = detach
 
     def __enter__(self) -> Any:
         return self.msg
@@ -68,8 +71,11 @@ class LoanedMessage:
 
     def release(self) -> None:
         """Detach the array from the message (its field becomes empty): the slot is free again as
-        soon as no other view of the array lives and the subscriber released what was published."""
-        setattr(self.msg, self.field, b"")
+        soon as no other view of the array lives and the subscriber released what was published.
+        Not for a publisher with ``intraprocess=True``: its in-process subscribers may hold this
+        very message object, which must stay whole (the slot then waits for them to drop it)."""
+        if self._detach:
+            setattr(self.msg, self.field, b"")
 
     def __repr__(self) -> str:
         where = "shared memory" if self.shared else "the heap"
@@ -116,7 +122,7 @@ def loan(publisher: Publisher, length: int, field: str | None, fields: dict[str,
 
         array = numpy.empty(length, dtype=numpy.uint8)
     setattr(msg, name, array)
-    return LoanedMessage(msg, name, shared)
+    return LoanedMessage(msg, name, shared, not publisher.intraprocess)
 
 
 def _shared_array(publisher: Publisher, length: int) -> Any:
