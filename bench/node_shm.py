@@ -72,6 +72,9 @@ def _sender(pub, msg):  # noqa: ANN001, ANN202
     size = len(msg.data)
     frame = memoryview(msg.data)
 
+    with impl.loan(size, **fields):  # warm up: numpy's import and the first loan are one-time costs
+        pass
+
     def send_loaned(stamp: bool) -> None:
         with impl.loan(size, **fields) as m:
             if loan == "fill":

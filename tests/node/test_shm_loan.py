@@ -230,3 +230,15 @@ def test_an_intraprocess_publisher_leaves_the_shared_loaned_object_whole(make_no
     assert wait_until(lambda: inproc and remote, timeout=10)
     assert inproc[0] is msg and len(msg.data) == SIZE and msg.data[-1] == 6  # not detached
     assert bytes(remote[0].data) == bytes([6]) * SIZE
+
+
+def test_a_numpy_image_serializes_without_a_copy_and_with_the_same_bytes() -> None:
+    np = pytest.importorskip("numpy")
+    pixels = np.arange(H * W * 3, dtype=np.uint8).reshape(H, W, 3)  # as cv_bridge makes them
+    img = Image(**_image_fields(0), data=pixels)
+    _, parts = img.frame_parts()
+    big = [p for p in parts if len(p) == SIZE]
+    assert len(big) == 1 and isinstance(big[0], memoryview) and big[0].obj is pixels  # a view, no copy
+    assert img.serialize_to_bytes() == Image(**_image_fields(0), data=pixels.tobytes()).serialize_to_bytes()
+    strided = pixels[:, ::2]  # not contiguous: copied, as before
+    assert Image(data=strided).serialize_to_bytes()[-len(strided.tobytes()) :] == strided.tobytes()

@@ -139,7 +139,7 @@ class WriterRing:
         self._gen = [0] * slots  # what we stamped
         #: slots loaned to the user (see lend): busy until the last view of the loan is gone
         self._lent = [False] * slots
-        self._lease_types: dict[int, type] = {}
+        self._lease_types: dict[int, Any] = {}  # ctypes array types by size
         self._address = 0  # where the mapping starts in this process (found on the first loan)
         self._reclaimed = [0] * slots  # notices dropped before sending (queue_size)
         self._reserved = [0] * slots  # bytes of each slot backed by tmpfs pages (no SIGBUS)
@@ -344,7 +344,7 @@ class WriterRing:
                 pass  # a loan is still held: the mapping goes with its last view
 
 
-def _loan_type(nbytes: int) -> type:
+def _loan_type(nbytes: int) -> Any:
     """A ctypes array type of ``nbytes`` whose instances export one loaned slot; when the last view
     of one goes, its slot is lent no more (it may still wait for the subscriber to release it)."""
     import ctypes
