@@ -209,6 +209,16 @@ def _spawn(cmd: list[str], env: dict[str, str], cpu: str):  # noqa: ANN202
     return role
 
 
+def _ratios(what: str, values: dict[str, float], ours: list[str]) -> None:
+    """One line per implementation of ours: its value over rospy's and roscpp's (lower is better)."""
+    from node_common import CPP, REAL
+
+    for impl in ours:
+        parts = [f"/{ref} {values[impl] / values[ref]:.3f}x" for ref in (REAL, CPP) if values.get(ref)]
+        if parts and impl in values:
+            print(f"{what}: {impl} {', '.join(parts)}", flush=True)
+
+
 def main() -> None:
     sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
     import node_shm_roscpp
@@ -226,8 +236,10 @@ def main() -> None:
     rows: list[str] = []
     with master() as uri:
         for place, cpus in (("one CPU", SAME_CPU), ("across CPUs", CROSS_CPU)):
+            oneway: dict[str, float] = {}
             for impl in impls:
                 lat = _run(impl, uri, "hd", "latency", "30", cpus)
+                oneway[impl] = lat["latency_ms"]
                 row = f"1080p rgb8 {place:11s} {impl:18s} one-way p50 {lat['latency_ms']:7.2f} ms"
                 if impl != LOAN_FILL:
                     flood = _run(impl, uri, "hd", "flood", seconds, cpus)
@@ -236,13 +248,17 @@ def main() -> None:
                         row += " (the image is not rewritten per frame: GB/s the subscriber could read)"
                 rows.append(row)
                 print(rows[-1], flush=True)
+            _ratios(f"1080p one-way {place}", oneway, [LOAN, OURS])
+        cpus_4k: dict[str, float] = {}
         for impl in impls:
             r = _run(impl, uri, "uhd", "rate30", seconds, CROSS_CPU)
             cpu = (r["pub_cpu_s"] / r["pub_wall_s"] + r["cpu_s"] / r["span_s"]) * 100
+            cpus_4k[impl] = cpu
             rows.append(
                 f"4K rgb8 30 Hz  across CPUs {impl:18s} pub+sub CPU {cpu:6.1f} % of one core ({r['per_s']:.1f} Hz)"
             )
             print(rows[-1], flush=True)
+        _ratios("4K 30 Hz CPU", cpus_4k, [LOAN, OURS])
         clouds = {}
         for impl in impls:
             if impl == LOAN_FILL:
