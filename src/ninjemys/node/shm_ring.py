@@ -51,6 +51,8 @@ NOTICE_TAG, INLINE_TAG = 1, 0
 #: the frame that names the ring, sent once before the first notice: tag 2, then the segment name
 RING_TAG = 2
 
+#: madvise(2) advice (Linux 5.14+; Python 3.11's mmap module does not name it)
+_MADV_POPULATE_WRITE = getattr(mmap, "MADV_POPULATE_WRITE", 23)
 #: how often a waiting publisher looks for a released slot (seconds)
 _POLL = 100e-6
 #: where a loaned array starts in its slot: the message's fields before the array (header, sizes,
@@ -201,10 +203,15 @@ class WriterRing:
         """Back the first ``end`` bytes of ``slot`` with tmpfs pages (lock held); False when
         /dev/shm is full (the caller then goes inline rather than taking a SIGBUS on the copy)."""
         if self._reserved[slot] < end:
+            base = self._data + slot * self.slot_size
             try:
-                os.posix_fallocate(self._fd, self._data + slot * self.slot_size, end)  # type: ignore[arg-type]
+                os.posix_fallocate(self._fd, base, end)  # type: ignore[arg-type]
             except OSError:
                 return False
+            try:  # map the new pages in one call, not ~1500 faults for 6 MB on the first copy
+                self._mm.madvise(_MADV_POPULATE_WRITE, base, end)
+            except (OSError, ValueError):
+                pass  # Linux before 5.14: the copy faults them in
             self._reserved[slot] = end
         return True
 
