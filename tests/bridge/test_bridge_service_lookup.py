@@ -90,3 +90,40 @@ def test_a_provider_that_restarts_with_another_type_is_followed(
         assert (reply.success, reply.message) == (True, "now a trigger")  # probed again: its new type
     finally:
         third.shutdown("test over")
+
+
+def test_the_gateway_starts_without_probing_services_and_advertises_them_next(
+    master_uri: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """start() returns with the graph and topics known; the services' types (a lookup and a connection
+    per service, two services per node) come from the poller's first round, not from the caller's."""
+    from ninjemys.bridge.server import Gateway, GatewayOptions
+    from ninjemys.testing import free_port, wait_until
+
+    provider = Node("lookup_start_provider", master_uri=master_uri)
+    provider.service("/lookup_add", AddTwoInts, lambda r: r.a + r.b)
+    probed_on: list[str] = []
+    real_type = Services.service_type
+
+    def recording_type(self: Services, service: str) -> str:
+        import threading
+
+        probed_on.append(threading.current_thread().name)
+        return real_type(self, service)
+
+    monkeypatch.setattr(Services, "service_type", recording_type)
+    gateway = Gateway(GatewayOptions(port=free_port(), update_period=0.2))
+    try:
+        gateway.start()
+        # the first refresh (in start) knew the graph: the provider's node is in it
+        assert "/lookup_start_provider" in gateway.catalog.node_names()
+        entry = wait_until(
+            lambda: next((s for s in gateway.catalog.services.values() if s["name"] == "/lookup_add"), None),
+            20.0,
+            "/lookup_add advertised",
+        )
+        assert entry["type"] == "rospy_tutorials/AddTwoInts"
+        assert probed_on and set(probed_on) == {"gateway-graph"}, probed_on
+    finally:
+        gateway.shutdown()
+        provider.shutdown("test over")
