@@ -92,6 +92,22 @@ def test_a_provider_that_restarts_with_another_type_is_followed(
         third.shutdown("test over")
 
 
+def test_a_service_unregistered_by_a_live_node_is_gone_for_the_gateway_too(
+    services: tuple[Services, list[str]], master_uri: str
+) -> None:
+    """The persistent connection is no licence to call a service its node withdrew."""
+    calls, _ = services
+    provider = Node("lookup_withdraws", anonymous=True, master_uri=master_uri)
+    try:
+        server = provider.service("/lookup_add", AddTwoInts, lambda r: r.a + r.b)
+        assert add(calls, 1, 2).sum == 3
+        server.shutdown()
+        with pytest.raises(ServiceError, match="does not exist"):
+            add(calls, 1, 2)
+    finally:
+        provider.shutdown("test over")
+
+
 def test_the_gateway_starts_without_probing_services_and_advertises_them_next(
     master_uri: str, monkeypatch: pytest.MonkeyPatch
 ) -> None:
