@@ -3,9 +3,12 @@
     .venv/bin/python bench/master_auth.py [--calls 300] [--pairs 40]
 
 Two of our masters run at once, one with a secret; one client in this process registers publishers
-(registerPublisher, a new topic each) and looks a node up (lookupNode), signing its requests only
-for the secured master. So "on" pays both HMACs of a call: the client's signature and the master's
-check (with its replay bookkeeping); replies are not signed.
+(registerPublisher, a new topic each) and looks a node up (lookupNode) on one keep-alive connection,
+as every node's master client does: the connection is authenticated by its first signed call, like a
+TCPROS connection by its header (net.auth), so "on" pays the HMACs once per connection. A third
+measure opens a connection per call (lookupNode, as the slave API and rospy's ServerProxy do): each
+of those calls pays both HMACs, the client's signature and the master's check (with its replay
+bookkeeping); replies are not signed.
 
 Robust against a busy machine: the run is many short *pairs* of rounds, one on and one off back to
 back (ABBA order, so neither side always goes first), and each pair gives one on/off ratio. Load
@@ -55,22 +58,29 @@ def cpu_seconds(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
+KINDS = ("registerPublisher", "lookupNode", "lookupNode, a connection per call")
+
+
 def rates(uri: str, pid: int, calls: int, tag: str) -> list[float]:
-    """One round on a fresh client, ``calls`` of each kind: [registerPublisher/s, lookupNode/s, CPU
-    microseconds per call of master + client for each]. CPU time is what a busy machine disturbs
-    least: waiting for a core does not count in it."""
+    """One round on a fresh client, ``calls`` of each kind: [calls/s of each kind, CPU microseconds per
+    call of master + client for each]. CPU time is what a busy machine disturbs least: waiting for a
+    core does not count in it."""
     client = MasterClient(uri, f"/bench_{tag}", timeout=30)
     client.get_system_state()  # connection and caches warm before the clock starts
     out: list[float] = []
     cpu: list[float] = []
-    for kind in ("register", "lookup"):
+    for kind in KINDS:
         cpu0, mine0, start = cpu_seconds(pid), time.process_time(), time.perf_counter()
-        if kind == "register":
+        if kind == "registerPublisher":
             for i in range(calls):
                 client.register_publisher(f"/{tag}/topic_{i}", "std_msgs/String", "http://127.0.0.1:1/")
+        elif kind == "lookupNode":
+            for _ in range(calls):
+                client.lookup_node(f"/bench_{tag}")
         else:
             for _ in range(calls):
                 client.lookup_node(f"/bench_{tag}")
+                client.close()  # the next call opens (and signs) a new connection
         out.append(calls / (time.perf_counter() - start))
         cpu.append((cpu_seconds(pid) - cpu0 + time.process_time() - mine0) / calls * 1e6)
     client.close()
@@ -145,23 +155,24 @@ def main() -> None:
         f"(load {load_before:.1f} -> {os.getloadavg()[0]:.1f})"
     )
     print(f"  HMAC-SHA256 of a ~400-byte call (timeit): sign {sign_us:.1f} us, sign + check {both_us:.1f} us")
-    for label, k in (("registerPublisher", 0), ("lookupNode", 1)):
+    n = len(KINDS)
+    for k, label in enumerate(KINDS):
         off = statistics.median(pr[False][k] for pr in pairs)
         on = statistics.median(pr[True][k] for pr in pairs)
         costs = [1 - pr[True][k] / pr[False][k] for pr in pairs]
         extra_us = [1e6 / pr[True][k] - 1e6 / pr[False][k] for pr in pairs]
-        report(f"{label} calls/s", off, on, costs, f"{statistics.median(extra_us):+.0f} us a call")
-        off_cpu = statistics.median(pr[False][k + 2] for pr in pairs)
-        on_cpu = statistics.median(pr[True][k + 2] for pr in pairs)
-        cpu_costs = [pr[True][k + 2] / pr[False][k + 2] - 1 for pr in pairs]
-        report(f"{label} CPU us/call", off_cpu, on_cpu, cpu_costs, "master + client")
+        report(f"{label}: calls/s", off, on, costs, f"{statistics.median(extra_us):+.0f} us a call")
+        off_cpu = statistics.median(pr[False][k + n] for pr in pairs)
+        on_cpu = statistics.median(pr[True][k + n] for pr in pairs)
+        cpu_costs = [pr[True][k + n] / pr[False][k + n] - 1 for pr in pairs]
+        report(f"{label}: CPU us/call", off_cpu, on_cpu, cpu_costs, "master + client")
 
 
 def report(label: str, off: float, on: float, costs: list[float], note: str) -> None:
     q1, q2, q3 = quartiles(costs)
     low, high = median_ci(costs)
     print(
-        f"  {label:29s} off {off:6.0f}  on {on:6.0f}  cost: median of pairs {100 * q2:+.1f} %"
+        f"  {label:48s} off {off:6.0f}  on {on:6.0f}  cost: median of pairs {100 * q2:+.1f} %"
         f" (95 % interval {100 * low:+.1f} .. {100 * high:+.1f} %; single pairs' quartiles"
         f" {100 * q1:+.1f} .. {100 * q3:+.1f} %), {note}; target <= 10 %: {verdict(costs)}"
     )

@@ -201,3 +201,34 @@ def test_a_real_ros1_tool_is_refused_with_the_reason_and_works_without_a_secret(
                 got = subprocess.run(["/usr/bin/rosparam", "get", "/x"], env=testing.ros1_env(uri),
                                      capture_output=True, text=True, timeout=30)  # fmt: skip
                 assert got.stdout.strip() == "1"
+
+
+def test_the_master_clients_connection_is_signed_once_and_then_trusted(secured: str, monkeypatch) -> None:  # noqa: ANN001
+    """With a shared secret a connection proven once is trusted for every caller; a master client
+    signs its first call on each connection and again after a reconnect."""
+    from ninjemys.master.client import MasterClient
+
+    signed: list[str] = []
+    real = auth.header_line
+
+    def counting(creds: auth.Credentials | None, body: bytes, caller: str | None = None) -> str:
+        line = real(creds, body, caller)
+        signed.append(line)
+        return line
+
+    monkeypatch.setattr(auth, "header_line", counting)
+    with MasterClient(secured, "/counted") as client:
+        for _ in range(5):
+            client.get_system_state()
+        assert len(signed) == 1 and signed[0].startswith("X-Ninjemys-Auth: v1 ")
+        client.close()
+        client.get_system_state()
+        client.get_system_state()
+        assert len(signed) == 2
+    host, port = secured.split("//")[1].strip("/").split(":")
+    with socket.create_connection((host, int(port)), timeout=10) as s:  # untrusted: refused
+        body = xmlrpc.client.dumps(("/counted",), "getSystemState").encode()
+        s.sendall(
+            f"POST /RPC2 HTTP/1.1\r\nHost: {host}\r\nContent-Length: {len(body)}\r\n\r\n".encode() + body
+        )
+        assert b"authentication failed: not signed" in s.recv(65536)
