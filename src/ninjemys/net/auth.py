@@ -225,6 +225,10 @@ class Credentials:
                 return signer
         return None
 
+    def listed_names(self) -> list[tuple[str, bytes]]:
+        """(name, key) of every name listed exactly (not patterns)."""
+        return [(name, s.key) for name, s in self._exact.items()]
+
     def signer_for(self, name: str) -> Signer | None:
         """The signer this process uses when it speaks as ``name``."""
         return self._own if self._own is not None else self.key_for(name)
