@@ -232,3 +232,54 @@ def test_the_master_clients_connection_is_signed_once_and_then_trusted(secured: 
             f"POST /RPC2 HTTP/1.1\r\nHost: {host}\r\nContent-Length: {len(body)}\r\n\r\n".encode() + body
         )
         assert b"authentication failed: not signed" in s.recv(65536)
+
+
+_ROSPY_TALKER = """
+import rospy
+from std_msgs.msg import String
+rospy.init_node("ros1_talker")
+pub = rospy.Publisher("from_ros1", String, queue_size=10)
+got = []
+rospy.Subscriber("from_ninjemys", String, lambda m: got.append(m.data))
+rate = rospy.Rate(20)
+while not rospy.is_shutdown() and not got:
+    pub.publish(String("hello from rospy"))
+    rate.sleep()
+print(got[0] if got else "nothing")
+"""
+
+
+@pytest.mark.ros1
+def test_a_real_rospy_node_talks_as_before_with_authentication_off(monkeypatch, tmp_path: Path) -> None:  # noqa: ANN001
+    """Authentication off (no variable set): Debian's rospy node and ours exchange messages both ways
+    through our master, nothing signed on either side."""
+    if not testing.have_ros1():
+        pytest.skip("Debian's ROS 1 is not installed")
+    for name in ("NINJEMYS_SECRET", "NINJEMYS_SECRET_FILE", "NINJEMYS_KEYS_FILE", "NINJEMYS_KEY"):
+        monkeypatch.delenv(name, raising=False)
+    assert auth.credentials() is None
+    env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_LOG_DIR=str(tmp_path))
+    with testing.run_master(env=env) as uri:
+        node = Node("ours", master_uri=uri)
+        try:
+            heard: list[str] = []
+            node.subscriber("from_ros1", String, lambda m: heard.append(m.data))
+            pub = node.publisher("from_ninjemys", String)
+            proc = subprocess.Popen(
+                [testing.ROS1_PYTHON, "-c", _ROSPY_TALKER], env=testing.ros1_env(uri),
+                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+            )  # fmt: skip
+            try:
+                testing.wait_until(lambda: bool(heard), timeout=60, what="rospy's message")
+                testing.wait_until(
+                    lambda: pub.publish(String("hello from ninjemys")) or proc.poll() is not None,
+                    timeout=60, what="rospy to hear us", step=0.05,
+                )  # fmt: skip
+                out, err = proc.communicate(timeout=30)
+            finally:
+                proc.kill()
+                proc.wait()
+            assert heard[0] == "hello from rospy"
+            assert out.strip() == "hello from ninjemys", err
+        finally:
+            node.shutdown()

@@ -21,10 +21,7 @@ it needs certificates the secret cannot give, so it stays the user's configurati
 
 from __future__ import annotations
 
-import hashlib
-import hmac
 import os
-import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
 
@@ -41,6 +38,9 @@ class AccessError(NinjemysError):
 
 def password(key: bytes) -> str:
     """The Zenoh password derived from a graph key (hex of an HMAC: one-way, no ':' or newline)."""
+    import hashlib
+    import hmac
+
     return hmac.new(key, _CONTEXT, hashlib.sha256).hexdigest()
 
 
@@ -65,6 +65,8 @@ def usrpwd_settings(creds: Credentials | None, bridge_name: str) -> Iterator[dic
     if creds is None:
         yield {}
         return
+    import tempfile
+
     user, secret, admitted = logins(creds, bridge_name)
     with tempfile.TemporaryDirectory(prefix="ninjemys-zenoh-") as folder:  # 0700
         path = os.path.join(folder, "usrpwd")
