@@ -37,7 +37,7 @@ def test_signatures_check_once_within_the_window_and_with_the_right_secret(monke
     assert b.check(a.sign(b"x"), b"x") == "wrong secret"
     assert a.check(a.sign(b"x"), b"y") == "wrong secret"  # the body is covered
     assert "not signed" in (a.check(None, b"x") or "")
-    assert a.check("v2 1 2 3", b"x") == "malformed signature"
+    assert a.check("v1 1 2 3", b"x") == "malformed signature"  # the old format
     old = a.sign(b"x")
     monkeypatch.setattr(auth.time, "time", lambda: time.monotonic() + 1e9)
     assert "clocks more than 120 s apart" in (a.check(old, b"x") or "")
@@ -220,7 +220,7 @@ def test_the_master_clients_connection_is_signed_once_and_then_trusted(secured: 
     with MasterClient(secured, "/counted") as client:
         for _ in range(5):
             client.get_system_state()
-        assert len(signed) == 1 and signed[0].startswith("X-Ninjemys-Auth: v1 ")
+        assert len(signed) == 1 and signed[0].startswith("X-Ninjemys-Auth: v2 ")
         client.close()
         client.get_system_state()
         client.get_system_state()

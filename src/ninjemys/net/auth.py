@@ -14,8 +14,8 @@ ROS 1 authenticates nothing: anyone who reaches the master can register, publish
 What is signed:
 
 - XML-RPC (the master's API and every node's slave API): an HTTP header
-  ``X-Ninjemys-Auth: v1 <time> <nonce> <mac>``, the MAC an HMAC-SHA256 (first 128 bits) over the
-  time, the nonce and the request body. The body stays exactly ROS 1's.
+  ``X-Ninjemys-Auth: v2 <time> <nonce> <mac>``, the MAC an HMAC-SHA256 (first 128 bits) over
+  what precedes it and the request body. The body stays exactly ROS 1's.
 - TCPROS and service connections (both directions): a connection-header field ``ninjemys_auth`` of
   the same form, over every other field of the header.
 
@@ -53,6 +53,8 @@ ENV_KEYS_FILE = "NINJEMYS_KEYS_FILE"
 ENV_KEY = "NINJEMYS_KEY"
 _ENV_ALL = (ENV_SECRET, ENV_SECRET_FILE, ENV_KEYS_FILE, ENV_KEY)
 HTTP_HEADER = "X-Ninjemys-Auth"
+#: the signature's format: v1 (before 2026-11-29) carried the whole 256-bit MAC over another layout
+VERSION = "v2"
 TCPROS_FIELD = "ninjemys_auth"
 #: seconds a signature stays good (clock difference between machines plus transit)
 WINDOW = 120.0
@@ -109,25 +111,26 @@ class Signer:
         self._seen: OrderedDict[str, float] = OrderedDict()
         self._lock = threading.Lock()
 
-    def mac(self, stamp: str, nonce: str, payload: bytes) -> str:
-        """The first 128 bits (hex) of HMAC-SHA256(key, stamp "\\n" nonce "\\n" payload)."""
+    def mac(self, head: str, payload: bytes) -> str:
+        """The first 128 bits (hex) of HMAC-SHA256(key, head + payload)."""
         inner = self._inner.copy()
-        inner.update(f"{stamp}\n{nonce}\n".encode())
+        inner.update(head.encode())
         inner.update(payload)
         outer = self._outer.copy()
         outer.update(inner.digest())
         return outer.hexdigest()[:32]
 
     def sign(self, payload: bytes) -> str:
-        stamp, nonce = f"{time.time():.3f}", f"{self._prefix}{next(self._count):x}"
-        return f"v1 {stamp} {nonce} {self.mac(stamp, nonce, payload)}"
+        """``v2 <time> <nonce> <mac>``, the MAC over everything before it and the payload."""
+        head = f"{VERSION} {time.time():.3f} {self._prefix}{next(self._count):x} "
+        return head + self.mac(head, payload)
 
     def check(self, token: str | None, payload: bytes) -> str | None:
         """Why ``token`` does not authenticate ``payload`` (None: it does)."""
         if not token:
             return _NOT_SIGNED
         parts = token.split(" ")
-        if len(parts) != 4 or parts[0] != "v1":
+        if len(parts) != 4 or parts[0] != VERSION:
             return "malformed signature"
         _, stamp, nonce, mac = parts
         try:
@@ -137,7 +140,7 @@ class Signer:
         now = time.time()
         if abs(now - when) > WINDOW:
             return f"signature from {now - when:+.0f} s away (clocks more than {WINDOW:.0f} s apart, or a replay)"
-        if not self._compare(mac, self.mac(stamp, nonce, payload)):
+        if not self._compare(mac, self.mac(token[: -len(mac)], payload)):
             return "wrong secret"
         with self._lock:
             seen = self._seen
