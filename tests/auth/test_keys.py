@@ -49,6 +49,8 @@ def test_a_keys_file_maps_names_and_patterns_to_keys(tmp_path: Path) -> None:
     assert creds.secret_for("/robot1/camera") == b"key-of-robot1"
     assert creds.secret_for("/robot1/arm/driver") == b"key-of-the-arm"  # the longest pattern wins
     assert creds.secret_for("/robot2/camera") is None
+    assert auth.parse_keys("/a k#1  # a comment\n") == {"/a": b"k#1"}  # a key may hold '#'
+
     # the talker's own key (NINJEMYS_KEY) signs whatever it claims; the master checks the claim
     mine = auth.load_credentials({"NINJEMYS_KEY": "key-of-the-talker"})
     assert mine is not None and not mine.can_check
@@ -78,6 +80,7 @@ def test_the_caller_is_read_from_the_call_itself() -> None:
     ("text", "error"),
     [
         ("/talker\n", "keys:1: expected '<node name> <key>'"),
+        ("# a comment\n/talker two words\n", "keys:2: expected '<node name> <key>'"),
         ("talker k\n", "keys:1: 'talker' is not a global node name"),
         ("/a*b k\n", "keys:1: '/a*b' is not a global node name"),
         ("/a k\n\n/a j\n", "keys:3: /a is listed twice"),

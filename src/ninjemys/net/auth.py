@@ -157,19 +157,19 @@ class Signer:
 
 
 def parse_keys(text: str, source: str = "<keys>") -> dict[str, bytes]:
-    """``<name> <key>`` lines (``#`` comments, blank lines) -> {name or pattern: key}. A name is a
-    global graph name (``/talker``), or a pattern ending in ``*`` covering every name that starts with
-    what precedes the star (``/robot1/*``, ``/rostopic_*``, ``*`` for every name)."""
+    """``<name> <key>`` lines -> {name or pattern: key}. A name is a global graph name (``/talker``),
+    or a pattern ending in ``*`` covering every name that starts with what precedes the star
+    (``/robot1/*``, ``/rostopic_*``, ``*`` for every name). A key is one word (it may hold ``#``);
+    blank lines, lines starting with ``#`` and ``# ...`` after the key are comments."""
     keys: dict[str, bytes] = {}
     for number, raw in enumerate(text.splitlines(), 1):
-        line = raw.split("#", 1)[0].strip()
-        if not line:
+        parts = raw.split()
+        if not parts or parts[0].startswith("#"):
             continue
-        parts = line.split(None, 1)
         where = f"{source}:{number}"
-        if len(parts) != 2:
-            raise AuthError(f"{where}: expected '<node name> <key>', got {line[:60]!r}")
-        name, key = parts[0], parts[1].strip()
+        if len(parts) < 2 or (len(parts) > 2 and not parts[2].startswith("#")):
+            raise AuthError(f"{where}: expected '<node name> <key>', got {raw.strip()[:60]!r}")
+        name, key = parts[0], parts[1]
         if not (name.startswith("/") or name == "*") or "*" in name[:-1]:
             raise AuthError(
                 f"{where}: {name!r} is not a global node name (/talker) or a pattern ending in * (/robot1/*)"
