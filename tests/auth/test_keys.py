@@ -155,7 +155,7 @@ def test_the_master_checks_each_caller_with_its_own_key(keyed: str) -> None:
         (["/listener", *args], "key-of-the-talker", "wrong secret"),  # the talker's key, the listener's name
         (["/robot1/arm/x", *args], "key-of-robot1", "wrong secret"),  # the arm has a key of its own
         (["/intruder", *args], "key-of-the-talker", "no key for /intruder"),
-        (["/talker", *args], None, "not signed"),
+        (["/talker", *args], None, "not signed (this graph requires per-node keys: /talker has none"),
     ):
         code, status, _ = _call(keyed, "registerPublisher", params, key)  # type: ignore[misc]
         assert code == -1 and status.startswith(f"authentication failed: {why}"), (params, status)

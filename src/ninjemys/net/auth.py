@@ -247,7 +247,7 @@ class Credentials:
             if not self.can_check:
                 return f"this process cannot check callers: it has {ENV_KEY} but no {ENV_KEYS_FILE}"
             if not token:
-                return _NOT_SIGNED
+                return f"not signed (this graph requires per-node keys: {caller or 'the caller'} has none, or is a ROS 1 node)"
             s = self.key_for(caller)
             if s is None:
                 return f"no key for {caller or 'a caller without a name'} in {self.source}"
