@@ -6,7 +6,7 @@ Two of our masters run at once, one with a secret; one client in this process re
 (registerPublisher, a new topic each) and looks a node up (lookupNode) on one keep-alive connection,
 as every node's master client does: the connection is authenticated by its first signed call, like a
 TCPROS connection by its header (net.auth), so "on" pays the HMACs once per connection. A third
-measure opens a connection per call (lookupNode, as the slave API and rospy's ServerProxy do): each
+measure opens a connection per call (lookupNode, as node-to-node slave API calls do): each
 of those calls pays both HMACs, the client's signature and the master's check (with its replay
 bookkeeping); replies are not signed.
 
