@@ -19,7 +19,10 @@ slower) is *met* when the whole interval is within 10 %, *missed* when all of it
 *not shown* (noise) when it straddles 10 %. The time one call's HMACs
 take alone (timeit) is printed beside it, as the cost to expect. Beside throughput, each round
 measures the CPU time per call of the master and the client together, which waiting for a core on a
-loaded machine does not inflate: the same verdict is given for it.
+loaded machine does not inflate: the same verdict is given for it. And each pair ends with a round
+that alternates the two masters call by call and compares the median latencies: the throughput of a
+serial client, robust to load (calls next to each other see the same machine; a median ignores the
+preempted ones).
 """
 
 from __future__ import annotations
@@ -85,6 +88,35 @@ def rates(uri: str, pid: int, calls: int, tag: str) -> list[float]:
         cpu.append((cpu_seconds(pid) - cpu0 + time.process_time() - mine0) / calls * 1e6)
     client.close()
     return out + cpu
+
+
+def interleaved(secured: str, plain: str, calls: int, tag: str) -> list[float]:
+    """One round of ``calls`` of each kind alternating call by call between the two masters (one
+    client each, keep-alive): [registerPublisher, lookupNode] median latency with the secret on over
+    off, minus 1. Calls next to each other see the same machine, and a median ignores the calls a
+    busy machine preempted: the robust form of the throughput comparison for a serial client."""
+    clients = {}
+    for on, uri in ((True, secured), (False, plain)):
+        with secret(on):  # a client takes its credentials when it is made
+            clients[on] = MasterClient(uri, f"/bench_{tag}", timeout=30)
+            clients[on].get_system_state()
+    out = []
+    for kind in ("register", "lookup"):
+        times: dict[bool, list[float]] = {True: [], False: []}
+        for i in range(calls):
+            for on in (True, False) if i % 2 else (False, True):
+                client = clients[on]
+                start = time.perf_counter()
+                if kind == "register":
+                    client.register_publisher(f"/{tag}/i{i}", "std_msgs/String", "http://127.0.0.1:1/")
+                else:
+                    client.lookup_node(f"/bench_{tag}")
+                times[on].append(time.perf_counter() - start)
+        out.append(statistics.median(times[True]) / statistics.median(times[False]) - 1)
+        out.append(statistics.median(times[False]) * 1e6)
+    for client in clients.values():
+        client.close()
+    return out
 
 
 def hmac_cost() -> tuple[float, float, float]:
@@ -156,6 +188,7 @@ def main() -> None:
             with secret(on):
                 wait_ready(core)
         pairs: list[dict[bool, list[float]]] = []
+        steps: list[list[float]] = []
         for p in range(opts.pairs):
             pair: dict[bool, list[float]] = {}
             order = (
@@ -165,6 +198,7 @@ def main() -> None:
                 with secret(on):
                     pair[on] = rates(core.uri, core.proc.pid, opts.calls, f"p{p}{int(on)}")
             pairs.append(pair)
+            steps.append(interleaved(secured.uri, plain.uri, opts.calls // 2, f"s{p}"))
     finally:
         secured.kill()
         plain.kill()
@@ -178,6 +212,16 @@ def main() -> None:
         f" {both_us:.1f} us (a call on a new connection); a call on a trusted keep-alive connection:"
         f" {trusted_us:.2f} us"
     )
+    for k, label in enumerate(("registerPublisher", "lookupNode")):
+        costs = [st[2 * k] for st in steps]
+        off_us = statistics.median(st[2 * k + 1] for st in steps)
+        report(
+            f"{label}: call by call, median latency",
+            off_us,
+            off_us * (1 + statistics.median(costs)),
+            costs,
+            "keep-alive, the two masters alternating (us)",
+        )
     n = len(KINDS)
     for k, label in enumerate(KINDS):
         off = statistics.median(pr[False][k] for pr in pairs)
