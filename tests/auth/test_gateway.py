@@ -43,10 +43,10 @@ def gateway(
         monkeypatch.delenv(name, raising=False)
     mode = request.param
     if mode == "shared":
-        monkeypatch.setenv("NINJEMYS_SECRET", "the graph's secret")
+        monkeypatch.setenv("NINJEMYS_SECRET", "the-graphs-secret")
     else:  # per-node keys: the gateway's node has a key of its own
         keys = tmp_path / "keys"
-        keys.write_text("/rosbridge_websocket the graph's secret\n* everyone else's key\n")
+        keys.write_text("/rosbridge_websocket the-graphs-secret\n* everyone-elses-key\n")
         monkeypatch.setenv("NINJEMYS_KEYS_FILE", str(keys))
     with MasterThread() as uri:
         monkeypatch.setenv("ROS_MASTER_URI", uri)
@@ -69,14 +69,12 @@ def test_the_gateway_takes_the_graphs_secret(gateway: Gateway) -> None:
         with pytest.raises(ConnectionClosed):
             intruder.recv(timeout=10)
     with connect(url) as friend:
-        friend.send(_auth_op("the graph's secret"))
+        friend.send(_auth_op("the-graphs-secret"))
         assert "not authenticated" not in _status(friend)
     with pytest.raises(InvalidStatus) as refused:
         connect(url + "?token=a-guess", subprotocols=["foxglove.websocket.v1"]).close()
     assert refused.value.response.status_code == 401
-    with connect(
-        url + "?token=" + quote("the graph's secret"), subprotocols=["foxglove.websocket.v1"]
-    ) as fox:
+    with connect(url + "?token=" + quote("the-graphs-secret"), subprotocols=["foxglove.websocket.v1"]) as fox:
         assert json.loads(fox.recv(timeout=10))["op"] == "serverInfo"
 
 
