@@ -98,13 +98,17 @@ class GatewayOptions:
         if not self.authenticate:
             return None
         if self.secret_file is None:
-            # the graph's own secret (NINJEMYS_SECRET / NINJEMYS_SECRET_FILE, ninjemys.net.auth)
-            shared = auth.load_secret()
-            if shared is None:
+            # the graph's own credentials (ninjemys.net.auth): NINJEMYS_SECRET / NINJEMYS_SECRET_FILE, or
+            # with per-node keys the key of the gateway's node (NINJEMYS_KEY, or its NINJEMYS_KEYS_FILE line)
+            creds = auth.credentials()
+            name = self.node_name if self.node_name.startswith("/") else f"/{self.node_name}"
+            key = None if creds is None else creds.secret_for(name)
+            if key is None:
                 raise NinjemysError(
-                    "authentication is on but no secret is set (secret_file, or NINJEMYS_SECRET for the graph's)"
+                    "authentication is on but no secret is set (secret_file, or NINJEMYS_SECRET for the "
+                    f"graph's, or a key for {name} in NINJEMYS_KEYS_FILE)"
                 )
-            return shared.decode("utf-8", "replace")
+            return key.decode("utf-8", "replace")
         return Path(self.secret_file).read_text().strip()
 
     def foxglove_token(self) -> str | None:
