@@ -86,7 +86,9 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=1)
     parser.add_argument("--floor", action="store_true", help="add the receive-only and no-FK copies of ours")
     parser.add_argument(
-        "--compare", metavar="SRC", help="add ours as found in another source tree (e.g. a git archive of main)"
+        "--compare",
+        metavar="SRC",
+        help="add ours as found in another source tree (e.g. a git archive of main)",
     )
     opts = parser.parse_args()
     from ninjemys import testing

@@ -652,6 +652,19 @@ class Publisher:
             return
         self._pub.publish_frame(frame, self)
 
+    def publish_framed(self, frame: bytes) -> None:
+        """Send a TCPROS frame built by the caller (``uint32`` length, then the serialized message):
+        :meth:`publish_raw` without its copy, for a node that packs the length with the message
+        (robot_state_publisher's plans, whose messages have a constant size)."""
+        if self._closed:
+            raise ShutdownError(f"publisher of {self.name} is unregistered")
+        if self._pub.intra:
+            item = Handoff(None, memoryview(frame)[4:])
+            self._pub.publish_intra(item, self)
+            self._pub.publish_frame(frame, self, item)
+            return
+        self._pub.publish_frame(frame, self)
+
     def get_num_connections(self) -> int:
         return len(self._pub.connections) + len(self._pub.intra)
 

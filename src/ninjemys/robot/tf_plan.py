@@ -44,7 +44,8 @@ class TfPlan:
     """The transforms of one list of joint names (see the module docstring).
 
     ``message(positions, secs, nsecs) -> bytes`` is the serialized TFMessage; ``positions`` are the
-    message's, in its order, after ``skip`` leading items (the unpacked position count, say)."""
+    message's, in its order, after ``skip`` leading items (the unpacked position count, say). With
+    ``framed`` it is the whole TCPROS frame: the length (constant for a plan) packed in front."""
 
     def __init__(
         self,
@@ -53,6 +54,7 @@ class TfPlan:
         mimics: dict[str, list[Joint]],
         frames: Callable[[Joint], bytes],
         skip: int = 0,
+        framed: bool = False,
     ) -> None:
         #: the names the robot has, for the throttle's bookkeeping
         self.known = [n for n in names if n in joints]
@@ -69,10 +71,16 @@ class TfPlan:
                     moving.append(mimic)
         self.count = len(moving)
         self.source = _Source()
-        self.message: Callable[[Sequence[float], int, int], bytes] = self._compile(moving, values, frames)
+        self.message: Callable[[Sequence[float], int, int], bytes] = self._compile(
+            moving, values, frames, framed
+        )
 
     def _compile(
-        self, moving: list[Joint], values: dict[str, tuple[int, float, float]], frames: Callable[[Joint], bytes]
+        self,
+        moving: list[Joint],
+        values: dict[str, tuple[int, float, float]],
+        frames: Callable[[Joint], bytes],
+        framed: bool,
     ) -> Callable[[Sequence[float], int, int], bytes]:
         src = self.source
         fmt = ["<I"]
@@ -88,18 +96,20 @@ class TfPlan:
             if joint.type == "prismatic":
                 dx, dy, dz = apply_rotation(joint.rotation, joint.axis)
                 v = f"v{k}"  # every value lives until the one pack at the end: a name per joint
-                body.append(f"{v} = p[{index}] * {lit(a)} + {lit(b)}")
+                body.append(f"{v} = p[{index}]{_affine(a, b, lit)}")
                 pose = [f"{lit(x0)} + {lit(dx)} * {v}", f"{lit(y0)} + {lit(dy)} * {v}"]
                 pose += [f"{lit(z0)} + {lit(dz)} * {v}", lit(ox), lit(oy), lit(oz), lit(ow)]
             else:
-                if joint.type not in _MOVING:  # a floating or planar mimic joint stays at its origin, as in KDL
+                if (
+                    joint.type not in _MOVING
+                ):  # a floating or planar mimic joint stays at its origin, as in KDL
                     a = b = 0.0
                 ax, ay, az = joint.axis
                 bx, by = ow * ax + oy * az - oz * ay, ow * ay - ox * az + oz * ax
                 bz, bw = ow * az + ox * ay - oy * ax, -(ox * ax + oy * ay + oz * az)
                 q = [f"x{k}", f"y{k}", f"z{k}", f"w{k}"]
                 body += [
-                    f"h = p[{index}] * {lit(a * 0.5)} + {lit(b * 0.5)}",
+                    f"h = p[{index}]{_affine(a * 0.5, b * 0.5, lit)}",
                     "c = cos(h); s = sin(h)",
                     f"{q[0]} = c * {lit(ox)} + s * {lit(bx)}; {q[1]} = c * {lit(oy)} + s * {lit(by)}",
                     f"{q[2]} = c * {lit(oz)} + s * {lit(bz)}; {q[3]} = c * {lit(ow)} + s * {lit(bw)}",
@@ -107,10 +117,22 @@ class TfPlan:
                 ]
                 pose = [lit(x0), lit(y0), lit(z0), *q]
             args += ["0", "secs", "nsecs", src.constant(frame), *pose]
+        if framed:
+            fmt[0] = "<II"
+            args.insert(0, str(struct.calcsize("".join(fmt)) - 4))
         src.names["pack"] = struct.Struct("".join(fmt)).pack
-        lines = ["def message(p, secs, nsecs):", *(f"    {line}" for line in body)]
+        # the functions as defaults: local names, cheaper than globals on every use
+        lines = [
+            "def message(p, secs, nsecs, cos=cos, sin=sin, pack=pack):",
+            *(f"    {line}" for line in body),
+        ]
         lines.append(f"    return pack({', '.join(args)})")
         return src.function("\n".join(lines), "message")
+
+
+def _affine(a: float, b: float, lit: Callable[[float], str]) -> str:
+    """`` * a + b`` as source, without the operations that change nothing (``b == 0``; ``a == 1``)."""
+    return ("" if a == 1.0 else f" * {lit(a)}") + (f" + {lit(b)}" if b else "")
 
 
 def _sign(x: str, y: str, z: str, w: str) -> list[str]:
