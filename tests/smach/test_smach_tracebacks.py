@@ -53,7 +53,9 @@ def test_a_failing_state_names_the_users_line_not_ours(quiet_logs: list[str]) ->
     assert "smach.exceptions.InvalidUserCodeError: Could not execute state 'STATE'" in printed
     assert "During handling" not in printed and "direct cause" not in printed  # the traceback once
     assert printed.count("ZeroDivisionError: division by zero") == 1
-    assert any(line.startswith("InvalidUserCodeError: Could not execute state 'STATE'") for line in quiet_logs)
+    assert any(
+        line.startswith("InvalidUserCodeError: Could not execute state 'STATE'") for line in quiet_logs
+    )
 
 
 def test_smach_exceptions_is_smachs_module() -> None:

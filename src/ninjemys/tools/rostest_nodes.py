@@ -92,7 +92,9 @@ class PublishTest(unittest.TestCase):
         _wait_for_sim_clock(self)
         checks = []
         for topic in self.topics:
-            print(f"Waiting [{topic['name']}] for [{int(topic['timeout'])}] seconds with negative [{topic['negative']}]")
+            print(
+                f"Waiting [{topic['name']}] for [{int(topic['timeout'])}] seconds with negative [{topic['negative']}]"
+            )
             checks.append(_Heard(topic["name"], float(topic["timeout"]), bool(topic["negative"])))
         pending = list(checks)
         while pending and not rospy.is_shutdown():
@@ -170,9 +172,7 @@ class AdvertiseTest(unittest.TestCase):
 
         self._check("Service", self.services, advertised)
 
-    def _check(
-        self, kind: str, wanted: dict[str, dict[str, Any]], advertised: Callable[[], Any]
-    ) -> None:
+    def _check(self, kind: str, wanted: dict[str, dict[str, Any]], advertised: Callable[[], Any]) -> None:
         if not wanted:
             return
         pending = set(wanted)
