@@ -26,8 +26,8 @@ from collections.abc import Callable
 from typing import Any
 
 import rospy
-import rostest
 import rosservice
+import rostest
 
 #: each checklist entry's defaults, as rostest's nodes have them
 _TOPIC_DEFAULTS = {"timeout": 10, "negative": False}
