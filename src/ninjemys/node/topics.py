@@ -149,8 +149,17 @@ class PubConnection:
             self._last = now
             self._published += 1
             if (not hot or len(data) >= _LARGE) and self._partial is None and not self._queue:
-                n = self._write_direct(self.sock.send, data)
-                if n is None or n == len(data):
+                # _write_direct written out: this is every idle publish's path (a call costs when cold)
+                try:
+                    n = self.sock.send(data)
+                except (BlockingIOError, InterruptedError):
+                    n = 0
+                except OSError as exc:
+                    self._fail(f"write failed: {exc}")
+                    return
+                self.bytes_sent += n
+                self.num_sent += 1
+                if n == len(data):
                     return
                 self._partial = [memoryview(data)[n:]]
                 if queue_size is not None or len(data) < _LARGE:
