@@ -142,6 +142,78 @@ HZ_TEST = """<launch>
 </launch>
 """
 
+#: rostest's publishtest: chatter comes, /nobody stays silent (negative); /silent never comes
+PUBLISH_TEST = """<launch>
+  <node name="talker" pkg="probe_tests" type="talker.py"/>
+  <test test-name="chatter_published" pkg="rostest" type="publishtest" name="publish">
+    <rosparam>
+topics:
+  - name: /chatter
+    timeout: 30
+  - name: /nobody
+    timeout: 2
+    negative: true
+    </rosparam>
+  </test>
+  <test test-name="silent_published" pkg="rostest" type="publishtest" name="publish_silent">
+    <rosparam>
+topics:
+  - name: /silent
+    timeout: 2
+    </rosparam>
+  </test>
+</launch>
+"""
+
+#: rostest's paramtest: a parameter set by the file (right value, wrong value) and one never set
+PARAM_TEST = """<launch>
+  <param name="robot_name" value="probe"/>
+  <test test-name="param_set" pkg="rostest" type="paramtest" name="param_set">
+    <param name="param_name_target" value="/robot_name"/>
+    <param name="param_value_expected" value="probe"/>
+    <param name="wait_time" value="5"/>
+  </test>
+  <test test-name="param_wrong" pkg="rostest" type="paramtest" name="param_wrong">
+    <param name="param_name_target" value="/robot_name"/>
+    <param name="param_value_expected" value="other"/>
+    <param name="wait_time" value="5"/>
+  </test>
+  <test test-name="param_missing" pkg="rostest" type="paramtest" name="param_missing">
+    <param name="param_name_target" value="/nowhere"/>
+    <param name="wait_time" value="1"/>
+  </test>
+</launch>
+"""
+
+#: rostest's advertisetest: the talker's topic and logger service (with their types), and a topic
+#: that is never advertised beside one that must not be
+ADVERTISE_TEST = """<launch>
+  <node name="talker" pkg="probe_tests" type="talker.py"/>
+  <test test-name="advertised" pkg="rostest" type="advertisetest" name="advertise">
+    <rosparam>
+topics:
+  - name: /chatter
+    type: std_msgs/String
+    timeout: 30
+services:
+  - name: /talker/get_loggers
+    type: roscpp/GetLoggers
+    timeout: 30
+    </rosparam>
+  </test>
+  <test test-name="not_advertised" pkg="rostest" type="advertisetest" name="advertise_missing">
+    <rosparam>
+topics:
+  - name: /missing
+    timeout: 2
+  - name: /nobody
+    timeout: 2
+    negative: true
+    </rosparam>
+  </test>
+</launch>
+"""
+
 
 def _workspace(root: Path) -> Path:
     pkg = root / "src" / "probe_tests"
@@ -161,6 +233,9 @@ def _workspace(root: Path) -> Path:
     (pkg / "test" / "failing.test").write_text(FAILING_TEST)
     (pkg / "test" / "slow.test").write_text(SLOW_TEST)
     (pkg / "test" / "hz.test").write_text(HZ_TEST)
+    (pkg / "test" / "publish.test").write_text(PUBLISH_TEST)
+    (pkg / "test" / "param.test").write_text(PARAM_TEST)
+    (pkg / "test" / "advertise.test").write_text(ADVERTISE_TEST)
     return root
 
 
@@ -246,6 +321,37 @@ def test_hztest_checks_a_topics_rate(workspace: Path) -> None:
     assert "exceeded minimum (90.000Hz)" in out
 
 
+def test_publishtest_waits_for_messages_on_each_topic(workspace: Path) -> None:
+    result = _rostest(workspace, "probe_tests", "publish.test")
+    out = result.stdout
+    assert result.returncode == 2, out + result.stderr
+    assert "[probe_tests.rosunit-chatter_published/test_publish][passed]" in out
+    assert "[probe_tests.rosunit-silent_published/test_publish][FAILURE]" in out
+    assert "Topic [/silent] is not published" in out
+
+
+def test_paramtest_checks_a_parameter_and_its_value(workspace: Path) -> None:
+    result = _rostest(workspace, "probe_tests", "param.test")
+    out = result.stdout
+    assert result.returncode == 2, out + result.stderr
+    assert "[probe_tests.rosunit-param_set/test_param][passed]" in out
+    assert "[probe_tests.rosunit-param_wrong/test_param][FAILURE]" in out
+    assert "'other' != 'probe'" in out
+    assert "[probe_tests.rosunit-param_missing/test_param][FAILURE]" in out
+    assert "unexpectedly None" in out
+
+
+def test_advertisetest_checks_topics_services_and_types(workspace: Path) -> None:
+    result = _rostest(workspace, "probe_tests", "advertise.test")
+    out = result.stdout
+    assert result.returncode == 2, out + result.stderr
+    assert "[probe_tests.rosunit-advertised/test_advertise_topics][passed]" in out
+    assert "[probe_tests.rosunit-advertised/test_advertise_services][passed]" in out
+    assert "[probe_tests.rosunit-not_advertised/test_advertise_services][passed]" in out  # none listed
+    assert "[probe_tests.rosunit-not_advertised/test_advertise_topics][FAILURE]" in out
+    assert "Topic [/missing] is not advertised" in out
+
+
 def test_find_package_rostest_is_known_to_catkin_make(workspace: Path) -> None:
     listed = subprocess.run(
         [ninjemys_bin("rospack"), "find", "rostest"],
@@ -310,7 +416,16 @@ def _report_lines(text: str) -> list[str]:
     not Path("/usr/bin/rostest").exists(), reason="Debian's rostest (python3-rostest) not installed"
 )
 @pytest.mark.parametrize(
-    ("test_file", "code"), [("talker.test", 0), ("failing.test", 2), ("slow.test", 1), ("hz.test", 2)]
+    ("test_file", "code"),
+    [
+        ("talker.test", 0),
+        ("failing.test", 2),
+        ("slow.test", 1),
+        ("hz.test", 2),
+        ("publish.test", 2),
+        ("param.test", 2),
+        ("advertise.test", 2),
+    ],
 )
 def test_same_report_as_debians_rostest(workspace: Path, tmp_path: Path, test_file: str, code: int) -> None:
     theirs = _workspace(tmp_path / "debian")

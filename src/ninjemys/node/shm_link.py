@@ -144,7 +144,12 @@ class ShmPubConnection(PubConnection):
 
     def send(self, data: bytes, queue_size: int | None) -> None:
         length = len(data) - 4
-        ring = self._ring() if length >= THRESHOLD and not self.closed else None
+        if length < THRESHOLD:  # inline: tag_inline written out, in one copy (every small message)
+            PubConnection.send(
+                self, b"".join((pack_len(length + 1), _INLINE, memoryview(data)[4:])), queue_size
+            )
+            return
+        ring = self._ring() if not self.closed else None
         if ring is not None:
             notice = ring.put([memoryview(data)[4:]], length, SLOT_WAIT if queue_size is None else 0.0)
             if notice is not None:

@@ -156,7 +156,11 @@ class _Poller:
         """What is readable, waiting at most ``timeout`` seconds (None: until something is)."""
         if self._epoll is not None:
             objs = self._objs
-            return [objs[fd] for fd, _ in self._epoll.poll(-1 if timeout is None else timeout) if fd in objs]
+            events = self._epoll.poll(-1 if timeout is None else timeout)
+            if len(events) == 1:  # the usual wake-up: one socket (a comprehension is one more call)
+                fd = events[0][0]
+                return [objs[fd]] if fd in objs else []
+            return [objs[fd] for fd, _ in events if fd in objs]
         assert self._selector is not None
         return [key.data for key, _ in self._selector.select(timeout)]
 

@@ -150,8 +150,17 @@ class PubConnection:
             self._last = now
             self._published += 1
             if (not hot or len(data) >= _LARGE) and self._partial is None and not self._queue:
-                n = self._write_direct(self.sock.send, data)
-                if n is None or n == len(data):
+                # _write_direct written out: this is every idle publish's path (a call costs when cold)
+                try:
+                    n = self.sock.send(data)
+                except (BlockingIOError, InterruptedError):
+                    n = 0
+                except OSError as exc:
+                    self._fail(f"write failed: {exc}")
+                    return
+                self.bytes_sent += n
+                self.num_sent += 1
+                if n == len(data):
                     return
                 self._partial = [memoryview(data)[n:]]
                 if queue_size is not None or len(data) < _LARGE:
@@ -657,6 +666,19 @@ class Publisher:
         if self._closed:
             raise ShutdownError(f"publisher of {self.name} is unregistered")
         frame = pack_len(len(payload)) + bytes(payload)
+        if self._pub.intra:
+            item = Handoff(None, memoryview(frame)[4:])
+            self._pub.publish_intra(item, self)
+            self._pub.publish_frame(frame, self, item)
+            return
+        self._pub.publish_frame(frame, self)
+
+    def publish_framed(self, frame: bytes) -> None:
+        """Send a TCPROS frame built by the caller (``uint32`` length, then the serialized message):
+        :meth:`publish_raw` without its copy, for a node that packs the length with the message
+        (robot_state_publisher's plans, whose messages have a constant size)."""
+        if self._closed:
+            raise ShutdownError(f"publisher of {self.name} is unregistered")
         if self._pub.intra:
             item = Handoff(None, memoryview(frame)[4:])
             self._pub.publish_intra(item, self)

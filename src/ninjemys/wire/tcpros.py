@@ -87,6 +87,10 @@ class FrameReader:
 
     def commit(self, n: int) -> list[bytes | bytearray]:
         """Account for ``n`` freshly received bytes and return the frames now complete."""
+        if not self._end and n > 4 and self._big is None:  # one whole frame in one read: the usual case
+            (length,) = _U32.unpack_from(self._buf, 0)
+            if length == n - 4:
+                return [self._view[4:n].tobytes()]
         frames: list[bytes | bytearray] = []
         if self._big is not None:
             self._big_fill += n
