@@ -24,9 +24,10 @@ def run(uri: str, impl: str, cpus: tuple[str, str], count: int, queue_size: str)
             return ping.result()
 
 
-def in_process(uri: str, count: int) -> dict:
-    """Two Nodes of this process, both ends ``intraprocess=True``: the object is handed over, and
-    each hop is one wake-up of the receiving handle's thread."""
+def in_process(uri: str, count: int, direct: bool) -> dict:
+    """Two Nodes of this process, both ends ``intraprocess=True``: the object is handed over. Each hop
+    is one wake-up of the receiving handle's thread, or none with ``direct=True`` (the publishing
+    thread calls an idle subscriber back itself, as a nodelet's publish does)."""
     from ninjemys.node import Node
     from std_msgs.msg import String
 
@@ -34,9 +35,9 @@ def in_process(uri: str, count: int) -> dict:
     pong_node = Node("inproc_pong", anonymous=True, master_uri=uri, rosout=False, logger_services=False)
     try:
         back = pong_node.publisher("/inproc_pong", String, intraprocess=True)
-        pong_node.subscriber("/inproc_ping", String, back.publish, intraprocess=True)
+        pong_node.subscriber("/inproc_ping", String, back.publish, intraprocess=True, direct=direct)
         got = threading.Event()
-        ping_node.subscriber("/inproc_pong", String, lambda m: got.set(), intraprocess=True)
+        ping_node.subscriber("/inproc_pong", String, lambda m: got.set(), intraprocess=True, direct=direct)
         pub = ping_node.publisher("/inproc_ping", String, intraprocess=True)
         msg = String("x" * 64)
         deadline = time.monotonic() + 20
@@ -77,10 +78,10 @@ def main() -> None:
                     o, t = results[OURS], results["rospy"]
                     p50, p99 = ratio(o["p50_us"], t["p50_us"]), ratio(o["p99_us"], t["p99_us"])
                     print(f"{label:35s} ratio     p50 {p50}   p99 {p99}")
-        r = in_process(uri, count)
-        print(
-            f"{'in one process (intraprocess=True)':35s} {OURS:9s} p50 {r['p50_us']:8.1f} us   p99 {r['p99_us']:8.1f} us"
-        )
+        for direct in (False, True):
+            r = in_process(uri, count, direct)
+            label = "in one process, direct=True" if direct else "in one process (intraprocess=True)"
+            print(f"{label:35s} {OURS:9s} p50 {r['p50_us']:8.1f} us   p99 {r['p99_us']:8.1f} us")
 
 
 if __name__ == "__main__":

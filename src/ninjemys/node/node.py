@@ -284,6 +284,7 @@ class Node(ParamAccess):
         lazy: float = 0.0,
         batch: bool = False,
         intraprocess: bool = False,
+        direct: bool = False,
     ) -> Subscriber:
         """Subscribe to ``topic``; ``callback(msg[, callback_args])`` runs on this subscriber's own thread.
 
@@ -308,8 +309,19 @@ class Node(ParamAccess):
         message: from a publisher made with ``intraprocess=True`` too, the callback gets the
         published object itself, shared with that publisher and every such subscriber; otherwise its
         own copy (docs/node.md, in-process delivery).
+        ``direct=True`` (with ``intraprocess=True``) lets an in-process publisher's thread run the
+        callback itself, inside ``publish()``, when this handle is idle (nothing queued, no callback
+        running), as a nodelet's publish does: no thread wake-up, so a round trip costs a few
+        microseconds; a callback that takes long then delays that ``publish()``. Otherwise (busy, or
+        from another process) the message is queued for the handle's thread as usual.
         """
         self._check_alive()
+        if direct and not intraprocess:
+            raise NinjemysError(f"subscriber of {topic}: direct=True needs intraprocess=True")
+        if direct and (lazy or share_thread is not None):
+            raise NinjemysError(
+                f"subscriber of {topic}: direct=True cannot be combined with lazy or share_thread"
+            )
         resolved = self.resolve_name(topic)
         with self._lock:
             sub = self._subscriptions.get(resolved)
@@ -319,7 +331,7 @@ class Node(ParamAccess):
                 self._subscriptions[resolved] = sub
             handle = Subscriber(
                 sub, callback, callback_args, queue_size, raw, coalesce, share_thread, lazy, batch,
-                intraprocess,
+                intraprocess, direct,
             )  # fmt: skip
             sub.handles.append(handle)
         if new:

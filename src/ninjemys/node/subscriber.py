@@ -490,10 +490,17 @@ class Subscriber:
         lazy: float = 0.0,
         batch: bool = False,
         intraprocess: bool = False,
+        direct: bool = False,
     ) -> None:
         self._sub = subscription
         #: an in-process publisher that opted in too hands this handle its message objects, shared
         self.intraprocess = intraprocess
+        #: an idle handle is called back on an in-process publisher's thread (see push_local)
+        self._direct = direct
+        #: direct handles: held while a callback of this handle runs, by its worker or by an in-process
+        #: publisher's thread that delivers itself (other handles call back only on their worker)
+        self._busy = threading.Lock()
+        self._busy_owner = 0  # the thread delivering directly now (unregister waits for any other)
         #: seconds a message may wait so that one wake-up of the worker takes several (see Node.subscriber)
         self._coalesce = max(0.0, coalesce)
         self.name = subscription.topic
@@ -575,8 +582,15 @@ class Subscriber:
         self._push(frames, header)
         self._wakeup()
 
-    def push_local(self, item: Handoff, header: Mapping[str, str], pub_queue_size: int | None) -> int:
+    def push_local(
+        self, item: Handoff, header: Mapping[str, str], pub_queue_size: int | None, direct: bool = False
+    ) -> int:
         """A message from a publisher of this process (its thread); returns how many it dropped.
+
+        ``direct`` (a publish, not a latched replay on the loop): a handle made with ``direct=True``
+        that is idle (nothing queued, no callback of it running) is called back right here, on the
+        publisher's thread, with no wake-up; the lock it holds meanwhile keeps its callbacks one at a
+        time and in order (the worker pops its queue under the same lock).
 
         This handle's own ``queue_size`` drops the oldest, as for a socket. An unbounded handle gets
         the publisher's ``queue_size`` semantics instead, as over TCPROS: a bounded publisher drops
@@ -585,6 +599,16 @@ class Subscriber:
         :data:`_LOCAL_HIGH_WATER` wait, unless it publishes from this handle's own thread.
         """
         queue = self._queue
+        busy = self._busy
+        if direct and self._direct and not queue and not self._closed and busy.acquire(False):
+            try:
+                if not queue and not self._closed:
+                    self._busy_owner = threading.get_ident()
+                    self._deliver_handoff(item, header)
+                    return 0
+            finally:
+                self._busy_owner = 0
+                busy.release()
         dropped = 0
         if queue.maxlen is None and pub_queue_size != 0:
             if pub_queue_size is not None:
@@ -629,8 +653,16 @@ class Subscriber:
                 for handle in self._served:
                     queue = handle._queue
                     if queue:
-                        frame, header = queue.popleft()
-                        handle._deliver(frame, header)
+                        if handle._direct:
+                            # popped under the lock: a direct delivery sees the queue empty only
+                            # once everything before it has been called back (order kept)
+                            with handle._busy:
+                                if queue:
+                                    frame, header = queue.popleft()
+                                    handle._deliver(frame, header)
+                        else:
+                            frame, header = queue.popleft()
+                            handle._deliver(frame, header)
                         busy = True
                 if busy:
                     continue
@@ -764,7 +796,11 @@ class Subscriber:
             maxlen = owner._queue.maxlen
             if maxlen is not None and len(frames) > maxlen:
                 frames = owner._keep_newest(frames, 0)
-            owner._deliver_batch(frames, conn.header)
+            if owner._direct:
+                with owner._busy:
+                    owner._deliver_batch(frames, conn.header)
+            else:
+                owner._deliver_batch(frames, conn.header)
 
     def _finish(self) -> None:
         """Worker exit: pass our connections to the next handle of their topic, or close them."""
@@ -932,13 +968,15 @@ class Subscriber:
             if shared:  # the thread goes on for the others: it hands this handle's streams on
                 host._ops.append(("release", self))
         self._wakeup()
+        me = threading.get_ident()
         # not from a callback: on the worker's thread, or in a pull, which holds what the worker needs
-        if (
-            not shared
-            and threading.current_thread() is not self._thread
-            and host._puller != threading.get_ident()
-        ):
+        if not shared and threading.current_thread() is not self._thread and host._puller != me:
             self._thread.join(2.0)
+        busy = self._busy
+        if self._direct and self._busy_owner != me and threading.current_thread() is not self._thread:
+            # a publisher's thread may be calling back directly: once unregister returns, no callback runs
+            if busy.acquire(timeout=2.0):
+                busy.release()
 
     @property
     def closed(self) -> bool:

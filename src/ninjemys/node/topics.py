@@ -511,7 +511,7 @@ class Publication:
             links = self.intra
         queue_size = handle.queue_size
         for link in links:
-            link.deliver(item, queue_size)
+            link.deliver(item, queue_size, True)
 
     def add_intra(self, link: IntraLink) -> None:
         """An in-process subscriber joined: it gets the latched messages first, as over a socket."""
