@@ -127,12 +127,15 @@ class _Poller:
 
     def __init__(self) -> None:
         self._objs: dict[int, SubConnection | None] = {}
+        #: at most this many events per wait (epoll otherwise sizes its buffer for 1023 on every call)
+        self._max = 1
         self._epoll = select.epoll() if hasattr(select, "epoll") else None
         self._selector = None if self._epoll is not None else selectors.DefaultSelector()
 
     def register(self, fd: int, obj: SubConnection | None) -> None:
         """Watch ``fd``; :meth:`wait` reports it as ``obj`` (None is the worker's wake-up socket)."""
         self._objs[fd] = obj
+        self._max = len(self._objs)
         if self._epoll is not None:
             self._epoll.register(fd, select.EPOLLIN)
         else:
@@ -143,6 +146,7 @@ class _Poller:
         if fd not in self._objs:
             return
         del self._objs[fd]
+        self._max = max(1, len(self._objs))
         try:
             if self._epoll is not None:
                 self._epoll.unregister(fd)
@@ -156,7 +160,8 @@ class _Poller:
         """What is readable, waiting at most ``timeout`` seconds (None: until something is)."""
         if self._epoll is not None:
             objs = self._objs
-            return [objs[fd] for fd, _ in self._epoll.poll(-1 if timeout is None else timeout) if fd in objs]
+            events = self._epoll.poll(-1 if timeout is None else timeout, self._max)
+            return [objs[fd] for fd, _ in events if fd in objs]
         assert self._selector is not None
         return [key.data for key, _ in self._selector.select(timeout)]
 

@@ -99,6 +99,9 @@ class PubConnection:
     threads fighting over the GIL and this connection's lock.
     """
 
+    #: small frames go to this connection with a tag byte (SHMROS: see :meth:`Publication.publish_small`)
+    tag_small = False
+
     def __init__(
         self, node: NodeContext, sock: socket.socket, topic: str, subscriber: str, uri: str = ""
     ) -> None:
@@ -127,6 +130,8 @@ class PubConnection:
         self._refused = False  # the kernel refused a burst's batch: the publisher yields once
         #: the subscriber is a Node of this process (shares our GIL): yield to it when it lags
         self._same_process = is_local_node(subscriber)
+        #: Unix sockets: what the subscriber has not read yet (see :meth:`send`); None on TCP
+        self._unread = transport.unread_probe(sock)
 
     @property
     def transport(self) -> str:
@@ -140,6 +145,10 @@ class PubConnection:
         An idle connection is written to directly (lowest latency). Publishes closer together than
         :data:`HOT_INTERVAL` are queued instead and written :data:`_FLUSH_FRAMES` at a time, or
         :data:`_MAX_HOLD` after the last try: one system call and one wake-up of the subscriber per batch.
+        Over a Unix socket a publish that is close to the previous one is queued only while the
+        subscriber has not read the previous frames yet (it is busy: they will be read together); a
+        subscriber waiting for data gets it at once, so a ping-pong faster than :data:`HOT_INTERVAL`
+        never waits for the I/O loop.
         """
         with self._lock:
             if self.closed:
@@ -148,9 +157,25 @@ class PubConnection:
             hot = now - self._last < HOT_INTERVAL
             self._last = now
             self._published += 1
+            if (
+                hot
+                and self._unread is not None
+                and self._partial is None
+                and not self._queue
+                and not self._unread()
+            ):
+                hot = False  # the subscriber has read everything: it waits for this frame
             if (not hot or len(data) >= _LARGE) and self._partial is None and not self._queue:
-                n = self._write_direct(self.sock.send, data)
-                if n is None or n == len(data):
+                try:  # _write_direct, inlined: this is every idle publish's path
+                    n = self.sock.send(data)
+                except (BlockingIOError, InterruptedError):
+                    n = 0
+                except OSError as exc:
+                    self._fail(f"write failed: {exc}")
+                    return
+                self.bytes_sent += n
+                self.num_sent += 1
+                if n == len(data):
                     return
                 self._partial = [memoryview(data)[n:]]
                 if queue_size is not None or len(data) < _LARGE:
@@ -482,6 +507,32 @@ class Publication:
         for conn in conns:
             conn.send(data, queue_size)
 
+    def publish_small(
+        self, parts: list[Any], total: int, handle: Publisher, item: Handoff | None = None
+    ) -> None:
+        """A frame below :data:`_LARGE` in pieces: joined once for plain connections and once, with the
+        inline tag byte, for SHMROS ones (which send every frame that small inline)."""
+        if handle.latch:
+            with self.lock:
+                plain: bytes | None = b"".join(parts)
+                handle.latched = plain
+                handle.latched_item = item
+                conns = self.connections
+        else:
+            conns = self.connections
+            plain = None
+        queue_size = handle.queue_size
+        tagged = None
+        for conn in conns:
+            if conn.tag_small:
+                if tagged is None:
+                    tagged = b"".join([pack_len(total - 3), b"\0", *parts[1:]])
+                PubConnection.send(conn, tagged, queue_size)
+            else:
+                if plain is None:
+                    plain = b"".join(parts)
+                conn.send(plain, queue_size)
+
     def publish_parts(
         self, parts: list[Any], total: int, handle: Publisher, item: Handoff | None = None
     ) -> None:
@@ -600,7 +651,9 @@ class Publisher:
                 raise
             self._pub.publish_frame(self._frame_other(msg), self, item)
             return
-        if total >= _LARGE and len(parts) <= _MAX_PARTS:
+        if total < _LARGE:
+            self._pub.publish_small(parts, total, self, item)
+        elif len(parts) <= _MAX_PARTS:
             self._pub.publish_parts(parts, total, self, item)
         else:
             self._pub.publish_frame(b"".join(parts), self, item)
