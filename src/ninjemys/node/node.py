@@ -335,9 +335,10 @@ class Node(ParamAccess):
             )  # fmt: skip
             sub.handles.append(handle)
         if new:
+            updates = sub.updates  # 0: read before the master can notify us of this topic
             publishers = self.registrar.add_subscriber(resolved, sub.type_name)
             if publishers is not None:
-                self.publisher_update(resolved, publishers)
+                self.runtime.call_soon(sub.registered, publishers, updates, self.registrar.settling())
         else:
             self.runtime.call_soon(self._replay_latched, sub, handle)
         return handle

@@ -294,6 +294,8 @@ class Subscription:
         self.handles: list[Subscriber] = []
         self.connections: dict[str, SubConnection | intraprocess.IntraLink] = {}
         self.publishers: list[str] = []
+        #: publisher lists applied so far (see :meth:`registered`)
+        self.updates = 0
         self._connecting: set[str] = set()
         #: publishers whose shared memory failed here: TCPROS only from then on
         self.shm_refused: set[str] = set()
@@ -306,6 +308,7 @@ class Subscription:
         (``keep_live``: keep open connections the list omits, as a master still filling in may)."""
         if self.closed:
             return
+        self.updates += 1
         if keep_live:
             uris = list(uris) + [
                 uri for uri, conn in self.connections.items() if uri not in uris and not conn.closed
@@ -321,6 +324,15 @@ class Subscription:
             if uri not in self.connections and uri not in self._connecting:
                 self._connecting.add(uri)
                 loop.create_task(self._connect(uri))
+
+    def registered(self, uris: list[str], updates: int, keep_live: bool = False) -> None:
+        """The master's answer to this subscription's registerSubscriber (on the loop), sent when
+        ``self.updates`` was ``updates``. A publisherUpdate that arrived since is newer than this
+        answer (the master notifies a subscriber only once it is registered), so the answer is then
+        stale and ignored: applied after it, it would drop a publisher that appeared meanwhile
+        (a fresh subscriber racing a publisher's start got nothing, ever)."""
+        if updates == self.updates:
+            self.update_publishers(uris, keep_live)
 
     def _drop(self, conn: SubConnection | intraprocess.IntraLink) -> None:
         if conn.intra:

@@ -6,7 +6,8 @@ The publish path is built for latency and throughput:
   the caller may modify it afterwards, as in rospy);
 * for each idle connection the frame is written straight to the (non-blocking) socket from the
   caller's thread: no hand-off, no wake-up of another thread;
-* in a burst (publishes closer than ``HOT_INTERVAL``) frames are queued and the caller's thread
+* in a burst (a publish that starts less than ``HOT_INTERVAL`` after the previous one ended) frames
+  are queued and the caller's thread
   writes them a batch at a time (many frames joined into one ``send``, one wake-up of the
   subscriber); the I/O loop only writes what is left once the burst ends, or what the kernel refused;
 * ``queue_size=N`` bounds each connection's queue and drops the oldest frame; ``queue_size=None``
@@ -50,8 +51,14 @@ connection_ids = itertools.count(1)
 
 #: Most bytes joined into one send when the loop drains a queue.
 _BATCH_BYTES = 1 << 20
-#: Publishes closer together than this (seconds) are batched instead of sent one by one.
-HOT_INTERVAL = 50e-6
+#: A publish that starts less than this (seconds) after the previous one's write ended is part of a
+#: burst and batched instead of sent alone. Measured from the end of the write, not its start: a
+#: flat-out loop comes back within a few microseconds, a ping-pong only after a whole round trip
+#: (on this VM 3 us against 30 us and more), so a fast ping-pong is never mistaken for a burst.
+HOT_INTERVAL = 20e-6
+#: Within HOT_INTERVAL but at least this late (seconds), a Unix socket whose subscriber has read
+#: everything is written at once (it waits for the frame); sooner, it is a burst without asking.
+_SURE_BURST = 5e-6
 #: In a burst, the publishing thread writes once this many frames are queued ...
 _FLUSH_FRAMES = 32
 #: ... or this long after the last try (seconds), so a slow trickle of a burst still goes out.
@@ -142,30 +149,29 @@ class PubConnection:
         """Send ``data`` (one or more frames) to this subscriber; blocks only when ``queue_size`` is
         None and the kernel lags (synchronous, lossless: rospy's blocking send, with a short buffer).
 
-        An idle connection is written to directly (lowest latency). Publishes closer together than
-        :data:`HOT_INTERVAL` are queued instead and written :data:`_FLUSH_FRAMES` at a time, or
-        :data:`_MAX_HOLD` after the last try: one system call and one wake-up of the subscriber per batch.
-        Over a Unix socket a publish that is close to the previous one is queued only while the
-        subscriber has not read the previous frames yet (it is busy: they will be read together); a
-        subscriber waiting for data gets it at once, so a ping-pong faster than :data:`HOT_INTERVAL`
-        never waits for the I/O loop.
+        An idle connection is written to directly (lowest latency). A publish that comes less than
+        :data:`HOT_INTERVAL` after the previous write is queued instead, and the queue is written
+        :data:`_FLUSH_FRAMES` at a time, or :data:`_MAX_HOLD` after the last try: one system call and
+        one wake-up of the subscriber per batch. Between :data:`_SURE_BURST` and
+        :data:`HOT_INTERVAL`, over a Unix socket, a subscriber that has read everything (it waits for
+        data) still gets the frame at once: a ping-pong is never held for the I/O loop.
         """
         with self._lock:
             if self.closed:
                 return
             now = _clock()
-            hot = now - self._last < HOT_INTERVAL
+            gap = now - self._last
             self._last = now
             self._published += 1
             if (
-                hot
-                and self._unread is not None
-                and self._partial is None
+                self._partial is None
                 and not self._queue
-                and not self._unread()
+                and (
+                    gap >= HOT_INTERVAL
+                    or len(data) >= _LARGE
+                    or (gap >= _SURE_BURST and self._unread is not None and not self._unread())
+                )
             ):
-                hot = False  # the subscriber has read everything: it waits for this frame
-            if (not hot or len(data) >= _LARGE) and self._partial is None and not self._queue:
                 try:  # _write_direct, inlined: this is every idle publish's path
                     n = self.sock.send(data)
                 except (BlockingIOError, InterruptedError):
@@ -176,6 +182,7 @@ class PubConnection:
                 self.bytes_sent += n
                 self.num_sent += 1
                 if n == len(data):
+                    self._last = _clock()  # the next publish's gap counts from the end of this write
                     return
                 self._partial = [memoryview(data)[n:]]
                 if queue_size is not None or len(data) < _LARGE:
