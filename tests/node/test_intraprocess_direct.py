@@ -155,6 +155,32 @@ def test_unregister_waits_for_a_direct_callback_in_flight(make_node) -> None:  #
     assert done.is_set()  # no callback of the handle runs once unregister has returned
 
 
+def test_a_direct_callback_may_unregister_its_handle_without_a_stall(make_node) -> None:  # noqa: ANN001
+    talker, listener = make_node("talker"), make_node("listener")
+    pub = talker.publisher("t", Header, intraprocess=True)
+    queued = threading.Event()
+    took: list[float] = []
+    handle: list[object] = []
+
+    def once(msg) -> None:  # noqa: ANN001
+        if msg.frame_id != "first":
+            return
+        other = threading.Thread(target=pub.publish, args=(Header(frame_id="second"),))
+        other.start()  # this handle is busy: queued, and its worker waits for the handle's lock
+        other.join(5)
+        queued.set()
+        time.sleep(0.05)
+        start = time.monotonic()
+        handle[0].unregister()  # type: ignore[attr-defined]
+        took.append(time.monotonic() - start)
+
+    handle.append(listener.subscriber("t", Header, once, intraprocess=True, direct=True))
+    assert _connected(pub)
+    pub.publish(Header(frame_id="first"))
+    assert queued.is_set() and len(took) == 1
+    assert took[0] < 1.0  # not the 2 s join of a worker that waits for the lock this thread holds
+
+
 def test_latched_replay_is_not_run_on_the_io_loop(make_node) -> None:  # noqa: ANN001
     talker, listener = make_node("talker"), make_node("listener")
     pub = talker.publisher("map", Header, latch=True, intraprocess=True)

@@ -986,14 +986,20 @@ class Subscriber:
                 host._ops.append(("release", self))
         self._wakeup()
         me = threading.get_ident()
-        # not from a callback: on the worker's thread, or in a pull, which holds what the worker needs
-        if not shared and threading.current_thread() is not self._thread and host._puller != me:
+        # not from a callback: on the worker's thread, in a pull, which holds what the worker needs, or
+        # in a direct callback on a publisher's thread, which holds the lock the worker may wait for
+        if (
+            threading.current_thread() is self._thread
+            or host._puller == me
+            or (self._direct and self._busy_owner == me)
+        ):
+            return
+        if not shared:
             self._thread.join(2.0)
-        busy = self._busy
-        if self._direct and self._busy_owner != me and threading.current_thread() is not self._thread:
+        if self._direct:
             # a publisher's thread may be calling back directly: once unregister returns, no callback runs
-            if busy.acquire(timeout=2.0):
-                busy.release()
+            if self._busy.acquire(timeout=2.0):
+                self._busy.release()
 
     @property
     def closed(self) -> bool:
