@@ -338,7 +338,7 @@ class Node(ParamAccess):
             updates = sub.updates  # 0: read before the master can notify us of this topic
             publishers = self.registrar.add_subscriber(resolved, sub.type_name)
             if publishers is not None:
-                self.runtime.call_soon(sub.registered, publishers, updates, self.registrar.settling())
+                self.publisher_update(resolved, publishers, updates)
         else:
             self.runtime.call_soon(self._replay_latched, sub, handle)
         return handle
@@ -350,13 +350,24 @@ class Node(ParamAccess):
 
     # -- NodeContext: calls back from the node's parts ------------------------------------------------
 
-    def publisher_update(self, topic: str, publishers: list[str]) -> None:
+    def publisher_update(self, topic: str, publishers: list[str], updates: int | None = None) -> None:
         """Connect to the current publishers of ``topic`` (from the master: slave API, re-registration).
         Just after a master restart the list may be short of publishers that have not re-registered
-        yet: live connections are then kept (registration.py, ``settling``)."""
+        yet: live connections are then kept (registration.py, ``settling``). ``updates``: the list is
+        the master's answer to a registerSubscriber sent when :meth:`publisher_updates` said that; it
+        is dropped if a publisherUpdate (newer) was applied since (``Subscription.registered``)."""
         sub = self._subscriptions.get(topic)
-        if sub is not None:
+        if sub is None:
+            return
+        if updates is None:
             self.runtime.call_soon(sub.update_publishers, publishers, self.registrar.settling())
+        else:
+            self.runtime.call_soon(sub.registered, publishers, updates, self.registrar.settling())
+
+    def publisher_updates(self, topic: str) -> int:
+        """How many publisher lists the subscription of ``topic`` has applied (0 if none)."""
+        sub = self._subscriptions.get(topic)
+        return 0 if sub is None else sub.updates
 
     def release_publisher(self, handle: Publisher) -> None:
         """Forget an unregistered Publisher handle; the topic's last one unregisters the topic."""
