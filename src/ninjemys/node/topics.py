@@ -25,6 +25,7 @@ import itertools
 import logging
 import select
 import socket
+import struct
 import threading
 import time
 from collections import deque
@@ -83,6 +84,8 @@ _MAX_PARTS = 64
 #: starved for tenths of a second. A subscriber in another process has its own GIL: no pause.
 _LAG_YIELD = 20e-6
 _clock = time.perf_counter
+#: an SHMROS inline frame's head: its length prefix and the tag byte 0 (shm_link)
+_pack_tagged_head = struct.Struct("<IB").pack
 
 
 def _unsent(buffers: list[Any], sent: int) -> list[Any] | None:
@@ -533,7 +536,10 @@ class Publication:
         for conn in conns:
             if conn.tag_small:
                 if tagged is None:
-                    tagged = b"".join([pack_len(total - 3), b"\0", *parts[1:]])
+                    head = parts[0]
+                    parts[0] = _pack_tagged_head(total - 3, 0)  # the length prefix, then tag 0
+                    tagged = b"".join(parts)
+                    parts[0] = head
                 PubConnection.send(conn, tagged, queue_size)
             else:
                 if plain is None:
