@@ -39,6 +39,28 @@ def test_an_idle_direct_handle_is_called_back_inside_publish(make_node) -> None:
     assert seen == [(msg, threading.current_thread().name)]
 
 
+def test_several_subscribers_direct_queued_and_remote(make_node) -> None:  # noqa: ANN001
+    talker = make_node("talker")
+    pub = talker.publisher("chatter", String, intraprocess=True)
+    seen: dict[str, list[tuple[str, str]]] = {"a": [], "b": [], "queued": [], "remote": []}
+
+    def keep(who: str):  # noqa: ANN202
+        return lambda m: seen[who].append((m.data, threading.current_thread().name))
+
+    make_node("a").subscriber("chatter", String, keep("a"), intraprocess=True, direct=True)
+    make_node("b").subscriber("chatter", String, keep("b"), intraprocess=True, direct=True)
+    make_node("queued").subscriber("chatter", String, keep("queued"), intraprocess=True)
+    make_node("remote").subscriber("chatter", String, keep("remote"))
+    assert _connected(pub, 4)
+    me = threading.current_thread().name
+    for i in range(3):
+        pub.publish(String(data=str(i)))
+    assert seen["a"] == seen["b"] == [(str(i), me) for i in range(3)]  # before publish returned
+    assert wait_until(lambda: len(seen["queued"]) == 3 and len(seen["remote"]) == 3)
+    assert [d for d, _ in seen["queued"]] == [d for d, _ in seen["remote"]] == ["0", "1", "2"]
+    assert {t for _, t in seen["queued"]} == {"sub:/chatter"}
+
+
 def test_a_copy_when_the_publisher_did_not_opt_in(make_node) -> None:  # noqa: ANN001
     talker, listener = make_node("talker"), make_node("listener")
     pub = talker.publisher("chatter", Header)
