@@ -7,8 +7,10 @@ so one Debian ``rosmaster --core`` (or our roscore when ROS 1 is absent) serves 
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -20,7 +22,6 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
-import node_roscpp  # noqa: E402
 from ninjemys.master.client import MasterClient  # noqa: E402
 from ninjemys.testing import ROS1_PYTHON, free_port, have_ros1, ninjemys_bin, ros1_env  # noqa: E402
 
@@ -29,6 +30,41 @@ OURS = "ninjemys"
 REAL = "rospy"
 CPP = "roscpp"
 IMPLS = [OURS, REAL] if have_ros1() else [OURS]
+
+
+def cpp_program(name: str, source: str) -> str | None:
+    """Build a roscpp reference program once (cached by the hash of its source under the temp dir)
+    against Debian's libroscpp-dev; its path, or None when there is no g++ or roscpp. Every C++
+    reference of the node benchmarks (node_roscpp.py, node_shm_roscpp.py) is built here."""
+    if shutil.which("g++") is None or not Path("/usr/include/ros/ros.h").exists():
+        return None
+    digest = hashlib.sha256(source.encode()).hexdigest()[:16]
+    cache = Path(tempfile.gettempdir()) / f"ninjemys-bench-{name}-{digest}"
+    out = cache / "roles"
+    if out.exists():
+        return str(out)
+    cache.mkdir(parents=True, exist_ok=True)
+    src = cache / "roles.cpp"
+    src.write_text(source)
+    tmp = cache / f"roles-{os.getpid()}.tmp"
+    libs = [
+        "-lroscpp",
+        "-lrosconsole",
+        "-lroscpp_serialization",
+        "-lrostime",
+        "-lcpp_common",
+        "-lboost_system",
+    ]
+    result = subprocess.run(["g++", "-O2", "-o", str(tmp), str(src), *libs, "-lpthread"], capture_output=True)
+    if result.returncode != 0:
+        print(f"{name} reference did not build:", result.stderr.decode()[-500:])
+        return None
+    os.replace(tmp, out)
+    return str(out)
+
+
+import node_roscpp  # noqa: E402  (it builds with cpp_program, above)
+
 #: With the native reference, for the scenarios the C++ program implements.
 IMPLS_CPP = IMPLS + ([CPP] if have_ros1() and node_roscpp.binary() else [])
 #: CPU placements: both processes on one CPU, or one each.

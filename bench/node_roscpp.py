@@ -3,13 +3,6 @@
 
 from __future__ import annotations
 
-import hashlib
-import os
-import shutil
-import subprocess
-import tempfile
-from pathlib import Path
-
 SOURCE = r"""
 #include <ros/ros.h>
 #include <std_msgs/String.h>
@@ -81,29 +74,7 @@ int main(int argc, char** argv) {
 
 
 def binary() -> str | None:
-    """Path of the built reference program, or None when no C++ toolchain / roscpp is installed."""
-    if shutil.which("g++") is None or not Path("/usr/include/ros/ros.h").exists():
-        return None
-    digest = hashlib.sha256(SOURCE.encode()).hexdigest()[:16]
-    cache = Path(tempfile.gettempdir()) / f"ninjemys-bench-roscpp-{digest}"
-    out = cache / "roles"
-    if out.exists():
-        return str(out)
-    cache.mkdir(parents=True, exist_ok=True)
-    src = cache / "roles.cpp"
-    src.write_text(SOURCE)
-    tmp = cache / f"roles-{os.getpid()}.tmp"
-    libs = [
-        "-lroscpp",
-        "-lrosconsole",
-        "-lroscpp_serialization",
-        "-lrostime",
-        "-lcpp_common",
-        "-lboost_system",
-    ]
-    result = subprocess.run(["g++", "-O2", "-o", str(tmp), str(src), *libs, "-lpthread"], capture_output=True)
-    if result.returncode != 0:
-        print("roscpp reference did not build:", result.stderr.decode()[-500:])
-        return None
-    os.replace(tmp, out)
-    return str(out)
+    """Path of the built program, or None when no C++ toolchain / roscpp is installed."""
+    from node_common import cpp_program  # node_common imports this module: looked up at call time
+
+    return cpp_program("roscpp", SOURCE)

@@ -3,13 +3,6 @@ PointCloud2; latency, flood and 30 Hz modes) as one C++ program built against De
 
 from __future__ import annotations
 
-import hashlib
-import os
-import shutil
-import subprocess
-import tempfile
-from pathlib import Path
-
 SOURCE = r"""
 #include <ros/ros.h>
 #include <sensor_msgs/Image.h>
@@ -86,28 +79,6 @@ int main(int argc, char** argv) {
 
 def binary() -> str | None:
     """Path of the built program, or None when no C++ toolchain / roscpp is installed."""
-    if shutil.which("g++") is None or not Path("/usr/include/ros/ros.h").exists():
-        return None
-    digest = hashlib.sha256(SOURCE.encode()).hexdigest()[:16]
-    cache = Path(tempfile.gettempdir()) / f"ninjemys-bench-shm-roscpp-{digest}"
-    out = cache / "roles"
-    if out.exists():
-        return str(out)
-    cache.mkdir(parents=True, exist_ok=True)
-    src = cache / "roles.cpp"
-    src.write_text(SOURCE)
-    tmp = cache / f"roles-{os.getpid()}.tmp"
-    libs = [
-        "-lroscpp",
-        "-lrosconsole",
-        "-lroscpp_serialization",
-        "-lrostime",
-        "-lcpp_common",
-        "-lboost_system",
-    ]
-    result = subprocess.run(["g++", "-O2", "-o", str(tmp), str(src), *libs, "-lpthread"], capture_output=True)
-    if result.returncode != 0:
-        print("roscpp reference did not build:", result.stderr.decode()[-500:])
-        return None
-    os.replace(tmp, out)
-    return str(out)
+    from node_common import cpp_program  # node_common imports this module: looked up at call time
+
+    return cpp_program("shm-roscpp", SOURCE)

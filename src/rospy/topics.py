@@ -181,6 +181,19 @@ class Publisher(Topic):
         except NinjemysError as exc:
             raise translate(exc) from None
 
+    def loan(self, length: int, field: str | None = None, **fields: Any) -> Any:
+        """ninjemys' addition: a message whose ``uint8[]`` array of ``length`` bytes is written straight
+        into a shared-memory slot of a same-host subscriber (``with pub.loan(n, ...) as msg: fill
+        msg.data; pub.publish(msg)``); see ``ninjemys.node.shm_loan`` for the rules."""
+        impl = self._impl
+        if impl is None:
+            self._not_ready()
+            raise ROSException(f"loan() from a closed topic [{self.resolved_name}]")
+        try:
+            return impl.loan(length, field, **fields)
+        except NinjemysError as exc:
+            raise translate(exc) from None
+
     def _not_ready(self) -> None:
         if self._unregistered:
             raise ROSException(f"publish() to an unregistered() handle [{self.resolved_name}]")

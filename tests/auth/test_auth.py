@@ -37,7 +37,7 @@ def test_signatures_check_once_within_the_window_and_with_the_right_secret(monke
     assert b.check(a.sign(b"x"), b"x") == "wrong secret"
     assert a.check(a.sign(b"x"), b"y") == "wrong secret"  # the body is covered
     assert "not signed" in (a.check(None, b"x") or "")
-    assert a.check("v2 1 2 3", b"x") == "malformed signature"
+    assert a.check("v1 1 2 3", b"x") == "malformed signature"  # the old format
     old = a.sign(b"x")
     monkeypatch.setattr(auth.time, "time", lambda: time.monotonic() + 1e9)
     assert "clocks more than 120 s apart" in (a.check(old, b"x") or "")
@@ -201,3 +201,85 @@ def test_a_real_ros1_tool_is_refused_with_the_reason_and_works_without_a_secret(
                 got = subprocess.run(["/usr/bin/rosparam", "get", "/x"], env=testing.ros1_env(uri),
                                      capture_output=True, text=True, timeout=30)  # fmt: skip
                 assert got.stdout.strip() == "1"
+
+
+def test_the_master_clients_connection_is_signed_once_and_then_trusted(secured: str, monkeypatch) -> None:  # noqa: ANN001
+    """With a shared secret a connection proven once is trusted for every caller; a master client
+    signs its first call on each connection and again after a reconnect."""
+    from ninjemys.master.client import MasterClient
+
+    signed: list[str] = []
+    real = auth.header_line
+
+    def counting(creds: auth.Credentials | None, body: bytes, caller: str | None = None) -> str:
+        line = real(creds, body, caller)
+        signed.append(line)
+        return line
+
+    monkeypatch.setattr(auth, "header_line", counting)
+    with MasterClient(secured, "/counted") as client:
+        for _ in range(5):
+            client.get_system_state()
+        assert len(signed) == 1 and signed[0].startswith("X-Ninjemys-Auth: v2 ")
+        client.close()
+        client.get_system_state()
+        client.get_system_state()
+        assert len(signed) == 2
+    host, port = secured.split("//")[1].strip("/").split(":")
+    with socket.create_connection((host, int(port)), timeout=10) as s:  # untrusted: refused
+        body = xmlrpc.client.dumps(("/counted",), "getSystemState").encode()
+        s.sendall(
+            f"POST /RPC2 HTTP/1.1\r\nHost: {host}\r\nContent-Length: {len(body)}\r\n\r\n".encode() + body
+        )
+        assert b"authentication failed: not signed" in s.recv(65536)
+
+
+_ROSPY_TALKER = """
+import rospy
+from std_msgs.msg import String
+rospy.init_node("ros1_talker")
+pub = rospy.Publisher("from_ros1", String, queue_size=10)
+got = []
+rospy.Subscriber("from_ninjemys", String, lambda m: got.append(m.data))
+rate = rospy.Rate(20)
+while not rospy.is_shutdown() and not got:
+    pub.publish(String("hello from rospy"))
+    rate.sleep()
+print(got[0] if got else "nothing")
+"""
+
+
+@pytest.mark.ros1
+def test_a_real_rospy_node_talks_as_before_with_authentication_off(monkeypatch, tmp_path: Path) -> None:  # noqa: ANN001
+    """Authentication off (no variable set): Debian's rospy node and ours exchange messages both ways
+    through our master, nothing signed on either side."""
+    if not testing.have_ros1():
+        pytest.skip("Debian's ROS 1 is not installed")
+    for name in ("NINJEMYS_SECRET", "NINJEMYS_SECRET_FILE", "NINJEMYS_KEYS_FILE", "NINJEMYS_KEY"):
+        monkeypatch.delenv(name, raising=False)
+    assert auth.credentials() is None
+    env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_LOG_DIR=str(tmp_path))
+    with testing.run_master(env=env) as uri:
+        node = Node("ours", master_uri=uri)
+        try:
+            heard: list[str] = []
+            node.subscriber("from_ros1", String, lambda m: heard.append(m.data))
+            pub = node.publisher("from_ninjemys", String)
+            proc = subprocess.Popen(
+                [testing.ROS1_PYTHON, "-c", _ROSPY_TALKER], env=testing.ros1_env(uri),
+                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+            )  # fmt: skip
+            try:
+                testing.wait_until(lambda: bool(heard), timeout=60, what="rospy's message")
+                testing.wait_until(
+                    lambda: pub.publish(String("hello from ninjemys")) or proc.poll() is not None,
+                    timeout=60, what="rospy to hear us", step=0.05,
+                )  # fmt: skip
+                out, err = proc.communicate(timeout=30)
+            finally:
+                proc.kill()
+                proc.wait()
+            assert heard[0] == "hello from rospy"
+            assert out.strip() == "hello from ninjemys", err
+        finally:
+            node.shutdown()

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 import os
-import signal
 import subprocess
 import time
 from pathlib import Path
@@ -205,52 +204,55 @@ class Probe:
 
 
 class NavSession:
-    """A master, ``roslaunch puzzlebot_navigation <file> <args>`` and a :class:`Probe`; closed in order."""
+    """A master, ``roslaunch puzzlebot_navigation <file> <args>`` (a :class:`NodeProcess`) and a
+    :class:`Probe`; closed in order, the launch's output saved to ``launch.log`` for a post-mortem."""
 
     def __init__(self, launch_file: str, args: list[str], tmp_path: Path) -> None:
-        from ninjemys.testing import ninjemys_bin, run_master
+        from ninjemys.testing import NodeProcess, ninjemys_bin, run_master
 
         self._master = run_master()
         self.uri = self._master.__enter__()
         self.env = dict(os.environ)
         self.env.update(ROS_MASTER_URI=self.uri, ROS_HOME=str(tmp_path / "ros_home"), PYTHONUNBUFFERED="1")
         self.log_path = tmp_path / "launch.log"
-        self._log = open(self.log_path, "w")  # noqa: SIM115 - closed in close()
-        self.proc = subprocess.Popen(
-            [ninjemys_bin("roslaunch"), "puzzlebot_navigation", launch_file, *args],
-            env=self.env,
-            stdin=subprocess.DEVNULL,
-            stdout=self._log,
-            stderr=subprocess.STDOUT,
-            start_new_session=True,
-        )
+        try:
+            self.launch = NodeProcess(
+                [ninjemys_bin("roslaunch"), "puzzlebot_navigation", launch_file, *args],
+                env=self.env,
+                merge_stderr=True,
+            )
+        except BaseException:
+            self._master.__exit__(None, None, None)
+            raise
         self.probe = Probe(self.uri)
 
     def log(self) -> str:
-        return self.log_path.read_text(errors="replace")
+        """Everything roslaunch and its nodes printed so far."""
+        return self.launch.text()
+
+    def alive(self) -> bool:
+        """Whether roslaunch is still running (it exits when a required node dies)."""
+        return self.launch.proc.poll() is None
 
     def wait_for(self, predicate, timeout: float = 60.0) -> bool:
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            if predicate():
-                return True
-            if self.proc.poll() is not None:
-                return False
-            time.sleep(0.05)
-        return False
+        """Whether ``predicate`` came true within ``timeout`` s (False at once if roslaunch ended)."""
+        from ninjemys.testing import WaitTimeout, wait_until
+
+        try:
+            wait_until(lambda: predicate() or not self.alive(), timeout, "the navigation session")
+        except WaitTimeout:
+            return False
+        return bool(predicate())
 
     def close(self) -> None:
+        """Ctrl-C to roslaunch (it stops its nodes in order), then SIGKILL to whatever is left."""
         self.probe.close()
-        if self.proc.poll() is None:
-            os.killpg(self.proc.pid, signal.SIGINT)
+        if self.alive():
+            self.launch.interrupt()
             try:
-                self.proc.wait(15)
+                self.launch.wait(20)
             except subprocess.TimeoutExpired:
-                os.killpg(self.proc.pid, signal.SIGKILL)
-                self.proc.wait(5)
-        try:
-            os.killpg(self.proc.pid, signal.SIGKILL)  # anything the launch left in its group
-        except (ProcessLookupError, PermissionError):
-            pass
-        self._log.close()
+                pass
+        self.launch.stop(grace=0)
+        self.log_path.write_text(self.log())
         self._master.__exit__(None, None, None)

@@ -22,7 +22,7 @@ import yaml
 
 from ninjemys.idl.loader import get_message_class, get_service_class
 from ninjemys.rostime import Time
-from ninjemys.testing import have_ros1, ninjemys_bin, ros1_env, run_master
+from ninjemys.testing import NodeProcess, have_ros1, ninjemys_bin, ros1_env, run_master
 
 PARAMS = (
     Path(__file__).resolve().parents[2]
@@ -108,14 +108,10 @@ class Rig:
         self._running = True
         self._clock_thread = threading.Thread(target=self._run_clock, name="rig-clock", daemon=True)
         self._clock_thread.start()
-        self.log_path = tmp_path / "safety_monitor.out"
-        self._log = open(self.log_path, "w")  # noqa: SIM115 - closed in close()
-        self.proc = subprocess.Popen(
+        self.proc = NodeProcess(
             [ninjemys_bin("rosrun"), "puzzlebot_safety", "safety_monitor", f"__name:={name}"],
             env=self.env,
-            stdin=subprocess.DEVNULL,
-            stdout=self._log,
-            stderr=subprocess.STDOUT,
+            merge_stderr=True,
         )
         self.node.wait_for_service(f"/{name}/reset_e_stop", timeout=30.0)
         # the monitor connected to every fixed input (the command inputs depend on ~topics: stream())
@@ -246,7 +242,8 @@ class Rig:
         return recent[-1][1], recent[-1][2]
 
     def log(self) -> str:
-        return self.log_path.read_text(errors="replace")
+        """Everything the monitor printed so far."""
+        return self.proc.text() if hasattr(self, "proc") else ""
 
     def status(self, since: float) -> Any:
         """The monitor's DiagnosticStatus from the first /diagnostics received after sim time ``since``."""
@@ -256,16 +253,8 @@ class Rig:
 
     def close(self) -> None:
         """Stop whatever was started, in reverse order (also after a failed start)."""
-        proc = getattr(self, "proc", None)
-        if proc is not None:
-            proc.terminate()
-            try:
-                proc.wait(10)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait()
-        if hasattr(self, "_log"):
-            self._log.close()
+        if hasattr(self, "proc"):
+            self.proc.stop(grace=10)
         self._running = False
         if hasattr(self, "_clock_thread"):
             self._clock_thread.join(5)

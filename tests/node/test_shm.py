@@ -160,14 +160,21 @@ def test_a_malformed_notice_is_rejected_with_one_line_and_falls_back_to_tcpros(m
     assert wait_until(lambda: got == [1])
     ring = _pub_connection(talker, "/img").ring
     good_put = ring.put
-    for bad in ({"slot": 99}, {"gen": 12345}, {"length": shm_link.SLOT_SIZE + 1}):
+    for bad in (
+        {"slot": 99},
+        {"gen": 12345},
+        {"length": shm_link.SLOT_SIZE + 1},
+        {"offset": shm_link.SLOT_SIZE},
+    ):
         caplog.clear()
 
         def forged(parts, length, wait=0.0, bad=bad, good_put=good_put):  # noqa: ANN001, ANN202
             frame = good_put(parts, length, wait)
-            _, slot, gen, size = shm_ring.NOTICE.unpack_from(frame, 4)
-            values = {"slot": slot, "gen": gen, "length": size, **bad}
-            return frame[:4] + shm_ring.NOTICE.pack(1, values["slot"], values["gen"], values["length"])
+            _, slot, gen, offset, size = shm_ring.NOTICE.unpack_from(frame, 4)
+            values = {"slot": slot, "gen": gen, "offset": offset, "length": size, **bad}
+            return frame[:4] + shm_ring.NOTICE.pack(
+                1, values["slot"], values["gen"], values["offset"], values["length"]
+            )
 
         conn = _pub_connection(talker, "/img")
         conn.ring.put = forged

@@ -105,3 +105,24 @@ def test_our_6mb_reaches_roscpp_over_tcpros_and_ours_over_shm(make_node, master,
     assert wait_until(lambda: ours, timeout=10) and ours[0].data == text
     assert child.wait_for(lambda line: line.startswith(f"big {len(text)} "), timeout=20), child.describe()
     assert _transports(talker, "/big") == ["SHMROS", "TCPROS"]
+
+
+def test_a_loaned_image_reaches_rospy_over_tcpros_identical_to_ours_over_shm(
+    make_node, master, peers
+) -> None:  # noqa: ANN001
+    camera = make_node("camera")
+    pub = camera.publisher("image", Image, queue_size=None)
+    ours: list[Image] = []
+    make_node("viewer").subscriber("image", Image, ours.append)
+    child = _start(peers, rospy(ROSPY_IMAGE_SUB, master.uri))
+    assert wait_until(lambda: pub.get_num_connections() == 2, timeout=20)
+    assert _transports(camera, "/image") == ["SHMROS", "TCPROS"]
+    frame = bytes((k + 7) % 256 for k in range(256)) * (1920 * 1080 * 3 // 256)
+    with pub.loan(len(frame), height=1080, width=1920, encoding="rgb8", step=5760) as msg:
+        assert pub.loan(10).shared is False  # (a small loan never takes a slot)
+        msg.data[:] = memoryview(frame)
+        pub.publish(msg)
+    expected = f"image 1920x1080 rgb8 {len(frame)} {hashlib.md5(frame).hexdigest()}"
+    assert child.wait_for(lambda line: line == expected, timeout=20), child.describe()
+    assert wait_until(lambda: ours, timeout=10)
+    assert ours[0].data == frame and type(ours[0].data.obj).__name__ == "Lease"

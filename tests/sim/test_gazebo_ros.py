@@ -416,3 +416,18 @@ def test_set_physics_properties_takes_another_time_step(gazebo: Gazebo) -> None:
             "/gazebo/set_physics_properties", SetPhysicsProperties, time_step=0.01, max_update_rate=100.0
         )
     assert gazebo.call("/gazebo/get_physics_properties", GetPhysicsProperties).time_step == 0.01
+
+
+def test_spawn_model_database_puts_a_shipped_model_in(gazebo: Gazebo) -> None:
+    """``spawn_model -sdf -database unit_cylinder``: the shipped model, at the spawn pose, in
+    model_states; deleted again by name."""
+    # model_states goes out as the world steps (Gazebo's world update), not while physics is paused
+    gazebo.call("/gazebo/unpause_physics", get_service_class("std_srvs/Empty"))
+    out = gazebo.spawn_model("-sdf", "-database", "unit_cylinder", "-model", "pillar", "-x", "-4", "-y", "3")
+    assert out.returncode == 0, out.stdout + out.stderr
+    assert gazebo.model_states()["pillar"][:2] == pytest.approx((-4.0, 3.0), abs=1e-6)
+    resp = gazebo.call("/gazebo/delete_model", DeleteModel, model_name="pillar")
+    assert resp.success, resp.status_message
+    assert "pillar" not in gazebo.model_states()
+    out = gazebo.spawn_model("-sdf", "-database", "no_such_model", "-model", "ghost")
+    assert out.returncode == 1 and "no_such_model" in out.stdout + out.stderr

@@ -324,6 +324,7 @@ def test_camera_sees_the_square_painted_on_the_floor():
 
 
 def test_spawn_model_xml_kinds():
+    from ninjemys.maps.mapfile import MapFileError
     from ninjemys.sim.gazebo_api import parse_model_xml
 
     urdf = (ROBOTS_DIR / "puzzlebot.urdf").read_text()
@@ -334,10 +335,15 @@ def test_spawn_model_xml_kinds():
         '<robot name="b"><link name="l"><collision><geometry><box size="0.4 0.6 0.5"/></geometry></collision></link></robot>'
     )
     assert box == ("obstacle", ("box", (0.4, 0.6), 0.5, (180, 130, 80)))
-    cyl = parse_model_xml(
-        "<sdf><model name='c'><link name='l'><collision name='x'><geometry><cylinder><radius>0.2</radius><length>1.0</length></cylinder></geometry></collision></link></model></sdf>"
+    # an SDF document goes through the SDF reader: its footprint, standing on the floor (a cylinder
+    # centred on the model's origin reaches below it), as spawn_sdf_model places it
+    kind, (cyl,) = parse_model_xml(
+        "<sdf version='1.6'><model name='c'><link name='l'><collision name='x'><geometry><cylinder><radius>0.2</radius><length>1.0</length></cylinder></geometry></collision></link></model></sdf>"
     )
-    assert cyl[1][:3] == ("cylinder", (0.2, 0.2), 1.0)
+    assert kind == "sdf" and cyl.kind == "cylinder" and cyl.height == pytest.approx(1.0)
+    assert np.abs(cyl.outline).max() == pytest.approx(0.2, abs=1e-9)
+    with pytest.raises(MapFileError, match="missing attribute 'version'"):
+        parse_model_xml("<sdf><model name='c'/></sdf>")
     with pytest.raises(SpawnError, match="not valid XML"):
         parse_model_xml("<robot")
     with pytest.raises(SpawnError, match="neither a differential-drive robot"):

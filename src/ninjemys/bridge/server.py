@@ -98,13 +98,17 @@ class GatewayOptions:
         if not self.authenticate:
             return None
         if self.secret_file is None:
-            # the graph's own secret (NINJEMYS_SECRET / NINJEMYS_SECRET_FILE, ninjemys.net.auth)
-            shared = auth.load_secret()
-            if shared is None:
+            # the graph's own credentials (ninjemys.net.auth): NINJEMYS_SECRET / NINJEMYS_SECRET_FILE, or
+            # with per-node keys the key of the gateway's node (NINJEMYS_KEY, or its NINJEMYS_KEYS_FILE line)
+            creds = auth.credentials()
+            name = self.node_name if self.node_name.startswith("/") else f"/{self.node_name}"
+            key = None if creds is None else creds.secret_for(name)
+            if key is None:
                 raise NinjemysError(
-                    "authentication is on but no secret is set (secret_file, or NINJEMYS_SECRET for the graph's)"
+                    "authentication is on but no secret is set (secret_file, or NINJEMYS_SECRET for the "
+                    f"graph's, or a key for {name} in NINJEMYS_KEYS_FILE)"
                 )
-            return shared.decode("utf-8", "replace")
+            return key.decode("utf-8", "replace")
         return Path(self.secret_file).read_text().strip()
 
     def foxglove_token(self) -> str | None:
@@ -150,12 +154,18 @@ class Catalog:
         return app
 
     def refresh(
-        self, node: Node, services: Services, learn: Callable[[str, str], str | None] = lambda t, n: None
+        self,
+        node: Node,
+        services: Services,
+        learn: Callable[[str, str], str | None] = lambda t, n: None,
+        probe: bool = True,
     ) -> dict[str, Any]:
         """Poll the master; returns what changed: added/removed channels and services, graph diff.
 
         ``learn(topic, type)`` gives the definition text of a type the gateway cannot load (as a
-        publisher sent it), or None while it is not known yet."""
+        publisher sent it), or None while it is not known yet. ``probe=False`` leaves out the services
+        whose type is not known yet (a later refresh probes them): each probe is a lookup and a
+        connection to its provider, and every node has two services (get_loggers, set_logger_level)."""
         snapshot = GraphSnapshot.fetch(node.master, published=False)
         types, pubs, srvs = snapshot.topic_types, snapshot.publishers, snapshot.services
         added, removed = [], []
@@ -200,6 +210,8 @@ class Catalog:
         for name in srvs:
             # a provider's type is probed once per service name, not on every refresh
             type_name = self._service_types.get(name)
+            if type_name is None and not probe:
+                continue
             try:
                 if type_name is None:
                     type_name = self._service_types[name] = services.service_type(name)
@@ -416,7 +428,9 @@ class Gateway:
             self._clock_sub = self.node.subscriber(
                 "/clock", get_message_class("rosgraph_msgs/Clock"), self._on_clock, queue_size=1
             )
-        self._refresh()
+        # the graph and the topics at once; the services' types from the poller's first round (probing
+        # them one by one held the first 100-node graph back by 200-300 ms)
+        self._refresh(probe=False)
         self._poller.start()
 
     def _count_clients(self) -> None:
@@ -430,6 +444,7 @@ class Gateway:
                 client.session.send_time(self._sim_ns)
 
     def _poll(self) -> None:
+        self._refresh()
         while not self._stop.wait(self.options.update_period):
             self._refresh()
 
@@ -455,9 +470,9 @@ class Gateway:
             log.warning("gateway: cannot learn the definition of %s on %s: %s", type_name, topic, exc)
         return None
 
-    def _refresh(self) -> None:
+    def _refresh(self, probe: bool = True) -> None:
         try:
-            diff = self.catalog.refresh(self.node, self.services, self._learn)
+            diff = self.catalog.refresh(self.node, self.services, self._learn, probe)
         except NinjemysError as exc:
             # once per outage (a dead master fails every refresh), then once more when it is back
             if not self._refresh_failing:

@@ -236,7 +236,14 @@ def u8_buffer(value: Any) -> Any:
     if isinstance(value, str):
         return value.encode("latin-1")
     if type(value).__module__ == "numpy":
-        return value.astype("u1", copy=False).tobytes()
+        array = value.astype("u1", copy=False)
+        if array.ndim and array.flags.c_contiguous:
+            # the array's own memory: a camera frame is copied once, into the socket or the
+            # shared-memory ring, not first into a bytes object (publishers that keep a frame past
+            # publish, for a lagging subscriber or a latch, join it into bytes of their own)
+            view = memoryview(array)
+            return view if array.ndim == 1 else view.cast("B")
+        return array.tobytes()
     return bytes(value)  # list/tuple of ints: ValueError/TypeError on bad items -> diagnosis
 
 

@@ -46,7 +46,9 @@ async def call(uri: str, method: str, params: tuple[Any, ...] | list[Any], timeo
     except ValueError as exc:
         raise ProtocolError(str(exc)) from None
     body = wire.dump_call(method, params)
-    request = wire.http_request(host, port, body, keep_alive=False, extra_headers=auth.http_header_line(body))
+    caller = params[0] if params and isinstance(params[0], str) else ""
+    signature = auth.http_header_line(body, caller)
+    request = wire.http_request(host, port, body, keep_alive=False, extra_headers=signature)
     try:
         async with deadline(timeout):
             return await _exchange(host, port, request)

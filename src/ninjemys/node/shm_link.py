@@ -7,7 +7,8 @@ usual connection header plus ``ninjemys_shm=<host identity>``; the publisher agr
 header (``ninjemys_shm=1``). Without that field in the reply the stream is plain TCPROS.
 
 On an SHMROS stream every TCPROS frame starts with a tag byte: 0 = the message follows inline,
-1 = a notice ``(slot u32, generation u64, length u64)`` naming a slot of the ring, 2 = the ring's
+1 = a notice ``(slot u32, generation u64, offset u64, length u64)`` naming a span of a slot of the
+ring (offset 0 except for loaned messages, :mod:`ninjemys.node.shm_loan`), 2 = the ring's
 segment name (sent once, before the first notice: the ring is made with the first large message, so
 a topic of small messages costs no segment, mapping or file descriptor). Messages of at
 least :data:`THRESHOLD` bytes go through the ring; smaller ones inline, and so does a large one when
@@ -158,7 +159,9 @@ class ShmPubConnection(PubConnection):
         length = total - 4
         ring = self._ring() if length >= THRESHOLD and not self.closed else None
         if ring is not None:
-            notice = ring.put(parts[1:], length, SLOT_WAIT if queue_size is None else 0.0)
+            notice = ring.put_lent(parts[1:], length) if ring.lending else None  # see shm_loan
+            if notice is None:
+                notice = ring.put(parts[1:], length, SLOT_WAIT if queue_size is None else 0.0)
             if notice is not None:
                 PubConnection.send(self, notice, queue_size)
                 return

@@ -44,6 +44,7 @@ if TYPE_CHECKING:
     from typing import Any
 
     from ninjemys.node.context import NodeContext
+    from ninjemys.node.shm_loan import LoanedMessage
 
 _log = logging.getLogger(__name__)
 
@@ -670,6 +671,17 @@ class Publisher:
             self._pub.publish_parts(parts, total, self, item)
         else:
             self._pub.publish_frame(b"".join(parts), self, item)
+
+    def loan(self, length: int, field: str | None = None, **fields: Any) -> LoanedMessage:
+        """A message of this topic's type whose ``uint8[]`` array (``field``, found by itself when the
+        type has one) of ``length`` bytes lives in a free shared-memory slot of an SHMROS subscriber:
+        fill it, then :meth:`publish` sends only a slot notice (no copy). ``fields`` set the others.
+        Falls back to a heap array when no slot is available; see :mod:`ninjemys.node.shm_loan`."""
+        if self._closed:
+            raise ShutdownError(f"publisher of {self.name} is unregistered")
+        from ninjemys.node import shm_loan  # only a loaning publisher needs it
+
+        return shm_loan.loan(self, length, field, fields)
 
     def _frame(self, msg: Any) -> bytes:
         """``msg``'s whole TCPROS frame in one buffer."""

@@ -22,10 +22,13 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from ninjemys.idl.loader import get_message_class, get_service_class
 from ninjemys.maps.mapfile import MapFileError
 from ninjemys.rostime import Time
 from ninjemys.sim.robot_model import load_robot_model, model_from_urdf
+from ninjemys.sim.sdf import sdf_model_obstacles
 from ninjemys.sim.simcore import Robot, SpawnError, wrap_angle
 from ninjemys.tf2.math import quaternion_from_yaw, yaw_from_quaternion
 
@@ -252,6 +255,22 @@ class GazeboApi:
                 namespace = req.robot_namespace.strip("/")
                 clash = any(io.prefix == "" for io in sn.io.values())
                 sn.add_robot(name, spec, x, y, yaw, clash and not namespace, namespace or None)
+            elif kind == "sdf":
+                if not spec:
+                    # a light, a ground plane: nothing the floor plan holds (Gazebo would add it)
+                    sn.log.info("model [%s] has no collision this simulator sees: nothing added", name)
+                    return _spawned(resp)
+                (piece,) = spec
+                c, s = math.cos(yaw), math.sin(yaw)
+                rel = piece.outline
+                outline = np.column_stack(
+                    [x + c * rel[:, 0] - s * rel[:, 1], y + s * rel[:, 0] + c * rel[:, 1]]
+                )
+                with sn.lock:
+                    sn.sim.add_outline(name, piece.kind, outline, yaw, piece.height, piece.color)
+                sn.log.info(
+                    "spawned %s [%s] (SDF model %s) at (%.3f, %.3f)", piece.kind, name, piece.name, x, y
+                )
             else:
                 shape, size, height, colour = spec
                 with sn.lock:
@@ -262,8 +281,7 @@ class GazeboApi:
             sn.log.error("spawn refused: %s", exc)
             resp.success, resp.status_message = False, f"SpawnModel: Failure - {exc}"
             return resp
-        resp.success, resp.status_message = True, "SpawnModel: Successfully spawned entity"
-        return resp
+        return _spawned(resp)
 
     def _delete(self, req: Any) -> Any:
         resp = DeleteModel._response_class()
@@ -561,9 +579,18 @@ class GazeboApi:
             self.link_states_pub.publish(LinkStates(name=names, pose=poses, twist=twists))
 
 
+def _spawned(resp: Any) -> Any:
+    resp.success, resp.status_message = True, "SpawnModel: Successfully spawned entity"
+    return resp
+
+
 def parse_model_xml(text: str) -> tuple[str, Any]:
-    """What a SpawnModel request's ``model_xml`` describes: ("robot", RobotModel) or
-    ("obstacle", (shape, size, height, colour)). Empty text or ``puzzlebot`` is the PuzzleBot."""
+    """What a SpawnModel request's ``model_xml`` describes: ("robot", RobotModel),
+    ("obstacle", (shape, size, height, colour)) for a URDF box or cylinder, or ("sdf", [Obstacle])
+    for an SDF document (a ``<model>``, or spawn_model -database's ``<world>`` of one ``model://``
+    include, found on GAZEBO_MODEL_PATH or among the shipped models), its solid in the model's frame
+    (empty for a model with nothing solid: a light, a ground plane). Empty text or ``puzzlebot`` is
+    the PuzzleBot."""
     body = text.strip()
     if not body:
         return "robot", load_robot_model("puzzlebot")
@@ -573,6 +600,16 @@ def parse_model_xml(text: str) -> tuple[str, Any]:
         root = ET.fromstring(body)
     except ET.ParseError as exc:
         raise SpawnError(f"model_xml is not valid XML: {exc}") from None
+    if root.tag == "sdf":
+        # SdfError (a MapFileError) names the element and the reason
+        pieces = sdf_model_obstacles(body, lift=True)
+        if len(pieces) > 1:
+            raise SpawnError(
+                f"the SDF model has {len(pieces)} collision pieces ({', '.join(p.name for p in pieces)}); "
+                "spawn_sdf_model takes models of one piece here: put this model in the world file, "
+                "where every piece is kept"
+            )
+        return "sdf", pieces
     if root.tag == "robot" and any(j.get("type") == "continuous" for j in root.iter("joint")):
         # a robot with wheels: the URDF reader says what it is, or why it cannot be simulated
         return "robot", model_from_urdf(body, "model_xml")

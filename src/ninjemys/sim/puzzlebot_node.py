@@ -17,6 +17,8 @@ map_server YAML used as the world instead), ``~rate`` (real-time factor; 0 runs 
 possible), ``~x ~y ~yaw`` (start pose of the first robot), ``~model`` (``puzzlebot``, a YAML or URDF
 path), ``~update_rate`` (physics steps per simulated second, default 100), ``~seed`` (noise),
 ``~odom_alpha`` (amcl's α1-α4), ``~laser_noise``, ``~gui`` (serve the browser view),
+``~pub_clock_frequency`` (/clock messages per simulated second; default
+``/gazebo/pub_clock_frequency``, else 0: every physics step, as gazebo_ros),
 ``~cmd_vel_timeout`` (simulated seconds without a command after which the wheels are stopped, as
 diff_drive_controller's ``cmd_vel_timeout`` does; default 0: off, the last command holds, as with
 Gazebo's diff drive plugin), ``~no_robot`` (start with an empty world: robots come from
@@ -57,8 +59,9 @@ from ninjemys.rostime import Time
 from ninjemys.sim import messages
 from ninjemys.sim.gazebo_api import GazeboApi, parse_model_xml
 from ninjemys.sim.gazebo_worlds import load_gazebo_world
-from ninjemys.sim.robot_model import RobotModel, load_robot_model
+from ninjemys.sim.robot_model import CameraSpec, RobotModel, load_robot_model
 from ninjemys.sim.ros_control.hardware import ControlLoop
+from ninjemys.sim.sensors import Camera
 from ninjemys.sim.simcore import Robot, Simulation, SpawnError
 from ninjemys.sim.stepper import Due, StepLock, Stepper
 from ninjemys.sim.world2d import World, load_world, world_from_map
@@ -80,7 +83,17 @@ Log: Any = get_message_class("rosgraph_msgs/Log")
 
 WORLD_FRAME = "map"  # ground truth frame: the shipped maps are rasterized in world coordinates
 
-__all__ = ["SimNode", "RobotIO", "StepLock", "Due", "parse_model_xml", "keep_freed_memory", "main"]
+__all__ = ["SimNode", "RobotIO", "scoped", "StepLock", "Due", "parse_model_xml", "keep_freed_memory", "main"]
+
+
+@dataclass
+class ExtraSensor:
+    """A description's further lidar or camera (beyond its first of each): publishers and schedule."""
+
+    kind: str  # "laser" or "camera"
+    index: int  # into the model's extra_lasers or extra_cameras
+    pubs: dict[str, Any]
+    due: Due
 
 
 @dataclass
@@ -104,17 +117,32 @@ class RobotIO:
     topics: dict[str, str] = field(default_factory=dict)  # role -> relative topic name (the view's)
     #: gazebo_ros_control's controller_manager for this robot (a ros_control description), else None
     control: ControlLoop | None = None
+    extras: list[ExtraSensor] = field(default_factory=list)
 
     def frame(self, name: str) -> str:
-        return self.frame_prefix + name
+        return scoped(self.frame_prefix, name)
 
     def close(self) -> None:
         if self.control is not None:
             self.control.close()
         if self.cmd_sub is not None:
             self.cmd_sub.unregister()
-        for pub in self.pubs.values():
-            pub.unregister()
+        for pubs in (self.pubs, *(e.pubs for e in self.extras)):
+            for pub in pubs.values():
+                pub.unregister()
+
+
+def scoped(prefix: str, name: str) -> str:
+    """``name`` under a robot's prefix (``""`` or ``"ns/"``), never as ``ns//name``.
+
+    A description's plugin topics are absolute (gazebo_ros resolves them in the robot's namespace:
+    ``/odom``, ``/heavy/odom``) and its frames may already carry the namespace (``heavy/odom``): a
+    name already inside the prefix's namespace is kept, any other goes under the prefix, less its
+    leading slash (``/odom`` of robot ``heavy`` in a multi-robot world is ``heavy/odom``)."""
+    if not prefix:
+        return name
+    inner = name.lstrip("/")
+    return name if inner.startswith(prefix) else prefix + inner
 
 
 def _period(rate: float | None, default: float, dt: float) -> float:
@@ -139,6 +167,9 @@ class SimNode:
             self._step_and_publish, lambda: sim.time, sim.dt, rate, self.lock, self._step_failed
         )
         self.cmd_timeout = 0.0  # ~cmd_vel_timeout (0: off)
+        #: sim seconds between /clock messages (gazebo_ros' pub_clock_frequency; 0: every step)
+        self.clock_period = 0.0
+        self._last_clock: float | None = None
         self.view: Any = None
         self.clock_pub = node.publisher("/clock", Clock, queue_size=10)
         self.tf_pub = node.publisher("/tf", TFMessage, queue_size=100)
@@ -215,39 +246,31 @@ class SimNode:
         drive = model.drive
         driven = drive.kind != "none"
         pubs: dict[str, Any] = {
-            "ground_truth": n.publisher(prefix + "base_pose_ground_truth", Odometry, queue_size=10),
-            "contact": n.publisher(prefix + "contact", Bool, queue_size=1, latch=True),
+            "ground_truth": n.publisher(scoped(prefix, "base_pose_ground_truth"), Odometry, queue_size=10),
+            "contact": n.publisher(scoped(prefix, "contact"), Bool, queue_size=1, latch=True),
         }
         topics = {  # what the browser view subscribes to (the camera's defaults when it has none)
-            "cmd_vel": prefix + drive.command_topic,
-            "color": prefix + "camera/color/image_raw",
-            "depth": prefix + "camera/depth/image_rect_raw",
+            "cmd_vel": scoped(prefix, drive.command_topic),
+            "color": scoped(prefix, "camera/color/image_raw"),
+            "depth": scoped(prefix, "camera/depth/image_rect_raw"),
         }
         if driven and drive.publish_wheel_speeds:
-            pubs["wl"] = n.publisher(prefix + "wl", Float32, queue_size=10)
-            pubs["wr"] = n.publisher(prefix + "wr", Float32, queue_size=10)
+            pubs["wl"] = n.publisher(scoped(prefix, "wl"), Float32, queue_size=10)
+            pubs["wr"] = n.publisher(scoped(prefix, "wr"), Float32, queue_size=10)
         if driven and drive.publish_wheel_joint_state:
-            pubs["joint_states"] = n.publisher(prefix + "joint_states", JointState, queue_size=10)
+            pubs["joint_states"] = n.publisher(scoped(prefix, "joint_states"), JointState, queue_size=10)
         if driven and drive.publish_odom:
-            pubs["odom"] = n.publisher(prefix + drive.odom_topic, Odometry, queue_size=10)
+            pubs["odom"] = n.publisher(scoped(prefix, drive.odom_topic), Odometry, queue_size=10)
         laser, camera, imu = model.laser, model.camera, model.imu
         if laser is not None:
-            pubs["scan"] = n.publisher(prefix + laser.topic, LaserScan, queue_size=10)
+            pubs["scan"] = n.publisher(scoped(prefix, laser.topic), LaserScan, queue_size=10)
         if camera is not None:
-            topics["color"] = prefix + camera.image_topic
-            pubs["image"] = n.publisher(prefix + camera.image_topic, Image, queue_size=2)
-            # image_transport's <base>/compressed, encoded only while subscribed
-            pubs["image_compressed"] = CompressedPublisher(n, prefix + camera.image_topic)
-            pubs["color_info"] = n.publisher(prefix + camera.info_topic, CameraInfo, queue_size=2)
+            topics["color"] = scoped(prefix, camera.image_topic)
             if camera.depth_topic:
-                topics["depth"] = prefix + camera.depth_topic
-                pubs["depth"] = n.publisher(prefix + camera.depth_topic, Image, queue_size=2)
-                if camera.depth_info_topic:
-                    pubs["depth_info"] = n.publisher(
-                        prefix + camera.depth_info_topic, CameraInfo, queue_size=2
-                    )
+                topics["depth"] = scoped(prefix, camera.depth_topic)
+            pubs.update(self._camera_pubs(prefix, camera))
         if imu is not None:
-            pubs["imu"] = n.publisher(prefix + imu.topic, Imu, queue_size=10)
+            pubs["imu"] = n.publisher(scoped(prefix, imu.topic), Imu, queue_size=10)
         io = RobotIO(
             robot,
             prefix,
@@ -260,13 +283,42 @@ class SimNode:
             Due(_period(imu.rate, 100.0, dt), now) if imu else None,
             topics=topics,
         )
+        for i, spec in enumerate(model.extra_lasers):
+            scan_pub = n.publisher(scoped(prefix, spec.topic), LaserScan, queue_size=10)
+            io.extras.append(
+                ExtraSensor("laser", i, {"scan": scan_pub}, Due(_period(spec.rate, 10.0, dt), now))
+            )
+        for i, cam in enumerate(model.extra_cameras):
+            due = Due(_period(cam.rate, 30.0, dt), now)
+            io.extras.append(ExtraSensor("camera", i, self._camera_pubs(prefix, cam), due))
         if driven and drive.command_topic:  # ros_control: the controllers subscribe their own cmd_vel
             io.cmd_sub = n.subscriber(
-                prefix + drive.command_topic, Twist, self._on_cmd_vel, callback_args=robot.name, queue_size=1
+                scoped(prefix, drive.command_topic),
+                Twist,
+                self._on_cmd_vel,
+                callback_args=robot.name,
+                queue_size=1,
             )
         if drive.kind == "puzzlebot":  # a URDF robot's sensor frames come from robot_state_publisher
             io.static_tfs = messages.static_transforms(model, frame_prefix, self._stamp())
         return io
+
+    def _camera_pubs(self, prefix: str, camera: CameraSpec) -> dict[str, Any]:
+        """A camera's publishers: image (and image_transport's <base>/compressed, encoded only while
+        subscribed), camera_info, and the depth image and its camera_info for an RGB-D camera."""
+        n = self.node
+        pubs: dict[str, Any] = {
+            "image": n.publisher(scoped(prefix, camera.image_topic), Image, queue_size=2),
+            "image_compressed": CompressedPublisher(n, scoped(prefix, camera.image_topic)),
+            "color_info": n.publisher(scoped(prefix, camera.info_topic), CameraInfo, queue_size=2),
+        }
+        if camera.depth_topic:
+            pubs["depth"] = n.publisher(scoped(prefix, camera.depth_topic), Image, queue_size=2)
+            if camera.depth_info_topic:
+                pubs["depth_info"] = n.publisher(
+                    scoped(prefix, camera.depth_info_topic), CameraInfo, queue_size=2
+                )
+        return pubs
 
     def remove_robot(self, name: str) -> None:
         with self.lock:
@@ -314,7 +366,7 @@ class SimNode:
         """Outputs due now, contact re-announced, the stepping thread re-reads the clock."""
         now = self.sim.time
         for io in self.io.values():
-            for due in (io.odom_due, io.scan_due, io.camera_due, io.imu_due):
+            for due in (io.odom_due, io.scan_due, io.camera_due, io.imu_due, *(e.due for e in io.extras)):
                 if due is not None:
                     due.next = now
             self._publish_contact(io)
@@ -348,7 +400,7 @@ class SimNode:
         touched = sim.step()
         now = sim.time
         stamp = self._stamp()
-        if self.clock_pub.get_num_connections():  # nobody listening costs nothing (checked every step)
+        if self.clock_pub.get_num_connections() and self._clock_due(now):  # nobody listening: nothing
             self.clock_pub.publish(Clock(clock=stamp))
         for r in touched:
             self.log.warn(
@@ -389,11 +441,24 @@ class SimNode:
                 )
                 if want:  # a browser view watches the cameras as ROS topics too (through its gateway)
                     self._camera(io, stamp)
+            for extra in io.extras:
+                if extra.due.fire(now):
+                    self._extra_sensor(io, extra, stamp)
         if tfs:
             self.tf_pub.publish(TFMessage(transforms=tfs))
         self.gazebo.after_step(stamp)
         if view is not None:
             view.publish(now)
+
+    def _clock_due(self, now: float) -> bool:
+        """Whether /clock goes out this step: every step, or with ``clock_period`` set, once that much
+        simulated time has passed since the last one (gazebo_ros' publishSimTime); a clock set back
+        (reset_world) publishes at once."""
+        last = self._last_clock
+        if self.clock_period > 0 and last is not None and 0.0 <= now - last < self.clock_period - 1e-9:
+            return False
+        self._last_clock = now
+        return True
 
     def _odometry(self, io: RobotIO, stamp: Time, tfs: list[Any] | None) -> None:
         """Advance the robot's odometry; publish odom, ground truth, wl/wr and joint_states to whoever
@@ -448,6 +513,21 @@ class SimNode:
                 )
             )
 
+    def _extra_sensor(self, io: RobotIO, extra: ExtraSensor, stamp: Time) -> None:
+        """A further lidar's scan or camera's images, to whoever reads them (nobody: not computed)."""
+        model = io.robot.model
+        if extra.kind == "laser":
+            laser = model.extra_lasers[extra.index]
+            if extra.pubs["scan"].get_num_connections():
+                ranges = self.sim.scan(io.robot, laser=laser)
+                extra.pubs["scan"].publish(
+                    messages.laser_scan(stamp, io.frame(laser.pose.frame), laser, ranges)
+                )
+            return
+        if any(pub.get_num_connections() for pub in extra.pubs.values()):
+            spec = model.extra_cameras[extra.index]
+            self._camera_images(io, spec, io.robot.extra_cameras[extra.index], extra.pubs, stamp, extra.index)
+
     def _camera(self, io: RobotIO, stamp: Time) -> None:
         """Render and publish the camera's images, each only when someone reads it (camera_info
         alone needs no image at all)."""
@@ -455,14 +535,25 @@ class SimNode:
         spec = r.model.camera
         if spec is None or r.camera is None:
             return
-        pubs = io.pubs
+        self._camera_images(io, spec, r.camera, io.pubs, stamp, None)
+
+    def _camera_images(
+        self,
+        io: RobotIO,
+        spec: CameraSpec,
+        camera: Camera,
+        pubs: dict[str, Any],
+        stamp: Time,
+        extra: int | None,
+    ) -> None:
+        r = io.robot
         frame = io.frame(spec.frame)
         depth_frame = io.frame(spec.depth_frame)
         want_raw = pubs["image"].get_num_connections()
         want_colour = bool(want_raw or pubs["image_compressed"].get_num_connections())
         want_depth = bool("depth" in pubs and pubs["depth"].get_num_connections())
         if want_colour or want_depth:
-            rgb, depth = self.sim.render(r, colour=want_colour, depth=want_depth)
+            rgb, depth = self.sim.render(r, colour=want_colour, depth=want_depth, extra=extra)
             if want_colour:
                 img = messages.rgb_image(stamp, frame, rgb)
                 if want_raw:
@@ -470,7 +561,7 @@ class SimNode:
                 pubs["image_compressed"].publish(img)
             if want_depth:
                 pubs["depth"].publish(messages.depth_image(stamp, depth_frame, depth))
-        intrinsics = r.camera.intrinsics()
+        intrinsics = camera.intrinsics()
         for key, frame_id in (("color_info", frame), ("depth_info", depth_frame)):
             if key in pubs and pubs[key].get_num_connections():
                 pubs[key].publish(messages.camera_info(stamp, frame_id, spec, intrinsics))
@@ -558,6 +649,15 @@ def configure_model(
         model.imu.topic = param("imu_topic", model.imu.topic, str)
 
 
+def _gazebo_clock_frequency(node: Node) -> float:
+    """/gazebo/pub_clock_frequency when set (a number), else 0: /clock every physics step."""
+    try:
+        value = node.get_param("/gazebo/pub_clock_frequency", 0.0)
+        return float(value)
+    except (NinjemysError, TypeError, ValueError):
+        return 0.0
+
+
 def load_sim_world(log: NodeLog, world_arg: str, map_arg: str) -> World:
     if map_arg:
         log.info("world from map_server map %s", map_arg)
@@ -642,6 +742,9 @@ def main(argv: list[str] | None = None, view: ViewStarter | None = None) -> int:
         )
         app = SimNode(node, log, sim, rate, float(laser_noise) if laser_noise is not None else None)
         app.cmd_timeout = max(0.0, _param(node, log, "cmd_vel_timeout", 0.0, float))
+        # gazebo_ros reads /gazebo/pub_clock_frequency (empty_world.launch's use_clock_frequency sets it)
+        clock_hz = _param(node, log, "pub_clock_frequency", _gazebo_clock_frequency(node), float)
+        app.clock_period = 1.0 / clock_hz if clock_hz > 0 else 0.0
         starts = list(world.robots) or []
         if not starts:
             from ninjemys.sim.world2d import RobotStart

@@ -131,6 +131,10 @@ class RobotModel:
     #: gazebo_ros_diff_drive's publishWheelTF: the wheel joints whose parent -> child transforms go
     #: on /tf with the wheels' angles (left, right); empty when not asked for
     wheel_tf_joints: list[Joint] = field(default_factory=list)
+    #: a description's further lidars and cameras (``laser`` and ``camera`` are its first ones), each
+    #: on its plugin's own topics and frames, at its own rate
+    extra_lasers: list[LaserSpec] = field(default_factory=list)
+    extra_cameras: list[CameraSpec] = field(default_factory=list)
 
 
 def _merge(base: dict, over: dict) -> dict:

@@ -619,9 +619,14 @@ def sdf_model_obstacles(
     source: str = "<spawn_sdf_model>",
     env: Mapping[str, str] | None = None,
     warn: Callable[[str], None] | None = None,
+    lift: bool = False,
 ) -> list[Obstacle]:
     """The obstacles of an SDF model document (``<sdf><model>``, as spawn_sdf_model receives it, or a
-    ``<world>`` of includes), in the model's frame: place them at the spawn pose."""
+    ``<world>`` of includes), in the model's frame: place them at the spawn pose.
+
+    ``lift``: a piece reaching below the floor (a shape centred on the model's origin, spawned at
+    z 0) stands on the floor with its whole height, as Gazebo's physics pushes a model out of the
+    ground plane."""
     ctx = _Context(os.environ if env is None else env)
     root = _sdf_root(data.encode() if isinstance(data, str) else data, source, ctx)
     solids: list[_Solid] = []
@@ -633,6 +638,11 @@ def sdf_model_obstacles(
     if world_el is None and root.find("model") is None:
         raise root.error("no <model> in this SDF document")
     _report(ctx, source, warn)
+    if lift:
+        for solid in solids:
+            fp = solid.footprint
+            if fp.bottom < 0.0:
+                fp.top, fp.bottom = fp.top - fp.bottom, 0.0
     return _obstacles(solids)
 
 

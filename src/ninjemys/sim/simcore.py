@@ -21,7 +21,7 @@ import numpy as np
 
 from ninjemys.errors import NinjemysError
 from ninjemys.sim.raycast import grid_edges
-from ninjemys.sim.robot_model import LaserSpec, RobotModel
+from ninjemys.sim.robot_model import CameraSpec, LaserSpec, RobotModel
 from ninjemys.sim.sensors import Camera, FloorPaint, Scene, imu_reading, lidar_ranges
 from ninjemys.sim.world2d import MovingObstacle, Obstacle, World, box_outline, circle_outline
 
@@ -94,6 +94,7 @@ class Robot:
     trail_count: int = 0  # points ever appended (the view sends only the new ones)
     free: tuple[float, float, float] | None = None  # (x, y, r): a disk free of static geometry
     camera: Camera | None = None
+    extra_cameras: list[Camera] = field(default_factory=list)  # for model.extra_cameras, in order
 
     def command(self, linear: float, angular: float) -> None:
         """Set the body velocity to reach (cmd_vel): wheel targets, scaled together to the speed limit."""
@@ -406,13 +407,8 @@ class Simulation:
         robot = Robot(name, model, x, y, yaw, (x, y, yaw), rng)
         robot.odom_ref = (x, y, yaw)
         if model.camera is not None:
-            robot.camera = Camera(
-                model.camera.width,
-                model.camera.height,
-                model.camera.hfov,
-                model.camera.pose.xyz[2],
-                model.camera.depth_max,
-            )
+            robot.camera = camera_for(model.camera)
+        robot.extra_cameras = [camera_for(spec) for spec in model.extra_cameras]
         self.robots[name] = robot
         return robot
 
@@ -487,11 +483,24 @@ class Simulation:
         color: tuple[int, int, int],
     ) -> None:
         """Add a static box (size = length, width) or cylinder (size[0] = radius); refused on a robot or a name clash."""
-        if any(o.name == name for o in self.world.obstacles) or name in self.robots:
-            raise SpawnError(f"a model named [{name}] already exists")
         outline = (
             circle_outline(x, y, size[0]) if kind == "cylinder" else box_outline(x, y, size[0], size[1], yaw)
         )
+        self.add_outline(name, kind, outline, yaw, height, color)
+
+    def add_outline(
+        self,
+        name: str,
+        kind: str,
+        outline: np.ndarray,
+        yaw: float,
+        height: float,
+        color: tuple[int, int, int],
+    ) -> None:
+        """Add a static obstacle of any outline (world coordinates; an SDF model's footprint, spawned);
+        refused on a robot or a name clash."""
+        if any(o.name == name for o in self.world.obstacles) or name in self.robots:
+            raise SpawnError(f"a model named [{name}] already exists")
         for r in self.robots.values():
             d = point_segment_distance(
                 np.array([r.x]), np.array([r.y]), np.hstack([outline, np.roll(outline, -1, axis=0)])
@@ -702,8 +711,9 @@ class Simulation:
         c, s = math.cos(r.yaw), math.sin(r.yaw)
         return r.x + c * xyz[0] - s * xyz[1], r.y + s * xyz[0] + c * xyz[1]
 
-    def scan(self, r: Robot, scene: Scene | None = None) -> np.ndarray:
-        spec = r.model.laser
+    def scan(self, r: Robot, scene: Scene | None = None, laser: LaserSpec | None = None) -> np.ndarray:
+        """``r``'s lidar ranges (its first lidar's, or ``laser``'s: one of its ``extra_lasers``)."""
+        spec = laser or r.model.laser
         assert spec is not None
         lx, ly = self.sensor_pose(r, spec.pose.xyz)
         angle_min, _angle_max, inc = scan_angles(spec)
@@ -723,13 +733,22 @@ class Simulation:
         )
 
     def render(
-        self, r: Robot, scene: Scene | None = None, colour: bool = True, depth: bool = True
+        self,
+        r: Robot,
+        scene: Scene | None = None,
+        colour: bool = True,
+        depth: bool = True,
+        extra: int | None = None,
     ) -> tuple[np.ndarray, np.ndarray]:
-        """``r``'s camera images (colour, depth); one not wanted is left empty (see Camera.render)."""
-        spec = r.model.camera
-        assert spec is not None and r.camera is not None
+        """``r``'s camera images (colour, depth); one not wanted is left empty (see Camera.render).
+        ``extra``: the images of ``r.model.extra_cameras[extra]`` instead of its first camera's."""
+        if extra is None:
+            spec, camera = r.model.camera, r.camera
+        else:
+            spec, camera = r.model.extra_cameras[extra], r.extra_cameras[extra]
+        assert spec is not None and camera is not None
         cx, cy = self.sensor_pose(r, spec.pose.xyz)
-        return r.camera.render(
+        return camera.render(
             scene or self.scene(r.name), cx, cy, r.yaw + spec.pose.rpy[2], colour=colour, depth=depth
         )
 
@@ -737,6 +756,11 @@ class Simulation:
         spec = r.model.imu
         assert spec is not None
         return imu_reading(r.yaw, r.v, r.w, r.v_prev, self.dt, spec.gyro_noise, spec.accel_noise, r.rng)
+
+
+def camera_for(spec: CameraSpec) -> Camera:
+    """The renderer of a camera description (its per-row tables are built once, here)."""
+    return Camera(spec.width, spec.height, spec.hfov, spec.pose.xyz[2], spec.depth_max)
 
 
 def floor_paint(world: World, resolution: float = 0.01, max_cells: int = 2000) -> FloorPaint | None:

@@ -63,10 +63,13 @@ def _request(method: str, params: tuple[str, ...], host: str) -> bytes:
         f"<params>{body}</params></methodCall>"
     ).encode()
     signature = ""
-    if os.environ.get("NINJEMYS_SECRET") or os.environ.get("NINJEMYS_SECRET_FILE"):
+    if any(
+        os.environ.get(v)
+        for v in ("NINJEMYS_SECRET", "NINJEMYS_SECRET_FILE", "NINJEMYS_KEYS_FILE", "NINJEMYS_KEY")
+    ):
         from ninjemys.net import auth  # only a graph with a secret pays for signing
 
-        signature = auth.http_header_line(payload)
+        signature = auth.http_header_line(payload, params[0] if params else "")
     head = (
         f"POST /RPC2 HTTP/1.1\r\nHost: {host}\r\nContent-Type: text/xml\r\n"
         f"Content-Length: {len(payload)}\r\n{signature}Connection: close\r\n\r\n"

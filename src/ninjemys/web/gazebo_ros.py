@@ -3,9 +3,12 @@
 ``gzserver [-u] [-e physics] [--verbose] [-s plugin ...] [world]`` runs the simulator as the node
 ``gazebo`` on a Gazebo world (``worlds/empty.world`` by default), with no robot until
 ``spawn_model`` brings one, physics paused with ``-u``; it serves the browser view (unless
-``--headless``) and leaves its address in the parameter ``/gazebo/gui_url``. ``gzclient`` waits for
-that parameter and opens the view, as Gazebo's client attaches to a running server. ``gazebo`` is
-both in one process. Gazebo's options this simulator has no use for (``-r``, ``-s``, ``-g``,
+``--headless``) and leaves its address in the parameter ``/gazebo/gui_url`` (an empty address when
+headless). ``gzclient`` is not Gazebo's 3D client: it waits for that parameter and opens the
+simulator's browser view (the world from above with the robots, their scans and camera images), as
+Gazebo's client attaches to a running server; facing a headless server it says so and exits 1 (there
+is nothing to attach to), and an address that does not answer (a server that has gone) is not
+opened. ``gazebo`` is both in one process. Gazebo's options this simulator has no use for (``-r``, ``-s``, ``-g``,
 ``--seed`` ...) are accepted and named once.
 """
 
@@ -14,6 +17,7 @@ from __future__ import annotations
 import argparse
 import sys
 import threading
+import urllib.request
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
@@ -60,6 +64,15 @@ def _view_with_url(sim_node: SimNode, options: argparse.Namespace, log: NodeLog)
     return stop
 
 
+def _headless_view(sim_node: SimNode, _options: argparse.Namespace, log: NodeLog) -> Callable[[], None]:
+    """No view: an empty /gazebo/gui_url tells gzclient there is nothing to attach to."""
+    try:
+        sim_node.node.set_param(GUI_URL_PARAM, "")
+    except NinjemysError as exc:
+        log.warn("could not set %s: %s", GUI_URL_PARAM, exc)
+    return lambda: None
+
+
 def server_main(argv: list[str] | None, open_browser: bool, prog: str) -> int:
     """gzserver (``open_browser`` False) or gazebo (True): the simulator on a Gazebo world."""
     from ninjemys.sim import puzzlebot_node
@@ -83,11 +96,9 @@ def server_main(argv: list[str] | None, open_browser: bool, prog: str) -> int:
     if options.seed is not None:
         sim_args.append(f"_seed:={int(options.seed)}")
     sim_args += ["--port", str(options.port), "--host", options.host]
-    if options.headless:
-        sim_args.append("--headless")
     if not open_browser:
         sim_args.append("--no-browser")
-    return puzzlebot_node.main(sim_args, view=_view_with_url)
+    return puzzlebot_node.main(sim_args, view=_headless_view if options.headless else _view_with_url)
 
 
 def gzserver_main(argv: list[str] | None = None) -> int:
@@ -98,23 +109,47 @@ def gazebo_main(argv: list[str] | None = None) -> int:
     return server_main(argv, True, "gazebo")
 
 
+def _answers(url: str) -> bool:
+    """Whether the view at ``url`` is served (a parameter left by a server that has gone is not)."""
+    try:
+        with urllib.request.urlopen(url, timeout=2.0) as reply:
+            return bool(200 <= reply.status < 400)
+    except (OSError, ValueError):
+        return False
+
+
 def gzclient_main(argv: list[str] | None = None) -> int:
-    """Wait for a server's view and open it (or print its address where there is no display)."""
+    """Wait for a server's view and open it (or print its address where there is no display); exit 1
+    when the server is headless (there is no view to attach to)."""
     argv = sys.argv[1:] if argv is None else argv
     ros_args = [a for a in argv if ":=" in a]
+    print(
+        "gzclient: this is not Gazebo's 3D client: it opens the ninjemys simulator's browser view",
+        flush=True,
+    )
+    code = [0]
 
     def build(node: Node) -> None:
         def attach() -> None:
             waited = 0.0
+            stale = ""
             while not node.is_shutdown:
                 try:
                     url: Any = node.get_param(GUI_URL_PARAM, None)
                 except NinjemysError:
                     url = None
-                if url:
+                if url == "":
+                    print("gzclient: gzserver runs headless: there is no view to attach to", flush=True)
+                    code[0] = 1
+                    node.shutdown("gzserver is headless")
+                    return
+                if url and _answers(str(url)):
                     print(f"gzclient: simulator view {url}", flush=True)
                     open_if_display(str(url))
                     return
+                if url and url != stale:
+                    stale = str(url)
+                    node.log.warn("the view at %s does not answer (a gzserver that has gone?): waiting", url)
                 if waited == 5.0:
                     node.log.info("waiting for gzserver's view (%s)", GUI_URL_PARAM)
                 waited += 0.25
@@ -122,7 +157,8 @@ def gzclient_main(argv: list[str] | None = None) -> int:
 
         threading.Thread(target=attach, name="gzclient-attach", daemon=True).start()
 
-    return run_node("gazebo_gui", ros_args, build)
+    status = run_node("gazebo_gui", ros_args, build)
+    return code[0] or status
 
 
 gzserver_console = entry(gzserver_main)

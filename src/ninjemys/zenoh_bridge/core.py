@@ -13,10 +13,12 @@ import logging
 import threading
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
-from typing import Any
+from typing import Any, Literal
 
 from ninjemys.errors import NinjemysError
-from ninjemys.zenoh_bridge import keys
+from ninjemys.net import auth
+from ninjemys.net.auth import Credentials
+from ninjemys.zenoh_bridge import access, keys
 from ninjemys.zenoh_bridge.discovery import Beacons, RemoteDirectory
 from ninjemys.zenoh_bridge.keys import Resource
 from ninjemys.zenoh_bridge.options import AUTO, DISABLED, LAZY_AUTO, BridgeOptions
@@ -32,17 +34,24 @@ class ZenohSessionError(NinjemysError):
     """The Zenoh session could not be opened (bad configuration, an endpoint that cannot listen)."""
 
 
-def open_session(options: BridgeOptions) -> Any:
-    """A Zenoh session configured from the command line (over ``--config`` when given)."""
+def open_session(options: BridgeOptions, creds: Credentials | None | Literal["env"] = "env") -> Any:
+    """A Zenoh session configured from the command line (over ``--config`` when given). With the
+    graph's authentication on (``creds``: the process's by default), Zenoh's user/password
+    authentication from the same secret (zenoh_bridge.access)."""
     import json
 
     import zenoh
 
+    if creds == "env":
+        creds = auth.credentials()
     try:
         config = zenoh.Config.from_file(options.config_file) if options.config_file else zenoh.Config()
         for key, value in options.zenoh_config_json().items():
             config.insert_json5(key, json.dumps(value))
-        return zenoh.open(config)
+        with access.usrpwd_settings(creds, options.node_name()) as settings:
+            for key, value in settings.items():
+                config.insert_json5(key, json.dumps(value))
+            return zenoh.open(config)
     except zenoh.ZError as exc:
         raise ZenohSessionError(f"cannot open the Zenoh session ({_endpoints(options)}): {exc}") from None
 

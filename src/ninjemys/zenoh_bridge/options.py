@@ -60,6 +60,12 @@ class BridgeOptions:
         """The bridging mode of ``topic`` for ``kind``: its custom entry, else the global one."""
         return self.custom_modes[kind].get(topic, self.modes[kind])
 
+    def node_name(self) -> str:
+        """The bridge node's global name (what it signs as with per-node keys)."""
+        if self.ros_name.startswith("/"):
+            return self.ros_name
+        return self.ros_namespace.rstrip("/") + "/" + self.ros_name
+
     def zenoh_config_json(self) -> dict[str, Any]:
         """The settings this command line puts over the Zenoh configuration (key -> JSON value)."""
         out: dict[str, Any] = {"mode": self.mode}

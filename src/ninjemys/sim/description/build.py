@@ -87,6 +87,8 @@ def model_from_description(text: str, source: str, *, robot_namespace: str | Non
         right_joint=right.joint,
         laser=cfg.laser,
         camera=cfg.camera,
+        extra_lasers=cfg.extra_lasers,
+        extra_cameras=cfg.extra_cameras,
         imu=cfg.imu,
         odom_rate=drive.update_rate or 100.0,
         source=source,

@@ -57,6 +57,8 @@ class GazeboConfig:
     wheel_accel: float | None = None  # m/s^2 at the rim; 0 = immediate
     laser: LaserSpec | None = None
     camera: CameraSpec | None = None
+    extra_lasers: list[LaserSpec] = field(default_factory=list)
+    extra_cameras: list[CameraSpec] = field(default_factory=list)
     imu: ImuSpec | None = None
     materials: dict[str, tuple[int, int, int]] = field(default_factory=dict)
     ignored: list[str] = field(default_factory=list)
@@ -259,9 +261,6 @@ def _sensor(
     rate = s.number("update_rate", 0.0, minimum=0)
     ns = _namespace(p, ns_override)
     if kind in ("ray", "gpu_ray") and filename in LASERS:
-        if cfg.laser is not None:
-            cfg.warnings.append(f"{label}: only the first laser is simulated")
-            return
         h = "ray/scan/horizontal/"
         samples = s.integer(h + "samples", 640, positive=True)
         resolution = s.number(h + "resolution", 1.0, positive=True)
@@ -287,7 +286,7 @@ def _sensor(
         frame_id = frame(p.text("frameName", "/world"), ns)
         if not p.has("frameName"):
             cfg.warnings.append(f"{label}: missing <frameName>, defaults to /world")
-        cfg.laser = LaserSpec(
+        laser = LaserSpec(
             _sensor_pose(geo, link, local, frame_id),
             rate or 10.0,
             beams,
@@ -299,10 +298,11 @@ def _sensor(
             hi,
             range_resolution=s.number("ray/range/resolution", 0.0, minimum=0),
         )
+        if cfg.laser is None:
+            cfg.laser = laser
+        else:  # a second lidar: its own topic, frame and rate
+            cfg.extra_lasers.append(laser)
     elif kind in ("camera", "depth") and filename in (CAMERA, KINECT, DEPTH_CAMERA):
-        if cfg.camera is not None:
-            cfg.warnings.append(f"{label}: only the first camera is simulated")
-            return
         width = s.integer("camera/image/width", 320, positive=True)
         height = s.integer("camera/image/height", 240, positive=True)
         hfov = s.number("camera/horizontal_fov", 1.047, positive=True)
@@ -326,7 +326,7 @@ def _sensor(
         depth = filename in (KINECT, DEPTH_CAMERA)
         if depth:
             far = min(far, p.number("pointCloudCutoffMax", 5.0, positive=True))
-        cfg.camera = CameraSpec(
+        camera = CameraSpec(
             _sensor_pose(geo, link, local, link),
             plugin_rate or rate or 30.0,
             width,
@@ -340,6 +340,10 @@ def _sensor(
             f"{cam_ns}/{p.text('depthImageCameraInfoTopicName', 'depth/camera_info')}" if depth else None,
             frame_id,
         )
+        if cfg.camera is None:
+            cfg.camera = camera
+        else:  # a second camera: its own topics, frame and rate
+            cfg.extra_cameras.append(camera)
     elif kind == "imu" and filename == IMU_SENSOR:
         if not p.has("frameName"):
             raise doc.error(

@@ -67,11 +67,11 @@ export function markerObject(m, onError = () => {}) {
     case 8: return new THREE.Points(pointsGeom(), new THREE.PointsMaterial({ color: perPoint ? 0xffffff : color, vertexColors: perPoint, size: s.x, transparent, opacity }));
     case 9: { const g = new THREE.Group(); g.userData.text = m.text; return g; }
     case 10: { // MESH_RESOURCE: the file through the web app, scaled; the marker's colour unless
-      // a COLLADA file's own materials are asked for (mesh_use_embedded_materials)
+      // a COLLADA file's or an OBJ's (its mtllib) own materials are asked for (mesh_use_embedded_materials)
       if (!m.mesh_resource) throw new Error("MESH_RESOURCE marker without a mesh_resource");
       const g = new THREE.Group();
       g.scale.set(s.x, s.y, s.z);
-      const embedded = m.mesh_use_embedded_materials && /\.dae$/i.test(m.mesh_resource);
+      const embedded = m.mesh_use_embedded_materials && /\.(dae|obj)$/i.test(m.mesh_resource);
       loadMesh(m.mesh_resource, lambert()).then((o) => {
         if (!embedded) o.traverse((x) => { if (x.isMesh) x.material = lambert(); });
         g.add(o);
