@@ -177,3 +177,16 @@ def test_a_tagged_reader_cuts_inline_frames_untagged_and_keeps_the_others() -> N
     buf = plain.buffer()
     buf[: len(FRAME)] = FRAME
     assert plain.commit(len(FRAME)) == [b"abcd"] and plain.special == 0
+
+
+def test_a_tagged_reader_given_one_whole_frame_per_read_cuts_it_the_same_way() -> None:
+    """The one-frame-per-read shortcut (the usual wake-up) keeps the tagged stream's rules."""
+    reader = FrameReader(size=64, tagged=True)
+    got: list[Any] = []
+    for frame in (pack_len(3) + b"\0ab", pack_len(2) + b"\x01n", pack_len(3) + b"\0cd"):
+        buf = reader.buffer()
+        buf[: len(frame)] = frame
+        got += reader.commit(len(frame))
+    assert got == [b"ab", b"\x01n", b"cd"]
+    assert got[0].__class__ is bytes and isinstance(got[1], TaggedFrame) and got[2].__class__ is bytes
+    assert reader.special == 1

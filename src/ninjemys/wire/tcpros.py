@@ -106,8 +106,8 @@ class FrameReader:
         """Account for ``n`` freshly received bytes and return the frames now complete."""
         if not self._end and n > 4 and self._big is None:  # one whole frame in one read: the usual case
             (length,) = _U32.unpack_from(self._buf, 0)
-            if length == n - 4:
-                return [self._view[4:n].tobytes()]
+            if length == n - 4 and (self._skip == 4 or not self._buf[4]):  # (tagged: an inline frame)
+                return [self._view[self._skip : n].tobytes()]
         frames: list[bytes | bytearray] = []
         if self._big is not None:
             self._big_fill += n
