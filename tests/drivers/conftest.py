@@ -5,10 +5,12 @@ nodes, then devices, then the master) so each test says only what it drives and 
 from __future__ import annotations
 
 import os
+import select
 import signal
 import subprocess
 import sys
 import threading
+import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any, Protocol, TypeVar
@@ -123,6 +125,24 @@ class Rig:
             testing.kill_tree(proc)
             out, _ = proc.communicate()
         return out or ""
+
+    def read_until(self, proc: subprocess.Popen, text: str, timeout: float = 30.0) -> str:
+        """The output of ``proc`` up to a line holding ``text`` (a step a test must see happen before
+        its next one: a process starting on a loaded machine may take seconds to get there). Read
+        from the pipe itself, so that :meth:`stop` later returns the rest."""
+        fd = proc.stdout.fileno()  # type: ignore[union-attr]
+        got = b""
+        deadline = time.monotonic() + timeout
+        while text.encode() not in got:
+            left = deadline - time.monotonic()
+            ready, _, _ = select.select([fd], [], [], max(0.0, left))
+            chunk = os.read(fd, 65536) if ready else b""
+            if not chunk:
+                raise AssertionError(
+                    f"no {text!r} in the output within {timeout:g} s: {got.decode(errors='replace')}"
+                )
+            got += chunk
+        return got.decode(errors="replace")
 
     def exit_output(self, proc: subprocess.Popen) -> str:
         """The output of a driver that must give up by itself: non-zero exit, no traceback."""
