@@ -93,6 +93,9 @@ def _pose_function(joint: Joint) -> Callable[[float], Pose]:
 
 
 def _kdl_sign(x: float, y: float, z: float, w: float) -> tuple[float, float, float, float]:
+    """The quaternion's sign as KDL's Rotation::GetQuaternion picks it (the trace, else the largest
+    diagonal term, made positive), as robot_state_publisher publishes it. TfPlan.message
+    (tf_plan.py) inlines this on its hot path: change both together."""
     xx, yy, zz, ww = x * x, y * y, z * z, w * w
     if 4.0 * ww - (xx + yy + zz + ww) > 1e-12:
         key = w

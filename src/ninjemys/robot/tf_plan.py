@@ -104,6 +104,9 @@ class TfPlan:
                 half = positions[src] * a + b
                 c, s = cos(half), sin(half)
                 x, y, z, w = c * ox + s * bx, c * oy + s * by, c * oz + s * bz, c * ow + s * bw
+                # kinematics._kdl_sign, written out on purpose: this loop runs per joint per
+                # joint_states message, and the call (a tuple built and unpacked) cost more than the
+                # sign choice itself. Change both together (tests/robot/test_tf_plan.py compares the paths).
                 xx, yy, zz, ww = x * x, y * y, z * z, w * w
                 if 4.0 * ww - (xx + yy + zz + ww) > 1e-12:
                     key = w
