@@ -422,7 +422,8 @@ class NodeProcess:
 class CatkinWorkspace:
     """A catkin workspace for tests (ours and a user's): packages written from text, our
     ``catkin_make`` run in it, and the environment its programs see (what sourcing ``devel/setup.bash``
-    gives: the workspace's packages on ROS_PACKAGE_PATH, its generated Python on PYTHONPATH) with
+    gives: the workspace's packages on ROS_PACKAGE_PATH, its generated Python on PYTHONPATH, devel/ on
+    CMAKE_PREFIX_PATH) with
     the outer environment's ROS variables left out, so nothing from the caller's workspace leaks in.
 
         ws = CatkinWorkspace(tmp_path)
@@ -459,6 +460,7 @@ class CatkinWorkspace:
             ROS_HOME=str(self.root / "ros_home"),
             ROS_HOSTNAME="localhost",
             PYTHONPATH=str(self.root / "devel" / "lib" / "python3" / "dist-packages"),
+            CMAKE_PREFIX_PATH=str(self.root / "devel"),  # where rosrun finds devel/lib/<pkg>/ programs
         )
         if master_uri is not None:
             env["ROS_MASTER_URI"] = master_uri
@@ -469,7 +471,7 @@ class CatkinWorkspace:
         return subprocess.run(
             [ninjemys_bin("catkin_make"), *args],
             cwd=self.root,
-            env={k: v for k, v in self.env().items() if k != "PYTHONPATH"},
+            env={k: v for k, v in self.env().items() if k not in ("PYTHONPATH", "CMAKE_PREFIX_PATH")},
             capture_output=True,
             text=True,
             timeout=timeout,

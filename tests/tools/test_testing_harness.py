@@ -143,4 +143,4 @@ def test_catkin_workspace_writes_packages_and_keeps_the_callers_ros_environment_
         env["ROS_PACKAGE_PATH"] == str(tmp_path / "src") and env["ROS_MASTER_URI"] == "http://localhost:1234"
     )
     assert env["PYTHONPATH"] == str(tmp_path / "devel" / "lib" / "python3" / "dist-packages")
-    assert "CMAKE_PREFIX_PATH" not in env and "ROS_MASTER_URI" not in ws.env()
+    assert env["CMAKE_PREFIX_PATH"] == str(tmp_path / "devel") and "ROS_MASTER_URI" not in ws.env()
