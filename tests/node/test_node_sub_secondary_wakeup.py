@@ -51,7 +51,7 @@ def test_second_handle_of_a_fast_topic_never_stalls() -> None:
                     last = seen[-1]
                     seen.append(
                         wait_until(
-                            lambda last=last: counts[1] > last and counts[1],  # type: ignore[misc]
+                            lambda last=last: counts[1] > last and counts[1],
                             timeout=15.0,
                             what=f"the second handle to receive more than {last} messages",
                         )
