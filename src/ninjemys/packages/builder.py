@@ -35,6 +35,7 @@ from ninjemys.packages.cpp_build import (
     find_toolchain,
     missing_cpp_dependency,
 )
+from ninjemys.packages.cpp_msgs import CppPrefix, packages_without_cpp_side, write_prefix
 from ninjemys.packages.cpp_targets import CppTarget, cpp_targets, skipped_message
 from ninjemys.packages.discovery import PackageIndex, package_path_dirs, underlay_dirs
 from ninjemys.packages.manifest import PackageManifest
@@ -161,6 +162,7 @@ def _build_cpp_packages(
     report: BuildReport,
     log: Callable[[str], None],
     finder: Callable[[str], Path | None],
+    env: Mapping[str, str],
 ) -> None:
     """Build the C++ packages with catkin's CMake and link their programs into devel/lib/<pkg>/.
 
@@ -169,10 +171,13 @@ def _build_cpp_packages(
     it; the Python side of the workspace is built in any case."""
     remaining = set(wanted)
     built: dict[str, list[Path]] = {}
+    messages = _shipped_messages(ws, env, log)
     while remaining:
         chosen = cpp_closure(ordered, remaining)
         try:
-            built = build_cpp(chosen, ws.build / "ninjemys_cpp", ws.root / "install", toolchain, log)
+            built = build_cpp(
+                chosen, ws.build / "ninjemys_cpp", ws.root / "install", toolchain, log, messages=messages
+            )
             break
         except PackageError as exc:
             text = str(exc)
@@ -189,7 +194,9 @@ def _build_cpp_packages(
                 skip = {w for w in remaining if culprit in {p.name for p in cpp_closure(ordered, {w})}}
                 skip = skip or set(remaining)
             debian = f"lib{missing.lower().replace('_', '-')}-dev"
-            why = f"the C++ side of '{missing}' is not installed (Debian: {debian} or ros-{debian[3:-4]})"
+            # a ROS package has a ros-<name> alternative; a system library's CMake name (OpenCV) does not
+            other = f" or ros-{debian[3:-4]}" if missing == missing.lower() else ""
+            why = f"the C++ side of '{missing}' is not installed (Debian: {debian}{other})"
             for line in text.splitlines():
                 if any(
                     marker in line
@@ -210,6 +217,43 @@ def _build_cpp_packages(
             writer.outputs.add(str(link))
             log(f"-- ~~  - {package}: built {program.name}")
     report.cpp_built = built
+    _link_message_headers(ws, ws.build / "ninjemys_cpp" / "devel" / "include")
+
+
+def _shipped_messages(ws: Workspace, env: Mapping[str, str], log: Callable[[str], None]) -> CppPrefix:
+    """The C++ side of every message package ninjemys ships and this machine lacks (a workspace
+    package of the same name takes its place), brought up to date in build/ninjemys_cpp/shipped."""
+    wanted = packages_without_cpp_side(env, exclude={p.name for p in ws.packages})
+    root = ws.build / "ninjemys_cpp" / "shipped"
+    try:
+        prefix = write_prefix(root, wanted)
+    except OSError as exc:
+        raise PackageError(f"{root}: cannot write the C++ message headers: {exc.strerror or exc}") from None
+    if prefix.written:
+        log(
+            f"-- ~~  C++ message headers of ninjemys' packages ({len(prefix.written)} file(s) written): "
+            + " ".join(prefix.packages)
+        )
+    return prefix
+
+
+def _link_message_headers(ws: Workspace, generated: Path) -> None:
+    """devel/include/<pkg> for each workspace message package whose C++ headers catkin generated,
+    where catkin_make puts them (IDEs and other build tools look there); links, re-made each run."""
+    include = ws.devel / "include"
+    if include.is_dir():
+        for entry in include.iterdir():
+            if entry.is_symlink() and generated in Path(os.readlink(entry)).parents:
+                entry.unlink()
+    if not generated.is_dir():
+        return
+    for directory in sorted(generated.iterdir()):
+        if directory.is_dir() and directory.name in {p.name for p in ws.packages}:
+            link = include / directory.name
+            if link.exists() or link.is_symlink():
+                continue  # the user's own directory: left alone
+            include.mkdir(parents=True, exist_ok=True)
+            link.symlink_to(directory, target_is_directory=True)
 
 
 def _package_finder(ws: Workspace, env: Mapping[str, str]) -> Callable[[str], Path | None]:
@@ -309,7 +353,7 @@ def build_workspace(
 
     if toolchain is not None and cpp_packages:
         finder = _package_finder(ws, env)
-        _build_cpp_packages(ws, ordered, cpp_packages, toolchain, writer, report, log, finder)
+        _build_cpp_packages(ws, ordered, cpp_packages, toolchain, writer, report, log, finder, env)
 
     wsenv = WorkspaceEnv(source=ws.source, devel=ws.devel)
     underlays = underlay_workspaces(ws.devel, env)

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ninjemys.errors import PackageError
+from ninjemys.packages.cpp_msgs import CppPrefix
 from ninjemys.packages.manifest import PackageManifest
 
 #: where catkin's top-level CMake file lives: Debian's ``catkin``, then ROS 1 binary installs
@@ -136,9 +137,13 @@ def build_cpp(
     toolchain: Toolchain,
     log: Callable[[str], None],
     jobs: int = 0,
+    messages: CppPrefix | None = None,
 ) -> dict[str, list[Path]]:
     """Configure and build the packages with catkin's CMake; the programs built, per package.
 
+    ``messages`` is the prefix with the C++ side of ninjemys' own message packages
+    (:mod:`ninjemys.packages.cpp_msgs`): it goes last on CMAKE_PREFIX_PATH (anything installed
+    wins) and its headers on every target's include path, as ``/opt/ros/noetic/include`` is.
     Raises PackageError with CMake's or the compiler's output (as catkin_make prints it) on failure.
     """
     src = build_root / "src"
@@ -147,6 +152,11 @@ def build_cpp(
     _link_sources(src, packages, toolchain.toplevel)
     build.mkdir(parents=True, exist_ok=True)
     env = dict(os.environ)
+    extra: list[str] = []
+    if messages is not None and messages.packages:
+        paths = [p for p in env.get("CMAKE_PREFIX_PATH", "").split(os.pathsep) if p]
+        env["CMAKE_PREFIX_PATH"] = os.pathsep.join([*paths, str(messages.root)])
+        extra.append(f"-DCMAKE_CXX_STANDARD_INCLUDE_DIRECTORIES={messages.include}")
     configure = [
         toolchain.cmake,
         str(src),
@@ -155,6 +165,7 @@ def build_cpp(
         f"-DPYTHON_EXECUTABLE={toolchain.python}",
         f"-DCMAKE_CXX_COMPILER={toolchain.compiler}",
         "-DCATKIN_ENABLE_TESTING=OFF",
+        *extra,
     ]
     flags = noetic_compat_flags()
     if flags:
