@@ -16,7 +16,7 @@ import pytest
 
 from ninjemys.rostest.junit import CaseResult, SuiteResult, read_xml, results_file, write_xml
 from ninjemys.rostest.pyunit import restore_removed_aliases
-from ninjemys.testing import ninjemys_bin
+from ninjemys.testing import CatkinWorkspace, ninjemys_bin
 
 PACKAGE_XML = """<?xml version="1.0"?>
 <package format="2">
@@ -215,52 +215,39 @@ topics:
 """
 
 
-def _workspace(root: Path) -> Path:
-    pkg = root / "src" / "probe_tests"
-    for sub in ("scripts", "test"):
-        (pkg / sub).mkdir(parents=True)
-    (pkg / "package.xml").write_text(PACKAGE_XML)
-    (pkg / "CMakeLists.txt").write_text(CMAKE)
-    for folder, name, text in (
-        ("scripts", "talker.py", TALKER),
-        ("test", "test_hears.py", HEARS),
-        ("test", "test_fails.py", FAILS),
-        ("test", "sleeper.py", SLEEPER),
-    ):
-        (pkg / folder / name).write_text(text)
-        (pkg / folder / name).chmod(0o755)
-    (pkg / "test" / "talker.test").write_text(TALKER_TEST)
-    (pkg / "test" / "failing.test").write_text(FAILING_TEST)
-    (pkg / "test" / "slow.test").write_text(SLOW_TEST)
-    (pkg / "test" / "hz.test").write_text(HZ_TEST)
-    (pkg / "test" / "publish.test").write_text(PUBLISH_TEST)
-    (pkg / "test" / "param.test").write_text(PARAM_TEST)
-    (pkg / "test" / "advertise.test").write_text(ADVERTISE_TEST)
-    return root
+def _workspace(root: Path) -> CatkinWorkspace:
+    ws = CatkinWorkspace(root)
+    scripts = {"scripts/talker.py": TALKER, "test/test_hears.py": HEARS, "test/test_fails.py": FAILS}
+    scripts["test/sleeper.py"] = SLEEPER
+    ws.package(
+        "probe_tests",
+        {
+            "package.xml": PACKAGE_XML,
+            "CMakeLists.txt": CMAKE,
+            **scripts,
+            "test/talker.test": TALKER_TEST,
+            "test/failing.test": FAILING_TEST,
+            "test/slow.test": SLOW_TEST,
+            "test/hz.test": HZ_TEST,
+            "test/publish.test": PUBLISH_TEST,
+            "test/param.test": PARAM_TEST,
+            "test/advertise.test": ADVERTISE_TEST,
+        },
+        executables=list(scripts),
+    )
+    return ws
 
 
 def _env(ws: Path) -> dict[str, str]:
-    env = {k: v for k, v in os.environ.items() if not k.startswith("ROS_")}
-    env.update(ROS_PACKAGE_PATH=str(ws / "src"), ROS_HOME=str(ws / "ros_home"), ROS_HOSTNAME="localhost")
-    env["PYTHONPATH"] = str(ws / "devel" / "lib" / "python3" / "dist-packages")
-    return env
+    return CatkinWorkspace(ws).env()
 
 
 @pytest.fixture(scope="module")
 def workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
     ws = _workspace(tmp_path_factory.mktemp("rostest_ws"))
-    env = _env(ws)
-    made = subprocess.run(
-        [ninjemys_bin("catkin_make")],
-        cwd=ws,
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=300,
-        check=False,
-    )
+    made = ws.catkin_make(timeout=300)
     assert made.returncode == 0, made.stdout + made.stderr
-    return ws
+    return ws.root
 
 
 def _rostest(ws: Path, *args: str, timeout: float = 180) -> subprocess.CompletedProcess[str]:
@@ -428,7 +415,7 @@ def _report_lines(text: str) -> list[str]:
     ],
 )
 def test_same_report_as_debians_rostest(workspace: Path, tmp_path: Path, test_file: str, code: int) -> None:
-    theirs = _workspace(tmp_path / "debian")
+    theirs = _workspace(tmp_path / "debian").root
     env = {
         "PATH": "/usr/bin:/bin",
         "HOME": str(tmp_path / "home"),
@@ -453,15 +440,7 @@ def test_same_report_as_debians_rostest(workspace: Path, tmp_path: Path, test_fi
 def test_catkin_make_run_tests_runs_the_add_rostest_files(workspace: Path) -> None:
     combined = workspace / "ros_home" / "test_results" / "probe_tests" / "rostest-test_talker.xml"
     combined.unlink(missing_ok=True)
-    made = subprocess.run(
-        [ninjemys_bin("catkin_make"), "run_tests"],
-        cwd=workspace,
-        env={k: v for k, v in _env(workspace).items() if k != "PYTHONPATH"},
-        capture_output=True,
-        text=True,
-        timeout=300,
-        check=False,
-    )
+    made = CatkinWorkspace(workspace).catkin_make("run_tests", timeout=300)
     assert made.returncode == 0, made.stdout + made.stderr
     assert "-- run_tests_probe_tests_rostest_test_talker.test" in made.stdout
     assert "[probe_tests.rosunit-talker_test/test_hears_hello][passed]" in made.stdout
