@@ -191,10 +191,20 @@ class Rig:
         with self.lock:
             self.flags[topic] = (pub, value)
 
-    def jump(self, seconds: float) -> None:
-        """Move sim time by ``seconds`` at once (negative: a simulation reset)."""
+    def jump(self, seconds: float, stop: str | None = None) -> int:
+        """Move sim time by ``seconds`` at once (negative: a simulation reset), in the same step
+        stopping input ``stop`` if given (a loaded test thread must not let the watchdog fire
+        before the jump); returns how many commands came before it (see :meth:`cmds_since`)."""
         with self.lock:
+            if stop is not None:
+                self.streams.pop(stop, None)
             self.now = round(self.now + seconds, 6)
+            return len(self.cmds)
+
+    def cmds_since(self, index: int) -> list[tuple[float, float, float]]:
+        """The commands received after the first ``index`` ones (stamps repeat after a jump back)."""
+        with self.lock:
+            return self.cmds[index:]
 
     def scan_off(self) -> None:
         """The laser goes quiet."""
@@ -305,11 +315,11 @@ def test_safety_live_watchdog_survives_time_moving_backwards(rig):
     rig.stream("navigation", 0.2, 0.0)
     assert rig.output() == pytest.approx((0.2, 0.0))
     diags = len(rig.diags)
-    rig.stream("navigation", None)
-    rig.jump(-15.0)  # /gazebo/reset_simulation: the last command now lies 15 s in the future
+    # /gazebo/reset_simulation: navigation stops and the last command now lies 15 s in the future
+    before = rig.jump(-15.0, stop="navigation")
     back = rig.now
     assert rig.output(1.0) == (0.0, 0.0)
-    first_zero = next(t for t, v, w in rig.cmds_from(back) if v == 0.0)
+    first_zero = next(t for t, v, w in rig.cmds_since(before) if v == 0.0)
     assert first_zero - back <= 0.5 + 0.1
     rig.settle(1.5)
     assert len(rig.diags) > diags + 1  # diagnostics go on after the jump
