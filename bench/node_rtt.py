@@ -1,18 +1,22 @@
 """Ping-pong round trip of a 64-byte std_msgs/String: ninjemys vs real rospy (and roscpp), two
 placements, publishers with ``queue_size=10`` and ``queue_size=None``; plus ninjemys in one process.
 
-Run: ``.venv/bin/python bench/node_rtt.py [count]``. Targets: p50 <= 0.3x rospy on one CPU,
+Run: ``.venv/bin/python bench/node_rtt.py [count] [rounds]``; rounds interleave the implementations
+(load on a shared machine then hits them alike), and the machine's floor (``floor_rtt.py``) is
+measured in the same run. Targets: p50 <= 0.3x rospy on one CPU,
 p99 <= rospy's and <= 150 us in every placement and queue_size mode; in-process (two Nodes of one
-process, ``intraprocess=True``) p50 <= 10 us.
+process, ``intraprocess=True``, subscribers ``direct=True``) p50 <= 10 us.
 """
 
 from __future__ import annotations
 
+import statistics
 import sys
 import threading
 import time
 
-from node_common import CPP, CROSS_CPU, IMPLS_CPP, OURS, SAME_CPU, Role, header, master, ratio, roles
+import floor_rtt
+from node_common import CPP, CROSS_CPU, IMPLS_CPP, OURS, SAME_CPU, Role, header, master, roles
 
 
 def run(uri: str, impl: str, cpus: tuple[str, str], count: int, queue_size: str) -> dict:
@@ -24,9 +28,10 @@ def run(uri: str, impl: str, cpus: tuple[str, str], count: int, queue_size: str)
             return ping.result()
 
 
-def in_process(uri: str, count: int) -> dict:
-    """Two Nodes of this process, both ends ``intraprocess=True``: the object is handed over, and
-    each hop is one wake-up of the receiving handle's thread."""
+def in_process(uri: str, count: int, direct: bool) -> dict:
+    """Two Nodes of this process, both ends ``intraprocess=True``: the object is handed over. Each hop
+    is one wake-up of the receiving handle's thread, or none with ``direct=True`` (the publishing
+    thread calls an idle subscriber back itself, as a nodelet's publish does)."""
     from ninjemys.node import Node
     from std_msgs.msg import String
 
@@ -34,9 +39,9 @@ def in_process(uri: str, count: int) -> dict:
     pong_node = Node("inproc_pong", anonymous=True, master_uri=uri, rosout=False, logger_services=False)
     try:
         back = pong_node.publisher("/inproc_pong", String, intraprocess=True)
-        pong_node.subscriber("/inproc_ping", String, back.publish, intraprocess=True)
+        pong_node.subscriber("/inproc_ping", String, back.publish, intraprocess=True, direct=direct)
         got = threading.Event()
-        ping_node.subscriber("/inproc_pong", String, lambda m: got.set(), intraprocess=True)
+        ping_node.subscriber("/inproc_pong", String, lambda m: got.set(), intraprocess=True, direct=direct)
         pub = ping_node.publisher("/inproc_ping", String, intraprocess=True)
         msg = String("x" * 64)
         deadline = time.monotonic() + 20
@@ -59,9 +64,35 @@ def in_process(uri: str, count: int) -> dict:
         ping_node.shutdown("bench over")
 
 
+def report(label: str, rounds: list[dict[str, dict]]) -> None:
+    """Median over rounds of each implementation's p50 and p99; the ratio taken within each round."""
+    impls = list(rounds[0])
+    for impl in impls:
+        p50s = [r[impl]["p50_us"] for r in rounds]
+        p99 = statistics.median(r[impl]["p99_us"] for r in rounds)
+        print(
+            f"{label:35s} {impl:9s} p50 {statistics.median(p50s):8.1f} us"
+            f" (spread {min(p50s):6.1f}-{max(p50s):6.1f})   p99 {p99:8.1f} us"
+        )
+    if "rospy" in impls:
+        r50 = [r[OURS]["p50_us"] / r["rospy"]["p50_us"] for r in rounds]
+        r99 = [r[OURS]["p99_us"] / r["rospy"]["p99_us"] for r in rounds]
+        print(
+            f"{label:35s} ratio     p50 {statistics.median(r50):.2f}x (rounds {min(r50):.2f}-{max(r50):.2f})"
+            f"   p99 {statistics.median(r99):.2f}x (rounds {min(r99):.2f}-{max(r99):.2f})"
+        )
+
+
 def main() -> None:
     count = int(sys.argv[1]) if len(sys.argv) > 1 else 5000
-    header(f"ping-pong RTT, {count} round trips")
+    n_rounds = int(sys.argv[2]) if len(sys.argv) > 2 else 3
+    header(f"ping-pong RTT, {count} round trips, {n_rounds} interleaved rounds")
+    for name, cpus in (("same CPU", SAME_CPU), ("across CPUs", CROSS_CPU)):
+        # the machine's floor in the same run: a bare Python ping-pong, and the ping role's shape
+        # (a receiving thread that wakes the main thread with an Event), over a Unix socket
+        for shape in ("bare", "thread+event"):
+            p50, p99 = floor_rtt.run(shape, cpus, count)
+            print(f"{'floor ' + shape + ', ' + name:35s} {'python':9s} p50 {p50:8.1f} us   p99 {p99:8.1f} us")
     with master() as uri:
         for queue_size in ("10", "None"):
             for name, cpus in (
@@ -70,17 +101,14 @@ def main() -> None:
             ):
                 label = f"{name} q={queue_size}"
                 impls = [i for i in IMPLS_CPP if i != CPP or queue_size == "10"]
-                results = {impl: run(uri, impl, cpus, count, queue_size) for impl in impls}
-                for impl, r in results.items():
-                    print(f"{label:35s} {impl:9s} p50 {r['p50_us']:8.1f} us   p99 {r['p99_us']:8.1f} us")
-                if "rospy" in results:
-                    o, t = results[OURS], results["rospy"]
-                    p50, p99 = ratio(o["p50_us"], t["p50_us"]), ratio(o["p99_us"], t["p99_us"])
-                    print(f"{label:35s} ratio     p50 {p50}   p99 {p99}")
-        r = in_process(uri, count)
-        print(
-            f"{'in one process (intraprocess=True)':35s} {OURS:9s} p50 {r['p50_us']:8.1f} us   p99 {r['p99_us']:8.1f} us"
-        )
+                rounds = [
+                    {impl: run(uri, impl, cpus, count, queue_size) for impl in impls} for _ in range(n_rounds)
+                ]
+                report(label, rounds)
+        for direct in (False, True):
+            r = in_process(uri, count, direct)
+            label = "in one process, direct=True" if direct else "in one process (intraprocess=True)"
+            print(f"{label:35s} {OURS:9s} p50 {r['p50_us']:8.1f} us   p99 {r['p99_us']:8.1f} us")
 
 
 if __name__ == "__main__":

@@ -76,7 +76,12 @@ class MasterError(NinjemysError):
 
 
 class MasterUnreachable(MasterError):
-    """The master could not be contacted at all."""
+    """The master could not be contacted at all; ``cause`` is the socket's error when there was one
+    (rospy lets it through as it is: ``ConnectionRefusedError`` when no master runs)."""
+
+    def __init__(self, message: str, cause: OSError | None = None) -> None:
+        super().__init__(message)
+        self.cause = cause
 
 
 class ParameterError(NinjemysError):

@@ -417,3 +417,63 @@ class NodeProcess:
 
     def __exit__(self, *exc: object) -> None:
         self.kill()
+
+
+class CatkinWorkspace:
+    """A catkin workspace for tests (ours and a user's): packages written from text, our
+    ``catkin_make`` run in it, and the environment its programs see (what sourcing ``devel/setup.bash``
+    gives: the workspace's packages on ROS_PACKAGE_PATH, its generated Python on PYTHONPATH, devel/ on
+    CMAKE_PREFIX_PATH) with
+    the outer environment's ROS variables left out, so nothing from the caller's workspace leaks in.
+
+        ws = CatkinWorkspace(tmp_path)
+        ws.package("chat", {"package.xml": XML, "CMakeLists.txt": CMAKE, "scripts/talk.py": TALK},
+                   executables=["scripts/talk.py"])
+        assert ws.catkin_make().returncode == 0
+        subprocess.run([...], env=ws.env(master_uri))
+    """
+
+    def __init__(self, root: str | os.PathLike[str]) -> None:
+        self.root = Path(root)
+
+    def package(self, name: str, files: dict[str, str], executables: Sequence[str] = ()) -> Path:
+        """Write package ``name`` under ``src/``: ``files`` maps paths in the package to their text;
+        the paths in ``executables`` are made executable (scripts rosrun and rostest start)."""
+        pkg = self.root / "src" / name
+        for relative, text in files.items():
+            path = pkg / relative
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text(text)
+            if relative in executables:
+                path.chmod(0o755)
+        return pkg
+
+    def env(self, master_uri: str | None = None) -> dict[str, str]:
+        """The environment of a program run in this workspace (``ROS_HOME`` is ``ros_home/`` in it)."""
+        env = {
+            k: v
+            for k, v in os.environ.items()
+            if not k.startswith("ROS_") and k not in ("CMAKE_PREFIX_PATH", "NINJEMYS_CATKIN_CPP")
+        }
+        env.update(
+            ROS_PACKAGE_PATH=str(self.root / "src"),
+            ROS_HOME=str(self.root / "ros_home"),
+            ROS_HOSTNAME="localhost",
+            PYTHONPATH=str(self.root / "devel" / "lib" / "python3" / "dist-packages"),
+            CMAKE_PREFIX_PATH=str(self.root / "devel"),  # where rosrun finds devel/lib/<pkg>/ programs
+        )
+        if master_uri is not None:
+            env["ROS_MASTER_URI"] = master_uri
+        return env
+
+    def catkin_make(self, *args: str, timeout: float = 600.0) -> subprocess.CompletedProcess[str]:
+        """Our ``catkin_make args`` in the workspace, its output captured (the caller asserts on it)."""
+        return subprocess.run(
+            [ninjemys_bin("catkin_make"), *args],
+            cwd=self.root,
+            env={k: v for k, v in self.env().items() if k not in ("PYTHONPATH", "CMAKE_PREFIX_PATH")},
+            capture_output=True,
+            text=True,
+            timeout=timeout,
+            check=False,
+        )

@@ -15,7 +15,7 @@ import sys
 import threading
 import time
 
-from ninjemys.errors import MasterError, NameError_, NinjemysError, ParameterError
+from ninjemys.errors import MasterError, MasterUnreachable, NameError_, NinjemysError, ParameterError
 from ninjemys.interrupt import wait_event
 from ninjemys.node.log import INFO
 from rospy.core import _process, is_shutdown, signal_shutdown, warn_illegal_name
@@ -443,6 +443,8 @@ def get_published_topics(namespace: str = "/") -> list[list[str]]:
     ctx = _params()  # works before init_node, as rospy's /unnamed
     try:
         return [list(x) for x in ctx.master.get_published_topics(namespace)]
+    except MasterUnreachable as exc:
+        raise translate(exc) from None  # rospy: the socket's error, as for parameters
     except MasterError as exc:
         raise ROSException(f"unable to get published topics: {exc}") from None
 

@@ -92,7 +92,21 @@ def translate(exc: BaseException) -> BaseException:
         return ROSSerializationException(text)
     if isinstance(exc, errors.NameError_):
         return ValueError(text)
+    if isinstance(exc, errors.MasterUnreachable) and exc.cause is not None:
+        return _socket_error(exc.cause)
     return ROSException(text)
+
+
+def _socket_error(cause: OSError) -> OSError:
+    """What rospy raises when the master cannot be reached: its XML-RPC proxy's socket error, as it
+    came (``ConnectionRefusedError: [Errno 111] Connection refused`` when no master runs). A new
+    instance of the same class: the original's traceback runs through our client's frames."""
+    try:
+        if cause.errno is not None and cause.strerror is not None:
+            return type(cause)(cause.errno, cause.strerror)
+        return type(cause)(*cause.args)
+    except TypeError:  # an OSError subclass with another constructor
+        return OSError(cause.errno, cause.strerror)
 
 
 @contextmanager

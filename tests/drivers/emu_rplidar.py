@@ -17,6 +17,8 @@ import threading
 import time
 import tty
 
+import pytest
+
 from ninjemys.drivers import rplidar_capsules as rc
 from ninjemys.drivers import rplidar_protocol as rp
 
@@ -433,3 +435,31 @@ class EmulatedA3(EmulatedA1):
 
     def _drop(self, index: int, mm: int) -> int:
         return 0 if self.drop_every and index % self.drop_every == 5 else mm
+
+
+def check_room(scan, samples: list[tuple[float, float]], multiple: int = 1) -> None:  # noqa: ANN001
+    """Every beam of a compensated scan against the emulator's samples: rplidar_ros' compensation puts
+    each sample (in angle order) into the ``multiple`` bins of 1/multiple degree from its own, the later
+    one winning (angles as the SDK hands them on: 1/64 degree made q14), and publishes bin b of n at laser angle pi - 359 b / (n - 1) degrees (for one bin a
+    degree: pi - b); the range there is the room's along the winning sample's angle, within 1 cm."""
+    count = 360 * multiple
+    assert len(scan.ranges) == count
+    winner: dict[int, float] = {}
+    for a_q6, d in sorted(samples):
+        a = rp.q14_degrees(int(round(a_q6 * 64)))  # what rplidar_ros reads (see q14_degrees)
+        if d:
+            for j in range(multiple):
+                winner[min(int(a * multiple) + j, count - 1)] = a
+    checked = 0
+    for j, r in enumerate(scan.ranges):
+        phi = scan.angle_min + j * scan.angle_increment
+        device_bin = count - 1 - j
+        if device_bin not in winner:
+            assert math.isinf(r), (j, r)
+            continue
+        a = winner[device_bin]
+        # rplidar_ros spreads the bins evenly over [pi - 359 deg, pi] whatever their count
+        assert phi == pytest.approx(math.pi - math.radians(359.0 * device_bin / (count - 1)), abs=1e-6)
+        assert abs(r - room_range(math.pi - math.radians(a))) < 0.01, (j, r, a)
+        checked += 1
+    assert checked > 0.8 * count

@@ -4,12 +4,10 @@ only while the enable button is held; the shipped teleop.launch brings both up o
 from __future__ import annotations
 
 import os
-import signal
 import subprocess
-import sys
-import threading
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 
@@ -27,10 +25,12 @@ from ninjemys.drivers.joystick import (
 )
 from ninjemys.drivers.teleop_twist_joy import Teleop, read_config
 from ninjemys.idl.loader import get_message_class
-from ninjemys.node import Node
 
 Twist = get_message_class("geometry_msgs/Twist")
 Joy = get_message_class("sensor_msgs/Joy")
+
+if TYPE_CHECKING:
+    from .conftest import Rig
 
 
 def state(**kw: object) -> JoyState:
@@ -173,29 +173,6 @@ def test_holonomic_maps_and_axes_beyond_the_message() -> None:
 # -- the nodes on a FIFO joystick ------------------------------------------------------------------
 
 
-class Collect:
-    def __init__(self) -> None:
-        self.items: list = []
-        self.cond = threading.Condition()
-
-    def __call__(self, msg) -> None:  # noqa: ANN001
-        with self.cond:
-            self.items.append(msg)
-            self.cond.notify_all()
-
-    def wait_for(self, pred, timeout: float = 10.0):  # noqa: ANN001, ANN201
-        deadline = time.monotonic() + timeout
-        with self.cond:
-            while True:
-                for m in reversed(self.items):
-                    if pred(m):
-                        return m
-                left = deadline - time.monotonic()
-                if left <= 0:
-                    raise AssertionError(f"no matching message in {len(self.items)} received")
-                self.cond.wait(left)
-
-
 @pytest.fixture
 def fifo(tmp_path: Path):  # noqa: ANN201
     path = tmp_path / "js0"
@@ -209,124 +186,64 @@ def send(fd: int, *events: JoyEvent) -> None:
     os.write(fd, b"".join(e.pack() for e in events))
 
 
-def test_teleop_launch_drives_cmd_vel_from_a_fifo_joystick(fifo, tmp_path: Path) -> None:  # noqa: ANN001
+def test_teleop_launch_drives_cmd_vel_from_a_fifo_joystick(fifo, rig: Rig) -> None:  # noqa: ANN001
     path, fd = fifo
-    env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_LOG_DIR=str(tmp_path))
-    with testing.run_master(env=env) as uri:
-        env["ROS_MASTER_URI"] = uri
-        node = Node("joy_test", master_uri=uri)
-        joys, twists = Collect(), Collect()
-        node.subscriber("/joy", Joy, joys)
-        node.subscriber("/cmd_vel", Twist, twists)
-        launch = subprocess.Popen(
-            [
-                testing.ninjemys_bin("roslaunch"),
-                "teleop_twist_joy",
-                "teleop.launch",
-                f"joy_dev:={path}",
-                "joy_config:=xbox",
-            ],
-            env=env,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-            start_new_session=True,
-        )
-        try:
-            # the kernel's init burst, then the xbox enable button (2) and the stick pushed up
-            send(
-                fd,
-                *(JoyEvent(0, 0, JS_EVENT_BUTTON | JS_EVENT_INIT, b) for b in range(6)),
-                *(JoyEvent(0, 0, JS_EVENT_AXIS | JS_EVENT_INIT, a) for a in range(4)),
-            )
-            first = joys.wait_for(lambda m: len(m.buttons) == 6, timeout=30)
-            assert first.header.frame_id == str(path) and list(first.axes) == [0.0] * 4
-            send(fd, JoyEvent(1, -32767, JS_EVENT_AXIS, 1))
-            joys.wait_for(lambda m: len(m.axes) > 1 and m.axes[1] > 0.99)
-            assert not [t for t in twists.items if t.linear.x != 0.0]  # not enabled: no motion
-            send(fd, JoyEvent(2, 1, JS_EVENT_BUTTON, 2))
-            moving = twists.wait_for(lambda m: m.linear.x > 0.5)
-            assert moving.linear.x == pytest.approx(0.7)  # scale_linear of xbox.config.yaml
-            # autorepeat_rate 20 in teleop.launch: the held state keeps coming without events
-            count = len(joys.items)
-            time.sleep(0.5)
-            assert len(joys.items) >= count + 5
-            send(fd, JoyEvent(3, 0, JS_EVENT_BUTTON, 2))
-            twists.wait_for(lambda m: m.linear.x == 0.0 and m.angular.z == 0.0)
-        finally:
-            os.killpg(launch.pid, signal.SIGINT)
-            try:
-                launch.wait(20)
-            except subprocess.TimeoutExpired:
-                testing.kill_tree(launch)
-            node.shutdown()
+    node = rig.node("joy_test")
+    joys, twists = rig.collect(node, "/joy", Joy), rig.collect(node, "/cmd_vel", Twist)
+    rig.roslaunch("teleop_twist_joy", "teleop.launch", f"joy_dev:={path}", "joy_config:=xbox")
+    # the kernel's init burst, then the xbox enable button (2) and the stick pushed up
+    send(
+        fd,
+        *(JoyEvent(0, 0, JS_EVENT_BUTTON | JS_EVENT_INIT, b) for b in range(6)),
+        *(JoyEvent(0, 0, JS_EVENT_AXIS | JS_EVENT_INIT, a) for a in range(4)),
+    )
+    first = joys.wait_for(lambda m: len(m.buttons) == 6, timeout=30)
+    assert first.header.frame_id == str(path) and list(first.axes) == [0.0] * 4
+    send(fd, JoyEvent(1, -32767, JS_EVENT_AXIS, 1))
+    joys.wait_for(lambda m: len(m.axes) > 1 and m.axes[1] > 0.99)
+    assert not [t for t in twists.items if t.linear.x != 0.0]  # not enabled: no motion
+    send(fd, JoyEvent(2, 1, JS_EVENT_BUTTON, 2))
+    moving = twists.wait_for(lambda m: m.linear.x > 0.5)
+    assert moving.linear.x == pytest.approx(0.7)  # scale_linear of xbox.config.yaml
+    # autorepeat_rate 20 in teleop.launch: the held state keeps coming without events
+    count = len(joys.items)
+    time.sleep(0.5)
+    assert len(joys.items) >= count + 5
+    send(fd, JoyEvent(3, 0, JS_EVENT_BUTTON, 2))
+    twists.wait_for(lambda m: m.linear.x == 0.0 and m.angular.z == 0.0)
 
 
-def test_joy_node_retries_a_missing_device_and_reopens_when_it_comes_back(tmp_path: Path) -> None:
+def test_joy_node_retries_a_missing_device_and_reopens_when_it_comes_back(rig: Rig, tmp_path: Path) -> None:
     path = tmp_path / "js9"
-    env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_LOG_DIR=str(tmp_path))
-    with testing.run_master(env=env) as uri:
-        env["ROS_MASTER_URI"] = uri
-        node = Node("joy_test2", master_uri=uri)
-        joys = Collect()
-        node.subscriber("/joy", Joy, joys)
-        proc = subprocess.Popen(
-            [sys.executable, "-m", "ninjemys.packages.run_shipped", "joy", "joy_node", f"_dev:={path}"],
-            env=env,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-            text=True,
-        )
-        try:
-            time.sleep(1.5)
-            os.mkfifo(path)
-            fd = os.open(path, os.O_RDWR | os.O_NONBLOCK)
-            try:
-                send(fd, JoyEvent(0, 1, JS_EVENT_BUTTON, 0))
-                joys.wait_for(lambda m: list(m.buttons) == [1], timeout=15)
-            finally:
-                os.close(fd)
-        finally:
-            proc.send_signal(signal.SIGINT)
-            out, _ = proc.communicate(timeout=20)
-            node.shutdown()
-        assert out.count(f"Couldn't open joystick {path}. Will retry every second.") == 1, out
-        assert f"Opened joystick: {path} (Unknown). deadzone_: 0.050000." in out, out
+    joys = rig.collect(rig.node("joy_test2"), "/joy", Joy)
+    proc = rig.shipped("joy", "joy_node", f"_dev:={path}")
+    out = rig.read_until(proc, "Couldn't open joystick")  # the device comes only after the first try
+    os.mkfifo(path)
+    fd = os.open(path, os.O_RDWR | os.O_NONBLOCK)
+    try:
+        send(fd, JoyEvent(0, 1, JS_EVENT_BUTTON, 0))
+        joys.wait_for(lambda m: list(m.buttons) == [1], timeout=15)
+    finally:
+        os.close(fd)
+    out += rig.stop(proc)
+    assert out.count(f"Couldn't open joystick {path}. Will retry every second.") == 1, out
+    assert f"Opened joystick: {path} (Unknown). deadzone_: 0.050000." in out, out
 
 
 @pytest.mark.ros1
-def test_debian_rostopic_reads_joy_node(fifo, tmp_path: Path) -> None:  # noqa: ANN001
+def test_debian_rostopic_reads_joy_node(fifo, rig: Rig) -> None:  # noqa: ANN001
     if not testing.have_ros1():
         pytest.skip("Debian's ROS 1 is not installed")
     path, fd = fifo
-    env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_LOG_DIR=str(tmp_path))
-    with testing.run_master(env=env) as uri:
-        env["ROS_MASTER_URI"] = uri
-        proc = subprocess.Popen(
-            [
-                sys.executable,
-                "-m",
-                "ninjemys.packages.run_shipped",
-                "joy",
-                "joy_node",
-                f"_dev:={path}",
-                "_autorepeat_rate:=10",
-            ],
-            env=env,
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.DEVNULL,
-        )
-        try:
-            send(fd, JoyEvent(0, 16384, JS_EVENT_AXIS, 0), JoyEvent(0, 1, JS_EVENT_BUTTON, 1))
-            out = subprocess.run(
-                ["/usr/bin/rostopic", "echo", "-n", "1", "/joy"],
-                env=testing.ros1_env(uri),
-                capture_output=True,
-                text=True,
-                timeout=30,
-            ).stdout
-        finally:
-            proc.send_signal(signal.SIGINT)
-            proc.wait(20)
-        assert "buttons: [0, 1]" in out, out
-        assert f'frame_id: "{path}"' in out, out
-        assert "axes: [-0.47" in out, out  # (16384 - 1638.35) / 0.95 / 32767, sign flipped
+    rig.shipped("joy", "joy_node", f"_dev:={path}", "_autorepeat_rate:=10", quiet=True)
+    send(fd, JoyEvent(0, 16384, JS_EVENT_AXIS, 0), JoyEvent(0, 1, JS_EVENT_BUTTON, 1))
+    out = subprocess.run(
+        ["/usr/bin/rostopic", "echo", "-n", "1", "/joy"],
+        env=testing.ros1_env(rig.uri),
+        capture_output=True,
+        text=True,
+        timeout=30,
+    ).stdout
+    assert "buttons: [0, 1]" in out, out
+    assert f'frame_id: "{path}"' in out, out
+    assert "axes: [-0.47" in out, out  # (16384 - 1638.35) / 0.95 / 32767, sign flipped

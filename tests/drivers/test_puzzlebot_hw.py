@@ -17,9 +17,9 @@ from ninjemys.drivers.joystick import JS_EVENT_AXIS, JS_EVENT_BUTTON, JoyEvent
 from ninjemys.idl.loader import get_message_class
 from ninjemys.node import Node
 
+from .conftest import Collect
 from .emu_arduino import EmulatedArduino
 from .emu_rplidar import EmulatedA1
-from .test_joy import Collect
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "puzzlebot_hw"
 TOPICS = {

@@ -7,13 +7,9 @@ stops syncing is asked for its topics again with ROS 1's "Lost sync with device,
 
 from __future__ import annotations
 
-import os
-import signal
 import subprocess
-import sys
-import threading
 import time
-from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 
@@ -21,9 +17,11 @@ from ninjemys import testing
 from ninjemys.drivers import rosserial_protocol as proto
 from ninjemys.drivers.rosserial_host import RosserialError, param_response_lists
 from ninjemys.idl.loader import get_message_class, get_service_class
-from ninjemys.node import Node
 
 from .emu_arduino import WHEEL_BASE, EmulatedArduino
+
+if TYPE_CHECKING:
+    from .conftest import Rig
 
 Float32 = get_message_class("std_msgs/Float32")
 ColorRGBA = get_message_class("std_msgs/ColorRGBA")
@@ -86,51 +84,6 @@ def test_parameter_kinds_as_request_param_carries_them() -> None:
 # -- the node against the emulated board --------------------------------------------------------------
 
 
-class Collect:
-    def __init__(self) -> None:
-        self.items: list = []
-        self.cond = threading.Condition()
-
-    def __call__(self, msg) -> None:  # noqa: ANN001
-        with self.cond:
-            self.items.append(msg)
-            self.cond.notify_all()
-
-    def wait_for(self, pred, timeout: float = 20.0):  # noqa: ANN001, ANN201
-        with self.cond:
-            found: list = []
-
-            def check() -> bool:
-                found[:] = [m for m in self.items if pred(m)]
-                return bool(found)
-
-            if not self.cond.wait_for(check, timeout):
-                raise AssertionError(f"no matching message in {len(self.items)} received")
-            return found[-1]
-
-
-def serial_node(
-    env: dict[str, str], *args: str, package: str = "rosserial_python", exe: str = "serial_node.py"
-) -> subprocess.Popen:
-    return subprocess.Popen(
-        [sys.executable, "-m", "ninjemys.packages.run_shipped", package, exe, *args],
-        env=env,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-    )
-
-
-def stop(proc: subprocess.Popen) -> str:
-    proc.send_signal(signal.SIGINT)
-    try:
-        out, _ = proc.communicate(timeout=20)
-    except subprocess.TimeoutExpired:
-        testing.kill_tree(proc)
-        out, _ = proc.communicate()
-    return out
-
-
 @pytest.fixture
 def board():  # noqa: ANN201
     b = EmulatedArduino(rate_hz=20.0)
@@ -140,174 +93,150 @@ def board():  # noqa: ANN201
 
 @pytest.mark.ros1
 def test_debian_rostopic_reads_wl_and_drives_cmd_vel_through_the_board(
-    board: EmulatedArduino, tmp_path: Path
+    board: EmulatedArduino, rig: Rig
 ) -> None:
     if not testing.have_ros1():
         pytest.skip("Debian's ROS 1 is not installed")
-    env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_LOG_DIR=str(tmp_path))
-    with testing.run_master(env=env) as uri:
-        env["ROS_MASTER_URI"] = uri
-        node = Node("rosserial_test", master_uri=uri)
-        node.set_param("/wheel_radius", 0.05)
-        logs = Collect()
-        node.subscriber("/rosout", Log, logs)
-        wl = Collect()
-        node.subscriber("/wl", Float32, wl)
-        led = node.publisher("/led", ColorRGBA)
-        proc = serial_node(env, f"_port:={board.path}", "_baud:=115200")
-        try:
-            board.wait(lambda: board.configured and board.wheel_radius is not None and board.time_syncs > 0)
-            assert board.wheel_radius == pytest.approx(0.05)
-            secs, _ = board.host_time
-            assert abs(secs - time.time()) < 5  # the host answered the board's time request with its clock
-            warn = logs.wait_for(lambda m: m.msg == "PuzzleBot board: motors armed")
-            assert warn.level == Log.WARN and warn.name == "/serial_node"
+    node = rig.node("rosserial_test")
+    node.set_param("/wheel_radius", 0.05)
+    logs = rig.collect(node, "/rosout", Log)
+    wl = rig.collect(node, "/wl", Float32)
+    led = node.publisher("/led", ColorRGBA)
+    proc = serial_node(rig, f"_port:={board.path}", "_baud:=115200")
+    board.wait(lambda: board.configured and board.wheel_radius is not None and board.time_syncs > 0)
+    assert board.wheel_radius == pytest.approx(0.05)
+    secs, _ = board.host_time
+    assert abs(secs - time.time()) < 5  # the host answered the board's time request with its clock
+    warn = logs.wait_for(lambda m: m.msg == "PuzzleBot board: motors armed")
+    assert warn.level == Log.WARN and warn.name == "/serial_node"
 
-            r = testing.ros1_env(uri)
-            echo = subprocess.run(
-                ["/usr/bin/rostopic", "echo", "-n", "1", "/wl"],
-                env=r,
-                capture_output=True,
-                text=True,
-                timeout=30,
-            )
-            assert "data: 0.0" in echo.stdout, echo
-            info = subprocess.run(
-                ["/usr/bin/rostopic", "info", "/cmd_vel"], env=r, capture_output=True, text=True, timeout=30
-            )
-            assert "Type: geometry_msgs/Twist" in info.stdout and "/serial_node" in info.stdout, info
-            pub = subprocess.run(
-                [
-                    "/usr/bin/rostopic",
-                    "pub",
-                    "-1",
-                    "/cmd_vel",
-                    "geometry_msgs/Twist",
-                    "{linear: {x: 0.2}, angular: {z: 1.0}}",
-                ],
-                env=r,
-                capture_output=True,
-                text=True,
-                timeout=30,
-            )
-            assert pub.returncode == 0, pub
-            board.wait(lambda: any(t.linear.x == pytest.approx(0.2) for t in board.cmd_vels))
-            expected_wl = (0.2 - 1.0 * WHEEL_BASE / 2) / 0.05
-            got = wl.wait_for(lambda m: abs(m.data - expected_wl) < 1e-4)
-            assert got.data == pytest.approx(expected_wl, abs=1e-5)
-            echo = subprocess.run(
-                ["/usr/bin/rostopic", "echo", "-n", "1", "/wr"],
-                env=r,
-                capture_output=True,
-                text=True,
-                timeout=30,
-            )
-            assert "data: 5.9" in echo.stdout, echo  # (0.2 + 0.095) / 0.05 = 5.9 in float32
+    r = testing.ros1_env(rig.uri)
+    echo = subprocess.run(
+        ["/usr/bin/rostopic", "echo", "-n", "1", "/wl"],
+        env=r,
+        capture_output=True,
+        text=True,
+        timeout=30,
+    )
+    assert "data: 0.0" in echo.stdout, echo
+    info = subprocess.run(
+        ["/usr/bin/rostopic", "info", "/cmd_vel"], env=r, capture_output=True, text=True, timeout=30
+    )
+    assert "Type: geometry_msgs/Twist" in info.stdout and "/serial_node" in info.stdout, info
+    pub = subprocess.run(
+        [
+            "/usr/bin/rostopic",
+            "pub",
+            "-1",
+            "/cmd_vel",
+            "geometry_msgs/Twist",
+            "{linear: {x: 0.2}, angular: {z: 1.0}}",
+        ],
+        env=r,
+        capture_output=True,
+        text=True,
+        timeout=30,
+    )
+    assert pub.returncode == 0, pub
+    board.wait(lambda: any(t.linear.x == pytest.approx(0.2) for t in board.cmd_vels))
+    expected_wl = (0.2 - 1.0 * WHEEL_BASE / 2) / 0.05
+    got = wl.wait_for(lambda m: abs(m.data - expected_wl) < 1e-4)
+    assert got.data == pytest.approx(expected_wl, abs=1e-5)
+    echo = subprocess.run(
+        ["/usr/bin/rostopic", "echo", "-n", "1", "/wr"],
+        env=r,
+        capture_output=True,
+        text=True,
+        timeout=30,
+    )
+    assert "data: 5.9" in echo.stdout, echo  # (0.2 + 0.095) / 0.05 = 5.9 in float32
 
-            led.publish(ColorRGBA(r=1.0, g=0.5, b=0.0, a=1.0))
-            board.wait(lambda: any(c.g == 0.5 for c in board.leds))
+    led.publish(ColorRGBA(r=1.0, g=0.5, b=0.0, a=1.0))
+    board.wait(lambda: any(c.g == 0.5 for c in board.leds))
 
-            call = subprocess.run(
-                ["/usr/bin/rosservice", "call", "/reset_encoders"],
-                env=r,
-                capture_output=True,
-                text=True,
-                timeout=30,
-            )
-            assert "success: True" in call.stdout and "encoders reset (1)" in call.stdout, call
+    call = subprocess.run(
+        ["/usr/bin/rosservice", "call", "/reset_encoders"],
+        env=r,
+        capture_output=True,
+        text=True,
+        timeout=30,
+    )
+    assert "success: True" in call.stdout and "encoders reset (1)" in call.stdout, call
 
-            # noise, a broken packet and a bad length, then the link goes on without a restart
-            count = len(wl.items)
-            bad = bytearray(proto.frame(125, Float32(data=99.0).serialize_to_bytes()))
-            bad[-1] ^= 0xFF
-            board.inject(b"\x00garbage\xff\x13" + bytes(bad) + b"\xff\xfe\x04\x00\x00" + b"\x00" * 8)
-            wl.wait_for(lambda m: len(wl.items) > count + 10)
-            assert not [m for m in wl.items if m.data == 99.0]
-            assert board.negotiations == 1  # recovered without asking for the topics again
-        finally:
-            out = stop(proc)
-            node.shutdown()
-        assert board.stopped_by_host  # rosserial_python's TX_STOP at shutdown
-        assert "wrong checksum for topic id and msg" in out, out
-        assert "Mismatched protocol version in packet (0x13)" in out, out
-        assert "wrong checksum for msg length, length 4, dropping message." in out, out
-        assert "Setup publisher on wl [std_msgs/Float32]" in out, out
-        assert "Setup subscriber on cmd_vel [geometry_msgs/Twist]" in out, out
-        assert f"Connecting to {board.path} at 115200 baud" in out, out
-        assert "Traceback" not in out, out
+    # noise, a broken packet and a bad length, then the link goes on without a restart
+    count = len(wl.items)
+    bad = bytearray(proto.frame(125, Float32(data=99.0).serialize_to_bytes()))
+    bad[-1] ^= 0xFF
+    board.inject(b"\x00garbage\xff\x13" + bytes(bad) + b"\xff\xfe\x04\x00\x00" + b"\x00" * 8)
+    wl.wait_for(lambda m: len(wl.items) > count + 10)
+    assert not [m for m in wl.items if m.data == 99.0]
+    assert board.negotiations == 1  # recovered without asking for the topics again
+    out = rig.stop(proc)
+    assert board.stopped_by_host  # rosserial_python's TX_STOP at shutdown
+    assert "wrong checksum for topic id and msg" in out, out
+    assert "Mismatched protocol version in packet (0x13)" in out, out
+    assert "wrong checksum for msg length, length 4, dropping message." in out, out
+    assert "Setup publisher on wl [std_msgs/Float32]" in out, out
+    assert "Setup subscriber on cmd_vel [geometry_msgs/Twist]" in out, out
+    assert f"Connecting to {board.path} at 115200 baud" in out, out
+    assert "Traceback" not in out, out
 
 
-def test_lost_sync_is_logged_and_the_topics_are_requested_again(
-    board: EmulatedArduino, tmp_path: Path
-) -> None:
-    env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_LOG_DIR=str(tmp_path))
-    with testing.run_master(env=env) as uri:
-        env["ROS_MASTER_URI"] = uri
-        node = Node("rosserial_sync_test", master_uri=uri)
-        node.set_param("/wheel_radius", 0.05)
-        proc = serial_node(env, board.path, "_sync_timeout:=1.0", "__name:=arduino")
-        try:
-            board.wait(lambda: board.configured)
-            board.sync_enabled = False  # a sketch stuck without spinOnce's time sync
-            board.wait(lambda: board.negotiations >= 2, timeout=15)
-            board.sync_enabled = True
-        finally:
-            out = stop(proc)
-            node.shutdown()
-        assert "Lost sync with device, restarting..." in out, out
-        assert out.count("Requesting topics...") >= 2, out
+def test_lost_sync_is_logged_and_the_topics_are_requested_again(board: EmulatedArduino, rig: Rig) -> None:
+    rig.node("rosserial_sync_test").set_param("/wheel_radius", 0.05)
+    proc = serial_node(rig, board.path, "_sync_timeout:=1.0", "__name:=arduino")
+    board.wait(lambda: board.configured)
+    board.sync_enabled = False  # a sketch stuck without spinOnce's time sync
+    board.wait(lambda: board.negotiations >= 2, timeout=15)
+    board.sync_enabled = True
+    out = rig.stop(proc)
+    assert "Lost sync with device, restarting..." in out, out
+    assert out.count("Requesting topics...") >= 2, out
 
 
-def test_a_device_with_an_unknown_md5_gets_one_clear_error_and_the_rest_works(tmp_path: Path) -> None:
+def test_a_device_with_an_unknown_md5_gets_one_clear_error_and_the_rest_works(rig: Rig) -> None:
     from .emu_arduino import _info
 
-    b = EmulatedArduino()
-    env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_LOG_DIR=str(tmp_path))
-    with testing.run_master(env=env) as uri:
-        env["ROS_MASTER_URI"] = uri
-        proc = serial_node(env, f"_port:={b.path}", package="rosserial_server", exe="serial_node")
-        try:
-            b.wait(lambda: b.configured)
-            b.send(proto.ID_PUBLISHER, _info(130, "odd", "std_msgs/Float32", "0" * 32))
-            b.send(proto.ID_PUBLISHER, _info(131, "nope", "no_such_pkg/Thing", "0" * 32))
-            time.sleep(1.0)
-            assert proc.poll() is None
-        finally:
-            out = stop(proc)
-            b.close()
-        assert "Creation of publisher failed: Checksum does not match: " in out, out
-        assert "Creation of publisher failed:" in out and "no_such_pkg" in out, out
-        assert "Traceback" not in out, out
+    b = rig.device(EmulatedArduino())
+    proc = serial_node(rig, f"_port:={b.path}", package="rosserial_server", exe="serial_node")
+    b.wait(lambda: b.configured)
+    b.send(proto.ID_PUBLISHER, _info(130, "odd", "std_msgs/Float32", "0" * 32))
+    b.send(proto.ID_PUBLISHER, _info(131, "nope", "no_such_pkg/Thing", "0" * 32))
+    time.sleep(1.0)
+    assert proc.poll() is None
+    out = rig.stop(proc)
+    assert "Creation of publisher failed: Checksum does not match: " in out, out
+    assert "Creation of publisher failed:" in out and "no_such_pkg" in out, out
+    assert "Traceback" not in out, out
 
 
 def test_tcp_mode_serves_a_wifi_board_whose_sketch_calls_a_ros_service(
-    board: EmulatedArduino, tmp_path: Path
+    board: EmulatedArduino, rig: Rig
 ) -> None:
-    env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_LOG_DIR=str(tmp_path))
     port = testing.free_port()
-    with testing.run_master(env=env) as uri:
-        env["ROS_MASTER_URI"] = uri
-        node = Node("rosserial_tcp_test", master_uri=uri)
-        node.set_param("/wheel_radius", 0.1)
-        wr = Collect()
-        node.subscriber("/wr", Float32, wr)
-        Trigger = get_service_class("std_srvs/Trigger")
-        node.service(
-            "/board_config",
-            Trigger,
-            lambda _req: Trigger._response_class(success=True, message="gains 1.5 0.2"),
-        )
-        proc = serial_node(env, "tcp", str(port))
-        try:
-            board.connect_tcp(port)
-            board.wait(lambda: board.configured and board.wheel_radius is not None)
-            assert board.wheel_radius == pytest.approx(0.1)
-            wr.wait_for(lambda m: m.data == 0.0)
-            board.call_config()
-            board.wait(lambda: bool(board.config_answers))
-            assert board.config_answers[0].success and board.config_answers[0].message == "gains 1.5 0.2"
-        finally:
-            out = stop(proc)
-            node.shutdown()
-        assert f"Waiting for socket connections on port {port}" in out, out
-        assert "Established a socket connection from 127.0.0.1" in out, out
+    node = rig.node("rosserial_tcp_test")
+    node.set_param("/wheel_radius", 0.1)
+    wr = rig.collect(node, "/wr", Float32)
+    Trigger = get_service_class("std_srvs/Trigger")
+    node.service(
+        "/board_config",
+        Trigger,
+        lambda _req: Trigger._response_class(success=True, message="gains 1.5 0.2"),
+    )
+    proc = serial_node(rig, "tcp", str(port))
+    board.connect_tcp(port)
+    board.wait(lambda: board.configured and board.wheel_radius is not None)
+    assert board.wheel_radius == pytest.approx(0.1)
+    wr.wait_for(lambda m: m.data == 0.0)
+    board.call_config()
+    board.wait(lambda: bool(board.config_answers))
+    assert board.config_answers[0].success and board.config_answers[0].message == "gains 1.5 0.2"
+    out = rig.stop(proc)
+    assert f"Waiting for socket connections on port {port}" in out, out
+    assert "Established a socket connection from 127.0.0.1" in out, out
+
+
+def serial_node(
+    rig: Rig, *args: str, package: str = "rosserial_python", exe: str = "serial_node.py"
+) -> subprocess.Popen:
+    return rig.shipped(package, exe, *args)

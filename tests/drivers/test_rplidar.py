@@ -5,24 +5,22 @@ device."""
 from __future__ import annotations
 
 import math
-import os
-import signal
 import subprocess
-import sys
-import threading
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pytest
 
-from ninjemys import testing
 from ninjemys.drivers import rplidar_protocol as rp
 from ninjemys.drivers.rplidar_scan import ascend, compensate_multiple, revolution_to_scan
 from ninjemys.idl.loader import get_message_class, get_service_class
-from ninjemys.node import Node
 
-from .emu_rplidar import EmulatedA1, room_range
+from .emu_rplidar import EmulatedA1, check_room
+
+if TYPE_CHECKING:
+    from .conftest import Rig
 
 LaserScan = get_message_class("sensor_msgs/LaserScan")
 Empty = get_service_class("std_srvs/Empty")
@@ -98,205 +96,85 @@ def test_angle_convention_is_pi_minus_the_device_angle_with_reversed_ranges() ->
 # -- the node on the emulated device -----------------------------------------------------------------------
 
 
-class Collect:
-    def __init__(self) -> None:
-        self.items: list = []
-        self.cond = threading.Condition()
-
-    def __call__(self, msg) -> None:  # noqa: ANN001
-        with self.cond:
-            self.items.append(msg)
-            self.cond.notify_all()
-
-    def wait_count(self, n: int, timeout: float = 20.0) -> None:
-        with self.cond:
-            if not self.cond.wait_for(lambda: len(self.items) >= n, timeout):
-                raise AssertionError(f"{len(self.items)} scans received, wanted {n}")
-
-
-def rplidar(env: dict[str, str], *args: str) -> subprocess.Popen:
-    return subprocess.Popen(
-        [sys.executable, "-m", "ninjemys.packages.run_shipped", "rplidar_ros", "rplidarNode", *args],
-        env=env,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-    )
-
-
-def stop(proc: subprocess.Popen) -> str:
-    if proc.poll() is None:
-        proc.send_signal(signal.SIGINT)
-    try:
-        out, _ = proc.communicate(timeout=20)
-    except subprocess.TimeoutExpired:
-        testing.kill_tree(proc)
-        out, _ = proc.communicate()
-    return out
-
-
-def check_room(scan, samples: list[tuple[float, float]], multiple: int = 1) -> None:  # noqa: ANN001
-    """Every beam of a compensated scan against the emulator's samples: rplidar_ros' compensation puts
-    each sample (in angle order) into the ``multiple`` bins of 1/multiple degree from its own, the later
-    one winning (angles as the SDK hands them on: 1/64 degree made q14), and publishes bin b of n at laser angle pi - 359 b / (n - 1) degrees (for one bin a
-    degree: pi - b); the range there is the room's along the winning sample's angle, within 1 cm."""
-    count = 360 * multiple
-    assert len(scan.ranges) == count
-    winner: dict[int, float] = {}
-    for a_q6, d in sorted(samples):
-        a = rp.q14_degrees(int(round(a_q6 * 64)))  # what rplidar_ros reads (see q14_degrees)
-        if d:
-            for j in range(multiple):
-                winner[min(int(a * multiple) + j, count - 1)] = a
-    checked = 0
-    for j, r in enumerate(scan.ranges):
-        phi = scan.angle_min + j * scan.angle_increment
-        device_bin = count - 1 - j
-        if device_bin not in winner:
-            assert math.isinf(r), (j, r)
-            continue
-        a = winner[device_bin]
-        # rplidar_ros spreads the bins evenly over [pi - 359 deg, pi] whatever their count
-        assert phi == pytest.approx(math.pi - math.radians(359.0 * device_bin / (count - 1)), abs=1e-6)
-        assert abs(r - room_range(math.pi - math.radians(a))) < 0.01, (j, r, a)
-        checked += 1
-    assert checked > 0.8 * count
-
-
 @pytest.mark.parametrize("mode", ["Standard", "Express"])
-def test_scan_of_the_known_room_within_1cm_and_stop_motor_reaches_the_device(
-    mode: str, tmp_path: Path
-) -> None:
-    a1 = EmulatedA1(samples_per_s=2000.0 if mode == "Standard" else 4000.0)
-    env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_LOG_DIR=str(tmp_path))
-    with testing.run_master(env=env) as uri:
-        env["ROS_MASTER_URI"] = uri
-        node = Node("rplidar_test", master_uri=uri)
-        scans = Collect()
-        node.subscriber("/scan", LaserScan, scans)
-        args = [f"_serial_port:={a1.path}", "_frame_id:=laser", "_angle_compensate:=true"]
-        proc = rplidar(env, *args, *([] if mode == "Express" else ["_scan_mode:=Standard"]))
-        try:
-            scans.wait_count(3, timeout=30)
-            scan = scans.items[-1]
-            assert scan.header.frame_id == "laser"
-            assert scan.range_min == pytest.approx(0.15) and scan.range_max == pytest.approx(16.0)
-            assert scan.scan_time > 0 and scan.time_increment == pytest.approx(scan.scan_time / 359)
-            samples = a1.standard_samples() if mode == "Standard" else a1.express_samples()
-            check_room(scan, samples)
-            assert rp.CMD_GET_INFO in a1.commands and rp.CMD_GET_HEALTH in a1.commands
+def test_scan_of_the_known_room_within_1cm_and_stop_motor_reaches_the_device(mode: str, rig: Rig) -> None:
+    a1 = rig.device(EmulatedA1(samples_per_s=2000.0 if mode == "Standard" else 4000.0))
+    node = rig.node("rplidar_test")
+    scans = rig.collect(node, "/scan", LaserScan)
+    args = [f"_serial_port:={a1.path}", "_frame_id:=laser", "_angle_compensate:=true"]
+    proc = rplidar(rig, *args, *([] if mode == "Express" else ["_scan_mode:=Standard"]))
+    scans.wait_count(3, timeout=30)
+    scan = scans.items[-1]
+    assert scan.header.frame_id == "laser"
+    assert scan.range_min == pytest.approx(0.15) and scan.range_max == pytest.approx(16.0)
+    assert scan.scan_time > 0 and scan.time_increment == pytest.approx(scan.scan_time / 359)
+    samples = a1.standard_samples() if mode == "Standard" else a1.express_samples()
+    check_room(scan, samples)
+    assert rp.CMD_GET_INFO in a1.commands and rp.CMD_GET_HEALTH in a1.commands
 
-            before = len(a1.commands)
-            node.service_proxy("/stop_motor", Empty)(Empty._request_class())
-            a1.wait(lambda: rp.CMD_STOP in a1.commands[before:])
-            assert a1.mode is None  # the device stopped streaming
-            time.sleep(0.5)
-            count = len(scans.items)
-            time.sleep(0.5)
-            assert len(scans.items) == count  # no scans while stopped
-            node.service_proxy("/start_motor", Empty)(Empty._request_class())
-            scans.wait_count(count + 2)
-        finally:
-            out = stop(proc)
-            node.shutdown()
-            a1.close()
-        assert "RPLIDAR S/N: A0A1A2A3A4A5A6A7A8A9AAABACADAEAF" in out, out
-        assert "Firmware Ver: 1.29" in out and "Hardware Rev: 7" in out, out
-        assert "RPLidar health status : 0" in out, out
-        assert f"current scan mode: {mode}, max_distance: 16.0 m" in out, out
-        assert "Traceback" not in out, out
-
-
-def test_a_bad_descriptor_is_one_clear_error_and_the_node_stays_up(tmp_path: Path) -> None:
-    a1 = EmulatedA1(bad_scan_descriptor=True)
-    env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_LOG_DIR=str(tmp_path))
-    with testing.run_master(env=env) as uri:
-        env["ROS_MASTER_URI"] = uri
-        proc = rplidar(env, f"_serial_port:={a1.path}", "_scan_mode:=Standard")
-        try:
-            a1.wait(lambda: a1.commands.count(rp.CMD_SCAN) >= 3)  # retried, once a second
-            assert proc.poll() is None
-        finally:
-            out = stop(proc)
-            a1.close()
-        line = (
-            "Can not start scan: the device answered SCAN (0x20) with a response descriptor of length 84, "
-            "send mode 1, type 0x82; expected length 5, send mode 1, type 0x81"
-        )
-        assert out.count(line) == 1, out
-        assert "Traceback" not in out, out
-
-
-def test_health_error_and_unknown_scan_mode_stop_the_node_as_rplidar_ros_does(tmp_path: Path) -> None:
-    env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_LOG_DIR=str(tmp_path))
-    with testing.run_master(env=env) as uri:
-        env["ROS_MASTER_URI"] = uri
-        sick = EmulatedA1(health=(2, 0x8001))
-        try:
-            out = stop_after_exit(rplidar(env, f"_serial_port:={sick.path}"))
-            sick.wait(lambda: rp.CMD_RESET in sick.commands, timeout=5)  # the protection stop is reset
-            assert rp.CMD_SCAN not in sick.commands and rp.CMD_EXPRESS_SCAN not in sick.commands
-        finally:
-            sick.close()
-        assert "RPLidar health status : 2" in out, out
-        assert "Error, rplidar internal error detected. Please reboot the device to retry." in out, out
-        a1 = EmulatedA1()
-        try:
-            out = stop_after_exit(rplidar(env, f"_serial_port:={a1.path}", "_scan_mode:=Sensitivity"))
-        finally:
-            a1.close()
-        assert "scan mode `Sensitivity' is not supported by lidar, supported modes:" in out, out
-        assert "\tStandard: max_distance: 16.0 m, Point number: 2.0K" in out, out
-        out = stop_after_exit(rplidar(env, f"_serial_port:={tmp_path / 'nothing'}"))
-        assert f"Error, cannot bind to the specified serial port {tmp_path / 'nothing'}." in out, out
-
-
-def stop_after_exit(proc: subprocess.Popen) -> str:
-    try:
-        out, _ = proc.communicate(timeout=30)
-    except subprocess.TimeoutExpired:
-        return stop(proc) + "\n(did not exit)"
-    assert proc.returncode != 0
+    before = len(a1.commands)
+    node.service_proxy("/stop_motor", Empty)(Empty._request_class())
+    a1.wait(lambda: rp.CMD_STOP in a1.commands[before:])
+    assert a1.mode is None  # the device stopped streaming
+    time.sleep(0.5)
+    count = len(scans.items)
+    time.sleep(0.5)
+    assert len(scans.items) == count  # no scans while stopped
+    node.service_proxy("/start_motor", Empty)(Empty._request_class())
+    scans.wait_count(count + 2)
+    out = rig.stop(proc)
+    assert "RPLIDAR S/N: A0A1A2A3A4A5A6A7A8A9AAABACADAEAF" in out, out
+    assert "Firmware Ver: 1.29" in out and "Hardware Rev: 7" in out, out
+    assert "RPLidar health status : 0" in out, out
+    assert f"current scan mode: {mode}, max_distance: 16.0 m" in out, out
     assert "Traceback" not in out, out
-    return out
 
 
-def test_rplidar_a1_launch_brings_up_the_node_on_the_emulated_device(tmp_path: Path) -> None:
-    a1 = EmulatedA1()
-    env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_LOG_DIR=str(tmp_path))
-    with testing.run_master(env=env) as uri:
-        env["ROS_MASTER_URI"] = uri
-        node = Node("rplidar_launch_test", master_uri=uri)
-        scans = Collect()
-        node.subscriber("/scan", LaserScan, scans)
-        launch = subprocess.Popen(
-            [
-                testing.ninjemys_bin("roslaunch"),
-                "rplidar_ros",
-                "rplidar_a1.launch",
-                f"serial_port:={a1.path}",
-            ],
-            env=env,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-            text=True,
-            start_new_session=True,
-        )
-        try:
-            scans.wait_count(2, timeout=40)
-            scan = scans.items[-1]
-            assert (
-                scan.header.frame_id == "laser" and len(scan.ranges) == 360
-            )  # angle_compensate from the file
-            assert node.get_param("/rplidarNode/serial_baudrate") == 115200
-        finally:
-            os.killpg(launch.pid, signal.SIGINT)
-            try:
-                launch.communicate(timeout=20)
-            except subprocess.TimeoutExpired:
-                testing.kill_tree(launch)
-            node.shutdown()
-            a1.close()
+def test_a_bad_descriptor_is_one_clear_error_and_the_node_stays_up(rig: Rig) -> None:
+    a1 = rig.device(EmulatedA1(bad_scan_descriptor=True))
+    proc = rplidar(rig, f"_serial_port:={a1.path}", "_scan_mode:=Standard")
+    a1.wait(lambda: a1.commands.count(rp.CMD_SCAN) >= 3)  # retried, once a second
+    assert proc.poll() is None
+    out = rig.stop(proc)
+    line = (
+        "Can not start scan: the device answered SCAN (0x20) with a response descriptor of length 84, "
+        "send mode 1, type 0x82; expected length 5, send mode 1, type 0x81"
+    )
+    assert out.count(line) == 1, out
+    assert "Traceback" not in out, out
+
+
+def test_health_error_and_unknown_scan_mode_stop_the_node_as_rplidar_ros_does(
+    rig: Rig, tmp_path: Path
+) -> None:
+    sick = rig.device(EmulatedA1(health=(2, 0x8001)))
+    out = rig.exit_output(rplidar(rig, f"_serial_port:={sick.path}"))
+    sick.wait(lambda: rp.CMD_RESET in sick.commands, timeout=5)  # the protection stop is reset
+    assert rp.CMD_SCAN not in sick.commands and rp.CMD_EXPRESS_SCAN not in sick.commands
+    assert "RPLidar health status : 2" in out, out
+    assert "Error, rplidar internal error detected. Please reboot the device to retry." in out, out
+    a1 = rig.device(EmulatedA1())
+    out = rig.exit_output(rplidar(rig, f"_serial_port:={a1.path}", "_scan_mode:=Sensitivity"))
+    assert "scan mode `Sensitivity' is not supported by lidar, supported modes:" in out, out
+    assert "\tStandard: max_distance: 16.0 m, Point number: 2.0K" in out, out
+    out = rig.exit_output(rplidar(rig, f"_serial_port:={tmp_path / 'nothing'}"))
+    assert f"Error, cannot bind to the specified serial port {tmp_path / 'nothing'}." in out, out
+
+
+def test_rplidar_a1_launch_brings_up_the_node_on_the_emulated_device(rig: Rig) -> None:
+    a1 = rig.device(EmulatedA1())
+    node = rig.node("rplidar_launch_test")
+    scans = rig.collect(node, "/scan", LaserScan)
+    rig.roslaunch("rplidar_ros", "rplidar_a1.launch", f"serial_port:={a1.path}")
+    scans.wait_count(2, timeout=40)
+    scan = scans.items[-1]
+    assert scan.header.frame_id == "laser" and len(scan.ranges) == 360  # angle_compensate from the file
+    assert node.get_param("/rplidarNode/serial_baudrate") == 115200
+
+
+def rplidar(rig: Rig, *args: str) -> subprocess.Popen:
+    """rplidar_ros' rplidarNode with ``args``."""
+    return rig.shipped("rplidar_ros", "rplidarNode", *args)
 
 
 def test_launch_files_name_the_node_and_its_parameters() -> None:

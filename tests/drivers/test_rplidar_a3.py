@@ -4,23 +4,21 @@ the room within 1 cm; corrupted capsules are dropped with a warning and the scan
 
 from __future__ import annotations
 
-import os
-import signal
-import subprocess
-from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pytest
 
-from ninjemys import testing
 from ninjemys.drivers import rplidar_capsules as rc
 from ninjemys.drivers import rplidar_protocol as rp
 from ninjemys.drivers.rplidar_scan import compensate_multiple
 from ninjemys.idl.loader import get_message_class
-from ninjemys.node import Node
 
-from .emu_rplidar import A3_MODES, EmulatedA3, ModeInfo
-from .test_rplidar import Collect, check_room, rplidar, stop, stop_after_exit
+from .emu_rplidar import A3_MODES, EmulatedA3, ModeInfo, check_room
+from .test_rplidar import rplidar
+
+if TYPE_CHECKING:
+    from .conftest import Rig
 
 LaserScan = get_message_class("sensor_msgs/LaserScan")
 ULTRA = rp.ANS_TYPE_MEASUREMENT_CAPSULED_ULTRA
@@ -108,87 +106,48 @@ def test_bad_capsules_are_dropped_and_the_stream_resynchronises() -> None:
 # -- the node on an emulated A3 ----------------------------------------------------------------------------
 
 
-def test_rplidar_a3_launch_streams_sensitivity_and_the_room_matches_within_1cm(tmp_path: Path) -> None:
-    a3 = EmulatedA3(corrupt_every=40)
-    env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_LOG_DIR=str(tmp_path))
-    with testing.run_master(env=env) as uri:
-        env["ROS_MASTER_URI"] = uri
-        node = Node("rplidar_a3_test", master_uri=uri)
-        scans = Collect()
-        node.subscriber("/scan", LaserScan, scans)
-        launch = subprocess.Popen(
-            [
-                testing.ninjemys_bin("roslaunch"),
-                "rplidar_ros",
-                "rplidar_a3.launch",
-                f"serial_port:={a3.path}",
-            ],
-            env=env,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-            text=True,
-            start_new_session=True,
-        )
-        try:
-            scans.wait_count(4, timeout=40)
-            assert node.get_param("/rplidarNode/serial_baudrate") == 256000
-            assert node.get_param("/rplidarNode/scan_mode") == "Sensitivity"
-            assert a3.mode == ULTRA and a3.working_mode == 3
-            scan = scans.items[-1]
-            assert scan.header.frame_id == "laser" and scan.range_max == pytest.approx(25.0)
-            multiple = compensate_multiple(16000 >> 8)
-            assert multiple == 4
-            check_room(scan, a3.mode_samples(ULTRA), multiple)
-            assert a3.corrupted > 0
-            count = len(scans.items)
-            scans.wait_count(count + 3)  # corrupted capsules do not stop the stream
-        finally:
-            os.killpg(launch.pid, signal.SIGINT)
-            try:
-                out, _ = launch.communicate(timeout=20)
-            except subprocess.TimeoutExpired:
-                testing.kill_tree(launch)
-                out, _ = launch.communicate()
-            node.shutdown()
-            a3.close()
+def test_rplidar_a3_launch_streams_sensitivity_and_the_room_matches_within_1cm(rig: Rig) -> None:
+    a3 = rig.device(EmulatedA3(corrupt_every=40))
+    node = rig.node("rplidar_a3_test")
+    scans = rig.collect(node, "/scan", LaserScan)
+    launch = rig.roslaunch("rplidar_ros", "rplidar_a3.launch", f"serial_port:={a3.path}")
+    scans.wait_count(4, timeout=40)
+    assert node.get_param("/rplidarNode/serial_baudrate") == 256000
+    assert node.get_param("/rplidarNode/scan_mode") == "Sensitivity"
+    assert a3.mode == ULTRA and a3.working_mode == 3
+    scan = scans.items[-1]
+    assert scan.header.frame_id == "laser" and scan.range_max == pytest.approx(25.0)
+    multiple = compensate_multiple(16000 >> 8)
+    assert multiple == 4
+    check_room(scan, a3.mode_samples(ULTRA), multiple)
+    assert a3.corrupted > 0
+    count = len(scans.items)
+    scans.wait_count(count + 3)  # corrupted capsules do not stop the stream
+    out = rig.stop(launch)
     assert "current scan mode: Sensitivity, max_distance: 25.0 m, Point number: 16.1K" in out, out
     assert "RPLIDAR: dropped" in out and "Sensitivity scan data that failed the sync or checksum check" in out
     assert "Traceback" not in out, out
 
 
 @pytest.mark.parametrize("mode", ["Stability", "DenseBoost"])
-def test_other_ultra_and_dense_modes_match_the_room(mode: str, tmp_path: Path) -> None:
-    a3 = EmulatedA3()
+def test_other_ultra_and_dense_modes_match_the_room(mode: str, rig: Rig) -> None:
+    a3 = rig.device(EmulatedA3())
     info = next(m for m in A3_MODES if m.name == mode)
-    env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_LOG_DIR=str(tmp_path))
-    with testing.run_master(env=env) as uri:
-        env["ROS_MASTER_URI"] = uri
-        node = Node("rplidar_a3_modes", master_uri=uri)
-        scans = Collect()
-        node.subscriber("/scan", LaserScan, scans)
-        proc = rplidar(env, f"_serial_port:={a3.path}", "_angle_compensate:=true", f"_scan_mode:={mode}")
-        try:
-            scans.wait_count(3, timeout=30)
-            assert a3.working_mode == info.id
-            multiple = compensate_multiple(info.us_q8 >> 8)
-            check_room(scans.items[-1], a3.mode_samples(info.ans_type), multiple)
-        finally:
-            out = stop(proc)
-            node.shutdown()
-            a3.close()
+    node = rig.node("rplidar_a3_modes")
+    scans = rig.collect(node, "/scan", LaserScan)
+    proc = rplidar(rig, f"_serial_port:={a3.path}", "_angle_compensate:=true", f"_scan_mode:={mode}")
+    scans.wait_count(3, timeout=30)
+    assert a3.working_mode == info.id
+    multiple = compensate_multiple(info.us_q8 >> 8)
+    check_room(scans.items[-1], a3.mode_samples(info.ans_type), multiple)
+    out = rig.stop(proc)
     assert f"current scan mode: {mode}, max_distance: 25.0 m, Point number: 10.0K" in out, out
     assert "Traceback" not in out, out
 
 
-def test_the_a3_lists_its_modes_when_asked_for_one_it_lacks(tmp_path: Path) -> None:
-    a3 = EmulatedA3()
-    env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_LOG_DIR=str(tmp_path))
-    with testing.run_master(env=env) as uri:
-        env["ROS_MASTER_URI"] = uri
-        try:
-            out = stop_after_exit(rplidar(env, f"_serial_port:={a3.path}", "_scan_mode:=HighSpeed"))
-        finally:
-            a3.close()
+def test_the_a3_lists_its_modes_when_asked_for_one_it_lacks(rig: Rig) -> None:
+    a3 = rig.device(EmulatedA3())
+    out = rig.exit_output(rplidar(rig, f"_serial_port:={a3.path}", "_scan_mode:=HighSpeed"))
     assert "scan mode `HighSpeed' is not supported by lidar, supported modes:" in out, out
     for line in (
         "\tStandard: max_distance: 16.0 m, Point number: 4.0K",
@@ -201,26 +160,17 @@ def test_the_a3_lists_its_modes_when_asked_for_one_it_lacks(tmp_path: Path) -> N
     assert (rp.CONF_SCAN_MODE_COUNT, 0) in a3.conf_queries
 
 
-def test_an_hq_mode_and_a_garbled_mode_list_are_one_clear_line_each(tmp_path: Path) -> None:
-    env = dict(os.environ, ROS_HOME=str(tmp_path), ROS_LOG_DIR=str(tmp_path))
+def test_an_hq_mode_and_a_garbled_mode_list_are_one_clear_line_each(rig: Rig) -> None:
     hq = (*A3_MODES[:2], ModeInfo(2, "HighQuality", 16000, 25, rp.ANS_TYPE_MEASUREMENT_HQ))
-    with testing.run_master(env=env) as uri:
-        env["ROS_MASTER_URI"] = uri
-        a3 = EmulatedA3(modes=hq)
-        try:
-            out = stop_after_exit(rplidar(env, f"_serial_port:={a3.path}", "_scan_mode:=HighQuality"))
-        finally:
-            a3.close()
-        assert (
-            "scan mode `HighQuality' streams answers of type 0x83, which this driver does not decode "
-            "(it decodes 0x81, 0x82, 0x84 and 0x85)"
-        ) in out, out
-        garbled = EmulatedA3(bad_conf=True)
-        try:
-            out = stop_after_exit(rplidar(env, f"_serial_port:={garbled.path}"))
-        finally:
-            garbled.close()
-        assert (
-            "Error, cannot get the scan modes of the lidar: GET_LIDAR_CONF asked for entry 0x70 "
-            "and was answered 0x71"
-        ) in out, out
+    a3 = rig.device(EmulatedA3(modes=hq))
+    out = rig.exit_output(rplidar(rig, f"_serial_port:={a3.path}", "_scan_mode:=HighQuality"))
+    assert (
+        "scan mode `HighQuality' streams answers of type 0x83, which this driver does not decode "
+        "(it decodes 0x81, 0x82, 0x84 and 0x85)"
+    ) in out, out
+    garbled = rig.device(EmulatedA3(bad_conf=True))
+    out = rig.exit_output(rplidar(rig, f"_serial_port:={garbled.path}"))
+    assert (
+        "Error, cannot get the scan modes of the lidar: GET_LIDAR_CONF asked for entry 0x70 "
+        "and was answered 0x71"
+    ) in out, out

@@ -10,6 +10,7 @@ import pytest
 from dyn_fixtures import TUTORIAL_CFG
 
 from ninjemys.errors import DefinitionError
+from ninjemys.testing import CatkinWorkspace
 from ninjemys.tools import catkin_make
 
 MANIFEST = """<?xml version="1.0"?>
@@ -32,11 +33,9 @@ CMAKE = "cmake_minimum_required(VERSION 3.0.2)\nproject(dyn_demo)\nfind_package(
 def ws(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
     monkeypatch.delenv("CMAKE_PREFIX_PATH", raising=False)
-    pkg = tmp_path / "ws" / "src" / "dyn_demo"
-    (pkg / "cfg").mkdir(parents=True)
-    (pkg / "package.xml").write_text(MANIFEST)
-    (pkg / "CMakeLists.txt").write_text(CMAKE)
-    (pkg / "cfg" / "Tutorials.cfg").write_text(TUTORIAL_CFG)
+    CatkinWorkspace(tmp_path / "ws").package(
+        "dyn_demo", {"package.xml": MANIFEST, "CMakeLists.txt": CMAKE, "cfg/Tutorials.cfg": TUTORIAL_CFG}
+    )
     monkeypatch.chdir(tmp_path / "ws")
     return tmp_path / "ws"
 

@@ -36,7 +36,7 @@ import rospy
 
 KINDS = (rospy.ROSInterruptException, rospy.ROSInitException, rospy.ROSSerializationException,
          rospy.ServiceException, rospy.ROSException, KeyError, ZeroDivisionError, TypeError,
-         ValueError, AttributeError)
+         ValueError, AttributeError, ConnectionRefusedError, OSError)
 
 def show(label, fn, text=True):
     try:
@@ -116,6 +116,21 @@ show("names", lambda: sorted(n for n in rospy.get_param_names() if "parity_ns" i
 show("delete", lambda: rospy.delete_param("~parity_ns_priv"))
 """,
         ["__ns:=/parity_ns"],
+    ),
+    "params_without_master": (
+        r"""
+import os
+os.environ["ROS_MASTER_URI"] = "http://localhost:1"  # read at the first call; nothing listens on port 1
+show("get", lambda: rospy.get_param("/a"))
+show("get default", lambda: rospy.get_param("/a", 5))
+show("set", lambda: rospy.set_param("/a", 1))
+show("has", lambda: rospy.has_param("/a"))
+show("delete", lambda: rospy.delete_param("/a"))
+show("search", lambda: rospy.search_param("a"))
+show("names", rospy.get_param_names)
+show("topics", rospy.get_published_topics)
+""",
+        [],
     ),
     # 3. illegal graph names after init: warnings, never errors
     "illegal_graph_names": (

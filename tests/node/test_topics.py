@@ -49,6 +49,23 @@ def test_callback_args_and_raw_subscription(make_node) -> None:
     assert raw[0].connection_header["type"] == "std_msgs/String"
 
 
+def test_publish_framed_sends_a_frame_the_caller_built(make_node) -> None:
+    """publish_framed: the caller packs the length with the message (robot_state_publisher's plans);
+    socket and in-process subscribers get the message, a latched one reaches a late subscriber."""
+    talker, listener = make_node("talker"), make_node("listener")
+    got: list[str] = []
+    listener.subscriber("framed", String, lambda m: got.append(m.data))
+    local: list[str] = []
+    talker.subscriber("framed", String, lambda m: local.append(m.data), intraprocess=True)
+    pub = talker.publisher("framed", String, latch=True)
+    assert _connected(pub, 2)
+    pub.publish_framed(b"\x09\x00\x00\x00\x05\x00\x00\x00hello")
+    assert wait_until(lambda: got == ["hello"] and local == ["hello"])
+    late: list[str] = []
+    make_node("late").subscriber("framed", String, lambda m: late.append(m.data))
+    assert wait_until(lambda: late == ["hello"])
+
+
 def test_latched_message_reaches_late_subscribers_per_publisher(make_node) -> None:
     talker, listener = make_node("talker"), make_node("listener")
     a = talker.publisher("static", String, latch=True)

@@ -18,7 +18,7 @@ from ninjemys.packages.cpp_build import (
     missing_definitions_hint,
     noetic_compat_flags,
 )
-from ninjemys.testing import kill_tree, ninjemys_bin, run_master
+from ninjemys.testing import CatkinWorkspace, kill_tree, ninjemys_bin, run_master
 
 PACKAGE_XML = """<?xml version="1.0"?>
 <package format="2">
@@ -125,40 +125,24 @@ needs_toolchain = pytest.mark.skipif(find_toolchain(os.environ)[0] is None, reas
 
 @pytest.fixture(scope="module")
 def workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    ws = tmp_path_factory.mktemp("cpp_ws")
-    pkg = ws / "src" / "cpp_chat"
-    (pkg / "src").mkdir(parents=True)
-    (pkg / "msg").mkdir()
-    (pkg / "scripts").mkdir()
-    (pkg / "package.xml").write_text(PACKAGE_XML)
-    (pkg / "CMakeLists.txt").write_text(CMAKE)
-    (pkg / "msg" / "Reading.msg").write_text("std_msgs/Header header\nstring label\nfloat64 value\n")
-    (pkg / "src" / "chatter.cpp").write_text(CHATTER)
-    (pkg / "src" / "echo.cpp").write_text(ECHO)
-    (pkg / "scripts" / "py_listener.py").write_text(PY_LISTENER)
-    (pkg / "scripts" / "py_listener.py").chmod(0o755)
-    env = {k: v for k, v in os.environ.items() if k not in ("ROS_PACKAGE_PATH", "CMAKE_PREFIX_PATH")}
-    env.pop("NINJEMYS_CATKIN_CPP", None)
-    result = subprocess.run(
-        [ninjemys_bin("catkin_make")],
-        cwd=ws,
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=600,
-        check=False,
-    )
+    ws = CatkinWorkspace(tmp_path_factory.mktemp("cpp_ws"))
+    files = {
+        "package.xml": PACKAGE_XML,
+        "CMakeLists.txt": CMAKE,
+        "msg/Reading.msg": "std_msgs/Header header\nstring label\nfloat64 value\n",
+        "src/chatter.cpp": CHATTER,
+        "src/echo.cpp": ECHO,
+        "scripts/py_listener.py": PY_LISTENER,
+    }
+    ws.package("cpp_chat", files, executables=["scripts/py_listener.py"])
+    result = ws.catkin_make(timeout=600)
     assert result.returncode == 0, result.stdout + result.stderr
     assert "cpp_chat: C++ program(s) built by catkin's CMake: chatter cpp_chat_echo" in result.stdout
-    return ws
+    return ws.root
 
 
 def _env(ws: Path, master: str) -> dict[str, str]:
-    env = dict(os.environ, ROS_MASTER_URI=master, ROS_PACKAGE_PATH=str(ws / "src"), ROS_HOSTNAME="localhost")
-    env["PYTHONPATH"] = str(ws / "devel" / "lib" / "python3" / "dist-packages")
-    env["CMAKE_PREFIX_PATH"] = str(ws / "devel")
-    env["ROS_HOME"] = str(ws / "ros_home")
-    return env
+    return CatkinWorkspace(ws).env(master)
 
 
 @pytest.fixture

@@ -31,6 +31,11 @@ class _Pub:
     def publish_raw(self, data: bytes) -> None:
         self.sent.append(bytes(data))
 
+    def publish_framed(self, frame: bytes) -> None:
+        (length,) = struct.unpack_from("<I", frame)
+        assert length == len(frame) - 4  # the plan's constant length is the message's
+        self.sent.append(bytes(frame[4:]))
+
 
 class _Node:
     def __init__(self, params: dict[str, Any]) -> None:

@@ -52,6 +52,13 @@ def test_core_errors_map_to_rospy_exceptions(core: Exception, expected: type) ->
     assert translate(plain) is plain
 
 
+def test_an_unreachable_master_raises_the_socket_error_as_rospy() -> None:
+    refused = ConnectionRefusedError(111, "Connection refused")
+    mapped = translate(errors.MasterUnreachable("cannot reach the master at http://h:1", cause=refused))
+    assert type(mapped) is ConnectionRefusedError and str(mapped) == "[Errno 111] Connection refused"
+    assert type(translate(errors.MasterUnreachable("t", cause=TimeoutError("timed out")))) is TimeoutError
+
+
 class _HeaderOnly:
     _type = "test/HeaderOnly"
     _md5sum = "0" * 32
@@ -112,7 +119,7 @@ def test_state_before_init_node(capsys: pytest.CaptureFixture[str]) -> None:
     assert abs(rospy.get_time() - time.time()) < 5
     assert rospy.resolve_name("chatter") == "/chatter"
     assert rospy.myargv(["prog", "a:=b", "_p:=1", "keep"]) == ["prog", "keep"]
-    with pytest.raises(rospy.ROSException, match="cannot reach the master"):
+    with pytest.raises(ConnectionRefusedError, match=r"^\[Errno 111\] Connection refused$"):
         rospy.get_param("x")  # as in rospy, allowed before init_node (as /unnamed): no master here
     pub = rospy.Publisher("chatter", String, queue_size=1)
     try:

@@ -16,7 +16,7 @@ import pytest
 
 from ninjemys.rostest.junit import CaseResult, SuiteResult, read_xml, results_file, write_xml
 from ninjemys.rostest.pyunit import restore_removed_aliases
-from ninjemys.testing import ninjemys_bin
+from ninjemys.testing import CatkinWorkspace, ninjemys_bin
 
 PACKAGE_XML = """<?xml version="1.0"?>
 <package format="2">
@@ -142,50 +142,112 @@ HZ_TEST = """<launch>
 </launch>
 """
 
+#: rostest's publishtest: chatter comes, /nobody stays silent (negative); /silent never comes
+PUBLISH_TEST = """<launch>
+  <node name="talker" pkg="probe_tests" type="talker.py"/>
+  <test test-name="chatter_published" pkg="rostest" type="publishtest" name="publish">
+    <rosparam>
+topics:
+  - name: /chatter
+    timeout: 30
+  - name: /nobody
+    timeout: 2
+    negative: true
+    </rosparam>
+  </test>
+  <test test-name="silent_published" pkg="rostest" type="publishtest" name="publish_silent">
+    <rosparam>
+topics:
+  - name: /silent
+    timeout: 2
+    </rosparam>
+  </test>
+</launch>
+"""
 
-def _workspace(root: Path) -> Path:
-    pkg = root / "src" / "probe_tests"
-    for sub in ("scripts", "test"):
-        (pkg / sub).mkdir(parents=True)
-    (pkg / "package.xml").write_text(PACKAGE_XML)
-    (pkg / "CMakeLists.txt").write_text(CMAKE)
-    for folder, name, text in (
-        ("scripts", "talker.py", TALKER),
-        ("test", "test_hears.py", HEARS),
-        ("test", "test_fails.py", FAILS),
-        ("test", "sleeper.py", SLEEPER),
-    ):
-        (pkg / folder / name).write_text(text)
-        (pkg / folder / name).chmod(0o755)
-    (pkg / "test" / "talker.test").write_text(TALKER_TEST)
-    (pkg / "test" / "failing.test").write_text(FAILING_TEST)
-    (pkg / "test" / "slow.test").write_text(SLOW_TEST)
-    (pkg / "test" / "hz.test").write_text(HZ_TEST)
-    return root
+#: rostest's paramtest: a parameter set by the file (right value, wrong value) and one never set
+PARAM_TEST = """<launch>
+  <param name="robot_name" value="probe"/>
+  <test test-name="param_set" pkg="rostest" type="paramtest" name="param_set">
+    <param name="param_name_target" value="/robot_name"/>
+    <param name="param_value_expected" value="probe"/>
+    <param name="wait_time" value="5"/>
+  </test>
+  <test test-name="param_wrong" pkg="rostest" type="paramtest" name="param_wrong">
+    <param name="param_name_target" value="/robot_name"/>
+    <param name="param_value_expected" value="other"/>
+    <param name="wait_time" value="5"/>
+  </test>
+  <test test-name="param_missing" pkg="rostest" type="paramtest" name="param_missing">
+    <param name="param_name_target" value="/nowhere"/>
+    <param name="wait_time" value="1"/>
+  </test>
+</launch>
+"""
+
+#: rostest's advertisetest: the talker's topic and logger service (with their types), and a topic
+#: that is never advertised beside one that must not be
+ADVERTISE_TEST = """<launch>
+  <node name="talker" pkg="probe_tests" type="talker.py"/>
+  <test test-name="advertised" pkg="rostest" type="advertisetest" name="advertise">
+    <rosparam>
+topics:
+  - name: /chatter
+    type: std_msgs/String
+    timeout: 30
+services:
+  - name: /talker/get_loggers
+    type: roscpp/GetLoggers
+    timeout: 30
+    </rosparam>
+  </test>
+  <test test-name="not_advertised" pkg="rostest" type="advertisetest" name="advertise_missing">
+    <rosparam>
+topics:
+  - name: /missing
+    timeout: 2
+  - name: /nobody
+    timeout: 2
+    negative: true
+    </rosparam>
+  </test>
+</launch>
+"""
+
+
+def _workspace(root: Path) -> CatkinWorkspace:
+    ws = CatkinWorkspace(root)
+    scripts = {"scripts/talker.py": TALKER, "test/test_hears.py": HEARS, "test/test_fails.py": FAILS}
+    scripts["test/sleeper.py"] = SLEEPER
+    ws.package(
+        "probe_tests",
+        {
+            "package.xml": PACKAGE_XML,
+            "CMakeLists.txt": CMAKE,
+            **scripts,
+            "test/talker.test": TALKER_TEST,
+            "test/failing.test": FAILING_TEST,
+            "test/slow.test": SLOW_TEST,
+            "test/hz.test": HZ_TEST,
+            "test/publish.test": PUBLISH_TEST,
+            "test/param.test": PARAM_TEST,
+            "test/advertise.test": ADVERTISE_TEST,
+        },
+        executables=list(scripts),
+    )
+    return ws
 
 
 def _env(ws: Path) -> dict[str, str]:
-    env = {k: v for k, v in os.environ.items() if not k.startswith("ROS_")}
-    env.update(ROS_PACKAGE_PATH=str(ws / "src"), ROS_HOME=str(ws / "ros_home"), ROS_HOSTNAME="localhost")
-    env["PYTHONPATH"] = str(ws / "devel" / "lib" / "python3" / "dist-packages")
-    return env
+    return CatkinWorkspace(ws).env()
 
 
 @pytest.fixture(scope="module")
 def workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
     ws = _workspace(tmp_path_factory.mktemp("rostest_ws"))
-    env = _env(ws)
-    made = subprocess.run(
-        [ninjemys_bin("catkin_make")],
-        cwd=ws,
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=300,
-        check=False,
-    )
+    made = ws.catkin_make(timeout=300)
     assert made.returncode == 0, made.stdout + made.stderr
-    return ws
+    return ws.root
 
 
 def _rostest(ws: Path, *args: str, timeout: float = 180) -> subprocess.CompletedProcess[str]:
@@ -244,6 +306,37 @@ def test_hztest_checks_a_topics_rate(workspace: Path) -> None:
     assert "[probe_tests.rosunit-talker_hz/test_hz][passed]" in out
     assert "[probe_tests.rosunit-talker_too_slow/test_hz][FAILURE]" in out
     assert "exceeded minimum (90.000Hz)" in out
+
+
+def test_publishtest_waits_for_messages_on_each_topic(workspace: Path) -> None:
+    result = _rostest(workspace, "probe_tests", "publish.test")
+    out = result.stdout
+    assert result.returncode == 2, out + result.stderr
+    assert "[probe_tests.rosunit-chatter_published/test_publish][passed]" in out
+    assert "[probe_tests.rosunit-silent_published/test_publish][FAILURE]" in out
+    assert "Topic [/silent] is not published" in out
+
+
+def test_paramtest_checks_a_parameter_and_its_value(workspace: Path) -> None:
+    result = _rostest(workspace, "probe_tests", "param.test")
+    out = result.stdout
+    assert result.returncode == 2, out + result.stderr
+    assert "[probe_tests.rosunit-param_set/test_param][passed]" in out
+    assert "[probe_tests.rosunit-param_wrong/test_param][FAILURE]" in out
+    assert "'other' != 'probe'" in out
+    assert "[probe_tests.rosunit-param_missing/test_param][FAILURE]" in out
+    assert "unexpectedly None" in out
+
+
+def test_advertisetest_checks_topics_services_and_types(workspace: Path) -> None:
+    result = _rostest(workspace, "probe_tests", "advertise.test")
+    out = result.stdout
+    assert result.returncode == 2, out + result.stderr
+    assert "[probe_tests.rosunit-advertised/test_advertise_topics][passed]" in out
+    assert "[probe_tests.rosunit-advertised/test_advertise_services][passed]" in out
+    assert "[probe_tests.rosunit-not_advertised/test_advertise_services][passed]" in out  # none listed
+    assert "[probe_tests.rosunit-not_advertised/test_advertise_topics][FAILURE]" in out
+    assert "Topic [/missing] is not advertised" in out
 
 
 def test_find_package_rostest_is_known_to_catkin_make(workspace: Path) -> None:
@@ -310,10 +403,19 @@ def _report_lines(text: str) -> list[str]:
     not Path("/usr/bin/rostest").exists(), reason="Debian's rostest (python3-rostest) not installed"
 )
 @pytest.mark.parametrize(
-    ("test_file", "code"), [("talker.test", 0), ("failing.test", 2), ("slow.test", 1), ("hz.test", 2)]
+    ("test_file", "code"),
+    [
+        ("talker.test", 0),
+        ("failing.test", 2),
+        ("slow.test", 1),
+        ("hz.test", 2),
+        ("publish.test", 2),
+        ("param.test", 2),
+        ("advertise.test", 2),
+    ],
 )
 def test_same_report_as_debians_rostest(workspace: Path, tmp_path: Path, test_file: str, code: int) -> None:
-    theirs = _workspace(tmp_path / "debian")
+    theirs = _workspace(tmp_path / "debian").root
     env = {
         "PATH": "/usr/bin:/bin",
         "HOME": str(tmp_path / "home"),
@@ -338,15 +440,7 @@ def test_same_report_as_debians_rostest(workspace: Path, tmp_path: Path, test_fi
 def test_catkin_make_run_tests_runs_the_add_rostest_files(workspace: Path) -> None:
     combined = workspace / "ros_home" / "test_results" / "probe_tests" / "rostest-test_talker.xml"
     combined.unlink(missing_ok=True)
-    made = subprocess.run(
-        [ninjemys_bin("catkin_make"), "run_tests"],
-        cwd=workspace,
-        env={k: v for k, v in _env(workspace).items() if k != "PYTHONPATH"},
-        capture_output=True,
-        text=True,
-        timeout=300,
-        check=False,
-    )
+    made = CatkinWorkspace(workspace).catkin_make("run_tests", timeout=300)
     assert made.returncode == 0, made.stdout + made.stderr
     assert "-- run_tests_probe_tests_rostest_test_talker.test" in made.stdout
     assert "[probe_tests.rosunit-talker_test/test_hears_hello][passed]" in made.stdout

@@ -124,3 +124,23 @@ def test_wait_for_master_waits_for_readiness_as_well_as_an_answer():
         wait_for_master(uri, timeout=5.0)
         with pytest.raises(WaitTimeout, match="answered but was not ready within 0.3 s"):
             wait_for_master(uri, timeout=0.3, ready=lambda state: any(t == "/x" for t, _ in state[0]))
+
+
+def test_catkin_workspace_writes_packages_and_keeps_the_callers_ros_environment_out(tmp_path, monkeypatch):
+    from ninjemys.testing import CatkinWorkspace
+
+    monkeypatch.setenv("ROS_PACKAGE_PATH", "/elsewhere/src")
+    monkeypatch.setenv("ROS_MASTER_URI", "http://elsewhere:11311")
+    monkeypatch.setenv("CMAKE_PREFIX_PATH", "/elsewhere/devel")
+    ws = CatkinWorkspace(tmp_path)
+    pkg = ws.package(
+        "demo", {"package.xml": "<package/>", "scripts/run.py": "#!/bin/sh\n"}, ["scripts/run.py"]
+    )
+    assert pkg == tmp_path / "src" / "demo" and (pkg / "package.xml").read_text() == "<package/>"
+    assert os.access(pkg / "scripts" / "run.py", os.X_OK) and not os.access(pkg / "package.xml", os.X_OK)
+    env = ws.env("http://localhost:1234")
+    assert (
+        env["ROS_PACKAGE_PATH"] == str(tmp_path / "src") and env["ROS_MASTER_URI"] == "http://localhost:1234"
+    )
+    assert env["PYTHONPATH"] == str(tmp_path / "devel" / "lib" / "python3" / "dist-packages")
+    assert env["CMAKE_PREFIX_PATH"] == str(tmp_path / "devel") and "ROS_MASTER_URI" not in ws.env()

@@ -239,8 +239,7 @@ def test_bag_timeline_shows_topics_ticks_thumbnails_and_plays(
     page.wait_for_selector('.bag-plot[data-points="20"]', timeout=5000)
     # play at 20x: the bag's messages reach a subscriber
     page.fill(".bag-speed", "20")
-    time.sleep(1.0)  # the subscriber learns of the player's publisher only once playback starts
-    page.click(".bag-play")
+    page.click(".bag-play")  # playback waits for this subscriber to connect to its new publisher
     wait_until(lambda: len(received) >= 5, what="played messages")
     assert received == sorted(received)
 

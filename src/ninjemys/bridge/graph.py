@@ -77,7 +77,7 @@ class Delivery:
         return self._msg
 
     def encoded(self, key: Any, build: Callable[[Delivery], Any]) -> Any:
-        """``build(self)`` once per ``key`` (all sinks of a topic run on one thread: no lock needed)."""
+        """``build(self)`` once per ``key`` (a tap feeds its sinks one at a time, under its lock)."""
         try:
             return self.cache[key]
         except KeyError:
@@ -89,20 +89,52 @@ Sink = Callable[[Delivery], None]
 
 
 class _Tap:
-    def __init__(self, node: Node, topic: str, msg_class: Any, clock: Callable[[], int]) -> None:
+    """One raw subscription and the sinks it feeds.
+
+    Latched messages reach every sink, as each ROS subscriber gets them: the first sink is in place
+    before the subscription exists (a latched publisher's message can arrive on the subscription's
+    thread before ``node.subscriber`` returns, and it is sent once per connection: a sink added a
+    moment later missed it, and a browser switching to a latched topic never got a frame), and a
+    sink joining a running tap is first given the last message of each latched publisher still
+    connected. ``_lock`` makes "add a sink, replay" and "deliver to every sink" exclusive, so a
+    joining sink gets each message once and in order."""
+
+    def __init__(
+        self, node: Node, topic: str, msg_class: Any, clock: Callable[[], int], owner: object, sink: Sink
+    ) -> None:
         self.topic = topic
         self.msg_class = msg_class
-        self.sinks: dict[object, Sink] = {}
+        self.sinks: dict[object, Sink] = {owner: sink}
         self._clock = clock
+        self._lock = threading.Lock()
+        self._latched: dict[str, Delivery] = {}  # publisher caller id -> its last message
         self.sub = node.subscriber(topic, msg_class, self._on_message, raw=True, queue_size=100)
 
     def _on_message(self, raw: RawMessage) -> None:
         delivery = Delivery(self.topic, raw, self._clock(), self.msg_class)
-        for sink in list(self.sinks.values()):
-            try:
-                sink(delivery)
-            except Exception as exc:  # one client's bad state must not stop the others
-                log.warning("gateway: delivering %s failed: %s", self.topic, exc)
+        with self._lock:
+            if raw.connection_header.get("latching") == "1":
+                self._latched[raw.connection_header.get("callerid", "")] = delivery
+            for sink in list(self.sinks.values()):
+                _feed(sink, delivery)
+
+    def join(self, owner: object, sink: Sink) -> None:
+        """Add ``sink``; it gets the latched messages of the publishers connected now first."""
+        with self._lock:
+            self.sinks[owner] = sink
+            live = self.sub.publisher_ids()
+            for caller_id, delivery in list(self._latched.items()):
+                if caller_id in live:
+                    _feed(sink, delivery)
+                else:
+                    del self._latched[caller_id]  # that publisher left: a new subscriber would not get it
+
+
+def _feed(sink: Sink, delivery: Delivery) -> None:
+    try:
+        sink(delivery)
+    except Exception as exc:  # one client's bad state must not stop the others
+        log.warning("gateway: delivering %s failed: %s", delivery.topic, exc)
 
 
 class Taps:
@@ -131,10 +163,11 @@ class Taps:
                     except NinjemysError:
                         if type_name != published_as:
                             raise
-                tap = self._taps[topic] = _Tap(self.node, topic, msg_class, self._clock)
+                tap = self._taps[topic] = _Tap(self.node, topic, msg_class, self._clock, owner, sink)
             elif type_name and tap.msg_class is not None and type_name not in ("*", tap.msg_class._type):
                 raise NinjemysError(f"topic {topic} is subscribed as {tap.msg_class._type}, not {type_name}")
-            tap.sinks[owner] = sink
+            else:
+                tap.join(owner, sink)
             return tap.msg_class._type if tap.msg_class is not None else (type_name or "*")
 
     def remove(self, topic: str, owner: object) -> None:

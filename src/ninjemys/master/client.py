@@ -73,7 +73,9 @@ class MasterClient:
                         continue  # the master closed our idle keep-alive connection; reconnect once
                     if isinstance(exc, ProtocolError):
                         raise MasterError(f"{method}: master at {self.uri} broke protocol: {exc}") from None
-                    raise MasterUnreachable(f"cannot reach the master at {self.uri} ({exc})") from None
+                    raise MasterUnreachable(
+                        f"cannot reach the master at {self.uri} ({exc})", cause=exc
+                    ) from None
             if response.start[1] != "200":
                 self._close_locked()
                 raise MasterError(f"{method}: master at {self.uri} answered HTTP {response.start[1]}")

@@ -66,8 +66,13 @@ class NodeContext(Protocol):
         """A subscriber's connection to one of our publications ended (called on the I/O loop)."""
         ...
 
-    def publisher_update(self, topic: str, publishers: list[str]) -> None:
-        """The master says these are now the publishers of ``topic`` (slave API, re-registration)."""
+    def publisher_update(self, topic: str, publishers: list[str], updates: int | None = None) -> None:
+        """The master says these are now the publishers of ``topic`` (slave API, re-registration);
+        ``updates``: an answer to registerSubscriber sent when :meth:`publisher_updates` said that."""
+        ...
+
+    def publisher_updates(self, topic: str) -> int:
+        """How many publisher lists the subscription of ``topic`` has applied."""
         ...
 
     def param_update(self, key: str, value: Any) -> bool:

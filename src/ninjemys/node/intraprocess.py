@@ -134,9 +134,10 @@ class IntraLink:
         self.dropped = 0
         self.closed = False
 
-    def deliver(self, item: Handoff, queue_size: int | None = 0) -> None:
+    def deliver(self, item: Handoff, queue_size: int | None = 0, direct: bool = False) -> None:
         """Put ``item`` in the queue of every open handle of the subscription (publisher's thread).
-        ``queue_size`` is the publishing handle's, as over TCPROS (0: a latched replay, never waits)."""
+        ``queue_size`` is the publishing handle's, as over TCPROS (0: a latched replay, never waits);
+        ``direct``: a publish, whose thread may call an idle ``direct=True`` handle back itself."""
         if self.closed:
             return
         self.num_sent += 1
@@ -145,7 +146,7 @@ class IntraLink:
             self.last = item  # a handle added later replays it, as a socket's last frame
         for handle in self.sub.handles:
             if not handle.closed:
-                self.dropped += handle.push_local(item, self.header, queue_size)
+                self.dropped += handle.push_local(item, self.header, queue_size, direct)
 
     def close(self) -> None:
         """Either end went away (any thread; idempotent): forget the link on both sides."""

@@ -284,6 +284,7 @@ class Node(ParamAccess):
         lazy: float = 0.0,
         batch: bool = False,
         intraprocess: bool = False,
+        direct: bool = False,
     ) -> Subscriber:
         """Subscribe to ``topic``; ``callback(msg[, callback_args])`` runs on this subscriber's own thread.
 
@@ -308,8 +309,19 @@ class Node(ParamAccess):
         message: from a publisher made with ``intraprocess=True`` too, the callback gets the
         published object itself, shared with that publisher and every such subscriber; otherwise its
         own copy (docs/node.md, in-process delivery).
+        ``direct=True`` (with ``intraprocess=True``) lets an in-process publisher's thread run the
+        callback itself, inside ``publish()``, when this handle is idle (nothing queued, no callback
+        running), as a nodelet's publish does: no thread wake-up, so a round trip costs a few
+        microseconds; a callback that takes long then delays that ``publish()``. Otherwise (busy, or
+        from another process) the message is queued for the handle's thread as usual.
         """
         self._check_alive()
+        if direct and not intraprocess:
+            raise NinjemysError(f"subscriber of {topic}: direct=True needs intraprocess=True")
+        if direct and (lazy or share_thread is not None):
+            raise NinjemysError(
+                f"subscriber of {topic}: direct=True cannot be combined with lazy or share_thread"
+            )
         resolved = self.resolve_name(topic)
         with self._lock:
             sub = self._subscriptions.get(resolved)
@@ -319,13 +331,14 @@ class Node(ParamAccess):
                 self._subscriptions[resolved] = sub
             handle = Subscriber(
                 sub, callback, callback_args, queue_size, raw, coalesce, share_thread, lazy, batch,
-                intraprocess,
+                intraprocess, direct,
             )  # fmt: skip
             sub.handles.append(handle)
         if new:
+            updates = sub.updates  # 0: read before the master can notify us of this topic
             publishers = self.registrar.add_subscriber(resolved, sub.type_name)
             if publishers is not None:
-                self.publisher_update(resolved, publishers)
+                self.publisher_update(resolved, publishers, updates)
         else:
             self.runtime.call_soon(self._replay_latched, sub, handle)
         return handle
@@ -337,13 +350,24 @@ class Node(ParamAccess):
 
     # -- NodeContext: calls back from the node's parts ------------------------------------------------
 
-    def publisher_update(self, topic: str, publishers: list[str]) -> None:
+    def publisher_update(self, topic: str, publishers: list[str], updates: int | None = None) -> None:
         """Connect to the current publishers of ``topic`` (from the master: slave API, re-registration).
         Just after a master restart the list may be short of publishers that have not re-registered
-        yet: live connections are then kept (registration.py, ``settling``)."""
+        yet: live connections are then kept (registration.py, ``settling``). ``updates``: the list is
+        the master's answer to a registerSubscriber sent when :meth:`publisher_updates` said that; it
+        is dropped if a publisherUpdate (newer) was applied since (``Subscription.registered``)."""
         sub = self._subscriptions.get(topic)
-        if sub is not None:
+        if sub is None:
+            return
+        if updates is None:
             self.runtime.call_soon(sub.update_publishers, publishers, self.registrar.settling())
+        else:
+            self.runtime.call_soon(sub.registered, publishers, updates, self.registrar.settling())
+
+    def publisher_updates(self, topic: str) -> int:
+        """How many publisher lists the subscription of ``topic`` has applied (0 if none)."""
+        sub = self._subscriptions.get(topic)
+        return 0 if sub is None else sub.updates
 
     def release_publisher(self, handle: Publisher) -> None:
         """Forget an unregistered Publisher handle; the topic's last one unregisters the topic."""

@@ -282,9 +282,10 @@ class Registrar:
             for topic, type_name in pubs.items():
                 again(partial(master.register_publisher, topic, type_name, uri))
             for topic, type_name in subs.items():
+                updates = self.node.publisher_updates(topic)  # an update newer than the answer wins
                 publishers = again(partial(master.register_subscriber, topic, type_name, uri))
                 if isinstance(publishers, list):
-                    self.node.publisher_update(topic, list(publishers))
+                    self.node.publisher_update(topic, list(publishers), updates)
             for name, service_uri in srvs.items():
                 again(partial(master.register_service, name, service_uri, uri))
             for key in keys:
@@ -302,9 +303,10 @@ class Registrar:
             subs = dict(self.subscriptions)
         try:
             for topic, type_name in subs.items():
+                updates = self.node.publisher_updates(topic)
                 publishers = self._probe.register_subscriber(topic, type_name, self.node.uri)
                 if isinstance(publishers, list):
-                    self.node.publisher_update(topic, list(publishers))
+                    self.node.publisher_update(topic, list(publishers), updates)
         except MasterUnreachable:
             self._master_down = True  # the next re-registration opens a new window
         except MasterError as exc:

@@ -31,7 +31,7 @@ import threading
 from ninjemys.node import shm_ring, transport
 from ninjemys.node.subscriber import SubConnection
 from ninjemys.node.topics import PubConnection
-from ninjemys.wire.tcpros import pack_len
+from ninjemys.wire.tcpros import FrameReader, pack_len
 
 TYPE_CHECKING = False
 if TYPE_CHECKING:
@@ -102,6 +102,9 @@ def announcement(name: str) -> bytes:
 class ShmPubConnection(PubConnection):
     """A subscriber on this host: large messages into the ring, a notice on the socket."""
 
+    #: frames below topics._LARGE (<= THRESHOLD) are always inline: the publication tags them itself
+    tag_small = True
+
     @property
     def transport(self) -> str:
         """What getBusInfo reports (rosnode info shows it)."""
@@ -144,7 +147,12 @@ class ShmPubConnection(PubConnection):
 
     def send(self, data: bytes, queue_size: int | None) -> None:
         length = len(data) - 4
-        ring = self._ring() if length >= THRESHOLD and not self.closed else None
+        if length < THRESHOLD:  # inline: tag_inline written out, in one copy (every small message)
+            PubConnection.send(
+                self, b"".join((pack_len(length + 1), _INLINE, memoryview(data)[4:])), queue_size
+            )
+            return
+        ring = self._ring() if not self.closed else None
         if ring is not None:
             notice = ring.put([memoryview(data)[4:]], length, SLOT_WAIT if queue_size is None else 0.0)
             if notice is not None:
@@ -215,14 +223,20 @@ class ShmSubConnection(SubConnection):
     ) -> None:
         super().__init__(sub, sock, uri, header)
         self.ring: shm_ring.ReaderRing | None = None  # mapped when the publisher announces it
+        self._reader = FrameReader(tagged=True)  # small inline messages come untagged already
 
     def read(self, budget: int | None = None) -> list[bytes | bytearray] | None:
         last = self.last
         frames = super().read(budget)
-        if not frames:
-            return frames
+        reader = self._reader
+        if not frames or not reader.special:
+            return frames  # small inline messages only: cut without their tag by the reader
+        reader.special = 0
         out: list[Any] = []
         for frame in frames:
+            if frame.__class__ is bytes:  # inline, tag dropped by the reader
+                out.append(frame)
+                continue
             tag = frame[0] if frame else -1
             if tag == shm_ring.INLINE_TAG:
                 out.append(frame[1:] if len(frame) < THRESHOLD else memoryview(frame)[1:])

@@ -127,12 +127,15 @@ class _Poller:
 
     def __init__(self) -> None:
         self._objs: dict[int, SubConnection | None] = {}
+        #: at most this many events per wait (epoll otherwise sizes its buffer for 1023 on every call)
+        self._max = 1
         self._epoll = select.epoll() if hasattr(select, "epoll") else None
         self._selector = None if self._epoll is not None else selectors.DefaultSelector()
 
     def register(self, fd: int, obj: SubConnection | None) -> None:
         """Watch ``fd``; :meth:`wait` reports it as ``obj`` (None is the worker's wake-up socket)."""
         self._objs[fd] = obj
+        self._max = len(self._objs)
         if self._epoll is not None:
             self._epoll.register(fd, select.EPOLLIN)
         else:
@@ -143,6 +146,7 @@ class _Poller:
         if fd not in self._objs:
             return
         del self._objs[fd]
+        self._max = max(1, len(self._objs))
         try:
             if self._epoll is not None:
                 self._epoll.unregister(fd)
@@ -156,7 +160,11 @@ class _Poller:
         """What is readable, waiting at most ``timeout`` seconds (None: until something is)."""
         if self._epoll is not None:
             objs = self._objs
-            return [objs[fd] for fd, _ in self._epoll.poll(-1 if timeout is None else timeout) if fd in objs]
+            events = self._epoll.poll(-1 if timeout is None else timeout, self._max)
+            if len(events) == 1:  # the usual wake-up: one socket (a comprehension is one more call)
+                fd = events[0][0]
+                return [objs[fd]] if fd in objs else []
+            return [objs[fd] for fd, _ in events if fd in objs]
         assert self._selector is not None
         return [key.data for key, _ in self._selector.select(timeout)]
 
@@ -289,6 +297,8 @@ class Subscription:
         self.handles: list[Subscriber] = []
         self.connections: dict[str, SubConnection | intraprocess.IntraLink] = {}
         self.publishers: list[str] = []
+        #: publisher lists applied so far (see :meth:`registered`)
+        self.updates = 0
         self._connecting: set[str] = set()
         #: publishers whose shared memory failed here: TCPROS only from then on
         self.shm_refused: set[str] = set()
@@ -301,6 +311,7 @@ class Subscription:
         (``keep_live``: keep open connections the list omits, as a master still filling in may)."""
         if self.closed:
             return
+        self.updates += 1
         if keep_live:
             uris = list(uris) + [
                 uri for uri, conn in self.connections.items() if uri not in uris and not conn.closed
@@ -316,6 +327,15 @@ class Subscription:
             if uri not in self.connections and uri not in self._connecting:
                 self._connecting.add(uri)
                 loop.create_task(self._connect(uri))
+
+    def registered(self, uris: list[str], updates: int, keep_live: bool = False) -> None:
+        """The master's answer to this subscription's registerSubscriber (on the loop), sent when
+        ``self.updates`` was ``updates``. A publisherUpdate that arrived since is newer than this
+        answer (the master notifies a subscriber only once it is registered), so the answer is then
+        stale and ignored: applied after it, it would drop a publisher that appeared meanwhile
+        (a fresh subscriber racing a publisher's start got nothing, ever)."""
+        if updates == self.updates:
+            self.update_publishers(uris, keep_live)
 
     def _drop(self, conn: SubConnection | intraprocess.IntraLink) -> None:
         if conn.intra:
@@ -490,10 +510,17 @@ class Subscriber:
         lazy: float = 0.0,
         batch: bool = False,
         intraprocess: bool = False,
+        direct: bool = False,
     ) -> None:
         self._sub = subscription
         #: an in-process publisher that opted in too hands this handle its message objects, shared
         self.intraprocess = intraprocess
+        #: an idle handle is called back on an in-process publisher's thread (see push_local)
+        self._direct = direct
+        #: direct handles: held while a callback of this handle runs, by its worker or by an in-process
+        #: publisher's thread that delivers itself (other handles call back only on their worker)
+        self._busy = threading.Lock()
+        self._busy_owner = 0  # the thread delivering directly now (unregister waits for any other)
         #: seconds a message may wait so that one wake-up of the worker takes several (see Node.subscriber)
         self._coalesce = max(0.0, coalesce)
         self.name = subscription.topic
@@ -575,8 +602,15 @@ class Subscriber:
         self._push(frames, header)
         self._wakeup()
 
-    def push_local(self, item: Handoff, header: Mapping[str, str], pub_queue_size: int | None) -> int:
+    def push_local(
+        self, item: Handoff, header: Mapping[str, str], pub_queue_size: int | None, direct: bool = False
+    ) -> int:
         """A message from a publisher of this process (its thread); returns how many it dropped.
+
+        ``direct`` (a publish, not a latched replay on the loop): a handle made with ``direct=True``
+        that is idle (nothing queued, no callback of it running) is called back right here, on the
+        publisher's thread, with no wake-up; the lock it holds meanwhile keeps its callbacks one at a
+        time and in order (the worker pops its queue under the same lock).
 
         This handle's own ``queue_size`` drops the oldest, as for a socket. An unbounded handle gets
         the publisher's ``queue_size`` semantics instead, as over TCPROS: a bounded publisher drops
@@ -585,6 +619,16 @@ class Subscriber:
         :data:`_LOCAL_HIGH_WATER` wait, unless it publishes from this handle's own thread.
         """
         queue = self._queue
+        busy = self._busy
+        if direct and self._direct and not queue and not self._closed and busy.acquire(False):
+            try:
+                if not queue and not self._closed:
+                    self._busy_owner = threading.get_ident()
+                    self._deliver_handoff(item, header)
+                    return 0
+            finally:
+                self._busy_owner = 0
+                busy.release()
         dropped = 0
         if queue.maxlen is None and pub_queue_size != 0:
             if pub_queue_size is not None:
@@ -629,8 +673,16 @@ class Subscriber:
                 for handle in self._served:
                     queue = handle._queue
                     if queue:
-                        frame, header = queue.popleft()
-                        handle._deliver(frame, header)
+                        if handle._direct:
+                            # popped under the lock: a direct delivery sees the queue empty only
+                            # once everything before it has been called back (order kept)
+                            with handle._busy:
+                                if queue:
+                                    frame, header = queue.popleft()
+                                    handle._deliver(frame, header)
+                        else:
+                            frame, header = queue.popleft()
+                            handle._deliver(frame, header)
                         busy = True
                 if busy:
                     continue
@@ -764,7 +816,11 @@ class Subscriber:
             maxlen = owner._queue.maxlen
             if maxlen is not None and len(frames) > maxlen:
                 frames = owner._keep_newest(frames, 0)
-            owner._deliver_batch(frames, conn.header)
+            if owner._direct:
+                with owner._busy:
+                    owner._deliver_batch(frames, conn.header)
+            else:
+                owner._deliver_batch(frames, conn.header)
 
     def _finish(self) -> None:
         """Worker exit: pass our connections to the next handle of their topic, or close them."""
@@ -932,13 +988,21 @@ class Subscriber:
             if shared:  # the thread goes on for the others: it hands this handle's streams on
                 host._ops.append(("release", self))
         self._wakeup()
-        # not from a callback: on the worker's thread, or in a pull, which holds what the worker needs
+        me = threading.get_ident()
+        # not from a callback: on the worker's thread, in a pull, which holds what the worker needs, or
+        # in a direct callback on a publisher's thread, which holds the lock the worker may wait for
         if (
-            not shared
-            and threading.current_thread() is not self._thread
-            and host._puller != threading.get_ident()
+            threading.current_thread() is self._thread
+            or host._puller == me
+            or (self._direct and self._busy_owner == me)
         ):
+            return
+        if not shared:
             self._thread.join(2.0)
+        if self._direct:
+            # a publisher's thread may be calling back directly: once unregister returns, no callback runs
+            if self._busy.acquire(timeout=2.0):
+                self._busy.release()
 
     @property
     def closed(self) -> bool:

@@ -70,7 +70,8 @@ THREADS: tuple[Thread, ...] = (
         "sub:<topic>",
         "node.subscriber.Subscriber (one per Subscriber handle)",
         "the topic's reader (first handle): reads its publisher sockets, cuts frames; every handle: "
-        "its queue, deserialization and its callback",
+        "its queue, deserialization and its callback (a direct=True handle's callback also runs on an "
+        "in-process publisher's thread, inside publish, when the handle is idle)",
         "subscriber callbacks",
     ),
     Thread(
@@ -324,6 +325,10 @@ RESOURCES: tuple[Resource, ...] = (
              "bounded by queue_size"),
     Resource("lock", "ninjemys.node.subscriber:Subscriber._ops_lock", "sub:<topic>",
              "connection hand-offs (post) from the loop and enqueue from other threads"),
+    Resource("lock", "ninjemys.node.subscriber:Subscriber._busy", "sub:<topic>",
+             "direct=True handles only: held around each callback of the handle, by its worker (which "
+             "pops the queue under it) or by an in-process publisher's thread delivering directly; "
+             "unregister takes it to wait for a callback in flight"),
     Resource("lock", "ninjemys.node.subscriber:Subscriber._read_lock", "sub:<topic>",
              "held while the sockets are read and their frames delivered: by the worker, "
              "and by a thread that pulls a lazy handle (its callbacks then run on that thread)"),

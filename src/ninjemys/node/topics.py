@@ -6,7 +6,8 @@ The publish path is built for latency and throughput:
   the caller may modify it afterwards, as in rospy);
 * for each idle connection the frame is written straight to the (non-blocking) socket from the
   caller's thread: no hand-off, no wake-up of another thread;
-* in a burst (publishes closer than ``HOT_INTERVAL``) frames are queued and the caller's thread
+* in a burst (a publish that starts less than ``HOT_INTERVAL`` after the previous one ended) frames
+  are queued and the caller's thread
   writes them a batch at a time (many frames joined into one ``send``, one wake-up of the
   subscriber); the I/O loop only writes what is left once the burst ends, or what the kernel refused;
 * ``queue_size=N`` bounds each connection's queue and drops the oldest frame; ``queue_size=None``
@@ -24,6 +25,7 @@ import itertools
 import logging
 import select
 import socket
+import struct
 import threading
 import time
 from collections import deque
@@ -51,8 +53,14 @@ connection_ids = itertools.count(1)
 
 #: Most bytes joined into one send when the loop drains a queue.
 _BATCH_BYTES = 1 << 20
-#: Publishes closer together than this (seconds) are batched instead of sent one by one.
-HOT_INTERVAL = 50e-6
+#: A publish that starts less than this (seconds) after the previous one's write ended is part of a
+#: burst and batched instead of sent alone. Measured from the end of the write, not its start: a
+#: flat-out loop comes back within a few microseconds, a ping-pong only after a whole round trip
+#: (on this VM 3 us against 30 us and more), so a fast ping-pong is never mistaken for a burst.
+HOT_INTERVAL = 20e-6
+#: Within HOT_INTERVAL but at least this late (seconds), a Unix socket whose subscriber has read
+#: everything is written at once (it waits for the frame); sooner, it is a burst without asking.
+_SURE_BURST = 5e-6
 #: In a burst, the publishing thread writes once this many frames are queued ...
 _FLUSH_FRAMES = 32
 #: ... or this long after the last try (seconds), so a slow trickle of a burst still goes out.
@@ -77,6 +85,8 @@ _MAX_PARTS = 64
 #: starved for tenths of a second. A subscriber in another process has its own GIL: no pause.
 _LAG_YIELD = 20e-6
 _clock = time.perf_counter
+#: an SHMROS inline frame's head: its length prefix and the tag byte 0 (shm_link)
+_pack_tagged_head = struct.Struct("<IB").pack
 
 
 def _unsent(buffers: list[Any], sent: int) -> list[Any] | None:
@@ -99,6 +109,9 @@ class PubConnection:
     a bounded queue the kernel refused (:meth:`_drain`). So a flood keeps one thread busy, not two
     threads fighting over the GIL and this connection's lock.
     """
+
+    #: small frames go to this connection with a tag byte (SHMROS: see :meth:`Publication.publish_small`)
+    tag_small = False
 
     def __init__(
         self, node: NodeContext, sock: socket.socket, topic: str, subscriber: str, uri: str = ""
@@ -128,6 +141,8 @@ class PubConnection:
         self._refused = False  # the kernel refused a burst's batch: the publisher yields once
         #: the subscriber is a Node of this process (shares our GIL): yield to it when it lags
         self._same_process = is_local_node(subscriber)
+        #: Unix sockets: what the subscriber has not read yet (see :meth:`send`); None on TCP
+        self._unread = transport.unread_probe(sock)
 
     @property
     def transport(self) -> str:
@@ -138,20 +153,40 @@ class PubConnection:
         """Send ``data`` (one or more frames) to this subscriber; blocks only when ``queue_size`` is
         None and the kernel lags (synchronous, lossless: rospy's blocking send, with a short buffer).
 
-        An idle connection is written to directly (lowest latency). Publishes closer together than
-        :data:`HOT_INTERVAL` are queued instead and written :data:`_FLUSH_FRAMES` at a time, or
-        :data:`_MAX_HOLD` after the last try: one system call and one wake-up of the subscriber per batch.
+        An idle connection is written to directly (lowest latency). A publish that comes less than
+        :data:`HOT_INTERVAL` after the previous write is queued instead, and the queue is written
+        :data:`_FLUSH_FRAMES` at a time, or :data:`_MAX_HOLD` after the last try: one system call and
+        one wake-up of the subscriber per batch. Between :data:`_SURE_BURST` and
+        :data:`HOT_INTERVAL`, over a Unix socket, a subscriber that has read everything (it waits for
+        data) still gets the frame at once: a ping-pong is never held for the I/O loop.
         """
         with self._lock:
             if self.closed:
                 return
             now = _clock()
-            hot = now - self._last < HOT_INTERVAL
+            gap = now - self._last
             self._last = now
             self._published += 1
-            if (not hot or len(data) >= _LARGE) and self._partial is None and not self._queue:
-                n = self._write_direct(self.sock.send, data)
-                if n is None or n == len(data):
+            if (
+                self._partial is None
+                and not self._queue
+                and (
+                    gap >= HOT_INTERVAL
+                    or len(data) >= _LARGE
+                    or (gap >= _SURE_BURST and self._unread is not None and not self._unread())
+                )
+            ):
+                try:  # _write_direct, inlined: this is every idle publish's path
+                    n = self.sock.send(data)
+                except (BlockingIOError, InterruptedError):
+                    n = 0
+                except OSError as exc:
+                    self._fail(f"write failed: {exc}")
+                    return
+                self.bytes_sent += n
+                self.num_sent += 1
+                if n == len(data):
+                    self._last = _clock()  # the next publish's gap counts from the end of this write
                     return
                 self._partial = [memoryview(data)[n:]]
                 if queue_size is not None or len(data) < _LARGE:
@@ -483,6 +518,35 @@ class Publication:
         for conn in conns:
             conn.send(data, queue_size)
 
+    def publish_small(
+        self, parts: list[Any], total: int, handle: Publisher, item: Handoff | None = None
+    ) -> None:
+        """A frame below :data:`_LARGE` in pieces: joined once for plain connections and once, with the
+        inline tag byte, for SHMROS ones (which send every frame that small inline)."""
+        if handle.latch:
+            with self.lock:
+                plain: bytes | None = b"".join(parts)
+                handle.latched = plain
+                handle.latched_item = item
+                conns = self.connections
+        else:
+            conns = self.connections
+            plain = None
+        queue_size = handle.queue_size
+        tagged = None
+        for conn in conns:
+            if conn.tag_small:
+                if tagged is None:
+                    head = parts[0]
+                    parts[0] = _pack_tagged_head(total - 3, 0)  # the length prefix, then tag 0
+                    tagged = b"".join(parts)
+                    parts[0] = head
+                PubConnection.send(conn, tagged, queue_size)
+            else:
+                if plain is None:
+                    plain = b"".join(parts)
+                conn.send(plain, queue_size)
+
     def publish_parts(
         self, parts: list[Any], total: int, handle: Publisher, item: Handoff | None = None
     ) -> None:
@@ -512,7 +576,7 @@ class Publication:
             links = self.intra
         queue_size = handle.queue_size
         for link in links:
-            link.deliver(item, queue_size)
+            link.deliver(item, queue_size, True)
 
     def add_intra(self, link: IntraLink) -> None:
         """An in-process subscriber joined: it gets the latched messages first, as over a socket."""
@@ -601,7 +665,9 @@ class Publisher:
                 raise
             self._pub.publish_frame(self._frame_other(msg), self, item)
             return
-        if total >= _LARGE and len(parts) <= _MAX_PARTS:
+        if total < _LARGE:
+            self._pub.publish_small(parts, total, self, item)
+        elif len(parts) <= _MAX_PARTS:
             self._pub.publish_parts(parts, total, self, item)
         else:
             self._pub.publish_frame(b"".join(parts), self, item)
@@ -657,6 +723,19 @@ class Publisher:
         if self._closed:
             raise ShutdownError(f"publisher of {self.name} is unregistered")
         frame = pack_len(len(payload)) + bytes(payload)
+        if self._pub.intra:
+            item = Handoff(None, memoryview(frame)[4:])
+            self._pub.publish_intra(item, self)
+            self._pub.publish_frame(frame, self, item)
+            return
+        self._pub.publish_frame(frame, self)
+
+    def publish_framed(self, frame: bytes) -> None:
+        """Send a TCPROS frame built by the caller (``uint32`` length, then the serialized message):
+        :meth:`publish_raw` without its copy, for a node that packs the length with the message
+        (robot_state_publisher's plans, whose messages have a constant size)."""
+        if self._closed:
+            raise ShutdownError(f"publisher of {self.name} is unregistered")
         if self._pub.intra:
             item = Handoff(None, memoryview(frame)[4:])
             self._pub.publish_intra(item, self)

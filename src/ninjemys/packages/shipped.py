@@ -44,7 +44,12 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
         },
         "rqt_graph": {"rqt_graph": ("ninjemys.web.rqt_graph:main", ())},
         "smach_viewer": {"smach_viewer.py": ("ninjemys.web.smach_viewer:main", ())},
-        "rostest": {"hztest": ("ninjemys.tools.hztest:main", ())},
+        "rostest": {
+            "hztest": ("ninjemys.tools.hztest:main", ()),
+            "publishtest": ("ninjemys.tools.rostest_nodes:publishtest_main", ()),
+            "paramtest": ("ninjemys.tools.rostest_nodes:paramtest_main", ()),
+            "advertisetest": ("ninjemys.tools.rostest_nodes:advertisetest_main", ()),
+        },
         "rviz": {"rviz": ("ninjemys.web.rviz:main", ())},
         "rqt_gui": {"rqt_gui": ("ninjemys.web.rqt:rqt_main", ())},
         "rqt_plot": {"rqt_plot": ("ninjemys.web.rqt:plot_main", ())},

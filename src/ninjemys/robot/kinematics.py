@@ -77,7 +77,7 @@ def _pose_function(joint: Joint) -> Callable[[float], Pose]:
             qy = ow * by - ox * bz + oy * c + oz * bx
             qz = ow * bz + ox * by - oy * bx + oz * c
             qw = ow * c - ox * bx - oy * by - oz * bz
-            return (x0, y0, z0, *_kdl_sign(qx, qy, qz, qw))
+            return (x0, y0, z0, *kdl_sign(qx, qy, qz, qw))
 
         return revolute
     if joint.type == "prismatic":
@@ -92,11 +92,17 @@ def _pose_function(joint: Joint) -> Callable[[float], Pose]:
     return lambda _position: fixed
 
 
-def _kdl_sign(x: float, y: float, z: float, w: float) -> tuple[float, float, float, float]:
-    xx, yy, zz, ww = x * x, y * y, z * z, w * w
-    if 4.0 * ww - (xx + yy + zz + ww) > 1e-12:
-        key = w
-    elif xx > yy and xx > zz:
+def kdl_sign(x: float, y: float, z: float, w: float) -> tuple[float, float, float, float]:
+    """The unit quaternion with the sign KDL's GetQuaternion gives its rotation: GetQuaternion takes
+    the branch of the largest of trace, R00, R11 and R22 (``4w^2 - 1``, and for x, y, z compared in
+    pairs: ``R00 > R11`` iff ``x^2 > y^2``) and makes that component positive. The ``w`` branch
+    (trace > 1e-12, so ``|w| > 0.5``) is looked at first: it is the common case."""
+    if w > 0.5:
+        return x, y, z, w
+    if w < -0.5:
+        return -x, -y, -z, -w
+    xx, yy, zz = x * x, y * y, z * z
+    if xx > yy and xx > zz:
         key = x
     elif yy > zz:
         key = y

@@ -15,7 +15,6 @@ have, with one warning per new set of unknown names (ROS 1 ignores them silently
 from __future__ import annotations
 
 import struct
-import threading
 from collections.abc import Callable
 from typing import Any
 
@@ -58,14 +57,15 @@ class StatePublisher:
         self.last_published: dict[str, int] = {}  # joint -> stamp (ns) of its last transform
         self.last_stamp_ns = 0
         self.unknown_seen: set[frozenset[str]] = set()
-        self.lock = threading.Lock()
         self.tf = node.publisher("/tf", self.TFMessage, queue_size=100)
         self.tf_static = node.publisher("/tf_static", self.TFMessage, queue_size=100, latch=True)
         JointState = get_message_class("sensor_msgs/JointState")
         self.names_cache: dict[bytes, tuple[str, ...]] = {}
         self.plans: dict[bytes, _Entry] = {}
         self.last_entry: _Entry | None = None
-        self.streak: tuple[_Entry, int] | None = None  # (list of names, its joints' last stamp)
+        #: the list of names that followed itself, and its joints' last stamp (see :meth:`_admit`)
+        self.streak: _Entry | None = None
+        self.streak_ns = 0
         self.sub = node.subscriber("joint_states", JointState, self.on_raw, queue_size=100, raw=True)
 
     def start(self) -> None:
@@ -83,30 +83,43 @@ class StatePublisher:
         """A JointState as bytes: only the stamp, the names and the positions are read.
 
         The names are the same in every message of a stream: each distinct list is decoded once, and
-        with it a :class:`TfPlan` is made that turns the positions into the TFMessage's bytes. The list
+        with it a :class:`TfPlan` is made that turns the positions into the TFMessage's frame. The list
         of the previous message is recognised by comparing its bytes where the names start, so a steady
-        stream costs no walk through the names either."""
+        stream costs no walk through the names either. Called on the subscription's one thread (the
+        throttle's record needs no lock); the steady case is written out inline, as this runs 50 times
+        a second with cold caches, where every call and attribute costs."""
         data = raw.data
         try:
-            _seq, secs, nsecs, frame_len = _HEADER.unpack_from(data, 0)
+            secs, nsecs, frame_len = _STAMP_FRAME.unpack_from(data, 4)
             start = 16 + frame_len
             entry = self.last_entry
-            if entry is None or data[start : start + entry.size] != entry.key:
+            if entry is None or not data.startswith(entry.key, start):
                 key, count = self._names_section(data, start)
                 entry = self.plans.get(key)
                 if entry is None:
                     self._general(data, secs, nsecs, key, count, start + len(key))
                     return
                 self.last_entry = entry
-            if not entry.fits(data, start):  # another number of positions: the general path says why
+            try:
+                found = entry.positions.unpack_from(data, start + entry.size)  # the count, then positions
+            except struct.error:
+                found = None
+            if found is None or found[0] != entry.count:  # the general path says what is wrong
                 self._general(data, secs, nsecs, entry.key, entry.count, start + entry.size)
                 return
-            found = entry.positions.unpack_from(data, start + entry.size)  # the count, then positions
         except (struct.error, UnicodeDecodeError, IndexError, ValueError):
             self.warn("Robot state publisher ignored a malformed JointState message")
             return
-        if self._admit(entry, secs * 1_000_000_000 + nsecs) and entry.plan.count:
-            self.tf.publish_raw(entry.plan.message(found[1:], secs, nsecs))
+        now_ns = secs * 1_000_000_000 + nsecs
+        if self.streak is entry and now_ns >= self.last_stamp_ns:  # the steady case of _admit
+            self.last_stamp_ns = now_ns
+            if now_ns <= self.streak_ns + self.interval_ns and not self.ignore_timestamp:
+                return
+            self.streak_ns = now_ns
+        elif not self._admit(entry, now_ns):
+            return
+        if entry.plan.count:
+            self.tf.publish_framed(entry.plan.message(found, secs, nsecs))
 
     def _general(self, data: Any, secs: int, nsecs: int, key: bytes, count: int, offset: int) -> None:
         """A list of names without a plan yet (or positions that do not match it): decoded in full."""
@@ -123,7 +136,7 @@ class StatePublisher:
             self.names_cache[key] = names
         self.on_joint_state(names, values, secs, nsecs)
         if key not in self.plans and len(names) == n and len(set(names)) == n and len(self.plans) < 64:
-            plan = TfPlan(names, self.model.joints, self.mimics, self._frames)
+            plan = TfPlan(names, self.model.joints, self.mimics, self._frames, skip=1, framed=True)
             self.plans[key] = self.last_entry = _Entry(key, n, plan)
 
     def _frames(self, joint: Joint) -> bytes:
@@ -145,59 +158,51 @@ class StatePublisher:
         """ROS 1's throttle: publish unless every joint named was published less than one interval ago
         (``ignore_timestamp`` publishes all); a stamp older than the last one clears the record.
 
-        While one list of names follows itself, the record of its joints is one number (the streak)
-        instead of a stamp per joint; another list (or the general path) writes it out first."""
-        with self.lock:
-            if now_ns < self.last_stamp_ns:
-                self.warn(
-                    "Moved backwards in time (probably because ROS clock was reset), re-publishing joint transforms!"
-                )
-                self.last_published.clear()
-                self.streak = None
-            self.last_stamp_ns = now_ns
-            known = entry.known
-            if not known:
+        While one list of names follows itself, the record of its joints is one number (the streak,
+        whose steady case :meth:`on_raw` checks inline) instead of a stamp per joint; another list (or
+        the general path) writes it out first."""
+        self._check_clock(now_ns)
+        known = entry.known
+        if not known:
+            return False
+        if self.streak is entry:
+            if not self.ignore_timestamp and now_ns <= self.streak_ns + self.interval_ns:
                 return False
-            streak = self.streak
-            if streak is not None and streak[0] is entry:
-                if not self.ignore_timestamp and now_ns <= streak[1] + self.interval_ns:
-                    return False
-                self.streak = (entry, now_ns)
-                return True
-            self._flush_streak()
-            last = self.last_published
-            if (
-                not self.ignore_timestamp
-                and now_ns <= min(map(last.get, known, entry.zeros)) + self.interval_ns
-            ):
-                return False
-            self.streak = (entry, now_ns)
+            self.streak_ns = now_ns
             return True
+        self._flush_streak()
+        last = self.last_published
+        if not self.ignore_timestamp and now_ns <= min(map(last.get, known, entry.zeros)) + self.interval_ns:
+            return False
+        self.streak, self.streak_ns = entry, now_ns
+        return True
 
     def _admit_names(self, known: list[str], now_ns: int) -> bool:
         """:meth:`_admit` for a list of names without a plan (a stamp per joint)."""
-        with self.lock:
-            if now_ns < self.last_stamp_ns:
-                self.warn(
-                    "Moved backwards in time (probably because ROS clock was reset), re-publishing joint transforms!"
-                )
-                self.last_published.clear()
-                self.streak = None
-            self.last_stamp_ns = now_ns
-            if not known:
-                return False
-            self._flush_streak()
-            last = self.last_published
-            if not self.ignore_timestamp and now_ns <= min(last.get(n, 0) for n in known) + self.interval_ns:
-                return False
-            last.update(dict.fromkeys(known, now_ns))
-            return True
+        self._check_clock(now_ns)
+        if not known:
+            return False
+        self._flush_streak()
+        last = self.last_published
+        if not self.ignore_timestamp and now_ns <= min(last.get(n, 0) for n in known) + self.interval_ns:
+            return False
+        last.update(dict.fromkeys(known, now_ns))
+        return True
+
+    def _check_clock(self, now_ns: int) -> None:
+        """A stamp older than the last one (a clock reset, a bag looping): every joint republished."""
+        if now_ns < self.last_stamp_ns:
+            self.warn(
+                "Moved backwards in time (probably because ROS clock was reset), re-publishing joint transforms!"
+            )
+            self.last_published.clear()
+            self.streak = None
+        self.last_stamp_ns = now_ns
 
     def _flush_streak(self) -> None:
-        """Write the streak's stamp to each of its joints (under the lock)."""
+        """Write the streak's stamp to each of its joints."""
         if self.streak is not None:
-            entry, stamp = self.streak
-            self.last_published.update(dict.fromkeys(entry.known, stamp))
+            self.last_published.update(dict.fromkeys(self.streak.known, self.streak_ns))
             self.streak = None
 
     def on_joint_state(
@@ -246,14 +251,15 @@ class StatePublisher:
 
 _MOVING = frozenset(("revolute", "continuous", "prismatic"))
 _COUNT = struct.Struct("<I")
-_HEADER = struct.Struct("<4I")  # seq, stamp secs, stamp nsecs, frame_id length
+_STAMP_FRAME = struct.Struct("<3I")  # after the seq: stamp secs, stamp nsecs, frame_id length
 _STAMP = struct.Struct("<3I")
 _POSE = struct.Struct("<7d")
 
 
 class _Entry:
     """A list of names seen before: its bytes, the joints of it the robot has, its plan, and the
-    precompiled unpacking of the position count and positions that follow it."""
+    precompiled unpacking of the position count and positions that follow it (the plan takes them
+    as unpacked, count first)."""
 
     __slots__ = ("count", "key", "known", "plan", "positions", "size", "zeros")
 
@@ -262,11 +268,6 @@ class _Entry:
         self.known = plan.known
         self.zeros = [0] * len(self.known)
         self.positions = struct.Struct(f"<I{count}d")
-
-    def fits(self, data: Any, start: int) -> bool:
-        """The message has as many positions as names (and the bytes for them)."""
-        offset = start + self.size
-        return offset + self.positions.size <= len(data) and _COUNT.unpack_from(data, offset)[0] == self.count
 
 
 def _names(section: bytes, count: int) -> tuple[str, ...]:

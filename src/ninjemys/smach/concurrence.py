@@ -10,12 +10,16 @@ from __future__ import annotations
 
 import copy
 import threading
-import traceback
 from collections.abc import Callable
 from typing import Any
 
 from ninjemys.smach.container import Container
-from ninjemys.smach.errors import InvalidStateError, InvalidTransitionError, InvalidUserCodeError
+from ninjemys.smach.errors import (
+    InvalidStateError,
+    InvalidTransitionError,
+    InvalidUserCodeError,
+    user_traceback,
+)
 from ninjemys.smach.log import logdebug, logerr, loginfo, logwarn
 from ninjemys.smach.state import State
 from ninjemys.smach.userdata import Remapper, UserData
@@ -145,10 +149,10 @@ class Concurrence(Container):
         if self._outcome_cb is not None:
             try:
                 chosen = self._outcome_cb(copy.copy(self._child_outcomes))
-            except Exception as exc:
+            except Exception:
                 raise InvalidUserCodeError(
-                    f"Could not execute outcome callback '{self._outcome_cb}': " + traceback.format_exc()
-                ) from exc
+                    f"Could not execute outcome callback '{self._outcome_cb}': " + user_traceback()
+                ) from None  # its traceback is in the message (see errors.user_traceback)
             if chosen and isinstance(chosen, str):
                 outcome = chosen
             elif chosen:
@@ -173,7 +177,7 @@ class Concurrence(Container):
                 )
             )
         except Exception as exc:
-            logerr(f"Could not execute child state '{label}': " + traceback.format_exc())
+            logerr(f"Could not execute child state '{label}': " + user_traceback())
             with self._cond:
                 self._errors.append(exc)
                 self._cond.notify_all()
@@ -194,7 +198,7 @@ class Concurrence(Container):
                 try:
                     stop = self._child_termination_cb(dict(self._child_outcomes))
                 except Exception:
-                    logerr("Could not execute child termination callback: " + traceback.format_exc())
+                    logerr("Could not execute child termination callback: " + user_traceback())
                     self._errors.append(InvalidUserCodeError("child termination callback raised"))
                     stop = False
                 if stop:

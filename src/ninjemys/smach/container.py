@@ -8,12 +8,16 @@ reentrant lock, so two threads cannot interleave their constructions.
 from __future__ import annotations
 
 import threading
-import traceback
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import Any, ClassVar, TypeVar
 
-from ninjemys.smach.errors import InvalidConstructionError, InvalidStateError, InvalidTransitionError
+from ninjemys.smach.errors import (
+    InvalidConstructionError,
+    InvalidStateError,
+    InvalidTransitionError,
+    user_traceback,
+)
 from ninjemys.smach.log import logerr, logwarn
 from ninjemys.smach.state import State
 from ninjemys.smach.userdata import UserData
@@ -101,21 +105,21 @@ class Container(State):
             for cb, args in self._start_cbs:
                 cb(self.userdata, self.get_initial_states(), *args)
         except Exception:
-            logerr("Could not execute start callback: " + traceback.format_exc())
+            logerr("Could not execute start callback: " + user_traceback())
 
     def call_transition_cbs(self) -> None:
         try:
             for cb, args in self._transition_cbs:
                 cb(self.userdata, self.get_active_states(), *args)
         except Exception:
-            logerr("Could not execute transition callback: " + traceback.format_exc())
+            logerr("Could not execute transition callback: " + user_traceback())
 
     def call_termination_cbs(self, terminal_states: Any, outcome: str | None) -> None:
         try:
             for cb, args in self._termination_cbs:
                 cb(self.userdata, terminal_states, outcome, *args)
         except Exception:
-            logerr("Could not execute termination callback: " + traceback.format_exc())
+            logerr("Could not execute termination callback: " + user_traceback())
 
     # -- construction --
     def __enter__(self: C) -> C:
@@ -127,10 +131,7 @@ class Container(State):
             self.close()
             return None
         if exc_type not in (InvalidStateError, InvalidTransitionError):
-            logerr(
-                "Error raised during SMACH container construction: \n"
-                + "\n".join(traceback.format_exception(exc_type, exc_val, exc_tb))
-            )
+            logerr("Error raised during SMACH container construction: \n" + user_traceback(exc_val))
         # the exception propagates, but the container must not stay on the stack
         if Container._construction_stack and Container._construction_stack[-1] is self:
             Container._construction_stack.pop()

@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import traceback
 from collections.abc import Callable, Iterable
 from typing import Any
 
 from ninjemys.smach.container import Container
-from ninjemys.smach.errors import InvalidUserCodeError
+from ninjemys.smach.errors import InvalidUserCodeError, user_traceback
 from ninjemys.smach.log import is_shutdown, logerr, loginfo, logwarn
 from ninjemys.smach.state import State
 from ninjemys.smach.userdata import UserData
@@ -97,11 +96,11 @@ class Iterator(Container):
             except InvalidUserCodeError:
                 logerr(f"Could not execute Iterator state '{self._state_label}'")
                 raise
-            except Exception as exc:
+            except Exception:
                 raise InvalidUserCodeError(
                     f"Could not execute iterator state '{self._state_label}' of type '{self._state}': "
-                    + traceback.format_exc()
-                ) from exc
+                    + user_traceback()
+                ) from None  # its traceback is in the message (see errors.user_traceback)
             if (
                 self._preempt_requested
                 or outcome in self._break_outcomes

@@ -8,11 +8,15 @@ so a preempt request lands either on the running child or before the next one st
 from __future__ import annotations
 
 import threading
-import traceback
 from typing import Any
 
 from ninjemys.smach.container import Container
-from ninjemys.smach.errors import InvalidStateError, InvalidTransitionError, InvalidUserCodeError
+from ninjemys.smach.errors import (
+    InvalidStateError,
+    InvalidTransitionError,
+    InvalidUserCodeError,
+    user_traceback,
+)
 from ninjemys.smach.log import is_shutdown, logdebug, logerr, loginfo, logwarn
 from ninjemys.smach.state import State
 from ninjemys.smach.userdata import Remapper, UserData
@@ -208,10 +212,10 @@ class StateMachine(Container):
         except InvalidUserCodeError:
             logerr(f"State '{label}' failed to execute.")
             raise
-        except Exception as exc:
+        except Exception:
             raise InvalidUserCodeError(
-                f"Could not execute state '{label}' of type '{state}': " + traceback.format_exc()
-            ) from exc
+                f"Could not execute state '{label}' of type '{state}': " + user_traceback()
+            ) from None  # its traceback is in the message (see errors.user_traceback)
         finally:
             self._transition_lock.acquire()
         registered = state.get_registered_outcomes()
@@ -264,7 +268,7 @@ class StateMachine(Container):
             if self._preempted_state is not None:
                 self._preempted_state.request_preempt()
         except Exception:
-            logerr(f"Failed to preempt contained state '{self._preempted_label}': {traceback.format_exc()}")
+            logerr(f"Failed to preempt contained state '{self._preempted_label}': {user_traceback()}")
 
     # -- introspection --
     def get_children(self) -> dict[str, State]:

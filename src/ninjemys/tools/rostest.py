@@ -250,7 +250,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"... logging to {log_file}", flush=True)
         print(f"[ROSUNIT] Outputting test results to {combined}", flush=True)
         runs: list[TestRun] = []
-        for test in plan.tests:
+        # rostest makes each <test> a method test<test-name> of one TestCase, which unittest runs
+        # sorted by name: not in the file's order
+        for test in sorted(plan.tests, key=lambda t: t.test_name or t.name or t.type):
             run = _run_test(test, plan, package, uri, log_dir, env, opts.text)
             runs.append(run)
             verdict = {"ok": "ok", "failure": "FAILURE!", "error": "ERROR!"}[run.verdict]

@@ -27,7 +27,7 @@ from ninjemys.bag.play import stand_in_class
 from ninjemys.bag.reader import BagReader
 from ninjemys.bridge.server import Gateway, GatewayOptions
 from ninjemys.commands import entry
-from ninjemys.errors import NinjemysError
+from ninjemys.errors import MasterError, NinjemysError
 from ninjemys.node import Node
 from ninjemys.serve.http import HttpError, Request, Response
 from ninjemys.web.app import STATIC_DIR, WebApp
@@ -58,6 +58,9 @@ class BagSession:
     Playback publishes the bag's bytes as recorded, each topic with the type, md5sum and definition
     of its connection (no deserialization), paced by the bag's stamps divided by ``speed``.
     """
+
+    #: seconds playback waits for the subscribers of newly advertised topics to connect
+    CONNECT_WAIT = 3.0
 
     def __init__(self, node: Node, paths: list[str]) -> None:
         self.node = node
@@ -172,13 +175,37 @@ class BagSession:
             self._publishers[conn.topic] = pub
         return pub
 
+    def _advertise(self, streams: list[Any]) -> None:
+        """Advertise every topic about to play, then wait (``CONNECT_WAIT`` at most) until each new
+        publisher is connected to every subscriber the master lists for its topic. A message sent
+        before a subscriber has connected is lost to it, and at 20x a short bag was over before a
+        subscriber on a loaded machine had connected (rosbag play waits a fixed ``--delay`` after
+        advertising for the same reason; here the wait ends as soon as everyone is there)."""
+        new = []
+        for raw in streams:
+            if raw.connection.topic not in self._publishers:
+                new.append(self._publisher(raw))
+        if not new:
+            return
+        deadline = time.monotonic() + self.CONNECT_WAIT
+        while not self._stop.is_set() and time.monotonic() < deadline:
+            try:
+                _, subscribed, _ = self.node.master.get_system_state()
+            except MasterError:
+                return  # no master: nobody to wait for
+            wanted = {topic: set(nodes) - {self.node.name} for topic, nodes in subscribed}
+            if all(wanted.get(p.resolved_name, set()) <= p.subscriber_ids() for p in new):
+                return
+            self._stop.wait(0.05)
+
     def _run(self) -> None:
         begin = self.position if self.position is not None else self.start
         if begin is None:
             return
-        wall0 = time.monotonic()
         streams = [m for r in self.readers for m in r.read(None, begin, None)]
         streams.sort(key=lambda m: m.time)
+        self._advertise(streams)
+        wall0 = time.monotonic()
         for raw in streams:
             due = wall0 + (raw.time - begin) / NSEC / self.speed
             while not self._stop.is_set():

@@ -46,17 +46,32 @@ def decode_length(prefix: bytes | bytearray | memoryview, limit: int = MAX_FRAME
     return n
 
 
+class TaggedFrame(bytes):
+    """A frame of a tagged stream (see :class:`FrameReader`) whose first byte is a tag other than 0."""
+
+    __slots__ = ()
+
+
 class FrameReader:
     """Incremental decoder of ``uint32 len`` + body frames fed by ``recv_into``.
 
     Usage: ``n = sock.recv_into(reader.buffer())``; ``frames = reader.commit(n)``. ``buffer()``
     returns a writable view of where the next bytes belong; ``commit`` returns every frame completed
     so far as ``bytes`` (small) or ``bytearray`` (large, received in place).
+
+    ``tagged=True`` is for streams whose bodies start with a tag byte (SHMROS): a small frame tagged 0
+    comes back as ``bytes`` without its tag (cut in the same copy), any other small frame as a
+    :class:`TaggedFrame` with its tag, a large frame as a ``bytearray`` with its tag; ``special``
+    counts the frames that are not plain ``bytes`` (the caller resets it), so a stream of small
+    inline messages costs its reader no second pass over the frames.
     """
 
-    __slots__ = ("_buf", "_view", "_start", "_end", "_big", "_big_view", "_big_fill", "_limit", "_large")
+    __slots__ = (
+        "_buf", "_view", "_start", "_end", "_big", "_big_view", "_big_fill", "_limit", "_large", "_skip",
+        "special",
+    )  # fmt: skip
 
-    def __init__(self, size: int = 1 << 16, limit: int = MAX_FRAME_LEN) -> None:
+    def __init__(self, size: int = 1 << 16, limit: int = MAX_FRAME_LEN, tagged: bool = False) -> None:
         self._buf = bytearray(size)
         self._view = memoryview(self._buf)
         self._start = 0  # first unconsumed byte
@@ -66,6 +81,8 @@ class FrameReader:
         self._big_fill = 0
         self._limit = limit
         self._large = size // 2  # frames at least this long are received in place
+        self._skip = 5 if tagged else 4  # the body of a plain frame starts here (tag 0 dropped)
+        self.special = 0
 
     def buffer(self) -> memoryview:
         """Where the next received bytes should go (never empty)."""
@@ -87,6 +104,10 @@ class FrameReader:
 
     def commit(self, n: int) -> list[bytes | bytearray]:
         """Account for ``n`` freshly received bytes and return the frames now complete."""
+        if not self._end and n > 4 and self._big is None:  # one whole frame in one read: the usual case
+            (length,) = _U32.unpack_from(self._buf, 0)
+            if length == n - 4 and (self._skip == 4 or not self._buf[4]):  # (tagged: an inline frame)
+                return [self._view[self._skip : n].tobytes()]
         frames: list[bytes | bytearray] = []
         if self._big is not None:
             self._big_fill += n
@@ -95,16 +116,23 @@ class FrameReader:
             frames.append(self._big)
             self._big = self._big_view = None
             self._big_fill = 0
+            if self._skip == 5:
+                self.special += 1
             return frames
         self._end += n
         buf, view, start, end = self._buf, self._view, self._start, self._end
         unpack_from = _U32.unpack_from
         append = frames.append
+        skip = self._skip
         while start + 4 <= end:
             (length,) = unpack_from(buf, start)
             stop = start + 4 + length
             if stop <= end:  # complete, so it fits the buffer: no limit to check
-                append(view[start + 4 : stop].tobytes())
+                if skip == 4 or (length and not buf[start + 4]):
+                    append(view[start + skip : stop].tobytes())
+                else:  # a tagged stream's frame with another tag (or none): kept whole
+                    append(TaggedFrame(view[start + 4 : stop]))
+                    self.special += 1
                 start = stop
                 continue
             if length > self._limit:

@@ -1,0 +1,192 @@
+"""The small-message paths of issue 25: which publish is a burst (batched) and which goes out at once,
+SHMROS inline frames tagged once by the publication and cut untagged by the reader."""
+
+from __future__ import annotations
+
+import socket
+from typing import Any
+
+import pytest
+
+from ninjemys.node import shm_link, topics
+from ninjemys.wire.tcpros import FrameReader, TaggedFrame, pack_len
+
+
+class _Loop:
+    def __init__(self) -> None:
+        self.calls: list[Any] = []
+
+    def call_soon(self, fn: Any, *args: Any) -> None:
+        self.calls.append(fn)
+
+    def call_later(self, delay: float, fn: Any, *args: Any) -> None:
+        self.calls.append(fn)
+
+    def add_writer(self, fd: int, fn: Any) -> None:
+        self.calls.append(fn)
+
+
+class _Node:
+    name = "/pub"
+
+    def __init__(self) -> None:
+        self.runtime = _Loop()
+        self.runtime.loop = self.runtime  # type: ignore[attr-defined]
+
+
+class _Clock:
+    def __init__(self) -> None:
+        self.now = 100.0
+
+    def __call__(self) -> float:
+        return self.now
+
+
+@pytest.fixture
+def clock(monkeypatch: pytest.MonkeyPatch) -> _Clock:
+    fake = _Clock()
+    monkeypatch.setattr(topics, "_clock", fake)
+    return fake
+
+
+def _pair(family: int = socket.AF_UNIX) -> tuple[socket.socket, socket.socket]:
+    if family == socket.AF_UNIX:
+        a, b = socket.socketpair()
+    else:
+        server = socket.create_server(("127.0.0.1", 0))
+        a = socket.create_connection(server.getsockname())
+        b, _ = server.accept()
+        server.close()
+    a.setblocking(False)
+    return a, b
+
+
+def _drain(sock: socket.socket, expect: int = 0) -> bytes:
+    """What has arrived; with ``expect``, waits (up to 5 s) until that many bytes have (loopback TCP)."""
+    got = b""
+    while True:
+        if len(got) >= expect:
+            sock.setblocking(False)
+        else:
+            sock.settimeout(5.0)
+        try:
+            chunk = sock.recv(1 << 20)
+        except (BlockingIOError, TimeoutError):
+            return got
+        if not chunk:
+            return got
+        got += chunk
+        if expect and len(got) >= expect:
+            return got
+
+
+FRAME = pack_len(4) + b"abcd"
+
+
+@pytest.mark.parametrize("family", [socket.AF_UNIX, socket.AF_INET])
+def test_a_publish_after_a_round_trip_goes_out_at_once(clock: _Clock, family: int) -> None:
+    a, b = _pair(family)
+    conn = topics.PubConnection(_Node(), a, "/t", "/sub")  # type: ignore[arg-type]
+    for _ in range(20):
+        clock.now += 30e-6  # a ping-pong: the previous write ended a whole round trip ago
+        conn.send(FRAME, 10)
+        assert not conn._queue and conn._partial is None
+    assert len(_drain(b, 20 * len(FRAME))) == 20 * len(FRAME)
+    assert conn.node.runtime.calls == []  # the I/O loop never had to write a reply
+
+
+@pytest.mark.parametrize("family", [socket.AF_UNIX, socket.AF_INET])
+def test_a_flat_out_loop_is_batched(clock: _Clock, family: int) -> None:
+    a, b = _pair(family)
+    conn = topics.PubConnection(_Node(), a, "/t", "/sub")  # type: ignore[arg-type]
+    for _ in range(topics._FLUSH_FRAMES):
+        clock.now += 2e-6
+        conn.send(FRAME, 10000)
+    # the first went out alone; the rest waited to go out together in one send
+    assert len(conn._queue) == topics._FLUSH_FRAMES - 1
+    clock.now += 2e-6
+    conn.send(FRAME, 10000)
+    assert not conn._queue
+    assert len(_drain(b, (topics._FLUSH_FRAMES + 1) * len(FRAME))) == (topics._FLUSH_FRAMES + 1) * len(FRAME)
+
+
+def test_between_the_marks_a_unix_socket_asks_whether_the_subscriber_waits(clock: _Clock) -> None:
+    a, b = _pair()
+    conn = topics.PubConnection(_Node(), a, "/t", "/sub")  # type: ignore[arg-type]
+    assert conn._unread is not None
+    conn.send(FRAME, 10)
+    clock.now += 10e-6
+    conn.send(FRAME, 10)  # the subscriber has not read the first frame: it is busy, batch
+    assert len(conn._queue) == 1
+    assert _drain(b) == FRAME
+    conn._queue.clear()
+    clock.now += 10e-6
+    conn.send(FRAME, 10)  # everything read: the subscriber waits for this one
+    assert not conn._queue and _drain(b) == FRAME
+
+
+def test_tcp_has_no_unread_probe() -> None:
+    a, _b = _pair(socket.AF_INET)
+    assert topics.transport.unread_probe(a) is None
+
+
+def test_shmros_small_frames_are_tagged_once_by_the_publication(clock: _Clock) -> None:
+    assert topics._LARGE - 5 < shm_link.THRESHOLD  # every frame publish_small takes is inline for SHMROS
+    from std_msgs.msg import String
+
+    node = _Node()
+    pub = topics.Publication(node, "/t", String)  # type: ignore[arg-type]
+    a, b = _pair()
+    c, d = _pair()
+    pub.connections = (
+        shm_link.ShmPubConnection(node, a, "/t", "/shm"),  # type: ignore[arg-type]
+        topics.PubConnection(node, c, "/t", "/plain"),  # type: ignore[arg-type]
+    )
+    handle = topics.Publisher(pub, 10, False, None)
+    handle.publish(String(data="hi"))
+    body = pack_len(2) + b"hi"
+    assert _drain(b) == pack_len(len(body) + 1) + b"\0" + body
+    assert _drain(d) == pack_len(len(body)) + body
+
+
+def test_a_tagged_reader_cuts_inline_frames_untagged_and_keeps_the_others() -> None:
+    reader = FrameReader(size=64, tagged=True)
+    stream = (
+        pack_len(3) + b"\0ab"  # inline
+        + pack_len(2) + b"\x01n"  # a notice-like frame: kept whole, tagged
+        + pack_len(0)  # no tag at all: kept, for the caller to refuse
+        + pack_len(40) + b"\0" + b"x" * 39  # a large frame (>= half the buffer): received in place
+    )  # fmt: skip
+    frames: list[Any] = []
+    for i in range(0, len(stream), 7):
+        chunk = stream[i : i + 7]
+        buf = reader.buffer()
+        while len(chunk) > len(buf):  # a large frame's buffer is exactly its size
+            buf[:] = chunk[: len(buf)]
+            frames += reader.commit(len(buf))
+            chunk = chunk[len(buf) :]
+            buf = reader.buffer()
+        buf[: len(chunk)] = chunk
+        frames += reader.commit(len(chunk))
+    assert frames[0] == b"ab" and frames[0].__class__ is bytes
+    assert frames[1] == b"\x01n" and isinstance(frames[1], TaggedFrame)
+    assert frames[2] == b"" and isinstance(frames[2], TaggedFrame)
+    assert isinstance(frames[3], bytearray) and frames[3][0] == 0 and len(frames[3]) == 40
+    assert reader.special == 3
+    plain = FrameReader(size=64)
+    buf = plain.buffer()
+    buf[: len(FRAME)] = FRAME
+    assert plain.commit(len(FRAME)) == [b"abcd"] and plain.special == 0
+
+
+def test_a_tagged_reader_given_one_whole_frame_per_read_cuts_it_the_same_way() -> None:
+    """The one-frame-per-read shortcut (the usual wake-up) keeps the tagged stream's rules."""
+    reader = FrameReader(size=64, tagged=True)
+    got: list[Any] = []
+    for frame in (pack_len(3) + b"\0ab", pack_len(2) + b"\x01n", pack_len(3) + b"\0cd"):
+        buf = reader.buffer()
+        buf[: len(frame)] = frame
+        got += reader.commit(len(frame))
+    assert got == [b"ab", b"\x01n", b"cd"]
+    assert got[0].__class__ is bytes and isinstance(got[1], TaggedFrame) and got[2].__class__ is bytes
+    assert reader.special == 1
