@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import bisect
+import collections
 import math
 import os
 import subprocess
@@ -106,6 +108,9 @@ class Probe:
         self.truth: tuple[float, float, float] | None = None
         self.truth_v = 0.0
         self.truth_w = 0.0
+        self.truth_log: collections.deque[tuple[float, tuple[float, float, float]]] = collections.deque(
+            maxlen=4000
+        )  # (stamp, pose) of the recent ground truth, to compare amcl with the truth of its instant
         self.contacts = 0
         self.amcl: tuple[float, float, float] | None = None
         self.amcl_cov = (0.0, 0.0)
@@ -137,6 +142,10 @@ class Probe:
     def _truth(self, msg) -> None:
         p = msg.pose.pose
         self.truth = (p.position.x, p.position.y, self._yaw(p.orientation))
+        t = msg.header.stamp.to_sec()
+        if self.truth_log and t < self.truth_log[-1][0]:
+            self.truth_log.clear()  # the clock went back (a world reset): keep the log in time order
+        self.truth_log.append((t, self.truth))
         self.truth_v = msg.twist.twist.linear.x
         self.truth_w = msg.twist.twist.angular.z
 
@@ -191,6 +200,31 @@ class Probe:
             return tf_to_2d(self.buffer.lookup("map", "base_link", 0)[1])
         except TransformException:
             return None
+
+    def localized_with_truth(self) -> tuple[tuple[float, float, float], tuple[float, float, float]] | None:
+        """(the pose through TF at its latest stamp, the ground truth of that same stamp), or None.
+
+        Comparing TF with the newest ground truth instead would charge amcl with however far the robot
+        drove while this process's TF listener caught up with /tf (under load, tenths of a second)."""
+        from ninjemys.nav.rosglue import tf_to_2d
+        from ninjemys.tf2.errors import TransformException
+
+        try:
+            stamp_ns, tf = self.buffer.lookup("map", "base_link", 0)
+        except TransformException:
+            return None
+        t = stamp_ns * 1e-9
+        log = list(self.truth_log)
+        stamps = [s for s, _ in log]
+        i = bisect.bisect_left(stamps, t)
+        if i == len(log) or (i == 0 and stamps[0] != t):
+            return None  # the truth of that instant is not here (yet, or any more)
+        s1, p1 = log[i]
+        if s1 == t or i == 0:
+            return tf_to_2d(tf), p1
+        s0, p0 = log[i - 1]
+        f = (t - s0) / (s1 - s0)
+        return tf_to_2d(tf), (p0[0] + f * (p1[0] - p0[0]), p0[1] + f * (p1[1] - p0[1]), p1[2])
 
     def wait_sim(self, seconds: float, timeout: float = 120.0) -> None:
         """Sleep ``seconds`` of simulated time."""

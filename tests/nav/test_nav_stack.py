@@ -114,14 +114,20 @@ def test_office_goals_through_ros1_simple_action_client(office):
     start_time = probe.sim_time
     contacts = probe.contacts
 
+    lagged: list[float] = []
+
     def sample() -> None:  # amcl's pose (through TF) against the ground truth, every 0.1 s of sim time
         last = -1.0
         while not stop.is_set():
             if probe.sim_time - last >= 0.1:
                 last = probe.sim_time
+                pair = probe.localized_with_truth()  # both of one instant: amcl's error, not our lag
+                if pair is not None:
+                    (ex, ey, _), (tx, ty, _) = pair
+                    errors.append(math.hypot(ex - tx, ey - ty))
                 est, truth = probe.localized(), probe.truth
                 if est is not None and truth is not None:
-                    errors.append(math.hypot(est[0] - truth[0], est[1] - truth[1]))
+                    lagged.append(math.hypot(est[0] - truth[0], est[1] - truth[1]))
             time.sleep(0.01)
 
     sampler = threading.Thread(target=sample, daemon=True)
@@ -160,23 +166,29 @@ def test_office_goals_through_ros1_simple_action_client(office):
         contacts=probe.contacts - contacts,
         driven=probe.sim_time - start_time,
         rms=math.sqrt(float(np.mean(np.square(errors)))),
+        lagged_rms=math.sqrt(float(np.mean(np.square(lagged)))),
+        samples=len(errors),
         report="\n".join(report),
     )
 
 
 def test_office_run_meets_the_navigation_targets():
-    """The targets on the run above: >= 19 of 20 goals, no contact, amcl RMS < 0.10 m over 5 min.
+    """The targets on the run above: all 20 goals, no contact, amcl RMS < 0.10 m over 5 min.
 
-    Issue 22 asks the full count (20) on a loaded machine; beside two busy loops (load 14-23) 2 runs of 4
-    reached all 20 and 2 reached 19, both missing goal (2.98, 0.23, 3.11) by 1-11 mm with move_base
-    right by its own estimate: amcl was 0.11-0.13 m off there. Localization, not the navigation stack,
-    so the test keeps the navigation issue's >= 19 rather than go red under load. (One of the 20-of-20
-    runs failed the RMS target instead: 0.118 m over 1,037 s at load 14-16.)"""
+    Issue 22 asks the full count on a loaded machine. Beside two busy loops, runs with the earlier amcl
+    parameters missed goal (2.98, 0.23, 3.11) by 1-11 mm with move_base right by its own estimate: amcl
+    was 0.11-0.13 m off along the corridor there (100 particles resampled at every update and odometry
+    noise twice the robot's diffused the set along it, the more so as load spaced the updates out). The
+    corridor drive in test_nav_amcl.py reproduces it offline; the shipped parameters fix it."""
     if not OFFICE_RUN:
         pytest.skip("the office goals run did not finish")
     run = OFFICE_RUN
-    print(run["report"], f"\namcl RMS {run['rms']:.3f} m over {run['driven']:.0f} s")  # shown by -rA
-    assert run["reached"] >= 19, run["report"]
+    print(
+        run["report"],
+        f"\namcl RMS {run['rms']:.3f} m over {run['driven']:.0f} s ({run['samples']} samples; "
+        f"{run['lagged_rms']:.3f} m against the newest ground truth instead of the TF stamp's)",
+    )  # shown by -rA
+    assert run["reached"] == 20, run["report"]
     assert run["contacts"] == 0, run["report"]
     assert run["driven"] >= 300, f"only {run['driven']:.0f} s of driving\n{run['report']}"  # 5-minute run
     assert run["rms"] < 0.10, f"amcl RMS error {run['rms']:.3f} m over {run['driven']:.0f} s\n{run['report']}"
