@@ -260,7 +260,9 @@ def test_teleop_overrides_navigation(office):
         ),
         120,
     )
-    assert ok and probe.contacts == contacts
+    assert ok and probe.contacts == contacts, (
+        f"target {target}: truth {probe.truth}, v {probe.truth_v}, contacts {probe.contacts - contacts}"
+    )
     teleop.unregister()
     goal_pub.unregister()
 
