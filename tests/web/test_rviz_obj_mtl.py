@@ -106,7 +106,11 @@ def test_obj_parts_take_their_mtl_colours_and_the_rest_the_visuals(live: str, br
     page.goto(live + "?view=top&scale=100&fixed=map")
     page.wait_for_function("window.rviz && window.rviz.ready", timeout=20000)
     status = page.locator('.rv-display[data-name="Robot"] .rv-status')
-    wait_until(lambda: "2 meshes" in status.inner_text(), what=f"mesh status ({status.inner_text()!r})")
+    # "loading 2 meshes" first, then "2 meshes" once both are in the scene
+    wait_until(
+        lambda: "2 meshes" in (text := status.inner_text()) and "loading" not in text,
+        what=f"mesh status ({status.inner_text()!r})",
+    )
     # Kd per usemtl; d and Tr give the opacity; a name the library lacks: the URDF's red
     assert page.evaluate(COLOURS, "fin.obj") == [["0000ff", 1], ["ffff00", 0.5], ["ff0000", 1]]
     # a library that cannot be read: drawn all the same, in the visual's green
