@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from ninjemys.packages.cpp_build import find_toolchain
-from ninjemys.testing import kill_tree, ninjemys_bin, run_master
+from ninjemys.testing import CatkinWorkspace, kill_tree, ninjemys_bin, run_master
 
 needs_toolchain = pytest.mark.skipif(find_toolchain(os.environ)[0] is None, reason="no C++ toolchain")
 # the module's one compile runs inside the first test's time: minutes on a loaded 2-core machine
@@ -294,11 +294,7 @@ def workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 def _env(ws: Path, master: str = "http://localhost:1") -> dict[str, str]:
-    env = dict(os.environ, ROS_MASTER_URI=master, ROS_PACKAGE_PATH=str(ws / "src"), ROS_HOSTNAME="localhost")
-    env["PYTHONPATH"] = str(ws / "devel" / "lib" / "python3" / "dist-packages")
-    env["CMAKE_PREFIX_PATH"] = str(ws / "devel")
-    env["ROS_HOME"] = str(ws / "ros_home")
-    return env
+    return CatkinWorkspace(ws).env(master)
 
 
 @pytest.fixture
