@@ -149,6 +149,53 @@ def test_shmros_small_frames_are_tagged_once_by_the_publication(clock: _Clock) -
     assert _drain(d) == pack_len(len(body)) + body
 
 
+def test_a_small_generated_message_is_framed_in_one_piece_latched_untagged(
+    clock: _Clock, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The fused path (issue 25): no frame_parts at all for a small generated type; a latched handle
+    keeps the untagged frame, whichever connections it was sent to."""
+    from ninjemys.idl.message import Message
+    from std_msgs.msg import String
+
+    node = _Node()
+    pub = topics.Publication(node, "/t", String)  # type: ignore[arg-type]
+    a, b = _pair()
+    c, d = _pair()
+    pub.connections = (
+        shm_link.ShmPubConnection(node, a, "/t", "/shm"),  # type: ignore[arg-type]
+        topics.PubConnection(node, c, "/t", "/plain"),  # type: ignore[arg-type]
+    )
+    handle = topics.Publisher(pub, None, True, None)
+
+    def no_parts(self: Message) -> None:
+        raise AssertionError("the generic frame was built")
+
+    monkeypatch.setattr(String, "frame_parts", no_parts)
+    handle.publish(String(data="latched"))
+    body = pack_len(7) + b"latched"
+    assert handle.latched == pack_len(len(body)) + body
+    assert _drain(b) == pack_len(len(body) + 1) + b"\0" + body
+    assert _drain(d) == pack_len(len(body)) + body
+
+
+def test_a_long_string_leaves_the_fused_path_before_anything_is_sent(clock: _Clock) -> None:
+    """A small type's message can still be big (a long string): it goes the general way, which never
+    copies a big payload, and arrives once, whole."""
+    from std_msgs.msg import String
+
+    node = _Node()
+    pub = topics.Publication(node, "/t", String)  # type: ignore[arg-type]
+    c, d = _pair()
+    pub.connections = (topics.PubConnection(node, c, "/t", "/plain"),)  # type: ignore[arg-type]
+    handle = topics.Publisher(pub, None, False, None)
+    text = "y" * (topics._LARGE + 10)
+    assert not pub.publish_wire(String(data=text), String._wire_frame, handle)
+    assert _drain(d) == b""
+    handle.publish(String(data=text))
+    body = pack_len(len(text)) + text.encode()
+    assert _drain(d, len(body) + 4) == pack_len(len(body)) + body
+
+
 def test_a_tagged_reader_cuts_inline_frames_untagged_and_keeps_the_others() -> None:
     reader = FrameReader(size=64, tagged=True)
     stream = (

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import keyword
 import math
+import re
 from collections.abc import Callable
 
 from ninjemys.errors import DefinitionError
@@ -222,7 +223,7 @@ class _DeserEmitter(_Emitter):
         if not self.run:
             return
         fmt = "<" + "".join(f for f, _ in self.run)
-        size = _struct_size(fmt)
+        size = struct_size(fmt)
         targets = [t for _, t in self.run]
         self.emit(f"({', '.join(targets)},) = {self.struct_name(fmt)}.unpack_from(mv, pos)")
         self.emit(f"pos += {size}")
@@ -350,7 +351,7 @@ class _DeserEmitter(_Emitter):
             self.fields(self.lookup(base), v)
 
 
-def _struct_size(fmt: str) -> int:
+def struct_size(fmt: str) -> int:
     import struct
 
     return struct.calcsize(fmt)
@@ -402,6 +403,95 @@ def _straight_serializers(ser_lines: list[str]) -> list[str]:
     ]
 
 
+#: helpers whose arrays may be any size: a type using them gets no ``_wire_frame`` of its own
+_UNBOUNDED = ("_u8(", "_pack_num(")
+
+
+def _wire_frame(ser_lines: list[str], structs: dict[str, str]) -> list[str]:
+    """``_wire_frame(tag)``: the whole TCPROS frame of a small straight-line type as ONE bytes object,
+    with the frame's length prefix (and, when ``tag``, the SHMROS inline tag byte) packed by the same
+    ``Struct`` call as the first run of fixed-size fields. A publish of a small message then costs
+    one pack per run, one ``len`` per string and one concatenation: no parts list, no separate
+    length prefix, no join in the publisher (issue 25: Python calls per ``publish``).
+
+    The first run's pack moves after the later statements (its total needs their lengths); that is
+    safe because every later statement binds only temporaries made after it (checked here, else no
+    method: the generic one joins ``frame_parts``). Types with ``uint8[]`` or numeric arrays of any
+    length get no method either: a big array must go to the socket or the ring without a copy.
+    """
+    if any(h in line for line in ser_lines for h in _UNBOUNDED):
+        return []
+    stmts = [line.strip() for line in ser_lines]
+    writes = [i for i, s in enumerate(stmts) if s.startswith("w(") and s.endswith(")")]
+    if not writes:  # no field: a constant frame
+        return [
+            "",
+            "    _wire_small = True",
+            "",
+            "    def _wire_frame(self, _tag=0):",
+            '        return b"\\x01\\0\\0\\0\\0" if _tag else b"\\0\\0\\0\\0"',
+        ]
+    first = writes[0]
+    head = re.fullmatch(r"w\((_S\d+)\.pack\((.*)\)\)", stmts[first])
+    if head is None:
+        return []
+    name, args = head.groups()
+    fmt = next(f for f, n in structs.items() if n == name)
+    used = set(re.findall(r"\b_\w+", args))
+    bound = {m for stmt in stmts[first + 1 :] for m in re.findall(r"(?:^|: )(_\w+) = ", stmt)}
+    if used & bound:
+        return []
+    plain = f"_F{len(structs)}"
+    structs["<I" + fmt[1:] + "@plain"] = plain  # the key only has to be unique; the format is below
+    tagged = f"_F{len(structs)}"
+    structs["<IB" + fmt[1:] + "@tagged"] = tagged
+    fixed = struct_size(fmt)
+    body: list[str] = []
+    parts: list[str] = [plain]
+    sizes: list[str] = []
+    for i, stmt in enumerate(stmts):
+        if i == first:
+            continue
+        if i in writes:
+            expr = stmt[2:-1]
+            inner = re.fullmatch(r"(_S\d+)\.pack\(.*\)", expr)
+            if re.fullmatch(r"_\w+", expr):  # a string's bytes: a part as it is
+                parts.append(expr)
+                sizes.append(f"len({expr})")
+                continue
+            part = f"_p{len(parts)}"
+            body.append(f"{part} = {expr}")
+            parts.append(part)
+            if inner is not None:
+                fixed += struct_size(next(f for f, n in structs.items() if n == inner.group(1)))
+            else:
+                sizes.append(f"len({part})")
+        else:
+            body.append(stmt)
+    total = " + ".join([str(fixed), *sizes])
+    body.append(f"_n = {total}")
+    body.append(f"_h = {tagged}.pack(_n + 1, 0, {args}) if _tag else {plain}.pack(_n, {args})")
+    parts[0] = "_h"
+    joined = (
+        f"{parts[0]} + {parts[1]}"
+        if len(parts) == 2
+        else parts[0]
+        if len(parts) == 1
+        else (f'b"".join(({", ".join(parts)},))')
+    )
+    return [
+        "",
+        "    _wire_small = True",
+        "",
+        "    def _wire_frame(self, _tag=0):",
+        "        try:",
+        *[f"            {stmt}" for stmt in body],
+        "        except _SER_ERRORS:",
+        "            return _Message._wire_frame(self, _tag)",
+        f"        return {joined}",
+    ]
+
+
 def generate_class_source(spec: MsgSpec, lookup: Lookup, md5sum: str, full_text: str) -> str:
     """Python source defining the class for ``spec`` (named by its short name) and its structs."""
     _check_names(spec)
@@ -440,12 +530,13 @@ def generate_class_source(spec: MsgSpec, lookup: Lookup, md5sum: str, full_text:
     ser = _SerEmitter(spec.full_name, lookup, structs)
     ser.fields(spec, "self")
     ser.flush()
-    _ser_structs = dict(structs)
     body.append("")
     body.append("    def _ser(self, w):")
     body.extend(ser.lines or ["        pass"])
     if not ser.loops:
         body.extend(_straight_serializers(ser.lines))
+        body.extend(_wire_frame(ser.lines, structs))
+    _ser_structs = dict(structs)
 
     de = _DeserEmitter(spec.full_name, lookup, structs, depth=3)
     de.fields(spec, "o")
@@ -473,5 +564,5 @@ def generate_class_source(spec: MsgSpec, lookup: Lookup, md5sum: str, full_text:
     body.append("            raise _deser_failed(cls, mv, exc) from None")
     body.append("        return o")
 
-    head = [f"{name} = _struct.Struct({fmt!r})" for fmt, name in structs.items()]
+    head = [f"{name} = _struct.Struct({fmt.split('@')[0]!r})" for fmt, name in structs.items()]
     return "\n".join(head + [""] + body) + "\n"

@@ -23,6 +23,7 @@ if TYPE_CHECKING:
 
 _SER_ERRORS = (struct.error, TypeError, AttributeError, ValueError, OverflowError, UnicodeError, IndexError)
 _pack_len = struct.Struct("<I").pack
+_pack_tagged = struct.Struct("<IB").pack
 _DESER_ERRORS = (struct.error, ValueError, IndexError, TypeError, UnicodeError, MemoryError, OverflowError)
 
 
@@ -88,6 +89,18 @@ class Message:
         size = sum(map(len, parts))
         parts[0] = _pack_len(size)
         return size + 4, parts
+
+    #: generated classes set it when their ``_wire_frame`` is the fused one (no array of any length)
+    _wire_small = False
+
+    def _wire_frame(self, _tag: int = 0) -> bytes:
+        """The whole TCPROS frame in one bytes object; with ``_tag``, as an SHMROS inline frame (the
+        length counts the tag byte 0 that follows it). Small types generate a fused version
+        (:func:`ninjemys.idl.codegen._wire_frame`); this one is their fallback, and names the bad field."""
+        total, parts = self.frame_parts()
+        if _tag:
+            parts[0] = _pack_tagged(total - 3, 0)
+        return b"".join(parts)
 
     def serialize(self, buff: Any) -> None:
         """genpy API: write the wire bytes into a file-like ``buff`` (e.g. ``io.BytesIO``)."""

@@ -447,6 +447,10 @@ class PubConnection:
             self._close_locked()
 
 
+#: ``PubConnection.send`` itself, also for its subclasses (a frame already in their format)
+_send = PubConnection.send
+
+
 class Publication:
     """A topic this node publishes: type, connections, and the Publisher handles sharing them."""
 
@@ -547,6 +551,42 @@ class Publication:
                     plain = b"".join(parts)
                 conn.send(plain, queue_size)
 
+    def publish_wire(self, msg: Any, wire: Callable[[Any, int], bytes], handle: Publisher) -> bool:
+        """A message of a small generated type (``_wire_small``): its frame made in one piece by the
+        generated ``_wire_frame`` (length prefix packed with the first fields), once untagged for plain
+        connections and once tagged for SHMROS ones, then written to each. False, with nothing sent
+        or latched, when the frame turns out big (a long string): the caller then takes the general
+        path, which hands a big payload to the socket or the ring without copying it."""
+        conns = self.connections
+        tagged = plain = None
+        if handle.latch:
+            plain = wire(msg, 0)
+            if len(plain) >= _LARGE:
+                return False
+            with self.lock:  # a subscriber being accepted gets either this frame latched or live
+                handle.latched = plain
+                handle.latched_item = Handoff(msg) if handle.intraprocess else None
+                conns = self.connections
+        elif conns and conns[0].tag_small:
+            tagged = wire(msg, 1)
+            if len(tagged) > _LARGE:  # the tag byte counts: the payload is what decides
+                return False
+        else:
+            plain = wire(msg, 0)  # also with no subscriber: a bad message raises all the same
+            if len(plain) >= _LARGE:
+                return False
+        queue_size = handle.queue_size
+        for conn in conns:
+            if conn.tag_small:
+                if tagged is None:
+                    tagged = wire(msg, 1)
+                _send(conn, tagged, queue_size)  # already tagged: not ShmPubConnection.send
+            else:
+                if plain is None:
+                    plain = wire(msg, 0)
+                conn.send(plain, queue_size)
+        return True
+
     def publish_parts(
         self, parts: list[Any], total: int, handle: Publisher, item: Handoff | None = None
     ) -> None:
@@ -621,6 +661,9 @@ class Publisher:
         intraprocess: bool = False,
     ) -> None:
         self._pub = publication
+        #: the topic's Publication, shared by every handle of it (its ``connections`` and ``intra``
+        #: tuples say who listens now, without a call: rospy.Publisher reads them per publish)
+        self.publication = publication
         self.name = publication.topic
         self.resolved_name = publication.topic
         self.data_class = publication.msg_class
@@ -635,6 +678,12 @@ class Publisher:
         #: in-process subscribers that opted in too get the published object itself (never changed after)
         self.intraprocess = intraprocess
         self._has_header = bool(getattr(publication.msg_class, "_has_header", False))
+        #: the generated one-piece frame builder of a small type (see Publication.publish_wire)
+        self._wire: Callable[[Any, int], bytes] | None = (
+            publication.msg_class._wire_frame
+            if getattr(publication.msg_class, "_wire_small", False)
+            else None
+        )
         self._seq = 0
         self._closed = False
 
@@ -655,6 +704,9 @@ class Publisher:
             pub.publish_intra(handoff, self)
             if pub.connections:
                 pub.publish_frame(self._frame(msg) if frame is None else frame, self, handoff)
+            return
+        wire = self._wire
+        if wire is not None and msg.__class__ is self.data_class and pub.publish_wire(msg, wire, self):
             return
         # a latched object an in-process subscriber that comes later may share
         item = Handoff(msg) if self.latch and self.intraprocess else None
