@@ -34,7 +34,7 @@ from ninjemys.master.client import MasterClient
 from ninjemys.net.addresses import advertised_host, advertised_host_problem
 from ninjemys.net.addresses import master_uri as env_master_uri
 from ninjemys.net.xmlrpc_server import XmlRpcServer
-from ninjemys.node import intraprocess, timers, transport
+from ninjemys.node import gcsettle, intraprocess, timers, transport
 from ninjemys.node import runtime as _runtime
 from ninjemys.node.clock import CLOCK_TOPIC, USE_SIM_TIME, Clock
 from ninjemys.node.log import INFO, NodeLog
@@ -156,6 +156,7 @@ class Node(ParamAccess):
             raise
         if default_clock or (default_clock is None and rostime.default_clock_owner() is None):
             rostime.claim_default_clock(self, None if self.clock.is_wallclock else self.clock.now_pair)
+        gcsettle.settle()  # start-up's objects out of the collector's way (tail latency)
 
     def _start_clock(self, sim_time: bool | str, driven: bool) -> None:
         """Follow ``/clock`` when simulated time is asked for (or, for "auto", when ``/use_sim_time``
