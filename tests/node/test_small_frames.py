@@ -110,6 +110,46 @@ def test_a_flat_out_loop_is_batched(clock: _Clock, family: int) -> None:
     assert len(_drain(b, (topics._FLUSH_FRAMES + 1) * len(FRAME))) == (topics._FLUSH_FRAMES + 1) * len(FRAME)
 
 
+@pytest.mark.parametrize("queue_size", [10, None])
+def test_a_flood_into_a_lagging_subscriber_keeps_the_bound_or_loses_nothing(
+    clock: _Clock, queue_size: int | None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The burst path queues most frames without a call (issue 25); bounds still hold: queue_size=10
+    keeps the newest 10 of what the kernel refused and drops the oldest; queue_size=None loses nothing
+    (the publisher writes its backlog itself at the high-water mark)."""
+    a, b = _pair()
+    a.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, 4096)
+    conn = topics.PubConnection(_Node(), a, "/t", "/sub")  # type: ignore[arg-type]
+    if queue_size is None:  # the reader takes a little whenever the publisher must wait for it
+        real_select = topics.select.select
+
+        def reading_select(r: Any, w: Any, x: Any, t: float) -> Any:
+            received.append(_drain(b))
+            return real_select(r, w, x, t)
+
+        monkeypatch.setattr(topics.select, "select", reading_select)
+    received: list[bytes] = []
+    count = 3000
+    for i in range(count):
+        clock.now += 1e-6
+        conn.send(pack_len(4) + i.to_bytes(4, "little"), queue_size)
+        if queue_size is not None:  # what waits because the kernel refused it is bounded
+            assert len(conn._queue) <= (queue_size if conn._partial is not None else topics._FLUSH_FRAMES)
+        else:  # synchronous: the backlog never passes the high-water mark (the publisher waits)
+            assert len(conn._queue) <= topics._SYNC_HIGH_WATER
+    while conn._queue or conn._partial is not None:
+        received.append(_drain(b))
+        conn._write_locked()
+    received.append(_drain(b))
+    stream = b"".join(received)
+    seqs = [int.from_bytes(stream[k + 4 : k + 8], "little") for k in range(0, len(stream), 8)]
+    assert seqs == sorted(seqs) and seqs[-1] == count - 1  # in order, the newest never dropped
+    if queue_size is None:
+        assert seqs == list(range(count)) and conn.dropped == 0
+    else:
+        assert conn.dropped > 0 and len(seqs) + conn.dropped == count
+
+
 def test_between_the_marks_a_unix_socket_asks_whether_the_subscriber_waits(clock: _Clock) -> None:
     a, b = _pair()
     conn = topics.PubConnection(_Node(), a, "/t", "/sub")  # type: ignore[arg-type]

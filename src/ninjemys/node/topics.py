@@ -194,6 +194,27 @@ class PubConnection:
                     return
                 must_wait = True  # a big synchronous message: finish it here, at the subscriber's pace
             else:
+                queue = self._queue
+                queued = len(queue)
+                if (
+                    queued
+                    and (self._checking or self._armed)
+                    and self._since_try < _FLUSH_FRAMES - 1
+                    and now - self._tried <= _MAX_HOLD
+                    and (
+                        (not queue_size or queued < queue_size)
+                        if queue_size is not None
+                        else queued + 1 < _SYNC_HIGH_WATER
+                        and self._queued_bytes + len(data) < _SYNC_HIGH_WATER_BYTES
+                    )
+                ):
+                    # the middle of a burst: _enqueue's common case inlined (a flood's every publish
+                    # but one in _FLUSH_FRAMES): no batch is due, no bound or high-water mark is
+                    # reached, the loop's check is scheduled already: just queue it
+                    queue.append(data)
+                    self._queued_bytes += len(data)
+                    self._since_try += 1
+                    return
                 must_wait = self._enqueue(data, queue_size, now)
         if must_wait:
             self._write_until_below(len(data) >= _LARGE)
@@ -706,8 +727,21 @@ class Publisher:
                 pub.publish_frame(self._frame(msg) if frame is None else frame, self, handoff)
             return
         wire = self._wire
-        if wire is not None and msg.__class__ is self.data_class and pub.publish_wire(msg, wire, self):
-            return
+        if wire is not None and msg.__class__ is self.data_class:
+            conns = pub.connections
+            if len(conns) == 1 and not self.latch:
+                # one subscriber (the common case), publish_wire inlined: one call less per message
+                conn = conns[0]
+                tag = conn.tag_small
+                frame = wire(msg, tag)
+                if len(frame) - tag < _LARGE:
+                    if tag:
+                        _send(conn, frame, self.queue_size)  # already tagged: not ShmPubConnection.send
+                    else:
+                        conn.send(frame, self.queue_size)
+                    return
+            elif pub.publish_wire(msg, wire, self):
+                return
         # a latched object an in-process subscriber that comes later may share
         item = Handoff(msg) if self.latch and self.intraprocess else None
         try:
