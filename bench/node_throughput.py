@@ -13,7 +13,11 @@ import sys
 from node_common import CROSS_CPU, IMPLS, OURS, SAME_CPU, Role, header, master, ratio, roles
 
 
-def run(uri: str, impl: str, queue_size: str, seconds: str, cpus: tuple[str, str]) -> tuple[float, float]:
+def run(
+    uri: str, impl: str, queue_size: str, seconds: str, cpus: tuple[str, str]
+) -> tuple[float, float, float]:
+    """Delivered rate, loss, and the publisher's own rate (what it published per second: a publisher
+    slower than the target cannot be made up for by the subscriber)."""
     sink = Role(impl, uri, "sink", cpu=cpus[1])
     with roles(sink):
         sink.ready()
@@ -21,7 +25,7 @@ def run(uri: str, impl: str, queue_size: str, seconds: str, cpus: tuple[str, str
         with roles(flood):
             sent = flood.result()["sent"]
             got = sink.result()
-    return got["rate"], 1.0 - got["received"] / max(sent, 1)
+    return got["rate"], 1.0 - got["received"] / max(sent, 1), sent / float(seconds)
 
 
 def main() -> None:
@@ -32,9 +36,10 @@ def main() -> None:
             for qs in ("10000", "None"):
                 results = {impl: run(uri, impl, qs, seconds, cpus) for impl in IMPLS}
                 label = f"{place:11s} queue_size={qs:6s}"
-                for impl, (rate, loss) in results.items():
+                for impl, (rate, loss, published) in results.items():
                     print(
                         f"{label} {impl:9s} {rate / 1e3:8.1f} k msgs/s delivered   loss {loss * 100:5.1f} %"
+                        f"   (published {published / 1e3:6.1f} k/s)"
                     )
                 if len(results) > 1:
                     print(f"{label} ratio     {ratio(results[OURS][0], results['rospy'][0])}")
