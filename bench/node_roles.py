@@ -361,7 +361,73 @@ def small_pub(seconds: str) -> None:
     rospy.signal_shutdown("done")
 
 
+def _cpu() -> tuple[float, float]:
+    t = os.times()
+    return t.user, t.system
+
+
+def pong_cpu(count: str) -> None:
+    """``pong`` (queue_size=None) that reports its process's CPU time (user, system) per message over
+    ``count`` messages after the first 1000: what one hop costs, whatever else the machine runs."""
+    import rospy
+    from std_msgs.msg import String
+
+    rospy.init_node("pong")
+    pub = rospy.Publisher("/pong", String, queue_size=None, tcp_nodelay=True)
+    n, total, marks = [0], int(count), {}
+
+    def cb(msg: String) -> None:
+        n[0] += 1
+        if n[0] == 1000:
+            marks["a"] = _cpu()
+        elif n[0] == 1000 + total:
+            b = _cpu()
+            print(json.dumps({"user_us": (b[0] - marks["a"][0]) / total * 1e6,
+                              "sys_us": (b[1] - marks["a"][1]) / total * 1e6}), flush=True)  # fmt: skip
+        pub.publish(msg)
+
+    rospy.Subscriber("/ping", String, cb, tcp_nodelay=True)
+    rospy.spin()
+
+
+def ping_cpu(count: str) -> None:
+    """``ping`` (queue_size=None) that reports its process's CPU time per round trip (1000 warm-up
+    round trips, then ``count``) and the mean round trip."""
+    import rospy
+    from std_msgs.msg import String
+
+    rospy.init_node("ping")
+    got = threading.Event()
+    rospy.Subscriber("/pong", String, lambda m: got.set(), tcp_nodelay=True)
+    pub = rospy.Publisher("/ping", String, queue_size=None, tcp_nodelay=True)
+    _wait_connections(pub)
+    msg = String("x" * 64)
+    deadline = time.monotonic() + 20
+    while time.monotonic() < deadline:
+        got.clear()
+        pub.publish(msg)
+        if got.wait(0.2):
+            break
+    for _ in range(998):
+        got.clear()
+        pub.publish(msg)
+        got.wait(2.0)
+    total = int(count)
+    a, t0 = _cpu(), time.perf_counter()
+    for _ in range(total + 2):  # the pong counts the 1000th to the (1000 + count)th
+        got.clear()
+        pub.publish(msg)
+        got.wait(2.0)
+    b, t1 = _cpu(), time.perf_counter()
+    print(json.dumps({"user_us": (b[0] - a[0]) / total * 1e6, "sys_us": (b[1] - a[1]) / total * 1e6,
+                      "rtt_us": (t1 - t0) / total * 1e6}), flush=True)  # fmt: skip
+    time.sleep(0.5)
+    rospy.signal_shutdown("done")
+
+
 ROLES = {
+    "pong_cpu": pong_cpu,
+    "ping_cpu": ping_cpu,
     "pong": pong,
     "ping": ping,
     "flood": flood,
