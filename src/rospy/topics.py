@@ -138,6 +138,8 @@ class Publisher(Topic):
         self.headers = dict(headers or {})
         self.queue_size = queue_size
         self._raw = data_class is AnyMsg
+        #: publish's fast path takes messages of exactly this class (None for AnyMsg: never)
+        self._plain_class = None if self._raw else data_class
         _process.attach(self)
 
     def _create(self, node: Any) -> Any:
@@ -153,6 +155,15 @@ class Publisher(Topic):
     def publish(self, *args: Any, **kwds: Any) -> None:
         """Publish a message, or build one from the arguments: ``pub.publish("hello")`` for a String."""
         impl = self._impl
+        if impl is not None and not kwds and len(args) == 1 and args[0].__class__ is self._plain_class:
+            # the common case first (a message of the topic's own class, not AnyMsg): fewer checks
+            publication = impl.publication
+            if publication.connections or publication.intra or self.latch:
+                try:
+                    impl.publish(args[0])
+                except NinjemysError as exc:
+                    self._publish_failed(exc)
+            return
         if impl is None:
             self._not_ready()  # raises, unless the node is shutting down (then nothing is sent)
             return
@@ -176,6 +187,13 @@ class Publisher(Topic):
                 impl.publish_raw(msg._buff)
             else:
                 impl.publish(msg)
+        except NinjemysError as exc:
+            self._publish_failed(exc)
+
+    def _publish_failed(self, exc: NinjemysError) -> None:
+        """rospy's exception for a failed publish (raised from the handler of ``exc``)."""
+        try:
+            raise exc
         except ShutdownError:
             if is_shutdown():
                 return  # as rospy: publishing while the node shuts down is quietly dropped

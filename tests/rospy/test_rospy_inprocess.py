@@ -140,3 +140,25 @@ def test_publisher_made_before_init_node_binds_to_the_node(rospy_env: str) -> No
         got.wait(0.05)
     sub.unregister()
     assert got.is_set()
+
+
+def test_publish_fast_path_keeps_rospy_errors_and_the_no_subscriber_rule(rospy_env: str) -> None:
+    """rospy.Publisher.publish takes a message of the topic's own class by a shorter path (issue 25);
+    it still serializes nothing without a subscriber, delivers with one, and turns a bad field into
+    ROSSerializationException; other arguments still take the general path."""
+    import rospy
+    from ninjemys.testing import wait_until
+    from std_msgs.msg import String
+
+    rospy.init_node("fast", argv=["fast"], disable_signals=True)
+    pub = rospy.Publisher("/fast", String, queue_size=10)
+    pub.publish(String(data=5))  # nobody listens: not serialized, no error (as rospy)
+    got: list[str] = []
+    rospy.Subscriber("/fast", String, lambda m: got.append(m.data))
+    assert wait_until(lambda: pub.get_num_connections() == 1)
+    pub.publish(String(data="hello"))
+    assert wait_until(lambda: got == ["hello"])
+    with pytest.raises(rospy.ROSSerializationException, match="data"):
+        pub.publish(String(data=5))
+    pub.publish("built")  # arguments still build the message (the general path)
+    assert wait_until(lambda: got == ["hello", "built"])
