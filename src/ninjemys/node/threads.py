@@ -350,6 +350,9 @@ RESOURCES: tuple[Resource, ...] = (
              "read under BandwidthWindow.lock"),
     Resource("lock", "ninjemys.node.registration:Registrar._lock", "any thread",
              "guards what the node has registered; reg:<node> copies it to re-register"),
+    Resource("lock", "ninjemys.node.registration:Turns._cond", "any thread",
+             "per-name order of registration calls: a ticket is taken under Node._lock, the master "
+             "call waits until the earlier tickets of that name are done; never held across a call"),
     Resource("event", "ninjemys.node.registration:Registrar._stop", "the shutting-down thread",
              "reg:<node> waits on it"),
     Resource("event", "ninjemys.node.registration:Registrar._link_lost", LOOP,
