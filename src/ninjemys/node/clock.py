@@ -23,6 +23,7 @@ import threading
 import time
 from collections.abc import Callable
 
+from ninjemys import interrupt
 from ninjemys.interrupt import wait_slice
 
 TYPE_CHECKING = False  # importing typing costs ~7 ms of every node's start-up; checkers set it
@@ -189,8 +190,11 @@ class Clock:
     def _gate(self) -> Any:
         gate = getattr(self._local, "gate", None)
         if gate is None:
-            gate = threading.Lock()
-            gate.acquire()
+            if interrupt.on_main_thread():
+                gate = _MainGate()  # a long rospy.sleep on the main thread never wakes to check
+            else:
+                gate = threading.Lock()
+                gate.acquire()
             self._local.gate = gate
         return gate
 
@@ -216,7 +220,7 @@ class Clock:
                 if wake is not None:
                     return wake
                 # True: someone opened the gate (we hold it again, re-armed); False: the time is up
-                gate.acquire(True, wait_slice(remaining))
+                gate.acquire(True, remaining)
         finally:
             with self._gates_lock:
                 self._gates.discard(gate)
@@ -273,3 +277,21 @@ def for_node(node: Any) -> Clock:
 
         clock.subscribe(node, get_message_class("rosgraph_msgs/Clock"))
     return clock
+
+
+class _MainGate:
+    """The main thread's wall-time gate: the lock-gate's two calls over an :class:`interrupt.Event`,
+    so the sleep waits in :func:`interrupt.wait_event`: no periodic wake-up, and a signal that landed
+    on any thread runs its handler at once (a worker thread's gate is a plain lock, never sliced)."""
+
+    def __init__(self) -> None:
+        self._event = interrupt.Event()
+
+    def acquire(self, blocking: bool = True, timeout: float = -1) -> bool:
+        """Wait until opened (True, re-armed) or ``timeout`` seconds pass (False)."""
+        opened = interrupt.wait_event(self._event, timeout if blocking and timeout >= 0 else None)
+        self._event.clear()
+        return opened
+
+    def release(self) -> None:
+        self._event.set()

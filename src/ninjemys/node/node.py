@@ -27,7 +27,7 @@ import socket
 import threading
 from collections.abc import Callable, Mapping
 
-from ninjemys import names, rostime
+from ninjemys import interrupt, names, rostime
 from ninjemys.errors import MasterError, NinjemysError, ShutdownError
 from ninjemys.interrupt import wait_event
 from ninjemys.master.client import MasterClient
@@ -116,7 +116,7 @@ class Node(ParamAccess):
         self._shutdown_hooks: list[Callable[[], Any]] = []
         self._timers: list[timers.Timer] = []
         self._lock = threading.RLock()
-        self._shutdown_event = threading.Event()
+        self._shutdown_event = interrupt.Event()  # spin() waits on it with no periodic wake-up
         self._shutdown_done = threading.Event()
         self.shutdown_reason = ""
         self.tcpros_host = advertised_host()
