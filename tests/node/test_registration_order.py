@@ -149,3 +149,17 @@ def test_a_turn_given_up_while_waiting_does_not_block_the_name(give_up: bool) ->
     turns.wait(c)  # returns at once: a and b are over
     turns.done(c)
     assert turns.waiting("sub", "/t") == 0 and not turns._next and not turns._serving and not turns._finished
+
+
+def test_a_limited_wait_goes_out_of_turn_and_the_line_still_clears() -> None:
+    """A shutting-down node does not wait long for a call still in flight (a hung master)."""
+    from ninjemys.node.registration import Turns
+
+    turns = Turns()
+    first, second = turns.take("srv", "/s"), turns.take("srv", "/s")
+    turns.wait(first)
+    assert turns.wait(second, limit=0.05) is False  # first is still in flight
+    turns.done(second)  # went out of turn and finished
+    assert turns.waiting("srv", "/s") == 2
+    turns.done(first)
+    assert turns.waiting("srv", "/s") == 0 and not turns._next and not turns._finished

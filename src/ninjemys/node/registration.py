@@ -55,6 +55,10 @@ IDLE_CHECK_PERIOD = 15.0
 SETTLE_PERIOD = 10.0
 
 
+#: Seconds a shutting-down node's unregistration waits for a call of the same name still in flight
+#: (a user thread's registration with a master that hangs): shutdown stays prompt.
+_SHUTDOWN_TURN = 2.0
+
 #: (kind, name): the registration calls of one publisher topic, subscriber topic or service
 TurnKey = tuple[str, str]
 
@@ -89,12 +93,18 @@ class Turns:
         with self._cond:
             return self._next.get(key, 0) - self._serving.get(key, 0)
 
-    def wait(self, place: tuple[TurnKey, int]) -> None:
-        """Block until every earlier ticket of the same name is done."""
+    def wait(self, place: tuple[TurnKey, int], limit: float | None = None) -> bool:
+        """Block until every earlier ticket of the same name is done (True), or ``limit`` seconds
+        have passed (False: the caller goes out of turn)."""
         key, ticket = place
+        deadline = None if limit is None else time.monotonic() + limit
         with self._cond:
             while self._serving.get(key, 0) != ticket:
-                self._cond.wait(wait_slice(None))
+                left = None if deadline is None else deadline - time.monotonic()
+                if left is not None and left <= 0:
+                    return False
+                self._cond.wait(wait_slice(left))
+        return True
 
     def done(self, place: tuple[TurnKey, int]) -> None:
         """The call of ``place`` is over, failed, or was given up while waiting: let the next go."""
@@ -178,12 +188,15 @@ class Registrar:
             log.log(FATAL, "%s", text)
 
     @contextmanager
-    def _turn(self, kind: str, name: str, place: tuple[TurnKey, int] | None) -> Iterator[None]:
-        """Run the body as the call of ``place`` (a new place in line when None)."""
+    def _turn(
+        self, kind: str, name: str, place: tuple[TurnKey, int] | None, limit: float | None = None
+    ) -> Iterator[None]:
+        """Run the body as the call of ``place`` (a new place in line when None), after waiting at
+        most ``limit`` seconds for the earlier ones."""
         if place is None:
             place = self.turns.take(kind, name)
         try:
-            self.turns.wait(place)
+            self.turns.wait(place, limit)
             yield
         finally:
             self.turns.done(place)
@@ -226,7 +239,7 @@ class Registrar:
     def remove_publisher(
         self, topic: str, client: MasterClient | None = None, place: tuple[TurnKey, int] | None = None
     ) -> None:
-        with self._turn("pub", topic, place):
+        with self._turn("pub", topic, place, _SHUTDOWN_TURN if client is not None else None):
             with self._lock:
                 self.publications.pop(topic, None)
             self._quiet(lambda c: c.unregister_publisher(topic, self.node.uri), client)
@@ -234,7 +247,7 @@ class Registrar:
     def remove_subscriber(
         self, topic: str, client: MasterClient | None = None, place: tuple[TurnKey, int] | None = None
     ) -> None:
-        with self._turn("sub", topic, place):
+        with self._turn("sub", topic, place, _SHUTDOWN_TURN if client is not None else None):
             with self._lock:
                 self.subscriptions.pop(topic, None)
             self._quiet(lambda c: c.unregister_subscriber(topic, self.node.uri), client)
@@ -242,7 +255,7 @@ class Registrar:
     def remove_service(
         self, name: str, client: MasterClient | None = None, place: tuple[TurnKey, int] | None = None
     ) -> None:
-        with self._turn("srv", name, place):
+        with self._turn("srv", name, place, _SHUTDOWN_TURN if client is not None else None):
             with self._lock:
                 uri = self.services.pop(name, None)
             if uri is not None:
