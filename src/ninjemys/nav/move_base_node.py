@@ -585,13 +585,15 @@ class MoveBase:
         return pose, too_old
 
     def _robot_poses(self) -> tuple[Pose2D | None, Pose2D | None, bool]:
-        """The robot's pose in the global and in the local costmap's frame, and whether one of them
-        was refused as too old."""
-        g, g_old = self._pose(self.global_cm)
+        """The robot's pose in the global and in the local costmap's frame, and whether the local
+        one was refused as too old. As in ROS 1, only the controller's own (local costmap) pose is
+        held to its ``transform_tolerance`` here: dwa_local_planner refuses a stale one, while the
+        plan is carried into its frame with the newest ``map -> odom``, however old (amcl's lags
+        under load; the planner refuses that one, see _plan_once)."""
+        lp, too_old = self._pose(self.local_cm)
         if self.local_cm.global_frame == self.global_cm.global_frame:
-            return g, g, g_old
-        lp, l_old = self._pose(self.local_cm)
-        return g, lp, g_old or l_old
+            return lp, lp, too_old
+        return self.tf.lookup(self.global_cm.global_frame, self.global_cm.robot_base_frame), lp, too_old
 
     def cycle(self) -> None:
         """One control cycle: goals from the inbox, then the state machine on the robot's poses."""
@@ -604,7 +606,7 @@ class MoveBase:
             return
         gpose, lpose, too_old = self._robot_poses()
         if too_old:
-            # too old to drive on (transform_tolerance): stand still, as ROS 1's move_base
+            # too old to drive on (the local costmap's transform_tolerance): stand still, as ROS 1
             with self.lock:
                 step = self.fsm.pose_too_old(self.node.get_time())
             self._apply(step)
