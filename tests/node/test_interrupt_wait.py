@@ -152,3 +152,29 @@ def test_a_wall_time_sleep_on_the_main_thread_does_not_wake_and_wake_still_ends_
     opener.start()
     assert clock.wait_for(60.0, cancelled=stop.is_set) == Wake.CANCELLED
     opener.join()
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="counts the main thread's wake-ups in /proc")
+def test_a_sim_time_sleep_on_the_main_thread_does_not_wake_until_its_time_comes(on_main: None) -> None:
+    from ninjemys.node.clock import Clock, Wake
+
+    tid = threading.main_thread().native_id
+    assert tid is not None
+    clock = Clock(sim=True)
+    clock.set_time(100)
+    counts: list[int] = []
+
+    def drive() -> None:
+        time.sleep(0.2)
+        counts.append(_switches(tid))
+        clock.set_time(100, 500_000_000)  # not yet: no wake-up
+        time.sleep(1.5)
+        counts.append(_switches(tid))
+        clock.set_time(101)
+
+    driver = threading.Thread(target=drive)
+    driver.start()
+    assert clock.wait_for(1.0) == Wake.REACHED
+    driver.join()
+    assert counts[1] - counts[0] <= 3, counts
+    assert clock.now() == 101.0
