@@ -163,3 +163,30 @@ def test_a_limited_wait_goes_out_of_turn_and_the_line_still_clears() -> None:
     assert turns.waiting("srv", "/s") == 2
     turns.done(first)
     assert turns.waiting("srv", "/s") == 0 and not turns._next and not turns._finished
+
+
+def test_a_reregistration_does_not_undo_an_unsubscribe_made_meanwhile(make_node) -> None:  # noqa: ANN001
+    """After a master restart the watchdog registers everything again from a copy of the node's
+    registrations; a topic unsubscribed meanwhile must not be registered again behind it."""
+    node = make_node("order_rereg")
+    handle = node.subscriber("chatter", String, None)
+    arrived, opened = threading.Event(), threading.Event()
+    real = node.publisher_updates
+
+    def held(topic: str) -> int:  # the watchdog asks this just before its registerSubscriber
+        if threading.current_thread().name == "rereg":
+            arrived.set()
+            assert opened.wait(30)
+        return real(topic)
+
+    node.publisher_updates = held  # type: ignore[method-assign]
+    rereg = threading.Thread(target=node.registrar._reregister, name="rereg", daemon=True)
+    rereg.start()
+    assert arrived.wait(30), "the re-registration never reached the subscriber"
+    t2, done2 = _in_thread(handle.unregister)
+    wait_until(lambda: done2.is_set() or _queued(node, "sub", "/chatter") >= 2, timeout=30)
+    opened.set()
+    rereg.join(30)
+    t2.join(30)
+    assert "/chatter" not in _state(node)[1], "the re-registration undid the unsubscribe"
+    assert "/chatter" not in node.registrar.subscriptions

@@ -384,15 +384,24 @@ class Registrar:
                 return None
 
         try:
+            # each in its name's turn, and only if still registered then: an unregistration made
+            # meanwhile is not undone (see Turns)
             for topic, type_name in pubs.items():
-                again(partial(master.register_publisher, topic, type_name, uri))
+                with self._turn("pub", topic, None):
+                    if topic in self.publications:
+                        again(partial(master.register_publisher, topic, type_name, uri))
             for topic, type_name in subs.items():
-                updates = self.node.publisher_updates(topic)  # an update newer than the answer wins
-                publishers = again(partial(master.register_subscriber, topic, type_name, uri))
+                with self._turn("sub", topic, None):
+                    if topic not in self.subscriptions:
+                        continue
+                    updates = self.node.publisher_updates(topic)  # an update newer than the answer wins
+                    publishers = again(partial(master.register_subscriber, topic, type_name, uri))
                 if isinstance(publishers, list):
                     self.node.publisher_update(topic, list(publishers), updates)
             for name, service_uri in srvs.items():
-                again(partial(master.register_service, name, service_uri, uri))
+                with self._turn("srv", name, None):
+                    if self.services.get(name) == service_uri:
+                        again(partial(master.register_service, name, service_uri, uri))
             for key in keys:
                 again(partial(master.subscribe_param, uri, key))
         except MasterError as exc:
@@ -408,8 +417,11 @@ class Registrar:
             subs = dict(self.subscriptions)
         try:
             for topic, type_name in subs.items():
-                updates = self.node.publisher_updates(topic)
-                publishers = self._probe.register_subscriber(topic, type_name, self.node.uri)
+                with self._turn("sub", topic, None):
+                    if topic not in self.subscriptions:
+                        continue
+                    updates = self.node.publisher_updates(topic)
+                    publishers = self._probe.register_subscriber(topic, type_name, self.node.uri)
                 if isinstance(publishers, list):
                     self.node.publisher_update(topic, list(publishers), updates)
         except MasterUnreachable:
