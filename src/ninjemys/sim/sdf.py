@@ -1,8 +1,11 @@
 """Gazebo worlds (SDF 1.4-1.7 ``.world`` files) read into the simulator's floor-plan :class:`World`.
 
 No ROS in here. A lidar in Gazebo hits collision geometry, so every ``<collision>`` of every model
-becomes one obstacle: its footprint on the floor (the outline of the shape's projection) and its top
-(the highest point), coloured by its link's ``<visual>`` material. Poses compose down the tree
+becomes one obstacle: its footprint on the floor (the outline of the shape's projection), its bottom
+and its top, coloured by its link's ``<visual>`` material. Heights are where Gazebo's physics leaves
+the model: a ``<static>`` model stays at its pose (a table top held at 0.75 m: a low lidar and a low
+robot pass under it), one with physics falls onto the floor (or is pushed up out of it) as a whole.
+A model of several pieces gives one obstacle per piece, each knowing its model. Poses compose down the tree
 (world, nested models, link, collision; x y z roll pitch yaw, fixed axes as SDF says), so a tilted
 box or a lying cylinder gets the footprint it really has.
 
@@ -50,8 +53,6 @@ ROUND_SIDES = 24
 #: shapes whose top is lower than this (metres) lie on the floor: nothing for a sensor to hit
 MIN_TOP = 1e-3
 DEFAULT_COLOUR = (180, 180, 180)
-#: a shape whose lowest point is higher than this (metres) floats: reported, as it stands on the floor here
-FLOATING = 0.05
 MAX_INCLUDE_DEPTH = 16
 
 #: Gazebo's material scripts (gazebo.material) by name, as the RGB they render roughly as
@@ -474,6 +475,28 @@ class _Solid:
     path: list[str]  # model names from the top, then link, then collision
     footprint: Footprint
     colour: tuple[int, int, int]
+    static: bool = False  # its model is static: it stays where it is put
+
+
+def _settle(solids: list[_Solid]) -> list[_Solid]:
+    """Heights as Gazebo's physics leaves each top-level model (all its pieces together): a static
+    model stays at its pose (a table top held at 0.75 m floats there; a part below the floor is
+    hidden), a model with physics falls onto the floor, or is pushed up out of it, until its lowest
+    point touches it. The floor is the only thing models land on here (a box dropped onto a table
+    lands on the floor). Pieces with nothing above the floor are dropped."""
+    lowest: dict[str, float] = {}
+    for s in solids:
+        if not s.static:
+            key = s.path[0]
+            lowest[key] = min(lowest.get(key, math.inf), s.footprint.bottom)
+    kept = []
+    for s in solids:
+        fp = s.footprint
+        drop = lowest.get(s.path[0], 0.0) if not s.static else 0.0
+        fp.top, fp.bottom = fp.top - drop, max(fp.bottom - drop, 0.0)
+        if fp.top > MIN_TOP and len(fp.outline) >= 2:
+            kept.append(s)
+    return kept
 
 
 def _model(
@@ -484,27 +507,34 @@ def _model(
     scope: list[str],
     depth: int,
     pose_override: np.ndarray | None = None,
+    static: bool | None = None,
 ) -> None:
+    """Read a model's pieces into ``out``; ``static`` (an include's or a parent's) overrides its own."""
     name = el.attrib.get("name")
     if not name:
         raise el.error("missing attribute 'name'")
     m = parent @ (pose_override if pose_override is not None else _pose(el, ctx))
     here = [*scope, name]
+    if static is None:
+        own = el.find("static")
+        static = _bool(own) if own is not None else False
     for child in el.children:
         tag = child.tag
         if tag == "link":
-            _link(child, m, ctx, out, here)
+            _link(child, m, ctx, out, here, static)
         elif tag == "model":
-            _model(child, m, ctx, out, here, depth + 1)
+            _model(child, m, ctx, out, here, depth + 1, static=static or None)
         elif tag == "include":
-            _include(child, m, ctx, out, here, depth + 1)
+            _include(child, m, ctx, out, here, depth + 1, static=static or None)
         elif tag == "plugin":
             ctx.skip(f"model plugin {child.attrib.get('filename', '?')}", child)
         elif tag not in _QUIET_MODEL:
             ctx.skip(f"<{tag}> in a model", child)
 
 
-def _link(el: Element, model: np.ndarray, ctx: _Context, out: list[_Solid], scope: list[str]) -> None:
+def _link(
+    el: Element, model: np.ndarray, ctx: _Context, out: list[_Solid], scope: list[str], static: bool
+) -> None:
     name = el.attrib.get("name")
     if not name:
         raise el.error("missing attribute 'name'")
@@ -519,13 +549,7 @@ def _link(el: Element, model: np.ndarray, ctx: _Context, out: list[_Solid], scop
             if geom is None:
                 raise child.error("missing <geometry>")
             for fp in _geometry(geom, m @ _pose(child, ctx), ctx):
-                if fp.top > MIN_TOP and len(fp.outline) >= 2:
-                    out.append(_Solid([*scope, name, cname], fp, colour))
-                    if fp.bottom > FLOATING:
-                        # a table top, a shelf: the floor plan has no space under things
-                        ctx.skip(
-                            "space under shapes that float above the floor (they stand on it here)", child
-                        )
+                out.append(_Solid([*scope, name, cname], fp, colour, static))
             for sub in child.children:
                 if sub.tag not in _QUIET_COLLISION and sub.tag != "geometry":
                     ctx.skip(f"<{sub.tag}> in a collision", sub)
@@ -543,6 +567,7 @@ def _include(
     scope: list[str],
     depth: int,
     saved: dict[str, np.ndarray] | None = None,
+    static: bool | None = None,
 ) -> None:
     if depth > MAX_INCLUDE_DEPTH:
         raise el.error(f"includes nested more than {MAX_INCLUDE_DEPTH} deep (a model including itself?)")
@@ -560,14 +585,14 @@ def _include(
     name = el.value("name")
     if name:
         model.attrib["name"] = name
-    static = el.find("static")
-    if static is not None:
-        _bool(static)
+    static_el = el.find("static")
+    if static is None and static_el is not None:
+        static = _bool(static_el)
     pose = el.find("pose")
     override = pose_matrix(*_numbers(pose, 6, "x y z roll pitch yaw")) if pose is not None else None
     if saved and model.attrib.get("name") in saved:
         override = saved[model.attrib["name"]]
-    _model(model, parent, ctx, out, scope, depth, override)
+    _model(model, parent, ctx, out, scope, depth, override, static)
 
 
 def _state_poses(world: Element, ctx: _Context) -> dict[str, np.ndarray]:
@@ -608,7 +633,7 @@ def parse_sdf_world(
     world_el = root.find("world")
     if world_el is None:
         raise root.error("no <world> in this file (a model file? spawn it with spawn_model -sdf)")
-    solids = _world_solids(world_el, ctx)
+    solids = _settle(_world_solids(world_el, ctx))
     world = World(world_el.attrib.get("name", Path(source).stem), _obstacles(solids), source=source)
     _report(ctx, source, warn)
     return world
@@ -619,14 +644,13 @@ def sdf_model_obstacles(
     source: str = "<spawn_sdf_model>",
     env: Mapping[str, str] | None = None,
     warn: Callable[[str], None] | None = None,
-    lift: bool = False,
+    z: float = 0.0,
 ) -> list[Obstacle]:
     """The obstacles of an SDF model document (``<sdf><model>``, as spawn_sdf_model receives it, or a
-    ``<world>`` of includes), in the model's frame: place them at the spawn pose.
-
-    ``lift``: a piece reaching below the floor (a shape centred on the model's origin, spawned at
-    z 0) stands on the floor with its whole height, as Gazebo's physics pushes a model out of the
-    ground plane."""
+    ``<world>`` of includes), their outlines in the model's frame (place them at the spawn pose),
+    their heights as the model settles when spawned at height ``z``: a static model stays there, one
+    with physics falls onto the floor or is pushed up out of it (:func:`_settle`). A model of several
+    pieces (a table: top and legs) gives one obstacle per piece, each naming the model."""
     ctx = _Context(os.environ if env is None else env)
     root = _sdf_root(data.encode() if isinstance(data, str) else data, source, ctx)
     solids: list[_Solid] = []
@@ -638,12 +662,10 @@ def sdf_model_obstacles(
     if world_el is None and root.find("model") is None:
         raise root.error("no <model> in this SDF document")
     _report(ctx, source, warn)
-    if lift:
-        for solid in solids:
-            fp = solid.footprint
-            if fp.bottom < 0.0:
-                fp.top, fp.bottom = fp.top - fp.bottom, 0.0
-    return _obstacles(solids)
+    for solid in solids:
+        solid.footprint.top += z
+        solid.footprint.bottom += z
+    return _obstacles(_settle(solids))
 
 
 def _world_solids(world_el: Element, ctx: _Context) -> list[_Solid]:
@@ -670,17 +692,22 @@ def _report(ctx: _Context, source: str, warn: Callable[[str], None] | None) -> N
 
 def _obstacles(solids: list[_Solid]) -> list[Obstacle]:
     """One obstacle per collision piece, named by its top-level model when that model has one piece,
-    else ``model::link::collision`` (``#n`` for the parts of one mesh), as Gazebo scopes names."""
+    else ``model::link::collision`` (``#n`` for the parts of one mesh), as Gazebo scopes names; the
+    pieces of a model of several know their model (Gazebo's services move and delete it whole)."""
     per_model: dict[str, int] = {}
     for s in solids:
         per_model[s.path[0]] = per_model.get(s.path[0], 0) + 1
     seen: dict[str, int] = {}
     obstacles = []
     for s in solids:
-        name = s.path[0] if per_model[s.path[0]] == 1 else "::".join(s.path)
+        single = per_model[s.path[0]] == 1
+        name = s.path[0] if single else "::".join(s.path)
         n = seen.get(name, 0)
         seen[name] = n + 1
         if n:
             name = f"{name}#{n}"
-        obstacles.append(Obstacle(name, s.footprint.kind, s.footprint.outline, s.footprint.top, s.colour))
+        fp = s.footprint
+        obstacles.append(
+            Obstacle(name, fp.kind, fp.outline, fp.top, s.colour, fp.bottom, "" if single else s.path[0])
+        )
     return obstacles

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -138,6 +138,7 @@ class Simulation:
         self.world_time = 0.0  # moving obstacles' clock (reset_world restarts it, time goes on)
         self.robots: dict[str, Robot] = {}
         self.obstacle_yaw: dict[str, float] = {}  # yaw of spawned or moved obstacles (outlines have none)
+        self.obstacle_origin: dict[str, tuple[float, float]] = {}  # spawned models: their pose's x, y
         self._spawned = 0
         self._static: np.ndarray
         self.static_names: list[str] = []
@@ -173,7 +174,7 @@ class Simulation:
         w = self.world
         w.rebuild()
         segs, heights, colours = [w.segments], [w.seg_height], [w.seg_color]
-        facing = [w.seg_facing]
+        facing, bases = [w.seg_facing], [w.seg_base]
         names = [w.obstacles[i].name for i in w.seg_owner]
         if w.grid is not None:
             g = w.grid
@@ -181,10 +182,14 @@ class Simulation:
             segs.append(edges)
             facing.append(np.zeros(len(edges), dtype=np.int8))
             heights.append(np.full(len(edges), g.height))
+            bases.append(np.zeros(len(edges)))
             colours.append(np.tile(np.array(g.color, dtype=np.uint8), (len(edges), 1)))
             names += ["map"] * len(edges)
         self._static = np.vstack(segs) if any(len(s) for s in segs) else np.zeros((0, 4))
         self._static_height = np.concatenate(heights)
+        self._static_base = np.concatenate(bases)
+        #: the static world has something held above the floor (a table top): sensors and robots pass under it
+        self._any_base = bool((self._static_base > 0).any())
         self._static_color = np.vstack(colours).astype(np.uint8)
         self._static_facing = np.concatenate(facing).astype(np.int8)
         self.static_names = names
@@ -272,6 +277,9 @@ class Simulation:
         segs = np.vstack([self._static, ms]) if len(ms) else self._static
         heights = np.concatenate([self._static_height, mh]) if len(ms) else self._static_height
         colours = np.vstack([self._static_color, mc]) if len(ms) else self._static_color
+        bases = None
+        if self._any_base:
+            bases = np.concatenate([self._static_base, np.zeros(len(ms))]) if len(ms) else self._static_base
         # a moving obstacle may walk over a robot (the camera inside it sees its inside): both sides
         facing = (
             np.concatenate([self._static_facing, np.zeros(len(ms), dtype=np.int8)])
@@ -289,22 +297,36 @@ class Simulation:
             np.array([r.model.color for r in others], dtype=np.uint8).reshape(-1, 3),
             self._floor,
             facing,
+            bases,
         )
 
-    def clearance(self, x: float, y: float, exclude: str | None = None) -> tuple[float, str]:
-        """Distance from a point to the nearest solid thing, and its name."""
+    def clearance(
+        self, x: float, y: float, exclude: str | None = None, height: float = math.inf
+    ) -> tuple[float, str]:
+        """Distance from a point to the nearest solid thing lower than ``height`` (what a body that
+        tall meets: it passes under a table top held higher), and its name."""
         d, name = self._clearances(
-            np.array([x]), np.array([y]), exclude, self._collision_geometry(x, y, 1e9, exclude)
+            np.array([x]), np.array([y]), exclude, self._collision_geometry(x, y, 1e9, exclude, height=height)
         )
         return float(d[0]), name[0]
 
     def _collision_geometry(
-        self, x: float, y: float, reach: float, exclude: str | None, static: bool = True
+        self,
+        x: float,
+        y: float,
+        reach: float,
+        exclude: str | None,
+        static: bool = True,
+        height: float | None = None,
     ) -> tuple:
         """Segments (with names) and other robots' circles within ``reach`` of (x, y); ``static=False``
-        leaves the static world out (only what moves: moving obstacles and robots)."""
+        leaves the static world out (only what moves: moving obstacles and robots). Static pieces
+        held at or above ``height`` (default: robot ``exclude``'s body height) are passed under."""
+        if height is None:
+            robot = self.robots.get(exclude) if exclude is not None else None
+            height = robot.model.body_height if robot is not None else math.inf
         if static:
-            near = self._static_near(x, y, reach)
+            near = self._static_near(x, y, reach, height)
             segs = self._static[near]
             names = [self.static_names[i] for i in near]
         else:
@@ -318,14 +340,18 @@ class Simulation:
         radii = np.array([r.model.body_radius for r in others])
         return segs, names, centres, radii, [r.name for r in others]
 
-    def _static_near(self, x: float, y: float, reach: float) -> np.ndarray:
-        """Indices of the static segments whose bounding box comes within ``reach`` of (x, y)."""
-        return np.flatnonzero(
+    def _static_near(self, x: float, y: float, reach: float, below: float = math.inf) -> np.ndarray:
+        """Indices of the static segments whose bounding box comes within ``reach`` of (x, y), of
+        the pieces starting lower than ``below`` (a body that tall passes under the others)."""
+        mask = (
             (self._static_lo[:, 0] <= x + reach)
             & (self._static_hi[:, 0] >= x - reach)
             & (self._static_lo[:, 1] <= y + reach)
             & (self._static_hi[:, 1] >= y - reach)
         )
+        if self._any_base and below != math.inf:
+            mask &= self._static_base < below
+        return np.flatnonzero(mask)
 
     def _static_free(self, r: Robot, x: float, y: float) -> bool:
         """True when (x, y) lies in ``r``'s free disk: a disk around a past position holding no static
@@ -340,7 +366,7 @@ class Simulation:
         ):
             return True  # both ends in the disk: so is the straight move between them (a disk is convex)
         reach = 2.0
-        segs = self._static[self._static_near(r.x, r.y, reach)]
+        segs = self._static[self._static_near(r.x, r.y, reach, r.model.body_height)]
         near = point_segment_distance(np.array([r.x]), np.array([r.y]), segs)
         clear = min(float(near.min()) if near.size else reach, reach)
         r.free = (r.x, r.y, clear)
@@ -371,10 +397,11 @@ class Simulation:
         return best, who
 
     # -- robots and obstacles -------------------------------------------------------------------
-    def solid_at(self, x: float, y: float) -> str:
-        """The name of the solid thing covering point (x, y), or "" (inside a box, a thick wall, a map cell)."""
+    def solid_at(self, x: float, y: float, height: float = math.inf) -> str:
+        """The name of the solid thing covering point (x, y), or "" (inside a box, a thick wall, a map
+        cell); pieces held at or above ``height`` (a table top over a lower robot) do not count."""
         for o in self.world.obstacles:
-            if len(o.outline) > 2 and _inside(x, y, o.outline):
+            if o.base < height and len(o.outline) > 2 and _inside(x, y, o.outline):
                 return o.name
         for m in self.world.moving:
             if _inside(x, y, m.outline_at(self.world_time)):
@@ -393,8 +420,8 @@ class Simulation:
             raise SpawnError(f"a robot named [{name}] already exists")
         if not all(math.isfinite(v) for v in (x, y, yaw)):
             raise SpawnError(f"spawn pose of [{name}] is not finite: ({x}, {y}, {yaw})")
-        gap, what = self.clearance(x, y)
-        solid = self.solid_at(x, y)
+        gap, what = self.clearance(x, y, height=model.body_height)
+        solid = self.solid_at(x, y, model.body_height)
         if solid:
             gap, what = 0.0, solid
         if gap < model.body_radius:
@@ -420,8 +447,8 @@ class Simulation:
             raise SpawnError(f"no robot named [{name}]")
         if not all(math.isfinite(v) for v in (x, y, yaw)):
             raise SpawnError(f"pose of [{name}] is not finite: ({x}, {y}, {yaw})")
-        gap, what = self.clearance(x, y, exclude=name)
-        solid = self.solid_at(x, y)
+        gap, what = self.clearance(x, y, exclude=name, height=r.model.body_height)
+        solid = self.solid_at(x, y, r.model.body_height)
         if solid:
             gap, what = 0.0, solid
         if gap < r.model.body_radius:
@@ -435,36 +462,45 @@ class Simulation:
         r.contact, r.contact_with = False, ""
         return r
 
+    def _pieces(self, name: str) -> list[int]:
+        """Indices of the obstacles making up model ``name`` (one, or a model's several pieces)."""
+        return [i for i, o in enumerate(self.world.obstacles) if o.model_name == name]
+
     def obstacle_pose(self, name: str) -> tuple[float, float, float]:
-        """An obstacle's (x, y, yaw): the centre of its outline, and the yaw it was spawned or moved
-        with (0 for the world's own)."""
-        o = next((o for o in self.world.obstacles if o.name == name), None)
-        if o is None:
+        """A model's (x, y, yaw): where it was spawned or last moved to, else the centre of its
+        outline(s), and the yaw it was spawned or moved with (0 for the world's own)."""
+        pieces = self._pieces(name)
+        if not pieces:
             raise SpawnError(f"no model named [{name}]")
-        cx, cy = (float(v) for v in o.outline.mean(axis=0))
-        return cx, cy, self.obstacle_yaw.get(name, 0.0)
+        origin = self.obstacle_origin.get(name)
+        if origin is None:
+            outlines = np.vstack([self.world.obstacles[i].outline for i in pieces])
+            origin = (float(outlines[:, 0].mean()), float(outlines[:, 1].mean()))
+        return origin[0], origin[1], self.obstacle_yaw.get(name, 0.0)
 
     def move_obstacle(self, name: str, x: float, y: float, yaw: float) -> None:
-        """Move a static obstacle so its centre is at (x, y), turned by ``yaw`` from its first pose
-        (Gazebo's set_model_state on a model); refused when it would overlap a robot."""
-        index = next((i for i, o in enumerate(self.world.obstacles) if o.name == name), None)
-        if index is None:
+        """Move a static model (all its pieces together) so its pose is (x, y), turned by ``yaw``
+        from its first pose (Gazebo's set_model_state on a model); refused when it would overlap a
+        robot."""
+        pieces = self._pieces(name)
+        if not pieces:
             raise SpawnError(f"no model named [{name}]")
-        o = self.world.obstacles[index]
         if not all(math.isfinite(v) for v in (x, y, yaw)):
             raise SpawnError(f"pose of [{name}] is not finite: ({x}, {y}, {yaw})")
         cx, cy, cyaw = self.obstacle_pose(name)
         c, s = math.cos(yaw - cyaw), math.sin(yaw - cyaw)
-        rel = o.outline - np.array([cx, cy])
-        outline = np.column_stack([c * rel[:, 0] - s * rel[:, 1] + x, s * rel[:, 0] + c * rel[:, 1] + y])
-        for r in self.robots.values():
-            d = point_segment_distance(
-                np.array([r.x]), np.array([r.y]), np.hstack([outline, np.roll(outline, -1, axis=0)])
-            )
-            if (len(outline) > 2 and _inside(r.x, r.y, outline)) or float(d.min()) < r.model.body_radius:
-                raise SpawnError(f"cannot move [{name}]: it would overlap robot [{r.name}]")
-        self.world.obstacles[index] = Obstacle(o.name, o.kind, outline, o.height, o.color)
+        moved = []
+        for i in pieces:
+            o = self.world.obstacles[i]
+            rel = o.outline - np.array([cx, cy])
+            outline = np.column_stack([c * rel[:, 0] - s * rel[:, 1] + x, s * rel[:, 0] + c * rel[:, 1] + y])
+            moved.append(replace(o, outline=outline))
+        self._check_clear_of_robots(name, moved, "move")
+        for i, o in zip(pieces, moved, strict=True):
+            self.world.obstacles[i] = o
         self.obstacle_yaw[name] = yaw
+        if name in self.obstacle_origin:
+            self.obstacle_origin[name] = (x, y)
         self._rebuild_static()
 
     def remove_robot(self, name: str) -> None:
@@ -496,27 +532,49 @@ class Simulation:
         yaw: float,
         height: float,
         color: tuple[int, int, int],
+        base: float = 0.0,
     ) -> None:
         """Add a static obstacle of any outline (world coordinates; an SDF model's footprint, spawned);
         refused on a robot or a name clash."""
-        if any(o.name == name for o in self.world.obstacles) or name in self.robots:
+        self.add_model(name, [Obstacle(name, kind, outline, height, color, base)], yaw)
+
+    def add_model(
+        self, name: str, pieces: list[Obstacle], yaw: float, origin: tuple[float, float] | None = None
+    ) -> None:
+        """Add a static model of one or several pieces (outlines in world coordinates; a spawned SDF
+        table: top and legs), posed at ``origin`` (None: the centre of its outlines); refused as a
+        whole on a robot or a name clash."""
+        if name in self.robots or any(o.model_name == name or o.name == name for o in self.world.obstacles):
             raise SpawnError(f"a model named [{name}] already exists")
-        for r in self.robots.values():
-            d = point_segment_distance(
-                np.array([r.x]), np.array([r.y]), np.hstack([outline, np.roll(outline, -1, axis=0)])
-            )
-            inside = _inside(r.x, r.y, outline)
-            if inside or float(d.min()) < r.model.body_radius:
-                raise SpawnError(f"cannot spawn [{name}]: it would overlap robot [{r.name}]")
-        self.world.obstacles.append(Obstacle(name, kind, outline, height, color))
+        self._check_clear_of_robots(name, pieces, "spawn")
+        self.world.obstacles.extend(pieces)
         self.obstacle_yaw[name] = yaw
+        if origin is not None:
+            self.obstacle_origin[name] = origin
         self._rebuild_static()
 
+    def _check_clear_of_robots(self, name: str, pieces: list[Obstacle], verb: str) -> None:
+        """SpawnError when a piece would overlap a robot (pieces held above the robot pass over it)."""
+        for r in self.robots.values():
+            for o in pieces:
+                if o.base >= r.model.body_height:
+                    continue
+                outline = o.outline
+                d = point_segment_distance(
+                    np.array([r.x]), np.array([r.y]), np.hstack([outline, np.roll(outline, -1, axis=0)])
+                )
+                inside = len(outline) > 2 and _inside(r.x, r.y, outline)
+                if inside or float(d.min()) < r.model.body_radius:
+                    raise SpawnError(f"cannot {verb} [{name}]: it would overlap robot [{r.name}]")
+
     def remove_obstacle(self, name: str) -> None:
+        """Delete a static model: all its pieces."""
         before = len(self.world.obstacles)
-        self.world.obstacles = [o for o in self.world.obstacles if o.name != name]
+        self.world.obstacles = [o for o in self.world.obstacles if o.model_name != name]
         if len(self.world.obstacles) == before:
             raise SpawnError(f"no model named [{name}]")
+        self.obstacle_yaw.pop(name, None)
+        self.obstacle_origin.pop(name, None)
         self._rebuild_static()
 
     # -- time -----------------------------------------------------------------------------------
