@@ -30,6 +30,7 @@ from __future__ import annotations
 import logging
 import math
 import os
+import re
 import xml.parsers.expat
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -141,8 +142,28 @@ class Element:
         return SdfError(f"{self.source}:{self.line}: <{self.tag}>: {reason}")
 
 
+#: an XML declaration (``<?xml version="1.0"?>``)
+_DECLARATION = re.compile(rb"<\?xml\s[^>]*\?>")
+
+
+def _stray_declarations_blanked(data: bytes) -> bytes:
+    """The text with every XML declaration that is not at its very start blanked (newlines kept,
+    so line numbers stay). sdformat's TinyXML reads a world with ``<?xml ...?>`` pasted into the
+    middle (worlds assembled from a saved world and a model file have them) or after a blank line;
+    expat refuses both ("XML or text declaration not at start of entity")."""
+
+    def blank(m: re.Match[bytes]) -> bytes:
+        if m.start() == 0:
+            return m.group(0)
+        return re.sub(rb"[^\n]", b" ", m.group(0))
+
+    return _DECLARATION.sub(blank, data)
+
+
 def parse_xml(data: bytes, source: str) -> Element:
-    """The document's root element, each element knowing its line (expat; errors name file and line)."""
+    """The document's root element, each element knowing its line (expat; errors name file and line).
+    Declarations out of place are read past, as sdformat (TinyXML) does."""
+    data = _stray_declarations_blanked(data)
     parser = xml.parsers.expat.ParserCreate()
     stack: list[Element] = []
     root: list[Element] = []
