@@ -80,7 +80,10 @@ def test_a_velocity_controller_forwards_the_command_and_a_nan_stops_the_wheel() 
             {"type": EFFORT, "joint": "nope", "pid": {"p": 1.0}},
             "Could not find joint 'nope' in 'hardware_interface::EffortJointInterface'.",
         ),
-        ({"type": EFFORT, "joint": "base_to_left_w", "pid": {"p": "x"}}, "/wheel/pid: gain 'p' must be a number"),
+        (
+            {"type": EFFORT, "joint": "base_to_left_w", "pid": {"p": "x"}},
+            "/wheel/pid: gain 'p' must be a number",
+        ),
     ],
 )
 def test_bad_parameters_are_refused_with_the_reason(params: dict, line: str) -> None:

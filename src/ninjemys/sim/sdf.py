@@ -300,6 +300,17 @@ class Footprint:
 class _Context:
     env: Mapping[str, str]
     unsupported: dict[str, str] = field(default_factory=dict)  # what -> first place
+    #: a world file: what cannot be found (a model:// of Gazebo's online database, a mesh) is left
+    #: out and reported, as Gazebo loads the world without it ("Unable to find uri[...]")
+    lenient: bool = False
+
+    def missing(self, uri: str, el: Element, exc: SdfError | None = None) -> None:
+        """SdfError, or in a world a note that ``uri`` is left out (Gazebo's behaviour)."""
+        if not self.lenient:
+            raise exc or el.error(f"{uri} not found")
+        self.skip(
+            f"{uri.strip()} (not found, left out as Gazebo does: 'Unable to find uri[{uri.strip()}]')", el
+        )
 
     def skip(self, what: str, el: Element) -> None:
         self.unsupported.setdefault(what, f"{el.source}:{el.line}")
@@ -474,7 +485,14 @@ def _geometry(geom: Element, m: np.ndarray, ctx: _Context) -> list[Footprint]:
         scale_el = shape.find("scale")
         if scale_el is not None:
             scale = np.array(_numbers(scale_el, 3, "x y z"))
-        path = resolve_uri(uri, shape, ctx.env)
+        try:
+            path = resolve_uri(uri, shape, ctx.env)
+        except SdfError as exc:
+            ctx.missing(uri, shape, exc)
+            return []
+        if not path.exists():
+            ctx.missing(uri, shape, shape.error(f"{path}: cannot read mesh: No such file or directory"))
+            return []
         try:
             parts = load_mesh_parts(path)
         except MapFileError as exc:
@@ -595,7 +613,14 @@ def _include(
     uri = el.value("uri")
     if not uri:
         raise el.error("missing <uri>")
-    target = resolve_uri(uri, el, ctx.env)
+    try:
+        target = resolve_uri(uri, el, ctx.env)
+    except SdfError as exc:
+        ctx.missing(uri, el, exc)
+        return
+    if not target.exists():
+        ctx.missing(uri, el, el.error(f"{uri}: {target} does not exist"))
+        return
     path = _model_file(target, el) if target.is_dir() else target
     root = _read_sdf(path, ctx, el)
     model = root.find("model")
@@ -649,7 +674,7 @@ def parse_sdf_world(
     warn: Callable[[str], None] | None = None,
 ) -> World:
     """A World from SDF text (``source`` names it in errors; relative mesh paths start at its folder)."""
-    ctx = _Context(os.environ if env is None else env)
+    ctx = _Context(os.environ if env is None else env, lenient=True)
     root = _sdf_root(data.encode() if isinstance(data, str) else data, source, ctx)
     world_el = root.find("world")
     if world_el is None:
