@@ -21,7 +21,7 @@ from ninjemys.sim.puzzlebot_node import SimNode
 from ninjemys.sim.robot_model import load_robot_model
 from ninjemys.sim.sdf import load_sdf_world, sdf_model_obstacles
 from ninjemys.sim.simcore import Simulation
-from ninjemys.sim.world2d import World
+from ninjemys.sim.world2d import Obstacle, World
 from ninjemys.testing import run_master
 
 SpawnModel = get_service_class("gazebo_msgs/SpawnModel")
@@ -265,3 +265,64 @@ def test_an_xml_declaration_out_of_place_is_read_past(tmp_path: Path) -> None:
         load_sdf_world(path, env=NO_ENV)
     path.write_text(text.replace("<model name='bad'><pose>1 2</pose></model>", ""))
     assert [o.name for o in load_sdf_world(path, env=NO_ENV).obstacles] == ["b"]
+
+
+def test_a_robot_spawned_slightly_into_a_wall_is_placed_and_may_only_move_away() -> None:
+    """Gazebo spawns a robot overlapping a wall and its physics pushes it out (a course's maze
+    launch spawns the PuzzleBot 7 cm from a wall, closer than its body circle's 12.8 cm): placed,
+    with the overlap noted, as long as the overlap is less than half the body radius."""
+    from ninjemys.sim.simcore import SpawnError
+    from ninjemys.sim.world2d import box_outline
+
+    wall = World("w", [Obstacle("wall", "box", box_outline(0.0, -0.5, 4.0, 0.2), 0.5, (90, 90, 90))])
+    sim = Simulation(wall)
+    model = load_robot_model("puzzlebot")
+    radius = model.body_radius
+    y = -0.4 + radius - 0.04  # 4 cm into the wall's face at y = -0.4
+    r = sim.add_robot("pb", model, 0.0, y, -math.pi / 2)
+    assert r.spawn_overlap == ("wall", pytest.approx(0.04))
+    for _ in range(50):  # towards the wall: refused, it does not go deeper
+        r.command(0.2, 0.0)
+        sim.step()
+    assert r.y == pytest.approx(y, abs=1e-9) and r.contact_with == "wall"
+    r.yaw = math.pi / 2  # turned round on the spot
+    for _ in range(50):  # away from it: free
+        r.command(0.2, 0.0)
+        sim.step()
+    assert r.y > y + 0.05
+    with pytest.raises(SpawnError, match=r"inside 'wall'"):
+        sim.add_robot("deep", load_robot_model("puzzlebot"), 1.0, -0.4 + radius * 0.4, 0.0)
+
+
+def test_a_maze_in_one_mesh_is_its_walls_not_its_hull(tmp_path: Path) -> None:
+    """The course mazes are one COLLADA or STL of joined walls; Gazebo's rays meet its triangles. Its
+    convex hull would fill the maze: the walls cut near the floor are its outline instead."""
+    from ninjemys.sim.meshes import write_binary_stl
+
+    ring = np.array([(0, 0), (2, 0), (2, 0.2), (0.2, 0.2), (0.2, 2), (0, 2)], dtype=float)  # an L
+    low, high = np.column_stack([ring, np.zeros(6)]), np.column_stack([ring, np.full(6, 0.3)])
+    tris = [(low[0], low[i], low[i + 1]) for i in range(1, 5)]  # a fan fits this L
+    tris += [(high[0], high[i + 1], high[i]) for i in range(1, 5)]
+    for i in range(6):
+        j = (i + 1) % 6
+        tris += [(low[i], low[j], high[j]), (low[i], high[j], high[i])]
+    write_binary_stl(tmp_path / "maze.stl", np.array(tris))
+    text = (
+        '<sdf version="1.6"><world name="w"><model name="maze"><static>1</static><link name="walls">'
+        '<collision name="collision"><geometry><mesh><uri>maze.stl</uri></mesh></geometry></collision>'
+        "</link></model></world></sdf>"
+    )
+    path = tmp_path / "w.world"
+    path.write_text(text)
+    world = load_sdf_world(path, env=NO_ENV)
+    # each side's two triangles are cut: two segments per side
+    assert {o.model_name for o in world.obstacles} == {"maze"} and len(world.obstacles) == 12
+    assert all(len(o.outline) == 2 and o.height == pytest.approx(0.3) for o in world.obstacles)
+    sim = Simulation(world)
+    model = load_robot_model("puzzlebot")
+    model.laser.noise = 0.0
+    r = sim.add_robot("pb", model, 1.0, 1.0, 0.0)  # inside the L's hull, clear of its walls
+    ranges = sim.scan(r).astype(np.float64)
+    assert ranges[beam(-90)] == pytest.approx(0.8, abs=1e-6)  # the wall's inner face at y = 0.2
+    assert ranges[beam(180)] == pytest.approx(0.8, abs=1e-6)  # and at x = 0.2
+    assert math.isinf(ranges[beam(45)])

@@ -41,7 +41,7 @@ import numpy as np
 from ninjemys.errors import PackageError
 from ninjemys.maps.mapfile import MapFileError
 from ninjemys.packages.discovery import find_package
-from ninjemys.sim.meshes import load_mesh_parts
+from ninjemys.sim.meshes import load_mesh
 from ninjemys.sim.world2d import Obstacle, World
 
 log = logging.getLogger(__name__)
@@ -494,14 +494,74 @@ def _geometry(geom: Element, m: np.ndarray, ctx: _Context) -> list[Footprint]:
             ctx.missing(uri, shape, shape.error(f"{path}: cannot read mesh: No such file or directory"))
             return []
         try:
-            parts = load_mesh_parts(path)
+            parts = load_mesh(path)
         except MapFileError as exc:
             raise shape.error(str(exc)) from None
-        return [_piece(_transform(m, part * scale), "mesh") for part in parts if len(part)]
+        out: list[Footprint] = []
+        for part in parts:
+            if len(part.vertices):
+                tris = _transform(m, part.triangles.reshape(-1, 3) * scale).reshape(-1, 3, 3)
+                out += _mesh_footprints(_transform(m, part.vertices * scale), tris)
+        return out
     if kind == "plane":
         return []  # the floor
     ctx.skip(f"<{kind}> geometry", shape)
     return []
+
+
+def _cross_section(tris: np.ndarray, z: float) -> np.ndarray:
+    """The (K, 4) segments where the plane at height ``z`` cuts the (T, 3, 3) triangles."""
+    d = tris[:, :, 2] - z
+    d = np.where(d == 0.0, 1e-12, d)  # a vertex on the plane counts as just above it
+    above = d > 0
+    cut = above.any(axis=1) & ~above.all(axis=1)
+    t, dd = tris[cut], d[cut]
+    ends = []
+    for a, b in ((0, 1), (1, 2), (2, 0)):
+        crosses = (dd[:, a] > 0) != (dd[:, b] > 0)
+        with np.errstate(divide="ignore", invalid="ignore"):  # edges that do not cross: dropped below
+            f = dd[:, a] / (dd[:, a] - dd[:, b])
+            point = t[:, a, :2] + (t[:, b, :2] - t[:, a, :2]) * f[:, None]
+        ends.append(np.where(crosses[:, None], point, np.nan))
+    pts = np.stack(ends, axis=1)  # (K, 3 edges, 2): two of the three edges cross
+    first = np.where(np.isnan(pts[:, 0, 0])[:, None], pts[:, 1], pts[:, 0])
+    second = np.where(np.isnan(pts[:, 2, 0])[:, None], pts[:, 1], pts[:, 2])
+    segs = np.hstack([first, second])
+    return segs[np.hypot(segs[:, 2] - segs[:, 0], segs[:, 3] - segs[:, 1]) > 1e-9]
+
+
+def _mesh_footprints(vertices: np.ndarray, tris: np.ndarray) -> list[Footprint]:
+    """A mesh part's footprint: its convex hull, unless its walls cut at a low height lie inside the
+    hull (a maze, an L-shaped wall, a room exported as one mesh): then the cut's segments, each a
+    thin wall as tall as the part, as Gazebo's rays meet the triangles themselves."""
+    hull = _piece(vertices, "mesh")
+    if len(tris) < 4 or len(hull.outline) < 3:
+        return [hull]
+    low, high = hull.bottom, hull.top
+    z = low + min(0.05, 0.25 * (high - low))  # near the floor: where a planar lidar looks
+    segs = _cross_section(tris, z)
+    if not len(segs):
+        return [hull]
+    outline = hull.outline
+    edges = np.hstack([outline, np.roll(outline, -1, axis=0)])
+    mids = (segs[:, :2] + segs[:, 2:]) / 2.0
+    # how far each cut segment's middle lies inside the hull: near its edge, the hull is the outline
+    span = float(min(np.ptp(outline[:, 0]), np.ptp(outline[:, 1])))
+    depth = _distance_to_segments(mids, edges).min(axis=1)
+    if float(depth.max()) <= max(0.02, 0.1 * span):
+        return [hull]
+    return [Footprint(seg.reshape(2, 2), high, "mesh", low) for seg in segs]
+
+
+def _distance_to_segments(points: np.ndarray, segs: np.ndarray) -> np.ndarray:
+    """(P, S) distances from points to segments."""
+    a, b = segs[None, :, :2], segs[None, :, 2:]
+    ab = b - a
+    ap = points[:, None, :] - a
+    length2 = np.maximum((ab * ab).sum(axis=2), 1e-18)
+    t = np.clip((ap * ab).sum(axis=2) / length2, 0.0, 1.0)
+    closest = a + ab * t[:, :, None]
+    return np.hypot(*(points[:, None, :] - closest).transpose(2, 0, 1))
 
 
 def _piece(points: np.ndarray, kind: str) -> Footprint:

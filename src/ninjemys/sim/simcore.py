@@ -28,6 +28,8 @@ from ninjemys.sim.world2d import MovingObstacle, Obstacle, World, box_outline, c
 TRAIL_LENGTH = 2000
 PERSONAL_SPACE = 0.2  # m: the gap a person who gives way keeps from a robot's body
 LOOK_AHEAD = 2.0  # m: how far ahead on its route such a person starts to step aside
+#: a robot is spawned when its body circle overlaps something by less than this share of its radius
+SPAWN_OVERLAP = 0.5
 #: the longest physics step set_physics_properties accepts (s): the collision check splits a move
 #: into short pieces, but sensors fire at most once a step, so a longer one would slow a 10 Hz lidar
 MAX_TIME_STEP = 0.1
@@ -93,6 +95,8 @@ class Robot:
     trail: deque = field(default_factory=lambda: deque(maxlen=TRAIL_LENGTH))
     trail_count: int = 0  # points ever appended (the view sends only the new ones)
     free: tuple[float, float, float] | None = None  # (x, y, r): a disk free of static geometry
+    #: spawned with its body overlapping this (name, metres): it may only move away from it
+    spawn_overlap: tuple[str, float] | None = None
     camera: Camera | None = None
     extra_cameras: list[Camera] = field(default_factory=list)  # for model.extra_cameras, in order
 
@@ -424,7 +428,10 @@ class Simulation:
         solid = self.solid_at(x, y, model.body_height)
         if solid:
             gap, what = 0.0, solid
-        if gap < model.body_radius:
+        # Gazebo spawns into an overlap and its physics pushes the body out; here a body whose
+        # circle overlaps by less than half its radius (the circle is wider than the real shape)
+        # is placed, and moves that bring it closer are refused; deeper than that, it is refused
+        if gap < model.body_radius * SPAWN_OVERLAP:
             raise SpawnError(
                 f"cannot spawn [{name}] at ({x:.3f}, {y:.3f}): it would be inside '{what}' "
                 f"(clearance {max(gap, 0.0):.3f} m, body radius {model.body_radius:.3f} m)"
@@ -432,6 +439,8 @@ class Simulation:
         rng = np.random.default_rng([self.seed, self._spawned])
         self._spawned += 1
         robot = Robot(name, model, x, y, yaw, (x, y, yaw), rng)
+        if gap < model.body_radius:
+            robot.spawn_overlap = (what, model.body_radius - gap)
         robot.odom_ref = (x, y, yaw)
         if model.camera is not None:
             robot.camera = camera_for(model.camera)
