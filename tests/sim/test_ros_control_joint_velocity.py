@@ -91,3 +91,40 @@ def test_bad_parameters_are_refused_with_the_reason(params: dict, line: str) -> 
     assert not cm.load("wheel")
     assert any(line in text for _, text in node.log.lines), node.log.lines
     assert node.log.lines[-1][1] == "Initializing controller 'wheel' failed"
+
+
+def test_a_course_control_package_naming_ros_control_builds(
+    tmp_path: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The course's puzzlebot_control asks catkin for ros_control's packages (a Python node beside
+    them): they are known, so catkin_make builds it, as on a machine with Gazebo and ros_control."""
+    from pathlib import Path
+
+    from ninjemys.packages.discovery import find_package
+    from ninjemys.tools import catkin_make
+
+    monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
+    monkeypatch.delenv("CMAKE_PREFIX_PATH", raising=False)
+    names = (
+        "controller_manager", "diff_drive_controller", "hardware_interface", "transmission_interface",
+        "effort_controllers", "velocity_controllers", "joint_state_controller", "gazebo_ros_control",
+    )  # fmt: skip
+    for name in names:
+        assert (find_package(name, {}) / "package.xml").is_file(), name
+    ws = Path(str(tmp_path))
+    pkg = ws / "src" / "course_control"
+    pkg.mkdir(parents=True)
+    (pkg / "package.xml").write_text(
+        '<?xml version="1.0"?>\n<package format="2"><name>course_control</name><version>0.0.1</version>'
+        '<description>d</description><maintainer email="a@b.c">a</maintainer><license>BSD</license>'
+        "<buildtool_depend>catkin</buildtool_depend>"
+        + "".join(f"<depend>{n}</depend>" for n in names)
+        + "</package>\n"
+    )
+    (pkg / "CMakeLists.txt").write_text(
+        "cmake_minimum_required(VERSION 3.0.2)\nproject(course_control)\n"
+        f"find_package(catkin REQUIRED COMPONENTS\n  rospy\n  {' '.join(names)}\n  std_msgs\n)\n"
+        "catkin_package()\n"
+    )
+    monkeypatch.chdir(ws)
+    assert catkin_make.main([]) == 0
