@@ -326,3 +326,20 @@ def test_a_maze_in_one_mesh_is_its_walls_not_its_hull(tmp_path: Path) -> None:
     assert ranges[beam(-90)] == pytest.approx(0.8, abs=1e-6)  # the wall's inner face at y = 0.2
     assert ranges[beam(180)] == pytest.approx(0.8, abs=1e-6)  # and at x = 0.2
     assert math.isinf(ranges[beam(45)])
+
+
+def test_a_world_models_pose_is_its_sdf_pose(tmp_path: Path) -> None:
+    """/gazebo/model_states gives a world model's own pose (its frame), not the centre of its shapes."""
+    text = (
+        '<sdf version="1.6"><world name="w"><model name="arm"><static>1</static><pose>1 2 0 0 0 0.5</pose>'
+        '<link name="l"><collision name="c"><pose>0.5 0 0.1 0 0 0</pose><geometry><box><size>0.2 0.2 0.2</size>'
+        "</box></geometry></collision></link></model></world></sdf>"
+    )
+    path = tmp_path / "w.world"
+    path.write_text(text)
+    sim = Simulation(load_sdf_world(path, env=NO_ENV))
+    assert sim.obstacle_pose("arm") == pytest.approx((1.0, 2.0, 0.5))
+    sim.move_obstacle("arm", 0.0, 0.0, 0.0)
+    (ob,) = sim.world.obstacles
+    assert ob.outline.mean(axis=0) == pytest.approx([0.5, 0.0], abs=1e-9)
+    assert sim.obstacle_pose("arm") == pytest.approx((0.0, 0.0, 0.0))

@@ -303,6 +303,8 @@ class _Context:
     #: a world file: what cannot be found (a model:// of Gazebo's online database, a mesh) is left
     #: out and reported, as Gazebo loads the world without it ("Unable to find uri[...]")
     lenient: bool = False
+    #: each top-level model's pose (x, y, yaw), as /gazebo/model_states reports it
+    origins: dict[str, tuple[float, float, float]] = field(default_factory=dict)
 
     def missing(self, uri: str, el: Element, exc: SdfError | None = None) -> None:
         """SdfError, or in a world a note that ``uri`` is left out (Gazebo's behaviour)."""
@@ -614,6 +616,8 @@ def _model(
         raise el.error("missing attribute 'name'")
     m = parent @ (pose_override if pose_override is not None else _pose(el, ctx))
     here = [*scope, name]
+    if not scope:
+        ctx.origins[name] = (float(m[0, 3]), float(m[1, 3]), math.atan2(float(m[1, 0]), float(m[0, 0])))
     if static is None:
         own = el.find("static")
         static = _bool(own) if own is not None else False
@@ -741,6 +745,8 @@ def parse_sdf_world(
         raise root.error("no <world> in this file (a model file? spawn it with spawn_model -sdf)")
     solids = _settle(_world_solids(world_el, ctx))
     world = World(world_el.attrib.get("name", Path(source).stem), _obstacles(solids), source=source)
+    kept = {s.path[0] for s in solids}
+    world.model_poses = {name: pose for name, pose in ctx.origins.items() if name in kept}
     _report(ctx, source, warn)
     return world
 

@@ -149,6 +149,9 @@ class Simulation:
         self._movers_at: tuple[float, tuple] | None = None
         self._mover_fixed: tuple | None = None
         self._floor = floor_paint(world)
+        for name, (x, y, yaw) in world.model_poses.items():  # an SDF world's models: their own poses
+            self.obstacle_origin[name] = (x, y)
+            self.obstacle_yaw[name] = yaw
         self._rebuild_static()
 
     @property

@@ -198,6 +198,8 @@ class World:
     grid: Grid | None = None
     bounds: tuple[float, float, float, float] | None = None  # xmin, ymin, xmax, ymax
     source: str = ""
+    #: models' poses (x, y, yaw) where the file gives them (an SDF world's models), by model name
+    model_poses: dict[str, tuple[float, float, float]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         self.rebuild()
