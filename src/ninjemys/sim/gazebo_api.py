@@ -12,7 +12,8 @@ the links fixed to its base, 1 kg without any), and its wheels stop it when the 
 
 The world is flat: a model's pose has the height it was spawned with and no roll or pitch. Models
 are the robots (links: the base, the wheels and the sensors) and the static obstacles (one link,
-``link``, or the links of an SDF model of several pieces: spawned, moved and deleted whole). Everything here runs under the simulation's lock; nothing here publishes per robot.
+``link``, or the links of an SDF model of several pieces: spawned, moved and deleted whole).
+Everything here runs under the simulation's lock; nothing here publishes per robot.
 """
 
 from __future__ import annotations
