@@ -343,3 +343,21 @@ def test_a_world_models_pose_is_its_sdf_pose(tmp_path: Path) -> None:
     (ob,) = sim.world.obstacles
     assert ob.outline.mean(axis=0) == pytest.approx([0.5, 0.0], abs=1e-9)
     assert sim.obstacle_pose("arm") == pytest.approx((0.0, 0.0, 0.0))
+
+
+def test_a_collada_triangle_past_its_positions_names_the_file(tmp_path: Path) -> None:
+    from ninjemys.sim.meshes import MeshError, load_mesh
+
+    dae = (
+        '<?xml version="1.0"?><COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">'
+        '<library_geometries><geometry id="g"><mesh><source id="p"><float_array id="a" count="9">'
+        '0 0 0 1 0 0 0 1 0</float_array></source><vertices id="v"><input semantic="POSITION" source="#p"/>'
+        '</vertices><triangles count="1"><input semantic="VERTEX" source="#v" offset="0"/><p>0 1 7</p>'
+        "</triangles></mesh></geometry></library_geometries></COLLADA>"
+    )
+    (tmp_path / "bad.dae").write_text(dae)
+    with pytest.raises(MeshError, match=r"bad.dae: <triangles> index 7 is past the 3 positions"):
+        load_mesh(tmp_path / "bad.dae")
+    (tmp_path / "good.dae").write_text(dae.replace("0 1 7", "0 1 2"))
+    (part,) = load_mesh(tmp_path / "good.dae")
+    assert part.triangles.shape == (1, 3, 3) and len(part.vertices) == 3
