@@ -361,3 +361,57 @@ def test_a_collada_triangle_past_its_positions_names_the_file(tmp_path: Path) ->
     (tmp_path / "good.dae").write_text(dae.replace("0 1 7", "0 1 2"))
     (part,) = load_mesh(tmp_path / "good.dae")
     assert part.triangles.shape == (1, 3, 3) and len(part.vertices) == 3
+
+
+def test_a_textured_track_plane_is_a_picture_the_camera_sees(tmp_path: Path) -> None:
+    """The course's line-following tracks are a plane with an OGRE material script whose texture is a
+    PNG (``model://track/materials/scripts`` + ``.../textures``): the camera sees the line on the floor."""
+    import cv2
+
+    model = tmp_path / "models" / "track"
+    (model / "materials" / "scripts").mkdir(parents=True)
+    (model / "materials" / "textures").mkdir(parents=True)
+    (model / "materials" / "scripts" / "track.material").write_text(
+        "material other\n{\n technique { pass { texture_unit { texture nothing.png } } }\n}\n"
+        "material track_line\n{\n  technique\n  {\n    pass\n    {\n      texture_unit\n      {\n"
+        "        texture line.png\n      }\n    }\n  }\n}\n"
+    )
+    image = np.full((200, 200, 3), 255, dtype=np.uint8)
+    image[95:105, :] = 0  # a black line across the middle: along x, at y = 0
+    image[:10, :] = (0, 0, 255)  # a red band along the +y edge (BGR): which way is up
+    cv2.imwrite(str(model / "materials" / "textures" / "line.png"), image)
+    text = (
+        '<?xml version="1.0"?>\n<sdf version="1.6"><world name="w"><model name="track"><static>1</static>'
+        '<link name="l"><visual name="v"><geometry><plane><normal>0 0 1</normal><size>4 4</size></plane>'
+        "</geometry><material><script><uri>model://track/materials/scripts</uri>"
+        "<uri>model://track/materials/textures</uri><name>track_line</name></script></material></visual>"
+        '<collision name="c"><geometry><plane><normal>0 0 1</normal><size>4 4</size></plane></geometry>'
+        "</collision></link></model></world></sdf>"
+    )
+    path = tmp_path / "w.world"
+    path.write_text(text)
+    warnings: list[str] = []
+    world = load_sdf_world(
+        path, env={**NO_ENV, "GAZEBO_MODEL_PATH": str(tmp_path / "models")}, warn=warnings.append
+    )
+    assert warnings == [] and world.obstacles == []
+    (picture,) = world.floor_images
+    assert picture.rgb.shape == (200, 200, 3) and (picture.width, picture.height) == (4.0, 4.0)
+    sim = Simulation(world)
+    floor = sim._floor
+    assert floor is not None
+
+    def floor_rgb(x: float, y: float) -> tuple[int, ...]:
+        col = int((x - floor.origin_x) / floor.resolution)
+        row = int((y - floor.origin_y) / floor.resolution)
+        return tuple(int(v) for v in floor.palette[int(floor.texture[row, col]) - 1])
+
+    assert floor_rgb(1.0, 0.0) == (0, 0, 0) and floor_rgb(1.0, 1.0) == (255, 255, 255)
+    assert floor_rgb(0.0, 1.95) == (255, 0, 0)  # the image's top row lies at +y
+    on = sim.add_robot("on", load_robot_model("puzzlebot"), -1.0, 0.0, 0.0)
+    rgb, _ = sim.render(on)
+    bottom = rgb[-1, on.camera.width // 2].astype(int)
+    assert bottom.max() < 60  # the line ahead of the robot, under the image's centre
+    off = sim.add_robot("off", load_robot_model("puzzlebot"), -1.0, 1.0, 0.0)
+    rgb, _ = sim.render(off)
+    assert rgb[-1, off.camera.width // 2].astype(int).min() > 150  # white floor beside it

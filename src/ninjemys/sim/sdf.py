@@ -42,7 +42,7 @@ from ninjemys.errors import PackageError
 from ninjemys.maps.mapfile import MapFileError
 from ninjemys.packages.discovery import find_package
 from ninjemys.sim.meshes import load_mesh
-from ninjemys.sim.world2d import Obstacle, World
+from ninjemys.sim.world2d import FloorImage, Obstacle, World
 
 log = logging.getLogger(__name__)
 
@@ -303,6 +303,8 @@ class _Context:
     #: a world file: what cannot be found (a model:// of Gazebo's online database, a mesh) is left
     #: out and reported, as Gazebo loads the world without it ("Unable to find uri[...]")
     lenient: bool = False
+    #: textured planes lying on the floor (a course's track), for the camera
+    floor_images: list[FloorImage] = field(default_factory=list)
     #: each top-level model's pose (x, y, yaw), as /gazebo/model_states reports it
     origins: dict[str, tuple[float, float, float]] = field(default_factory=dict)
 
@@ -402,9 +404,12 @@ def _sdf_root(data: bytes, source: str, ctx: _Context) -> Element:
     return root
 
 
-def _colour(link: Element, ctx: _Context) -> tuple[int, int, int]:
-    """The colour of a link's first visual material: diffuse, ambient, then the script's name."""
+def _colour(link: Element, ctx: _Context, pictures: tuple[Element, ...] = ()) -> tuple[int, int, int]:
+    """The colour of a link's first visual material: diffuse, ambient, then the script's name
+    (``pictures``: visuals drawn as floor pictures, not looked at)."""
     for visual in link.findall("visual"):
+        if any(visual is p for p in pictures):
+            continue
         mat = visual.find("material")
         if mat is None:
             continue
@@ -425,6 +430,83 @@ def _colour(link: Element, ctx: _Context) -> tuple[int, int, int]:
                 return GAZEBO_MATERIALS[name.lower()]
             ctx.skip(f"material script {name!r} (drawn grey)", script)
     return DEFAULT_COLOUR
+
+
+def _floor_picture(visual: Element, m: np.ndarray, ctx: _Context, name: str) -> FloorImage | None:
+    """A visual that is a horizontal ``<plane>`` with a textured material script (the course's
+    tracks: ``model://track/materials/scripts`` + ``.../textures``, material ``track``) as a picture on
+    the floor, wherever its height (the floor plan has one floor); None for anything else."""
+    geom = visual.find("geometry")
+    plane = geom.find("plane") if geom is not None else None
+    mat = visual.find("material")
+    script = mat.find("script") if mat is not None else None
+    if plane is None or script is None:
+        return None
+    material = (script.value("name") or "").strip()
+    if not material or material.lower() in GAZEBO_MATERIALS:
+        return None
+    size_el = plane.find("size")
+    if size_el is None:
+        return None
+    width, height = _numbers(size_el, 2, "x y")
+    normal_el = plane.find("normal")
+    vm = m @ _pose(visual, ctx)
+    normal = vm[:3, :3] @ np.array(_numbers(normal_el, 3, "x y z") if normal_el is not None else [0, 0, 1.0])
+    if width <= 0 or height <= 0 or abs(normal[2]) < 0.99 * float(np.linalg.norm(normal)):
+        return None  # a wall-like plane: nothing the floor shows
+    texture = _texture(script, material, ctx)
+    if texture is None:
+        ctx.skip(f"material script {material!r} (no texture found for it: drawn grey)", script)
+        return None
+    import cv2  # the course's PNG/JPEG textures; cv2 is a dependency already (cv_bridge)
+
+    bgr = cv2.imread(str(texture), cv2.IMREAD_COLOR)
+    if bgr is None:
+        ctx.skip(f"texture {texture} (not an image cv2 reads: drawn grey)", script)
+        return None
+    rgb = np.ascontiguousarray(bgr[:, :, ::-1])
+    yaw = math.atan2(float(vm[1, 0]), float(vm[0, 0]))
+    return FloorImage(name, rgb, float(vm[0, 3]), float(vm[1, 3]), width, height, yaw)
+
+
+#: ``material NAME`` (optionally ``: PARENT``) opening a block of an OGRE material script
+_MATERIAL = re.compile(r"^\s*material\s+([^\s{:]+)", re.MULTILINE)
+
+
+def _texture(script: Element, material: str, ctx: _Context) -> Path | None:
+    """The image of ``material``'s first ``texture`` in the material scripts its ``<uri>``s name
+    (folders of ``.material`` files, or files), looked for beside the script, in ``../textures``
+    and in the folders the ``<uri>``s name, as Gazebo's resource paths find it."""
+    dirs: list[Path] = []
+    files: list[Path] = []
+    for uri in script.findall("uri"):
+        try:
+            path = resolve_uri(uri.text, uri, ctx.env)
+        except SdfError:
+            continue
+        if path.is_dir():
+            dirs.append(path)
+        elif path.is_file():
+            files.append(path)
+    for script_file in files + [f for d in dirs for f in sorted(d.glob("*.material"))]:
+        try:
+            text = script_file.read_text(errors="replace")
+        except OSError:
+            continue
+        starts = list(_MATERIAL.finditer(text))
+        for i, block in enumerate(starts):
+            if block.group(1) != material:
+                continue
+            body = text[block.end() : starts[i + 1].start() if i + 1 < len(starts) else len(text)]
+            found = re.search(r"\btexture\s+([^\s}]+)", body)
+            if found is None:
+                return None
+            for d in (script_file.parent, script_file.parent.parent / "textures", *dirs):
+                candidate = d / found.group(1)
+                if candidate.is_file():
+                    return candidate
+            return None
+    return None
 
 
 def _pose(el: Element, ctx: _Context) -> np.ndarray:
@@ -642,7 +724,13 @@ def _link(
     if not name:
         raise el.error("missing attribute 'name'")
     m = model @ _pose(el, ctx)
-    colour = _colour(el, ctx)
+    pictures = []
+    for visual in el.findall("visual"):
+        picture = _floor_picture(visual, m, ctx, "::".join([*scope, name, visual.attrib.get("name", "")]))
+        if picture is not None:
+            ctx.floor_images.append(picture)
+            pictures.append(visual)
+    colour = _colour(el, ctx, tuple(pictures))
     for child in el.children:
         if child.tag == "collision":
             cname = child.attrib.get("name")
@@ -747,6 +835,7 @@ def parse_sdf_world(
     world = World(world_el.attrib.get("name", Path(source).stem), _obstacles(solids), source=source)
     kept = {s.path[0] for s in solids}
     world.model_poses = {name: pose for name, pose in ctx.origins.items() if name in kept}
+    world.floor_images = ctx.floor_images
     _report(ctx, source, warn)
     return world
 

@@ -834,11 +834,17 @@ def camera_for(spec: CameraSpec) -> Camera:
 
 
 def floor_paint(world: World, resolution: float = 0.01, max_cells: int = 2000) -> FloorPaint | None:
-    """The world's floor markings rasterized for the camera (None without markings)."""
-    if not world.markings:
+    """The world's floor markings and floor pictures rasterized for the camera (None without any).
+    Pictures come first (their colours quantized to a 6x6x6 cube), markings are painted over them."""
+    if not world.markings and not world.floor_images:
         return None
-    pts = np.vstack([m.points for m in world.markings])
-    margin = max(m.width for m in world.markings)
+    corners = [m.points for m in world.markings]
+    for im in world.floor_images:
+        c, s = math.cos(im.yaw), math.sin(im.yaw)
+        local = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * [im.width / 2, im.height / 2]
+        corners.append(local @ np.array([[c, s], [-s, c]]) + [im.cx, im.cy])
+    pts = np.vstack(corners)
+    margin = max((m.width for m in world.markings), default=0.0)
     lo = pts.min(axis=0) - margin
     hi = pts.max(axis=0) + margin
     res = max(resolution, float((hi - lo).max()) / max_cells)
@@ -848,7 +854,20 @@ def floor_paint(world: World, resolution: float = 0.01, max_cells: int = 2000) -
     gx, gy = np.meshgrid(cx, cy)
     texture = np.zeros((rows, cols), dtype=np.uint8)
     palette: list[tuple[int, int, int]] = []
-    for m in world.markings:
+    if world.floor_images:
+        levels = np.array([0, 51, 102, 153, 204, 255])
+        palette = [(int(r), int(g), int(b)) for r in levels for g in levels for b in levels]
+        for im in world.floor_images:
+            c, s = math.cos(im.yaw), math.sin(im.yaw)
+            lx = c * (gx - im.cx) + s * (gy - im.cy)
+            ly = -s * (gx - im.cx) + c * (gy - im.cy)
+            h, w = im.rgb.shape[:2]
+            u = np.floor((lx / im.width + 0.5) * w).astype(np.int64)
+            v = np.floor((0.5 - ly / im.height) * h).astype(np.int64)
+            on = (u >= 0) & (u < w) & (v >= 0) & (v < h)
+            q = (im.rgb[v[on], u[on]].astype(np.int64) + 25) // 51  # the nearest of the 6 levels
+            texture[on] = 1 + q[:, 0] * 36 + q[:, 1] * 6 + q[:, 2]
+    for m in world.markings[: 255 - len(palette)]:
         ink = len(palette) + 1
         palette.append(m.color)
         path = np.vstack([m.points, m.points[:1]]) if m.closed else m.points

@@ -101,6 +101,20 @@ class Marking:
 
 
 @dataclass
+class FloorImage:
+    """A picture on the floor (a Gazebo plane with a textured material: a course's track): its RGB
+    pixels (row 0 at the +y edge, column 0 at the -x edge, as seen from above), centre, size and yaw."""
+
+    name: str
+    rgb: np.ndarray  # (H, W, 3) uint8
+    cx: float
+    cy: float
+    width: float
+    height: float
+    yaw: float = 0.0
+
+
+@dataclass
 class RobotStart:
     name: str
     x: float
@@ -200,6 +214,8 @@ class World:
     source: str = ""
     #: models' poses (x, y, yaw) where the file gives them (an SDF world's models), by model name
     model_poses: dict[str, tuple[float, float, float]] = field(default_factory=dict)
+    #: pictures on the floor (an SDF world's textured planes): the camera sees them
+    floor_images: list[FloorImage] = field(default_factory=list)
 
     def __post_init__(self) -> None:
         self.rebuild()
