@@ -415,3 +415,29 @@ def test_a_textured_track_plane_is_a_picture_the_camera_sees(tmp_path: Path) -> 
     off = sim.add_robot("off", load_robot_model("puzzlebot"), -1.0, 1.0, 0.0)
     rgb, _ = sim.render(off)
     assert rgb[-1, off.camera.width // 2].astype(int).min() > 150  # white floor beside it
+
+
+def test_models_a_package_exports_for_gazebo_ros_are_found(tmp_path: Path) -> None:
+    """The maker's puzzlebot_world exports ``<gazebo_ros gazebo_model_path="${prefix}/models"/>``:
+    gazebo_ros' paths plugin adds it to the model path, so its worlds' model:// includes resolve
+    with nothing but the workspace sourced."""
+    pkg = tmp_path / "src" / "course_world"
+    (pkg / "models" / "pillar").mkdir(parents=True)
+    (pkg / "package.xml").write_text(
+        '<package format="2"><name>course_world</name><version>0.0.1</version><description>d</description>'
+        '<maintainer email="a@b.c">a</maintainer><license>BSD</license><exec_depend>gazebo_ros</exec_depend>'
+        '<export><gazebo_ros gazebo_model_path="${prefix}/models"/>'
+        '<gazebo_ros gazebo_media_path="${prefix}/models"/></export></package>'
+    )
+    (pkg / "models" / "pillar" / "model.sdf").write_text(
+        '<sdf version="1.6">' + BOX.format(name="pillar", static=STATIC, x=0, y=0, z=0.2) + "</sdf>"
+    )
+    text = '<sdf version="1.6"><world name="w"><include><uri>model://pillar</uri></include></world></sdf>'
+    path = tmp_path / "w.world"
+    path.write_text(text)
+    env = {**NO_ENV, "ROS_PACKAGE_PATH": str(tmp_path / "src")}
+    (ob,) = load_sdf_world(path, env=env).obstacles
+    assert ob.name == "pillar" and ob.height == pytest.approx(0.4)
+    warnings: list[str] = []
+    assert load_sdf_world(path, env=NO_ENV, warn=warnings.append).obstacles == []
+    assert "Unable to find uri[model://pillar]" in warnings[0]

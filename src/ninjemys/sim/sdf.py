@@ -27,10 +27,12 @@ Malformed SDF raises :class:`SdfError` with ``file:line: <element>: reason``.
 
 from __future__ import annotations
 
+import functools
 import logging
 import math
 import os
 import re
+import xml.etree.ElementTree as ET
 import xml.parsers.expat
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -40,7 +42,7 @@ import numpy as np
 
 from ninjemys.errors import PackageError
 from ninjemys.maps.mapfile import MapFileError
-from ninjemys.packages.discovery import find_package
+from ninjemys.packages.discovery import crawl, find_package
 from ninjemys.sim.meshes import load_mesh
 from ninjemys.sim.world2d import FloorImage, Obstacle, World
 
@@ -321,14 +323,37 @@ class _Context:
 
 
 def model_dirs(env: Mapping[str, str] | None = None) -> list[Path]:
-    """Where ``model://`` URIs are looked up, in Gazebo's order, ending with our shipped models."""
+    """Where ``model://`` URIs are looked up, in Gazebo's order, ending with our shipped models:
+    GAZEBO_MODEL_PATH, the ``gazebo_model_path`` the packages on ROS_PACKAGE_PATH export (what
+    gazebo_ros' paths plugin adds), ``~/.gazebo/models``."""
     environ = os.environ if env is None else env
     dirs = [Path(d) for d in environ.get("GAZEBO_MODEL_PATH", "").split(":") if d]
+    dirs += [Path(d) for d in _exported_model_paths(environ.get("ROS_PACKAGE_PATH", ""))]
     home = environ.get("HOME")
     if home:
         dirs.append(Path(home) / ".gazebo" / "models")
     dirs.append(SHIPPED_MODELS)
     return dirs
+
+
+@functools.lru_cache(maxsize=8)
+def _exported_model_paths(ros_package_path: str) -> tuple[str, ...]:
+    """``<export><gazebo_ros gazebo_model_path="${prefix}/models"/></export>`` of every package on
+    ``ros_package_path`` (the maker's puzzlebot_world has it), ``${prefix}`` being the package's
+    folder: gazebo_ros' paths plugin adds these to Gazebo's model path (``rospack plugins``)."""
+    found: list[str] = []
+    for root in (Path(d) for d in ros_package_path.split(":") if d):
+        for pkg_dir in crawl(root):
+            try:
+                tree = ET.parse(pkg_dir / "package.xml")
+            except (OSError, ET.ParseError):
+                continue
+            for export in tree.getroot().findall("export"):
+                for gz in export.findall("gazebo_ros"):
+                    value = gz.get("gazebo_model_path")
+                    if value:
+                        found.append(value.replace("${prefix}", str(pkg_dir)))
+    return tuple(found)
 
 
 def resolve_uri(uri: str, el: Element, env: Mapping[str, str]) -> Path:
