@@ -218,6 +218,10 @@ def test_spawning_several_pieces_onto_a_robot_is_refused_unless_held_above_it(si
     # a static box spawned at 1 m is held there, over the robot; without <static> it falls on it
     box = '<sdf version="1.6">' + BOX.format(name="b", static=STATIC, x=0, y=0, z=0) + "</sdf>"
     assert spawn(sim, "lamp", box, 0.0, 0.0, 1.0).success
+    assert sim.gazebo.model_pose("lamp") == pytest.approx((0.0, 0.0, 1.0, 0.0))  # held where it was put
+    box_physics = '<sdf version="1.6">' + BOX.format(name="b", static="", x=0, y=0, z=0) + "</sdf>"
+    assert spawn(sim, "dropped", box_physics, 2.0, 0.0, 1.0).success
+    assert sim.gazebo.model_pose("dropped") == pytest.approx((2.0, 0.0, 0.2, 0.0))  # resting on the floor
     box = '<sdf version="1.6">' + BOX.format(name="b", static="", x=0, y=0, z=0) + "</sdf>"
     resp = spawn(sim, "falls", box, 0.0, 0.0, 1.0)
     assert not resp.success and "would overlap robot [puzzlebot]" in resp.status_message

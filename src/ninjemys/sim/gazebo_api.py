@@ -268,7 +268,8 @@ class GazeboApi:
                     return resp
                 pose = compose(ref, pose)
             x, y, z, yaw = pose
-            kind, spec = parse_model_xml(req.model_xml, z)
+            drops: dict[str, float] = {}
+            kind, spec = parse_model_xml(req.model_xml, z, drops)
             if kind == "robot":
                 namespace = req.robot_namespace.strip("/")
                 clash = any(io.prefix == "" for io in sn.io.values())
@@ -281,6 +282,7 @@ class GazeboApi:
                 pieces = _placed(name, spec, x, y, yaw)
                 with sn.lock:
                     sn.sim.add_model(name, pieces, yaw, (x, y))
+                z -= max(drops.values(), default=0.0)  # a model with physics settles on the floor
                 what = pieces[0].kind if len(pieces) == 1 else f"{len(pieces)} pieces"
                 sn.log.info("spawned SDF model [%s] (%s) at (%.3f, %.3f, %.3f)", name, what, x, y, z)
             else:
@@ -617,14 +619,14 @@ def _placed(name: str, pieces: list[Obstacle], x: float, y: float, yaw: float) -
     return placed
 
 
-def parse_model_xml(text: str, z: float = 0.0) -> tuple[str, Any]:
+def parse_model_xml(text: str, z: float = 0.0, drops: dict[str, float] | None = None) -> tuple[str, Any]:
     """What a SpawnModel request's ``model_xml`` describes: ("robot", RobotModel),
     ("obstacle", (shape, size, height, colour)) for a URDF box or cylinder, or ("sdf", [Obstacle])
     for an SDF document (a ``<model>``, or spawn_model -database's ``<world>`` of one ``model://``
     include, found on GAZEBO_MODEL_PATH or among the shipped models), its pieces in the model's
     frame with their heights as the model settles when spawned at height ``z`` (static: held there;
-    else on the floor), none for a model with nothing solid (a light, a ground plane). Empty text or
-    ``puzzlebot`` is the PuzzleBot."""
+    else on the floor; ``drops``: how far it fell), none for a model with nothing solid (a light, a
+    ground plane). Empty text or ``puzzlebot`` is the PuzzleBot."""
     body = text.strip()
     if not body:
         return "robot", load_robot_model("puzzlebot")
@@ -636,7 +638,7 @@ def parse_model_xml(text: str, z: float = 0.0) -> tuple[str, Any]:
         raise SpawnError(f"model_xml is not valid XML: {exc}") from None
     if root.tag == "sdf":
         # SdfError (a MapFileError) names the element and the reason
-        return "sdf", sdf_model_obstacles(body, z=z)
+        return "sdf", sdf_model_obstacles(body, z=z, drops=drops)
     if root.tag == "robot" and any(j.get("type") == "continuous" for j in root.iter("joint")):
         # a robot with wheels: the URDF reader says what it is, or why it cannot be simulated
         return "robot", model_from_urdf(body, "model_xml")

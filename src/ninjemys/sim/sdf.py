@@ -686,17 +686,20 @@ class _Solid:
     static: bool = False  # its model is static: it stays where it is put
 
 
-def _settle(solids: list[_Solid]) -> list[_Solid]:
+def _settle(solids: list[_Solid], drops: dict[str, float] | None = None) -> list[_Solid]:
     """Heights as Gazebo's physics leaves each top-level model (all its pieces together): a static
     model stays at its pose (a table top held at 0.75 m floats there; a part below the floor is
     hidden), a model with physics falls onto the floor, or is pushed up out of it, until its lowest
     point touches it. The floor is the only thing models land on here (a box dropped onto a table
-    lands on the floor). Pieces with nothing above the floor are dropped."""
+    lands on the floor). Pieces with nothing above the floor are dropped. ``drops`` receives how far
+    each model fell (negative: pushed up)."""
     lowest: dict[str, float] = {}
     for s in solids:
         if not s.static:
             key = s.path[0]
             lowest[key] = min(lowest.get(key, math.inf), s.footprint.bottom)
+    if drops is not None:
+        drops.update(lowest)
     kept = []
     for s in solids:
         fp = s.footprint
@@ -871,12 +874,14 @@ def sdf_model_obstacles(
     env: Mapping[str, str] | None = None,
     warn: Callable[[str], None] | None = None,
     z: float = 0.0,
+    drops: dict[str, float] | None = None,
 ) -> list[Obstacle]:
     """The obstacles of an SDF model document (``<sdf><model>``, as spawn_sdf_model receives it, or a
     ``<world>`` of includes), their outlines in the model's frame (place them at the spawn pose),
     their heights as the model settles when spawned at height ``z``: a static model stays there, one
     with physics falls onto the floor or is pushed up out of it (:func:`_settle`). A model of several
-    pieces (a table: top and legs) gives one obstacle per piece, each naming the model."""
+    pieces (a table: top and legs) gives one obstacle per piece, each naming the model. ``drops``
+    receives how far each model with physics fell from ``z`` (its pose after it settles: ``z - drop``)."""
     ctx = _Context(os.environ if env is None else env)
     root = _sdf_root(data.encode() if isinstance(data, str) else data, source, ctx)
     solids: list[_Solid] = []
@@ -891,7 +896,7 @@ def sdf_model_obstacles(
     for solid in solids:
         solid.footprint.top += z
         solid.footprint.bottom += z
-    return _obstacles(_settle(solids))
+    return _obstacles(_settle(solids, drops))
 
 
 def _world_solids(world_el: Element, ctx: _Context) -> list[_Solid]:
