@@ -14,7 +14,7 @@ bytes to the same values. Signature of the generated function::
     decode_frames(data: bytes, pos: int, stop: int, out: list, bad: list) -> int
 
 It decodes the complete frames of ``data[pos:stop]`` into ``out`` and returns the offset of the first
-incomplete one; a frame that does not decode adds a DeserializationError to ``bad`` and is skipped
+incomplete one; a frame that does not decode adds ``(its length, DeserializationError)`` to ``bad`` and is skipped
 (its length prefix says where the next one starts). ``data`` must be immutable ``bytes``: array fields
 are views into it, which keep it alive as long as the message lives.
 """
@@ -68,9 +68,9 @@ def frames_decoder_source(spec: Any, lookup: Callable[[str], Any]) -> str:
         *de.lines,
         "            append(o)",
         "        except _DeserializationError as exc:",
-        "            bad.append(exc)",
+        "            bad.append((_fl, exc))",
         "        except _DESER_ERRORS as exc:",
-        "            bad.append(_deser_failed(cls, data[end - _fl:end], exc))",
+        "            bad.append((_fl, _deser_failed(cls, data[end - _fl:end], exc)))",
         "        pos = end",
         "    return pos",
     ]

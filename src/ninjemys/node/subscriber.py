@@ -249,6 +249,64 @@ class SubConnection:
                 self.last = frames[-1]
         return frames
 
+    def read_decoded(
+        self, budget: int | None, decode: Any, cap: int | None, min_frame: int
+    ) -> tuple[list[Any], list[bytes | bytearray], list[tuple[int, Exception]]] | None:
+        """:meth:`read` fused with decoding (the worker's fast path for a plain, unlatched stream):
+        ``(messages, frames, failures)``: the messages decoded as they were cut, then the frames left
+        to decode one by one (a large frame received in place, or, once ``cap`` messages could be
+        exceeded, everything after: a bounded queue drops those unread rather than decoded), and
+        ``(length, error)`` for each frame that did not decode. None when the stream has ended."""
+        reader, sock = self._reader, self.sock
+        msgs: list[Any] = []
+        frames: list[bytes | bytearray] = []
+        bad: list[tuple[int, Exception]] = []
+        got = 0
+        fused = True
+        while True:
+            buf = reader.buffer()
+            try:
+                n = sock.recv_into(buf)
+            except (BlockingIOError, InterruptedError):
+                break
+            except OSError as exc:
+                self._lost(f"read failed: {exc}")
+                return None
+            if n == 0:
+                if reader.pending:
+                    self._lost(
+                        f"publisher disconnected mid-message ({reader.pending} bytes of a frame received)",
+                        logging.WARNING,
+                    )
+                else:
+                    self._lost("publisher closed the connection")
+                return None
+            self.bytes_recv += n
+            got += n
+            if fused and cap is not None and len(msgs) + (reader.pending + n) // min_frame > cap:
+                fused = False
+            try:
+                if fused and not frames:
+                    frames = reader.commit_decoded(n, decode, msgs, bad)
+                    if frames:  # a large frame: decoded here, so that everything stays in order
+                        _decode_into(self.sub.msg_class, frames, msgs, bad)
+                        frames = []
+                else:
+                    frames.extend(reader.commit(n))
+            except ProtocolError as exc:
+                _log.warning("topic %s: dropped publisher %s: %s", self.sub.topic, self.publisher, exc)
+                self.close()
+                self.sub.node.runtime.call_soon(self.sub.connection_lost, self, False)
+                return None
+            if n < len(buf):
+                break  # the kernel had no more: skip the EAGAIN round trip
+            if budget is None:
+                budget = got + _kernel_pending(sock)  # the first full read: this round ends there
+            if got >= budget:
+                break
+        self.num_recv += len(msgs) + len(frames) + len(bad)
+        return msgs, frames, bad
+
     def _lost(self, why: str, level: int = logging.INFO) -> None:
         _log.log(level, "topic %s: %s (%s)", self.sub.topic, why, self.publisher)
         self.close()
@@ -260,6 +318,16 @@ class SubConnection:
             return
         self.closed = True
         transport.close_quietly(self.sock)
+
+
+def _decode_into(cls: Any, frames: list[bytes | bytearray], out: list[Any], bad: list[tuple[int, Exception]]) -> None:
+    """Decode ``frames`` one by one onto ``out`` (failures onto ``bad``, as the fused decoder does)."""
+    decode = cls.deserialize_from
+    for frame in frames:
+        try:
+            out.append(decode(frame))
+        except Exception as exc:  # generated code raises DeserializationError, struct.error, ...
+            bad.append((len(frame), exc))
 
 
 def shm_offer() -> list[str] | None:
@@ -545,6 +613,8 @@ class Subscriber:
             maxlen=queue_size if queue_size and queue_size > 0 else None
         )
         self._closed = False
+        #: the fused decoder of this type (None: not looked up yet; False: none), see _read_fused
+        self._fused: Any = None
         if share is not None:
             host = share._host
             with host._ops_lock:
@@ -801,7 +871,14 @@ class Subscriber:
         owner = conn.reader or self
         # a bounded queue keeps the newest: read what the kernel holds and drop; an unbounded one
         # delivers as it goes (reading megabytes of backlog first would stall every callback meanwhile)
-        frames = conn.read(None if owner._queue.maxlen is not None else _READ_BUDGET)
+        maxlen = owner._queue.maxlen
+        fused = owner._fused
+        if fused is None:
+            fused = owner._fused = owner._frames_decoder()
+        if fused and conn.__class__ is SubConnection and not conn.latching and len(owner._sub.handles) == 1:
+            self._read_fused(owner, conn, fused, maxlen)
+            return
+        frames = conn.read(None if maxlen is not None else _READ_BUDGET)
         if frames is None:
             self._forget(conn)
             return
@@ -821,6 +898,66 @@ class Subscriber:
                     owner._deliver_batch(frames, conn.header)
             else:
                 owner._deliver_batch(frames, conn.header)
+
+    def _frames_decoder(self) -> Any:
+        """The fused decoder of this handle's type (see :mod:`ninjemys.idl.framedecode`), or False when
+        its messages go the per-frame way (raw, batch, a class not generated here)."""
+        if self._decode is None or self.batch or self.data_class is None:
+            return False
+        from ninjemys.idl.framedecode import frames_decoder
+
+        try:
+            return frames_decoder(self.data_class) or False
+        except Exception as exc:  # a class whose generated code we cannot regenerate: keep the old path
+            _log.info("topic %s: per-frame decoding (%s)", self.name, exc)
+            return False
+
+    def _read_fused(self, owner: Subscriber, conn: SubConnection, fused: Any, maxlen: int | None) -> None:
+        """The fast path of :meth:`_read`: one handle, a plain stream; frames are decoded as they are
+        cut and the callback is called in a tight loop."""
+        got = conn.read_decoded(None if maxlen is not None else _READ_BUDGET, fused[0], maxlen, fused[1])
+        if got is None:
+            self._forget(conn)
+            return
+        msgs, frames, bad = got
+        for length, exc in bad:
+            owner._undecodable_length(length, conn.header, exc)
+        if maxlen is not None and len(msgs) + len(frames) > maxlen:  # drop the oldest, as the queue would
+            over = len(msgs) + len(frames) - maxlen
+            owner.dropped += over
+            if over >= len(msgs):
+                frames = frames[over - len(msgs) :]
+                msgs = []
+            else:
+                msgs = msgs[over:]
+        if owner._direct:
+            with owner._busy:
+                owner._deliver_msgs(msgs)
+                if frames:
+                    owner._deliver_batch(frames, conn.header)
+        else:
+            owner._deliver_msgs(msgs)
+            if frames:
+                owner._deliver_batch(frames, conn.header)
+
+    def _deliver_msgs(self, msgs: list[Any]) -> None:
+        """Call back with decoded messages, in order; the usual case (one callback without args) in a
+        tight loop, as this runs once per received message."""
+        callbacks = self._callbacks
+        if len(callbacks) == 1 and callbacks[0][1] is None:
+            callback = callbacks[0][0]
+            for msg in msgs:
+                if self._closed:
+                    return
+                try:
+                    callback(msg)
+                except Exception:
+                    _log.exception("topic %s: callback %r raised", self.name, callback)
+            return
+        for msg in msgs:
+            if self._closed:
+                return
+            self._call(msg)
 
     def _finish(self) -> None:
         """Worker exit: pass our connections to the next handle of their topic, or close them."""
@@ -889,10 +1026,13 @@ class Subscriber:
                 _log.exception("topic %s: callback %r raised", self.name, callback)
 
     def _undecodable(self, frame: bytes | bytearray, header: Mapping[str, str], exc: Exception) -> None:
+        self._undecodable_length(len(frame), header, exc)
+
+    def _undecodable_length(self, length: int, header: Mapping[str, str], exc: Exception) -> None:
         _log.warning(
             "topic %s: cannot deserialize a %d-byte %s from %s: %s",
             self.name,
-            len(frame),
+            length,
             self.type,
             header.get("callerid", "?"),
             exc,

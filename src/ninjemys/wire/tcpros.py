@@ -13,6 +13,7 @@ handed over as the frame (one copy from the kernel, none in Python).
 from __future__ import annotations
 
 import struct
+from collections.abc import Callable
 
 from ninjemys.errors import ProtocolError
 
@@ -135,19 +136,47 @@ class FrameReader:
                     self.special += 1
                 start = stop
                 continue
-            if length > self._limit:
-                raise ProtocolError(f"message length prefix {length} exceeds the {self._limit}-byte limit")
-            if length >= self._large:
-                have = end - start - 4
-                big = bytearray(length)
-                big[:have] = buf[start + 4 : end]
-                self._big, self._big_view, self._big_fill = big, memoryview(big), have
-                start = end
+            start = self._incomplete(length, start, end)
             break
         if start == end:
             start = end = 0
         self._start, self._end = start, end
         return frames
+
+    def _incomplete(self, length: int, start: int, end: int) -> int:
+        """The frame at ``start`` (``length`` bytes of body) is not complete: refuse a length above the
+        limit, and receive a large one in place. Returns where the unconsumed bytes start now."""
+        if length > self._limit:
+            raise ProtocolError(f"message length prefix {length} exceeds the {self._limit}-byte limit")
+        if length >= self._large:
+            have = end - start - 4
+            big = bytearray(length)
+            big[:have] = self._buf[start + 4 : end]
+            self._big, self._big_view, self._big_fill = big, memoryview(big), have
+            return end
+        return start
+
+    def commit_decoded(self, n: int, decode: Callable[[bytes, int, int, list, list], int], out: list,
+                       bad: list) -> list[bytes | bytearray]:  # fmt: skip
+        """Like :meth:`commit`, for an untagged stream, with the complete small frames decoded by
+        ``decode`` (a generated ``decode_frames``, see :mod:`ninjemys.idl.framedecode`) into ``out``
+        and their failures into ``bad``. Returns the frames left undecoded (a large frame received in
+        place; never together with decoded ones), which the caller decodes itself, in order.
+
+        The decoder reads an immutable copy of the bytes received (decoded arrays are views of it, so
+        the buffer can be reused at once): one copy per read, not one per frame."""
+        if self._big is not None or self._skip != 4:
+            return self.commit(n)
+        end = self._end + n
+        start = self._start
+        data = self._view[start:end].tobytes()
+        start += decode(data, 0, end - start, out, bad)
+        if start + 4 <= end:
+            start = self._incomplete(_U32.unpack_from(self._buf, start)[0], start, end)
+        if start == end:
+            start = end = 0
+        self._start, self._end = start, end
+        return []
 
     @property
     def pending(self) -> int:
