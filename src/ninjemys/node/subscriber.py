@@ -179,6 +179,8 @@ class SubConnection:
     """One publisher's stream for one topic, read on the loop."""
 
     intra = False
+    #: frames start with a tag byte (SHMROS): the reader's and the fused decoder's framing
+    tagged = False
 
     def __init__(self, sub: Subscription, sock: socket.socket, uri: str, header: Mapping[str, str]) -> None:
         self.sub = sub
@@ -288,9 +290,13 @@ class SubConnection:
             try:
                 if fused and not frames:
                     frames = reader.commit_decoded(n, decode, msgs, bad)
-                    if frames:  # a large frame: decoded here, so that everything stays in order
-                        _decode_into(self.sub.msg_class, frames, msgs, bad)
+                    if frames:  # a large frame (or a tagged one): decoded here, so that order is kept
+                        frames = self.untag(frames)
+                        if frames:
+                            _decode_into(self.sub.msg_class, frames, msgs, bad)
                         frames = []
+                        if self.closed:
+                            break  # a malformed stream, closed: deliver what came before
                 else:
                     frames.extend(reader.commit(n))
             except ProtocolError as exc:
@@ -304,8 +310,15 @@ class SubConnection:
                 budget = got + _kernel_pending(sock)  # the first full read: this round ends there
             if got >= budget:
                 break
+        if frames:
+            frames = self.untag(frames) or []
         self.num_recv += len(msgs) + len(frames) + len(bad)
         return msgs, frames, bad
+
+    def untag(self, frames: list[Any]) -> list[Any] | None:
+        """The messages' bytes in frames cut from this stream (a tagged stream overrides this); None
+        when the stream turned out malformed (then it is closed)."""
+        return frames
 
     def _lost(self, why: str, level: int = logging.INFO) -> None:
         _log.log(level, "topic %s: %s (%s)", self.sub.topic, why, self.publisher)
@@ -613,8 +626,9 @@ class Subscriber:
             maxlen=queue_size if queue_size and queue_size > 0 else None
         )
         self._closed = False
-        #: the fused decoder of this type (None: not looked up yet; False: none), see _read_fused
-        self._fused: Any = None
+        #: the fused decoders of this type for plain and tagged streams (None: not made yet; False:
+        #: none), see _read_fused
+        self._fused: list[Any] = [None, None]
         if share is not None:
             host = share._host
             with host._ops_lock:
@@ -872,10 +886,11 @@ class Subscriber:
         # a bounded queue keeps the newest: read what the kernel holds and drop; an unbounded one
         # delivers as it goes (reading megabytes of backlog first would stall every callback meanwhile)
         maxlen = owner._queue.maxlen
-        fused = owner._fused
+        tagged = conn.tagged
+        fused = owner._fused[tagged]
         if fused is None:
-            fused = owner._fused = owner._frames_decoder()
-        if fused and conn.__class__ is SubConnection and not conn.latching and len(owner._sub.handles) == 1:
+            fused = owner._fused[tagged] = owner._frames_decoder(tagged)
+        if fused and not conn.latching and len(owner._sub.handles) == 1:
             self._read_fused(owner, conn, fused, maxlen)
             return
         frames = conn.read(None if maxlen is not None else _READ_BUDGET)
@@ -899,7 +914,7 @@ class Subscriber:
             else:
                 owner._deliver_batch(frames, conn.header)
 
-    def _frames_decoder(self) -> Any:
+    def _frames_decoder(self, tagged: bool) -> Any:
         """The fused decoder of this handle's type (see :mod:`ninjemys.idl.framedecode`), or False when
         its messages go the per-frame way (raw, batch, a class not generated here)."""
         if self._decode is None or self.batch or self.data_class is None:
@@ -907,7 +922,7 @@ class Subscriber:
         from ninjemys.idl.framedecode import frames_decoder
 
         try:
-            return frames_decoder(self.data_class) or False
+            return frames_decoder(self.data_class, tagged) or False
         except Exception as exc:  # a class whose generated code we cannot regenerate: keep the old path
             _log.info("topic %s: per-frame decoding (%s)", self.name, exc)
             return False

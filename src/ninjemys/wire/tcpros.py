@@ -121,6 +121,10 @@ class FrameReader:
                 self.special += 1
             return frames
         self._end += n
+        return self._cut(frames)
+
+    def _cut(self, frames: list[bytes | bytearray]) -> list[bytes | bytearray]:
+        """Append the complete frames between ``_start`` and ``_end`` to ``frames``; keep the rest."""
         buf, view, start, end = self._buf, self._view, self._start, self._end
         unpack_from = _U32.unpack_from
         append = frames.append
@@ -158,25 +162,24 @@ class FrameReader:
 
     def commit_decoded(self, n: int, decode: Callable[[bytes, int, int, list, list], int], out: list,
                        bad: list) -> list[bytes | bytearray]:  # fmt: skip
-        """Like :meth:`commit`, for an untagged stream, with the complete small frames decoded by
-        ``decode`` (a generated ``decode_frames``, see :mod:`ninjemys.idl.framedecode`) into ``out``
-        and their failures into ``bad``. Returns the frames left undecoded (a large frame received in
-        place; never together with decoded ones), which the caller decodes itself, in order.
+        """Like :meth:`commit`, with the complete small frames decoded by ``decode`` (a generated
+        ``decode_frames`` for this stream's tagging, see :mod:`ninjemys.idl.framedecode`) into ``out``
+        and their failures into ``bad``. Returns the frames left undecoded, which follow ``out``'s
+        and which the caller decodes itself: a large frame received in place, or on a tagged stream
+        a frame with another tag than 0 and every frame after it in this read.
 
         The decoder reads an immutable copy of the bytes received (decoded arrays are views of it, so
         the buffer can be reused at once): one copy per read, not one per frame."""
-        if self._big is not None or self._skip != 4:
+        if self._big is not None:
             return self.commit(n)
         end = self._end + n
         start = self._start
-        data = self._view[start:end].tobytes()
-        start += decode(data, 0, end - start, out, bad)
-        if start + 4 <= end:
-            start = self._incomplete(_U32.unpack_from(self._buf, start)[0], start, end)
+        start += decode(self._view[start:end].tobytes(), 0, end - start, out, bad)
         if start == end:
-            start = end = 0
+            self._start = self._end = 0
+            return []
         self._start, self._end = start, end
-        return []
+        return self._cut([])
 
     @property
     def pending(self) -> int:
