@@ -38,17 +38,37 @@ _lock = threading.Lock()
 _decoders: dict[tuple[type, bool], tuple[FramesDecoder, int] | None] = {}
 
 
+class _FrameDeserEmitter(_DeserEmitter):
+    """The class's decode, bounded by its frame: ``deserialize_from`` gets a buffer that ends where
+    the message ends, so a fixed-size run past it is a ``struct.error``; here the chunk goes on with
+    the next frame, so every fixed-size read is followed by a check against the frame's end (one
+    comparison per run)."""
+
+    def emit(self, line: str) -> None:
+        super().emit(line)
+        if line.startswith("pos += ") and self._after_unpack:
+            super().emit("if pos > end: raise _overrun(end - pos)")
+        self._after_unpack = ".unpack_from(mv, pos)" in line
+
+    _after_unpack = False
+
+
+def _overrun(short: int) -> ValueError:
+    """The error of a frame that ends inside a fixed-size field (``deserialize_from`` wraps it)."""
+    return ValueError(f"the frame ends {-short} bytes before its fixed-size fields do")
+
+
 def frames_decoder_source(spec: Any, lookup: Callable[[str], Any], tagged: bool = False) -> str:
     """Python source of ``decode_frames`` for ``spec`` (a pure function of its inputs). ``tagged``: for
     a stream whose bodies start with a tag byte (SHMROS): a frame tagged 0 is decoded after its tag,
     and the first frame with another tag ends the run (the caller's generic path takes it)."""
     structs: dict[str, str] = {}
-    de = _DeserEmitter(spec.full_name, lookup, structs, depth=3)
+    de = _FrameDeserEmitter(spec.full_name, lookup, structs, depth=3)
     de.fields(spec, "o")
     de.flush()
     if not de.views:  # strings and numbers only: slice and decode the bytes directly
         structs.clear()
-        de = _DeserEmitter(spec.full_name, lookup, structs, depth=3, bytes_buffer=True)
+        de = _FrameDeserEmitter(spec.full_name, lookup, structs, depth=3, bytes_buffer=True)
         de.fields(spec, "o")
         de.flush()
     head = [f"{name} = _struct.Struct({fmt!r})" for fmt, name in structs.items()]
@@ -107,6 +127,7 @@ def _make(cls: Any, tagged: bool) -> tuple[FramesDecoder, int] | None:
     namespace = dict(deser.__func__.__globals__)  # the class's own runtime names and nested classes
     namespace["_cls"] = cls
     namespace["_DeserializationError"] = DeserializationError
+    namespace["_overrun"] = _overrun
     source = frames_decoder_source(spec, lookup, tagged)
     exec(compile_cached(source, f"<ninjemys frames decoder {spec.full_name}>"), namespace)  # noqa: S102
     return namespace["decode_frames"], (5 if tagged else 4) + min_size(spec, lookup)
