@@ -44,13 +44,26 @@ class _FrameDeserEmitter(_DeserEmitter):
     the next frame, so every fixed-size read is followed by a check against the frame's end (one
     comparison per run)."""
 
+    _after_unpack = False  # the last line read a fixed-size run
+    _check = ""  # the check owed by the last run, emitted before whatever comes next
+
     def emit(self, line: str) -> None:
+        if self._check:
+            # a length prefix read in the run is checked against the frame's end next anyway
+            # (``end - pos`` is then negative): only a run that no such check follows needs its own
+            if ": raise _short(" not in line:
+                super().emit(self._check)
+            self._check = ""
         super().emit(line)
         if line.startswith("pos += ") and self._after_unpack:
-            super().emit("if pos > end: raise _overrun(end - pos)")
+            self._check = "if pos > end: raise _overrun(end - pos)"
         self._after_unpack = ".unpack_from(mv, pos)" in line
 
-    _after_unpack = False
+    def finish(self) -> None:
+        """Emit the check the last run owes."""
+        if self._check:
+            super().emit(self._check)
+            self._check = ""
 
 
 def _overrun(short: int) -> ValueError:
@@ -66,11 +79,13 @@ def frames_decoder_source(spec: Any, lookup: Callable[[str], Any], tagged: bool 
     de = _FrameDeserEmitter(spec.full_name, lookup, structs, depth=3)
     de.fields(spec, "o")
     de.flush()
+    de.finish()
     if not de.views:  # strings and numbers only: slice and decode the bytes directly
         structs.clear()
         de = _FrameDeserEmitter(spec.full_name, lookup, structs, depth=3, bytes_buffer=True)
         de.fields(spec, "o")
         de.flush()
+        de.finish()
     head = [f"{name} = _struct.Struct({fmt!r})" for fmt, name in structs.items()]
     # where a failed frame's body starts (``pos`` has moved into it): after its length and its tag
     body_start = "end - _fl + 1" if tagged else "end - _fl"
