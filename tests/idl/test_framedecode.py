@@ -144,6 +144,25 @@ def test_the_decoder_is_made_once_per_class_and_tagging() -> None:
     assert frames_decoder(object) is None  # not one of our generated classes: the caller's old path
 
 
+def test_a_subclass_is_decoded_as_itself_unless_it_decodes_its_own_way() -> None:
+    class Plain(String):  # type: ignore[misc, valid-type]
+        __slots__ = ()
+
+    class Own(String):  # type: ignore[misc, valid-type]
+        __slots__ = ()
+
+        @classmethod
+        def deserialize_from(cls, buf):  # type: ignore[no-untyped-def]
+            return super().deserialize_from(buf)
+
+    decode, _ = frames_decoder(Plain)  # type: ignore[misc]
+    data = _frame(String("x").serialize_to_bytes())
+    out: list[object] = []
+    decode(data, 0, len(data), out, [])
+    assert type(out[0]) is Plain and out[0].data == "x"  # type: ignore[attr-defined]
+    assert frames_decoder(Own) is None
+
+
 @pytest.mark.parametrize("tagged", [False, True], ids=["plain", "tagged"])
 def test_the_reader_fed_in_random_pieces_gives_every_message_in_order(tagged: bool) -> None:
     """commit_decoded against commit + deserialize_from, with a large frame received in place and, on a

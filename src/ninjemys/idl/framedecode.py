@@ -139,7 +139,11 @@ def _make(cls: Any, tagged: bool) -> tuple[FramesDecoder, int] | None:
     from ninjemys.idl.codecache import compile_cached
 
     spec, lookup = made
-    namespace = dict(deser.__func__.__globals__)  # the class's own runtime names and nested classes
+    generated = deser.__func__.__globals__  # the class's own runtime names and nested classes
+    own = generated.get(spec.short_name)
+    if own is None or deser.__func__ is not own.__dict__.get("deserialize_from").__func__:
+        return None  # a subclass that decodes its own way: the fused loop would bypass it
+    namespace = dict(generated)
     namespace["_cls"] = cls
     namespace["_DeserializationError"] = DeserializationError
     namespace["_overrun"] = _overrun
