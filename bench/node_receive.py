@@ -21,11 +21,10 @@ import struct
 import sys
 import time
 
-from node_common import CROSS_CPU, IMPLS, OURS, SAME_CPU, Role, header, master, ratio, roles
-
 from ninjemys.idl.framedecode import frames_decoder
 from ninjemys.idl.loader import get_message_class
 from ninjemys.wire.tcpros import FrameReader
+from node_common import CROSS_CPU, IMPLS, OURS, SAME_CPU, Role, header, master, ratio, roles
 
 
 def _chunks(body: bytes, count: int, size: int = 1 << 16) -> list[bytes]:
@@ -96,7 +95,9 @@ def in_process() -> None:
         old = _best_us(_per_frame, cls, chunks, count)
         new = _best_us(_fused, cls, chunks, count)
         name = cls._type  # type: ignore[attr-defined]
-        print(f"in-process {name:22s} per-frame {old:6.2f} us/msg   fused {new:6.2f} us/msg   {ratio(new, old)}")
+        print(
+            f"in-process {name:22s} per-frame {old:6.2f} us/msg   fused {new:6.2f} us/msg   {ratio(new, old)}"
+        )
 
 
 def _cpu(pid: int) -> float:

@@ -101,7 +101,11 @@ def frames_decoder_source(spec: Any, lookup: Callable[[str], Any], tagged: bool 
         "        end = pos + 4 + _fl",
         "        if end > stop:",
         "            break",
-        *(["        if not _fl or data[pos + 4]:", "            break", "        pos += 5"] if tagged else ["        pos += 4"]),
+        *(
+            ["        if not _fl or data[pos + 4]:", "            break", "        pos += 5"]
+            if tagged
+            else ["        pos += 4"]
+        ),
         "        try:",
         "            o = _new(cls)",
         *de.lines,

@@ -292,9 +292,9 @@ class SubConnection:
                 if fused and not frames:
                     frames = reader.commit_decoded(n, decode, msgs, bad)
                     if frames:  # a large frame (or a tagged one): decoded here, so that order is kept
-                        frames = self.untag(frames)
-                        if frames:
-                            _decode_into(self.sub.msg_class, frames, msgs, bad)
+                        untagged = self.untag(frames)
+                        if untagged:
+                            _decode_into(self.sub.msg_class, untagged, msgs, bad)
                         frames = []
                         if self.closed:
                             break  # a malformed stream, closed: deliver what came before
@@ -334,7 +334,9 @@ class SubConnection:
         transport.close_quietly(self.sock)
 
 
-def _decode_into(cls: Any, frames: list[bytes | bytearray], out: list[Any], bad: list[tuple[int, Exception]]) -> None:
+def _decode_into(
+    cls: Any, frames: list[bytes | bytearray], out: list[Any], bad: list[tuple[int, Exception]]
+) -> None:
     """Decode ``frames`` one by one onto ``out`` (failures onto ``bad``, as the fused decoder does)."""
     decode = cls.deserialize_from
     for frame in frames:
@@ -803,11 +805,12 @@ class Subscriber:
         read = self._read
         while not queue and not self._closed and self._served is served:
             for fd, _ in poll(-1, poller.max_events):
-                conn = objs.get(fd, False)
-                if conn is None:
-                    self._on_wake()
-                elif conn is not False:
-                    read(conn)
+                if fd in objs:
+                    conn = objs[fd]
+                    if conn is None:
+                        self._on_wake()
+                    else:
+                        read(conn)
 
     def _lazy_round(self) -> None:
         """One wait of a lazy handle's worker: on the low-water marks (:meth:`_lazy_wait`), or per
