@@ -8,7 +8,8 @@ Run: ``.venv/bin/python bench/node_receive.py [seconds]``. Two parts:
   callback included, for a 16-byte ``std_msgs/String`` and a 20-joint ``sensor_msgs/JointState``;
 * between processes, one ninjemys publisher floods 16-byte Strings (``queue_size=None``) to a sink
   that is ninjemys, then rospy, on one CPU and across two: messages per second delivered and the
-  sink's CPU time per message (user + system, all its threads, from /proc).
+  sink's CPU time per message received (user + system, all its threads, from /proc, from the moment
+  it is subscribed until it reports).
 
 The publisher is the same for both sinks, so the rates say what the publisher and the kernel allow;
 the CPU per message is the receive side's own cost.
@@ -107,20 +108,19 @@ def _cpu(pid: int) -> float:
 
 
 def between(uri: str, impl: str, cpus: tuple[str, str], seconds: str) -> tuple[float, float]:
-    """Delivered rate and the sink's CPU microseconds per message, over the middle of the flood."""
+    """Delivered rate, and the sink's CPU microseconds per message received: its CPU time from
+    "ready" (subscribed, idle) to its result, over the messages it received (set-up costs included,
+    the same for both)."""
     sink = Role(impl, uri, "sink", cpu=cpus[1])
     with roles(sink):
         sink.ready()
+        cpu0 = _cpu(sink.proc.pid)
         flood = Role(OURS, uri, "flood", "None", seconds, cpu=cpus[0])
         with roles(flood):
-            time.sleep(1.5)  # connected and flowing (the flood starts 0.5 s after its connection)
-            cpu0, t0 = _cpu(sink.proc.pid), time.monotonic()
-            time.sleep(max(0.5, float(seconds) - 1.0))
-            cpu1, t1 = _cpu(sink.proc.pid), time.monotonic()
             flood.result()
             got = sink.result()
-    rate = got["rate"]
-    return rate, (cpu1 - cpu0) / max(rate * (t1 - t0), 1.0) * 1e6
+            cpu1 = _cpu(sink.proc.pid)
+    return got["rate"], (cpu1 - cpu0) / max(got["received"], 1) * 1e6
 
 
 def main() -> None:
