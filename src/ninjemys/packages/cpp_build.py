@@ -188,6 +188,30 @@ def build_cpp(
     return built
 
 
+def install_cpp(build: Path, log: Callable[[str], None], jobs: int = 0) -> int:
+    """``make install`` in catkin's build tree of the C++ packages (configured with the install
+    prefix by :func:`build_cpp`): what ``install(TARGETS ...)`` names goes where catkin puts it
+    (``lib/<pkg>/`` for ``${CATKIN_PACKAGE_BIN_DESTINATION}``, ``lib/`` for libraries, ``include/``),
+    with catkin's CMake config files and RPATH handling, because it is catkin doing it. Run before
+    ninjemys' own install, which then writes the setup scripts over catkin's. The number of files
+    CMake installed or found up to date; raises PackageError with CMake's output on failure."""
+    jobs = jobs or max(1, os.cpu_count() or 1)
+    proc = subprocess.run(
+        ["make", "install", f"-j{jobs}"], cwd=build, capture_output=True, text=True, check=False
+    )
+    if proc.returncode != 0:
+        output = (proc.stdout + proc.stderr).rstrip()
+        raise PackageError(f"{output}\nInvoking \"make install -j{jobs}\" failed")
+    count = 0
+    for line in proc.stdout.splitlines():
+        if line.startswith(("-- Installing:", "-- Up-to-date:")):
+            count += 1
+            log(line)
+        elif line.startswith("-- Set runtime path"):
+            log(line)
+    return count
+
+
 #: genmsg's error when a dependency's .msg files are not where its CMake config says
 _NO_MSG = re.compile(r"Cannot locate message \[(\w+)\] in package \[(\w+)\] with paths\s+\[\['([^']+)'\]\]")
 
@@ -258,6 +282,7 @@ __all__ = [
     "cpp_closure",
     "failing_package",
     "find_toolchain",
+    "install_cpp",
     "missing_cpp_dependency",
     "missing_definitions_hint",
     "noetic_compat_flags",
