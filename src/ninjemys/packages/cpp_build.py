@@ -201,7 +201,7 @@ def install_cpp(build: Path, log: Callable[[str], None], jobs: int = 0) -> int:
     )
     if proc.returncode != 0:
         output = (proc.stdout + proc.stderr).rstrip()
-        raise PackageError(f"{output}\nInvoking \"make install -j{jobs}\" failed")
+        raise PackageError(f'{output}\nInvoking "make install -j{jobs}" failed')
     count = 0
     for line in proc.stdout.splitlines():
         if line.startswith(("-- Installing:", "-- Up-to-date:")):
