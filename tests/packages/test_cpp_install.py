@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from ninjemys.packages.cpp_build import find_toolchain
+from ninjemys.packages.cpp_build import cmake_env, find_toolchain
 from ninjemys.testing import CatkinWorkspace, kill_tree, ninjemys_bin, run_master
 
 PACKAGE_XML = """<?xml version="1.0"?>
@@ -147,3 +147,16 @@ def test_cmake_install_prefix_moves_the_cpp_programs_too(tmp_path: Path) -> None
     assert (tmp_path / "elsewhere" / "lib" / "libgreeting.so").is_file()
     assert not (tmp_path / "install").exists()
     assert f"prefix {tmp_path / 'elsewhere'}" in result.stdout
+    # the everyday loop: a shell that sourced the workspace (ROS_DISTRO=noetic, the install space on
+    # CMAKE_PREFIX_PATH) builds again; Debian's catkin env hook must not break the C++ configure
+    for setup in ("devel/setup.bash", "elsewhere/setup.bash"):
+        again = subprocess.run(
+            ["bash", "-c", f"source {setup} && exec catkin_make install -DCMAKE_INSTALL_PREFIX=elsewhere"],
+            cwd=tmp_path, env=ours.env(), capture_output=True, text=True, timeout=600, check=False,
+        )  # fmt: skip
+        assert again.returncode == 0, setup + again.stdout + again.stderr
+
+
+def test_catkins_cmake_runs_without_the_shells_ros_distro() -> None:
+    env = cmake_env({"ROS_DISTRO": "noetic", "PATH": "/usr/bin"})
+    assert env == {"PATH": "/usr/bin"}

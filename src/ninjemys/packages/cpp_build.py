@@ -130,6 +130,17 @@ def _link_sources(src: Path, packages: list[PackageManifest], toplevel: Path) ->
     (src / "CMakeLists.txt").symlink_to(toplevel)
 
 
+def cmake_env(base: Mapping[str, str]) -> dict[str, str]:
+    """The environment catkin's CMake runs in: the caller's, without ROS_DISTRO. A shell that
+    sourced a ninjemys workspace has ``ROS_DISTRO=noetic``; catkin's configure step runs its env
+    hooks to cache the environment, and Debian's ``1.ros_distro.sh`` hook then prints "ROS_DISTRO was
+    set to 'noetic' before ..." on stdout, which catkin reads as a Python dict: the configure fails.
+    The hook sets the distribution of the catkin in use itself, as in a fresh ROS 1 shell."""
+    env = dict(base)
+    env.pop("ROS_DISTRO", None)
+    return env
+
+
 def build_cpp(
     packages: list[PackageManifest],
     build_root: Path,
@@ -151,7 +162,7 @@ def build_cpp(
     devel = build_root / "devel"
     _link_sources(src, packages, toolchain.toplevel)
     build.mkdir(parents=True, exist_ok=True)
-    env = dict(os.environ)
+    env = cmake_env(os.environ)
     extra: list[str] = []
     if messages is not None and messages.packages:
         paths = [p for p in env.get("CMAKE_PREFIX_PATH", "").split(os.pathsep) if p]
@@ -197,7 +208,12 @@ def install_cpp(build: Path, log: Callable[[str], None], jobs: int = 0) -> int:
     CMake installed or found up to date; raises PackageError with CMake's output on failure."""
     jobs = jobs or max(1, os.cpu_count() or 1)
     proc = subprocess.run(
-        ["make", "install", f"-j{jobs}"], cwd=build, capture_output=True, text=True, check=False
+        ["make", "install", f"-j{jobs}"],
+        cwd=build,
+        env=cmake_env(os.environ),
+        capture_output=True,
+        text=True,
+        check=False,
     )
     if proc.returncode != 0:
         output = (proc.stdout + proc.stderr).rstrip()
@@ -279,6 +295,7 @@ def _run(cmd: list[str], cwd: Path, env: dict[str, str], failure: str, log: Call
 __all__ = [
     "Toolchain",
     "build_cpp",
+    "cmake_env",
     "cpp_closure",
     "failing_package",
     "find_toolchain",
