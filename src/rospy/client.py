@@ -458,5 +458,5 @@ def get_master(env: Any = None) -> Any:
     if node is None:
         from ninjemys.node.cli_args import parse_args
 
-        return MasterProxy(parse_args(sys.argv, env).master_uri, "/unnamed")
+        return MasterProxy(parse_args(sys.argv, env, strict_names=False).master_uri, "/unnamed")
     return MasterProxy(node.master_uri, node.name, node.resolve_name)

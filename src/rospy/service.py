@@ -49,7 +49,7 @@ class _Unnamed(ParamAccess):
         from ninjemys.master.client import MasterClient
         from ninjemys.node.cli_args import parse_args
 
-        args = parse_args(sys.argv)
+        args = parse_args(sys.argv, strict_names=False)  # rospy checks no name before init_node
         self.name = names.canonicalize_name(args.namespace + "unnamed")
         self.remappings = args.resolved_remappings(self.name)
         self.master = MasterClient(args.master_uri, self.name)
