@@ -39,6 +39,7 @@ import argparse
 import ctypes
 import math
 import signal
+import struct
 import sys
 import threading
 from collections.abc import Callable
@@ -80,6 +81,9 @@ Imu: Any = get_message_class("sensor_msgs/Imu")
 TFMessage: Any = get_message_class("tf2_msgs/TFMessage")
 Clock: Any = get_message_class("rosgraph_msgs/Clock")
 Log: Any = get_message_class("rosgraph_msgs/Log")
+
+#: a rosgraph_msgs/Clock TCPROS frame: its length (8), then secs and nsecs
+_CLOCK_FRAME = struct.Struct("<III").pack
 
 WORLD_FRAME = "map"  # ground truth frame: the shipped maps are rasterized in world coordinates
 
@@ -388,8 +392,8 @@ class SimNode:
         self.log.error("simulation step failed: %s: %s", type(exc).__name__, exc)
 
     def _stamp(self) -> Time:
-        ns = self.sim.time_ns
-        return Time(ns // 1_000_000_000, ns % 1_000_000_000)
+        secs, nsecs = divmod(self.sim.time_ns, 1_000_000_000)
+        return Time._raw(secs, nsecs)  # wire integers, already valid: no re-validation per step
 
     def _step_and_publish(self) -> None:
         sim = self.sim
@@ -401,7 +405,8 @@ class SimNode:
         now = sim.time
         stamp = self._stamp()
         if self.clock_pub.get_num_connections() and self._clock_due(now):  # nobody listening: nothing
-            self.clock_pub.publish(Clock(clock=stamp))
+            # rosgraph_msgs/Clock is two uint32s: its frame is packed here, with no message object
+            self.clock_pub.publish_framed(_CLOCK_FRAME(8, stamp.secs, stamp.nsecs))
         for r in touched:
             self.log.warn(
                 "robot [%s] hit '%s' at (%.3f, %.3f): stopped at contact", r.name, r.contact_with, r.x, r.y
