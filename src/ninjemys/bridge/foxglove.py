@@ -302,6 +302,7 @@ class FoxgloveSession:
     def op_subscribeConnectionGraph(self, msg: dict[str, Any]) -> None:  # noqa: N802
         self.graph_subscribed = True
         self.send(self.gateway.graph_update())
+        self.gateway.sweep_bus()
 
     def op_unsubscribeConnectionGraph(self, msg: dict[str, Any]) -> None:  # noqa: N802
         self.graph_subscribed = False

@@ -516,11 +516,15 @@ class Gateway:
 
     def graph_update(self) -> dict[str, Any]:
         """The full connection graph for a client that just subscribed, with the bus state so far
-        (a sweep starts at once; its result follows as an update)."""
-        self.bus.poke(self.catalog.node_names(), force=True)
+        (call :meth:`sweep_bus` once it is sent: the sweep's result follows as an update)."""
         update = self.catalog.graph_update(full=True)
         update["rosBus"] = self.bus.state()
         return update
+
+    def sweep_bus(self) -> None:
+        """Ask every node for its connections now. Started after the graph is on its way, so that
+        a hundred getBusInfo calls do not hold up the first picture of the graph."""
+        self.bus.poke(self.catalog.node_names(), force=True)
 
     def watch_param(self, name: str) -> None:
         """Forward master paramUpdate for ``name`` to the Foxglove clients that subscribed it."""
