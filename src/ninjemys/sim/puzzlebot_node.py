@@ -122,6 +122,8 @@ class RobotIO:
     #: gazebo_ros_control's controller_manager for this robot (a ros_control description), else None
     control: ControlLoop | None = None
     extras: list[ExtraSensor] = field(default_factory=list)
+    #: the odometry message, built at the first sample and refreshed in place after that
+    odom_msg: Any = None
 
     def frame(self, name: str) -> str:
         return scoped(self.frame_prefix, name)
@@ -479,9 +481,13 @@ class SimNode:
         odom_frame, base_frame = io.frame(drive.odom_frame), io.frame(drive.base_frame)
         odom = pubs.get("odom")
         if odom is not None and odom.get_num_connections():
-            odom.publish(
-                messages.odometry(stamp, odom_frame, base_frame, pose, (r.v, r.w), r.model.odom_alpha)
-            )
+            if io.odom_msg is None:
+                io.odom_msg = messages.odometry(
+                    stamp, odom_frame, base_frame, pose, (r.v, r.w), r.model.odom_alpha
+                )
+            else:
+                messages.odometry_into(io.odom_msg, stamp, pose, (r.v, r.w))
+            odom.publish(io.odom_msg)
         if pubs["ground_truth"].get_num_connections():
             pubs["ground_truth"].publish(
                 messages.odometry(stamp, WORLD_FRAME, io.frame("base_link"), (r.x, r.y, r.yaw), (r.v, r.w))
