@@ -160,7 +160,6 @@ class Camera:
         # scratch, reused by every frame (render runs on one thread at a time: the node's lock)
         self._offset = np.empty((height, width), dtype=self._row_type)
         self._mask = np.empty((height, width), dtype=bool)
-        self._cv2 = _opencv()
 
     def render(
         self,
@@ -231,7 +230,7 @@ class Camera:
         column's value (``per_column``: one value or pixel per column), in place (OpenCV's masked
         copy, a few times faster than numpy's ``where`` or ``copyto(where=)`` here)."""
         full = np.ascontiguousarray(np.broadcast_to(per_column, image.shape))
-        self._cv2.copyTo(full, mask, image)
+        _opencv().copyTo(full, mask, image)
 
     def _farther_layers(
         self,
@@ -375,8 +374,10 @@ def _thresholds(heights: bytes, most: int) -> tuple[float, ...]:
     return tuple(float(h) for h in distinct)
 
 
+@functools.cache
 def _opencv() -> Any:
-    """OpenCV (a runtime dependency), imported when a camera is made: not at import time."""
+    """OpenCV (a runtime dependency), imported at the first frame drawn: not at import time, nor
+    when a robot is spawned (its 25-80 ms would delay the first scan after a spawn)."""
     import cv2
 
     return cv2
