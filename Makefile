@@ -30,6 +30,8 @@ ROS1_DEBS += python3-angles
 ROS1_DEBS += python3-rostest
 # C++ packages with .action files (the books' C++ action servers): actionlib_msgs' .msg definitions
 ROS1_DEBS += ros-actionlib-msgs
+# interactive_markers' Python server and menu (course code): Debian's, the reference for ours (tests/markers)
+ROS1_DEBS += python3-interactive-markers
 BROWSER_DEBS := chromium chromium-driver fonts-dejavu-core
 # multi-host tests: network namespaces (iproute2), roslaunch <machine> over ssh (openssh-server)
 NET_DEBS     := iproute2 openssh-server openssh-client

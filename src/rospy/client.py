@@ -15,6 +15,7 @@ import sys
 import threading
 import time
 
+from ninjemys import interrupt
 from ninjemys.errors import MasterError, MasterUnreachable, NameError_, NinjemysError, ParameterError
 from ninjemys.interrupt import wait_event
 from ninjemys.node.log import INFO
@@ -404,7 +405,7 @@ def wait_for_message(topic: str, topic_type: Any, timeout: float | None = None) 
 
     node = _process.node  # None before init_node: rospy waits all the same (init_node may come)
     box: list[Any] = []
-    got = threading.Event()
+    got = interrupt.Event()
 
     def take(msg: Any) -> None:
         if not box:
@@ -457,5 +458,5 @@ def get_master(env: Any = None) -> Any:
     if node is None:
         from ninjemys.node.cli_args import parse_args
 
-        return MasterProxy(parse_args(sys.argv, env).master_uri, "/unnamed")
+        return MasterProxy(parse_args(sys.argv, env, strict_names=False).master_uri, "/unnamed")
     return MasterProxy(node.master_uri, node.name, node.resolve_name)

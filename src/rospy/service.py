@@ -10,7 +10,7 @@ import sys
 import threading
 from collections.abc import Callable, Mapping
 
-from ninjemys import names
+from ninjemys import interrupt, names
 from ninjemys.errors import NinjemysError, ServiceError
 from ninjemys.interrupt import wait_event
 from ninjemys.node.log import ERROR
@@ -49,11 +49,11 @@ class _Unnamed(ParamAccess):
         from ninjemys.master.client import MasterClient
         from ninjemys.node.cli_args import parse_args
 
-        args = parse_args(sys.argv)
+        args = parse_args(sys.argv, strict_names=False)  # rospy checks no name before init_node
         self.name = names.canonicalize_name(args.namespace + "unnamed")
         self.remappings = args.resolved_remappings(self.name)
         self.master = MasterClient(args.master_uri, self.name)
-        self._stop = threading.Event()
+        self._stop = interrupt.Event()
 
     @property
     def is_shutdown(self) -> bool:

@@ -72,6 +72,21 @@ CASES: dict[str, tuple[str, list[str]]] = {
     "node_name_dash": ('NAME = "a-b"' + NODE_NAME, []),
     "node_name_tilde": ('NAME = "~x"' + NODE_NAME, []),
     "node_name_from_argv": ('NAME = "wheel"' + NODE_NAME, ["__name:=a/b"]),
+    # a launch file's name="fake_scan.py" (a student repository's): parameter and master calls
+    # before init_node work under the illegal __name, and init_node then warns and runs
+    "params_before_init_with_illegal_launch_name": (
+        r"""
+show("set", lambda: rospy.set_param("/parity_rate", 20))
+show("get", lambda: rospy.get_param("/parity_rate"))
+show("default", lambda: rospy.get_param("/parity_missing", "fallback"))
+show("has", lambda: rospy.has_param("/parity_rate"))
+show("master", lambda: rospy.get_master().getPid()[0])
+rospy.init_node("parity_dot", disable_signals=True)
+print("name", rospy.get_name(), flush=True)
+rospy.signal_shutdown("done")
+""",
+        ["__name:=fake_scan.py"],
+    ),
     "node_name_anonymous_dash": (
         r"""
 rospy.init_node("my-node", anonymous=True, disable_signals=True)

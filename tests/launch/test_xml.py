@@ -127,3 +127,15 @@ def test_ros_namespace_env_prefixes_everything(tmp_path: Path) -> None:
     plan = load_launch([path], env={"ROS_PACKAGE_PATH": str(PKGS), "ROS_NAMESPACE": "/robot"})
     assert plan.node_names() == ["/robot/a"]
     assert plan.params == {"/robot/p": 1}
+
+
+def test_an_illegal_node_name_warns_with_ros1s_lines_and_keeps_the_node(tmp_path: Path) -> None:
+    """A student's launch file names its nodes after their scripts (``name="fake_scan.py"``):
+    ROS 1's roslaunch warns (the name, the wiki page, the consequence) and starts the node."""
+    plan = load(tmp_path, '<node pkg="rospy_tutorials" type="talker.py" name="fake_scan.py"/>')
+    assert [n.name for n in plan.nodes] == ["fake_scan.py"]  # type: ignore[attr-defined]
+    (warning,) = [w for w in plan.warnings if "illegal" in w]  # type: ignore[attr-defined]
+    assert warning.endswith(
+        "t.launch:2] illegal <node> name 'fake_scan.py'.\nhttp://ros.org/wiki/Names\n"
+        "This will likely cause problems with other ROS tools."
+    )

@@ -156,6 +156,38 @@ def test_controller_patience_replans_then_recovers():
     assert 3.0 < t < 3.2  # patience counts from the last valid command, not from the last plan
 
 
+def test_a_pose_older_than_transform_tolerance_stops_replans_then_recovers():
+    """ROS 1's local planner fails on a pose the costmap refuses as too old: move_base stands still
+    at once, replans, and after controller_patience of refused poses runs its recoveries."""
+    fsm, _ = make(controller_patience=3.0, recovery_behavior_enabled=False)
+    fsm.accept(GOAL, "h1", 0.0)
+    fsm.plan_now(POSE, 0.0)
+    assert fsm.cycle(0.05, POSE, POSE, (0, 0)).cmd == (0.2, 0.0)  # driving on a fresh pose
+    step = fsm.pose_too_old(0.1)
+    assert step.cmd == (0.0, 0.0) and fsm.state == CONTROLLING and not step.ended  # stopped at once
+    t, states_seen = 0.1, set()
+    while not step.ended:
+        t += 0.05
+        step = fsm.pose_too_old(t)
+        assert step.cmd == (0.0, 0.0)
+        states_seen.add(fsm.state)
+        if fsm.state == PLANNING:
+            fsm.plan_now(POSE, t)  # plans come, but the pose stays too old to drive on
+    assert PLANNING in states_seen
+    assert step.ended[0].status == states.ABORTED
+    assert step.ended[0].text == "Aborting because a valid control could not be found"
+    assert 3.0 < t < 3.2
+
+
+def test_a_pose_too_old_while_idle_or_planning_commands_nothing_new():
+    fsm, _ = make()
+    assert fsm.pose_too_old(0.0).cmd is None  # no goal: move_base says nothing
+    fsm.accept(GOAL, "h1", 0.0)
+    assert fsm.state == PLANNING
+    step = fsm.pose_too_old(0.1)
+    assert step.cmd == (0.0, 0.0) and fsm.state == PLANNING and not step.ended
+
+
 def test_oscillation_runs_a_full_rotation_and_progress_resets_the_recovery_list():
     fsm, _ = make(oscillation_timeout=2.0, oscillation_distance=0.2)
     fsm.accept(GOAL, "h1", 0.0)

@@ -207,10 +207,19 @@ def test_bad_goals_are_rejected_with_the_reason(office):
     assert office.alive()
 
 
+def connected(pub, what: str) -> None:
+    """Wait until ``pub`` has a subscriber: a publisher's first messages go nowhere until the safety
+    monitor has connected, which took over a second under load right after the stack started (a fixed
+    1 s sleep here left the robot still, or half way to its speed, after the 1 s of teleop below)."""
+    from ninjemys.testing import wait_until
+
+    wait_until(lambda: pub.get_num_connections() > 0, timeout=60, what=what)
+
+
 def test_stale_teleop_command_stops_the_robot(office):
     probe = office.probe
     pub = probe.node.publisher("/teleop/cmd_vel", probe.twist_cls, queue_size=1)
-    time.sleep(1.0)
+    connected(pub, "the safety monitor to subscribe /teleop/cmd_vel")
     msg = probe.twist_cls()
     msg.angular.z = 1.0
     end = probe.sim_time + 1.0
@@ -230,7 +239,8 @@ def test_teleop_overrides_navigation(office):
     probe = office.probe
     goal_pub = probe.node.publisher("/move_base_simple/goal", probe.pose_cls, queue_size=1, latch=True)
     teleop = probe.node.publisher("/teleop/cmd_vel", probe.twist_cls, queue_size=1)
-    time.sleep(1.0)
+    connected(goal_pub, "move_base to subscribe /move_base_simple/goal")
+    connected(teleop, "the safety monitor to subscribe /teleop/cmd_vel")
     contacts = probe.contacts
     target = (-1.0, 0.0, math.pi)
     if probe.truth and math.hypot(probe.truth[0] - target[0], probe.truth[1] - target[1]) < 1.0:

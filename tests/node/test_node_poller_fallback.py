@@ -18,7 +18,7 @@ def test_poller_reports_ready_sockets_and_closes(monkeypatch: pytest.MonkeyPatch
     elif not hasattr(select, "epoll"):
         pytest.skip("no epoll here")
     poller = subscriber._Poller()
-    assert (poller._epoll is not None) is use_epoll
+    assert (poller.epoll is not None) is use_epoll
     a, b = socket.socketpair()
     wake_r, wake_w = socket.socketpair()
     try:

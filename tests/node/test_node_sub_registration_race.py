@@ -17,8 +17,8 @@ def test_a_stale_registration_answer_does_not_undo_a_newer_publisher_update(make
     listener = make_node("listener")
     real = listener.registrar.add_subscriber
 
-    def answer_then_overtaken(topic: str, type_name: str) -> list[str] | None:
-        real(topic, type_name)  # registered now; the master would answer [talker]
+    def answer_then_overtaken(topic: str, type_name: str, *place: object) -> list[str] | None:
+        real(topic, type_name, *place)  # type: ignore[arg-type]  # registered now; the master would answer [talker]
         # the interleaving of the race, made certain: the master answered before the publisher was
         # registered, and its publisherUpdate reached the node's loop before that answer was applied
         listener.publisher_update(topic, [talker.uri])

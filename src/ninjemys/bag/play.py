@@ -17,12 +17,12 @@ import select
 import signal
 import struct
 import sys
-import threading
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any, TextIO
 
+from ninjemys import interrupt
 from ninjemys.bag.format import NSEC, Connection
 from ninjemys.bag.reader import BagReader, RawMessage
 from ninjemys.errors import BagError
@@ -121,7 +121,7 @@ class Player:
         self.out = out or sys.stdout
         self.keyboard = keyboard
         self._monotonic = monotonic
-        self._stop = threading.Event()
+        self._stop = interrupt.Event()
         self._sleep = sleep or self._interruptible_sleep
         self.readers: list[BagReader] = []
         try:

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ninjemys import interrupt
 from ninjemys.bag.format import DEFAULT_CHUNK_THRESHOLD
 from ninjemys.bag.writer import BagWriter
 from ninjemys.errors import BagError, NinjemysError
@@ -165,7 +166,7 @@ class Recorder:
         self._latched: dict[int, tuple[str, Mapping[str, str], bytes, int]] = {}
         self._writer: BagWriter | None = None
         self._bag_started = 0.0
-        self._stop = threading.Event()
+        self._stop = interrupt.Event()
         self._done = threading.Event()
         self._last_drop_warning = 0.0
         self._lock = threading.Lock()

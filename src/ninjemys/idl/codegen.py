@@ -25,7 +25,7 @@ from collections.abc import Callable
 
 from ninjemys.errors import DefinitionError
 from ninjemys.idl.arrays import LITTLE_ENDIAN_HOST
-from ninjemys.idl.spec import PRIMITIVE_FORMATS, FieldType, MsgSpec
+from ninjemys.idl.spec import PRIMITIVE_FORMATS, Constant, Field, FieldType, MsgSpec
 
 Lookup = Callable[[str], MsgSpec]
 
@@ -356,9 +356,31 @@ def _struct_size(fmt: str) -> int:
     return struct.calcsize(fmt)
 
 
+def _reserved(name: str) -> bool:
+    return keyword.iskeyword(name) or name == "self"
+
+
+def python_safe(spec: MsgSpec) -> MsgSpec:
+    """genpy's rule for names Python cannot take: a field or constant named like a keyword (or
+    ``self``) is ``name_`` on the class (``string in`` of a .srv is ``req.in_``, as in ROS 1). The
+    wire format, the definition text and the md5sum keep the name as written."""
+    if not any(_reserved(f.name) for f in spec.fields) and not any(_reserved(c.name) for c in spec.constants):
+        return spec
+    fields = tuple(Field(f.name + "_", f.type, f.raw_type) if _reserved(f.name) else f for f in spec.fields)
+    constants = tuple(
+        Constant(c.type, c.name + "_", c.value, c.value_text) if _reserved(c.name) else c
+        for c in spec.constants
+    )
+    return MsgSpec(spec.full_name, fields, constants, spec.text, spec.path)
+
+
+def _safe_lookup(lookup: Lookup) -> Lookup:
+    return lambda name: python_safe(lookup(name))
+
+
 def _check_names(spec: MsgSpec) -> None:
     for f in spec.fields:
-        if keyword.iskeyword(f.name) or f.name.startswith("_"):
+        if f.name.startswith("_"):
             raise DefinitionError(
                 f"{spec.full_name}: field name {f.name!r} cannot be used in Python", spec.path
             )
@@ -404,7 +426,9 @@ def _straight_serializers(ser_lines: list[str]) -> list[str]:
 
 def generate_class_source(spec: MsgSpec, lookup: Lookup, md5sum: str, full_text: str) -> str:
     """Python source defining the class for ``spec`` (named by its short name) and its structs."""
+    spec = python_safe(spec)
     _check_names(spec)
+    lookup = _safe_lookup(lookup)  # nested types get Python-safe names too
     cls = spec.short_name
     names = [f.name for f in spec.fields]
     structs: dict[str, str] = {}

@@ -195,6 +195,7 @@ def _build_class(
     exec(compile_cached(source, f"<ninjemys generated {spec.full_name}>"), namespace)  # noqa: S102
     cls = namespace[spec.short_name]
     cls._fields = tuple((f.name, f.type) for f in spec.fields)
+    cls._spec_lookup = (spec, lookup)  # what framedecode needs to generate the fused receive loop
     cls.__module__ = module
     cls._source = source
     return cls

@@ -561,7 +561,9 @@ class _Loader:
             name = self.req(el, scope, "name")
         if not is_legal_name(name):
             self.plan.warnings.append(
-                f"[{scope.filename}:{el.line}] illegal <node> name '{name}' (http://ros.org/wiki/Names)"
+                # ROS 1's lines (roslaunch then starts the node under that name), with the file:line
+                f"[{scope.filename}:{el.line}] illegal <node> name '{name}'.\nhttp://ros.org/wiki/Names\n"
+                "This will likely cause problems with other ROS tools."
             )
         child = self.ns_clear_params(el, scope, node_name=name)
         param_scope = child.child(name)

@@ -31,6 +31,8 @@ class CostmapROS:
         self.robot_base_frame = str(g("robot_base_frame", "base_link")).lstrip("/")
         self.update_frequency = g("update_frequency", 5.0)
         self.publish_frequency = g("publish_frequency", 0.0)
+        #: seconds a robot pose may lag ROS time before it is refused (costmap_2d's default)
+        self.transform_tolerance = g("transform_tolerance", 0.3)
         p = CostmapParams(
             resolution=g("resolution", 0.05),
             width=g("width", 10.0 if self.name == "global_costmap" else 3.0),

@@ -396,7 +396,6 @@ class MoveBaseFsm:
         self.plan = plan[len(plan) - self.controller.remaining() :]  # pruned as the controller did
         if cmd.reached:
             return self._finish(step, states.SUCCEEDED, "Goal reached")
-        p = self.params
         if cmd.valid:
             self.last_valid = now
             step.cmd = (cmd.v, cmd.w)
@@ -419,8 +418,12 @@ class MoveBaseFsm:
                     step, now, "Aborting because the robot appears to be oscillating over and over"
                 )
             return step
+        return self._control_failed(step, now)
+
+    def _control_failed(self, step: Step, now: float) -> Step:
+        """No valid command this cycle: stand still; replan, and after ``controller_patience`` recover."""
         step.cmd = (0.0, 0.0)
-        if now - self.last_valid > p.controller_patience:
+        if now - self.last_valid > self.params.controller_patience:
             self._start_recovery(step, now, "Aborting because a valid control could not be found")
         elif now - self.last_plan > 1.0:
             # ROS 1 replans when the local planner fails
@@ -428,6 +431,19 @@ class MoveBaseFsm:
                 self.planning_since = now
             self.state = PLANNING
             self.plan_pending = True
+        return step
+
+    def pose_too_old(self, now: float) -> Step:
+        """A cycle whose robot pose is older than the costmap's ``transform_tolerance``. ROS 1's local
+        planner then fails ("Could not get robot pose"): move_base stands still and treats it as a
+        failed control (replan; recoveries after ``controller_patience``). Planning and recovering
+        wait with the robot stopped."""
+        step = Step()
+        if self.state == IDLE or self.goal is None:
+            return step
+        step.cmd = (0.0, 0.0)
+        if self.state == CONTROLLING and self.plan is not None:
+            return self._control_failed(step, now)
         return step
 
     # -- recoveries -------------------------------------------------------------------------------------

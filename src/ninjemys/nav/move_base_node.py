@@ -324,7 +324,7 @@ class MoveBase:
         """One update of ``cm`` (ROS 1's updateMap): a map-sized costmap takes its newest scans, a
         rolling window follows the robot; then the costs are recomputed where needed."""
         if cm.costmap.params.rolling_window:
-            robot = self.tf.lookup(cm.global_frame, cm.robot_base_frame)
+            robot = self._robot_pose(cm)
             if robot is not None:
                 with self.lock:
                     self._refresh(cm, robot)
@@ -433,7 +433,7 @@ class MoveBase:
             return resp
         start: Pose2D | None = pose_msg_to_2d(req.start.pose) if req.start.header.frame_id else None
         if start is None:
-            start = self.tf.lookup(self.global_cm.global_frame, self.global_cm.robot_base_frame)
+            start = self._robot_pose(self.global_cm)
         if start is None:
             self.log.error("move_base: make_plan: no robot pose in %s", self.global_cm.global_frame)
             return resp
@@ -562,11 +562,38 @@ class MoveBase:
             except ShutdownError:
                 return
 
-    def _robot_poses(self) -> tuple[Pose2D | None, Pose2D | None]:
-        g = self.tf.lookup(self.global_cm.global_frame, self.global_cm.robot_base_frame)
+    def _robot_pose(self, cm: CostmapROS) -> Pose2D | None:
+        """The robot's pose in ``cm``'s global frame, or None when unknown or too old (see _pose)."""
+        return self._pose(cm)[0]
+
+    def _pose(self, cm: CostmapROS) -> tuple[Pose2D | None, bool]:
+        """``(pose, too_old)``: the robot's pose in ``cm``'s global frame; None when unknown, or when
+        older than ``cm``'s ``transform_tolerance`` (then ``too_old``, warned as costmap_2d does, at
+        most once a second)."""
+        now = self.node.get_time()
+        pose, stamp = self.tf.robot_pose(cm.global_frame, cm.robot_base_frame, now, cm.transform_tolerance)
+        too_old = pose is None and stamp != 0.0
+        if too_old:
+            self.log.log_throttle(
+                1.0,
+                WARN,
+                "Costmap2DROS transform timeout. Current time: %.4f, global_pose stamp: %.4f, tolerance: %.4f",
+                now,
+                stamp,
+                cm.transform_tolerance,
+            )
+        return pose, too_old
+
+    def _robot_poses(self) -> tuple[Pose2D | None, Pose2D | None, bool]:
+        """The robot's pose in the global and in the local costmap's frame, and whether the local
+        one was refused as too old. As in ROS 1, only the controller's own (local costmap) pose is
+        held to its ``transform_tolerance`` here: dwa_local_planner refuses a stale one, while the
+        plan is carried into its frame with the newest ``map -> odom``, however old (amcl's lags
+        under load; the planner refuses that one, see _plan_once)."""
+        lp, too_old = self._pose(self.local_cm)
         if self.local_cm.global_frame == self.global_cm.global_frame:
-            return g, g
-        return g, self.tf.lookup(self.local_cm.global_frame, self.local_cm.robot_base_frame)
+            return lp, lp, too_old
+        return self.tf.lookup(self.global_cm.global_frame, self.global_cm.robot_base_frame), lp, too_old
 
     def cycle(self) -> None:
         """One control cycle: goals from the inbox, then the state machine on the robot's poses."""
@@ -577,7 +604,13 @@ class MoveBase:
             self._apply(step)
         if idle:
             return
-        gpose, lpose = self._robot_poses()
+        gpose, lpose, too_old = self._robot_poses()
+        if too_old:
+            # too old to drive on (the local costmap's transform_tolerance): stand still, as ROS 1
+            with self.lock:
+                step = self.fsm.pose_too_old(self.node.get_time())
+            self._apply(step)
+            return
         if gpose is None or lpose is None:
             self.log.log_throttle(
                 5.0,
@@ -617,7 +650,7 @@ class MoveBase:
                     self.fsm.planner_busy = False
 
     def _plan_once(self) -> None:
-        gpose = self.tf.lookup(self.global_cm.global_frame, self.global_cm.robot_base_frame)
+        gpose = self._robot_pose(self.global_cm)
         if gpose is None:
             return
         now = self.node.get_time()

@@ -120,6 +120,28 @@ class Tf2D:
         except TransformException:
             return None
 
+    def robot_pose(
+        self, target: str, source: str, now: float, tolerance: float
+    ) -> tuple[Pose2D | None, float]:
+        """costmap_2d's getRobotPose: ``source``'s pose in ``target`` at ``now`` when the buffer has it,
+        else the newest; refused (``None``) when it is older than ``now - tolerance``, the costmap's
+        ``transform_tolerance``. Returns ``(pose, stamp)``; ``(None, 0.0)`` when unknown, ``(None,
+        stamp)`` when too old. A zero stamp (a static chain) is never too old, as in ROS 1.
+
+        Under load /tf reaches move_base late: driving on the newest pose then steers from where the
+        robot was tenths of a second ago. ROS 1 refuses such a pose (move_base stands still, replans,
+        and runs its recoveries after ``controller_patience``); so does move_base here."""
+        t_ns = int(round(now * 1e9))
+        try:
+            ok, _ = self.buffer.can_transform(target, source, t_ns)
+            stamp_ns, tr = self.buffer.lookup(target, source, t_ns if ok else 0)
+        except TransformException:
+            return None, 0.0
+        stamp = stamp_ns * 1e-9
+        if stamp_ns and now - stamp > tolerance:
+            return None, stamp
+        return tf_to_2d(tr), stamp
+
     def lookup_at(self, target: str, source: str, t: float, timeout: float = STAMP_WAIT) -> Pose2D | None:
         """``source``'s pose in ``target`` at exactly the data's stamp ``t``, waiting up to ``timeout``
         wall seconds for the transform to arrive; None when it does not (the data is then dropped).

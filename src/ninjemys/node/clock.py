@@ -23,7 +23,7 @@ import threading
 import time
 from collections.abc import Callable
 
-from ninjemys.interrupt import wait_slice
+from ninjemys import interrupt
 
 TYPE_CHECKING = False  # importing typing costs ~7 ms of every node's start-up; checkers set it
 if TYPE_CHECKING:
@@ -59,7 +59,7 @@ class Clock:
         self._lock = threading.Lock()
         self._cond = threading.Condition(self._lock)
         #: simulated-time waiters: each thread's own condition on the clock's lock -> its target
-        self._sim_waiters: dict[threading.Condition, float] = {}
+        self._sim_waiters: dict[threading.Condition | _MainSimWaiter, float] = {}
         self._subscription: Any = None
         # wall-time sleepers wait on a per-thread "gate" lock with a timeout (one futex wait, as cheap as
         # time.sleep); wake() and shutdown() release every registered gate
@@ -161,7 +161,11 @@ class Clock:
             return self._wall_wait(target, cancelled)
         waiter = getattr(self._local, "waiter", None)
         if waiter is None:
-            waiter = self._local.waiter = threading.Condition(self._lock)
+            # the main thread's own never wakes to check (interrupt.wait_event); others' a Condition
+            waiter = (
+                _MainSimWaiter(self._lock) if interrupt.on_main_thread() else threading.Condition(self._lock)
+            )
+            self._local.waiter = waiter
         with self._cond:
             epoch = self._epoch
             self._sim_waiters[waiter] = target
@@ -170,7 +174,7 @@ class Clock:
                     wake = self._why_awake(epoch, cancelled, target - self.now())
                     if wake is not None:
                         return wake
-                    waiter.wait(wait_slice(None))
+                    waiter.wait()
             finally:
                 del self._sim_waiters[waiter]
 
@@ -189,8 +193,11 @@ class Clock:
     def _gate(self) -> Any:
         gate = getattr(self._local, "gate", None)
         if gate is None:
-            gate = threading.Lock()
-            gate.acquire()
+            if interrupt.on_main_thread():
+                gate = _MainGate()  # a long rospy.sleep on the main thread never wakes to check
+            else:
+                gate = threading.Lock()
+                gate.acquire()
             self._local.gate = gate
         return gate
 
@@ -216,7 +223,7 @@ class Clock:
                 if wake is not None:
                     return wake
                 # True: someone opened the gate (we hold it again, re-armed); False: the time is up
-                gate.acquire(True, wait_slice(remaining))
+                gate.acquire(True, remaining)
         finally:
             with self._gates_lock:
                 self._gates.discard(gate)
@@ -273,3 +280,45 @@ def for_node(node: Any) -> Clock:
 
         clock.subscribe(node, get_message_class("rosgraph_msgs/Clock"))
     return clock
+
+
+class _MainGate:
+    """The main thread's wall-time gate: the lock-gate's two calls over an :class:`interrupt.Event`,
+    so the sleep waits in :func:`interrupt.wait_event`: no periodic wake-up, and a signal that landed
+    on any thread runs its handler at once (a worker thread's gate is a plain lock, never sliced)."""
+
+    def __init__(self) -> None:
+        self._event = interrupt.Event()
+
+    def acquire(self, blocking: bool = True, timeout: float = -1) -> bool:
+        """Wait until opened (True, re-armed) or ``timeout`` seconds pass (False)."""
+        opened = interrupt.wait_event(self._event, timeout if blocking and timeout >= 0 else None)
+        self._event.clear()
+        return opened
+
+    def release(self) -> None:
+        self._event.set()
+
+
+class _MainSimWaiter:
+    """The main thread's simulated-time waiter: a Condition's ``wait``/``notify`` on the clock's lock
+    over an :class:`interrupt.Event` (a sim-time ``rospy.sleep`` on the main thread used to wake 5
+    times a second; a signal on any thread still ends it at once)."""
+
+    def __init__(self, lock: threading.Lock) -> None:
+        self._lock = lock
+        self._event = interrupt.Event()
+
+    def notify(self) -> None:
+        """Called with the clock's lock held."""
+        self._event.set()
+
+    def wait(self) -> None:
+        """Called with the clock's lock held: released while waiting, held again on return (the caller
+        re-checks its condition under it, so a notify between the wake-up and the clear is not lost)."""
+        self._lock.release()
+        try:
+            interrupt.wait_event(self._event)
+        finally:
+            self._lock.acquire()
+        self._event.clear()

@@ -27,7 +27,7 @@ import socket
 import threading
 from collections.abc import Callable, Mapping
 
-from ninjemys import names, rostime
+from ninjemys import interrupt, names, rostime
 from ninjemys.errors import MasterError, NinjemysError, ShutdownError
 from ninjemys.interrupt import wait_event
 from ninjemys.master.client import MasterClient
@@ -116,7 +116,7 @@ class Node(ParamAccess):
         self._shutdown_hooks: list[Callable[[], Any]] = []
         self._timers: list[timers.Timer] = []
         self._lock = threading.RLock()
-        self._shutdown_event = threading.Event()
+        self._shutdown_event = interrupt.Event()  # spin() waits on it with no periodic wake-up
         self._shutdown_done = threading.Event()
         self.shutdown_reason = ""
         self.tcpros_host = advertised_host()
@@ -266,8 +266,10 @@ class Node(ParamAccess):
                 )
             handle = Publisher(pub, queue_size, latch, headers, intraprocess)
             pub.handles.append(handle)
-        if new:
-            self.registrar.add_publisher(resolved, pub.type_name)
+            # the master hears of this topic's changes in the order they were made here
+            place = self.registrar.turns.take("pub", resolved) if new else None
+        if place is not None:
+            self.registrar.add_publisher(resolved, pub.type_name, place)
         return handle
 
     def subscriber(
@@ -334,9 +336,10 @@ class Node(ParamAccess):
                 intraprocess, direct,
             )  # fmt: skip
             sub.handles.append(handle)
-        if new:
+            place = self.registrar.turns.take("sub", resolved) if new else None
+        if place is not None:
             updates = sub.updates  # 0: read before the master can notify us of this topic
-            publishers = self.registrar.add_subscriber(resolved, sub.type_name)
+            publishers = self.registrar.add_subscriber(resolved, sub.type_name, place)
             if publishers is not None:
                 self.publisher_update(resolved, publishers, updates)
         else:
@@ -379,7 +382,8 @@ class Node(ParamAccess):
             if pub.handles:
                 return
             del self._publications[pub.topic]
-        self.registrar.remove_publisher(pub.topic)
+            place = self.registrar.turns.take("pub", pub.topic)
+        self.registrar.remove_publisher(pub.topic, place=place)
         pub.close()
 
     def release_subscriber(self, handle: Subscriber) -> None:
@@ -392,7 +396,8 @@ class Node(ParamAccess):
             if sub.handles:
                 return
             del self._subscriptions[sub.topic]
-        self.registrar.remove_subscriber(sub.topic)
+            place = self.registrar.turns.take("sub", sub.topic)
+        self.registrar.remove_subscriber(sub.topic, place=place)
         self.runtime.call_soon(sub.close)
 
     def connection_closed(self, conn: PubConnection) -> None:
@@ -431,7 +436,8 @@ class Node(ParamAccess):
                 raise NinjemysError(f"service [{resolved}] is already provided by {self.name}")
             server = ServiceServer(self, resolved, service_class, handler)
             self._services[resolved] = server
-        self.registrar.add_service(resolved, f"rosrpc://{self.tcpros_host}:{self.tcpros_port}")
+            place = self.registrar.turns.take("srv", resolved)
+        self.registrar.add_service(resolved, f"rosrpc://{self.tcpros_host}:{self.tcpros_port}", place)
         return server
 
     def service_proxy(
@@ -459,7 +465,8 @@ class Node(ParamAccess):
             if self._services.get(server.name) is not server:
                 return
             del self._services[server.name]
-        self.registrar.remove_service(server.name)
+            place = self.registrar.turns.take("srv", server.name)
+        self.registrar.remove_service(server.name, place=place)
 
     async def _on_service_connection(self, sock: socket.socket, header: Mapping[str, str]) -> None:
         server = self._services.get(header["service"])
@@ -626,6 +633,7 @@ class Node(ParamAccess):
             node_timers, self._timers = self._timers, []
         self.registrar.stop()
         quick = MasterClient(self.master_uri, self.name, timeout=1.0)
+        turns = self.registrar.turns
         with self._lock:
             pubs = list(self._publications.values())
             subs = list(self._subscriptions.values())
@@ -634,13 +642,18 @@ class Node(ParamAccess):
             self._publications.clear()
             self._subscriptions.clear()
             self._services.clear()
+            places = (
+                [turns.take("sub", sub.topic) for sub in subs],
+                [turns.take("pub", pub.topic) for pub in pubs],
+                [turns.take("srv", srv.name) for srv in srvs],
+            )
         try:
-            for sub in subs:
-                self.registrar.remove_subscriber(sub.topic, quick)
-            for pub in pubs:
-                self.registrar.remove_publisher(pub.topic, quick)
-            for srv in srvs:
-                self.registrar.remove_service(srv.name, quick)
+            for sub, place in zip(subs, places[0], strict=True):
+                self.registrar.remove_subscriber(sub.topic, quick, place)
+            for pub, place in zip(pubs, places[1], strict=True):
+                self.registrar.remove_publisher(pub.topic, quick, place)
+            for srv, place in zip(srvs, places[2], strict=True):
+                self.registrar.remove_service(srv.name, quick, place)
         finally:
             quick.close()
         for srv in srvs:

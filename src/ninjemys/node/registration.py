@@ -29,10 +29,12 @@ import logging
 import socket
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from functools import partial
 
 from ninjemys.errors import MasterError, MasterUnreachable, ShutdownError
+from ninjemys.interrupt import wait_slice
 from ninjemys.master.client import MasterClient
 from ninjemys.net.addresses import split_uri
 from ninjemys.node.transport import connect
@@ -53,8 +55,79 @@ IDLE_CHECK_PERIOD = 15.0
 SETTLE_PERIOD = 10.0
 
 
+#: Seconds a shutting-down node's unregistration waits for a call of the same name still in flight
+#: (a user thread's registration with a master that hangs): shutdown stays prompt.
+_SHUTDOWN_TURN = 2.0
+
+#: (kind, name): the registration calls of one publisher topic, subscriber topic or service
+TurnKey = tuple[str, str]
+
+
+class Turns:
+    """Per-name order of a node's registration calls, as the node's tables changed.
+
+    The node changes its tables under its own lock, but makes the master call after releasing it
+    (never across a master call). So an unsubscribe on one thread and a subscribe of the same topic on
+    another could reach the master in the opposite order: the master would then forget a live
+    subscription. A ticket taken under the node's lock fixes each call's place; :meth:`turn` waits
+    until the calls of the earlier tickets of that name are done. Names never wait on each other.
+    """
+
+    def __init__(self) -> None:
+        self._cond = threading.Condition(threading.Lock())
+        self._next: dict[TurnKey, int] = {}  # the ticket the next take() hands out
+        self._serving: dict[TurnKey, int] = {}  # the ticket whose call may run now
+        self._finished: set[tuple[TurnKey, int]] = set()  # done out of order (given up while waiting)
+
+    def take(self, kind: str, name: str) -> tuple[TurnKey, int]:
+        """A place in line for one call about ``name`` (take it while the change is made)."""
+        key = (kind, name)
+        with self._cond:
+            ticket = self._next.get(key, 0)
+            self._next[key] = ticket + 1
+        return key, ticket
+
+    def waiting(self, kind: str, name: str) -> int:
+        """How many tickets of ``name`` are taken and not done (for tests and diagnostics)."""
+        key = (kind, name)
+        with self._cond:
+            return self._next.get(key, 0) - self._serving.get(key, 0)
+
+    def wait(self, place: tuple[TurnKey, int], limit: float | None = None) -> bool:
+        """Block until every earlier ticket of the same name is done (True), or ``limit`` seconds
+        have passed (False: the caller goes out of turn)."""
+        key, ticket = place
+        deadline = None if limit is None else time.monotonic() + limit
+        with self._cond:
+            while self._serving.get(key, 0) != ticket:
+                left = None if deadline is None else deadline - time.monotonic()
+                if left is not None and left <= 0:
+                    return False
+                self._cond.wait(wait_slice(left))
+        return True
+
+    def done(self, place: tuple[TurnKey, int]) -> None:
+        """The call of ``place`` is over, failed, or was given up while waiting: let the next go."""
+        key, ticket = place
+        with self._cond:
+            self._finished.add(place)
+            serving = self._serving.get(key, 0)
+            while (key, serving) in self._finished:
+                self._finished.discard((key, serving))
+                serving += 1
+            if self._next.get(key) == serving:  # nobody in line: forget the name
+                del self._next[key]
+                self._serving.pop(key, None)
+            else:
+                self._serving[key] = serving
+            self._cond.notify_all()
+
+
 class Registrar:
-    """Registrations of one node, with a watchdog that restores them on a new master."""
+    """Registrations of one node, with a watchdog that restores them on a new master.
+
+    Each add/remove call takes a ``place`` from :attr:`turns`, given by the node when it made the
+    change under its lock, or taken on entry; the call runs when its turn comes (:class:`Turns`)."""
 
     def __init__(self, node: NodeContext) -> None:
         self.node = node
@@ -72,6 +145,8 @@ class Registrar:
         self._link_up = False
         self._link_lost = threading.Event()
         self._settle_deadline = 0.0  # monotonic end of the settling window; 0: none pending
+        #: the order of each name's registration calls (see :class:`Turns`)
+        self.turns = Turns()
 
     def start(self) -> None:
         self._thread = threading.Thread(target=self._watch, name=f"reg:{self.node.name}", daemon=True)
@@ -112,49 +187,79 @@ class Registrar:
 
             log.log(FATAL, "%s", text)
 
-    def add_publisher(self, topic: str, type_name: str) -> None:
-        with self._lock:
-            self.publications[topic] = type_name
-        self._try(
-            f"publisher {topic}", lambda: self.node.master.register_publisher(topic, type_name, self.node.uri)
-        )
+    @contextmanager
+    def _turn(
+        self, kind: str, name: str, place: tuple[TurnKey, int] | None, limit: float | None = None
+    ) -> Iterator[None]:
+        """Run the body as the call of ``place`` (a new place in line when None), after waiting at
+        most ``limit`` seconds for the earlier ones."""
+        if place is None:
+            place = self.turns.take(kind, name)
+        try:
+            self.turns.wait(place, limit)
+            yield
+        finally:
+            self.turns.done(place)
 
-    def add_subscriber(self, topic: str, type_name: str) -> list[str] | None:
-        with self._lock:
-            self.subscriptions[topic] = type_name
-        result = self._try(
-            f"subscriber {topic}",
-            lambda: self.node.master.register_subscriber(topic, type_name, self.node.uri),
-        )
+    def add_publisher(self, topic: str, type_name: str, place: tuple[TurnKey, int] | None = None) -> None:
+        with self._turn("pub", topic, place):
+            with self._lock:
+                self.publications[topic] = type_name
+            self._try(
+                f"publisher {topic}",
+                lambda: self.node.master.register_publisher(topic, type_name, self.node.uri),
+            )
+
+    def add_subscriber(
+        self, topic: str, type_name: str, place: tuple[TurnKey, int] | None = None
+    ) -> list[str] | None:
+        with self._turn("sub", topic, place):
+            with self._lock:
+                self.subscriptions[topic] = type_name
+            result = self._try(
+                f"subscriber {topic}",
+                lambda: self.node.master.register_subscriber(topic, type_name, self.node.uri),
+            )
         return list(result) if isinstance(result, list) else None
 
-    def add_service(self, name: str, service_uri: str) -> None:
-        with self._lock:
-            self.services[name] = service_uri
-        self._try(
-            f"service {name}", lambda: self.node.master.register_service(name, service_uri, self.node.uri)
-        )
+    def add_service(self, name: str, service_uri: str, place: tuple[TurnKey, int] | None = None) -> None:
+        with self._turn("srv", name, place):
+            with self._lock:
+                self.services[name] = service_uri
+            self._try(
+                f"service {name}",
+                lambda: self.node.master.register_service(name, service_uri, self.node.uri),
+            )
 
     def add_param_subscription(self, key: str) -> object | None:
         with self._lock:
             self.param_keys.add(key)
         return self._try(f"param {key}", lambda: self.node.master.subscribe_param(self.node.uri, key))
 
-    def remove_publisher(self, topic: str, client: MasterClient | None = None) -> None:
-        with self._lock:
-            self.publications.pop(topic, None)
-        self._quiet(lambda c: c.unregister_publisher(topic, self.node.uri), client)
+    def remove_publisher(
+        self, topic: str, client: MasterClient | None = None, place: tuple[TurnKey, int] | None = None
+    ) -> None:
+        with self._turn("pub", topic, place, _SHUTDOWN_TURN if client is not None else None):
+            with self._lock:
+                self.publications.pop(topic, None)
+            self._quiet(lambda c: c.unregister_publisher(topic, self.node.uri), client)
 
-    def remove_subscriber(self, topic: str, client: MasterClient | None = None) -> None:
-        with self._lock:
-            self.subscriptions.pop(topic, None)
-        self._quiet(lambda c: c.unregister_subscriber(topic, self.node.uri), client)
+    def remove_subscriber(
+        self, topic: str, client: MasterClient | None = None, place: tuple[TurnKey, int] | None = None
+    ) -> None:
+        with self._turn("sub", topic, place, _SHUTDOWN_TURN if client is not None else None):
+            with self._lock:
+                self.subscriptions.pop(topic, None)
+            self._quiet(lambda c: c.unregister_subscriber(topic, self.node.uri), client)
 
-    def remove_service(self, name: str, client: MasterClient | None = None) -> None:
-        with self._lock:
-            uri = self.services.pop(name, None)
-        if uri is not None:
-            self._quiet(lambda c: c.unregister_service(name, uri), client)
+    def remove_service(
+        self, name: str, client: MasterClient | None = None, place: tuple[TurnKey, int] | None = None
+    ) -> None:
+        with self._turn("srv", name, place, _SHUTDOWN_TURN if client is not None else None):
+            with self._lock:
+                uri = self.services.pop(name, None)
+            if uri is not None:
+                self._quiet(lambda c: c.unregister_service(name, uri), client)
 
     def _quiet(self, fn: Callable[[MasterClient], object], client: MasterClient | None) -> None:
         if self._master_down and client is not None:
@@ -279,15 +384,24 @@ class Registrar:
                 return None
 
         try:
+            # each in its name's turn, and only if still registered then: an unregistration made
+            # meanwhile is not undone (see Turns)
             for topic, type_name in pubs.items():
-                again(partial(master.register_publisher, topic, type_name, uri))
+                with self._turn("pub", topic, None):
+                    if topic in self.publications:
+                        again(partial(master.register_publisher, topic, type_name, uri))
             for topic, type_name in subs.items():
-                updates = self.node.publisher_updates(topic)  # an update newer than the answer wins
-                publishers = again(partial(master.register_subscriber, topic, type_name, uri))
+                with self._turn("sub", topic, None):
+                    if topic not in self.subscriptions:
+                        continue
+                    updates = self.node.publisher_updates(topic)  # an update newer than the answer wins
+                    publishers = again(partial(master.register_subscriber, topic, type_name, uri))
                 if isinstance(publishers, list):
                     self.node.publisher_update(topic, list(publishers), updates)
             for name, service_uri in srvs.items():
-                again(partial(master.register_service, name, service_uri, uri))
+                with self._turn("srv", name, None):
+                    if self.services.get(name) == service_uri:
+                        again(partial(master.register_service, name, service_uri, uri))
             for key in keys:
                 again(partial(master.subscribe_param, uri, key))
         except MasterError as exc:
@@ -303,8 +417,11 @@ class Registrar:
             subs = dict(self.subscriptions)
         try:
             for topic, type_name in subs.items():
-                updates = self.node.publisher_updates(topic)
-                publishers = self._probe.register_subscriber(topic, type_name, self.node.uri)
+                with self._turn("sub", topic, None):
+                    if topic not in self.subscriptions:
+                        continue
+                    updates = self.node.publisher_updates(topic)
+                    publishers = self._probe.register_subscriber(topic, type_name, self.node.uri)
                 if isinstance(publishers, list):
                     self.node.publisher_update(topic, list(publishers), updates)
         except MasterUnreachable:

@@ -225,11 +225,24 @@ class ShmSubConnection(SubConnection):
         self.ring: shm_ring.ReaderRing | None = None  # mapped when the publisher announces it
         self._reader = FrameReader(tagged=True)  # small inline messages come untagged already
 
+    tagged = True
+
     def read(self, budget: int | None = None) -> list[bytes | bytearray] | None:
         last = self.last
         frames = super().read(budget)
+        if not frames:
+            return frames
+        out = self.untag(frames)
+        if self.latching and out is not None:  # the latched message, not the tagged frame super() kept
+            self.last = out[-1] if out else last
+        return out
+
+    def untag(self, frames: list[Any]) -> list[Any] | None:
+        """Frames cut by the tagged reader -> the messages' bytes: inline ones as they are, notices as
+        read-only views into the ring, the ring's announcement mapped. None (the connection closed,
+        after one line) when the stream is malformed and nothing came before."""
         reader = self._reader
-        if not frames or not reader.special:
+        if not reader.special:
             return frames  # small inline messages only: cut without their tag by the reader
         reader.special = 0
         out: list[Any] = []
@@ -259,8 +272,6 @@ class ShmSubConnection(SubConnection):
             else:
                 self._malformed(f"a frame with tag {tag}")
                 return out or None
-        if self.latching:  # the latched message, not the tagged frame super() kept
-            self.last = out[-1] if out else last
         return out
 
     def _malformed(self, why: str) -> None:

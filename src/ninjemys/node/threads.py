@@ -350,6 +350,9 @@ RESOURCES: tuple[Resource, ...] = (
              "read under BandwidthWindow.lock"),
     Resource("lock", "ninjemys.node.registration:Registrar._lock", "any thread",
              "guards what the node has registered; reg:<node> copies it to re-register"),
+    Resource("lock", "ninjemys.node.registration:Turns._cond", "any thread",
+             "per-name order of registration calls: a ticket is taken under Node._lock, the master "
+             "call waits until the earlier tickets of that name are done; never held across a call"),
     Resource("event", "ninjemys.node.registration:Registrar._stop", "the shutting-down thread",
              "reg:<node> waits on it"),
     Resource("event", "ninjemys.node.registration:Registrar._link_lost", LOOP,
@@ -363,6 +366,11 @@ RESOURCES: tuple[Resource, ...] = (
     Resource("lock", "ninjemys.node.clock:Clock._gates_lock", "any thread",
              "wall time: guards the set of sleeping threads' gates that wake()/shutdown() open"),
     Resource("lock", "ninjemys.node.clock:Clock._local", "each sleeping thread", "its own gate lock, nobody else's"),
+    Resource("event", "ninjemys.node.clock:_MainGate._event", "the main thread (sleeping in wall time)",
+             "wake()/shutdown() set it to open the main thread's gate; waited on with interrupt.wait_event"),
+    Resource("event", "ninjemys.node.clock:_MainSimWaiter._event", "the main thread (sleeping in sim time)",
+             "the /clock callback (sub:/clock) sets it under Clock._lock when the main thread's time has "
+             "come; waited on with interrupt.wait_event"),
     Resource("lock", "ninjemys.node.log:NodeLog._lock", "any logging thread", "serializes log-file writes"),
     Resource("lock", "ninjemys.node.log:NodeLog._hold_lock", "any logging thread",
              "messages held until /rosout is attached; attach/detach at start and shutdown"),

@@ -75,6 +75,8 @@ class BuildReport:
     cpp_skipped: list[CppTarget] = field(default_factory=list)
     #: the programs catkin's CMake built, per package (where a C++ toolchain exists)
     cpp_built: dict[str, list[Path]] = field(default_factory=dict)
+    #: catkin's CMake build tree of the C++ packages when it built ('make install' runs there)
+    cpp_build: Path | None = None
 
 
 class _Writer:
@@ -163,6 +165,7 @@ def _build_cpp_packages(
     log: Callable[[str], None],
     finder: Callable[[str], Path | None],
     env: Mapping[str, str],
+    install_prefix: Path,
 ) -> None:
     """Build the C++ packages with catkin's CMake and link their programs into devel/lib/<pkg>/.
 
@@ -176,8 +179,9 @@ def _build_cpp_packages(
         chosen = cpp_closure(ordered, remaining)
         try:
             built = build_cpp(
-                chosen, ws.build / "ninjemys_cpp", ws.root / "install", toolchain, log, messages=messages
+                chosen, ws.build / "ninjemys_cpp", install_prefix, toolchain, log, messages=messages
             )
+            report.cpp_build = ws.build / "ninjemys_cpp" / "build"
             break
         except PackageError as exc:
             text = str(exc)
@@ -275,9 +279,15 @@ def _package_finder(ws: Workspace, env: Mapping[str, str]) -> Callable[[str], Pa
 
 
 def build_workspace(
-    ws: Workspace, env: Mapping[str, str] | None = None, log: Callable[[str], None] = print
+    ws: Workspace,
+    env: Mapping[str, str] | None = None,
+    log: Callable[[str], None] = print,
+    install_prefix: Path | None = None,
 ) -> BuildReport:
-    """Run the whole build; raises PackageError / DefinitionError before writing anything wrong."""
+    """Run the whole build; raises PackageError / DefinitionError before writing anything wrong.
+    ``install_prefix`` (default ``install/``) is the CMAKE_INSTALL_PREFIX the C++ build is configured
+    with, as catkin_make configures it, so a later ``make install`` there puts programs in the
+    install space."""
     env = os.environ if env is None else env
     report = BuildReport()
     ws.load()
@@ -353,7 +363,8 @@ def build_workspace(
 
     if toolchain is not None and cpp_packages:
         finder = _package_finder(ws, env)
-        _build_cpp_packages(ws, ordered, cpp_packages, toolchain, writer, report, log, finder, env)
+        prefix = ws.root / "install" if install_prefix is None else install_prefix
+        _build_cpp_packages(ws, ordered, cpp_packages, toolchain, writer, report, log, finder, env, prefix)
 
     wsenv = WorkspaceEnv(source=ws.source, devel=ws.devel)
     underlays = underlay_workspaces(ws.devel, env)

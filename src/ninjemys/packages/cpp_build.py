@@ -130,6 +130,17 @@ def _link_sources(src: Path, packages: list[PackageManifest], toplevel: Path) ->
     (src / "CMakeLists.txt").symlink_to(toplevel)
 
 
+def cmake_env(base: Mapping[str, str]) -> dict[str, str]:
+    """The environment catkin's CMake runs in: the caller's, without ROS_DISTRO. A shell that
+    sourced a ninjemys workspace has ``ROS_DISTRO=noetic``; catkin's configure step runs its env
+    hooks to cache the environment, and Debian's ``1.ros_distro.sh`` hook then prints "ROS_DISTRO was
+    set to 'noetic' before ..." on stdout, which catkin reads as a Python dict: the configure fails.
+    The hook sets the distribution of the catkin in use itself, as in a fresh ROS 1 shell."""
+    env = dict(base)
+    env.pop("ROS_DISTRO", None)
+    return env
+
+
 def build_cpp(
     packages: list[PackageManifest],
     build_root: Path,
@@ -151,7 +162,7 @@ def build_cpp(
     devel = build_root / "devel"
     _link_sources(src, packages, toolchain.toplevel)
     build.mkdir(parents=True, exist_ok=True)
-    env = dict(os.environ)
+    env = cmake_env(os.environ)
     extra: list[str] = []
     if messages is not None and messages.packages:
         paths = [p for p in env.get("CMAKE_PREFIX_PATH", "").split(os.pathsep) if p]
@@ -186,6 +197,35 @@ def build_cpp(
             if programs:
                 built[pkg.name] = programs
     return built
+
+
+def install_cpp(build: Path, log: Callable[[str], None], jobs: int = 0) -> int:
+    """``make install`` in catkin's build tree of the C++ packages (configured with the install
+    prefix by :func:`build_cpp`): what ``install(TARGETS ...)`` names goes where catkin puts it
+    (``lib/<pkg>/`` for ``${CATKIN_PACKAGE_BIN_DESTINATION}``, ``lib/`` for libraries, ``include/``),
+    with catkin's CMake config files and RPATH handling, because it is catkin doing it. Run before
+    ninjemys' own install, which then writes the setup scripts over catkin's. The number of files
+    CMake installed or found up to date; raises PackageError with CMake's output on failure."""
+    jobs = jobs or max(1, os.cpu_count() or 1)
+    proc = subprocess.run(
+        ["make", "install", f"-j{jobs}"],
+        cwd=build,
+        env=cmake_env(os.environ),
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    if proc.returncode != 0:
+        output = (proc.stdout + proc.stderr).rstrip()
+        raise PackageError(f'{output}\nInvoking "make install -j{jobs}" failed')
+    count = 0
+    for line in proc.stdout.splitlines():
+        if line.startswith(("-- Installing:", "-- Up-to-date:")):
+            count += 1
+            log(line)
+        elif line.startswith("-- Set runtime path"):
+            log(line)
+    return count
 
 
 #: genmsg's error when a dependency's .msg files are not where its CMake config says
@@ -255,9 +295,11 @@ def _run(cmd: list[str], cwd: Path, env: dict[str, str], failure: str, log: Call
 __all__ = [
     "Toolchain",
     "build_cpp",
+    "cmake_env",
     "cpp_closure",
     "failing_package",
     "find_toolchain",
+    "install_cpp",
     "missing_cpp_dependency",
     "missing_definitions_hint",
     "noetic_compat_flags",

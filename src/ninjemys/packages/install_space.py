@@ -18,8 +18,10 @@ this writes, from the same CMakeLists.txt:
   ``install(DIRECTORY launch DESTINATION ${CATKIN_PACKAGE_SHARE_DESTINATION})``. As with catkin, a
   launch/ directory no install() rule names is not installed (catkin_make says so).
 
-The install space is a copy: it works once the sources are gone. ``install(TARGETS ...)`` are the
-C++ targets the build already reported as not built.
+The install space is a copy: it works once the sources are gone. ``install(TARGETS ...)`` and the
+other install rules of C++ packages that catkin's CMake built (where a toolchain exists,
+:mod:`ninjemys.packages.cpp_build`) are run by CMake's ``make install`` before this; without a
+toolchain they are the C++ targets the build already reported as not built.
 """
 
 from __future__ import annotations

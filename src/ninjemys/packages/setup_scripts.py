@@ -3,7 +3,8 @@
 Sourcing sets ROS_PACKAGE_PATH (workspace sources first), PYTHONPATH (devel's dist-packages, where
 message stubs and catkin_python_setup relays live), PATH (the directory ninjemys' commands and
 interpreter live in, so ``rosrun``/``python3`` are ours), CMAKE_PREFIX_PATH (the devel space, which
-``rosrun`` searches for ``lib/<pkg>``), a default ROS_MASTER_URI, and the roscd/rosls functions.
+``rosrun`` searches for ``lib/<pkg>``), LD_LIBRARY_PATH (its ``lib/``, where installed C++
+libraries are, as catkin's env hook sets it), a default ROS_MASTER_URI, and the roscd/rosls functions.
 
 Chaining: the workspaces that were sourced when catkin_make ran are recorded as the underlay and
 re-applied first, so ``source devel/setup.bash`` gives "this workspace over its underlays over the
@@ -91,6 +92,8 @@ def render_setup_sh(ws: WorkspaceEnv, underlays: list[WorkspaceEnv], bin_dir: Pa
         lines.append(f"_nj_prepend ROS_PACKAGE_PATH {shlex.quote(str(env.source))}")
         lines.append(f"_nj_prepend PYTHONPATH {shlex.quote(str(env.python_dir))}")
         lines.append(f"_nj_prepend CMAKE_PREFIX_PATH {shlex.quote(str(env.devel))}")
+        # catkin's env hook does the same: C++ programs find the workspace's libraries there
+        lines.append(f"_nj_prepend LD_LIBRARY_PATH {shlex.quote(str(env.devel / 'lib'))}")
     lines.append(f"_nj_prepend PATH {shlex.quote(str(bin_dir))}")
     lines.append('export ROS_MASTER_URI="${ROS_MASTER_URI:-http://localhost:11311}"')
     lines.append('export ROS_VERSION="${ROS_VERSION:-1}"')

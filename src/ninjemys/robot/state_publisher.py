@@ -56,6 +56,7 @@ class StatePublisher:
         self.interval_ns = int(self.interval.to_nsec())
         self.last_published: dict[str, int] = {}  # joint -> stamp (ns) of its last transform
         self.last_stamp_ns = 0
+        self.last_clock_ns = 0  # the node's ROS time at the last message off the steady path
         self.unknown_seen: set[frozenset[str]] = set()
         self.tf = node.publisher("/tf", self.TFMessage, queue_size=100)
         self.tf_static = node.publisher("/tf_static", self.TFMessage, queue_size=100, latch=True)
@@ -190,13 +191,18 @@ class StatePublisher:
         return True
 
     def _check_clock(self, now_ns: int) -> None:
-        """A stamp older than the last one (a clock reset, a bag looping): every joint republished."""
-        if now_ns < self.last_stamp_ns:
+        """The node's ROS time older than at the last message (a clock reset, a bag looping): every
+        joint republished. As ROS 1's, this looks at the clock, not at the stamps: two publishers
+        of one robot's joints (joint_state_publisher beside Gazebo's joint_state_controller, as the
+        course launch files have them) interleave older and newer stamps with no reset."""
+        clock_ns = self.node.now().to_nsec()
+        if clock_ns < self.last_clock_ns:
             self.warn(
                 "Moved backwards in time (probably because ROS clock was reset), re-publishing joint transforms!"
             )
             self.last_published.clear()
             self.streak = None
+        self.last_clock_ns = clock_ns
         self.last_stamp_ns = now_ns
 
     def _flush_streak(self) -> None:

@@ -12,14 +12,15 @@ the links fixed to its base, 1 kg without any), and its wheels stop it when the 
 
 The world is flat: a model's pose has the height it was spawned with and no roll or pitch. Models
 are the robots (links: the base, the wheels and the sensors) and the static obstacles (one link,
-``link``). Everything here runs under the simulation's lock; nothing here publishes per robot.
+``link``, or the links of an SDF model of several pieces: spawned, moved and deleted whole).
+Everything here runs under the simulation's lock; nothing here publishes per robot.
 """
 
 from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -30,6 +31,7 @@ from ninjemys.rostime import Time
 from ninjemys.sim.robot_model import load_robot_model, model_from_urdf
 from ninjemys.sim.sdf import sdf_model_obstacles
 from ninjemys.sim.simcore import Robot, SpawnError, wrap_angle
+from ninjemys.sim.world2d import Obstacle
 from ninjemys.tf2.math import quaternion_from_yaw, yaw_from_quaternion
 
 if TYPE_CHECKING:
@@ -150,7 +152,22 @@ class GazeboApi:
     # -- the model tree ----------------------------------------------------------------------------
     def model_names(self) -> list[str]:
         sim = self.sn.sim
-        return [o.name for o in sim.world.obstacles] + list(sim.robots)
+        return list(dict.fromkeys(o.model_name for o in sim.world.obstacles)) + list(sim.robots)
+
+    def obstacle_links(self, name: str) -> dict[str, list[str]]:
+        """A static model's links and, per link, its collisions (``link`` for a model of one piece)."""
+        links: dict[str, list[str]] = {}
+        for o in self.sn.sim.world.obstacles:
+            if o.model_name != name:
+                continue
+            if not o.model:
+                links.setdefault("link", []).append("collision")
+                continue
+            parts = o.name.partition("#")[0].split("::")
+            link, geom = (parts[-2], parts[-1]) if len(parts) >= 3 else ("link", parts[-1])
+            if geom not in links.setdefault(link, []):
+                links[link].append(geom)
+        return links
 
     def model_pose(self, name: str) -> Planar | None:
         sim = self.sn.sim
@@ -194,7 +211,8 @@ class GazeboApi:
             return None
         r = self.sn.sim.robots.get(model)
         if r is None:
-            return {"link": pose}
+            # a static model's links: at its pose (the pieces' own offsets are in their outlines)
+            return dict.fromkeys(self.obstacle_links(model), pose)
         return {name: compose(pose, rel) for name, rel in self.robot_links(r).items()}
 
     def entity_pose(self, name: str) -> Planar | None:
@@ -250,7 +268,8 @@ class GazeboApi:
                     return resp
                 pose = compose(ref, pose)
             x, y, z, yaw = pose
-            kind, spec = parse_model_xml(req.model_xml)
+            drops: dict[str, float] = {}
+            kind, spec = parse_model_xml(req.model_xml, z, drops)
             if kind == "robot":
                 namespace = req.robot_namespace.strip("/")
                 clash = any(io.prefix == "" for io in sn.io.values())
@@ -260,17 +279,12 @@ class GazeboApi:
                     # a light, a ground plane: nothing the floor plan holds (Gazebo would add it)
                     sn.log.info("model [%s] has no collision this simulator sees: nothing added", name)
                     return _spawned(resp)
-                (piece,) = spec
-                c, s = math.cos(yaw), math.sin(yaw)
-                rel = piece.outline
-                outline = np.column_stack(
-                    [x + c * rel[:, 0] - s * rel[:, 1], y + s * rel[:, 0] + c * rel[:, 1]]
-                )
+                pieces = _placed(name, spec, x, y, yaw)
                 with sn.lock:
-                    sn.sim.add_outline(name, piece.kind, outline, yaw, piece.height, piece.color)
-                sn.log.info(
-                    "spawned %s [%s] (SDF model %s) at (%.3f, %.3f)", piece.kind, name, piece.name, x, y
-                )
+                    sn.sim.add_model(name, pieces, yaw, (x, y))
+                z -= max(drops.values(), default=0.0)  # a model with physics settles on the floor
+                what = pieces[0].kind if len(pieces) == 1 else f"{len(pieces)} pieces"
+                sn.log.info("spawned SDF model [%s] (%s) at (%.3f, %.3f, %.3f)", name, what, x, y, z)
             else:
                 shape, size, height, colour = spec
                 with sn.lock:
@@ -389,11 +403,16 @@ class GazeboApi:
                 resp.success, resp.status_message = False, "GetModelProperties: model does not exist"
                 return resp
             r = self.sn.sim.robots.get(name)
-            bodies = list(self.robot_links(r)) if r is not None else ["link"]
             resp.parent_model_name = ""
+            if r is not None:
+                bodies = list(self.robot_links(r))
+                resp.geom_names = [f"{b}_collision" for b in bodies]
+            else:
+                links = self.obstacle_links(name)
+                bodies = list(links)
+                resp.geom_names = [g for geoms in links.values() for g in geoms]
             resp.canonical_body_name = bodies[0]
             resp.body_names = bodies
-            resp.geom_names = [f"{b}_collision" for b in bodies]
             resp.joint_names = [r.model.left_joint, r.model.right_joint] if r is not None else []
             resp.child_model_names = []
             resp.is_static = r is None
@@ -584,13 +603,30 @@ def _spawned(resp: Any) -> Any:
     return resp
 
 
-def parse_model_xml(text: str) -> tuple[str, Any]:
+def _placed(name: str, pieces: list[Obstacle], x: float, y: float, yaw: float) -> list[Obstacle]:
+    """An SDF model's pieces (outlines in the model's frame) at the spawn pose, named as Gazebo
+    names them: the model's name for a model of one piece, ``name::link::collision`` otherwise."""
+    c, s = math.cos(yaw), math.sin(yaw)
+    placed = []
+    for piece in pieces:
+        rel = piece.outline
+        outline = np.column_stack([x + c * rel[:, 0] - s * rel[:, 1], y + s * rel[:, 0] + c * rel[:, 1]])
+        if len(pieces) == 1:
+            placed.append(replace(piece, name=name, outline=outline, model=""))
+        else:
+            scoped = piece.name.partition("::")[2] if piece.model else piece.name
+            placed.append(replace(piece, name=f"{name}::{scoped}", outline=outline, model=name))
+    return placed
+
+
+def parse_model_xml(text: str, z: float = 0.0, drops: dict[str, float] | None = None) -> tuple[str, Any]:
     """What a SpawnModel request's ``model_xml`` describes: ("robot", RobotModel),
     ("obstacle", (shape, size, height, colour)) for a URDF box or cylinder, or ("sdf", [Obstacle])
     for an SDF document (a ``<model>``, or spawn_model -database's ``<world>`` of one ``model://``
-    include, found on GAZEBO_MODEL_PATH or among the shipped models), its solid in the model's frame
-    (empty for a model with nothing solid: a light, a ground plane). Empty text or ``puzzlebot`` is
-    the PuzzleBot."""
+    include, found on GAZEBO_MODEL_PATH or among the shipped models), its pieces in the model's
+    frame with their heights as the model settles when spawned at height ``z`` (static: held there;
+    else on the floor; ``drops``: how far it fell), none for a model with nothing solid (a light, a
+    ground plane). Empty text or ``puzzlebot`` is the PuzzleBot."""
     body = text.strip()
     if not body:
         return "robot", load_robot_model("puzzlebot")
@@ -602,14 +638,7 @@ def parse_model_xml(text: str) -> tuple[str, Any]:
         raise SpawnError(f"model_xml is not valid XML: {exc}") from None
     if root.tag == "sdf":
         # SdfError (a MapFileError) names the element and the reason
-        pieces = sdf_model_obstacles(body, lift=True)
-        if len(pieces) > 1:
-            raise SpawnError(
-                f"the SDF model has {len(pieces)} collision pieces ({', '.join(p.name for p in pieces)}); "
-                "spawn_sdf_model takes models of one piece here: put this model in the world file, "
-                "where every piece is kept"
-            )
-        return "sdf", pieces
+        return "sdf", sdf_model_obstacles(body, z=z, drops=drops)
     if root.tag == "robot" and any(j.get("type") == "continuous" for j in root.iter("joint")):
         # a robot with wheels: the URDF reader says what it is, or why it cannot be simulated
         return "robot", model_from_urdf(body, "model_xml")

@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 import struct
 import xml.etree.ElementTree as ET
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -33,8 +34,23 @@ class MeshError(MapFileError):
     """A mesh file that cannot be read; the text names the file and the reason."""
 
 
+@dataclass
+class MeshPart:
+    """One part of a mesh: its vertices (N, 3) and, where the file says how they join, its
+    triangles (T, 3, 3); metres, z up."""
+
+    vertices: np.ndarray
+    triangles: np.ndarray
+
+
 def load_mesh_parts(path: str | Path) -> list[np.ndarray]:
     """The mesh's parts, each an (N, 3) float array of vertex positions in metres (z up)."""
+    return [part.vertices for part in load_mesh(path)]
+
+
+def load_mesh(path: str | Path) -> list[MeshPart]:
+    """The mesh's parts with their triangles (a maze of walls in one piece is cut at a height from
+    them: its outline is not its convex hull)."""
     p = Path(path)
     try:
         data = p.read_bytes()
@@ -44,7 +60,8 @@ def load_mesh_parts(path: str | Path) -> list[np.ndarray]:
     if suffix == ".stl":
         parts = [_stl_triangles(data, p)]
     elif suffix == ".dae":
-        parts = _collada_parts(data, p)
+        collada = _collada_parts(data, p)
+        parts = [c.vertices for c in collada] + [c.triangles for c in collada]
     elif suffix == ".obj":
         parts = [_obj_triangles(data, p)]
     else:
@@ -54,7 +71,9 @@ def load_mesh_parts(path: str | Path) -> list[np.ndarray]:
             raise MeshError(f"{p}: a vertex is not a finite number (nan or inf)")
         if len(part) and np.abs(part).max() > MAX_COORDINATE:
             raise MeshError(f"{p}: a vertex lies more than {MAX_COORDINATE:g} m from the origin")
-    return _components(parts[0]) if suffix in (".stl", ".obj") else parts
+    if suffix == ".dae":
+        return collada
+    return [MeshPart(tris.reshape(-1, 3), tris) for tris in _components(parts[0])]
 
 
 # -- STL -------------------------------------------------------------------------------------------
@@ -130,10 +149,10 @@ def _obj_triangles(data: bytes, p: Path) -> np.ndarray:
 
 
 def _components(tris: np.ndarray) -> list[np.ndarray]:
-    """Split (T, 3, 3) triangles into connected pieces (shared welded vertices), each as its vertices."""
+    """Split (T, 3, 3) triangles into connected pieces (shared welded vertices), each (T', 3, 3)."""
     flat = tris.reshape(-1, 3)
-    if len(tris) > MAX_COMPONENT_TRIANGLES:
-        return [flat]
+    if len(tris) > MAX_COMPONENT_TRIANGLES or not len(tris):
+        return [tris]
     keys = np.round(flat / WELD).astype(np.int64)
     _, vid = np.unique(keys, axis=0, return_inverse=True)
     vid = vid.reshape(-1)
@@ -152,10 +171,7 @@ def _components(tris: np.ndarray) -> list[np.ndarray]:
         parent[rb] = ra
         parent[find(rc)] = ra
     roots = np.array([find(int(i)) for i in vid[::3]])
-    parts = []
-    for root in np.unique(roots):
-        parts.append(tris[roots == root].reshape(-1, 3))
-    return parts
+    return [tris[roots == root] for root in np.unique(roots)]
 
 
 # -- COLLADA ---------------------------------------------------------------------------------------
@@ -232,7 +248,52 @@ def _geometry_positions(geom: ET.Element, p: Path) -> np.ndarray:
     return values.reshape(-1, 3)
 
 
-def _collada_parts(data: bytes, p: Path) -> list[np.ndarray]:
+def _geometry_triangles(geom: ET.Element, positions: np.ndarray, p: Path) -> np.ndarray:
+    """The (T, 3, 3) triangles of a <geometry>'s <triangles>, <polylist> and <polygons> (polygons
+    as fans), from the VERTEX input's indices into ``positions``."""
+    mesh = next((c for c in geom if _local(c.tag) == "mesh"), None)
+    out: list[np.ndarray] = []
+    for prim in mesh if mesh is not None else []:
+        kind = _local(prim.tag)
+        if kind not in ("triangles", "polylist", "polygons"):
+            continue
+        inputs = [c for c in prim if _local(c.tag) == "input"]
+        try:
+            offsets = [int(i.get("offset", "0")) for i in inputs]
+            vertex = next(int(i.get("offset", "0")) for i in inputs if i.get("semantic") == "VERTEX")
+        except (ValueError, StopIteration):
+            continue  # no vertex indices: the positions alone give the outline
+        stride = max(offsets) + 1
+        polys: list[np.ndarray] = []
+        lists = [c for c in prim if _local(c.tag) == "p"]
+        for plist in lists:
+            idx = _floats(plist.text, p, f"<{kind}> <p>").astype(np.int64)[vertex::stride]
+            if kind == "polygons":
+                polys.append(idx)
+            elif kind == "triangles":
+                polys.extend(idx[: len(idx) // 3 * 3].reshape(-1, 3))
+            else:
+                vcount_el = next((c for c in prim if _local(c.tag) == "vcount"), None)
+                counts = _floats(vcount_el.text if vcount_el is not None else "", p, "<vcount>").astype(
+                    np.int64
+                )
+                starts = np.concatenate([[0], np.cumsum(counts)])
+                if starts[-1] > len(idx):
+                    raise MeshError(f"{p}: <polylist> <vcount> asks for more indices than <p> has")
+                polys.extend(idx[a:b] for a, b in zip(starts[:-1], starts[1:], strict=True))
+        for poly in polys:
+            if len(poly) < 3:
+                continue
+            if poly.min() < 0 or poly.max() >= len(positions):
+                raise MeshError(
+                    f"{p}: <{kind}> index {int(poly.max())} is past the {len(positions)} positions"
+                )
+            fan = np.column_stack([np.full(len(poly) - 2, poly[0]), poly[1:-1], poly[2:]])
+            out.append(positions[fan])
+    return np.concatenate(out) if out else np.zeros((0, 3, 3))
+
+
+def _collada_parts(data: bytes, p: Path) -> list[MeshPart]:
     try:
         root = ET.fromstring(data)
     except ET.ParseError as exc:
@@ -257,8 +318,17 @@ def _collada_parts(data: bytes, p: Path) -> list[np.ndarray]:
     elif up == "X_UP":
         fix[:3, :3] = [[0, -1, 0], [1, 0, 0], [0, 0, 1]]
     fix = np.diag([unit, unit, unit, 1.0]) @ fix
-    parts: list[np.ndarray] = []
+    parts: list[MeshPart] = []
     scenes = [s for s in root.iter() if _local(s.tag) == "visual_scene"]
+
+    def placed(geom: ET.Element, m: np.ndarray) -> MeshPart | None:
+        pts = _geometry_positions(geom, p)
+        if not len(pts):
+            return None
+        tris = _geometry_triangles(geom, pts, p)
+        h = np.hstack([pts, np.ones((len(pts), 1))]) @ m.T
+        t = tris.reshape(-1, 3) @ m[:3, :3].T + m[:3, 3]
+        return MeshPart(h[:, :3], t.reshape(-1, 3, 3))
 
     def walk(node: ET.Element, m: np.ndarray) -> None:
         m = m @ _node_matrix(node, p)
@@ -266,11 +336,9 @@ def _collada_parts(data: bytes, p: Path) -> list[np.ndarray]:
             tag = _local(child.tag)
             if tag == "instance_geometry":
                 geom = geometries.get((child.get("url") or "").lstrip("#"))
-                if geom is not None:
-                    pts = _geometry_positions(geom, p)
-                    if len(pts):
-                        h = np.hstack([pts, np.ones((len(pts), 1))]) @ m.T
-                        parts.append(h[:, :3])
+                part = placed(geom, m) if geom is not None else None
+                if part is not None:
+                    parts.append(part)
             elif tag == "node":
                 walk(child, m)
 
@@ -279,9 +347,9 @@ def _collada_parts(data: bytes, p: Path) -> list[np.ndarray]:
             walk(node, fix)
     if not scenes:
         for geom in geometries.values():
-            pts = _geometry_positions(geom, p)
-            if len(pts):
-                parts.append((np.hstack([pts, np.ones((len(pts), 1))]) @ fix.T)[:, :3])
+            part = placed(geom, fix)
+            if part is not None:
+                parts.append(part)
     if not parts:
         raise MeshError(f"{p}: COLLADA document with no geometry")
     return parts

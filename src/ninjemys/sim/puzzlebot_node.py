@@ -221,6 +221,15 @@ class SimNode:
             self.io[name] = io
             self._publish_static()
             self._publish_contact(io)
+        if robot.spawn_overlap is not None:
+            what, depth = robot.spawn_overlap
+            self.log.warn(
+                "robot [%s] spawned %.3f m into '%s' (Gazebo's physics would push it out): it moves "
+                "only away from it",
+                name,
+                depth,
+                what,
+            )
         self.log.info(
             "spawned robot [%s] (%s) at (%.3f, %.3f, %.3f)%s",
             name,

@@ -1,8 +1,11 @@
 """Gazebo worlds (SDF 1.4-1.7 ``.world`` files) read into the simulator's floor-plan :class:`World`.
 
 No ROS in here. A lidar in Gazebo hits collision geometry, so every ``<collision>`` of every model
-becomes one obstacle: its footprint on the floor (the outline of the shape's projection) and its top
-(the highest point), coloured by its link's ``<visual>`` material. Poses compose down the tree
+becomes one obstacle: its footprint on the floor (the outline of the shape's projection), its bottom
+and its top, coloured by its link's ``<visual>`` material. Heights are where Gazebo's physics leaves
+the model: a ``<static>`` model stays at its pose (a table top held at 0.75 m: a low lidar and a low
+robot pass under it), one with physics falls onto the floor (or is pushed up out of it) as a whole.
+A model of several pieces gives one obstacle per piece, each knowing its model. Poses compose down the tree
 (world, nested models, link, collision; x y z roll pitch yaw, fixed axes as SDF says), so a tilted
 box or a lying cylinder gets the footprint it really has.
 
@@ -24,9 +27,12 @@ Malformed SDF raises :class:`SdfError` with ``file:line: <element>: reason``.
 
 from __future__ import annotations
 
+import functools
 import logging
 import math
 import os
+import re
+import xml.etree.ElementTree as ET
 import xml.parsers.expat
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -36,9 +42,9 @@ import numpy as np
 
 from ninjemys.errors import PackageError
 from ninjemys.maps.mapfile import MapFileError
-from ninjemys.packages.discovery import find_package
-from ninjemys.sim.meshes import load_mesh_parts
-from ninjemys.sim.world2d import Obstacle, World
+from ninjemys.packages.discovery import crawl, find_package
+from ninjemys.sim.meshes import load_mesh
+from ninjemys.sim.world2d import FloorImage, Obstacle, World
 
 log = logging.getLogger(__name__)
 
@@ -50,8 +56,6 @@ ROUND_SIDES = 24
 #: shapes whose top is lower than this (metres) lie on the floor: nothing for a sensor to hit
 MIN_TOP = 1e-3
 DEFAULT_COLOUR = (180, 180, 180)
-#: a shape whose lowest point is higher than this (metres) floats: reported, as it stands on the floor here
-FLOATING = 0.05
 MAX_INCLUDE_DEPTH = 16
 
 #: Gazebo's material scripts (gazebo.material) by name, as the RGB they render roughly as
@@ -140,8 +144,28 @@ class Element:
         return SdfError(f"{self.source}:{self.line}: <{self.tag}>: {reason}")
 
 
+#: an XML declaration (``<?xml version="1.0"?>``)
+_DECLARATION = re.compile(rb"<\?xml\s[^>]*\?>")
+
+
+def _stray_declarations_blanked(data: bytes) -> bytes:
+    """The text with every XML declaration that is not at its very start blanked (newlines kept,
+    so line numbers stay). sdformat's TinyXML reads a world with ``<?xml ...?>`` pasted into the
+    middle (worlds assembled from a saved world and a model file have them) or after a blank line;
+    expat refuses both ("XML or text declaration not at start of entity")."""
+
+    def blank(m: re.Match[bytes]) -> bytes:
+        if m.start() == 0:
+            return m.group(0)
+        return re.sub(rb"[^\n]", b" ", m.group(0))
+
+    return _DECLARATION.sub(blank, data)
+
+
 def parse_xml(data: bytes, source: str) -> Element:
-    """The document's root element, each element knowing its line (expat; errors name file and line)."""
+    """The document's root element, each element knowing its line (expat; errors name file and line).
+    Declarations out of place are read past, as sdformat (TinyXML) does."""
+    data = _stray_declarations_blanked(data)
     parser = xml.parsers.expat.ParserCreate()
     stack: list[Element] = []
     root: list[Element] = []
@@ -278,20 +302,58 @@ class Footprint:
 class _Context:
     env: Mapping[str, str]
     unsupported: dict[str, str] = field(default_factory=dict)  # what -> first place
+    #: a world file: what cannot be found (a model:// of Gazebo's online database, a mesh) is left
+    #: out and reported, as Gazebo loads the world without it ("Unable to find uri[...]")
+    lenient: bool = False
+    #: textured planes lying on the floor (a course's track), for the camera
+    floor_images: list[FloorImage] = field(default_factory=list)
+    #: each top-level model's pose (x, y, yaw), as /gazebo/model_states reports it
+    origins: dict[str, tuple[float, float, float]] = field(default_factory=dict)
+
+    def missing(self, uri: str, el: Element, exc: SdfError | None = None) -> None:
+        """SdfError, or in a world a note that ``uri`` is left out (Gazebo's behaviour)."""
+        if not self.lenient:
+            raise exc or el.error(f"{uri} not found")
+        self.skip(
+            f"{uri.strip()} (not found, left out as Gazebo does: 'Unable to find uri[{uri.strip()}]')", el
+        )
 
     def skip(self, what: str, el: Element) -> None:
         self.unsupported.setdefault(what, f"{el.source}:{el.line}")
 
 
 def model_dirs(env: Mapping[str, str] | None = None) -> list[Path]:
-    """Where ``model://`` URIs are looked up, in Gazebo's order, ending with our shipped models."""
+    """Where ``model://`` URIs are looked up, in Gazebo's order, ending with our shipped models:
+    GAZEBO_MODEL_PATH, the ``gazebo_model_path`` the packages on ROS_PACKAGE_PATH export (what
+    gazebo_ros' paths plugin adds), ``~/.gazebo/models``."""
     environ = os.environ if env is None else env
     dirs = [Path(d) for d in environ.get("GAZEBO_MODEL_PATH", "").split(":") if d]
+    dirs += [Path(d) for d in _exported_model_paths(environ.get("ROS_PACKAGE_PATH", ""))]
     home = environ.get("HOME")
     if home:
         dirs.append(Path(home) / ".gazebo" / "models")
     dirs.append(SHIPPED_MODELS)
     return dirs
+
+
+@functools.lru_cache(maxsize=8)
+def _exported_model_paths(ros_package_path: str) -> tuple[str, ...]:
+    """``<export><gazebo_ros gazebo_model_path="${prefix}/models"/></export>`` of every package on
+    ``ros_package_path`` (the maker's puzzlebot_world has it), ``${prefix}`` being the package's
+    folder: gazebo_ros' paths plugin adds these to Gazebo's model path (``rospack plugins``)."""
+    found: list[str] = []
+    for root in (Path(d) for d in ros_package_path.split(":") if d):
+        for pkg_dir in crawl(root):
+            try:
+                tree = ET.parse(pkg_dir / "package.xml")
+            except (OSError, ET.ParseError):
+                continue
+            for export in tree.getroot().findall("export"):
+                for gz in export.findall("gazebo_ros"):
+                    value = gz.get("gazebo_model_path")
+                    if value:
+                        found.append(value.replace("${prefix}", str(pkg_dir)))
+    return tuple(found)
 
 
 def resolve_uri(uri: str, el: Element, env: Mapping[str, str]) -> Path:
@@ -367,9 +429,12 @@ def _sdf_root(data: bytes, source: str, ctx: _Context) -> Element:
     return root
 
 
-def _colour(link: Element, ctx: _Context) -> tuple[int, int, int]:
-    """The colour of a link's first visual material: diffuse, ambient, then the script's name."""
+def _colour(link: Element, ctx: _Context, pictures: tuple[Element, ...] = ()) -> tuple[int, int, int]:
+    """The colour of a link's first visual material: diffuse, ambient, then the script's name
+    (``pictures``: visuals drawn as floor pictures, not looked at)."""
     for visual in link.findall("visual"):
+        if any(visual is p for p in pictures):
+            continue
         mat = visual.find("material")
         if mat is None:
             continue
@@ -390,6 +455,83 @@ def _colour(link: Element, ctx: _Context) -> tuple[int, int, int]:
                 return GAZEBO_MATERIALS[name.lower()]
             ctx.skip(f"material script {name!r} (drawn grey)", script)
     return DEFAULT_COLOUR
+
+
+def _floor_picture(visual: Element, m: np.ndarray, ctx: _Context, name: str) -> FloorImage | None:
+    """A visual that is a horizontal ``<plane>`` with a textured material script (the course's
+    tracks: ``model://track/materials/scripts`` + ``.../textures``, material ``track``) as a picture on
+    the floor, wherever its height (the floor plan has one floor); None for anything else."""
+    geom = visual.find("geometry")
+    plane = geom.find("plane") if geom is not None else None
+    mat = visual.find("material")
+    script = mat.find("script") if mat is not None else None
+    if plane is None or script is None:
+        return None
+    material = (script.value("name") or "").strip()
+    if not material or material.lower() in GAZEBO_MATERIALS:
+        return None
+    size_el = plane.find("size")
+    if size_el is None:
+        return None
+    width, height = _numbers(size_el, 2, "x y")
+    normal_el = plane.find("normal")
+    vm = m @ _pose(visual, ctx)
+    normal = vm[:3, :3] @ np.array(_numbers(normal_el, 3, "x y z") if normal_el is not None else [0, 0, 1.0])
+    if width <= 0 or height <= 0 or abs(normal[2]) < 0.99 * float(np.linalg.norm(normal)):
+        return None  # a wall-like plane: nothing the floor shows
+    texture = _texture(script, material, ctx)
+    if texture is None:
+        ctx.skip(f"material script {material!r} (no texture found for it: drawn grey)", script)
+        return None
+    import cv2  # the course's PNG/JPEG textures; cv2 is a dependency already (cv_bridge)
+
+    bgr = cv2.imread(str(texture), cv2.IMREAD_COLOR)
+    if bgr is None:
+        ctx.skip(f"texture {texture} (not an image cv2 reads: drawn grey)", script)
+        return None
+    rgb = np.ascontiguousarray(bgr[:, :, ::-1])
+    yaw = math.atan2(float(vm[1, 0]), float(vm[0, 0]))
+    return FloorImage(name, rgb, float(vm[0, 3]), float(vm[1, 3]), width, height, yaw)
+
+
+#: ``material NAME`` (optionally ``: PARENT``) opening a block of an OGRE material script
+_MATERIAL = re.compile(r"^\s*material\s+([^\s{:]+)", re.MULTILINE)
+
+
+def _texture(script: Element, material: str, ctx: _Context) -> Path | None:
+    """The image of ``material``'s first ``texture`` in the material scripts its ``<uri>``s name
+    (folders of ``.material`` files, or files), looked for beside the script, in ``../textures``
+    and in the folders the ``<uri>``s name, as Gazebo's resource paths find it."""
+    dirs: list[Path] = []
+    files: list[Path] = []
+    for uri in script.findall("uri"):
+        try:
+            path = resolve_uri(uri.text, uri, ctx.env)
+        except SdfError:
+            continue
+        if path.is_dir():
+            dirs.append(path)
+        elif path.is_file():
+            files.append(path)
+    for script_file in files + [f for d in dirs for f in sorted(d.glob("*.material"))]:
+        try:
+            text = script_file.read_text(errors="replace")
+        except OSError:
+            continue
+        starts = list(_MATERIAL.finditer(text))
+        for i, block in enumerate(starts):
+            if block.group(1) != material:
+                continue
+            body = text[block.end() : starts[i + 1].start() if i + 1 < len(starts) else len(text)]
+            found = re.search(r"\btexture\s+([^\s}]+)", body)
+            if found is None:
+                return None
+            for d in (script_file.parent, script_file.parent.parent / "textures", *dirs):
+                candidate = d / found.group(1)
+                if candidate.is_file():
+                    return candidate
+            return None
+    return None
 
 
 def _pose(el: Element, ctx: _Context) -> np.ndarray:
@@ -452,16 +594,83 @@ def _geometry(geom: Element, m: np.ndarray, ctx: _Context) -> list[Footprint]:
         scale_el = shape.find("scale")
         if scale_el is not None:
             scale = np.array(_numbers(scale_el, 3, "x y z"))
-        path = resolve_uri(uri, shape, ctx.env)
         try:
-            parts = load_mesh_parts(path)
+            path = resolve_uri(uri, shape, ctx.env)
+        except SdfError as exc:
+            ctx.missing(uri, shape, exc)
+            return []
+        if not path.exists():
+            ctx.missing(uri, shape, shape.error(f"{path}: cannot read mesh: No such file or directory"))
+            return []
+        try:
+            parts = load_mesh(path)
         except MapFileError as exc:
             raise shape.error(str(exc)) from None
-        return [_piece(_transform(m, part * scale), "mesh") for part in parts if len(part)]
+        out: list[Footprint] = []
+        for part in parts:
+            if len(part.vertices):
+                tris = _transform(m, part.triangles.reshape(-1, 3) * scale).reshape(-1, 3, 3)
+                out += _mesh_footprints(_transform(m, part.vertices * scale), tris)
+        return out
     if kind == "plane":
         return []  # the floor
     ctx.skip(f"<{kind}> geometry", shape)
     return []
+
+
+def _cross_section(tris: np.ndarray, z: float) -> np.ndarray:
+    """The (K, 4) segments where the plane at height ``z`` cuts the (T, 3, 3) triangles."""
+    d = tris[:, :, 2] - z
+    d = np.where(d == 0.0, 1e-12, d)  # a vertex on the plane counts as just above it
+    above = d > 0
+    cut = above.any(axis=1) & ~above.all(axis=1)
+    t, dd = tris[cut], d[cut]
+    ends = []
+    for a, b in ((0, 1), (1, 2), (2, 0)):
+        crosses = (dd[:, a] > 0) != (dd[:, b] > 0)
+        with np.errstate(divide="ignore", invalid="ignore"):  # edges that do not cross: dropped below
+            f = dd[:, a] / (dd[:, a] - dd[:, b])
+            point = t[:, a, :2] + (t[:, b, :2] - t[:, a, :2]) * f[:, None]
+        ends.append(np.where(crosses[:, None], point, np.nan))
+    pts = np.stack(ends, axis=1)  # (K, 3 edges, 2): two of the three edges cross
+    first = np.where(np.isnan(pts[:, 0, 0])[:, None], pts[:, 1], pts[:, 0])
+    second = np.where(np.isnan(pts[:, 2, 0])[:, None], pts[:, 1], pts[:, 2])
+    segs = np.hstack([first, second])
+    return segs[np.hypot(segs[:, 2] - segs[:, 0], segs[:, 3] - segs[:, 1]) > 1e-9]
+
+
+def _mesh_footprints(vertices: np.ndarray, tris: np.ndarray) -> list[Footprint]:
+    """A mesh part's footprint: its convex hull, unless its walls cut at a low height lie inside the
+    hull (a maze, an L-shaped wall, a room exported as one mesh): then the cut's segments, each a
+    thin wall as tall as the part, as Gazebo's rays meet the triangles themselves."""
+    hull = _piece(vertices, "mesh")
+    if len(tris) < 4 or len(hull.outline) < 3:
+        return [hull]
+    low, high = hull.bottom, hull.top
+    z = low + min(0.05, 0.25 * (high - low))  # near the floor: where a planar lidar looks
+    segs = _cross_section(tris, z)
+    if not len(segs):
+        return [hull]
+    outline = hull.outline
+    edges = np.hstack([outline, np.roll(outline, -1, axis=0)])
+    mids = (segs[:, :2] + segs[:, 2:]) / 2.0
+    # how far each cut segment's middle lies inside the hull: near its edge, the hull is the outline
+    span = float(min(np.ptp(outline[:, 0]), np.ptp(outline[:, 1])))
+    depth = _distance_to_segments(mids, edges).min(axis=1)
+    if float(depth.max()) <= max(0.02, 0.1 * span):
+        return [hull]
+    return [Footprint(seg.reshape(2, 2), high, "mesh", low) for seg in segs]
+
+
+def _distance_to_segments(points: np.ndarray, segs: np.ndarray) -> np.ndarray:
+    """(P, S) distances from points to segments."""
+    a, b = segs[None, :, :2], segs[None, :, 2:]
+    ab = b - a
+    ap = points[:, None, :] - a
+    length2 = np.maximum((ab * ab).sum(axis=2), 1e-18)
+    t = np.clip((ap * ab).sum(axis=2) / length2, 0.0, 1.0)
+    closest = a + ab * t[:, :, None]
+    return np.hypot(*(points[:, None, :] - closest).transpose(2, 0, 1))
 
 
 def _piece(points: np.ndarray, kind: str) -> Footprint:
@@ -474,6 +683,31 @@ class _Solid:
     path: list[str]  # model names from the top, then link, then collision
     footprint: Footprint
     colour: tuple[int, int, int]
+    static: bool = False  # its model is static: it stays where it is put
+
+
+def _settle(solids: list[_Solid], drops: dict[str, float] | None = None) -> list[_Solid]:
+    """Heights as Gazebo's physics leaves each top-level model (all its pieces together): a static
+    model stays at its pose (a table top held at 0.75 m floats there; a part below the floor is
+    hidden), a model with physics falls onto the floor, or is pushed up out of it, until its lowest
+    point touches it. The floor is the only thing models land on here (a box dropped onto a table
+    lands on the floor). Pieces with nothing above the floor are dropped. ``drops`` receives how far
+    each model fell (negative: pushed up)."""
+    lowest: dict[str, float] = {}
+    for s in solids:
+        if not s.static:
+            key = s.path[0]
+            lowest[key] = min(lowest.get(key, math.inf), s.footprint.bottom)
+    if drops is not None:
+        drops.update(lowest)
+    kept = []
+    for s in solids:
+        fp = s.footprint
+        drop = lowest.get(s.path[0], 0.0) if not s.static else 0.0
+        fp.top, fp.bottom = fp.top - drop, max(fp.bottom - drop, 0.0)
+        if fp.top > MIN_TOP and len(fp.outline) >= 2:
+            kept.append(s)
+    return kept
 
 
 def _model(
@@ -484,32 +718,47 @@ def _model(
     scope: list[str],
     depth: int,
     pose_override: np.ndarray | None = None,
+    static: bool | None = None,
 ) -> None:
+    """Read a model's pieces into ``out``; ``static`` (an include's or a parent's) overrides its own."""
     name = el.attrib.get("name")
     if not name:
         raise el.error("missing attribute 'name'")
     m = parent @ (pose_override if pose_override is not None else _pose(el, ctx))
     here = [*scope, name]
+    if not scope:
+        ctx.origins[name] = (float(m[0, 3]), float(m[1, 3]), math.atan2(float(m[1, 0]), float(m[0, 0])))
+    if static is None:
+        own = el.find("static")
+        static = _bool(own) if own is not None else False
     for child in el.children:
         tag = child.tag
         if tag == "link":
-            _link(child, m, ctx, out, here)
+            _link(child, m, ctx, out, here, static)
         elif tag == "model":
-            _model(child, m, ctx, out, here, depth + 1)
+            _model(child, m, ctx, out, here, depth + 1, static=static or None)
         elif tag == "include":
-            _include(child, m, ctx, out, here, depth + 1)
+            _include(child, m, ctx, out, here, depth + 1, static=static or None)
         elif tag == "plugin":
             ctx.skip(f"model plugin {child.attrib.get('filename', '?')}", child)
         elif tag not in _QUIET_MODEL:
             ctx.skip(f"<{tag}> in a model", child)
 
 
-def _link(el: Element, model: np.ndarray, ctx: _Context, out: list[_Solid], scope: list[str]) -> None:
+def _link(
+    el: Element, model: np.ndarray, ctx: _Context, out: list[_Solid], scope: list[str], static: bool
+) -> None:
     name = el.attrib.get("name")
     if not name:
         raise el.error("missing attribute 'name'")
     m = model @ _pose(el, ctx)
-    colour = _colour(el, ctx)
+    pictures = []
+    for visual in el.findall("visual"):
+        picture = _floor_picture(visual, m, ctx, "::".join([*scope, name, visual.attrib.get("name", "")]))
+        if picture is not None:
+            ctx.floor_images.append(picture)
+            pictures.append(visual)
+    colour = _colour(el, ctx, tuple(pictures))
     for child in el.children:
         if child.tag == "collision":
             cname = child.attrib.get("name")
@@ -519,13 +768,7 @@ def _link(el: Element, model: np.ndarray, ctx: _Context, out: list[_Solid], scop
             if geom is None:
                 raise child.error("missing <geometry>")
             for fp in _geometry(geom, m @ _pose(child, ctx), ctx):
-                if fp.top > MIN_TOP and len(fp.outline) >= 2:
-                    out.append(_Solid([*scope, name, cname], fp, colour))
-                    if fp.bottom > FLOATING:
-                        # a table top, a shelf: the floor plan has no space under things
-                        ctx.skip(
-                            "space under shapes that float above the floor (they stand on it here)", child
-                        )
+                out.append(_Solid([*scope, name, cname], fp, colour, static))
             for sub in child.children:
                 if sub.tag not in _QUIET_COLLISION and sub.tag != "geometry":
                     ctx.skip(f"<{sub.tag}> in a collision", sub)
@@ -543,13 +786,21 @@ def _include(
     scope: list[str],
     depth: int,
     saved: dict[str, np.ndarray] | None = None,
+    static: bool | None = None,
 ) -> None:
     if depth > MAX_INCLUDE_DEPTH:
         raise el.error(f"includes nested more than {MAX_INCLUDE_DEPTH} deep (a model including itself?)")
     uri = el.value("uri")
     if not uri:
         raise el.error("missing <uri>")
-    target = resolve_uri(uri, el, ctx.env)
+    try:
+        target = resolve_uri(uri, el, ctx.env)
+    except SdfError as exc:
+        ctx.missing(uri, el, exc)
+        return
+    if not target.exists():
+        ctx.missing(uri, el, el.error(f"{uri}: {target} does not exist"))
+        return
     path = _model_file(target, el) if target.is_dir() else target
     root = _read_sdf(path, ctx, el)
     model = root.find("model")
@@ -560,14 +811,14 @@ def _include(
     name = el.value("name")
     if name:
         model.attrib["name"] = name
-    static = el.find("static")
-    if static is not None:
-        _bool(static)
+    static_el = el.find("static")
+    if static is None and static_el is not None:
+        static = _bool(static_el)
     pose = el.find("pose")
     override = pose_matrix(*_numbers(pose, 6, "x y z roll pitch yaw")) if pose is not None else None
     if saved and model.attrib.get("name") in saved:
         override = saved[model.attrib["name"]]
-    _model(model, parent, ctx, out, scope, depth, override)
+    _model(model, parent, ctx, out, scope, depth, override, static)
 
 
 def _state_poses(world: Element, ctx: _Context) -> dict[str, np.ndarray]:
@@ -603,13 +854,16 @@ def parse_sdf_world(
     warn: Callable[[str], None] | None = None,
 ) -> World:
     """A World from SDF text (``source`` names it in errors; relative mesh paths start at its folder)."""
-    ctx = _Context(os.environ if env is None else env)
+    ctx = _Context(os.environ if env is None else env, lenient=True)
     root = _sdf_root(data.encode() if isinstance(data, str) else data, source, ctx)
     world_el = root.find("world")
     if world_el is None:
         raise root.error("no <world> in this file (a model file? spawn it with spawn_model -sdf)")
-    solids = _world_solids(world_el, ctx)
+    solids = _settle(_world_solids(world_el, ctx))
     world = World(world_el.attrib.get("name", Path(source).stem), _obstacles(solids), source=source)
+    kept = {s.path[0] for s in solids}
+    world.model_poses = {name: pose for name, pose in ctx.origins.items() if name in kept}
+    world.floor_images = ctx.floor_images
     _report(ctx, source, warn)
     return world
 
@@ -619,14 +873,15 @@ def sdf_model_obstacles(
     source: str = "<spawn_sdf_model>",
     env: Mapping[str, str] | None = None,
     warn: Callable[[str], None] | None = None,
-    lift: bool = False,
+    z: float = 0.0,
+    drops: dict[str, float] | None = None,
 ) -> list[Obstacle]:
     """The obstacles of an SDF model document (``<sdf><model>``, as spawn_sdf_model receives it, or a
-    ``<world>`` of includes), in the model's frame: place them at the spawn pose.
-
-    ``lift``: a piece reaching below the floor (a shape centred on the model's origin, spawned at
-    z 0) stands on the floor with its whole height, as Gazebo's physics pushes a model out of the
-    ground plane."""
+    ``<world>`` of includes), their outlines in the model's frame (place them at the spawn pose),
+    their heights as the model settles when spawned at height ``z``: a static model stays there, one
+    with physics falls onto the floor or is pushed up out of it (:func:`_settle`). A model of several
+    pieces (a table: top and legs) gives one obstacle per piece, each naming the model. ``drops``
+    receives how far each model with physics fell from ``z`` (its pose after it settles: ``z - drop``)."""
     ctx = _Context(os.environ if env is None else env)
     root = _sdf_root(data.encode() if isinstance(data, str) else data, source, ctx)
     solids: list[_Solid] = []
@@ -638,12 +893,10 @@ def sdf_model_obstacles(
     if world_el is None and root.find("model") is None:
         raise root.error("no <model> in this SDF document")
     _report(ctx, source, warn)
-    if lift:
-        for solid in solids:
-            fp = solid.footprint
-            if fp.bottom < 0.0:
-                fp.top, fp.bottom = fp.top - fp.bottom, 0.0
-    return _obstacles(solids)
+    for solid in solids:
+        solid.footprint.top += z
+        solid.footprint.bottom += z
+    return _obstacles(_settle(solids, drops))
 
 
 def _world_solids(world_el: Element, ctx: _Context) -> list[_Solid]:
@@ -670,17 +923,22 @@ def _report(ctx: _Context, source: str, warn: Callable[[str], None] | None) -> N
 
 def _obstacles(solids: list[_Solid]) -> list[Obstacle]:
     """One obstacle per collision piece, named by its top-level model when that model has one piece,
-    else ``model::link::collision`` (``#n`` for the parts of one mesh), as Gazebo scopes names."""
+    else ``model::link::collision`` (``#n`` for the parts of one mesh), as Gazebo scopes names; the
+    pieces of a model of several know their model (Gazebo's services move and delete it whole)."""
     per_model: dict[str, int] = {}
     for s in solids:
         per_model[s.path[0]] = per_model.get(s.path[0], 0) + 1
     seen: dict[str, int] = {}
     obstacles = []
     for s in solids:
-        name = s.path[0] if per_model[s.path[0]] == 1 else "::".join(s.path)
+        single = per_model[s.path[0]] == 1
+        name = s.path[0] if single else "::".join(s.path)
         n = seen.get(name, 0)
         seen[name] = n + 1
         if n:
             name = f"{name}#{n}"
-        obstacles.append(Obstacle(name, s.footprint.kind, s.footprint.outline, s.footprint.top, s.colour))
+        fp = s.footprint
+        obstacles.append(
+            Obstacle(name, fp.kind, fp.outline, fp.top, s.colour, fp.bottom, "" if single else s.path[0])
+        )
     return obstacles

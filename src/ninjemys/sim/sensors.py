@@ -39,6 +39,9 @@ class Scene:
     #: per segment: +1/-1 when it is a side of a convex outline going counter-/clockwise, 0 otherwise
     #: (None: unknown, every side is cast); casts skip the sides facing away (see Obstacle.facing)
     facing: np.ndarray | None = None
+    #: per segment: the height its obstacle starts at (None: everything stands on the floor); a
+    #: planar lidar below a table top held in the air sees under it
+    bases: np.ndarray | None = None
 
 
 @dataclass
@@ -68,10 +71,13 @@ def lidar_ranges(
 ) -> np.ndarray:
     """float32 ranges (REP 117: +inf no return within range_max, -inf closer than range_min).
 
-    Only obstacles at least as tall as the lidar (``z``) are seen, as with a real planar lidar.
+    Only obstacles at least as tall as the lidar (``z``) are seen, as with a real planar lidar, and
+    of those held above the floor (``scene.bases``) only the ones reaching down to it.
     """
     angles = yaw + angle_min + increment * np.arange(beams)
     tall = scene.heights >= z
+    if scene.bases is not None:
+        tall &= scene.bases <= z
     segments, facing = scene.segments, scene.facing
     if not tall.all():
         segments = segments[tall]

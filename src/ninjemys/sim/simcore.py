@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -28,6 +28,8 @@ from ninjemys.sim.world2d import MovingObstacle, Obstacle, World, box_outline, c
 TRAIL_LENGTH = 2000
 PERSONAL_SPACE = 0.2  # m: the gap a person who gives way keeps from a robot's body
 LOOK_AHEAD = 2.0  # m: how far ahead on its route such a person starts to step aside
+#: a robot is spawned when its body circle overlaps something by less than this share of its radius
+SPAWN_OVERLAP = 0.5
 #: the longest physics step set_physics_properties accepts (s): the collision check splits a move
 #: into short pieces, but sensors fire at most once a step, so a longer one would slow a 10 Hz lidar
 MAX_TIME_STEP = 0.1
@@ -93,6 +95,8 @@ class Robot:
     trail: deque = field(default_factory=lambda: deque(maxlen=TRAIL_LENGTH))
     trail_count: int = 0  # points ever appended (the view sends only the new ones)
     free: tuple[float, float, float] | None = None  # (x, y, r): a disk free of static geometry
+    #: spawned with its body overlapping this (name, metres): it may only move away from it
+    spawn_overlap: tuple[str, float] | None = None
     camera: Camera | None = None
     extra_cameras: list[Camera] = field(default_factory=list)  # for model.extra_cameras, in order
 
@@ -138,12 +142,16 @@ class Simulation:
         self.world_time = 0.0  # moving obstacles' clock (reset_world restarts it, time goes on)
         self.robots: dict[str, Robot] = {}
         self.obstacle_yaw: dict[str, float] = {}  # yaw of spawned or moved obstacles (outlines have none)
+        self.obstacle_origin: dict[str, tuple[float, float]] = {}  # spawned models: their pose's x, y
         self._spawned = 0
         self._static: np.ndarray
         self.static_names: list[str] = []
         self._movers_at: tuple[float, tuple] | None = None
         self._mover_fixed: tuple | None = None
         self._floor = floor_paint(world)
+        for name, (x, y, yaw) in world.model_poses.items():  # an SDF world's models: their own poses
+            self.obstacle_origin[name] = (x, y)
+            self.obstacle_yaw[name] = yaw
         self._rebuild_static()
 
     @property
@@ -173,7 +181,7 @@ class Simulation:
         w = self.world
         w.rebuild()
         segs, heights, colours = [w.segments], [w.seg_height], [w.seg_color]
-        facing = [w.seg_facing]
+        facing, bases = [w.seg_facing], [w.seg_base]
         names = [w.obstacles[i].name for i in w.seg_owner]
         if w.grid is not None:
             g = w.grid
@@ -181,10 +189,14 @@ class Simulation:
             segs.append(edges)
             facing.append(np.zeros(len(edges), dtype=np.int8))
             heights.append(np.full(len(edges), g.height))
+            bases.append(np.zeros(len(edges)))
             colours.append(np.tile(np.array(g.color, dtype=np.uint8), (len(edges), 1)))
             names += ["map"] * len(edges)
         self._static = np.vstack(segs) if any(len(s) for s in segs) else np.zeros((0, 4))
         self._static_height = np.concatenate(heights)
+        self._static_base = np.concatenate(bases)
+        #: the static world has something held above the floor (a table top): sensors and robots pass under it
+        self._any_base = bool((self._static_base > 0).any())
         self._static_color = np.vstack(colours).astype(np.uint8)
         self._static_facing = np.concatenate(facing).astype(np.int8)
         self.static_names = names
@@ -272,6 +284,9 @@ class Simulation:
         segs = np.vstack([self._static, ms]) if len(ms) else self._static
         heights = np.concatenate([self._static_height, mh]) if len(ms) else self._static_height
         colours = np.vstack([self._static_color, mc]) if len(ms) else self._static_color
+        bases = None
+        if self._any_base:
+            bases = np.concatenate([self._static_base, np.zeros(len(ms))]) if len(ms) else self._static_base
         # a moving obstacle may walk over a robot (the camera inside it sees its inside): both sides
         facing = (
             np.concatenate([self._static_facing, np.zeros(len(ms), dtype=np.int8)])
@@ -289,22 +304,36 @@ class Simulation:
             np.array([r.model.color for r in others], dtype=np.uint8).reshape(-1, 3),
             self._floor,
             facing,
+            bases,
         )
 
-    def clearance(self, x: float, y: float, exclude: str | None = None) -> tuple[float, str]:
-        """Distance from a point to the nearest solid thing, and its name."""
+    def clearance(
+        self, x: float, y: float, exclude: str | None = None, height: float = math.inf
+    ) -> tuple[float, str]:
+        """Distance from a point to the nearest solid thing lower than ``height`` (what a body that
+        tall meets: it passes under a table top held higher), and its name."""
         d, name = self._clearances(
-            np.array([x]), np.array([y]), exclude, self._collision_geometry(x, y, 1e9, exclude)
+            np.array([x]), np.array([y]), exclude, self._collision_geometry(x, y, 1e9, exclude, height=height)
         )
         return float(d[0]), name[0]
 
     def _collision_geometry(
-        self, x: float, y: float, reach: float, exclude: str | None, static: bool = True
+        self,
+        x: float,
+        y: float,
+        reach: float,
+        exclude: str | None,
+        static: bool = True,
+        height: float | None = None,
     ) -> tuple:
         """Segments (with names) and other robots' circles within ``reach`` of (x, y); ``static=False``
-        leaves the static world out (only what moves: moving obstacles and robots)."""
+        leaves the static world out (only what moves: moving obstacles and robots). Static pieces
+        held at or above ``height`` (default: robot ``exclude``'s body height) are passed under."""
+        if height is None:
+            robot = self.robots.get(exclude) if exclude is not None else None
+            height = robot.model.body_height if robot is not None else math.inf
         if static:
-            near = self._static_near(x, y, reach)
+            near = self._static_near(x, y, reach, height)
             segs = self._static[near]
             names = [self.static_names[i] for i in near]
         else:
@@ -318,14 +347,18 @@ class Simulation:
         radii = np.array([r.model.body_radius for r in others])
         return segs, names, centres, radii, [r.name for r in others]
 
-    def _static_near(self, x: float, y: float, reach: float) -> np.ndarray:
-        """Indices of the static segments whose bounding box comes within ``reach`` of (x, y)."""
-        return np.flatnonzero(
+    def _static_near(self, x: float, y: float, reach: float, below: float = math.inf) -> np.ndarray:
+        """Indices of the static segments whose bounding box comes within ``reach`` of (x, y), of
+        the pieces starting lower than ``below`` (a body that tall passes under the others)."""
+        mask = (
             (self._static_lo[:, 0] <= x + reach)
             & (self._static_hi[:, 0] >= x - reach)
             & (self._static_lo[:, 1] <= y + reach)
             & (self._static_hi[:, 1] >= y - reach)
         )
+        if self._any_base and below != math.inf:
+            mask &= self._static_base < below
+        return np.flatnonzero(mask)
 
     def _static_free(self, r: Robot, x: float, y: float) -> bool:
         """True when (x, y) lies in ``r``'s free disk: a disk around a past position holding no static
@@ -340,7 +373,7 @@ class Simulation:
         ):
             return True  # both ends in the disk: so is the straight move between them (a disk is convex)
         reach = 2.0
-        segs = self._static[self._static_near(r.x, r.y, reach)]
+        segs = self._static[self._static_near(r.x, r.y, reach, r.model.body_height)]
         near = point_segment_distance(np.array([r.x]), np.array([r.y]), segs)
         clear = min(float(near.min()) if near.size else reach, reach)
         r.free = (r.x, r.y, clear)
@@ -371,10 +404,11 @@ class Simulation:
         return best, who
 
     # -- robots and obstacles -------------------------------------------------------------------
-    def solid_at(self, x: float, y: float) -> str:
-        """The name of the solid thing covering point (x, y), or "" (inside a box, a thick wall, a map cell)."""
+    def solid_at(self, x: float, y: float, height: float = math.inf) -> str:
+        """The name of the solid thing covering point (x, y), or "" (inside a box, a thick wall, a map
+        cell); pieces held at or above ``height`` (a table top over a lower robot) do not count."""
         for o in self.world.obstacles:
-            if len(o.outline) > 2 and _inside(x, y, o.outline):
+            if o.base < height and len(o.outline) > 2 and _inside(x, y, o.outline):
                 return o.name
         for m in self.world.moving:
             if _inside(x, y, m.outline_at(self.world_time)):
@@ -393,11 +427,14 @@ class Simulation:
             raise SpawnError(f"a robot named [{name}] already exists")
         if not all(math.isfinite(v) for v in (x, y, yaw)):
             raise SpawnError(f"spawn pose of [{name}] is not finite: ({x}, {y}, {yaw})")
-        gap, what = self.clearance(x, y)
-        solid = self.solid_at(x, y)
+        gap, what = self.clearance(x, y, height=model.body_height)
+        solid = self.solid_at(x, y, model.body_height)
         if solid:
             gap, what = 0.0, solid
-        if gap < model.body_radius:
+        # Gazebo spawns into an overlap and its physics pushes the body out; here a body whose
+        # circle overlaps by less than half its radius (the circle is wider than the real shape)
+        # is placed, and moves that bring it closer are refused; deeper than that, it is refused
+        if gap < model.body_radius * SPAWN_OVERLAP:
             raise SpawnError(
                 f"cannot spawn [{name}] at ({x:.3f}, {y:.3f}): it would be inside '{what}' "
                 f"(clearance {max(gap, 0.0):.3f} m, body radius {model.body_radius:.3f} m)"
@@ -405,6 +442,8 @@ class Simulation:
         rng = np.random.default_rng([self.seed, self._spawned])
         self._spawned += 1
         robot = Robot(name, model, x, y, yaw, (x, y, yaw), rng)
+        if gap < model.body_radius:
+            robot.spawn_overlap = (what, model.body_radius - gap)
         robot.odom_ref = (x, y, yaw)
         if model.camera is not None:
             robot.camera = camera_for(model.camera)
@@ -420,8 +459,8 @@ class Simulation:
             raise SpawnError(f"no robot named [{name}]")
         if not all(math.isfinite(v) for v in (x, y, yaw)):
             raise SpawnError(f"pose of [{name}] is not finite: ({x}, {y}, {yaw})")
-        gap, what = self.clearance(x, y, exclude=name)
-        solid = self.solid_at(x, y)
+        gap, what = self.clearance(x, y, exclude=name, height=r.model.body_height)
+        solid = self.solid_at(x, y, r.model.body_height)
         if solid:
             gap, what = 0.0, solid
         if gap < r.model.body_radius:
@@ -435,36 +474,45 @@ class Simulation:
         r.contact, r.contact_with = False, ""
         return r
 
+    def _pieces(self, name: str) -> list[int]:
+        """Indices of the obstacles making up model ``name`` (one, or a model's several pieces)."""
+        return [i for i, o in enumerate(self.world.obstacles) if o.model_name == name]
+
     def obstacle_pose(self, name: str) -> tuple[float, float, float]:
-        """An obstacle's (x, y, yaw): the centre of its outline, and the yaw it was spawned or moved
-        with (0 for the world's own)."""
-        o = next((o for o in self.world.obstacles if o.name == name), None)
-        if o is None:
+        """A model's (x, y, yaw): where it was spawned or last moved to, else the centre of its
+        outline(s), and the yaw it was spawned or moved with (0 for the world's own)."""
+        pieces = self._pieces(name)
+        if not pieces:
             raise SpawnError(f"no model named [{name}]")
-        cx, cy = (float(v) for v in o.outline.mean(axis=0))
-        return cx, cy, self.obstacle_yaw.get(name, 0.0)
+        origin = self.obstacle_origin.get(name)
+        if origin is None:
+            outlines = np.vstack([self.world.obstacles[i].outline for i in pieces])
+            origin = (float(outlines[:, 0].mean()), float(outlines[:, 1].mean()))
+        return origin[0], origin[1], self.obstacle_yaw.get(name, 0.0)
 
     def move_obstacle(self, name: str, x: float, y: float, yaw: float) -> None:
-        """Move a static obstacle so its centre is at (x, y), turned by ``yaw`` from its first pose
-        (Gazebo's set_model_state on a model); refused when it would overlap a robot."""
-        index = next((i for i, o in enumerate(self.world.obstacles) if o.name == name), None)
-        if index is None:
+        """Move a static model (all its pieces together) so its pose is (x, y), turned by ``yaw``
+        from its first pose (Gazebo's set_model_state on a model); refused when it would overlap a
+        robot."""
+        pieces = self._pieces(name)
+        if not pieces:
             raise SpawnError(f"no model named [{name}]")
-        o = self.world.obstacles[index]
         if not all(math.isfinite(v) for v in (x, y, yaw)):
             raise SpawnError(f"pose of [{name}] is not finite: ({x}, {y}, {yaw})")
         cx, cy, cyaw = self.obstacle_pose(name)
         c, s = math.cos(yaw - cyaw), math.sin(yaw - cyaw)
-        rel = o.outline - np.array([cx, cy])
-        outline = np.column_stack([c * rel[:, 0] - s * rel[:, 1] + x, s * rel[:, 0] + c * rel[:, 1] + y])
-        for r in self.robots.values():
-            d = point_segment_distance(
-                np.array([r.x]), np.array([r.y]), np.hstack([outline, np.roll(outline, -1, axis=0)])
-            )
-            if (len(outline) > 2 and _inside(r.x, r.y, outline)) or float(d.min()) < r.model.body_radius:
-                raise SpawnError(f"cannot move [{name}]: it would overlap robot [{r.name}]")
-        self.world.obstacles[index] = Obstacle(o.name, o.kind, outline, o.height, o.color)
+        moved = []
+        for i in pieces:
+            o = self.world.obstacles[i]
+            rel = o.outline - np.array([cx, cy])
+            outline = np.column_stack([c * rel[:, 0] - s * rel[:, 1] + x, s * rel[:, 0] + c * rel[:, 1] + y])
+            moved.append(replace(o, outline=outline))
+        self._check_clear_of_robots(name, moved, "move")
+        for i, o in zip(pieces, moved, strict=True):
+            self.world.obstacles[i] = o
         self.obstacle_yaw[name] = yaw
+        if name in self.obstacle_origin:
+            self.obstacle_origin[name] = (x, y)
         self._rebuild_static()
 
     def remove_robot(self, name: str) -> None:
@@ -496,27 +544,49 @@ class Simulation:
         yaw: float,
         height: float,
         color: tuple[int, int, int],
+        base: float = 0.0,
     ) -> None:
         """Add a static obstacle of any outline (world coordinates; an SDF model's footprint, spawned);
         refused on a robot or a name clash."""
-        if any(o.name == name for o in self.world.obstacles) or name in self.robots:
+        self.add_model(name, [Obstacle(name, kind, outline, height, color, base)], yaw)
+
+    def add_model(
+        self, name: str, pieces: list[Obstacle], yaw: float, origin: tuple[float, float] | None = None
+    ) -> None:
+        """Add a static model of one or several pieces (outlines in world coordinates; a spawned SDF
+        table: top and legs), posed at ``origin`` (None: the centre of its outlines); refused as a
+        whole on a robot or a name clash."""
+        if name in self.robots or any(o.model_name == name or o.name == name for o in self.world.obstacles):
             raise SpawnError(f"a model named [{name}] already exists")
-        for r in self.robots.values():
-            d = point_segment_distance(
-                np.array([r.x]), np.array([r.y]), np.hstack([outline, np.roll(outline, -1, axis=0)])
-            )
-            inside = _inside(r.x, r.y, outline)
-            if inside or float(d.min()) < r.model.body_radius:
-                raise SpawnError(f"cannot spawn [{name}]: it would overlap robot [{r.name}]")
-        self.world.obstacles.append(Obstacle(name, kind, outline, height, color))
+        self._check_clear_of_robots(name, pieces, "spawn")
+        self.world.obstacles.extend(pieces)
         self.obstacle_yaw[name] = yaw
+        if origin is not None:
+            self.obstacle_origin[name] = origin
         self._rebuild_static()
 
+    def _check_clear_of_robots(self, name: str, pieces: list[Obstacle], verb: str) -> None:
+        """SpawnError when a piece would overlap a robot (pieces held above the robot pass over it)."""
+        for r in self.robots.values():
+            for o in pieces:
+                if o.base >= r.model.body_height:
+                    continue
+                outline = o.outline
+                d = point_segment_distance(
+                    np.array([r.x]), np.array([r.y]), np.hstack([outline, np.roll(outline, -1, axis=0)])
+                )
+                inside = len(outline) > 2 and _inside(r.x, r.y, outline)
+                if inside or float(d.min()) < r.model.body_radius:
+                    raise SpawnError(f"cannot {verb} [{name}]: it would overlap robot [{r.name}]")
+
     def remove_obstacle(self, name: str) -> None:
+        """Delete a static model: all its pieces."""
         before = len(self.world.obstacles)
-        self.world.obstacles = [o for o in self.world.obstacles if o.name != name]
+        self.world.obstacles = [o for o in self.world.obstacles if o.model_name != name]
         if len(self.world.obstacles) == before:
             raise SpawnError(f"no model named [{name}]")
+        self.obstacle_yaw.pop(name, None)
+        self.obstacle_origin.pop(name, None)
         self._rebuild_static()
 
     # -- time -----------------------------------------------------------------------------------
@@ -764,11 +834,17 @@ def camera_for(spec: CameraSpec) -> Camera:
 
 
 def floor_paint(world: World, resolution: float = 0.01, max_cells: int = 2000) -> FloorPaint | None:
-    """The world's floor markings rasterized for the camera (None without markings)."""
-    if not world.markings:
+    """The world's floor markings and floor pictures rasterized for the camera (None without any).
+    Pictures come first (their colours quantized to a 6x6x6 cube), markings are painted over them."""
+    if not world.markings and not world.floor_images:
         return None
-    pts = np.vstack([m.points for m in world.markings])
-    margin = max(m.width for m in world.markings)
+    corners = [m.points for m in world.markings]
+    for im in world.floor_images:
+        c, s = math.cos(im.yaw), math.sin(im.yaw)
+        local = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * [im.width / 2, im.height / 2]
+        corners.append(local @ np.array([[c, s], [-s, c]]) + [im.cx, im.cy])
+    pts = np.vstack(corners)
+    margin = max((m.width for m in world.markings), default=0.0)
     lo = pts.min(axis=0) - margin
     hi = pts.max(axis=0) + margin
     res = max(resolution, float((hi - lo).max()) / max_cells)
@@ -778,7 +854,20 @@ def floor_paint(world: World, resolution: float = 0.01, max_cells: int = 2000) -
     gx, gy = np.meshgrid(cx, cy)
     texture = np.zeros((rows, cols), dtype=np.uint8)
     palette: list[tuple[int, int, int]] = []
-    for m in world.markings:
+    if world.floor_images:
+        levels = np.array([0, 51, 102, 153, 204, 255])
+        palette = [(int(r), int(g), int(b)) for r in levels for g in levels for b in levels]
+        for im in world.floor_images:
+            c, s = math.cos(im.yaw), math.sin(im.yaw)
+            lx = c * (gx - im.cx) + s * (gy - im.cy)
+            ly = -s * (gx - im.cx) + c * (gy - im.cy)
+            h, w = im.rgb.shape[:2]
+            u = np.floor((lx / im.width + 0.5) * w).astype(np.int64)
+            v = np.floor((0.5 - ly / im.height) * h).astype(np.int64)
+            on = (u >= 0) & (u < w) & (v >= 0) & (v < h)
+            q = (im.rgb[v[on], u[on]].astype(np.int64) + 25) // 51  # the nearest of the 6 levels
+            texture[on] = 1 + q[:, 0] * 36 + q[:, 1] * 6 + q[:, 2]
+    for m in world.markings[: 255 - len(palette)]:
         ink = len(palette) + 1
         palette.append(m.color)
         path = np.vstack([m.points, m.points[:1]]) if m.closed else m.points

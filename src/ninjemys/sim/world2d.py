@@ -48,13 +48,25 @@ COLOURS: dict[str, tuple[int, int, int]] = {
 
 @dataclass
 class Obstacle:
-    """A solid shape: its outline polygon (closed, counter-clockwise) or a thin wall (2 points)."""
+    """A solid shape: its outline polygon (closed, counter-clockwise) or a thin wall (2 points).
+
+    It fills the space from ``base`` (0: it stands on the floor) up to ``height`` above the floor:
+    a static SDF table top held at its pose has a base, and what passes under it (a low lidar beam,
+    a robot lower than the base) does not meet it. ``model`` names the model the piece belongs to
+    when that model has several pieces (a table: top and legs), "" when the piece is the model."""
 
     name: str
     kind: str  # wall | box | cylinder
     outline: np.ndarray  # (K, 2)
     height: float
     color: tuple[int, int, int]
+    base: float = 0.0
+    model: str = ""
+
+    @property
+    def model_name(self) -> str:
+        """The model this piece belongs to (Gazebo's model name)."""
+        return self.model or self.name
 
     def segments(self) -> np.ndarray:
         pts = self.outline
@@ -86,6 +98,20 @@ class Marking:
     closed: bool
     width: float
     color: tuple[int, int, int]
+
+
+@dataclass
+class FloorImage:
+    """A picture on the floor (a Gazebo plane with a textured material: a course's track): its RGB
+    pixels (row 0 at the +y edge, column 0 at the -x edge, as seen from above), centre, size and yaw."""
+
+    name: str
+    rgb: np.ndarray  # (H, W, 3) uint8
+    cx: float
+    cy: float
+    width: float
+    height: float
+    yaw: float = 0.0
 
 
 @dataclass
@@ -186,22 +212,29 @@ class World:
     grid: Grid | None = None
     bounds: tuple[float, float, float, float] | None = None  # xmin, ymin, xmax, ymax
     source: str = ""
+    #: models' poses (x, y, yaw) where the file gives them (an SDF world's models), by model name
+    model_poses: dict[str, tuple[float, float, float]] = field(default_factory=dict)
+    #: pictures on the floor (an SDF world's textured planes): the camera sees them
+    floor_images: list[FloorImage] = field(default_factory=list)
 
     def __post_init__(self) -> None:
         self.rebuild()
 
     def rebuild(self) -> None:
         """Recompute the flat segment arrays after obstacles were added or removed."""
-        segs, heights, colours, owner, facing = [], [], [], [], []
+        segs, heights, colours, owner, facing, bases = [], [], [], [], [], []
         for i, ob in enumerate(self.obstacles):
             s = ob.segments()
             segs.append(s)
             facing.append(np.full(len(s), ob.facing(), dtype=np.int8))
             heights.append(np.full(len(s), ob.height))
+            bases.append(np.full(len(s), ob.base))
             colours.append(np.tile(np.array(ob.color, dtype=np.uint8), (len(s), 1)))
             owner.append(np.full(len(s), i))
         self.segments = np.vstack(segs) if segs else np.zeros((0, 4))
         self.seg_height = np.concatenate(heights) if heights else np.zeros(0)
+        #: per segment: the height its obstacle starts at (0 on the floor)
+        self.seg_base = np.concatenate(bases) if bases else np.zeros(0)
         self.seg_color = np.vstack(colours) if colours else np.zeros((0, 3), dtype=np.uint8)
         self.seg_owner = np.concatenate(owner) if owner else np.zeros(0, dtype=int)
         #: per segment: its outline's :meth:`Obstacle.facing` (+1, -1, or 0: both sides seen)

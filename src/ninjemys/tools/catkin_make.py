@@ -17,6 +17,7 @@ from pathlib import Path
 from ninjemys.commands import command_path
 from ninjemys.packages.builder import build_workspace, clean_workspace
 from ninjemys.packages.cmake_hints import read_cmake_hints
+from ninjemys.packages.cpp_build import install_cpp
 from ninjemys.packages.install_space import install_workspace
 from ninjemys.packages.workspace import Workspace
 from ninjemys.tools.cli import entry
@@ -61,7 +62,8 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     start = time.monotonic()
     print("-- ~~  traversing packages in topological order:")
-    report = build_workspace(ws, env=os.environ, log=print)
+    prefix = _install_prefix(ws, passthrough)
+    report = build_workspace(ws, env=os.environ, log=print, install_prefix=prefix)
     elapsed = time.monotonic() - start
     print(
         f"[100%] Built target(s) {' '.join(report.packages) or '(none)'}: "
@@ -73,7 +75,7 @@ def main(argv: list[str] | None = None) -> int:
         names = ", ".join(t.name for t in report.cpp_skipped)
         print(f"-- {len(report.cpp_skipped)} C++ target(s) not built (see above): {names}")
     if "install" in args.targets:
-        _install(ws, passthrough)
+        _install(ws, prefix, report.cpp_build)
     if "run_tests" in args.targets:
         _run_tests(ws)
     return 0
@@ -103,15 +105,23 @@ def _run_tests(ws: Workspace) -> None:
             )
 
 
-def _install(ws: Workspace, cmake_args: list[str]) -> None:
-    """``catkin_make install``: after the build, the install space (CMAKE_INSTALL_PREFIX, default
-    ``install/`` next to ``devel/``)."""
+def _install_prefix(ws: Workspace, cmake_args: list[str]) -> Path:
+    """CMAKE_INSTALL_PREFIX: ``-DCMAKE_INSTALL_PREFIX[:PATH]=dir`` (relative to the workspace), by
+    default ``install/`` next to ``devel/``."""
     prefix = ws.root / "install"
     for arg in cmake_args:
         name, _, value = arg[2:].partition("=")
-        if name.split(":", 1)[0] == "CMAKE_INSTALL_PREFIX" and value:  # -DCMAKE_INSTALL_PREFIX[:PATH]=dir
+        if name.split(":", 1)[0] == "CMAKE_INSTALL_PREFIX" and value:
             prefix = ws.root / Path(value).expanduser()
-    count = install_workspace(ws, prefix.resolve(), os.environ, log=print)
+    return prefix.resolve()
+
+
+def _install(ws: Workspace, prefix: Path, cpp_build: Path | None) -> None:
+    """``catkin_make install``: after the build, the install space. The C++ packages' own install
+    rules (``install(TARGETS ...)`` & co) run first through catkin's CMake, where a toolchain built
+    them; ninjemys' install of the Python side and the setup scripts follows."""
+    count = install_cpp(cpp_build, log=print) if cpp_build is not None else 0
+    count += install_workspace(ws, prefix, os.environ, log=print)
     print(f"[100%] Installed {count} file(s) in {prefix}: source {prefix / 'setup.bash'} to use them")
 
 

@@ -13,6 +13,7 @@ import threading
 import webbrowser
 from collections.abc import Callable
 
+from ninjemys import interrupt
 from ninjemys.interrupt import wait_event
 
 
@@ -38,7 +39,7 @@ def stop_signals() -> threading.Event:
     A page tool calls this before it starts its server: a Ctrl-C landing between the server's start
     and the wait would otherwise raise KeyboardInterrupt where nothing stops the server, and the node
     would leave without unregistering from the master."""
-    stopped = threading.Event()
+    stopped = interrupt.Event()
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: stopped.set())
     return stopped

@@ -32,6 +32,7 @@ from ninjemys.node import Node
 from ninjemys.serve.http import HttpError, Request, Response
 from ninjemys.web.app import STATIC_DIR, WebApp
 from ninjemys.web.browser import serve_until_stopped, stop_signals
+from ninjemys.web.launched_name import LaunchedName, launched_name
 
 DEFAULT_MASTER = "http://localhost:11311"
 NSEC = 1_000_000_000
@@ -309,8 +310,16 @@ class Rqt:
         host: str = "127.0.0.1",
         port: int = 0,
         update_period: float = 1.0,
+        launched: LaunchedName | None = None,
     ) -> None:
-        self.node = Node(name, anonymous=True, master_uri=master_uri)
+        launched = launched or LaunchedName(name, "/", {}, anonymous=True)
+        self.node = Node(
+            launched.name,
+            namespace=launched.namespace,
+            anonymous=launched.anonymous,
+            remappings=launched.remappings,
+            master_uri=master_uri,
+        )
         try:
             options = GatewayOptions(node_name=self.node.name, update_period=update_period)
             self.gateway = Gateway(options, node=self.node)
@@ -356,10 +365,12 @@ def _serve(
     query: list[tuple[str, str]],
     args: argparse.Namespace,
     bags: list[str] | None = None,
+    argv: list[str] | None = None,
 ) -> int:
     master_uri = os.environ.get("ROS_MASTER_URI", DEFAULT_MASTER)
     try:
-        rqt = Rqt(master_uri, prog, bags, args.host, args.port)
+        launched = launched_name(prog, argv if argv is not None else sys.argv[1:])
+        rqt = Rqt(master_uri, prog, bags, args.host, args.port, launched=launched)
     except NinjemysError as exc:
         print(f"ERROR: {prog}: {exc}", file=sys.stderr)
         return 1
@@ -380,7 +391,8 @@ def _serve(
 
 
 def _ros_args(argv: list[str] | None) -> list[str]:
-    # ROS passes remappings (name:=value) and __name/__log args; they do not apply to the page
+    # ROS passes remappings (name:=value) and __name/__ns/__log args: the node takes them
+    # (launched_name), the page's own options do not
     return [a for a in (argv if argv is not None else sys.argv[1:]) if ":=" not in a]
 
 
@@ -389,7 +401,7 @@ def _simple(prog: str, tool: str | None, description: str) -> Callable[[list[str
         args = _common(argparse.ArgumentParser(prog=prog, description=description)).parse_args(
             _ros_args(argv)
         )
-        return _serve(prog, tool, [], args)
+        return _serve(prog, tool, [], args, argv=argv)
 
     return main
 
@@ -416,7 +428,7 @@ def rqt_main(argv: list[str] | None = None) -> int:
         "-s", "--standalone", metavar="PLUGIN", choices=sorted(PLUGINS), help="open on this plugin's tab"
     )
     args = p.parse_args(_ros_args(argv))
-    return _serve("rqt", PLUGINS[args.standalone] if args.standalone else None, [], args)
+    return _serve("rqt", PLUGINS[args.standalone] if args.standalone else None, [], args, argv=argv)
 
 
 console_plugin_main = _simple("rqt_console", "console", "Messages of /rosout_agg, filtered, in a browser.")
@@ -438,21 +450,23 @@ def plot_main(argv: list[str] | None = None) -> int:
             head, _, rest = item.rpartition("/")
             parts = rest.split(":") if ":" in rest else [rest]
             fields.extend(f"{head}/{part}" for part in parts if part)
-    return _serve("rqt_plot", "plot", [("topic", f) for f in fields], args)
+    return _serve("rqt_plot", "plot", [("topic", f) for f in fields], args, argv=argv)
 
 
 def bag_main(argv: list[str] | None = None) -> int:
     p = _common(argparse.ArgumentParser(prog="rqt_bag", description="Browse, play and plot bag files."))
     p.add_argument("bagfiles", nargs="*", help="bag files to open")
     args = p.parse_args(_ros_args(argv))
-    return _serve("rqt_bag", "bag", [], args, bags=args.bagfiles)
+    return _serve("rqt_bag", "bag", [], args, bags=args.bagfiles, argv=argv)
 
 
 def image_view_main(argv: list[str] | None = None) -> int:
     p = _common(argparse.ArgumentParser(prog="rqt_image_view", description="Show an image topic."))
     p.add_argument("image", nargs="?", help="image topic to show first")
     args = p.parse_args(_ros_args(argv))
-    return _serve("rqt_image_view", "image_view", [("topic", args.image)] if args.image else [], args)
+    return _serve(
+        "rqt_image_view", "image_view", [("topic", args.image)] if args.image else [], args, argv=argv
+    )
 
 
 def reconfigure_main(argv: list[str] | None = None) -> int:
@@ -461,7 +475,9 @@ def reconfigure_main(argv: list[str] | None = None) -> int:
     )
     p.add_argument("node", nargs="?", help="server to open first")
     args = p.parse_args(_ros_args(argv))
-    return _serve("rqt_reconfigure", "reconfigure", [("node", args.node)] if args.node else [], args)
+    return _serve(
+        "rqt_reconfigure", "reconfigure", [("node", args.node)] if args.node else [], args, argv=argv
+    )
 
 
 def axclient_main(argv: list[str] | None = None) -> int:
@@ -470,7 +486,7 @@ def axclient_main(argv: list[str] | None = None) -> int:
     p.add_argument("type", nargs="?", help="action type, e.g. actionlib_tutorials/FibonacciAction")
     args = p.parse_args(_ros_args(argv))
     query = [("action", args.action)] + ([("type", args.type)] if args.type else [])
-    return _serve("axclient", "axclient", query, args)
+    return _serve("axclient", "axclient", query, args, argv=argv)
 
 
 rqt_console_main: Any = entry(rqt_main)

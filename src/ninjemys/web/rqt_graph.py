@@ -16,6 +16,7 @@ from ninjemys.commands import entry
 from ninjemys.node import Node
 from ninjemys.web.app import WebApp
 from ninjemys.web.browser import serve_until_stopped, stop_signals
+from ninjemys.web.launched_name import launched_name
 
 DEFAULT_MASTER = "http://localhost:11311"
 
@@ -31,8 +32,10 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    # ROS passes remappings (name:=value) and __name/__log args; they do not apply to this tool
-    args = _parser().parse_args([a for a in (argv or []) if ":=" not in a])
+    # ROS passes remappings (name:=value) and __name/__ns/__log args: the node takes them
+    # (launched_name), the page's own options do not
+    argv = list(argv or [])
+    args = _parser().parse_args([a for a in argv if ":=" not in a])
     master_uri = os.environ.get("ROS_MASTER_URI", DEFAULT_MASTER)
     app = WebApp(master_uri, caller_id="/rqt_graph", host=args.host, port=args.port)
     stopped = stop_signals()
@@ -44,7 +47,14 @@ def main(argv: list[str] | None = None) -> int:
             file=sys.stderr,
         )
         return 1
-    node = Node("rqt_graph", anonymous=True, master_uri=master_uri)
+    launched = launched_name("rqt_graph", argv)
+    node = Node(
+        launched.name,
+        namespace=launched.namespace,
+        anonymous=launched.anonymous,
+        remappings=launched.remappings,
+        master_uri=master_uri,
+    )
     gateway = Gateway(GatewayOptions(node_name=node.name, hide_own_node=True, update_period=0.5), node=node)
     gateway.start()
     app.add_gateway(gateway)

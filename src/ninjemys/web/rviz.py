@@ -24,6 +24,7 @@ from ninjemys.serve.http import HttpError, Request, Response
 from ninjemys.web import rvizconfig
 from ninjemys.web.app import STATIC_DIR, WebApp
 from ninjemys.web.browser import serve_until_stopped, stop_signals
+from ninjemys.web.launched_name import LaunchedName, launched_name
 
 DEFAULT_MASTER = "http://localhost:11311"
 #: where rviz saves when it was not started with -d
@@ -104,8 +105,16 @@ class Rviz:
         host: str = "127.0.0.1",
         port: int = 0,
         update_period: float = 1.0,
+        launched: LaunchedName | None = None,
     ) -> None:
-        self.node = Node("rviz", anonymous=True, master_uri=master_uri)
+        launched = launched or LaunchedName("rviz", "/", {}, anonymous=True)
+        self.node = Node(
+            launched.name,
+            namespace=launched.namespace,
+            anonymous=launched.anonymous,
+            remappings=launched.remappings,
+            master_uri=master_uri,
+        )
         try:
             options = GatewayOptions(node_name=self.node.name, update_period=update_period)
             self.gateway = Gateway(options, node=self.node)
@@ -162,12 +171,17 @@ def _wait_for_master(uri: str) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    # ROS passes remappings (name:=value) and __name/__log args; they do not apply to the page
-    args = _parser().parse_args([a for a in (argv if argv is not None else sys.argv[1:]) if ":=" not in a])
+    # ROS passes remappings (name:=value) and __name/__ns/__log args: the node takes them
+    # (launched_name), the page's own options do not
+    argv = argv if argv is not None else sys.argv[1:]
+    args = _parser().parse_args([a for a in argv if ":=" not in a])
     master_uri = os.environ.get("ROS_MASTER_URI", DEFAULT_MASTER)
     _wait_for_master(master_uri)
     try:
-        rviz = Rviz(master_uri, args.display_config, args.fixed_frame, args.host, args.port)
+        launched = launched_name("rviz", argv)
+        rviz = Rviz(
+            master_uri, args.display_config, args.fixed_frame, args.host, args.port, launched=launched
+        )
     except NinjemysError as exc:
         print(f"ERROR: rviz: {exc}", file=sys.stderr)
         return 1

@@ -13,6 +13,7 @@ handed over as the frame (one copy from the kernel, none in Python).
 from __future__ import annotations
 
 import struct
+from collections.abc import Callable
 
 from ninjemys.errors import ProtocolError
 
@@ -120,6 +121,10 @@ class FrameReader:
                 self.special += 1
             return frames
         self._end += n
+        return self._cut(frames)
+
+    def _cut(self, frames: list[bytes | bytearray]) -> list[bytes | bytearray]:
+        """Append the complete frames between ``_start`` and ``_end`` to ``frames``; keep the rest."""
         buf, view, start, end = self._buf, self._view, self._start, self._end
         unpack_from = _U32.unpack_from
         append = frames.append
@@ -135,19 +140,46 @@ class FrameReader:
                     self.special += 1
                 start = stop
                 continue
-            if length > self._limit:
-                raise ProtocolError(f"message length prefix {length} exceeds the {self._limit}-byte limit")
-            if length >= self._large:
-                have = end - start - 4
-                big = bytearray(length)
-                big[:have] = buf[start + 4 : end]
-                self._big, self._big_view, self._big_fill = big, memoryview(big), have
-                start = end
+            start = self._incomplete(length, start, end)
             break
         if start == end:
             start = end = 0
         self._start, self._end = start, end
         return frames
+
+    def _incomplete(self, length: int, start: int, end: int) -> int:
+        """The frame at ``start`` (``length`` bytes of body) is not complete: refuse a length above the
+        limit, and receive a large one in place. Returns where the unconsumed bytes start now."""
+        if length > self._limit:
+            raise ProtocolError(f"message length prefix {length} exceeds the {self._limit}-byte limit")
+        if length >= self._large:
+            have = end - start - 4
+            big = bytearray(length)
+            big[:have] = self._buf[start + 4 : end]
+            self._big, self._big_view, self._big_fill = big, memoryview(big), have
+            return end
+        return start
+
+    def commit_decoded(self, n: int, decode: Callable[[bytes, int, int, list, list], int], out: list,
+                       bad: list) -> list[bytes | bytearray]:  # fmt: skip
+        """Like :meth:`commit`, with the complete small frames decoded by ``decode`` (a generated
+        ``decode_frames`` for this stream's tagging, see :mod:`ninjemys.idl.framedecode`) into ``out``
+        and their failures into ``bad``. Returns the frames left undecoded, which follow ``out``'s
+        and which the caller decodes itself: a large frame received in place, or on a tagged stream
+        a frame with another tag than 0 and every frame after it in this read.
+
+        The decoder reads an immutable copy of the bytes received (decoded arrays are views of it, so
+        the buffer can be reused at once): one copy per read, not one per frame."""
+        if self._big is not None:
+            return self.commit(n)
+        end = self._end + n
+        start = self._start
+        start += decode(self._view[start:end].tobytes(), 0, end - start, out, bad)
+        if start == end:
+            self._start = self._end = 0
+            return []
+        self._start, self._end = start, end
+        return self._cut([])
 
     @property
     def pending(self) -> int:

@@ -15,10 +15,14 @@ from typing import Any
 
 from ninjemys.errors import NinjemysError
 from ninjemys.idl.loader import get_message_class, get_service_class
-from ninjemys.sim.ros_control.controllers import CONTROLLER_TYPES, Controller, ControllerError
+from ninjemys.sim.ros_control.controllers import CONTROLLER_TYPES as DRIVE_TYPES
+from ninjemys.sim.ros_control.controllers import Controller, ControllerError
 from ninjemys.sim.ros_control.hardware import SimRobotHW
+from ninjemys.sim.ros_control.joint_controllers import JOINT_CONTROLLER_TYPES
 
 BEST_EFFORT, STRICT = 1, 2
+#: every controller type the simulator's controller_manager loads
+CONTROLLER_TYPES = {**DRIVE_TYPES, **JOINT_CONTROLLER_TYPES}
 BASE_CLASS = "controller_interface::ControllerBase"
 
 

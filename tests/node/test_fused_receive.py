@@ -1,0 +1,116 @@
+"""The subscriber's fused receive path (issue 25): a plain stream read by one handle is cut and decoded
+in one generated loop. Over TCPROS, UNIXROS and SHMROS every message arrives, once, in order; a
+stream the fused loop cannot serve (several handles, latching, raw) still takes the per-frame path;
+a large SHMROS message in the middle of small inline ones keeps its place."""
+
+from __future__ import annotations
+
+import threading
+
+import pytest
+
+from ninjemys.idl.loader import get_message_class
+from ninjemys.node import subscriber
+from ninjemys.testing import wait_until
+
+String = get_message_class("std_msgs/String")
+
+TRANSPORTS = {
+    "tcpros": {"NINJEMYS_SHM": "0", "NINJEMYS_UNIXROS": "0"},
+    "unixros": {"NINJEMYS_SHM": "0", "NINJEMYS_UNIXROS": "1"},
+    "shmros": {"NINJEMYS_SHM": "1", "NINJEMYS_UNIXROS": "1"},
+}
+
+
+@pytest.fixture
+def reads(monkeypatch: pytest.MonkeyPatch) -> dict[str, int]:
+    """How many reads went each way."""
+    counts = {"fused": 0, "frames": 0}
+    lock = threading.Lock()
+    fused, plain = subscriber.SubConnection.read_decoded, subscriber.SubConnection.read
+
+    def read_decoded(self, *args):  # type: ignore[no-untyped-def]
+        with lock:
+            counts["fused"] += 1
+        return fused(self, *args)
+
+    def read(self, *args):  # type: ignore[no-untyped-def]
+        with lock:
+            counts["frames"] += 1
+        return plain(self, *args)
+
+    monkeypatch.setattr(subscriber.SubConnection, "read_decoded", read_decoded)
+    monkeypatch.setattr(subscriber.SubConnection, "read", read)
+    return counts
+
+
+@pytest.mark.parametrize("transport", list(TRANSPORTS))
+def test_a_burst_arrives_whole_and_in_order_through_the_fused_loop(
+    make_node, monkeypatch: pytest.MonkeyPatch, reads: dict[str, int], transport: str
+) -> None:
+    for key, value in TRANSPORTS[transport].items():
+        monkeypatch.setenv(key, value)
+    talker, listener = make_node("talker"), make_node("listener")
+    got: list[str] = []
+    sub = listener.subscriber("burst", String, lambda m: got.append(m.data), queue_size=None)
+    pub = talker.publisher("burst", String, queue_size=None)
+    assert wait_until(lambda: pub.get_num_connections() == 1 and sub.get_num_connections() == 1)
+    expected = [f"m{i}" for i in range(5000)]
+    if transport == "shmros":  # a large message through the ring in the middle of the inline ones
+        expected[2500] = "L" * 200_000
+    for text in expected:
+        pub.publish(String(text))
+    assert wait_until(lambda: len(got) >= len(expected), timeout=30), len(got)
+    assert got == expected
+    assert reads["fused"] > 0
+    assert reads["frames"] == 0
+
+
+def test_a_second_handle_or_a_latched_stream_takes_the_per_frame_path(
+    make_node, reads: dict[str, int]
+) -> None:
+    talker, listener = make_node("talker"), make_node("listener")
+    first: list[str] = []
+    second: list[str] = []
+    a = listener.subscriber("two", String, lambda m: first.append(m.data))
+    b = listener.subscriber("two", String, lambda m: second.append(m.data))
+    latched: list[str] = []
+    c = listener.subscriber("latched", String, lambda m: latched.append(m.data))
+    pub = talker.publisher("two", String, queue_size=None)
+    lpub = talker.publisher("latched", String, latch=True)
+    assert wait_until(lambda: a.get_num_connections() == 1 and c.get_num_connections() == 1)
+    assert b.get_num_connections() == 1
+    for i in range(200):
+        pub.publish(String(f"m{i}"))
+    lpub.publish(String("kept"))
+    want = [f"m{i}" for i in range(200)]
+    assert wait_until(lambda: first == want and second == want and latched == ["kept"])
+    assert reads["frames"] > 0
+    assert reads["fused"] == 0
+
+
+def test_a_bounded_queue_keeps_the_newest_and_counts_the_dropped(make_node) -> None:
+    """queue_size drop-oldest with the fused loop: a callback blocked while 300 messages arrive sees
+    the newest of them, in order, and the handle counts every other one as dropped."""
+    talker, listener = make_node("talker"), make_node("listener")
+    gate = threading.Event()
+    got: list[str] = []
+
+    def slow(msg: object) -> None:
+        got.append(msg.data)  # type: ignore[attr-defined]
+        gate.wait(10)
+
+    sub = listener.subscriber("bounded", String, slow, queue_size=10)
+    pub = talker.publisher("bounded", String, queue_size=None)
+    assert wait_until(lambda: pub.get_num_connections() == 1 and sub.get_num_connections() == 1)
+    pub.publish(String("first"))
+    assert wait_until(lambda: got == ["first"])
+    for i in range(300):
+        pub.publish(String(f"m{i}"))
+    gate.set()
+    assert wait_until(lambda: got[-1:] == ["m299"]), got[-3:]
+    numbers = [int(text[1:]) for text in got[1:]]
+    assert numbers == sorted(numbers)
+    assert numbers[-10:] == list(range(290, 300))  # the newest always arrive
+    assert len(numbers) + sub.dropped == 300  # and every other one was counted as dropped
+    assert sub.dropped > 0
