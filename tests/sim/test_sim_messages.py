@@ -85,6 +85,20 @@ def test_odometry_and_transforms() -> None:
     assert not any("depth" in child for _, child in pairs)  # a colour-only camera has no depth frame
 
 
+def test_odometry_refreshed_in_place_is_a_fresh_message() -> None:
+    """The node builds its odometry message once and refreshes it per sample: the bytes are those of
+    a message built for that sample (noise covariance, frames, stamp, pose and twist)."""
+    from ninjemys.rostime import Time
+
+    alpha = (0.2, 0.0, 0.1, 0.0)
+    kept = messages.odometry(Time(0, 0), "odom", "base_link", (0.0, 0.0, 0.0), (0.0, 0.0), alpha)
+    for secs, pose, twist in ((1, (1.0, 2.0, 0.3), (0.1, 0.2)), (2, (-1.5, 0.25, -3.1), (-0.4, 1.9))):
+        fresh = messages.odometry(Time(secs, 500), "odom", "base_link", pose, twist, alpha)
+        same = messages.odometry_into(kept, Time(secs, 500), pose, twist)
+        assert same is kept
+        assert b"".join(kept.frame_parts()[1]) == b"".join(fresh.frame_parts()[1])
+
+
 def test_camera_messages() -> None:
     model = load_robot_model("puzzlebot")
     rgb = np.zeros((4, 6, 3), dtype=np.uint8)

@@ -1,5 +1,5 @@
-"""The simulator's fast paths give the same answers as the plain ones: the camera's bitwise select
-against ``np.where`` and a per-column renderer, the collision broad phase for moving obstacles,
+"""The simulator's fast paths give the same answers as the plain ones: the camera's span masks and
+masked paint against ``np.where``, the camera against a per-pixel renderer, the collision broad phase for moving obstacles,
 and the simulation lock that the stepping thread hands over only when someone waits."""
 
 from __future__ import annotations
@@ -16,30 +16,44 @@ from ninjemys.sim import sensors
 from ninjemys.sim.puzzlebot_node import keep_freed_memory
 from ninjemys.sim.raycast import cast_segments
 from ninjemys.sim.robot_model import load_robot_model
-from ninjemys.sim.sensors import FLOOR_RGB, SKY_RGB, _padded_copy, _padded_empty, _select
+from ninjemys.sim.sensors import FLOOR_RGB, SKY_RGB
 from ninjemys.sim.simcore import Simulation
 from ninjemys.sim.stepper import StepLock
 from ninjemys.sim.world2d import load_world
 from ninjemys.sim.worlds import world_path
 
 
-@pytest.mark.parametrize("dtype", [np.uint8, np.uint16])
-@pytest.mark.parametrize("shape", [(240, 960), (7, 5), (1, 3), (33, 17)])
-def test_bitwise_select_equals_where(dtype, shape):
-    """Any shape (sizes that are not whole 8-byte words too), a broadcast row and a full image."""
-    rng = np.random.default_rng(1)
-    top = np.iinfo(dtype).max
-    back = _padded_copy(rng.integers(0, top, shape, dtype=dtype, endpoint=True))
-    mask = rng.random(shape) > 0.4
-    for fore in (
-        rng.integers(0, top, (1, shape[1]), dtype=dtype, endpoint=True),
-        rng.integers(0, top, shape, dtype=dtype, endpoint=True),
-    ):
-        lanes = _padded_empty(shape, dtype)
-        np.copyto(lanes, mask)
-        out = _select(lanes, fore, back)
-        assert out.dtype == dtype and out.shape == shape and out.flags.c_contiguous
-        assert np.array_equal(out, np.where(mask, fore, back))
+@pytest.mark.parametrize("height", [1, 7, 240, 255, 256, 300])
+def test_span_mask_and_masked_paint_equal_where(height):
+    """The wrapping-subtraction span mask is ``top <= v < bottom`` per column (empty spans and spans
+    touching the first or last row too, uint8 rows up to 255 and uint16 rows beyond), over the whole
+    image and over a band of rows; the masked paint into a band of an image equals ``np.where``."""
+    width = 37
+    cam = sensors.Camera(width, height, 60.0, 0.12, 10.0)
+    rng = np.random.default_rng(height)
+    rows = np.arange(height)[:, None]
+    for _ in range(20):
+        top = rng.integers(0, height + 1, width).astype(cam._row_type)
+        bottom = rng.integers(0, height + 1, width).astype(cam._row_type)
+        top[:3], bottom[:3] = (0, height, 5 % (height + 1)), (height, 0, 5 % (height + 1))
+        r0 = int(rng.integers(0, height))
+        r1 = int(rng.integers(r0 + 1, height + 1))
+        want = (rows >= top) & (rows < bottom)
+        assert np.array_equal(cam._span_mask(top, bottom, 0, height).view(bool), want)
+        band = cam._span_mask(top, bottom, r0, r1)
+        assert band.dtype == np.uint8 and np.array_equal(band.view(bool), want[r0:r1])
+        for image, per_column in (
+            (rng.integers(0, 256, (height, width, 3), dtype=np.uint8), rng.integers(0, 256, (width, 3))),
+            (rng.integers(0, 65536, (height, width), dtype=np.uint16), rng.integers(0, 65536, width)),
+        ):
+            expect = image.copy()
+            expect[r0:r1] = np.where(
+                want[r0:r1] if image.ndim == 2 else want[r0:r1, :, None],
+                per_column.astype(image.dtype),
+                image[r0:r1],
+            )
+            cam._paint(image[r0:r1], per_column.astype(image.dtype), band)
+            assert np.array_equal(image, expect)
 
 
 def ray_hits(x: float, y: float, angle: float, segs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

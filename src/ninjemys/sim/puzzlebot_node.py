@@ -39,6 +39,7 @@ import argparse
 import ctypes
 import math
 import signal
+import struct
 import sys
 import threading
 from collections.abc import Callable
@@ -81,6 +82,9 @@ TFMessage: Any = get_message_class("tf2_msgs/TFMessage")
 Clock: Any = get_message_class("rosgraph_msgs/Clock")
 Log: Any = get_message_class("rosgraph_msgs/Log")
 
+#: a rosgraph_msgs/Clock TCPROS frame: its length (8), then secs and nsecs
+_CLOCK_FRAME = struct.Struct("<III").pack
+
 WORLD_FRAME = "map"  # ground truth frame: the shipped maps are rasterized in world coordinates
 
 __all__ = ["SimNode", "RobotIO", "scoped", "StepLock", "Due", "parse_model_xml", "keep_freed_memory", "main"]
@@ -118,6 +122,8 @@ class RobotIO:
     #: gazebo_ros_control's controller_manager for this robot (a ros_control description), else None
     control: ControlLoop | None = None
     extras: list[ExtraSensor] = field(default_factory=list)
+    #: the odometry message, built at the first sample and refreshed in place after that
+    odom_msg: Any = None
 
     def frame(self, name: str) -> str:
         return scoped(self.frame_prefix, name)
@@ -397,8 +403,8 @@ class SimNode:
         self.log.error("simulation step failed: %s: %s", type(exc).__name__, exc)
 
     def _stamp(self) -> Time:
-        ns = self.sim.time_ns
-        return Time(ns // 1_000_000_000, ns % 1_000_000_000)
+        secs, nsecs = divmod(self.sim.time_ns, 1_000_000_000)
+        return Time._raw(secs, nsecs)  # wire integers, already valid: no re-validation per step
 
     def _step_and_publish(self) -> None:
         sim = self.sim
@@ -410,7 +416,8 @@ class SimNode:
         now = sim.time
         stamp = self._stamp()
         if self.clock_pub.get_num_connections() and self._clock_due(now):  # nobody listening: nothing
-            self.clock_pub.publish(Clock(clock=stamp))
+            # rosgraph_msgs/Clock is two uint32s: its frame is packed here, with no message object
+            self.clock_pub.publish_framed(_CLOCK_FRAME(8, stamp.secs, stamp.nsecs))
         for r in touched:
             self.log.warn(
                 "robot [%s] hit '%s' at (%.3f, %.3f): stopped at contact", r.name, r.contact_with, r.x, r.y
@@ -483,9 +490,13 @@ class SimNode:
         odom_frame, base_frame = io.frame(drive.odom_frame), io.frame(drive.base_frame)
         odom = pubs.get("odom")
         if odom is not None and odom.get_num_connections():
-            odom.publish(
-                messages.odometry(stamp, odom_frame, base_frame, pose, (r.v, r.w), r.model.odom_alpha)
-            )
+            if io.odom_msg is None:
+                io.odom_msg = messages.odometry(
+                    stamp, odom_frame, base_frame, pose, (r.v, r.w), r.model.odom_alpha
+                )
+            else:
+                messages.odometry_into(io.odom_msg, stamp, pose, (r.v, r.w))
+            odom.publish(io.odom_msg)
         if pubs["ground_truth"].get_num_connections():
             pubs["ground_truth"].publish(
                 messages.odometry(stamp, WORLD_FRAME, io.frame("base_link"), (r.x, r.y, r.yaw), (r.v, r.w))

@@ -11,6 +11,7 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -145,9 +146,6 @@ class Camera:
         # static background: floor shaded with distance, sky above the horizon
         shade = np.clip(1.15 - floor_depth / 12.0, 0.55, 1.0)[:, None] * FLOOR_RGB[None, :]
         bg = np.where(below[:, None], shade, SKY_RGB[None, :]).astype(np.uint8)
-        self._background = _padded_copy(
-            np.broadcast_to(bg[:, None, :], (height, width, 3)).reshape(height, 3 * width)
-        )
         self._floor_rows = np.flatnonzero(floor_depth > 0)  # rows that see the floor within range
         forward = floor_depth[self._floor_rows][:, None]
         #: where each floor pixel meets the floor, in the camera's horizontal frame (x ahead, y left)
@@ -156,18 +154,18 @@ class Camera:
             (forward * ((self.cx - u) / self.fx)[None, :]).astype(np.float32),
         )
         self._neg_slope = -self.row_slope
-        # a column's wall rows are top <= v < bottom, with top and bottom in [0, height]: compared
-        # in the narrowest unsigned type that holds them (uint8 up to 255 rows), so building the
-        # masks is one byte-wide vectorised comparison per pixel
+        # a column's wall rows are top <= v < bottom, with top and bottom in [0, height]: held in the
+        # narrowest unsigned type that holds them (uint8 up to 255 rows), and tested as one wrapping
+        # subtraction and one comparison per pixel, (v - top) mod 2^bits < bottom - top
         self._row_type = np.uint8 if height <= 255 else np.uint16
         self._rows = np.arange(height, dtype=self._row_type)[:, None]
-        self._floor_depth_image = _padded_copy(np.broadcast_to(self.floor_depth_mm[:, None], (height, width)))
-        # scratch masks, reused by every frame (render runs on one thread at a time: the node's lock)
-        self._lanes3 = _padded_empty((height, 3 * width), np.uint8)
-        self._below3 = np.empty((height, 3 * width), dtype=bool)
-        self._lanes1 = _padded_empty((height, width), np.uint16)
-        self._wall1 = np.empty((height, width), dtype=bool)
-        self._below1 = np.empty((height, width), dtype=bool)
+        self._background = np.ascontiguousarray(np.broadcast_to(bg[:, None, :], (height, width, 3)))
+        self._floor_depth_image = np.ascontiguousarray(
+            np.broadcast_to(self.floor_depth_mm[:, None], (height, width))
+        )
+        # scratch, reused by every frame (render runs on one thread at a time: the node's lock)
+        self._offset = np.empty((height, width), dtype=self._row_type)
+        self._mask = np.empty((height, width), dtype=bool)
 
     def render(
         self,
@@ -200,39 +198,47 @@ class Camera:
         hits = _Crossings(scene, x, y, angles, far)
         dist, item = nearest_hits(self.width, hits.ray_of, hits.item_of, hits.t)
         found, depth, top, bottom, colors, _heights = self._layer(hits, dist, item, None)
-        rows = self._rows
-        paint = scene.floor is not None and want_rgb
-        wall3 = self._lanes3.view(bool)
-        if want_rgb or want_depth:
-            # the image as (H, 3W) bytes, each pixel's mask repeated over its three channels: selecting
-            # bytes is cheaper than any interleaving of channels or a select over 3-byte elements
-            np.greater_equal(rows, np.repeat(top, 3), out=wall3)
-            np.less(rows, np.repeat(bottom, 3), out=self._below3)
-            wall3 &= self._below3
-        # the wall mask per pixel (the floor markings are painted elsewhere): every third lane
-        wall = wall3.reshape(self.height, self.width, 3)[:, :, 0].copy() if paint else None
-        depth_mm = _EMPTY_DEPTH
+        rgb, depth_mm, wall = _EMPTY_RGB, _EMPTY_DEPTH, None
+        if not (want_rgb or want_depth):
+            return rgb, depth_mm
+        mask = self._span_mask(top, bottom, 0, self.height)
         if want_depth:
             wall_mm = np.rint(np.where(found, depth, 0.0) * 1000.0).astype(np.uint16)
-            # the per-pixel mask again, from byte-wide comparisons (cheaper than every third lane)
-            wall1, below1 = self._wall1, self._below1
-            np.greater_equal(rows, top, out=wall1)
-            np.less(rows, bottom, out=below1)
-            wall1 &= below1
-            np.copyto(self._lanes1, wall1)
-            depth_mm = _select(self._lanes1, wall_mm[None, :], self._floor_depth_image)
-        rgb = _EMPTY_RGB
+            depth_mm = self._floor_depth_image.copy()
+            self._paint(depth_mm, wall_mm, mask)
         if want_rgb:
             light = np.clip(1.1 - depth / 15.0, 0.45, 1.0)  # flat shading, darker with distance
-            col = (colors * light[:, None]).astype(np.uint8).reshape(1, 3 * self.width)
-            rgb = _select(self._lanes3, col, self._background).reshape(self.height, self.width, 3)
+            rgb = self._background.copy()
+            self._paint(rgb, (colors * light[:, None]).astype(np.uint8), mask)
+            if scene.floor is not None:
+                wall = mask.astype(bool)  # where the floor markings may not show (grows with each layer)
         thresholds = layer_thresholds(scene, self.cam_z)
-        if thresholds and (want_rgb or want_depth):
+        if thresholds:
             self._farther_layers(hits, thresholds, found, item, top, rgb, depth_mm, wall)
-        if paint:
-            assert scene.floor is not None and wall is not None
+        if wall is not None:
+            assert scene.floor is not None
             self._paint_floor(rgb, wall, scene.floor, x, y, yaw)
         return rgb, depth_mm
+
+    def _span_mask(self, top: np.ndarray, bottom: np.ndarray, r0: int, r1: int) -> np.ndarray:
+        """uint8 (r1 - r0, width): 1 at the rows v in [r0, r1) of each column u with
+        top[u] <= v < bottom[u] (none where bottom <= top), as (v - top) mod 2^bits < bottom - top:
+        a row above top wraps around to at least 2^bits - top, more than any span below ``height``."""
+        span = np.subtract(bottom, top, dtype=self._row_type)
+        span[bottom <= top] = 0
+        offset, mask = self._offset[: r1 - r0], self._mask[: r1 - r0]
+        np.subtract(self._rows[r0:r1], top, out=offset)
+        np.less(offset, span, out=mask)
+        return mask.view(np.uint8)
+
+    def _paint(self, image: np.ndarray, per_column: np.ndarray, mask: np.ndarray) -> None:
+        """Set ``image``'s pixels under ``mask`` (uint8, ``image``'s rows and columns) to their
+        column's value (``per_column``: one value or pixel per column), in place (OpenCV's masked
+        copy, a few times faster than numpy's ``where`` or ``copyto(where=)`` here; the column values
+        repeated down the rows by OpenCV too, a third faster than a contiguous copy of a broadcast)."""
+        cv2 = _opencv()
+        full = cv2.repeat(np.ascontiguousarray(per_column)[None], image.shape[0], 1)
+        cv2.copyTo(full, mask, image)
 
     def _farther_layers(
         self,
@@ -263,10 +269,8 @@ class Camera:
         if not len(keep):
             return
         ray_of, item_of, t, pair_level = ray_of[keep], item_of[keep], t[keep], pair_level[keep]
-        cut = (
-            top.copy()
-        )  # rows at or below a nearer layer's top are that layer's (or the floor in front of it)
-        rows = self._rows
+        # rows at or below a nearer layer's top are that layer's (or the floor in front of it)
+        cut = top.copy()
         while len(t):
             dist, nearest = nearest_hits(self.width, ray_of, item_of, t)
             cols = np.flatnonzero(nearest >= 0)
@@ -278,28 +282,26 @@ class Camera:
             # a layer beyond the depth range ends its column (nothing farther is in range either)
             reached[cols] = np.where(found_c, level[nearest[cols]], len(thresholds) + 1)
             if visible.any():
-                # the layer's visible rows lie in one band: masked copies over that band only
+                # the layer's visible rows lie in one band: masked copies over that band's rows only
                 vis = cols[visible]
                 top_v, bottom_v = top_c[visible], bottom_c[visible]
                 r0, r1 = int(top_v.min()), int(bottom_v.max())
-                band = rows[r0:r1]
-                mask = (band >= top_v[None, :]) & (
-                    band < bottom_v[None, :]
-                )  # (rows of the band, visible cols)
+                band_top = np.zeros(self.width, dtype=self._row_type)
+                band_bottom = np.zeros(self.width, dtype=self._row_type)  # other columns: no span
+                band_top[vis], band_bottom[vis] = top_v, bottom_v
+                mask = self._span_mask(band_top, band_bottom, r0, r1)
                 depth_v = depth_c[visible]
-                light_v = np.clip(1.1 - depth_v / 15.0, 0.45, 1.0)
                 if rgb.size:
-                    colour_v = (colors_c[visible] * light_v[:, None]).astype(np.uint8)
-                    sub = rgb[r0:r1, vis]
-                    np.copyto(sub, np.broadcast_to(colour_v[None, :, :], sub.shape), where=mask[:, :, None])
-                    rgb[r0:r1, vis] = sub
+                    light_v = np.clip(1.1 - depth_v / 15.0, 0.45, 1.0)
+                    colour = np.zeros((self.width, 3), dtype=np.uint8)
+                    colour[vis] = (colors_c[visible] * light_v[:, None]).astype(np.uint8)
+                    self._paint(rgb[r0:r1], colour, mask)
                 if depth_mm.size:
-                    mm_v = np.rint(depth_v * 1000.0).astype(np.uint16)
-                    dsub = depth_mm[r0:r1, vis]
-                    np.copyto(dsub, np.broadcast_to(mm_v[None, :], dsub.shape), where=mask)
-                    depth_mm[r0:r1, vis] = dsub
+                    mm = np.zeros(self.width, dtype=np.uint16)
+                    mm[vis] = np.rint(depth_v * 1000.0).astype(np.uint16)
+                    self._paint(depth_mm[r0:r1], mm, mask)
                 if wall is not None:
-                    wall[r0:r1, vis] |= mask
+                    wall[r0:r1] |= mask.view(bool)
             cut[cols] = np.minimum(cut[cols], top_c)
             more = np.flatnonzero(pair_level > reached[ray_of])
             ray_of, item_of, t, pair_level = ray_of[more], item_of[more], t[more], pair_level[more]
@@ -380,45 +382,13 @@ def _thresholds(heights: bytes, most: int) -> tuple[float, ...]:
     return tuple(float(h) for h in distinct)
 
 
-def _padded_empty(shape: tuple[int, ...], dtype: type) -> np.ndarray:
-    """An uninitialised C-contiguous array on a buffer of whole 8-byte words (``.base``, uint64).
-    The last word is zeroed, so padding past the array's end holds no garbage that a
-    multiplication on words could carry into the array (on a big-endian machine)."""
-    size = math.prod(shape) * np.dtype(dtype).itemsize
-    words = np.empty(-(-size // 8), dtype=np.uint64)
-    if len(words):
-        words[-1] = 0
-    return words.view(np.uint8)[:size].view(dtype).reshape(shape)
+@functools.cache
+def _opencv() -> Any:
+    """OpenCV (a runtime dependency), imported at the first frame drawn: not at import time, nor
+    when a robot is spawned (its 25-80 ms would delay the first scan after a spawn)."""
+    import cv2
 
-
-def _padded_copy(image: np.ndarray) -> np.ndarray:
-    out = _padded_empty(image.shape, image.dtype.type)
-    out[...] = image
-    return out
-
-
-def _words(image: np.ndarray) -> np.ndarray:
-    """The 8-byte words under an array made by :func:`_padded_empty`."""
-    base = image
-    while base.base is not None:
-        base = base.base
-    return base
-
-
-def _select(lanes: np.ndarray, fore: np.ndarray, back: np.ndarray) -> np.ndarray:
-    """``np.where(lanes, fore, back)`` for an unsigned-integer image ``back`` from :func:`_padded_copy`,
-    a few times faster. ``lanes`` (from :func:`_padded_empty`, ``back``'s shape and type) holds 0 or 1
-    per element and is used up; ``fore`` broadcasts to ``back``'s shape. Computed as
-    ``back ^ ((back ^ fore) & lanes)`` on 8-byte words, with each lane turned into all ones by one
-    multiplication: 1 times 0xFF (0xFFFF, ...) fits its own element, so no carry reaches the next."""
-    out = _padded_empty(back.shape, back.dtype.type)
-    np.bitwise_xor(back, fore, out=out)
-    lane_words = _words(lanes)
-    lane_words *= np.uint64((1 << (8 * back.itemsize)) - 1)
-    words = _words(out)
-    words &= lane_words
-    words ^= _words(back)
-    return out
+    return cv2
 
 
 def imu_reading(
