@@ -184,3 +184,29 @@ def test_second_interrupt_kills_at_once() -> None:
     assert any("second interrupt" in line for line in lines)
     assert not any("escalating" in line for line in lines)
     assert not alive(sup.procs[0].popen.pid)  # type: ignore[union-attr]
+
+
+def test_shutdown_stops_the_nodes_in_reverse_start_order() -> None:
+    """ROS 1's roslaunch queues its kills last-started first ("killing on exit" lines in that order)."""
+    lines: list[str] = []
+    names = ["first", "second", "third"]
+    sup = Supervisor(
+        [spec(f"{n}-{i}", "sleeper.py", f"__name:={n}") for i, n in enumerate(names, 1)],
+        write=lines.append,
+        prefix_output=True,
+    )
+    thread, result = run_in_thread(sup)
+    stop = threading.Event()
+
+    def stop_when_ready() -> None:
+        while not all(any(f"{n} ready" in line for line in lines) for n in names):
+            if stop.wait(0.02):
+                return
+        sup.request_shutdown()
+
+    threading.Thread(target=stop_when_ready, daemon=True).start()
+    thread.join(60)
+    stop.set()
+    assert result == [0]
+    killed = [line.split("]")[0].lstrip("[") for line in lines if "killing on exit" in line]
+    assert killed == ["third-3", "second-2", "first-1"]

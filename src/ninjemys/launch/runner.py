@@ -10,7 +10,7 @@ output stays readable. Timers (respawn delays, shutdown
 escalation) are the selector timeout. No polling loops, no thread per node.
 
 Shutdown (Ctrl-C, SIGTERM, a required node's death, or the master's death): SIGINT to every
-node's process group at once, SIGTERM after the node's ``sigint_timeout`` (default
+node's process group at once (in reverse start order, as ROS 1 queues its kills), SIGTERM after the node's ``sigint_timeout`` (default
 :data:`DEFAULT_SIGINT_TIMEOUT`, ROS 1: 15 s), SIGKILL after :data:`DEFAULT_SIGTERM_TIMEOUT` more
 (ROS 1: 2 s); the auto-started master is stopped last, after the nodes had a chance to unregister.
 """
@@ -251,7 +251,8 @@ class Supervisor:
             return
         self.shutting_down = True
         now = time.monotonic()
-        for proc in self.procs:
+        # last started, first stopped: ROS 1's process monitor queues its parallel kills in reverse
+        for proc in reversed(self.procs):
             proc.restart_at = None
             if proc.spec.is_core:
                 continue
