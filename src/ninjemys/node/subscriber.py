@@ -215,30 +215,17 @@ class SubConnection:
         got = 0
         while True:
             buf = reader.buffer()
-            try:
-                n = sock.recv_into(buf)
-            except (BlockingIOError, InterruptedError):
+            n = self._recv_into(buf)
+            if n is None:
+                return None
+            if n < 0:
                 break
-            except OSError as exc:
-                self._lost(f"read failed: {exc}")
-                return None
-            if n == 0:
-                if reader.pending:
-                    self._lost(
-                        f"publisher disconnected mid-message ({reader.pending} bytes of a frame received)",
-                        logging.WARNING,
-                    )
-                else:
-                    self._lost("publisher closed the connection")
-                return None
             self.bytes_recv += n
             got += n
             try:
                 frames.extend(reader.commit(n))
             except ProtocolError as exc:
-                _log.warning("topic %s: dropped publisher %s: %s", self.sub.topic, self.publisher, exc)
-                self.close()
-                self.sub.node.runtime.call_soon(self.sub.connection_lost, self, False)
+                self._drop_broken_stream(exc)
                 return None
             if n < len(buf):
                 break  # the kernel had no more: skip the EAGAIN round trip
@@ -268,22 +255,11 @@ class SubConnection:
         fused = True
         while True:
             buf = reader.buffer()
-            try:
-                n = sock.recv_into(buf)
-            except (BlockingIOError, InterruptedError):
+            n = self._recv_into(buf)
+            if n is None:
+                return None
+            if n < 0:
                 break
-            except OSError as exc:
-                self._lost(f"read failed: {exc}")
-                return None
-            if n == 0:
-                if reader.pending:
-                    self._lost(
-                        f"publisher disconnected mid-message ({reader.pending} bytes of a frame received)",
-                        logging.WARNING,
-                    )
-                else:
-                    self._lost("publisher closed the connection")
-                return None
             self.bytes_recv += n
             got += n
             if fused and cap is not None and len(msgs) + (reader.pending + n) // min_frame > cap:
@@ -301,9 +277,7 @@ class SubConnection:
                 else:
                     frames.extend(reader.commit(n))
             except ProtocolError as exc:
-                _log.warning("topic %s: dropped publisher %s: %s", self.sub.topic, self.publisher, exc)
-                self.close()
-                self.sub.node.runtime.call_soon(self.sub.connection_lost, self, False)
+                self._drop_broken_stream(exc)
                 return None
             if n < len(buf):
                 break  # the kernel had no more: skip the EAGAIN round trip
@@ -320,6 +294,34 @@ class SubConnection:
         """The messages' bytes in frames cut from this stream (a tagged stream overrides this); None
         when the stream turned out malformed (then it is closed)."""
         return frames
+
+    def _recv_into(self, buf: Any) -> int | None:
+        """One ``recv_into`` for both read paths: the byte count, -1 when the kernel has nothing
+        now, None when the stream has ended (reported and closed)."""
+        try:
+            n = self.sock.recv_into(buf)
+        except (BlockingIOError, InterruptedError):
+            return -1
+        except OSError as exc:
+            self._lost(f"read failed: {exc}")
+            return None
+        if n == 0:
+            pending = self._reader.pending
+            if pending:
+                self._lost(
+                    f"publisher disconnected mid-message ({pending} bytes of a frame received)",
+                    logging.WARNING,
+                )
+            else:
+                self._lost("publisher closed the connection")
+            return None
+        return n
+
+    def _drop_broken_stream(self, exc: ProtocolError) -> None:
+        """Drop a publisher whose stream broke the framing (no reconnection: it would send the same)."""
+        _log.warning("topic %s: dropped publisher %s: %s", self.sub.topic, self.publisher, exc)
+        self.close()
+        self.sub.node.runtime.call_soon(self.sub.connection_lost, self, False)
 
     def _lost(self, why: str, level: int = logging.INFO) -> None:
         _log.log(level, "topic %s: %s (%s)", self.sub.topic, why, self.publisher)

@@ -808,13 +808,7 @@ class Publisher:
         """Send already-serialized bytes (relays, bag play, AnyMsg)."""
         if self._closed:
             raise ShutdownError(f"publisher of {self.name} is unregistered")
-        frame = pack_len(len(payload)) + bytes(payload)
-        if self._pub.intra:
-            item = Handoff(None, memoryview(frame)[4:])
-            self._pub.publish_intra(item, self)
-            self._pub.publish_frame(frame, self, item)
-            return
-        self._pub.publish_frame(frame, self)
+        self.publish_framed(pack_len(len(payload)) + bytes(payload))
 
     def publish_framed(self, frame: bytes) -> None:
         """Send a TCPROS frame built by the caller (``uint32`` length, then the serialized message):

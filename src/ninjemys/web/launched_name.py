@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ninjemys.node import Node
 from ninjemys.node.cli_args import parse_args
 
 
@@ -22,6 +23,21 @@ class LaunchedName:
     namespace: str
     remappings: dict[str, str]
     anonymous: bool
+
+    @classmethod
+    def anonymous_default(cls, name: str) -> LaunchedName:
+        """The tool started by hand with no node arguments: ``name``, anonymous, at the root."""
+        return cls(name, "/", {}, anonymous=True)
+
+    def node(self, master_uri: str) -> Node:
+        """The tool's node, registered under this name (the same for every page tool)."""
+        return Node(
+            self.name,
+            namespace=self.namespace,
+            anonymous=self.anonymous,
+            remappings=self.remappings,
+            master_uri=master_uri,
+        )
 
 
 def launched_name(default: str, argv: list[str]) -> LaunchedName:

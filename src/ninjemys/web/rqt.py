@@ -312,14 +312,7 @@ class Rqt:
         update_period: float = 1.0,
         launched: LaunchedName | None = None,
     ) -> None:
-        launched = launched or LaunchedName(name, "/", {}, anonymous=True)
-        self.node = Node(
-            launched.name,
-            namespace=launched.namespace,
-            anonymous=launched.anonymous,
-            remappings=launched.remappings,
-            master_uri=master_uri,
-        )
+        self.node = (launched or LaunchedName.anonymous_default(name)).node(master_uri)
         try:
             options = GatewayOptions(node_name=self.node.name, update_period=update_period)
             self.gateway = Gateway(options, node=self.node)

@@ -13,7 +13,6 @@ import sys
 
 from ninjemys.bridge.server import Gateway, GatewayOptions
 from ninjemys.commands import entry
-from ninjemys.node import Node
 from ninjemys.web.app import WebApp
 from ninjemys.web.browser import serve_until_stopped, stop_signals
 from ninjemys.web.launched_name import launched_name
@@ -47,14 +46,7 @@ def main(argv: list[str] | None = None) -> int:
             file=sys.stderr,
         )
         return 1
-    launched = launched_name("rqt_graph", argv)
-    node = Node(
-        launched.name,
-        namespace=launched.namespace,
-        anonymous=launched.anonymous,
-        remappings=launched.remappings,
-        master_uri=master_uri,
-    )
+    node = launched_name("rqt_graph", argv).node(master_uri)
     gateway = Gateway(GatewayOptions(node_name=node.name, hide_own_node=True, update_period=0.5), node=node)
     gateway.start()
     app.add_gateway(gateway)

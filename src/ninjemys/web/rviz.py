@@ -19,7 +19,6 @@ from typing import Any
 from ninjemys.bridge.server import Gateway, GatewayOptions
 from ninjemys.commands import entry
 from ninjemys.errors import NinjemysError
-from ninjemys.node import Node
 from ninjemys.serve.http import HttpError, Request, Response
 from ninjemys.web import rvizconfig
 from ninjemys.web.app import STATIC_DIR, WebApp
@@ -107,14 +106,7 @@ class Rviz:
         update_period: float = 1.0,
         launched: LaunchedName | None = None,
     ) -> None:
-        launched = launched or LaunchedName("rviz", "/", {}, anonymous=True)
-        self.node = Node(
-            launched.name,
-            namespace=launched.namespace,
-            anonymous=launched.anonymous,
-            remappings=launched.remappings,
-            master_uri=master_uri,
-        )
+        self.node = (launched or LaunchedName.anonymous_default("rviz")).node(master_uri)
         try:
             options = GatewayOptions(node_name=self.node.name, update_period=update_period)
             self.gateway = Gateway(options, node=self.node)
