@@ -170,18 +170,24 @@ def test_tcp_has_no_unread_probe() -> None:
     assert topics.transport.unread_probe(a) is None
 
 
-def test_shmros_small_frames_are_tagged_once_by_the_publication(clock: _Clock) -> None:
-    assert topics._LARGE - 5 < shm_link.THRESHOLD  # every frame publish_small takes is inline for SHMROS
-    from std_msgs.msg import String
-
+def _shm_and_plain(msg_class: type) -> tuple[topics.Publication, socket.socket, socket.socket]:
+    """A publication of /t with one SHMROS and one plain connection, and the two far ends."""
     node = _Node()
-    pub = topics.Publication(node, "/t", String)  # type: ignore[arg-type]
+    pub = topics.Publication(node, "/t", msg_class)  # type: ignore[arg-type]
     a, b = _pair()
     c, d = _pair()
     pub.connections = (
         shm_link.ShmPubConnection(node, a, "/t", "/shm"),  # type: ignore[arg-type]
         topics.PubConnection(node, c, "/t", "/plain"),  # type: ignore[arg-type]
     )
+    return pub, b, d
+
+
+def test_shmros_small_frames_are_tagged_once_by_the_publication(clock: _Clock) -> None:
+    assert topics._LARGE - 5 < shm_link.THRESHOLD  # every frame publish_small takes is inline for SHMROS
+    from std_msgs.msg import String
+
+    pub, b, d = _shm_and_plain(String)
     handle = topics.Publisher(pub, 10, False, None)
     handle.publish(String(data="hi"))
     body = pack_len(2) + b"hi"
@@ -197,14 +203,7 @@ def test_a_small_generated_message_is_framed_in_one_piece_latched_untagged(
     from ninjemys.idl.message import Message
     from std_msgs.msg import String
 
-    node = _Node()
-    pub = topics.Publication(node, "/t", String)  # type: ignore[arg-type]
-    a, b = _pair()
-    c, d = _pair()
-    pub.connections = (
-        shm_link.ShmPubConnection(node, a, "/t", "/shm"),  # type: ignore[arg-type]
-        topics.PubConnection(node, c, "/t", "/plain"),  # type: ignore[arg-type]
-    )
+    pub, b, d = _shm_and_plain(String)
     handle = topics.Publisher(pub, None, True, None)
 
     def no_parts(self: Message) -> None:
