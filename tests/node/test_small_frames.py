@@ -95,6 +95,42 @@ def test_a_publish_after_a_round_trip_goes_out_at_once(clock: _Clock, family: in
     assert conn.node.runtime.calls == []  # the I/O loop never had to write a reply
 
 
+class _PreemptedWrites:
+    """A clock under which every write takes ``took`` seconds: the publishing thread lost the CPU
+    inside ``send`` (each publish reads the clock before and after its write)."""
+
+    def __init__(self, took: float) -> None:
+        self.now = 100.0
+        self.took = took
+        self._end = False
+
+    def __call__(self) -> float:
+        self._end = not self._end
+        return self.now if self._end else self.now + self.took
+
+
+@pytest.mark.parametrize("queue_size", [10, None])
+@pytest.mark.parametrize("family", [socket.AF_UNIX, socket.AF_INET])
+def test_a_publish_right_after_a_preempted_write_goes_out_at_once(
+    monkeypatch: pytest.MonkeyPatch, family: int, queue_size: int | None
+) -> None:
+    """On one CPU the subscriber runs while the publisher is inside ``send``, and a ping-pong's reply
+    can be back before ``send`` returns: the next ping comes microseconds after the write ended, yet
+    the subscriber waits for it. A write that took a burst's whole gap counts from its start, so it is
+    no burst: written at once, never left to the I/O loop (it was, for 3 % of a one-CPU ping-pong's
+    publishes: a wake-up of another thread each, the round trip's p99)."""
+    clock = _PreemptedWrites(took=35e-6)
+    monkeypatch.setattr(topics, "_clock", clock)
+    a, b = _pair(family)
+    conn = topics.PubConnection(_Node(), a, "/t", "/sub")  # type: ignore[arg-type]
+    for _ in range(20):
+        conn.send(FRAME, queue_size)
+        assert not conn._queue and conn._partial is None
+        clock.now += 37e-6  # the reply came during the write; the next ping 2 us after it ended
+    assert len(_drain(b, 20 * len(FRAME))) == 20 * len(FRAME)
+    assert conn.node.runtime.calls == []
+
+
 @pytest.mark.parametrize("family", [socket.AF_UNIX, socket.AF_INET])
 def test_a_flat_out_loop_is_batched(clock: _Clock, family: int) -> None:
     a, b = _pair(family)

@@ -57,6 +57,8 @@ _BATCH_BYTES = 1 << 20
 #: burst and batched instead of sent alone. Measured from the end of the write, not its start: a
 #: flat-out loop comes back within a few microseconds, a ping-pong only after a whole round trip
 #: (on this VM 3 us against 30 us and more), so a fast ping-pong is never mistaken for a burst.
+#: A write that itself took this long counts from its start: the thread was off the CPU inside it
+#: (on one CPU the reply to a ping can arrive before the ping's ``send`` returns).
 HOT_INTERVAL = 20e-6
 #: Within HOT_INTERVAL but at least this late (seconds), a Unix socket whose subscriber has read
 #: everything is written at once (it waits for the frame); sooner, it is a burst without asking.
@@ -186,7 +188,13 @@ class PubConnection:
                 self.bytes_sent += n
                 self.num_sent += 1
                 if n == len(data):
-                    self._last = _clock()  # the next publish's gap counts from the end of this write
+                    end = _clock()
+                    if end - now < HOT_INTERVAL:
+                        # the next publish's gap counts from the end of this write; unless the write
+                        # took a burst's whole gap (this thread was off the CPU inside it, and the
+                        # subscriber ran: on one CPU a ping-pong's reply can come back before send
+                        # returns): then from its start, or the next ping would look like a burst
+                        self._last = end
                     return
                 self._partial = [memoryview(data)[n:]]
                 if queue_size is not None or len(data) < _LARGE:
