@@ -114,3 +114,45 @@ def test_a_bounded_queue_keeps_the_newest_and_counts_the_dropped(make_node) -> N
     assert numbers[-10:] == list(range(290, 300))  # the newest always arrive
     assert len(numbers) + sub.dropped == 300  # and every other one was counted as dropped
     assert sub.dropped > 0
+
+
+@pytest.mark.parametrize("transport", ["unixros", "shmros"])
+def test_a_lone_handle_is_read_and_called_back_by_its_worker_loop_itself(
+    make_node, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture, transport: str
+) -> None:
+    """A ping-pong's hop (issue 25): the worker of a lone handle reads, decodes and calls back in its
+    own loop, not through the general per-connection dispatch (three calls less per message measured
+    ~5 us of CPU on a cold path). A callback that raises is logged and the next message still comes;
+    the stream stays on that loop."""
+    for key, value in TRANSPORTS[transport].items():
+        monkeypatch.setenv(key, value)
+    dispatched = [0]
+    general = subscriber.Subscriber._read
+
+    def counted(self, conn):  # type: ignore[no-untyped-def]
+        dispatched[0] += 1
+        return general(self, conn)
+
+    monkeypatch.setattr(subscriber.Subscriber, "_read", counted)
+    talker, listener = make_node("talker"), make_node("listener")
+    got: list[str] = []
+    arrived = threading.Event()
+
+    def callback(msg) -> None:  # type: ignore[no-untyped-def]
+        got.append(msg.data)
+        arrived.set()
+        if msg.data == "m50":
+            raise ValueError("callback failed on purpose")
+
+    sub = listener.subscriber("hop", String, callback, queue_size=None)
+    pub = talker.publisher("hop", String, queue_size=None)
+    assert wait_until(lambda: pub.get_num_connections() == 1 and sub.get_num_connections() == 1)
+    before = dispatched[0]  # the read made when the connection was added (latched data)
+    expected = [f"m{i}" for i in range(200)]
+    for text in expected:  # one at a time, as a ping-pong sends them
+        arrived.clear()
+        pub.publish(String(text))
+        assert arrived.wait(10.0), text
+    assert got == expected
+    assert dispatched[0] == before
+    assert "callback failed on purpose" in caplog.text

@@ -805,14 +805,50 @@ class Subscriber:
         queue = self._queue
         served = self._served
         read = self._read
+        handles = self._sub.handles
+        fused_of = self._fused
+        maxlen = queue.maxlen
+        budget = None if maxlen is not None else _READ_BUDGET
         while not queue and not self._closed and self._served is served:
             for fd, _ in poll(-1, poller.max_events):
                 if fd in objs:
                     conn = objs[fd]
                     if conn is None:
                         self._on_wake()
-                    else:
+                        continue
+                    fused = fused_of[conn.tagged]
+                    if (
+                        not fused
+                        or conn.latching
+                        or conn.closed
+                        or self._direct
+                        or conn.reader is not self
+                        or len(handles) != 1
+                    ):
                         read(conn)
+                        continue
+                    # _read and _read_fused inlined for an unlatched stream and one handle, and
+                    # _deliver_msgs for a single callback: each call is cache misses on a cold path
+                    got = conn.read_decoded(budget, fused[0], maxlen, fused[1])
+                    if got is None:
+                        self._forget(conn)
+                        continue
+                    msgs, frames, bad = got
+                    if frames or bad or (maxlen is not None and len(msgs) > maxlen):
+                        self._fused_rest(conn, msgs, frames, bad, maxlen)
+                        continue
+                    callbacks = self._callbacks
+                    if len(callbacks) == 1 and callbacks[0][1] is None:
+                        callback = callbacks[0][0]
+                        for msg in msgs:
+                            if self._closed:
+                                break
+                            try:
+                                callback(msg)
+                            except Exception:
+                                _log.exception("topic %s: callback %r raised", self.name, callback)
+                    else:
+                        self._deliver_msgs(msgs)
 
     def _lazy_round(self) -> None:
         """One wait of a lazy handle's worker: on the low-water marks (:meth:`_lazy_wait`), or per
@@ -964,7 +1000,21 @@ class Subscriber:
         if got is None:
             self._forget(conn)
             return
-        msgs, frames, bad = got
+        self._fused_rest(conn, *got, maxlen, owner)
+
+    def _fused_rest(
+        self,
+        conn: SubConnection,
+        msgs: list[Any],
+        frames: list[bytes | bytearray],
+        bad: list[tuple[int, Exception]],
+        maxlen: int | None,
+        owner: Subscriber | None = None,
+    ) -> None:
+        """Deliver what :meth:`SubConnection.read_decoded` returned for ``owner`` (this handle by
+        default): failures reported, ``maxlen`` kept, then the messages and the frames left."""
+        if owner is None:
+            owner = self
         for length, exc in bad:
             owner._undecodable_length(length, conn.header, exc)
         if maxlen is not None and len(msgs) + len(frames) > maxlen:  # drop the oldest, as the queue would
