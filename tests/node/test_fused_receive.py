@@ -147,7 +147,8 @@ def test_a_lone_handle_is_read_and_called_back_by_its_worker_loop_itself(
     sub = listener.subscriber("hop", String, callback, queue_size=None)
     pub = talker.publisher("hop", String, queue_size=None)
     assert wait_until(lambda: pub.get_num_connections() == 1 and sub.get_num_connections() == 1)
-    before = dispatched[0]  # the read made when the connection was added (latched data)
+    assert wait_until(lambda: dispatched[0] >= 1)  # the read made when the worker added the stream
+    before = dispatched[0]
     expected = [f"m{i}" for i in range(200)]
     for text in expected:  # one at a time, as a ping-pong sends them
         arrived.clear()
