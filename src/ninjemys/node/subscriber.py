@@ -809,7 +809,16 @@ class Subscriber:
         fused_of = self._fused
         maxlen = queue.maxlen
         budget = None if maxlen is not None else _READ_BUDGET
+        # what a round delivered, dropped before the next wait: a message kept alive by this frame's
+        # locals while the worker sleeps would hold its shared-memory slot (and its memory) until the
+        # next message, for ever after the last one
+        got: tuple[list[Any], list[bytes | bytearray], list[tuple[int, Exception]]] | None = None
+        msgs: list[Any] | None = None
+        frames: list[bytes | bytearray] | None = None
+        bad: list[tuple[int, Exception]] | None = None
+        msg: Any = None
         while not queue and not self._closed and self._served is served:
+            got = msgs = frames = bad = msg = None
             for fd, _ in poll(-1, poller.max_events):
                 if fd in objs:
                     conn = objs[fd]
