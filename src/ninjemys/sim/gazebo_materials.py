@@ -74,10 +74,9 @@ def stock_colour(name: str) -> tuple[int, int, int] | None:
 
 #: ``material NAME`` (optionally ``: PARENT``) opening a block of an OGRE material script
 MATERIAL_BLOCK = re.compile(r"^\s*material\s+([^\s{:]+)", re.MULTILINE)
-_COLOUR_LINE = re.compile(
-    r"^\s*(diffuse|ambient)\s+([-+0-9.eE]+)\s+([-+0-9.eE]+)\s+([-+0-9.eE]+)", re.MULTILINE
-)
-_TEXTURE_LINE = re.compile(r"^\s*texture\s+([^\s}]+)", re.MULTILINE)
+#: a colour or texture line anywhere in a block (one-line blocks too: ``{ pass { diffuse 1 0 0 } }``)
+_COLOUR_LINE = re.compile(r"(?<![\w/])(diffuse|ambient)\s+([-+0-9.eE]+)\s+([-+0-9.eE]+)\s+([-+0-9.eE]+)")
+_TEXTURE_LINE = re.compile(r"(?<![\w/])texture\s+([^\s}]+)")
 
 
 def material_block(text: str, material: str) -> str | None:

@@ -1,0 +1,138 @@
+"""Gazebo material scripts become colours (issue 23 leftovers, item 2).
+
+``<material><script><uri>file://media/materials/scripts/gazebo.material</uri><name>Gazebo/Red</name>``
+is red without Gazebo installed (our table of its stock names); a material of one's own is read from
+the ``.material`` file its ``<uri>`` names (``file://``, ``model://``, a folder of scripts): its
+diffuse colour, else its ambient, else its texture's mean colour. A name found nowhere is drawn grey
+and named once in the world's warning; nothing fails."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ninjemys.sim.description.build import model_from_description
+from ninjemys.sim.gazebo_materials import script_colour, stock_colour
+from ninjemys.sim.sdf import DEFAULT_COLOUR, parse_sdf_world
+
+STOCK_URI = "file://media/materials/scripts/gazebo.material"
+
+
+def _box(name: str, x: float, material: str) -> str:
+    return (
+        f'<model name="{name}"><static>true</static><pose>{x} 0 0 0 0 0</pose><link name="l">'
+        '<collision name="c"><pose>0 0 0.2 0 0 0</pose><geometry><box><size>0.4 0.4 0.4</size></box>'
+        f'</geometry></collision><visual name="v"><geometry><box><size>0.4 0.4 0.4</size></box></geometry>'
+        f"<material>{material}</material></visual></link></model>"
+    )
+
+
+def _script(uris: list[str], name: str) -> str:
+    return "<script>" + "".join(f"<uri>{u}</uri>" for u in uris) + f"<name>{name}</name></script>"
+
+
+def test_stock_names_need_no_gazebo_installed() -> None:
+    assert stock_colour("Gazebo/Red") == (255, 0, 0)
+    assert stock_colour("Gazebo/BlueGlow") == stock_colour("gazebo/blue") == (0, 0, 255)
+    assert stock_colour("Gazebo/GreyTransparent") == stock_colour("Gazebo/Grey")
+    assert stock_colour("Gazebo/Orange") == (255, 130, 12)
+    assert stock_colour("Custom/Thing") is None
+
+
+def test_world_materials_from_stock_names_own_scripts_and_textures(tmp_path: Path) -> None:
+    import cv2
+
+    model = tmp_path / "models" / "painted"
+    (model / "materials" / "scripts").mkdir(parents=True)
+    (model / "materials" / "textures").mkdir(parents=True)
+    (model / "materials" / "scripts" / "painted.material").write_text(
+        "material Painted/Teal\n{\n  technique\n  {\n    pass\n    {\n      ambient 0.1 0.1 0.1 1\n"
+        "      diffuse 0.0 0.5 0.5 1.0\n    }\n  }\n}\n"
+        "material Painted/AmbientOnly : Painted/Teal\n{ technique { pass { ambient 1 0.5 0 1 } } }\n"
+        "material Painted/Checker\n{\n  technique\n  {\n    pass\n    {\n      texture_unit\n      {\n"
+        "        texture checker.png\n      }\n    }\n  }\n}\n"
+    )
+    checker = np.zeros((8, 8, 3), dtype=np.uint8)
+    checker[:, :4] = (0, 0, 200)  # BGR: half red (200, 0, 0), half black
+    cv2.imwrite(str(model / "materials" / "textures" / "checker.png"), checker)
+    own = tmp_path / "own.material"
+    own.write_text("material Own/Purple\n{\n technique { pass { diffuse 0.5 0 0.5 } }\n}\n")
+    scripts = "model://painted/materials/scripts"
+    text = (
+        '<sdf version="1.6"><world name="w">'
+        + _box("red", 0, _script([STOCK_URI], "Gazebo/Red"))
+        + _box("glow", 1, _script([STOCK_URI], "Gazebo/GreenGlow"))
+        + _box("teal", 2, _script([scripts, "model://painted/materials/textures"], "Painted/Teal"))
+        + _box("amber", 3, _script([scripts], "Painted/AmbientOnly"))
+        + _box("checker", 4, _script([scripts], "Painted/Checker"))
+        + _box("purple", 5, _script([f"file://{own}"], "Own/Purple"))
+        + _box("mystery", 6, _script([STOCK_URI], "Nowhere/ToBeFound"))
+        + _box("mystery2", 7, _script([STOCK_URI], "Nowhere/ToBeFound"))
+        + "</world></sdf>"
+    )
+    warnings: list[str] = []
+    env = {"HOME": "/nonexistent", "GAZEBO_MODEL_PATH": str(tmp_path / "models")}
+    world = parse_sdf_world(text, str(tmp_path / "w.world"), env, warnings.append)
+    colour = {o.name: o.color for o in world.obstacles}
+    assert colour["red"] == (255, 0, 0)
+    assert colour["glow"] == (0, 255, 0)
+    assert colour["teal"] == (0, 128, 128)  # diffuse wins over ambient
+    assert colour["amber"] == (255, 128, 0)  # ambient when there is no diffuse
+    assert colour["checker"] == (100, 0, 0)  # the texture's mean colour
+    assert colour["purple"] == (128, 0, 128)  # file:///absolute/path.material
+    assert colour["mystery"] == colour["mystery2"] == DEFAULT_COLOUR  # grey, not fatal
+    (warning,) = warnings
+    assert warning.count("Nowhere/ToBeFound") == 1 and "drawn grey" in warning
+
+
+def test_file_media_uris_are_read_from_gazebo_resource_path(tmp_path: Path) -> None:
+    """With Gazebo's resources present (GAZEBO_RESOURCE_PATH), a non-stock name in its scripts is read there."""
+    scripts = tmp_path / "gz" / "media" / "materials" / "scripts"
+    scripts.mkdir(parents=True)
+    (scripts / "gazebo.material").write_text(
+        "material Gazebo/Mauve\n{ technique { pass { diffuse 0.8 0.4 0.6 } } }\n"
+    )
+    assert script_colour(scripts / "gazebo.material", "Gazebo/Mauve") == (204, 102, 153)
+    text = (
+        '<sdf version="1.6"><world name="w">'
+        + _box("m", 0, _script([STOCK_URI], "Gazebo/Mauve"))
+        + "</world></sdf>"
+    )
+    env = {"HOME": "/nonexistent", "GAZEBO_RESOURCE_PATH": str(tmp_path / "gz")}
+    (box,) = parse_sdf_world(text, str(tmp_path / "w.world"), env).obstacles
+    assert box.color == (204, 102, 153)
+
+
+URDF = """<robot name="r">
+  <link name="base_link"><collision><origin xyz="0 0 0.05"/><geometry><box size="0.2 0.16 0.06"/></geometry>
+  </collision><visual><geometry><box size="0.2 0.16 0.06"/></geometry><material name="m"><color rgba="0 1 0 1"/>
+  </material></visual></link>
+  <link name="wl"><collision><geometry><cylinder radius="0.05" length="0.02"/></geometry></collision></link>
+  <link name="wr"><collision><geometry><cylinder radius="0.05" length="0.02"/></geometry></collision></link>
+  <joint name="jl" type="continuous"><parent link="base_link"/><child link="wl"/><origin xyz="0 0.09 0.05"/></joint>
+  <joint name="jr" type="continuous"><parent link="base_link"/><child link="wr"/><origin xyz="0 -0.09 0.05"/></joint>
+  <gazebo reference="base_link"><material>{material}</material></gazebo>
+  <gazebo><plugin name="dd" filename="libgazebo_ros_diff_drive.so"><leftJoint>jl</leftJoint>
+  <rightJoint>jr</rightJoint></plugin></gazebo>
+</robot>"""
+
+
+@pytest.mark.parametrize(
+    ("material", "colour", "warned"),
+    [
+        ("Gazebo/Orange", (255, 130, 12), False),
+        ("Gazebo/RedGlow", (255, 0, 0), False),
+        ("My/Paint", (0, 255, 0), True),
+    ],
+)
+def test_a_robots_gazebo_material_is_its_colour_or_named_once(
+    material: str, colour: tuple, warned: bool
+) -> None:
+    m = model_from_description(URDF.format(material=material), "r.urdf")
+    assert m.color == colour
+    named = [w for w in m.warnings if material in w]
+    assert len(named) == (1 if warned else 0)
+    if warned:
+        assert "r.urdf:" in named[0] and "keeps its URDF colour" in named[0]
