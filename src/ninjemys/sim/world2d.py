@@ -216,12 +216,16 @@ class World:
     model_poses: dict[str, tuple[float, float, float]] = field(default_factory=dict)
     #: pictures on the floor (an SDF world's textured planes): the camera sees them
     floor_images: list[FloorImage] = field(default_factory=list)
+    #: counts the rebuilds: a view that drew the obstacles redraws them when it changes (a model
+    #: spawned, moved or deleted)
+    revision: int = 0
 
     def __post_init__(self) -> None:
         self.rebuild()
 
     def rebuild(self) -> None:
         """Recompute the flat segment arrays after obstacles were added or removed."""
+        self.revision += 1
         segs, heights, colours, owner, facing, bases = [], [], [], [], [], []
         for i, ob in enumerate(self.obstacles):
             s = ob.segments()
