@@ -215,3 +215,25 @@ def test_a_urdf_box_falls_onto_the_table_and_a_static_one_stays_in_the_air(sim: 
     (lamp,) = [o for o in sim.sim.world.obstacles if o.name == "lamp"]
     assert (lamp.base, lamp.height) == pytest.approx((1.4, 1.6))
     assert math.isclose(sim.gazebo.model_pose("lamp")[2], 1.5)  # type: ignore[index]
+
+
+def test_a_world_files_models_report_the_heights_they_settled_at() -> None:
+    text = (
+        '<sdf version="1.6"><world name="w">'
+        + TABLE.format(name="table", x=0, y=0)
+        + BOX.format(name="on_table", x=0.2, y=0.1, z=2.0)
+        + BOX.format(name="beside", x=2.0, y=0.0, z=2.0)
+        + '<model name="shelf"><static>true</static><pose>4 0 1.2 0 0 0</pose><link name="l">'
+        '<collision name="c"><geometry><box><size>0.5 0.3 0.04</size></box></geometry></collision></link></model>'
+        + "</world></sdf>"
+    )
+    world = parse_sdf_world(text, "w.world", NO_ENV)
+    assert world.model_heights == pytest.approx({"table": 0.0, "on_table": 0.85, "beside": 0.1, "shelf": 1.2})
+    with run_master() as master:
+        node = Node("world_heights", master_uri=master)
+        try:
+            sn = SimNode(node, NodeLog(node.name), Simulation(world), 0.0, None)
+            assert state_z(sn, "on_table") == pytest.approx(0.85)
+            assert state_z(sn, "shelf") == pytest.approx(1.2)
+        finally:
+            node.shutdown("test over")

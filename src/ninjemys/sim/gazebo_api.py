@@ -183,7 +183,10 @@ class GazeboApi:
             x, y, yaw = sim.obstacle_pose(name)
         except SpawnError:
             return None
-        return x, y, self.heights.get(name, 0.0), yaw
+        z = self.heights.get(name)
+        if z is None:  # one of the world file's models, where it settled
+            z = sim.world.model_heights.get(name, 0.0)
+        return x, y, z, yaw
 
     def model_twist(self, name: str) -> tuple[float, float, float]:
         r = self.sn.sim.robots.get(name)

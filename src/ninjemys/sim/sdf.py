@@ -278,6 +278,8 @@ class _Context:
     floor_images: list[FloorImage] = field(default_factory=list)
     #: each top-level model's pose (x, y, yaw), as /gazebo/model_states reports it
     origins: dict[str, tuple[float, float, float]] = field(default_factory=dict)
+    #: each top-level model's pose height, before it settles
+    heights: dict[str, float] = field(default_factory=dict)
 
     def missing(self, uri: str, el: Element, exc: SdfError | None = None) -> None:
         """SdfError, or in a world a note that ``uri`` is left out (Gazebo's behaviour)."""
@@ -783,6 +785,7 @@ def _model(
     here = [*scope, name]
     if not scope:
         ctx.origins[name] = (float(m[0, 3]), float(m[1, 3]), math.atan2(float(m[1, 0]), float(m[0, 0])))
+        ctx.heights[name] = float(m[2, 3])
     if static is None:
         own = el.find("static")
         static = _bool(own) if own is not None else False
@@ -914,10 +917,12 @@ def parse_sdf_world(
     world_el = root.find("world")
     if world_el is None:
         raise root.error("no <world> in this file (a model file? spawn it with spawn_model -sdf)")
-    solids = _settle(_world_solids(world_el, ctx))
+    drops: dict[str, float] = {}
+    solids = _settle(_world_solids(world_el, ctx), drops)
     world = World(world_el.attrib.get("name", Path(source).stem), _obstacles(solids), source=source)
     kept = {s.path[0] for s in solids}
     world.model_poses = {name: pose for name, pose in ctx.origins.items() if name in kept}
+    world.model_heights = {name: z - drops.get(name, 0.0) for name, z in ctx.heights.items() if name in kept}
     world.floor_images = ctx.floor_images
     _report(ctx, source, warn)
     return world

@@ -214,6 +214,9 @@ class World:
     source: str = ""
     #: models' poses (x, y, yaw) where the file gives them (an SDF world's models), by model name
     model_poses: dict[str, tuple[float, float, float]] = field(default_factory=dict)
+    #: the heights of those models' poses once Gazebo's physics has settled them (a static shelf at
+    #: 1 m stays there; a box with physics rests on the floor or a table), by model name
+    model_heights: dict[str, float] = field(default_factory=dict)
     #: pictures on the floor (an SDF world's textured planes): the camera sees them
     floor_images: list[FloorImage] = field(default_factory=list)
     #: counts the rebuilds: a view that drew the obstacles redraws them when it changes (a model
