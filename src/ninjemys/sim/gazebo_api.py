@@ -127,6 +127,17 @@ class GazeboApi:
     def __init__(self, sim_node: SimNode) -> None:
         self.sn = sim_node
         self.heights: dict[str, float] = {}  # model -> the z it was spawned at
+        world = sim_node.sim.world
+        #: models with nothing the floor plan holds (a ground plane): Gazebo lists them all the same
+        self.bare: dict[str, Planar] = {
+            name: (
+                *world.model_poses[name][:2],
+                world.model_heights.get(name, 0.0),
+                world.model_poses[name][2],
+            )
+            for name in world.bare_models
+            if name in world.model_poses
+        }
         self.pushes: dict[str, Push] = {}
         n = sim_node.node
         for name, cls, handler in (
@@ -155,11 +166,18 @@ class GazeboApi:
 
     # -- the model tree ----------------------------------------------------------------------------
     def model_names(self) -> list[str]:
+        """Gazebo's order: the world file's models as the file has them (a ground plane first, as
+        empty_world's is), then the models spawned since, then the robots."""
         sim = self.sn.sim
-        return list(dict.fromkeys(o.model_name for o in sim.world.obstacles)) + list(sim.robots)
+        solid = dict.fromkeys(o.model_name for o in sim.world.obstacles)
+        listed = [n for n in sim.world.model_poses if n in solid or n in self.bare]
+        rest = [n for n in (*solid, *self.bare) if n not in listed]
+        return list(dict.fromkeys(listed + rest)) + list(sim.robots)
 
     def obstacle_links(self, name: str) -> dict[str, list[str]]:
         """A static model's links and, per link, its collisions (``link`` for a model of one piece)."""
+        if name in self.bare:
+            return {"link": ["collision"]}  # a ground plane's one link and its plane
         links: dict[str, list[str]] = {}
         for o in self.sn.sim.world.obstacles:
             if o.model_name != name:
@@ -175,6 +193,8 @@ class GazeboApi:
 
     def model_pose(self, name: str) -> Planar | None:
         sim = self.sn.sim
+        if name in self.bare:
+            return self.bare[name]
         r = sim.robots.get(name)
         if r is not None:
             # a robot stands on the floor, whatever height it was spawned or set at (Gazebo drops it)
@@ -289,9 +309,10 @@ class GazeboApi:
                 pose = compose(ref, pose)
             x, y, z, yaw = pose
             drops: dict[str, float] = {}
+            models: list[str] = []
             with sn.lock:
                 supports = self._supports(x, y, yaw)
-            kind, spec = parse_model_xml(req.model_xml, z, drops, supports)
+            kind, spec = parse_model_xml(req.model_xml, z, drops, supports, models)
             if kind == "robot":
                 namespace = req.robot_namespace.strip("/")
                 clash = any(io.prefix == "" for io in sn.io.values())
@@ -299,8 +320,13 @@ class GazeboApi:
                 z = spec.rest_z  # it falls onto the floor (or is pushed up out of it) on its wheels
             elif kind == "sdf":
                 if not spec:
-                    # a light, a ground plane: nothing the floor plan holds (Gazebo would add it)
-                    sn.log.info("model [%s] has no collision this simulator sees: nothing added", name)
+                    if models:  # a ground plane: a model all the same, with nothing the floor plan holds
+                        self.bare[name] = (x, y, z, yaw)
+                        sn.log.info(
+                            "model [%s] has no collision this simulator sees: listed, nothing added", name
+                        )
+                    else:  # a light (Gazebo's sun): not a model
+                        sn.log.info("[%s] is a light: nothing added", name)
                     return _spawned(resp)
                 pieces = _placed(name, spec, x, y, yaw)
                 with sn.lock:
@@ -348,7 +374,9 @@ class GazeboApi:
         name = req.model_name
         sn = self.sn
         try:
-            if name in sn.sim.robots:
+            if name in self.bare:
+                del self.bare[name]
+            elif name in sn.sim.robots:
                 sn.remove_robot(name)
             else:
                 with sn.lock:
@@ -405,7 +433,9 @@ class GazeboApi:
                 pose = compose(ref, pose)
             x, y, z, yaw = pose
             try:
-                if name in sn.sim.robots:
+                if name in self.bare:
+                    self.bare[name] = (x, y, z, yaw)
+                elif name in sn.sim.robots:
                     r = sn.sim.place_robot(name, x, y, yaw)
                     lin, ang = state.twist.linear, state.twist.angular
                     if all(math.isfinite(v) for v in (lin.x, lin.y, ang.z)):
@@ -666,7 +696,11 @@ def _placed(name: str, pieces: list[Obstacle], x: float, y: float, yaw: float) -
 
 
 def parse_model_xml(
-    text: str, z: float = 0.0, drops: dict[str, float] | None = None, supports: list[Support] | None = None
+    text: str,
+    z: float = 0.0,
+    drops: dict[str, float] | None = None,
+    supports: list[Support] | None = None,
+    models: list[str] | None = None,
 ) -> tuple[str, Any]:
     """What a SpawnModel request's ``model_xml`` describes: ("robot", RobotModel),
     ("obstacle", UrdfShape) for a URDF box or cylinder, or ("sdf", [Obstacle])
@@ -687,7 +721,7 @@ def parse_model_xml(
         raise SpawnError(f"model_xml is not valid XML: {exc}") from None
     if root.tag == "sdf":
         # SdfError (a MapFileError) names the element and the reason
-        return "sdf", sdf_model_obstacles(body, z=z, drops=drops, supports=supports)
+        return "sdf", sdf_model_obstacles(body, z=z, drops=drops, supports=supports, models=models)
     if root.tag == "robot" and any(j.get("type") == "continuous" for j in root.iter("joint")):
         # a robot with wheels: the URDF reader says what it is, or why it cannot be simulated
         return "robot", model_from_urdf(body, "model_xml")

@@ -921,8 +921,10 @@ def parse_sdf_world(
     solids = _settle(_world_solids(world_el, ctx), drops)
     world = World(world_el.attrib.get("name", Path(source).stem), _obstacles(solids), source=source)
     kept = {s.path[0] for s in solids}
-    world.model_poses = {name: pose for name, pose in ctx.origins.items() if name in kept}
-    world.model_heights = {name: z - drops.get(name, 0.0) for name, z in ctx.heights.items() if name in kept}
+    # every top-level model, in the file's order (Gazebo lists them so), the bare ones too (a ground plane)
+    world.model_poses = dict(ctx.origins)
+    world.model_heights = {name: z - drops.get(name, 0.0) for name, z in ctx.heights.items()}
+    world.bare_models = [name for name in ctx.origins if name not in kept]
     world.floor_images = ctx.floor_images
     _report(ctx, source, warn)
     return world
@@ -936,6 +938,7 @@ def sdf_model_obstacles(
     z: float = 0.0,
     drops: dict[str, float] | None = None,
     supports: list[Support] | None = None,
+    models: list[str] | None = None,
 ) -> list[Obstacle]:
     """The obstacles of an SDF model document (``<sdf><model>``, as spawn_sdf_model receives it, or a
     ``<world>`` of includes), their outlines in the model's frame (place them at the spawn pose),
@@ -944,7 +947,8 @@ def sdf_model_obstacles(
     pieces (a table: top and legs) gives one obstacle per piece, each naming the model. ``drops``
     receives how far each model with physics fell from ``z`` (its pose after it settles: ``z - drop``);
     ``supports`` (outlines in the model's frame) are what it may land on besides the floor: the world
-    it is spawned into (a box dropped over a table lands on the table)."""
+    it is spawned into (a box dropped over a table lands on the table); ``models`` receives the names
+    of the models the document holds, in order (a ground plane is one, with no obstacle)."""
     ctx = _Context(os.environ if env is None else env)
     root = _sdf_root(data.encode() if isinstance(data, str) else data, source, ctx)
     solids: list[_Solid] = []
@@ -956,6 +960,8 @@ def sdf_model_obstacles(
     if world_el is None and root.find("model") is None:
         raise root.error("no <model> in this SDF document")
     _report(ctx, source, warn)
+    if models is not None:
+        models.extend(ctx.origins)  # the models it holds (none for a light: Gazebo's sun)
     for solid in solids:
         solid.footprint.top += z
         solid.footprint.bottom += z

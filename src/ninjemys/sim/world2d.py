@@ -217,6 +217,9 @@ class World:
     #: the heights of those models' poses once Gazebo's physics has settled them (a static shelf at
     #: 1 m stays there; a box with physics rests on the floor or a table), by model name
     model_heights: dict[str, float] = field(default_factory=dict)
+    #: an SDF world's models with nothing the floor plan holds (Gazebo's ground_plane): still models
+    #: for Gazebo (listed in /gazebo/model_states, in the file's order), by name
+    bare_models: list[str] = field(default_factory=list)
     #: pictures on the floor (an SDF world's textured planes): the camera sees them
     floor_images: list[FloorImage] = field(default_factory=list)
     #: counts the rebuilds: a view that drew the obstacles redraws them when it changes (a model
