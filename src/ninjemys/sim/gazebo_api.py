@@ -766,10 +766,11 @@ def _urdf_shape(root: ET.Element) -> UrdfShape | None:
         return None
     holder, geom = found
     origin = holder.find("origin")
+    xyz = (origin.get("xyz") if origin is not None else None) or "0 0 0"
     try:
-        oz = float((origin.get("xyz") or "0 0 0").split()[2]) if origin is not None else 0.0
+        oz = float(xyz.split()[2])
     except (ValueError, IndexError):
-        raise SpawnError(f"<origin xyz> {origin.get('xyz')!r} is not three numbers") from None
+        raise SpawnError(f"<{holder.tag}><origin xyz> {xyz!r} is not three numbers") from None
     box = geom.find("box")
     if box is not None:
         size_text = box.get("size") or (box.findtext("size") or "")
