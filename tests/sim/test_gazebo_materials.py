@@ -136,3 +136,35 @@ def test_a_robots_gazebo_material_is_its_colour_or_named_once(
     assert len(named) == (1 if warned else 0)
     if warned:
         assert "r.urdf:" in named[0] and "keeps its URDF colour" in named[0]
+
+
+def test_a_relative_file_uri_of_a_mesh_is_looked_for_on_the_resource_path_then_beside_the_world(
+    tmp_path: Path,
+) -> None:
+    stl = (
+        "solid s\n"
+        + "".join(
+            f"facet normal 0 0 1\nouter loop\nvertex {a}\nvertex {b}\nvertex {c}\nendloop\nendfacet\n"
+            for a, b, c in (("0 0 0", "1 0 0", "0 1 0.5"), ("1 0 0", "1 1 0.5", "0 1 0.5"))
+        )
+        + "endsolid s\n"
+    )
+    (tmp_path / "gz" / "media" / "meshes").mkdir(parents=True)
+    (tmp_path / "gz" / "media" / "meshes" / "ramp.stl").write_text(stl)
+    (tmp_path / "world" / "media" / "meshes").mkdir(parents=True)
+    (tmp_path / "world" / "media" / "meshes" / "beside.stl").write_text(stl)
+
+    def world(uri: str) -> str:
+        return (
+            '<sdf version="1.6"><world name="w"><model name="m"><static>1</static><link name="l">'
+            f'<collision name="c"><geometry><mesh><uri>{uri}</uri></mesh></geometry></collision>'
+            "</link></model></world></sdf>"
+        )
+
+    env = {"HOME": "/nonexistent", "GAZEBO_RESOURCE_PATH": str(tmp_path / "gz")}
+    source = str(tmp_path / "world" / "w.world")
+    (ramp,) = parse_sdf_world(world("file://media/meshes/ramp.stl"), source, env).obstacles
+    (beside,) = parse_sdf_world(world("file://media/meshes/beside.stl"), source, env).obstacles
+    for ob in (ramp, beside):
+        assert ob.height == pytest.approx(0.5)
+        assert ob.outline.max(axis=0) == pytest.approx([1.0, 1.0])

@@ -15,8 +15,9 @@ box or a lying cylinder gets the footprint it really has.
 * ``<include>`` of ``model://NAME`` is found as Gazebo finds it: ``GAZEBO_MODEL_PATH``, then
   ``~/.gazebo/models``, then the models that ship with us (``ground_plane``, ``sun`` and a few simple
   obstacles, share/gazebo_models). The include's ``<name>``, ``<pose>`` and ``<static>`` override
-  the model's. Mesh URIs may be ``model://``, ``package://`` (ROS_PACKAGE_PATH), ``file://`` or a
-  path relative to the file.
+  the model's. Mesh URIs may be ``model://``, ``package://`` (ROS_PACKAGE_PATH), ``file://`` (a
+  relative one, ``file://media/...``, on GAZEBO_RESOURCE_PATH, then beside the file) or a path
+  relative to the file.
 * A saved world's ``<state>`` moves its models to the poses saved there, as Gazebo does on load.
 * Materials: ``<diffuse>``, else ``<ambient>``, else a script: ``Gazebo/Red``-style stock names
   (:mod:`ninjemys.sim.gazebo_materials`), else the colour the ``.material`` files its ``<uri>``s name
@@ -349,7 +350,15 @@ def resolve_uri(uri: str, el: Element, env: Mapping[str, str]) -> Path:
             raise el.error(f"package '{pkg}' of {text} not found on ROS_PACKAGE_PATH") from None
         return pdir / tail
     if text.startswith("file://"):
-        return Path(text[len("file://") :])
+        rest = text[len("file://") :]
+        if rest.startswith("/"):
+            return Path(rest)
+        # relative (``file://media/materials/...``): Gazebo looks on its resource path, then beside the file
+        roots = [r for r in (env.get("GAZEBO_RESOURCE_PATH") or DEFAULT_RESOURCE_PATH).split(":") if r]
+        for candidate in [*(Path(r) / rest for r in roots), Path(el.source).parent / rest]:
+            if candidate.exists():
+                return candidate
+        return Path(el.source).parent / rest
     if "://" in text:
         raise el.error(f"cannot fetch {text}: only model://, package://, file:// and paths are read")
     path = Path(text)
@@ -481,24 +490,14 @@ def _script_files(script: Element, ctx: _Context) -> list[Path]:
     meshes."""
     files: list[Path] = []
     for uri in script.findall("uri"):
-        text = uri.text.strip()
-        candidates: list[Path] = []
-        if text.startswith("file://") and not text[len("file://") :].startswith("/"):
-            rel = text[len("file://") :]
-            roots = (ctx.env.get("GAZEBO_RESOURCE_PATH") or DEFAULT_RESOURCE_PATH).split(":")
-            candidates = [Path(r) / rel for r in roots if r] + [Path(uri.source).parent / rel]
-        else:
-            try:
-                candidates = [resolve_uri(text, uri, ctx.env)]
-            except SdfError:
-                continue
-        for path in candidates:
-            if path.is_dir():
-                files.extend(sorted(path.glob("*.material")))
-                break
-            if path.is_file():
-                files.append(path)
-                break
+        try:
+            path = resolve_uri(uri.text, uri, ctx.env)
+        except SdfError:
+            continue
+        if path.is_dir():
+            files.extend(sorted(path.glob("*.material")))
+        elif path.is_file():
+            files.append(path)
     return files
 
 
