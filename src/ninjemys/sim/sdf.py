@@ -698,6 +698,12 @@ class Support:
 
     outline: np.ndarray
     top: float
+    lo: tuple[float, float] = (0.0, 0.0)  # its bounding box (set from the outline)
+    hi: tuple[float, float] = (0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        mn, mx = self.outline.min(axis=0), self.outline.max(axis=0)
+        self.lo, self.hi = (float(mn[0]), float(mn[1])), (float(mx[0]), float(mx[1]))
 
 
 def overlaps(a: np.ndarray, b: np.ndarray, margin: float = TOUCH) -> bool:
@@ -722,8 +728,18 @@ def rest_height(outline: np.ndarray, bottom: float, top: float, ground: list[Sup
     middle = (bottom + top) / 2.0
     if len(outline) < 2:
         return 0.0
+    (x0, y0), (x1, y1) = outline.min(axis=0), outline.max(axis=0)
     return max(
-        (g.top for g in ground if 0.0 < g.top <= middle and overlaps(outline, g.outline)),
+        (
+            g.top
+            for g in ground
+            if 0.0 < g.top <= middle
+            and g.lo[0] < x1
+            and g.hi[0] > x0
+            and g.lo[1] < y1
+            and g.hi[1] > y0  # boxes first: cheap
+            and overlaps(outline, g.outline)
+        ),
         default=0.0,
     )
 
