@@ -237,3 +237,19 @@ def test_a_world_files_models_report_the_heights_they_settled_at() -> None:
             assert state_z(sn, "shelf") == pytest.approx(1.2)
         finally:
             node.shutdown("test over")
+
+
+def test_a_pose_of_three_numbers_is_a_position_as_gazebo_11_loads_the_makers_models() -> None:
+    """The maker's ``puzzlebot_base`` and ``office_floor`` models have ``<pose>0 0 0.0</pose>`` on a
+    visual; Gazebo 11 loads them. Ours reads x y z with no rotation and notes it once."""
+    text = (
+        '<sdf version="1.6"><world name="w"><model name="m"><static>1</static><pose>1 2 0.5</pose>'
+        '<link name="l"><collision name="c"><pose>0 0 0.0</pose><geometry><box><size>0.2 0.2 0.2</size>'
+        "</box></geometry></collision></link></model></world></sdf>"
+    )
+    warnings: list[str] = []
+    (box,) = parse_sdf_world(text, "w.world", NO_ENV, warnings.append).obstacles
+    assert box.outline.mean(axis=0) == pytest.approx([1.0, 2.0])
+    assert (box.base, box.height) == pytest.approx((0.4, 0.6))
+    (warning,) = warnings
+    assert warning.count("<pose> of 3 numbers") == 1 and "w.world:1" in warning

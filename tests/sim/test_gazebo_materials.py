@@ -168,3 +168,42 @@ def test_a_relative_file_uri_of_a_mesh_is_looked_for_on_the_resource_path_then_b
     for ob in (ramp, beside):
         assert ob.height == pytest.approx(0.5)
         assert ob.outline.max(axis=0) == pytest.approx([1.0, 1.0])
+
+
+def test_media_a_package_exports_for_gazebo_ros_is_searched(tmp_path: Path) -> None:
+    """The maker's puzzlebot_gazebo exports ``gazebo_media_path="${prefix}/models"``; its floor (an
+    8 m wooden plane with a logo) and goal markers name ``file://media/materials/scripts/
+    mcr2_materials.material``, found there as gazebo_ros' paths plugin finds it."""
+    import cv2
+
+    pkg = tmp_path / "src" / "course_gazebo"
+    media = pkg / "models" / "media" / "materials"
+    (media / "scripts").mkdir(parents=True)
+    (media / "textures").mkdir(parents=True)
+    (pkg / "package.xml").write_text(
+        '<package format="2"><name>course_gazebo</name><version>0.0.1</version><description>d</description>'
+        '<maintainer email="a@b.c">m</maintainer><license>BSD</license>'
+        '<export><gazebo_ros gazebo_media_path="${prefix}/models"/></export></package>'
+    )
+    (media / "scripts" / "course.material").write_text(
+        "material course/wood\n{\n technique { pass { texture_unit { texture wood.png } } }\n}\n"
+    )
+    wood = np.zeros((16, 16, 3), dtype=np.uint8)
+    wood[:, :] = (30, 90, 160)  # BGR
+    cv2.imwrite(str(media / "textures" / "wood.png"), wood)
+    text = (
+        '<sdf version="1.6"><world name="w"><model name="floor"><static>1</static><link name="l">'
+        '<visual name="v"><geometry><plane><normal>0 0 1</normal><size>8 8</size></plane></geometry>'
+        "<material>"
+        + _script(["file://media/materials/scripts/course.material"], "course/wood")
+        + "</material>"
+        "</visual></link></model></world></sdf>"
+    )
+    warnings: list[str] = []
+    env = {"HOME": "/nonexistent", "ROS_PACKAGE_PATH": str(tmp_path / "src")}
+    world = parse_sdf_world(text, str(tmp_path / "w.world"), env, warnings.append)
+    (floor,) = world.floor_images
+    assert (floor.width, floor.height) == (8.0, 8.0)
+    assert floor.rgb[0, 0].tolist() == [160, 90, 30]
+    assert warnings == []
+    assert world.bare_models == ["floor"]  # a plane: a model with nothing solid

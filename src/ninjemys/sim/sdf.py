@@ -308,11 +308,22 @@ def model_dirs(env: Mapping[str, str] | None = None) -> list[Path]:
     return dirs
 
 
-@functools.lru_cache(maxsize=8)
-def _exported_model_paths(ros_package_path: str) -> tuple[str, ...]:
-    """``<export><gazebo_ros gazebo_model_path="${prefix}/models"/></export>`` of every package on
-    ``ros_package_path`` (the maker's puzzlebot_world has it), ``${prefix}`` being the package's
-    folder: gazebo_ros' paths plugin adds these to Gazebo's model path (``rospack plugins``)."""
+def resource_dirs(env: Mapping[str, str]) -> list[Path]:
+    """Where a relative ``file://`` URI (``file://media/materials/scripts/x.material``) is looked up,
+    as Gazebo does: GAZEBO_RESOURCE_PATH, the ``gazebo_media_path`` the packages on ROS_PACKAGE_PATH
+    export (the maker's puzzlebot_gazebo: ``${prefix}/models``), then Gazebo's own install."""
+    roots = [r for r in (env.get("GAZEBO_RESOURCE_PATH") or "").split(":") if r]
+    roots += _exported_model_paths(env.get("ROS_PACKAGE_PATH", ""), "gazebo_media_path")
+    roots += DEFAULT_RESOURCE_PATH.split(":")
+    return [Path(r) for r in dict.fromkeys(roots)]
+
+
+@functools.lru_cache(maxsize=16)
+def _exported_model_paths(ros_package_path: str, attribute: str = "gazebo_model_path") -> tuple[str, ...]:
+    """``<export><gazebo_ros gazebo_model_path="${prefix}/models"/></export>`` (or another
+    ``attribute``: ``gazebo_media_path``) of every package on ``ros_package_path`` (the maker's
+    puzzlebot_world has it), ``${prefix}`` being the package's folder: gazebo_ros' paths plugin adds
+    these to Gazebo's model (resource) path (``rospack plugins``)."""
     found: list[str] = []
     for root in (Path(d) for d in ros_package_path.split(":") if d):
         for pkg_dir in crawl(root):
@@ -322,7 +333,7 @@ def _exported_model_paths(ros_package_path: str) -> tuple[str, ...]:
                 continue
             for export in tree.getroot().findall("export"):
                 for gz in export.findall("gazebo_ros"):
-                    value = gz.get("gazebo_model_path")
+                    value = gz.get(attribute)
                     if value:
                         found.append(value.replace("${prefix}", str(pkg_dir)))
     return tuple(found)
@@ -354,8 +365,7 @@ def resolve_uri(uri: str, el: Element, env: Mapping[str, str]) -> Path:
         if rest.startswith("/"):
             return Path(rest)
         # relative (``file://media/materials/...``): Gazebo looks on its resource path, then beside the file
-        roots = [r for r in (env.get("GAZEBO_RESOURCE_PATH") or DEFAULT_RESOURCE_PATH).split(":") if r]
-        for candidate in [*(Path(r) / rest for r in roots), Path(el.source).parent / rest]:
+        for candidate in [*(r / rest for r in resource_dirs(env)), Path(el.source).parent / rest]:
             if candidate.exists():
                 return candidate
         return Path(el.source).parent / rest
@@ -540,6 +550,17 @@ def _pose(el: Element, ctx: _Context) -> np.ndarray:
     frame = pose.attrib.get("relative_to") or pose.attrib.get("frame")
     if frame:
         ctx.skip(f"pose relative to '{frame}' (taken relative to the parent)", pose)
+    return _pose_matrix(pose, ctx)
+
+
+def _pose_matrix(pose: Element, ctx: _Context) -> np.ndarray:
+    """A ``<pose>``'s transform. Three numbers (``<pose>0 0 0.0</pose>``, in the maker's PuzzleBot
+    models) are a position with no rotation, as Gazebo 11 loads those models (noted once); any other
+    count is an SdfError naming the file and line."""
+    words = pose.text.split()
+    if len(words) == 3:
+        ctx.skip("<pose> of 3 numbers (read as x y z, no rotation)", pose)
+        return pose_matrix(*_numbers(pose, 3, "x y z"), 0.0, 0.0, 0.0)
     return pose_matrix(*_numbers(pose, 6, "x y z roll pitch yaw"))
 
 
@@ -888,7 +909,7 @@ def _include(
     if static is None and static_el is not None:
         static = _bool(static_el)
     pose = el.find("pose")
-    override = pose_matrix(*_numbers(pose, 6, "x y z roll pitch yaw")) if pose is not None else None
+    override = _pose_matrix(pose, ctx) if pose is not None else None
     if saved and model.attrib.get("name") in saved:
         override = saved[model.attrib["name"]]
     _model(model, parent, ctx, out, scope, depth, override, static)
@@ -902,7 +923,7 @@ def _state_poses(world: Element, ctx: _Context) -> dict[str, np.ndarray]:
             pose = model.find("pose")
             name = model.attrib.get("name")
             if name and pose is not None and pose.text.strip():
-                poses[name] = pose_matrix(*_numbers(pose, 6, "x y z roll pitch yaw"))
+                poses[name] = _pose_matrix(pose, ctx)
     return poses
 
 
