@@ -560,7 +560,8 @@ def _pose_matrix(pose: Element, ctx: _Context) -> np.ndarray:
     words = pose.text.split()
     if len(words) == 3:
         ctx.skip("<pose> of 3 numbers (read as x y z, no rotation)", pose)
-        return pose_matrix(*_numbers(pose, 3, "x y z"), 0.0, 0.0, 0.0)
+        x, y, z = _numbers(pose, 3, "x y z")
+        return pose_matrix(x, y, z, 0.0, 0.0, 0.0)
     return pose_matrix(*_numbers(pose, 6, "x y z roll pitch yaw"))
 
 
