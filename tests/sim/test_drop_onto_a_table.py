@@ -253,3 +253,21 @@ def test_a_pose_of_three_numbers_is_a_position_as_gazebo_11_loads_the_makers_mod
     assert (box.base, box.height) == pytest.approx((0.4, 0.6))
     (warning,) = warnings
     assert warning.count("<pose> of 3 numbers") == 1 and "w.world:1" in warning
+
+
+def test_a_spawned_ground_plane_is_a_model_and_a_sun_is_not(sim: SimNode) -> None:
+    database = (
+        '<sdf version="1.6"><world name="default"><include><uri>model://{}</uri></include></world></sdf>'
+    )
+    spawn(sim, "gp", database.format("ground_plane"))
+    spawn(sim, "sun", database.format("sun"))
+    spawn(sim, "crate", '<sdf version="1.6">' + BOX.format(name="b", x=0, y=0, z=0) + "</sdf>", 1.0, 0.0, 0.5)
+    assert sim.gazebo.model_names() == ["gp", "crate"]
+    assert state_z(sim, "gp") == 0.0
+    assert not [o for o in sim.sim.world.obstacles if o.model_name == "gp"]
+    from ninjemys.sim.gazebo_api import DeleteModel
+
+    req = DeleteModel._request_class()
+    req.model_name = "gp"
+    assert sim.gazebo._delete(req).success
+    assert sim.gazebo.model_names() == ["crate"]

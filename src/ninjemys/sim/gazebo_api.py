@@ -127,6 +127,7 @@ class GazeboApi:
     def __init__(self, sim_node: SimNode) -> None:
         self.sn = sim_node
         self.heights: dict[str, float] = {}  # model -> the z it was spawned at
+        self.spawned: dict[str, None] = {}  # the models spawned since the start, in order (robots aside)
         world = sim_node.sim.world
         #: models with nothing the floor plan holds (a ground plane): Gazebo lists them all the same
         self.bare: dict[str, Planar] = {
@@ -170,9 +171,8 @@ class GazeboApi:
         empty_world's is), then the models spawned since, then the robots."""
         sim = self.sn.sim
         solid = dict.fromkeys(o.model_name for o in sim.world.obstacles)
-        listed = [n for n in sim.world.model_poses if n in solid or n in self.bare]
-        rest = [n for n in (*solid, *self.bare) if n not in listed]
-        return list(dict.fromkeys(listed + rest)) + list(sim.robots)
+        exists = [*sim.world.model_poses, *self.spawned, *solid, *self.bare]
+        return [n for n in dict.fromkeys(exists) if n in solid or n in self.bare] + list(sim.robots)
 
     def obstacle_links(self, name: str) -> dict[str, list[str]]:
         """A static model's links and, per link, its collisions (``link`` for a model of one piece)."""
@@ -322,6 +322,7 @@ class GazeboApi:
                 if not spec:
                     if models:  # a ground plane: a model all the same, with nothing the floor plan holds
                         self.bare[name] = (x, y, z, yaw)
+                        self.spawned[name] = None
                         sn.log.info(
                             "model [%s] has no collision this simulator sees: listed, nothing added", name
                         )
@@ -337,6 +338,8 @@ class GazeboApi:
             else:
                 z = self._add_urdf_shape(name, spec, x, y, z, yaw, supports)
             self.heights[name] = z
+            if kind != "robot":
+                self.spawned[name] = None
         except (SpawnError, MapFileError) as exc:
             sn.log.error("spawn refused: %s", exc)
             resp.success, resp.status_message = False, f"SpawnModel: Failure - {exc}"
@@ -387,6 +390,7 @@ class GazeboApi:
             return resp
         self.heights.pop(name, None)
         self.pushes.pop(name, None)
+        self.spawned.pop(name, None)
         sn.log.info("deleted model [%s]", name)
         resp.success, resp.status_message = True, "DeleteModel: successfully deleted model"
         return resp
