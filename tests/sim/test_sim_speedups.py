@@ -12,11 +12,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ninjemys.sim import sensors
+from ninjemys.sim import camera as sim_camera
 from ninjemys.sim.puzzlebot_node import keep_freed_memory
 from ninjemys.sim.raycast import cast_segments
 from ninjemys.sim.robot_model import load_robot_model
-from ninjemys.sim.sensors import FLOOR_RGB, SKY_RGB
+from ninjemys.sim.sensors import Scene
+from ninjemys.sim.camera import FLOOR_RGB, SKY_RGB
 from ninjemys.sim.simcore import Simulation
 from ninjemys.sim.stepper import StepLock
 from ninjemys.sim.world2d import load_world
@@ -29,7 +30,7 @@ def test_span_mask_and_masked_paint_equal_where(height):
     touching the first or last row too, uint8 rows up to 255 and uint16 rows beyond), over the whole
     image and over a band of rows; the masked paint into a band of an image equals ``np.where``."""
     width = 37
-    cam = sensors.Camera(width, height, 60.0, 0.12, 10.0)
+    cam = sim_camera.Camera(width, height, 60.0, 0.12, 10.0)
     rng = np.random.default_rng(height)
     rows = np.arange(height)[:, None]
     for _ in range(20):
@@ -110,11 +111,9 @@ def reference_render(sim: Simulation, r) -> tuple[np.ndarray, np.ndarray]:  # ty
     return rgb, depth
 
 
-def test_camera_matches_a_per_pixel_renderer(monkeypatch):
+def test_camera_matches_a_per_pixel_renderer():
     """Colour and depth of the office seen from three poses, pixel by pixel (a pixel on a wall's
-    exact top or foot row may go either way in floating point: at most one such row per column).
-    Every height class is a layer here (the office has nine), so the layered renderer is exact."""
-    monkeypatch.setattr(sensors, "MAX_EXTRA_LAYERS", 16)
+    exact top or foot row may go either way in floating point: at most one such row per column)."""
     sim = Simulation(load_world(world_path("office")), 0.01, 0)
     r = sim.add_robot("pb", load_robot_model("puzzlebot"), 0.0, 0.0, 0.0)
     for x, y, yaw in ((0.0, 0.0, 0.3), (-3.0, 0.2, 1.4), (2.5, -0.3, -2.0)):
@@ -260,7 +259,7 @@ def test_casts_that_skip_back_faces_see_the_same(world):
     for x, y, yaw in valid_poses(sim, 25, 3):
         r.x, r.y, r.yaw = x, y, yaw
         scene = sim.scene(r.name)
-        plain = sensors.Scene(**{**scene.__dict__, "facing": None})
+        plain = Scene(**{**scene.__dict__, "facing": None})
         angles = yaw + np.linspace(-math.pi, math.pi, 360, endpoint=False)
         culled, _ = cast_segments(x, y, angles, scene.segments, 12.0, scene.facing)
         full, _ = cast_segments(x, y, angles, scene.segments, 12.0)

@@ -274,3 +274,79 @@ def cast_grid(
     result = result * resolution
     result[result > max_range] = np.inf
     return result
+
+
+def column_pairs(
+    ox: float,
+    oy: float,
+    yaw: float,
+    slopes: np.ndarray,
+    segments: np.ndarray,
+    depth_max: float,
+    facing: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every crossing of a pinhole camera's column rays with the segments, within ``depth_max``:
+    ``(col_of, seg_of, depth)`` with ``depth`` along the optical axis (the camera-frame x of the point
+    hit), in no particular order.
+
+    The camera stands at (ox, oy) looking along ``yaw``; column u's ray is (1, ``slopes[u]``) in the
+    camera frame (x ahead, y to the left, ``slopes`` decreasing from the first column to the last,
+    all within +-90 degrees). Why not :func:`segment_pairs`: a camera's rays are sorted already and its
+    field of view is a wedge, so each segment's columns follow in closed form from the angles of its
+    end points (no sort, no search), and the depth a camera needs is one division per crossing,
+    ``cross(p, e) / (e_y - k e_x)`` (the point p + s e on the ray (d, d k)). Segments behind the
+    camera, beyond ``depth_max`` or facing away (``facing``, as in :func:`segment_pairs`) are dropped
+    before any crossing is made, so the work follows what the camera can see.
+    """
+    none = (np.zeros(0, np.intp), np.zeros(0, np.intp), np.zeros(0))
+    n = len(slopes)
+    if not n or not len(segments):
+        return none
+    c, s = math.cos(yaw), math.sin(yaw)
+    # both end points of every segment in the camera frame at once: (2N, 2) @ rotation by -yaw
+    ends = (segments.reshape(-1, 2) - (ox, oy)) @ np.array([[c, -s], [s, c]])
+    xs, ys = ends[:, 0].reshape(-1, 2), ends[:, 1].reshape(-1, 2)
+    x0, x1, y0, y1 = xs[:, 0], xs[:, 1], ys[:, 0], ys[:, 1]
+    ex, ey = x1 - x0, y1 - y0
+    num = x0 * ey - y0 * ex  # cross(p, e): the same in any frame
+    # some point ahead of the camera and some point within the depth range (a point's depth is its x)
+    keep = (np.maximum(x0, x1) > 0.0) & (np.minimum(x0, x1) <= depth_max)
+    if facing is not None:
+        keep &= facing * num <= 0.0  # the outer face looks at the camera (see segment_pairs)
+    idx = np.flatnonzero(keep)
+    if not len(idx):
+        return none
+    if len(idx) < len(num):
+        xs, ys, ex, ey, num = xs[idx], ys[idx], ex[idx], ey[idx], num[idx]
+    m = len(idx)
+    angles = np.arctan2(ys, xs)  # (m, 2): each end point's bearing, left positive
+    lo, hi = angles.min(axis=1), angles.max(axis=1)
+    # a segment passing behind the camera subtends [hi, pi] + [-pi, lo] (its short arc): of those two
+    # pieces only one can meet a field of view narrower than 180 degrees
+    lim = math.atan(float(slopes[0])) + 1e-9
+    wrap = hi - lo > math.pi
+    if wrap.any():
+        left = wrap & (hi <= lim)  # the piece [hi, pi] reaches into the view
+        lo, hi = np.where(wrap, np.where(left, hi, -lim), lo), np.where(wrap, np.where(left, lim, lo), hi)
+    np.clip(lo, -lim, lim, out=lo)
+    np.clip(hi, -lim, lim, out=hi)
+    # column u looks along atan(slopes[u]); the ones within [lo, hi]: u from cx - fx tan(hi) to cx - fx tan(lo)
+    k0, k1 = float(slopes[0]), float(slopes[-1])
+    scale = (n - 1) / (k0 - k1) if n > 1 else 0.0
+    first = np.ceil((k0 - np.tan(hi)) * scale - 1e-9).astype(np.intp)
+    last = np.floor((k0 - np.tan(lo)) * scale + 1e-9).astype(np.intp)
+    np.clip(first, 0, n, out=first)
+    np.clip(last, -1, n - 1, out=last)
+    counts = last - first + 1
+    counts[counts < 0] = 0
+    total = int(counts.sum())
+    if not total:
+        return none
+    seg_of = np.repeat(np.arange(m), counts)
+    col_of = np.repeat(first - (np.cumsum(counts) - counts), counts) + np.arange(total)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        depth = num[seg_of] / (ey[seg_of] - slopes[col_of] * ex[seg_of])
+    ok = np.flatnonzero((depth > 1e-9) & (depth <= depth_max))  # NaN (seen edge-on) fails too
+    if len(ok) < total:
+        col_of, seg_of, depth = col_of[ok], seg_of[ok], depth[ok]
+    return col_of, (seg_of if len(idx) == len(keep) else idx[seg_of]), depth
