@@ -122,7 +122,9 @@ class Camera:
         seen = self._crossings(scene, x, y, yaw)
         rgb = self._background.copy() if want_rgb else _EMPTY_RGB
         depth_mm = self._floor_depth_image.copy() if want_depth else _EMPTY_DEPTH
-        wall = np.zeros((self.height, self.width), dtype=bool) if want_rgb and scene.floor is not None else None
+        wall = (
+            np.zeros((self.height, self.width), dtype=bool) if want_rgb and scene.floor is not None else None
+        )
         if seen is not None:
             self._paint_crossings(seen, rgb, depth_mm, wall)
         if wall is not None:
@@ -132,19 +134,51 @@ class Camera:
 
     def _crossings(self, scene: Scene, x: float, y: float, yaw: float) -> _Seen | None:
         """The crossings that show in the image, each with its rows cut to what the nearer strips
-        standing on the floor leave free; None when nothing shows."""
-        col, item, d = column_pairs(x, y, yaw, self.col_slopes, scene.segments, self.depth_max, scene.facing)
-        heights, bases, colors = scene.heights, scene.bases, scene.colors
+        standing on the floor leave free; None when nothing shows.
+
+        The far side of a convex shape (``scene.facing``) shows only through the shape's lid (a shape
+        lower than the camera, seen from above) or its underside (a shape held above the camera): it
+        is cast only for those shapes, and its visible rows are the lid's or the underside's, drawn
+        at the depth where each row's ray meets that plane (see :meth:`_paint_crossings`)."""
+        heights, bases, colors, facing = scene.heights, scene.bases, scene.colors, scene.facing
+        segments = scene.segments
+        inner_plane: np.ndarray | None = None  # per segment: the lid's or underside's height, or NaN
+        if facing is not None and len(segments):
+            straddles = heights >= self.cam_z
+            if bases is not None:
+                straddles &= bases <= self.cam_z
+            if not straddles.all():
+                # sides facing away are cast for shapes the camera sees from above or below
+                plane = np.where(heights < self.cam_z, heights, bases if bases is not None else 0.0)
+                inner_plane = np.where(straddles | (facing == 0), np.nan, plane)
+                facing = np.where(straddles, facing, 0).astype(np.int8)
+        col, item, d = column_pairs(x, y, yaw, self.col_slopes, segments, self.depth_max, facing)
+        plane_of: np.ndarray | None = None
+        if inner_plane is not None and len(item):
+            assert scene.facing is not None
+            seg = segments[item]
+            # the side faces away from the camera: (p - o) x e has the sign of the outline's turning
+            away = scene.facing[item] * (
+                (seg[:, 0] - x) * (seg[:, 3] - seg[:, 1]) - (seg[:, 1] - y) * (seg[:, 2] - seg[:, 0])
+            )
+            plane_of = np.where(away > 0.0, inner_plane[item], np.nan)
         if len(scene.circles):  # other robots: round bodies standing on the floor, listed after the segments
             ray_c, circle_c, t_c = circle_pairs(
-                x, y, yaw + self.col_angles, scene.circles, scene.radii, self.depth_max / float(self.col_cos.min())
+                x,
+                y,
+                yaw + self.col_angles,
+                scene.circles,
+                scene.radii,
+                self.depth_max / float(self.col_cos.min()),
             )
             d_c = t_c * self.col_cos[ray_c]
             near = d_c <= self.depth_max
-            n = len(scene.segments)
+            n = len(segments)
             col = np.concatenate([col, ray_c[near]])
             item = np.concatenate([item, circle_c[near] + n])
             d = np.concatenate([d, d_c[near]])
+            if plane_of is not None:
+                plane_of = np.concatenate([plane_of, np.full(int(near.sum()), np.nan)])
             heights = np.concatenate([heights, scene.circle_heights])
             colors = np.concatenate([colors, scene.circle_colors])
             if bases is not None:
@@ -158,9 +192,16 @@ class Camera:
         # rows v whose ray meets the strip between its base and its top: base <= cam_z + slope_v d <= top,
         # slope_v = (cy - v) / fy; the bound is one row past the base's row (exclusive)
         top = np.ceil(self.cy - self.fy * (heights[item] - self.cam_z) / d)
-        np.clip(top, 0, h, out=top)
         low = -self.cam_z if bases is None else bases[item] - self.cam_z
         bottom = np.floor(self.cy - self.fy * low / d) + 1.0
+        plane = None
+        if plane_of is not None:
+            plane = plane_of[order]
+            if np.isnan(plane).all():
+                plane = None
+            else:
+                self._through_planes(scene, col, item, d, plane, top, bottom)
+        np.clip(top, 0, h, out=top)
         np.clip(bottom, 0, h, out=bottom)
         # a strip standing on the floor hides every row of a farther one from its own top down: the
         # farther one's lowest row is above its foot. The lowest top among the nearer ones in the same
@@ -176,16 +217,71 @@ class Camera:
         shows = np.flatnonzero(top < bottom)
         if not len(shows):
             return None
+        if plane is not None:
+            plane = plane[shows]
+            if np.isnan(plane).all():
+                plane = None
         return _Seen(
-            col[shows], item[shows], d[shows], top[shows], bottom[shows], colors, self.width, self._row_type
+            col[shows],
+            item[shows],
+            d[shows],
+            top[shows],
+            bottom[shows],
+            colors,
+            plane,
+            self.width,
+            self._row_type,
         )
+
+    def _through_planes(
+        self,
+        scene: Scene,
+        col: np.ndarray,
+        item: np.ndarray,
+        d: np.ndarray,
+        plane: np.ndarray,
+        top: np.ndarray,
+        bottom: np.ndarray,
+    ) -> None:
+        """Turn the rows of each far side seen through a lid or an underside (``plane`` not NaN) into
+        that plane's rows: a ray meets the lid (or the underside) at height ``plane`` between the
+        side it enters the shape by (at depth ``d_in``) and the side it leaves by (``d``). So a lid's
+        rows run from its far edge's row down to its near edge's (the near side's top row, where the
+        near side's own rows begin); an underside's from its near edge's row (below the near side's
+        rows) down to its far edge's. The side it enters by is the nearest one of the same shape in
+        the same column (a camera inside the shape's outline, under a table top, has none: d_in 0).
+        Arrays by crossing, sorted by column and depth; ``top`` and ``bottom`` changed in place."""
+        shape = (
+            np.flatnonzero(scene.owners[item] >= 0)
+            if scene.owners is not None
+            else np.flatnonzero(~np.isnan(plane))
+        )
+        shape = shape[item[shape] < len(scene.segments)]
+        owner = scene.owners[item[shape]] if scene.owners is not None else np.zeros(len(shape), np.intp)
+        by_shape = shape[np.lexsort((d[shape], owner, col[shape]))]
+        # consecutive crossings of one shape in one column: the first enters, the next leaves by
+        prev, cur = by_shape[:-1], by_shape[1:]
+        same = (col[prev] == col[cur]) & (np.isnan(plane[prev])) & (~np.isnan(plane[cur]))
+        if scene.owners is not None:
+            same &= scene.owners[item[prev]] == scene.owners[item[cur]]
+        inner = np.flatnonzero(~np.isnan(plane))
+        d_in = np.zeros(len(d))
+        d_in[cur[same]] = d[prev[same]]
+        rise = plane[inner] - self.cam_z
+        with np.errstate(divide="ignore", invalid="ignore"):
+            edge = -self.fy * rise / d_in[inner]  # the near edge's row, less cy (+-inf at d_in 0)
+        lid = rise < 0.0
+        bottom[inner] = np.where(lid, np.ceil(self.cy + edge), bottom[inner])
+        top[inner] = np.where(lid, top[inner], np.floor(self.cy + edge) + 1.0)
 
     def _paint_crossings(
         self, seen: _Seen, rgb: np.ndarray, depth_mm: np.ndarray, wall: np.ndarray | None
     ) -> None:
         """Fill each crossing's rows with its colour (flat, darker with distance) and depth: one
         masked copy per rank within the column, the farthest first, over the band of rows that rank
-        spans (a nearer strip in the air is painted over what it hides)."""
+        spans (a nearer strip in the air is painted over what it hides). A lid's or an underside's
+        rows (a far side seen through them) get, in the depth image, the depth where each row's ray
+        meets that plane: (plane - cam_z) / slope_v."""
         if rgb.size:
             light = np.clip(1.1 - seen.depth / 15.0, 0.45, 1.0)
             shaded = (seen.colors[seen.item] * light[:, None]).astype(np.uint8)
@@ -200,6 +296,8 @@ class Camera:
             band_bottom = np.zeros(self.width, dtype=self._row_type)  # other columns: no rows
             band_top[cols], band_bottom[cols] = top, bottom
             mask = self._span_mask(band_top, band_bottom, r0, r1)
+            if wall is not None:
+                wall[r0:r1] |= mask.view(bool)
             if rgb.size:
                 colour = np.zeros((self.width, 3), dtype=np.uint8)
                 colour[cols] = shaded if sel is None else shaded[sel]
@@ -208,8 +306,35 @@ class Camera:
                 per_column = np.zeros(self.width, dtype=np.uint16)
                 per_column[cols] = mm if sel is None else mm[sel]
                 self._paint(depth_mm[r0:r1], per_column, mask)
-            if wall is not None:
-                wall[r0:r1] |= mask.view(bool)
+                if seen.plane is not None:
+                    self._paint_planes(seen, sel, depth_mm)
+
+    def _paint_planes(self, seen: _Seen, sel: np.ndarray | None, depth_mm: np.ndarray) -> None:
+        """The depth of the lids and undersides among one pass's crossings (their columns' rows, at
+        the depth where each row's ray meets the plane), over what the pass painted there."""
+        assert seen.plane is not None
+        plane = seen.plane if sel is None else seen.plane[sel]
+        lid = np.flatnonzero(~np.isnan(plane))
+        if not len(lid):
+            return
+        pick = lid if sel is None else sel[lid]
+        cols, top, bottom = seen.col[pick], seen.top[pick], seen.bottom[pick]
+        r0, r1 = int(top.min()), int(bottom.max())
+        band_top = np.zeros(self.width, dtype=self._row_type)
+        band_bottom = np.zeros(self.width, dtype=self._row_type)
+        band_top[cols], band_bottom[cols] = top, bottom
+        rise = np.zeros(self.width)
+        rise[cols] = plane[lid] - self.cam_z
+        with np.errstate(divide="ignore", invalid="ignore"):
+            metres = rise[None, :] / self.row_slope[r0:r1, None]
+        np.nan_to_num(metres, copy=False, nan=0.0, posinf=0.0, neginf=0.0)
+        np.clip(metres, 0.0, self.depth_max, out=metres)
+        self._paint(
+            depth_mm[r0:r1],
+            np.rint(metres * 1000.0).astype(np.uint16),
+            self._span_mask(band_top, band_bottom, r0, r1),
+            whole=True,
+        )
 
     def _span_mask(self, top: np.ndarray, bottom: np.ndarray, r0: int, r1: int) -> np.ndarray:
         """uint8 (r1 - r0, width): 1 at the rows v in [r0, r1) of each column u with
@@ -222,13 +347,16 @@ class Camera:
         np.less(offset, span, out=mask)
         return mask.view(np.uint8)
 
-    def _paint(self, image: np.ndarray, per_column: np.ndarray, mask: np.ndarray) -> None:
+    def _paint(
+        self, image: np.ndarray, per_column: np.ndarray, mask: np.ndarray, whole: bool = False
+    ) -> None:
         """Set ``image``'s pixels under ``mask`` (uint8, ``image``'s rows and columns) to their
-        column's value (``per_column``: one value or pixel per column), in place (OpenCV's masked
-        copy, a few times faster than numpy's ``where`` or ``copyto(where=)`` here; the column values
-        repeated down the rows by OpenCV too, a third faster than a contiguous copy of a broadcast)."""
+        column's value (``per_column``: one value or pixel per column; ``whole``: already one per
+        pixel), in place (OpenCV's masked copy, a few times faster than numpy's ``where`` or
+        ``copyto(where=)`` here; the column values repeated down the rows by OpenCV too, a third
+        faster than a contiguous copy of a broadcast)."""
         cv2 = _opencv()
-        full = cv2.repeat(np.ascontiguousarray(per_column)[None], image.shape[0], 1)
+        full = per_column if whole else cv2.repeat(np.ascontiguousarray(per_column)[None], image.shape[0], 1)
         cv2.copyTo(full, mask, image)
 
     def _paint_floor(
@@ -270,16 +398,20 @@ class _Seen:
         top: np.ndarray,
         bottom: np.ndarray,
         colors: np.ndarray,
+        plane: np.ndarray | None,
         width: int,
         row_type: type,
     ) -> None:
         self.col, self.item, self.depth, self.colors, self.width = col, item, depth, colors, width
         self.top, self.bottom = top.astype(row_type), bottom.astype(row_type)
+        #: per crossing: the height of the lid or underside it is seen through (NaN: a side seen
+        #: directly); None when no crossing is
+        self.plane = plane
 
     def ranks(self) -> list[np.ndarray | None]:
-        """The crossings of each paint pass, farthest rank first: pass p holds the crossings that
-        have p nearer ones in their column's list after them... put simply, each column's crossings
-        from its farthest to its nearest, one per pass (None: every crossing, all in one pass)."""
+        """The crossings of each paint pass: each column's crossings from its farthest to its
+        nearest, one per pass (a column with fewer joins the later passes); None: every crossing,
+        all in one pass (one per column)."""
         count = np.bincount(self.col, minlength=self.width)
         if int(count.max()) == 1:
             return [None]

@@ -31,6 +31,9 @@ class Scene:
     #: per segment: the height its obstacle starts at (None: everything stands on the floor); a
     #: planar lidar below a table top held in the air sees under it
     bases: np.ndarray | None = None
+    #: per segment: which obstacle's outline it belongs to (-1: none known); the camera pairs the
+    #: side a ray enters a shape by with the side it leaves by (a lid seen between them)
+    owners: np.ndarray | None = None
 
 
 @dataclass
