@@ -20,9 +20,9 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ninjemys.errors import NinjemysError
+from ninjemys.sim.camera import Camera
 from ninjemys.sim.raycast import grid_edges
 from ninjemys.sim.robot_model import CameraSpec, LaserSpec, RobotModel
-from ninjemys.sim.camera import Camera
 from ninjemys.sim.sensors import FloorPaint, Scene, imu_reading, lidar_ranges
 from ninjemys.sim.world2d import MovingObstacle, Obstacle, World, box_outline, circle_outline
 
