@@ -82,6 +82,10 @@ class Camera:
         # scratch, reused by every frame (render runs on one thread at a time: the node's lock)
         self._offset = np.empty((height, width), dtype=self._row_type)
         self._mask = np.empty((height, width), dtype=bool)
+        self._span_row = np.zeros(width, dtype=self._row_type)
+        self._top_row = np.zeros(width, dtype=self._row_type)
+        self._colour_row = np.zeros((width, 3), dtype=np.uint8)
+        self._depth_row = np.zeros(width, dtype=np.uint16)
         #: the last frame's pose and images, and a copy of its scene once the camera stood still
         self._last: tuple[tuple[float, float, float, bool, bool], tuple[np.ndarray, np.ndarray]] | None = None
         self._still: _SceneCopy | None = None
@@ -186,14 +190,28 @@ class Camera:
         if not len(d):
             return None
         # by column, nearest first
-        order = np.argsort(col * (2.0 * self.depth_max + 2.0) + d, kind="stable")
+        key = col * (2.0 * self.depth_max + 2.0)
+        key += d
+        order = np.argsort(key, kind="stable")  # on a tie (two sides flush) the first listed wins
         col, item, d = col[order], item[order], d[order]
         h = self.height
         # rows v whose ray meets the strip between its base and its top: base <= cam_z + slope_v d <= top,
         # slope_v = (cy - v) / fy; the bound is one row past the base's row (exclusive)
-        top = np.ceil(self.cy - self.fy * (heights[item] - self.cam_z) / d)
-        low = -self.cam_z if bases is None else bases[item] - self.cam_z
-        bottom = np.floor(self.cy - self.fy * low / d) + 1.0
+        per_m = self.fy / d
+        top = heights[item]
+        top -= self.cam_z
+        top *= per_m
+        np.subtract(self.cy, top, out=top)
+        np.ceil(top, out=top)
+        if bases is None:
+            bottom = per_m * self.cam_z
+        else:
+            bottom = bases[item]
+            bottom -= self.cam_z
+            bottom *= per_m
+            np.negative(bottom, out=bottom)
+        bottom += self.cy + 1.0
+        np.floor(bottom, out=bottom)
         plane = None
         if plane_of is not None:
             plane = plane_of[order]
@@ -201,22 +219,26 @@ class Camera:
                 plane = None
             else:
                 self._through_planes(scene, col, item, d, plane, top, bottom)
-        np.clip(top, 0, h, out=top)
-        np.clip(bottom, 0, h, out=bottom)
+        np.maximum(top, 0.0, out=top)
+        np.minimum(bottom, float(h), out=bottom)
         # a strip standing on the floor hides every row of a farther one from its own top down: the
         # farther one's lowest row is above its foot. The lowest top among the nearer ones in the same
         # column, from one running minimum (each column shifted below all earlier ones, so a column
         # starts afresh; a value carried over from an earlier column comes back above ``h``)
         stride = float(h + 1)
-        grounded = top if bases is None else np.where(bases[item] <= 0.0, top, float(h))
-        running = np.minimum.accumulate(grounded - col * stride)
-        cover = np.empty_like(running)
-        cover[0] = stride
-        cover[1:] = running[:-1] + col[1:] * stride
-        np.minimum(bottom, cover, out=bottom)
-        shows = np.flatnonzero(top < bottom)
-        if not len(shows):
-            return None
+        shift = col * stride
+        grounded = top - shift if bases is None else np.where(bases[item] <= 0.0, top, float(h)) - shift
+        running = np.minimum.accumulate(grounded)
+        shift[1:] += running[:-1]
+        shift[0] = stride
+        np.minimum(bottom, shift, out=bottom)
+        shows = top < bottom
+        if shows.all():
+            shows = slice(None)
+        else:
+            shows = np.flatnonzero(shows)
+            if not len(shows):
+                return None
         if plane is not None:
             plane = plane[shows]
             if np.isnan(plane).all():
@@ -292,22 +314,32 @@ class Camera:
             top = seen.top if sel is None else seen.top[sel]
             bottom = seen.bottom if sel is None else seen.bottom[sel]
             r0, r1 = int(top.min()), int(bottom.max())
-            band_top = np.zeros(self.width, dtype=self._row_type)
-            band_bottom = np.zeros(self.width, dtype=self._row_type)  # other columns: no rows
-            band_top[cols], band_bottom[cols] = top, bottom
-            mask = self._span_mask(band_top, band_bottom, r0, r1)
+            mask = self._column_mask(cols, top, bottom, r0, r1)
             if wall is not None:
                 wall[r0:r1] |= mask.view(bool)
+            # the values of columns outside the mask do not matter: the scratch rows are not cleared
             if rgb.size:
-                colour = np.zeros((self.width, 3), dtype=np.uint8)
-                colour[cols] = shaded if sel is None else shaded[sel]
-                self._paint(rgb[r0:r1], colour, mask)
+                self._colour_row[cols] = shaded if sel is None else shaded[sel]
+                self._paint(rgb[r0:r1], self._colour_row, mask)
             if depth_mm.size:
-                per_column = np.zeros(self.width, dtype=np.uint16)
-                per_column[cols] = mm if sel is None else mm[sel]
-                self._paint(depth_mm[r0:r1], per_column, mask)
+                self._depth_row[cols] = mm if sel is None else mm[sel]
+                self._paint(depth_mm[r0:r1], self._depth_row, mask)
                 if seen.plane is not None:
                     self._paint_planes(seen, sel, depth_mm)
+
+    def _column_mask(
+        self, cols: np.ndarray, top: np.ndarray, bottom: np.ndarray, r0: int, r1: int
+    ) -> np.ndarray:
+        """uint8 (r1 - r0, width): 1 at the rows top <= v < bottom of columns ``cols`` (each once,
+        top < bottom), 0 in the other columns; see :meth:`_span_mask`."""
+        span, start = self._span_row, self._top_row
+        span.fill(0)
+        span[cols] = bottom - top
+        start[cols] = top
+        offset, mask = self._offset[: r1 - r0], self._mask[: r1 - r0]
+        np.subtract(self._rows[r0:r1], start, out=offset)
+        np.less(offset, span, out=mask)
+        return mask.view(np.uint8)
 
     def _paint_planes(self, seen: _Seen, sel: np.ndarray | None, depth_mm: np.ndarray) -> None:
         """The depth of the lids and undersides among one pass's crossings (their columns' rows, at
@@ -410,14 +442,19 @@ class _Seen:
 
     def ranks(self) -> list[np.ndarray | None]:
         """The crossings of each paint pass: each column's crossings from its farthest to its
-        nearest, one per pass (a column with fewer joins the later passes); None: every crossing,
-        all in one pass (one per column)."""
-        count = np.bincount(self.col, minlength=self.width)
-        if int(count.max()) == 1:
+        nearest, one per pass (pass p holds those with p farther ones in their column); None: every
+        crossing, all in one pass (one per column, the common case)."""
+        col = self.col
+        repeated = col[1:] == col[:-1]
+        if not repeated.any():
             return [None]
-        first = np.cumsum(count) - count  # where each column's run starts
-        from_far = count[self.col] - 1 - (np.arange(len(self.col)) - first[self.col])
-        return [np.flatnonzero(from_far == p) for p in range(int(count.max()))]
+        n = len(col)
+        starts = np.flatnonzero(np.concatenate([[True], ~repeated]))
+        lengths = np.diff(np.append(starts, n))
+        from_far = np.repeat(starts + lengths, lengths)  # each crossing's column's end
+        from_far -= np.arange(1, n + 1)
+        passes = int(lengths.max())
+        return [np.flatnonzero(from_far == p) for p in range(passes)]
 
 
 class _SceneCopy:

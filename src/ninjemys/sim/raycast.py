@@ -303,50 +303,64 @@ def column_pairs(
     if not n or not len(segments):
         return none
     c, s = math.cos(yaw), math.sin(yaw)
-    # both end points of every segment in the camera frame at once: (2N, 2) @ rotation by -yaw
-    ends = (segments.reshape(-1, 2) - (ox, oy)) @ np.array([[c, -s], [s, c]])
-    xs, ys = ends[:, 0].reshape(-1, 2), ends[:, 1].reshape(-1, 2)
-    x0, x1, y0, y1 = xs[:, 0], xs[:, 1], ys[:, 0], ys[:, 1]
+    # both end points of every segment in the camera frame in one product: rows x0, y0, x1, y1
+    turn = np.array([[c, -s, 0.0, 0.0], [s, c, 0.0, 0.0], [0.0, 0.0, c, -s], [0.0, 0.0, s, c]])
+    ends = turn.T @ (segments - (ox, oy, ox, oy)).T
+    x0, y0, x1, y1 = ends
     ex, ey = x1 - x0, y1 - y0
-    num = x0 * ey - y0 * ex  # cross(p, e): the same in any frame
+    num = x0 * ey
+    num -= y0 * ex  # cross(p, e): the same in any frame
     # some point ahead of the camera and some point within the depth range (a point's depth is its x)
-    keep = (np.maximum(x0, x1) > 0.0) & (np.minimum(x0, x1) <= depth_max)
+    keep = np.maximum(x0, x1) > 0.0
+    keep &= np.minimum(x0, x1) <= depth_max
     if facing is not None:
         keep &= facing * num <= 0.0  # the outer face looks at the camera (see segment_pairs)
     idx = np.flatnonzero(keep)
-    if not len(idx):
-        return none
-    if len(idx) < len(num):
-        xs, ys, ex, ey, num = xs[idx], ys[idx], ex[idx], ey[idx], num[idx]
     m = len(idx)
-    angles = np.arctan2(ys, xs)  # (m, 2): each end point's bearing, left positive
-    lo, hi = angles.min(axis=1), angles.max(axis=1)
-    # a segment passing behind the camera subtends [hi, pi] + [-pi, lo] (its short arc): of those two
-    # pieces only one can meet a field of view narrower than 180 degrees
+    if not m:
+        return none
+    if m < len(num):
+        ends, ex, ey, num = ends[:, idx], ex[idx], ey[idx], num[idx]
+    # each end point's bearing, left positive, in two rows: the smaller, the larger
+    bearing = np.sort(np.arctan2(ends[1::2], ends[0::2]), axis=0)
     lim = math.atan(float(slopes[0])) + 1e-9
-    wrap = hi - lo > math.pi
+    wrap = bearing[1] - bearing[0] > math.pi
     if wrap.any():
+        # a segment passing behind the camera subtends [hi, pi] + [-pi, lo] (its short arc): of those
+        # two pieces only one can meet a field of view narrower than 180 degrees
+        lo, hi = bearing
         left = wrap & (hi <= lim)  # the piece [hi, pi] reaches into the view
-        lo, hi = np.where(wrap, np.where(left, hi, -lim), lo), np.where(wrap, np.where(left, lim, lo), hi)
-    np.clip(lo, -lim, lim, out=lo)
-    np.clip(hi, -lim, lim, out=hi)
-    # column u looks along atan(slopes[u]); the ones within [lo, hi]: u from cx - fx tan(hi) to cx - fx tan(lo)
-    k0, k1 = float(slopes[0]), float(slopes[-1])
-    scale = (n - 1) / (k0 - k1) if n > 1 else 0.0
-    first = np.ceil((k0 - np.tan(hi)) * scale - 1e-9).astype(np.intp)
-    last = np.floor((k0 - np.tan(lo)) * scale + 1e-9).astype(np.intp)
-    np.clip(first, 0, n, out=first)
-    np.clip(last, -1, n - 1, out=last)
-    counts = last - first + 1
-    counts[counts < 0] = 0
+        bearing = np.array(
+            [np.where(wrap, np.where(left, hi, -lim), lo), np.where(wrap, np.where(left, lim, lo), hi)]
+        )
+    np.maximum(bearing, -lim, out=bearing)
+    np.minimum(bearing, lim, out=bearing)
+    # column u looks along atan(slopes[u]), slopes evenly spaced (a pinhole camera's): the columns
+    # within [lo, hi] run from u(hi) to u(lo), u(a) = (slopes[0] - tan a) / (slopes[0] - slopes[1])
+    k0 = float(slopes[0])
+    scale = (n - 1) / (k0 - float(slopes[-1])) if n > 1 else 0.0
+    at = np.tan(bearing)
+    np.subtract(k0, at, out=at)
+    at *= scale
+    first = np.ceil(at[1] - 1e-9)
+    counts = np.floor(at[0] + 1e-9)
+    counts -= first
+    counts += 1.0
+    np.maximum(first, 0.0, out=first)  # never needed but for rounding: an index stays an index
+    np.minimum(counts, n - first, out=counts)
+    np.maximum(counts, 0.0, out=counts)
+    counts = counts.astype(np.intp)
     total = int(counts.sum())
     if not total:
         return none
     seg_of = np.repeat(np.arange(m), counts)
-    col_of = np.repeat(first - (np.cumsum(counts) - counts), counts) + np.arange(total)
+    col_of = np.arange(total)
+    col_of += np.repeat(first.astype(np.intp) - (np.cumsum(counts) - counts), counts)
     with np.errstate(divide="ignore", invalid="ignore"):
         depth = num[seg_of] / (ey[seg_of] - slopes[col_of] * ex[seg_of])
-    ok = np.flatnonzero((depth > 1e-9) & (depth <= depth_max))  # NaN (seen edge-on) fails too
+    ok = depth > 1e-9  # NaN (seen edge-on) fails too
+    ok &= depth <= depth_max
+    ok = np.flatnonzero(ok)
     if len(ok) < total:
         col_of, seg_of, depth = col_of[ok], seg_of[ok], depth[ok]
-    return col_of, (seg_of if len(idx) == len(keep) else idx[seg_of]), depth
+    return col_of, (seg_of if m == len(keep) else idx[seg_of]), depth
