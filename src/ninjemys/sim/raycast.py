@@ -21,6 +21,10 @@ import math
 
 import numpy as np
 
+#: reductions called as ufunc methods: ``a.any()`` and ``a.min()`` go through numpy's Python-level
+#: wrappers, a few microseconds a call that the camera's per-frame code feels
+_ANY = np.logical_or.reduce
+
 
 def cast_segments(
     ox: float,
@@ -315,17 +319,18 @@ def column_pairs(
     keep &= np.minimum(x0, x1) <= depth_max
     if facing is not None:
         keep &= facing * num <= 0.0  # the outer face looks at the camera (see segment_pairs)
-    idx = np.flatnonzero(keep)
+    idx = keep.nonzero()[0]
     m = len(idx)
     if not m:
         return none
     if m < len(num):
         ends, ex, ey, num = ends[:, idx], ex[idx], ey[idx], num[idx]
     # each end point's bearing, left positive, in two rows: the smaller, the larger
-    bearing = np.sort(np.arctan2(ends[1::2], ends[0::2]), axis=0)
+    bearing = np.arctan2(ends[1::2], ends[0::2])
+    bearing.sort(axis=0)
     lim = math.atan(float(slopes[0])) + 1e-9
     wrap = bearing[1] - bearing[0] > math.pi
-    if wrap.any():
+    if _ANY(wrap):
         # a segment passing behind the camera subtends [hi, pi] + [-pi, lo] (its short arc): of those
         # two pieces only one can meet a field of view narrower than 180 degrees
         lo, hi = bearing
@@ -350,17 +355,17 @@ def column_pairs(
     np.minimum(counts, n - first, out=counts)
     np.maximum(counts, 0.0, out=counts)
     counts = counts.astype(np.intp)
-    total = int(counts.sum())
+    total = int(np.add.reduce(counts))
     if not total:
         return none
-    seg_of = np.repeat(np.arange(m), counts)
+    seg_of = np.arange(m).repeat(counts)
     col_of = np.arange(total)
-    col_of += np.repeat(first.astype(np.intp) - (np.cumsum(counts) - counts), counts)
+    col_of += (first.astype(np.intp) - (counts.cumsum() - counts)).repeat(counts)
     with np.errstate(divide="ignore", invalid="ignore"):
         depth = num[seg_of] / (ey[seg_of] - slopes[col_of] * ex[seg_of])
     ok = depth > 1e-9  # NaN (seen edge-on) fails too
     ok &= depth <= depth_max
-    ok = np.flatnonzero(ok)
+    ok = ok.nonzero()[0]
     if len(ok) < total:
         col_of, seg_of, depth = col_of[ok], seg_of[ok], depth[ok]
     return col_of, (seg_of if m == len(keep) else idx[seg_of]), depth
