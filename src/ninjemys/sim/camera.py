@@ -158,8 +158,8 @@ class Camera:
                 straddles &= bases <= self.cam_z
             if not _ALL(straddles):
                 # sides facing away are cast for shapes the camera sees from above or below
-                plane = np.where(heights < self.cam_z, heights, bases if bases is not None else 0.0)
-                inner_plane = np.where(straddles | (facing == 0), np.nan, plane)
+                level = np.where(heights < self.cam_z, heights, bases if bases is not None else 0.0)
+                inner_plane = np.where(straddles | (facing == 0), np.nan, level)
                 facing = np.where(straddles, facing, 0).astype(np.int8)
         col, item, d = column_pairs(x, y, yaw, self.col_slopes, segments, self.depth_max, facing)
         plane_of: np.ndarray | None = None
@@ -217,7 +217,7 @@ class Camera:
             np.negative(bottom, out=bottom)
         bottom += self.cy + 1.0
         np.floor(bottom, out=bottom)
-        plane = None
+        plane: np.ndarray | None = None
         if plane_of is not None:
             plane = plane_of[order]
             if np.isnan(plane).all():
@@ -440,7 +440,8 @@ class _Seen:
         row_type: type,
     ) -> None:
         self.col, self.item, self.depth, self.colors, self.width = col, item, depth, colors, width
-        self.top, self.bottom = top.astype(row_type), bottom.astype(row_type)
+        self.top: np.ndarray = top.astype(row_type)
+        self.bottom: np.ndarray = bottom.astype(row_type)
         #: per crossing: the height of the lid or underside it is seen through (NaN: a side seen
         #: directly); None when no crossing is
         self.plane = plane
@@ -473,7 +474,10 @@ class _SceneCopy:
         if scene.floor is not self.floor:
             return False
         for kept, now in zip(self.arrays, _scene_arrays(scene), strict=True):
-            if (kept is None) != (now is None) or (kept is not None and not np.array_equal(kept, now)):
+            if kept is None or now is None:
+                if kept is not now:
+                    return False
+            elif not np.array_equal(kept, now):
                 return False
         return True
 
