@@ -4,8 +4,9 @@ No ROS in here: a :class:`~ninjemys.sim.sensors.Scene` and a pose in, arrays out
 heights: every obstacle side is a vertical strip standing between its base (0 on the floor, higher for
 a table top held in the air) and its top. One vectorised cast (:func:`~ninjemys.sim.raycast.column_pairs`)
 gives every crossing of a column's ray with a strip, and a crossing covers the image rows whose rays
-meet the strip between its base and its top. Each pixel shows the nearest strip that covers it; where
-none does, the background: the floor (shaded with distance, with its markings) below the horizon, the
+meet the strip between its base and its top. Each pixel shows the nearest strip that covers it (or
+the lid of a shape lower than the camera, the underside of one held above it, seen through them);
+where none does, the background: the floor (shaded with distance, with its markings) below the horizon, the
 sky above. The depth image holds the optical-axis depth in millimetres (16UC1, as RealSense's
 ``depth/image_rect_raw``), 0 where there is no return (sky, beyond the depth range).
 
