@@ -66,7 +66,7 @@ FLOOR_PATCHES = {
         "import ninjemys.robot.tf_plan as m; init = m.TfPlan.__init__\n"
         "def once(self, *args, **kwargs):\n"
         "    init(self, *args, **kwargs); full, made = self.message, []\n"
-        "    self.message = lambda p, s, n: made[0] if made else made.append(full(p, s, n)) or made[0]\n"
+        "    self.message = lambda p, st: made[0] if made else made.append(full(p, st)) or made[0]\n"
         "m.TfPlan.__init__ = once"
     ),
 }

@@ -130,7 +130,7 @@ def test_plan_of_a_mimic_and_a_prismatic_joint_in_closed_form() -> None:
     mimics = {"finger_l_joint": [model.joints["finger_r_joint"]]}
     plan = TfPlan(["finger_l_joint", "j1"], model.joints, mimics, lambda joint: b"")
     assert plan.count == 3 and plan.known == ["finger_l_joint", "j1"]
-    values = struct.unpack("<I" + "III0s7d" * 3, plan.message((0.009, math.pi / 2), 7, 8))
+    values = struct.unpack("<I" + "III0s7d" * 3, plan.message((0.009, math.pi / 2), struct.pack("<II", 7, 8)))
     rows = [values[1 + 11 * i : 12 + 11 * i] for i in range(3)]
     # finger_l slides along y from y = 0.02; j1 turns about z from yaw 0.3; finger_r mimics -x + 0.001
     assert rows[0][:3] == (0, 7, 8) and rows[0][4:7] == pytest.approx((0.0, 0.029, 0.05))

@@ -90,6 +90,8 @@ class StatePublisher:
         throttle's record needs no lock); the steady case is written out inline, as this runs 50 times
         a second with cold caches, where every call and attribute costs."""
         data = raw.data
+        if data.__class__ is memoryview:  # a view into a shared-memory ring (a message of >64 KiB)
+            data = data.tobytes()
         try:
             secs, nsecs, frame_len = _STAMP_FRAME.unpack_from(data, 4)
             start = 16 + frame_len
@@ -120,7 +122,7 @@ class StatePublisher:
         elif not self._admit(entry, now_ns):
             return
         if entry.plan.count:
-            self.tf.publish_framed(entry.plan.message(found, secs, nsecs))
+            self.tf.publish_framed(entry.plan.message(found, data[4:12]))
 
     def _general(self, data: Any, secs: int, nsecs: int, key: bytes, count: int, offset: int) -> None:
         """A list of names without a plan yet (or positions that do not match it): decoded in full."""
