@@ -1,8 +1,9 @@
 """CPU of robot_state_publisher at 50 Hz joint states for a 20-joint robot: ninjemys vs Debian's C++.
 
 Run: ``.venv/bin/python bench/robot_state_publisher.py`` (``--seconds N`` per round, default 20;
-``--rounds N``, default 1; ``--floor`` adds two stripped copies of ours that show where the floor is:
-``receive`` takes each JointState and does nothing with it, ``no_fk`` does everything but compute and
+``--rounds N``, default 1; ``--still``: the robot at rest, the same positions in every message (a
+joint_state_publisher with nothing moving), only the stamps new; ``--floor`` adds two stripped copies
+of ours that show where the floor is: ``receive`` takes each JointState and does nothing with it, ``no_fk`` does everything but compute and
 serialise the transforms, publishing the first message it made again and again).
 
 One master (ours), one description (a chain of 20 revolute joints with odd origins and axes, and
@@ -86,6 +87,11 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=1)
     parser.add_argument("--floor", action="store_true", help="add the receive-only and no-FK copies of ours")
     parser.add_argument(
+        "--still",
+        action="store_true",
+        help="the robot at rest: the same positions in every message, only the stamps change",
+    )
+    parser.add_argument(
         "--compare",
         metavar="SRC",
         help="add ours as found in another source tree (e.g. a git archive of main)",
@@ -157,7 +163,8 @@ def main() -> None:
                 next_t = start
                 while time.monotonic() - start < opts.seconds:
                     stamp = time.time()
-                    msg = JointState(name=names, position=[0.01 * k + 0.1 * i for i in range(JOINTS)])
+                    moved = 0.0 if opts.still else 0.01 * k
+                    msg = JointState(name=names, position=[moved + 0.1 * i for i in range(JOINTS)])
                     msg.header.stamp = Time.from_sec(stamp)
                     pub.publish(msg)
                     k += 1

@@ -187,3 +187,27 @@ def test_two_publishers_with_interleaved_stamps_are_no_clock_reset() -> None:
     assert warnings == [
         "Moved backwards in time (probably because ROS clock was reset), re-publishing joint transforms!"
     ]
+
+
+def test_a_robot_at_rest_gets_the_same_transforms_with_each_new_stamp() -> None:
+    """Positions repeated from the last message published (joint_state_publisher's robot at rest)
+    reuse that message with the new stamps: still what the general path publishes, message for
+    message, also when the stream moves again, repeats an older position or skips a stamp."""
+    fast, _ = _publisher({})
+    general, _ = _publisher({})
+    rest = [0.3 - 0.2 * i for i in range(len(MOVING))]
+    moved = [0.1 * i for i in range(len(MOVING))]
+    stream = [rest] * 4 + [moved] * 3 + [rest] * 2 + [moved] * 2
+    for k, positions in enumerate(stream):
+        stamp = (300 + k, 5_000_000 * k)
+        fast.node.clock = general.node.clock = Time(*stamp)
+        fast.on_raw(_Raw(_encode(MOVING, positions, *stamp)))
+        general.on_joint_state(tuple(MOVING), tuple(positions), *stamp)
+    entry = next(iter(fast.plans.values()))
+    assert entry.segments is not None  # the last message repeated the one before
+    assert len(fast.tf.sent) == len(general.tf.sent) == len(stream)
+    for ours, theirs in zip(fast.tf.sent, general.tf.sent, strict=True):
+        a, b = _transforms(ours), _transforms(theirs)
+        assert [t[:4] for t in a] == [t[:4] for t in b]
+        for ta, tb in zip(a, b, strict=True):
+            assert max(abs(x - y) for x, y in zip(ta[4], tb[4], strict=True)) < 1e-12, ta[1]

@@ -103,13 +103,18 @@ class StatePublisher:
                     self._general(data, secs, nsecs, key, count, start + len(key))
                     return
                 self.last_entry = entry
-            try:
-                found = entry.positions.unpack_from(data, start + entry.size)  # the count, then positions
-            except struct.error:
-                found = None
-            if found is None or found[0] != entry.count:  # the general path says what is wrong
-                self._general(data, secs, nsecs, entry.key, entry.count, start + entry.size)
-                return
+            offset = start + entry.size  # the position count, then the positions
+            still = entry.still
+            if still is not None and data.startswith(still, offset):
+                found = None  # the positions of the last message published: only the stamps change
+            else:
+                try:
+                    found = entry.positions.unpack_from(data, offset)
+                except struct.error:
+                    found = None
+                if found is None or found[0] != entry.count:  # the general path says what is wrong
+                    self._general(data, secs, nsecs, entry.key, entry.count, offset)
+                    return
         except (struct.error, UnicodeDecodeError, IndexError, ValueError):
             self.warn("Robot state publisher ignored a malformed JointState message")
             return
@@ -121,8 +126,16 @@ class StatePublisher:
             self.streak_ns = now_ns
         elif not self._admit(entry, now_ns):
             return
-        if entry.plan.count:
-            self.tf.publish_framed(entry.plan.message(found, data[4:12]))
+        if not entry.plan.count:
+            return
+        if found is None:
+            if entry.segments is None:
+                entry.segments = entry.plan.segments(entry.frame)
+            self.tf.publish_framed(data[4:12].join(entry.segments))
+            return
+        entry.frame = frame = entry.plan.message(found, data[4:12])
+        entry.still, entry.segments = data[offset : offset + entry.span], None
+        self.tf.publish_framed(frame)
 
     def _general(self, data: Any, secs: int, nsecs: int, key: bytes, count: int, offset: int) -> None:
         """A list of names without a plan yet (or positions that do not match it): decoded in full."""
@@ -269,13 +282,31 @@ class _Entry:
     precompiled unpacking of the position count and positions that follow it (the plan takes them
     as unpacked, count first)."""
 
-    __slots__ = ("count", "key", "known", "plan", "positions", "size", "zeros")
+    __slots__ = (
+        "count",
+        "frame",
+        "key",
+        "known",
+        "plan",
+        "positions",
+        "segments",
+        "size",
+        "span",
+        "still",
+        "zeros",
+    )
 
     def __init__(self, key: bytes, count: int, plan: TfPlan) -> None:
         self.key, self.size, self.count, self.plan = key, len(key), count, plan
         self.known = plan.known
         self.zeros = [0] * len(self.known)
         self.positions = struct.Struct(f"<I{count}d")
+        self.span = self.positions.size
+        #: the count and positions (as received) of the last message published, and its frame; the
+        #: frame cut around its stamps once a message repeats them (None until then)
+        self.still: bytes | None = None
+        self.frame = b""
+        self.segments: list[bytes] | None = None
 
 
 def _names(section: bytes, count: int) -> tuple[str, ...]:

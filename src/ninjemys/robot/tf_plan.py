@@ -76,6 +76,8 @@ class TfPlan:
                 if mimic.type != "fixed":
                     moving.append(mimic)
         self.count = len(moving)
+        #: the offset of each transform's stamp in a message (see :meth:`segments`)
+        self.stamps: list[int] = []
         self.source = _Source()
         self.message: Callable[[Sequence[float], bytes], bytes] = self._compile(
             moving, values, frames, framed
@@ -96,6 +98,7 @@ class TfPlan:
         fmt = ["<"]
         body: list[str] = []
         args: list[str] = []
+        stamps: list[int] = []  # where in fmt each transform's seq pad and stamp are
         head = struct.pack("<I", self.count)
         for k, joint in enumerate(moving):
             index, a, b = values[joint.name]
@@ -108,6 +111,7 @@ class TfPlan:
                 v = f"v{k}"  # every value lives until the one pack at the end: a name per joint
                 body.append(f"{v} = p[{index}]{_affine(a, b, lit)}")
                 _constant(fmt, args, head)
+                stamps.append(len(fmt))
                 fmt.append(f"4x8s{len(frame)}s3d")
                 args += ["stamp", repr(frame)]
                 args += [f"{lit(x0)} + {lit(dx)} * {v}", f"{lit(y0)} + {lit(dy)} * {v}"]
@@ -131,6 +135,7 @@ class TfPlan:
                 ]
                 constant = frame + _TRANSLATION.pack(x0, y0, z0)
                 _constant(fmt, args, head)
+                stamps.append(len(fmt))
                 fmt.append(f"4x8s{len(constant)}s4d")
                 args += ["stamp", repr(constant), *q]
                 head = b""
@@ -138,6 +143,7 @@ class TfPlan:
         if framed:  # the length in front, with the count (fmt[1], args[0]): one constant
             first = struct.pack("<II", struct.calcsize("".join(fmt)), self.count)
             fmt[1], args[0] = f"{len(first)}s", repr(first)
+        self.stamps = [struct.calcsize("".join(fmt[:i])) + 4 for i in stamps]
         src.names["pack"] = struct.Struct("".join(fmt)).pack
         # the functions as defaults: local names, cheaper than globals on every use
         lines = [
@@ -146,6 +152,12 @@ class TfPlan:
         ]
         lines.append(f"    return pack({', '.join(args)})")
         return src.function("\n".join(lines), "message")
+
+    def segments(self, message: bytes) -> list[bytes]:
+        """``message`` cut around its stamps: ``stamp.join(segments)`` is the same message with
+        another stamp (a stream whose positions have not changed: a robot at rest)."""
+        cuts = [0, *(o for offset in self.stamps for o in (offset, offset + 8)), len(message)]
+        return [message[cuts[i] : cuts[i + 1]] for i in range(0, len(cuts), 2)]
 
 
 def _constant(fmt: list[str], args: list[str], data: bytes) -> None:
