@@ -211,3 +211,27 @@ def test_a_robot_at_rest_gets_the_same_transforms_with_each_new_stamp() -> None:
         assert [t[:4] for t in a] == [t[:4] for t in b]
         for ta, tb in zip(a, b, strict=True):
             assert max(abs(x - y) for x, y in zip(ta[4], tb[4], strict=True)) < 1e-12, ta[1]
+
+
+def test_joints_without_origin_rotation_about_each_axis_match_the_general_pose() -> None:
+    """The generated code leaves out the terms a zero constant removes (an origin without rotation,
+    an axis along x, y, z or -z: most URDFs): the same poses as the general pose function."""
+    axes = ["1 0 0", "0 1 0", "0 0 1", "0 0 -1"]
+    urdf = (
+        '<robot name="r"><link name="l0"/>'
+        + "".join(
+            f'<link name="l{i + 1}"/><joint name="j{i}" type="continuous"><parent link="l{i}"/>'
+            f'<child link="l{i + 1}"/><origin xyz="0.1 0 {i}"/><axis xyz="{axis}"/></joint>'
+            for i, axis in enumerate(axes)
+        )
+        + "</robot>"
+    )
+    model = parse_urdf(urdf)
+    names = [f"j{i}" for i in range(len(axes))]
+    plan = TfPlan(names, model.joints, {}, lambda joint: b"")
+    assert "c * 0.0" not in plan.source.text and "s * 1.0" not in plan.source.text
+    for angle in (0.0, 0.4, 2.0, 3.0, -2.5, 6.0):
+        values = struct.unpack("<" + "4x8s0s7d" * len(axes), plan.message([angle] * len(axes), bytes(8))[4:])
+        for i, name in enumerate(names):
+            expected = model.joints[name].transform(angle)
+            assert values[2 + 9 * i : 9 + 9 * i] == pytest.approx(expected, abs=1e-12), (name, angle)

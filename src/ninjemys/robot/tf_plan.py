@@ -129,8 +129,8 @@ class TfPlan:
                 body += [
                     f"h = p[{index}]{_affine(a * 0.5, b * 0.5, lit)}",
                     "c = cos(h); s = sin(h)",
-                    f"{q[0]} = c * {lit(ox)} + s * {lit(bx)}; {q[1]} = c * {lit(oy)} + s * {lit(by)}",
-                    f"{q[2]} = c * {lit(oz)} + s * {lit(bz)}; {q[3]} = c * {lit(ow)} + s * {lit(bw)}",
+                    f"{q[0]} = {_mix(ox, bx, lit)}; {q[1]} = {_mix(oy, by, lit)}",
+                    f"{q[2]} = {_mix(oz, bz, lit)}; {q[3]} = {_mix(ow, bw, lit)}",
                     *_sign(*q),
                 ]
                 constant = frame + _TRANSLATION.pack(x0, y0, z0)
@@ -165,6 +165,15 @@ def _constant(fmt: list[str], args: list[str], data: bytes) -> None:
     if data:
         fmt.append(f"{len(data)}s")
         args.append(repr(data))
+
+
+def _mix(a: float, b: float, lit: Callable[[float], str]) -> str:
+    """``c * a + s * b`` as source, without the terms a zero removes or the products a one does
+    (an origin without rotation and an axis along x, y or z, as most URDFs have them: a joint's
+    quaternion is then ``(0, 0, s, c)``, 2 assignments instead of 4 sums of 2 products)."""
+    terms = [f"{name}" if k == 1.0 else f"-{name}" if k == -1.0 else f"{name} * {lit(k)}"
+             for name, k in (("c", a), ("s", b)) if k != 0.0]  # fmt: skip
+    return " + ".join(terms) if terms else "0.0"
 
 
 def _affine(a: float, b: float, lit: Callable[[float], str]) -> str:
