@@ -235,3 +235,27 @@ def test_joints_without_origin_rotation_about_each_axis_match_the_general_pose()
         for i, name in enumerate(names):
             expected = model.joints[name].transform(angle)
             assert values[2 + 9 * i : 9 + 9 * i] == pytest.approx(expected, abs=1e-12), (name, angle)
+
+
+@pytest.mark.parametrize("fast", [True, False])
+def test_a_stream_exactly_at_publish_frequency_is_published_whole(fast: bool) -> None:
+    """ROS 1 publishes when the stamp is at least one period after the joints' last one
+    (``stamp >= last + interval``, measured: Debian's node publishes all 50 of a stream stamped
+    20 ms apart at the default 50 Hz); closer stamps are throttled."""
+    rsp, _ = _publisher({})
+    steps = [20_000_000] * 6 + [10_000_000] * 4  # 6 at the period, then 4 at half of it
+    nsecs = 0
+    for step in steps:
+        nsecs += step
+        rsp.node.clock = Time(300, nsecs)
+        if fast:
+            rsp.on_raw(_Raw(_encode(MOVING, [nsecs * 1e-9] * len(MOVING), 300, nsecs)))
+        else:
+            rsp.on_joint_state(tuple(MOVING), (nsecs * 1e-9,) * len(MOVING), 300, nsecs)
+    assert len(rsp.tf.sent) == 6 + 2
+
+
+def test_publish_frequency_below_one_hertz_is_one_hertz() -> None:
+    assert _publisher({"~publish_frequency": 0.0})[0].interval_ns == 1_000_000_000
+    assert _publisher({"~publish_frequency": 0.25})[0].interval_ns == 1_000_000_000
+    assert _publisher({"~publish_frequency": 10.0})[0].interval_ns == 100_000_000

@@ -6,8 +6,10 @@ every joint that mimics one), parent link -> child link on ``/tf`` stamped with 
 stamp. Fixed joints go once on the latched ``/tf_static`` (``~use_tf_static``, default true), or
 else on ``/tf`` every ``1/publish_frequency`` stamped half a second ahead, as ROS 1 does.
 
-``~publish_frequency`` (50 Hz) throttles a joint's transforms to that rate unless
-``~ignore_timestamp`` is set; ``tf_prefix`` (searched up the namespace) prefixes frames with tf's
+``~publish_frequency`` (50 Hz; below 1 Hz taken as 1, as ROS 1) throttles a joint's transforms to
+that rate unless ``~ignore_timestamp`` is set: a message is published when its stamp is at least one
+period after the joints' last, so a stream exactly at that rate goes out whole; the subscription's
+queue holds one message, as ROS 1's (a backlog is published newest only); ``tf_prefix`` (searched up the namespace) prefixes frames with tf's
 resolve rule. A message naming joints the robot does not have is used for the joints it does
 have, with one warning per new set of unknown names (ROS 1 ignores them silently).
 """
@@ -43,7 +45,7 @@ class StatePublisher:
         self.node, self.model, self.warn = node, model, log
         self.TFMessage = get_message_class("tf2_msgs/TFMessage")
         self.frequency = float(node.get_param("~publish_frequency", 50.0))
-        self.interval = Duration.from_sec(1.0 / self.frequency) if self.frequency > 0 else Duration(0)
+        self.interval = Duration.from_sec(1.0 / max(self.frequency, 1.0))  # as ROS 1: at least 1 Hz
         self.ignore_timestamp = bool(node.get_param("~ignore_timestamp", False))
         self.use_tf_static = bool(node.get_param("~use_tf_static", True))
         prefix_key = node.search_param("tf_prefix")
@@ -67,13 +69,15 @@ class StatePublisher:
         #: the list of names that followed itself, and its joints' last stamp (see :meth:`_admit`)
         self.streak: _Entry | None = None
         self.streak_ns = 0
-        self.sub = node.subscriber("joint_states", JointState, self.on_raw, queue_size=100, raw=True)
+        # a queue of one, as ROS 1's node: a backlog (a slow moment, a burst) is read and only the
+        # newest message of it published
+        self.sub = node.subscriber("joint_states", JointState, self.on_raw, queue_size=1, raw=True)
 
     def start(self) -> None:
         """Fixed joints: once, latched (use_tf_static), or on a timer on /tf."""
         if self.use_tf_static:
             self.tf_static.publish_raw(self._message(self.model.fixed, {}, self.node.now()))
-        elif self.model.fixed and self.frequency > 0:
+        elif self.model.fixed:
             self.node.timer(self.interval, lambda _e: self._publish_fixed_on_tf())
 
     def _publish_fixed_on_tf(self) -> None:
@@ -121,7 +125,7 @@ class StatePublisher:
         now_ns = secs * 1_000_000_000 + nsecs
         if self.streak is entry and now_ns >= self.last_stamp_ns:  # the steady case of _admit
             self.last_stamp_ns = now_ns
-            if now_ns <= self.streak_ns + self.interval_ns and not self.ignore_timestamp:
+            if now_ns < self.streak_ns + self.interval_ns and not self.ignore_timestamp:
                 return
             self.streak_ns = now_ns
         elif not self._admit(entry, now_ns):
@@ -171,8 +175,9 @@ class StatePublisher:
         return bytes(data[start:offset]), count
 
     def _admit(self, entry: _Entry, now_ns: int) -> bool:
-        """ROS 1's throttle: publish unless every joint named was published less than one interval ago
-        (``ignore_timestamp`` publishes all); a stamp older than the last one clears the record.
+        """ROS 1's throttle: publish when the stamp is at least one interval after the oldest last
+        stamp of the joints named (``ignore_timestamp`` publishes all): a stream exactly at
+        ``publish_frequency`` (simulated time) is published whole; the clock going back clears it.
 
         While one list of names follows itself, the record of its joints is one number (the streak,
         whose steady case :meth:`on_raw` checks inline) instead of a stamp per joint; another list (or
@@ -182,13 +187,13 @@ class StatePublisher:
         if not known:
             return False
         if self.streak is entry:
-            if not self.ignore_timestamp and now_ns <= self.streak_ns + self.interval_ns:
+            if not self.ignore_timestamp and now_ns < self.streak_ns + self.interval_ns:
                 return False
             self.streak_ns = now_ns
             return True
         self._flush_streak()
         last = self.last_published
-        if not self.ignore_timestamp and now_ns <= min(map(last.get, known, entry.zeros)) + self.interval_ns:
+        if not self.ignore_timestamp and now_ns < min(map(last.get, known, entry.zeros)) + self.interval_ns:
             return False
         self.streak, self.streak_ns = entry, now_ns
         return True
@@ -200,7 +205,7 @@ class StatePublisher:
             return False
         self._flush_streak()
         last = self.last_published
-        if not self.ignore_timestamp and now_ns <= min(last.get(n, 0) for n in known) + self.interval_ns:
+        if not self.ignore_timestamp and now_ns < min(last.get(n, 0) for n in known) + self.interval_ns:
             return False
         last.update(dict.fromkeys(known, now_ns))
         return True
