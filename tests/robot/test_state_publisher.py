@@ -101,6 +101,15 @@ class _Collector:
                 key = (t.child_frame_id, t.header.stamp.to_nsec())
                 self.seen[key] = (t.header.frame_id, (tr.x, tr.y, tr.z, q.x, q.y, q.z, q.w))
 
+    def wait_stamp(self, stamp_ns: int, timeout: float = 30.0) -> None:
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            with self.lock:
+                if any(stamp == stamp_ns for _, stamp in self.seen):
+                    return
+            time.sleep(0.02)
+        raise AssertionError(f"no transform stamped {stamp_ns} arrived")
+
     def wait(self, count: int, timeout: float = 30.0) -> None:
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
@@ -143,9 +152,9 @@ def _run_arm(
     master, extra_nodes: list[list[str]], expect: dict[str, int], messages: int, step_ns: int = 10**9
 ):
     """Publish `messages` joint states to the state publishers in `extra_nodes` and wait, while the
-    subscribers still live, until each topic in `expect` has that many transforms. The states go
-    0.1 s apart: Debian's robot_state_publisher subscribes with a queue of one, so closer states can
-    be dropped on a loaded machine."""
+    subscribers still live, until each topic in `expect` has that many transforms. Each state is
+    sent once the one before it is out on every /tf topic: both nodes subscribe with a queue of one
+    (as ROS 1's), so states that arrive together are published newest only."""
     uri, env = master
     node = Node("rsp_check", master_uri=uri)
     procs: list[subprocess.Popen[bytes]] = []
@@ -155,22 +164,25 @@ def _run_arm(
         TFMessage = get_message_class("tf2_msgs/TFMessage")
         JointState = get_message_class("sensor_msgs/JointState")
         collectors = {t: _Collector() for t in expect}
-        for topic, collector in collectors.items():
-            node.subscriber(topic, TFMessage, collector, queue_size=1000)
+        subs = [node.subscriber(t, TFMessage, c, queue_size=1000) for t, c in collectors.items()]
         pub = node.publisher("/joint_states", JointState, queue_size=100)
         procs = [_start(argv, env) for argv in extra_nodes]
         deadline = time.monotonic() + 30
-        while pub.get_num_connections() < len(extra_nodes):
-            assert time.monotonic() < deadline, "the state publishers did not subscribe"
+        while pub.get_num_connections() < len(extra_nodes) or not all(
+            sub.get_num_connections() for sub in subs
+        ):
+            assert time.monotonic() < deadline, "the state publishers did not connect"
             time.sleep(0.05)
         time.sleep(0.5)
+        moving = [c for t, c in collectors.items() if "static" not in t]
         for k in range(messages):
             msg = JointState()
             msg.header.stamp = Time(100, 0) + Duration(0, step_ns * k)  # 1 s apart: no throttling
             msg.name = MOVING + (["not_a_joint"] if k % 2 else [])
             msg.position = _positions(k) + ([9.0] if k % 2 else [])
             pub.publish(msg)
-            time.sleep(0.1)
+            for collector in moving:  # one at a time: each node's queue holds one message, as ROS 1's
+                collector.wait_stamp(msg.header.stamp.to_nsec())
         for topic, count in expect.items():
             collectors[topic].wait(count)
         return collectors, procs
