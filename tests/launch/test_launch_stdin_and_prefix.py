@@ -1,11 +1,12 @@
-"""Two things course launch files rely on, side by side with Debian's roslaunch.
+"""What course launch files meet in ROS 1's roslaunch, side by side with Debian's.
 
 - A node reads roslaunch's own stdin: ``roslaunch turtlebot3_teleop turtlebot3_teleop_key.launch`` is
   how the TurtleBot3 book drives the robot, and turtlebot3_example's client asks for its goal with
   ``input()``. ROS 1 hands the nodes roslaunch's stdin; a node given /dev/null cannot be driven.
-- A launch-prefix naming a program that is not installed (a course's
-  ``launch-prefix="gnome-terminal --command"`` on a machine without GNOME) stops the launch with ROS
-  1's "bad launch-prefix" message and exit code 1, before any later node starts.
+- A launch-prefix naming a program that is not installed (a course's ``launch-prefix="gnome-terminal
+  --command"`` on a machine without GNOME) stops the launch with ROS 1's "bad launch-prefix"
+  message and exit code 1, before any later node starts; so does a node file without its ``#!``
+  line (ROS 1: "you may be missing a '#!' declaration").
 """
 
 from __future__ import annotations
@@ -47,6 +48,14 @@ PREFIX_LAUNCH = """<launch>
 </launch>
 """
 
+#: a node file without its "#!" line (a student's chmod +x'ed script): exec refuses it (ENOEXEC)
+NO_SHEBANG_LAUNCH = """<launch>
+  <node pkg="keys_pkg" type="plain_node" name="plain" output="screen"/>
+  <node pkg="keys_pkg" type="read_key.py" name="second" output="screen"/>
+</launch>
+"""
+NO_SHEBANG_LINE = "If it is a script, you may be missing a '#!' declaration at the top."
+
 BAD_PREFIX_LINES = (
     "Roslaunch got a 'No such file or directory' error while attempting to run:",
     "no-such-terminal-program --command ",
@@ -62,6 +71,9 @@ def _package(tmp: Path) -> Path:
     node = pkg / "read_key.py"
     node.write_text(READER)
     node.chmod(0o755)
+    plain = pkg / "plain_node"
+    plain.write_text("echo started without a shebang\n")
+    plain.chmod(0o755)
     return tmp / "src"
 
 
@@ -123,6 +135,15 @@ def test_a_missing_launch_prefix_program_stops_the_launch(tmp_path: Path) -> Non
     assert "process[first" not in out, out
 
 
+def test_a_node_file_without_shebang_stops_the_launch(tmp_path: Path) -> None:
+    src = _package(tmp_path)
+    (tmp_path / "plain.launch").write_text(NO_SHEBANG_LAUNCH)
+    code, out = _roslaunch(OURS, tmp_path / "plain.launch", _ours_env(tmp_path, src), "")
+    assert code == 1, out
+    assert "Unable to launch [plain" in out and NO_SHEBANG_LINE in out, out
+    assert "process[second" not in out, out
+
+
 @pytest.mark.ros1
 @pytest.mark.skipif(not Path(DEBIAN).exists(), reason="Debian's roslaunch is not installed")
 def test_stdin_and_bad_prefix_as_debians_roslaunch(tmp_path: Path) -> None:
@@ -137,4 +158,9 @@ def test_stdin_and_bad_prefix_as_debians_roslaunch(tmp_path: Path) -> None:
         assert code == 1, (command, out)
         for line in BAD_PREFIX_LINES:
             assert line in out, (command, out)
+        assert "process[second" not in out, (command, out)
+        (tmp_path / "plain.launch").write_text(NO_SHEBANG_LAUNCH)
+        code, out = _roslaunch(command, tmp_path / "plain.launch", env, "")
+        assert code == 1, (command, out)
+        assert "Unable to launch [plain" in out and NO_SHEBANG_LINE in out, (command, out)
         assert "process[second" not in out, (command, out)

@@ -133,6 +133,16 @@ class Supervisor:
             if not spec.is_core and not _runnable(spec.argv[0], spec.env):
                 self._fatal_launch(proc)
                 return
+            if not spec.is_core and not _exec_format_ok(spec.argv[0]):
+                # ROS 1's FatalProcessLaunch for ENOEXEC: a script without its "#!" line
+                self.write(
+                    f"RLException: Unable to launch [{spec.name}]. \n"
+                    "If it is a script, you may be missing a '#!' declaration at the top.\n"
+                )
+                proc.exit_code = 126
+                self.failed = True
+                self.shutdown()
+                return
             try:
                 # stdin is roslaunch's own, as in ROS 1: keyboard teleops and input() prompts started
                 # by a launch file (turtlebot3_teleop_key.launch) read the terminal roslaunch runs in
@@ -426,6 +436,19 @@ def _runnable(program: str, env: dict[str, str]) -> bool:
     if "/" in program:
         return os.path.isfile(program) and os.access(program, os.X_OK)
     return shutil.which(program, path=env.get("PATH", os.defpath)) is not None
+
+
+def _exec_format_ok(program: str) -> bool:
+    """False for a file exec would refuse with ENOEXEC: neither ELF nor starting with ``#!``
+    (a program found on PATH by name is left to exec)."""
+    if "/" not in program:
+        return True
+    try:
+        with open(program, "rb") as f:
+            head = f.read(4)
+    except OSError:
+        return True
+    return head.startswith((b"#!", b"\x7fELF"))
 
 
 def _stdout_write(text: str) -> None:
