@@ -1,9 +1,12 @@
 """CPU of robot_state_publisher at 50 Hz joint states for a 20-joint robot: ninjemys vs Debian's C++.
 
 Run: ``.venv/bin/python bench/robot_state_publisher.py`` (``--seconds N`` per round, default 20;
-``--rounds N``, default 1; ``--floor`` adds two stripped copies of ours that show where the floor is:
-``receive`` takes each JointState and does nothing with it, ``no_fk`` does everything but compute and
-serialise the transforms, publishing the first message it made again and again).
+``--rounds N``, default 1; ``--still``: the robot at rest, the same positions in every message (a
+joint_state_publisher with nothing moving), only the stamps new; ``--floor`` adds two stripped
+copies of ours that show where the floor is: ``receive`` takes each JointState and does nothing
+with it, ``no_fk`` does everything but compute and serialise the transforms, publishing the first
+message it made again and again; ``--compare SRC`` adds ours from another tree, two copies of each
+side interleaved, and prints their CPU ratio).
 
 One master (ours), one description (a chain of 20 revolute joints with odd origins and axes, and
 two fixed joints), one JointState stream at 50 Hz from this process with a new stamp every message.
@@ -66,7 +69,7 @@ FLOOR_PATCHES = {
         "import ninjemys.robot.tf_plan as m; init = m.TfPlan.__init__\n"
         "def once(self, *args, **kwargs):\n"
         "    init(self, *args, **kwargs); full, made = self.message, []\n"
-        "    self.message = lambda p, s, n: made[0] if made else made.append(full(p, s, n)) or made[0]\n"
+        "    self.message = lambda p, st: made[0] if made else made.append(full(p, st)) or made[0]\n"
         "m.TfPlan.__init__ = once"
     ),
 }
@@ -85,6 +88,11 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, default=20.0)
     parser.add_argument("--rounds", type=int, default=1)
     parser.add_argument("--floor", action="store_true", help="add the receive-only and no-FK copies of ours")
+    parser.add_argument(
+        "--still",
+        action="store_true",
+        help="the robot at rest: the same positions in every message, only the stamps change",
+    )
     parser.add_argument(
         "--compare",
         metavar="SRC",
@@ -132,8 +140,12 @@ def main() -> None:
         if opts.floor:
             commands.update({name: floor_command(name) for name in FLOOR_PATCHES})
         if opts.compare:
-            code = f"import sys; sys.path.insert(0, {opts.compare!r}); {FLOOR_MAIN}"
-            commands["base"] = [sys.executable, "-c", code, "/tf:=/tf_base", "__name:=rsp_base"]
+            # two copies of each side, started alike and interleaved: where the scheduler puts a
+            # process moves its CPU by up to +-10 % (the same tree twice differed that much)
+            here = str(Path(__file__).resolve().parent.parent / "src")
+            for name, tree in (("base", opts.compare), ("ours2", here), ("base2", opts.compare)):
+                code = f"import sys; sys.path.insert(0, {tree!r}); {FLOOR_MAIN}"
+                commands[name] = [sys.executable, "-c", code, f"/tf:=/tf_{name}", f"__name:=rsp_{name}"]
         counts.update(dict.fromkeys(commands, 0))
         for name in commands:
             node.subscriber(f"/tf_{name}", TFMessage, counter(name), queue_size=1000)
@@ -149,6 +161,7 @@ def main() -> None:
             names = [f"j{i}" for i in range(JOINTS)]
             period, k = 1.0 / 50.0, 0
             ratios = []
+            totals = dict.fromkeys(commands, 0.0)
             for round_ in range(opts.rounds):
                 start_cpu = {name: cpu_seconds(p.pid) for name, p in procs.items()}
                 with lock:
@@ -157,7 +170,8 @@ def main() -> None:
                 next_t = start
                 while time.monotonic() - start < opts.seconds:
                     stamp = time.time()
-                    msg = JointState(name=names, position=[0.01 * k + 0.1 * i for i in range(JOINTS)])
+                    moved = 0.0 if opts.still else 0.01 * k
+                    msg = JointState(name=names, position=[moved + 0.1 * i for i in range(JOINTS)])
                     msg.header.stamp = Time.from_sec(stamp)
                     pub.publish(msg)
                     k += 1
@@ -178,10 +192,15 @@ def main() -> None:
                         f"  {name:7s} CPU {100 * cpu[name] / wall:5.2f} % of a core, "
                         f"{sent[name]} transforms published{versus}"
                     )
+                for name in procs:
+                    totals[name] += cpu[name]
                 if "debian" in cpu and cpu["debian"] > 0:
                     ratios.append(cpu["ours"] / cpu["debian"])
                     print(f"  ratio ours/debian: {ratios[-1]:.2f}")
                 time.sleep(0.5)
+            if opts.compare:
+                ours, base = totals["ours"] + totals["ours2"], totals["base"] + totals["base2"]
+                print(f"A/B over {opts.rounds} rounds: (ours + ours2) / (base + base2) = {ours / base:.3f}")
             if len(ratios) > 1:
                 ratios.sort()
                 print(

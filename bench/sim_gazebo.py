@@ -18,7 +18,12 @@
    image, queue_size 1): the simulation must not wait for them (ROS 1 drops what a subscriber
    cannot take).
 
-Run alone: ``.venv/bin/python bench/sim_gazebo.py [--quick] [--before REV] [--only launch|ab]``.
+3. The camera alone: CPU time of one frame (colour + depth, 320x240) of the URDF PuzzleBot's camera
+   turning and driving in the office world, rendered in a child process by the older tree and by this
+   tree, alternating (process CPU time, the best of 5 repetitions of 300 frames each: a shared
+   machine's load disturbs it less than the real-time factor).
+
+Run alone: ``.venv/bin/python bench/sim_gazebo.py [--quick] [--before REV] [--only launch|ab|camera]``.
 """
 
 from __future__ import annotations
@@ -225,6 +230,61 @@ def bench_ab(before: str, duration: float, rounds: int) -> None:
             print(f"load average: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
 
 
+CAMERA_FRAMES = """
+import math, sys, time
+from ninjemys.sim.robot_model import load_robot_model
+from ninjemys.sim.simcore import Simulation
+from ninjemys.sim.world2d import load_world
+from ninjemys.sim.worlds import world_path
+sim = Simulation(load_world(world_path("office")), 0.01, 0)
+r = sim.add_robot("pb", load_robot_model(sys.argv[1]), 0.0, 0.0, 0.0)
+poses = [(0.5 * math.cos(i * 0.05), 0.5 * math.sin(i * 0.05), i * 0.05) for i in range(300)]
+for r.x, r.y, r.yaw in poses[:30]:
+    sim.render(r)
+best = math.inf
+for _ in range(5):
+    t = time.process_time()
+    for r.x, r.y, r.yaw in poses:
+        sim.render(r)
+    best = min(best, (time.process_time() - t) / len(poses))
+print(best * 1e3)
+"""
+
+
+def camera_frame_ms(src: Path | None) -> float:
+    """CPU ms of one camera frame (colour + depth) by the tree at ``src`` (None: this tree)."""
+    env = dict(os.environ)
+    if src is not None:
+        env["PYTHONPATH"] = str(src)
+    out = subprocess.run(
+        [sys.executable, "-c", CAMERA_FRAMES, str(URDF_MODEL)],
+        env=env,
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    return float(out.stdout.strip().splitlines()[-1])
+
+
+def bench_camera(before: str, rounds: int) -> None:
+    rev = subprocess.run(
+        ["git", "-C", str(ROOT), "rev-parse", "--short", before], capture_output=True, text=True, check=True
+    ).stdout.strip()
+    print(f"\n## the camera alone, A/B: {rev} (before) and this tree (after), alternating")
+    print("| frame (colour + depth, 320x240, office, URDF PuzzleBot) | before | after | after / before |")
+    print("|---|---:|---:|---:|")
+    with tempfile.TemporaryDirectory() as tmp:
+        old = extract_tree(before, Path(tmp))
+        a: list[float] = []
+        b: list[float] = []
+        for _ in range(rounds):
+            a.append(camera_frame_ms(old))
+            b.append(camera_frame_ms(None))
+        am, bm = statistics.median(a), statistics.median(b)
+        print(f"| CPU time, median of {rounds} | {am:.3f} ms | {bm:.3f} ms | {bm / am:.2f} |")
+        print(f"load average: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
+
+
 def default_before() -> str:
     out = subprocess.run(
         ["git", "-C", str(ROOT), "merge-base", "HEAD", "main"], capture_output=True, text=True
@@ -236,13 +296,15 @@ def main() -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--quick", action="store_true", help="fewer repetitions and shorter runs")
     p.add_argument("--before", default=None, help="the older tree (default: merge-base with main)")
-    p.add_argument("--only", choices=("launch", "ab"), help="run one part")
+    p.add_argument("--only", choices=("launch", "ab", "camera"), help="run one part")
     args = p.parse_args()
     print(f"load average: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
     if args.only in (None, "launch"):
         bench_launch(2 if args.quick else 5)
     if args.only in (None, "ab"):
         bench_ab(args.before or default_before(), 5.0 if args.quick else 10.0, 1 if args.quick else 2)
+    if args.only in (None, "camera"):
+        bench_camera(args.before or default_before(), 3 if args.quick else 5)
     print(f"load average: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
     return 0
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 import os
+import select
 import subprocess
 import sys
 import threading
@@ -19,7 +20,7 @@ from ninjemys import testing
 from ninjemys.idl.loader import get_message_class
 from ninjemys.node import Node
 from ninjemys.robot.kinematics import URDFError, parse_urdf, quaternion, rpy_matrix
-from ninjemys.rostime import Time
+from ninjemys.rostime import Duration, Time
 
 DEBIAN_RSP = Path("/usr/lib/robot_state_publisher/robot_state_publisher")
 
@@ -100,6 +101,15 @@ class _Collector:
                 key = (t.child_frame_id, t.header.stamp.to_nsec())
                 self.seen[key] = (t.header.frame_id, (tr.x, tr.y, tr.z, q.x, q.y, q.z, q.w))
 
+    def wait_stamp(self, stamp_ns: int, timeout: float = 30.0) -> None:
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            with self.lock:
+                if any(stamp == stamp_ns for _, stamp in self.seen):
+                    return
+            time.sleep(0.02)
+        raise AssertionError(f"no transform stamped {stamp_ns} arrived")
+
     def wait(self, count: int, timeout: float = 30.0) -> None:
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
@@ -114,6 +124,19 @@ def _start(argv: list[str], env: dict[str, str]) -> subprocess.Popen[bytes]:
     return subprocess.Popen(argv, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
 
 
+def _output_until(proc: subprocess.Popen[bytes], seen: bytearray, text: str, count: int) -> None:
+    """Read ``proc``'s output (unbuffered, into ``seen``) until ``text`` occurs ``count`` times."""
+    assert proc.stdout is not None
+    fd, deadline = proc.stdout.fileno(), time.monotonic() + 30
+    while seen.decode(errors="replace").count(text) < count:
+        left = deadline - time.monotonic()
+        assert left > 0, f"{text!r} not {count} times in 30 s: {seen.decode(errors='replace')}"
+        if select.select([fd], [], [], left)[0]:
+            chunk = os.read(fd, 65536)
+            assert chunk, f"the node exited: {seen.decode(errors='replace')}"
+            seen += chunk
+
+
 def _positions(k: int) -> list[float]:
     return [0.3 * k - 1.0, 0.2 * k - 0.9, -0.25 * k + 1.1, 0.4 * k, 0.01 * k, -0.15 * k + 0.5, 0.003 * k]
 
@@ -125,11 +148,13 @@ def master(tmp_path: Path):
         yield uri, dict(env, ROS_MASTER_URI=uri, ROS_HOSTNAME="localhost")
 
 
-def _run_arm(master, extra_nodes: list[list[str]], expect: dict[str, int], messages: int):
+def _run_arm(
+    master, extra_nodes: list[list[str]], expect: dict[str, int], messages: int, step_ns: int = 10**9
+):
     """Publish `messages` joint states to the state publishers in `extra_nodes` and wait, while the
-    subscribers still live, until each topic in `expect` has that many transforms. The states go
-    0.1 s apart: Debian's robot_state_publisher subscribes with a queue of one, so closer states can
-    be dropped on a loaded machine."""
+    subscribers still live, until each topic in `expect` has that many transforms. Each state is
+    sent once the one before it is out on every /tf topic: both nodes subscribe with a queue of one
+    (as ROS 1's), so states that arrive together are published newest only."""
     uri, env = master
     node = Node("rsp_check", master_uri=uri)
     procs: list[subprocess.Popen[bytes]] = []
@@ -139,22 +164,25 @@ def _run_arm(master, extra_nodes: list[list[str]], expect: dict[str, int], messa
         TFMessage = get_message_class("tf2_msgs/TFMessage")
         JointState = get_message_class("sensor_msgs/JointState")
         collectors = {t: _Collector() for t in expect}
-        for topic, collector in collectors.items():
-            node.subscriber(topic, TFMessage, collector, queue_size=1000)
+        subs = [node.subscriber(t, TFMessage, c, queue_size=1000) for t, c in collectors.items()]
         pub = node.publisher("/joint_states", JointState, queue_size=100)
         procs = [_start(argv, env) for argv in extra_nodes]
         deadline = time.monotonic() + 30
-        while pub.get_num_connections() < len(extra_nodes):
-            assert time.monotonic() < deadline, "the state publishers did not subscribe"
+        while pub.get_num_connections() < len(extra_nodes) or not all(
+            sub.get_num_connections() for sub in subs
+        ):
+            assert time.monotonic() < deadline, "the state publishers did not connect"
             time.sleep(0.05)
         time.sleep(0.5)
+        moving = [c for t, c in collectors.items() if "static" not in t]
         for k in range(messages):
             msg = JointState()
-            msg.header.stamp = Time(100 + k, 0)  # 1 s apart: never throttled by publish_frequency
+            msg.header.stamp = Time(100, 0) + Duration(0, step_ns * k)  # 1 s apart: no throttling
             msg.name = MOVING + (["not_a_joint"] if k % 2 else [])
             msg.position = _positions(k) + ([9.0] if k % 2 else [])
             pub.publish(msg)
-            time.sleep(0.1)
+            for collector in moving:  # one at a time: each node's queue holds one message, as ROS 1's
+                collector.wait_stamp(msg.header.stamp.to_nsec())
         for topic, count in expect.items():
             collectors[topic].wait(count)
         return collectors, procs
@@ -245,6 +273,19 @@ def test_same_transforms_as_debians_robot_state_publisher(master) -> None:
     assert max(abs(a - b) for a, b in zip(values, ovalues, strict=True)) < 1e-9
 
 
+@pytest.mark.ros1
+@pytest.mark.skipif(not DEBIAN_RSP.exists(), reason="Debian's ros-robot-state-publisher is not installed")
+def test_a_stream_stamped_at_publish_frequency_is_published_whole_as_by_debians(master) -> None:
+    """Stamps exactly 1/publish_frequency apart (simulated time at 50 Hz): ROS 1 publishes every one
+    (``stamp >= last + interval``); each node must publish all 8 transforms of all 6 messages."""
+    nodes = [
+        [str(DEBIAN_RSP), "/tf:=/tf_debian", "__name:=rsp_debian"],
+        _ours("robot_state_publisher", "/tf:=/tf_ours", "__name:=rsp_ours"),
+    ]
+    collectors, _ = _run_arm(master, nodes, {"/tf_debian": 6 * 8, "/tf_ours": 6 * 8}, 6, 20_000_000)
+    assert set(collectors["/tf_debian"].seen) == set(collectors["/tf_ours"].seen)
+
+
 def test_a_malformed_joint_state_is_reported_and_the_node_goes_on(master) -> None:
     uri, env = master
     node = Node("rsp_bad_input", master_uri=uri)
@@ -263,8 +304,12 @@ def test_a_malformed_joint_state_is_reported_and_the_node_goes_on(master) -> Non
             while pub.get_num_connections() < 1:
                 assert time.monotonic() < deadline
                 time.sleep(0.05)
-            pub.publish_raw(b"\x00\x01\x02")  # not a JointState
-            pub.publish_raw(b"\x00" * 12 + b"\xff\xff\xff\x7f")  # a frame_id longer than the message
+            # one at a time: the subscription's queue holds one message, as ROS 1's
+            seen = bytearray()
+            warning = "ignored a malformed JointState message"
+            for k, bad in enumerate((b"\x00\x01\x02", b"\x00" * 12 + b"\xff\xff\xff\x7f")):
+                pub.publish_raw(bad)  # not a JointState; a frame_id longer than the message
+                _output_until(proc, seen, warning, k + 1)
             good = JointState(name=MOVING, position=_positions(1))
             good.header.stamp = Time(7, 0)
             pub.publish(good)
@@ -272,6 +317,6 @@ def test_a_malformed_joint_state_is_reported_and_the_node_goes_on(master) -> Non
         finally:
             proc.terminate()
             out = proc.communicate(timeout=10)[0].decode()
-        assert out.count("ignored a malformed JointState message") == 2, out
+        assert (seen.decode() + out).count(warning) == 2, seen.decode() + out
     finally:
         node.shutdown("test done")

@@ -130,7 +130,7 @@ def test_plan_of_a_mimic_and_a_prismatic_joint_in_closed_form() -> None:
     mimics = {"finger_l_joint": [model.joints["finger_r_joint"]]}
     plan = TfPlan(["finger_l_joint", "j1"], model.joints, mimics, lambda joint: b"")
     assert plan.count == 3 and plan.known == ["finger_l_joint", "j1"]
-    values = struct.unpack("<I" + "III0s7d" * 3, plan.message((0.009, math.pi / 2), 7, 8))
+    values = struct.unpack("<I" + "III0s7d" * 3, plan.message((0.009, math.pi / 2), struct.pack("<II", 7, 8)))
     rows = [values[1 + 11 * i : 12 + 11 * i] for i in range(3)]
     # finger_l slides along y from y = 0.02; j1 turns about z from yaw 0.3; finger_r mimics -x + 0.001
     assert rows[0][:3] == (0, 7, 8) and rows[0][4:7] == pytest.approx((0.0, 0.029, 0.05))
@@ -187,3 +187,75 @@ def test_two_publishers_with_interleaved_stamps_are_no_clock_reset() -> None:
     assert warnings == [
         "Moved backwards in time (probably because ROS clock was reset), re-publishing joint transforms!"
     ]
+
+
+def test_a_robot_at_rest_gets_the_same_transforms_with_each_new_stamp() -> None:
+    """Positions repeated from the last message published (joint_state_publisher's robot at rest)
+    reuse that message with the new stamps: still what the general path publishes, message for
+    message, also when the stream moves again, repeats an older position or skips a stamp."""
+    fast, _ = _publisher({})
+    general, _ = _publisher({})
+    rest = [0.3 - 0.2 * i for i in range(len(MOVING))]
+    moved = [0.1 * i for i in range(len(MOVING))]
+    stream = [rest] * 4 + [moved] * 3 + [rest] * 2 + [moved] * 2
+    for k, positions in enumerate(stream):
+        stamp = (300 + k, 5_000_000 * k)
+        fast.node.clock = general.node.clock = Time(*stamp)
+        fast.on_raw(_Raw(_encode(MOVING, positions, *stamp)))
+        general.on_joint_state(tuple(MOVING), tuple(positions), *stamp)
+    entry = next(iter(fast.plans.values()))
+    assert entry.segments is not None  # the last message repeated the one before
+    assert len(fast.tf.sent) == len(general.tf.sent) == len(stream)
+    for ours, theirs in zip(fast.tf.sent, general.tf.sent, strict=True):
+        a, b = _transforms(ours), _transforms(theirs)
+        assert [t[:4] for t in a] == [t[:4] for t in b]
+        for ta, tb in zip(a, b, strict=True):
+            assert max(abs(x - y) for x, y in zip(ta[4], tb[4], strict=True)) < 1e-12, ta[1]
+
+
+def test_joints_without_origin_rotation_about_each_axis_match_the_general_pose() -> None:
+    """The generated code leaves out the terms a zero constant removes (an origin without rotation,
+    an axis along x, y, z or -z: most URDFs): the same poses as the general pose function."""
+    axes = ["1 0 0", "0 1 0", "0 0 1", "0 0 -1"]
+    urdf = (
+        '<robot name="r"><link name="l0"/>'
+        + "".join(
+            f'<link name="l{i + 1}"/><joint name="j{i}" type="continuous"><parent link="l{i}"/>'
+            f'<child link="l{i + 1}"/><origin xyz="0.1 0 {i}"/><axis xyz="{axis}"/></joint>'
+            for i, axis in enumerate(axes)
+        )
+        + "</robot>"
+    )
+    model = parse_urdf(urdf)
+    names = [f"j{i}" for i in range(len(axes))]
+    plan = TfPlan(names, model.joints, {}, lambda joint: b"")
+    assert "c * 0.0" not in plan.source.text and "s * 1.0" not in plan.source.text
+    for angle in (0.0, 0.4, 2.0, 3.0, -2.5, 6.0):
+        values = struct.unpack("<" + "4x8s0s7d" * len(axes), plan.message([angle] * len(axes), bytes(8))[4:])
+        for i, name in enumerate(names):
+            expected = model.joints[name].transform(angle)
+            assert values[2 + 9 * i : 9 + 9 * i] == pytest.approx(expected, abs=1e-12), (name, angle)
+
+
+@pytest.mark.parametrize("fast", [True, False])
+def test_a_stream_exactly_at_publish_frequency_is_published_whole(fast: bool) -> None:
+    """ROS 1 publishes when the stamp is at least one period after the joints' last one
+    (``stamp >= last + interval``, measured: Debian's node publishes all 50 of a stream stamped
+    20 ms apart at the default 50 Hz); closer stamps are throttled."""
+    rsp, _ = _publisher({})
+    steps = [20_000_000] * 6 + [10_000_000] * 4  # 6 at the period, then 4 at half of it
+    nsecs = 0
+    for step in steps:
+        nsecs += step
+        rsp.node.clock = Time(300, nsecs)
+        if fast:
+            rsp.on_raw(_Raw(_encode(MOVING, [nsecs * 1e-9] * len(MOVING), 300, nsecs)))
+        else:
+            rsp.on_joint_state(tuple(MOVING), (nsecs * 1e-9,) * len(MOVING), 300, nsecs)
+    assert len(rsp.tf.sent) == 6 + 2
+
+
+def test_publish_frequency_below_one_hertz_is_one_hertz() -> None:
+    assert _publisher({"~publish_frequency": 0.0})[0].interval_ns == 1_000_000_000
+    assert _publisher({"~publish_frequency": 0.25})[0].interval_ns == 1_000_000_000
+    assert _publisher({"~publish_frequency": 10.0})[0].interval_ns == 100_000_000

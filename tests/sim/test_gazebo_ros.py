@@ -159,7 +159,8 @@ def test_real_rosservice_and_rospy_move_a_model_and_model_states_follow(gazebo: 
     assert out.returncode == 0, out.stderr
     lines = out.stdout.splitlines()
     assert lines[0] == "True 2.0 -1.0 GetModelState: got properties"
-    assert lines[1] == "['puzzlebot'] GetWorldProperties: got properties"
+    # empty.world's ground plane is a model, listed first, as Gazebo lists it
+    assert lines[1] == "['ground_plane', 'puzzlebot'] GetWorldProperties: got properties"
     assert lines[2] == "False GetModelState: model does not exist"
     # the topic form of set_model_state
     pub = gazebo.real(
@@ -215,7 +216,7 @@ def test_spawn_and_delete_sdf_and_urdf_models_refused_inside_a_wall(gazebo: Gaze
     for name in ("guest", "crate"):
         resp = gazebo.call("/gazebo/delete_model", DeleteModel, model_name=name)
         assert (resp.success, resp.status_message) == (True, "DeleteModel: successfully deleted model")
-    assert set(gazebo.model_states()) == {"puzzlebot"}
+    assert set(gazebo.model_states()) == {"ground_plane", "puzzlebot"}
     resp = gazebo.call("/gazebo/delete_model", DeleteModel, model_name="crate")
     assert not resp.success and resp.status_message.startswith("DeleteModel: model does not exist")
 

@@ -223,6 +223,9 @@ def test_spawning_several_pieces_onto_a_robot_is_refused_unless_held_above_it(si
     assert spawn(sim, "dropped", box_physics, 2.0, 0.0, 1.0).success
     assert sim.gazebo.model_pose("dropped") == pytest.approx((2.0, 0.0, 0.2, 0.0))  # resting on the floor
     box = '<sdf version="1.6">' + BOX.format(name="b", static="", x=0, y=0, z=0) + "</sdf>"
+    dreq = DeleteModel._request_class()
+    dreq.model_name = "over"  # (the table top over the robot would hold it: test_drop_onto_a_table.py)
+    assert sim.gazebo._delete(dreq).success
     resp = spawn(sim, "falls", box, 0.0, 0.0, 1.0)
     assert not resp.success and "would overlap robot [puzzlebot]" in resp.status_message
 

@@ -239,8 +239,8 @@ def test_stl_ascii_and_binary_and_connected_parts(tmp_path):
 @pytest.mark.parametrize(
     ("text", "pattern"),
     [
-        ('<sdf version="1.6"><world name="w"><model name="m">\n<pose>1 2 3</pose></model></world></sdf>',
-         r"w.world:2: <pose>: expected 6 numbers \(x y z roll pitch yaw\), got '1 2 3'"),
+        ('<sdf version="1.6"><world name="w"><model name="m">\n<pose>1 2 3 4</pose></model></world></sdf>',
+         r"w.world:2: <pose>: expected 6 numbers \(x y z roll pitch yaw\), got '1 2 3 4'"),
         ('<sdf version="1.6"><world name="w">\n<model name="m"><link name="l"><collision name="c">'
          "<geometry><box/></geometry></collision></link></model></world></sdf>",
          r"w.world:2: <box>: missing <size>"),

@@ -334,7 +334,14 @@ def test_spawn_model_xml_kinds():
     box = parse_model_xml(
         '<robot name="b"><link name="l"><collision><geometry><box size="0.4 0.6 0.5"/></geometry></collision></link></robot>'
     )
-    assert box == ("obstacle", ("box", (0.4, 0.6), 0.5, (180, 130, 80)))
+    assert box[0] == "obstacle"
+    assert (box[1].kind, box[1].size, box[1].height, box[1].colour) == (
+        "box",
+        (0.4, 0.6),
+        0.5,
+        (180, 130, 80),
+    )
+    assert box[1].bottom == pytest.approx(-0.25) and not box[1].static  # centred on its origin: falls
     # an SDF document goes through the SDF reader: its footprint, standing on the floor (a cylinder
     # centred on the model's origin reaches below it), as spawn_sdf_model places it
     kind, (cyl,) = parse_model_xml(

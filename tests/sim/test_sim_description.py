@@ -31,7 +31,7 @@ def test_diff_drive_variant_gives_the_makers_names_and_geometry():
     # the footprint is the chassis box about base_footprint: corner (-0.11, 0.08); top 0.05 + 0.08
     assert m.body_radius == pytest.approx(math.hypot(0.11, 0.08))
     assert m.body_height == pytest.approx(0.13)
-    assert m.color == (0, 0, 204)  # Gazebo/Blue on base_link wins over the URDF's visual colour
+    assert m.color == (0, 0, 255)  # Gazebo/Blue on base_link wins over the URDF's visual colour
     d = m.drive
     assert d.kind == "diff_drive"
     assert (d.command_topic, d.odom_topic, d.odom_frame, d.base_frame) == (

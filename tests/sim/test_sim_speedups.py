@@ -11,12 +11,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from camera_reference import assert_matches_reference
 
-from ninjemys.sim import sensors
+from ninjemys.sim import camera as sim_camera
 from ninjemys.sim.puzzlebot_node import keep_freed_memory
 from ninjemys.sim.raycast import cast_segments
 from ninjemys.sim.robot_model import load_robot_model
-from ninjemys.sim.sensors import FLOOR_RGB, SKY_RGB
+from ninjemys.sim.sensors import Scene
 from ninjemys.sim.simcore import Simulation
 from ninjemys.sim.stepper import StepLock
 from ninjemys.sim.world2d import load_world
@@ -29,7 +30,7 @@ def test_span_mask_and_masked_paint_equal_where(height):
     touching the first or last row too, uint8 rows up to 255 and uint16 rows beyond), over the whole
     image and over a band of rows; the masked paint into a band of an image equals ``np.where``."""
     width = 37
-    cam = sensors.Camera(width, height, 60.0, 0.12, 10.0)
+    cam = sim_camera.Camera(width, height, 60.0, 0.12, 10.0)
     rng = np.random.default_rng(height)
     rows = np.arange(height)[:, None]
     for _ in range(20):
@@ -56,76 +57,13 @@ def test_span_mask_and_masked_paint_equal_where(height):
             assert np.array_equal(image, expect)
 
 
-def ray_hits(x: float, y: float, angle: float, segs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Distances along one ray to every segment it crosses, nearest first, and those segments."""
-    dx, dy = math.cos(angle), math.sin(angle)
-    ex, ey = segs[:, 2] - segs[:, 0], segs[:, 3] - segs[:, 1]
-    px, py = segs[:, 0] - x, segs[:, 1] - y
-    den = dx * ey - dy * ex
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t = (px * ey - py * ex) / den
-        s = (px * dy - py * dx) / den
-    ok = (den != 0) & (t > 0) & (s >= 0) & (s <= 1)
-    idx = np.flatnonzero(ok)
-    order = np.argsort(t[idx], kind="stable")
-    return t[idx][order], idx[order]
-
-
-def reference_render(sim: Simulation, r) -> tuple[np.ndarray, np.ndarray]:  # type: ignore[no-untyped-def]
-    """The camera image drawn the slow, obvious way: for each pixel, the nearest obstacle along its
-    column's ray that the pixel's ray meets between the floor and the obstacle's top (so a tall wall
-    shows above a desk in front of it); else floor below the horizon, else sky."""
-    cam = r.camera
-    spec = r.model.camera
-    scene = sim.scene(r.name)
-    x, y = sim.sensor_pose(r, spec.pose.xyz)
-    yaw = r.yaw + spec.pose.rpy[2]
-    far = cam.depth_max / float(cam.col_cos.min())
-    rgb = np.zeros((cam.height, cam.width, 3), dtype=np.uint8)
-    depth = np.zeros((cam.height, cam.width), dtype=np.uint16)
-    for u in range(cam.width):
-        dists, segs = ray_hits(x, y, yaw + cam.col_angles[u], scene.segments)
-        keep = dists <= far
-        depths, segs = dists[keep] * cam.col_cos[u], segs[keep]
-        keep = depths <= cam.depth_max
-        depths, segs = depths[keep], segs[keep]
-        for v in range(cam.height):
-            slope = cam.row_slope[v]
-            z = cam.cam_z + slope * depths
-            covering = np.flatnonzero((z >= 0.0) & (z <= scene.heights[segs] + 1e-12))
-            if len(covering):
-                k = covering[0]
-                d = depths[k]
-                light = min(max(1.1 - d / 15.0, 0.45), 1.0)
-                rgb[v, u] = (scene.colors[segs[k]].astype(np.float32) * light).astype(np.uint8)
-                depth[v, u] = round(d * 1000.0)
-            elif slope < -1e-9:
-                floor = cam.cam_z / -slope
-                floor = floor if floor <= cam.depth_max else 0.0  # beyond the depth range: no data
-                shade = min(max(1.15 - floor / 12.0, 0.55), 1.0)
-                rgb[v, u] = (shade * FLOOR_RGB).astype(np.uint8)
-                depth[v, u] = round(floor * 1000.0)
-            else:
-                rgb[v, u] = SKY_RGB.astype(np.uint8)
-    return rgb, depth
-
-
-def test_camera_matches_a_per_pixel_renderer(monkeypatch):
-    """Colour and depth of the office seen from three poses, pixel by pixel (a pixel on a wall's
-    exact top or foot row may go either way in floating point: at most one such row per column).
-    Every height class is a layer here (the office has nine), so the layered renderer is exact."""
-    monkeypatch.setattr(sensors, "MAX_EXTRA_LAYERS", 16)
+def test_camera_matches_a_per_pixel_renderer():
+    """Colour and depth of the office seen from three poses, pixel by pixel."""
     sim = Simulation(load_world(world_path("office")), 0.01, 0)
     r = sim.add_robot("pb", load_robot_model("puzzlebot"), 0.0, 0.0, 0.0)
     for x, y, yaw in ((0.0, 0.0, 0.3), (-3.0, 0.2, 1.4), (2.5, -0.3, -2.0)):
         r.x, r.y, r.yaw = x, y, yaw
-        rgb, depth = sim.render(r)
-        ref_rgb, ref_depth = reference_render(sim, r)
-        assert rgb.shape == ref_rgb.shape and depth.dtype == np.uint16
-        rgb_off = (rgb != ref_rgb).any(axis=2).sum(axis=0)
-        depth_off = (depth != ref_depth).sum(axis=0)
-        assert rgb_off.max() <= 1 and depth_off.max() <= 1
-        assert rgb_off.sum() < 20 and depth_off.sum() < 20
+        assert_matches_reference(sim, r)
 
 
 def walker_world(tmp_path: Path, waypoints: str) -> Simulation:
@@ -260,7 +198,7 @@ def test_casts_that_skip_back_faces_see_the_same(world):
     for x, y, yaw in valid_poses(sim, 25, 3):
         r.x, r.y, r.yaw = x, y, yaw
         scene = sim.scene(r.name)
-        plain = sensors.Scene(**{**scene.__dict__, "facing": None})
+        plain = Scene(**{**scene.__dict__, "facing": None})
         angles = yaw + np.linspace(-math.pi, math.pi, 360, endpoint=False)
         culled, _ = cast_segments(x, y, angles, scene.segments, 12.0, scene.facing)
         full, _ = cast_segments(x, y, angles, scene.segments, 12.0)

@@ -35,6 +35,7 @@ ALLOWED_ROUTES = {
     ): "rqt_bag: play the file (onto ROS topics, which the pages see via the gateway)",
     ("POST", "/api/rqt/bag/pause"): "rqt_bag: pause the player",
     ("GET", "/api/turtlesim/snapshot.png"): "a still image of the canvas (screenshots and tests)",
+    ("GET", "/api/puzzlebot/floor.png"): "a picture on the simulated world's floor (a file's texture)",
     ("GET", "/api/bridge/status"): "the gateway's own status (clients, queues)",
 }
 

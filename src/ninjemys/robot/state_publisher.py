@@ -6,8 +6,10 @@ every joint that mimics one), parent link -> child link on ``/tf`` stamped with 
 stamp. Fixed joints go once on the latched ``/tf_static`` (``~use_tf_static``, default true), or
 else on ``/tf`` every ``1/publish_frequency`` stamped half a second ahead, as ROS 1 does.
 
-``~publish_frequency`` (50 Hz) throttles a joint's transforms to that rate unless
-``~ignore_timestamp`` is set; ``tf_prefix`` (searched up the namespace) prefixes frames with tf's
+``~publish_frequency`` (50 Hz; below 1 Hz taken as 1, as ROS 1) throttles a joint's transforms to
+that rate unless ``~ignore_timestamp`` is set: a message is published when its stamp is at least one
+period after the joints' last, so a stream exactly at that rate goes out whole; the subscription's
+queue holds one message, as ROS 1's (a backlog is published newest only); ``tf_prefix`` (searched up the namespace) prefixes frames with tf's
 resolve rule. A message naming joints the robot does not have is used for the joints it does
 have, with one warning per new set of unknown names (ROS 1 ignores them silently).
 """
@@ -43,7 +45,7 @@ class StatePublisher:
         self.node, self.model, self.warn = node, model, log
         self.TFMessage = get_message_class("tf2_msgs/TFMessage")
         self.frequency = float(node.get_param("~publish_frequency", 50.0))
-        self.interval = Duration.from_sec(1.0 / self.frequency) if self.frequency > 0 else Duration(0)
+        self.interval = Duration.from_sec(1.0 / max(self.frequency, 1.0))  # as ROS 1: at least 1 Hz
         self.ignore_timestamp = bool(node.get_param("~ignore_timestamp", False))
         self.use_tf_static = bool(node.get_param("~use_tf_static", True))
         prefix_key = node.search_param("tf_prefix")
@@ -67,13 +69,15 @@ class StatePublisher:
         #: the list of names that followed itself, and its joints' last stamp (see :meth:`_admit`)
         self.streak: _Entry | None = None
         self.streak_ns = 0
-        self.sub = node.subscriber("joint_states", JointState, self.on_raw, queue_size=100, raw=True)
+        # a queue of one, as ROS 1's node: a backlog (a slow moment, a burst) is read and only the
+        # newest message of it published
+        self.sub = node.subscriber("joint_states", JointState, self.on_raw, queue_size=1, raw=True)
 
     def start(self) -> None:
         """Fixed joints: once, latched (use_tf_static), or on a timer on /tf."""
         if self.use_tf_static:
             self.tf_static.publish_raw(self._message(self.model.fixed, {}, self.node.now()))
-        elif self.model.fixed and self.frequency > 0:
+        elif self.model.fixed:
             self.node.timer(self.interval, lambda _e: self._publish_fixed_on_tf())
 
     def _publish_fixed_on_tf(self) -> None:
@@ -90,6 +94,8 @@ class StatePublisher:
         throttle's record needs no lock); the steady case is written out inline, as this runs 50 times
         a second with cold caches, where every call and attribute costs."""
         data = raw.data
+        if data.__class__ is memoryview:  # a view into a shared-memory ring (a message of >64 KiB)
+            data = data.tobytes()
         try:
             secs, nsecs, frame_len = _STAMP_FRAME.unpack_from(data, 4)
             start = 16 + frame_len
@@ -101,26 +107,39 @@ class StatePublisher:
                     self._general(data, secs, nsecs, key, count, start + len(key))
                     return
                 self.last_entry = entry
-            try:
-                found = entry.positions.unpack_from(data, start + entry.size)  # the count, then positions
-            except struct.error:
-                found = None
-            if found is None or found[0] != entry.count:  # the general path says what is wrong
-                self._general(data, secs, nsecs, entry.key, entry.count, start + entry.size)
-                return
+            offset = start + entry.size  # the position count, then the positions
+            still = entry.still
+            if still is not None and data.startswith(still, offset):
+                found = None  # the positions of the last message published: only the stamps change
+            else:
+                try:
+                    found = entry.positions.unpack_from(data, offset)
+                except struct.error:
+                    found = None
+                if found is None or found[0] != entry.count:  # the general path says what is wrong
+                    self._general(data, secs, nsecs, entry.key, entry.count, offset)
+                    return
         except (struct.error, UnicodeDecodeError, IndexError, ValueError):
             self.warn("Robot state publisher ignored a malformed JointState message")
             return
         now_ns = secs * 1_000_000_000 + nsecs
         if self.streak is entry and now_ns >= self.last_stamp_ns:  # the steady case of _admit
             self.last_stamp_ns = now_ns
-            if now_ns <= self.streak_ns + self.interval_ns and not self.ignore_timestamp:
+            if now_ns < self.streak_ns + self.interval_ns and not self.ignore_timestamp:
                 return
             self.streak_ns = now_ns
         elif not self._admit(entry, now_ns):
             return
-        if entry.plan.count:
-            self.tf.publish_framed(entry.plan.message(found, secs, nsecs))
+        if not entry.plan.count:
+            return
+        if found is None:
+            if entry.segments is None:
+                entry.segments = entry.plan.segments(entry.frame)
+            self.tf.publish_framed(data[4:12].join(entry.segments))
+            return
+        entry.frame = frame = entry.plan.message(found, data[4:12])
+        entry.still, entry.segments = data[offset : offset + entry.span], None
+        self.tf.publish_framed(frame)
 
     def _general(self, data: Any, secs: int, nsecs: int, key: bytes, count: int, offset: int) -> None:
         """A list of names without a plan yet (or positions that do not match it): decoded in full."""
@@ -156,8 +175,9 @@ class StatePublisher:
         return bytes(data[start:offset]), count
 
     def _admit(self, entry: _Entry, now_ns: int) -> bool:
-        """ROS 1's throttle: publish unless every joint named was published less than one interval ago
-        (``ignore_timestamp`` publishes all); a stamp older than the last one clears the record.
+        """ROS 1's throttle: publish when the stamp is at least one interval after the oldest last
+        stamp of the joints named (``ignore_timestamp`` publishes all): a stream exactly at
+        ``publish_frequency`` (simulated time) is published whole; the clock going back clears it.
 
         While one list of names follows itself, the record of its joints is one number (the streak,
         whose steady case :meth:`on_raw` checks inline) instead of a stamp per joint; another list (or
@@ -167,13 +187,13 @@ class StatePublisher:
         if not known:
             return False
         if self.streak is entry:
-            if not self.ignore_timestamp and now_ns <= self.streak_ns + self.interval_ns:
+            if not self.ignore_timestamp and now_ns < self.streak_ns + self.interval_ns:
                 return False
             self.streak_ns = now_ns
             return True
         self._flush_streak()
         last = self.last_published
-        if not self.ignore_timestamp and now_ns <= min(map(last.get, known, entry.zeros)) + self.interval_ns:
+        if not self.ignore_timestamp and now_ns < min(map(last.get, known, entry.zeros)) + self.interval_ns:
             return False
         self.streak, self.streak_ns = entry, now_ns
         return True
@@ -185,7 +205,7 @@ class StatePublisher:
             return False
         self._flush_streak()
         last = self.last_published
-        if not self.ignore_timestamp and now_ns <= min(last.get(n, 0) for n in known) + self.interval_ns:
+        if not self.ignore_timestamp and now_ns < min(last.get(n, 0) for n in known) + self.interval_ns:
             return False
         last.update(dict.fromkeys(known, now_ns))
         return True
@@ -267,13 +287,31 @@ class _Entry:
     precompiled unpacking of the position count and positions that follow it (the plan takes them
     as unpacked, count first)."""
 
-    __slots__ = ("count", "key", "known", "plan", "positions", "size", "zeros")
+    __slots__ = (
+        "count",
+        "frame",
+        "key",
+        "known",
+        "plan",
+        "positions",
+        "segments",
+        "size",
+        "span",
+        "still",
+        "zeros",
+    )
 
     def __init__(self, key: bytes, count: int, plan: TfPlan) -> None:
         self.key, self.size, self.count, self.plan = key, len(key), count, plan
         self.known = plan.known
         self.zeros = [0] * len(self.known)
         self.positions = struct.Struct(f"<I{count}d")
+        self.span = self.positions.size
+        #: the count and positions (as received) of the last message published, and its frame; the
+        #: frame cut around its stamps once a message repeats them (None until then)
+        self.still: bytes | None = None
+        self.frame = b""
+        self.segments: list[bytes] | None = None
 
 
 def _names(section: bytes, count: int) -> tuple[str, ...]:

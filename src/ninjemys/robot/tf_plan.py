@@ -14,8 +14,11 @@ from the received bytes and, per moving joint:
   origin's translation;
 * a prismatic one: the origin's translation plus ``value`` times the rotated axis, the origin's rotation;
 
-and packs the whole TFMessage with one precompiled ``struct`` (the frame names are constant arguments,
-seq 0 as tf2 sends). Why generated: the node wakes 50 times a second with its caches cold, and then
+and packs the whole TFMessage with one precompiled ``struct``. What does not change is one bytes
+literal per run of it (the length and count; a transform's frame names with a revolute joint's
+translation, or a prismatic joint's rotation), the seq (0, as tf2 sends) pad bytes, and the stamp the
+8 bytes received: per transform 6 arguments instead of 11, each a conversion of the ``struct``'s loop
+(measured ~20 % of a message's FK and packing). Why generated: the node wakes 50 times a second with its caches cold, and then
 each bytecode costs several times what it costs in a loop; a loop over rows of constants spends most
 of its bytecodes unpacking the rows. The straight-line function runs only the arithmetic (about half
 the bytecodes), and is cheaper than numpy for a robot of a few dozen joints, whose per-call overhead
@@ -38,13 +41,16 @@ from collections.abc import Callable, Sequence
 from ninjemys.robot.kinematics import Joint, apply_rotation, quaternion
 
 _MOVING = frozenset(("revolute", "continuous", "prismatic"))
+_TRANSLATION = struct.Struct("<3d")
+_ROTATION = struct.Struct("<4d")
 
 
 class TfPlan:
     """The transforms of one list of joint names (see the module docstring).
 
-    ``message(positions, secs, nsecs) -> bytes`` is the serialized TFMessage; ``positions`` are the
-    message's, in its order, after ``skip`` leading items (the unpacked position count, say). With
+    ``message(positions, stamp) -> bytes`` is the serialized TFMessage; ``positions`` are the
+    message's, in its order, after ``skip`` leading items (the unpacked position count, say), and
+    ``stamp`` the 8 bytes of a ``time`` (secs, nsecs, little-endian: the JointState's, as received). With
     ``framed`` it is the whole TCPROS frame: the length (constant for a plan) packed in front."""
 
     def __init__(
@@ -70,8 +76,10 @@ class TfPlan:
                 if mimic.type != "fixed":
                     moving.append(mimic)
         self.count = len(moving)
+        #: the offset of each transform's stamp in a message (see :meth:`segments`)
+        self.stamps: list[int] = []
         self.source = _Source()
-        self.message: Callable[[Sequence[float], int, int], bytes] = self._compile(
+        self.message: Callable[[Sequence[float], bytes], bytes] = self._compile(
             moving, values, frames, framed
         )
 
@@ -81,15 +89,20 @@ class TfPlan:
         values: dict[str, tuple[int, float, float]],
         frames: Callable[[Joint], bytes],
         framed: bool,
-    ) -> Callable[[Sequence[float], int, int], bytes]:
+    ) -> Callable[[Sequence[float], bytes], bytes]:
         src = self.source
-        fmt = ["<I"]
+        # what never changes goes into the struct as bytes ('s'), a run of it one argument: the
+        # length and count, each transform's frame names with a revolute joint's translation (or a
+        # prismatic one's rotation), and the seq (0) as pad bytes; per transform the stamp (8 bytes,
+        # as received) and the 4 (or 3) moving floats are the only other arguments
+        fmt = ["<"]
         body: list[str] = []
-        args = [str(self.count)]
+        args: list[str] = []
+        stamps: list[int] = []  # where in fmt each transform's seq pad and stamp are
+        head = struct.pack("<I", self.count)
         for k, joint in enumerate(moving):
             index, a, b = values[joint.name]
             frame = frames(joint)
-            fmt.append(f"III{len(frame)}s7d")
             ox, oy, oz, ow = quaternion(joint.rotation)
             x0, y0, z0 = joint.xyz
             lit = src.literal
@@ -97,8 +110,13 @@ class TfPlan:
                 dx, dy, dz = apply_rotation(joint.rotation, joint.axis)
                 v = f"v{k}"  # every value lives until the one pack at the end: a name per joint
                 body.append(f"{v} = p[{index}]{_affine(a, b, lit)}")
-                pose = [f"{lit(x0)} + {lit(dx)} * {v}", f"{lit(y0)} + {lit(dy)} * {v}"]
-                pose += [f"{lit(z0)} + {lit(dz)} * {v}", lit(ox), lit(oy), lit(oz), lit(ow)]
+                _constant(fmt, args, head)
+                stamps.append(len(fmt))
+                fmt.append(f"4x8s{len(frame)}s3d")
+                args += ["stamp", repr(frame)]
+                args += [f"{lit(x0)} + {lit(dx)} * {v}", f"{lit(y0)} + {lit(dy)} * {v}"]
+                args.append(f"{lit(z0)} + {lit(dz)} * {v}")
+                head = _ROTATION.pack(ox, oy, oz, ow)
             else:
                 if (
                     joint.type not in _MOVING
@@ -111,23 +129,51 @@ class TfPlan:
                 body += [
                     f"h = p[{index}]{_affine(a * 0.5, b * 0.5, lit)}",
                     "c = cos(h); s = sin(h)",
-                    f"{q[0]} = c * {lit(ox)} + s * {lit(bx)}; {q[1]} = c * {lit(oy)} + s * {lit(by)}",
-                    f"{q[2]} = c * {lit(oz)} + s * {lit(bz)}; {q[3]} = c * {lit(ow)} + s * {lit(bw)}",
+                    f"{q[0]} = {_mix(ox, bx, lit)}; {q[1]} = {_mix(oy, by, lit)}",
+                    f"{q[2]} = {_mix(oz, bz, lit)}; {q[3]} = {_mix(ow, bw, lit)}",
                     *_sign(*q),
                 ]
-                pose = [lit(x0), lit(y0), lit(z0), *q]
-            args += ["0", "secs", "nsecs", src.constant(frame), *pose]
-        if framed:
-            fmt[0] = "<II"
-            args.insert(0, str(struct.calcsize("".join(fmt)) - 4))
+                constant = frame + _TRANSLATION.pack(x0, y0, z0)
+                _constant(fmt, args, head)
+                stamps.append(len(fmt))
+                fmt.append(f"4x8s{len(constant)}s4d")
+                args += ["stamp", repr(constant), *q]
+                head = b""
+        _constant(fmt, args, head)
+        if framed:  # the length in front, with the count (fmt[1], args[0]): one constant
+            first = struct.pack("<II", struct.calcsize("".join(fmt)), self.count)
+            fmt[1], args[0] = f"{len(first)}s", repr(first)
+        self.stamps = [struct.calcsize("".join(fmt[:i])) + 4 for i in stamps]
         src.names["pack"] = struct.Struct("".join(fmt)).pack
         # the functions as defaults: local names, cheaper than globals on every use
         lines = [
-            "def message(p, secs, nsecs, cos=cos, sin=sin, pack=pack):",
+            "def message(p, stamp, cos=cos, sin=sin, pack=pack):",
             *(f"    {line}" for line in body),
         ]
         lines.append(f"    return pack({', '.join(args)})")
         return src.function("\n".join(lines), "message")
+
+    def segments(self, message: bytes) -> list[bytes]:
+        """``message`` cut around its stamps: ``stamp.join(segments)`` is the same message with
+        another stamp (a stream whose positions have not changed: a robot at rest)."""
+        cuts = [0, *(o for offset in self.stamps for o in (offset, offset + 8)), len(message)]
+        return [message[cuts[i] : cuts[i + 1]] for i in range(0, len(cuts), 2)]
+
+
+def _constant(fmt: list[str], args: list[str], data: bytes) -> None:
+    """Constant bytes into the struct: one ``s`` item and its literal (nothing when empty)."""
+    if data:
+        fmt.append(f"{len(data)}s")
+        args.append(repr(data))
+
+
+def _mix(a: float, b: float, lit: Callable[[float], str]) -> str:
+    """``c * a + s * b`` as source, without the terms a zero removes or the products a one does
+    (an origin without rotation and an axis along x, y or z, as most URDFs have them: a joint's
+    quaternion is then ``(0, 0, s, c)``, 2 assignments instead of 4 sums of 2 products)."""
+    terms = [f"{name}" if k == 1.0 else f"-{name}" if k == -1.0 else f"{name} * {lit(k)}"
+             for name, k in (("c", a), ("s", b)) if k != 0.0]  # fmt: skip
+    return " + ".join(terms) if terms else "0.0"
 
 
 def _affine(a: float, b: float, lit: Callable[[float], str]) -> str:

@@ -10,7 +10,10 @@ the links fixed to its base, 1 kg without any), and its wheels stop it when the 
 ``/gazebo/model_states`` and ``/gazebo/link_states`` out (every physics step, while subscribed),
 ``/gazebo/set_model_state`` in.
 
-The world is flat: a model's pose has the height it was spawned with and no roll or pitch. Models
+The world is flat: a model's pose has no roll or pitch. Its height is where Gazebo's physics leaves
+it: a robot stands on the floor (the z of its root link when its wheels touch it, whatever ``-z`` it
+was spawned with), a static model stays where it was put, and a model with physics falls onto the
+floor or onto what is under it (a box dropped over a table lands on the table top). Models
 are the robots (links: the base, the wheels and the sensors) and the static obstacles (one link,
 ``link``, or the links of an SDF model of several pieces: spawned, moved and deleted whole).
 Everything here runs under the simulation's lock; nothing here publishes per robot.
@@ -28,10 +31,11 @@ import numpy as np
 from ninjemys.idl.loader import get_message_class, get_service_class
 from ninjemys.maps.mapfile import MapFileError
 from ninjemys.rostime import Time
+from ninjemys.sim.gazebo_materials import stock_colour
 from ninjemys.sim.robot_model import load_robot_model, model_from_urdf
-from ninjemys.sim.sdf import sdf_model_obstacles
+from ninjemys.sim.sdf import Support, rest_height, sdf_model_obstacles
 from ninjemys.sim.simcore import Robot, SpawnError, wrap_angle
-from ninjemys.sim.world2d import Obstacle
+from ninjemys.sim.world2d import Obstacle, box_outline, circle_outline
 from ninjemys.tf2.math import quaternion_from_yaw, yaw_from_quaternion
 
 if TYPE_CHECKING:
@@ -123,6 +127,18 @@ class GazeboApi:
     def __init__(self, sim_node: SimNode) -> None:
         self.sn = sim_node
         self.heights: dict[str, float] = {}  # model -> the z it was spawned at
+        self.spawned: dict[str, None] = {}  # the models spawned since the start, in order (robots aside)
+        world = sim_node.sim.world
+        #: models with nothing the floor plan holds (a ground plane): Gazebo lists them all the same
+        self.bare: dict[str, Planar] = {
+            name: (
+                *world.model_poses[name][:2],
+                world.model_heights.get(name, 0.0),
+                world.model_poses[name][2],
+            )
+            for name in world.bare_models
+            if name in world.model_poses
+        }
         self.pushes: dict[str, Push] = {}
         n = sim_node.node
         for name, cls, handler in (
@@ -151,11 +167,17 @@ class GazeboApi:
 
     # -- the model tree ----------------------------------------------------------------------------
     def model_names(self) -> list[str]:
+        """Gazebo's order: the world file's models as the file has them (a ground plane first, as
+        empty_world's is), then the models spawned since, then the robots."""
         sim = self.sn.sim
-        return list(dict.fromkeys(o.model_name for o in sim.world.obstacles)) + list(sim.robots)
+        solid = dict.fromkeys(o.model_name for o in sim.world.obstacles)
+        exists = [*sim.world.model_poses, *self.spawned, *solid, *self.bare]
+        return [n for n in dict.fromkeys(exists) if n in solid or n in self.bare] + list(sim.robots)
 
     def obstacle_links(self, name: str) -> dict[str, list[str]]:
         """A static model's links and, per link, its collisions (``link`` for a model of one piece)."""
+        if name in self.bare:
+            return {"link": ["collision"]}  # a ground plane's one link and its plane
         links: dict[str, list[str]] = {}
         for o in self.sn.sim.world.obstacles:
             if o.model_name != name:
@@ -171,14 +193,20 @@ class GazeboApi:
 
     def model_pose(self, name: str) -> Planar | None:
         sim = self.sn.sim
+        if name in self.bare:
+            return self.bare[name]
         r = sim.robots.get(name)
         if r is not None:
-            return r.x, r.y, self.heights.get(name, 0.0), r.yaw
+            # a robot stands on the floor, whatever height it was spawned or set at (Gazebo drops it)
+            return r.x, r.y, r.model.rest_z, r.yaw
         try:
             x, y, yaw = sim.obstacle_pose(name)
         except SpawnError:
             return None
-        return x, y, self.heights.get(name, 0.0), yaw
+        z = self.heights.get(name)
+        if z is None:  # one of the world file's models, where it settled
+            z = sim.world.model_heights.get(name, 0.0)
+        return x, y, z, yaw
 
     def model_twist(self, name: str) -> tuple[float, float, float]:
         r = self.sn.sim.robots.get(name)
@@ -192,16 +220,18 @@ class GazeboApi:
 
     @staticmethod
     def robot_links(r: Robot) -> dict[str, Planar]:
-        """A robot's links in its own frame: the base, the wheels and the sensors."""
+        """A robot's links in its model's frame (the root link, ``rest_z`` above the floor): the base,
+        the wheels (their axles a wheel radius above the floor) and the sensors (their poses are
+        kept above the floor)."""
         m = r.model
         links: dict[str, Planar] = {m.drive.base_frame: (0.0, 0.0, 0.0, 0.0)}
         half = m.wheel_separation / 2.0
         for joint, side in ((m.left_joint, half), (m.right_joint, -half)):
-            links[joint.removesuffix("_joint")] = (0.0, side, m.wheel_radius, 0.0)
+            links[joint.removesuffix("_joint")] = (0.0, side, m.wheel_radius - m.rest_z, 0.0)
         for spec in (m.laser, m.camera, m.imu):
             if spec is not None:
                 xyz, rpy = spec.pose.xyz, spec.pose.rpy
-                links[spec.pose.frame] = (xyz[0], xyz[1], xyz[2], rpy[2])
+                links[spec.pose.frame] = (xyz[0], xyz[1], xyz[2] - m.rest_z, rpy[2])
         return links
 
     def links(self, model: str) -> dict[str, Planar] | None:
@@ -222,6 +252,16 @@ class GazeboApi:
             return self.model_pose(model)
         links = self.links(model)
         return None if links is None else links.get(link)
+
+    def _supports(self, x: float, y: float, yaw: float) -> list[Support]:
+        """The world's pieces as a model spawned at (x, y, yaw) sees them from its own frame: what it
+        may land on when it falls (call with the sim lock held)."""
+        c, s = math.cos(yaw), math.sin(yaw)
+        out = []
+        for o in self.sn.sim.world.obstacles:
+            dx, dy = o.outline[:, 0] - x, o.outline[:, 1] - y
+            out.append(Support(np.column_stack([c * dx + s * dy, -s * dx + c * dy]), o.height))
+        return out
 
     # -- services ----------------------------------------------------------------------------------
     def _reset_simulation(self, _req: Any) -> Any:
@@ -269,40 +309,77 @@ class GazeboApi:
                 pose = compose(ref, pose)
             x, y, z, yaw = pose
             drops: dict[str, float] = {}
-            kind, spec = parse_model_xml(req.model_xml, z, drops)
+            models: list[str] = []
+            with sn.lock:
+                supports = self._supports(x, y, yaw)
+            kind, spec = parse_model_xml(req.model_xml, z, drops, supports, models)
             if kind == "robot":
                 namespace = req.robot_namespace.strip("/")
                 clash = any(io.prefix == "" for io in sn.io.values())
                 sn.add_robot(name, spec, x, y, yaw, clash and not namespace, namespace or None)
+                z = spec.rest_z  # it falls onto the floor (or is pushed up out of it) on its wheels
             elif kind == "sdf":
                 if not spec:
-                    # a light, a ground plane: nothing the floor plan holds (Gazebo would add it)
-                    sn.log.info("model [%s] has no collision this simulator sees: nothing added", name)
+                    if models:  # a ground plane: a model all the same, with nothing the floor plan holds
+                        self.bare[name] = (x, y, z, yaw)
+                        self.spawned[name] = None
+                        sn.log.info(
+                            "model [%s] has no collision this simulator sees: listed, nothing added", name
+                        )
+                    else:  # a light (Gazebo's sun): not a model
+                        sn.log.info("[%s] is a light: nothing added", name)
                     return _spawned(resp)
                 pieces = _placed(name, spec, x, y, yaw)
                 with sn.lock:
                     sn.sim.add_model(name, pieces, yaw, (x, y))
-                z -= max(drops.values(), default=0.0)  # a model with physics settles on the floor
+                z -= max(drops.values(), default=0.0)  # a model with physics settles on what is under it
                 what = pieces[0].kind if len(pieces) == 1 else f"{len(pieces)} pieces"
                 sn.log.info("spawned SDF model [%s] (%s) at (%.3f, %.3f, %.3f)", name, what, x, y, z)
             else:
-                shape, size, height, colour = spec
-                with sn.lock:
-                    sn.sim.add_obstacle(name, shape, size, x, y, yaw, height, colour)
-                sn.log.info("spawned %s [%s] at (%.3f, %.3f)", shape, name, x, y)
+                z = self._add_urdf_shape(name, spec, x, y, z, yaw, supports)
             self.heights[name] = z
+            if kind != "robot":
+                self.spawned[name] = None
         except (SpawnError, MapFileError) as exc:
             sn.log.error("spawn refused: %s", exc)
             resp.success, resp.status_message = False, f"SpawnModel: Failure - {exc}"
             return resp
         return _spawned(resp)
 
+    def _add_urdf_shape(
+        self, name: str, shape: UrdfShape, x: float, y: float, z: float, yaw: float, supports: list[Support]
+    ) -> float:
+        """Place a URDF box or cylinder: a static one at ``z``, one with physics on the floor or on
+        what is under it; returns its model's z as Gazebo reports it then."""
+        sim = self.sn.sim
+        outline = (
+            circle_outline(x, y, shape.size[0])
+            if shape.kind == "cylinder"
+            else box_outline(x, y, shape.size[0], shape.size[1], yaw)
+        )
+        base = z + shape.bottom
+        if not shape.static:
+            c, s = math.cos(yaw), math.sin(yaw)
+            dx, dy = outline[:, 0] - x, outline[:, 1] - y
+            local = np.column_stack([c * dx + s * dy, -s * dx + c * dy])
+            base = rest_height(local, base, base + shape.height, supports)
+            z = base - shape.bottom
+        top = base + shape.height
+        if top <= 0.0:
+            raise SpawnError(f"a static {shape.kind} at z {z:g} is under the floor")
+        with self.sn.lock:
+            sim.add_outline(name, shape.kind, outline, yaw, top, shape.colour, max(base, 0.0))
+        self.sn.log.info("spawned %s [%s] at (%.3f, %.3f, %.3f)", shape.kind, name, x, y, z)
+        return z
+
     def _delete(self, req: Any) -> Any:
         resp = DeleteModel._response_class()
         name = req.model_name
         sn = self.sn
         try:
-            if name in sn.sim.robots:
+            if name in self.bare:
+                del self.bare[name]
+            elif name in sn.sim.robots:
                 sn.remove_robot(name)
             else:
                 with sn.lock:
@@ -313,6 +390,7 @@ class GazeboApi:
             return resp
         self.heights.pop(name, None)
         self.pushes.pop(name, None)
+        self.spawned.pop(name, None)
         sn.log.info("deleted model [%s]", name)
         resp.success, resp.status_message = True, "DeleteModel: successfully deleted model"
         return resp
@@ -359,7 +437,9 @@ class GazeboApi:
                 pose = compose(ref, pose)
             x, y, z, yaw = pose
             try:
-                if name in sn.sim.robots:
+                if name in self.bare:
+                    self.bare[name] = (x, y, z, yaw)
+                elif name in sn.sim.robots:
                     r = sn.sim.place_robot(name, x, y, yaw)
                     lin, ang = state.twist.linear, state.twist.angular
                     if all(math.isfinite(v) for v in (lin.x, lin.y, ang.z)):
@@ -619,14 +699,21 @@ def _placed(name: str, pieces: list[Obstacle], x: float, y: float, yaw: float) -
     return placed
 
 
-def parse_model_xml(text: str, z: float = 0.0, drops: dict[str, float] | None = None) -> tuple[str, Any]:
+def parse_model_xml(
+    text: str,
+    z: float = 0.0,
+    drops: dict[str, float] | None = None,
+    supports: list[Support] | None = None,
+    models: list[str] | None = None,
+) -> tuple[str, Any]:
     """What a SpawnModel request's ``model_xml`` describes: ("robot", RobotModel),
-    ("obstacle", (shape, size, height, colour)) for a URDF box or cylinder, or ("sdf", [Obstacle])
+    ("obstacle", UrdfShape) for a URDF box or cylinder, or ("sdf", [Obstacle])
     for an SDF document (a ``<model>``, or spawn_model -database's ``<world>`` of one ``model://``
     include, found on GAZEBO_MODEL_PATH or among the shipped models), its pieces in the model's
     frame with their heights as the model settles when spawned at height ``z`` (static: held there;
     else on the floor; ``drops``: how far it fell), none for a model with nothing solid (a light, a
-    ground plane). Empty text or ``puzzlebot`` is the PuzzleBot."""
+    ground plane; ``supports``: what it may land on besides the floor). Empty text or ``puzzlebot``
+    is the PuzzleBot."""
     body = text.strip()
     if not body:
         return "robot", load_robot_model("puzzlebot")
@@ -638,27 +725,86 @@ def parse_model_xml(text: str, z: float = 0.0, drops: dict[str, float] | None = 
         raise SpawnError(f"model_xml is not valid XML: {exc}") from None
     if root.tag == "sdf":
         # SdfError (a MapFileError) names the element and the reason
-        return "sdf", sdf_model_obstacles(body, z=z, drops=drops)
+        return "sdf", sdf_model_obstacles(body, z=z, drops=drops, supports=supports, models=models)
     if root.tag == "robot" and any(j.get("type") == "continuous" for j in root.iter("joint")):
         # a robot with wheels: the URDF reader says what it is, or why it cannot be simulated
         return "robot", model_from_urdf(body, "model_xml")
-    for geom in root.iter("geometry"):
-        box = geom.find("box")
-        cyl = geom.find("cylinder")
-        if box is not None:
-            size_text = box.get("size") or (box.findtext("size") or "")
-            try:
-                sx, sy, sz = (float(v) for v in size_text.split())
-            except ValueError:
-                raise SpawnError(f"box size {size_text!r} is not three numbers") from None
-            return "obstacle", ("box", (sx, sy), sz, (180, 130, 80))
-        if cyl is not None:
-            try:
-                radius = float(cyl.get("radius") or cyl.findtext("radius") or "")
-                length = float(cyl.get("length") or cyl.findtext("length") or "")
-            except ValueError:
-                raise SpawnError("cylinder needs numeric radius and length") from None
-            return "obstacle", ("cylinder", (radius, radius), length, (60, 90, 200))
+    shape = _urdf_shape(root)
+    if shape is not None:
+        return "obstacle", shape
     raise SpawnError(
         "model_xml describes neither a differential-drive robot (URDF with 2 continuous joints) nor a box or cylinder"
     )
+
+
+@dataclass
+class UrdfShape:
+    """A URDF model of one box or cylinder (no wheels): a body that falls (or, ``<static>`` in a
+    ``<gazebo>`` block, stays where it is spawned)."""
+
+    kind: str  # box | cylinder
+    size: tuple[float, float]  # box: length, width; cylinder: radius, radius
+    height: float
+    colour: tuple[int, int, int]
+    bottom: float  # its collision's lowest point in the model's frame (the origin's z - height / 2)
+    static: bool
+
+
+#: a URDF shape without a colour of its own is drawn as the simulator's boxes and cylinders are
+_URDF_COLOURS = {"box": (180, 130, 80), "cylinder": (60, 90, 200)}
+
+
+def _urdf_shape(root: ET.Element) -> UrdfShape | None:
+    """The first box or cylinder collision (else visual) of a URDF, its colour (a ``<gazebo>``
+    block's stock material, else the visual's ``<color rgba>``) and whether Gazebo holds it still."""
+    found: tuple[ET.Element, ET.Element] | None = None
+    for tag in ("collision", "visual"):
+        for holder in root.iter(tag):
+            geom = holder.find("geometry")
+            if geom is not None and (geom.find("box") is not None or geom.find("cylinder") is not None):
+                found = (holder, geom)
+                break
+        if found is not None:
+            break
+    if found is None:
+        return None
+    holder, geom = found
+    origin = holder.find("origin")
+    xyz = (origin.get("xyz") if origin is not None else None) or "0 0 0"
+    try:
+        oz = float(xyz.split()[2])
+    except (ValueError, IndexError):
+        raise SpawnError(f"<{holder.tag}><origin xyz> {xyz!r} is not three numbers") from None
+    box = geom.find("box")
+    if box is not None:
+        size_text = box.get("size") or (box.findtext("size") or "")
+        try:
+            sx, sy, sz = (float(v) for v in size_text.split())
+        except ValueError:
+            raise SpawnError(f"box size {size_text!r} is not three numbers") from None
+        kind, size, height = "box", (sx, sy), sz
+    else:
+        cyl = geom.find("cylinder")
+        assert cyl is not None
+        try:
+            radius = float(cyl.get("radius") or cyl.findtext("radius") or "")
+            length = float(cyl.get("length") or cyl.findtext("length") or "")
+        except ValueError:
+            raise SpawnError("cylinder needs numeric radius and length") from None
+        kind, size, height = "cylinder", (radius, radius), length
+    colour = _URDF_COLOURS[kind]
+    rgba = root.find(".//visual/material/color")
+    if rgba is not None:
+        try:
+            r, g, b = (min(max(float(v), 0.0), 1.0) for v in (rgba.get("rgba") or "").split()[:3])
+            colour = (round(r * 255), round(g * 255), round(b * 255))
+        except ValueError:
+            raise SpawnError(f"<color rgba> {rgba.get('rgba')!r} is not four numbers in 0-1") from None
+    static = False
+    for block in root.findall("gazebo"):
+        stock = stock_colour(block.findtext("material") or "")
+        if stock is not None:
+            colour = stock
+        if (block.findtext("static") or "").strip().lower() in ("true", "1"):
+            static = True
+    return UrdfShape(kind, size, height, colour, oz - height / 2.0, static)

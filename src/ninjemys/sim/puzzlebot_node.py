@@ -58,11 +58,11 @@ from ninjemys.node.cli_args import parse_args
 from ninjemys.node.log import NodeLog
 from ninjemys.rostime import Time
 from ninjemys.sim import messages
+from ninjemys.sim.camera import Camera
 from ninjemys.sim.gazebo_api import GazeboApi, parse_model_xml
 from ninjemys.sim.gazebo_worlds import load_gazebo_world
 from ninjemys.sim.robot_model import CameraSpec, RobotModel, load_robot_model
 from ninjemys.sim.ros_control.hardware import ControlLoop
-from ninjemys.sim.sensors import Camera
 from ninjemys.sim.simcore import Robot, Simulation, SpawnError
 from ninjemys.sim.stepper import Due, StepLock, Stepper
 from ninjemys.sim.world2d import World, load_world, world_from_map

@@ -21,6 +21,10 @@ import math
 
 import numpy as np
 
+#: reductions called as ufunc methods: ``a.any()`` and ``a.min()`` go through numpy's Python-level
+#: wrappers, a few microseconds a call that the camera's per-frame code feels
+_ANY = np.logical_or.reduce
+
 
 def cast_segments(
     ox: float,
@@ -274,3 +278,94 @@ def cast_grid(
     result = result * resolution
     result[result > max_range] = np.inf
     return result
+
+
+def column_pairs(
+    ox: float,
+    oy: float,
+    yaw: float,
+    slopes: np.ndarray,
+    segments: np.ndarray,
+    depth_max: float,
+    facing: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every crossing of a pinhole camera's column rays with the segments, within ``depth_max``:
+    ``(col_of, seg_of, depth)`` with ``depth`` along the optical axis (the camera-frame x of the point
+    hit), in no particular order.
+
+    The camera stands at (ox, oy) looking along ``yaw``; column u's ray is (1, ``slopes[u]``) in the
+    camera frame (x ahead, y to the left, ``slopes`` decreasing from the first column to the last,
+    all within +-90 degrees). Why not :func:`segment_pairs`: a camera's rays are sorted already and its
+    field of view is a wedge, so each segment's columns follow in closed form from the angles of its
+    end points (no sort, no search), and the depth a camera needs is one division per crossing,
+    ``cross(p, e) / (e_y - k e_x)`` (the point p + s e on the ray (d, d k)). Segments behind the
+    camera, beyond ``depth_max`` or facing away (``facing``, as in :func:`segment_pairs`) are dropped
+    before any crossing is made, so the work follows what the camera can see.
+    """
+    none = (np.zeros(0, np.intp), np.zeros(0, np.intp), np.zeros(0))
+    n = len(slopes)
+    if not n or not len(segments):
+        return none
+    c, s = math.cos(yaw), math.sin(yaw)
+    # both end points of every segment in the camera frame in one product: rows x0, y0, x1, y1
+    turn = np.array([[c, -s, 0.0, 0.0], [s, c, 0.0, 0.0], [0.0, 0.0, c, -s], [0.0, 0.0, s, c]])
+    ends = turn.T @ (segments - (ox, oy, ox, oy)).T
+    x0, y0, x1, y1 = ends
+    ex, ey = x1 - x0, y1 - y0
+    num = x0 * ey
+    num -= y0 * ex  # cross(p, e): the same in any frame
+    # some point ahead of the camera and some point within the depth range (a point's depth is its x)
+    keep = np.maximum(x0, x1) > 0.0
+    keep &= np.minimum(x0, x1) <= depth_max
+    if facing is not None:
+        keep &= facing * num <= 0.0  # the outer face looks at the camera (see segment_pairs)
+    idx = keep.nonzero()[0]
+    m = len(idx)
+    if not m:
+        return none
+    if m < len(num):
+        ends, ex, ey, num = ends[:, idx], ex[idx], ey[idx], num[idx]
+    # each end point's bearing, left positive, in two rows: the smaller, the larger
+    bearing = np.arctan2(ends[1::2], ends[0::2])
+    bearing.sort(axis=0)
+    lim = math.atan(float(slopes[0])) + 1e-9
+    wrap = bearing[1] - bearing[0] > math.pi
+    if _ANY(wrap):
+        # a segment passing behind the camera subtends [hi, pi] + [-pi, lo] (its short arc): of those
+        # two pieces only one can meet a field of view narrower than 180 degrees
+        lo, hi = bearing
+        left = wrap & (hi <= lim)  # the piece [hi, pi] reaches into the view
+        bearing = np.array(
+            [np.where(wrap, np.where(left, hi, -lim), lo), np.where(wrap, np.where(left, lim, lo), hi)]
+        )
+    np.maximum(bearing, -lim, out=bearing)
+    np.minimum(bearing, lim, out=bearing)
+    # column u looks along atan(slopes[u]), slopes evenly spaced (a pinhole camera's): the columns
+    # within [lo, hi] run from u(hi) to u(lo), u(a) = (slopes[0] - tan a) / (slopes[0] - slopes[1])
+    k0 = float(slopes[0])
+    scale = (n - 1) / (k0 - float(slopes[-1])) if n > 1 else 0.0
+    at = np.tan(bearing)
+    np.subtract(k0, at, out=at)
+    at *= scale
+    first = np.ceil(at[1] - 1e-9)
+    counts = np.floor(at[0] + 1e-9)
+    counts -= first
+    counts += 1.0
+    np.maximum(first, 0.0, out=first)  # never needed but for rounding: an index stays an index
+    np.minimum(counts, n - first, out=counts)
+    np.maximum(counts, 0.0, out=counts)
+    counts = counts.astype(np.intp)
+    total = int(np.add.reduce(counts))
+    if not total:
+        return none
+    seg_of = np.arange(m).repeat(counts)
+    col_of = np.arange(total)
+    col_of += (first.astype(np.intp) - (counts.cumsum() - counts)).repeat(counts)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        depth = num[seg_of] / (ey[seg_of] - slopes[col_of] * ex[seg_of])
+    ok = depth > 1e-9  # NaN (seen edge-on) fails too
+    ok &= depth <= depth_max
+    ok = ok.nonzero()[0]
+    if len(ok) < total:
+        col_of, seg_of, depth = col_of[ok], seg_of[ok], depth[ok]
+    return col_of, (seg_of if m == len(keep) else idx[seg_of]), depth

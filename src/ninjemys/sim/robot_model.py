@@ -135,6 +135,10 @@ class RobotModel:
     #: on its plugin's own topics and frames, at its own rate
     extra_lasers: list[LaserSpec] = field(default_factory=list)
     extra_cameras: list[CameraSpec] = field(default_factory=list)
+    #: the height of the model's frame (the description's root link) above the floor when the robot
+    #: stands on it: Gazebo's model pose z once the robot has fallen or been pushed onto the floor
+    #: (a root link at the wheels' axles stands at the wheel radius), whatever z it was spawned at
+    rest_z: float = 0.0
 
 
 def _merge(base: dict, over: dict) -> dict:

@@ -15,10 +15,13 @@ box or a lying cylinder gets the footprint it really has.
 * ``<include>`` of ``model://NAME`` is found as Gazebo finds it: ``GAZEBO_MODEL_PATH``, then
   ``~/.gazebo/models``, then the models that ship with us (``ground_plane``, ``sun`` and a few simple
   obstacles, share/gazebo_models). The include's ``<name>``, ``<pose>`` and ``<static>`` override
-  the model's. Mesh URIs may be ``model://``, ``package://`` (ROS_PACKAGE_PATH), ``file://`` or a
-  path relative to the file.
+  the model's. Mesh URIs may be ``model://``, ``package://`` (ROS_PACKAGE_PATH), ``file://`` (a
+  relative one, ``file://media/...``, on GAZEBO_RESOURCE_PATH, then beside the file) or a path
+  relative to the file.
 * A saved world's ``<state>`` moves its models to the poses saved there, as Gazebo does on load.
-* Materials: ``<diffuse>``, else ``<ambient>``, else a ``Gazebo/Red``-style script name.
+* Materials: ``<diffuse>``, else ``<ambient>``, else a script: ``Gazebo/Red``-style stock names
+  (:mod:`ninjemys.sim.gazebo_materials`), else the colour the ``.material`` files its ``<uri>``s name
+  give it; a material found nowhere is drawn grey and named once in the warning.
 * What has no place in a floor plan (lights, physics, plugins, actors, joints ...) is skipped; the
   elements that would have changed what sensors see are reported once, in one warning.
 
@@ -43,6 +46,7 @@ import numpy as np
 from ninjemys.errors import PackageError
 from ninjemys.maps.mapfile import MapFileError
 from ninjemys.packages.discovery import crawl, find_package
+from ninjemys.sim.gazebo_materials import STOCK, material_block, script_colour, stock_colour
 from ninjemys.sim.meshes import load_mesh
 from ninjemys.sim.world2d import FloorImage, Obstacle, World
 
@@ -58,44 +62,10 @@ MIN_TOP = 1e-3
 DEFAULT_COLOUR = (180, 180, 180)
 MAX_INCLUDE_DEPTH = 16
 
-#: Gazebo's material scripts (gazebo.material) by name, as the RGB they render roughly as
-GAZEBO_MATERIALS: dict[str, tuple[int, int, int]] = {
-    "gazebo/grey": (178, 178, 178),
-    "gazebo/gray": (178, 178, 178),
-    "gazebo/darkgrey": (89, 89, 89),
-    "gazebo/darkgray": (89, 89, 89),
-    "gazebo/lightgrey": (204, 204, 204),
-    "gazebo/white": (255, 255, 255),
-    "gazebo/flatblack": (26, 26, 26),
-    "gazebo/black": (0, 0, 0),
-    "gazebo/red": (255, 0, 0),
-    "gazebo/redbright": (222, 33, 33),
-    "gazebo/redglow": (255, 0, 0),
-    "gazebo/green": (0, 255, 0),
-    "gazebo/greenglow": (0, 255, 0),
-    "gazebo/blue": (0, 0, 255),
-    "gazebo/blueglow": (0, 0, 255),
-    "gazebo/skyblue": (33, 150, 243),
-    "gazebo/yellow": (255, 255, 0),
-    "gazebo/zincyellow": (231, 214, 36),
-    "gazebo/darkyellow": (178, 178, 0),
-    "gazebo/yellowglow": (255, 255, 0),
-    "gazebo/purple": (255, 0, 255),
-    "gazebo/purpleglow": (255, 0, 255),
-    "gazebo/turquoise": (0, 255, 255),
-    "gazebo/turquoiseglow": (0, 255, 255),
-    "gazebo/orange": (255, 128, 0),
-    "gazebo/indigo": (51, 0, 128),
-    "gazebo/wood": (156, 112, 74),
-    "gazebo/woodfloor": (173, 133, 92),
-    "gazebo/woodpallet": (166, 128, 84),
-    "gazebo/bricks": (160, 82, 62),
-    "gazebo/residential": (196, 186, 170),
-    "gazebo/ceilingtiled": (230, 230, 225),
-    "gazebo/paintedwall": (235, 230, 220),
-    "gazebo/asphalt": (60, 60, 60),
-    "gazebo/grass": (80, 140, 50),
-}
+#: Gazebo's stock material names as colours (kept in :mod:`ninjemys.sim.gazebo_materials`)
+GAZEBO_MATERIALS = STOCK
+#: where ``file://media/...`` of Gazebo's own resources is looked for when GAZEBO_RESOURCE_PATH is unset
+DEFAULT_RESOURCE_PATH = "/usr/share/gazebo-11:/usr/share/gazebo"
 
 #: elements that change nothing a sensor of the floor plan sees: skipped without a word
 _QUIET_WORLD = {
@@ -309,6 +279,8 @@ class _Context:
     floor_images: list[FloorImage] = field(default_factory=list)
     #: each top-level model's pose (x, y, yaw), as /gazebo/model_states reports it
     origins: dict[str, tuple[float, float, float]] = field(default_factory=dict)
+    #: each top-level model's pose height, before it settles
+    heights: dict[str, float] = field(default_factory=dict)
 
     def missing(self, uri: str, el: Element, exc: SdfError | None = None) -> None:
         """SdfError, or in a world a note that ``uri`` is left out (Gazebo's behaviour)."""
@@ -336,11 +308,22 @@ def model_dirs(env: Mapping[str, str] | None = None) -> list[Path]:
     return dirs
 
 
-@functools.lru_cache(maxsize=8)
-def _exported_model_paths(ros_package_path: str) -> tuple[str, ...]:
-    """``<export><gazebo_ros gazebo_model_path="${prefix}/models"/></export>`` of every package on
-    ``ros_package_path`` (the maker's puzzlebot_world has it), ``${prefix}`` being the package's
-    folder: gazebo_ros' paths plugin adds these to Gazebo's model path (``rospack plugins``)."""
+def resource_dirs(env: Mapping[str, str]) -> list[Path]:
+    """Where a relative ``file://`` URI (``file://media/materials/scripts/x.material``) is looked up,
+    as Gazebo does: GAZEBO_RESOURCE_PATH, the ``gazebo_media_path`` the packages on ROS_PACKAGE_PATH
+    export (the maker's puzzlebot_gazebo: ``${prefix}/models``), then Gazebo's own install."""
+    roots = [r for r in (env.get("GAZEBO_RESOURCE_PATH") or "").split(":") if r]
+    roots += _exported_model_paths(env.get("ROS_PACKAGE_PATH", ""), "gazebo_media_path")
+    roots += DEFAULT_RESOURCE_PATH.split(":")
+    return [Path(r) for r in dict.fromkeys(roots)]
+
+
+@functools.lru_cache(maxsize=16)
+def _exported_model_paths(ros_package_path: str, attribute: str = "gazebo_model_path") -> tuple[str, ...]:
+    """``<export><gazebo_ros gazebo_model_path="${prefix}/models"/></export>`` (or another
+    ``attribute``: ``gazebo_media_path``) of every package on ``ros_package_path`` (the maker's
+    puzzlebot_world has it), ``${prefix}`` being the package's folder: gazebo_ros' paths plugin adds
+    these to Gazebo's model (resource) path (``rospack plugins``)."""
     found: list[str] = []
     for root in (Path(d) for d in ros_package_path.split(":") if d):
         for pkg_dir in crawl(root):
@@ -350,7 +333,7 @@ def _exported_model_paths(ros_package_path: str) -> tuple[str, ...]:
                 continue
             for export in tree.getroot().findall("export"):
                 for gz in export.findall("gazebo_ros"):
-                    value = gz.get("gazebo_model_path")
+                    value = gz.get(attribute)
                     if value:
                         found.append(value.replace("${prefix}", str(pkg_dir)))
     return tuple(found)
@@ -378,7 +361,14 @@ def resolve_uri(uri: str, el: Element, env: Mapping[str, str]) -> Path:
             raise el.error(f"package '{pkg}' of {text} not found on ROS_PACKAGE_PATH") from None
         return pdir / tail
     if text.startswith("file://"):
-        return Path(text[len("file://") :])
+        rest = text[len("file://") :]
+        if rest.startswith("/"):
+            return Path(rest)
+        # relative (``file://media/materials/...``): Gazebo looks on its resource path, then beside the file
+        for candidate in [*(r / rest for r in resource_dirs(env)), Path(el.source).parent / rest]:
+            if candidate.exists():
+                return candidate
+        return Path(el.source).parent / rest
     if "://" in text:
         raise el.error(f"cannot fetch {text}: only model://, package://, file:// and paths are read")
     path = Path(text)
@@ -451,9 +441,17 @@ def _colour(link: Element, ctx: _Context, pictures: tuple[Element, ...] = ()) ->
         script = mat.find("script")
         if script is not None:
             name = (script.value("name") or "").strip()
-            if name.lower() in GAZEBO_MATERIALS:
-                return GAZEBO_MATERIALS[name.lower()]
-            ctx.skip(f"material script {name!r} (drawn grey)", script)
+            colour = stock_colour(name)
+            if colour is None:
+                colour = next(
+                    (c for f in _script_files(script, ctx) if (c := script_colour(f, name)) is not None), None
+                )
+            if colour is not None:
+                return colour
+            ctx.skip(
+                f"material script {name!r} (not found in Gazebo's stock names nor its <uri>s: drawn grey)",
+                script,
+            )
     return DEFAULT_COLOUR
 
 
@@ -468,7 +466,7 @@ def _floor_picture(visual: Element, m: np.ndarray, ctx: _Context, name: str) -> 
     if plane is None or script is None:
         return None
     material = (script.value("name") or "").strip()
-    if not material or material.lower() in GAZEBO_MATERIALS:
+    if not material or stock_colour(material) is not None:
         return None
     size_el = plane.find("size")
     if size_el is None:
@@ -494,15 +492,12 @@ def _floor_picture(visual: Element, m: np.ndarray, ctx: _Context, name: str) -> 
     return FloorImage(name, rgb, float(vm[0, 3]), float(vm[1, 3]), width, height, yaw)
 
 
-#: ``material NAME`` (optionally ``: PARENT``) opening a block of an OGRE material script
-_MATERIAL = re.compile(r"^\s*material\s+([^\s{:]+)", re.MULTILINE)
+def _script_files(script: Element, ctx: _Context) -> list[Path]:
+    """The ``.material`` files a material ``<script>``'s ``<uri>``s name (files, or folders of them).
 
-
-def _texture(script: Element, material: str, ctx: _Context) -> Path | None:
-    """The image of ``material``'s first ``texture`` in the material scripts its ``<uri>``s name
-    (folders of ``.material`` files, or files), looked for beside the script, in ``../textures``
-    and in the folders the ``<uri>``s name, as Gazebo's resource paths find it."""
-    dirs: list[Path] = []
+    ``file://media/...`` (Gazebo's own resources, a relative path) is looked for on
+    GAZEBO_RESOURCE_PATH, then beside the file that names it; ``model://`` and ``package://`` as for
+    meshes."""
     files: list[Path] = []
     for uri in script.findall("uri"):
         try:
@@ -510,28 +505,42 @@ def _texture(script: Element, material: str, ctx: _Context) -> Path | None:
         except SdfError:
             continue
         if path.is_dir():
-            dirs.append(path)
+            files.extend(sorted(path.glob("*.material")))
         elif path.is_file():
             files.append(path)
-    for script_file in files + [f for d in dirs for f in sorted(d.glob("*.material"))]:
+    return files
+
+
+def _texture(script: Element, material: str, ctx: _Context) -> Path | None:
+    """The image of ``material``'s first ``texture`` in the material scripts its ``<uri>``s name
+    (folders of ``.material`` files, or files), looked for beside the script, in ``../textures``
+    and in the folders the ``<uri>``s name, as Gazebo's resource paths find it."""
+    dirs = [d for uri in script.findall("uri") if (d := _uri_dir(uri, ctx)) is not None]
+    for script_file in _script_files(script, ctx):
         try:
             text = script_file.read_text(errors="replace")
         except OSError:
             continue
-        starts = list(_MATERIAL.finditer(text))
-        for i, block in enumerate(starts):
-            if block.group(1) != material:
-                continue
-            body = text[block.end() : starts[i + 1].start() if i + 1 < len(starts) else len(text)]
-            found = re.search(r"\btexture\s+([^\s}]+)", body)
-            if found is None:
-                return None
-            for d in (script_file.parent, script_file.parent.parent / "textures", *dirs):
-                candidate = d / found.group(1)
-                if candidate.is_file():
-                    return candidate
+        body = material_block(text, material)
+        if body is None:
+            continue
+        found = re.search(r"\btexture\s+([^\s}]+)", body)
+        if found is None:
             return None
+        for d in (script_file.parent, script_file.parent.parent / "textures", *dirs):
+            candidate = d / found.group(1)
+            if candidate.is_file():
+                return candidate
+        return None
     return None
+
+
+def _uri_dir(uri: Element, ctx: _Context) -> Path | None:
+    try:
+        path = resolve_uri(uri.text, uri, ctx.env)
+    except SdfError:
+        return None
+    return path if path.is_dir() else None
 
 
 def _pose(el: Element, ctx: _Context) -> np.ndarray:
@@ -541,6 +550,18 @@ def _pose(el: Element, ctx: _Context) -> np.ndarray:
     frame = pose.attrib.get("relative_to") or pose.attrib.get("frame")
     if frame:
         ctx.skip(f"pose relative to '{frame}' (taken relative to the parent)", pose)
+    return _pose_matrix(pose, ctx)
+
+
+def _pose_matrix(pose: Element, ctx: _Context) -> np.ndarray:
+    """A ``<pose>``'s transform. Three numbers (``<pose>0 0 0.0</pose>``, in the maker's PuzzleBot
+    models) are a position with no rotation, as Gazebo 11 loads those models (noted once); any other
+    count is an SdfError naming the file and line."""
+    words = pose.text.split()
+    if len(words) == 3:
+        ctx.skip("<pose> of 3 numbers (read as x y z, no rotation)", pose)
+        x, y, z = _numbers(pose, 3, "x y z")
+        return pose_matrix(x, y, z, 0.0, 0.0, 0.0)
     return pose_matrix(*_numbers(pose, 6, "x y z roll pitch yaw"))
 
 
@@ -686,24 +707,97 @@ class _Solid:
     static: bool = False  # its model is static: it stays where it is put
 
 
-def _settle(solids: list[_Solid], drops: dict[str, float] | None = None) -> list[_Solid]:
+#: a piece lands on a support whose top is below its middle (a box spawned a little into a table
+#: top is pushed up onto it, as Gazebo's contacts push it; one spawned mostly below falls past)
+#: and overlaps its outline by more than this (m): shapes that only touch side by side hold nothing
+TOUCH = 1e-6
+
+
+@dataclass
+class Support:
+    """Something a falling model may land on: an outline (in the frame the falling pieces' outlines
+    are in) and its top (m above the floor)."""
+
+    outline: np.ndarray
+    top: float
+    lo: tuple[float, float] = (0.0, 0.0)  # its bounding box (set from the outline)
+    hi: tuple[float, float] = (0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        mn, mx = self.outline.min(axis=0), self.outline.max(axis=0)
+        self.lo, self.hi = (float(mn[0]), float(mn[1])), (float(mx[0]), float(mx[1]))
+
+
+def overlaps(a: np.ndarray, b: np.ndarray, margin: float = TOUCH) -> bool:
+    """Whether two convex outlines (or 2-point walls), (K, 2) each, overlap by more than ``margin``
+    (the separating-axis test: no edge normal of either separates them)."""
+    for poly in (a, b):
+        edges = np.roll(poly, -1, axis=0) - poly if len(poly) > 2 else (poly[1:] - poly[:1])
+        for ex, ey in edges:
+            n = np.array([-ey, ex])
+            norm = float(np.hypot(*n))
+            if norm < 1e-12:
+                continue
+            pa, pb = a @ n / norm, b @ n / norm
+            if pa.max() - margin <= pb.min() or pb.max() - margin <= pa.min():
+                return False
+    return True
+
+
+def rest_height(outline: np.ndarray, bottom: float, top: float, ground: list[Support]) -> float:
+    """Where a falling piece (outline, bottom and top in metres) comes to rest: the highest top
+    below its middle among the supports it overlaps, else the floor (0)."""
+    middle = (bottom + top) / 2.0
+    if len(outline) < 2:
+        return 0.0
+    (x0, y0), (x1, y1) = outline.min(axis=0), outline.max(axis=0)
+    return max(
+        (
+            g.top
+            for g in ground
+            if 0.0 < g.top <= middle
+            and g.lo[0] < x1
+            and g.hi[0] > x0
+            and g.lo[1] < y1
+            and g.hi[1] > y0  # boxes first: cheap
+            and overlaps(outline, g.outline)
+        ),
+        default=0.0,
+    )
+
+
+def _settle(
+    solids: list[_Solid], drops: dict[str, float] | None = None, supports: list[Support] | None = None
+) -> list[_Solid]:
     """Heights as Gazebo's physics leaves each top-level model (all its pieces together): a static
     model stays at its pose (a table top held at 0.75 m floats there; a part below the floor is
-    hidden), a model with physics falls onto the floor, or is pushed up out of it, until its lowest
-    point touches it. The floor is the only thing models land on here (a box dropped onto a table
-    lands on the floor). Pieces with nothing above the floor are dropped. ``drops`` receives how far
-    each model fell (negative: pushed up)."""
-    lowest: dict[str, float] = {}
+    hidden); a model with physics falls, or is pushed up, until one of its pieces rests on the floor
+    or on what is under it: a static piece, a model that settled before it (lowest first: a stack of
+    boxes) or one of ``supports`` (the world a spawned model falls into). Pieces with nothing above
+    the floor are dropped. ``drops`` receives how far each model fell (negative: pushed up)."""
+    ground: list[Support] = list(supports or [])
+    for s in solids:
+        if s.static and s.footprint.top > MIN_TOP:
+            ground.append(Support(s.footprint.outline, s.footprint.top))
+    models: dict[str, list[_Solid]] = {}
     for s in solids:
         if not s.static:
-            key = s.path[0]
-            lowest[key] = min(lowest.get(key, math.inf), s.footprint.bottom)
+            models.setdefault(s.path[0], []).append(s)
+    fallen: dict[str, float] = {}
+    for name, pieces in sorted(models.items(), key=lambda kv: min(p.footprint.bottom for p in kv[1])):
+        drop = math.inf
+        for p in pieces:
+            fp = p.footprint
+            drop = min(drop, fp.bottom - rest_height(fp.outline, fp.bottom, fp.top, ground))
+        fallen[name] = drop
+        for p in pieces:
+            ground.append(Support(p.footprint.outline, p.footprint.top - drop))
     if drops is not None:
-        drops.update(lowest)
+        drops.update(fallen)
     kept = []
     for s in solids:
         fp = s.footprint
-        drop = lowest.get(s.path[0], 0.0) if not s.static else 0.0
+        drop = fallen.get(s.path[0], 0.0) if not s.static else 0.0
         fp.top, fp.bottom = fp.top - drop, max(fp.bottom - drop, 0.0)
         if fp.top > MIN_TOP and len(fp.outline) >= 2:
             kept.append(s)
@@ -728,6 +822,7 @@ def _model(
     here = [*scope, name]
     if not scope:
         ctx.origins[name] = (float(m[0, 3]), float(m[1, 3]), math.atan2(float(m[1, 0]), float(m[0, 0])))
+        ctx.heights[name] = float(m[2, 3])
     if static is None:
         own = el.find("static")
         static = _bool(own) if own is not None else False
@@ -815,7 +910,7 @@ def _include(
     if static is None and static_el is not None:
         static = _bool(static_el)
     pose = el.find("pose")
-    override = pose_matrix(*_numbers(pose, 6, "x y z roll pitch yaw")) if pose is not None else None
+    override = _pose_matrix(pose, ctx) if pose is not None else None
     if saved and model.attrib.get("name") in saved:
         override = saved[model.attrib["name"]]
     _model(model, parent, ctx, out, scope, depth, override, static)
@@ -829,7 +924,7 @@ def _state_poses(world: Element, ctx: _Context) -> dict[str, np.ndarray]:
             pose = model.find("pose")
             name = model.attrib.get("name")
             if name and pose is not None and pose.text.strip():
-                poses[name] = pose_matrix(*_numbers(pose, 6, "x y z roll pitch yaw"))
+                poses[name] = _pose_matrix(pose, ctx)
     return poses
 
 
@@ -859,10 +954,14 @@ def parse_sdf_world(
     world_el = root.find("world")
     if world_el is None:
         raise root.error("no <world> in this file (a model file? spawn it with spawn_model -sdf)")
-    solids = _settle(_world_solids(world_el, ctx))
+    drops: dict[str, float] = {}
+    solids = _settle(_world_solids(world_el, ctx), drops)
     world = World(world_el.attrib.get("name", Path(source).stem), _obstacles(solids), source=source)
     kept = {s.path[0] for s in solids}
-    world.model_poses = {name: pose for name, pose in ctx.origins.items() if name in kept}
+    # every top-level model, in the file's order (Gazebo lists them so), the bare ones too (a ground plane)
+    world.model_poses = dict(ctx.origins)
+    world.model_heights = {name: z - drops.get(name, 0.0) for name, z in ctx.heights.items()}
+    world.bare_models = [name for name in ctx.origins if name not in kept]
     world.floor_images = ctx.floor_images
     _report(ctx, source, warn)
     return world
@@ -875,13 +974,18 @@ def sdf_model_obstacles(
     warn: Callable[[str], None] | None = None,
     z: float = 0.0,
     drops: dict[str, float] | None = None,
+    supports: list[Support] | None = None,
+    models: list[str] | None = None,
 ) -> list[Obstacle]:
     """The obstacles of an SDF model document (``<sdf><model>``, as spawn_sdf_model receives it, or a
     ``<world>`` of includes), their outlines in the model's frame (place them at the spawn pose),
     their heights as the model settles when spawned at height ``z``: a static model stays there, one
     with physics falls onto the floor or is pushed up out of it (:func:`_settle`). A model of several
     pieces (a table: top and legs) gives one obstacle per piece, each naming the model. ``drops``
-    receives how far each model with physics fell from ``z`` (its pose after it settles: ``z - drop``)."""
+    receives how far each model with physics fell from ``z`` (its pose after it settles: ``z - drop``);
+    ``supports`` (outlines in the model's frame) are what it may land on besides the floor: the world
+    it is spawned into (a box dropped over a table lands on the table); ``models`` receives the names
+    of the models the document holds, in order (a ground plane is one, with no obstacle)."""
     ctx = _Context(os.environ if env is None else env)
     root = _sdf_root(data.encode() if isinstance(data, str) else data, source, ctx)
     solids: list[_Solid] = []
@@ -893,10 +997,12 @@ def sdf_model_obstacles(
     if world_el is None and root.find("model") is None:
         raise root.error("no <model> in this SDF document")
     _report(ctx, source, warn)
+    if models is not None:
+        models.extend(ctx.origins)  # the models it holds (none for a light: Gazebo's sun)
     for solid in solids:
         solid.footprint.top += z
         solid.footprint.bottom += z
-    return _obstacles(_settle(solids, drops))
+    return _obstacles(_settle(solids, drops, supports))
 
 
 def _world_solids(world_el: Element, ctx: _Context) -> list[_Solid]:

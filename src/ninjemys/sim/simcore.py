@@ -20,9 +20,10 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ninjemys.errors import NinjemysError
+from ninjemys.sim.camera import Camera
 from ninjemys.sim.raycast import grid_edges
 from ninjemys.sim.robot_model import CameraSpec, LaserSpec, RobotModel
-from ninjemys.sim.sensors import Camera, FloorPaint, Scene, imu_reading, lidar_ranges
+from ninjemys.sim.sensors import FloorPaint, Scene, imu_reading, lidar_ranges
 from ninjemys.sim.world2d import MovingObstacle, Obstacle, World, box_outline, circle_outline
 
 TRAIL_LENGTH = 2000
@@ -181,7 +182,7 @@ class Simulation:
         w = self.world
         w.rebuild()
         segs, heights, colours = [w.segments], [w.seg_height], [w.seg_color]
-        facing, bases = [w.seg_facing], [w.seg_base]
+        facing, bases, owners = [w.seg_facing], [w.seg_base], [w.seg_owner]
         names = [w.obstacles[i].name for i in w.seg_owner]
         if w.grid is not None:
             g = w.grid
@@ -190,6 +191,7 @@ class Simulation:
             facing.append(np.zeros(len(edges), dtype=np.int8))
             heights.append(np.full(len(edges), g.height))
             bases.append(np.zeros(len(edges)))
+            owners.append(np.full(len(edges), -1))
             colours.append(np.tile(np.array(g.color, dtype=np.uint8), (len(edges), 1)))
             names += ["map"] * len(edges)
         self._static = np.vstack(segs) if any(len(s) for s in segs) else np.zeros((0, 4))
@@ -199,6 +201,7 @@ class Simulation:
         self._any_base = bool((self._static_base > 0).any())
         self._static_color = np.vstack(colours).astype(np.uint8)
         self._static_facing = np.concatenate(facing).astype(np.int8)
+        self._static_owner = np.concatenate(owners).astype(np.intp)
         self.static_names = names
         for r in self.robots.values():
             r.free = None  # the static world changed
@@ -293,6 +296,7 @@ class Simulation:
             if len(ms)
             else self._static_facing
         )
+        owners = np.concatenate([self._static_owner, np.full(len(ms), -1)]) if len(ms) else self._static_owner
         others = [r for r in self.robots.values() if r.name != exclude]
         return Scene(
             segs,
@@ -305,6 +309,7 @@ class Simulation:
             self._floor,
             facing,
             bases,
+            owners,
         )
 
     def clearance(

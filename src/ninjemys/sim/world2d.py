@@ -214,14 +214,24 @@ class World:
     source: str = ""
     #: models' poses (x, y, yaw) where the file gives them (an SDF world's models), by model name
     model_poses: dict[str, tuple[float, float, float]] = field(default_factory=dict)
+    #: the heights of those models' poses once Gazebo's physics has settled them (a static shelf at
+    #: 1 m stays there; a box with physics rests on the floor or a table), by model name
+    model_heights: dict[str, float] = field(default_factory=dict)
+    #: an SDF world's models with nothing the floor plan holds (Gazebo's ground_plane): still models
+    #: for Gazebo (listed in /gazebo/model_states, in the file's order), by name
+    bare_models: list[str] = field(default_factory=list)
     #: pictures on the floor (an SDF world's textured planes): the camera sees them
     floor_images: list[FloorImage] = field(default_factory=list)
+    #: counts the rebuilds: a view that drew the obstacles redraws them when it changes (a model
+    #: spawned, moved or deleted)
+    revision: int = 0
 
     def __post_init__(self) -> None:
         self.rebuild()
 
     def rebuild(self) -> None:
         """Recompute the flat segment arrays after obstacles were added or removed."""
+        self.revision += 1
         segs, heights, colours, owner, facing, bases = [], [], [], [], [], []
         for i, ob in enumerate(self.obstacles):
             s = ob.segments()

@@ -1,8 +1,9 @@
 """The PuzzleBot simulator's browser view, a page of the web tools app (as turtlesim's window is),
 and the ``sim_node`` command that shows it.
 
-``/puzzlebot`` draws the world from above (walls, furniture, floor markings), the robots with their
-trails and lidar rays, and the selected robot's colour and depth images; the keyboard (arrows or
+``/puzzlebot`` draws the world from above (the floor's pictures, a course's track; walls and
+furniture in their colours, the taller over the lower, their shadows as long as they are tall, what
+is held in the air see-through; floor markings), the robots with their trails and lidar rays, and the selected robot's colour and depth images; the keyboard (arrows or
 WASD, space to stop) drives the selected robot. Everything goes through the gateway mounted on the
 page's server, the browser's one data path: the page subscribes to the ``view:puzzlebot`` JSON
 channel (the static world once, then updates at most 20 times a wall-clock second) and to the
@@ -23,6 +24,7 @@ import numpy as np
 
 from ninjemys.bridge.server import Gateway, GatewayOptions
 from ninjemys.commands import entry
+from ninjemys.serve.http import Request, Response
 from ninjemys.sim.simcore import scan_angles
 from ninjemys.web.app import WebApp
 from ninjemys.web.browser import open_if_display
@@ -34,6 +36,9 @@ if TYPE_CHECKING:
 UPDATE_PERIOD = 0.05  # wall seconds between updates sent to the pages
 #: the gateway channel the page subscribes to (JSON; not a ROS topic, see ninjemys.bridge.appchannels)
 CHANNEL = "view:puzzlebot"
+#: the floor pictures of the world (``?i=<index>``), drawn under the models
+FLOOR_ROUTE = "/api/puzzlebot/floor.png"
+FLOOR_MAX_PIXELS = 2048
 
 
 class PuzzlebotView:
@@ -53,6 +58,9 @@ class PuzzlebotView:
         self._trail_sent: dict[str, int] = {}
         app.add_page("PuzzleBot", "/puzzlebot")
         app.server.route("GET", "/puzzlebot", lambda _r: app._static_page("puzzlebot.html"))
+        app.server.route("GET", "/api/puzzlebot/floor.png", self._floor_png)
+        self._revision = -1
+        self._pngs: dict[tuple[int, int], bytes] = {}
         self.channel = gateway.app_channel(CHANNEL, "ninjemys/PuzzlebotView", self._full_state, sim_node.lock)
 
     # -- what the sim thread asks -----------------------------------------------------------------
@@ -71,8 +79,23 @@ class PuzzlebotView:
                 "outline": np.round(o.outline, 4).tolist(),
                 "color": list(o.color),
                 "height": o.height,
+                "base": o.base,
+                "model": o.model_name,
             }
             for o in w.obstacles
+        ]
+        self._revision = w.revision
+        floor = [
+            {
+                "name": f.name,
+                "url": f"{FLOOR_ROUTE}?i={i}&rev={w.revision}",
+                "cx": f.cx,
+                "cy": f.cy,
+                "width": f.width,
+                "height": f.height,
+                "yaw": f.yaw,
+            }
+            for i, f in enumerate(w.floor_images)
         ]
         grid_edges = np.round(sim.map_edges(), 4).tolist()
         markings = [
@@ -90,7 +113,9 @@ class PuzzlebotView:
             "node": self.sim_node.node.name,
             "world": w.name,
             "bounds": list(w.extent()),
+            "revision": w.revision,
             "obstacles": obstacles,
+            "floor_images": floor,
             "grid_edges": grid_edges,
             "markings": markings,
             "update": self._update(full_trails=True),
@@ -155,6 +180,30 @@ class PuzzlebotView:
             "movers": movers,
         }
 
+    def _floor_png(self, request: Request) -> Response:
+        """A picture on the world's floor (a textured plane: a course's track) as PNG, at most
+        :data:`FLOOR_MAX_PIXELS` a side (the page draws it under the models, to scale)."""
+        try:
+            index = int(request.arg("i", "") or "")
+            image = self.sim_node.sim.world.floor_images[index]
+        except (ValueError, IndexError):
+            return Response(b"no such floor picture", 404, "text/plain; charset=utf-8")
+        key = (index, id(image))
+        png = self._pngs.get(key)
+        if png is None:
+            import cv2  # a dependency already (cv_bridge); only when a world has floor pictures
+
+            bgr = np.ascontiguousarray(image.rgb[:, :, ::-1])
+            side = max(bgr.shape[:2])
+            if side > FLOOR_MAX_PIXELS:
+                f = FLOOR_MAX_PIXELS / side
+                bgr = cv2.resize(bgr, (max(1, round(bgr.shape[1] * f)), max(1, round(bgr.shape[0] * f))))
+            ok, data = cv2.imencode(".png", bgr)
+            if not ok:
+                return Response(b"cannot encode the floor picture", 500, "text/plain; charset=utf-8")
+            png = self._pngs[key] = data.tobytes()
+        return Response(png, 200, "image/png")
+
     def _topics(self, topics: dict[str, str]) -> dict[str, str]:
         """The robot's command and camera topics, resolved (its model names them)."""
         resolve = self.sim_node.node.resolve_name
@@ -168,6 +217,10 @@ class PuzzlebotView:
         if now - self._last_sent < UPDATE_PERIOD:
             return
         self._last_sent = now
+        if self.sim_node.sim.world.revision != self._revision:
+            # a model was spawned, moved or deleted: the pages get the world again
+            self.channel.publish(self._full_state())
+            return
         self.channel.publish(self._update())
 
 

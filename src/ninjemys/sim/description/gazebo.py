@@ -16,6 +16,7 @@ from ninjemys.robot.kinematics import rpy_matrix
 from ninjemys.sim.description.geometry import Geometry, Transform, compose, rpy_of
 from ninjemys.sim.description.params import Reader
 from ninjemys.sim.description.xmltree import Document
+from ninjemys.sim.gazebo_materials import stock_colour
 from ninjemys.sim.robot_model import CameraSpec, DriveSpec, ImuSpec, LaserSpec, SensorPose
 
 DIFF_DRIVE = "libgazebo_ros_diff_drive.so"
@@ -28,23 +29,6 @@ DEPTH_CAMERA = "libgazebo_ros_depth_camera.so"  # the same depth parameters as t
 IMU_SENSOR = "libgazebo_ros_imu_sensor.so"
 IMU_MODEL = "libgazebo_ros_imu.so"
 DRIVES = (DIFF_DRIVE, SKID_STEER, ROS_CONTROL)
-
-#: Gazebo's stock material scripts most descriptions use, as 0-255 RGB (their diffuse colour)
-GAZEBO_MATERIALS = {
-    "Gazebo/Black": (0, 0, 0),
-    "Gazebo/Blue": (0, 0, 204),
-    "Gazebo/DarkGrey": (45, 45, 45),
-    "Gazebo/Gray": (179, 179, 179),
-    "Gazebo/Grey": (179, 179, 179),
-    "Gazebo/Green": (0, 204, 0),
-    "Gazebo/Orange": (255, 128, 0),
-    "Gazebo/Purple": (255, 0, 255),
-    "Gazebo/Red": (204, 0, 0),
-    "Gazebo/Turquoise": (0, 204, 204),
-    "Gazebo/White": (255, 255, 255),
-    "Gazebo/Yellow": (255, 255, 0),
-    "Gazebo/Wood": (130, 90, 50),
-}
 
 
 @dataclass
@@ -63,6 +47,7 @@ class GazeboConfig:
     materials: dict[str, tuple[int, int, int]] = field(default_factory=dict)
     ignored: list[str] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
+    unknown_materials: list[str] = field(default_factory=list)  # named once in a warning
 
 
 def topic(namespace: str, name: str) -> str:
@@ -98,8 +83,16 @@ def read_gazebo(doc: Document, geo: Geometry, robot_namespace: str | None = None
         mat = block.find("material")
         if ref is not None and mat is not None and mat.text:
             name = mat.text.strip()
-            if name in GAZEBO_MATERIALS:
-                cfg.materials[ref] = GAZEBO_MATERIALS[name]
+            colour = stock_colour(name)
+            if colour is not None:
+                cfg.materials[ref] = colour
+            elif name not in cfg.unknown_materials:
+                # a material of the robot's own scripts (not read from a URDF): drawn in the URDF's colour
+                cfg.unknown_materials.append(name)
+                cfg.warnings.append(
+                    f"{doc.source}:{doc.line(mat)}: <gazebo reference='{ref}'> material '{name}' is not one of"
+                    " Gazebo's stock materials: the link keeps its URDF colour"
+                )
         for plugin in block.findall("plugin"):
             _model_plugin(doc, plugin, geo, cfg, robot_namespace)
         for sensor in block.findall("sensor"):

@@ -19,6 +19,8 @@ let update = { robots: [], movers: [], time: 0, paused: false };
 const trails = new Map();
 let frameQueued = false;
 let view = { scale: 50, x0: 0, y0: 0 };
+let byHeight = [];  // the world's obstacles, the lowest first (drawn in that order)
+const floorPictures = new Map();  // url -> Image
 
 function rgb(c, a) { return a === undefined ? `rgb(${c[0]},${c[1]},${c[2]})` : `rgba(${c[0]},${c[1]},${c[2]},${a})`; }
 
@@ -43,14 +45,33 @@ function draw() {
   ctx.strokeStyle = "rgba(0,0,0,0.06)"; ctx.lineWidth = 1;  // 1 m grid
   for (let x = Math.ceil(world.bounds[0]); x <= world.bounds[2]; x++) { const [a] = px(x, 0); ctx.beginPath(); ctx.moveTo(a, 0); ctx.lineTo(a, canvas.height); ctx.stroke(); }
   for (let y = Math.ceil(world.bounds[1]); y <= world.bounds[3]; y++) { const [, b] = px(0, y); ctx.beginPath(); ctx.moveTo(0, b); ctx.lineTo(canvas.width, b); ctx.stroke(); }
+  for (const f of world.floor_images) {  // pictures on the floor (a course's track), under everything
+    const img = floorPictures.get(f.url);
+    if (!img || !img.complete || !img.naturalWidth) continue;
+    const [cx, cy] = px(f.cx, f.cy);
+    ctx.save(); ctx.translate(cx, cy); ctx.rotate(-f.yaw);
+    ctx.drawImage(img, -f.width * view.scale / 2, -f.height * view.scale / 2, f.width * view.scale, f.height * view.scale);
+    ctx.restore();
+  }
   for (const m of world.markings) {
     polygon(m.points, m.closed);
     ctx.strokeStyle = rgb(m.color); ctx.lineWidth = Math.max(2, m.width * view.scale); ctx.stroke();
   }
-  for (const o of world.obstacles) {
-    polygon(o.outline, o.outline.length > 2);
-    if (o.outline.length > 2) { ctx.fillStyle = rgb(o.color); ctx.fill(); }
-    ctx.strokeStyle = "#555"; ctx.lineWidth = 1; ctx.stroke();
+  // models in their colours, the lower first; a shadow as long as the piece is tall; what is held
+  // in the air (a table top, a shelf) see-through with a dashed edge, so what is under it shows
+  for (const o of byHeight) {
+    const closed = o.outline.length > 2;
+    polygon(o.outline, closed);
+    ctx.save();
+    if (closed) {
+      const off = Math.min(14, 2 + 6 * o.height);
+      ctx.shadowColor = "rgba(0,0,0,0.3)"; ctx.shadowOffsetX = off; ctx.shadowOffsetY = off; ctx.shadowBlur = 2;
+      ctx.fillStyle = rgb(o.color, o.base > 0 ? 0.55 : undefined); ctx.fill();
+    }
+    ctx.restore();
+    ctx.strokeStyle = "#555"; ctx.lineWidth = 1;
+    if (o.base > 0) ctx.setLineDash([4, 3]);
+    ctx.stroke(); ctx.setLineDash([]);
   }
   ctx.strokeStyle = "#333"; ctx.lineWidth = 2;
   for (const [x0, y0, x1, y1] of world.grid_edges) { const a = px(x0, y0), b = px(x1, y1); ctx.beginPath(); ctx.moveTo(a[0], a[1]); ctx.lineTo(b[0], b[1]); ctx.stroke(); }
@@ -88,7 +109,7 @@ function queueDraw() { if (!frameQueued) { frameQueued = true; requestAnimationF
 
 function applyUpdate(u) {
   update = u;
-  window.puzzlebot = { world, update, trails };
+  window.puzzlebot = { world, update, trails, px };
   for (const r of u.robots) {
     if (r.trail_reset || !trails.has(r.name)) trails.set(r.name, []);
     const t = trails.get(r.name);
@@ -111,9 +132,19 @@ function applyUpdate(u) {
 }
 
 function loadState(state) {
+  const first = !world || world.bounds.join() !== state.bounds.join();
   world = state;
+  byHeight = [...state.obstacles].sort((a, b) => a.height - b.height);
+  for (const f of state.floor_images) {
+    if (floorPictures.has(f.url)) continue;
+    const img = new Image();
+    img.onload = () => { document.body.dataset.floorPictures = String(Number(document.body.dataset.floorPictures || 0) + 1); queueDraw(); };
+    img.src = f.url;
+    floorPictures.set(f.url, img);
+  }
+  document.body.dataset.worldRevision = String(state.revision);
   trails.clear();
-  fit();
+  if (first) fit();
   statusLine.textContent = `node ${state.node} · world ${state.world}`;
   statusLine.className = "";
   applyUpdate(state.update);
