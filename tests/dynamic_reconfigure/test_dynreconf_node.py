@@ -146,6 +146,11 @@ def test_dynparam_commands(served, tmp_path: Path, capsys) -> None:
         == 0
     )
     assert node.get_param("~int_param") == 33 and node.get_param("~str_param") == "from_params"
+    capsys.readouterr()
+    # ros_basic's param_pkg dumps to its author's /home/... path: one line, exit 1, no traceback
+    missing = tmp_path / "no_such_dir" / "dump.yaml"
+    assert dynparam.main(["dump", "/dyn_server", str(missing)]) == 1
+    assert capsys.readouterr().err == f"ERROR: cannot write {missing}: No such file or directory\n"
 
 
 def test_dynparam_errors(master_uri: str, capsys) -> None:

@@ -293,3 +293,34 @@ def test_catkin_ignore_beside_a_package_xml_hides_the_package(
     (pkg / "CATKIN_IGNORE").touch()
     assert _make(tmp_path, monkeypatch) == 0
     assert (tmp_path / "devel" / "setup.bash").is_file()
+
+
+#: MR3001C's links_act template lists two scripts its students have not written yet
+GONE_SCRIPT_CMAKE = (
+    "find_package(catkin REQUIRED COMPONENTS rospy)\n"
+    "catkin_install_python(PROGRAMS\n  scripts/gone.py\n  DESTINATION bin\n)\n"
+)
+
+
+def test_an_install_python_program_that_is_missing_fails_with_catkins_words_and_its_line(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, clean_env: None
+) -> None:
+    pkg = _package(tmp_path, "gone", "  <depend>rospy</depend>\n", GONE_SCRIPT_CMAKE)
+    with pytest.raises(PackageError) as info:
+        _make(tmp_path, monkeypatch)
+    assert str(info.value) == (
+        f"{pkg}/CMakeLists.txt:4: catkin_install_python() called with non-existing file '{pkg}/scripts/gone.py'."
+    )
+
+
+@pytest.mark.ros1
+@pytest.mark.skipif(
+    not Path("/usr/bin/catkin_make").exists() or not shutil.which("cmake"), reason="no catkin"
+)
+def test_a_missing_install_python_program_fails_debians_catkin_make_the_same_way(tmp_path: Path) -> None:
+    pkg = _package(tmp_path, "gone", "  <depend>rospy</depend>\n", GONE_SCRIPT_CMAKE)
+    debian = _debian_catkin_make(tmp_path)
+    assert debian.returncode != 0
+    flat = " ".join((debian.stdout + debian.stderr).split())
+    assert f"catkin_install_python() called with non-existing file '{pkg}/scripts/gone.py'." in flat
+    assert "gone/CMakeLists.txt:4 (catkin_install_python)" in flat

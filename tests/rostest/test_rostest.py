@@ -39,6 +39,8 @@ catkin_package()
 if(CATKIN_ENABLE_TESTING)
   find_package(rostest REQUIRED)
   add_rostest(test/talker.test)
+  add_rostest(test/failing.test)
+  add_rostest(test/broken.test)
 endif()
 """
 
@@ -232,6 +234,7 @@ def _workspace(root: Path) -> CatkinWorkspace:
             "test/publish.test": PUBLISH_TEST,
             "test/param.test": PARAM_TEST,
             "test/advertise.test": ADVERTISE_TEST,
+            "test/broken.test": "<launch><test test-name=",
         },
         executables=list(scripts),
     )
@@ -437,11 +440,63 @@ def test_same_report_as_debians_rostest(workspace: Path, tmp_path: Path, test_fi
     assert _report_lines(ours.stdout) == _report_lines(debian.stdout)
 
 
-def test_catkin_make_run_tests_runs_the_add_rostest_files(workspace: Path) -> None:
-    combined = workspace / "ros_home" / "test_results" / "probe_tests" / "rostest-test_talker.xml"
-    combined.unlink(missing_ok=True)
+@pytest.fixture(scope="module")
+def run_tests(workspace: Path) -> tuple[subprocess.CompletedProcess[str], Path]:
+    """``catkin_make run_tests`` once for the module (three rostests): its output and results dir."""
     made = CatkinWorkspace(workspace).catkin_make("run_tests", timeout=300)
+    return made, workspace / "build" / "test_results"
+
+
+def test_catkin_make_run_tests_runs_the_add_rostest_files(run_tests) -> None:
+    """Results where catkin's add_rostest puts them: build/test_results/<pkg>/rostest-<file>.xml."""
+    made, results = run_tests
     assert made.returncode == 0, made.stdout + made.stderr
     assert "-- run_tests_probe_tests_rostest_test_talker.test" in made.stdout
     assert "[probe_tests.rosunit-talker_test/test_hears_hello][passed]" in made.stdout
-    assert read_xml(combined).ok
+    assert read_xml(results / "probe_tests" / "rostest-test_talker.xml").ok
+    failing = read_xml(results / "probe_tests" / "rostest-test_failing.xml")
+    assert len(failing.cases) == 2 and not failing.ok
+    # broken.test writes no result: a MISSING- failure file stands for it, as catkin's run_tests.py
+    missing = results / "probe_tests" / "MISSING-rostest-test_broken.xml"
+    assert not read_xml(missing).ok
+    assert f"Cannot find results, writing failure results to '{missing}'" in made.stderr
+
+
+@pytest.mark.ros1
+@pytest.mark.skipif(
+    not Path("/usr/bin/catkin_test_results").exists(), reason="Debian's catkin_test_results not installed"
+)
+def test_debians_catkin_test_results_counts_them(run_tests) -> None:
+    """``catkin_make run_tests && catkin_test_results``, the CI idiom: the failures are counted."""
+    _made, results = run_tests
+    summary = subprocess.run(
+        ["/usr/bin/catkin_test_results", str(results)],
+        env={"PATH": "/usr/bin:/bin", "LANG": "C.UTF-8"},
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
+    assert summary.returncode == 1, summary.stdout + summary.stderr
+    # rostest's combined files, the test nodes' own rosunit- files beside them (as ROS 1 writes them
+    # with --results-base-dir), and the MISSING- stand-in for broken.test
+    assert "probe_tests/MISSING-rostest-test_broken.xml: 1 tests, 0 errors, 1 failures" in summary.stdout
+    assert "probe_tests/rostest-test_failing.xml: 2 tests, 0 errors, 1 failures" in summary.stdout
+    assert "Summary: 9 tests, 0 errors, 3 failures, 0 skipped" in summary.stdout, summary.stdout
+
+
+def test_results_filename_is_a_name_in_the_results_dir(workspace: Path, tmp_path: Path) -> None:
+    """``--results-filename`` names the file inside ``--results-base-dir``/<pkg>, as rostest_main does."""
+    ran = _rostest(
+        workspace,
+        "--results-filename",
+        "chosen.name.xml",
+        "--results-base-dir",
+        str(tmp_path / "results"),
+        "probe_tests",
+        "failing.test",
+    )
+    assert ran.returncode == 2, ran.stdout + ran.stderr
+    written = tmp_path / "results" / "probe_tests" / "rostest-chosen.name.xml"
+    assert f"[ROSUNIT] Outputting test results to {written}" in ran.stdout
+    assert len(read_xml(written).cases) == 2

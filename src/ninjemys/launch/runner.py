@@ -130,10 +130,25 @@ class Supervisor:
                 spec.log_dir.mkdir(parents=True, exist_ok=True)
                 proc.log_file = open(spec.log_dir / f"{spec.name}-stdout.log", "ab")  # noqa: SIM115 - closed on exit
                 stdout = proc.log_file
+            if not spec.is_core and not _runnable(spec.argv[0], spec.env):
+                self._fatal_launch(proc)
+                return
+            if not spec.is_core and not _exec_format_ok(spec.argv[0]):
+                # ROS 1's FatalProcessLaunch for ENOEXEC: a script without its "#!" line
+                self.write(
+                    f"RLException: Unable to launch [{spec.name}]. \n"
+                    "If it is a script, you may be missing a '#!' declaration at the top.\n"
+                )
+                proc.exit_code = 126
+                self.failed = True
+                self.shutdown()
+                return
             try:
+                # stdin is roslaunch's own, as in ROS 1: keyboard teleops and input() prompts started
+                # by a launch file (turtlebot3_teleop_key.launch) read the terminal roslaunch runs in
                 proc.popen = subprocess.Popen(
                     [*DEATH_WRAPPER, *spec.argv],
-                    stdin=subprocess.DEVNULL,
+                    stdin=None,
                     stdout=stdout,
                     stderr=stderr,
                     env=spec.env,
@@ -157,6 +172,19 @@ class Supervisor:
         if not spec.is_core:
             self.write(f"process[{spec.name}]: started with pid [{proc.popen.pid}]\n")
         self._event("started", spec.name)
+
+    def _fatal_launch(self, proc: _Running) -> None:
+        """The program a node's command starts with (usually its launch-prefix) does not exist: ROS 1
+        raises FatalProcessLaunch, starts nothing more, stops what it started and exits with 1."""
+        self.write(
+            "RLException: Roslaunch got a 'No such file or directory' error while attempting to run:\n\n"
+            f"{' '.join(proc.spec.argv)}\n\n"
+            "Please make sure that all the executables in this command exist and have\n"
+            "executable permission. This is often caused by a bad launch-prefix.\n"
+        )
+        proc.exit_code = 127
+        self.failed = True
+        self.shutdown()
 
     def _event(self, kind: str, name: str) -> None:
         if self.on_event is not None:
@@ -401,6 +429,26 @@ class Supervisor:
 
     def respawn_count(self, name: str) -> int:
         return next(p.respawns for p in self.procs if p.spec.name == name)
+
+
+def _runnable(program: str, env: dict[str, str]) -> bool:
+    """Whether exec would find ``program``: a path that is an executable file, or a name on PATH."""
+    if "/" in program:
+        return os.path.isfile(program) and os.access(program, os.X_OK)
+    return shutil.which(program, path=env.get("PATH", os.defpath)) is not None
+
+
+def _exec_format_ok(program: str) -> bool:
+    """False for a file exec would refuse with ENOEXEC: neither ELF nor starting with ``#!``
+    (a program found on PATH by name is left to exec)."""
+    if "/" not in program:
+        return True
+    try:
+        with open(program, "rb") as f:
+            head = f.read(4)
+    except OSError:
+        return True
+    return head.startswith((b"#!", b"\x7fELF"))
 
 
 def _stdout_write(text: str) -> None:

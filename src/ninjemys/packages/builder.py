@@ -355,9 +355,7 @@ def build_workspace(
         for program, destination in hints.install_programs:
             script = (pkg.path / program).resolve()
             if not script.is_file():
-                raise PackageError(
-                    f"{pkg.path / 'CMakeLists.txt'}: catkin_install_python(PROGRAMS {program}) names a missing file"
-                )
+                raise PackageError(hints.missing_program(pkg.path, program))
             target = ws.devel / destination.format(pkg=pkg.name) / script.name
             writer.write(target, _relay_script(script), executable=True)
 

@@ -35,10 +35,18 @@ class CMakeHints:
     required: tuple[Requirement, ...] = ()
     #: the .test files of ``add_rostest(file ...)``, relative to the package (``catkin_make run_tests``)
     rostests: tuple[str, ...] = ()
+    #: the CMakeLists.txt line of each ``catkin_install_python`` program, for error messages
+    program_lines: tuple[tuple[str, int], ...] = ()
 
     @property
     def programs(self) -> tuple[str, ...]:
         return tuple(program for program, _ in self.install_programs)
+
+    def missing_program(self, package_dir: Path, program: str) -> str:
+        """catkin's words for a ``catkin_install_python`` program that does not exist, with the place."""
+        line = dict(self.program_lines).get(program)
+        where = f"{package_dir / 'CMakeLists.txt'}" + (f":{line}" if line else "")
+        return f"{where}: catkin_install_python() called with non-existing file '{package_dir / program}'."
 
 
 def read_cmake_hints(package_dir: Path) -> CMakeHints:
@@ -52,6 +60,7 @@ def read_cmake_hints(package_dir: Path) -> CMakeHints:
     programs: list[tuple[str, str]] = []
     required: list[Requirement] = []
     rostests: list[str] = []
+    program_lines: list[tuple[str, int]] = []
     for match in _CALL.finditer(text):
         command = match.group(1).lower()
         args = [a.strip("\"'") for a in match.group(2).split()]
@@ -65,6 +74,7 @@ def read_cmake_hints(package_dir: Path) -> CMakeHints:
                     break
                 if "${" not in arg:
                     programs.append((arg, destination))
+                    program_lines.append((arg, line))
         elif command == "find_package" and args:
             required.extend(_requirements(args, line))
         elif command == "add_rostest" and args and "${" not in args[0]:
@@ -74,6 +84,7 @@ def read_cmake_hints(package_dir: Path) -> CMakeHints:
         install_programs=tuple(programs),
         required=tuple(required),
         rostests=tuple(rostests),
+        program_lines=tuple(program_lines),
     )
 
 

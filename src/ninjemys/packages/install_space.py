@@ -242,9 +242,7 @@ def _install_package(pkg: PackageManifest, out: _Installer) -> None:
     for program, destination in hints.install_programs:
         script = pkg.path / program
         if not script.is_file():
-            raise PackageError(
-                f"{pkg.path / 'CMakeLists.txt'}: catkin_install_python(PROGRAMS {program}) names a missing file"
-            )
+            raise PackageError(hints.missing_program(pkg.path, program))
         out.copy(script, out.prefix / destination.format(pkg=pkg.name) / script.name, executable=True)
     if hints.python_setup and (pkg.path / "setup.py").is_file():
         dist = out.prefix / "lib" / "python3" / "dist-packages"

@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import os
 import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -20,6 +21,7 @@ from ninjemys.packages.cmake_hints import read_cmake_hints
 from ninjemys.packages.cpp_build import install_cpp
 from ninjemys.packages.install_space import install_workspace
 from ninjemys.packages.workspace import Workspace
+from ninjemys.rostest.junit import CaseResult, SuiteResult, write_xml
 from ninjemys.tools.cli import entry
 
 
@@ -84,7 +86,10 @@ def main(argv: list[str] | None = None) -> int:
 def _run_tests(ws: Workspace) -> None:
     """``catkin_make run_tests``: every ``add_rostest(file)`` of the workspace, through ``rostest``
     with the devel space on the paths. As with catkin, a failing test does not fail catkin_make:
-    the results are in ~/.ros/test_results (or ROS_TEST_RESULTS_DIR)."""
+    the results go where catkin puts them, ``build/test_results/<pkg>/rostest-<file>.xml``, for
+    ``catkin_test_results`` (``catkin_make run_tests && catkin_test_results`` is the CI idiom; with
+    the results elsewhere it would report 0 tests and pass). A test that writes no result leaves a
+    ``MISSING-`` failure file there, as catkin's run_tests.py does."""
     env = dict(os.environ)
     for key, value in (
         ("ROS_PACKAGE_PATH", str(ws.source)),
@@ -93,6 +98,7 @@ def _run_tests(ws: Workspace) -> None:
     ):
         env[key] = os.pathsep.join([value, *([env[key]] if env.get(key) else [])])
     rostest = command_path("rostest")
+    results_dir = ws.build / "test_results"
     for pkg in ws.ordered():
         for test_file in read_cmake_hints(pkg.path).rostests:
             path = pkg.path / test_file
@@ -100,9 +106,48 @@ def _run_tests(ws: Workspace) -> None:
             if not path.is_file():
                 print(f"-- {pkg.path / 'CMakeLists.txt'}: add_rostest({test_file}) names a missing file")
                 continue
+            # catkin's add_rostest: the results file is named after the path without its extensions
+            stem = test_file.replace("/", "_").split(".")[0]
+            results = results_dir / pkg.name / f"rostest-{stem}.xml"
+            for old in (results, results.with_name(f"MISSING-{results.name}")):
+                old.unlink(missing_ok=True)
             subprocess.run(
-                [rostest, "--pkgdir", str(pkg.path), "--package", pkg.name, str(path)], env=env, check=False
+                [
+                    rostest,
+                    "--pkgdir",
+                    str(pkg.path),
+                    "--package",
+                    pkg.name,
+                    "--results-filename",
+                    f"{stem}.xml",
+                    "--results-base-dir",
+                    str(results_dir),
+                    str(path),
+                ],
+                env=env,
+                check=False,
             )
+            if not results.is_file():
+                _write_missing_result(results, f"run_tests_{pkg.name}_rostest_{test_file.replace('/', '_')}")
+
+
+def _write_missing_result(results: Path, target: str) -> None:
+    """A failing JUnit file beside the expected one: ``catkin_test_results`` counts it as a failure."""
+    missing = results.with_name(f"MISSING-{results.name}")
+    print(f"Cannot find results, writing failure results to '{missing}'", file=sys.stderr)
+    write_xml(
+        missing,
+        SuiteResult(
+            name=results.stem,
+            cases=[
+                CaseResult(
+                    classname="Results",
+                    name="test_ran",
+                    failure=f"{target}: the test did not write its result file {results}",
+                )
+            ],
+        ),
+    )
 
 
 def _install_prefix(ws: Workspace, cmake_args: list[str]) -> Path:

@@ -226,8 +226,12 @@ def do_dump(session: _Session) -> None:
     session.connect()
     params = _get(session, node, options.timeout)
     if params is not None:
-        with open(path, "w", encoding="utf-8") as f:
-            yaml.dump(params, f)
+        # a course's hard-coded path (/home/<author>/...) is one line naming the file, not a traceback
+        try:
+            with open(path, "w", encoding="utf-8") as f:
+                yaml.dump(params, f)
+        except OSError as exc:
+            raise NinjemysError(f"cannot write {path}: {exc.strerror}") from None
         return
     print(f"couldn't get parameters from node {node}")
 

@@ -246,7 +246,12 @@ def main(argv: list[str] | None = None) -> int:
             launch = [command_path("roslaunch"), "--no-summary", str(test_file), *launch_args]
             nodes = subprocess.Popen(launch, env=env, stdin=subprocess.DEVNULL, start_new_session=True)
         suite_name = _test_file_name(pkg_dir, test_file)
-        combined = opts.results_filename or str(results_file(package, suite_name, is_rostest=True, env=env))
+        if opts.results_filename:
+            # a name, not a path (catkin's add_rostest passes one): its stem names the results, which
+            # go to <results dir>/<pkg>/rostest-<stem>.xml like every other rostest result
+            name = opts.results_filename
+            suite_name = name[: name.rfind(".")] if "." in name else name
+        combined = str(results_file(package, suite_name, is_rostest=True, env=env))
         print(f"... logging to {log_file}", flush=True)
         print(f"[ROSUNIT] Outputting test results to {combined}", flush=True)
         runs: list[TestRun] = []
