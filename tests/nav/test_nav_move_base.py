@@ -51,7 +51,7 @@ class FakeController:
     def set_plan(self, plan):
         self.plans.append(plan)
 
-    def compute(self, pose, velocity, period):
+    def compute(self, pose, velocity, period, stamps=None):
         return self.answer
 
     def remaining(self) -> int:

@@ -49,6 +49,9 @@ PREEMPTED_TEXT = "This goal was canceled because another goal was received by th
 PLAN_RETRY = 0.5
 #: how much the final turn must shrink the heading error (rad) to count as progress
 TURN_PROGRESS = 0.05
+#: the longest gap (s) between a pose and a newer odometry message that the pose is carried over
+#: (larger gaps are a clock reset or a stalled publisher, not transport lag: the pose is used as it is)
+MAX_EXTRAPOLATION = 1.0
 
 
 @dataclass
@@ -85,9 +88,17 @@ class Controller(Protocol):
         """The plan (n, 3) in the controller's frame; keeps the goal latch of the current goal."""
         ...
 
-    def compute(self, pose: Pose2D, velocity: tuple[float, float], period: float | None) -> Command:
+    def compute(
+        self,
+        pose: Pose2D,
+        velocity: tuple[float, float],
+        period: float | None,
+        stamps: tuple[float, float] | None = None,
+    ) -> Command:
         """One cycle's command from the pose (controller's frame) and velocity (v, w). ``period`` is
-        the longest recent cycle: how long the command may stand before the next one."""
+        the longest recent cycle: how long the command may stand before the next one. ``stamps``:
+        the ROS times of the pose and of the odometry (None: unknown); the goal is reached only on a
+        pose no older than the odometry that showed the robot stopped."""
         ...
 
     def remaining(self) -> int:
@@ -363,8 +374,17 @@ class MoveBaseFsm:
 
     # -- control ----------------------------------------------------------------------------------------
 
-    def cycle(self, now: float, gpose: Pose2D, lpose: Pose2D, velocity: tuple[float, float]) -> Step:
-        """One control cycle with the robot's pose in the global and in the controller's frame."""
+    def cycle(
+        self,
+        now: float,
+        gpose: Pose2D,
+        lpose: Pose2D,
+        velocity: tuple[float, float],
+        stamps: tuple[float, float] | None = None,
+    ) -> Step:
+        """One control cycle with the robot's pose in the global and in the controller's frame.
+        ``stamps``: (ROS time of ``lpose``, ROS time of the odometry ``velocity`` came from), when
+        known; under load /tf and /odom arrive out of step, and the goal check needs both."""
         step = Step()
         if self.state == IDLE or self.goal is None:
             return step
@@ -384,15 +404,27 @@ class MoveBaseFsm:
             return self._recovery_step(step, now, gpose, lpose)
         if self.plan is None:
             return step
-        return self._control(step, now, gpose, lpose, velocity)
+        return self._control(step, now, gpose, lpose, velocity, stamps)
 
     def _control(
-        self, step: Step, now: float, gpose: Pose2D, lpose: Pose2D, velocity: tuple[float, float]
+        self,
+        step: Step,
+        now: float,
+        gpose: Pose2D,
+        lpose: Pose2D,
+        velocity: tuple[float, float],
+        stamps: tuple[float, float] | None,
     ) -> Step:
         plan = self.plan
         assert plan is not None
+        if stamps is not None:
+            # under load /tf reaches move_base later than /odom: steer from where odometry says the
+            # robot is now, not from where TF last saw it (the goal check still waits for a real pose
+            # of the standstill, see the controller)
+            gpose = extrapolate(gpose, velocity, stamps[1] - stamps[0])
+            lpose = extrapolate(lpose, velocity, stamps[1] - stamps[0])
         self.controller.set_plan(to_frame(plan, se2_compose(lpose, se2_inverse(gpose))))
-        cmd = self.controller.compute(lpose, velocity, max(self.periods, default=None))
+        cmd = self.controller.compute(lpose, velocity, max(self.periods, default=None), stamps)
         self.plan = plan[len(plan) - self.controller.remaining() :]  # pruned as the controller did
         if cmd.reached:
             return self._finish(step, states.SUCCEEDED, "Goal reached")
@@ -484,6 +516,17 @@ class MoveBaseFsm:
         self.progress.reset(None, now)
         self._want_plan(step, now)
         return step
+
+
+def extrapolate(pose: Pose2D, velocity: tuple[float, float], dt: float) -> Pose2D:
+    """``pose`` carried ``dt`` seconds forward along the arc of ``velocity`` (v, w) in its own frame;
+    unchanged for ``dt`` <= 0 or > :data:`MAX_EXTRAPOLATION`. Moving the global and the local pose by
+    the same body motion keeps the transform between their frames (the plan lands where it was)."""
+    if not 0.0 < dt <= MAX_EXTRAPOLATION:
+        return pose
+    v, w = velocity
+    turn = w * dt
+    return se2_compose(pose, (v * dt * math.cos(turn / 2), v * dt * math.sin(turn / 2), turn))
 
 
 def to_frame(plan: np.ndarray, tf: Pose2D) -> np.ndarray:
