@@ -188,6 +188,33 @@ def test_a_pose_too_old_while_idle_or_planning_commands_nothing_new():
     assert step.cmd == (0.0, 0.0) and fsm.state == PLANNING and not step.ended
 
 
+def test_time_standing_blind_for_a_refused_pose_is_not_oscillation():
+    """A loaded maze run: /tf stalled for seconds at a time, the robot stood still on refused poses,
+    and move_base called it "oscillating over and over" 13 times, 1.7-4.8 m from any goal, running
+    the recoveries. The blind time is paused out of oscillation_timeout; real standing still is not."""
+    fsm, _ = make(oscillation_timeout=2.0, oscillation_distance=0.2, controller_patience=100.0)
+    fsm.accept(GOAL, "h1", 0.0)
+    fsm.plan_now(POSE, 0.0)
+    t = 0.0
+    for _ in range(20):  # 1 s of valid commands, no 0.2 m of progress
+        t += 0.05
+        fsm.cycle(t, (0.05, 0.0, 0.0), (0.05, 0.0, 0.0), (0, 0))
+    for _ in range(60):  # 3 s of refused poses: standing still, blind
+        t += 0.05
+        step = fsm.pose_too_old(t)
+        assert step.cmd == (0.0, 0.0) and not step.log
+        if fsm.state == PLANNING:
+            fsm.plan_now(POSE, t)
+    for _ in range(10):  # 0.5 s more with poses: 1.5 s without progress in all, under the 2 s
+        t += 0.05
+        step = fsm.cycle(t, (0.05, 0.0, 0.0), (0.05, 0.0, 0.0), (0, 0))
+        assert fsm.state == CONTROLLING and not step.log, step.log
+    while fsm.state != CLEARING:  # ...and standing still with poses still counts
+        t += 0.05
+        fsm.cycle(t, (0.05, 0.0, 0.0), (0.05, 0.0, 0.0), (0, 0))
+    assert 5.0 < t < 5.2
+
+
 def test_oscillation_runs_a_full_rotation_and_progress_resets_the_recovery_list():
     fsm, _ = make(oscillation_timeout=2.0, oscillation_distance=0.2)
     fsm.accept(GOAL, "h1", 0.0)

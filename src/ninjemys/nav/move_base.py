@@ -122,6 +122,11 @@ class ProgressChecker(Protocol):
         """False when the robot has been stuck too long (move_base then runs a recovery)."""
         ...
 
+    def pause(self, seconds: float) -> None:
+        """``seconds`` in which the robot could not make progress (it stood still for want of a
+        fresh pose) do not count towards being stuck."""
+        ...
+
 
 class Recovery(Protocol):
     """One recovery behaviour: started once, then stepped every cycle until it says it is done."""
@@ -192,6 +197,9 @@ class OscillationChecker:
             return True
         self.moved(pose, now)
         return now - self.since <= self.params.oscillation_timeout
+
+    def pause(self, seconds: float) -> None:
+        self.since += seconds
 
 
 class ClearCostmaps:
@@ -270,6 +278,7 @@ class MoveBaseFsm:
         self.pose: Pose2D | None = None  # the last global pose a cycle saw
         self.started_recovery = False
         self.last_cycle: float | None = None
+        self.last_tick: float | None = None  # the last cycle or refused pose (see pose_too_old)
         self.periods: deque[float] = deque(maxlen=20)  # measured control periods
 
     # -- goals ------------------------------------------------------------------------------------------
@@ -389,6 +398,7 @@ class MoveBaseFsm:
         if self.state == IDLE or self.goal is None:
             return step
         self.pose = gpose
+        self.last_tick = now
         if self.last_cycle is not None and now > self.last_cycle:
             self.periods.append(now - self.last_cycle)
         self.last_cycle = now
@@ -469,10 +479,17 @@ class MoveBaseFsm:
         """A cycle whose robot pose is older than the costmap's ``transform_tolerance``. ROS 1's local
         planner then fails ("Could not get robot pose"): move_base stands still and treats it as a
         failed control (replan; recoveries after ``controller_patience``). Planning and recovering
-        wait with the robot stopped."""
+        wait with the robot stopped.
+
+        The time spent so does not count as oscillation (ROS 1 counts it): under load /tf stalled for
+        seconds at a time, the robot stood blind, and "the robot appears to be oscillating" sent it
+        into the recoveries (a full turn, in a maze) miles from any tight spot."""
         step = Step()
         if self.state == IDLE or self.goal is None:
             return step
+        if self.last_tick is not None and now > self.last_tick:
+            self.progress.pause(now - self.last_tick)
+        self.last_tick = now
         step.cmd = (0.0, 0.0)
         if self.state == CONTROLLING and self.plan is not None:
             return self._control_failed(step, now)

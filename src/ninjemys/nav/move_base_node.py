@@ -634,6 +634,11 @@ class MoveBase:
                 self.global_cm.global_frame,
                 self.global_cm.robot_base_frame,
             )
+            # no pose at all is no better than one too old: stand still (the robot kept its last
+            # command before, until the base's own timeout stopped it)
+            with self.lock:
+                step = self.fsm.pose_too_old(self.node.get_time())
+            self._apply(step)
             return
         v, w, odom_stamp = self.odom
         # a static chain (stamp 0) or no odometry yet: the goal is judged on the pose as it is
