@@ -17,7 +17,7 @@ import random
 import numpy as np
 
 from ninjemys.actionlib import states
-from ninjemys.nav.dwa import DWAParams, DWAPlanner
+from ninjemys.nav.dwa import MAX_FRESH_WAIT, DWAParams, DWAPlanner
 from ninjemys.nav.move_base import MAX_EXTRAPOLATION, MoveBaseFsm, MoveBaseParams, extrapolate
 from ninjemys.tf2.math import angle_diff, se2_compose, se2_inverse
 
@@ -90,6 +90,36 @@ def test_the_standstill_is_dated_from_the_first_stopped_odometry():
     # ...and a translation above trans_stopped_vel is not a standstill either
     fsm.cycle(5.15, here, here, (0.015, 0.0), (5.10, 5.15))
     assert dwa.stopped_since is None
+
+
+def test_the_global_pose_must_be_of_the_standstill_too():
+    """The goal is judged in the map frame, through amcl's ``map -> odom``. In a loaded run move_base
+    judged goal (1.83, 0.03, 2.82) reached with a fresh odom -> base_link and a map -> odom from before
+    amcl's last correction: 0.4 rad off in truth, for good (amcl does not update a standing robot)."""
+    fsm, dwa = make_fsm(0.0)
+    here = (*GOAL_XY, 0.02)
+    stopped = (0.0, 0.0)
+    fsm.cycle(7.00, here, here, stopped, (7.00, 7.00), 6.50)  # stopped at 7.00, map -> odom of 6.50
+    step = fsm.cycle(7.05, here, here, stopped, (7.05, 7.05), 6.50)
+    assert step.ended == [] and step.cmd == (0.0, 0.0)
+    assert dwa.fresh_waits == 2
+    step = fsm.cycle(7.10, here, here, stopped, (7.10, 7.10), 7.25)  # amcl's transform of the standstill
+    assert [o.status for o in step.ended] == [states.SUCCEEDED]
+
+
+def test_the_wait_for_a_pose_of_the_standstill_is_bounded():
+    """A transform that is never republished (a dead publisher) must not hold the goal for ever: after
+    MAX_FRESH_WAIT of odometry time the goal is judged on the pose there is, as ROS 1 does."""
+    fsm, dwa = make_fsm(0.0)
+    here = (*GOAL_XY, 0.02)
+    t = 7.0
+    while t < 7.0 + MAX_FRESH_WAIT - 0.1:
+        assert fsm.cycle(t, here, here, (0.0, 0.0), (t, t), 6.5).ended == []
+        t += 0.05
+    while not fsm.cycle(t, here, here, (0.0, 0.0), (t, t), 6.5).ended:
+        t += 0.05
+        assert t < 7.0 + MAX_FRESH_WAIT + 0.2
+    assert dwa.fresh_waits > 0
 
 
 def final_turn(goal_yaw: float, seed: int, max_lag: float, stamped: bool = True) -> tuple[int, float]:

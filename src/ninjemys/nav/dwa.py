@@ -40,6 +40,11 @@ NEAR_GOAL = 1.5
 #: out of xy_goal_tolerance while the robot turned in place (ours; see DWAPlanner.compute)
 MAX_REAPPROACHES = 2
 
+#: the longest wait (s of odometry time) of a robot stopped inside the tolerances for a pose newer than
+#: its standstill; then the goal is judged on the pose there is (a transform published seldom, or no
+#: more: ROS 1's rule), rather than never
+MAX_FRESH_WAIT = 3.0
+
 #: control cycles (5 s at controller_frequency 20) that the drives back in of one goal may take in all;
 #: then the approach ends with the turn where the robot stands, as the latched approach did
 REAPPROACH_CYCLES = 100
@@ -241,11 +246,17 @@ class DWAPlanner:
                 # base_local_planner::stopped too). Ended at once, a late pose or a late stop under load
                 # carried the turn on past the tolerance after the goal had been reported reached.
                 return Command(0.0, 0.0, turning=True)
-            if stamps is not None and self.stopped_since is not None and stamps[0] < self.stopped_since:
+            if (
+                stamps is not None
+                and self.stopped_since is not None
+                and stamps[0] < self.stopped_since
+                and stamps[1] - self.stopped_since <= MAX_FRESH_WAIT
+            ):
                 # odometry says stopped, but the pose (TF) is from before that: under load /tf lags
                 # /odom, and a pose from the middle of the turn (or of its braking) read "in tolerance"
                 # while the robot came to rest 0.3 rad further on. Wait for a pose of the standstill;
-                # the local costmap's transform_tolerance bounds the wait (an older pose is refused).
+                # the local costmap's transform_tolerance bounds the wait for odom -> base_link (an
+                # older pose is refused), MAX_FRESH_WAIT the wait for the rest of the chain.
                 self.fresh_waits += 1
                 return Command(0.0, 0.0, turning=True)
             return Command(0.0, 0.0, reached=True)

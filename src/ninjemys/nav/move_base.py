@@ -390,10 +390,14 @@ class MoveBaseFsm:
         lpose: Pose2D,
         velocity: tuple[float, float],
         stamps: tuple[float, float] | None = None,
+        global_stamp: float | None = None,
     ) -> Step:
         """One control cycle with the robot's pose in the global and in the controller's frame.
         ``stamps``: (ROS time of ``lpose``, ROS time of the odometry ``velocity`` came from), when
-        known; under load /tf and /odom arrive out of step, and the goal check needs both."""
+        known; under load /tf and /odom arrive out of step, and the goal check needs both.
+        ``global_stamp``: the ROS time of ``gpose`` (its chain's oldest link, e.g. amcl's
+        ``map -> odom``), when it differs from ``lpose``'s: the goal is judged in the global frame,
+        so neither may predate the standstill."""
         step = Step()
         if self.state == IDLE or self.goal is None:
             return step
@@ -414,7 +418,7 @@ class MoveBaseFsm:
             return self._recovery_step(step, now, gpose, lpose)
         if self.plan is None:
             return step
-        return self._control(step, now, gpose, lpose, velocity, stamps)
+        return self._control(step, now, gpose, lpose, velocity, stamps, global_stamp)
 
     def _control(
         self,
@@ -424,6 +428,7 @@ class MoveBaseFsm:
         lpose: Pose2D,
         velocity: tuple[float, float],
         stamps: tuple[float, float] | None,
+        global_stamp: float | None,
     ) -> Step:
         plan = self.plan
         assert plan is not None
@@ -433,6 +438,10 @@ class MoveBaseFsm:
             # of the standstill, see the controller)
             gpose = extrapolate(gpose, velocity, stamps[1] - stamps[0])
             lpose = extrapolate(lpose, velocity, stamps[1] - stamps[0])
+            if global_stamp is not None and global_stamp < stamps[0]:
+                # the goal is judged through map -> odom too: under load amcl's newest correction
+                # reaches move_base late, and a heading judged with the one before it was 0.4 rad off
+                stamps = (global_stamp, stamps[1])
         self.controller.set_plan(to_frame(plan, se2_compose(lpose, se2_inverse(gpose))))
         cmd = self.controller.compute(lpose, velocity, max(self.periods, default=None), stamps)
         self.plan = plan[len(plan) - self.controller.remaining() :]  # pruned as the controller did

@@ -597,18 +597,20 @@ class MoveBase:
             )
         return pose, too_old, stamp
 
-    def _robot_poses(self) -> tuple[Pose2D | None, Pose2D | None, bool, float]:
+    def _robot_poses(self) -> tuple[Pose2D | None, Pose2D | None, bool, float, float]:
         """The robot's pose in the global and in the local costmap's frame, and whether the local
         one was refused as too old. As in ROS 1, only the controller's own (local costmap) pose is
         held to its ``transform_tolerance`` here: dwa_local_planner refuses a stale one, while the
         plan is carried into its frame with the newest ``map -> odom``, however old (amcl's lags
-        under load; the planner refuses that one, see _plan_once). The last item is the local pose's
-        ROS time."""
+        under load; the planner refuses that one, see _plan_once). The last two items are the local
+        and the global pose's ROS times."""
         lp, too_old, stamp = self._pose(self.local_cm)
         if self.local_cm.global_frame == self.global_cm.global_frame:
-            return lp, lp, too_old, stamp
-        gp = self.tf.lookup(self.global_cm.global_frame, self.global_cm.robot_base_frame)
-        return gp, lp, too_old, stamp
+            return lp, lp, too_old, stamp, stamp
+        found = self.tf.lookup_stamped(self.global_cm.global_frame, self.global_cm.robot_base_frame)
+        if found is None:
+            return None, lp, too_old, stamp, 0.0
+        return found[0], lp, too_old, stamp, found[1]
 
     def cycle(self) -> None:
         """One control cycle: goals from the inbox, then the state machine on the robot's poses."""
@@ -619,7 +621,7 @@ class MoveBase:
             self._apply(step)
         if idle:
             return
-        gpose, lpose, too_old, pose_stamp = self._robot_poses()
+        gpose, lpose, too_old, pose_stamp, global_stamp = self._robot_poses()
         if too_old:
             # too old to drive on (the local costmap's transform_tolerance): stand still, as ROS 1
             with self.lock:
@@ -645,7 +647,7 @@ class MoveBase:
         stamps = (pose_stamp, odom_stamp) if pose_stamp and odom_stamp else None
         with self.lock:
             handle = self.fsm.token
-            step = self.fsm.cycle(self.node.get_time(), gpose, lpose, (v, w), stamps)
+            step = self.fsm.cycle(self.node.get_time(), gpose, lpose, (v, w), stamps, global_stamp or None)
         if step.feedback is not None and handle is not None:
             self._feedback(handle, step.feedback)
         self._apply(step)
