@@ -215,6 +215,21 @@ def test_time_standing_blind_for_a_refused_pose_is_not_oscillation():
     assert 5.0 < t < 5.2
 
 
+def test_time_the_control_loop_did_not_run_is_not_oscillation():
+    """Under load the control loop ran late (the simulator at 8x kept going): what passed between two
+    cycles beyond one period is not the robot's failure to progress. Oscillation is still caught
+    after oscillation_timeout worth of cycles."""
+    fsm, _ = make(oscillation_timeout=2.0, oscillation_distance=0.2)
+    fsm.accept(GOAL, "h1", 0.0)
+    fsm.plan_now(POSE, 0.0)
+    t, cycles = 0.0, 0
+    while fsm.state != CLEARING:  # a cycle every 0.5 s (ten periods of 20 Hz), no progress
+        t += 0.5
+        cycles += 1
+        fsm.cycle(t, (0.05, 0.0, 0.0), (0.05, 0.0, 0.0), (0, 0))
+    assert 40 <= cycles <= 42  # 2 s of 0.05 s periods, not 2 s of clock
+
+
 def test_oscillation_runs_a_full_rotation_and_progress_resets_the_recovery_list():
     fsm, _ = make(oscillation_timeout=2.0, oscillation_distance=0.2)
     fsm.accept(GOAL, "h1", 0.0)

@@ -49,6 +49,9 @@ PREEMPTED_TEXT = "This goal was canceled because another goal was received by th
 PLAN_RETRY = 0.5
 #: how much the final turn must shrink the heading error (rad) to count as progress
 TURN_PROGRESS = 0.05
+#: a control cycle this many periods after the previous one ran late (the process was starved): the
+#: time beyond one period is paused out of the oscillation check
+LATE_CYCLE = 2.0
 #: the longest gap (s) between a pose and a newer odometry message that the pose is carried over
 #: (larger gaps are a clock reset or a stalled publisher, not transport lag: the pose is used as it is)
 MAX_EXTRAPOLATION = 1.0
@@ -123,8 +126,8 @@ class ProgressChecker(Protocol):
         ...
 
     def pause(self, seconds: float) -> None:
-        """``seconds`` in which the robot could not make progress (it stood still for want of a
-        fresh pose) do not count towards being stuck."""
+        """``seconds`` in which the robot could not be controlled (it stood still for want of a
+        fresh pose, or the control loop did not get to run) do not count towards being stuck."""
         ...
 
 
@@ -402,6 +405,17 @@ class MoveBaseFsm:
         if self.state == IDLE or self.goal is None:
             return step
         self.pose = gpose
+        period = 1.0 / self.params.controller_frequency
+        if (
+            self.state == CONTROLLING
+            and self.last_tick is not None
+            and now - self.last_tick > LATE_CYCLE * period
+        ):
+            # the control loop did not run for a while (under load the simulator, at 8x, kept going
+            # while move_base waited for a core): the robot stood on the base's command timeout or
+            # drove on an old command, not under control. Counted, the loaded maze runs called that
+            # "oscillating over and over" 13-19 times each, at the corners where the robot turns.
+            self.progress.pause(now - self.last_tick - period)
         self.last_tick = now
         if self.last_cycle is not None and now > self.last_cycle:
             self.periods.append(now - self.last_cycle)
