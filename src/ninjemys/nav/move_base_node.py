@@ -607,10 +607,15 @@ class MoveBase:
         lp, too_old, stamp = self._pose(self.local_cm)
         if self.local_cm.global_frame == self.global_cm.global_frame:
             return lp, lp, too_old, stamp, stamp
-        found = self.tf.lookup_stamped(self.global_cm.global_frame, self.global_cm.robot_base_frame)
-        if found is None:
+        # the global pose is the local one carried by the newest map -> odom. Looked up at the chain's
+        # latest common time instead (map -> base_link at time 0), it was the robot's pose of when
+        # amcl last published, which under load is tenths of a second before the local pose: the plan
+        # and the goal, carried into the local frame by local * global^-1, then turned with the robot
+        # (0.4 rad of goal heading after a turn at 1 rad/s), and move_base stopped short of it.
+        found = self.tf.lookup_stamped(self.global_cm.global_frame, self.local_cm.global_frame)
+        if found is None or lp is None:
             return None, lp, too_old, stamp, 0.0
-        return found[0], lp, too_old, stamp, found[1]
+        return se2_compose(found[0], lp), lp, too_old, stamp, found[1]
 
     def cycle(self) -> None:
         """One control cycle: goals from the inbox, then the state machine on the robot's poses."""
