@@ -226,8 +226,12 @@ def test_time_the_control_loop_did_not_run_is_not_oscillation():
     while fsm.state != CLEARING:  # a cycle every 0.5 s (ten periods of 20 Hz), no progress
         t += 0.5
         cycles += 1
-        fsm.cycle(t, (0.05, 0.0, 0.0), (0.05, 0.0, 0.0), (0, 0))
+        step = fsm.cycle(t, (0.05, 0.0, 0.0), (0.05, 0.0, 0.0), (0, 0))
     assert 40 <= cycles <= 42  # 2 s of 0.05 s periods, not 2 s of clock
+    # the log line says what the robot did meanwhile (here: nothing, in 40 cycles)
+    (level, text), *_ = step.log
+    assert level == "warn" and "oscillating over and over at (0.05, 0.00, 0.00)" in text, text
+    assert "(41 control cycles, 18.0 s out of control not counted, turned 0.00 rad and drove 0.00 m" in text
 
 
 def test_oscillation_runs_a_full_rotation_and_progress_resets_the_recovery_list():

@@ -130,6 +130,10 @@ class ProgressChecker(Protocol):
         fresh pose, or the control loop did not get to run) do not count towards being stuck."""
         ...
 
+    def describe(self) -> str:
+        """What the robot did since the last progress, for the log line of a recovery."""
+        ...
+
 
 class Recovery(Protocol):
     """One recovery behaviour: started once, then stepped every cycle until it says it is done."""
@@ -181,9 +185,14 @@ class OscillationChecker:
         self.params = params
         self.pose: Pose2D | None = None
         self.since = 0.0
+        # since the reference: control cycles checked, seconds paused, and the motion seen meanwhile
+        self.cycles, self.paused, self.turned, self.driven = 0, 0.0, 0.0, 0.0
+        self.last: Pose2D | None = None
 
     def reset(self, pose: Pose2D | None, now: float) -> None:
         self.pose, self.since = pose, now
+        self.cycles, self.paused, self.turned, self.driven = 0, 0.0, 0.0, 0.0
+        self.last = pose
 
     def moved(self, pose: Pose2D, now: float) -> bool:
         """True (and a new reference) when the robot got ``oscillation_distance`` away."""
@@ -198,11 +207,23 @@ class OscillationChecker:
     def check(self, pose: Pose2D, now: float) -> bool:
         if self.params.oscillation_timeout <= 0:
             return True
-        self.moved(pose, now)
+        if not self.moved(pose, now):
+            self.cycles += 1
+            if self.last is not None:
+                self.turned += abs(angle_diff(pose[2], self.last[2]))
+                self.driven += math.hypot(pose[0] - self.last[0], pose[1] - self.last[1])
+            self.last = pose
         return now - self.since <= self.params.oscillation_timeout
 
     def pause(self, seconds: float) -> None:
         self.since += seconds
+        self.paused += seconds
+
+    def describe(self) -> str:
+        return (
+            f"{self.cycles} control cycles, {self.paused:.1f} s out of control not counted, "
+            f"turned {self.turned:.2f} rad and drove {self.driven:.2f} m meanwhile"
+        )
 
 
 class ClearCostmaps:
@@ -480,7 +501,10 @@ class MoveBaseFsm:
                     self.recovery_index = 0  # real progress: the recovery list starts over, as in ROS 1
             if not self.progress.check(gpose, now):
                 self._start_recovery(
-                    step, now, "Aborting because the robot appears to be oscillating over and over"
+                    step,
+                    now,
+                    "Aborting because the robot appears to be oscillating over and over",
+                    self.progress.describe(),
                 )
             return step
         return self._control_failed(step, now)
@@ -520,7 +544,7 @@ class MoveBaseFsm:
 
     # -- recoveries -------------------------------------------------------------------------------------
 
-    def _start_recovery(self, step: Step, now: float, failure: str) -> None:
+    def _start_recovery(self, step: Step, now: float, failure: str, detail: str = "") -> None:
         if not self.params.recovery_behavior_enabled or self.recovery_index >= len(self.recoveries):
             self._finish(step, states.ABORTED, failure)
             return
@@ -535,8 +559,8 @@ class MoveBaseFsm:
         step.log.append(
             (
                 "warn",
-                f"{failure.split('.')[0]}{where}; running recovery behavior "
-                f"{self.recoveries[self.recovery_index].name}",
+                f"{failure.split('.')[0]}{where}{f' ({detail})' if detail else ''}; running recovery "
+                f"behavior {self.recoveries[self.recovery_index].name}",
             )
         )
 
