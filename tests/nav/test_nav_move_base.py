@@ -188,50 +188,20 @@ def test_a_pose_too_old_while_idle_or_planning_commands_nothing_new():
     assert step.cmd == (0.0, 0.0) and fsm.state == PLANNING and not step.ended
 
 
-def test_time_standing_blind_for_a_refused_pose_is_not_oscillation():
-    """A loaded maze run: /tf stalled for seconds at a time, the robot stood still on refused poses,
-    and move_base called it "oscillating over and over" 13 times, 1.7-4.8 m from any goal, running
-    the recoveries. The blind time is paused out of oscillation_timeout; real standing still is not."""
-    fsm, _ = make(oscillation_timeout=2.0, oscillation_distance=0.2, controller_patience=100.0)
-    fsm.accept(GOAL, "h1", 0.0)
-    fsm.plan_now(POSE, 0.0)
-    t = 0.0
-    for _ in range(20):  # 1 s of valid commands, no 0.2 m of progress
-        t += 0.05
-        fsm.cycle(t, (0.05, 0.0, 0.0), (0.05, 0.0, 0.0), (0, 0))
-    for _ in range(60):  # 3 s of refused poses: standing still, blind
-        t += 0.05
-        step = fsm.pose_too_old(t)
-        assert step.cmd == (0.0, 0.0) and not step.log
-        if fsm.state == PLANNING:
-            fsm.plan_now(POSE, t)
-    for _ in range(10):  # 0.5 s more with poses: 1.5 s without progress in all, under the 2 s
-        t += 0.05
-        step = fsm.cycle(t, (0.05, 0.0, 0.0), (0.05, 0.0, 0.0), (0, 0))
-        assert fsm.state == CONTROLLING and not step.log, step.log
-    while fsm.state != CLEARING:  # ...and standing still with poses still counts
-        t += 0.05
-        fsm.cycle(t, (0.05, 0.0, 0.0), (0.05, 0.0, 0.0), (0, 0))
-    assert 5.0 < t < 5.2
-
-
-def test_time_the_control_loop_did_not_run_is_not_oscillation():
-    """Under load the control loop ran late (the simulator at 8x kept going): what passed between two
-    cycles beyond one period is not the robot's failure to progress. Oscillation is still caught
-    after oscillation_timeout worth of cycles."""
+def test_the_oscillation_recovery_says_what_the_robot_did_meanwhile():
+    """Loaded maze runs stalled at the corners: the log line tells a starved controller (few cycles)
+    from a robot standing under valid commands (cycles at full rate, no motion)."""
     fsm, _ = make(oscillation_timeout=2.0, oscillation_distance=0.2)
     fsm.accept(GOAL, "h1", 0.0)
     fsm.plan_now(POSE, 0.0)
-    t, cycles = 0.0, 0
-    while fsm.state != CLEARING:  # a cycle every 0.5 s (ten periods of 20 Hz), no progress
-        t += 0.5
-        cycles += 1
-        step = fsm.cycle(t, (0.05, 0.0, 0.0), (0.05, 0.0, 0.0), (0, 0))
-    assert 40 <= cycles <= 42  # 2 s of 0.05 s periods, not 2 s of clock
-    # the log line says what the robot did meanwhile (here: nothing, in 40 cycles)
+    t, yaw = 0.0, 0.0
+    while fsm.state != CLEARING:
+        t += 0.05
+        yaw += 0.01
+        step = fsm.cycle(t, (0.05, 0.0, yaw), (0.05, 0.0, yaw), (0, 0))
     (level, text), *_ = step.log
-    assert level == "warn" and "oscillating over and over at (0.05, 0.00, 0.00)" in text, text
-    assert "(41 control cycles, 18.0 s out of control not counted, turned 0.00 rad and drove 0.00 m" in text
+    assert level == "warn" and "oscillating over and over at (0.05, 0.00, 0." in text, text
+    assert "(41 control cycles, turned 0.40 rad and drove 0.00 m meanwhile)" in text, text
 
 
 def test_oscillation_runs_a_full_rotation_and_progress_resets_the_recovery_list():

@@ -49,9 +49,6 @@ PREEMPTED_TEXT = "This goal was canceled because another goal was received by th
 PLAN_RETRY = 0.5
 #: how much the final turn must shrink the heading error (rad) to count as progress
 TURN_PROGRESS = 0.05
-#: a control cycle this many periods after the previous one ran late (the process was starved): the
-#: time beyond one period is paused out of the oscillation check
-LATE_CYCLE = 2.0
 #: the longest gap (s) between a pose and a newer odometry message that the pose is carried over
 #: (larger gaps are a clock reset or a stalled publisher, not transport lag: the pose is used as it is)
 MAX_EXTRAPOLATION = 1.0
@@ -125,11 +122,6 @@ class ProgressChecker(Protocol):
         """False when the robot has been stuck too long (move_base then runs a recovery)."""
         ...
 
-    def pause(self, seconds: float) -> None:
-        """``seconds`` in which the robot could not be controlled (it stood still for want of a
-        fresh pose, or the control loop did not get to run) do not count towards being stuck."""
-        ...
-
     def describe(self) -> str:
         """What the robot did since the last progress, for the log line of a recovery."""
         ...
@@ -185,13 +177,13 @@ class OscillationChecker:
         self.params = params
         self.pose: Pose2D | None = None
         self.since = 0.0
-        # since the reference: control cycles checked, seconds paused, and the motion seen meanwhile
-        self.cycles, self.paused, self.turned, self.driven = 0, 0.0, 0.0, 0.0
+        # since the reference: control cycles checked, and the motion seen meanwhile
+        self.cycles, self.turned, self.driven = 0, 0.0, 0.0
         self.last: Pose2D | None = None
 
     def reset(self, pose: Pose2D | None, now: float) -> None:
         self.pose, self.since = pose, now
-        self.cycles, self.paused, self.turned, self.driven = 0, 0.0, 0.0, 0.0
+        self.cycles, self.turned, self.driven = 0, 0.0, 0.0
         self.last = pose
 
     def moved(self, pose: Pose2D, now: float) -> bool:
@@ -215,14 +207,10 @@ class OscillationChecker:
             self.last = pose
         return now - self.since <= self.params.oscillation_timeout
 
-    def pause(self, seconds: float) -> None:
-        self.since += seconds
-        self.paused += seconds
-
     def describe(self) -> str:
         return (
-            f"{self.cycles} control cycles, {self.paused:.1f} s out of control not counted, "
-            f"turned {self.turned:.2f} rad and drove {self.driven:.2f} m meanwhile"
+            f"{self.cycles} control cycles, turned {self.turned:.2f} rad and drove {self.driven:.2f} m "
+            "meanwhile"
         )
 
 
@@ -302,7 +290,6 @@ class MoveBaseFsm:
         self.pose: Pose2D | None = None  # the last global pose a cycle saw
         self.started_recovery = False
         self.last_cycle: float | None = None
-        self.last_tick: float | None = None  # the last cycle or refused pose (see pose_too_old)
         self.periods: deque[float] = deque(maxlen=20)  # measured control periods
 
     # -- goals ------------------------------------------------------------------------------------------
@@ -426,18 +413,6 @@ class MoveBaseFsm:
         if self.state == IDLE or self.goal is None:
             return step
         self.pose = gpose
-        period = 1.0 / self.params.controller_frequency
-        if (
-            self.state == CONTROLLING
-            and self.last_tick is not None
-            and now - self.last_tick > LATE_CYCLE * period
-        ):
-            # the control loop did not run for a while (under load the simulator, at 8x, kept going
-            # while move_base waited for a core): the robot stood on the base's command timeout or
-            # drove on an old command, not under control. Counted, the loaded maze runs called that
-            # "oscillating over and over" 13-19 times each, at the corners where the robot turns.
-            self.progress.pause(now - self.last_tick - period)
-        self.last_tick = now
         if self.last_cycle is not None and now > self.last_cycle:
             self.periods.append(now - self.last_cycle)
         self.last_cycle = now
@@ -526,17 +501,10 @@ class MoveBaseFsm:
         """A cycle whose robot pose is older than the costmap's ``transform_tolerance``. ROS 1's local
         planner then fails ("Could not get robot pose"): move_base stands still and treats it as a
         failed control (replan; recoveries after ``controller_patience``). Planning and recovering
-        wait with the robot stopped.
-
-        The time spent so does not count as oscillation (ROS 1 counts it): under load /tf stalled for
-        seconds at a time, the robot stood blind, and "the robot appears to be oscillating" sent it
-        into the recoveries (a full turn, in a maze) miles from any tight spot."""
+        wait with the robot stopped."""
         step = Step()
         if self.state == IDLE or self.goal is None:
             return step
-        if self.last_tick is not None and now > self.last_tick:
-            self.progress.pause(now - self.last_tick)
-        self.last_tick = now
         step.cmd = (0.0, 0.0)
         if self.state == CONTROLLING and self.plan is not None:
             return self._control_failed(step, now)
