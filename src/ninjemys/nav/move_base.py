@@ -406,9 +406,9 @@ class MoveBaseFsm:
         """One control cycle with the robot's pose in the global and in the controller's frame.
         ``stamps``: (ROS time of ``lpose``, ROS time of the odometry ``velocity`` came from), when
         known; under load /tf and /odom arrive out of step, and the goal check needs both.
-        ``global_stamp``: the ROS time of ``gpose`` (its chain's oldest link, e.g. amcl's
-        ``map -> odom``), when it differs from ``lpose``'s: the goal is judged in the global frame,
-        so neither may predate the standstill."""
+        ``global_stamp``: the ROS time of the transform that carries ``lpose`` into the global frame
+        (amcl's ``map -> odom``), when there is one: the goal is judged in the global frame, so
+        neither may predate the standstill."""
         step = Step()
         if self.state == IDLE or self.goal is None:
             return step
@@ -450,7 +450,7 @@ class MoveBaseFsm:
             lpose = extrapolate(lpose, velocity, stamps[1] - stamps[0])
             if global_stamp is not None and global_stamp < stamps[0]:
                 # the goal is judged through map -> odom too: under load amcl's newest correction
-                # reaches move_base late, and a heading judged with the one before it was 0.4 rad off
+                # reaches move_base late, and a heading judged with an older one is off by it
                 stamps = (global_stamp, stamps[1])
         self.controller.set_plan(to_frame(plan, se2_compose(lpose, se2_inverse(gpose))))
         cmd = self.controller.compute(lpose, velocity, max(self.periods, default=None), stamps)
