@@ -51,7 +51,7 @@ class FakeController:
     def set_plan(self, plan):
         self.plans.append(plan)
 
-    def compute(self, pose, velocity, period):
+    def compute(self, pose, velocity, period, stamps=None):
         return self.answer
 
     def remaining(self) -> int:
@@ -186,6 +186,22 @@ def test_a_pose_too_old_while_idle_or_planning_commands_nothing_new():
     assert fsm.state == PLANNING
     step = fsm.pose_too_old(0.1)
     assert step.cmd == (0.0, 0.0) and fsm.state == PLANNING and not step.ended
+
+
+def test_the_oscillation_recovery_says_what_the_robot_did_meanwhile():
+    """Loaded maze runs stalled at the corners: the log line tells a starved controller (few cycles)
+    from a robot standing under valid commands (cycles at full rate, no motion)."""
+    fsm, _ = make(oscillation_timeout=2.0, oscillation_distance=0.2)
+    fsm.accept(GOAL, "h1", 0.0)
+    fsm.plan_now(POSE, 0.0)
+    t, yaw = 0.0, 0.0
+    while fsm.state != CLEARING:
+        t += 0.05
+        yaw += 0.01
+        step = fsm.cycle(t, (0.05, 0.0, yaw), (0.05, 0.0, yaw), (0, 0))
+    (level, text), *_ = step.log
+    assert level == "warn" and "oscillating over and over at (0.05, 0.00, 0." in text, text
+    assert "(41 control cycles, turned 0.40 rad and drove 0.00 m meanwhile)" in text, text
 
 
 def test_oscillation_runs_a_full_rotation_and_progress_resets_the_recovery_list():

@@ -47,10 +47,10 @@ class DwaSeam:
         self.dwa.set_plan(plan)
         self.dwa.xy_latched = latched
 
-    def compute(self, pose, velocity, period):
+    def compute(self, pose, velocity, period, stamps=None):
         self.cm.update_origin(pose[0], pose[1])
         self.cm.update()
-        return self.dwa.compute(pose, velocity, self.cm, period)
+        return self.dwa.compute(pose, velocity, self.cm, period, stamps)
 
     def remaining(self) -> int:
         return len(self.dwa.plan)

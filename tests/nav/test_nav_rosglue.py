@@ -71,3 +71,59 @@ def test_robot_pose_takes_the_transform_at_now_when_the_buffer_has_it() -> None:
 def test_robot_pose_of_a_static_chain_is_never_too_old() -> None:
     tf = _tf(_item("base_link", "laser", 0.0, 0.1))
     assert tf.robot_pose("base_link", "laser", now=1000.0, tolerance=0.3)[0] == (0.1, 0.0, 0.0)
+
+
+def test_lookup_stamped_gives_the_newest_transform_and_its_time() -> None:
+    """move_base's goal check needs the age of amcl's map -> odom (late under load): a fresh
+    odom -> base_link does not make it fresh."""
+    tf = _tf(_item("map", "odom", 9.0, 0.5), _item("map", "odom", 9.5, 0.6))
+    found = tf.lookup_stamped("map", "odom")
+    assert found is not None and found[0] == (0.6, 0.0, 0.0) and abs(found[1] - 9.5) < 1e-9
+    tf.buffer.set_transforms([_item("map", "odom", 10.2, 0.7)])  # amcl's next, future-dated
+    found = tf.lookup_stamped("map", "odom")
+    assert found is not None and found[0] == (0.7, 0.0, 0.0) and abs(found[1] - 10.2) < 1e-9
+    assert tf.lookup_stamped("map", "nowhere") is None
+
+
+def test_move_base_carries_the_local_pose_by_the_newest_map_to_odom() -> None:
+    """move_base's global pose under TF lag: amcl's map -> odom of 9.5, the robot's odom -> base_link
+    of 10.0 after turning 0.5 rad since 9.5. The global pose is the fresh local one carried by the
+    newest map -> odom, so local * global^-1 is map -> odom itself; map -> base_link at the chain's
+    latest common time (9.5) was half a second old and turned the goal with the robot."""
+    import math
+    from types import SimpleNamespace
+
+    from ninjemys.nav.move_base_node import MoveBase
+    from ninjemys.tf2.math import se2_compose, se2_inverse
+
+    def odom_base(t: float, yaw: float) -> tuple:
+        return (
+            "odom",
+            "base_link",
+            int(round(t * 1e9)),
+            1.0,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            math.sin(yaw / 2),
+            math.cos(yaw / 2),
+        )
+
+    tf = _tf(
+        _item("map", "odom", 9.5, 0.3),
+        *(odom_base(9.0 + i * 0.1, max(0.0, i * 0.1 - 0.5)) for i in range(11)),
+    )
+    local = tf.lookup("odom", "base_link", 10.0)
+    assert local is not None and abs(local[2] - 0.5) < 1e-9
+    fake = SimpleNamespace(
+        _pose=lambda cm: (local, False, 10.0),
+        tf=tf,
+        local_cm=SimpleNamespace(global_frame="odom"),
+        global_cm=SimpleNamespace(global_frame="map", robot_base_frame="base_link"),
+    )
+    gpose, lpose, too_old, stamp, global_stamp = MoveBase._robot_poses(fake)  # type: ignore[arg-type]
+    assert lpose == local and not too_old and stamp == 10.0 and abs(global_stamp - 9.5) < 1e-9
+    assert gpose is not None and abs(gpose[2] - 0.5) < 1e-9 and abs(gpose[0] - 1.3) < 1e-9
+    odom_from_map = se2_compose(lpose, se2_inverse(gpose))
+    assert all(abs(a - b) < 1e-9 for a, b in zip(odom_from_map, (-0.3, 0.0, 0.0), strict=True))

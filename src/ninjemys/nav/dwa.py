@@ -40,6 +40,11 @@ NEAR_GOAL = 1.5
 #: out of xy_goal_tolerance while the robot turned in place (ours; see DWAPlanner.compute)
 MAX_REAPPROACHES = 2
 
+#: the longest wait (s of odometry time) of a robot stopped inside the tolerances for a pose newer than
+#: its standstill; then the goal is judged on the pose there is (a transform published seldom, or no
+#: more: ROS 1's rule), rather than never
+MAX_FRESH_WAIT = 3.0
+
 #: control cycles (5 s at controller_frequency 20) that the drives back in of one goal may take in all;
 #: then the approach ends with the turn where the robot stands, as the latched approach did
 REAPPROACH_CYCLES = 100
@@ -72,6 +77,8 @@ class DWAParams:
     #: below this angular speed (rad/s, from odometry) the robot counts as stopped: the goal is judged
     #: then (base_local_planner's ``rot_stopped_vel``, same default)
     rot_stopped_vel: float = 0.01
+    #: and below this speed (m/s; base_local_planner's ``trans_stopped_vel``, same default)
+    trans_stopped_vel: float = 0.01
     prune_plan: bool = True
 
     def update(self, values: dict[str, object]) -> list[str]:
@@ -113,6 +120,10 @@ class DWAPlanner:
         self.xy_latched = False
         self.reapproaches = 0  # drives back in after the final turn found the estimate out of tolerance
         self.reapproach_cycles = 0  # control cycles spent driving back in, for this goal
+        #: the odometry stamp from which the robot has been seen stopped (None: moving, or not known)
+        self.stopped_since: float | None = None
+        #: cycles this goal waited, stopped inside the tolerances, for a pose newer than the stop
+        self.fresh_waits = 0
 
     def set_plan(self, plan: np.ndarray) -> None:
         """A new global plan (n, 3) in the local costmap's frame; resets the goal latch."""
@@ -124,6 +135,20 @@ class DWAPlanner:
         self.xy_latched = False
         self.reapproaches = 0
         self.reapproach_cycles = 0
+        self.stopped_since = None
+        self.fresh_waits = 0
+
+    def stopped(self, vel: tuple[float, float]) -> bool:
+        """base_local_planner's ``stopped()``: odometry says the robot stands (``trans_stopped_vel``,
+        ``rot_stopped_vel``)."""
+        return abs(vel[0]) <= self.params.trans_stopped_vel and abs(vel[1]) <= self.params.rot_stopped_vel
+
+    def _track_stop(self, vel: tuple[float, float], stamps: tuple[float, float] | None) -> None:
+        """Remember the odometry stamp at which the current standstill was first seen."""
+        if stamps is None or not self.stopped(vel):
+            self.stopped_since = None
+        elif self.stopped_since is None or stamps[1] < self.stopped_since:  # (time went back: a reset)
+            self.stopped_since = stamps[1]
 
     def _drifted(self, x: float, y: float) -> bool:
         """At the end of the final turn, the robot's estimate is out of ``xy_goal_tolerance`` again
@@ -153,14 +178,20 @@ class DWAPlanner:
         vel: tuple[float, float],
         costmap: Costmap,
         period: float | None = None,
+        stamps: tuple[float, float] | None = None,
     ) -> Command:
         """The velocity for this cycle from the robot's pose and velocity (costmap frame).
 
         ``period`` is how long the command will actually stand (the measured cycle period, when the
         controller runs late); the turn to the goal's yaw never goes further than it can stop within
-        that time, so a late cycle does not swing the robot past ``yaw_goal_tolerance``."""
+        that time, so a late cycle does not swing the robot past ``yaw_goal_tolerance``.
+
+        ``stamps`` (ROS times of the pose and of the odometry that gave ``vel``) make the goal check
+        wait for a pose no older than the moment odometry first showed the robot stopped (see
+        :meth:`_rotate_to`); None judges on the pose as it is, as ROS 1 does."""
         p = self.params
         x, y, th = pose
+        self._track_stop(vel, stamps)
         if len(self.plan) == 0:
             return Command(0.0, 0.0, valid=False)
         self._prune(x, y)
@@ -169,7 +200,7 @@ class DWAPlanner:
         inner = 0.5 if self.reapproaches else 1.0
         if self.goal_reached_xy(x, y, inner) or (self.xy_latched and p.latch_xy_goal_tolerance):
             self.xy_latched = True
-            cmd = self._rotate_to(th, gyaw, vel, period)
+            cmd = self._rotate_to(th, gyaw, vel, period, stamps)
             if not (cmd.reached and self._drifted(x, y)):
                 return cmd
             # the turn is done but the pose estimate has left the xy tolerance while the robot stood
@@ -182,7 +213,7 @@ class DWAPlanner:
                 # a drive back in that cannot get there (a narrow spot, costs near the goal) ends as the
                 # latched approach would have ended: with the turn, never with the recoveries
                 self.xy_latched = True
-                return self._rotate_to(th, gyaw, vel, period)
+                return self._rotate_to(th, gyaw, vel, period, stamps)
         cmd = self._sample(x, y, th, vel, costmap)
         stopped = abs(vel[0]) <= p.acc_lim_x / p.controller_frequency  # turning in place was sampled
         if not cmd.valid and stopped and math.hypot(gx - x, gy - y) <= NEAR_GOAL * p.xy_goal_tolerance:
@@ -192,11 +223,16 @@ class DWAPlanner:
             # this the robot stood there until controller_patience ran out, and the recoveries and
             # the abort left it at any heading. (A robot still moving first stops: no arc is safe.)
             self.xy_latched = True
-            return self._rotate_to(th, gyaw, vel, period)
+            return self._rotate_to(th, gyaw, vel, period, stamps)
         return cmd
 
     def _rotate_to(
-        self, th: float, goal_yaw: float, vel: tuple[float, float], period: float | None = None
+        self,
+        th: float,
+        goal_yaw: float,
+        vel: tuple[float, float],
+        period: float | None = None,
+        stamps: tuple[float, float] | None = None,
     ) -> Command:
         p = self.params
         dt = 1.0 / p.controller_frequency
@@ -205,10 +241,23 @@ class DWAPlanner:
             return Command(v, 0.0, turning=True)
         err = angle_diff(goal_yaw, th)
         if abs(err) <= p.yaw_goal_tolerance:
-            if abs(vel[1]) > p.rot_stopped_vel:
+            if not self.stopped(vel):
                 # still turning: stop, and judge the heading once stopped (ROS 1's isGoalReached asks
                 # base_local_planner::stopped too). Ended at once, a late pose or a late stop under load
                 # carried the turn on past the tolerance after the goal had been reported reached.
+                return Command(0.0, 0.0, turning=True)
+            if (
+                stamps is not None
+                and self.stopped_since is not None
+                and stamps[0] < self.stopped_since
+                and stamps[1] - self.stopped_since <= MAX_FRESH_WAIT
+            ):
+                # odometry says stopped, but the pose (TF) is from before that: under load /tf lags
+                # /odom, and a pose from the middle of the turn (or of its braking) read "in tolerance"
+                # while the robot came to rest 0.3 rad further on. Wait for a pose of the standstill;
+                # the local costmap's transform_tolerance bounds the wait for odom -> base_link (an
+                # older pose is refused), MAX_FRESH_WAIT the wait for the rest of the chain.
+                self.fresh_waits += 1
                 return Command(0.0, 0.0, turning=True)
             return Command(0.0, 0.0, reached=True)
         # the fastest turn that can still stop at the goal yaw within the acceleration limits, and no

@@ -49,6 +49,9 @@ PREEMPTED_TEXT = "This goal was canceled because another goal was received by th
 PLAN_RETRY = 0.5
 #: how much the final turn must shrink the heading error (rad) to count as progress
 TURN_PROGRESS = 0.05
+#: the longest gap (s) between a pose and a newer odometry message that the pose is carried over
+#: (larger gaps are a clock reset or a stalled publisher, not transport lag: the pose is used as it is)
+MAX_EXTRAPOLATION = 1.0
 
 
 @dataclass
@@ -85,9 +88,17 @@ class Controller(Protocol):
         """The plan (n, 3) in the controller's frame; keeps the goal latch of the current goal."""
         ...
 
-    def compute(self, pose: Pose2D, velocity: tuple[float, float], period: float | None) -> Command:
+    def compute(
+        self,
+        pose: Pose2D,
+        velocity: tuple[float, float],
+        period: float | None,
+        stamps: tuple[float, float] | None = None,
+    ) -> Command:
         """One cycle's command from the pose (controller's frame) and velocity (v, w). ``period`` is
-        the longest recent cycle: how long the command may stand before the next one."""
+        the longest recent cycle: how long the command may stand before the next one. ``stamps``:
+        the ROS times of the pose and of the odometry (None: unknown); the goal is reached only on a
+        pose no older than the odometry that showed the robot stopped."""
         ...
 
     def remaining(self) -> int:
@@ -109,6 +120,10 @@ class ProgressChecker(Protocol):
 
     def check(self, pose: Pose2D, now: float) -> bool:
         """False when the robot has been stuck too long (move_base then runs a recovery)."""
+        ...
+
+    def describe(self) -> str:
+        """What the robot did since the last progress, for the log line of a recovery."""
         ...
 
 
@@ -162,9 +177,14 @@ class OscillationChecker:
         self.params = params
         self.pose: Pose2D | None = None
         self.since = 0.0
+        # since the reference: control cycles checked, and the motion seen meanwhile
+        self.cycles, self.turned, self.driven = 0, 0.0, 0.0
+        self.last: Pose2D | None = None
 
     def reset(self, pose: Pose2D | None, now: float) -> None:
         self.pose, self.since = pose, now
+        self.cycles, self.turned, self.driven = 0, 0.0, 0.0
+        self.last = pose
 
     def moved(self, pose: Pose2D, now: float) -> bool:
         """True (and a new reference) when the robot got ``oscillation_distance`` away."""
@@ -179,8 +199,19 @@ class OscillationChecker:
     def check(self, pose: Pose2D, now: float) -> bool:
         if self.params.oscillation_timeout <= 0:
             return True
-        self.moved(pose, now)
+        if not self.moved(pose, now):
+            self.cycles += 1
+            if self.last is not None:
+                self.turned += abs(angle_diff(pose[2], self.last[2]))
+                self.driven += math.hypot(pose[0] - self.last[0], pose[1] - self.last[1])
+            self.last = pose
         return now - self.since <= self.params.oscillation_timeout
+
+    def describe(self) -> str:
+        return (
+            f"{self.cycles} control cycles, turned {self.turned:.2f} rad and drove {self.driven:.2f} m "
+            "meanwhile"
+        )
 
 
 class ClearCostmaps:
@@ -363,8 +394,21 @@ class MoveBaseFsm:
 
     # -- control ----------------------------------------------------------------------------------------
 
-    def cycle(self, now: float, gpose: Pose2D, lpose: Pose2D, velocity: tuple[float, float]) -> Step:
-        """One control cycle with the robot's pose in the global and in the controller's frame."""
+    def cycle(
+        self,
+        now: float,
+        gpose: Pose2D,
+        lpose: Pose2D,
+        velocity: tuple[float, float],
+        stamps: tuple[float, float] | None = None,
+        global_stamp: float | None = None,
+    ) -> Step:
+        """One control cycle with the robot's pose in the global and in the controller's frame.
+        ``stamps``: (ROS time of ``lpose``, ROS time of the odometry ``velocity`` came from), when
+        known; under load /tf and /odom arrive out of step, and the goal check needs both.
+        ``global_stamp``: the ROS time of the transform that carries ``lpose`` into the global frame
+        (amcl's ``map -> odom``), when there is one: the goal is judged in the global frame, so
+        neither may predate the standstill."""
         step = Step()
         if self.state == IDLE or self.goal is None:
             return step
@@ -384,15 +428,32 @@ class MoveBaseFsm:
             return self._recovery_step(step, now, gpose, lpose)
         if self.plan is None:
             return step
-        return self._control(step, now, gpose, lpose, velocity)
+        return self._control(step, now, gpose, lpose, velocity, stamps, global_stamp)
 
     def _control(
-        self, step: Step, now: float, gpose: Pose2D, lpose: Pose2D, velocity: tuple[float, float]
+        self,
+        step: Step,
+        now: float,
+        gpose: Pose2D,
+        lpose: Pose2D,
+        velocity: tuple[float, float],
+        stamps: tuple[float, float] | None,
+        global_stamp: float | None,
     ) -> Step:
         plan = self.plan
         assert plan is not None
+        if stamps is not None:
+            # under load /tf reaches move_base later than /odom: steer from where odometry says the
+            # robot is now, not from where TF last saw it (the goal check still waits for a real pose
+            # of the standstill, see the controller)
+            gpose = extrapolate(gpose, velocity, stamps[1] - stamps[0])
+            lpose = extrapolate(lpose, velocity, stamps[1] - stamps[0])
+            if global_stamp is not None and global_stamp < stamps[0]:
+                # the goal is judged through map -> odom too: under load amcl's newest correction
+                # reaches move_base late, and a heading judged with an older one is off by it
+                stamps = (global_stamp, stamps[1])
         self.controller.set_plan(to_frame(plan, se2_compose(lpose, se2_inverse(gpose))))
-        cmd = self.controller.compute(lpose, velocity, max(self.periods, default=None))
+        cmd = self.controller.compute(lpose, velocity, max(self.periods, default=None), stamps)
         self.plan = plan[len(plan) - self.controller.remaining() :]  # pruned as the controller did
         if cmd.reached:
             return self._finish(step, states.SUCCEEDED, "Goal reached")
@@ -415,7 +476,10 @@ class MoveBaseFsm:
                     self.recovery_index = 0  # real progress: the recovery list starts over, as in ROS 1
             if not self.progress.check(gpose, now):
                 self._start_recovery(
-                    step, now, "Aborting because the robot appears to be oscillating over and over"
+                    step,
+                    now,
+                    "Aborting because the robot appears to be oscillating over and over",
+                    self.progress.describe(),
                 )
             return step
         return self._control_failed(step, now)
@@ -448,7 +512,7 @@ class MoveBaseFsm:
 
     # -- recoveries -------------------------------------------------------------------------------------
 
-    def _start_recovery(self, step: Step, now: float, failure: str) -> None:
+    def _start_recovery(self, step: Step, now: float, failure: str, detail: str = "") -> None:
         if not self.params.recovery_behavior_enabled or self.recovery_index >= len(self.recoveries):
             self._finish(step, states.ABORTED, failure)
             return
@@ -463,8 +527,8 @@ class MoveBaseFsm:
         step.log.append(
             (
                 "warn",
-                f"{failure.split('.')[0]}{where}; running recovery behavior "
-                f"{self.recoveries[self.recovery_index].name}",
+                f"{failure.split('.')[0]}{where}{f' ({detail})' if detail else ''}; running recovery "
+                f"behavior {self.recoveries[self.recovery_index].name}",
             )
         )
 
@@ -484,6 +548,17 @@ class MoveBaseFsm:
         self.progress.reset(None, now)
         self._want_plan(step, now)
         return step
+
+
+def extrapolate(pose: Pose2D, velocity: tuple[float, float], dt: float) -> Pose2D:
+    """``pose`` carried ``dt`` seconds forward along the arc of ``velocity`` (v, w) in its own frame;
+    unchanged for ``dt`` <= 0 or > :data:`MAX_EXTRAPOLATION`. Moving the global and the local pose by
+    the same body motion keeps the transform between their frames (the plan lands where it was)."""
+    if not 0.0 < dt <= MAX_EXTRAPOLATION:
+        return pose
+    v, w = velocity
+    turn = w * dt
+    return se2_compose(pose, (v * dt * math.cos(turn / 2), v * dt * math.sin(turn / 2), turn))
 
 
 def to_frame(plan: np.ndarray, tf: Pose2D) -> np.ndarray:

@@ -106,9 +106,15 @@ class DwaController:
         self.dwa.set_plan(plan)
         self.dwa.xy_latched = latched  # a replan for the same goal keeps the goal latch
 
-    def compute(self, pose: Pose2D, velocity: tuple[float, float], period: float | None) -> Command:
+    def compute(
+        self,
+        pose: Pose2D,
+        velocity: tuple[float, float],
+        period: float | None,
+        stamps: tuple[float, float] | None = None,
+    ) -> Command:
         self._refresh(self.local_cm, pose)
-        return self.dwa.compute(pose, velocity, self.local_cm.costmap, period)
+        return self.dwa.compute(pose, velocity, self.local_cm.costmap, period, stamps)
 
     def remaining(self) -> int:
         return len(self.dwa.plan)
@@ -163,7 +169,7 @@ class MoveBase:
         self.local_cm = CostmapROS(node, "~local_costmap")
         self.dwa = DWAPlanner(dwa_params(node))
         self.tf = Tf2D(node)
-        self.velocity = (0.0, 0.0)
+        self.odom = (0.0, 0.0, 0.0)  # the newest odometry: v, w and its stamp (0: none yet)
         self.fsm = MoveBaseFsm(
             self.params,
             GridPlanner(self),
@@ -275,7 +281,12 @@ class MoveBase:
         )
 
     def on_odom(self, msg: Any) -> None:
-        self.velocity = (float(msg.twist.twist.linear.x), float(msg.twist.twist.angular.z))
+        # one assignment: the control cycle reads a velocity and its stamp of the same message
+        self.odom = (
+            float(msg.twist.twist.linear.x),
+            float(msg.twist.twist.angular.z),
+            msg.header.stamp.to_sec(),
+        )
 
     def on_scan(self, scan: Any, source: tuple[str, list[CostmapROS]]) -> None:
         """A rolling window (the local costmap the controller reads) marks the scan at once; a map-sized
@@ -516,9 +527,11 @@ class MoveBase:
         handle = outcome.token
         if outcome.goal is not None and outcome.pose is not None:
             (gx, gy, gyaw), (x, y, yaw) = outcome.goal, outcome.pose
+            waits = self.dwa.fresh_waits if outcome.status == states.SUCCEEDED else 0
             self.log.info(
-                "move_base: goal (%.2f, %.2f, %.2f) %s at (%.2f, %.2f, %.2f)",
+                "move_base: goal (%.2f, %.2f, %.2f) %s at (%.2f, %.2f, %.2f)%s",
                 gx, gy, gyaw, outcome.name, x, y, yaw,
+                f" ({waits} cycles stopped waiting for a pose newer than the stop)" if waits else "",
             )  # fmt: skip
         if outcome.status == states.SUCCEEDED:
             self.log.info("move_base: %s", outcome.text or "goal reached")
@@ -566,10 +579,10 @@ class MoveBase:
         """The robot's pose in ``cm``'s global frame, or None when unknown or too old (see _pose)."""
         return self._pose(cm)[0]
 
-    def _pose(self, cm: CostmapROS) -> tuple[Pose2D | None, bool]:
-        """``(pose, too_old)``: the robot's pose in ``cm``'s global frame; None when unknown, or when
-        older than ``cm``'s ``transform_tolerance`` (then ``too_old``, warned as costmap_2d does, at
-        most once a second)."""
+    def _pose(self, cm: CostmapROS) -> tuple[Pose2D | None, bool, float]:
+        """``(pose, too_old, stamp)``: the robot's pose in ``cm``'s global frame and its ROS time;
+        None when unknown, or when older than ``cm``'s ``transform_tolerance`` (then ``too_old``,
+        warned as costmap_2d does, at most once a second)."""
         now = self.node.get_time()
         pose, stamp = self.tf.robot_pose(cm.global_frame, cm.robot_base_frame, now, cm.transform_tolerance)
         too_old = pose is None and stamp != 0.0
@@ -582,18 +595,27 @@ class MoveBase:
                 stamp,
                 cm.transform_tolerance,
             )
-        return pose, too_old
+        return pose, too_old, stamp
 
-    def _robot_poses(self) -> tuple[Pose2D | None, Pose2D | None, bool]:
+    def _robot_poses(self) -> tuple[Pose2D | None, Pose2D | None, bool, float, float]:
         """The robot's pose in the global and in the local costmap's frame, and whether the local
         one was refused as too old. As in ROS 1, only the controller's own (local costmap) pose is
         held to its ``transform_tolerance`` here: dwa_local_planner refuses a stale one, while the
         plan is carried into its frame with the newest ``map -> odom``, however old (amcl's lags
-        under load; the planner refuses that one, see _plan_once)."""
-        lp, too_old = self._pose(self.local_cm)
+        under load; the planner refuses that one, see _plan_once). The last two items are the local
+        and the global pose's ROS times."""
+        lp, too_old, stamp = self._pose(self.local_cm)
         if self.local_cm.global_frame == self.global_cm.global_frame:
-            return lp, lp, too_old
-        return self.tf.lookup(self.global_cm.global_frame, self.global_cm.robot_base_frame), lp, too_old
+            return lp, lp, too_old, stamp, stamp
+        # the global pose is the local one carried by the newest map -> odom. Looked up at the chain's
+        # latest common time instead (map -> base_link at time 0), it was the robot's pose of when
+        # amcl last published, which under load is tenths of a second before the local pose: the plan
+        # and the goal, carried into the local frame by local * global^-1, then turned with the robot
+        # (0.4 rad of goal heading after a turn at 1 rad/s), and move_base stopped short of it.
+        found = self.tf.lookup_stamped(self.global_cm.global_frame, self.local_cm.global_frame)
+        if found is None or lp is None:
+            return None, lp, too_old, stamp, 0.0
+        return se2_compose(found[0], lp), lp, too_old, stamp, found[1]
 
     def cycle(self) -> None:
         """One control cycle: goals from the inbox, then the state machine on the robot's poses."""
@@ -604,7 +626,7 @@ class MoveBase:
             self._apply(step)
         if idle:
             return
-        gpose, lpose, too_old = self._robot_poses()
+        gpose, lpose, too_old, pose_stamp, global_stamp = self._robot_poses()
         if too_old:
             # too old to drive on (the local costmap's transform_tolerance): stand still, as ROS 1
             with self.lock:
@@ -619,10 +641,18 @@ class MoveBase:
                 self.global_cm.global_frame,
                 self.global_cm.robot_base_frame,
             )
+            # no pose at all is no better than one too old: stand still (the robot kept its last
+            # command before, until the base's own timeout stopped it)
+            with self.lock:
+                step = self.fsm.pose_too_old(self.node.get_time())
+            self._apply(step)
             return
+        v, w, odom_stamp = self.odom
+        # a static chain (stamp 0) or no odometry yet: the goal is judged on the pose as it is
+        stamps = (pose_stamp, odom_stamp) if pose_stamp and odom_stamp else None
         with self.lock:
             handle = self.fsm.token
-            step = self.fsm.cycle(self.node.get_time(), gpose, lpose, self.velocity)
+            step = self.fsm.cycle(self.node.get_time(), gpose, lpose, (v, w), stamps, global_stamp or None)
         if step.feedback is not None and handle is not None:
             self._feedback(handle, step.feedback)
         self._apply(step)

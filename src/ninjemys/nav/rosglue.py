@@ -120,6 +120,15 @@ class Tf2D:
         except TransformException:
             return None
 
+    def lookup_stamped(self, target: str, source: str) -> tuple[Pose2D, float] | None:
+        """``source``'s newest pose in ``target`` and its ROS time (the chain's latest common time; 0 for
+        a static chain); None when unknown."""
+        try:
+            stamp_ns, tr = self.buffer.lookup(target, source, 0)
+        except TransformException:
+            return None
+        return tf_to_2d(tr), stamp_ns * 1e-9
+
     def robot_pose(
         self, target: str, source: str, now: float, tolerance: float
     ) -> tuple[Pose2D | None, float]:
