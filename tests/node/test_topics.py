@@ -236,3 +236,38 @@ def test_queue_size_none_is_lossless(make_node) -> None:
         pub.publish(Int64(i))
     assert wait_until(lambda: len(got) == 20000, timeout=20)
     assert got == list(range(20000))
+
+
+def test_a_raising_callback_is_logged_as_rospys_bad_callback_on_rosout(make_node) -> None:
+    """rospy logs a callback's exception as ``bad callback: <cb>`` plus the traceback at ERROR, so it
+    reaches /rosout and rqt_console; the subscriber goes on with the next message."""
+    from rosgraph_msgs.msg import Log
+
+    listener, talker, watcher = make_node("listener"), make_node("talker"), make_node("watcher")
+    logged: list = []
+    watcher.subscriber("/rosout", Log, logged.append)
+    got: list[str] = []
+
+    def crashy(msg: String) -> None:
+        if msg.data == "boom":
+            raise ZeroDivisionError("the callback's own fault")
+        got.append(msg.data)
+
+    listener.subscriber("chatter", String, crashy)
+    pub = talker.publisher("chatter", String, queue_size=10)
+    assert _connected(pub)
+
+    def heard_listener() -> bool:  # /rosout keeps nothing for late subscribers: connect first
+        listener.log.info("are you there")
+        return any(m.name == listener.name for m in logged)
+
+    assert wait_until(heard_listener)
+    pub.publish(String("boom"))
+    pub.publish(String("after"))
+    assert wait_until(lambda: got == ["after"])
+    assert wait_until(lambda: any(m.msg.startswith("bad callback: ") for m in logged))
+    entry = next(m for m in logged if m.msg.startswith("bad callback: "))
+    assert entry.level == Log.ERROR
+    assert entry.name == listener.name
+    assert "crashy" in entry.msg.splitlines()[0]
+    assert "ZeroDivisionError: the callback's own fault" in entry.msg

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 if TYPE_CHECKING:
     from ninjemys.master.client import MasterClient
+    from ninjemys.node.log import NodeLog
     from ninjemys.node.runtime import Runtime
     from ninjemys.node.services import ServiceServer
     from ninjemys.node.subscriber import Subscriber
@@ -36,6 +37,8 @@ class NodeContext(Protocol):
     master: MasterClient
     #: the process's I/O loop and its thread hand-offs
     runtime: Runtime
+    #: the node's console, log file and /rosout logger
+    log: NodeLog
     #: where the node's TCPROS server listens, as advertised to peers
     tcpros_host: str
     tcpros_port: int

@@ -47,6 +47,7 @@ from ninjemys.errors import NinjemysError, ProtocolError
 from ninjemys.net import auth, xmlrpc_client
 from ninjemys.node import intraprocess, transport
 from ninjemys.node.intraprocess import Handoff
+from ninjemys.node.log import ERROR
 from ninjemys.node.topics import connection_ids
 from ninjemys.records import SlotRecord
 from ninjemys.wire import headers
@@ -855,9 +856,18 @@ class Subscriber:
                             try:
                                 callback(msg)
                             except Exception:
-                                _log.exception("topic %s: callback %r raised", self.name, callback)
+                                self._callback_raised(callback)
                     else:
                         self._deliver_msgs(msgs)
+
+    def _callback_raised(self, callback: Callable[..., Any]) -> None:
+        """A user callback raised: logged as rospy logs it, ``bad callback: <callback>`` and the
+        traceback at ERROR on the console and /rosout (where rqt_console shows it), and the worker
+        goes on with the next message. After shutdown only the Python logger hears of it, as in rospy."""
+        if self._sub.node.is_shutdown:
+            _log.warning("topic %s: callback %r raised during shutdown", self.name, callback, exc_info=True)
+            return
+        self._sub.node.log.log(ERROR, "bad callback: %s", callback, exc_info=True)
 
     def _lazy_round(self) -> None:
         """One wait of a lazy handle's worker: on the low-water marks (:meth:`_lazy_wait`), or per
@@ -1056,7 +1066,7 @@ class Subscriber:
                 try:
                     callback(msg)
                 except Exception:
-                    _log.exception("topic %s: callback %r raised", self.name, callback)
+                    self._callback_raised(callback)
             return
         for msg in msgs:
             if self._closed:
@@ -1086,7 +1096,7 @@ class Subscriber:
                 else:
                     callback(msg, args)
             except Exception:
-                _log.exception("topic %s: callback %r raised", self.name, callback)
+                self._callback_raised(callback)
 
     def _deliver_batch(self, frames: list[bytes | bytearray], header: Mapping[str, str]) -> None:
         """Deliver frames in order; the common case (decode, one callback without args) is inlined,
@@ -1114,7 +1124,7 @@ class Subscriber:
                 try:
                     callback(RawMessage(frame, header))
                 except Exception:
-                    _log.exception("topic %s: callback %r raised", self.name, callback)
+                    self._callback_raised(callback)
             return
         for frame in frames:
             if self._closed:
@@ -1127,7 +1137,7 @@ class Subscriber:
             try:
                 callback(msg)
             except Exception:
-                _log.exception("topic %s: callback %r raised", self.name, callback)
+                self._callback_raised(callback)
 
     def _undecodable(self, frame: bytes | bytearray, header: Mapping[str, str], exc: Exception) -> None:
         self._undecodable_length(len(frame), header, exc)
