@@ -88,8 +88,9 @@ typecheck: venv
 # --dist loadfile: each test file runs on one worker, in order (the navigation sessions of
 # tests/nav/test_nav_stack.py run one at a time, and the office session's tests follow its goals run).
 # --durations: the slowest tests are listed at the end, so a CI log shows what eats the 20-minute budget.
+# --no-loadscope-reorder: tests/conftest.py orders the files (the long navigation sessions first).
 test: venv system npm lint typecheck
-	$(VENV)/bin/pytest -n 2 -q --dist loadfile --durations=25
+	$(VENV)/bin/pytest -n 2 -q --dist loadfile --no-loadscope-reorder --durations=25
 
 test-fast: venv
 	$(VENV)/bin/pytest -n 2 -q -m "not ros1 and not browser and not slow"
