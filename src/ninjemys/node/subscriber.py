@@ -254,13 +254,51 @@ class SubConnection:
         bad: list[tuple[int, Exception]] = []
         got = 0
         fused = True
-        while True:
-            buf = reader.buffer()
-            n = self._recv_into(buf)
+        buf = reader.buffer()
+        if buf is reader.whole:
+            # the usual wake-up: no frame pending, and the few small frames the kernel holds fit the
+            # buffer: one recv and one decode, without the general loop's calls and checks (about a
+            # microsecond of every small message's hop, measured in a ping-pong's CPU time)
+            try:
+                n = sock.recv_into(buf)
+            except (BlockingIOError, InterruptedError):
+                return msgs, frames, bad
+            except OSError as exc:
+                self._lost(f"read failed: {exc}")
+                return None
+            if 0 < n < len(buf) and (cap is None or n // min_frame <= cap):
+                self.bytes_recv += n
+                # commit_decoded's work, with the reader untouched when every frame was whole
+                start = decode(buf[:n].tobytes(), 0, n, msgs, bad)
+                if start != n:
+                    try:
+                        frames = reader.commit_rest(start, n)
+                    except ProtocolError as exc:
+                        self._drop_broken_stream(exc)
+                        return None
+                if frames:  # a large frame begun, or tagged frames: the general path's way
+                    frames = self.untag(frames) or []
+                    if frames:
+                        _decode_into(self.sub.msg_class, frames, msgs, bad)
+                        frames = []
+                self.num_recv += len(msgs) + len(bad)
+                return msgs, frames, bad
+            n = self._received(n)
             if n is None:
                 return None
-            if n < 0:
-                break
+            first: int | None = n
+        else:
+            first = None
+        while True:
+            if first is not None:
+                n, first = first, None
+            else:
+                buf = reader.buffer()
+                n = self._recv_into(buf)
+                if n is None:
+                    return None
+                if n < 0:
+                    break
             self.bytes_recv += n
             got += n
             if fused and cap is not None and len(msgs) + (reader.pending + n) // min_frame > cap:
@@ -306,6 +344,11 @@ class SubConnection:
         except OSError as exc:
             self._lost(f"read failed: {exc}")
             return None
+        return self._received(n)
+
+    def _received(self, n: int) -> int | None:
+        """``n`` bytes came from ``recv_into``: ``n``, or None when 0 said the stream has ended
+        (reported and closed)."""
         if n == 0:
             pending = self._reader.pending
             if pending:

@@ -69,12 +69,15 @@ class FrameReader:
 
     __slots__ = (
         "_buf", "_view", "_start", "_end", "_big", "_big_view", "_big_fill", "_limit", "_large", "_skip",
-        "special",
+        "special", "whole",
     )  # fmt: skip
 
     def __init__(self, size: int = 1 << 16, limit: int = MAX_FRAME_LEN, tagged: bool = False) -> None:
         self._buf = bytearray(size)
         self._view = memoryview(self._buf)
+        #: the whole buffer: what :meth:`buffer` returns when no frame is pending (a read that gets it
+        #: starts at a frame boundary, and what it receives is ``whole[:n]``)
+        self.whole = self._view
         self._start = 0  # first unconsumed byte
         self._end = 0  # end of valid data
         self._big: bytearray | None = None  # a large frame being received in place
@@ -89,7 +92,10 @@ class FrameReader:
         """Where the next received bytes should go (never empty)."""
         if self._big_view is not None:
             return self._big_view[self._big_fill :]
-        if self._end == len(self._buf):
+        end = self._end
+        if not end:
+            return self._view
+        if end == len(self._buf):
             self._compact()
         return self._view[self._end :]
 
@@ -179,6 +185,13 @@ class FrameReader:
             self._start = self._end = 0
             return []
         self._start, self._end = start, end
+        return self._cut([])
+
+    def commit_rest(self, start: int, n: int) -> list[bytes | bytearray]:
+        """For a caller that received ``n`` bytes into :attr:`whole` (no frame was pending) and
+        decoded the complete frames of the first ``start`` itself (as :meth:`commit_decoded` would):
+        keep the rest and return the frames :meth:`commit_decoded` would have left undecoded."""
+        self._start, self._end = start, n
         return self._cut([])
 
     @property
