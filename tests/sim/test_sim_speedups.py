@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 from camera_reference import assert_matches_reference
 
+from ninjemys.idl.loader import get_message_class
 from ninjemys.sim import camera as sim_camera
 from ninjemys.sim.puzzlebot_node import keep_freed_memory
 from ninjemys.sim.raycast import cast_segments
@@ -234,3 +235,86 @@ def test_camera_draws_only_the_images_asked_for(world):
         assert np.array_equal(rgb, rgb_only) and np.array_equal(depth, depth_only)
         assert no_depth.size == 0 and no_rgb.size == 0
         assert rgb.shape == (240, 320, 3) and depth.shape == (240, 320)
+
+
+def _drive(sim: Simulation, name: str, steps: int) -> list[tuple[float, float, float, bool, str]]:
+    """Poses and contacts of robot ``name`` driving a fixed sequence of commands (into a wall too)."""
+    r = sim.robots[name]
+    out = []
+    for i in range(steps):
+        if i % 300 == 0:
+            r.command((0.4, 0.2, 0.0)[(i // 300) % 3], (0.0, 0.9, -0.6)[(i // 300) % 3])
+        sim.step()
+        out.append((r.x, r.y, r.yaw, r.contact, r.contact_with))
+    return out
+
+
+def test_a_step_alone_in_open_space_moves_as_the_checked_step():
+    """A robot alone in the world, in open space, skips the collision samples along its move (no
+    arrays built): it drives, turns and stops at the wall exactly as when a second robot elsewhere
+    in the world makes every step go through the full check."""
+    world = world_path("square")
+    alone = Simulation(load_world(world), 0.01, 3)
+    alone.add_robot("pb", load_robot_model("puzzlebot"), 0.0, 0.0, 0.3)
+    checked = Simulation(load_world(world), 0.01, 3)
+    checked.add_robot("pb", load_robot_model("puzzlebot"), 0.0, 0.0, 0.3)
+    checked.add_robot("far", load_robot_model("puzzlebot"), -1.2, -1.2, 0.0)  # never in reach
+    calls = {"full": 0}
+    real = checked._clearances
+
+    def counted(*args):
+        calls["full"] += 1
+        return real(*args)
+
+    checked._clearances = counted  # type: ignore[method-assign]
+    a, b = _drive(alone, "pb", 2400), _drive(checked, "pb", 2400)
+    assert a == b
+    assert any(c for *_, c, _w in a), "the drive must reach a wall"
+    assert calls["full"] >= 1000  # the checked run did check its moving steps
+
+
+def test_sensors_firing_in_one_step_share_its_scene():
+    """The lidar and the camera firing in the same step see one scene, built once for that step
+    and dropped after it (the next step's world has moved)."""
+    from ninjemys.node import Node
+    from ninjemys.node.log import NodeLog
+    from ninjemys.sim.puzzlebot_node import SimNode
+    from ninjemys.testing import run_master, wait_until
+
+    with run_master() as master:
+        node = Node("scene_share_sim", master_uri=master)
+        client = Node("scene_share_client", master_uri=master)
+        try:
+            sn = SimNode(
+                node, NodeLog(node.name), Simulation(load_world(world_path("office")), 0.01), 0.0, None
+            )
+            io = sn.add_robot("puzzlebot", load_robot_model("puzzlebot"), 0.0, 0.0, 0.0, False)
+            built, seen = [], []
+            real_scene, real_scan, real_render = sn.sim.scene, sn.sim.scan, sn.sim.render
+            sn.sim.scene = lambda exclude=None: built.append(exclude) or real_scene(exclude)  # type: ignore[method-assign]
+            sn.sim.scan = lambda r, scene=None, laser=None: seen.append(scene) or real_scan(r, scene, laser)  # type: ignore[method-assign]
+            sn.sim.render = lambda r, scene=None, **kw: seen.append(scene) or real_render(r, scene, **kw)  # type: ignore[method-assign]
+            model = io.robot.model
+            assert model.laser is not None and model.camera is not None
+            subs = [
+                client.subscriber(
+                    "/" + model.laser.topic, get_message_class("sensor_msgs/LaserScan"), lambda _m: None
+                ),
+                client.subscriber(
+                    "/" + model.camera.image_topic, get_message_class("sensor_msgs/Image"), lambda _m: None
+                ),
+            ]
+            wait_until(
+                lambda: io.pubs["scan"].get_num_connections() and io.pubs["image"].get_num_connections(),
+                10,
+                "the subscribers",
+            )
+            io.scan_due.next = io.camera_due.next = sn.sim.time + sn.sim.dt  # both fire next step
+            sn._step_and_publish()
+            assert built == ["puzzlebot"] and len(seen) == 2 and seen[0] is seen[1] is not None
+            assert sn._scenes == {}
+            for sub in subs:
+                sub.unregister()
+        finally:
+            client.shutdown("test over")
+            node.shutdown("test over")
