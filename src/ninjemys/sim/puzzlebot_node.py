@@ -206,6 +206,7 @@ class SimNode:
         yaw: float,
         namespaced: bool,
         namespace: str | None = None,
+        elevation: float = 0.0,
     ) -> RobotIO:
         """Place a robot and create its topics (raises SpawnError when the place is taken).
 
@@ -213,7 +214,7 @@ class SimNode:
         the description names them, as Gazebo's plugins do; ``namespaced`` puts topics and frames
         under ``<name>/`` (our multi-robot worlds)."""
         with self.lock:
-            robot = self.sim.add_robot(name, model, x, y, yaw)
+            robot = self.sim.add_robot(name, model, x, y, yaw, elevation)
             if self.laser_noise is not None and model.laser is not None:
                 model.laser.noise = self.laser_noise
             if namespace:

@@ -220,6 +220,8 @@ class World:
     #: an SDF world's models with nothing the floor plan holds (Gazebo's ground_plane): still models
     #: for Gazebo (listed in /gazebo/model_states, in the file's order), by name
     bare_models: list[str] = field(default_factory=list)
+    #: an SDF world's models with physics (not ``<static>``): they fall when set in the air
+    dynamic_models: list[str] = field(default_factory=list)
     #: pictures on the floor (an SDF world's textured planes): the camera sees them
     floor_images: list[FloorImage] = field(default_factory=list)
     #: counts the rebuilds: a view that drew the obstacles redraws them when it changes (a model
