@@ -273,6 +273,8 @@ class GazeboApi:
         c, s = math.cos(yaw), math.sin(yaw)
         out = []
         for o in self.sn.sim.world.obstacles:
+            if not o.solid:
+                continue  # a visual without collision holds nothing up
             dx, dy = o.outline[:, 0] - x, o.outline[:, 1] - y
             out.append(Support(np.column_stack([c * dx + s * dy, -s * dx + c * dy]), o.height))
         return out
@@ -323,7 +325,7 @@ class GazeboApi:
         ground = [
             Support(o.outline, o.height)
             for o in self.sn.sim.world.obstacles
-            if o.model_name != name and len(o.outline) > 2
+            if o.model_name != name and len(o.outline) > 2 and o.solid
         ]
 
         def land(pieces: list[Obstacle]) -> float:
@@ -388,7 +390,7 @@ class GazeboApi:
             else:
                 self._hold_while_paused(name, z)
                 z = self._add_urdf_shape(name, spec, x, y, z, yaw, supports)
-                if not spec.static:
+                if not spec.static and spec.solid:
                     self.dynamic.add(name)
             self.heights[name] = z
             if kind != "robot":
@@ -411,7 +413,7 @@ class GazeboApi:
             else box_outline(x, y, shape.size[0], shape.size[1], yaw)
         )
         base = z + shape.bottom
-        if not shape.static:
+        if not shape.static and shape.solid:
             c, s = math.cos(yaw), math.sin(yaw)
             dx, dy = outline[:, 0] - x, outline[:, 1] - y
             local = np.column_stack([c * dx + s * dy, -s * dx + c * dy])
@@ -421,7 +423,7 @@ class GazeboApi:
         if top <= 0.0:
             raise SpawnError(f"a static {shape.kind} at z {z:g} is under the floor")
         with self.sn.lock:
-            sim.add_outline(name, shape.kind, outline, yaw, top, shape.colour, max(base, 0.0))
+            sim.add_outline(name, shape.kind, outline, yaw, top, shape.colour, max(base, 0.0), shape.solid)
         self.sn.log.info("spawned %s [%s] at (%.3f, %.3f, %.3f)", shape.kind, name, x, y, z)
         return z
 
@@ -810,6 +812,8 @@ class UrdfShape:
     colour: tuple[int, int, int]
     bottom: float  # its collision's lowest point in the model's frame (the origin's z - height / 2)
     static: bool
+    #: False: a visual without a collision (a marker board): seen by cameras only, held where put
+    solid: bool = True
 
 
 #: a URDF shape without a colour of its own is drawn as the simulator's boxes and cylinders are
@@ -831,6 +835,7 @@ def _urdf_shape(root: ET.Element) -> UrdfShape | None:
     if found is None:
         return None
     holder, geom = found
+    solid = holder.tag == "collision"
     origin = holder.find("origin")
     xyz = (origin.get("xyz") if origin is not None else None) or "0 0 0"
     try:
@@ -869,4 +874,4 @@ def _urdf_shape(root: ET.Element) -> UrdfShape | None:
             colour = stock
         if (block.findtext("static") or "").strip().lower() in ("true", "1"):
             static = True
-    return UrdfShape(kind, size, height, colour, oz - height / 2.0, static)
+    return UrdfShape(kind, size, height, colour, oz - height / 2.0, static, solid)

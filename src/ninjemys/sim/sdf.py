@@ -705,6 +705,9 @@ class _Solid:
     footprint: Footprint
     colour: tuple[int, int, int]
     static: bool = False  # its model is static: it stays where it is put
+    #: a visual of a link with no collision (an ArUco board): seen by cameras only; it neither falls
+    #: nor holds anything up here (Gazebo's would fall through the floor unless static, as they are)
+    visual: bool = False
 
 
 #: a piece lands on a support whose top is below its middle (a box spawned a little into a table
@@ -777,11 +780,11 @@ def _settle(
     the floor are dropped. ``drops`` receives how far each model fell (negative: pushed up)."""
     ground: list[Support] = list(supports or [])
     for s in solids:
-        if s.static and s.footprint.top > MIN_TOP:
+        if s.static and not s.visual and s.footprint.top > MIN_TOP:
             ground.append(Support(s.footprint.outline, s.footprint.top))
     models: dict[str, list[_Solid]] = {}
     for s in solids:
-        if not s.static:
+        if not s.static and not s.visual:
             models.setdefault(s.path[0], []).append(s)
     fallen: dict[str, float] = {}
     for name, pieces in sorted(models.items(), key=lambda kv: min(p.footprint.bottom for p in kv[1])):
@@ -797,7 +800,7 @@ def _settle(
     kept = []
     for s in solids:
         fp = s.footprint
-        drop = fallen.get(s.path[0], 0.0) if not s.static else 0.0
+        drop = fallen.get(s.path[0], 0.0) if not (s.static or s.visual) else 0.0
         fp.top, fp.bottom = fp.top - drop, max(fp.bottom - drop, 0.0)
         if fp.top > MIN_TOP and len(fp.outline) >= 2:
             kept.append(s)
@@ -871,6 +874,15 @@ def _link(
             ctx.skip(f"<sensor type='{child.attrib.get('type', '?')}'> in a world model", child)
         elif child.tag != "visual" and child.tag not in _QUIET_LINK:
             ctx.skip(f"<{child.tag}> in a link", child)
+    if el.find("collision") is None:
+        # nothing to collide with: its visuals are for cameras only (a fiducial marker, a tag board)
+        for visual in el.findall("visual"):
+            geom = visual.find("geometry")
+            if geom is None or any(visual is p for p in pictures):
+                continue
+            vname = visual.attrib.get("name", "visual")
+            for fp in _geometry(geom, m @ _pose(visual, ctx), ctx):
+                out.append(_Solid([*scope, name, vname], fp, colour, static, visual=True))
 
 
 def _include(
@@ -1046,6 +1058,15 @@ def _obstacles(solids: list[_Solid]) -> list[Obstacle]:
             name = f"{name}#{n}"
         fp = s.footprint
         obstacles.append(
-            Obstacle(name, fp.kind, fp.outline, fp.top, s.colour, fp.bottom, "" if single else s.path[0])
+            Obstacle(
+                name,
+                fp.kind,
+                fp.outline,
+                fp.top,
+                s.colour,
+                fp.bottom,
+                "" if single else s.path[0],
+                solid=not s.visual,
+            )
         )
     return obstacles

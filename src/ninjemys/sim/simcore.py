@@ -210,6 +210,11 @@ class Simulation:
         self._static_facing = np.concatenate(facing).astype(np.int8)
         self._static_owner = np.concatenate(owners).astype(np.intp)
         self.static_names = names
+        # visuals without collision (ArUco boards): drawn by the camera, passed through by all else
+        solid = np.ones(len(self._static), dtype=bool)
+        solid[: len(w.seg_owner)] = [w.obstacles[i].solid for i in w.seg_owner]
+        self._static_solid = solid
+        self._any_visual = not bool(solid.all())
         for r in self.robots.values():
             r.free = None  # the static world changed
         st = self._static
@@ -288,22 +293,25 @@ class Simulation:
                 near_names += names[i]
         return (np.vstack(segs) if segs else self._static[:0]), near_names
 
-    def scene(self, exclude: str | None = None) -> Scene:
-        """Everything solid now, as seen by robot ``exclude`` (its own body left out)."""
+    def scene(self, exclude: str | None = None, solid_only: bool = False) -> Scene:
+        """Everything seen now by robot ``exclude`` (its own body left out): by a camera, or with
+        ``solid_only`` by a lidar (visuals without collision left out)."""
         ms, mh, mc, _ = self._mover_segments()
-        segs = np.vstack([self._static, ms]) if len(ms) else self._static
-        heights = np.concatenate([self._static_height, mh]) if len(ms) else self._static_height
-        colours = np.vstack([self._static_color, mc]) if len(ms) else self._static_color
+        static, s_height, s_color = self._static, self._static_height, self._static_color
+        s_base, s_facing, s_owner = self._static_base, self._static_facing, self._static_owner
+        if solid_only and self._any_visual:
+            keep = self._static_solid
+            static, s_height, s_color = static[keep], s_height[keep], s_color[keep]
+            s_base, s_facing, s_owner = s_base[keep], s_facing[keep], s_owner[keep]
+        segs = np.vstack([static, ms]) if len(ms) else static
+        heights = np.concatenate([s_height, mh]) if len(ms) else s_height
+        colours = np.vstack([s_color, mc]) if len(ms) else s_color
         bases = None
         if self._any_base:
-            bases = np.concatenate([self._static_base, np.zeros(len(ms))]) if len(ms) else self._static_base
+            bases = np.concatenate([s_base, np.zeros(len(ms))]) if len(ms) else s_base
         # a moving obstacle may walk over a robot (the camera inside it sees its inside): both sides
-        facing = (
-            np.concatenate([self._static_facing, np.zeros(len(ms), dtype=np.int8)])
-            if len(ms)
-            else self._static_facing
-        )
-        owners = np.concatenate([self._static_owner, np.full(len(ms), -1)]) if len(ms) else self._static_owner
+        facing = np.concatenate([s_facing, np.zeros(len(ms), dtype=np.int8)]) if len(ms) else s_facing
+        owners = np.concatenate([s_owner, np.full(len(ms), -1)]) if len(ms) else s_owner
         others = [r for r in self.robots.values() if r.name != exclude]
         return Scene(
             segs,
@@ -382,6 +390,8 @@ class Simulation:
             mask &= self._static_base < below
         if above > 0.0:
             mask &= self._static_height > above + STANDS_ON
+        if self._any_visual:
+            mask &= self._static_solid
         return np.flatnonzero(mask)
 
     def _static_free(self, r: Robot, x: float, y: float) -> bool:
@@ -433,7 +443,7 @@ class Simulation:
         cell); pieces held at or above ``height`` (a table top over a lower robot) and pieces no
         higher than ``above`` (the table top a robot stands on) do not count."""
         for o in self.world.obstacles:
-            if above > 0.0 and o.height <= above + STANDS_ON:
+            if not o.solid or (above > 0.0 and o.height <= above + STANDS_ON):
                 continue
             if o.base < height and len(o.outline) > 2 and _inside(x, y, o.outline):
                 return o.name
@@ -612,10 +622,11 @@ class Simulation:
         height: float,
         color: tuple[int, int, int],
         base: float = 0.0,
+        solid: bool = True,
     ) -> None:
-        """Add a static obstacle of any outline (world coordinates; an SDF model's footprint, spawned);
-        refused on a robot or a name clash."""
-        self.add_model(name, [Obstacle(name, kind, outline, height, color, base)], yaw)
+        """Add a static obstacle of any outline (world coordinates; an SDF model's footprint, spawned;
+        ``solid`` False: a visual only); refused on a robot or a name clash."""
+        self.add_model(name, [Obstacle(name, kind, outline, height, color, base, solid=solid)], yaw)
 
     def add_model(
         self, name: str, pieces: list[Obstacle], yaw: float, origin: tuple[float, float] | None = None
@@ -636,7 +647,7 @@ class Simulation:
         """SpawnError when a piece would overlap a robot (pieces held above the robot pass over it)."""
         for r in self.robots.values():
             for o in pieces:
-                if o.base >= r.elevation + r.model.body_height or o.height <= r.elevation + STANDS_ON:
+                if not o.solid or o.base >= r.elevation + r.model.body_height or o.height <= r.elevation + STANDS_ON:
                     continue  # held above it, or under its wheels (the table top it stands on)
                 outline = o.outline
                 d = point_segment_distance(
@@ -755,7 +766,7 @@ class Simulation:
         on it, or nothing: the floor, 0): what a body's centre rests on there."""
         best = 0.0
         for o in self.world.obstacles:
-            if best < o.height <= at_most + STANDS_ON and len(o.outline) > 2 and _inside(x, y, o.outline):
+            if o.solid and best < o.height <= at_most + STANDS_ON and len(o.outline) > 2 and _inside(x, y, o.outline):
                 best = o.height
         return best
 
@@ -874,7 +885,7 @@ class Simulation:
         lx, ly = self.sensor_pose(r, spec.pose.xyz)
         angle_min, _angle_max, inc = scan_angles(spec)
         return lidar_ranges(
-            scene or self.scene(r.name),
+            scene or self.scene(r.name, solid_only=True),
             lx,
             ly,
             spec.pose.xyz[2] + r.elevation,

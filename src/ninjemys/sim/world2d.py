@@ -62,6 +62,9 @@ class Obstacle:
     color: tuple[int, int, int]
     base: float = 0.0
     model: str = ""
+    #: False for a visual without a collision (an ArUco tag board, a fiducial): the camera sees it,
+    #: the lidar, the robots and falling models pass through it, as in Gazebo
+    solid: bool = True
 
     @property
     def model_name(self) -> str:
