@@ -104,7 +104,9 @@ def test_p3d_publishes_the_true_pose_on_its_topic_frame_and_rate(sim) -> None:  
             sn._step_and_publish()
     wait_until(lambda: len(got) >= 20, 10, "20 ground truth messages")
     stamps = [m.header.stamp.to_sec() for m in got]
-    assert [round(b - a, 6) for a, b in zip(stamps[1:], stamps[2:])] == [0.05] * (len(got) - 2)  # 20 Hz
+    assert [round(b - a, 6) for a, b in zip(stamps[1:], stamps[2:], strict=False)] == [0.05] * (
+        len(got) - 2
+    )  # 20 Hz
     msg = got[-1]
     assert (msg.header.frame_id, msg.child_frame_id) == ("world", "base_link")
     assert (msg.pose.pose.position.x, msg.pose.pose.position.y) == pytest.approx((-0.5, 0.25))

@@ -10,12 +10,18 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 import pytest
-from test_drop_onto_a_table import BOX, ROBOT, TABLE, sim, spawn, state_z  # noqa: F401 - sim: the fixture
+from test_drop_onto_a_table import BOX, ROBOT, TABLE, spawn, state_z
 
 from ninjemys.idl.loader import get_message_class, get_service_class
+from ninjemys.node import Node
+from ninjemys.node.log import NodeLog
 from ninjemys.sim.puzzlebot_node import SimNode
-from ninjemys.testing import wait_until
+from ninjemys.sim.simcore import Simulation
+from ninjemys.sim.world2d import World
+from ninjemys.testing import run_master, wait_until
 
 SetModelState = get_service_class("gazebo_msgs/SetModelState")
 GetLinkState = get_service_class("gazebo_msgs/GetLinkState")
@@ -26,6 +32,16 @@ BOX_SDF = '<sdf version="1.6">' + BOX.format(name="b", x=0, y=0, z=0) + "</sdf>"
 #: the robot's root link stands 7 cm above what it stands on; the table top is at 0.75 m
 REST = 0.07
 TOP = 0.75
+
+
+@pytest.fixture
+def sim() -> Iterator[SimNode]:
+    with run_master() as master:
+        node = Node("settle_sim", master_uri=master)
+        try:
+            yield SimNode(node, NodeLog(node.name), Simulation(World("empty")), 0.0, None)
+        finally:
+            node.shutdown("test over")
 
 
 def set_state(sim: SimNode, name: str, x: float, y: float, z: float) -> tuple[bool, str]:
@@ -79,7 +95,9 @@ def test_a_robot_under_a_table_top_passes_under_it_and_one_on_it_is_not_stopped_
     assert state_z(sim, "low") == pytest.approx(REST)
 
 
-def test_set_model_state_re_settles_robots_and_models_with_physics_and_holds_static_ones(sim: SimNode) -> None:
+def test_set_model_state_re_settles_robots_and_models_with_physics_and_holds_static_ones(
+    sim: SimNode,
+) -> None:
     spawn(sim, "table", TABLE_SDF, 0.0, 0.0)
     spawn(sim, "bot", ROBOT, 2.0, 0.0, 0.0)
     spawn(sim, "box", BOX_SDF, -2.0, 0.0, 0.0)

@@ -30,13 +30,16 @@ BOARD = (
 )
 #: the same board with a collision: a solid board, for comparison
 SOLID_BOARD = BOARD.replace(
-    "</visual>", '</visual><collision name="c"><geometry><box><size>0.02 0.4 0.4</size></box></geometry></collision>'
+    "</visual>",
+    '</visual><collision name="c"><geometry><box><size>0.02 0.4 0.4</size></box></geometry></collision>',
 )
 
 
 def _world(board: str) -> World:
     return parse_sdf_world(
-        '<sdf version="1.6"><world name="w">' + board.format(name="aruco") + "</world></sdf>", "w.world", NO_ENV
+        '<sdf version="1.6"><world name="w">' + board.format(name="aruco") + "</world></sdf>",
+        "w.world",
+        NO_ENV,
     )
 
 
@@ -93,7 +96,9 @@ def sim() -> Iterator[SimNode]:
 
 
 def test_spawned_visual_only_models_hold_nothing_up_and_block_no_spawn(sim: SimNode) -> None:
-    spawn(sim, "tag", '<sdf version="1.6">' + BOARD.format(name="t").replace("1.5 0 0.2", "0 0 0.2") + "</sdf>")
+    spawn(
+        sim, "tag", '<sdf version="1.6">' + BOARD.format(name="t").replace("1.5 0 0.2", "0 0 0.2") + "</sdf>"
+    )
     (tag,) = [o for o in sim.sim.world.obstacles if o.model_name == "tag"]
     assert not tag.solid
     # a box dropped on it falls through to the floor; a robot can be spawned on it

@@ -49,7 +49,12 @@ def test_diff_drive_variant_gives_the_makers_names_and_geometry():
     assert m.ignored_plugins == []
     # its p3d plugin: the ground truth Gazebo publishes (nothing else: no contact topic)
     gt = m.ground_truth
-    assert gt is not None and (gt.topic, gt.frame, gt.body, gt.rate) == ("/ground_truth/state", "world", "base_link", 50.0)
+    assert gt is not None and (gt.topic, gt.frame, gt.body, gt.rate) == (
+        "/ground_truth/state",
+        "world",
+        "base_link",
+        50.0,
+    )
     assert m.contact_topic is None and m.bumper is None
 
 

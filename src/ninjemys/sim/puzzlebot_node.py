@@ -270,7 +270,9 @@ class SimNode:
         pubs: dict[str, Any] = {}
         # our PuzzleBot's ground truth and contact; a Gazebo description's only when a plugin asks
         if model.ground_truth is not None:
-            pubs["ground_truth"] = n.publisher(scoped(prefix, model.ground_truth.topic), Odometry, queue_size=10)
+            pubs["ground_truth"] = n.publisher(
+                scoped(prefix, model.ground_truth.topic), Odometry, queue_size=10
+            )
         if model.contact_topic is not None:
             pubs["contact"] = n.publisher(scoped(prefix, model.contact_topic), Bool, queue_size=1, latch=True)
         if model.bumper is not None:

@@ -14,8 +14,8 @@ and publishes what the sensors here compute.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -407,7 +407,9 @@ class Simulation:
         ):
             return True  # both ends in the disk: so is the straight move between them (a disk is convex)
         reach = 2.0
-        segs = self._static[self._static_near(r.x, r.y, reach, r.elevation + r.model.body_height, r.elevation)]
+        segs = self._static[
+            self._static_near(r.x, r.y, reach, r.elevation + r.model.body_height, r.elevation)
+        ]
         near = point_segment_distance(np.array([r.x]), np.array([r.y]), segs)
         clear = min(float(near.min()) if near.size else reach, reach)
         r.free = (r.x, r.y, clear)
@@ -505,9 +507,7 @@ class Simulation:
             self._mount_cameras(r, elevation)
             r.free = None
 
-    def place_robot(
-        self, name: str, x: float, y: float, yaw: float, elevation: float | None = None
-    ) -> Robot:
+    def place_robot(self, name: str, x: float, y: float, yaw: float, elevation: float | None = None) -> Robot:
         """Teleport a robot (Gazebo's set_model_state), onto ``elevation`` (None: the level it is on):
         refused (SpawnError) when the pose is not finite or the body would overlap anything; wheels
         and odometry keep running from the new pose."""
@@ -647,7 +647,11 @@ class Simulation:
         """SpawnError when a piece would overlap a robot (pieces held above the robot pass over it)."""
         for r in self.robots.values():
             for o in pieces:
-                if not o.solid or o.base >= r.elevation + r.model.body_height or o.height <= r.elevation + STANDS_ON:
+                if (
+                    not o.solid
+                    or o.base >= r.elevation + r.model.body_height
+                    or o.height <= r.elevation + STANDS_ON
+                ):
                     continue  # held above it, or under its wheels (the table top it stands on)
                 outline = o.outline
                 d = point_segment_distance(
@@ -766,7 +770,12 @@ class Simulation:
         on it, or nothing: the floor, 0): what a body's centre rests on there."""
         best = 0.0
         for o in self.world.obstacles:
-            if o.solid and best < o.height <= at_most + STANDS_ON and len(o.outline) > 2 and _inside(x, y, o.outline):
+            if (
+                o.solid
+                and best < o.height <= at_most + STANDS_ON
+                and len(o.outline) > 2
+                and _inside(x, y, o.outline)
+            ):
                 best = o.height
         return best
 

@@ -398,7 +398,9 @@ def _sensor(
     elif kind == "contact" and filename == BUMPER:
         collision = s.text("contact/collision", "")
         if not collision:
-            raise doc.error(sensor, f"{label}: <contact><collision> names no collision to watch", "sensor/contact")
+            raise doc.error(
+                sensor, f"{label}: <contact><collision> names no collision to watch", "sensor/contact"
+            )
         cfg.bumper = BumperSpec(
             topic(ns, p.text("bumperTopicName", "bumper_states")),
             frame(p.text("frameName", "world")),
