@@ -46,7 +46,7 @@ import numpy as np
 from ninjemys.errors import PackageError
 from ninjemys.maps.mapfile import MapFileError
 from ninjemys.packages.discovery import crawl, find_package
-from ninjemys.sim.gazebo_materials import STOCK, material_block, script_colour, stock_colour
+from ninjemys.sim.gazebo_materials import STOCK, TEXTURED, material_block, script_colour, stock_colour
 from ninjemys.sim.meshes import load_mesh
 from ninjemys.sim.world2d import FloorImage, Obstacle, World
 
@@ -428,6 +428,8 @@ def _colour(link: Element, ctx: _Context, pictures: tuple[Element, ...] = ()) ->
         mat = visual.find("material")
         if mat is None:
             continue
+        script = mat.find("script")
+        picture = (script.value("name") or "").strip() if script is not None else ""
         for tag in ("diffuse", "ambient"):
             el = mat.find(tag)
             if el is not None:
@@ -437,8 +439,10 @@ def _colour(link: Element, ctx: _Context, pictures: tuple[Element, ...] = ()) ->
                 rgb = _numbers(el, len(words), "r g b a")[:3]
                 if any(v < 0 or v > 1 for v in rgb):
                     raise el.error(f"colour components are 0-1, got {el.text.strip()!r}")
+                base = stock_colour(picture) if picture.lower() in TEXTURED else None
+                if base is not None:  # a stock picture (bricks, wood): the colour tints it
+                    return (round(base[0] * rgb[0]), round(base[1] * rgb[1]), round(base[2] * rgb[2]))
                 return (round(rgb[0] * 255), round(rgb[1] * 255), round(rgb[2] * 255))
-        script = mat.find("script")
         if script is not None:
             name = (script.value("name") or "").strip()
             colour = stock_colour(name)
