@@ -19,6 +19,7 @@ from ninjemys.idl.loader import get_message_class, get_service_class
 from ninjemys.node import Node
 from ninjemys.node.log import NodeLog
 from ninjemys.sim.puzzlebot_node import SimNode
+from ninjemys.sim.sdf import parse_sdf_world
 from ninjemys.sim.simcore import Simulation
 from ninjemys.sim.world2d import World
 from ninjemys.testing import run_master, wait_until
@@ -162,3 +163,25 @@ def test_a_paused_world_reports_spawn_poses_until_unpaused(sim: SimNode) -> None
     # running, a spawn settles at once
     spawn(sim, "box2", BOX_SDF, -2.0, 0.0, 2.0)
     assert state_z(sim, "box2") == pytest.approx(0.1)
+
+
+def test_a_world_loaded_paused_shows_its_models_where_the_file_puts_them_until_unpaused() -> None:
+    text = (
+        '<sdf version="1.6"><world name="w">'
+        + TABLE.format(name="table", x=0, y=0)
+        + BOX.format(name="crate", x=0.2, y=0.1, z=2.0)
+        + "</world></sdf>"
+    )
+    world = parse_sdf_world(text, "w.world", {"HOME": "/nonexistent"})
+    with run_master() as master:
+        node = Node("paused_world_sim", master_uri=master)
+        try:
+            sim = SimNode(node, NodeLog(node.name), Simulation(world), 0.0, None)
+            sim.stepper.paused = True  # what ~paused does at start
+            sim.gazebo.hold_world_models()
+            assert state_z(sim, "crate") == pytest.approx(2.0)
+            assert state_z(sim, "table") == pytest.approx(0.0)  # static: where the file puts it
+            sim.gazebo._unpause(None)
+            assert state_z(sim, "crate") == pytest.approx(TOP + 0.1)
+        finally:
+            node.shutdown("test over")

@@ -306,6 +306,13 @@ class GazeboApi:
         self.sn.stepper.set_paused(False)
         return Empty._response_class()
 
+    def hold_world_models(self) -> None:
+        """A world loaded with physics paused (``paused:=true``): its models with physics are where
+        the file puts them until unpause_physics, as Gazebo shows them."""
+        world = self.sn.sim.world
+        with self.sn.lock:
+            self.unsettled.update(world.placed_heights)
+
     def _hold_while_paused(self, name: str, z: float) -> None:
         """Gazebo's physics settles nothing while paused: remember the z a model was put at."""
         if self.sn.paused:

@@ -845,6 +845,7 @@ def main(argv: list[str] | None = None, view: ViewStarter | None = None) -> int:
         gui = _param(node, log, "gui", True, bool) and not options.headless
         if _param(node, log, "paused", False, bool):
             app.stepper.paused = True  # Gazebo's -u: physics waits for unpause_physics
+            app.gazebo.hold_world_models()  # nothing has fallen yet
             log.info("physics paused (call /gazebo/unpause_physics to start)")
         app.start()  # the physics and the sensors first: the view's server starts beside them
         try:

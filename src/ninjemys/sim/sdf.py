@@ -979,6 +979,7 @@ def parse_sdf_world(
     world.model_heights = {name: z - drops.get(name, 0.0) for name, z in ctx.heights.items()}
     world.bare_models = [name for name in ctx.origins if name not in kept]
     world.dynamic_models = list(drops)  # models with physics: a set_model_state re-drops them
+    world.placed_heights = {name: ctx.heights[name] for name in drops if name in ctx.heights}
     world.floor_images = ctx.floor_images
     _report(ctx, source, warn)
     return world

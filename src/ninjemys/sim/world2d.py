@@ -225,6 +225,8 @@ class World:
     bare_models: list[str] = field(default_factory=list)
     #: an SDF world's models with physics (not ``<static>``): they fall when set in the air
     dynamic_models: list[str] = field(default_factory=list)
+    #: the heights the file puts those models at, before they fall (a world loaded paused shows them there)
+    placed_heights: dict[str, float] = field(default_factory=dict)
     #: pictures on the floor (an SDF world's textured planes): the camera sees them
     floor_images: list[FloorImage] = field(default_factory=list)
     #: counts the rebuilds: a view that drew the obstacles redraws them when it changes (a model
