@@ -66,6 +66,13 @@ def test_a_robot_spawned_over_a_table_lands_on_its_top_and_falls_off_its_edge(si
     spawn(sim, "up", ROBOT, 0.2, 0.0, 1.0)  # spawn_model -z 1: over the table top
     spawn(sim, "beside", ROBOT, 2.0, 0.0, 1.0)  # nothing under it: the floor
     spawn(sim, "under", ROBOT, -2.0, 0.0, 0.0)
+    # a static box 0.3 m tall: a robot dropped over it stands on it
+    crate = '<sdf version="1.6">' + BOX.format(name="c", x=0, y=0, z=0).replace(
+        "<link", "<static>true</static><link"
+    )
+    spawn(sim, "crate", crate.replace("0.2 0.2 0.2", "0.6 0.6 0.3") + "</sdf>", 3.0, 3.0, 0.15)
+    spawn(sim, "on_crate", ROBOT, 3.0, 3.0, 0.8)
+    assert state_z(sim, "on_crate") == pytest.approx(0.3 + REST)
     assert state_z(sim, "up") == pytest.approx(TOP + REST)
     assert state_z(sim, "beside") == pytest.approx(REST)
     assert state_z(sim, "under") == pytest.approx(REST)
