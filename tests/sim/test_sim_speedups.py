@@ -273,27 +273,55 @@ def test_a_step_alone_in_open_space_moves_as_the_checked_step():
     assert calls["full"] >= 1000  # the checked run did check its moving steps
 
 
-def test_sensors_firing_in_one_step_share_its_scene():
+#: a red board 1.5 m ahead with no collision (an ArUco tag): the camera sees it, the lidar does not
+VISUAL_BOARD_WORLD = (
+    '<sdf version="1.6"><world name="w"><model name="aruco"><static>true</static>'
+    '<pose>1.5 0 0.2 0 0 0</pose><link name="tag"><visual name="face"><geometry><box>'
+    "<size>0.02 0.4 0.4</size></box></geometry></visual></link></model></world></sdf>"
+)
+
+
+@pytest.mark.parametrize("visual", [False, True], ids=["office", "visual-only board"])
+def test_sensors_firing_in_one_step_share_its_scene(visual: bool) -> None:
     """The lidar and the camera firing in the same step see one scene, built once for that step
-    and dropped after it (the next step's world has moved)."""
+    and dropped after it (the next step's world has moved); in a world with a visual-only piece
+    the lidar gets its own scene without it (it must not see the board the camera sees)."""
     from ninjemys.node import Node
     from ninjemys.node.log import NodeLog
     from ninjemys.sim.puzzlebot_node import SimNode
+    from ninjemys.sim.sdf import parse_sdf_world
     from ninjemys.testing import run_master, wait_until
 
+    world = (
+        parse_sdf_world(VISUAL_BOARD_WORLD, "w.world", {"HOME": "/nonexistent"})
+        if visual
+        else load_world(world_path("office"))
+    )
     with run_master() as master:
         node = Node("scene_share_sim", master_uri=master)
         client = Node("scene_share_client", master_uri=master)
         try:
-            sn = SimNode(
-                node, NodeLog(node.name), Simulation(load_world(world_path("office")), 0.01), 0.0, None
-            )
+            sn = SimNode(node, NodeLog(node.name), Simulation(world, 0.01), 0.0, None)
             io = sn.add_robot("puzzlebot", load_robot_model("puzzlebot"), 0.0, 0.0, 0.0, False)
-            built, seen = [], []
+            built: list[tuple[str | None, bool]] = []
+            scans: list[tuple[object, np.ndarray]] = []
+            renders: list[object] = []
             real_scene, real_scan, real_render = sn.sim.scene, sn.sim.scan, sn.sim.render
-            sn.sim.scene = lambda exclude=None: built.append(exclude) or real_scene(exclude)  # type: ignore[method-assign]
-            sn.sim.scan = lambda r, scene=None, laser=None: seen.append(scene) or real_scan(r, scene, laser)  # type: ignore[method-assign]
-            sn.sim.render = lambda r, scene=None, **kw: seen.append(scene) or real_render(r, scene, **kw)  # type: ignore[method-assign]
+
+            def scene(exclude=None, solid_only=False):
+                built.append((exclude, solid_only))
+                return real_scene(exclude, solid_only)
+
+            def scan(r, scene=None, laser=None):
+                ranges = real_scan(r, scene, laser)
+                scans.append((scene, ranges))
+                return ranges
+
+            def render(r, scene=None, **kw):
+                renders.append(scene)
+                return real_render(r, scene, **kw)
+
+            sn.sim.scene, sn.sim.scan, sn.sim.render = scene, scan, render  # type: ignore[method-assign]
             model = io.robot.model
             assert model.laser is not None and model.camera is not None
             subs = [
@@ -311,7 +339,15 @@ def test_sensors_firing_in_one_step_share_its_scene():
             )
             io.scan_due.next = io.camera_due.next = sn.sim.time + sn.sim.dt  # both fire next step
             sn._step_and_publish()
-            assert built == ["puzzlebot"] and len(seen) == 2 and seen[0] is seen[1] is not None
+            assert len(scans) == 1 and len(renders) == 1
+            (scan_scene, ranges), (render_scene,) = scans[0], renders
+            assert scan_scene is not None and render_scene is not None
+            if visual:
+                assert built == [("puzzlebot", True), ("puzzlebot", False)]
+                assert len(scan_scene.segments) < len(render_scene.segments)
+                assert float(np.min(ranges[np.isfinite(ranges)], initial=np.inf)) > 1.6  # not the board
+            else:
+                assert built == [("puzzlebot", True)] and scan_scene is render_scene
             assert sn._scenes == {}
             for sub in subs:
                 sub.unregister()

@@ -184,7 +184,7 @@ class SimNode:
         self._last_clock: float | None = None
         #: each robot's scene (what its sensors see) in the step being published: built once for
         #: the lidar and the cameras firing in the same step, dropped when the step is over
-        self._scenes: dict[str, Scene] = {}
+        self._scenes: dict[tuple[str, bool], Scene] = {}
         self.view: Any = None
         self.clock_pub = node.publisher("/clock", Clock, queue_size=10)
         self.tf_pub = node.publisher("/tf", TFMessage, queue_size=100)
@@ -457,11 +457,13 @@ class SimNode:
         secs, nsecs = divmod(self.sim.time_ns, 1_000_000_000)
         return Time._raw(secs, nsecs)  # wire integers, already valid: no re-validation per step
 
-    def _scene(self, r: Robot) -> Scene:
-        """Robot ``r``'s scene now, built at most once per step (the lock is held all the step)."""
-        scene = self._scenes.get(r.name)
+    def _scene(self, r: Robot, solid_only: bool = False) -> Scene:
+        """Robot ``r``'s scene now, for a camera or (``solid_only``) a lidar, built at most once per
+        step (the lock is held all the step); one scene serves both when nothing is only drawn."""
+        key = (r.name, solid_only and self.sim.has_visuals)
+        scene = self._scenes.get(key)
         if scene is None:
-            scene = self._scenes[r.name] = self.sim.scene(r.name)
+            scene = self._scenes[key] = self.sim.scene(r.name, solid_only=solid_only)
         return scene
 
     def _step_and_publish(self) -> None:
@@ -513,7 +515,7 @@ class SimNode:
                 if not subscribed and not (view is not None and view.wants_scans()):
                     io.scan_due.next = now  # idle: a new subscriber's first scan goes out at once
                 elif io.scan_due.fire(now):
-                    ranges = sim.scan(r, scene=self._scene(r))
+                    ranges = sim.scan(r, scene=self._scene(r, solid_only=True))
                     io.last_scan = ranges
                     if subscribed:
                         scan.publish(messages.laser_scan(stamp, io.frame(laser.pose.frame), laser, ranges))
@@ -605,7 +607,7 @@ class SimNode:
         if extra.kind == "laser":
             laser = model.extra_lasers[extra.index]
             if extra.pubs["scan"].get_num_connections():
-                ranges = self.sim.scan(io.robot, scene=self._scene(io.robot), laser=laser)
+                ranges = self.sim.scan(io.robot, scene=self._scene(io.robot, solid_only=True), laser=laser)
                 extra.pubs["scan"].publish(
                     messages.laser_scan(stamp, io.frame(laser.pose.frame), laser, ranges)
                 )

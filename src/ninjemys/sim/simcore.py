@@ -300,6 +300,12 @@ class Simulation:
                 near_names += names[i]
         return (np.vstack(segs) if segs else self._static[:0]), near_names
 
+    @property
+    def has_visuals(self) -> bool:
+        """Some static piece is only drawn, not solid (an ArUco board): a lidar's scene then differs
+        from a camera's (see :meth:`scene`)."""
+        return self._any_visual
+
     def scene(self, exclude: str | None = None, solid_only: bool = False) -> Scene:
         """Everything seen now by robot ``exclude`` (its own body left out): by a camera, or with
         ``solid_only`` by a lidar (visuals without collision left out)."""
