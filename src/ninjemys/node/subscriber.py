@@ -283,10 +283,9 @@ class SubConnection:
                         frames = []
                 self.num_recv += len(msgs) + len(bad)
                 return msgs, frames, bad
-            n = self._received(n)
-            if n is None:
+            first = self._received(n)
+            if first is None:
                 return None
-            first: int | None = n
         else:
             first = None
         while True:
@@ -294,11 +293,12 @@ class SubConnection:
                 n, first = first, None
             else:
                 buf = reader.buffer()
-                n = self._recv_into(buf)
-                if n is None:
+                received = self._recv_into(buf)
+                if received is None:
                     return None
-                if n < 0:
+                if received < 0:
                     break
+                n = received
             self.bytes_recv += n
             got += n
             if fused and cap is not None and len(msgs) + (reader.pending + n) // min_frame > cap:
