@@ -126,9 +126,7 @@ class CommStateMachine:
         try:
             path = states.comm_transitions(self.state, status.status)
         except KeyError:
-            self.log.error(
-                "goal %s: the action server sent unknown status %r", self.goal_id, status.status
-            )
+            self.log.error("goal %s: the action server sent unknown status %r", self.goal_id, status.status)
             return
         if path is None:
             self.log.error(

@@ -21,6 +21,7 @@ tests passed (catkin's run_tests target ignores it, as ROS 1 does).
 from __future__ import annotations
 
 import argparse
+import functools
 import importlib.util
 import inspect
 import os
@@ -55,7 +56,12 @@ def module_files(path: Path) -> Iterator[Path]:
         return
     entries = sorted(path.iterdir(), key=lambda p: p.name)
     for entry in entries:
-        if entry.is_file() and entry.suffix == ".py" and wanted(entry.stem) and not entry.name.startswith("."):
+        if (
+            entry.is_file()
+            and entry.suffix == ".py"
+            and wanted(entry.stem)
+            and not entry.name.startswith(".")
+        ):
             if os.access(entry, os.X_OK):
                 continue  # nose without --exe ignores executable files
             yield entry
@@ -136,7 +142,7 @@ class _ModuleSuite(unittest.TestSuite):
         super().__init__(tests)
         self.module = module
 
-    def run(self, result: unittest.TestResult, debug: bool = False) -> unittest.TestResult:  # type: ignore[override]
+    def run(self, result: unittest.TestResult, debug: bool = False) -> unittest.TestResult:
         setup = _fixture(self.module, "setup_module", "setupModule", "setUpModule", "setup", "setUp")
         teardown = _fixture(
             self.module, "teardown_module", "teardownModule", "tearDownModule", "teardown", "tearDown"
@@ -182,7 +188,7 @@ def _function_tests(fn: Callable[..., object], module_name: str) -> list[unittes
         call, *args = item if isinstance(item, tuple) else (item,)
         tests.append(
             _FunctionCase(
-                lambda call=call, args=args: call(*args),
+                functools.partial(call, *args),
                 module_name,
                 f"{fn.__name__}{tuple(args)!r}",
                 setup,
@@ -199,11 +205,7 @@ def module_tests(module: types.ModuleType) -> unittest.TestSuite:
     name = module.__name__
     # as nose: every name the module holds (imported ones too), none starting with "_", and
     # ``__test__ = False`` opts out
-    items = [
-        v
-        for k, v in vars(module).items()
-        if not k.startswith("_") and getattr(v, "__test__", True)
-    ]
+    items = [v for k, v in vars(module).items() if not k.startswith("_") and getattr(v, "__test__", True)]
     classes = sorted(
         (c for c in items if inspect.isclass(c) and not c.__name__.startswith("_")),
         key=lambda c: c.__name__,
@@ -216,11 +218,7 @@ def module_tests(module: types.ModuleType) -> unittest.TestSuite:
         elif wanted(cls.__name__):
             tests.extend(_class_suite(cls, name))
     functions = sorted(
-        (
-            f
-            for f in items
-            if inspect.isfunction(f) and not f.__name__.startswith("_") and wanted(f.__name__)
-        ),
+        (f for f in items if inspect.isfunction(f) and not f.__name__.startswith("_") and wanted(f.__name__)),
         key=lambda f: f.__code__.co_firstlineno,
     )
     for fn in functions:
@@ -269,11 +267,11 @@ class XunitResult(unittest.TextTestResult):
         super().addSuccess(test)
         self._record(test, "ok")
 
-    def addFailure(self, test: unittest.TestCase, err: object) -> None:  # type: ignore[override]
+    def addFailure(self, test: unittest.TestCase, err: object) -> None:
         super().addFailure(test, err)  # type: ignore[arg-type]
         self._record(test, "failure", err)
 
-    def addError(self, test: unittest.TestCase, err: object) -> None:  # type: ignore[override]
+    def addError(self, test: unittest.TestCase, err: object) -> None:
         super().addError(test, err)  # type: ignore[arg-type]
         self._record(test, "error", err)
 
@@ -318,7 +316,7 @@ def run(path: Path, xunit_file: Path) -> bool:
         try:
             suite.addTest(module_tests(import_file(file)))
         except Exception:
-            failed = _FunctionCase(lambda: None, dotted_name(file), "Failure")
+            failed = _FunctionCase(lambda: None, "nose.failure.Failure", "runTest")  # nose's id
             error = sys.exc_info()
             suite.addTest(_ImportFailure(failed, error))
     result = runner.run(suite)
@@ -334,7 +332,7 @@ class _ImportFailure(unittest.TestSuite):
         super().__init__()
         self.case, self.error = case, error
 
-    def run(self, result: unittest.TestResult, debug: bool = False) -> unittest.TestResult:  # type: ignore[override]
+    def run(self, result: unittest.TestResult, debug: bool = False) -> unittest.TestResult:
         result.startTest(self.case)
         result.addError(self.case, self.error)  # type: ignore[arg-type]
         result.stopTest(self.case)
