@@ -114,6 +114,15 @@ TALKER_TEST = """<launch>
 </launch>
 """
 
+# a test file committed without chmod +x, and a test of a package that is not there (course repositories
+# do both): those tests fail to run, the others run (CarND-Capstone's dbw_sim.test)
+UNRUNNABLE_TEST = """<launch>
+  <test test-name="arith" pkg="probe_tests" type="test_fails.py"/>
+  <test test-name="plain" pkg="probe_tests" type="test_plain.py"/>
+  <test test-name="elsewhere" pkg="no_such_probe_pkg" type="test_x.py"/>
+</launch>
+"""
+
 FAILING_TEST = """<launch>
   <test test-name="arith" pkg="probe_tests" type="test_fails.py"/>
 </launch>
@@ -235,6 +244,8 @@ def _workspace(root: Path) -> CatkinWorkspace:
             "test/param.test": PARAM_TEST,
             "test/advertise.test": ADVERTISE_TEST,
             "test/broken.test": "<launch><test test-name=",
+            "test/unrunnable.test": UNRUNNABLE_TEST,
+            "test/test_plain.py": FAILS,  # not executable
         },
         executables=list(scripts),
     )
@@ -279,6 +290,21 @@ def test_a_passing_test_file_runs_its_node_and_test_node(workspace: Path) -> Non
     assert read_xml(results / "rosunit-talker_test.xml").ok
     # the test node's own output went to its log, not the console
     assert "Outputting test results to" in out and "Ran 2 tests" not in out
+
+
+def test_tests_that_cannot_run_fail_and_the_others_run(workspace: Path) -> None:
+    result = _rostest(workspace, "probe_tests", "unrunnable.test")
+    out = re.sub(r"\x1b\[[0-9;]*m", "", result.stdout)
+    assert result.returncode == 1, out + result.stderr
+    assert "[Testcase: testarith] ... ok" in out
+    assert "FAILURE: Test node [probe_tests/test_plain.py] does not exist or is not executable" in out
+    assert (
+        "FAILURE: Package [no_such_probe_pkg] for test node [no_such_probe_pkg/test_x.py] does not exist"
+        in out
+    )
+    assert "ERROR: The following tests failed to run:\n * testelsewhere\n * testplain\n" in out
+    results = workspace / "ros_home" / "test_results" / "probe_tests"
+    assert len(read_xml(results / "rostest-test_unrunnable.xml").cases) == 2  # arith's own cases
 
 
 def test_a_failing_case_fails_the_run_and_is_named(workspace: Path) -> None:
@@ -411,6 +437,7 @@ def _report_lines(text: str) -> list[str]:
         ("talker.test", 0),
         ("failing.test", 2),
         ("slow.test", 1),
+        ("unrunnable.test", 1),
         ("hz.test", 2),
         ("publish.test", 2),
         ("param.test", 2),
