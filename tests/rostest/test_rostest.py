@@ -304,7 +304,13 @@ def test_tests_that_cannot_run_fail_and_the_others_run(workspace: Path) -> None:
     )
     assert "ERROR: The following tests failed to run:\n * testelsewhere\n * testplain\n" in out
     results = workspace / "ros_home" / "test_results" / "probe_tests"
-    assert len(read_xml(results / "rostest-test_unrunnable.xml").cases) == 2  # arith's own cases
+    combined = read_xml(results / "rostest-test_unrunnable.xml")
+    # arith's own two cases, and rostest's failing case for each test that did not run
+    assert [(c.classname, c.name) for c in combined.cases if c.classname == "rostest.runner.RosTest"] == [
+        ("rostest.runner.RosTest", "testelsewhere"),
+        ("rostest.runner.RosTest", "testplain"),
+    ]
+    assert len(combined.cases) == 4 and len(combined.failures) == 3
 
 
 def test_a_failing_case_fails_the_run_and_is_named(workspace: Path) -> None:

@@ -292,7 +292,19 @@ def main(argv: list[str] | None = None) -> int:
         if core is not None:
             _stop(core)
     cases = [case for run in runs for case in run.cases]
-    write_xml(Path(combined), SuiteResult(name=suite_name, cases=cases))
+    # a test that did not run or overran is rostest's own failing case (classname as ROS 1 writes it),
+    # so catkin_test_results counts it
+    not_run = [
+        CaseResult(
+            "rostest.runner.RosTest",
+            f"test{run.name}",
+            failure=run.why if run.verdict == "failure" else None,
+            error=run.why if run.verdict == "error" else None,
+        )
+        for run in runs
+        if run.verdict != "ok"
+    ]
+    write_xml(Path(combined), SuiteResult(name=suite_name, cases=cases + not_run))
     log_file.parent.mkdir(parents=True, exist_ok=True)
     report = _report(package, runs, log_file)
     log_file.write_text(report + "\n", encoding="utf-8")
