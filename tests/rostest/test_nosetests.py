@@ -192,13 +192,29 @@ def test_old_results_are_removed_and_results_dir_can_be_chosen(tmp_path: Path) -
     assert not (tmp_path / "ws" / "build" / "test_results").exists()
 
 
-def test_a_missing_path_is_named_and_the_rest_runs(tmp_path: Path) -> None:
-    ws = _workspace(tmp_path)
-    cmake = tmp_path / "src" / "nosy" / "CMakeLists.txt"
+def _missing_path(ws: CatkinWorkspace) -> None:
+    cmake = ws.root / "src" / "nosy" / "CMakeLists.txt"
     cmake.write_text(cmake.read_text().replace("catkin_add_nosetests(test)", "catkin_add_nosetests(tests)"))
-    made = ws.catkin_make("run_tests")
-    assert f"{cmake}: Can't find nosetests path 'tests'" in made.stdout
-    assert (tmp_path / "build" / "test_results" / "nosy" / "nosetests-test.test_single.py.xml").is_file()
+
+
+MISSING_PATH = (
+    "CMake Error at /usr/share/catkin/cmake/test/nosetests.cmake:54 (message):\n"
+    "  Can't find nosetests path 'tests'\nCall Stack (most recent call first):\n"
+    "  nosy/CMakeLists.txt:7 (catkin_add_nosetests)"
+)
+
+
+def test_a_missing_path_stops_the_build_as_catkins_configure_does(tmp_path: Path) -> None:
+    ws = _workspace(tmp_path)
+    _missing_path(ws)
+    made = ws.catkin_make()
+    assert made.returncode == 1
+    assert MISSING_PATH in made.stderr
+    assert not (tmp_path / "devel").exists()
+    # with testing off, catkin registers no tests: the build passes and run_tests runs none
+    made = ws.catkin_make("run_tests", "-DCATKIN_ENABLE_TESTING=OFF")
+    assert made.returncode == 0, made.stdout + made.stderr
+    assert not (tmp_path / "build" / "test_results" / "nosy").exists()
 
 
 @pytest.mark.ros1
@@ -240,3 +256,10 @@ def test_same_results_as_debians_catkin_make(tmp_path: Path) -> None:
     ]
     assert summary[0].returncode == summary[1].returncode == 1
     assert summary[0].stdout.splitlines()[-1] == summary[1].stdout.splitlines()[-1]
+    # a path that does not exist: both stop at configure with catkin's message
+    _missing_path(theirs)
+    shutil.rmtree(theirs.root / "build")
+    debian = subprocess.run(
+        ["/usr/bin/catkin_make"], cwd=theirs.root, env=env, capture_output=True, text=True, timeout=600
+    )
+    assert debian.returncode != 0 and MISSING_PATH in debian.stderr, debian.stdout + debian.stderr

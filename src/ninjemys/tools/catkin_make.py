@@ -16,6 +16,7 @@ import time
 from pathlib import Path
 
 from ninjemys.commands import command_path
+from ninjemys.errors import PackageError
 from ninjemys.packages.builder import build_workspace, clean_workspace
 from ninjemys.packages.cmake_hints import read_cmake_hints
 from ninjemys.packages.cpp_build import install_cpp
@@ -63,6 +64,8 @@ def main(argv: list[str] | None = None) -> int:
         print("####\n#### Removed build and devel spaces\n####")
         return 0
     start = time.monotonic()
+    if _testing_enabled(passthrough):
+        _check_nosetests_paths(ws)
     print("-- ~~  traversing packages in topological order:")
     prefix = _install_prefix(ws, passthrough)
     report = build_workspace(ws, env=os.environ, log=print, install_prefix=prefix)
@@ -79,7 +82,10 @@ def main(argv: list[str] | None = None) -> int:
     if "install" in args.targets:
         _install(ws, prefix, report.cpp_build)
     if "run_tests" in args.targets:
-        _run_tests(ws, _results_dir(ws, passthrough))
+        if _testing_enabled(passthrough):
+            _run_tests(ws, _results_dir(ws, passthrough))
+        else:
+            print("-- Skipping the tests: enable testing via -DCATKIN_ENABLE_TESTING (catkin's words)")
     return 0
 
 
@@ -106,8 +112,35 @@ def _run_tests(ws: Workspace, results_dir: Path) -> None:
         _clean_results(results_dir / pkg.name)
         for test_file in hints.rostests:
             _run_rostest(pkg.name, pkg.path, test_file, results_dir, env)
-        for test_path, workdir in hints.nosetests:
+        for test_path, workdir, _line in hints.nosetests:
             _run_nosetests(ws, pkg.name, pkg.path, test_path, workdir, results_dir, env)
+
+
+def _testing_enabled(cmake_args: list[str]) -> bool:
+    """catkin's CATKIN_ENABLE_TESTING (on unless ``-DCATKIN_ENABLE_TESTING=OFF``/0/FALSE/NO)."""
+    enabled = True
+    for arg in cmake_args:
+        name, _, value = arg[2:].partition("=")
+        if name.split(":", 1)[0] == "CATKIN_ENABLE_TESTING":
+            enabled = value.strip().upper() not in ("OFF", "0", "FALSE", "NO", "N", "")
+    return enabled
+
+
+def _check_nosetests_paths(ws: Workspace) -> None:
+    """catkin's configure step: a ``catkin_add_nosetests`` path that does not exist stops the build
+    (``Can't find nosetests path``), before anything is built, whatever the target."""
+    ws.load()
+    for pkg in ws.packages:
+        for test_path, _workdir, line in read_cmake_hints(pkg.path).nosetests:
+            text = _package_vars(test_path, pkg.path)
+            if "${" in text or (pkg.path / text).exists():
+                continue
+            where = f"{pkg.path.relative_to(ws.source)}/CMakeLists.txt:{line}"
+            raise PackageError(
+                "CMake Error at /usr/share/catkin/cmake/test/nosetests.cmake:54 (message):\n"
+                f"  Can't find nosetests path '{test_path}'\nCall Stack (most recent call first):\n"
+                f"  {where} (catkin_add_nosetests)"
+            )
 
 
 def _clean_results(package_results: Path) -> None:
@@ -174,8 +207,10 @@ def _run_nosetests(
     target = f"run_tests_{name}_nosetests_{output}"
     print(f"-- {target}", flush=True)
     path = pkg_dir / path_text
-    if "${" in path_text or not path.exists():
-        print(f"-- {pkg_dir / 'CMakeLists.txt'}: Can't find nosetests path '{test_path}'")
+    if "${" in path_text:
+        print(
+            f"-- {pkg_dir / 'CMakeLists.txt'}: nosetests path '{test_path}' names a CMake variable ninjemys does not know"
+        )
         return
     results = results_dir / name / f"nosetests-{output}.xml"
     cwd = Path(workdir) if workdir and "${" not in workdir else ws.build / name
