@@ -106,6 +106,19 @@ def test_never_runs():
     pass
 """
 
+PKG_TESTS = """from . import helper_values
+
+def test_relative_import():
+    assert helper_values.VALUE == 3
+
+class TestWithClassFixture:
+    @classmethod
+    def setup_class(cls):
+        cls.ready = True
+    def test_ready(self):
+        assert self.ready
+"""
+
 MORE = """import os
 def test_cwd():
     assert os.path.basename(os.getcwd()) == "other"
@@ -129,6 +142,10 @@ def _workspace(root: Path) -> CatkinWorkspace:
             "test/sub/test_other.py": BROKEN,  # one that does not match: not searched
             "test/helpers/test_hidden.py": BROKEN,  # neither a package nor a matching name: not searched
             "other/check_more.py": MORE,
+            # a package of tests: module names through the package, relative imports, setup_class
+            "test/pkg_tests/__init__.py": "",
+            "test/pkg_tests/helper_values.py": "VALUE = 3\n",
+            "test/pkg_tests/test_pkg.py": PKG_TESTS,
         },
         executables=["test/test_exec.py"],
     )
@@ -161,9 +178,11 @@ def test_run_tests_collects_by_noses_rules(tmp_path: Path) -> None:
         "nosy/nosetests-other.check_more.py.xml",
     }
     counts, cases = results["nosy/nosetests-test.xml"]
-    assert counts == {"name": "nosetests", "tests": "11", "errors": "2", "failures": "2", "skip": "1"}
+    assert counts == {"name": "nosetests", "tests": "13", "errors": "2", "failures": "2", "skip": "1"}
     assert cases == [
         ("nose.failure.Failure", "runTest", "error"),  # test_broken.py does not import
+        ("pkg_tests.test_pkg", "test_relative_import", "ok"),
+        ("pkg_tests.test_pkg.TestWithClassFixture", "test_ready", "ok"),
         ("test_deeper", "test_one", "ok"),
         ("test_math", "test_error", "error"),
         ("test_math", "test_function", "ok"),
