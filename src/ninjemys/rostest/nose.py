@@ -12,7 +12,8 @@ file, which ``catkin_test_results`` and CI read:
   (sorted by name), then functions whose name matches (in source order); methods whose name matches;
 - fixtures: ``setup_module``/``teardown_module`` (and nose's other spellings), ``setup_class``,
   ``setup``/``setUp`` of plain classes, ``with_setup`` attributes left by nose's decorator;
-- ``-P``: the test directory is not put on ``sys.path`` (a sibling import fails, as under catkin).
+- ``-P``: the test directory is not put on ``sys.path`` (a sibling import fails, as under catkin);
+- catkin's ``--process-timeout`` is nose's multiprocess plugin's, which catkin leaves off: no timeout.
 
 Run as ``python -m ninjemys.rostest.nose PATH --xunit-file FILE``; the exit code is 0 only when all
 tests passed (catkin's run_tests target ignores it, as ROS 1 does).
