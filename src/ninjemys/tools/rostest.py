@@ -292,9 +292,11 @@ def main(argv: list[str] | None = None) -> int:
         if core is not None:
             _stop(core)
     cases = [case for run in runs for case in run.cases]
-    # a test that did not run or overran is rostest's own failing case (classname as ROS 1 writes it),
-    # so catkin_test_results counts it
-    not_run = [
+    # as ROS 1 writes it, the combined file holds rostest's own case per <test> (``test<name>``, passing
+    # when the node ran and wrote its results; failing when it could not run or wrote none; an error
+    # when it overran); the node's own cases are in its rosunit-<name>.xml beside it, so
+    # catkin_test_results counts each case once
+    own = [
         CaseResult(
             "rostest.runner.RosTest",
             f"test{run.name}",
@@ -302,9 +304,8 @@ def main(argv: list[str] | None = None) -> int:
             error=run.why if run.verdict == "error" else None,
         )
         for run in runs
-        if run.verdict != "ok"
     ]
-    write_xml(Path(combined), SuiteResult(name=suite_name, cases=cases + not_run))
+    write_xml(Path(combined), SuiteResult(name=suite_name, cases=own))
     log_file.parent.mkdir(parents=True, exist_ok=True)
     report = _report(package, runs, log_file)
     log_file.write_text(report + "\n", encoding="utf-8")
