@@ -207,3 +207,31 @@ def test_media_a_package_exports_for_gazebo_ros_is_searched(tmp_path: Path) -> N
     assert floor.rgb[0, 0].tolist() == [160, 90, 30]
     assert warnings == []
     assert world.bare_models == ["floor"]  # a plane: a model with nothing solid
+
+
+def test_an_ambient_beside_a_stock_picture_tints_it_and_replaces_a_plain_colour(tmp_path: Path) -> None:
+    """The Building Editor saves its walls as ``Gazebo/Bricks`` with ``<ambient>1 1 1 1</ambient>``
+    and Gazebo shows bricks (a course world's house: white walls would be taken for the white ball a
+    ball chaser looks for); beside a plain colour, the ambient is the colour."""
+
+    def wall(name: str, script: str, extra: str) -> str:
+        return (
+            f'<model name="{name}"><static>1</static><link name="l"><visual name="v"><geometry><box>'
+            "<size>1 0.1 1</size></box></geometry><material><script>"
+            f"<uri>file://media/materials/scripts/gazebo.material</uri><name>{script}</name></script>{extra}"
+            '</material></visual><collision name="c"><geometry><box><size>1 0.1 1</size></box></geometry>'
+            "</collision></link></model>"
+        )
+
+    text = (
+        '<sdf version="1.6"><world name="w">'
+        + wall("bricks", "Gazebo/Bricks", "<ambient>1 1 1 1</ambient>")
+        + wall("dim_wood", "Gazebo/Wood", "<diffuse>0.5 0.5 0.5 1</diffuse>")
+        + wall("grey", "Gazebo/Grey", "<ambient>0.2 0.4 0.6 1</ambient>")
+        + "</world></sdf>"
+    )
+    colours = {o.name: o.color for o in parse_sdf_world(text, str(tmp_path / "w.world"), {}).obstacles}
+    assert colours["bricks"] == stock_colour("Gazebo/Bricks")
+    wood = stock_colour("Gazebo/Wood")
+    assert wood is not None and colours["dim_wood"] == tuple(round(c * 0.5) for c in wood)
+    assert colours["grey"] == (51, 102, 153)

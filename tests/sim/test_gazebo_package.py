@@ -77,6 +77,14 @@ def test_the_course_package_runs_unchanged(
         echo = subprocess.run(["/usr/bin/rostopic", "echo", "-n", "1", "/scan/header/frame_id"], env=real,
                               capture_output=True, text=True, timeout=60)  # fmt: skip
         assert "laser_frame" in echo.stdout, echo
+        # what Gazebo publishes for this description: its p3d plugin's ground truth, no contact topic
+        listed = subprocess.run(["/usr/bin/rostopic", "list"], env=real, capture_output=True, text=True,
+                                timeout=60).stdout.split()  # fmt: skip
+        assert "/ground_truth/state" in listed and "/contact" not in listed, listed
+        assert "/base_pose_ground_truth" not in listed, listed
+        truth = subprocess.run(["/usr/bin/rostopic", "echo", "-n", "1", "/ground_truth/state/child_frame_id"],
+                               env=real, capture_output=True, text=True, timeout=60)  # fmt: skip
+        assert "base_link" in truth.stdout, truth
         drive = subprocess.run(["/usr/bin/python3", "-c", _DRIVE, cmd_vel], env=real, capture_output=True,
                                text=True, timeout=120)  # fmt: skip
         assert drive.returncode == 0, drive.stderr[-2000:]

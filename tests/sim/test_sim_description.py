@@ -46,7 +46,16 @@ def test_diff_drive_variant_gives_the_makers_names_and_geometry():
     assert m.max_wheel_accel == pytest.approx(1.0 / 0.05)  # wheelAcceleration (m/s^2) at the rim
     assert m.max_wheel_speed == 20.0  # the wheel joint's <limit velocity>
     assert not m.sensor_tf  # robot_state_publisher publishes the links
-    assert m.ignored_plugins == ["libgazebo_ros_p3d.so"]
+    assert m.ignored_plugins == []
+    # its p3d plugin: the ground truth Gazebo publishes (nothing else: no contact topic)
+    gt = m.ground_truth
+    assert gt is not None and (gt.topic, gt.frame, gt.body, gt.rate) == (
+        "/ground_truth/state",
+        "world",
+        "base_link",
+        50.0,
+    )
+    assert m.contact_topic is None and m.bumper is None
 
 
 def test_lidar_turned_by_pi_with_its_beams_angles_and_names():

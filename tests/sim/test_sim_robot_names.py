@@ -68,9 +68,10 @@ def test_namespaced_robots_from_descriptions_get_single_slash_names(master: str)
         names = topics_of(node)
         assert not [t for t in names if "//" in t]
         for robot in ("heavy", "light"):
-            for topic in ("odom", "scan", "cmd_vel", "contact"):
+            for topic in ("odom", "scan", "cmd_vel"):
                 assert f"/{robot}/{topic}" in names
         assert "/odom" not in names and "/scan" not in names
+        assert "/heavy/contact" not in names  # a Gazebo description without a bumper has no contact topic
         # frames: tf_prefix style, one slash
         assert heavy.frame("odom") == "heavy/odom" and light.frame("base_link") == "light/base_link"
         assert heavy.frame("heavy/odom") == "heavy/odom"

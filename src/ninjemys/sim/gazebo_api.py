@@ -140,6 +140,11 @@ class GazeboApi:
             if name in world.model_poses
         }
         self.pushes: dict[str, Push] = {}
+        #: models with physics (they fall when put in the air): the world file's, then spawned ones
+        self.dynamic: set[str] = set(world.dynamic_models)
+        #: models spawned or set while physics is paused, and the z they were put at: Gazebo reports
+        #: that pose until physics runs again (they settle then)
+        self.unsettled: dict[str, float] = {}
         n = sim_node.node
         for name, cls, handler in (
             ("reset_simulation", Empty, self._reset_simulation),
@@ -192,13 +197,22 @@ class GazeboApi:
         return links
 
     def model_pose(self, name: str) -> Planar | None:
+        pose = self.settled_pose(name)
+        held = self.unsettled.get(name)
+        if pose is None or held is None:
+            return pose
+        return pose[0], pose[1], held, pose[3]  # paused: still where it was put
+
+    def settled_pose(self, name: str) -> Planar | None:
+        """A model's pose once physics has run: where it landed."""
         sim = self.sn.sim
         if name in self.bare:
             return self.bare[name]
         r = sim.robots.get(name)
         if r is not None:
-            # a robot stands on the floor, whatever height it was spawned or set at (Gazebo drops it)
-            return r.x, r.y, r.model.rest_z, r.yaw
+            # a robot stands on the floor or on what it landed on, whatever height it was spawned or
+            # set at (Gazebo drops it)
+            return r.x, r.y, r.model.rest_z + r.elevation, r.yaw
         try:
             x, y, yaw = sim.obstacle_pose(name)
         except SpawnError:
@@ -259,6 +273,8 @@ class GazeboApi:
         c, s = math.cos(yaw), math.sin(yaw)
         out = []
         for o in self.sn.sim.world.obstacles:
+            if not o.solid:
+                continue  # a visual without collision holds nothing up
             dx, dy = o.outline[:, 0] - x, o.outline[:, 1] - y
             out.append(Support(np.column_stack([c * dx + s * dy, -s * dx + c * dy]), o.height))
         return out
@@ -285,8 +301,44 @@ class GazeboApi:
         return Empty._response_class()
 
     def _unpause(self, _req: Any) -> Any:
+        with self.sn.lock:
+            self.unsettled.clear()  # physics runs: what was put in the air while paused lands
         self.sn.stepper.set_paused(False)
         return Empty._response_class()
+
+    def hold_world_models(self) -> None:
+        """A world loaded with physics paused (``paused:=true``): its models with physics are where
+        the file puts them until unpause_physics, as Gazebo shows them."""
+        world = self.sn.sim.world
+        with self.sn.lock:
+            self.unsettled.update(world.placed_heights)
+
+    def _hold_while_paused(self, name: str, z: float) -> None:
+        """Gazebo's physics settles nothing while paused: remember the z a model was put at."""
+        if self.sn.paused:
+            self.unsettled[name] = z
+        else:
+            self.unsettled.pop(name, None)
+
+    def _robot_level(self, model: Any, x: float, y: float, z: float) -> float:
+        """Where a robot put at height ``z`` (its root link's) lands: the highest top under its
+        centre below its body's middle (a table top it was dropped over), else the floor."""
+        bottom = z - model.rest_z
+        return self.sn.sim.ground_under(x, y, bottom + model.body_height / 2.0)
+
+    def _obstacle_landing(self, name: str) -> Any:
+        """How far a model with physics falls from where its pieces were put: onto the highest top
+        under it (the other models' pieces), else the floor (rest_height's rule)."""
+        ground = [
+            Support(o.outline, o.height)
+            for o in self.sn.sim.world.obstacles
+            if o.model_name != name and len(o.outline) > 2 and o.solid
+        ]
+
+        def land(pieces: list[Obstacle]) -> float:
+            return min(p.base - rest_height(p.outline, p.base, p.height, ground) for p in pieces)
+
+        return land
 
     def _spawn(self, req: Any) -> Any:
         resp = SpawnModel._response_class()
@@ -316,8 +368,12 @@ class GazeboApi:
             if kind == "robot":
                 namespace = req.robot_namespace.strip("/")
                 clash = any(io.prefix == "" for io in sn.io.values())
-                sn.add_robot(name, spec, x, y, yaw, clash and not namespace, namespace or None)
-                z = spec.rest_z  # it falls onto the floor (or is pushed up out of it) on its wheels
+                with sn.lock:
+                    level = self._robot_level(spec, x, y, z)
+                self._hold_while_paused(name, z)
+                sn.add_robot(name, spec, x, y, yaw, clash and not namespace, namespace or None, level)
+                # it falls onto the floor or a table top (or is pushed up out of it) on its wheels
+                z = spec.rest_z + level
             elif kind == "sdf":
                 if not spec:
                     if models:  # a ground plane: a model all the same, with nothing the floor plan holds
@@ -332,11 +388,17 @@ class GazeboApi:
                 pieces = _placed(name, spec, x, y, yaw)
                 with sn.lock:
                     sn.sim.add_model(name, pieces, yaw, (x, y))
+                self._hold_while_paused(name, z)
+                if drops:
+                    self.dynamic.add(name)
                 z -= max(drops.values(), default=0.0)  # a model with physics settles on what is under it
                 what = pieces[0].kind if len(pieces) == 1 else f"{len(pieces)} pieces"
                 sn.log.info("spawned SDF model [%s] (%s) at (%.3f, %.3f, %.3f)", name, what, x, y, z)
             else:
+                self._hold_while_paused(name, z)
                 z = self._add_urdf_shape(name, spec, x, y, z, yaw, supports)
+                if not spec.static and spec.solid:
+                    self.dynamic.add(name)
             self.heights[name] = z
             if kind != "robot":
                 self.spawned[name] = None
@@ -358,7 +420,7 @@ class GazeboApi:
             else box_outline(x, y, shape.size[0], shape.size[1], yaw)
         )
         base = z + shape.bottom
-        if not shape.static:
+        if not shape.static and shape.solid:
             c, s = math.cos(yaw), math.sin(yaw)
             dx, dy = outline[:, 0] - x, outline[:, 1] - y
             local = np.column_stack([c * dx + s * dy, -s * dx + c * dy])
@@ -368,7 +430,7 @@ class GazeboApi:
         if top <= 0.0:
             raise SpawnError(f"a static {shape.kind} at z {z:g} is under the floor")
         with self.sn.lock:
-            sim.add_outline(name, shape.kind, outline, yaw, top, shape.colour, max(base, 0.0))
+            sim.add_outline(name, shape.kind, outline, yaw, top, shape.colour, max(base, 0.0), shape.solid)
         self.sn.log.info("spawned %s [%s] at (%.3f, %.3f, %.3f)", shape.kind, name, x, y, z)
         return z
 
@@ -391,6 +453,8 @@ class GazeboApi:
         self.heights.pop(name, None)
         self.pushes.pop(name, None)
         self.spawned.pop(name, None)
+        self.unsettled.pop(name, None)
+        self.dynamic.discard(name)
         sn.log.info("deleted model [%s]", name)
         resp.success, resp.status_message = True, "DeleteModel: successfully deleted model"
         return resp
@@ -436,22 +500,29 @@ class GazeboApi:
                     return False, "SetModelState: specified reference frame entity does not exist"
                 pose = compose(ref, pose)
             x, y, z, yaw = pose
+            put_at = z
             try:
                 if name in self.bare:
                     self.bare[name] = (x, y, z, yaw)
                 elif name in sn.sim.robots:
-                    r = sn.sim.place_robot(name, x, y, yaw)
+                    model = sn.sim.robots[name].model
+                    r = sn.sim.place_robot(name, x, y, yaw, self._robot_level(model, x, y, z))
                     lin, ang = state.twist.linear, state.twist.angular
                     if all(math.isfinite(v) for v in (lin.x, lin.y, ang.z)):
                         # the twist, in the robot's own terms: forward speed and turn rate
                         forward = lin.x * math.cos(yaw) + lin.y * math.sin(yaw)
                         r.command(forward, ang.z)
                 else:
-                    sn.sim.move_obstacle(name, x, y, yaw)
+                    before = self.settled_pose(name)
+                    assert before is not None
+                    land = self._obstacle_landing(name) if name in self.dynamic else None
+                    # a static model is held where it is put; one with physics falls from there
+                    z = before[2] + sn.sim.move_obstacle(name, x, y, yaw, z - before[2], land)
             except SpawnError as exc:
                 sn.log.error("SetModelState refused: %s", exc)
                 return False, f"SetModelState: {exc}"
             self.heights[name] = z
+            self._hold_while_paused(name, put_at)
             self.pushes.pop(name, None)
         return True, "SetModelState: set model state done"
 
@@ -748,6 +819,8 @@ class UrdfShape:
     colour: tuple[int, int, int]
     bottom: float  # its collision's lowest point in the model's frame (the origin's z - height / 2)
     static: bool
+    #: False: a visual without a collision (a marker board): seen by cameras only, held where put
+    solid: bool = True
 
 
 #: a URDF shape without a colour of its own is drawn as the simulator's boxes and cylinders are
@@ -769,6 +842,7 @@ def _urdf_shape(root: ET.Element) -> UrdfShape | None:
     if found is None:
         return None
     holder, geom = found
+    solid = holder.tag == "collision"
     origin = holder.find("origin")
     xyz = (origin.get("xyz") if origin is not None else None) or "0 0 0"
     try:
@@ -807,4 +881,4 @@ def _urdf_shape(root: ET.Element) -> UrdfShape | None:
             colour = stock
         if (block.findtext("static") or "").strip().lower() in ("true", "1"):
             static = True
-    return UrdfShape(kind, size, height, colour, oz - height / 2.0, static)
+    return UrdfShape(kind, size, height, colour, oz - height / 2.0, static, solid)

@@ -57,6 +57,27 @@ STOCK: dict[str, tuple[int, int, int]] = {
     "gazebo/trunk": (100, 70, 40),
     "gazebo/leaf": (60, 120, 40),
 }
+#: the stock materials that are pictures (a texture): an SDF ``<ambient>``/``<diffuse>`` beside
+#: their script tints the picture, it does not replace it (the Building Editor writes
+#: ``<ambient>1 1 1 1</ambient>`` beside ``Gazebo/Bricks``, and Gazebo shows bricks)
+TEXTURED = frozenset(
+    {
+        "gazebo/wood",
+        "gazebo/woodfloor",
+        "gazebo/woodpallet",
+        "gazebo/bricks",
+        "gazebo/residential",
+        "gazebo/ceilingtiled",
+        "gazebo/paintedwall",
+        "gazebo/asphalt",
+        "gazebo/road",
+        "gazebo/motorway",
+        "gazebo/footway",
+        "gazebo/grass",
+        "gazebo/trunk",
+        "gazebo/leaf",
+    }
+)
 #: the glowing, emissive and see-through variants are drawn in their base colour
 _SUFFIXES = ("glow", "emissive", "transparent", "laser")
 

@@ -72,6 +72,8 @@ from ninjemys.tf2.math import quaternion_from_yaw
 Twist: Any = get_message_class("geometry_msgs/Twist")
 Float32: Any = get_message_class("std_msgs/Float32")
 Bool: Any = get_message_class("std_msgs/Bool")
+ContactsState: Any = get_message_class("gazebo_msgs/ContactsState")
+ContactState: Any = get_message_class("gazebo_msgs/ContactState")
 JointState: Any = get_message_class("sensor_msgs/JointState")
 Odometry: Any = get_message_class("nav_msgs/Odometry")
 LaserScan: Any = get_message_class("sensor_msgs/LaserScan")
@@ -124,6 +126,9 @@ class RobotIO:
     extras: list[ExtraSensor] = field(default_factory=list)
     #: the odometry message, built at the first sample and refreshed in place after that
     odom_msg: Any = None
+    #: a p3d plugin's ground truth and a bumper plugin's contacts, at their own rates (None: not asked for)
+    truth_due: Due | None = None
+    bumper_due: Due | None = None
 
     def frame(self, name: str) -> str:
         return scoped(self.frame_prefix, name)
@@ -179,7 +184,8 @@ class SimNode:
         self.view: Any = None
         self.clock_pub = node.publisher("/clock", Clock, queue_size=10)
         self.tf_pub = node.publisher("/tf", TFMessage, queue_size=100)
-        self.tf_static_pub = node.publisher("/tf_static", TFMessage, queue_size=100, latch=True)
+        #: advertised with the first static transform (a Gazebo description's come from robot_state_publisher)
+        self.tf_static_pub: Any = None
         self.gazebo = GazeboApi(self)
 
     @property
@@ -200,6 +206,7 @@ class SimNode:
         yaw: float,
         namespaced: bool,
         namespace: str | None = None,
+        elevation: float = 0.0,
     ) -> RobotIO:
         """Place a robot and create its topics (raises SpawnError when the place is taken).
 
@@ -207,7 +214,7 @@ class SimNode:
         the description names them, as Gazebo's plugins do; ``namespaced`` puts topics and frames
         under ``<name>/`` (our multi-robot worlds)."""
         with self.lock:
-            robot = self.sim.add_robot(name, model, x, y, yaw)
+            robot = self.sim.add_robot(name, model, x, y, yaw, elevation)
             if self.laser_noise is not None and model.laser is not None:
                 model.laser.noise = self.laser_noise
             if namespace:
@@ -260,10 +267,16 @@ class SimNode:
         n, model, dt, now = self.node, robot.model, self.sim.dt, self.sim.time
         drive = model.drive
         driven = drive.kind != "none"
-        pubs: dict[str, Any] = {
-            "ground_truth": n.publisher(scoped(prefix, "base_pose_ground_truth"), Odometry, queue_size=10),
-            "contact": n.publisher(scoped(prefix, "contact"), Bool, queue_size=1, latch=True),
-        }
+        pubs: dict[str, Any] = {}
+        # our PuzzleBot's ground truth and contact; a Gazebo description's only when a plugin asks
+        if model.ground_truth is not None:
+            pubs["ground_truth"] = n.publisher(
+                scoped(prefix, model.ground_truth.topic), Odometry, queue_size=10
+            )
+        if model.contact_topic is not None:
+            pubs["contact"] = n.publisher(scoped(prefix, model.contact_topic), Bool, queue_size=1, latch=True)
+        if model.bumper is not None:
+            pubs["bumper"] = n.publisher(scoped(prefix, model.bumper.topic), ContactsState, queue_size=1)
         topics = {  # what the browser view subscribes to (the camera's defaults when it has none)
             "cmd_vel": scoped(prefix, drive.command_topic),
             "color": scoped(prefix, "camera/color/image_raw"),
@@ -298,6 +311,11 @@ class SimNode:
             Due(_period(imu.rate, 100.0, dt), now) if imu else None,
             topics=topics,
         )
+        gt = model.ground_truth
+        if gt is not None and gt.rate is not None:  # a p3d plugin's own rate (ours: with the odometry)
+            io.truth_due = Due(_period(gt.rate, 0.0, dt), now)
+        if model.bumper is not None:
+            io.bumper_due = Due(_period(model.bumper.rate, 0.0, dt), now)
         for i, spec in enumerate(model.extra_lasers):
             scan_pub = n.publisher(scoped(prefix, spec.topic), LaserScan, queue_size=10)
             io.extras.append(
@@ -343,15 +361,44 @@ class SimNode:
         io.close()
 
     def _publish_static(self) -> None:
-        """/tf_static is latched: one message holds every robot's static transforms."""
-        self.tf_static_pub.publish(
-            TFMessage(transforms=[t for io in self.io.values() for t in io.static_tfs])
-        )
+        """/tf_static is latched: one message holds every robot's static transforms. Gazebo publishes
+        none, so with only Gazebo descriptions it is not even advertised."""
+        transforms = [t for io in self.io.values() for t in io.static_tfs]
+        if self.tf_static_pub is None:
+            if not transforms:
+                return
+            self.tf_static_pub = self.node.publisher("/tf_static", TFMessage, queue_size=100, latch=True)
+        self.tf_static_pub.publish(TFMessage(transforms=transforms))
 
     def _publish_contact(self, io: RobotIO) -> None:
-        if io.last_contact != io.robot.contact:
+        pub = io.pubs.get("contact")
+        if pub is not None and io.last_contact != io.robot.contact:
             io.last_contact = io.robot.contact
-            io.pubs["contact"].publish(Bool(data=io.robot.contact))
+            pub.publish(Bool(data=io.robot.contact))
+
+    def _ground_truth(self, io: RobotIO, stamp: Time) -> None:
+        """The true pose: ours in ``map`` (Stage's way), a p3d plugin's in its frameName, for its bodyName."""
+        pub, spec, r = io.pubs.get("ground_truth"), io.robot.model.ground_truth, io.robot
+        if pub is None or spec is None or not pub.get_num_connections():
+            return
+        own = r.model.sensor_tf  # our own description: frames under the robot's prefix
+        frame, body = (WORLD_FRAME, io.frame(spec.body)) if own else (spec.frame, spec.body)
+        pub.publish(messages.odometry(stamp, frame, body, (r.x, r.y, r.yaw), (r.v, r.w)))
+
+    def _bumper(self, io: RobotIO, stamp: Time) -> None:
+        """gazebo_ros_bumper: every update, the contacts of the watched collision (none: an empty list)."""
+        pub, spec, r = io.pubs.get("bumper"), io.robot.model.bumper, io.robot
+        if pub is None or spec is None or not pub.get_num_connections():
+            return
+        msg = ContactsState()
+        msg.header.stamp, msg.header.frame_id = stamp, spec.frame
+        if r.contact:
+            state = ContactState()
+            state.info = f"Debug:  i:(0/1)     my geom:{spec.collision}   other geom:{r.contact_with}"
+            state.collision1_name = f"{r.name}::{spec.collision}"
+            state.collision2_name = r.contact_with
+            msg.states.append(state)
+        pub.publish(msg)
 
     def _on_cmd_vel(self, msg: Any, name: str) -> None:
         """Runs on the subscriber's thread without the simulation lock (a command is one atomic
@@ -434,6 +481,10 @@ class SimNode:
             pubs = io.pubs
             if io.odom_due is not None and io.odom_due.fire(now):
                 self._odometry(io, stamp, tfs)
+            if io.truth_due is not None and io.truth_due.fire(now):
+                self._ground_truth(io, stamp)
+            if io.bumper_due is not None and io.bumper_due.fire(now):
+                self._bumper(io, stamp)
             imu, imu_spec = pubs.get("imu"), r.model.imu
             if io.imu_due is not None and io.imu_due.fire(now) and imu is not None and imu_spec is not None:
                 if imu.get_num_connections():
@@ -497,10 +548,8 @@ class SimNode:
             else:
                 messages.odometry_into(io.odom_msg, stamp, pose, (r.v, r.w))
             odom.publish(io.odom_msg)
-        if pubs["ground_truth"].get_num_connections():
-            pubs["ground_truth"].publish(
-                messages.odometry(stamp, WORLD_FRAME, io.frame("base_link"), (r.x, r.y, r.yaw), (r.v, r.w))
-            )
+        if io.truth_due is None:
+            self._ground_truth(io, stamp)
         wl, wr = pubs.get("wl"), pubs.get("wr")
         if wl is not None and wl.get_num_connections():
             wl.publish(Float32(data=r.wl))
@@ -796,6 +845,7 @@ def main(argv: list[str] | None = None, view: ViewStarter | None = None) -> int:
         gui = _param(node, log, "gui", True, bool) and not options.headless
         if _param(node, log, "paused", False, bool):
             app.stepper.paused = True  # Gazebo's -u: physics waits for unpause_physics
+            app.gazebo.hold_world_models()  # nothing has fallen yet
             log.info("physics paused (call /gazebo/unpause_physics to start)")
         app.start()  # the physics and the sensors first: the view's server starts beside them
         try:

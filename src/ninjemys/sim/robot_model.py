@@ -71,6 +71,29 @@ class ImuSpec:
 
 
 @dataclass
+class GroundTruthSpec:
+    """The true pose as nav_msgs/Odometry: our PuzzleBot's ``base_pose_ground_truth`` (Stage's name),
+    or what a description's ``libgazebo_ros_p3d.so`` asks for (topicName, frameName, bodyName,
+    updateRate; 0: every physics step, as the plugin does)."""
+
+    topic: str = "base_pose_ground_truth"
+    frame: str = "map"  # header.frame_id (p3d's frameName, "world" by default there)
+    body: str = "base_link"  # child_frame_id (p3d's bodyName)
+    rate: float | None = None  # Hz; None: the odometry's rate; 0: every physics step
+
+
+@dataclass
+class BumperSpec:
+    """A description's ``<sensor type="contact">`` with ``libgazebo_ros_bumper.so``: what it publishes
+    (gazebo_msgs/ContactsState on bumperTopicName, stamped in frameName) and for which collision."""
+
+    topic: str = "bumper_states"
+    frame: str = "world"
+    collision: str = ""  # the sensor's <contact><collision>, as Gazebo scopes it: model::link::collision
+    rate: float = 0.0  # Hz; 0: every physics step
+
+
+@dataclass
 class DriveSpec:
     """How the robot is driven and what its drive publishes: our PuzzleBot's defaults, or what a
     description's drive plugin (gazebo_ros_diff_drive, ros_control's DiffDriveController...) says."""
@@ -139,6 +162,12 @@ class RobotModel:
     #: stands on it: Gazebo's model pose z once the robot has fallen or been pushed onto the floor
     #: (a root link at the wheels' axles stands at the wheel radius), whatever z it was spawned at
     rest_z: float = 0.0
+    #: what the simulator publishes beyond the drive and sensors: our PuzzleBot's ground truth and
+    #: ``contact`` (std_msgs/Bool); a Gazebo description gets only what its plugins ask for (p3d,
+    #: bumper), as Gazebo publishes nothing else
+    ground_truth: GroundTruthSpec | None = field(default_factory=GroundTruthSpec)
+    contact_topic: str | None = "contact"
+    bumper: BumperSpec | None = None
 
 
 def _merge(base: dict, over: dict) -> dict:

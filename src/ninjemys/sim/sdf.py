@@ -46,7 +46,7 @@ import numpy as np
 from ninjemys.errors import PackageError
 from ninjemys.maps.mapfile import MapFileError
 from ninjemys.packages.discovery import crawl, find_package
-from ninjemys.sim.gazebo_materials import STOCK, material_block, script_colour, stock_colour
+from ninjemys.sim.gazebo_materials import STOCK, TEXTURED, material_block, script_colour, stock_colour
 from ninjemys.sim.meshes import load_mesh
 from ninjemys.sim.world2d import FloorImage, Obstacle, World
 
@@ -428,6 +428,8 @@ def _colour(link: Element, ctx: _Context, pictures: tuple[Element, ...] = ()) ->
         mat = visual.find("material")
         if mat is None:
             continue
+        script = mat.find("script")
+        picture = (script.value("name") or "").strip() if script is not None else ""
         for tag in ("diffuse", "ambient"):
             el = mat.find(tag)
             if el is not None:
@@ -437,8 +439,10 @@ def _colour(link: Element, ctx: _Context, pictures: tuple[Element, ...] = ()) ->
                 rgb = _numbers(el, len(words), "r g b a")[:3]
                 if any(v < 0 or v > 1 for v in rgb):
                     raise el.error(f"colour components are 0-1, got {el.text.strip()!r}")
+                base = stock_colour(picture) if picture.lower() in TEXTURED else None
+                if base is not None:  # a stock picture (bricks, wood): the colour tints it
+                    return (round(base[0] * rgb[0]), round(base[1] * rgb[1]), round(base[2] * rgb[2]))
                 return (round(rgb[0] * 255), round(rgb[1] * 255), round(rgb[2] * 255))
-        script = mat.find("script")
         if script is not None:
             name = (script.value("name") or "").strip()
             colour = stock_colour(name)
@@ -705,6 +709,9 @@ class _Solid:
     footprint: Footprint
     colour: tuple[int, int, int]
     static: bool = False  # its model is static: it stays where it is put
+    #: a visual of a link with no collision (an ArUco board): seen by cameras only; it neither falls
+    #: nor holds anything up here (Gazebo's would fall through the floor unless static, as they are)
+    visual: bool = False
 
 
 #: a piece lands on a support whose top is below its middle (a box spawned a little into a table
@@ -777,11 +784,11 @@ def _settle(
     the floor are dropped. ``drops`` receives how far each model fell (negative: pushed up)."""
     ground: list[Support] = list(supports or [])
     for s in solids:
-        if s.static and s.footprint.top > MIN_TOP:
+        if s.static and not s.visual and s.footprint.top > MIN_TOP:
             ground.append(Support(s.footprint.outline, s.footprint.top))
     models: dict[str, list[_Solid]] = {}
     for s in solids:
-        if not s.static:
+        if not s.static and not s.visual:
             models.setdefault(s.path[0], []).append(s)
     fallen: dict[str, float] = {}
     for name, pieces in sorted(models.items(), key=lambda kv: min(p.footprint.bottom for p in kv[1])):
@@ -797,7 +804,7 @@ def _settle(
     kept = []
     for s in solids:
         fp = s.footprint
-        drop = fallen.get(s.path[0], 0.0) if not s.static else 0.0
+        drop = fallen.get(s.path[0], 0.0) if not (s.static or s.visual) else 0.0
         fp.top, fp.bottom = fp.top - drop, max(fp.bottom - drop, 0.0)
         if fp.top > MIN_TOP and len(fp.outline) >= 2:
             kept.append(s)
@@ -871,6 +878,15 @@ def _link(
             ctx.skip(f"<sensor type='{child.attrib.get('type', '?')}'> in a world model", child)
         elif child.tag != "visual" and child.tag not in _QUIET_LINK:
             ctx.skip(f"<{child.tag}> in a link", child)
+    if el.find("collision") is None:
+        # nothing to collide with: its visuals are for cameras only (a fiducial marker, a tag board)
+        for visual in el.findall("visual"):
+            geom = visual.find("geometry")
+            if geom is None or any(visual is p for p in pictures):
+                continue
+            vname = visual.attrib.get("name", "visual")
+            for fp in _geometry(geom, m @ _pose(visual, ctx), ctx):
+                out.append(_Solid([*scope, name, vname], fp, colour, static, visual=True))
 
 
 def _include(
@@ -962,6 +978,8 @@ def parse_sdf_world(
     world.model_poses = dict(ctx.origins)
     world.model_heights = {name: z - drops.get(name, 0.0) for name, z in ctx.heights.items()}
     world.bare_models = [name for name in ctx.origins if name not in kept]
+    world.dynamic_models = list(drops)  # models with physics: a set_model_state re-drops them
+    world.placed_heights = {name: ctx.heights[name] for name in drops if name in ctx.heights}
     world.floor_images = ctx.floor_images
     _report(ctx, source, warn)
     return world
@@ -1045,6 +1063,15 @@ def _obstacles(solids: list[_Solid]) -> list[Obstacle]:
             name = f"{name}#{n}"
         fp = s.footprint
         obstacles.append(
-            Obstacle(name, fp.kind, fp.outline, fp.top, s.colour, fp.bottom, "" if single else s.path[0])
+            Obstacle(
+                name,
+                fp.kind,
+                fp.outline,
+                fp.top,
+                s.colour,
+                fp.bottom,
+                "" if single else s.path[0],
+                solid=not s.visual,
+            )
         )
     return obstacles

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -27,6 +28,8 @@ from ninjemys.sim.sensors import FloorPaint, Scene, imu_reading, lidar_ranges
 from ninjemys.sim.world2d import MovingObstacle, Obstacle, World, box_outline, circle_outline
 
 TRAIL_LENGTH = 2000
+#: m: a piece whose top is at most this far above a robot's feet is under it (what it stands on)
+STANDS_ON = 1e-3
 PERSONAL_SPACE = 0.2  # m: the gap a person who gives way keeps from a robot's body
 LOOK_AHEAD = 2.0  # m: how far ahead on its route such a person starts to step aside
 #: a robot is spawned when its body circle overlaps something by less than this share of its radius
@@ -100,6 +103,10 @@ class Robot:
     spawn_overlap: tuple[str, float] | None = None
     camera: Camera | None = None
     extra_cameras: list[Camera] = field(default_factory=list)  # for model.extra_cameras, in order
+    #: the height of what it stands on (0: the floor; 0.75: a table top it was spawned over): its
+    #: body spans [elevation, elevation + body_height] and its sensors ride that much higher
+    elevation: float = 0.0
+    start_elevation: float = 0.0  # where reset_world puts it back
 
     def command(self, linear: float, angular: float) -> None:
         """Set the body velocity to reach (cmd_vel): wheel targets, scaled together to the speed limit."""
@@ -203,6 +210,11 @@ class Simulation:
         self._static_facing = np.concatenate(facing).astype(np.int8)
         self._static_owner = np.concatenate(owners).astype(np.intp)
         self.static_names = names
+        # visuals without collision (ArUco boards): drawn by the camera, passed through by all else
+        solid = np.ones(len(self._static), dtype=bool)
+        solid[: len(w.seg_owner)] = [w.obstacles[i].solid for i in w.seg_owner]
+        self._static_solid = solid
+        self._any_visual = not bool(solid.all())
         for r in self.robots.values():
             r.free = None  # the static world changed
         st = self._static
@@ -281,22 +293,25 @@ class Simulation:
                 near_names += names[i]
         return (np.vstack(segs) if segs else self._static[:0]), near_names
 
-    def scene(self, exclude: str | None = None) -> Scene:
-        """Everything solid now, as seen by robot ``exclude`` (its own body left out)."""
+    def scene(self, exclude: str | None = None, solid_only: bool = False) -> Scene:
+        """Everything seen now by robot ``exclude`` (its own body left out): by a camera, or with
+        ``solid_only`` by a lidar (visuals without collision left out)."""
         ms, mh, mc, _ = self._mover_segments()
-        segs = np.vstack([self._static, ms]) if len(ms) else self._static
-        heights = np.concatenate([self._static_height, mh]) if len(ms) else self._static_height
-        colours = np.vstack([self._static_color, mc]) if len(ms) else self._static_color
+        static, s_height, s_color = self._static, self._static_height, self._static_color
+        s_base, s_facing, s_owner = self._static_base, self._static_facing, self._static_owner
+        if solid_only and self._any_visual:
+            keep = self._static_solid
+            static, s_height, s_color = static[keep], s_height[keep], s_color[keep]
+            s_base, s_facing, s_owner = s_base[keep], s_facing[keep], s_owner[keep]
+        segs = np.vstack([static, ms]) if len(ms) else static
+        heights = np.concatenate([s_height, mh]) if len(ms) else s_height
+        colours = np.vstack([s_color, mc]) if len(ms) else s_color
         bases = None
         if self._any_base:
-            bases = np.concatenate([self._static_base, np.zeros(len(ms))]) if len(ms) else self._static_base
+            bases = np.concatenate([s_base, np.zeros(len(ms))]) if len(ms) else s_base
         # a moving obstacle may walk over a robot (the camera inside it sees its inside): both sides
-        facing = (
-            np.concatenate([self._static_facing, np.zeros(len(ms), dtype=np.int8)])
-            if len(ms)
-            else self._static_facing
-        )
-        owners = np.concatenate([self._static_owner, np.full(len(ms), -1)]) if len(ms) else self._static_owner
+        facing = np.concatenate([s_facing, np.zeros(len(ms), dtype=np.int8)]) if len(ms) else s_facing
+        owners = np.concatenate([s_owner, np.full(len(ms), -1)]) if len(ms) else s_owner
         others = [r for r in self.robots.values() if r.name != exclude]
         return Scene(
             segs,
@@ -313,12 +328,16 @@ class Simulation:
         )
 
     def clearance(
-        self, x: float, y: float, exclude: str | None = None, height: float = math.inf
+        self, x: float, y: float, exclude: str | None = None, height: float = math.inf, above: float = 0.0
     ) -> tuple[float, str]:
         """Distance from a point to the nearest solid thing lower than ``height`` (what a body that
-        tall meets: it passes under a table top held higher), and its name."""
+        tall meets: it passes under a table top held higher) and higher than ``above`` (a body
+        standing on a table top is over it), and its name."""
         d, name = self._clearances(
-            np.array([x]), np.array([y]), exclude, self._collision_geometry(x, y, 1e9, exclude, height=height)
+            np.array([x]),
+            np.array([y]),
+            exclude,
+            self._collision_geometry(x, y, 1e9, exclude, height=height, above=above),
         )
         return float(d[0]), name[0]
 
@@ -330,15 +349,18 @@ class Simulation:
         exclude: str | None,
         static: bool = True,
         height: float | None = None,
+        above: float | None = None,
     ) -> tuple:
         """Segments (with names) and other robots' circles within ``reach`` of (x, y); ``static=False``
         leaves the static world out (only what moves: moving obstacles and robots). Static pieces
         held at or above ``height`` (default: robot ``exclude``'s body height) are passed under."""
+        robot = self.robots.get(exclude) if exclude is not None else None
         if height is None:
-            robot = self.robots.get(exclude) if exclude is not None else None
-            height = robot.model.body_height if robot is not None else math.inf
+            height = robot.elevation + robot.model.body_height if robot is not None else math.inf
+        if above is None:
+            above = robot.elevation if robot is not None else 0.0
         if static:
-            near = self._static_near(x, y, reach, height)
+            near = self._static_near(x, y, reach, height, above)
             segs = self._static[near]
             names = [self.static_names[i] for i in near]
         else:
@@ -352,9 +374,12 @@ class Simulation:
         radii = np.array([r.model.body_radius for r in others])
         return segs, names, centres, radii, [r.name for r in others]
 
-    def _static_near(self, x: float, y: float, reach: float, below: float = math.inf) -> np.ndarray:
+    def _static_near(
+        self, x: float, y: float, reach: float, below: float = math.inf, above: float = 0.0
+    ) -> np.ndarray:
         """Indices of the static segments whose bounding box comes within ``reach`` of (x, y), of
-        the pieces starting lower than ``below`` (a body that tall passes under the others)."""
+        the pieces starting lower than ``below`` (a body that tall passes under the others) and
+        reaching higher than ``above`` (a body standing on a table top passes over what is lower)."""
         mask = (
             (self._static_lo[:, 0] <= x + reach)
             & (self._static_hi[:, 0] >= x - reach)
@@ -363,6 +388,10 @@ class Simulation:
         )
         if self._any_base and below != math.inf:
             mask &= self._static_base < below
+        if above > 0.0:
+            mask &= self._static_height > above + STANDS_ON
+        if self._any_visual:
+            mask &= self._static_solid
         return np.flatnonzero(mask)
 
     def _static_free(self, r: Robot, x: float, y: float) -> bool:
@@ -378,7 +407,9 @@ class Simulation:
         ):
             return True  # both ends in the disk: so is the straight move between them (a disk is convex)
         reach = 2.0
-        segs = self._static[self._static_near(r.x, r.y, reach, r.model.body_height)]
+        segs = self._static[
+            self._static_near(r.x, r.y, reach, r.elevation + r.model.body_height, r.elevation)
+        ]
         near = point_segment_distance(np.array([r.x]), np.array([r.y]), segs)
         clear = min(float(near.min()) if near.size else reach, reach)
         r.free = (r.x, r.y, clear)
@@ -409,10 +440,13 @@ class Simulation:
         return best, who
 
     # -- robots and obstacles -------------------------------------------------------------------
-    def solid_at(self, x: float, y: float, height: float = math.inf) -> str:
+    def solid_at(self, x: float, y: float, height: float = math.inf, above: float = 0.0) -> str:
         """The name of the solid thing covering point (x, y), or "" (inside a box, a thick wall, a map
-        cell); pieces held at or above ``height`` (a table top over a lower robot) do not count."""
+        cell); pieces held at or above ``height`` (a table top over a lower robot) and pieces no
+        higher than ``above`` (the table top a robot stands on) do not count."""
         for o in self.world.obstacles:
+            if not o.solid or (above > 0.0 and o.height <= above + STANDS_ON):
+                continue
             if o.base < height and len(o.outline) > 2 and _inside(x, y, o.outline):
                 return o.name
         for m in self.world.moving:
@@ -426,14 +460,17 @@ class Simulation:
                 return "map"
         return ""
 
-    def add_robot(self, name: str, model: RobotModel, x: float, y: float, yaw: float) -> Robot:
-        """Place a robot; refused (SpawnError) when the name is taken or the body would overlap anything."""
+    def add_robot(
+        self, name: str, model: RobotModel, x: float, y: float, yaw: float, elevation: float = 0.0
+    ) -> Robot:
+        """Place a robot (standing ``elevation`` above the floor: on a table top); refused
+        (SpawnError) when the name is taken or the body would overlap anything."""
         if name in self.robots:
             raise SpawnError(f"a robot named [{name}] already exists")
-        if not all(math.isfinite(v) for v in (x, y, yaw)):
+        if not all(math.isfinite(v) for v in (x, y, yaw, elevation)):
             raise SpawnError(f"spawn pose of [{name}] is not finite: ({x}, {y}, {yaw})")
-        gap, what = self.clearance(x, y, height=model.body_height)
-        solid = self.solid_at(x, y, model.body_height)
+        gap, what = self.clearance(x, y, height=elevation + model.body_height, above=elevation)
+        solid = self.solid_at(x, y, elevation + model.body_height, elevation)
         if solid:
             gap, what = 0.0, solid
         # Gazebo spawns into an overlap and its physics pushes the body out; here a body whose
@@ -450,22 +487,39 @@ class Simulation:
         if gap < model.body_radius:
             robot.spawn_overlap = (what, model.body_radius - gap)
         robot.odom_ref = (x, y, yaw)
-        if model.camera is not None:
-            robot.camera = camera_for(model.camera)
-        robot.extra_cameras = [camera_for(spec) for spec in model.extra_cameras]
+        self._mount_cameras(robot, elevation)
+        robot.start_elevation = elevation
         self.robots[name] = robot
         return robot
 
-    def place_robot(self, name: str, x: float, y: float, yaw: float) -> Robot:
-        """Teleport a robot (Gazebo's set_model_state): refused (SpawnError) when the pose is not finite
-        or the body would overlap anything; wheels and odometry keep running from the new pose."""
+    @staticmethod
+    def _mount_cameras(r: Robot, elevation: float) -> None:
+        """Stand ``r`` at ``elevation`` and build its cameras' renderers for that height (a camera's
+        floor tables depend on its height; a robot changes level only when spawned, moved or falling)."""
+        r.elevation = elevation
+        m = r.model
+        r.camera = camera_for(m.camera, elevation) if m.camera is not None else None
+        r.extra_cameras = [camera_for(spec, elevation) for spec in m.extra_cameras]
+
+    def set_elevation(self, r: Robot, elevation: float) -> None:
+        """Put ``r`` on another level (landed on a table top, fallen off it, set there)."""
+        if elevation != r.elevation:
+            self._mount_cameras(r, elevation)
+            r.free = None
+
+    def place_robot(self, name: str, x: float, y: float, yaw: float, elevation: float | None = None) -> Robot:
+        """Teleport a robot (Gazebo's set_model_state), onto ``elevation`` (None: the level it is on):
+        refused (SpawnError) when the pose is not finite or the body would overlap anything; wheels
+        and odometry keep running from the new pose."""
         r = self.robots.get(name)
         if r is None:
             raise SpawnError(f"no robot named [{name}]")
         if not all(math.isfinite(v) for v in (x, y, yaw)):
             raise SpawnError(f"pose of [{name}] is not finite: ({x}, {y}, {yaw})")
-        gap, what = self.clearance(x, y, exclude=name, height=r.model.body_height)
-        solid = self.solid_at(x, y, r.model.body_height)
+        level = r.elevation if elevation is None else elevation
+        top = level + r.model.body_height
+        gap, what = self.clearance(x, y, exclude=name, height=top, above=level)
+        solid = self.solid_at(x, y, top, level)
         if solid:
             gap, what = 0.0, solid
         if gap < r.model.body_radius:
@@ -474,6 +528,7 @@ class Simulation:
                 f"(clearance {max(gap, 0.0):.3f} m, body radius {r.model.body_radius:.3f} m)"
             )
         r.x, r.y, r.yaw = x, y, wrap_angle(yaw)
+        self.set_elevation(r, level)
         r.odom_ref = (r.x, r.y, r.yaw)  # wheel odometry does not see a teleport (the wheels did not turn)
         r.free = None
         r.contact, r.contact_with = False, ""
@@ -495,10 +550,19 @@ class Simulation:
             origin = (float(outlines[:, 0].mean()), float(outlines[:, 1].mean()))
         return origin[0], origin[1], self.obstacle_yaw.get(name, 0.0)
 
-    def move_obstacle(self, name: str, x: float, y: float, yaw: float) -> None:
-        """Move a static model (all its pieces together) so its pose is (x, y), turned by ``yaw``
-        from its first pose (Gazebo's set_model_state on a model); refused when it would overlap a
-        robot."""
+    def move_obstacle(
+        self,
+        name: str,
+        x: float,
+        y: float,
+        yaw: float,
+        lift: float = 0.0,
+        land: Callable[[list[Obstacle]], float] | None = None,
+    ) -> float:
+        """Move a model (all its pieces together) so its pose is (x, y), turned by ``yaw`` from its
+        first pose and raised by ``lift`` (Gazebo's set_model_state on a model); ``land`` says how
+        far the moved pieces then fall (a model with physics). Returns the height change made;
+        refused when it would overlap a robot or end under the floor."""
         pieces = self._pieces(name)
         if not pieces:
             raise SpawnError(f"no model named [{name}]")
@@ -511,7 +575,14 @@ class Simulation:
             o = self.world.obstacles[i]
             rel = o.outline - np.array([cx, cy])
             outline = np.column_stack([c * rel[:, 0] - s * rel[:, 1] + x, s * rel[:, 0] + c * rel[:, 1] + y])
-            moved.append(replace(o, outline=outline))
+            moved.append(replace(o, outline=outline, base=o.base + lift, height=o.height + lift))
+        if land is not None:
+            drop = land(moved)
+            lift -= drop
+            moved = [replace(o, base=o.base - drop, height=o.height - drop) for o in moved]
+        if all(o.height <= 0.0 for o in moved):
+            raise SpawnError(f"cannot move [{name}] {-lift:.3f} m down: it would be under the floor")
+        moved = [replace(o, base=max(o.base, 0.0)) for o in moved]
         self._check_clear_of_robots(name, moved, "move")
         for i, o in zip(pieces, moved, strict=True):
             self.world.obstacles[i] = o
@@ -519,6 +590,7 @@ class Simulation:
         if name in self.obstacle_origin:
             self.obstacle_origin[name] = (x, y)
         self._rebuild_static()
+        return lift
 
     def remove_robot(self, name: str) -> None:
         if self.robots.pop(name, None) is None:
@@ -550,10 +622,11 @@ class Simulation:
         height: float,
         color: tuple[int, int, int],
         base: float = 0.0,
+        solid: bool = True,
     ) -> None:
-        """Add a static obstacle of any outline (world coordinates; an SDF model's footprint, spawned);
-        refused on a robot or a name clash."""
-        self.add_model(name, [Obstacle(name, kind, outline, height, color, base)], yaw)
+        """Add a static obstacle of any outline (world coordinates; an SDF model's footprint, spawned;
+        ``solid`` False: a visual only); refused on a robot or a name clash."""
+        self.add_model(name, [Obstacle(name, kind, outline, height, color, base, solid=solid)], yaw)
 
     def add_model(
         self, name: str, pieces: list[Obstacle], yaw: float, origin: tuple[float, float] | None = None
@@ -574,8 +647,12 @@ class Simulation:
         """SpawnError when a piece would overlap a robot (pieces held above the robot pass over it)."""
         for r in self.robots.values():
             for o in pieces:
-                if o.base >= r.model.body_height:
-                    continue
+                if (
+                    not o.solid
+                    or o.base >= r.elevation + r.model.body_height
+                    or o.height <= r.elevation + STANDS_ON
+                ):
+                    continue  # held above it, or under its wheels (the table top it stands on)
                 outline = o.outline
                 d = point_segment_distance(
                     np.array([r.x]), np.array([r.y]), np.hstack([outline, np.roll(outline, -1, axis=0)])
@@ -603,6 +680,7 @@ class Simulation:
         self._movers_at = None
         for r in self.robots.values():
             r.reset()
+            self.set_elevation(r, r.start_elevation)
 
     def reset_simulation(self) -> None:
         """reset_world, and simulated time back to 0 (Gazebo's reset_simulation)."""
@@ -680,10 +758,33 @@ class Simulation:
                 r.contact, r.contact_with = False, ""
         r.x, r.y = nx, ny
         r.yaw = wrap_angle(r.yaw + th)
+        if r.elevation > 0.0:
+            self._drop_if_unsupported(r)
         if not r.trail or math.hypot(r.x - r.trail[-1][0], r.y - r.trail[-1][1]) > 0.02:
             r.trail.append((round(r.x, 3), round(r.y, 3)))
             r.trail_count += 1
         return new_contact
+
+    def ground_under(self, x: float, y: float, at_most: float) -> float:
+        """The highest top at (x, y) no higher than ``at_most`` (a table top under a robot standing
+        on it, or nothing: the floor, 0): what a body's centre rests on there."""
+        best = 0.0
+        for o in self.world.obstacles:
+            if (
+                o.solid
+                and best < o.height <= at_most + STANDS_ON
+                and len(o.outline) > 2
+                and _inside(x, y, o.outline)
+            ):
+                best = o.height
+        return best
+
+    def _drop_if_unsupported(self, r: Robot) -> None:
+        """A robot whose centre left the top it stood on falls to what is under it (Gazebo's gravity;
+        a robot tipping over an edge is not modelled: its centre decides)."""
+        ground = self.ground_under(r.x, r.y, r.elevation)
+        if ground < r.elevation:
+            self.set_elevation(r, ground)
 
     def _walk(self, m: MovingObstacle, dt: float) -> None:
         """One step of a moving obstacle that gives way, as a person in a corridor does.
@@ -793,10 +894,10 @@ class Simulation:
         lx, ly = self.sensor_pose(r, spec.pose.xyz)
         angle_min, _angle_max, inc = scan_angles(spec)
         return lidar_ranges(
-            scene or self.scene(r.name),
+            scene or self.scene(r.name, solid_only=True),
             lx,
             ly,
-            spec.pose.xyz[2],
+            spec.pose.xyz[2] + r.elevation,
             r.yaw + spec.pose.rpy[2],
             angle_min,
             inc,
@@ -833,9 +934,10 @@ class Simulation:
         return imu_reading(r.yaw, r.v, r.w, r.v_prev, self.dt, spec.gyro_noise, spec.accel_noise, r.rng)
 
 
-def camera_for(spec: CameraSpec) -> Camera:
-    """The renderer of a camera description (its per-row tables are built once, here)."""
-    return Camera(spec.width, spec.height, spec.hfov, spec.pose.xyz[2], spec.depth_max)
+def camera_for(spec: CameraSpec, elevation: float = 0.0) -> Camera:
+    """The renderer of a camera description on a robot standing ``elevation`` above the floor (its
+    per-row tables are built once, here)."""
+    return Camera(spec.width, spec.height, spec.hfov, spec.pose.xyz[2] + elevation, spec.depth_max)
 
 
 def floor_paint(world: World, resolution: float = 0.01, max_cells: int = 2000) -> FloorPaint | None:

@@ -62,6 +62,9 @@ class Obstacle:
     color: tuple[int, int, int]
     base: float = 0.0
     model: str = ""
+    #: False for a visual without a collision (an ArUco tag board, a fiducial): the camera sees it,
+    #: the lidar, the robots and falling models pass through it, as in Gazebo
+    solid: bool = True
 
     @property
     def model_name(self) -> str:
@@ -220,6 +223,10 @@ class World:
     #: an SDF world's models with nothing the floor plan holds (Gazebo's ground_plane): still models
     #: for Gazebo (listed in /gazebo/model_states, in the file's order), by name
     bare_models: list[str] = field(default_factory=list)
+    #: an SDF world's models with physics (not ``<static>``): they fall when set in the air
+    dynamic_models: list[str] = field(default_factory=list)
+    #: the heights the file puts those models at, before they fall (a world loaded paused shows them there)
+    placed_heights: dict[str, float] = field(default_factory=dict)
     #: pictures on the floor (an SDF world's textured planes): the camera sees them
     floor_images: list[FloorImage] = field(default_factory=list)
     #: counts the rebuilds: a view that drew the obstacles redraws them when it changes (a model

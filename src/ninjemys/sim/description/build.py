@@ -99,7 +99,10 @@ def model_from_description(text: str, source: str, *, robot_namespace: str | Non
         control_joints=_control_joints(doc, geo, left, right) if drive.kind == "ros_control" else {},
         mass=mass,
         inertia_z=inertia_z,
-        rest_z=-geo.ground_z() + 0.0,  # (+ 0.0: never -0.0 in model_states)
+        rest_z=-geo.ground_z() + 0.0,
+        ground_truth=cfg.ground_truth,  # Gazebo publishes what the plugins ask for, nothing more
+        contact_topic=None,
+        bumper=cfg.bumper,  # (+ 0.0: never -0.0 in model_states)
         wheel_tf_joints=(
             [geo.joints[w.joint] for w in (left, right) if w.joint in geo.joints]
             if drive.publish_wheel_tf and left is not right

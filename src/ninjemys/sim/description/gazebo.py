@@ -17,7 +17,15 @@ from ninjemys.sim.description.geometry import Geometry, Transform, compose, rpy_
 from ninjemys.sim.description.params import Reader
 from ninjemys.sim.description.xmltree import Document
 from ninjemys.sim.gazebo_materials import stock_colour
-from ninjemys.sim.robot_model import CameraSpec, DriveSpec, ImuSpec, LaserSpec, SensorPose
+from ninjemys.sim.robot_model import (
+    BumperSpec,
+    CameraSpec,
+    DriveSpec,
+    GroundTruthSpec,
+    ImuSpec,
+    LaserSpec,
+    SensorPose,
+)
 
 DIFF_DRIVE = "libgazebo_ros_diff_drive.so"
 SKID_STEER = "libgazebo_ros_skid_steer_drive.so"
@@ -28,6 +36,8 @@ KINECT = "libgazebo_ros_openni_kinect.so"
 DEPTH_CAMERA = "libgazebo_ros_depth_camera.so"  # the same depth parameters as the kinect plugin
 IMU_SENSOR = "libgazebo_ros_imu_sensor.so"
 IMU_MODEL = "libgazebo_ros_imu.so"
+P3D = "libgazebo_ros_p3d.so"
+BUMPER = "libgazebo_ros_bumper.so"
 DRIVES = (DIFF_DRIVE, SKID_STEER, ROS_CONTROL)
 
 
@@ -44,6 +54,8 @@ class GazeboConfig:
     extra_lasers: list[LaserSpec] = field(default_factory=list)
     extra_cameras: list[CameraSpec] = field(default_factory=list)
     imu: ImuSpec | None = None
+    ground_truth: GroundTruthSpec | None = None  # a p3d plugin's (Gazebo publishes none without one)
+    bumper: BumperSpec | None = None  # a contact sensor's bumper plugin
     materials: dict[str, tuple[int, int, int]] = field(default_factory=dict)
     ignored: list[str] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
@@ -192,8 +204,27 @@ def _model_plugin(
         noise = r.number("gaussianNoise", 0.0, minimum=0)
         if cfg.imu is None:
             cfg.imu = ImuSpec(pose, rate or 100.0, noise, noise, topic(ns, r.text("topicName", body)))
+    elif filename == P3D:
+        cfg.ground_truth = _p3d(doc, plugin, r, geo, label, ns_override)
     else:
         cfg.ignored.append(filename or plugin.get("name", "<plugin>"))
+
+
+def _p3d(
+    doc: Document, plugin: ET.Element, r: Reader, geo: Geometry, label: str, ns_override: str | None
+) -> GroundTruthSpec:
+    """gazebo_ros_p3d: a body's true pose on topicName (both required, as the plugin refuses to load
+    without them), stamped in frameName (``world`` by default), every updateRate-th of a second."""
+    body, name = r.text("bodyName", ""), r.text("topicName", "")
+    for tag, value in (("bodyName", body), ("topicName", name)):
+        if not value:
+            raise doc.error(plugin, f"{label}: <{tag}> is required", f"plugin/{tag}")
+    if body not in geo.links:
+        raise doc.error(plugin, f"{label}: bodyName '{body}' names no link of the robot", "plugin/bodyName")
+    ns = _namespace(r, ns_override)
+    return GroundTruthSpec(
+        topic(ns, name), frame(r.text("frameName", "world")), body, r.number("updateRate", 0.0, minimum=0)
+    )
 
 
 #: the ROS 2 plugins' names of the ROS 1 parameters, often copied into ROS 1 descriptions by mistake
@@ -364,5 +395,17 @@ def _sensor(
                 noise,
                 f"{prefix}/{p.text('topicName', '/imu_data').lstrip('/')}",
             )
+    elif kind == "contact" and filename == BUMPER:
+        collision = s.text("contact/collision", "")
+        if not collision:
+            raise doc.error(
+                sensor, f"{label}: <contact><collision> names no collision to watch", "sensor/contact"
+            )
+        cfg.bumper = BumperSpec(
+            topic(ns, p.text("bumperTopicName", "bumper_states")),
+            frame(p.text("frameName", "world")),
+            collision,
+            rate,
+        )
     else:
         cfg.ignored.append(filename or name)
