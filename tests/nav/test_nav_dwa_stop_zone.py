@@ -180,3 +180,53 @@ def test_navigation_launch_points_move_base_at_the_monitor():
     assert 'name="DWAPlannerROS/stop_zone_from"' in launch("move_base.launch").read_text()
     assert "safety_monitor" in launch("safety.launch").read_text()
     assert Path(PARAMS / "safety_params.yaml").exists()
+
+
+class FakeNode:
+    """Just what the parameter readers use: a parameter dict under full names, a log, a name."""
+
+    name = "/move_base"
+
+    def __init__(self, params: dict) -> None:
+        self.params = params
+        self.lines: list[str] = []
+        self.log = self
+
+    def get_param(self, name: str, default=None):
+        return self.params.get(self.resolve_name(name), default)
+
+    def has_param(self, name: str) -> bool:
+        return self.resolve_name(name) in self.params
+
+    def resolve_name(self, name: str) -> str:
+        return self.name + "/" + name[1:] if name.startswith("~") else name
+
+    def error(self, fmt: str, *args) -> None:
+        self.lines.append("ERROR " + fmt % args)
+
+    def warn(self, fmt: str, *args) -> None:
+        self.lines.append("WARN " + fmt % args)
+
+
+def test_move_base_reads_the_monitors_own_parameters():
+    from ninjemys.nav.move_base_node import stop_zone
+
+    monitor = {
+        "/safety_monitor/footprint": "[[-0.1, -0.1], [0.2, -0.1], [0.2, 0.1], [-0.1, 0.1]]",
+        "/safety_monitor/robot_radius": 0.11,
+        "/safety_monitor/safety_margin": 0.08,
+        "/safety_monitor/max_decel": 1.5,
+        "/safety_monitor/reaction_time": "fast",
+    }
+    node = FakeNode({"/move_base/DWAPlannerROS/stop_zone_from": "/safety_monitor", **monitor})
+    zone = stop_zone(node)
+    assert zone is not None
+    assert zone.radius == pytest.approx(math.hypot(0.2, 0.1))  # the footprint's circumscribed radius
+    assert (zone.margin, zone.max_decel, zone.reaction_time, zone.obstacle_speed) == (0.08, 1.5, 0.15, 0.0)
+    assert node.lines == [
+        "ERROR /move_base: parameter /safety_monitor/reaction_time: expected a float, got 'fast'; using 0.15"
+    ]
+    assert stop_zone(FakeNode({})) is None  # not asked for: ROS 1's move_base, no such check
+    lone = FakeNode({"/move_base/DWAPlannerROS/stop_zone_from": "/nobody"})
+    assert stop_zone(lone) == StopZone()
+    assert lone.lines and "/nobody, but it has no robot_radius" in lone.lines[0]

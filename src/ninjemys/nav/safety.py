@@ -87,16 +87,13 @@ class TwistMux:
 @dataclass(frozen=True)
 class StopZone:
     """The stop zone's parameters (the monitor's ``~robot_radius`` or ``~footprint``, ``~safety_margin``,
-    ``~max_decel``, ``~reaction_time``, ``~obstacle_speed``); ``pad`` widens the clearance for callers
-    whose points stand for cells rather than laser returns (a cell centre is up to half a cell's
-    diagonal from the return that marked it)."""
+    ``~max_decel``, ``~reaction_time``, ``~obstacle_speed``; ``steps``: points along each arc)."""
 
     radius: float = 0.12
     margin: float = 0.05
     max_decel: float = 1.0
     reaction_time: float = 0.15
     obstacle_speed: float = 0.0
-    pad: float = 0.0
     steps: int = 12
 
 
@@ -140,7 +137,7 @@ def blocked_arcs(points: np.ndarray, v: np.ndarray, w: np.ndarray, zone: StopZon
     vm, wm = v[moving], w[moving]
     decel = max(zone.max_decel, 1e-6)
     horizon = zone.reaction_time + np.abs(vm) / decel
-    clearance = zone.radius + zone.margin + zone.pad + zone.obstacle_speed * horizon
+    clearance = zone.radius + zone.margin + zone.obstacle_speed * horizon
     travel = np.abs(vm) * horizon
     d_now_all = np.hypot(points[:, 0], points[:, 1])
     near = points[d_now_all < float((clearance + travel).max())]  # no other point can come that close

@@ -90,14 +90,17 @@ def _parse_handles(value: Any, param: str, cls: type[Any]) -> tuple[list[Any], l
 
 
 def _float_param(node: Any, name: str, default: float) -> float:
+    """A float parameter by full or ``~`` name, as :func:`~ninjemys.nav.rosglue.param` reads one."""
     value = node.get_param(name, default)
     try:
-        if isinstance(value, (bool, str)):
-            raise ValueError
         return float(value)
     except (TypeError, ValueError):
         node.log.error(
-            "%s: parameter %s: expected a float, got %r; using %r", node.name, name, value, default
+            "%s: parameter %s: expected a float, got %r; using %r",
+            node.name,
+            node.resolve_name(name),
+            value,
+            default,
         )
         return default
 
