@@ -6,7 +6,9 @@ joint_state_publisher with nothing moving), only the stamps new; ``--floor`` add
 copies of ours that show where the floor is: ``receive`` takes each JointState and does nothing
 with it, ``no_fk`` does everything but compute and serialise the transforms, publishing the first
 message it made again and again; ``--compare SRC`` adds ours from another tree, two copies of each
-side interleaved, and prints their CPU ratio).
+side interleaved, and prints their CPU ratio; ``--threads``: per thread of ours and Debian's, CPU
+per received message and wake-ups (voluntary context switches) per second, to see where a message's
+CPU goes and which threads wake without work).
 
 One master (ours), one description (a chain of 20 revolute joints with odd origins and axes, and
 two fixed joints), one JointState stream at 50 Hz from this process with a new stamp every message.
@@ -62,6 +64,39 @@ def cpu_seconds(pid: int) -> float:
         return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
+def thread_stats(pid: int) -> dict[int, tuple[float, int]]:
+    """Per thread of ``pid``: (CPU seconds from schedstat, voluntary context switches so far)."""
+    stats: dict[int, tuple[float, int]] = {}
+    for task in Path(f"/proc/{pid}/task").iterdir():
+        try:
+            cpu = int((task / "schedstat").read_text().split()[0]) / 1e9
+            status = (task / "status").read_text()
+        except (OSError, ValueError, IndexError):
+            continue
+        switches = next(int(line.split()[1]) for line in status.splitlines() if line.startswith("voluntary"))
+        stats[int(task.name)] = (cpu, switches)
+    return stats
+
+
+def print_threads(
+    name: str,
+    before: dict[int, tuple[float, int]],
+    after: dict[int, tuple[float, int]],
+    wall: float,
+    received: int,
+) -> None:
+    """The --threads lines of one process: the threads that ran in the window, busiest first."""
+    rows = []
+    for tid, (cpu, switches) in after.items():
+        cpu0, switches0 = before.get(tid, (0.0, 0))
+        rows.append((cpu - cpu0, (switches - switches0) / wall, tid))
+    rows.sort(reverse=True)
+    for cpu, rate, tid in rows:
+        if cpu > 0 or rate > 0:
+            per = f"{1e6 * cpu / received:6.1f} us/msg" if received else ""
+            print(f"    {name:7s} thread {tid}: {per}, {rate:6.1f} wake-ups/s")
+
+
 #: Python run by the --floor variants before our node's main
 FLOOR_PATCHES = {
     "receive": "import ninjemys.robot.state_publisher as m; m.StatePublisher.on_raw = lambda self, raw: None",
@@ -93,6 +128,7 @@ def main() -> None:
         action="store_true",
         help="the robot at rest: the same positions in every message, only the stamps change",
     )
+    parser.add_argument("--threads", action="store_true", help="per-thread CPU per message and wake-ups")
     parser.add_argument(
         "--compare",
         metavar="SRC",
@@ -164,6 +200,10 @@ def main() -> None:
             totals = dict.fromkeys(commands, 0.0)
             for round_ in range(opts.rounds):
                 start_cpu = {name: cpu_seconds(p.pid) for name, p in procs.items()}
+                start_threads = (
+                    {name: thread_stats(p.pid) for name, p in procs.items()} if opts.threads else {}
+                )
+                sent_before = k
                 with lock:
                     start_counts = dict(counts)
                 start = time.monotonic()
@@ -180,6 +220,7 @@ def main() -> None:
                 wall = time.monotonic() - start
                 time.sleep(0.5)
                 cpu = {name: cpu_seconds(p.pid) - start_cpu[name] for name, p in procs.items()}
+                end_threads = {name: thread_stats(p.pid) for name, p in procs.items()} if opts.threads else {}
                 with lock:
                     sent = {name: counts[name] - start_counts[name] for name in procs}
                 print(
@@ -192,6 +233,8 @@ def main() -> None:
                         f"  {name:7s} CPU {100 * cpu[name] / wall:5.2f} % of a core, "
                         f"{sent[name]} transforms published{versus}"
                     )
+                for name in end_threads:
+                    print_threads(name, start_threads[name], end_threads[name], wall, k - sent_before)
                 for name in procs:
                     totals[name] += cpu[name]
                 if "debian" in cpu and cpu["debian"] > 0:

@@ -259,3 +259,24 @@ def test_publish_frequency_below_one_hertz_is_one_hertz() -> None:
     assert _publisher({"~publish_frequency": 0.0})[0].interval_ns == 1_000_000_000
     assert _publisher({"~publish_frequency": 0.25})[0].interval_ns == 1_000_000_000
     assert _publisher({"~publish_frequency": 10.0})[0].interval_ns == 100_000_000
+
+
+def test_positions_that_do_not_match_the_plan_are_reported_even_inside_the_throttle() -> None:
+    """The fast path checks the position count before the throttle (and unpacks the positions only
+    for a message it publishes): a message with fewer positions than names is reported as invalid
+    though it comes within the interval, as ROS 1 checks the sizes first; the next good message
+    after the interval is published with its own positions."""
+    fast, warnings = _publisher({})
+    fast.on_raw(_Raw(_encode(MOVING, [0.1] * len(MOVING), 10, 0)))
+    fast.on_raw(_Raw(_encode(MOVING, [0.2] * (len(MOVING) - 1), 10, 1_000_000)))
+    fast.on_raw(_Raw(_encode(MOVING, [0.3] * len(MOVING), 10, 2_000_000)))  # throttled: 2 ms after
+    fast.on_raw(_Raw(_encode(MOVING, [0.4] * len(MOVING), 10, 30_000_000)))
+    assert warnings == ["Robot state publisher ignored an invalid JointState message"]
+    general, _ = _publisher({})
+    general.on_joint_state(tuple(MOVING), (0.1,) * len(MOVING), 10, 0)
+    general.on_joint_state(tuple(MOVING), (0.4,) * len(MOVING), 10, 30_000_000)
+    assert len(fast.tf.sent) == len(general.tf.sent) == 2
+    for ours, theirs in zip(fast.tf.sent, general.tf.sent, strict=True):
+        for ta, tb in zip(_transforms(ours), _transforms(theirs), strict=True):
+            assert ta[:4] == tb[:4]
+            assert max(abs(x - y) for x, y in zip(ta[4], tb[4], strict=True)) < 1e-12

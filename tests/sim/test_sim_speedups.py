@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 from camera_reference import assert_matches_reference
 
+from ninjemys.idl.loader import get_message_class
 from ninjemys.sim import camera as sim_camera
 from ninjemys.sim.puzzlebot_node import keep_freed_memory
 from ninjemys.sim.raycast import cast_segments
@@ -234,3 +235,122 @@ def test_camera_draws_only_the_images_asked_for(world):
         assert np.array_equal(rgb, rgb_only) and np.array_equal(depth, depth_only)
         assert no_depth.size == 0 and no_rgb.size == 0
         assert rgb.shape == (240, 320, 3) and depth.shape == (240, 320)
+
+
+def _drive(sim: Simulation, name: str, steps: int) -> list[tuple[float, float, float, bool, str]]:
+    """Poses and contacts of robot ``name`` driving a fixed sequence of commands (into a wall too)."""
+    r = sim.robots[name]
+    out = []
+    for i in range(steps):
+        if i % 300 == 0:
+            r.command((0.4, 0.2, 0.0)[(i // 300) % 3], (0.0, 0.9, -0.6)[(i // 300) % 3])
+        sim.step()
+        out.append((r.x, r.y, r.yaw, r.contact, r.contact_with))
+    return out
+
+
+def test_a_step_alone_in_open_space_moves_as_the_checked_step():
+    """A robot alone in the world, in open space, skips the collision samples along its move (no
+    arrays built): it drives, turns and stops at the wall exactly as when a second robot elsewhere
+    in the world makes every step go through the full check."""
+    world = world_path("square")
+    alone = Simulation(load_world(world), 0.01, 3)
+    alone.add_robot("pb", load_robot_model("puzzlebot"), 0.0, 0.0, 0.3)
+    checked = Simulation(load_world(world), 0.01, 3)
+    checked.add_robot("pb", load_robot_model("puzzlebot"), 0.0, 0.0, 0.3)
+    checked.add_robot("far", load_robot_model("puzzlebot"), -1.2, -1.2, 0.0)  # never in reach
+    calls = {"full": 0}
+    real = checked._clearances
+
+    def counted(*args):
+        calls["full"] += 1
+        return real(*args)
+
+    checked._clearances = counted  # type: ignore[method-assign]
+    a, b = _drive(alone, "pb", 2400), _drive(checked, "pb", 2400)
+    assert a == b
+    assert any(c for *_, c, _w in a), "the drive must reach a wall"
+    assert calls["full"] >= 1000  # the checked run did check its moving steps
+
+
+#: a red board 1.5 m ahead with no collision (an ArUco tag): the camera sees it, the lidar does not
+VISUAL_BOARD_WORLD = (
+    '<sdf version="1.6"><world name="w"><model name="aruco"><static>true</static>'
+    '<pose>1.5 0 0.2 0 0 0</pose><link name="tag"><visual name="face"><geometry><box>'
+    "<size>0.02 0.4 0.4</size></box></geometry></visual></link></model></world></sdf>"
+)
+
+
+@pytest.mark.parametrize("visual", [False, True], ids=["office", "visual-only board"])
+def test_sensors_firing_in_one_step_share_its_scene(visual: bool) -> None:
+    """The lidar and the camera firing in the same step see one scene, built once for that step
+    and dropped after it (the next step's world has moved); in a world with a visual-only piece
+    the lidar gets its own scene without it (it must not see the board the camera sees)."""
+    from ninjemys.node import Node
+    from ninjemys.node.log import NodeLog
+    from ninjemys.sim.puzzlebot_node import SimNode
+    from ninjemys.sim.sdf import parse_sdf_world
+    from ninjemys.testing import run_master, wait_until
+
+    world = (
+        parse_sdf_world(VISUAL_BOARD_WORLD, "w.world", {"HOME": "/nonexistent"})
+        if visual
+        else load_world(world_path("office"))
+    )
+    with run_master() as master:
+        node = Node("scene_share_sim", master_uri=master)
+        client = Node("scene_share_client", master_uri=master)
+        try:
+            sn = SimNode(node, NodeLog(node.name), Simulation(world, 0.01), 0.0, None)
+            io = sn.add_robot("puzzlebot", load_robot_model("puzzlebot"), 0.0, 0.0, 0.0, False)
+            built: list[tuple[str | None, bool]] = []
+            scans: list[tuple[object, np.ndarray]] = []
+            renders: list[object] = []
+            real_scene, real_scan, real_render = sn.sim.scene, sn.sim.scan, sn.sim.render
+
+            def scene(exclude=None, solid_only=False):
+                built.append((exclude, solid_only))
+                return real_scene(exclude, solid_only)
+
+            def scan(r, scene=None, laser=None):
+                ranges = real_scan(r, scene, laser)
+                scans.append((scene, ranges))
+                return ranges
+
+            def render(r, scene=None, **kw):
+                renders.append(scene)
+                return real_render(r, scene, **kw)
+
+            sn.sim.scene, sn.sim.scan, sn.sim.render = scene, scan, render  # type: ignore[method-assign]
+            model = io.robot.model
+            assert model.laser is not None and model.camera is not None
+            subs = [
+                client.subscriber(
+                    "/" + model.laser.topic, get_message_class("sensor_msgs/LaserScan"), lambda _m: None
+                ),
+                client.subscriber(
+                    "/" + model.camera.image_topic, get_message_class("sensor_msgs/Image"), lambda _m: None
+                ),
+            ]
+            wait_until(
+                lambda: io.pubs["scan"].get_num_connections() and io.pubs["image"].get_num_connections(),
+                10,
+                "the subscribers",
+            )
+            io.scan_due.next = io.camera_due.next = sn.sim.time + sn.sim.dt  # both fire next step
+            sn._step_and_publish()
+            assert len(scans) == 1 and len(renders) == 1
+            (scan_scene, ranges), (render_scene,) = scans[0], renders
+            assert scan_scene is not None and render_scene is not None
+            if visual:
+                assert built == [("puzzlebot", True), ("puzzlebot", False)]
+                assert len(scan_scene.segments) < len(render_scene.segments)
+                assert float(np.min(ranges[np.isfinite(ranges)], initial=np.inf)) > 1.6  # not the board
+            else:
+                assert built == [("puzzlebot", True)] and scan_scene is render_scene
+            assert sn._scenes == {}
+            for sub in subs:
+                sub.unregister()
+        finally:
+            client.shutdown("test over")
+            node.shutdown("test over")

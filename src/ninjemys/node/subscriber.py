@@ -818,6 +818,18 @@ class Subscriber:
         frames: list[bytes | bytearray] | None = None
         bad: list[tuple[int, Exception]] | None = None
         msg: Any = None
+        # a raw handle's one callback, called without arguments (else None), while the callbacks are
+        # these (add_callback replaces the tuple) and the handle is alone on its topic
+        callbacks = self._callbacks
+        raw_solo = (
+            callbacks[0][0]
+            if self._decode is None
+            and not self.batch
+            and not self._direct
+            and len(callbacks) == 1
+            and callbacks[0][1] is None
+            else None
+        )
         while not queue and not self._closed and self._served is served:
             got = msgs = frames = bad = msg = None
             for fd, _ in poll(-1, poller.max_events):
@@ -835,6 +847,32 @@ class Subscriber:
                         or conn.reader is not self
                         or len(handles) != 1
                     ):
+                        if (
+                            fused is False
+                            and raw_solo
+                            and not conn.latching
+                            and not conn.closed
+                            and conn.reader is self
+                            and len(handles) == 1
+                            and self._callbacks is callbacks
+                        ):
+                            # a raw handle (robot_state_publisher's joint states): _read and
+                            # _deliver_batch inlined, as the fused path below is for decoded ones
+                            frames = conn.read(budget)
+                            if frames is None:
+                                self._forget(conn)
+                                continue
+                            if maxlen is not None and len(frames) > maxlen:
+                                frames = self._keep_newest(frames, 0)
+                            header = conn.header
+                            for msg in frames:
+                                if self._closed:
+                                    break
+                                try:
+                                    raw_solo(RawMessage(msg, header))
+                                except Exception:
+                                    self._callback_raised(raw_solo)
+                            continue
                         read(conn)
                         continue
                     # _read and _read_fused inlined for an unlatched stream and one handle, and

@@ -63,6 +63,7 @@ from ninjemys.sim.gazebo_api import GazeboApi, parse_model_xml
 from ninjemys.sim.gazebo_worlds import load_gazebo_world
 from ninjemys.sim.robot_model import CameraSpec, RobotModel, load_robot_model
 from ninjemys.sim.ros_control.hardware import ControlLoop
+from ninjemys.sim.sensors import Scene
 from ninjemys.sim.simcore import Robot, Simulation, SpawnError
 from ninjemys.sim.stepper import Due, StepLock, Stepper
 from ninjemys.sim.world2d import World, load_world, world_from_map
@@ -181,6 +182,9 @@ class SimNode:
         #: sim seconds between /clock messages (gazebo_ros' pub_clock_frequency; 0: every step)
         self.clock_period = 0.0
         self._last_clock: float | None = None
+        #: each robot's scene (what its sensors see) in the step being published: built once for
+        #: the lidar and the cameras firing in the same step, dropped when the step is over
+        self._scenes: dict[tuple[str, bool], Scene] = {}
         self.view: Any = None
         self.clock_pub = node.publisher("/clock", Clock, queue_size=10)
         self.tf_pub = node.publisher("/tf", TFMessage, queue_size=100)
@@ -453,7 +457,22 @@ class SimNode:
         secs, nsecs = divmod(self.sim.time_ns, 1_000_000_000)
         return Time._raw(secs, nsecs)  # wire integers, already valid: no re-validation per step
 
+    def _scene(self, r: Robot, solid_only: bool = False) -> Scene:
+        """Robot ``r``'s scene now, for a camera or (``solid_only``) a lidar, built at most once per
+        step (the lock is held all the step); one scene serves both when nothing is only drawn."""
+        key = (r.name, solid_only and self.sim.has_visuals)
+        scene = self._scenes.get(key)
+        if scene is None:
+            scene = self._scenes[key] = self.sim.scene(r.name, solid_only=solid_only)
+        return scene
+
     def _step_and_publish(self) -> None:
+        try:
+            self._publish_step()
+        finally:
+            self._scenes.clear()  # the world moves on: no scene outlives its step
+
+    def _publish_step(self) -> None:
         sim = self.sim
         self.gazebo.before_step()
         for io in self.io.values():
@@ -496,7 +515,7 @@ class SimNode:
                 if not subscribed and not (view is not None and view.wants_scans()):
                     io.scan_due.next = now  # idle: a new subscriber's first scan goes out at once
                 elif io.scan_due.fire(now):
-                    ranges = sim.scan(r)
+                    ranges = sim.scan(r, scene=self._scene(r, solid_only=True))
                     io.last_scan = ranges
                     if subscribed:
                         scan.publish(messages.laser_scan(stamp, io.frame(laser.pose.frame), laser, ranges))
@@ -588,7 +607,7 @@ class SimNode:
         if extra.kind == "laser":
             laser = model.extra_lasers[extra.index]
             if extra.pubs["scan"].get_num_connections():
-                ranges = self.sim.scan(io.robot, laser=laser)
+                ranges = self.sim.scan(io.robot, scene=self._scene(io.robot, solid_only=True), laser=laser)
                 extra.pubs["scan"].publish(
                     messages.laser_scan(stamp, io.frame(laser.pose.frame), laser, ranges)
                 )
@@ -622,7 +641,9 @@ class SimNode:
         want_colour = bool(want_raw or pubs["image_compressed"].get_num_connections())
         want_depth = bool("depth" in pubs and pubs["depth"].get_num_connections())
         if want_colour or want_depth:
-            rgb, depth = self.sim.render(r, colour=want_colour, depth=want_depth, extra=extra)
+            rgb, depth = self.sim.render(
+                r, scene=self._scene(r), colour=want_colour, depth=want_depth, extra=extra
+            )
             if want_colour:
                 img = messages.rgb_image(stamp, frame, rgb)
                 if want_raw:

@@ -38,6 +38,13 @@ SPAWN_OVERLAP = 0.5
 #: into short pieces, but sensors fire at most once a step, so a longer one would slow a 10 Hz lidar
 MAX_TIME_STEP = 0.1
 
+#: shared empty results of the collision broad phase (never written to): a step in open space, or
+#: a robot alone in the world, builds no arrays for them
+_NONE_BLOCKED = np.zeros(0, dtype=np.intp)
+_NO_CENTRES = np.zeros((0, 2))
+_NO_RADII = np.zeros(0)
+_NO_COLOURS = np.zeros((0, 3), dtype=np.uint8)
+
 
 class SpawnError(NinjemysError, ValueError):
     """A spawn or delete the simulation refuses; the text says why (shown to the service caller)."""
@@ -293,6 +300,12 @@ class Simulation:
                 near_names += names[i]
         return (np.vstack(segs) if segs else self._static[:0]), near_names
 
+    @property
+    def has_visuals(self) -> bool:
+        """Some static piece is only drawn, not solid (an ArUco board): a lidar's scene then differs
+        from a camera's (see :meth:`scene`)."""
+        return self._any_visual
+
     def scene(self, exclude: str | None = None, solid_only: bool = False) -> Scene:
         """Everything seen now by robot ``exclude`` (its own body left out): by a camera, or with
         ``solid_only`` by a lidar (visuals without collision left out)."""
@@ -313,14 +326,20 @@ class Simulation:
         facing = np.concatenate([s_facing, np.zeros(len(ms), dtype=np.int8)]) if len(ms) else s_facing
         owners = np.concatenate([s_owner, np.full(len(ms), -1)]) if len(ms) else s_owner
         others = [r for r in self.robots.values() if r.name != exclude]
+        if others:
+            circles = (
+                np.array([[r.x, r.y] for r in others]),
+                np.array([r.model.body_radius for r in others]),
+                np.array([r.model.body_height for r in others]),
+                np.array([r.model.color for r in others], dtype=np.uint8).reshape(-1, 3),
+            )
+        else:  # alone in the world: the shared empty arrays (a scene is only read)
+            circles = (_NO_CENTRES, _NO_RADII, _NO_RADII, _NO_COLOURS)
         return Scene(
             segs,
             heights,
             colours,
-            np.array([[r.x, r.y] for r in others]).reshape(-1, 2),
-            np.array([r.model.body_radius for r in others]),
-            np.array([r.model.body_height for r in others]),
-            np.array([r.model.color for r in others], dtype=np.uint8).reshape(-1, 3),
+            *circles,
             self._floor,
             facing,
             bases,
@@ -370,6 +389,8 @@ class Simulation:
             segs = np.vstack([segs, ms])
             names = names + mnames
         others = [r for r in self.robots.values() if r.name != exclude]
+        if not others:  # alone in the world (the usual case): no circles, no arrays to build
+            return segs, names, _NO_CENTRES, _NO_RADII, []
         centres = np.array([[r.x, r.y] for r in others]).reshape(-1, 2)
         radii = np.array([r.model.body_radius for r in others])
         return segs, names, centres, radii, [r.name for r in others]
@@ -730,13 +751,15 @@ class Simulation:
             radius = m.body_radius
             static = not self._static_free(r, nx, ny)
             geometry = self._collision_geometry(r.x, r.y, travel + radius + 0.05, r.name, static)
-            pieces = max(1, math.ceil(travel / (radius * 0.5)))
-            f = np.arange(0, pieces + 1) / pieces
             if len(geometry[0]) or len(geometry[2]):
+                pieces = max(1, math.ceil(travel / (radius * 0.5)))
+                f = np.arange(0, pieces + 1) / pieces
                 dist, who = self._clearances(r.x + f * ddx, r.y + f * ddy, r.name, geometry)
                 blocked = np.flatnonzero((dist[1:] < radius) & (dist[1:] < dist[0] - 1e-12))
             else:
-                blocked = np.flatnonzero(f[:0])  # nothing within reach: the move is free
+                # nothing within reach: the move is free (the common step in open space, and the
+                # cheapest: no samples along the move are made at all)
+                blocked = _NONE_BLOCKED
             if len(blocked):
                 k = int(blocked[0]) + 1
                 lo, hi = f[k - 1], f[k]
