@@ -201,6 +201,30 @@ class Probe:
         except TransformException:
             return None
 
+    def truth_at(self, t: float) -> tuple[float, float, float] | None:
+        """The ground truth at ROS time ``t`` (interpolated), or None when the log does not hold it."""
+        log = list(self.truth_log)
+        stamps = [s for s, _ in log]
+        i = bisect.bisect_left(stamps, t)
+        if i == len(log) or (i == 0 and stamps[0] != t):
+            return None
+        s1, p1 = log[i]
+        if s1 == t or i == 0:
+            return p1
+        s0, p0 = log[i - 1]
+        f = (t - s0) / (s1 - s0)
+        return (p0[0] + f * (p1[0] - p0[0]), p0[1] + f * (p1[1] - p0[1]), p1[2])
+
+    def localized_at(self, t: float) -> tuple[float, float, float] | None:
+        """The pose through TF (``map -> base_link``) at ROS time ``t``, or None."""
+        from ninjemys.nav.rosglue import tf_to_2d
+        from ninjemys.tf2.errors import TransformException
+
+        try:
+            return tf_to_2d(self.buffer.lookup("map", "base_link", int(round(t * 1e9)))[1])
+        except TransformException:
+            return None
+
     def localized_with_truth(self) -> tuple[tuple[float, float, float], tuple[float, float, float]] | None:
         """(the pose through TF at its latest stamp, the ground truth of that same stamp), or None.
 
@@ -213,18 +237,8 @@ class Probe:
             stamp_ns, tf = self.buffer.lookup("map", "base_link", 0)
         except TransformException:
             return None
-        t = stamp_ns * 1e-9
-        log = list(self.truth_log)
-        stamps = [s for s, _ in log]
-        i = bisect.bisect_left(stamps, t)
-        if i == len(log) or (i == 0 and stamps[0] != t):
-            return None  # the truth of that instant is not here (yet, or any more)
-        s1, p1 = log[i]
-        if s1 == t or i == 0:
-            return tf_to_2d(tf), p1
-        s0, p0 = log[i - 1]
-        f = (t - s0) / (s1 - s0)
-        return tf_to_2d(tf), (p0[0] + f * (p1[0] - p0[0]), p0[1] + f * (p1[1] - p0[1]), p1[2])
+        truth = self.truth_at(stamp_ns * 1e-9)
+        return None if truth is None else (tf_to_2d(tf), truth)
 
     def wait_sim(self, seconds: float, timeout: float = 120.0) -> None:
         """Sleep ``seconds`` of simulated time."""

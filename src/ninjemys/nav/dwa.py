@@ -19,6 +19,12 @@ The latch holds while the robot turns, but when the turn ends with the pose esti
 ``xy_goal_tolerance`` (amcl corrected ``map -> odom`` during the turn) the robot drives in again, to
 half the tolerance, at most ``MAX_REAPPROACHES`` times and ``REAPPROACH_CYCLES`` cycles per goal (ours; ROS 1's latched controller reports success wherever
 the estimate has gone, which in the office left the robot 0.21 m from its goal in truth).
+With a :class:`~ninjemys.nav.safety.StopZone` (the safety monitor's parameters, ``stop_zone_from`` in
+move_base) and the newest laser returns, the arcs the monitor would refuse are dropped as well, by the
+monitor's own test on the monitor's own data (ours: in ROS 1 the planner's checks are move_base's only
+brake). Without it the planner chose arcs past corners at the inscribed radius (0.16 m) that the
+monitor, keeping 0.3-0.36 m, refused: it cut the linear speed cycle after cycle, the robot turned on
+the spot, and move_base saw an oscillation and ran its recoveries.
 Everything for one cycle is a handful of numpy operations over all samples at once.
 """
 
@@ -30,6 +36,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from ninjemys.nav.costmap import INSCRIBED, NO_INFORMATION, Costmap
+from ninjemys.nav.safety import StopZone, blocked_arcs, judged_speed
 from ninjemys.tf2.math import angle_diff
 
 #: within this many xy_goal_tolerance of the goal, a standing robot with no safe arc ends the approach:
@@ -114,8 +121,13 @@ class Command:
 class DWAPlanner:
     """Holds the plan and the latched goal state; :meth:`compute` runs one cycle."""
 
-    def __init__(self, params: DWAParams | None = None) -> None:
+    def __init__(self, params: DWAParams | None = None, stop_zone: StopZone | None = None) -> None:
         self.params = params or DWAParams()
+        #: the safety monitor's stop zone: arcs it would refuse are no candidates (None: no such check)
+        self.stop_zone = stop_zone
+        #: the newest laser returns in the robot's frame (n, 2), the monitor's data (set per scan by the
+        #: node; None: none yet, and the monitor, with none either, refuses nothing)
+        self.stop_points: np.ndarray | None = None
         self.plan = np.zeros((0, 3))
         self.xy_latched = False
         self.reapproaches = 0  # drives back in after the final turn found the estimate out of tolerance
@@ -317,6 +329,8 @@ class DWAPlanner:
         )
         occ = cost.max(axis=1)
         valid = occ < INSCRIBED
+        if self.stop_zone is not None:
+            valid &= ~self._refused(v0, V, Wv, valid)
         if not valid.any():
             return Command(0.0, 0.0, valid=False)
         # distance maps over the local costmap: to the plan's cells and to the local goal
@@ -345,6 +359,16 @@ class DWAPlanner:
         total = np.where(valid, total, np.inf)
         best = int(np.argmin(total))
         return Command(float(V[best]), float(Wv[best]))
+
+    def _refused(self, v0: float, V: np.ndarray, W: np.ndarray, valid: np.ndarray) -> np.ndarray:
+        """Which samples the safety monitor would refuse: its stop-zone test, at the speed it judges
+        each command at, on the laser returns it judges them on (``stop_points``; none yet: none)."""
+        out = np.zeros(V.shape, dtype=bool)
+        check = valid & (V != 0.0)
+        if self.stop_zone is None or self.stop_points is None or not check.any():
+            return out
+        out[check] = blocked_arcs(self.stop_points, judged_speed(V[check], v0), W[check], self.stop_zone)
+        return out
 
     def _local_plan(self, cm: Costmap) -> np.ndarray:
         """The plan's points (m, 2) inside the local costmap, up to where it first leaves it."""

@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from ninjemys.actionlib import states
-from ninjemys.errors import ShutdownError
+from ninjemys.errors import NinjemysError, ShutdownError
 from ninjemys.nav.costmap import INSCRIBED
 from ninjemys.nav.costmap_ros import CostmapROS
 from ninjemys.nav.dwa import DWAParams, DWAPlanner
@@ -65,6 +65,8 @@ from ninjemys.nav.rosglue import (
     run_core_node,
     scan_arrays,
 )
+from ninjemys.nav.safety import StopZone, scan_points
+from ninjemys.nav.safety_node import read_stop_zone
 from ninjemys.node.log import WARN
 from ninjemys.tf2.math import se2_compose
 
@@ -147,6 +149,27 @@ def dwa_params(node: Any) -> DWAParams:
     return p
 
 
+def stop_zone(node: Any) -> StopZone | None:
+    """The safety monitor's stop zone for the local planner, from the monitor's own parameters
+    (``~DWAPlannerROS/stop_zone_from``: its namespace, e.g. ``/safety_monitor``; empty: no check, as in
+    ROS 1). One set of numbers for both: a planner laxer than the monitor has its arcs refused."""
+    ns = str(param(node, "DWAPlannerROS/stop_zone_from", "")).strip()
+    if not ns:
+        return None
+    try:
+        prefix = node.resolve_name(ns).rstrip("/") + "/"
+    except NinjemysError as exc:
+        node.log.error("move_base: ~DWAPlannerROS/stop_zone_from: %s; no stop-zone check", exc)
+        return None
+    if not any(node.has_param(prefix + key) for key in ("robot_radius", "footprint", "safety_margin")):
+        node.log.warn(
+            "move_base: ~DWAPlannerROS/stop_zone_from is %s, but it has no robot_radius, footprint or "
+            "safety_margin: the planner keeps the default stop zone of the monitor",
+            prefix.rstrip("/"),
+        )
+    return read_stop_zone(node, prefix)
+
+
 class MoveBase:
     """The node: costmaps, planners, the control loop and the action server."""
 
@@ -167,7 +190,8 @@ class MoveBase:
         self.goal_tolerance = param(node, f"{planner_ns}/default_tolerance", 0.0)
         self.global_cm = CostmapROS(node, "~global_costmap")
         self.local_cm = CostmapROS(node, "~local_costmap")
-        self.dwa = DWAPlanner(dwa_params(node))
+        self.dwa = DWAPlanner(dwa_params(node), stop_zone(node))
+        self._stop_points: dict[str, np.ndarray] = {}  # per scan topic, robot frame (the planner's stop zone)
         self.tf = Tf2D(node)
         self.odom = (0.0, 0.0, 0.0)  # the newest odometry: v, w and its stamp (0: none yet)
         self.fsm = MoveBaseFsm(
@@ -293,11 +317,23 @@ class MoveBase:
         costmap keeps the newest scan of each source for its next update (ROS 1's observation buffer
         with ``observation_persistence`` 0), so it costs per its update_frequency, not per scan."""
         topic, cms = source
+        if self.dwa.stop_zone is not None and self.local_cm in cms:
+            self._stop_scan(topic, scan)
         for cm in cms:
             if cm.costmap.params.rolling_window:
                 self._apply_scan(cm, scan)
             else:
                 cm.observations[topic] = scan
+
+    def _stop_scan(self, topic: str, scan: Any) -> None:
+        """The scan's returns in the robot's frame, for the planner's stop-zone check: the points the
+        safety monitor judges the command on, read as it reads them (newest scan, latest transform)."""
+        ranges, angles = scan_arrays(scan)
+        base = self.local_cm.robot_base_frame
+        sensor = self.tf.lookup(base, scan.header.frame_id or base, 0.0) or (0.0, 0.0, 0.0)
+        self._stop_points[topic] = scan_points(ranges, angles, scan.range_min, scan.range_max, sensor)
+        points = list(self._stop_points.values())
+        self.dwa.stop_points = points[0] if len(points) == 1 else np.concatenate(points)
 
     def _apply_scan(self, cm: CostmapROS, scan: Any) -> None:
         """Raytrace and mark one scan (move_base's lock not held while the sensor's pose arrives)."""

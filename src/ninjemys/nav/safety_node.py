@@ -41,7 +41,16 @@ import yaml
 from ninjemys.errors import ShutdownError
 from ninjemys.nav.costmap import footprint_radii, parse_footprint
 from ninjemys.nav.rosglue import Tf2D, node_sleep, param, run_core_node, scan_arrays
-from ninjemys.nav.safety import NEVER, MuxInput, MuxLock, TwistMux, blocked
+from ninjemys.nav.safety import (
+    NEVER,
+    MuxInput,
+    MuxLock,
+    StopZone,
+    TwistMux,
+    blocked_arcs,
+    judged_speed,
+    scan_points,
+)
 from ninjemys.node.log import ERROR, WARN
 from ninjemys.node.timers import TimeMovedBackwardsError
 
@@ -80,6 +89,45 @@ def _parse_handles(value: Any, param: str, cls: type[Any]) -> tuple[list[Any], l
     return handles, errors
 
 
+def _float_param(node: Any, name: str, default: float) -> float:
+    """A float parameter by full or ``~`` name, as :func:`~ninjemys.nav.rosglue.param` reads one."""
+    value = node.get_param(name, default)
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        node.log.error(
+            "%s: parameter %s: expected a float, got %r; using %r",
+            node.name,
+            node.resolve_name(name),
+            value,
+            default,
+        )
+        return default
+
+
+def read_stop_zone(node: Any, prefix: str) -> StopZone:
+    """The stop zone from the parameters under ``prefix`` (``~`` for the monitor itself, the monitor's
+    namespace for move_base's planner, so the two read one set): ``robot_radius`` or the circumscribed
+    radius of ``footprint``, ``safety_margin``, ``max_decel``, ``reaction_time``, ``obstacle_speed``."""
+    radius = _float_param(node, prefix + "robot_radius", 0.12)
+    fp = node.get_param(prefix + "footprint", None)
+    if fp:
+        try:
+            radius = footprint_radii(parse_footprint(fp), radius)[1]
+        except (ValueError, TypeError, yaml.YAMLError) as exc:
+            reason = " ".join(str(exc).split())  # a YAML error spans lines: one line here
+            node.log.error(
+                "%s: %sfootprint: %s; using robot_radius %.3f", node.name.lstrip("/"), prefix, reason, radius
+            )
+    return StopZone(
+        radius=radius,
+        margin=_float_param(node, prefix + "safety_margin", 0.05),
+        max_decel=_float_param(node, prefix + "max_decel", 1.0),
+        reaction_time=_float_param(node, prefix + "reaction_time", 0.15),
+        obstacle_speed=_float_param(node, prefix + "obstacle_speed", 0.0),
+    )
+
+
 def parse_topics(value: Any) -> tuple[list[MuxInput], list[str]]:
     """twist_mux's ``topics`` parameter -> inputs, and error lines."""
     return _parse_handles(value, "topics", MuxInput)
@@ -115,19 +163,7 @@ class SafetyMonitor:
                     inp.name,
                     node.resolve_name(inp.topic),
                 )
-        radius = param(node, "robot_radius", 0.12)
-        fp = node.get_param("~footprint", None)
-        if fp:
-            try:
-                radius = footprint_radii(parse_footprint(fp), radius)[1]
-            except (ValueError, TypeError, yaml.YAMLError) as exc:
-                reason = " ".join(str(exc).split())  # a YAML error spans lines: one line here
-                self.node.log.error("safety_monitor: ~footprint: %s; using robot_radius %.3f", reason, radius)
-        self.radius = radius
-        self.margin = param(node, "safety_margin", 0.05)
-        self.max_decel = param(node, "max_decel", 1.0)
-        self.reaction = param(node, "reaction_time", 0.15)
-        self.obstacle_speed = param(node, "obstacle_speed", 0.0)
+        self.zone = read_stop_zone(node, "~")
         self.scan_timeout = param(node, "scan_timeout", 1.0)
         self.max_cov = param(node, "max_position_covariance", 0.5)
         self.loc_inputs = self._input_names(node.get_param("~localization_inputs", ["navigation"]))
@@ -206,15 +242,14 @@ class SafetyMonitor:
 
     def on_scan(self, scan: Any) -> None:
         ranges, angles = scan_arrays(scan)
-        # REP 117: -inf is "closer than range_min": something is right at the robot
-        ranges = np.where(np.isneginf(ranges), scan.range_min, ranges)
-        ok = np.isfinite(ranges) & (ranges >= scan.range_min) & (ranges <= scan.range_max)
-        if not self.bad_scan_reported and not np.isfinite(ranges).all():
+        # REP 117: -inf is "closer than range_min": something is right at the robot (scan_points)
+        bad = ~np.isfinite(np.where(np.isneginf(ranges), scan.range_min, ranges))
+        if not self.bad_scan_reported and bad.any():
             self.bad_scan_reported = True
             self.node.log.warn(
                 "safety_monitor: scan from %s has NaN/inf ranges (%d of %d); they are treated as no return",
                 scan.header.frame_id,
-                int((~np.isfinite(ranges)).sum()),
+                int(bad.sum()),
                 len(ranges),
             )
         laser = self.tf.lookup(self.base_frame, scan.header.frame_id or self.base_frame, 0.0) or (
@@ -222,8 +257,7 @@ class SafetyMonitor:
             0.0,
             0.0,
         )
-        r, a = ranges[ok], angles[ok] + laser[2]
-        pts = np.column_stack([laser[0] + r * np.cos(a), laser[1] + r * np.sin(a)])
+        pts = scan_points(ranges, angles, scan.range_min, scan.range_max, laser)
         with self.lock:
             self.points = pts
             self.scan_time = self.node.get_time()
@@ -301,16 +335,10 @@ class SafetyMonitor:
             # nothing new, and amcl needs the rotate recovery's new views to find itself again)
             if inp.name in self.loc_inputs and self.localization_lost():
                 v = 0.0
-            speed = v if abs(v) >= abs(self.velocity) or v * self.velocity <= 0 else self.velocity
-            self.blocked = v != 0.0 and blocked(
-                self.points,
-                speed,
-                w,
-                self.radius,
-                self.margin,
-                self.max_decel,
-                self.reaction,
-                self.obstacle_speed,
+            self.blocked = v != 0.0 and bool(
+                blocked_arcs(
+                    self.points, judged_speed(v, self.velocity).reshape(1), np.array([w]), self.zone
+                )[0]
             )
             if self.blocked or self.scan_stale:
                 v = 0.0
