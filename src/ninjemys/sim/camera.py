@@ -130,13 +130,18 @@ class Camera:
         if not (want_rgb or want_depth):
             return _EMPTY_RGB, _EMPTY_DEPTH
         seen = self._crossings(scene, x, y, yaw)
-        rgb = self._background.copy() if want_rgb else _EMPTY_RGB
-        depth_mm = self._floor_depth_image.copy() if want_depth else _EMPTY_DEPTH
         wall = (
             np.zeros((self.height, self.width), dtype=bool) if want_rgb and scene.floor is not None else None
         )
-        if seen is not None:
-            self._paint_crossings(seen, rgb, depth_mm, wall)
+        ranks = seen.ranks() if seen is not None else None
+        if seen is not None and seen.plane is None and ranks == [None]:
+            rgb, depth_mm = self._paint_one_layer(seen, want_rgb, want_depth, wall)
+        else:
+            rgb = self._background.copy() if want_rgb else _EMPTY_RGB
+            depth_mm = self._floor_depth_image.copy() if want_depth else _EMPTY_DEPTH
+            if seen is not None:
+                assert ranks is not None
+                self._paint_crossings(seen, ranks, rgb, depth_mm, wall)
         if wall is not None:
             assert scene.floor is not None
             self._paint_floor(rgb, wall, scene.floor, x, y, yaw)
@@ -302,8 +307,76 @@ class Camera:
         bottom[inner] = np.where(lid, np.ceil(self.cy + edge), bottom[inner])
         top[inner] = np.where(lid, top[inner], np.floor(self.cy + edge) + 1.0)
 
+    def _paint_one_layer(
+        self, seen: _Seen, want_rgb: bool, want_depth: bool, wall: np.ndarray | None
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The images when each column shows at most one crossing and no lid or underside (the common
+        case), the same pixels as :meth:`_paint_crossings` in fewer passes: each output pixel is
+        written about once. The rows above and below every crossing are the background's, copied;
+        when every column has a crossing, the rows all of them cover (the core) are their colours
+        and depths repeated down, with no mask; only the fringes between the highest and lowest
+        top (and bottom) are masked copies over the background."""
+        h, w = self.height, self.width
+        cols, top, bottom = seen.col, seen.top, seen.bottom
+        r0, r1 = int(_MIN(top)), int(_MAX(bottom))
+        full = len(cols) == w  # one crossing in every column: cols is 0..w-1, in order
+        c0 = c1 = r1  # the core's rows: none unless every column covers them
+        if full:
+            c0, c1 = int(_MAX(top)), int(_MIN(bottom))
+            if c0 >= c1:
+                c0 = c1 = r1
+        cv2 = _opencv()
+        rgb, depth_mm = _EMPTY_RGB, _EMPTY_DEPTH
+        if want_rgb:
+            light = np.clip(1.1 - seen.depth / 15.0, 0.45, 1.0)
+            shaded = (seen.colors[seen.item] * light[:, None]).astype(np.uint8)
+            if full:
+                colour_row = shaded
+            else:
+                colour_row = self._colour_row
+                colour_row[cols] = shaded
+            rgb = np.empty((h, w, 3), dtype=np.uint8)
+            rgb[:r0] = self._background[:r0]
+            rgb[r1:] = self._background[r1:]
+            if c0 < c1:
+                cv2.repeat(colour_row[None], c1 - c0, 1, dst=rgb[c0:c1])
+        if want_depth:
+            mm = np.rint(seen.depth * 1000.0).astype(np.uint16)
+            if full:
+                depth_row = mm
+            else:
+                depth_row = self._depth_row
+                depth_row[cols] = mm
+            depth_mm = np.empty((h, w), dtype=np.uint16)
+            depth_mm[:r0] = self._floor_depth_image[:r0]
+            depth_mm[r1:] = self._floor_depth_image[r1:]
+            if c0 < c1:
+                cv2.repeat(depth_row[None], c1 - c0, 1, dst=depth_mm[c0:c1])
+        if wall is not None and c0 < c1:
+            wall[c0:c1] = True
+        for a, b in ((r0, c0), (c1, r1)):
+            if a >= b:
+                continue
+            mask = self._column_mask(cols, top, bottom, a, b)
+            if want_rgb:
+                band = rgb[a:b]
+                band[...] = self._background[a:b]
+                cv2.copyTo(cv2.repeat(colour_row[None], b - a, 1), mask, band)
+            if want_depth:
+                band = depth_mm[a:b]
+                band[...] = self._floor_depth_image[a:b]
+                cv2.copyTo(cv2.repeat(depth_row[None], b - a, 1), mask, band)
+            if wall is not None:
+                wall[a:b] |= mask.view(bool)
+        return rgb, depth_mm
+
     def _paint_crossings(
-        self, seen: _Seen, rgb: np.ndarray, depth_mm: np.ndarray, wall: np.ndarray | None
+        self,
+        seen: _Seen,
+        ranks: list[np.ndarray | None],
+        rgb: np.ndarray,
+        depth_mm: np.ndarray,
+        wall: np.ndarray | None,
     ) -> None:
         """Fill each crossing's rows with its colour (flat, darker with distance) and depth: one
         masked copy per rank within the column, the farthest first, over the band of rows that rank
@@ -315,7 +388,7 @@ class Camera:
             shaded = (seen.colors[seen.item] * light[:, None]).astype(np.uint8)
         if depth_mm.size:
             mm = np.rint(seen.depth * 1000.0).astype(np.uint16)
-        for sel in seen.ranks():
+        for sel in ranks:
             cols = seen.col if sel is None else seen.col[sel]
             top = seen.top if sel is None else seen.top[sel]
             bottom = seen.bottom if sel is None else seen.bottom[sel]
