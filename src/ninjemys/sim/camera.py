@@ -38,6 +38,8 @@ _MIN, _MAX = np.minimum.reduce, np.maximum.reduce
 #: what :meth:`Camera.render` returns for an image it was asked not to draw
 _EMPTY_RGB = np.zeros((0, 0, 3), dtype=np.uint8)
 _EMPTY_DEPTH = np.zeros((0, 0), dtype=np.uint16)
+#: an RGB pixel as one 3-byte item (see Camera._colour_cells)
+_PIXEL = np.dtype("V3")
 FLOOR_RGB = np.array([176, 170, 160], dtype=np.float32)
 SKY_RGB = np.array([206, 220, 235], dtype=np.float32)
 
@@ -91,6 +93,9 @@ class Camera:
         self._span_row = np.zeros(width, dtype=self._row_type)
         self._top_row = np.zeros(width, dtype=self._row_type)
         self._colour_row = np.zeros((width, 3), dtype=np.uint8)
+        #: the same row as one 3-byte cell per column: set by column with a 1-D index, several
+        #: times cheaper than the rows of a 2-D array
+        self._colour_cells = self._colour_row.view(_PIXEL).reshape(width)
         self._depth_row = np.zeros(width, dtype=np.uint16)
         #: the last frame's pose and images, and a copy of its scene once the camera stood still
         self._last: tuple[tuple[float, float, float, bool, bool], tuple[np.ndarray, np.ndarray]] | None = None
@@ -204,12 +209,12 @@ class Camera:
         key = col * (2.0 * self.depth_max + 2.0)
         key += d
         order = key.argsort(kind="stable")  # on a tie (two sides flush) the first listed wins
-        col, item, d = col[order], item[order], d[order]
+        col, item, d = col.take(order), item.take(order), d.take(order)
         h = self.height
         # rows v whose ray meets the strip between its base and its top: base <= cam_z + slope_v d <= top,
         # slope_v = (cy - v) / fy; the bound is one row past the base's row (exclusive)
         per_m = self.fy / d
-        top = heights[item]
+        top = heights.take(item)
         top -= self.cam_z
         top *= per_m
         np.subtract(self.cy, top, out=top)
@@ -217,7 +222,7 @@ class Camera:
         if bases is None:
             bottom = per_m * self.cam_z
         else:
-            bottom = bases[item]
+            bottom = bases.take(item)
             bottom -= self.cam_z
             bottom *= per_m
             np.negative(bottom, out=bottom)
@@ -254,12 +259,14 @@ class Camera:
             plane = plane[shows]
             if np.isnan(plane).all():
                 plane = None
+        if not isinstance(shows, slice):
+            col, item, d, top, bottom = (a.take(shows) for a in (col, item, d, top, bottom))
         return _Seen(
-            col[shows],
-            item[shows],
-            d[shows],
-            top[shows],
-            bottom[shows],
+            col,
+            item,
+            d,
+            top,
+            bottom,
             colors,
             plane,
             self.width,
@@ -329,12 +336,12 @@ class Camera:
         rgb, depth_mm = _EMPTY_RGB, _EMPTY_DEPTH
         if want_rgb:
             light = np.clip(1.1 - seen.depth / 15.0, 0.45, 1.0)
-            shaded = (seen.colors[seen.item] * light[:, None]).astype(np.uint8)
+            shaded = (seen.colors.take(seen.item, axis=0) * light[:, None]).astype(np.uint8)
             if full:
                 colour_row = shaded
             else:
                 colour_row = self._colour_row
-                colour_row[cols] = shaded
+                self._colour_cells[cols] = shaded.view(_PIXEL).reshape(-1)
             rgb = np.empty((h, w, 3), dtype=np.uint8)
             rgb[:r0] = self._background[:r0]
             rgb[r1:] = self._background[r1:]
@@ -385,23 +392,24 @@ class Camera:
         meets that plane: (plane - cam_z) / slope_v."""
         if rgb.size:
             light = np.clip(1.1 - seen.depth / 15.0, 0.45, 1.0)
-            shaded = (seen.colors[seen.item] * light[:, None]).astype(np.uint8)
+            shaded = (seen.colors.take(seen.item, axis=0) * light[:, None]).astype(np.uint8)
         if depth_mm.size:
             mm = np.rint(seen.depth * 1000.0).astype(np.uint16)
         for sel in ranks:
-            cols = seen.col if sel is None else seen.col[sel]
-            top = seen.top if sel is None else seen.top[sel]
-            bottom = seen.bottom if sel is None else seen.bottom[sel]
+            cols = seen.col if sel is None else seen.col.take(sel)
+            top = seen.top if sel is None else seen.top.take(sel)
+            bottom = seen.bottom if sel is None else seen.bottom.take(sel)
             r0, r1 = int(_MIN(top)), int(_MAX(bottom))
             mask = self._column_mask(cols, top, bottom, r0, r1)
             if wall is not None:
                 wall[r0:r1] |= mask.view(bool)
             # the values of columns outside the mask do not matter: the scratch rows are not cleared
             if rgb.size:
-                self._colour_row[cols] = shaded if sel is None else shaded[sel]
+                cells = shaded.view(_PIXEL).reshape(-1)
+                self._colour_cells[cols] = cells if sel is None else cells.take(sel)
                 self._paint(rgb[r0:r1], self._colour_row, mask)
             if depth_mm.size:
-                self._depth_row[cols] = mm if sel is None else mm[sel]
+                self._depth_row[cols] = mm if sel is None else mm.take(sel)
                 self._paint(depth_mm[r0:r1], self._depth_row, mask)
                 if seen.plane is not None:
                     self._paint_planes(seen, sel, depth_mm)
