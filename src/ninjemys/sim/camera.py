@@ -71,11 +71,14 @@ class Camera:
         # static background: floor shaded with distance, sky above the horizon
         shade = np.clip(1.15 - floor_depth / 12.0, 0.55, 1.0)[:, None] * FLOOR_RGB[None, :]
         bg = np.where(below[:, None], shade, SKY_RGB[None, :]).astype(np.uint8)
-        self._floor_rows = np.flatnonzero(floor_depth > 0)  # rows that see the floor within range
-        forward = floor_depth[self._floor_rows][:, None]
-        #: where each floor pixel meets the floor, in the camera's horizontal frame (x ahead, y left)
+        # the rows that see the floor within range: the last ones, from the first such row down
+        # (the floor's depth shrinks row by row below the horizon)
+        self._floor_first = int(np.flatnonzero(floor_depth > 0)[0]) if (floor_depth > 0).any() else height
+        forward = floor_depth[self._floor_first :][:, None]
+        #: where each floor pixel meets the floor, in the camera's horizontal frame (x ahead, y left):
+        #: how far ahead (one value per row) and how far to the left
         self._floor_points = (
-            np.broadcast_to(forward, (len(self._floor_rows), width)).astype(np.float32),
+            forward.astype(np.float32),
             (forward * self.col_slopes[None, :]).astype(np.float32),
         )
         # a column's rows are top <= v < bottom, with top and bottom in [0, height]: held in the
@@ -483,23 +486,32 @@ class Camera:
     ) -> None:
         """Draw the floor markings (the course's 1 m square) where floor pixels see them: each floor
         pixel's point on the floor looked up in the markings' texture."""
-        rows = self._floor_rows
+        first = self._floor_first
         forward, lateral = self._floor_points
         c, s = np.float32(math.cos(yaw) / paint.resolution), np.float32(math.sin(yaw) / paint.resolution)
-        col = (c * forward - s * lateral + np.float32((x - paint.origin_x) / paint.resolution)).astype(
-            np.int32
-        )
-        row = (s * forward + c * lateral + np.float32((y - paint.origin_y) / paint.resolution)).astype(
-            np.int32
-        )
+        # ``forward`` is one value per row: its products are taken per row and broadcast along it
+        # (the same float32 operations, element by element, as over the whole block)
+        col = c * forward
+        col = col - s * lateral
+        col += np.float32((x - paint.origin_x) / paint.resolution)
+        row = s * forward
+        row = row + c * lateral
+        row += np.float32((y - paint.origin_y) / paint.resolution)
+        col, row = col.astype(np.int32), row.astype(np.int32)
         th, tw = paint.texture.shape
-        inside = (col >= 0) & (col < tw) & (row >= 0) & (row < th) & ~wall[rows]
-        if not inside.any():
+        # 0 <= i < n as one unsigned comparison (a negative index wraps to above any size)
+        inside = col.view(np.uint32) < tw
+        inside &= row.view(np.uint32) < th
+        np.greater(inside, wall[first:], out=inside)  # and not a wall pixel
+        on = np.flatnonzero(inside)
+        if not len(on):
             return
-        r_idx, c_idx = np.nonzero(inside)
-        ink = paint.texture[row[r_idx, c_idx], col[r_idx, c_idx]]
-        painted = ink > 0
-        rgb[rows[r_idx[painted]], c_idx[painted]] = paint.palette[ink[painted] - 1]
+        ink = paint.texture.take(row.take(on).astype(np.intp) * tw + col.take(on))
+        painted = ink.nonzero()[0]
+        cells = rgb.view(_PIXEL).reshape(-1)
+        cells[on.take(painted) + first * self.width] = paint.palette.view(_PIXEL).reshape(-1).take(
+            ink.take(painted) - 1
+        )
 
     def intrinsics(self) -> tuple[float, float, float, float]:
         return self.fx, self.fy, self.cx, self.cy
