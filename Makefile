@@ -32,6 +32,8 @@ ROS1_DEBS += python3-rostest
 ROS1_DEBS += ros-actionlib-msgs
 # interactive_markers' Python server and menu (course code): Debian's, the reference for ours (tests/markers)
 ROS1_DEBS += python3-interactive-markers
+# catkin_add_nosetests: Debian's nose, which Debian's catkin_make run_tests runs (the reference for ours)
+ROS1_DEBS += python3-nose
 BROWSER_DEBS := chromium chromium-driver fonts-dejavu-core
 # multi-host tests: network namespaces (iproute2), roslaunch <machine> over ssh (openssh-server)
 NET_DEBS     := iproute2 openssh-server openssh-client

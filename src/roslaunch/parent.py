@@ -15,7 +15,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from ninjemys.errors import NinjemysError
-from ninjemys.launch.launcher import LaunchOptions, LaunchSession
+from ninjemys.launch.launcher import NO_PROCESSES, LaunchOptions, LaunchSession
 from ninjemys.launch.plan import LaunchPlan, NodeSpec
 from ninjemys.launch.runner import ProcessSpec, Supervisor
 from ninjemys.launch.xml import load_launch
@@ -131,7 +131,7 @@ class _ScriptSession(LaunchSession):
         if self.stopping:
             return 0
         if not specs and not self.keep_up:
-            self._say("no nodes to launch")
+            self._say(NO_PROCESSES)
             return 0
         return self.supervisor.run()
 

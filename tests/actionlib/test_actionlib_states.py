@@ -8,7 +8,7 @@ import pytest
 from actionlib_fakes import ListLog
 
 from actionlib_msgs.msg import GoalStatus
-from actionlib_tutorials.msg import FibonacciActionGoal, FibonacciActionResult
+from actionlib_tutorials.msg import FibonacciActionFeedback, FibonacciActionGoal, FibonacciActionResult
 from ninjemys.actionlib import states
 from ninjemys.actionlib.client import ClientGoalHandle, CommStateMachine
 from ninjemys.actionlib.goal_id import GoalIDGenerator, client_goal_id
@@ -105,6 +105,79 @@ def test_goal_missing_from_status_after_ack_is_lost_with_one_line() -> None:
     assert seen == [CommState.ACTIVE, CommState.DONE]
     assert ClientGoalHandle(csm).get_goal_status() == S.LOST
     assert len(log.at("warn")) == 1 and "g1" in log.at("warn")[0] and "LOST" in log.at("warn")[0]
+
+
+def result_of(code: int) -> FibonacciActionResult:
+    result = FibonacciActionResult()
+    result.status = status(code)
+    return result
+
+
+def test_cancel_before_any_list_names_the_goal_is_not_lost_on_an_older_list() -> None:
+    """The smach flake: the goal runs on the server, the user cancels before a status list naming it
+    came, and a list the server sent before it had the goal arrives late. ROS 1 marks it LOST (then
+    drops the PREEMPTED result as 'already DONE'); it must end PREEMPTED."""
+    log = ListLog()
+    csm, seen, _ = machine(log)
+    ClientGoalHandle(csm).cancel()
+    csm.update_status(None)  # the older list
+    assert seen == [CommState.WAITING_FOR_CANCEL_ACK]
+    csm.update_status(status(S.PREEMPTING))
+    csm.update_status(status(S.PREEMPTED))
+    csm.update_result(result_of(S.PREEMPTED))
+    assert seen[-1] == CommState.DONE
+    assert ClientGoalHandle(csm).get_terminal_state() == S.PREEMPTED
+    assert log.at("warn") == [] and log.at("error") == []
+
+
+def test_feedback_before_any_list_does_not_make_an_older_list_lose_the_goal() -> None:
+    """Feedback (another topic) can overtake the status list that would name the goal."""
+    csm, seen, _ = machine()
+    feedback = FibonacciActionFeedback()
+    feedback.status = status(S.ACTIVE)
+    csm.update_feedback(feedback)
+    assert seen == [CommState.ACTIVE]
+    csm.update_status(None)
+    ClientGoalHandle(csm).cancel()
+    csm.update_status(None)
+    assert seen == [CommState.ACTIVE, CommState.WAITING_FOR_CANCEL_ACK]
+    csm.update_result(result_of(S.PREEMPTED))
+    assert ClientGoalHandle(csm).get_terminal_state() == S.PREEMPTED
+
+
+LISTED = {"active": S.ACTIVE, "preempting": S.PREEMPTING, "preempted": S.PREEMPTED}
+
+
+@pytest.mark.parametrize(
+    "events",
+    [
+        # the result before any list shows the cancel
+        ["active", "cancel", "result"],
+        # the result before the list that says PREEMPTING, then lists without the goal
+        ["active", "cancel", "result", "missing", "preempted"],
+        # the list says PREEMPTED, the goal leaves the list, then the result comes
+        ["active", "cancel", "preempting", "preempted", "missing", "result"],
+        # cancel before the ack, the result overtakes every list
+        ["cancel", "result", "missing"],
+        # cancel before the ack, an older list, then the lists and the result
+        ["cancel", "missing", "preempting", "result"],
+    ],
+)
+def test_cancelled_goal_ends_preempted_whatever_the_order(events: list[str]) -> None:
+    log = ListLog()
+    csm, _, _ = machine(log)
+    for event in events:
+        if event == "cancel":
+            ClientGoalHandle(csm).cancel()
+        elif event == "result":
+            csm.update_result(result_of(S.PREEMPTED))
+        elif event == "missing":
+            csm.update_status(None)
+        else:
+            csm.update_status(status(LISTED[event]))
+    assert csm.state == CommState.DONE
+    assert ClientGoalHandle(csm).get_terminal_state() == S.PREEMPTED
+    assert log.at("warn") == [] and log.at("error") == []
 
 
 def test_invalid_and_unknown_statuses_are_one_error_line_each_and_change_nothing() -> None:

@@ -100,3 +100,62 @@ def test_a_file_that_is_not_executable_gets_the_same_line(tmp_path: Path) -> Non
         "ERROR: cannot launch node of type [noexec_pkg/node.py]: Cannot locate node of type [node.py]" in out
     )
     assert "chmod +x" in out
+
+
+ONLY_MISSING = """<launch>
+  <param name="kept" value="1"/>
+  <node pkg="nosuch_pkg" type="nosuch_node" name="ghost"/>
+</launch>
+"""
+
+
+def _run_to_exit(command: list[str], tmp: Path, env: dict[str, str]) -> subprocess.CompletedProcess[str]:
+    """roslaunch against a running master (with a master of its own it would keep the master up)."""
+    with testing.run_master(env=dict(os.environ, ROS_HOME=str(tmp))) as uri:
+        return subprocess.run(
+            [*command, str(tmp / "m.launch")],
+            env=dict(env, ROS_MASTER_URI=uri, ROS_HOSTNAME="localhost"),
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+            timeout=120,
+            check=False,
+        )
+
+
+def _tail(out: str) -> list[str]:
+    """The missing node's line and the three closing lines (stderr and stdout interleave differently)."""
+    plain = out.replace("\x1b[31m", "").replace("\x1b[0m", "").replace("\x1b[1m", "")
+    lines = [line.split("\x07")[-1] for line in plain.splitlines()]
+    errors = [line.split("]:")[0] + "]:" for line in lines if line.startswith("ERROR: cannot launch node")]
+    start = lines.index("No processes to monitor") if "No processes to monitor" in lines else len(lines)
+    return errors + lines[start : start + 3]
+
+
+def test_nothing_left_to_run_ends_with_ros1s_lines(tmp_path: Path) -> None:
+    """The book code's case (a launch file of one node that cannot start): ROS 1 prints "No processes to
+    monitor" and the process monitor's shutdown, and exits 0."""
+    (tmp_path / "m.launch").write_text(ONLY_MISSING)
+    done = _run_to_exit(
+        [str(Path(sys.executable).parent / "roslaunch")], tmp_path, dict(os.environ, ROS_HOME=str(tmp_path))
+    )
+    assert done.returncode == 0, done.stdout
+    assert _tail(done.stdout) == [
+        "ERROR: cannot launch node of type [nosuch_pkg/nosuch_node]:",
+        "No processes to monitor",
+        "shutting down processing monitor...",
+        "... shutting down processing monitor complete",
+    ]
+
+
+@pytest.mark.ros1
+@pytest.mark.skipif(not Path("/usr/bin/roslaunch").exists(), reason="Debian's roslaunch is not installed")
+def test_nothing_left_to_run_as_debians_roslaunch(tmp_path: Path) -> None:
+    (tmp_path / "m.launch").write_text(ONLY_MISSING)
+    ours = _run_to_exit(
+        [str(Path(sys.executable).parent / "roslaunch")], tmp_path, dict(os.environ, ROS_HOME=str(tmp_path))
+    )
+    ros1_env = {"PATH": "/usr/bin:/bin", "HOME": str(tmp_path), "ROS_HOME": str(tmp_path), "LANG": "C.UTF-8"}
+    theirs = _run_to_exit(["/usr/bin/roslaunch"], tmp_path, ros1_env)
+    assert ours.returncode == theirs.returncode == 0
+    assert _tail(ours.stdout) == _tail(theirs.stdout) != []

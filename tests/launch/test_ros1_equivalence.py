@@ -31,6 +31,7 @@ CASES = [
     ("corpus_b/launch/animals.launch", ["dolphin_msg:=Hi"]),
     ("corpus_b/launch/namespaces.launch", []),
     ("corpus_b/launch/pubsub.launch", []),
+    ("corpus_b/launch/find_paths.launch", []),
 ]
 
 

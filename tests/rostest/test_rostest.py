@@ -114,6 +114,15 @@ TALKER_TEST = """<launch>
 </launch>
 """
 
+# a test file committed without chmod +x, and a test of a package that is not there (course repositories
+# do both): those tests fail to run, the others run (CarND-Capstone's dbw_sim.test)
+UNRUNNABLE_TEST = """<launch>
+  <test test-name="arith" pkg="probe_tests" type="test_fails.py"/>
+  <test test-name="plain" pkg="probe_tests" type="test_plain.py"/>
+  <test test-name="elsewhere" pkg="no_such_probe_pkg" type="test_x.py"/>
+</launch>
+"""
+
 FAILING_TEST = """<launch>
   <test test-name="arith" pkg="probe_tests" type="test_fails.py"/>
 </launch>
@@ -235,6 +244,8 @@ def _workspace(root: Path) -> CatkinWorkspace:
             "test/param.test": PARAM_TEST,
             "test/advertise.test": ADVERTISE_TEST,
             "test/broken.test": "<launch><test test-name=",
+            "test/unrunnable.test": UNRUNNABLE_TEST,
+            "test/test_plain.py": FAILS,  # not executable
         },
         executables=list(scripts),
     )
@@ -274,11 +285,34 @@ def test_a_passing_test_file_runs_its_node_and_test_node(workspace: Path) -> Non
     assert "[probe_tests.rosunit-talker_test/test_param_from_test_file][passed]" in out
     assert re.search(r"SUMMARY\n.* \* RESULT: SUCCESS.*\n \* TESTS: 2\n \* ERRORS: 0\n \* FAILURES: 0", out)
     results = workspace / "ros_home" / "test_results" / "probe_tests"
+    # rostest's own case per <test>, as ROS 1 writes the combined file; the node's cases in its own
     combined = read_xml(results / "rostest-test_talker.xml")
-    assert sorted(c.name for c in combined.cases) == ["test_hears_hello", "test_param_from_test_file"]
+    assert [(c.classname, c.name) for c in combined.cases] == [("rostest.runner.RosTest", "testtalker_test")]
+    assert combined.ok
     assert read_xml(results / "rosunit-talker_test.xml").ok
     # the test node's own output went to its log, not the console
     assert "Outputting test results to" in out and "Ran 2 tests" not in out
+
+
+def test_tests_that_cannot_run_fail_and_the_others_run(workspace: Path) -> None:
+    result = _rostest(workspace, "probe_tests", "unrunnable.test")
+    out = re.sub(r"\x1b\[[0-9;]*m", "", result.stdout)
+    assert result.returncode == 1, out + result.stderr
+    assert "[Testcase: testarith] ... ok" in out
+    assert "FAILURE: Test node [probe_tests/test_plain.py] does not exist or is not executable" in out
+    assert (
+        "FAILURE: Package [no_such_probe_pkg] for test node [no_such_probe_pkg/test_x.py] does not exist"
+        in out
+    )
+    assert "ERROR: The following tests failed to run:\n * testelsewhere\n * testplain\n" in out
+    results = workspace / "ros_home" / "test_results" / "probe_tests"
+    combined = read_xml(results / "rostest-test_unrunnable.xml")
+    # rostest's own case per test: the two that could not run fail (catkin_test_results counts them)
+    assert [(c.name, c.passed) for c in combined.cases] == [
+        ("testarith", True),
+        ("testelsewhere", False),
+        ("testplain", False),
+    ]
 
 
 def test_a_failing_case_fails_the_run_and_is_named(workspace: Path) -> None:
@@ -411,6 +445,7 @@ def _report_lines(text: str) -> list[str]:
         ("talker.test", 0),
         ("failing.test", 2),
         ("slow.test", 1),
+        ("unrunnable.test", 1),
         ("hz.test", 2),
         ("publish.test", 2),
         ("param.test", 2),
@@ -438,6 +473,13 @@ def test_same_report_as_debians_rostest(workspace: Path, tmp_path: Path, test_fi
     ours = _rostest(workspace, "probe_tests", test_file)
     assert (debian.returncode, ours.returncode) == (code, code), debian.stdout + debian.stderr
     assert _report_lines(ours.stdout) == _report_lines(debian.stdout)
+    # the combined file: rostest's own case per <test>, passing or not, as Debian's
+    name = f"rostest-test_{test_file.split('.')[0]}.xml"
+    theirs_xml = read_xml(tmp_path / "home" / ".ros" / "test_results" / "probe_tests" / name)
+    ours_xml = read_xml(workspace / "ros_home" / "test_results" / "probe_tests" / name)
+    assert [(c.classname, c.name, c.passed) for c in ours_xml.cases] == [
+        (c.classname, c.name, c.passed) for c in theirs_xml.cases
+    ]
 
 
 @pytest.fixture(scope="module")
@@ -454,7 +496,10 @@ def test_catkin_make_run_tests_runs_the_add_rostest_files(run_tests) -> None:
     assert "-- run_tests_probe_tests_rostest_test_talker.test" in made.stdout
     assert "[probe_tests.rosunit-talker_test/test_hears_hello][passed]" in made.stdout
     assert read_xml(results / "probe_tests" / "rostest-test_talker.xml").ok
-    failing = read_xml(results / "probe_tests" / "rostest-test_failing.xml")
+    # the test node ran and wrote its results: rostest's own case passes, the node's failure is in
+    # its rosunit- file (as ROS 1 writes them), so it is counted once
+    assert read_xml(results / "probe_tests" / "rostest-test_failing.xml").ok
+    failing = read_xml(results / "probe_tests" / "rosunit-arith.xml")
     assert len(failing.cases) == 2 and not failing.ok
     # broken.test writes no result: a MISSING- failure file stands for it, as catkin's run_tests.py
     missing = results / "probe_tests" / "MISSING-rostest-test_broken.xml"
@@ -481,8 +526,9 @@ def test_debians_catkin_test_results_counts_them(run_tests) -> None:
     # rostest's combined files, the test nodes' own rosunit- files beside them (as ROS 1 writes them
     # with --results-base-dir), and the MISSING- stand-in for broken.test
     assert "probe_tests/MISSING-rostest-test_broken.xml: 1 tests, 0 errors, 1 failures" in summary.stdout
-    assert "probe_tests/rostest-test_failing.xml: 2 tests, 0 errors, 1 failures" in summary.stdout
-    assert "Summary: 9 tests, 0 errors, 3 failures, 0 skipped" in summary.stdout, summary.stdout
+    assert "probe_tests/rosunit-arith.xml: 2 tests, 0 errors, 1 failures" in summary.stdout
+    # talker: rostest's case + the node's 2; failing: 1 + 2 (one failure); broken: the MISSING- one
+    assert "Summary: 7 tests, 0 errors, 2 failures, 0 skipped" in summary.stdout, summary.stdout
 
 
 def test_results_filename_is_a_name_in_the_results_dir(workspace: Path, tmp_path: Path) -> None:
@@ -499,4 +545,5 @@ def test_results_filename_is_a_name_in_the_results_dir(workspace: Path, tmp_path
     assert ran.returncode == 2, ran.stdout + ran.stderr
     written = tmp_path / "results" / "probe_tests" / "rostest-chosen.name.xml"
     assert f"[ROSUNIT] Outputting test results to {written}" in ran.stdout
-    assert len(read_xml(written).cases) == 2
+    assert [c.name for c in read_xml(written).cases] == ["testarith"]
+    assert len(read_xml(tmp_path / "results" / "probe_tests" / "rosunit-arith.xml").cases) == 2

@@ -65,6 +65,9 @@ class CommStateMachine:
         self.mutex = threading.RLock()
         self.latest_goal_status = goal_status_class()(status=states.PENDING)
         self.latest_result: Any = None
+        # whether a status list has named this goal: only then does a list without it mean the server
+        # forgot it (see update_status)
+        self._listed = False
 
     @property
     def goal_id(self) -> str:
@@ -87,13 +90,25 @@ class CommStateMachine:
             self.transition_cb(ClientGoalHandle(self))
 
     def update_status(self, status: Any | None) -> None:
-        """The server's status of this goal (None: the status list does not mention it)."""
+        """This goal's entry in a status list from the server (None: the list does not name it).
+
+        A list without the goal marks it LOST only once an earlier list named it. ROS 1 also marks it
+        LOST when the user cancelled before any list named it (WAITING_FOR_CANCEL_ACK straight from
+        WAITING_FOR_GOAL_ACK) or when feedback moved it to ACTIVE first: then a list the server sent
+        before the goal reached it, delivered late (a loaded machine, an unbounded queue), loses a
+        goal the server is running, and its PREEMPTED result comes to a goal already DONE. Status
+        lists come in order on one connection, so "named once, now missing" is the server's word;
+        "never named yet" is only a list older than the goal.
+        """
         with self.mutex:
             if self.state == CommState.DONE:
                 return
             if status is None:
-                # the server acknowledged this goal once and has forgotten it: it is lost
-                if self.state not in (CommState.WAITING_FOR_GOAL_ACK, CommState.WAITING_FOR_RESULT):
+                # the server named this goal once and has forgotten it: it is lost
+                if self._listed and self.state not in (
+                    CommState.WAITING_FOR_GOAL_ACK,
+                    CommState.WAITING_FOR_RESULT,
+                ):
                     self.log.warn(
                         "goal %s: the action server no longer lists it (state %s): marking it LOST",
                         self.goal_id,
@@ -102,24 +117,27 @@ class CommStateMachine:
                     self.latest_goal_status.status = states.LOST
                     self.transition_to(CommState.DONE)
                 return
-            self.latest_goal_status = status
-            try:
-                path = states.comm_transitions(self.state, status.status)
-            except KeyError:
-                self.log.error(
-                    "goal %s: the action server sent unknown status %r", self.goal_id, status.status
-                )
-                return
-            if path is None:
-                self.log.error(
-                    "goal %s: invalid goal status transition from %s to %s",
-                    self.goal_id,
-                    CommState.to_string(self.state),
-                    states.status_name(status.status),
-                )
-                return
-            for state in path:
-                self.transition_to(state)
+            self._listed = True
+            self._apply_status(status)
+
+    def _apply_status(self, status: Any) -> None:
+        """Move through the states ``status`` implies (the caller holds ``mutex``)."""
+        self.latest_goal_status = status
+        try:
+            path = states.comm_transitions(self.state, status.status)
+        except KeyError:
+            self.log.error("goal %s: the action server sent unknown status %r", self.goal_id, status.status)
+            return
+        if path is None:
+            self.log.error(
+                "goal %s: invalid goal status transition from %s to %s",
+                self.goal_id,
+                CommState.to_string(self.state),
+                states.status_name(status.status),
+            )
+            return
+        for state in path:
+            self.transition_to(state)
 
     def update_result(self, action_result: Any) -> None:
         with self.mutex:
@@ -128,7 +146,7 @@ class CommStateMachine:
             if self.state == CommState.DONE:
                 self.log.error("goal %s: got a result when already DONE", self.goal_id)
                 return
-            self.update_status(action_result.status)
+            self._apply_status(action_result.status)
             if self.state != CommState.DONE:
                 self.transition_to(CommState.DONE)
 
@@ -137,7 +155,7 @@ class CommStateMachine:
             if self.state in (CommState.WAITING_FOR_GOAL_ACK, CommState.PENDING):
                 # feedback can overtake the status list that says the goal is active (another
                 # topic): its own status says so too, so the user sees active before feedback
-                self.update_status(action_feedback.status)
+                self._apply_status(action_feedback.status)
             if self.state == CommState.DONE:
                 return
         if self.feedback_cb is not None:

@@ -39,6 +39,10 @@ if TYPE_CHECKING:
     import subprocess
     from typing import Any
 
+#: what ROS 1's roslaunch prints when nothing is left to run (a launch file of parameters only, or
+#: whose every node could not be launched), before it exits 0
+NO_PROCESSES = "No processes to monitor\nshutting down processing monitor...\n... shutting down processing monitor complete"
+
 
 @dataclass
 class LaunchOptions:
@@ -282,7 +286,7 @@ class LaunchSession:
             signal.signal(sig, lambda *_: self.supervisor.request_shutdown() if self.supervisor else None)
         try:
             if not specs:
-                self._say("no nodes to launch")
+                self._say(NO_PROCESSES)
                 return 0
             return self.supervisor.run()
         finally:

@@ -189,9 +189,30 @@ def _apply(text: str, ctx: SubstitutionContext, allowed: tuple[str, ...]) -> str
         else:  # find
             if len(params) != 1:
                 raise LaunchError(f"$(find pkg) command only accepts one argument [{body}]")
-            value = _find(ctx, params[0])
+            text = _replace_find(text, body, _find(ctx, params[0]))
+            continue
         text = _replace_once(text, body, value)
     return text
+
+
+def _replace_find(text: str, body: str, pkg_path: str) -> str:
+    """Each ``$(find pkg)`` with the path written right after it (up to the next space) joined on as
+    roslaunch does, ``os.path.join(pkg_path, path)``: ``$(find styx)../../data/x.csv`` (no slash, as
+    course launch files write it) is ``<styx>/../../data/x.csv``, not a sibling ``styx..`` directory."""
+    command = f"$({body})"
+    done = ""
+    while command in text:
+        start = text.index(command)
+        after = text[start + len(command) :]
+        space = after.find(" ")
+        path, rest = (after, "") if space < 0 else (after[:space], after[space:])
+        if path.startswith(("/", "\\")):
+            path = path[1:]
+        path = path.replace("\\", os.sep)
+        joined = os.path.join(pkg_path, path) if path else pkg_path
+        done += text[:start] + joined
+        text = rest
+    return done + text
 
 
 def resolve(text: str | None, ctx: SubstitutionContext) -> str | None:

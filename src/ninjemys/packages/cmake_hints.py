@@ -35,6 +35,8 @@ class CMakeHints:
     required: tuple[Requirement, ...] = ()
     #: the .test files of ``add_rostest(file ...)``, relative to the package (``catkin_make run_tests``)
     rostests: tuple[str, ...] = ()
+    #: ``catkin_add_nosetests(path [WORKING_DIRECTORY dir])``: (path, dir or None, line), in file order
+    nosetests: tuple[tuple[str, str | None, int], ...] = ()
     #: the CMakeLists.txt line of each ``catkin_install_python`` program, for error messages
     program_lines: tuple[tuple[str, int], ...] = ()
 
@@ -60,6 +62,7 @@ def read_cmake_hints(package_dir: Path) -> CMakeHints:
     programs: list[tuple[str, str]] = []
     required: list[Requirement] = []
     rostests: list[str] = []
+    nosetests: list[tuple[str, str | None, int]] = []
     program_lines: list[tuple[str, int]] = []
     for match in _CALL.finditer(text):
         command = match.group(1).lower()
@@ -79,11 +82,15 @@ def read_cmake_hints(package_dir: Path) -> CMakeHints:
             required.extend(_requirements(args, line))
         elif command == "add_rostest" and args and "${" not in args[0]:
             rostests.append(args[0])
+        elif command == "catkin_add_nosetests" and args:
+            workdir = args[args.index("WORKING_DIRECTORY") + 1] if "WORKING_DIRECTORY" in args[:-1] else None
+            nosetests.append((args[0], workdir, line))
     return CMakeHints(
         python_setup=python_setup,
         install_programs=tuple(programs),
         required=tuple(required),
         rostests=tuple(rostests),
+        nosetests=tuple(nosetests),
         program_lines=tuple(program_lines),
     )
 

@@ -16,6 +16,7 @@ import time
 from pathlib import Path
 
 from ninjemys.commands import command_path
+from ninjemys.errors import PackageError
 from ninjemys.packages.builder import build_workspace, clean_workspace
 from ninjemys.packages.cmake_hints import read_cmake_hints
 from ninjemys.packages.cpp_build import install_cpp
@@ -44,7 +45,7 @@ def _parser() -> argparse.ArgumentParser:
         "targets",
         nargs="*",
         help="make targets: 'clean' removes build/ and devel/; 'install' also writes the install space; "
-        "'run_tests' runs the add_rostest() files with rostest",
+        "'run_tests' runs the add_rostest() files with rostest and the catkin_add_nosetests() tests",
     )
     return p
 
@@ -63,6 +64,8 @@ def main(argv: list[str] | None = None) -> int:
         print("####\n#### Removed build and devel spaces\n####")
         return 0
     start = time.monotonic()
+    if _testing_enabled(passthrough):
+        _check_nosetests_paths(ws)
     print("-- ~~  traversing packages in topological order:")
     prefix = _install_prefix(ws, passthrough)
     report = build_workspace(ws, env=os.environ, log=print, install_prefix=prefix)
@@ -79,17 +82,22 @@ def main(argv: list[str] | None = None) -> int:
     if "install" in args.targets:
         _install(ws, prefix, report.cpp_build)
     if "run_tests" in args.targets:
-        _run_tests(ws)
+        if _testing_enabled(passthrough):
+            _run_tests(ws, _results_dir(ws, passthrough))
+        else:
+            print("-- Skipping the tests: enable testing via -DCATKIN_ENABLE_TESTING (catkin's words)")
     return 0
 
 
-def _run_tests(ws: Workspace) -> None:
-    """``catkin_make run_tests``: every ``add_rostest(file)`` of the workspace, through ``rostest``
-    with the devel space on the paths. As with catkin, a failing test does not fail catkin_make:
-    the results go where catkin puts them, ``build/test_results/<pkg>/rostest-<file>.xml``, for
-    ``catkin_test_results`` (``catkin_make run_tests && catkin_test_results`` is the CI idiom; with
-    the results elsewhere it would report 0 tests and pass). A test that writes no result leaves a
-    ``MISSING-`` failure file there, as catkin's run_tests.py does."""
+def _run_tests(ws: Workspace, results_dir: Path) -> None:
+    """``catkin_make run_tests``: every ``add_rostest(file)`` and ``catkin_add_nosetests(path)`` of the
+    workspace, with the devel space on the paths. As with catkin, a failing test does not fail
+    catkin_make: the results go where catkin puts them, ``<results>/<pkg>/rostest-<file>.xml`` and
+    ``nosetests-<path>.xml`` (``<results>`` is ``build/test_results`` or ``-DCATKIN_TEST_RESULTS_DIR``),
+    for ``catkin_test_results`` (``catkin_make run_tests && catkin_test_results`` is the CI idiom;
+    with the results elsewhere it would report 0 tests and pass). Each package's old result files
+    are removed first, as catkin's clean_test_results target does. A test that writes no result
+    leaves a ``MISSING-`` failure file there, as catkin's run_tests.py does."""
     env = dict(os.environ)
     for key, value in (
         ("ROS_PACKAGE_PATH", str(ws.source)),
@@ -97,38 +105,144 @@ def _run_tests(ws: Workspace) -> None:
         ("CMAKE_PREFIX_PATH", str(ws.devel)),
     ):
         env[key] = os.pathsep.join([value, *([env[key]] if env.get(key) else [])])
-    rostest = command_path("rostest")
-    results_dir = ws.build / "test_results"
     for pkg in ws.ordered():
-        for test_file in read_cmake_hints(pkg.path).rostests:
-            path = pkg.path / test_file
-            print(f"-- run_tests_{pkg.name}_rostest_{test_file.replace('/', '_')}", flush=True)
-            if not path.is_file():
-                print(f"-- {pkg.path / 'CMakeLists.txt'}: add_rostest({test_file}) names a missing file")
+        hints = read_cmake_hints(pkg.path)
+        if not hints.rostests and not hints.nosetests:
+            continue
+        _clean_results(results_dir / pkg.name)
+        for test_file in hints.rostests:
+            _run_rostest(pkg.name, pkg.path, test_file, results_dir, env)
+        for test_path, workdir, _line in hints.nosetests:
+            _run_nosetests(ws, pkg.name, pkg.path, test_path, workdir, results_dir, env)
+
+
+def _testing_enabled(cmake_args: list[str]) -> bool:
+    """catkin's CATKIN_ENABLE_TESTING (on unless ``-DCATKIN_ENABLE_TESTING=OFF``/0/FALSE/NO)."""
+    enabled = True
+    for arg in cmake_args:
+        name, _, value = arg[2:].partition("=")
+        if name.split(":", 1)[0] == "CATKIN_ENABLE_TESTING":
+            enabled = value.strip().upper() not in ("OFF", "0", "FALSE", "NO", "N", "")
+    return enabled
+
+
+def _check_nosetests_paths(ws: Workspace) -> None:
+    """catkin's configure step: a ``catkin_add_nosetests`` path that does not exist stops the build
+    (``Can't find nosetests path``), before anything is built, whatever the target."""
+    ws.load()
+    for pkg in ws.packages:
+        for test_path, _workdir, line in read_cmake_hints(pkg.path).nosetests:
+            text = _package_vars(test_path, pkg.path)
+            if "${" in text or (pkg.path / text).exists():
                 continue
-            # catkin's add_rostest: the results file is named after the path without its extensions
-            stem = test_file.replace("/", "_").split(".")[0]
-            results = results_dir / pkg.name / f"rostest-{stem}.xml"
-            for old in (results, results.with_name(f"MISSING-{results.name}")):
-                old.unlink(missing_ok=True)
-            subprocess.run(
-                [
-                    rostest,
-                    "--pkgdir",
-                    str(pkg.path),
-                    "--package",
-                    pkg.name,
-                    "--results-filename",
-                    f"{stem}.xml",
-                    "--results-base-dir",
-                    str(results_dir),
-                    str(path),
-                ],
-                env=env,
-                check=False,
+            where = f"{pkg.path.relative_to(ws.source)}/CMakeLists.txt:{line}"
+            raise PackageError(
+                "CMake Error at /usr/share/catkin/cmake/test/nosetests.cmake:54 (message):\n"
+                f"  Can't find nosetests path '{test_path}'\nCall Stack (most recent call first):\n"
+                f"  {where} (catkin_add_nosetests)"
             )
-            if not results.is_file():
-                _write_missing_result(results, f"run_tests_{pkg.name}_rostest_{test_file.replace('/', '_')}")
+
+
+def _clean_results(package_results: Path) -> None:
+    """catkin's ``clean_test_results_<pkg>``: every ``.xml`` below the package's results directory."""
+    print(f"Removing test result files from '{package_results}'")
+    if not package_results.is_dir():
+        return
+    for path in sorted(package_results.rglob("*.xml")):
+        if not any(part.startswith(".") for part in path.relative_to(package_results).parts[:-1]):
+            print(f"- removing '{path}'")
+            path.unlink()
+
+
+def _run_rostest(name: str, pkg_dir: Path, test_file: str, results_dir: Path, env: dict[str, str]) -> None:
+    target = f"run_tests_{name}_rostest_{test_file.replace('/', '_')}"
+    print(f"-- {target}", flush=True)
+    path = pkg_dir / test_file
+    if not path.is_file():
+        print(f"-- {pkg_dir / 'CMakeLists.txt'}: add_rostest({test_file}) names a missing file")
+        return
+    # catkin's add_rostest: the results file is named after the path without its extensions
+    stem = test_file.replace("/", "_").split(".")[0]
+    results = results_dir / name / f"rostest-{stem}.xml"
+    results.with_name(f"MISSING-{results.name}").unlink(missing_ok=True)
+    subprocess.run(
+        [
+            command_path("rostest"),
+            "--pkgdir",
+            str(pkg_dir),
+            "--package",
+            name,
+            "--results-filename",
+            f"{stem}.xml",
+            "--results-base-dir",
+            str(results_dir),
+            str(path),
+        ],
+        env=env,
+        check=False,
+    )
+    if not results.is_file():
+        _write_missing_result(results, target)
+
+
+def _run_nosetests(
+    ws: Workspace,
+    name: str,
+    pkg_dir: Path,
+    test_path: str,
+    workdir: str | None,
+    results_dir: Path,
+    env: dict[str, str],
+) -> None:
+    """One ``catkin_add_nosetests``: nose's collection by :mod:`ninjemys.rostest.nose`, in the
+    package's build directory (or WORKING_DIRECTORY), the file named as catkin names it."""
+    path_text, workdir = _package_vars(test_path, pkg_dir), workdir and _package_vars(workdir, pkg_dir)
+    output = path_text
+    for prefix in (str(pkg_dir), str(ws.build / name)):
+        if output == prefix or output == prefix + "/":
+            output = ""
+        elif output.startswith(prefix + "/"):
+            output = output[len(prefix) + 1 :]
+    output = (output or ".").replace("/", ".").replace(":", ".")
+    target = f"run_tests_{name}_nosetests_{output}"
+    print(f"-- {target}", flush=True)
+    path = pkg_dir / path_text
+    if "${" in path_text:
+        print(
+            f"-- {pkg_dir / 'CMakeLists.txt'}: nosetests path '{test_path}' names a CMake variable ninjemys does not know"
+        )
+        return
+    results = results_dir / name / f"nosetests-{output}.xml"
+    cwd = Path(workdir) if workdir and "${" not in workdir else ws.build / name
+    cwd = cwd if cwd.is_absolute() else pkg_dir / cwd
+    cwd.mkdir(parents=True, exist_ok=True)
+    results.with_name(f"MISSING-{results.name}").unlink(missing_ok=True)
+    subprocess.run(
+        [sys.executable, "-m", "ninjemys.rostest.nose", str(path), "--xunit-file", str(results)],
+        env=env,
+        cwd=cwd,
+        check=False,
+    )
+    if not results.is_file():
+        _write_missing_result(results, target)
+
+
+def _package_vars(text: str, pkg_dir: Path) -> str:
+    """The package-directory variables catkin_add_nosetests paths use, replaced."""
+    for var in ("PROJECT_SOURCE_DIR", "CMAKE_CURRENT_SOURCE_DIR", "CMAKE_CURRENT_LIST_DIR"):
+        text = text.replace("${" + var + "}", str(pkg_dir))
+    return text
+
+
+def _results_dir(ws: Workspace, cmake_args: list[str]) -> Path:
+    """``-DCATKIN_TEST_RESULTS_DIR=dir`` (relative: to the build space, where CMake runs), by default
+    ``build/test_results``."""
+    chosen = ws.build / "test_results"
+    for arg in cmake_args:
+        name, _, value = arg[2:].partition("=")
+        if name.split(":", 1)[0] == "CATKIN_TEST_RESULTS_DIR" and value:
+            chosen = ws.build / Path(value).expanduser()
+    return chosen.resolve()
 
 
 def _write_missing_result(results: Path, target: str) -> None:

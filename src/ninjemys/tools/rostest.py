@@ -20,13 +20,15 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from ninjemys.commands import command_path, entry
-from ninjemys.errors import LaunchError
+from ninjemys.errors import LaunchError, NinjemysError
 from ninjemys.launch import master_link
 from ninjemys.launch.launcher import LaunchOptions, process_specs
 from ninjemys.launch.plan import LaunchPlan, NodeSpec
 from ninjemys.launch.xml import load_launch
 from ninjemys.master.client import MasterClient
 from ninjemys.net.addresses import free_port
+from ninjemys.packages.discovery import PackageIndex
+from ninjemys.packages.executables import find_executable
 from ninjemys.roshome import log_directory
 from ninjemys.rostest.junit import (
     XML_OUTPUT_FLAG,
@@ -119,11 +121,28 @@ class TestRun:
     why: str = ""
 
 
+def _unrunnable(test: NodeSpec, index: PackageIndex) -> str | None:
+    """rostest's words for a ``<test>`` whose package or executable cannot be found (a test file
+    without ``chmod +x`` is the usual case): that test fails and the others still run."""
+    try:
+        manifest = index.find(test.package)
+    except NinjemysError:
+        return f"Package [{test.package}] for test node [{test.package}/{test.type}] does not exist"
+    try:
+        find_executable(manifest, test.type)
+    except NinjemysError:
+        return f"Test node [{test.package}/{test.type}] does not exist or is not executable"
+    return None
+
+
 def _run_test(
     test: NodeSpec, plan: LaunchPlan, package: str, uri: str, log_dir: Path, env: dict[str, str], text: bool
 ) -> TestRun:
     """Run one ``<test>`` node, again while it fails and retries are left."""
     name = test.test_name or test.name or test.type
+    unrunnable = _unrunnable(test, PackageIndex.from_environment())
+    if unrunnable is not None:
+        return TestRun(name, [], "failure", unrunnable)
     target = results_file(package, name, env=env)
     limit = test.time_limit if test.time_limit is not None else DEFAULT_TIME_LIMIT
     attempts = 1 + max(0, test.retry or 0)
@@ -199,6 +218,9 @@ def _report(package: str, runs: list[TestRun], log_file: Path) -> str:
     out += f" * TESTS: {len(cases)}\n"
     out += f"{red} * ERRORS: {errors}\033[0m\n" if errors else " * ERRORS: 0\n"
     out += f"{red} * FAILURES: {failures}\033[0m\n" if failures else " * FAILURES: 0\n"
+    not_run = [run.name for run in runs if run.verdict == "failure"]
+    if not_run:
+        out += "\nERROR: The following tests failed to run:\n" + "".join(f" * test{n}\n" for n in not_run)
     return out + f"\nrostest log file is in {log_file}"
 
 
@@ -270,7 +292,20 @@ def main(argv: list[str] | None = None) -> int:
         if core is not None:
             _stop(core)
     cases = [case for run in runs for case in run.cases]
-    write_xml(Path(combined), SuiteResult(name=suite_name, cases=cases))
+    # as ROS 1 writes it, the combined file holds rostest's own case per <test> (``test<name>``, passing
+    # when the node ran and wrote its results; failing when it could not run or wrote none; an error
+    # when it overran); the node's own cases are in its rosunit-<name>.xml beside it, so
+    # catkin_test_results counts each case once
+    own = [
+        CaseResult(
+            "rostest.runner.RosTest",
+            f"test{run.name}",
+            failure=run.why if run.verdict == "failure" else None,
+            error=run.why if run.verdict == "error" else None,
+        )
+        for run in runs
+    ]
+    write_xml(Path(combined), SuiteResult(name=suite_name, cases=own))
     log_file.parent.mkdir(parents=True, exist_ok=True)
     report = _report(package, runs, log_file)
     log_file.write_text(report + "\n", encoding="utf-8")
