@@ -252,18 +252,15 @@ class Camera:
         shift[0] = stride
         np.minimum(bottom, shift, out=bottom)
         shows = top < bottom
-        if _ALL(shows):
-            shows = slice(None)
-        else:
-            shows = shows.nonzero()[0]
-            if not len(shows):
+        if not _ALL(shows):
+            pick = shows.nonzero()[0]
+            if not len(pick):
                 return None
-        if plane is not None:
-            plane = plane[shows]
-            if np.isnan(plane).all():
-                plane = None
-        if not isinstance(shows, slice):
-            col, item, d, top, bottom = (a.take(shows) for a in (col, item, d, top, bottom))
+            col, item, d, top, bottom = (a.take(pick) for a in (col, item, d, top, bottom))
+            if plane is not None:
+                plane = plane.take(pick)
+        if plane is not None and np.isnan(plane).all():
+            plane = None
         return _Seen(
             col,
             item,
@@ -369,13 +366,13 @@ class Camera:
                 continue
             mask = self._column_mask(cols, top, bottom, a, b)
             if want_rgb:
-                band = rgb[a:b]
-                band[...] = self._background[a:b]
-                cv2.copyTo(cv2.repeat(colour_row[None], b - a, 1), mask, band)
+                rgb_band = rgb[a:b]
+                rgb_band[...] = self._background[a:b]
+                cv2.copyTo(cv2.repeat(colour_row[None], b - a, 1), mask, rgb_band)
             if want_depth:
-                band = depth_mm[a:b]
-                band[...] = self._floor_depth_image[a:b]
-                cv2.copyTo(cv2.repeat(depth_row[None], b - a, 1), mask, band)
+                depth_band = depth_mm[a:b]
+                depth_band[...] = self._floor_depth_image[a:b]
+                cv2.copyTo(cv2.repeat(depth_row[None], b - a, 1), mask, depth_band)
             if wall is not None:
                 wall[a:b] |= mask.view(bool)
         return rgb, depth_mm
@@ -509,8 +506,8 @@ class Camera:
         ink = paint.texture.take(row.take(on).astype(np.intp) * tw + col.take(on))
         painted = ink.nonzero()[0]
         cells = rgb.view(_PIXEL).reshape(-1)
-        cells[on.take(painted) + first * self.width] = paint.palette.view(_PIXEL).reshape(-1).take(
-            ink.take(painted) - 1
+        cells[on.take(painted) + first * self.width] = (
+            paint.palette.view(_PIXEL).reshape(-1).take(ink.take(painted) - 1)
         )
 
     def intrinsics(self) -> tuple[float, float, float, float]:
