@@ -291,12 +291,14 @@ class Camera:
         rows) down to its far edge's. The side it enters by is the nearest one of the same shape in
         the same column (a camera inside the shape's outline, under a table top, has none: d_in 0).
         Arrays by crossing, sorted by column and depth; ``top`` and ``bottom`` changed in place."""
-        shape = (
-            np.flatnonzero(scene.owners[item] >= 0)
-            if scene.owners is not None
-            else np.flatnonzero(~np.isnan(plane))
-        )
-        shape = shape[item[shape] < len(scene.segments)]
+        n = len(scene.segments)
+        if scene.owners is not None:
+            # crossings of other robots (items from n on, round bodies) belong to no outline
+            shape = np.flatnonzero(item < n)
+            shape = shape[scene.owners.take(item.take(shape)) >= 0]
+        else:
+            shape = np.flatnonzero(~np.isnan(plane))
+            shape = shape[item[shape] < n]
         owner = scene.owners[item[shape]] if scene.owners is not None else np.zeros(len(shape), np.intp)
         by_shape = shape[np.lexsort((d[shape], owner, col[shape]))]
         # consecutive crossings of one shape in one column: the first enters, the next leaves by
