@@ -490,26 +490,32 @@ class Camera:
         c, s = np.float32(math.cos(yaw) / paint.resolution), np.float32(math.sin(yaw) / paint.resolution)
         # ``forward`` is one value per row: its products are taken per row and broadcast along it
         # (the same float32 operations, element by element, as over the whole block)
-        col = c * forward
-        col = col - s * lateral
-        col += np.float32((x - paint.origin_x) / paint.resolution)
-        row = s * forward
-        row = row + c * lateral
-        row += np.float32((y - paint.origin_y) / paint.resolution)
-        col, row = col.astype(np.int32), row.astype(np.int32)
+        east = c * forward
+        east = east - s * lateral
+        east += np.float32((x - paint.origin_x) / paint.resolution)
+        north = s * forward
+        north = north + c * lateral
+        north += np.float32((y - paint.origin_y) / paint.resolution)
+        col, row = east.astype(np.int32), north.astype(np.int32)
         th, tw = paint.texture.shape
         # 0 <= i < n as one unsigned comparison (a negative index wraps to above any size)
         inside = col.view(np.uint32) < tw
         inside &= row.view(np.uint32) < th
         np.greater(inside, wall[first:], out=inside)  # and not a wall pixel
-        on = np.flatnonzero(inside)
-        if not len(on):
+        # every floor pixel looks its texel up (a few passes over whole rows, no index lists), an
+        # index outside it clipped to some texel and its ink cleared: left are the inked pixels,
+        # a few hundred, rather than index lists of the tens of thousands inside the texture
+        index = row
+        index *= tw
+        index += col
+        ink = paint.texture.reshape(-1).take(index, mode="clip")
+        np.multiply(ink, inside, out=ink)
+        painted = np.flatnonzero(ink)
+        if not len(painted):
             return
-        ink = paint.texture.take(row.take(on).astype(np.intp) * tw + col.take(on))
-        painted = ink.nonzero()[0]
         cells = rgb.view(_PIXEL).reshape(-1)
-        cells[on.take(painted) + first * self.width] = (
-            paint.palette.view(_PIXEL).reshape(-1).take(ink.take(painted) - 1)
+        cells[painted + first * self.width] = (
+            paint.palette.view(_PIXEL).reshape(-1).take(ink.reshape(-1).take(painted) - 1)
         )
 
     def intrinsics(self) -> tuple[float, float, float, float]:
