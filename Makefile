@@ -43,7 +43,7 @@ SYSTEM_DEBS  := $(ROS1_DEBS) $(BROWSER_DEBS) $(NET_DEBS) tmux
 NPM_DIR   := .cache/npm
 NPM_STAMP := $(NPM_DIR)/node_modules/.installed
 
-.PHONY: all venv system npm lint format typecheck test test-fast demo bench fuzz soak clean
+.PHONY: all venv system npm lint format typecheck bytecode test test-fast demo bench fuzz soak clean
 
 all: venv
 
@@ -91,11 +91,16 @@ typecheck: venv
 # tests/nav/test_nav_stack.py run one at a time, and the office session's tests follow its goals run).
 # --durations: the slowest tests are listed at the end, so a CI log shows what eats the 20-minute budget.
 # --no-loadscope-reorder: tests/conftest.py orders the files (the long navigation sessions first).
-test: venv system npm lint typecheck
+test: venv system npm lint typecheck bytecode
 	$(VENV)/bin/pytest -n 2 -q --dist loadfile --no-loadscope-reorder --durations=25
 
-test-fast: venv
+test-fast: venv bytecode
 	$(VENV)/bin/pytest -n 2 -q -m "not ros1 and not browser and not slow"
+
+# ninjemys compiled once: under PYTHONDONTWRITEBYTECODE every process a test starts (roscore, nodes,
+# commands: thousands) compiled the modules it imports again, a third of a command's start-up CPU.
+bytecode: venv
+	$(PY) -m compileall -q -j 0 src
 
 demo: venv
 	$(PY) -m ninjemys.demo

@@ -14,16 +14,45 @@ reproducible by its index.
 
 from __future__ import annotations
 
+import contextlib
 import io
 import json
+import os
 import random
+import shutil
 import struct
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from ninjemys.errors import NinjemysError
+
+_SCRATCH: list[tempfile.TemporaryDirectory[str]] = []
+
+
+@contextlib.contextmanager
+def _as_files(files: dict[str, bytes]) -> Iterator[Path]:
+    """The input written as ``files`` in the run's scratch directory; emptied again after the parse.
+
+    One directory for the whole run, not one per input: making and removing a directory for every
+    input cost ~7 ms on the loaded 2-core machine, more than most parses (the short form spent a
+    sixth of its time there). Each parse still sees only its own files: everything is removed after it.
+    """
+    if not _SCRATCH:
+        _SCRATCH.append(tempfile.TemporaryDirectory(prefix="ninjemys_fuzz_"))
+    root = Path(_SCRATCH[0].name)
+    try:
+        for name, data in files.items():
+            (root / name).write_bytes(data)
+        yield root
+    finally:
+        for entry in os.scandir(root):
+            if entry.is_dir(follow_symlinks=False):
+                shutil.rmtree(entry.path)
+            else:
+                os.unlink(entry.path)
+
 
 INTERESTING = (b"\xff\xff\xff\xff", b"\xff\xff\xff\x7f", b"\x00\x00\x00\x80", b"\x00\x00\x00\x00", b"\x01\x00\x00\x00",
                b"\x00\x00\x10\x00", b"\xfe\xff\xff\xff")  # fmt: skip
@@ -102,10 +131,8 @@ def _idl(data: bytes) -> None:
     from ninjemys.idl.parser import parse_file
 
     suffix = (".msg", ".srv", ".action")[data[0] % 3 if data else 0]
-    with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / f"Fuzz{suffix}"
-        path.write_bytes(data)
-        parse_file(path, "fuzz")
+    with _as_files({f"Fuzz{suffix}": data}) as tmp:
+        parse_file(tmp / f"Fuzz{suffix}", "fuzz")
 
 
 # -- TCPROS ----------------------------------------------------------------------------------------
@@ -208,10 +235,8 @@ def _launch(data: bytes) -> None:
     """A launch file as roslaunch reads it (bytes from the file system)."""
     from ninjemys.launch.xml import load_launch
 
-    with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / "fuzz.launch"
-        path.write_bytes(data)
-        load_launch([path], env={"ROS_MASTER_URI": "http://localhost:11311"})
+    with _as_files({"fuzz.launch": data}) as tmp:
+        load_launch([tmp / "fuzz.launch"], env={"ROS_MASTER_URI": "http://localhost:11311"})
 
 
 # -- bags, maps, worlds ----------------------------------------------------------------------------
@@ -238,10 +263,8 @@ def _bag_seeds() -> list[bytes]:
 def _bag(data: bytes) -> None:
     from ninjemys.bag.reader import BagReader
 
-    with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / "fuzz.bag"
-        path.write_bytes(data)
-        reader = BagReader(path)
+    with _as_files({"fuzz.bag": data}) as tmp:
+        reader = BagReader(tmp / "fuzz.bag")
         try:
             for _ in reader.read():
                 pass
@@ -261,10 +284,8 @@ def _map(data: bytes) -> None:
     from ninjemys.maps.mapfile import load_map
 
     yaml_part, _, image = data.partition(b"\x00MAP\x00")
-    with tempfile.TemporaryDirectory() as tmp:
-        (Path(tmp) / "map.pgm").write_bytes(image)
-        (Path(tmp) / "map.yaml").write_bytes(yaml_part)
-        load_map(Path(tmp) / "map.yaml")
+    with _as_files({"map.pgm": image, "map.yaml": yaml_part}) as tmp:
+        load_map(tmp / "map.yaml")
 
 
 def _world_seeds() -> list[bytes]:
@@ -276,10 +297,8 @@ def _world_seeds() -> list[bytes]:
 def _world(data: bytes) -> None:
     from ninjemys.sim.world2d import load_world
 
-    with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / "fuzz.yaml"
-        path.write_bytes(data)
-        load_world(path)
+    with _as_files({"fuzz.yaml": data}) as tmp:
+        load_world(tmp / "fuzz.yaml")
 
 
 # -- Gazebo worlds (SDF) and mesh files ---------------------------------------------------------------
@@ -340,10 +359,8 @@ def _mesh(data: bytes) -> None:
     from ninjemys.sim.meshes import load_mesh_parts
 
     kind = {b"stl": ".stl", b"dae": ".dae", b"obj": ".obj"}.get(data[:3], ".stl")
-    with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / f"fuzz{kind}"
-        path.write_bytes(data[3:])
-        load_mesh_parts(path)
+    with _as_files({f"fuzz{kind}": data[3:]}) as tmp:
+        load_mesh_parts(tmp / f"fuzz{kind}")
 
 
 # -- the gateway -------------------------------------------------------------------------------------

@@ -156,6 +156,11 @@ class Worker:
         assert self.proc is not None
         self.proc.kill()
 
+    def terminate(self) -> None:
+        """SIGTERM without waiting, so that all workers shut their nodes down at once."""
+        if self.proc is not None and self.proc.proc.poll() is None:
+            self.proc.proc.terminate()
+
     def stop(self) -> None:
         if self.proc is not None:
             self.proc.stop(grace=10.0)
@@ -500,6 +505,8 @@ def run_soak(
     finally:
         for r in recorders:
             r.kill()
+        for w in workers:
+            w.terminate()
         for w in workers:
             w.stop()
         master.sigkill()

@@ -13,13 +13,34 @@ from typing import Any
 
 import pytest
 
+from ninjemys.errors import NinjemysError
 from ninjemys.idl.loader import get_message_class
+from ninjemys.net import auth
 from ninjemys.node import Node
 from ninjemys.testing import free_port, wait_until
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
 GOAL = (3.5, 0.0)  # along the office corridor the robot starts in, facing +x
+
+
+def _goal_linked(node: Node, topic: str = "/move_base_simple/goal") -> bool:
+    """Every subscriber of the goal topic holds a live inbound link from every publisher of it
+    (the click is published once: sent before move_base connected, it would be lost)."""
+    try:
+        pubs, subs, _ = node.master.get_system_state()
+        publishers = {n for t, names in pubs if t == topic for n in names}
+        subscribers = {n for t, names in subs if t == topic for n in names}
+        if not publishers or not subscribers:
+            return False
+        want = {node.master.lookup_node(n) for n in publishers}
+        for name in subscribers:
+            bus = auth.server_proxy(node.master.lookup_node(name)).getBusInfo("/demo_watch")[2]
+            if not want <= {c[1] for c in bus if c[2] == "i" and c[4] == topic and c[5]}:
+                return False
+    except (OSError, NinjemysError):  # a node coming or going between the calls: not yet
+        return False
+    return True
 
 
 def test_a_goal_clicked_in_rviz_is_reached(tmp_path: Path, browser_page: Any) -> None:
@@ -57,7 +78,9 @@ def test_a_goal_clicked_in_rviz_is_reached(tmp_path: Path, browser_page: Any) ->
             timeout=30,
             what="the goal tool advertised",
         )
-        page.wait_for_timeout(1500)  # move_base connects to the page's goal publisher
+        wait_until(
+            lambda: _goal_linked(node), timeout=30, what="move_base connected to the page's goal publisher"
+        )
         page.get_by_role("button", name="2D Nav Goal").click()
         a = page.evaluate(f"rviz.project({GOAL[0]}, {GOAL[1]})")
         b = page.evaluate(f"rviz.project({GOAL[0] + 0.5}, {GOAL[1]})")
