@@ -257,7 +257,7 @@ from ninjemys.sim.robot_model import load_robot_model
 from ninjemys.sim.simcore import Simulation
 from ninjemys.sim.world2d import load_world
 from ninjemys.sim.worlds import world_path
-sim = Simulation(load_world(world_path("office")), 0.01, 0)
+sim = Simulation(load_world(world_path(sys.argv[2])), 0.01, 0)
 r = sim.add_robot("pb", load_robot_model(sys.argv[1]), 0.0, 0.0, 0.0)
 poses = [(0.5 * math.cos(i * 0.05), 0.5 * math.sin(i * 0.05), i * 0.05) for i in range(300)]
 for r.x, r.y, r.yaw in poses[:30]:
@@ -272,13 +272,14 @@ print(best * 1e3)
 """
 
 
-def camera_frame_ms(src: Path | None) -> float:
-    """CPU ms of one camera frame (colour + depth) by the tree at ``src`` (None: this tree)."""
+def camera_frame_ms(src: Path | None, world: str = "office") -> float:
+    """CPU ms of one camera frame (colour + depth) in ``world`` by the tree at ``src`` (None: this
+    tree)."""
     env = dict(os.environ)
     if src is not None:
         env["PYTHONPATH"] = str(src)
     out = subprocess.run(
-        [sys.executable, "-c", CAMERA_FRAMES, str(URDF_MODEL)],
+        [sys.executable, "-c", CAMERA_FRAMES, str(URDF_MODEL), world],
         env=env,
         capture_output=True,
         text=True,
@@ -292,18 +293,21 @@ def bench_camera(before: str, rounds: int) -> None:
         ["git", "-C", str(ROOT), "rev-parse", "--short", before], capture_output=True, text=True, check=True
     ).stdout.strip()
     print(f"\n## the camera alone, A/B: {rev} (before) and this tree (after), alternating")
-    print("| frame (colour + depth, 320x240, office, URDF PuzzleBot) | before | after | after / before |")
+    print("CPU time of a frame (colour + depth, 320x240, URDF PuzzleBot turning and driving), median")
+    print("| world | before | after | after / before |")
     print("|---|---:|---:|---:|")
     with tempfile.TemporaryDirectory() as tmp:
         old = extract_tree(before, Path(tmp))
-        a: list[float] = []
-        b: list[float] = []
-        for _ in range(rounds):
-            a.append(camera_frame_ms(old))
-            b.append(camera_frame_ms(None))
-        am, bm = statistics.median(a), statistics.median(b)
-        print(f"| CPU time, median of {rounds} | {am:.3f} ms | {bm:.3f} ms | {bm / am:.2f} |")
-        print(f"load average: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
+        # office: walls and furniture; square: the course's floor markings looked up per floor pixel
+        for world in ("office", "square"):
+            a: list[float] = []
+            b: list[float] = []
+            for _ in range(rounds):
+                a.append(camera_frame_ms(old, world))
+                b.append(camera_frame_ms(None, world))
+            am, bm = statistics.median(a), statistics.median(b)
+            print(f"| {world}, median of {rounds} | {am:.3f} ms | {bm:.3f} ms | {bm / am:.2f} |")
+            print(f"load average: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
 
 
 STAGES = """

@@ -188,3 +188,22 @@ def test_column_pairs_equal_a_brute_force_cast(seed: int) -> None:
     along = ((px - segs[seg, 0]) * ex + (py - segs[seg, 1]) * ey) / (ex * ex + ey * ey)
     off = np.abs((px - segs[seg, 0]) * ey - (py - segs[seg, 1]) * ex) / np.hypot(ex, ey)
     assert (along > -1e-6).all() and (along < 1 + 1e-6).all() and (off < 1e-6).all()
+
+
+def test_another_robot_in_view_of_a_lid_is_drawn() -> None:
+    """A second robot (a round body, listed after the segments) in a view that also shows a lid (the
+    low boxes seen from above): the lid's far sides are matched to their shapes' near sides by
+    outline, and the robot's crossings belong to no outline (this frame once raised IndexError)."""
+    sim = Simulation(held_world())
+    r = sim.add_robot("pb", load_robot_model("puzzlebot"), 0.2, -0.2, math.pi)  # along the low boxes
+    alone_rgb, alone_depth = sim.render(r)
+    other = sim.add_robot("pb2", load_robot_model("puzzlebot"), -0.6, -0.2, 0.0)  # before the first box
+    rgb, depth = sim.render(r)
+    assert not np.array_equal(rgb, alone_rgb) and not np.array_equal(depth, alone_depth)
+    cam = r.camera
+    assert cam is not None
+    # straight ahead, below the horizon: the other robot's body, nearer than the floor seen there alone
+    u, v = cam.width // 2, cam.height // 2 + 30
+    assert 0 < depth[v, u] < alone_depth[v, u], (depth[v, u], alone_depth[v, u])
+    assert depth[v, u] < 800, depth[v, u]
+    del other

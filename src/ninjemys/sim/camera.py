@@ -38,6 +38,8 @@ _MIN, _MAX = np.minimum.reduce, np.maximum.reduce
 #: what :meth:`Camera.render` returns for an image it was asked not to draw
 _EMPTY_RGB = np.zeros((0, 0, 3), dtype=np.uint8)
 _EMPTY_DEPTH = np.zeros((0, 0), dtype=np.uint16)
+#: an RGB pixel as one 3-byte item (see Camera._colour_cells)
+_PIXEL = np.dtype("V3")
 FLOOR_RGB = np.array([176, 170, 160], dtype=np.float32)
 SKY_RGB = np.array([206, 220, 235], dtype=np.float32)
 
@@ -69,11 +71,14 @@ class Camera:
         # static background: floor shaded with distance, sky above the horizon
         shade = np.clip(1.15 - floor_depth / 12.0, 0.55, 1.0)[:, None] * FLOOR_RGB[None, :]
         bg = np.where(below[:, None], shade, SKY_RGB[None, :]).astype(np.uint8)
-        self._floor_rows = np.flatnonzero(floor_depth > 0)  # rows that see the floor within range
-        forward = floor_depth[self._floor_rows][:, None]
-        #: where each floor pixel meets the floor, in the camera's horizontal frame (x ahead, y left)
+        # the rows that see the floor within range: the last ones, from the first such row down
+        # (the floor's depth shrinks row by row below the horizon)
+        self._floor_first = int(np.flatnonzero(floor_depth > 0)[0]) if (floor_depth > 0).any() else height
+        forward = floor_depth[self._floor_first :][:, None]
+        #: where each floor pixel meets the floor, in the camera's horizontal frame (x ahead, y left):
+        #: how far ahead (one value per row) and how far to the left
         self._floor_points = (
-            np.broadcast_to(forward, (len(self._floor_rows), width)).astype(np.float32),
+            forward.astype(np.float32),
             (forward * self.col_slopes[None, :]).astype(np.float32),
         )
         # a column's rows are top <= v < bottom, with top and bottom in [0, height]: held in the
@@ -91,6 +96,9 @@ class Camera:
         self._span_row = np.zeros(width, dtype=self._row_type)
         self._top_row = np.zeros(width, dtype=self._row_type)
         self._colour_row = np.zeros((width, 3), dtype=np.uint8)
+        #: the same row as one 3-byte cell per column: set by column with a 1-D index, several
+        #: times cheaper than the rows of a 2-D array
+        self._colour_cells = self._colour_row.view(_PIXEL).reshape(width)
         self._depth_row = np.zeros(width, dtype=np.uint16)
         #: the last frame's pose and images, and a copy of its scene once the camera stood still
         self._last: tuple[tuple[float, float, float, bool, bool], tuple[np.ndarray, np.ndarray]] | None = None
@@ -130,13 +138,18 @@ class Camera:
         if not (want_rgb or want_depth):
             return _EMPTY_RGB, _EMPTY_DEPTH
         seen = self._crossings(scene, x, y, yaw)
-        rgb = self._background.copy() if want_rgb else _EMPTY_RGB
-        depth_mm = self._floor_depth_image.copy() if want_depth else _EMPTY_DEPTH
         wall = (
             np.zeros((self.height, self.width), dtype=bool) if want_rgb and scene.floor is not None else None
         )
-        if seen is not None:
-            self._paint_crossings(seen, rgb, depth_mm, wall)
+        ranks = seen.ranks() if seen is not None else None
+        if seen is not None and seen.plane is None and ranks == [None]:
+            rgb, depth_mm = self._paint_one_layer(seen, want_rgb, want_depth, wall)
+        else:
+            rgb = self._background.copy() if want_rgb else _EMPTY_RGB
+            depth_mm = self._floor_depth_image.copy() if want_depth else _EMPTY_DEPTH
+            if seen is not None:
+                assert ranks is not None
+                self._paint_crossings(seen, ranks, rgb, depth_mm, wall)
         if wall is not None:
             assert scene.floor is not None
             self._paint_floor(rgb, wall, scene.floor, x, y, yaw)
@@ -199,12 +212,12 @@ class Camera:
         key = col * (2.0 * self.depth_max + 2.0)
         key += d
         order = key.argsort(kind="stable")  # on a tie (two sides flush) the first listed wins
-        col, item, d = col[order], item[order], d[order]
+        col, item, d = col.take(order), item.take(order), d.take(order)
         h = self.height
         # rows v whose ray meets the strip between its base and its top: base <= cam_z + slope_v d <= top,
         # slope_v = (cy - v) / fy; the bound is one row past the base's row (exclusive)
         per_m = self.fy / d
-        top = heights[item]
+        top = heights.take(item)
         top -= self.cam_z
         top *= per_m
         np.subtract(self.cy, top, out=top)
@@ -212,7 +225,7 @@ class Camera:
         if bases is None:
             bottom = per_m * self.cam_z
         else:
-            bottom = bases[item]
+            bottom = bases.take(item)
             bottom -= self.cam_z
             bottom *= per_m
             np.negative(bottom, out=bottom)
@@ -239,22 +252,21 @@ class Camera:
         shift[0] = stride
         np.minimum(bottom, shift, out=bottom)
         shows = top < bottom
-        if _ALL(shows):
-            shows = slice(None)
-        else:
-            shows = shows.nonzero()[0]
-            if not len(shows):
+        if not _ALL(shows):
+            pick = shows.nonzero()[0]
+            if not len(pick):
                 return None
-        if plane is not None:
-            plane = plane[shows]
-            if np.isnan(plane).all():
-                plane = None
+            col, item, d, top, bottom = (a.take(pick) for a in (col, item, d, top, bottom))
+            if plane is not None:
+                plane = plane.take(pick)
+        if plane is not None and np.isnan(plane).all():
+            plane = None
         return _Seen(
-            col[shows],
-            item[shows],
-            d[shows],
-            top[shows],
-            bottom[shows],
+            col,
+            item,
+            d,
+            top,
+            bottom,
             colors,
             plane,
             self.width,
@@ -279,12 +291,14 @@ class Camera:
         rows) down to its far edge's. The side it enters by is the nearest one of the same shape in
         the same column (a camera inside the shape's outline, under a table top, has none: d_in 0).
         Arrays by crossing, sorted by column and depth; ``top`` and ``bottom`` changed in place."""
-        shape = (
-            np.flatnonzero(scene.owners[item] >= 0)
-            if scene.owners is not None
-            else np.flatnonzero(~np.isnan(plane))
-        )
-        shape = shape[item[shape] < len(scene.segments)]
+        n = len(scene.segments)
+        if scene.owners is not None:
+            # crossings of other robots (items from n on, round bodies) belong to no outline
+            shape = np.flatnonzero(item < n)
+            shape = shape[scene.owners.take(item.take(shape)) >= 0]
+        else:
+            shape = np.flatnonzero(~np.isnan(plane))
+            shape = shape[item[shape] < n]
         owner = scene.owners[item[shape]] if scene.owners is not None else np.zeros(len(shape), np.intp)
         by_shape = shape[np.lexsort((d[shape], owner, col[shape]))]
         # consecutive crossings of one shape in one column: the first enters, the next leaves by
@@ -302,8 +316,76 @@ class Camera:
         bottom[inner] = np.where(lid, np.ceil(self.cy + edge), bottom[inner])
         top[inner] = np.where(lid, top[inner], np.floor(self.cy + edge) + 1.0)
 
+    def _paint_one_layer(
+        self, seen: _Seen, want_rgb: bool, want_depth: bool, wall: np.ndarray | None
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The images when each column shows at most one crossing and no lid or underside (the common
+        case), the same pixels as :meth:`_paint_crossings` in fewer passes: each output pixel is
+        written about once. The rows above and below every crossing are the background's, copied;
+        when every column has a crossing, the rows all of them cover (the core) are their colours
+        and depths repeated down, with no mask; only the fringes between the highest and lowest
+        top (and bottom) are masked copies over the background."""
+        h, w = self.height, self.width
+        cols, top, bottom = seen.col, seen.top, seen.bottom
+        r0, r1 = int(_MIN(top)), int(_MAX(bottom))
+        full = len(cols) == w  # one crossing in every column: cols is 0..w-1, in order
+        c0 = c1 = r1  # the core's rows: none unless every column covers them
+        if full:
+            c0, c1 = int(_MAX(top)), int(_MIN(bottom))
+            if c0 >= c1:
+                c0 = c1 = r1
+        cv2 = _opencv()
+        rgb, depth_mm = _EMPTY_RGB, _EMPTY_DEPTH
+        if want_rgb:
+            light = np.clip(1.1 - seen.depth / 15.0, 0.45, 1.0)
+            shaded = (seen.colors.take(seen.item, axis=0) * light[:, None]).astype(np.uint8)
+            if full:
+                colour_row = shaded
+            else:
+                colour_row = self._colour_row
+                self._colour_cells[cols] = shaded.view(_PIXEL).reshape(-1)
+            rgb = np.empty((h, w, 3), dtype=np.uint8)
+            rgb[:r0] = self._background[:r0]
+            rgb[r1:] = self._background[r1:]
+            if c0 < c1:
+                cv2.repeat(colour_row[None], c1 - c0, 1, dst=rgb[c0:c1])
+        if want_depth:
+            mm = np.rint(seen.depth * 1000.0).astype(np.uint16)
+            if full:
+                depth_row = mm
+            else:
+                depth_row = self._depth_row
+                depth_row[cols] = mm
+            depth_mm = np.empty((h, w), dtype=np.uint16)
+            depth_mm[:r0] = self._floor_depth_image[:r0]
+            depth_mm[r1:] = self._floor_depth_image[r1:]
+            if c0 < c1:
+                cv2.repeat(depth_row[None], c1 - c0, 1, dst=depth_mm[c0:c1])
+        if wall is not None and c0 < c1:
+            wall[c0:c1] = True
+        for a, b in ((r0, c0), (c1, r1)):
+            if a >= b:
+                continue
+            mask = self._column_mask(cols, top, bottom, a, b)
+            if want_rgb:
+                rgb_band = rgb[a:b]
+                rgb_band[...] = self._background[a:b]
+                cv2.copyTo(cv2.repeat(colour_row[None], b - a, 1), mask, rgb_band)
+            if want_depth:
+                depth_band = depth_mm[a:b]
+                depth_band[...] = self._floor_depth_image[a:b]
+                cv2.copyTo(cv2.repeat(depth_row[None], b - a, 1), mask, depth_band)
+            if wall is not None:
+                wall[a:b] |= mask.view(bool)
+        return rgb, depth_mm
+
     def _paint_crossings(
-        self, seen: _Seen, rgb: np.ndarray, depth_mm: np.ndarray, wall: np.ndarray | None
+        self,
+        seen: _Seen,
+        ranks: list[np.ndarray | None],
+        rgb: np.ndarray,
+        depth_mm: np.ndarray,
+        wall: np.ndarray | None,
     ) -> None:
         """Fill each crossing's rows with its colour (flat, darker with distance) and depth: one
         masked copy per rank within the column, the farthest first, over the band of rows that rank
@@ -312,23 +394,24 @@ class Camera:
         meets that plane: (plane - cam_z) / slope_v."""
         if rgb.size:
             light = np.clip(1.1 - seen.depth / 15.0, 0.45, 1.0)
-            shaded = (seen.colors[seen.item] * light[:, None]).astype(np.uint8)
+            shaded = (seen.colors.take(seen.item, axis=0) * light[:, None]).astype(np.uint8)
         if depth_mm.size:
             mm = np.rint(seen.depth * 1000.0).astype(np.uint16)
-        for sel in seen.ranks():
-            cols = seen.col if sel is None else seen.col[sel]
-            top = seen.top if sel is None else seen.top[sel]
-            bottom = seen.bottom if sel is None else seen.bottom[sel]
+        for sel in ranks:
+            cols = seen.col if sel is None else seen.col.take(sel)
+            top = seen.top if sel is None else seen.top.take(sel)
+            bottom = seen.bottom if sel is None else seen.bottom.take(sel)
             r0, r1 = int(_MIN(top)), int(_MAX(bottom))
             mask = self._column_mask(cols, top, bottom, r0, r1)
             if wall is not None:
                 wall[r0:r1] |= mask.view(bool)
             # the values of columns outside the mask do not matter: the scratch rows are not cleared
             if rgb.size:
-                self._colour_row[cols] = shaded if sel is None else shaded[sel]
+                cells = shaded.view(_PIXEL).reshape(-1)
+                self._colour_cells[cols] = cells if sel is None else cells.take(sel)
                 self._paint(rgb[r0:r1], self._colour_row, mask)
             if depth_mm.size:
-                self._depth_row[cols] = mm if sel is None else mm[sel]
+                self._depth_row[cols] = mm if sel is None else mm.take(sel)
                 self._paint(depth_mm[r0:r1], self._depth_row, mask)
                 if seen.plane is not None:
                     self._paint_planes(seen, sel, depth_mm)
@@ -402,23 +485,38 @@ class Camera:
     ) -> None:
         """Draw the floor markings (the course's 1 m square) where floor pixels see them: each floor
         pixel's point on the floor looked up in the markings' texture."""
-        rows = self._floor_rows
+        first = self._floor_first
         forward, lateral = self._floor_points
         c, s = np.float32(math.cos(yaw) / paint.resolution), np.float32(math.sin(yaw) / paint.resolution)
-        col = (c * forward - s * lateral + np.float32((x - paint.origin_x) / paint.resolution)).astype(
-            np.int32
-        )
-        row = (s * forward + c * lateral + np.float32((y - paint.origin_y) / paint.resolution)).astype(
-            np.int32
-        )
+        # ``forward`` is one value per row: its products are taken per row and broadcast along it
+        # (the same float32 operations, element by element, as over the whole block)
+        east = c * forward
+        east = east - s * lateral
+        east += np.float32((x - paint.origin_x) / paint.resolution)
+        north = s * forward
+        north = north + c * lateral
+        north += np.float32((y - paint.origin_y) / paint.resolution)
+        col, row = east.astype(np.int32), north.astype(np.int32)
         th, tw = paint.texture.shape
-        inside = (col >= 0) & (col < tw) & (row >= 0) & (row < th) & ~wall[rows]
-        if not inside.any():
+        # 0 <= i < n as one unsigned comparison (a negative index wraps to above any size)
+        inside = col.view(np.uint32) < tw
+        inside &= row.view(np.uint32) < th
+        np.greater(inside, wall[first:], out=inside)  # and not a wall pixel
+        # every floor pixel looks its texel up (a few passes over whole rows, no index lists), an
+        # index outside it clipped to some texel and its ink cleared: left are the inked pixels,
+        # a few hundred, rather than index lists of the tens of thousands inside the texture
+        index = row
+        index *= tw
+        index += col
+        ink = paint.texture.reshape(-1).take(index, mode="clip")
+        np.multiply(ink, inside, out=ink)
+        painted = np.flatnonzero(ink)
+        if not len(painted):
             return
-        r_idx, c_idx = np.nonzero(inside)
-        ink = paint.texture[row[r_idx, c_idx], col[r_idx, c_idx]]
-        painted = ink > 0
-        rgb[rows[r_idx[painted]], c_idx[painted]] = paint.palette[ink[painted] - 1]
+        cells = rgb.view(_PIXEL).reshape(-1)
+        cells[painted + first * self.width] = (
+            paint.palette.view(_PIXEL).reshape(-1).take(ink.reshape(-1).take(painted) - 1)
+        )
 
     def intrinsics(self) -> tuple[float, float, float, float]:
         return self.fx, self.fy, self.cx, self.cy
