@@ -1,5 +1,5 @@
 """Helpers for the Gazebo-names tests: genpy classes of our gazebo_msgs for Debian's tools (Debian
-packages no gazebo_msgs), and a roslaunch process with its log."""
+packages no gazebo_msgs), a roslaunch process with its log, and a small two-wheeled URDF."""
 
 from __future__ import annotations
 
@@ -12,6 +12,27 @@ from ninjemys.idl.search import SHIPPED_ROOT as _SHIPPED
 from ninjemys.testing import ROS1_PYTHON, kill_tree
 
 SHIPPED_ROOT = Path(_SHIPPED)
+
+
+def two_wheel_urdf(name: str, extra: str = "") -> str:
+    """A two-wheeled robot as the maker's description has it, with a diff drive plugin: its root link
+    at the wheels' axles, the wheels (radius 5 cm) 2 cm lower than the root, so standing on the floor
+    the root is 7 cm up; ``extra`` holds further ``<gazebo>`` blocks."""
+    return f"""<robot name="{name}">
+  <link name="base_link"><collision><origin xyz="0 0 0.03"/><geometry><box size="0.2 0.16 0.06"/></geometry>
+  </collision></link>
+  <link name="wheel_left"><collision><geometry><cylinder radius="0.05" length="0.02"/></geometry></collision></link>
+  <link name="wheel_right"><collision><geometry><cylinder radius="0.05" length="0.02"/></geometry></collision></link>
+  <joint name="wheel_left_joint" type="continuous"><parent link="base_link"/><child link="wheel_left"/>
+    <origin xyz="0 0.09 -0.02" rpy="-1.5708 0 0"/><axis xyz="0 0 1"/></joint>
+  <joint name="wheel_right_joint" type="continuous"><parent link="base_link"/><child link="wheel_right"/>
+    <origin xyz="0 -0.09 -0.02" rpy="-1.5708 0 0"/><axis xyz="0 0 1"/></joint>
+  <gazebo><plugin name="dd" filename="libgazebo_ros_diff_drive.so">
+    <leftJoint>wheel_left_joint</leftJoint><rightJoint>wheel_right_joint</rightJoint>
+    <wheelSeparation>0.18</wheelSeparation><wheelDiameter>0.1</wheelDiameter>
+    <robotBaseFrame>base_link</robotBaseFrame></plugin></gazebo>
+  {extra}
+</robot>"""
 
 
 def genpy_gazebo_msgs(dest: Path) -> Path:

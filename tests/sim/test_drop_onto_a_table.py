@@ -12,6 +12,7 @@ from collections.abc import Iterator
 
 import numpy as np
 import pytest
+from gazebo_helpers import two_wheel_urdf
 
 from ninjemys.idl.loader import get_service_class
 from ninjemys.node import Node
@@ -111,22 +112,7 @@ def test_a_spawned_model_lands_on_the_world_under_it() -> None:
 
 # -- through the /gazebo services ------------------------------------------------------------------
 
-#: a robot as the maker's description has it: its root link at the wheels' axles, the wheels 2 cm
-#: lower than the root (radius 5 cm): standing on the floor, the root is 7 cm up
-ROBOT = """<robot name="axlebot">
-  <link name="base_link"><collision><origin xyz="0 0 0.03"/><geometry><box size="0.2 0.16 0.06"/></geometry>
-  </collision></link>
-  <link name="wheel_left"><collision><geometry><cylinder radius="0.05" length="0.02"/></geometry></collision></link>
-  <link name="wheel_right"><collision><geometry><cylinder radius="0.05" length="0.02"/></geometry></collision></link>
-  <joint name="wheel_left_joint" type="continuous"><parent link="base_link"/><child link="wheel_left"/>
-    <origin xyz="0 0.09 -0.02" rpy="-1.5708 0 0"/><axis xyz="0 0 1"/></joint>
-  <joint name="wheel_right_joint" type="continuous"><parent link="base_link"/><child link="wheel_right"/>
-    <origin xyz="0 -0.09 -0.02" rpy="-1.5708 0 0"/><axis xyz="0 0 1"/></joint>
-  <gazebo><plugin name="dd" filename="libgazebo_ros_diff_drive.so">
-    <leftJoint>wheel_left_joint</leftJoint><rightJoint>wheel_right_joint</rightJoint>
-    <wheelSeparation>0.18</wheelSeparation><wheelDiameter>0.1</wheelDiameter>
-    <robotBaseFrame>base_link</robotBaseFrame></plugin></gazebo>
-</robot>"""
+ROBOT = two_wheel_urdf("axlebot")
 
 
 @pytest.fixture

@@ -9,6 +9,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 
 import pytest
+from gazebo_helpers import two_wheel_urdf
 
 from ninjemys.idl.loader import get_message_class
 from ninjemys.node import Node
@@ -23,22 +24,6 @@ from ninjemys.testing import run_master, wait_until
 Odometry = get_message_class("nav_msgs/Odometry")
 ContactsState = get_message_class("gazebo_msgs/ContactsState")
 
-#: a two-wheeled robot with a diff drive plugin and, in {extra}, further <gazebo> blocks
-ROBOT = """<robot name="plugbot">
-  <link name="base_link"><collision><origin xyz="0 0 0.03"/><geometry><box size="0.2 0.16 0.06"/></geometry>
-  </collision></link>
-  <link name="wheel_left"><collision><geometry><cylinder radius="0.05" length="0.02"/></geometry></collision></link>
-  <link name="wheel_right"><collision><geometry><cylinder radius="0.05" length="0.02"/></geometry></collision></link>
-  <joint name="wheel_left_joint" type="continuous"><parent link="base_link"/><child link="wheel_left"/>
-    <origin xyz="0 0.09 -0.02" rpy="-1.5708 0 0"/><axis xyz="0 0 1"/></joint>
-  <joint name="wheel_right_joint" type="continuous"><parent link="base_link"/><child link="wheel_right"/>
-    <origin xyz="0 -0.09 -0.02" rpy="-1.5708 0 0"/><axis xyz="0 0 1"/></joint>
-  <gazebo><plugin name="dd" filename="libgazebo_ros_diff_drive.so">
-    <leftJoint>wheel_left_joint</leftJoint><rightJoint>wheel_right_joint</rightJoint>
-    <wheelSeparation>0.18</wheelSeparation><wheelDiameter>0.1</wheelDiameter>
-    <robotBaseFrame>base_link</robotBaseFrame></plugin></gazebo>
-  {extra}
-</robot>"""
 
 P3D = """<gazebo><plugin name="truth" filename="libgazebo_ros_p3d.so">
     <alwaysOn>true</alwaysOn><updateRate>20.0</updateRate><bodyName>base_link</bodyName>
@@ -69,7 +54,7 @@ def _published(client: Node) -> dict[str, str]:
 
 def test_a_gazebo_description_without_p3d_or_bumper_publishes_no_truth_contact_or_tf_static(sim) -> None:  # type: ignore[no-untyped-def]
     sn, client = sim
-    model = model_from_urdf(ROBOT.format(extra=""), "plugbot.urdf")
+    model = model_from_urdf(two_wheel_urdf("plugbot"), "plugbot.urdf")
     assert model.ground_truth is None and model.contact_topic is None and model.bumper is None
     sn.add_robot("plugbot", model, 0.0, 0.0, 0.0, False)
     topics = _published(client)
@@ -90,7 +75,7 @@ def test_our_puzzlebot_keeps_its_ground_truth_contact_and_tf_static(sim) -> None
 
 def test_p3d_publishes_the_true_pose_on_its_topic_frame_and_rate(sim) -> None:  # type: ignore[no-untyped-def]
     sn, client = sim
-    model = model_from_urdf(ROBOT.format(extra=P3D), "plugbot.urdf")
+    model = model_from_urdf(two_wheel_urdf("plugbot", P3D), "plugbot.urdf")
     sn.add_robot("plugbot", model, -0.5, 0.25, 0.0, False)
     topics = _published(client)
     assert topics["/ground_truth/state"] == "nav_msgs/Odometry"
@@ -114,7 +99,7 @@ def test_p3d_publishes_the_true_pose_on_its_topic_frame_and_rate(sim) -> None:  
 
 def test_a_bumper_publishes_contacts_state_and_names_what_it_touches(sim) -> None:  # type: ignore[no-untyped-def]
     sn, client = sim
-    model = model_from_urdf(ROBOT.format(extra=BUMPER), "plugbot.urdf")
+    model = model_from_urdf(two_wheel_urdf("plugbot", BUMPER), "plugbot.urdf")
     assert model.bumper is not None and model.bumper.rate == 50.0
     sn.add_robot("plugbot", model, 0.7, 0.0, 0.0, False)
     topics = _published(client)
@@ -140,7 +125,7 @@ def test_a_bumper_publishes_contacts_state_and_names_what_it_touches(sim) -> Non
 def test_a_p3d_without_its_body_or_topic_is_refused_naming_the_element() -> None:
     bad = P3D.replace("<bodyName>base_link</bodyName>", "")
     with pytest.raises(DescriptionError, match=r"plugbot.urdf:\d+.*<bodyName> is required"):
-        model_from_urdf(ROBOT.format(extra=bad), "plugbot.urdf")
+        model_from_urdf(two_wheel_urdf("plugbot", bad), "plugbot.urdf")
     bad = P3D.replace("<bodyName>base_link</bodyName>", "<bodyName>chassis</bodyName>")
     with pytest.raises(DescriptionError, match="bodyName 'chassis' names no link"):
-        model_from_urdf(ROBOT.format(extra=bad), "plugbot.urdf")
+        model_from_urdf(two_wheel_urdf("plugbot", bad), "plugbot.urdf")

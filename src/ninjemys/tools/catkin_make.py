@@ -116,14 +116,21 @@ def _run_tests(ws: Workspace, results_dir: Path) -> None:
             _run_nosetests(ws, pkg.name, pkg.path, test_path, workdir, results_dir, env)
 
 
-def _testing_enabled(cmake_args: list[str]) -> bool:
-    """catkin's CATKIN_ENABLE_TESTING (on unless ``-DCATKIN_ENABLE_TESTING=OFF``/0/FALSE/NO)."""
-    enabled = True
+def _cmake_define(cmake_args: list[str], variable: str) -> str | None:
+    """The value of the last ``-DVARIABLE[:TYPE]=value`` among the arguments (None if none sets it):
+    on CMake's command line, as in its cache, the last definition wins."""
+    found = None
     for arg in cmake_args:
         name, _, value = arg[2:].partition("=")
-        if name.split(":", 1)[0] == "CATKIN_ENABLE_TESTING":
-            enabled = value.strip().upper() not in ("OFF", "0", "FALSE", "NO", "N", "")
-    return enabled
+        if arg.startswith("-D") and name.split(":", 1)[0] == variable:
+            found = value
+    return found
+
+
+def _testing_enabled(cmake_args: list[str]) -> bool:
+    """catkin's CATKIN_ENABLE_TESTING (on unless ``-DCATKIN_ENABLE_TESTING=OFF``/0/FALSE/NO)."""
+    value = _cmake_define(cmake_args, "CATKIN_ENABLE_TESTING")
+    return value is None or value.strip().upper() not in ("OFF", "0", "FALSE", "NO", "N", "")
 
 
 def _check_nosetests_paths(ws: Workspace) -> None:
@@ -237,11 +244,8 @@ def _package_vars(text: str, pkg_dir: Path) -> str:
 def _results_dir(ws: Workspace, cmake_args: list[str]) -> Path:
     """``-DCATKIN_TEST_RESULTS_DIR=dir`` (relative: to the build space, where CMake runs), by default
     ``build/test_results``."""
-    chosen = ws.build / "test_results"
-    for arg in cmake_args:
-        name, _, value = arg[2:].partition("=")
-        if name.split(":", 1)[0] == "CATKIN_TEST_RESULTS_DIR" and value:
-            chosen = ws.build / Path(value).expanduser()
+    value = _cmake_define(cmake_args, "CATKIN_TEST_RESULTS_DIR")
+    chosen = ws.build / Path(value).expanduser() if value else ws.build / "test_results"
     return chosen.resolve()
 
 
@@ -267,11 +271,8 @@ def _write_missing_result(results: Path, target: str) -> None:
 def _install_prefix(ws: Workspace, cmake_args: list[str]) -> Path:
     """CMAKE_INSTALL_PREFIX: ``-DCMAKE_INSTALL_PREFIX[:PATH]=dir`` (relative to the workspace), by
     default ``install/`` next to ``devel/``."""
-    prefix = ws.root / "install"
-    for arg in cmake_args:
-        name, _, value = arg[2:].partition("=")
-        if name.split(":", 1)[0] == "CMAKE_INSTALL_PREFIX" and value:
-            prefix = ws.root / Path(value).expanduser()
+    value = _cmake_define(cmake_args, "CMAKE_INSTALL_PREFIX")
+    prefix = ws.root / Path(value).expanduser() if value else ws.root / "install"
     return prefix.resolve()
 
 
