@@ -49,13 +49,13 @@ class SteppedRobot:
 
 
 @pytest.fixture
-def graph(tmp_path: Path) -> Iterator[tuple[str, Node, SteppedRobot]]:
+def graph(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[tuple[str, Node, SteppedRobot]]:
     with testing.run_master() as uri:
         node = Node("gazebo", master_uri=uri)
         config = load_yaml((PACKAGE / "config" / "diff_drive.yaml").read_text())
         for key, value in config.items():
             node.set_param(f"/{key}", value)
-        os.environ["ROS_PACKAGE_PATH"] = str(PACKAGE.parent)
+        monkeypatch.setenv("ROS_PACKAGE_PATH", str(PACKAGE.parent))  # not left to later tests
         model = load_robot_model(str(PACKAGE / "urdf" / "puzzlebot.urdf.xacro"))
         model.drive.controller_namespace = "/"
         loop = ControlLoop(node, model)
