@@ -1,7 +1,8 @@
 """Ping-pong round trip of a 64-byte std_msgs/String: ninjemys vs real rospy (and roscpp), two
 placements, publishers with ``queue_size=10`` and ``queue_size=None``; plus ninjemys in one process.
 
-Run: ``.venv/bin/python bench/node_rtt.py [count] [rounds]``; rounds interleave the implementations
+Run: ``.venv/bin/python bench/node_rtt.py [count] [rounds] [--quick]`` (``--quick``: the one-CPU
+``queue_size=10`` row only, with its floor, e.g. for ``bench/ab.py``); rounds interleave the implementations
 (load on a shared machine then hits them alike), and the machine's floor (``floor_rtt.py``) is
 measured in the same run. Targets: p50 <= 0.3x rospy on one CPU,
 p99 <= rospy's and <= 150 us in every placement and queue_size mode; in-process (two Nodes of one
@@ -84,28 +85,32 @@ def report(label: str, rounds: list[dict[str, dict]]) -> None:
 
 
 def main() -> None:
-    count = int(sys.argv[1]) if len(sys.argv) > 1 else 5000
-    n_rounds = int(sys.argv[2]) if len(sys.argv) > 2 else 3
+    args = [a for a in sys.argv[1:] if a != "--quick"]
+    # --quick: only the target's row (one CPU, queue_size=10) and its floor, for A/B runs (bench/ab.py)
+    quick = len(args) < len(sys.argv) - 1
+    count = int(args[0]) if args else 5000
+    n_rounds = int(args[1]) if len(args) > 1 else 3
     header(f"ping-pong RTT, {count} round trips, {n_rounds} interleaved rounds")
-    for name, cpus in (("same CPU", SAME_CPU), ("across CPUs", CROSS_CPU)):
+    placements = (("same CPU", SAME_CPU),) if quick else (("same CPU", SAME_CPU), ("across CPUs", CROSS_CPU))
+    for name, cpus in placements:
         # the machine's floor in the same run: a bare Python ping-pong, and the ping role's shape
         # (a receiving thread that wakes the main thread with an Event), over a Unix socket
         for shape in ("bare", "thread+event"):
             p50, p99 = floor_rtt.run(shape, cpus, count)
             print(f"{'floor ' + shape + ', ' + name:35s} {'python':9s} p50 {p50:8.1f} us   p99 {p99:8.1f} us")
     with master() as uri:
-        for queue_size in ("10", "None"):
+        for queue_size in ("10",) if quick else ("10", "None"):
             for name, cpus in (
                 ("same CPU (taskset -c 0)", SAME_CPU),
                 ("across CPUs (-c 0 / -c 1)", CROSS_CPU),
-            ):
+            )[: 1 if quick else 2]:
                 label = f"{name} q={queue_size}"
                 impls = [i for i in IMPLS_CPP if i != CPP or queue_size == "10"]
                 rounds = [
                     {impl: run(uri, impl, cpus, count, queue_size) for impl in impls} for _ in range(n_rounds)
                 ]
                 report(label, rounds)
-        for direct in (False, True):
+        for direct in () if quick else (False, True):
             r = in_process(uri, count, direct)
             label = "in one process, direct=True" if direct else "in one process (intraprocess=True)"
             print(f"{label:35s} {OURS:9s} p50 {r['p50_us']:8.1f} us   p99 {r['p99_us']:8.1f} us")
