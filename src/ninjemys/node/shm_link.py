@@ -227,9 +227,9 @@ class ShmSubConnection(SubConnection):
 
     tagged = True
 
-    def read(self, budget: int | None = None) -> list[bytes | bytearray] | None:
+    def read(self, budget: int | None = None, first: int | None = None) -> list[bytes | bytearray] | None:
         last = self.last
-        frames = super().read(budget)
+        frames = super().read(budget, first)
         if not frames:
             return frames
         out = self.untag(frames)

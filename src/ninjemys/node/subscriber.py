@@ -70,6 +70,10 @@ _READ_BUDGET = 256 * 1024
 _LOCAL_HIGH_WATER = 256
 _LOCAL_LOW_WATER = 128
 _LOCAL_WAIT = 100e-6
+#: A worker with one stream waits for it in a blocking ``recv`` (see Subscriber._solo_rounds) while
+#: its messages come less than this many seconds apart, and at most this long (``SO_RCVTIMEO``): the
+#: delay a connection add or release waits for, while that stream flows, before the worker sees it.
+_BLOCKING_WAIT = 0.1
 
 
 def _kernel_pending(sock: socket.socket) -> int:
@@ -183,6 +187,11 @@ class SubConnection:
     intra = False
     #: frames start with a tag byte (SHMROS): the reader's and the fused decoder's framing
     tagged = False
+    #: the flags of every read that must not wait: ``MSG_DONTWAIT`` once :meth:`make_blocking` made the
+    #: socket blocking (so that a solo worker can wait in ``recv`` itself), 0 while it is non-blocking
+    flags = 0
+    #: a drop ended the stream under a blocked reader (:meth:`interrupt`): its end is not news
+    _interrupted = False
 
     def __init__(self, sub: Subscription, sock: socket.socket, uri: str, header: Mapping[str, str]) -> None:
         self.sub = sub
@@ -206,21 +215,26 @@ class SubConnection:
         """The transport name getBusInfo reports (TCPROS or UNIXROS)."""
         return transport.transport_of(self.sock)
 
-    def read(self, budget: int | None = None) -> list[bytes | bytearray] | None:
+    def read(self, budget: int | None = None, first: int | None = None) -> list[bytes | bytearray] | None:
         """Read frames from the kernel (worker thread): about ``budget`` bytes at most when given, else
         what the kernel held when the read began, not what arrives meanwhile (a publisher as fast as
         this reader would keep it reading, and its callbacks waiting, for as long as the stream
-        lasts). None when the stream has ended."""
+        lasts). ``first``: the byte count of a :meth:`wait` that began this read. None when the
+        stream has ended."""
         reader, sock = self._reader, self.sock
         frames: list[bytes | bytearray] = []
         got = 0
         while True:
             buf = reader.buffer()
-            n = self._recv_into(buf)
-            if n is None:
-                return None
-            if n < 0:
-                break
+            if first is not None:
+                n, first = first, None
+            else:
+                received = self._recv_into(buf)
+                if received is None:
+                    return None
+                if received < 0:
+                    break
+                n = received
             self.bytes_recv += n
             got += n
             try:
@@ -241,13 +255,14 @@ class SubConnection:
         return frames
 
     def read_decoded(
-        self, budget: int | None, decode: Any, cap: int | None, min_frame: int
+        self, budget: int | None, decode: Any, cap: int | None, min_frame: int, first: int | None = None
     ) -> tuple[list[Any], list[bytes | bytearray], list[tuple[int, Exception]]] | None:
         """:meth:`read` fused with decoding (the worker's fast path for a plain, unlatched stream):
         ``(messages, frames, failures)``: the messages decoded as they were cut, then the frames left
         to decode one by one (a large frame received in place, or, once ``cap`` messages could be
         exceeded, everything after: a bounded queue drops those unread rather than decoded), and
-        ``(length, error)`` for each frame that did not decode. None when the stream has ended."""
+        ``(length, error)`` for each frame that did not decode. ``first``: the byte count of a
+        :meth:`wait` that began this read. None when the stream has ended."""
         reader, sock = self._reader, self.sock
         msgs: list[Any] = []
         frames: list[bytes | bytearray] = []
@@ -259,13 +274,16 @@ class SubConnection:
             # the usual wake-up: no frame pending, and the few small frames the kernel holds fit the
             # buffer: one recv and one decode, without the general loop's calls and checks (about a
             # microsecond of every small message's hop, measured in a ping-pong's CPU time)
-            try:
-                n = sock.recv_into(buf)
-            except (BlockingIOError, InterruptedError):
-                return msgs, frames, bad
-            except OSError as exc:
-                self._lost(f"read failed: {exc}")
-                return None
+            if first is not None:
+                n, first = first, None
+            else:
+                try:
+                    n = sock.recv_into(buf, 0, self.flags)
+                except (BlockingIOError, InterruptedError):
+                    return msgs, frames, bad
+                except OSError as exc:
+                    self._lost(f"read failed: {exc}")
+                    return None
             if 0 < n < len(buf) and (cap is None or n // min_frame <= cap):
                 self.bytes_recv += n
                 # commit_decoded's work, with the reader untouched when every frame was whole
@@ -286,8 +304,6 @@ class SubConnection:
             first = self._received(n)
             if first is None:
                 return None
-        else:
-            first = None
         while True:
             if first is not None:
                 n, first = first, None
@@ -338,7 +354,7 @@ class SubConnection:
         """One ``recv_into`` for both read paths: the byte count, -1 when the kernel has nothing
         now, None when the stream has ended (reported and closed)."""
         try:
-            n = self.sock.recv_into(buf)
+            n = self.sock.recv_into(buf, 0, self.flags)
         except (BlockingIOError, InterruptedError):
             return -1
         except OSError as exc:
@@ -346,10 +362,55 @@ class SubConnection:
             return None
         return self._received(n)
 
+    def make_blocking(self, timeout: float) -> bool:
+        """Make the socket blocking, each wait in it ending after ``timeout`` seconds at most, so that
+        :meth:`wait` can sleep in ``recv`` itself (one system call per message instead of a poll and
+        a ``recv``); every other read then passes ``MSG_DONTWAIT``. False, and the socket left as it
+        was, where the platform has neither flag nor timeout option (not Linux)."""
+        dontwait = getattr(socket, "MSG_DONTWAIT", 0)
+        option = getattr(socket, "SO_RCVTIMEO", None)
+        if not dontwait or option is None or self.closed:
+            return False
+        seconds = int(timeout)
+        try:
+            self.sock.setsockopt(
+                socket.SOL_SOCKET, option, struct.pack("@ll", seconds, int((timeout - seconds) * 1e6))
+            )
+            self.sock.settimeout(None)
+        except (OSError, struct.error):
+            return False
+        self.flags = dontwait
+        return True
+
+    def wait(self) -> int | None:
+        """Sleep in ``recv`` until bytes come (after :meth:`make_blocking`; worker thread): how many
+        came (the caller passes that as ``first`` to :meth:`read` or :meth:`read_decoded`), -1
+        when the wait timed out, None when the stream has ended (reported and closed)."""
+        try:
+            n = self.sock.recv_into(self._reader.buffer())
+        except (BlockingIOError, InterruptedError):
+            return -1
+        except OSError as exc:
+            self._lost(f"read failed: {exc}")
+            return None
+        return self._received(n)
+
+    def interrupt(self) -> None:
+        """End the stream under a reader blocked in :meth:`wait` (a drop: the reader closes it without
+        a word); any thread."""
+        self._interrupted = True
+        try:
+            self.sock.shutdown(socket.SHUT_RDWR)
+        except OSError:
+            pass
+
     def _received(self, n: int) -> int | None:
         """``n`` bytes came from ``recv_into``: ``n``, or None when 0 said the stream has ended
         (reported and closed)."""
         if n == 0:
+            if self.closed or self._interrupted:  # closed or dropped by another thread under a wait
+                self.close()
+                return None
             pending = self._reader.pending
             if pending:
                 self._lost(
@@ -368,6 +429,9 @@ class SubConnection:
         self.sub.node.runtime.call_soon(self.sub.connection_lost, self, False)
 
     def _lost(self, why: str, level: int = logging.INFO) -> None:
+        if self.closed or self._interrupted:  # closed or dropped by another thread: not news
+            self.close()
+            return
         _log.log(level, "topic %s: %s (%s)", self.sub.topic, why, self.publisher)
         self.close()
         self.sub.node.runtime.call_soon(self.sub.connection_lost, self, True)
@@ -377,6 +441,11 @@ class SubConnection:
         if self.closed:
             return
         self.closed = True
+        if self.flags:  # a reader may sleep in recv on it: a close alone would not wake it
+            try:
+                self.sock.shutdown(socket.SHUT_RDWR)
+            except OSError:
+                pass
         transport.close_quietly(self.sock)
 
 
@@ -729,6 +798,8 @@ class Subscriber:
         with host._ops_lock:
             host._ops.append(op)
         self._wakeup()
+        if op[0] == "drop" and op[1].flags:
+            op[1].interrupt()  # its worker may sleep in its recv, where the wake-up does not reach
 
     def enqueue(self, frames: list[bytes | bytearray], header: Mapping[str, str]) -> None:
         """Frames read by another thread (the reader handle, or a latched replay)."""
@@ -842,10 +913,19 @@ class Subscriber:
         returns to the general loop when that has work (a queued message, a handle joining, the
         handle closed). Why: at tens of hertz (a state publisher's joint states) every wake-up runs
         this code cold, and each call and attribute on the way costs cache misses, measured at
-        several microseconds per message."""
+        several microseconds per message.
+
+        With one stream whose messages come less than :data:`_BLOCKING_WAIT` apart, the worker
+        sleeps in that socket's ``recv`` instead of the poller (:meth:`SubConnection.wait`): one
+        system call per message, and the first bytes already read when it wakes. The wake-up
+        socket is then looked at after each wait, which ends on data, on the timeout, or on the
+        stream's end (a close or drop shuts the socket down under it); so a connection add or a
+        handle release waits at most that timeout while the stream flows, and an idle worker is
+        back in the poller, which sees everything at once."""
         poller = self._poller
         poll = poller.epoll.poll  # type: ignore[union-attr]
         objs = poller.objs
+        conns = self._conns
         queue = self._queue
         served = self._served
         read = self._read
@@ -853,6 +933,11 @@ class Subscriber:
         fused_of = self._fused
         maxlen = queue.maxlen
         budget = None if maxlen is not None else _READ_BUDGET
+        monotonic = time.monotonic
+        # the stream the next wait sleeps in (None: the poller), and when the poller last woke for it
+        waiter: SubConnection | None = None
+        last = 0.0
+        first: int | None = None
         # what a round delivered, dropped before the next wait: a message kept alive by this frame's
         # locals while the worker sleeps would hold its shared-memory slot (and its memory) until the
         # next message, for ever after the last one
@@ -875,18 +960,38 @@ class Subscriber:
         )
         while not queue and not self._closed and self._served is served:
             got = msgs = frames = bad = msg = None
-            for fd, _ in poll(-1, poller.max_events):
+            if waiter is not None:
+                first = waiter.wait()
+                if first is None or first < 0 or self._woken or len(conns) != 1:
+                    if first is None:
+                        self._forget(waiter)
+                    elif first > 0:
+                        read(waiter, first)  # the general way: the handles or connections changed
+                    waiter = None  # the poller next: it sees the wake-up socket too
+                    continue
+                events: Any = ((waiter.fd, 0),)
+            else:
+                first = None
+                events = poll(-1, poller.max_events)
+            for fd, _ in events:
                 if fd in objs:
                     conn = objs[fd]
                     if conn is None:
                         self._on_wake()
                         continue
+                    if first is None and conn.flags and len(conns) == 1:
+                        # messages coming fast: wait for the next one in recv (see the docstring)
+                        now = monotonic()
+                        if now - last < _BLOCKING_WAIT:
+                            waiter = conn
+                        last = now
                     fused = fused_of[conn.tagged]
                     if (
                         not fused
                         or conn.latching
                         or conn.closed
                         or self._direct
+                        or self._closed
                         or conn.reader is not self
                         or len(handles) != 1
                     ):
@@ -895,15 +1000,17 @@ class Subscriber:
                             and raw_solo
                             and not conn.latching
                             and not conn.closed
+                            and not self._closed
                             and conn.reader is self
                             and len(handles) == 1
                             and self._callbacks is callbacks
                         ):
                             # a raw handle (robot_state_publisher's joint states): _read and
                             # _deliver_batch inlined, as the fused path below is for decoded ones
-                            frames = conn.read(budget)
+                            frames = conn.read(budget, first)
                             if frames is None:
                                 self._forget(conn)
+                                waiter = None
                                 continue
                             if maxlen is not None and len(frames) > maxlen:
                                 frames = self._keep_newest(frames, 0)
@@ -916,13 +1023,16 @@ class Subscriber:
                                 except Exception:
                                     self._callback_raised(raw_solo)
                             continue
-                        read(conn)
+                        read(conn, first)
+                        if conn.closed:
+                            waiter = None
                         continue
                     # _read and _read_fused inlined for an unlatched stream and one handle, and
                     # _deliver_msgs for a single callback: each call is cache misses on a cold path
-                    got = conn.read_decoded(budget, fused[0], maxlen, fused[1])
+                    got = conn.read_decoded(budget, fused[0], maxlen, fused[1], first)
                     if got is None:
                         self._forget(conn)
+                        waiter = None
                         continue
                     msgs, frames, bad = got
                     if frames or bad or (maxlen is not None and len(msgs) > maxlen):
@@ -1020,6 +1130,8 @@ class Subscriber:
             if op == "add" and not obj.closed:
                 if self._lowat and not _low_water(obj.sock, True):
                     self._set_lowat(False)
+                if not self._lazy and not self._coalesce and self._poller.epoll is not None:
+                    obj.make_blocking(_BLOCKING_WAIT)  # solo rounds may wait in its recv
                 self._conns[obj.fd] = obj
                 self._poller.register(obj.fd, obj)
                 self._read(obj)  # latched data may already be waiting
@@ -1044,7 +1156,9 @@ class Subscriber:
         if self._conns.pop(conn.fd, None) is not None:
             self._poller.unregister(conn.fd)
 
-    def _read(self, conn: SubConnection) -> None:
+    def _read(self, conn: SubConnection, first: int | None = None) -> None:
+        """Read ``conn`` and deliver (``first``: the byte count of the :meth:`SubConnection.wait` that
+        began this read)."""
         if conn.closed:
             self._forget(conn)
             return
@@ -1056,19 +1170,19 @@ class Subscriber:
         fused = owner._fused[tagged]
         if fused is None:
             fused = owner._fused[tagged] = owner._frames_decoder(tagged)
-        if fused and not conn.latching and len(owner._sub.handles) == 1:
-            self._read_fused(owner, conn, fused, maxlen)
+        if fused and not conn.latching and not owner._closed and len(owner._sub.handles) == 1:
+            self._read_fused(owner, conn, fused, maxlen, first)
             return
-        frames = conn.read(None if maxlen is not None else _READ_BUDGET)
+        frames = conn.read(None if maxlen is not None else _READ_BUDGET, first)
         if frames is None:
             self._forget(conn)
             return
         if frames:
-            handles = owner._sub.handles
-            if len(handles) > 1:
-                for other in handles[1:]:
-                    if other is not owner:
-                        other.enqueue(frames, conn.header)
+            # every other handle of the topic, the next reader too when this one has just closed (its
+            # worker reads until it sees that, and the stream then goes on to the next reader)
+            for other in owner._sub.handles:
+                if other is not owner:
+                    other.enqueue(frames, conn.header)
             # the queues are empty whenever the worker reads (it delivers them first), so this
             # batch can go straight to the callbacks: no per-message queue entry
             maxlen = owner._queue.maxlen
@@ -1093,10 +1207,13 @@ class Subscriber:
             _log.info("topic %s: per-frame decoding (%s)", self.name, exc)
             return False
 
-    def _read_fused(self, owner: Subscriber, conn: SubConnection, fused: Any, maxlen: int | None) -> None:
+    def _read_fused(
+        self, owner: Subscriber, conn: SubConnection, fused: Any, maxlen: int | None, first: int | None = None
+    ) -> None:
         """The fast path of :meth:`_read`: one handle, a plain stream; frames are decoded as they are
         cut and the callback is called in a tight loop."""
-        got = conn.read_decoded(None if maxlen is not None else _READ_BUDGET, fused[0], maxlen, fused[1])
+        budget = None if maxlen is not None else _READ_BUDGET
+        got = conn.read_decoded(budget, fused[0], maxlen, fused[1], first)
         if got is None:
             self._forget(conn)
             return
