@@ -99,6 +99,7 @@ def _kernel_pending(sock: socket.socket) -> int:
 
 _ioctl: Any = None
 _unpack_int = struct.Struct("i").unpack
+_U32 = struct.Struct("<I")  # a frame's length prefix
 
 
 def _low_water(sock: socket.socket, lazy: bool) -> bool:
@@ -289,16 +290,7 @@ class SubConnection:
                 # commit_decoded's work, with the reader untouched when every frame was whole
                 start = decode(buf[:n].tobytes(), 0, n, msgs, bad)
                 if start != n:
-                    try:
-                        frames = reader.commit_rest(start, n)
-                    except ProtocolError as exc:
-                        self._drop_broken_stream(exc)
-                        return None
-                if frames:  # a large frame begun, or tagged frames: the general path's way
-                    frames = self.untag(frames) or []
-                    if frames:
-                        _decode_into(self.sub.msg_class, frames, msgs, bad)
-                        frames = []
+                    return self.decoded_rest(msgs, bad, start, n)
                 self.num_recv += len(msgs) + len(bad)
                 return msgs, frames, bad
             first = self._received(n)
@@ -343,6 +335,25 @@ class SubConnection:
         if frames:
             frames = self.untag(frames) or []
         self.num_recv += len(msgs) + len(frames) + len(bad)
+        return msgs, frames, bad
+
+    def decoded_rest(
+        self, msgs: list[Any], bad: list[tuple[int, Exception]], start: int, n: int
+    ) -> tuple[list[Any], list[bytes | bytearray], list[tuple[int, Exception]]] | None:
+        """:meth:`read_decoded`'s result when ``n`` bytes were received into the reader's whole buffer
+        and the fused decoder stopped at ``start`` (a large frame begun, a frame cut short, a tagged
+        frame): the rest kept in the reader, what it completes decoded one by one."""
+        try:
+            frames = self._reader.commit_rest(start, n)
+        except ProtocolError as exc:
+            self._drop_broken_stream(exc)
+            return None
+        if frames:  # a large frame begun, or tagged frames: the general path's way
+            frames = self.untag(frames) or []
+            if frames:
+                _decode_into(self.sub.msg_class, frames, msgs, bad)
+                frames = []
+        self.num_recv += len(msgs) + len(bad)
         return msgs, frames, bad
 
     def untag(self, frames: list[Any]) -> list[Any] | None:
@@ -948,7 +959,7 @@ class Subscriber:
         msg: Any = None
         # a raw handle's one callback, called without arguments (else None), while the callbacks are
         # these (add_callback replaces the tuple) and the handle is alone on its topic
-        callbacks = self._callbacks
+        callbacks = raw_callbacks = self._callbacks
         raw_solo = (
             callbacks[0][0]
             if self._decode is None
@@ -961,8 +972,8 @@ class Subscriber:
         while not queue and not self._closed and self._served is served:
             got = msgs = frames = bad = msg = None
             if waiter is not None:
-                first = waiter.wait()
-                if first is None or first < 0 or self._woken or len(conns) != 1:
+                first = self._wait_rounds(waiter, fused_of[waiter.tagged], raw_solo, raw_callbacks, served)
+                if first is None or first <= 0 or self._woken or len(conns) != 1:
                     if first is None:
                         self._forget(waiter)
                     elif first > 0:
@@ -1050,6 +1061,108 @@ class Subscriber:
                                 self._callback_raised(callback)
                     else:
                         self._deliver_msgs(msgs)
+
+    def _wait_rounds(
+        self,
+        conn: SubConnection,
+        fused: Any,
+        raw_solo: Callable[[Any], Any] | None,
+        raw_callbacks: tuple[tuple[Callable[..., Any], Any], ...],
+        served: tuple[Subscriber, ...],
+    ) -> int | None:
+        """:meth:`_solo_rounds` while it waits in ``conn``'s ``recv``: as long as nothing changes and
+        each read is whole small frames, a round is that ``recv``, one decode (or one RawMessage)
+        and the callbacks, with no other call on the way (a message at tens of hertz runs this with
+        cold caches, where each call costs). Returns when that ends: the byte count of a read it
+        did not deliver (in the reader's whole buffer: the caller reads it the general way, as the
+        first read of ``first``), 0 when something changed before a wait, -1 when a wait timed
+        out, None when the stream ended (reported and closed)."""
+        reader = conn._reader
+        whole = reader.whole
+        if reader.buffer() is not whole:  # a frame begun: the general way
+            return conn.wait()
+        if fused and not conn.latching and not self._direct:
+            decode, min_frame = fused
+            raw = None
+        elif fused is False and raw_solo is not None and not conn.latching:
+            decode = min_frame = None
+            raw = raw_solo
+        else:
+            return conn.wait()
+        skip = 5 if conn.tagged else 4  # a tagged stream's small inline frame: tag 0, then the body
+        recv_into = conn.sock.recv_into
+        size = len(whole)
+        queue = self._queue
+        maxlen = queue.maxlen
+        handles = self._sub.handles
+        header = conn.header
+        unpack_from = _U32.unpack_from
+        # a round's messages, dropped before the next wait (see _solo_rounds)
+        msgs: list[Any] | None = None
+        msg: Any = None
+        while True:
+            msgs = msg = None
+            if (
+                queue
+                or self._closed
+                or self._woken
+                or self._served is not served
+                or len(handles) != 1
+                or conn.reader is not self
+                or (raw is not None and self._callbacks is not raw_callbacks)
+            ):
+                return 0
+            try:
+                n = recv_into(whole)
+            except (BlockingIOError, InterruptedError):
+                return -1
+            except OSError as exc:
+                conn._lost(f"read failed: {exc}")
+                return None
+            if not n:
+                return conn._received(0)
+            if self._closed or self._woken or len(handles) != 1 or n >= size:
+                return n  # changed while it slept (or a large read): the general way delivers it
+            if raw is not None:
+                if n > skip and unpack_from(whole, 0)[0] == n - 4 and (skip == 4 or not whole[4]):
+                    conn.bytes_recv += n
+                    conn.num_recv += 1
+                    try:
+                        raw(RawMessage(whole[skip:n].tobytes(), header))
+                    except Exception:
+                        self._callback_raised(raw)
+                    continue
+                return n
+            if maxlen is not None and n // min_frame > maxlen:
+                return n  # a bounded queue drops some: decoded only if kept (the general way)
+            msgs = []
+            bad: list[tuple[int, Exception]] = []
+            start = decode(whole[:n].tobytes(), 0, n, msgs, bad)
+            conn.bytes_recv += n
+            if start != n:  # a large frame begun, a frame cut short, a tagged frame
+                got = conn.decoded_rest(msgs, bad, start, n)
+                if got is None:
+                    return None
+                self._fused_rest(conn, *got, maxlen)
+                if reader.buffer() is not whole:
+                    return 0
+                continue
+            conn.num_recv += len(msgs) + len(bad)
+            if bad or (maxlen is not None and len(msgs) > maxlen):
+                self._fused_rest(conn, msgs, [], bad, maxlen)
+                continue
+            callbacks = self._callbacks
+            if len(callbacks) == 1 and callbacks[0][1] is None:
+                callback = callbacks[0][0]
+                for msg in msgs:
+                    if self._closed:
+                        break
+                    try:
+                        callback(msg)
+                    except Exception:
+                        self._callback_raised(callback)
+            else:
+                self._deliver_msgs(msgs)
 
     def _callback_raised(self, callback: Callable[..., Any]) -> None:
         """A user callback raised: logged as rospy logs it, ``bad callback: <callback>`` and the
