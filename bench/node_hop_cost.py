@@ -39,8 +39,20 @@ def thread_stats(pid: int) -> dict[str, tuple[int, float]]:
         except OSError:
             continue
         found = re.search(r"^voluntary_ctxt_switches:\s*(\d+)", status, re.M)
-        out["main" if task.name == str(pid) else f"t{index}"] = (int(found.group(1)) if found else 0, ran)
+        name = "main" if task.name == str(pid) else f"t{index}"
+        out[f"{name}({_SYSCALLS.get(_syscall(task), 'other')})"] = (int(found.group(1)) if found else 0, ran)
     return out
+
+
+#: x86_64 system calls a thread of a node sleeps in, to tell the threads apart (they are all "python")
+_SYSCALLS = {"45": "recvfrom", "232": "epoll_wait", "202": "futex", "7": "poll", "23": "select", "0": "read"}
+
+
+def _syscall(task: Path) -> str:
+    try:
+        return (task / "syscall").read_text().split()[0]
+    except (OSError, IndexError):
+        return ""
 
 
 def strace_attach(pid: int, path: str) -> subprocess.Popen:

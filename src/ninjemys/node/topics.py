@@ -63,6 +63,12 @@ HOT_INTERVAL = 20e-6
 #: Within HOT_INTERVAL but at least this late (seconds), a Unix socket whose subscriber has read
 #: everything is written at once (it waits for the frame); sooner, it is a burst without asking.
 _SURE_BURST = 5e-6
+#: A direct write that took at least this long (seconds) had the thread off the CPU inside it, so the
+#: next publish's gap counts from its start. A small frame's ``send`` takes 2-4 us here; in a one-CPU
+#: ping-pong the peer's whole turn can fit in the write's return (measured 12-19 us), after which a
+#: subscriber that waits in ``recv`` gets the next ping and replies within _SURE_BURST of the write's
+#: end: counted from there, 5 % of the replies were taken for a burst and left to the I/O loop.
+_WRITE_OFF_CPU = 8e-6
 #: In a burst, the publishing thread writes once this many frames are queued ...
 _FLUSH_FRAMES = 32
 #: ... or this long after the last try (seconds), so a slow trickle of a burst still goes out.
@@ -189,7 +195,7 @@ class PubConnection:
                 self.num_sent += 1
                 if n == len(data):
                     end = _clock()
-                    if end - now < HOT_INTERVAL:
+                    if end - now < _WRITE_OFF_CPU:
                         # the next publish's gap counts from the end of this write; unless the write
                         # took a burst's whole gap (this thread was off the CPU inside it, and the
                         # subscriber ran: on one CPU a ping-pong's reply can come back before send
