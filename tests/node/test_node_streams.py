@@ -80,11 +80,11 @@ class _RefilledSocket:
     def fileno(self) -> int:
         return self.reader.fileno()
 
-    def recv_into(self, buf: memoryview) -> int:
+    def recv_into(self, buf: memoryview, nbytes: int = 0, flags: int = 0) -> int:
         self.reads += 1
         if self.reads > 5000:
             raise AssertionError("read() is still reading a stream that never drains")
-        n = self.reader.recv_into(buf)
+        n = self.reader.recv_into(buf, nbytes, flags)
         self._send(n)
         return n
 
