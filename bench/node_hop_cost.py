@@ -111,7 +111,7 @@ def one_side(uri: str, src: str, count: int, mode: str) -> dict[str, object]:
             proc.send_signal(signal.SIGINT)
             proc.wait(60)
         text = Path(out).read_text(errors="replace")
-        total = re.search(r"^(?:summary|totals):\s*(\d+)", text, re.M)
+        total = re.search(r"^totals:\s*(\d+)", text, re.M)
         result["instructions"] = int(total.group(1)) / messages if total else float("nan")
         return result
     with roles(Role(OURS, uri, "pong", "10", cpu=SAME_CPU[1])) as (pong,):
