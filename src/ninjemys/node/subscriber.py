@@ -70,9 +70,10 @@ _READ_BUDGET = 256 * 1024
 _LOCAL_HIGH_WATER = 256
 _LOCAL_LOW_WATER = 128
 _LOCAL_WAIT = 100e-6
-#: A worker with one stream waits for it in a blocking ``recv`` (see Subscriber._solo_rounds) while
-#: its messages come less than this many seconds apart, and at most this long (``SO_RCVTIMEO``): the
+#: A worker with one stream waits for it in a blocking ``recv`` (see Subscriber._solo_rounds) once two
+#: messages come less than half this many seconds apart, and at most this long (``SO_RCVTIMEO``): the
 #: delay a connection add or release waits for, while that stream flows, before the worker sees it.
+#: Half: a stream near 1/_BLOCKING_WAIT Hz would otherwise enter and time out by turns (a wake-up more).
 _BLOCKING_WAIT = 0.1
 
 
@@ -926,7 +927,7 @@ class Subscriber:
         this code cold, and each call and attribute on the way costs cache misses, measured at
         several microseconds per message.
 
-        With one stream whose messages come less than :data:`_BLOCKING_WAIT` apart, the worker
+        With one stream whose messages come less than :data:`_BLOCKING_WAIT` / 2 apart, the worker
         sleeps in that socket's ``recv`` instead of the poller (:meth:`SubConnection.wait`): one
         system call per message, and the first bytes already read when it wakes. The wake-up
         socket is then looked at after each wait, which ends on data, on the timeout, or on the
@@ -993,7 +994,7 @@ class Subscriber:
                     if first is None and conn.flags and len(conns) == 1:
                         # messages coming fast: wait for the next one in recv (see the docstring)
                         now = monotonic()
-                        if now - last < _BLOCKING_WAIT:
+                        if now - last < _BLOCKING_WAIT / 2:
                             waiter = conn
                         last = now
                     fused = fused_of[conn.tagged]
