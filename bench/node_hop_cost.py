@@ -16,6 +16,7 @@ from __future__ import annotations
 import argparse
 import os
 import re
+import shutil
 import signal
 import subprocess
 import tempfile
@@ -153,7 +154,7 @@ def main() -> None:
     keep = os.environ.get("PYTHONPATH")
     try:
         with master() as uri:
-            for name, src in sides:
+            for name, src in sides if shutil.which("strace") else ():  # (Debian's strace)
                 got = one_side(uri, src, opts.count, "strace")
                 calls = got["syscalls"]
                 assert isinstance(calls, dict)
@@ -177,7 +178,7 @@ def main() -> None:
                         f"{name:10s} round {round_ + 1} (load {os.getloadavg()[0]:.1f}): RTT p50 {got['p50_us']:6.1f} us,"
                         f" pong CPU {cpu:5.1f} us per message; per thread: {listed}"
                     )
-            if opts.callgrind:
+            if opts.callgrind and shutil.which("valgrind"):
                 for name, src in sides:
                     got = one_side(uri, src, opts.count, "callgrind")
                     print(
