@@ -62,9 +62,23 @@ def test_reader_resynchronises_after_noise_and_bad_checksums_byte_by_byte() -> N
     )
     assert proto.Drop(proto.DropReason.VERSION, 0x10) in drops
     assert drops[0].log_line() == "wrong checksum for topic id and msg"
-    assert (
-        "Mismatched protocol version in packet (0x10)"
-        in proto.Drop(proto.DropReason.VERSION, 0x10).log_line()
+    # rosserial_python's words and levels (noetic SerialClient.py): the version byte as Python 3's repr
+    assert proto.Drop(proto.DropReason.VERSION, 0x10).log_lines() == [
+        (
+            "error",
+            "Mismatched protocol version in packet (b'\\x10'): lost sync or rosserial_python is from "
+            "different ros release than the rosserial client",
+        ),
+        ("info", "Protocol version of client is unrecognized, expected Rev 1 (rosserial 0.5+)"),
+    ]
+    # a Groovy client's 0xFF 0xFF header is refused as Rev 0, as rosserial_python refuses it
+    assert proto.Drop(proto.DropReason.VERSION, 0xFF) in drops
+    assert proto.Drop(proto.DropReason.VERSION, 0xFF).log_lines()[1] == (
+        "info",
+        "Protocol version of client is Rev 0 (rosserial 0.4 and earlier), expected Rev 1 (rosserial 0.5+)",
+    )
+    assert proto.Drop(proto.DropReason.LENGTH_CHECKSUM, 4).log_line() == (
+        "Wrong checksum for msg length, length 4, dropping message."
     )
     # and all of it in one read gives the same
     assert [o for o in proto.FrameReader().feed(stream) if isinstance(o, proto.Frame)] == frames
@@ -79,6 +93,11 @@ def test_parameter_kinds_as_request_param_carries_them() -> None:
         param_response_lists({"a": 1})
     with pytest.raises(RosserialError, match="same type"):
         param_response_lists([1, "a"])
+    assert param_response_lists([True, False]) == ([1, 0], [], [])
+    with pytest.raises(RosserialError, match="same type"):
+        param_response_lists([1, True])  # rosserial_python compares exact types
+    with pytest.raises(RosserialError, match="same type"):
+        param_response_lists([1, 2.5])
 
 
 # -- the node against the emulated board --------------------------------------------------------------
@@ -174,8 +193,8 @@ def test_debian_rostopic_reads_wl_and_drives_cmd_vel_through_the_board(
     out = rig.stop(proc)
     assert board.stopped_by_host  # rosserial_python's TX_STOP at shutdown
     assert "wrong checksum for topic id and msg" in out, out
-    assert "Mismatched protocol version in packet (0x13)" in out, out
-    assert "wrong checksum for msg length, length 4, dropping message." in out, out
+    assert "Mismatched protocol version in packet (b'\\x13')" in out, out
+    assert "Wrong checksum for msg length, length 4, dropping message." in out, out
     assert "Setup publisher on wl [std_msgs/Float32]" in out, out
     assert "Setup subscriber on cmd_vel [geometry_msgs/Twist]" in out, out
     assert f"Connecting to {board.path} at 115200 baud" in out, out
@@ -204,6 +223,8 @@ def test_a_device_with_an_unknown_md5_gets_one_clear_error_and_the_rest_works(ri
     b.send(proto.ID_PUBLISHER, _info(131, "nope", "no_such_pkg/Thing", "0" * 32))
     time.sleep(1.0)
     assert proc.poll() is None
+    # rosserial_server's serial_node runs under its own default name, as ros::init names it
+    assert _publishers(rig, "/wl") == ["/rosserial_server_serial_node"]
     out = rig.stop(proc)
     assert "Creation of publisher failed: Checksum does not match: " in out, out
     assert "Creation of publisher failed:" in out and "no_such_pkg" in out, out
@@ -234,6 +255,47 @@ def test_tcp_mode_serves_a_wifi_board_whose_sketch_calls_a_ros_service(
     out = rig.stop(proc)
     assert f"Waiting for socket connections on port {port}" in out, out
     assert "Established a socket connection from 127.0.0.1" in out, out
+
+
+def test_rosserial_server_serial_launch_and_rosserial_arduinos_serial_node(rig: Rig) -> None:
+    """The names users' launch files use: ``roslaunch rosserial_server serial.launch port:=...`` (node
+    ``rosserial_server``), ``rosrun rosserial_arduino serial_node.py PORT`` (node ``serial_node``) and
+    ``message_info_service.py``, which rosserial keeps only to say it is no longer needed."""
+    rig.node("rosserial_names_test").set_param("/wheel_radius", 0.05)
+    b = rig.device(EmulatedArduino())
+    launch = rig.roslaunch("rosserial_server", "serial.launch", f"port:={b.path}")
+    b.wait(lambda: b.configured and b.wheel_radius is not None)
+    assert _publishers(rig, "/wl") == ["/rosserial_server"]
+    rig.stop(launch)
+    b.wait(lambda: not b.configured)  # the host's TX_STOP as it went down
+
+    b2 = rig.device(EmulatedArduino())
+    arduino = rig.shipped("rosserial_arduino", "serial_node.py", b2.path)
+    info = rig.shipped("rosserial_python", "message_info_service.py")
+    b2.wait(lambda: b2.configured and b2.wheel_radius is not None)
+    assert _publishers(rig, "/wr") == ["/serial_node"]
+    rig.read_until(info, "no longer needed")
+    assert info.poll() is None  # it stays up, as ROS 1's spins
+    out = rig.stop(arduino)
+    assert "Setup publisher on wr [std_msgs/Float32]" in out, out
+
+
+def test_tcp_port_falls_back_to_rosserial_embeddedlinux(board: EmulatedArduino, rig: Rig) -> None:
+    port = testing.free_port()
+    node = rig.node("rosserial_tcp_param_test")
+    node.set_param("/rosserial_embeddedlinux/tcp_port", port)
+    node.set_param("/wheel_radius", 0.05)
+    proc = serial_node(rig, "tcp")
+    rig.read_until(proc, f"Waiting for socket connections on port {port}")
+    board.connect_tcp(port)
+    board.wait(lambda: board.configured)
+
+
+def _publishers(rig: Rig, topic: str) -> list[str]:
+    import xmlrpc.client
+
+    _code, _msg, (pubs, _subs, _srvs) = xmlrpc.client.ServerProxy(rig.uri).getSystemState("/test")
+    return next((nodes for name, nodes in pubs if name == topic), [])
 
 
 def serial_node(

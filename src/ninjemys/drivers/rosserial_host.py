@@ -122,7 +122,8 @@ class RosserialHost:
                     for item in self.reader.feed(data):
                         if isinstance(item, proto.Drop):
                             self.dropped += 1
-                            self.log.info("%s", item.log_line())
+                            for level, line in item.log_lines():
+                                (self.log.error if level == "error" else self.log.info)("%s", line)
                         else:
                             self.frames_in += 1
                             self._dispatch(item)
@@ -364,8 +365,9 @@ class RosserialHost:
             2: self.log.warn,
             3: self.log.error,
             4: self.log.fatal,
-        }.get(msg.level, self.log.info)
-        emit("%s", msg.msg)
+        }.get(msg.level)
+        if emit is not None:  # another level is dropped, as rosserial_python drops it
+            emit("%s", msg.msg)
 
 
 def param_response_lists(value: Any) -> tuple[list[int], list[float], list[str]]:
@@ -379,11 +381,11 @@ def param_response_lists(value: Any) -> tuple[list[int], list[float], list[str]]
     values = list(value) if isinstance(value, list | tuple) else [value]
     if not values:
         return [], [], []
-    kinds = {int if isinstance(v, int) else type(v) for v in values}
+    kinds = {type(v) for v in values}  # rosserial_python compares exact types: [1, True] is mixed
     if len(kinds) != 1:
         raise RosserialError("All Paramers in the list {name} must be of the same type")
     kind = kinds.pop()
-    if kind is int:
+    if kind is int or kind is bool:
         return [int(v) for v in values], [], []
     if kind is float:
         return [], [float(v) for v in values], []
