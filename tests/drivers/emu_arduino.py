@@ -218,7 +218,10 @@ class EmulatedArduino:
                 if isinstance(item, proto.Drop):
                     self.drops += 1
                 else:
-                    self._handle(item)
+                    try:
+                        self._handle(item)
+                    except OSError:  # the host went away while the board answered it
+                        return
 
     def _publish_loop(self) -> None:
         period = 1.0 / self.rate_hz

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 import subprocess
+import xml.etree.ElementTree as ET
 import time
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -185,3 +186,21 @@ def test_launch_files_name_the_node_and_its_parameters() -> None:
     for name in ("rplidar", "rplidar_a1", "rplidar_a2", "rplidar_a3"):
         text = (share / f"{name}.launch").read_text()
         assert 'type="rplidarNode"' in text and 'name="angle_compensate"' in text
+    # rplidar_ros' values, launch file by launch file (1.10's rplidar*.launch, 2.x's per-model files)
+    bauds = {"rplidar": 115200, "rplidar_a1": 115200, "rplidar_a2": 115200, "rplidar_a2m8": 115200}
+    bauds |= {"rplidar_a2m7": 256000, "rplidar_a2m12": 256000, "rplidar_a3": 256000}
+    for name, baud in bauds.items():
+        root = ET.parse(share / f"{name}.launch").getroot()
+        args = {a.get("name"): a.get("default") for a in root.iter("arg")}
+        (node,) = root.iter("node")
+        assert (node.get("name"), node.get("pkg"), node.get("type")) == (
+            "rplidarNode",
+            "rplidar_ros",
+            "rplidarNode",
+        )
+        params = {p.get("name"): p.get("value") for p in node.iter("param")}
+        assert args == {"serial_port": "/dev/ttyUSB0", "serial_baudrate": str(baud), "frame_id": "laser"}, (
+            name
+        )
+        assert params["inverted"] == "false" and params["angle_compensate"] == "true", name
+        assert params.get("scan_mode") == ("Sensitivity" if name == "rplidar_a3" else None), name

@@ -32,6 +32,8 @@ from ninjemys.drivers.rosserial_host import SYNC_TIMEOUT, RosserialHost
 from ninjemys.node.run import run_node
 
 DEFAULT_TCP_PORT = 11411
+#: seconds between opening a serial port and asking the board for its topics (rosserial_python's)
+BOOT_WAIT = 2.1
 
 
 class SocketLink:
@@ -96,6 +98,14 @@ def serve_serial(node: Any, port: str, baud: int, sync_timeout: float) -> None:
             node.wait_for_shutdown(1.0)
             continue
         first_error = True
+        # opening the port pulses DTR, which resets an Arduino: its bootloader would swallow the topic
+        # request, and the sketch waits for one, so wait as rosserial_python does (0.1 + 2 s), then drop
+        # what the bootloader printed
+        node.wait_for_shutdown(BOOT_WAIT)
+        try:
+            link.reset_input_buffer()
+        except (OSError, AttributeError):
+            pass
         _serve(node, RosserialHost(node, link, sync_timeout))
         if not node.is_shutdown:
             node.wait_for_shutdown(1.0)
