@@ -151,6 +151,18 @@ def test_cmd_vel_only_while_the_enable_button_is_held_and_one_stop_after() -> No
     assert t.on_joy([], []) is None  # short arrays: not pressed, no crash
 
 
+def test_require_enable_button_false_drives_without_a_button_and_turbo_still_wins() -> None:
+    """The ROS 2 port's ``require_enable_button``, read so its config files work; true (the default)
+    keeps ROS 1's rule."""
+    t = Teleop(read_config(params({"require_enable_button": False, "enable_turbo_button": 3})), Twist)
+    assert t.on_joy([0.0, 0.5], [0, 0, 0, 0]).linear.x == pytest.approx(0.25)
+    assert t.on_joy([0.0, 0.5], [0, 0, 0, 1]).linear.x == pytest.approx(0.5)
+    strict = Teleop(read_config(params({})), Twist)
+    assert strict.on_joy([0.0, 0.5], [0]).linear.x == 0.0  # the one stop...
+    assert strict.on_joy([0.0, 0.5], [0]) is None  # ...then nothing: the button is required
+    assert strict.on_joy([0.0, 0.5], [1]).linear.x == pytest.approx(0.25)  # enable_button 0, scale 0.5
+
+
 def test_holonomic_maps_and_axes_beyond_the_message() -> None:
     t = Teleop(
         read_config(
