@@ -7,8 +7,10 @@ stops syncing is asked for its topics again with ROS 1's "Lost sync with device,
 
 from __future__ import annotations
 
+import os
 import subprocess
 import time
+import tty
 from typing import TYPE_CHECKING
 
 import pytest
@@ -210,7 +212,36 @@ def test_lost_sync_is_logged_and_the_topics_are_requested_again(board: EmulatedA
     board.sync_enabled = True
     out = rig.stop(proc)
     assert "Lost sync with device, restarting..." in out, out
+    # once a good packet came, it stays "lost sync" (rosserial_python never resets its `synced`)
+    assert "Unable to sync" not in out, out
     assert out.count("Requesting topics...") >= 2, out
+
+
+class _SilentBoard:
+    """A pty nobody answers on: a board with the wrong sketch, or a wrong baud rate's garbage."""
+
+    def __init__(self) -> None:
+        self.master, self.slave = os.openpty()
+        tty.setraw(self.slave)
+        self.path = os.ttyname(self.slave)
+
+    def close(self) -> None:
+        os.close(self.master)
+        os.close(self.slave)
+
+
+def test_a_board_that_never_answers_is_unable_to_sync_and_asked_again(rig: Rig) -> None:
+    b = rig.device(_SilentBoard())
+    os.write(b.master, b"\x00\x13 wrong baud rate \xfe\x01")  # noise, no packet
+    proc = serial_node(rig, b.path, "_sync_timeout:=1.0")
+    rig.read_until(
+        proc,
+        "Unable to sync with device; possible link problem or link software version "
+        "mismatch such as hydro rosserial_python with groovy Arduino",
+    )
+    out = rig.stop(proc)
+    assert "Lost sync with device" not in out, out  # it never had a good packet
+    assert "Traceback" not in out, out
 
 
 def test_a_device_with_an_unknown_md5_gets_one_clear_error_and_the_rest_works(rig: Rig) -> None:

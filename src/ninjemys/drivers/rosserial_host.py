@@ -15,7 +15,8 @@ the device's md5sum is the one of the type the host knows. Then it relays:
 * device service clients: the device's requests call the ROS service and its answer goes back.
 
 With no time sync for ``sync_timeout`` seconds (rosserial_python: 3 x 5 s) the host logs ROS 1's
-"Lost sync with device, restarting..." and asks for the topics again; bad packets are dropped with
+"Lost sync with device, restarting..." (or, if no good packet ever came on this link, "Unable to sync
+with device; ...") and asks for the topics again; bad packets are dropped with
 rosserial_python's log lines and never stop the link.
 """
 
@@ -126,6 +127,7 @@ class RosserialHost:
                                 (self.log.error if level == "error" else self.log.info)("%s", line)
                         else:
                             self.frames_in += 1
+                            self.synced = True  # any good packet, as rosserial_python counts it
                             self._dispatch(item)
                 now = time.monotonic()
                 if now - self.last_sync > self.sync_timeout:
@@ -136,7 +138,6 @@ class RosserialHost:
                             "Unable to sync with device; possible link problem or link software version "
                             "mismatch such as hydro rosserial_python with groovy Arduino"
                         )
-                    self.synced = False
                     self.request_topics()
                     self.last_sync = now
         finally:
@@ -340,7 +341,6 @@ class RosserialHost:
         msg = self.Time()
         msg.data = self.node.now()
         self.send(proto.ID_TIME, msg.serialize_to_bytes())
-        self.synced = True
         self.last_sync = time.monotonic()
 
     def _handle_parameter_request(self, payload: bytes) -> None:

@@ -89,8 +89,10 @@ class Drop:
         followed by an info line naming both protocol versions; the checksum drops are info lines."""
         if self.reason is DropReason.VERSION:
             found = _PROTOCOL_REVISIONS.get(self.detail)
-            client = f"Protocol version of client is {found}" if found else (
-                "Protocol version of client is unrecognized"
+            client = (
+                f"Protocol version of client is {found}"
+                if found
+                else ("Protocol version of client is unrecognized")
             )
             return [
                 (
