@@ -237,8 +237,12 @@ def test_joy_node_retries_a_missing_device_and_reopens_when_it_comes_back(rig: R
         joys.wait_for(lambda m: list(m.buttons) == [1], timeout=15)
     finally:
         os.close(fd)
+    # the writer gone is the device unplugged: joy_node's line, once, and no busy reopening
+    out += rig.read_until(proc, "Connection to joystick device lost unexpectedly. Will reopen.")
+    time.sleep(1.5)
     out += rig.stop(proc)
     assert out.count(f"Couldn't open joystick {path}. Will retry every second.") == 1, out
+    assert out.count("Connection to joystick device lost unexpectedly") == 1, out
     assert f"Opened joystick: {path} (Unknown). deadzone_: 0.050000." in out, out
 
 
