@@ -204,13 +204,21 @@ def test_debian_rostopic_reads_wl_and_drives_cmd_vel_through_the_board(
 
 
 def test_lost_sync_is_logged_and_the_topics_are_requested_again(board: EmulatedArduino, rig: Rig) -> None:
-    rig.node("rosserial_sync_test").set_param("/wheel_radius", 0.05)
+    node = rig.node("rosserial_sync_test")
+    node.set_param("/wheel_radius", 0.05)
+    diagnostics = rig.collect(node, "/diagnostics", get_message_class("diagnostic_msgs/DiagnosticArray"))
     proc = serial_node(rig, board.path, "_sync_timeout:=1.0", "__name:=arduino")
     board.wait(lambda: board.configured)
     board.sync_enabled = False  # a sketch stuck without spinOnce's time sync
     board.wait(lambda: board.negotiations >= 2, timeout=15)
     board.sync_enabled = True
+    # rosserial_python's ERROR status on /diagnostics for it
+    diag = diagnostics.wait_for(lambda m: m.status and m.status[0].message == "no sync with device")
+    status = diag.status[0]
+    assert (status.name, status.level) == ("rosserial_python", 2)
+    assert [kv.key for kv in status.values] == ["last sync", "last sync lost"]
     out = rig.stop(proc)
+    assert "Sending tx stop request" in out, out
     assert "Lost sync with device, restarting..." in out, out
     # once a good packet came, it stays "lost sync" (rosserial_python never resets its `synced`)
     assert "Unable to sync" not in out, out

@@ -35,6 +35,12 @@ from ninjemys.idl.loader import get_message_class, get_service_class
 SERVICE_TIMEOUT = 5.0
 #: rosserial_python's default: 3 x its 5 s timeout without time sync means the link is lost
 SYNC_TIMEOUT = 15.0
+#: the messages of rosserial_python's /diagnostics statuses
+ERROR_MISMATCHED_PROTOCOL = (
+    "Mismatched protocol version in packet: lost sync or rosserial_python is from different ros release "
+    "than the rosserial client"
+)
+ERROR_NO_SYNC = "no sync with device"
 
 
 class Transport(Protocol):
@@ -96,6 +102,12 @@ class RosserialHost:
         self._sub_buffer_noted = False
         self.frames_in = 0
         self.dropped = 0
+        self.DiagnosticArray: Any = get_message_class("diagnostic_msgs/DiagnosticArray")
+        self.DiagnosticStatus: Any = get_message_class("diagnostic_msgs/DiagnosticStatus")
+        self.KeyValue: Any = get_message_class("diagnostic_msgs/KeyValue")
+        self.diagnostics = node.publisher("/diagnostics", self.DiagnosticArray, queue_size=10)
+        self.last_sync_wall = time.time()  # "last sync" and "last sync lost" in the diagnostics
+        self.last_sync_lost_wall = 0.0
 
     # -- the link ------------------------------------------------------------------------------------
 
@@ -123,6 +135,8 @@ class RosserialHost:
                     for item in self.reader.feed(data):
                         if isinstance(item, proto.Drop):
                             self.dropped += 1
+                            if item.reason is proto.DropReason.VERSION:
+                                self.send_diagnostics(ERROR_MISMATCHED_PROTOCOL)
                             for level, line in item.log_lines():
                                 (self.log.error if level == "error" else self.log.info)("%s", line)
                         else:
@@ -138,6 +152,8 @@ class RosserialHost:
                             "Unable to sync with device; possible link problem or link software version "
                             "mismatch such as hydro rosserial_python with groovy Arduino"
                         )
+                    self.last_sync_lost_wall = time.time()
+                    self.send_diagnostics(ERROR_NO_SYNC)
                     self.request_topics()
                     self.last_sync = now
         finally:
@@ -145,8 +161,25 @@ class RosserialHost:
                 try:
                     with self._write_lock:
                         self.link.write(proto.TX_STOP)
+                    self.log.info("Sending tx stop request")
                 except OSError:
                     pass
+
+    def send_diagnostics(self, text: str) -> None:
+        """An ERROR status on ``/diagnostics``, as rosserial_python sends on a lost sync or a packet of
+        another protocol version: name ``rosserial_python``, with the last sync and last loss."""
+        status = self.DiagnosticStatus()
+        status.name = "rosserial_python"
+        status.level = self.DiagnosticStatus.ERROR
+        status.message = text
+        status.values = [
+            self.KeyValue(key="last sync", value=time.ctime(self.last_sync_wall)),
+            self.KeyValue(key="last sync lost", value=time.ctime(self.last_sync_lost_wall)),
+        ]
+        msg = self.DiagnosticArray()
+        msg.header.stamp = self.node.now()
+        msg.status = [status]
+        self.diagnostics.publish(msg)
 
     def close(self) -> None:
         """Release what this link set up on the node (the node itself stays up for a reconnect)."""
@@ -160,6 +193,7 @@ class RosserialHost:
         self.publishers.clear()
         self.subscribers.clear()
         self.services.clear()
+        self.diagnostics.unregister()
 
     # -- dispatch -------------------------------------------------------------------------------------
 
@@ -341,6 +375,7 @@ class RosserialHost:
         msg = self.Time()
         msg.data = self.node.now()
         self.send(proto.ID_TIME, msg.serialize_to_bytes())
+        self.last_sync_wall = time.time()
         self.last_sync = time.monotonic()
 
     def _handle_parameter_request(self, payload: bytes) -> None:
