@@ -145,7 +145,7 @@ def test_a_bad_descriptor_is_one_clear_error_and_the_node_stays_up(rig: Rig) -> 
     assert "Traceback" not in out, out
 
 
-def test_health_error_and_unknown_scan_mode_stop_the_node_as_rplidar_ros_does(
+def test_health_error_and_a_missing_port_stop_the_node_as_rplidar_ros_does(
     rig: Rig, tmp_path: Path
 ) -> None:
     sick = rig.device(EmulatedA1(health=(2, 0x8001)))
@@ -154,12 +154,28 @@ def test_health_error_and_unknown_scan_mode_stop_the_node_as_rplidar_ros_does(
     assert rp.CMD_SCAN not in sick.commands and rp.CMD_EXPRESS_SCAN not in sick.commands
     assert "RPLidar health status : 2" in out, out
     assert "Error, rplidar internal error detected. Please reboot the device to retry." in out, out
-    a1 = rig.device(EmulatedA1())
-    out = rig.exit_output(rplidar(rig, f"_serial_port:={a1.path}", "_scan_mode:=Sensitivity"))
-    assert "scan mode `Sensitivity' is not supported by lidar, supported modes:" in out, out
-    assert "\tStandard: max_distance: 16.0 m, Point number: 2.0K" in out, out
     out = rig.exit_output(rplidar(rig, f"_serial_port:={tmp_path / 'nothing'}"))
     assert f"Error, cannot bind to the specified serial port {tmp_path / 'nothing'}." in out, out
+
+
+def test_an_unknown_scan_mode_lists_the_modes_and_waits_for_start_motor_as_rplidar_ros(rig: Rig) -> None:
+    """rplidar_ros does not exit here: it prints the modes and ``Can not start scan: 80008001!``, stays
+    up without scans, and its ``start_motor`` starts the device's typical mode."""
+    a1 = rig.device(EmulatedA1())
+    node = rig.node("rplidar_mode_test")
+    scans = rig.collect(node, "/scan", LaserScan)
+    proc = rplidar(rig, f"_serial_port:={a1.path}", "_scan_mode:=Sensitivity")
+    out = rig.read_until(proc, "Can not start scan: 80008001!")
+    assert "scan mode `Sensitivity' is not supported by lidar, supported modes:" in out, out
+    assert "\tStandard: max_distance: 16.0 m, Point number: 2.0K" in out, out
+    time.sleep(1.0)
+    assert proc.poll() is None and not scans.items
+    assert rp.CMD_SCAN not in a1.commands and rp.CMD_EXPRESS_SCAN not in a1.commands
+    node.service_proxy("/start_motor", Empty)(Empty._request_class())
+    scans.wait_count(2, timeout=30)
+    out += rig.stop(proc)
+    assert "current scan mode: Express" in out, out
+    assert "Traceback" not in out, out
 
 
 def test_rplidar_a1_launch_brings_up_the_node_on_the_emulated_device(rig: Rig) -> None:

@@ -51,6 +51,8 @@ DECODERS: dict[int, Any] = {
 }
 #: a second between "bad capsule data" lines
 BAD_DATA_LOG_INTERVAL = 1.0
+#: the SDK's RESULT_OPERATION_FAIL, as rplidar_ros prints it when the scan mode asked for is not there
+RESULT_OPERATION_FAIL = 0x80008001
 
 
 class ScanMode:
@@ -319,6 +321,7 @@ class RplidarNode:
         except (TimeoutError, rp.RplidarError) as exc:
             self.log.error("Error, cannot get the scan modes of the lidar: %s", exc)
             return 1
+        by_id = {m.id: m for m in modes}
         if self.scan_mode_name:
             chosen = [m for m in modes if m.name == self.scan_mode_name]
             if not chosen:
@@ -332,10 +335,18 @@ class RplidarNode:
                         m.max_distance,
                         1000.0 / m.us_per_sample,
                     )
-                return 1
-            self.mode = chosen[0]
-        else:
-            by_id = {m.id: m for m in modes}
+                # rplidar_ros stays up without a scan (RESULT_OPERATION_FAIL); its start_motor service
+                # then starts the typical mode, which is kept ready here
+                self.log.error("Can not start scan: %08x!", RESULT_OPERATION_FAIL)
+                try:
+                    typical = typical_mode_id(self.dev, info)
+                except (TimeoutError, rp.RplidarError) as exc:
+                    self.log.error("Error, cannot get the scan modes of the lidar: %s", exc)
+                    return 1
+                self.stopped = True
+            else:
+                self.mode = chosen[0]
+        if self.mode is None:
             # the typical mode (legacy: Express when the device has it, else Standard)
             self.mode = by_id.get(typical if typical is not None else -1, modes[-1])
         if self.mode.ans_type not in DECODERS:
