@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 import subprocess
+import xmlrpc.client
 import xml.etree.ElementTree as ET
 import time
 from pathlib import Path
@@ -112,6 +113,9 @@ def test_scan_of_the_known_room_within_1cm_and_stop_motor_reaches_the_device(mod
     samples = a1.standard_samples() if mode == "Standard" else a1.express_samples()
     check_room(scan, samples)
     assert rp.CMD_GET_INFO in a1.commands and rp.CMD_GET_HEALTH in a1.commands
+    # by rosrun the node has rplidar_ros' ros::init name, rplidar_node (launch files call it rplidarNode)
+    _code, _msg, (pubs, _subs, _srvs) = xmlrpc.client.ServerProxy(rig.uri).getSystemState("/t")
+    assert dict((t, n) for t, n in pubs)["/scan"] == ["/rplidar_node"]
 
     before = len(a1.commands)
     node.service_proxy("/stop_motor", Empty)(Empty._request_class())

@@ -511,4 +511,5 @@ def main(argv: list[str] | None = None) -> int:
             port.close()
         return 0
 
-    return run_node("rplidarNode", argv, build)
+    # ros::init's name in rplidar_ros (the launch files name the node rplidarNode)
+    return run_node("rplidar_node", argv, build)
