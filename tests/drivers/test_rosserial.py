@@ -294,6 +294,7 @@ def test_tcp_mode_serves_a_wifi_board_whose_sketch_calls_a_ros_service(
     out = rig.stop(proc)
     assert f"Waiting for socket connections on port {port}" in out, out
     assert "Established a socket connection from 127.0.0.1" in out, out
+    assert out.count("Waiting for socket connection\n") == 1 and "calling startSerialClient" in out, out
 
 
 def test_rosserial_server_serial_launch_and_rosserial_arduinos_serial_node(rig: Rig) -> None:

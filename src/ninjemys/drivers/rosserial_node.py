@@ -117,9 +117,9 @@ def serve_tcp(node: Any, port: int, sync_timeout: float) -> None:
     node.on_shutdown(server.close)
     node.log.info("Fork_server is: %s", bool(node.get_param("~fork_server", False)))
     node.log.info("Waiting for socket connections on port %d", port)
+    node.log.info("Waiting for socket connection")
     try:
         while not node.is_shutdown:
-            node.log.info("waiting for socket connection")
             while not node.is_shutdown:
                 try:
                     sock, addr = server.accept()
@@ -131,7 +131,10 @@ def serve_tcp(node: Any, port: int, sync_timeout: float) -> None:
             else:
                 return
             node.log.info("Established a socket connection from %s on port %s", addr[0], addr[1])
+            node.log.info("calling startSerialClient")
             _serve(node, RosserialHost(node, SocketLink(sock), sync_timeout))
+            node.log.info("Client has exited, closing socket.")
+            node.log.info("startSerialClient() exited")
     finally:
         server.close()
 
