@@ -253,11 +253,33 @@ def test_a_board_that_never_answers_is_unable_to_sync_and_asked_again(rig: Rig) 
 
 
 def test_a_device_with_an_unknown_md5_gets_one_clear_error_and_the_rest_works(rig: Rig) -> None:
+    """Under rosserial_server's serial_node: the board's log levels on /rosout, RequestParam's int,
+    float and string arrays, and two endpoints the host cannot serve, each one clear error."""
     from .emu_arduino import _info
 
     b = rig.device(EmulatedArduino())
+    logs = rig.collect(rig.node("rosserial_levels_test"), "/rosout", Log)
     proc = serial_node(rig, f"_port:={b.path}", package="rosserial_server", exe="serial_node")
     b.wait(lambda: b.configured)
+    # every level of the board's nh.logxxx() reaches /rosout at rosgraph_msgs/Log's level
+    DeviceLog = get_message_class("rosserial_msgs/Log")
+    for level in (DeviceLog.INFO, DeviceLog.WARN, DeviceLog.ERROR, DeviceLog.FATAL, 7):
+        b.send(proto.ID_LOG, DeviceLog(level=level, msg=f"board level {level}").serialize_to_bytes())
+    for level, expected in ((1, Log.INFO), (2, Log.WARN), (3, Log.ERROR), (4, Log.FATAL)):
+        got = logs.wait_for(lambda m, n=level: m.msg == f"board level {n}")
+        assert got.level == expected and got.name == "/rosserial_server_serial_node"
+    # nh.getParam() of int, float and string arrays, a relative and a private name, end to end
+    node = rig.node("rosserial_param_test")
+    node.set_param("/gains", [3, 4, 5])
+    node.set_param("/offsets", [0.5, -1.25])
+    node.set_param("/rosserial_server_serial_node/names", ["left", "right"])
+    b.param_answers_only = True
+    RequestParam = get_service_class("rosserial_msgs/RequestParam")
+    for name in ("gains", "offsets", "~names", "/no_such_param"):
+        b.send(proto.ID_PARAMETER_REQUEST, RequestParam._request_class(name=name).serialize_to_bytes())
+    b.wait(lambda: len(b.param_answers) >= 3)  # no answer to a missing one (nor to wheel_radius here)
+    answers = [(list(a.ints), list(a.floats), list(a.strings)) for a in b.param_answers]
+    assert answers == [([3, 4, 5], [], []), ([], [0.5, -1.25], []), ([], [], ["left", "right"])]
     b.send(proto.ID_PUBLISHER, _info(130, "odd", "std_msgs/Float32", "0" * 32))
     b.send(proto.ID_PUBLISHER, _info(131, "nope", "no_such_pkg/Thing", "0" * 32))
     time.sleep(1.0)
@@ -267,6 +289,8 @@ def test_a_device_with_an_unknown_md5_gets_one_clear_error_and_the_rest_works(ri
     out = rig.stop(proc)
     assert "Creation of publisher failed: Checksum does not match: " in out, out
     assert "Creation of publisher failed:" in out and "no_such_pkg" in out, out
+    assert "board level 7" not in out  # a level rosserial_python does not know is dropped, as there
+    assert "Parameter /no_such_param does not exist" in out, out
     assert "Traceback" not in out, out
 
 

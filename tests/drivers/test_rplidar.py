@@ -149,9 +149,7 @@ def test_a_bad_descriptor_is_one_clear_error_and_the_node_stays_up(rig: Rig) -> 
     assert "Traceback" not in out, out
 
 
-def test_health_error_and_a_missing_port_stop_the_node_as_rplidar_ros_does(
-    rig: Rig, tmp_path: Path
-) -> None:
+def test_health_error_and_a_missing_port_stop_the_node_as_rplidar_ros_does(rig: Rig, tmp_path: Path) -> None:
     sick = rig.device(EmulatedA1(health=(2, 0x8001)))
     out = rig.exit_output(rplidar(rig, f"_serial_port:={sick.path}"))
     sick.wait(lambda: rp.CMD_RESET in sick.commands, timeout=5)  # the protection stop is reset
