@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import math
 import subprocess
-import xmlrpc.client
-import xml.etree.ElementTree as ET
 import time
+import xml.etree.ElementTree as ET
+import xmlrpc.client
 from pathlib import Path
 from typing import TYPE_CHECKING
 
