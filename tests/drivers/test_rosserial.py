@@ -349,7 +349,7 @@ def test_tcp_port_falls_back_to_rosserial_embeddedlinux(board: EmulatedArduino, 
     node = rig.node("rosserial_tcp_param_test")
     node.set_param("/rosserial_embeddedlinux/tcp_port", port)
     node.set_param("/wheel_radius", 0.05)
-    proc = serial_node(rig, "tcp")
+    proc = serial_node(rig, "_port:=tcp")  # "tcp" as the port parameter works as the argument does
     rig.read_until(proc, f"Waiting for socket connections on port {port}")
     board.connect_tcp(port)
     board.wait(lambda: board.configured)

@@ -155,7 +155,10 @@ def main(argv: list[str] | None = None) -> int:
     def build(node: Any) -> int:
         node.log.info("ROS Serial Python Node")
         sync_timeout = float(node.get_param("~sync_timeout", SYNC_TIMEOUT))
-        if positional and positional[0] == "tcp":
+        # as rosserial_python: the first argument (else ~port) names the port, and "tcp" there, from
+        # either, means the TCP server, on the second argument (else ~tcp_port)
+        port = positional[0] if positional else str(node.get_param("~port", "/dev/ttyUSB0"))
+        if port == "tcp":
             try:
                 tcp_port = int(positional[1]) if len(positional) > 1 else _tcp_port_param(node)
             except ValueError:
@@ -163,7 +166,6 @@ def main(argv: list[str] | None = None) -> int:
                 return 2
             serve_tcp(node, tcp_port, sync_timeout)
             return 0
-        port = positional[0] if positional else str(node.get_param("~port", "/dev/ttyUSB0"))
         baud = int(node.get_param("~baud", 57600))
         node.get_param("~fix_pyserial_for_test", False)
         serve_serial(node, port, baud, sync_timeout)
@@ -210,11 +212,7 @@ def arduino_main(argv: list[str] | None = None) -> int:
     """``rosrun rosserial_arduino serial_node.py``: rosserial_arduino's copy of the serial host (older
     tutorials start it under this package). ``~auto_reset_timeout`` is accepted; the board is not reset
     through DTR, the host asks it for its topics again as after any lost sync."""
-    args = sys.argv[1:] if argv is None else list(argv)
-    if _positional(args)[:1] == ["tcp"]:
-        print("rosserial_arduino serial_node.py: use rosserial_python serial_node.py tcp", file=sys.stderr)
-        return 2
-    return main(args)
+    return main(argv)
 
 
 def message_info_main(argv: list[str] | None = None) -> int:
