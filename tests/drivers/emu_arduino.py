@@ -71,6 +71,7 @@ class EmulatedArduino:
         self.host_time: tuple[int, int] | None = None
         self.wheel_radius: float | None = None
         self.param_answers: list[Any] = []  # every RequestParam response, in order
+        self.received: list[tuple[int, int]] = []  # (topic id, payload length) of every packet from the host
         self.param_answers_only = False  # True: a test's own requests, wheel_radius left alone
         self.cmd_vels: list[Any] = []
         self.leds: list[Any] = []
@@ -178,6 +179,7 @@ class EmulatedArduino:
     def _handle(self, f: proto.Frame) -> None:
         tid = f.topic_id
         with self.cond:
+            self.received.append((tid, len(f.payload)))
             if tid == proto.ID_PUBLISHER:
                 pass
             elif tid == proto.ID_TIME:

@@ -280,6 +280,17 @@ def test_a_device_with_an_unknown_md5_gets_one_clear_error_and_the_rest_works(ri
     b.wait(lambda: len(b.param_answers) >= 3)  # no answer to a missing one (nor to wheel_radius here)
     answers = [(list(a.ints), list(a.floats), list(a.strings)) for a in b.param_answers]
     assert answers == [([3, 4, 5], [], []), ([], [0.5, -1.25], []), ([], [], ["left", "right"])]
+    # a message larger than the board's input buffer (280 bytes, announced with its subscribers) is
+    # dropped with rosserial_python's error instead of overrunning the board; smaller ones go through
+    String = get_message_class("std_msgs/String")
+    b.send(proto.ID_SUBSCRIBER, _info(110, "display", "std_msgs/String", String._md5sum))
+    display = rig.node("rosserial_buffer_test").publisher("/display", String)
+    deadline = time.monotonic() + 20
+    while not any(t == 110 for t, _ in b.received) and time.monotonic() < deadline:
+        display.publish(String(data="x" * 300))
+        display.publish(String(data="hello"))
+        time.sleep(0.2)
+    assert (110, 9) in b.received and not [n for t, n in b.received if t == 110 and n > 280]
     b.send(proto.ID_PUBLISHER, _info(130, "odd", "std_msgs/Float32", "0" * 32))
     b.send(proto.ID_PUBLISHER, _info(131, "nope", "no_such_pkg/Thing", "0" * 32))
     time.sleep(1.0)
@@ -290,6 +301,7 @@ def test_a_device_with_an_unknown_md5_gets_one_clear_error_and_the_rest_works(ri
     assert "Creation of publisher failed: Checksum does not match: " in out, out
     assert "Creation of publisher failed:" in out and "no_such_pkg" in out, out
     assert "board level 7" not in out  # a level rosserial_python does not know is dropped, as there
+    assert "Message from ROS network dropped: message larger than buffer." in out, out
     assert "Parameter /no_such_param does not exist" in out, out
     assert "Traceback" not in out, out
 

@@ -100,6 +100,7 @@ class RosserialHost:
         self._last_unknown_request = 0.0
         self._pub_buffer_noted = False
         self._sub_buffer_noted = False
+        self.buffer_in = -1  # the device's input buffer, from its first subscriber's TopicInfo
         self.frames_in = 0
         self.dropped = 0
         self.DiagnosticArray: Any = get_message_class("diagnostic_msgs/DiagnosticArray")
@@ -112,6 +113,17 @@ class RosserialHost:
     # -- the link ------------------------------------------------------------------------------------
 
     def send(self, topic_id: int, payload: bytes | bytearray = b"") -> None:
+        """Frame and write ``payload``; one larger than the device's input buffer (the size its
+        subscribers announced) is dropped with rosserial_python's error, as it would overrun the board."""
+        if 0 < self.buffer_in < len(payload):
+            self.log.error(
+                "Message from ROS network dropped: message larger than buffer. (%d bytes on topic id %d, "
+                "the device's buffer holds %d)",
+                len(payload),
+                topic_id,
+                self.buffer_in,
+            )
+            return
         packet = proto.frame(topic_id, payload)
         with self._write_lock:
             self.link.write(packet)
@@ -289,6 +301,7 @@ class RosserialHost:
         self.log.info("Setup subscriber on %s [%s]", info.topic_name, info.message_type)
         if not self._sub_buffer_noted and info.buffer_size:
             self._sub_buffer_noted = True
+            self.buffer_in = info.buffer_size
             self.log.info("Note: subscribe buffer size is %d bytes", info.buffer_size)
 
     def _service_class(self, kind: str, info: Any) -> Any:
