@@ -222,3 +222,39 @@ def test_launch_files_name_the_node_and_its_parameters() -> None:
         )
         assert params["inverted"] == "false" and params["angle_compensate"] == "true", name
         assert params.get("scan_mode") == ("Sensitivity" if name == "rplidar_a3" else None), name
+
+
+def test_view_launch_files_bring_up_the_lidar_and_rviz_on_its_scan() -> None:
+    """rplidar_ros' view_rplidar*.launch: the matching rplidar*.launch and rviz with rplidar.rviz, a
+    LaserScan display on /scan in the lidar's frame (read by our rviz's own .rviz reader)."""
+    from ninjemys.web.rvizconfig import parse
+
+    share = Path(__file__).resolve().parents[2] / "src/ninjemys/packages/share/rplidar_ros"
+    config = parse((share / "rviz/rplidar.rviz").read_text(), "rplidar.rviz")
+    assert config.fixed_frame == "laser" and not config.unsupported
+    assert [(d["cls"], d["topic"]) for d in config.displays if d["cls"] == "rviz/LaserScan"] == [
+        ("rviz/LaserScan", "/scan")
+    ]
+    for model in ("", "_a1", "_a2", "_a2m7", "_a2m8", "_a2m12", "_a3"):
+        root = ET.parse(share / f"launch/view_rplidar{model}.launch").getroot()
+        (include,) = root.iter("include")
+        assert include.get("file") == f"$(find rplidar_ros)/launch/rplidar{model}.launch"
+        (rviz,) = root.iter("node")
+        assert (rviz.get("pkg"), rviz.get("type")) == ("rviz", "rviz")
+        assert rviz.get("args") == "-d $(find rplidar_ros)/rviz/rplidar.rviz"
+
+
+def test_view_rplidar_a1_launch_runs_the_lidar_and_rviz(rig: Rig) -> None:
+    for var in ("DISPLAY", "WAYLAND_DISPLAY"):
+        rig.env.pop(var, None)  # rviz only prints its URL
+    a1 = rig.device(EmulatedA1())
+    scans = rig.collect(rig.node("rplidar_view_test"), "/scan", LaserScan)
+    launch = rig.roslaunch("rplidar_ros", "view_rplidar_a1.launch", f"serial_port:={a1.path}")
+    scans.wait_count(2, timeout=40)
+    master = xmlrpc.client.ServerProxy(rig.uri)
+    deadline = time.monotonic() + 30
+    while master.lookupNode("/t", "/rviz")[0] != 1 and time.monotonic() < deadline:
+        time.sleep(0.5)  # rviz subscribes once a page shows the scan; its node is up before that
+    assert master.lookupNode("/t", "/rviz")[0] == 1
+    out = rig.stop(launch)
+    assert "process has died" not in out, out[-3000:]
