@@ -5,6 +5,8 @@ device."""
 from __future__ import annotations
 
 import math
+import os
+import re
 import subprocess
 import time
 import xml.etree.ElementTree as ET
@@ -15,6 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pytest
 
+from ninjemys import testing
 from ninjemys.drivers import rplidar_protocol as rp
 from ninjemys.drivers.rplidar_scan import ascend, compensate_multiple, revolution_to_scan
 from ninjemys.idl.loader import get_message_class, get_service_class
@@ -258,3 +261,30 @@ def test_view_rplidar_a1_launch_runs_the_lidar_and_rviz(rig: Rig) -> None:
     assert master.lookupNode("/t", "/rviz")[0] == 1
     out = rig.stop(launch)
     assert "process has died" not in out, out[-3000:]
+
+
+def test_create_and_delete_udev_rules_scripts_write_the_rplidar_symlink_rule(tmp_path: Path) -> None:
+    """``rosrun rplidar_ros create_udev_rules.sh`` as tutorials use it (here into a directory of the
+    test's: NINJEMYS_UDEV_RULES_DIR), and ``delete_udev_rules.sh`` removing it."""
+    env = dict(os.environ, NINJEMYS_UDEV_RULES_DIR=str(tmp_path / "rules.d"))
+    rosrun = testing.ninjemys_bin("rosrun")
+    made = subprocess.run(
+        [rosrun, "rplidar_ros", "create_udev_rules.sh"], env=env, capture_output=True, text=True, timeout=60
+    )
+    assert made.returncode == 0, made
+    rule = (tmp_path / "rules.d/rplidar.rules").read_text()
+    (line,) = [x for x in rule.splitlines() if x and not x.startswith("#")]
+    fields = re.findall(r'([A-Z]+(?:\{\w+\})?)(==|:=|\+=)"([^"]*)"', line)
+    assert fields == [
+        ("KERNEL", "==", "ttyUSB*"),
+        ("ATTRS{idVendor}", "==", "10c4"),
+        ("ATTRS{idProduct}", "==", "ea60"),
+        ("MODE", ":=", "0666"),
+        ("SYMLINK", "+=", "rplidar"),
+    ]
+    assert "/dev/rplidar" in made.stdout
+    gone = subprocess.run(
+        [rosrun, "rplidar_ros", "delete_udev_rules.sh"], env=env, capture_output=True, text=True, timeout=60
+    )
+    assert gone.returncode == 0, gone
+    assert not (tmp_path / "rules.d/rplidar.rules").exists()

@@ -147,7 +147,11 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
             "serial_node": ("ninjemys.drivers.rosserial_node:server_serial_main", ()),
             "socket_node": ("ninjemys.drivers.rosserial_node:socket_main", ()),
         },
-        "rplidar_ros": {"rplidarNode": ("ninjemys.drivers.rplidar_node:main", ())},
+        "rplidar_ros": {
+            "rplidarNode": ("ninjemys.drivers.rplidar_node:main", ()),
+            "create_udev_rules.sh": ("ninjemys.drivers.udev_rules:create_main", ()),
+            "delete_udev_rules.sh": ("ninjemys.drivers.udev_rules:delete_main", ()),
+        },
         # -- ros_control (docs/sim.md): the manager runs inside the simulator --
         "controller_manager": {
             "spawner": ("ninjemys.sim.ros_control.spawner:main", ()),
