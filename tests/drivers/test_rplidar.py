@@ -183,6 +183,20 @@ def test_an_unknown_scan_mode_lists_the_modes_and_waits_for_start_motor_as_rplid
     assert "Traceback" not in out, out
 
 
+def test_rplidar_ros_2_parameters_initial_reset_and_channel_type(rig: Rig) -> None:
+    """rplidar_ros 2.x's ``initial_reset`` (RESET, wait for the device, go on) works; its Ethernet
+    ``channel_type`` is refused in one clear line."""
+    a1 = rig.device(EmulatedA1())
+    scans = rig.collect(rig.node("rplidar_reset_test"), "/scan", LaserScan)
+    proc = rplidar(rig, f"_serial_port:={a1.path}", "_initial_reset:=true")
+    scans.wait_count(2, timeout=40)
+    out = rig.stop(proc)
+    assert rp.CMD_RESET in a1.commands
+    assert "Resetting rplidar" in out and "Rplidar reset successfully" in out, out
+    out = rig.exit_output(rplidar(rig, "_channel_type:=tcp"))
+    assert "Error, channel_type tcp is not supported here" in out, out
+
+
 def test_rplidar_a1_launch_brings_up_the_node_on_the_emulated_device(rig: Rig) -> None:
     a1 = rig.device(EmulatedA1())
     node = rig.node("rplidar_launch_test")

@@ -51,6 +51,8 @@ DECODERS: dict[int, Any] = {
 }
 #: a second between "bad capsule data" lines
 BAD_DATA_LOG_INTERVAL = 1.0
+#: seconds rplidar_ros 2.x waits for the device to answer again after initial_reset
+RESET_TIMEOUT = 15.0
 #: the SDK's RESULT_OPERATION_FAIL, as rplidar_ros prints it when the scan mode asked for is not there
 RESULT_OPERATION_FAIL = 0x80008001
 
@@ -266,6 +268,7 @@ class RplidarNode:
         self.inverted = bool(node.get_param("~inverted", False))
         self.angle_compensate = bool(node.get_param("~angle_compensate", False))
         self.scan_mode_name = str(node.get_param("~scan_mode", ""))
+        self.initial_reset = bool(node.get_param("~initial_reset", False))  # rplidar_ros 2.x
         self.pub = node.publisher("scan", self.LaserScan, queue_size=1000)
         self.actions: queue.Queue[tuple[str, threading.Event]] = queue.Queue()
         self.scanning = False
@@ -285,6 +288,25 @@ class RplidarNode:
 
         return self.node.service(action, Empty, handle)
 
+    def _reset_device(self) -> bool:
+        """rplidar_ros 2.x's ``initial_reset``: RESET, then GET_INFO every 0.5 s until the device
+        answers again (its boot banner is skipped by the descriptor search), 15 s at most."""
+        self.log.info("Resetting rplidar")
+        self.dev.reset()
+        deadline = time.monotonic() + RESET_TIMEOUT
+        while not self.node.is_shutdown:
+            self.node.wait_for_shutdown(0.5)
+            try:
+                self.dev.device_info()
+            except (TimeoutError, rp.RplidarError):
+                if time.monotonic() > deadline:
+                    break
+                continue
+            self.log.info("Rplidar reset successfully")
+            return True
+        self.log.error("Error resetting rplidar")
+        return False
+
     def setup(self) -> int:
         self.log.info("RPLIDAR running on ROS package rplidar_ros. SDK Version:%s", SDK_VERSION)
         try:
@@ -298,6 +320,8 @@ class RplidarNode:
         self.log.info("RPLIDAR S/N: %s", info.serialnum.hex().upper())
         self.log.info("Firmware Ver: %d.%02d", info.firmware_version >> 8, info.firmware_version & 0xFF)
         self.log.info("Hardware Rev: %d", info.hardware_version)
+        if self.initial_reset and not self._reset_device():
+            return 1
         try:
             health = self.dev.health()
         except (TimeoutError, rp.RplidarError) as exc:
@@ -483,6 +507,14 @@ def main(argv: list[str] | None = None) -> int:
     """``rosrun rplidar_ros rplidarNode``."""
 
     def build(node: Any) -> int:
+        channel = str(node.get_param("~channel_type", "serial"))
+        if channel != "serial":  # rplidar_ros 2.x: S-series lidars on Ethernet
+            node.log.error(
+                "Error, channel_type %s is not supported here: this rplidarNode speaks to the lidar on a "
+                "serial port only (channel_type serial, serial_port, serial_baudrate)",
+                channel,
+            )
+            return 1
         path = str(node.get_param("~serial_port", "/dev/ttyUSB0"))
         baud = int(node.get_param("~serial_baudrate", 115200))
         try:
