@@ -6,6 +6,7 @@ seen while the worker sleeps in ``recv``, and no message is lost or left behind 
 
 from __future__ import annotations
 
+import logging
 import os
 import platform
 import threading
@@ -129,7 +130,10 @@ def test_the_next_handle_gets_every_message_across_the_readers_unregister(make_n
     assert second == list(range(second[0], sent[-1] + 1))  # nothing lost at the hand-over
 
 
-def test_a_dropped_publisher_under_a_wait_leaves_the_worker_serving(make_node) -> None:
+def test_a_dropped_publisher_under_a_wait_leaves_the_worker_serving(make_node, caplog) -> None:
+    """The drop ends the worker's recv at once (the socket shut down under it) and without a word:
+    the stream did not end on its own, so neither "publisher closed the connection" nor a retry."""
+    caplog.set_level(logging.INFO, logger="ninjemys.node.subscriber")
     talker, later, listener = make_node("talker"), make_node("later"), make_node("listener")
     got: list[str] = []
     sub = listener.subscriber("dropped", String, lambda m: got.append(m.data), queue_size=None)
@@ -141,6 +145,8 @@ def test_a_dropped_publisher_under_a_wait_leaves_the_worker_serving(make_node) -
         # the master's publisherUpdate without it (on the loop, as the slave API applies it): a drop
         listener.runtime.call_soon(sub._sub.update_publishers, [])
         assert wait_until(lambda: conn.closed and not sub._conns)
+    said = [r.getMessage() for r in caplog.records if r.name == "ninjemys.node.subscriber"]
+    assert not [line for line in said if "closed the connection" in line or "read failed" in line], said
     assert sub._thread.is_alive()
     pub2 = later.publisher("dropped", String, queue_size=None)
     assert wait_until(lambda: sub.get_num_connections() == 2)
