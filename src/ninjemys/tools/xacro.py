@@ -23,11 +23,12 @@ from contextlib import contextmanager
 from typing import Any
 
 from ninjemys.commands import entry
+from ninjemys.errors import PackageError
 
 _FIND = re.compile(r"\$\(\s*find\s+(\S+)\s*\)")
 
 
-class ResourceNotFound(Exception):
+class ResourceNotFound(PackageError):
     """Noetic's ``rospkg`` error text: the package, then each ROS path searched on its own line."""
 
     def __init__(self, package: str, ros_paths: list[str]) -> None:
