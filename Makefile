@@ -34,6 +34,8 @@ ROS1_DEBS += ros-actionlib-msgs
 ROS1_DEBS += python3-interactive-markers
 # catkin_add_nosetests: Debian's nose, which Debian's catkin_make run_tests runs (the reference for ours)
 ROS1_DEBS += python3-nose
+# tf's C++ library (the navigation tutorials' robot_setup_tf/odometry_publisher, turtle_tf): C++ nodes on tf build
+ROS1_DEBS += libtf-dev
 BROWSER_DEBS := chromium chromium-driver fonts-dejavu-core
 # multi-host tests: network namespaces (iproute2), roslaunch <machine> over ssh (openssh-server)
 NET_DEBS     := iproute2 openssh-server openssh-client
