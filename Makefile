@@ -36,6 +36,8 @@ ROS1_DEBS += python3-interactive-markers
 ROS1_DEBS += python3-nose
 # tf's C++ library (the navigation tutorials' robot_setup_tf/odometry_publisher, turtle_tf): C++ nodes on tf build
 ROS1_DEBS += libtf-dev
+# image_geometry's camera models (vision course code): Debian's, the reference for ours (tests/image_geometry)
+ROS1_DEBS += python3-image-geometry
 BROWSER_DEBS := chromium chromium-driver fonts-dejavu-core
 # multi-host tests: network namespaces (iproute2), roslaunch <machine> over ssh (openssh-server)
 NET_DEBS     := iproute2 openssh-server openssh-client
