@@ -38,6 +38,8 @@ ROS1_DEBS += python3-nose
 ROS1_DEBS += libtf-dev
 # image_geometry's camera models (vision course code): Debian's, the reference for ours (tests/image_geometry)
 ROS1_DEBS += python3-image-geometry
+# diagnostic_updater (drivers' and nodes' /diagnostics): Debian's, the reference for ours (tests/diagnostic_updater)
+ROS1_DEBS += python3-diagnostic-updater
 BROWSER_DEBS := chromium chromium-driver fonts-dejavu-core
 # multi-host tests: network namespaces (iproute2), roslaunch <machine> over ssh (openssh-server)
 NET_DEBS     := iproute2 openssh-server openssh-client
