@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from ninjemys.sim.lighting import DEFAULT_LIGHTING, Lighting, SceneLook
 from ninjemys.sim.raycast import circle_pairs, column_pairs
 from ninjemys.sim.sensors import FloorPaint, Scene
 
@@ -40,8 +41,13 @@ _EMPTY_RGB = np.zeros((0, 0, 3), dtype=np.uint8)
 _EMPTY_DEPTH = np.zeros((0, 0), dtype=np.uint16)
 #: an RGB pixel as one 3-byte item (see Camera._colour_cells)
 _PIXEL = np.dtype("V3")
+#: the floor's own colour (lit by the world's lights: see :mod:`ninjemys.sim.lighting`) and the sky's,
+#: where the world does not give them (an SDF world gives Gazebo's grey ground and background)
 FLOOR_RGB = np.array([176, 170, 160], dtype=np.float32)
 SKY_RGB = np.array([206, 220, 235], dtype=np.float32)
+#: a scene that says nothing of its lights: Gazebo's default sun, every side flat
+_DEFAULT_LOOK = SceneLook()
+_UP = (0.0, 0.0, 1.0)
 
 
 class Camera:
@@ -68,9 +74,7 @@ class Camera:
         floor_depth[below] = cam_z / -self.row_slope[below]
         floor_depth[floor_depth > depth_max] = 0.0
         self.floor_depth_mm = np.rint(floor_depth * 1000).astype(np.uint16)
-        # static background: floor shaded with distance, sky above the horizon
-        shade = np.clip(1.15 - floor_depth / 12.0, 0.55, 1.0)[:, None] * FLOOR_RGB[None, :]
-        bg = np.where(below[:, None], shade, SKY_RGB[None, :]).astype(np.uint8)
+        self._below = below
         # the rows that see the floor within range: the last ones, from the first such row down
         # (the floor's depth shrinks row by row below the horizon)
         self._floor_first = int(np.flatnonzero(floor_depth > 0)[0]) if (floor_depth > 0).any() else height
@@ -86,7 +90,11 @@ class Camera:
         # subtraction and one comparison per pixel, (v - top) mod 2^bits < bottom - top
         self._row_type = np.uint8 if height <= 255 else np.uint16
         self._rows = np.arange(height, dtype=self._row_type)[:, None]
-        self._background = np.ascontiguousarray(np.broadcast_to(bg[:, None, :], (height, width, 3)))
+        #: the floor (one colour: a directional light does not fade with distance) below the horizon
+        #: and the sky above, for the lights of :attr:`_lit_by` (see :meth:`_light`)
+        self._lit_by: Lighting | None = None
+        self._background = np.zeros((height, width, 3), dtype=np.uint8)
+        self._lit_palette: tuple[np.ndarray, Lighting, np.ndarray] | None = None
         self._floor_depth_image = np.ascontiguousarray(
             np.broadcast_to(self.floor_depth_mm[:, None], (height, width))
         )
@@ -137,13 +145,21 @@ class Camera:
     ) -> tuple[np.ndarray, np.ndarray]:
         if not (want_rgb or want_depth):
             return _EMPTY_RGB, _EMPTY_DEPTH
+        look = scene.look or _DEFAULT_LOOK
+        if want_rgb:
+            self._light(look.lighting)
         seen = self._crossings(scene, x, y, yaw)
         wall = (
             np.zeros((self.height, self.width), dtype=bool) if want_rgb and scene.floor is not None else None
         )
         ranks = seen.ranks() if seen is not None else None
+        if seen is not None and want_rgb:
+            self._shade(seen, scene, look, x, y, yaw)
         if seen is not None and seen.plane is None and ranks == [None]:
             rgb, depth_mm = self._paint_one_layer(seen, want_rgb, want_depth, wall)
+            if seen.round_pixels is not None:
+                _, rows, cols, colours = seen.round_pixels
+                rgb[rows, cols] = colours
         else:
             rgb = self._background.copy() if want_rgb else _EMPTY_RGB
             depth_mm = self._floor_depth_image.copy() if want_depth else _EMPTY_DEPTH
@@ -152,8 +168,120 @@ class Camera:
                 self._paint_crossings(seen, ranks, rgb, depth_mm, wall)
         if wall is not None:
             assert scene.floor is not None
-            self._paint_floor(rgb, wall, scene.floor, x, y, yaw)
+            self._paint_floor(rgb, wall, scene.floor, x, y, yaw, look.lighting)
         return rgb, depth_mm
+
+    def _light(self, lighting: Lighting) -> None:
+        """Draw the background for ``lighting`` (when it changed): the floor lit as a surface facing
+        up (the same colour at every distance), the sky above the horizon."""
+        if lighting is self._lit_by:
+            return
+        floor = np.asarray(lighting.floor if lighting.floor is not None else FLOOR_RGB, dtype=np.float32)
+        sky = np.asarray(lighting.sky if lighting.sky is not None else SKY_RGB, dtype=np.float32)
+        row = np.where(self._below[:, None], lighting.shade_flat(floor, _UP)[None, :], sky.astype(np.uint8))
+        self._background[...] = row[:, None, :]
+        self._lit_by = lighting
+
+    def _shade(self, seen: _Seen, scene: Scene, look: SceneLook, x: float, y: float, yaw: float) -> None:
+        """Each crossing's colour (``seen.rgb``), lit by the world's lights on its face's normal: a
+        side's horizontal normal turned toward the camera (a round shape's from its axis to where
+        the ray meets it), a lid's up, an underside's down; and the pixels of the sides of spheres,
+        lit row by row on the sphere's normal at that height (``seen.round_pixels``)."""
+        item, d, cols = seen.item, seen.depth, seen.col
+        n_seg = len(scene.segments)
+        count = len(item)
+        normals = np.zeros((count, 3))
+        # where each crossing's ray meets its side, in the world
+        slope = self.col_slopes.take(cols)
+        c, s = math.cos(yaw), math.sin(yaw)
+        hx = x + d * (c - s * slope)
+        hy = y + d * (s + c * slope)
+        on_seg = item < n_seg
+        all_seg = bool(_ALL(on_seg))
+        k_seg = None if all_seg else np.flatnonzero(on_seg)
+        seg_item = item if k_seg is None else item.take(k_seg)
+        seg = scene.segments.take(seg_item, axis=0)
+        nx = seg[:, 3] - seg[:, 1]
+        ny = seg[:, 0] - seg[:, 2]
+        away = nx * (x - seg[:, 0]) + ny * (y - seg[:, 1]) < 0.0
+        nx[away] *= -1.0
+        ny[away] *= -1.0
+        owner = None
+        if scene.owners is not None and look.any_round:
+            owner = scene.owners.take(seg_item)
+            known = (owner >= 0) & (owner < len(look.round_centres))
+            centre = np.full((len(owner), 2), np.nan)
+            centre[known] = look.round_centres[owner[known]]
+            round_ = ~np.isnan(centre[:, 0])
+            if _ANY(round_):
+                at = k_seg[round_] if k_seg is not None else np.flatnonzero(round_)
+                nx[round_] = hx[at] - centre[round_, 0]
+                ny[round_] = hy[at] - centre[round_, 1]
+        length = np.hypot(nx, ny)
+        length[length == 0.0] = 1.0
+        if k_seg is None:
+            normals[:, 0] = nx / length
+            normals[:, 1] = ny / length
+        else:
+            normals[k_seg, 0] = nx / length
+            normals[k_seg, 1] = ny / length
+            k_c = np.flatnonzero(~on_seg)  # other robots' round bodies: from their centres
+            centre_c = scene.circles[item[k_c] - n_seg]
+            ex, ey = hx[k_c] - centre_c[:, 0], hy[k_c] - centre_c[:, 1]
+            norm = np.hypot(ex, ey)
+            norm[norm == 0.0] = 1.0
+            normals[k_c, 0], normals[k_c, 1] = ex / norm, ey / norm
+        if seen.plane is not None:
+            flat = ~np.isnan(seen.plane)
+            normals[flat] = 0.0
+            normals[flat, 2] = np.where(seen.plane[flat] < self.cam_z, 1.0, -1.0)
+        colours = seen.colors.take(item, axis=0)
+        seen.rgb = look.lighting.shade(colours, normals)
+        seen.round_pixels = None
+        if owner is not None and look.any_sphere:
+            self._sphere_pixels(seen, look, owner, k_seg, normals, colours)
+
+    def _sphere_pixels(
+        self,
+        seen: _Seen,
+        look: SceneLook,
+        owner: np.ndarray,
+        k_seg: np.ndarray | None,
+        normals: np.ndarray,
+        colours: np.ndarray,
+    ) -> None:
+        """The pixels of the sides of spheres (seen directly, not through a lid), each lit on the
+        sphere's normal at the height its ray meets the side: tilted up toward the top (a white
+        ball's upper part saturates, as in Gazebo), down toward the bottom."""
+        known = (owner >= 0) & (owner < len(look.sphere_r))
+        radius = np.full(len(owner), np.nan)
+        radius[known] = look.sphere_r[owner[known]]
+        ball = ~np.isnan(radius)
+        if seen.plane is not None:
+            at_all = np.flatnonzero(ball) if k_seg is None else k_seg[ball]
+            ball[ball] = np.isnan(seen.plane[at_all])
+        if not _ANY(ball):
+            return
+        k = np.flatnonzero(ball) if k_seg is None else k_seg[ball]
+        r = radius[ball]
+        cz = look.sphere_z[owner[ball]]
+        top, bottom = seen.top.take(k).astype(np.intp), seen.bottom.take(k).astype(np.intp)
+        lengths = bottom - top
+        keep = lengths > 0
+        k, r, cz, top, lengths = k[keep], r[keep], cz[keep], top[keep], lengths[keep]
+        if not len(k):
+            return
+        which = np.repeat(np.arange(len(k)), lengths)
+        starts = np.repeat(np.cumsum(lengths) - lengths, lengths)
+        rows = np.arange(len(which)) - starts + top[which]
+        height = self.cam_z + self.row_slope[rows] * seen.depth[k][which]
+        t = np.clip((height - cz[which]) / r[which], -1.0, 1.0)
+        across = np.sqrt(1.0 - t * t)
+        n = np.empty((len(which), 3))
+        n[:, 0] = normals[k[which], 0] * across
+        n[:, 1] = normals[k[which], 1] * across
+        n[:, 2] = t
+        seen.round_pixels = (k[which], rows, seen.col[k][which], look.lighting.shade(colours[k[which]], n))
 
     def _crossings(self, scene: Scene, x: float, y: float, yaw: float) -> _Seen | None:
         """The crossings that show in the image, each with its rows cut to what the nearer strips
@@ -337,8 +465,7 @@ class Camera:
         cv2 = _opencv()
         rgb, depth_mm = _EMPTY_RGB, _EMPTY_DEPTH
         if want_rgb:
-            light = np.clip(1.1 - seen.depth / 15.0, 0.45, 1.0)
-            shaded = (seen.colors.take(seen.item, axis=0) * light[:, None]).astype(np.uint8)
+            shaded = seen.rgb
             if full:
                 colour_row = shaded
             else:
@@ -387,17 +514,23 @@ class Camera:
         depth_mm: np.ndarray,
         wall: np.ndarray | None,
     ) -> None:
-        """Fill each crossing's rows with its colour (flat, darker with distance) and depth: one
-        masked copy per rank within the column, the farthest first, over the band of rows that rank
-        spans (a nearer strip in the air is painted over what it hides). A lid's or an underside's
-        rows (a far side seen through them) get, in the depth image, the depth where each row's ray
-        meets that plane: (plane - cam_z) / slope_v."""
+        """Fill each crossing's rows with its colour (lit, flat; a sphere's side row by row) and depth:
+        one masked copy per rank within the column, the farthest first, over the band of rows that
+        rank spans (a nearer strip in the air is painted over what it hides). A lid's or an
+        underside's rows (a far side seen through them) get, in the depth image, the depth where each
+        row's ray meets that plane: (plane - cam_z) / slope_v."""
         if rgb.size:
-            light = np.clip(1.1 - seen.depth / 15.0, 0.45, 1.0)
-            shaded = (seen.colors.take(seen.item, axis=0) * light[:, None]).astype(np.uint8)
+            shaded = seen.rgb
+            spheres = seen.round_pixels
+            if spheres is not None:
+                pass_of = np.zeros(len(seen.col), dtype=np.intp)
+                for p, sel in enumerate(ranks):
+                    if sel is not None:
+                        pass_of[sel] = p
+                sphere_pass = pass_of[spheres[0]]
         if depth_mm.size:
             mm = np.rint(seen.depth * 1000.0).astype(np.uint16)
-        for sel in ranks:
+        for p, sel in enumerate(ranks):
             cols = seen.col if sel is None else seen.col.take(sel)
             top = seen.top if sel is None else seen.top.take(sel)
             bottom = seen.bottom if sel is None else seen.bottom.take(sel)
@@ -410,6 +543,9 @@ class Camera:
                 cells = shaded.view(_PIXEL).reshape(-1)
                 self._colour_cells[cols] = cells if sel is None else cells.take(sel)
                 self._paint(rgb[r0:r1], self._colour_row, mask)
+                if spheres is not None:
+                    here = sphere_pass == p
+                    rgb[spheres[1][here], spheres[2][here]] = spheres[3][here]
             if depth_mm.size:
                 self._depth_row[cols] = mm if sel is None else mm.take(sel)
                 self._paint(depth_mm[r0:r1], self._depth_row, mask)
@@ -481,10 +617,17 @@ class Camera:
         cv2.copyTo(full, mask, image)
 
     def _paint_floor(
-        self, rgb: np.ndarray, wall: np.ndarray, paint: FloorPaint, x: float, y: float, yaw: float
+        self,
+        rgb: np.ndarray,
+        wall: np.ndarray,
+        paint: FloorPaint,
+        x: float,
+        y: float,
+        yaw: float,
+        lighting: Lighting = DEFAULT_LIGHTING,
     ) -> None:
         """Draw the floor markings (the course's 1 m square) where floor pixels see them: each floor
-        pixel's point on the floor looked up in the markings' texture."""
+        pixel's point on the floor looked up in the markings' texture, its colour lit as the floor."""
         first = self._floor_first
         forward, lateral = self._floor_points
         c, s = np.float32(math.cos(yaw) / paint.resolution), np.float32(math.sin(yaw) / paint.resolution)
@@ -514,8 +657,12 @@ class Camera:
         if not len(painted):
             return
         cells = rgb.view(_PIXEL).reshape(-1)
+        kept = self._lit_palette
+        if kept is None or kept[0] is not paint.palette or kept[1] is not lighting:
+            kept = (paint.palette, lighting, np.ascontiguousarray(lighting.shade_flat(paint.palette, _UP)))
+            self._lit_palette = kept
         cells[painted + first * self.width] = (
-            paint.palette.view(_PIXEL).reshape(-1).take(ink.reshape(-1).take(painted) - 1)
+            kept[2].view(_PIXEL).reshape(-1).take(ink.reshape(-1).take(painted) - 1)
         )
 
     def intrinsics(self) -> tuple[float, float, float, float]:
@@ -544,6 +691,10 @@ class _Seen:
         #: per crossing: the height of the lid or underside it is seen through (NaN: a side seen
         #: directly); None when no crossing is
         self.plane = plane
+        #: per crossing: its colour as lit (see Camera._shade), set when a colour image is drawn
+        self.rgb: np.ndarray = _EMPTY_RGB
+        #: the sides of spheres, pixel by pixel: (crossing, row, column, colour) arrays; None: none
+        self.round_pixels: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
 
     def ranks(self) -> list[np.ndarray | None]:
         """The crossings of each paint pass: each column's crossings from its farthest to its
@@ -568,9 +719,10 @@ class _SceneCopy:
     def __init__(self, scene: Scene) -> None:
         self.arrays = [None if a is None else a.copy() for a in _scene_arrays(scene)]
         self.floor = scene.floor
+        self.look = scene.look
 
     def same(self, scene: Scene) -> bool:
-        if scene.floor is not self.floor:
+        if scene.floor is not self.floor or scene.look is not self.look:
             return False
         for kept, now in zip(self.arrays, _scene_arrays(scene), strict=True):
             if kept is None or now is None:

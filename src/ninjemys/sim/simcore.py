@@ -344,6 +344,7 @@ class Simulation:
             facing,
             bases,
             owners,
+            self.world.look,
         )
 
     def clearance(
