@@ -95,6 +95,8 @@ class Camera:
         self._lit_by: Lighting | None = None
         self._background = np.zeros((height, width, 3), dtype=np.uint8)
         self._lit_palette: tuple[np.ndarray, Lighting, np.ndarray] | None = None
+        #: the segments' colours lit on each side, for the last scene seen (see _Palette)
+        self._palette: _Palette | None = None
         self._floor_depth_image = np.ascontiguousarray(
             np.broadcast_to(self.floor_depth_mm[:, None], (height, width))
         )
@@ -184,104 +186,134 @@ class Camera:
 
     def _shade(self, seen: _Seen, scene: Scene, look: SceneLook, x: float, y: float, yaw: float) -> None:
         """Each crossing's colour (``seen.rgb``), lit by the world's lights on its face's normal: a
-        side's horizontal normal turned toward the camera (a round shape's from its axis to where
-        the ray meets it), a lid's up, an underside's down; and the pixels of the sides of spheres,
-        lit row by row on the sphere's normal at that height (``seen.round_pixels``)."""
-        item, d, cols = seen.item, seen.depth, seen.col
-        n_seg = len(scene.segments)
-        count = len(item)
-        normals = np.zeros((count, 3))
-        # where each crossing's ray meets its side, in the world
-        slope = self.col_slopes.take(cols)
+        side's horizontal normal on the camera's side of it (one of the two colours of each segment,
+        lit once per scene: :class:`_Palette`), a round shape's from its axis to where the ray meets
+        it, a lid's up, an underside's down; and the pixels of the sides of spheres, lit row by row
+        on the sphere's normal at that height (``seen.round_pixels``)."""
+        pal = self._palette
+        if pal is None or not pal.fits(scene, look):
+            pal = self._palette = _Palette(scene, look)
+        item = seen.item
+        n = pal.n
+        on_seg = None
+        if len(scene.circles):
+            on_seg = item < n
+            if _ALL(on_seg):
+                on_seg = None
+        k_seg = None if on_seg is None else np.flatnonzero(on_seg)
+        it = item if k_seg is None else item.take(k_seg)
+        # the side of each segment the camera is on: n . (camera - p0) < 0 is its back
+        side = pal.nx.take(it) * x
+        side += pal.ny.take(it) * y
+        back = side < pal.c0.take(it)
+        pick = it * 2
+        pick += back
+        rgb = pal.table.take(pick, axis=0)
+        seen.round_pixels = None
+        if k_seg is not None or (pal.any_round and _ANY(pal.is_round.take(it))):
+            rgb = self._shade_round(seen, scene, look, pal, rgb, k_seg, it, x, y, yaw)
+        if seen.plane is not None:
+            flat = np.flatnonzero(~np.isnan(seen.plane))
+            lid = (seen.plane.take(flat) < self.cam_z)[:, None]
+            under = item.take(flat)
+            rgb[flat] = np.where(lid, pal.lid.take(under, axis=0), pal.under.take(under, axis=0))
+        seen.rgb = rgb
+
+    def _shade_round(
+        self,
+        seen: _Seen,
+        scene: Scene,
+        look: SceneLook,
+        pal: _Palette,
+        seg_rgb: np.ndarray,
+        k_seg: np.ndarray | None,
+        it: np.ndarray,
+        x: float,
+        y: float,
+        yaw: float,
+    ) -> np.ndarray:
+        """The colours of the crossings of round shapes (cylinders and spheres of the world, other
+        robots' bodies): lit on the normal from the shape's axis to where the ray meets it. Returns
+        every crossing's colour (``seg_rgb`` holds those of the segments' crossings, ``k_seg`` says
+        which they are: None, all)."""
+        count = len(seen.item)
+        if k_seg is None:
+            rgb = seg_rgb
+        else:
+            rgb = np.empty((count, 3), dtype=np.uint8)
+            rgb[k_seg] = seg_rgb
+        centres = np.full((count, 2), np.nan)
+        if pal.any_round:
+            at = np.arange(count) if k_seg is None else k_seg
+            centres[at] = pal.centres.take(it, axis=0)
+        if k_seg is not None:
+            k_c = np.flatnonzero(seen.item >= pal.n)  # other robots' round bodies
+            centres[k_c] = scene.circles[seen.item[k_c] - pal.n]
+        k = np.flatnonzero(~np.isnan(centres[:, 0]))
+        if not len(k):
+            return rgb
+        # where each ray meets the side, in the world
+        d = seen.depth.take(k)
+        slope = self.col_slopes.take(seen.col.take(k))
         c, s = math.cos(yaw), math.sin(yaw)
-        hx = x + d * (c - s * slope)
-        hy = y + d * (s + c * slope)
-        on_seg = item < n_seg
-        all_seg = bool(_ALL(on_seg))
-        k_seg = None if all_seg else np.flatnonzero(on_seg)
-        seg_item = item if k_seg is None else item.take(k_seg)
-        seg = scene.segments.take(seg_item, axis=0)
-        nx = seg[:, 3] - seg[:, 1]
-        ny = seg[:, 0] - seg[:, 2]
-        away = nx * (x - seg[:, 0]) + ny * (y - seg[:, 1]) < 0.0
-        nx[away] *= -1.0
-        ny[away] *= -1.0
-        owner = None
-        if scene.owners is not None and look.any_round:
-            owner = scene.owners.take(seg_item)
-            known = (owner >= 0) & (owner < len(look.round_centres))
-            centre = np.full((len(owner), 2), np.nan)
-            centre[known] = look.round_centres[owner[known]]
-            round_ = ~np.isnan(centre[:, 0])
-            if _ANY(round_):
-                at = k_seg[round_] if k_seg is not None else np.flatnonzero(round_)
-                nx[round_] = hx[at] - centre[round_, 0]
-                ny[round_] = hy[at] - centre[round_, 1]
+        nx = x + d * (c - s * slope) - centres[k, 0]
+        ny = y + d * (s + c * slope) - centres[k, 1]
         length = np.hypot(nx, ny)
         length[length == 0.0] = 1.0
-        if k_seg is None:
-            normals[:, 0] = nx / length
-            normals[:, 1] = ny / length
-        else:
-            normals[k_seg, 0] = nx / length
-            normals[k_seg, 1] = ny / length
-            k_c = np.flatnonzero(~on_seg)  # other robots' round bodies: from their centres
-            centre_c = scene.circles[item[k_c] - n_seg]
-            ex, ey = hx[k_c] - centre_c[:, 0], hy[k_c] - centre_c[:, 1]
-            norm = np.hypot(ex, ey)
-            norm[norm == 0.0] = 1.0
-            normals[k_c, 0], normals[k_c, 1] = ex / norm, ey / norm
-        if seen.plane is not None:
-            flat = ~np.isnan(seen.plane)
-            normals[flat] = 0.0
-            normals[flat, 2] = np.where(seen.plane[flat] < self.cam_z, 1.0, -1.0)
-        colours = seen.colors.take(item, axis=0)
-        seen.rgb = look.lighting.shade(colours, normals)
-        seen.round_pixels = None
-        if owner is not None and look.any_sphere:
-            self._sphere_pixels(seen, look, owner, k_seg, normals, colours)
+        normals = np.zeros((len(k), 3))
+        normals[:, 0], normals[:, 1] = nx / length, ny / length
+        colours = seen.colors.take(seen.item.take(k), axis=0)
+        rgb[k] = look.lighting.shade(colours, normals)
+        if pal.any_sphere:
+            self._sphere_pixels(seen, look, pal, k, normals, colours)
+        return rgb
 
     def _sphere_pixels(
         self,
         seen: _Seen,
         look: SceneLook,
-        owner: np.ndarray,
-        k_seg: np.ndarray | None,
+        pal: _Palette,
+        k: np.ndarray,
         normals: np.ndarray,
         colours: np.ndarray,
     ) -> None:
         """The pixels of the sides of spheres (seen directly, not through a lid), each lit on the
         sphere's normal at the height its ray meets the side: tilted up toward the top (a white
-        ball's upper part saturates, as in Gazebo), down toward the bottom."""
-        known = (owner >= 0) & (owner < len(look.sphere_r))
-        radius = np.full(len(owner), np.nan)
-        radius[known] = look.sphere_r[owner[known]]
-        ball = ~np.isnan(radius)
+        ball's upper part saturates, as in Gazebo), down toward the bottom. ``k``: the crossings of
+        round shapes, with their horizontal ``normals`` and ``colours``."""
+        item = seen.item.take(k)
+        ball = item < pal.n
+        ball[ball] = ~np.isnan(pal.sphere_r.take(item[ball]))
         if seen.plane is not None:
-            at_all = np.flatnonzero(ball) if k_seg is None else k_seg[ball]
-            ball[ball] = np.isnan(seen.plane[at_all])
+            ball &= np.isnan(seen.plane.take(k))
         if not _ANY(ball):
             return
-        k = np.flatnonzero(ball) if k_seg is None else k_seg[ball]
-        r = radius[ball]
-        cz = look.sphere_z[owner[ball]]
-        top, bottom = seen.top.take(k).astype(np.intp), seen.bottom.take(k).astype(np.intp)
+        pick = np.flatnonzero(ball)
+        kk, ball_item = k[pick], item[pick]
+        r, cz = pal.sphere_r.take(ball_item), pal.sphere_z.take(ball_item)
+        top, bottom = seen.top.take(kk).astype(np.intp), seen.bottom.take(kk).astype(np.intp)
         lengths = bottom - top
         keep = lengths > 0
-        k, r, cz, top, lengths = k[keep], r[keep], cz[keep], top[keep], lengths[keep]
-        if not len(k):
+        if not _ALL(keep):
+            pick, kk, r, cz, top, lengths = (a[keep] for a in (pick, kk, r, cz, top, lengths))
+        if not len(kk):
             return
-        which = np.repeat(np.arange(len(k)), lengths)
+        which = np.repeat(np.arange(len(kk)), lengths)
         starts = np.repeat(np.cumsum(lengths) - lengths, lengths)
         rows = np.arange(len(which)) - starts + top[which]
-        height = self.cam_z + self.row_slope[rows] * seen.depth[k][which]
+        height = self.cam_z + self.row_slope[rows] * seen.depth[kk][which]
         t = np.clip((height - cz[which]) / r[which], -1.0, 1.0)
         across = np.sqrt(1.0 - t * t)
         n = np.empty((len(which), 3))
-        n[:, 0] = normals[k[which], 0] * across
-        n[:, 1] = normals[k[which], 1] * across
+        n[:, 0] = normals[pick[which], 0] * across
+        n[:, 1] = normals[pick[which], 1] * across
         n[:, 2] = t
-        seen.round_pixels = (k[which], rows, seen.col[k][which], look.lighting.shade(colours[k[which]], n))
+        seen.round_pixels = (
+            kk[which],
+            rows,
+            seen.col[kk][which],
+            look.lighting.shade(colours[pick[which]], n),
+        )
 
     def _crossings(self, scene: Scene, x: float, y: float, yaw: float) -> _Seen | None:
         """The crossings that show in the image, each with its rows cut to what the nearer strips
@@ -711,6 +743,56 @@ class _Seen:
         from_far -= np.arange(1, n + 1)
         passes = int(lengths.max())
         return [np.flatnonzero(from_far == p) for p in range(passes)]
+
+
+class _Palette:
+    """A scene's segments' colours lit once, each on both of its sides (``table[2 i]`` seen from
+    the side of its normal (``nx``, ``ny``), ``table[2 i + 1]`` from the other), as a lid and as an
+    underside, with the round obstacles' centres and the spheres' centre heights and radii per
+    segment (NaN: not round, not a sphere). Built again when the scene's arrays or lights change (a
+    scene with moving obstacles has new arrays every step: a few vectorised passes over its segments)."""
+
+    def __init__(self, scene: Scene, look: SceneLook) -> None:
+        self.segments, self.colors, self.owners, self.look = scene.segments, scene.colors, scene.owners, look
+        seg = scene.segments
+        self.n = n = len(seg)
+        nx = seg[:, 3] - seg[:, 1]
+        ny = seg[:, 0] - seg[:, 2]
+        length = np.hypot(nx, ny)
+        length[length == 0.0] = 1.0
+        self.nx, self.ny = nx / length, ny / length
+        self.c0 = self.nx * seg[:, 0] + self.ny * seg[:, 1]
+        normals = np.zeros((2 * n, 3))
+        normals[0::2, 0], normals[0::2, 1] = self.nx, self.ny
+        normals[1::2, 0], normals[1::2, 1] = -self.nx, -self.ny
+        colours = scene.colors[:n]
+        lighting = look.lighting
+        self.table = lighting.shade(np.repeat(colours, 2, axis=0), normals)
+        self.lid = lighting.shade_flat(scene.colors, _UP)
+        self.under = lighting.shade_flat(scene.colors, (0.0, 0.0, -1.0))
+        self.centres = np.full((n, 2), np.nan)
+        self.sphere_z = np.full(n, np.nan)
+        self.sphere_r = np.full(n, np.nan)
+        self.any_round = self.any_sphere = False
+        if scene.owners is not None and look.any_round:
+            owner = scene.owners[:n]
+            known = (owner >= 0) & (owner < len(look.round_centres))
+            self.centres[known] = look.round_centres[owner[known]]
+            self.sphere_z[known] = look.sphere_z[owner[known]]
+            self.sphere_r[known] = look.sphere_r[owner[known]]
+            self.any_round = not bool(np.isnan(self.centres[:, 0]).all())
+            self.any_sphere = not bool(np.isnan(self.sphere_r).all())
+        #: per segment: a side of a round obstacle
+        self.is_round = ~np.isnan(self.centres[:, 0])
+
+    def fits(self, scene: Scene, look: SceneLook) -> bool:
+        """Built from these very arrays and lights."""
+        return (
+            scene.segments is self.segments
+            and scene.colors is self.colors
+            and scene.owners is self.owners
+            and look is self.look
+        )
 
 
 class _SceneCopy:
