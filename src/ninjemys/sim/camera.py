@@ -202,13 +202,7 @@ class Camera:
                 on_seg = None
         k_seg = None if on_seg is None else np.flatnonzero(on_seg)
         it = item if k_seg is None else item.take(k_seg)
-        # the side of each segment the camera is on: n . (camera - p0) < 0 is its back
-        side = pal.nx.take(it) * x
-        side += pal.ny.take(it) * y
-        back = side < pal.c0.take(it)
-        pick = it * 2
-        pick += back
-        rgb = pal.table.take(pick, axis=0)
+        rgb = pal.seen_from(x, y).take(it, axis=0)
         seen.round_pixels = None
         if k_seg is not None or (pal.any_round and _ANY(pal.is_round.take(it))):
             rgb = self._shade_round(seen, scene, look, pal, rgb, k_seg, it, x, y, yaw)
@@ -658,33 +652,40 @@ class Camera:
         yaw: float,
         lighting: Lighting = DEFAULT_LIGHTING,
     ) -> None:
-        """Draw the floor markings (the course's 1 m square) where floor pixels see them: each floor
-        pixel's point on the floor looked up in the markings' texture, its colour lit as the floor."""
+        """Draw the floor markings (the course's 1 m square) where floor pixels see them, lit as the
+        floor. The floor is a plane: the image rows that see it map onto the markings' texture by one
+        homography, so the texture is looked up for every floor pixel by one perspective warp
+        (OpenCV, nearest texel, 0 outside the texture) rather than a dozen numpy passes over the
+        floor's rows; the wall pixels are then cleared of ink."""
         first = self._floor_first
-        forward, lateral = self._floor_points
-        c, s = np.float32(math.cos(yaw) / paint.resolution), np.float32(math.sin(yaw) / paint.resolution)
-        # ``forward`` is one value per row: its products are taken per row and broadcast along it
-        # (the same float32 operations, element by element, as over the whole block)
-        east = c * forward
-        east = east - s * lateral
-        east += np.float32((x - paint.origin_x) / paint.resolution)
-        north = s * forward
-        north = north + c * lateral
-        north += np.float32((y - paint.origin_y) / paint.resolution)
-        col, row = east.astype(np.int32), north.astype(np.int32)
-        th, tw = paint.texture.shape
-        # 0 <= i < n as one unsigned comparison (a negative index wraps to above any size)
-        inside = col.view(np.uint32) < tw
-        inside &= row.view(np.uint32) < th
-        np.greater(inside, wall[first:], out=inside)  # and not a wall pixel
-        # every floor pixel looks its texel up (a few passes over whole rows, no index lists), an
-        # index outside it clipped to some texel and its ink cleared: left are the inked pixels,
-        # a few hundred, rather than index lists of the tens of thousands inside the texture
-        index = row
-        index *= tw
-        index += col
-        ink = paint.texture.reshape(-1).take(index, mode="clip")
-        np.multiply(ink, inside, out=ink)
+        if first >= self.height:
+            return
+        res = paint.resolution
+        c, s = math.cos(yaw), math.sin(yaw)
+        fx, cx = self.fx, self.cx
+        # one over the distance ahead of row first + r is g2 r + g3; the floor point seen by pixel
+        # (u, first + r) at texel (X, Y) = (a . (u, r, 1), b . (u, r, 1)) / (g2 r + g3), less half a
+        # texel so that the warp's rounding to the nearest texel takes the texel the point lies in
+        g2 = 1.0 / (self.cam_z * self.fy)
+        g3 = (first - self.cy) * g2
+        ex, ny = (x - paint.origin_x) / res - 0.5, (y - paint.origin_y) / res - 0.5
+        warp = np.array(
+            [
+                [s / (fx * res), ex * g2, ex * g3 + (c - s * cx / fx) / res],
+                [-c / (fx * res), ny * g2, ny * g3 + (s + c * cx / fx) / res],
+                [0.0, g2, g3],
+            ]
+        )
+        cv2 = _opencv()
+        ink = cv2.warpPerspective(
+            paint.texture,
+            warp,
+            (self.width, self.height - first),
+            flags=cv2.INTER_NEAREST | cv2.WARP_INVERSE_MAP,
+            borderMode=cv2.BORDER_CONSTANT,
+            borderValue=0,
+        )
+        np.copyto(ink, 0, where=wall[first:])  # a wall stands there
         painted = np.flatnonzero(ink)
         if not len(painted):
             return
@@ -746,8 +747,8 @@ class _Seen:
 
 
 class _Palette:
-    """A scene's segments' colours lit once, each on both of its sides (``table[2 i]`` seen from
-    the side of its normal (``nx``, ``ny``), ``table[2 i + 1]`` from the other), as a lid and as an
+    """A scene's segments' colours lit once, each on both of its sides (``front`` seen from the
+    side of its normal (``nx``, ``ny``), ``back`` from the other), as a lid and as an
     underside, with the round obstacles' centres and the spheres' centre heights and radii per
     segment (NaN: not round, not a sphere). Built again when the scene's arrays or lights change (a
     scene with moving obstacles has new arrays every step: a few vectorised passes over its segments)."""
@@ -767,7 +768,10 @@ class _Palette:
         normals[1::2, 0], normals[1::2, 1] = -self.nx, -self.ny
         colours = scene.colors[:n]
         lighting = look.lighting
-        self.table = lighting.shade(np.repeat(colours, 2, axis=0), normals)
+        table = lighting.shade(np.repeat(colours, 2, axis=0), normals)
+        #: each segment's colour seen from the side of its normal, and from the other
+        self.front, self.back = table[0::2], table[1::2]
+        self._seen_at: tuple[tuple[float, float], np.ndarray] | None = None
         self.lid = lighting.shade_flat(scene.colors, _UP)
         self.under = lighting.shade_flat(scene.colors, (0.0, 0.0, -1.0))
         self.centres = np.full((n, 2), np.nan)
@@ -784,6 +788,18 @@ class _Palette:
             self.any_sphere = not bool(np.isnan(self.sphere_r).all())
         #: per segment: a side of a round obstacle
         self.is_round = ~np.isnan(self.centres[:, 0])
+
+    def seen_from(self, x: float, y: float) -> np.ndarray:
+        """(N, 3): each segment's colour on the side a camera at (x, y) is on (n . (camera - p0) < 0:
+        its back); a few passes over the segments, cheaper than per crossing for a few hundred."""
+        if self._seen_at is not None and self._seen_at[0] == (x, y):
+            return self._seen_at[1]
+        side = self.nx * x
+        side += self.ny * y
+        back = np.less(side, self.c0)[:, None]
+        colours = np.where(back, self.back, self.front)
+        self._seen_at = ((x, y), colours)
+        return colours
 
     def fits(self, scene: Scene, look: SceneLook) -> bool:
         """Built from these very arrays and lights."""
