@@ -48,6 +48,7 @@ SKY_RGB = np.array([206, 220, 235], dtype=np.float32)
 #: a scene that says nothing of its lights: Gazebo's default sun, every side flat
 _DEFAULT_LOOK = SceneLook()
 _UP = (0.0, 0.0, 1.0)
+_DOWN = (0.0, 0.0, -1.0)
 
 
 class Camera:
@@ -95,8 +96,10 @@ class Camera:
         self._lit_by: Lighting | None = None
         self._background = np.zeros((height, width, 3), dtype=np.uint8)
         self._lit_palette: tuple[np.ndarray, Lighting, np.ndarray] | None = None
-        #: the segments' colours lit on each side, for the last scene seen (see _Palette)
+        #: the segments' colours lit on each side, for the last scene seen (see _Palette), and the
+        #: arrays of the last scene drawn without one
         self._palette: _Palette | None = None
+        self._last_scene: tuple[Any, ...] | None = None
         self._floor_depth_image = np.ascontiguousarray(
             np.broadcast_to(self.floor_depth_mm[:, None], (height, width))
         )
@@ -187,71 +190,86 @@ class Camera:
     def _shade(self, seen: _Seen, scene: Scene, look: SceneLook, x: float, y: float, yaw: float) -> None:
         """Each crossing's colour (``seen.rgb``), lit by the world's lights on its face's normal: a
         side's horizontal normal on the camera's side of it (one of the two colours of each segment,
-        lit once per scene: :class:`_Palette`), a round shape's from its axis to where the ray meets
+        lit once per world: :class:`_Palette`), a round shape's from its axis to where the ray meets
         it, a lid's up, an underside's down; and the pixels of the sides of spheres, lit row by row
         on the sphere's normal at that height (``seen.round_pixels``)."""
-        pal = self._palette
-        if pal is None or not pal.fits(scene, look):
-            pal = self._palette = _Palette(scene, look)
+        pal = self._palette_for(scene, look)
         item = seen.item
         n = pal.n
-        on_seg = None
-        if len(scene.circles):
-            on_seg = item < n
-            if _ALL(on_seg):
-                on_seg = None
-        k_seg = None if on_seg is None else np.flatnonzero(on_seg)
-        it = item if k_seg is None else item.take(k_seg)
-        rgb = pal.seen_from(x, y).take(it, axis=0)
         seen.round_pixels = None
-        if k_seg is not None or (pal.any_round and _ANY(pal.is_round.take(it))):
-            rgb = self._shade_round(seen, scene, look, pal, rgb, k_seg, it, x, y, yaw)
+        if n == len(scene.segments) + len(scene.circles) or _ALL(item < n):
+            rgb = pal.seen_from(x, y).take(item, axis=0)
+            if pal.any_round:
+                round_ = np.flatnonzero(pal.is_round.take(item))
+                if len(round_):
+                    self._shade_round(
+                        seen, look, rgb, round_, pal.centres.take(item.take(round_), axis=0), pal, x, y, yaw
+                    )
+        else:  # crossings of moving obstacles' sides and of other robots' round bodies
+            rgb = np.empty((len(item), 3), dtype=np.uint8)
+            known = np.flatnonzero(item < n)
+            rgb[known] = pal.seen_from(x, y).take(item.take(known), axis=0)
+            n_seg = len(scene.segments)
+            moved = np.flatnonzero((item >= n) & (item < n_seg))
+            if len(moved):
+                rgb[moved] = _flat_colours(scene, look.lighting, item.take(moved), x, y)
+            round_ = np.flatnonzero(item >= n_seg)
+            centres = scene.circles[item.take(round_) - n_seg]
+            if pal.any_round:
+                also = known[pal.is_round.take(item.take(known))]
+                round_ = np.concatenate([also, round_])
+                centres = np.concatenate([pal.centres.take(item.take(also), axis=0), centres])
+            if len(round_):
+                self._shade_round(seen, look, rgb, round_, centres, pal, x, y, yaw)
         if seen.plane is not None:
             flat = np.flatnonzero(~np.isnan(seen.plane))
             lid = (seen.plane.take(flat) < self.cam_z)[:, None]
             under = item.take(flat)
-            rgb[flat] = np.where(lid, pal.lid.take(under, axis=0), pal.under.take(under, axis=0))
+            if _ALL(under < n):
+                rgb[flat] = np.where(lid, pal.lid.take(under, axis=0), pal.under.take(under, axis=0))
+            else:  # a moving obstacle's lid
+                colours = seen.colors.take(under, axis=0)
+                lighting = look.lighting
+                rgb[flat] = np.where(
+                    lid, lighting.shade_flat(colours, _UP), lighting.shade_flat(colours, _DOWN)
+                )
         seen.rgb = rgb
+
+    def _palette_for(self, scene: Scene, look: SceneLook) -> _Palette:
+        """The palette of the scene's segments: the last one if the scene has the same arrays, or
+        starts with the same segments (the world's, before the moving obstacles' that change every
+        step); else a new one over the segments the scene shares with the last scene drawn."""
+        pal = self._palette
+        if pal is not None and (pal.fits(scene, look) or pal.prefix_of(scene, look)):
+            return pal
+        n = len(scene.segments)
+        last = self._last_scene
+        if last is not None and last[3] is look:
+            n = _common_rows(n, (last[0], scene.segments), (last[1], scene.colors), (last[2], scene.owners))
+        self._last_scene = _arrays_of(scene, look)
+        pal = self._palette = _Palette(scene, look, n)
+        return pal
 
     def _shade_round(
         self,
         seen: _Seen,
-        scene: Scene,
         look: SceneLook,
+        rgb: np.ndarray,
+        k: np.ndarray,
+        centres: np.ndarray,
         pal: _Palette,
-        seg_rgb: np.ndarray,
-        k_seg: np.ndarray | None,
-        it: np.ndarray,
         x: float,
         y: float,
         yaw: float,
-    ) -> np.ndarray:
-        """The colours of the crossings of round shapes (cylinders and spheres of the world, other
-        robots' bodies): lit on the normal from the shape's axis to where the ray meets it. Returns
-        every crossing's colour (``seg_rgb`` holds those of the segments' crossings, ``k_seg`` says
-        which they are: None, all)."""
-        count = len(seen.item)
-        if k_seg is None:
-            rgb = seg_rgb
-        else:
-            rgb = np.empty((count, 3), dtype=np.uint8)
-            rgb[k_seg] = seg_rgb
-        centres = np.full((count, 2), np.nan)
-        if pal.any_round:
-            at = np.arange(count) if k_seg is None else k_seg
-            centres[at] = pal.centres.take(it, axis=0)
-        if k_seg is not None:
-            k_c = np.flatnonzero(seen.item >= pal.n)  # other robots' round bodies
-            centres[k_c] = scene.circles[seen.item[k_c] - pal.n]
-        k = np.flatnonzero(~np.isnan(centres[:, 0]))
-        if not len(k):
-            return rgb
-        # where each ray meets the side, in the world
+    ) -> None:
+        """The colours (into ``rgb``) of crossings ``k``, sides of round shapes (the world's
+        cylinders and spheres, other robots' bodies) with axes at ``centres``: lit on the normal from
+        the axis to where the ray meets the side; spheres' pixels row by row (``_sphere_pixels``)."""
         d = seen.depth.take(k)
         slope = self.col_slopes.take(seen.col.take(k))
         c, s = math.cos(yaw), math.sin(yaw)
-        nx = x + d * (c - s * slope) - centres[k, 0]
-        ny = y + d * (s + c * slope) - centres[k, 1]
+        nx = x + d * (c - s * slope) - centres[:, 0]
+        ny = y + d * (s + c * slope) - centres[:, 1]
         length = np.hypot(nx, ny)
         length[length == 0.0] = 1.0
         normals = np.zeros((len(k), 3))
@@ -260,7 +278,6 @@ class Camera:
         rgb[k] = look.lighting.shade(colours, normals)
         if pal.any_sphere:
             self._sphere_pixels(seen, look, pal, k, normals, colours)
-        return rgb
 
     def _sphere_pixels(
         self,
@@ -747,16 +764,32 @@ class _Seen:
 
 
 class _Palette:
-    """A scene's segments' colours lit once, each on both of its sides (``front`` seen from the
-    side of its normal (``nx``, ``ny``), ``back`` from the other), as a lid and as an
-    underside, with the round obstacles' centres and the spheres' centre heights and radii per
-    segment (NaN: not round, not a sphere). Built again when the scene's arrays or lights change (a
-    scene with moving obstacles has new arrays every step: a few vectorised passes over its segments)."""
+    """The first ``n`` segments of a scene (the world's; a scene's moving obstacles' come after
+    them) with their colours lit once, each on both of its sides (``front`` seen from the side of
+    its normal (``nx``, ``ny``), ``back`` from the other), and per segment the centre of a round
+    obstacle and a sphere's centre height and radius (NaN: not round, not a sphere)."""
 
-    def __init__(self, scene: Scene, look: SceneLook) -> None:
-        self.segments, self.colors, self.owners, self.look = scene.segments, scene.colors, scene.owners, look
-        seg = scene.segments
-        self.n = n = len(seg)
+    def __init__(self, scene: Scene, look: SceneLook, n: int) -> None:
+        self.scene_arrays = _arrays_of(scene, look)
+        self.look = look
+        self.n = n
+        seg = self.segments = scene.segments[:n]
+        self.colors = scene.colors[:n]
+        self.owners = None if scene.owners is None else scene.owners[:n]
+        self.centres = np.full((n, 2), np.nan)
+        self.sphere_z = np.full(n, np.nan)
+        self.sphere_r = np.full(n, np.nan)
+        self.any_round = self.any_sphere = False
+        if self.owners is not None and look.any_round:
+            owner = self.owners
+            known = (owner >= 0) & (owner < len(look.round_centres))
+            self.centres[known] = look.round_centres[owner[known]]
+            self.sphere_z[known] = look.sphere_z[owner[known]]
+            self.sphere_r[known] = look.sphere_r[owner[known]]
+            self.any_round = not bool(np.isnan(self.centres[:, 0]).all())
+            self.any_sphere = not bool(np.isnan(self.sphere_r).all())
+        #: per segment: a side of a round obstacle
+        self.is_round = ~np.isnan(self.centres[:, 0])
         nx = seg[:, 3] - seg[:, 1]
         ny = seg[:, 0] - seg[:, 2]
         length = np.hypot(nx, ny)
@@ -766,31 +799,16 @@ class _Palette:
         normals = np.zeros((2 * n, 3))
         normals[0::2, 0], normals[0::2, 1] = self.nx, self.ny
         normals[1::2, 0], normals[1::2, 1] = -self.nx, -self.ny
-        colours = scene.colors[:n]
-        lighting = look.lighting
-        table = lighting.shade(np.repeat(colours, 2, axis=0), normals)
+        table = look.lighting.shade(np.repeat(self.colors, 2, axis=0), normals)
         #: each segment's colour seen from the side of its normal, and from the other
         self.front, self.back = table[0::2], table[1::2]
+        #: each segment's colour on a lid (seen from above) and on an underside
+        self.lid = look.lighting.shade_flat(self.colors, _UP)
+        self.under = look.lighting.shade_flat(self.colors, _DOWN)
         self._seen_at: tuple[tuple[float, float], np.ndarray] | None = None
-        self.lid = lighting.shade_flat(scene.colors, _UP)
-        self.under = lighting.shade_flat(scene.colors, (0.0, 0.0, -1.0))
-        self.centres = np.full((n, 2), np.nan)
-        self.sphere_z = np.full(n, np.nan)
-        self.sphere_r = np.full(n, np.nan)
-        self.any_round = self.any_sphere = False
-        if scene.owners is not None and look.any_round:
-            owner = scene.owners[:n]
-            known = (owner >= 0) & (owner < len(look.round_centres))
-            self.centres[known] = look.round_centres[owner[known]]
-            self.sphere_z[known] = look.sphere_z[owner[known]]
-            self.sphere_r[known] = look.sphere_r[owner[known]]
-            self.any_round = not bool(np.isnan(self.centres[:, 0]).all())
-            self.any_sphere = not bool(np.isnan(self.sphere_r).all())
-        #: per segment: a side of a round obstacle
-        self.is_round = ~np.isnan(self.centres[:, 0])
 
     def seen_from(self, x: float, y: float) -> np.ndarray:
-        """(N, 3): each segment's colour on the side a camera at (x, y) is on (n . (camera - p0) < 0:
+        """(n, 3): each segment's colour on the side a camera at (x, y) is on (n . (camera - p0) < 0:
         its back); a few passes over the segments, cheaper than per crossing for a few hundred."""
         if self._seen_at is not None and self._seen_at[0] == (x, y):
             return self._seen_at[1]
@@ -803,12 +821,63 @@ class _Palette:
 
     def fits(self, scene: Scene, look: SceneLook) -> bool:
         """Built from these very arrays and lights."""
-        return (
-            scene.segments is self.segments
-            and scene.colors is self.colors
-            and scene.owners is self.owners
-            and look is self.look
-        )
+        return all(a is b for a, b in zip(self.scene_arrays, _arrays_of(scene, look), strict=True))
+
+    def prefix_of(self, scene: Scene, look: SceneLook) -> bool:
+        """The scene starts with this palette's segments, colours and owners (a scene of the same
+        world whose moving obstacles moved)."""
+        n = self.n
+        if (
+            look is not self.look
+            or len(scene.segments) < n
+            or (scene.owners is None) != (self.owners is None)
+        ):
+            return False
+        if (
+            not np.equal(scene.segments[:n], self.segments).all()
+            or not np.equal(scene.colors[:n], self.colors).all()
+        ):
+            return False
+        owners = scene.owners
+        return owners is None or self.owners is None or bool(np.equal(owners[:n], self.owners).all())
+
+
+def _common_rows(n: int, *pairs: tuple[np.ndarray | None, np.ndarray | None]) -> int:
+    """How many first rows (at most ``n``) every pair of arrays has equal."""
+    for a, b in pairs:
+        if a is None or b is None:
+            if a is not b:
+                return 0
+            continue
+        m = min(n, len(a), len(b))
+        same = np.equal(a[:m], b[:m])
+        if same.ndim > 1:
+            same = same.all(axis=1)
+        n = m if same.all() else int(np.argmin(same))
+    return n
+
+
+def _flat_colours(scene: Scene, lighting: Lighting, it: np.ndarray, x: float, y: float) -> np.ndarray:
+    """(len(it), 3): the colours of segments ``it`` lit on the side a camera at (x, y) is on,
+    computed for these crossings alone (the moving obstacles' sides)."""
+    seg = scene.segments.take(it, axis=0)
+    ex = seg[:, 2] - seg[:, 0]
+    ey = seg[:, 3] - seg[:, 1]
+    toward = ey * (x - seg[:, 0])
+    toward -= ex * (y - seg[:, 1])
+    length = np.hypot(ex, ey)
+    length[length == 0.0] = 1.0
+    flip = np.where(toward < 0.0, -1.0, 1.0)
+    flip /= length
+    normals = np.zeros((len(it), 3))
+    normals[:, 0] = ey * flip
+    normals[:, 1] = -ex * flip
+    return lighting.shade(scene.colors.take(it, axis=0), normals)
+
+
+def _arrays_of(scene: Scene, look: SceneLook) -> tuple[Any, ...]:
+    """What a palette is built from (compared by identity)."""
+    return (scene.segments, scene.colors, scene.owners, look)
 
 
 class _SceneCopy:

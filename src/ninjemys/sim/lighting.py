@@ -20,6 +20,7 @@ one colour (the obstacle's): Gazebo's stock materials mostly have them equal (``
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -61,28 +62,46 @@ class Lighting:
     sky: tuple[int, int, int] | None = None
     floor: tuple[int, int, int] | None = None
 
+    @functools.cached_property
+    def _terms(self) -> tuple[bool, np.ndarray, np.ndarray, np.ndarray]:
+        """(grey: every light and the ambient the same in all channels, ambient (3,), each sun's
+        unit vector toward it (S, 3), each sun's diffuse (S, 3)), worked out once."""
+        ambient = np.asarray(self.ambient, dtype=np.float64)
+        toward = np.array([sun.toward() for sun in self.suns], dtype=np.float64).reshape(-1, 3)
+        diffuse = np.array([sun.diffuse for sun in self.suns], dtype=np.float64).reshape(-1, 3)
+        grey = bool((ambient == ambient[0]).all() and (diffuse == diffuse[:, :1]).all())
+        return grey, ambient, toward, diffuse
+
     def factors(self, normals: np.ndarray) -> np.ndarray:
-        """float32 (N, 3): what each surface's colour is multiplied by, per channel, for unit
-        ``normals`` (N, 3)."""
-        out = np.empty((len(normals), 3), dtype=np.float32)
-        out[:] = np.asarray(self.ambient, dtype=np.float32)
-        for sun in self.suns:
-            lambert = normals @ np.asarray(sun.toward())
-            np.maximum(lambert, 0.0, out=lambert)
-            out += lambert[:, None].astype(np.float32) * np.asarray(sun.diffuse, dtype=np.float32)
-        return out
+        """(N, 3): what each surface's colour is multiplied by, per channel, for unit ``normals``
+        (N, 3)."""
+        _grey, ambient, toward, diffuse = self._terms
+        lambert = normals @ toward.T  # (N, S)
+        np.maximum(lambert, 0.0, out=lambert)
+        return lambert @ diffuse + ambient
 
     def shade(self, colours: np.ndarray, normals: np.ndarray) -> np.ndarray:
         """uint8 (N, 3): ``colours`` (N, 3, 0-255) lit on surfaces of unit ``normals`` (N, 3)."""
-        lit = colours.astype(np.float32) * self.factors(normals)
+        grey, ambient, toward, diffuse = self._terms
+        if grey:  # one factor per surface (the common case: white lights)
+            factor = normals @ (toward.T if len(toward) > 1 else toward[0])
+            np.maximum(factor, 0.0, out=factor)
+            if len(toward) > 1:
+                factor = factor @ diffuse[:, 0]
+            else:
+                factor *= diffuse[0, 0]
+            factor += ambient[0]
+            lit = colours * factor[:, None]
+        else:
+            lit = colours * self.factors(normals)
         np.rint(lit, out=lit)
-        np.clip(lit, 0.0, 255.0, out=lit)
+        np.minimum(lit, 255.0, out=lit)
         return lit.astype(np.uint8)
 
     def shade_flat(self, colours: np.ndarray, normal: tuple[float, float, float]) -> np.ndarray:
         """uint8, ``colours``' shape (..., 3): every colour lit on one surface facing ``normal``."""
         f = self.factors(np.array([normal], dtype=np.float64))[0]
-        lit = np.asarray(colours, dtype=np.float32) * f
+        lit = np.asarray(colours, dtype=np.float64) * f
         np.rint(lit, out=lit)
         np.clip(lit, 0.0, 255.0, out=lit)
         return lit.astype(np.uint8)
@@ -104,11 +123,11 @@ class SceneLook:
     sphere_z: np.ndarray = field(default_factory=lambda: np.zeros(0))
     sphere_r: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
-    @property
+    @functools.cached_property
     def any_round(self) -> bool:
         return bool(len(self.round_centres)) and not bool(np.isnan(self.round_centres[:, 0]).all())
 
-    @property
+    @functools.cached_property
     def any_sphere(self) -> bool:
         return bool(len(self.sphere_r)) and not bool(np.isnan(self.sphere_r).all())
 
