@@ -185,13 +185,15 @@ def sim_run(
     model: Path | None = None,
     slow: float = 0.0,
     window: Callable[[int], None] | None = None,
+    camera: bool = True,
 ) -> SimRun:
     """One headless run, the simulator pinned to one core (``src``: that tree on PYTHONPATH; None:
     this tree). From outside: the advance of ``/odom``'s stamps over the wall time between their
     arrivals here, after a 1 s warm-up; per CPU s: that advance over the simulator process' CPU time
     in the same window (its threads' schedstat), not over the whole run: the simulator runs from
     its start until the subscribers connect, and after they leave, with nothing to render, several
-    times faster (its exit summary counts those seconds, see :class:`SimRun`).
+    times faster (its exit summary counts those seconds, see :class:`SimRun`). ``camera`` False:
+    ``subscribe`` reads the scan only (everything but the camera).
     ``slow``: the image subscribers take that long per image, with queue_size 1 (a reader that lags:
     ROS 1 drops what it cannot take, the simulation must not wait for it). ``window``: called with
     the simulator's pid at the start and at the end of the measured window."""
@@ -235,7 +237,7 @@ def sim_run(
                 ("/scan", "sensor_msgs/LaserScan"),
                 ("/camera/color/image_raw", "sensor_msgs/Image"),
                 ("/camera/depth/image_rect_raw", "sensor_msgs/Image"),
-            ):
+            )[: 3 if camera else 1]:
                 lagging = slow > 0 and kind == "sensor_msgs/Image"
                 node.subscriber(
                     topic,
@@ -295,17 +297,32 @@ def bench_ab(before: str, duration: float, rounds: int) -> None:
     print("|---|---|---:|---:|---:|")
     with tempfile.TemporaryDirectory() as tmp:
         old = extract_tree(before, Path(tmp))
-        for model, subscribe, slow, robot, label in (
-            (None, True, 0.0, "PuzzleBot (YAML)", "scan + camera + odom"),
-            (URDF_MODEL, True, 0.0, "PuzzleBot from its URDF", "scan + camera + odom"),
-            (URDF_MODEL, True, 0.05, "PuzzleBot from its URDF", "the same, images read in 50 ms (lagging)"),
-            (None, False, 0.0, "PuzzleBot (YAML)", "/odom only (nothing rendered)"),
+        for model, subscribe, slow, robot, label, camera in (
+            (None, True, 0.0, "PuzzleBot (YAML)", "scan + camera + odom", True),
+            (URDF_MODEL, True, 0.0, "PuzzleBot from its URDF", "scan + camera + odom", True),
+            (
+                URDF_MODEL,
+                True,
+                0.05,
+                "PuzzleBot from its URDF",
+                "the same, images read in 50 ms (lagging)",
+                True,
+            ),
+            (
+                URDF_MODEL,
+                True,
+                0.0,
+                "PuzzleBot from its URDF",
+                "scan + odom (everything but the camera)",
+                False,
+            ),
+            (None, False, 0.0, "PuzzleBot (YAML)", "/odom only (nothing rendered)", True),
         ):
             a: list[SimRun] = []
             b: list[SimRun] = []
             for _ in range(rounds):
-                a.append(sim_run(old, subscribe, duration, model, slow))
-                b.append(sim_run(None, subscribe, duration, model, slow))
+                a.append(sim_run(old, subscribe, duration, model, slow, camera=camera))
+                b.append(sim_run(None, subscribe, duration, model, slow, camera=camera))
             ao, ac = statistics.median(v.outside for v in a), statistics.median(v.per_cpu for v in a)
             bo, bc = statistics.median(v.outside for v in b), statistics.median(v.per_cpu for v in b)
             print(f"| {robot} | {label} | {ao:.1f}x / {ac:.1f}x | {bo:.1f}x / {bc:.1f}x | {bo / ao:.2f} |")

@@ -300,6 +300,20 @@ class Simulation:
                 near_names += names[i]
         return (np.vstack(segs) if segs else self._static[:0]), near_names
 
+    def _any_mover_near(self, x: float, y: float, reach: float) -> bool:
+        """Whether some moving obstacle comes within ``reach`` of (x, y) now: the test
+        :meth:`_movers_near` makes, without building any outline."""
+        moving = self.world.moving
+        if not moving:
+            return False
+        bounds = self._mover_shapes()[4]
+        t = self.world_time
+        for i, m in enumerate(moving):
+            mx, my, _ = m.position(t)
+            if math.hypot(mx - x, my - y) <= reach + bounds[i]:
+                return True
+        return False
+
     @property
     def has_visuals(self) -> bool:
         """Some static piece is only drawn, not solid (an ArUco board): a lidar's scene then differs
@@ -750,8 +764,15 @@ class Simulation:
         if travel > 0:
             radius = m.body_radius
             static = not self._static_free(r, nx, ny)
-            geometry = self._collision_geometry(r.x, r.y, travel + radius + 0.05, r.name, static)
-            if len(geometry[0]) or len(geometry[2]):
+            reach = travel + radius + 0.05
+            geometry: tuple | None
+            if not static and len(self.robots) == 1 and not self._any_mover_near(r.x, r.y, reach):
+                # alone, inside its free disk, no moving obstacle within reach (the common step):
+                # what _collision_geometry would find is nothing, so nothing is built
+                geometry = None
+            else:
+                geometry = self._collision_geometry(r.x, r.y, reach, r.name, static)
+            if geometry is not None and (len(geometry[0]) or len(geometry[2])):
                 pieces = max(1, math.ceil(travel / (radius * 0.5)))
                 f = np.arange(0, pieces + 1) / pieces
                 dist, who = self._clearances(r.x + f * ddx, r.y + f * ddy, r.name, geometry)
@@ -761,6 +782,7 @@ class Simulation:
                 # cheapest: no samples along the move are made at all)
                 blocked = _NONE_BLOCKED
             if len(blocked):
+                assert geometry is not None  # something was in reach
                 k = int(blocked[0]) + 1
                 lo, hi = f[k - 1], f[k]
                 for _ in range(12):  # contact point to travel/pieces/4096
