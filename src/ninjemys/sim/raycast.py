@@ -24,6 +24,7 @@ import numpy as np
 #: reductions called as ufunc methods: ``a.any()`` and ``a.min()`` go through numpy's Python-level
 #: wrappers, a few microseconds a call that the camera's per-frame code feels
 _ANY = np.logical_or.reduce
+_ALL = np.logical_and.reduce
 
 
 def cast_segments(
@@ -110,8 +111,12 @@ def segment_pairs(
     two_pi = 2.0 * math.pi
     a0 = float(angles.min())
     rel = (angles - a0) % two_pi
-    order = np.argsort(rel, kind="stable")
-    rel_sorted = rel[order]
+    if n < 2 or _ALL(rel[1:] >= rel[:-1]):
+        # already in order (a lidar's evenly spaced beams): the stable sort would be the identity
+        order, rel_sorted = None, rel
+    else:
+        order = np.argsort(rel, kind="stable")
+        rel_sorted = rel[order]
     ends = (np.arctan2(np.concatenate([py, qy]), np.concatenate([px, qx])) - a0) % two_pi
     r1, r2 = ends[:k], ends[k:]
     lo, hi = np.minimum(r1, r2), np.maximum(r1, r2)
@@ -130,7 +135,9 @@ def segment_pairs(
         return none
     seg_of = np.repeat(seg_ids, counts)
     shift = np.repeat(starts - (np.cumsum(counts) - counts), counts)
-    ray_of = order[np.arange(total) + shift]
+    ray_of = np.arange(total) + shift
+    if order is not None:
+        ray_of = order[ray_of]
     dx, dy = np.cos(angles)[ray_of], np.sin(angles)[ray_of]
     sx, sy, gx, gy = px[seg_of], py[seg_of], ex[seg_of], ey[seg_of]
     denom = dx * gy - dy * gx
