@@ -163,6 +163,7 @@ class Simulation:
         self.static_names: list[str] = []
         self._movers_at: tuple[float, tuple] | None = None
         self._mover_fixed: tuple | None = None
+        self._mover_joined: tuple[np.ndarray, np.ndarray, list[str]] | None = None
         self._floor = floor_paint(world)
         for name, (x, y, yaw) in world.model_poses.items():  # an SDF world's models: their own poses
             self.obstacle_origin[name] = (x, y)
@@ -225,6 +226,7 @@ class Simulation:
         for r in self.robots.values():
             r.free = None  # the static world changed
         st = self._static
+        self._scene_cache: dict[tuple[bool, int], tuple] = {}  # see _scene_parts
         self._static_lo = np.minimum(st[:, :2], st[:, 2:])  # bounding boxes for the collision broad phase
         self._static_hi = np.maximum(st[:, :2], st[:, 2:])
         self._movers_at = None
@@ -274,14 +276,12 @@ class Simulation:
         movers = self.world.moving
         if not movers:
             return np.zeros((0, 4)), np.zeros(0), np.zeros((0, 3), dtype=np.uint8), []
-        heights, colours, names, _, _ = self._mover_shapes()
+        if self._mover_joined is None:  # what does not move, joined once
+            heights, colours, names, _, _ = self._mover_shapes()
+            self._mover_joined = (np.concatenate(heights), np.vstack(colours), [n for g in names for n in g])
+        joined_heights, joined_colours, joined_names = self._mover_joined
         segs = [self._mover_outline(i, *m.position(self.world_time)) for i, m in enumerate(movers)]
-        return (
-            np.vstack(segs),
-            np.concatenate(heights),
-            np.vstack(colours),
-            [n for group in names for n in group],
-        )
+        return np.vstack(segs), joined_heights, joined_colours, joined_names
 
     def _movers_near(self, x: float, y: float, reach: float) -> tuple[np.ndarray, list[str]]:
         """Outline segments and names of the moving obstacles that come within ``reach`` of (x, y)
@@ -324,21 +324,10 @@ class Simulation:
         """Everything seen now by robot ``exclude`` (its own body left out): by a camera, or with
         ``solid_only`` by a lidar (visuals without collision left out)."""
         ms, mh, mc, _ = self._mover_segments()
-        static, s_height, s_color = self._static, self._static_height, self._static_color
-        s_base, s_facing, s_owner = self._static_base, self._static_facing, self._static_owner
-        if solid_only and self._any_visual:
-            keep = self._static_solid
-            static, s_height, s_color = static[keep], s_height[keep], s_color[keep]
-            s_base, s_facing, s_owner = s_base[keep], s_facing[keep], s_owner[keep]
+        static, heights, colours, bases, facing, owners = self._scene_parts(
+            solid_only and self._any_visual, mh, mc
+        )
         segs = np.vstack([static, ms]) if len(ms) else static
-        heights = np.concatenate([s_height, mh]) if len(ms) else s_height
-        colours = np.vstack([s_color, mc]) if len(ms) else s_color
-        bases = None
-        if self._any_base:
-            bases = np.concatenate([s_base, np.zeros(len(ms))]) if len(ms) else s_base
-        # a moving obstacle may walk over a robot (the camera inside it sees its inside): both sides
-        facing = np.concatenate([s_facing, np.zeros(len(ms), dtype=np.int8)]) if len(ms) else s_facing
-        owners = np.concatenate([s_owner, np.full(len(ms), -1)]) if len(ms) else s_owner
         others = [r for r in self.robots.values() if r.name != exclude]
         if others:
             circles = (
@@ -359,6 +348,33 @@ class Simulation:
             bases,
             owners,
         )
+
+    def _scene_parts(self, solid: bool, mh: np.ndarray, mc: np.ndarray) -> tuple:
+        """What a scene holds besides the moving obstacles' segments, which alone change from step to
+        step: the static segments (``solid``: the solid ones only) and every segment's height,
+        colour, base, facing and owner, the movers' included. Built once per static world and kind
+        of scene (a scene is only read), not at each of the 40 scenes a simulated second."""
+        key = (solid, len(mh))
+        parts = self._scene_cache.get(key)
+        if parts is not None:
+            return parts
+        static, s_height, s_color = self._static, self._static_height, self._static_color
+        s_base, s_facing, s_owner = self._static_base, self._static_facing, self._static_owner
+        if solid:
+            keep = self._static_solid
+            static, s_height, s_color = static[keep], s_height[keep], s_color[keep]
+            s_base, s_facing, s_owner = s_base[keep], s_facing[keep], s_owner[keep]
+        n = len(mh)
+        heights = np.concatenate([s_height, mh]) if n else s_height
+        colours = np.vstack([s_color, mc]) if n else s_color
+        bases = None
+        if self._any_base:
+            bases = np.concatenate([s_base, np.zeros(n)]) if n else s_base
+        # a moving obstacle may walk over a robot (the camera inside it sees its inside): both sides
+        facing = np.concatenate([s_facing, np.zeros(n, dtype=np.int8)]) if n else s_facing
+        owners = np.concatenate([s_owner, np.full(n, -1)]) if n else s_owner
+        parts = self._scene_cache[key] = (static, heights, colours, bases, facing, owners)
+        return parts
 
     def clearance(
         self, x: float, y: float, exclude: str | None = None, height: float = math.inf, above: float = 0.0
