@@ -133,6 +133,10 @@ class RobotIO:
     #: the drive's odometry and base frames under the robot's prefix (fixed at spawn: not rebuilt per step)
     odom_frame_id: str = ""
     base_frame_id: str = ""
+    #: the odom -> base transform and the wheels' joint_states, built at the first sample and
+    #: refreshed in place after that (as ``odom_msg``)
+    odom_tf: Any = None
+    joints_msg: Any = None
 
     def frame(self, name: str) -> str:
         return scoped(self.frame_prefix, name)
@@ -591,22 +595,22 @@ class SimNode:
             wr.publish(Float32(data=r.wr))
         js = pubs.get("joint_states")
         if js is not None and js.get_num_connections():
-            js.publish(
-                messages.joint_state(
-                    stamp,
-                    [r.model.left_joint, r.model.right_joint],
-                    [r.left_angle, r.right_angle],
-                    [r.wl, r.wr],
-                )
-            )
+            positions, speeds = [r.left_angle, r.right_angle], [r.wl, r.wr]
+            if io.joints_msg is None:
+                joints = [r.model.left_joint, r.model.right_joint]
+                io.joints_msg = messages.joint_state(stamp, joints, positions, speeds)
+            else:
+                messages.joint_state_into(io.joints_msg, stamp, positions, speeds)
+            js.publish(io.joints_msg)
         if tfs is None or drive.kind == "none":
             return
         if drive.publish_odom_tf:
-            tfs.append(
-                messages.transform(
-                    stamp, odom_frame, base_frame, (pose[0], pose[1], 0.0), quaternion_from_yaw(pose[2])
-                )
-            )
+            xyz, q = (pose[0], pose[1], 0.0), quaternion_from_yaw(pose[2])
+            if io.odom_tf is None:
+                io.odom_tf = messages.transform(stamp, odom_frame, base_frame, xyz, q)
+            else:
+                messages.transform_into(io.odom_tf, stamp, xyz, q)
+            tfs.append(io.odom_tf)
         # gazebo_ros_diff_drive's publishWheelTF: each wheel link in its parent's frame, turned by its angle
         for joint, angle in zip(r.model.wheel_tf_joints, (r.left_angle, r.right_angle), strict=False):
             x, y, z, qx, qy, qz, qw = joint.transform(angle)
