@@ -104,7 +104,9 @@ def segment_pairs(
         keep = np.flatnonzero(near)
         if not len(keep):
             return none
-        px, py, ex, ey, qx, qy = px[keep], py[keep], ex[keep], ey[keep], qx[keep], qy[keep]
+        # gathers by ``take`` (the same elements as fancy indexing, a few times cheaper at this size)
+        px, py, ex, ey = px.take(keep), py.take(keep), ex.take(keep), ey.take(keep)
+        qx, qy = qx.take(keep), qy.take(keep)
     else:
         keep = None
     k = len(px)
@@ -137,15 +139,15 @@ def segment_pairs(
     shift = np.repeat(starts - (np.cumsum(counts) - counts), counts)
     ray_of = np.arange(total) + shift
     if order is not None:
-        ray_of = order[ray_of]
-    dx, dy = np.cos(angles)[ray_of], np.sin(angles)[ray_of]
-    sx, sy, gx, gy = px[seg_of], py[seg_of], ex[seg_of], ey[seg_of]
+        ray_of = order.take(ray_of)
+    dx, dy = np.cos(angles).take(ray_of), np.sin(angles).take(ray_of)
+    sx, sy, gx, gy = px.take(seg_of), py.take(seg_of), ex.take(seg_of), ey.take(seg_of)
     denom = dx * gy - dy * gx
     with np.errstate(divide="ignore", invalid="ignore"):
         t = (sx * gy - sy * gx) / denom
         u = (sx * dy - sy * dx) / denom
     t[~((u >= -1e-9) & (u <= 1 + 1e-9) & (t >= 0) & (t <= max_range))] = np.inf  # NaN fails too
-    return ray_of, (seg_of if keep is None else keep[seg_of]), t
+    return ray_of, (seg_of if keep is None else keep.take(seg_of)), t
 
 
 def grid_edges(occupied: np.ndarray, resolution: float, origin_x: float, origin_y: float) -> np.ndarray:
