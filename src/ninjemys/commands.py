@@ -9,7 +9,9 @@ from __future__ import annotations
 
 import os
 import shutil
+import signal
 import sys
+import threading
 from collections.abc import Callable, Mapping
 
 from ninjemys.errors import MasterUnreachable, NinjemysError
@@ -43,10 +45,28 @@ def error(message: str) -> None:
     print(message if message.startswith("ERROR") else f"ERROR: {message}", file=sys.stderr)
 
 
+def answer_sigint() -> None:
+    """Make Ctrl-C reach this process even when it was started with SIGINT ignored.
+
+    A parent that ignores SIGINT passes that on through exec: a background job of a shell script, a
+    supervisor that ignores Ctrl-C while it cleans up, a test runner. Python then leaves SIGINT ignored
+    and never raises KeyboardInterrupt, so the process would not stop when roslaunch, a test or a user
+    sends SIGINT. ROS 1's rospy and roscpp install their own handler at init, so their nodes and
+    tools (rostopic, rosout, roscore) stop on SIGINT either way; ours do the same by restoring Python's
+    default handler. Only the main thread may set handlers; elsewhere this does nothing.
+    """
+    if (
+        threading.current_thread() is threading.main_thread()
+        and signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+    ):
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+
+
 def entry(main: Callable[[list[str] | None], int]) -> Callable[[], None]:
     """Wrap ``main`` for a console script: map our errors and Ctrl-C to exit codes, never a traceback."""
 
     def console_main() -> None:
+        answer_sigint()
         try:
             code = main(sys.argv[1:])
         except KeyboardInterrupt:

@@ -308,6 +308,9 @@ class _ignore_sigint:  # noqa: N801 - used as a context manager
 
 
 def main(argv: list[str] | None = None) -> int:
+    from ninjemys.commands import answer_sigint
+
+    answer_sigint()  # Ctrl-C stops the demo even when it was started with SIGINT ignored
     parser = argparse.ArgumentParser(prog="python -m ninjemys.demo", description=__doc__.splitlines()[0])
     parser.add_argument(
         "-p", "--port", type=int, default=None, help="master port (default 11311, else a free one)"

@@ -70,6 +70,9 @@ class EmulatedArduino:
         self.time_syncs = 0
         self.host_time: tuple[int, int] | None = None
         self.wheel_radius: float | None = None
+        self.param_answers: list[Any] = []  # every RequestParam response, in order
+        self.received: list[tuple[int, int]] = []  # (topic id, payload length) of every packet from the host
+        self.param_answers_only = False  # True: a test's own requests, wheel_radius left alone
         self.cmd_vels: list[Any] = []
         self.leds: list[Any] = []
         self.resets = 0
@@ -176,6 +179,7 @@ class EmulatedArduino:
     def _handle(self, f: proto.Frame) -> None:
         tid = f.topic_id
         with self.cond:
+            self.received.append((tid, len(f.payload)))
             if tid == proto.ID_PUBLISHER:
                 pass
             elif tid == proto.ID_TIME:
@@ -184,7 +188,13 @@ class EmulatedArduino:
                 self.time_syncs += 1
             elif tid == proto.ID_PARAMETER_REQUEST:
                 resp = RequestParam._response_class().deserialize(f.payload)
-                self.wheel_radius = resp.floats[0] if resp.floats else float(resp.ints[0])
+                with self.cond:
+                    self.param_answers.append(resp)  # ros_lib takes them in order, one at a time
+                    self.cond.notify_all()
+                if self.param_answers_only:
+                    pass
+                elif resp.floats or resp.ints:
+                    self.wheel_radius = resp.floats[0] if resp.floats else float(resp.ints[0])
             elif tid == proto.ID_TX_STOP:
                 self.stopped_by_host = True
                 self.configured = False
@@ -218,7 +228,10 @@ class EmulatedArduino:
                 if isinstance(item, proto.Drop):
                     self.drops += 1
                 else:
-                    self._handle(item)
+                    try:
+                        self._handle(item)
+                    except OSError:  # the host went away while the board answered it
+                        return
 
     def _publish_loop(self) -> None:
         period = 1.0 / self.rate_hz

@@ -175,6 +175,8 @@ class EmulatedA1:
             self.cond.notify_all()
         if cmd in (rp.CMD_STOP, rp.CMD_RESET):
             self.mode = None
+            if cmd == rp.CMD_RESET:  # the core reboots and prints its banner, as an A1 does
+                self._write(b"RP LIDAR System.\r\nFirmware Ver 1.29 - rtm, HW Ver 7\r\nModel: 18\r\n")
         elif cmd == rp.CMD_GET_INFO:
             info = rp.DeviceInfo(0x18, self.firmware[0] << 8 | self.firmware[1], 7, bytes(range(0xA0, 0xB0)))
             self._answer(rp.Descriptor(20, 0, rp.ANS_TYPE_DEVINFO), info.pack())

@@ -151,6 +151,18 @@ def test_cmd_vel_only_while_the_enable_button_is_held_and_one_stop_after() -> No
     assert t.on_joy([], []) is None  # short arrays: not pressed, no crash
 
 
+def test_require_enable_button_false_drives_without_a_button_and_turbo_still_wins() -> None:
+    """The ROS 2 port's ``require_enable_button``, read so its config files work; true (the default)
+    keeps ROS 1's rule."""
+    t = Teleop(read_config(params({"require_enable_button": False, "enable_turbo_button": 3})), Twist)
+    assert t.on_joy([0.0, 0.5], [0, 0, 0, 0]).linear.x == pytest.approx(0.25)
+    assert t.on_joy([0.0, 0.5], [0, 0, 0, 1]).linear.x == pytest.approx(0.5)
+    strict = Teleop(read_config(params({})), Twist)
+    assert strict.on_joy([0.0, 0.5], [0]).linear.x == 0.0  # the one stop...
+    assert strict.on_joy([0.0, 0.5], [0]) is None  # ...then nothing: the button is required
+    assert strict.on_joy([0.0, 0.5], [1]).linear.x == pytest.approx(0.25)  # enable_button 0, scale 0.5
+
+
 def test_holonomic_maps_and_axes_beyond_the_message() -> None:
     t = Teleop(
         read_config(
@@ -225,8 +237,12 @@ def test_joy_node_retries_a_missing_device_and_reopens_when_it_comes_back(rig: R
         joys.wait_for(lambda m: list(m.buttons) == [1], timeout=15)
     finally:
         os.close(fd)
+    # the writer gone is the device unplugged: joy_node's line, once, and no busy reopening
+    out += rig.read_until(proc, "Connection to joystick device lost unexpectedly. Will reopen.")
+    time.sleep(1.5)
     out += rig.stop(proc)
     assert out.count(f"Couldn't open joystick {path}. Will retry every second.") == 1, out
+    assert out.count("Connection to joystick device lost unexpectedly") == 1, out
     assert f"Opened joystick: {path} (Unknown). deadzone_: 0.050000." in out, out
 
 

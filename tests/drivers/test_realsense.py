@@ -21,6 +21,7 @@ from ninjemys.drivers.realsense_msgs import Intrinsics, camera_info_fields, poin
 from ninjemys.idl.loader import get_message_class
 from ninjemys.node import Node
 
+from .conftest import Rig
 from .realsense_recording import BASELINE_M, BOX_MM, FX, WALL_MM, H, W, write_recording
 
 Image = get_message_class("sensor_msgs/Image")
@@ -198,3 +199,20 @@ def test_without_pyrealsense2_the_node_says_so_in_one_line(tmp_path: Path) -> No
     assert done.stderr.strip().splitlines() == [
         "realsense2_camera: pyrealsense2 is not installed (pip install pyrealsense2): no RealSense camera can be read"
     ]
+
+
+def test_without_a_camera_the_node_says_so_as_realsense2_camera_and_gives_up_when_told(rig: Rig) -> None:
+    """No device on the machine (CI has none): realsense2_camera's warning each ``reconnect_timeout``,
+    and ``wait_for_device_timeout`` ends the wait with its error, no traceback."""
+    rs = pytest.importorskip("pyrealsense2")
+    if len(rs.context().query_devices()):
+        pytest.skip("a RealSense camera is attached to this machine")
+    proc = rig.shipped(
+        "realsense2_camera",
+        "realsense2_camera_node",
+        "_wait_for_device_timeout:=1.5",
+        "_reconnect_timeout:=0.5",
+    )
+    out = rig.exit_output(proc)
+    assert "No RealSense devices were found!" in out, out
+    assert "wait for device timeout of 1.5 secs expired" in out, out

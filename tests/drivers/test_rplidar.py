@@ -5,14 +5,19 @@ device."""
 from __future__ import annotations
 
 import math
+import os
+import re
 import subprocess
 import time
+import xml.etree.ElementTree as ET
+import xmlrpc.client
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 import pytest
 
+from ninjemys import testing
 from ninjemys.drivers import rplidar_protocol as rp
 from ninjemys.drivers.rplidar_scan import ascend, compensate_multiple, revolution_to_scan
 from ninjemys.idl.loader import get_message_class, get_service_class
@@ -111,6 +116,9 @@ def test_scan_of_the_known_room_within_1cm_and_stop_motor_reaches_the_device(mod
     samples = a1.standard_samples() if mode == "Standard" else a1.express_samples()
     check_room(scan, samples)
     assert rp.CMD_GET_INFO in a1.commands and rp.CMD_GET_HEALTH in a1.commands
+    # by rosrun the node has rplidar_ros' ros::init name, rplidar_node (launch files call it rplidarNode)
+    _code, _msg, (pubs, _subs, _srvs) = xmlrpc.client.ServerProxy(rig.uri).getSystemState("/t")
+    assert dict((t, n) for t, n in pubs)["/scan"] == ["/rplidar_node"]
 
     before = len(a1.commands)
     node.service_proxy("/stop_motor", Empty)(Empty._request_class())
@@ -144,21 +152,49 @@ def test_a_bad_descriptor_is_one_clear_error_and_the_node_stays_up(rig: Rig) -> 
     assert "Traceback" not in out, out
 
 
-def test_health_error_and_unknown_scan_mode_stop_the_node_as_rplidar_ros_does(
-    rig: Rig, tmp_path: Path
-) -> None:
+def test_health_error_and_a_missing_port_stop_the_node_as_rplidar_ros_does(rig: Rig, tmp_path: Path) -> None:
     sick = rig.device(EmulatedA1(health=(2, 0x8001)))
     out = rig.exit_output(rplidar(rig, f"_serial_port:={sick.path}"))
     sick.wait(lambda: rp.CMD_RESET in sick.commands, timeout=5)  # the protection stop is reset
     assert rp.CMD_SCAN not in sick.commands and rp.CMD_EXPRESS_SCAN not in sick.commands
     assert "RPLidar health status : 2" in out, out
     assert "Error, rplidar internal error detected. Please reboot the device to retry." in out, out
-    a1 = rig.device(EmulatedA1())
-    out = rig.exit_output(rplidar(rig, f"_serial_port:={a1.path}", "_scan_mode:=Sensitivity"))
-    assert "scan mode `Sensitivity' is not supported by lidar, supported modes:" in out, out
-    assert "\tStandard: max_distance: 16.0 m, Point number: 2.0K" in out, out
     out = rig.exit_output(rplidar(rig, f"_serial_port:={tmp_path / 'nothing'}"))
     assert f"Error, cannot bind to the specified serial port {tmp_path / 'nothing'}." in out, out
+
+
+def test_an_unknown_scan_mode_lists_the_modes_and_waits_for_start_motor_as_rplidar_ros(rig: Rig) -> None:
+    """rplidar_ros does not exit here: it prints the modes and ``Can not start scan: 80008001!``, stays
+    up without scans, and its ``start_motor`` starts the device's typical mode."""
+    a1 = rig.device(EmulatedA1())
+    node = rig.node("rplidar_mode_test")
+    scans = rig.collect(node, "/scan", LaserScan)
+    proc = rplidar(rig, f"_serial_port:={a1.path}", "_scan_mode:=Sensitivity")
+    out = rig.read_until(proc, "Can not start scan: 80008001!")
+    assert "scan mode `Sensitivity' is not supported by lidar, supported modes:" in out, out
+    assert "\tStandard: max_distance: 16.0 m, Point number: 2.0K" in out, out
+    time.sleep(1.0)
+    assert proc.poll() is None and not scans.items
+    assert rp.CMD_SCAN not in a1.commands and rp.CMD_EXPRESS_SCAN not in a1.commands
+    node.service_proxy("/start_motor", Empty)(Empty._request_class())
+    scans.wait_count(2, timeout=30)
+    out += rig.stop(proc)
+    assert "current scan mode: Express" in out, out
+    assert "Traceback" not in out, out
+
+
+def test_rplidar_ros_2_parameters_initial_reset_and_channel_type(rig: Rig) -> None:
+    """rplidar_ros 2.x's ``initial_reset`` (RESET, wait for the device, go on) works; its Ethernet
+    ``channel_type`` is refused in one clear line."""
+    a1 = rig.device(EmulatedA1())
+    scans = rig.collect(rig.node("rplidar_reset_test"), "/scan", LaserScan)
+    proc = rplidar(rig, f"_serial_port:={a1.path}", "_initial_reset:=true")
+    scans.wait_count(2, timeout=40)
+    out = rig.stop(proc)
+    assert rp.CMD_RESET in a1.commands
+    assert "Resetting rplidar" in out and "Rplidar reset successfully" in out, out
+    out = rig.exit_output(rplidar(rig, "_channel_type:=tcp"))
+    assert "Error, channel_type tcp is not supported here" in out, out
 
 
 def test_rplidar_a1_launch_brings_up_the_node_on_the_emulated_device(rig: Rig) -> None:
@@ -185,3 +221,84 @@ def test_launch_files_name_the_node_and_its_parameters() -> None:
     for name in ("rplidar", "rplidar_a1", "rplidar_a2", "rplidar_a3"):
         text = (share / f"{name}.launch").read_text()
         assert 'type="rplidarNode"' in text and 'name="angle_compensate"' in text
+    # rplidar_ros' values, launch file by launch file (1.10's rplidar*.launch, 2.x's per-model files)
+    bauds = {"rplidar": 115200, "rplidar_a1": 115200, "rplidar_a2": 115200, "rplidar_a2m8": 115200}
+    bauds |= {"rplidar_a2m7": 256000, "rplidar_a2m12": 256000, "rplidar_a3": 256000}
+    for name, baud in bauds.items():
+        root = ET.parse(share / f"{name}.launch").getroot()
+        args = {a.get("name"): a.get("default") for a in root.iter("arg")}
+        (node,) = root.iter("node")
+        assert (node.get("name"), node.get("pkg"), node.get("type")) == (
+            "rplidarNode",
+            "rplidar_ros",
+            "rplidarNode",
+        )
+        params = {p.get("name"): p.get("value") for p in node.iter("param")}
+        assert args == {"serial_port": "/dev/ttyUSB0", "serial_baudrate": str(baud), "frame_id": "laser"}, (
+            name
+        )
+        assert params["inverted"] == "false" and params["angle_compensate"] == "true", name
+        assert params.get("scan_mode") == ("Sensitivity" if name == "rplidar_a3" else None), name
+
+
+def test_view_launch_files_bring_up_the_lidar_and_rviz_on_its_scan() -> None:
+    """rplidar_ros' view_rplidar*.launch: the matching rplidar*.launch and rviz with rplidar.rviz, a
+    LaserScan display on /scan in the lidar's frame (read by our rviz's own .rviz reader)."""
+    from ninjemys.web.rvizconfig import parse
+
+    share = Path(__file__).resolve().parents[2] / "src/ninjemys/packages/share/rplidar_ros"
+    config = parse((share / "rviz/rplidar.rviz").read_text(), "rplidar.rviz")
+    assert config.fixed_frame == "laser" and not config.unsupported
+    assert [(d["cls"], d["topic"]) for d in config.displays if d["cls"] == "rviz/LaserScan"] == [
+        ("rviz/LaserScan", "/scan")
+    ]
+    for model in ("", "_a1", "_a2", "_a2m7", "_a2m8", "_a2m12", "_a3"):
+        root = ET.parse(share / f"launch/view_rplidar{model}.launch").getroot()
+        (include,) = root.iter("include")
+        assert include.get("file") == f"$(find rplidar_ros)/launch/rplidar{model}.launch"
+        (rviz,) = root.iter("node")
+        assert (rviz.get("pkg"), rviz.get("type")) == ("rviz", "rviz")
+        assert rviz.get("args") == "-d $(find rplidar_ros)/rviz/rplidar.rviz"
+
+
+def test_view_rplidar_a1_launch_runs_the_lidar_and_rviz(rig: Rig) -> None:
+    for var in ("DISPLAY", "WAYLAND_DISPLAY"):
+        rig.env.pop(var, None)  # rviz only prints its URL
+    a1 = rig.device(EmulatedA1())
+    scans = rig.collect(rig.node("rplidar_view_test"), "/scan", LaserScan)
+    launch = rig.roslaunch("rplidar_ros", "view_rplidar_a1.launch", f"serial_port:={a1.path}")
+    scans.wait_count(2, timeout=40)
+    master = xmlrpc.client.ServerProxy(rig.uri)
+    deadline = time.monotonic() + 30
+    while master.lookupNode("/t", "/rviz")[0] != 1 and time.monotonic() < deadline:
+        time.sleep(0.5)  # rviz subscribes once a page shows the scan; its node is up before that
+    assert master.lookupNode("/t", "/rviz")[0] == 1
+    out = rig.stop(launch)
+    assert "process has died" not in out, out[-3000:]
+
+
+def test_create_and_delete_udev_rules_scripts_write_the_rplidar_symlink_rule(tmp_path: Path) -> None:
+    """``rosrun rplidar_ros create_udev_rules.sh`` as tutorials use it (here into a directory of the
+    test's: NINJEMYS_UDEV_RULES_DIR), and ``delete_udev_rules.sh`` removing it."""
+    env = dict(os.environ, NINJEMYS_UDEV_RULES_DIR=str(tmp_path / "rules.d"))
+    rosrun = testing.ninjemys_bin("rosrun")
+    made = subprocess.run(
+        [rosrun, "rplidar_ros", "create_udev_rules.sh"], env=env, capture_output=True, text=True, timeout=60
+    )
+    assert made.returncode == 0, made
+    rule = (tmp_path / "rules.d/rplidar.rules").read_text()
+    (line,) = [x for x in rule.splitlines() if x and not x.startswith("#")]
+    fields = re.findall(r'([A-Z]+(?:\{\w+\})?)(==|:=|\+=)"([^"]*)"', line)
+    assert fields == [
+        ("KERNEL", "==", "ttyUSB*"),
+        ("ATTRS{idVendor}", "==", "10c4"),
+        ("ATTRS{idProduct}", "==", "ea60"),
+        ("MODE", ":=", "0666"),
+        ("SYMLINK", "+=", "rplidar"),
+    ]
+    assert "/dev/rplidar" in made.stdout
+    gone = subprocess.run(
+        [rosrun, "rplidar_ros", "delete_udev_rules.sh"], env=env, capture_output=True, text=True, timeout=60
+    )
+    assert gone.returncode == 0, gone
+    assert not (tmp_path / "rules.d/rplidar.rules").exists()

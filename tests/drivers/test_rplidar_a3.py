@@ -147,7 +147,10 @@ def test_other_ultra_and_dense_modes_match_the_room(mode: str, rig: Rig) -> None
 
 def test_the_a3_lists_its_modes_when_asked_for_one_it_lacks(rig: Rig) -> None:
     a3 = rig.device(EmulatedA3())
-    out = rig.exit_output(rplidar(rig, f"_serial_port:={a3.path}", "_scan_mode:=HighSpeed"))
+    proc = rplidar(rig, f"_serial_port:={a3.path}", "_scan_mode:=HighSpeed")
+    out = rig.read_until(proc, "Can not start scan: 80008001!")  # and it stays up, as rplidar_ros
+    assert proc.poll() is None
+    out += rig.stop(proc)
     assert "scan mode `HighSpeed' is not supported by lidar, supported modes:" in out, out
     for line in (
         "\tStandard: max_distance: 16.0 m, Point number: 4.0K",

@@ -82,20 +82,29 @@ class JoyNode:
         self.published = 0
 
     def run(self) -> None:
+        quiet = False  # the last opening found the device at its end at once: do not say it again
         while not self.node.is_shutdown:
             fd = self._open()
             if fd is None:
                 return
             try:
-                self.log.info(
-                    "Opened joystick: %s (%s). deadzone_: %f.",
-                    self.dev,
-                    device_name(fd),
-                    self.settings.deadzone,
-                )
-                self._serve(fd)
+                if not quiet:
+                    self.log.info(
+                        "Opened joystick: %s (%s). deadzone_: %f.",
+                        self.dev,
+                        device_name(fd),
+                        self.settings.deadzone,
+                    )
+                served = self._serve(fd)
             finally:
                 os.close(fd)
+            if self.node.is_shutdown:
+                break
+            quiet = not served
+            if served:
+                self.log.error("Connection to joystick device lost unexpectedly. Will reopen.")
+            else:  # opened but at its end at once (a FIFO without a writer): do not spin
+                self.node.wait_for_shutdown(1.0)
 
     def _open(self) -> int | None:
         """Open the device, retrying every second (ROS 1's open-close-open gets the current state
@@ -112,8 +121,9 @@ class JoyNode:
                 self.node.wait_for_shutdown(1.0)
         return None
 
-    def _serve(self, fd: int) -> None:
-        """Events until the device goes away or the node shuts down."""
+    def _serve(self, fd: int) -> bool:
+        """Events until the device goes away or the node shuts down; True if any came."""
+        got_any = False
         state = JoyState(self.settings)
         pending = b""
         deadline: float | None = None  # when the coalesce or autorepeat timer fires
@@ -129,9 +139,10 @@ class JoyNode:
                 except OSError as exc:
                     if exc.errno in (errno.EAGAIN, errno.EINTR):
                         continue
-                    return  # the joystick is gone
+                    return got_any  # the joystick is gone
                 if not data:
-                    return  # end of stream: a FIFO's writer closed
+                    return got_any  # end of stream: a FIFO's writer closed
+                got_any = True
                 pending += data
                 usable = len(pending) - len(pending) % EVENT.size
                 for offset in range(0, usable, EVENT.size):
@@ -151,6 +162,7 @@ class JoyNode:
                 deadline, coalescing = None, False
             if deadline is None and repeat is not None:
                 deadline = time.monotonic() + repeat
+        return got_any
 
     def _publish(self, state: JoyState) -> None:
         msg = self.Joy()

@@ -15,7 +15,8 @@ the device's md5sum is the one of the type the host knows. Then it relays:
 * device service clients: the device's requests call the ROS service and its answer goes back.
 
 With no time sync for ``sync_timeout`` seconds (rosserial_python: 3 x 5 s) the host logs ROS 1's
-"Lost sync with device, restarting..." and asks for the topics again; bad packets are dropped with
+"Lost sync with device, restarting..." (or, if no good packet ever came on this link, "Unable to sync
+with device; ...") and asks for the topics again; bad packets are dropped with
 rosserial_python's log lines and never stop the link.
 """
 
@@ -34,6 +35,12 @@ from ninjemys.idl.loader import get_message_class, get_service_class
 SERVICE_TIMEOUT = 5.0
 #: rosserial_python's default: 3 x its 5 s timeout without time sync means the link is lost
 SYNC_TIMEOUT = 15.0
+#: the messages of rosserial_python's /diagnostics statuses
+ERROR_MISMATCHED_PROTOCOL = (
+    "Mismatched protocol version in packet: lost sync or rosserial_python is from different ros release "
+    "than the rosserial client"
+)
+ERROR_NO_SYNC = "no sync with device"
 
 
 class Transport(Protocol):
@@ -93,12 +100,30 @@ class RosserialHost:
         self._last_unknown_request = 0.0
         self._pub_buffer_noted = False
         self._sub_buffer_noted = False
+        self.buffer_in = -1  # the device's input buffer, from its first subscriber's TopicInfo
         self.frames_in = 0
         self.dropped = 0
+        self.DiagnosticArray: Any = get_message_class("diagnostic_msgs/DiagnosticArray")
+        self.DiagnosticStatus: Any = get_message_class("diagnostic_msgs/DiagnosticStatus")
+        self.KeyValue: Any = get_message_class("diagnostic_msgs/KeyValue")
+        self.diagnostics = node.publisher("/diagnostics", self.DiagnosticArray, queue_size=10)
+        self.last_sync_wall = time.time()  # "last sync" and "last sync lost" in the diagnostics
+        self.last_sync_lost_wall = 0.0
 
     # -- the link ------------------------------------------------------------------------------------
 
     def send(self, topic_id: int, payload: bytes | bytearray = b"") -> None:
+        """Frame and write ``payload``; one larger than the device's input buffer (the size its
+        subscribers announced) is dropped with rosserial_python's error, as it would overrun the board."""
+        if 0 < self.buffer_in < len(payload):
+            self.log.error(
+                "Message from ROS network dropped: message larger than buffer. (%d bytes on topic id %d, "
+                "the device's buffer holds %d)",
+                len(payload),
+                topic_id,
+                self.buffer_in,
+            )
+            return
         packet = proto.frame(topic_id, payload)
         with self._write_lock:
             self.link.write(packet)
@@ -122,9 +147,13 @@ class RosserialHost:
                     for item in self.reader.feed(data):
                         if isinstance(item, proto.Drop):
                             self.dropped += 1
-                            self.log.info("%s", item.log_line())
+                            if item.reason is proto.DropReason.VERSION:
+                                self.send_diagnostics(ERROR_MISMATCHED_PROTOCOL)
+                            for level, line in item.log_lines():
+                                (self.log.error if level == "error" else self.log.info)("%s", line)
                         else:
                             self.frames_in += 1
+                            self.synced = True  # any good packet, as rosserial_python counts it
                             self._dispatch(item)
                 now = time.monotonic()
                 if now - self.last_sync > self.sync_timeout:
@@ -135,7 +164,8 @@ class RosserialHost:
                             "Unable to sync with device; possible link problem or link software version "
                             "mismatch such as hydro rosserial_python with groovy Arduino"
                         )
-                    self.synced = False
+                    self.last_sync_lost_wall = time.time()
+                    self.send_diagnostics(ERROR_NO_SYNC)
                     self.request_topics()
                     self.last_sync = now
         finally:
@@ -143,8 +173,25 @@ class RosserialHost:
                 try:
                     with self._write_lock:
                         self.link.write(proto.TX_STOP)
+                    self.log.info("Sending tx stop request")
                 except OSError:
                     pass
+
+    def send_diagnostics(self, text: str) -> None:
+        """An ERROR status on ``/diagnostics``, as rosserial_python sends on a lost sync or a packet of
+        another protocol version: name ``rosserial_python``, with the last sync and last loss."""
+        status = self.DiagnosticStatus()
+        status.name = "rosserial_python"
+        status.level = self.DiagnosticStatus.ERROR
+        status.message = text
+        status.values = [
+            self.KeyValue(key="last sync", value=time.ctime(self.last_sync_wall)),
+            self.KeyValue(key="last sync lost", value=time.ctime(self.last_sync_lost_wall)),
+        ]
+        msg = self.DiagnosticArray()
+        msg.header.stamp = self.node.now()
+        msg.status = [status]
+        self.diagnostics.publish(msg)
 
     def close(self) -> None:
         """Release what this link set up on the node (the node itself stays up for a reconnect)."""
@@ -158,6 +205,7 @@ class RosserialHost:
         self.publishers.clear()
         self.subscribers.clear()
         self.services.clear()
+        self.diagnostics.unregister()
 
     # -- dispatch -------------------------------------------------------------------------------------
 
@@ -253,6 +301,7 @@ class RosserialHost:
         self.log.info("Setup subscriber on %s [%s]", info.topic_name, info.message_type)
         if not self._sub_buffer_noted and info.buffer_size:
             self._sub_buffer_noted = True
+            self.buffer_in = info.buffer_size
             self.log.info("Note: subscribe buffer size is %d bytes", info.buffer_size)
 
     def _service_class(self, kind: str, info: Any) -> Any:
@@ -339,7 +388,7 @@ class RosserialHost:
         msg = self.Time()
         msg.data = self.node.now()
         self.send(proto.ID_TIME, msg.serialize_to_bytes())
-        self.synced = True
+        self.last_sync_wall = time.time()
         self.last_sync = time.monotonic()
 
     def _handle_parameter_request(self, payload: bytes) -> None:
@@ -364,8 +413,9 @@ class RosserialHost:
             2: self.log.warn,
             3: self.log.error,
             4: self.log.fatal,
-        }.get(msg.level, self.log.info)
-        emit("%s", msg.msg)
+        }.get(msg.level)
+        if emit is not None:  # another level is dropped, as rosserial_python drops it
+            emit("%s", msg.msg)
 
 
 def param_response_lists(value: Any) -> tuple[list[int], list[float], list[str]]:
@@ -379,11 +429,11 @@ def param_response_lists(value: Any) -> tuple[list[int], list[float], list[str]]
     values = list(value) if isinstance(value, list | tuple) else [value]
     if not values:
         return [], [], []
-    kinds = {int if isinstance(v, int) else type(v) for v in values}
+    kinds = {type(v) for v in values}  # rosserial_python compares exact types: [1, True] is mixed
     if len(kinds) != 1:
         raise RosserialError("All Paramers in the list {name} must be of the same type")
     kind = kinds.pop()
-    if kind is int:
+    if kind is int or kind is bool:
         return [int(v) for v in values], [], []
     if kind is float:
         return [], [float(v) for v in values], []

@@ -81,15 +81,39 @@ class Drop:
     detail: int
 
     def log_line(self) -> str:
-        """The line rosserial_python logs for it."""
+        """The first (main) line rosserial_python logs for it."""
+        return self.log_lines()[0][1]
+
+    def log_lines(self) -> list[tuple[str, str]]:
+        """``(level, line)`` as rosserial_python (noetic) logs them: a version mismatch is an error
+        followed by an info line naming both protocol versions; the checksum drops are info lines."""
         if self.reason is DropReason.VERSION:
-            return (
-                f"Mismatched protocol version in packet ({self.detail:#04x}): lost sync or rosserial_python "
-                "is from different ros release than the rosserial client"
+            found = _PROTOCOL_REVISIONS.get(self.detail)
+            client = (
+                f"Protocol version of client is {found}"
+                if found
+                else ("Protocol version of client is unrecognized")
             )
+            return [
+                (
+                    "error",
+                    f"Mismatched protocol version in packet ({bytes([self.detail])!r}): lost sync or "
+                    "rosserial_python is from different ros release than the rosserial client",
+                ),
+                ("info", f"{client}, expected {_PROTOCOL_REVISIONS[PROTOCOL_VER]}"),
+            ]
         if self.reason is DropReason.LENGTH_CHECKSUM:
-            return f"wrong checksum for msg length, length {self.detail}, dropping message."
-        return "wrong checksum for topic id and msg"
+            length = self.detail - 0x10000 if self.detail >= 0x8000 else self.detail  # read as "<h"
+            return [("info", f"Wrong checksum for msg length, length {length}, dropping message.")]
+        return [("info", "wrong checksum for topic id and msg")]
+
+
+#: the version byte's meaning, in rosserial_python's words
+_PROTOCOL_REVISIONS = {
+    0xFF: "Rev 0 (rosserial 0.4 and earlier)",
+    0xFE: "Rev 1 (rosserial 0.5+)",
+    0xFD: "Some future rosserial version",
+}
 
 
 class FrameReader:
@@ -119,10 +143,14 @@ class FrameReader:
             if len(buf) < 2:
                 break
             if buf[1] != PROTOCOL_VER:
-                if buf[1] == SYNC:  # 0xFF 0xFF...: the second 0xFF may start the real packet
-                    self.skipped += 1
-                    del buf[:1]
-                    continue
+                if buf[1] == SYNC:
+                    if len(buf) < 3:
+                        break
+                    if buf[2] == PROTOCOL_VER:  # 0xFF 0xFF 0xFE: a stray 0xFF before a real packet
+                        self.skipped += 1
+                        del buf[:1]
+                        continue
+                    # 0xFF 0xFF then no 0xFE: a Groovy (protocol rev 0) client, as rosserial_python sees it
                 out.append(Drop(DropReason.VERSION, buf[1]))
                 self.skipped += 2
                 del buf[:2]

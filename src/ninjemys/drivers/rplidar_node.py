@@ -51,6 +51,10 @@ DECODERS: dict[int, Any] = {
 }
 #: a second between "bad capsule data" lines
 BAD_DATA_LOG_INTERVAL = 1.0
+#: seconds rplidar_ros 2.x waits for the device to answer again after initial_reset
+RESET_TIMEOUT = 15.0
+#: the SDK's RESULT_OPERATION_FAIL, as rplidar_ros prints it when the scan mode asked for is not there
+RESULT_OPERATION_FAIL = 0x80008001
 
 
 class ScanMode:
@@ -264,6 +268,7 @@ class RplidarNode:
         self.inverted = bool(node.get_param("~inverted", False))
         self.angle_compensate = bool(node.get_param("~angle_compensate", False))
         self.scan_mode_name = str(node.get_param("~scan_mode", ""))
+        self.initial_reset = bool(node.get_param("~initial_reset", False))  # rplidar_ros 2.x
         self.pub = node.publisher("scan", self.LaserScan, queue_size=1000)
         self.actions: queue.Queue[tuple[str, threading.Event]] = queue.Queue()
         self.scanning = False
@@ -283,6 +288,25 @@ class RplidarNode:
 
         return self.node.service(action, Empty, handle)
 
+    def _reset_device(self) -> bool:
+        """rplidar_ros 2.x's ``initial_reset``: RESET, then GET_INFO every 0.5 s until the device
+        answers again (its boot banner is skipped by the descriptor search), 15 s at most."""
+        self.log.info("Resetting rplidar")
+        self.dev.reset()
+        deadline = time.monotonic() + RESET_TIMEOUT
+        while not self.node.is_shutdown:
+            self.node.wait_for_shutdown(0.5)
+            try:
+                self.dev.device_info()
+            except (TimeoutError, rp.RplidarError):
+                if time.monotonic() > deadline:
+                    break
+                continue
+            self.log.info("Rplidar reset successfully")
+            return True
+        self.log.error("Error resetting rplidar")
+        return False
+
     def setup(self) -> int:
         self.log.info("RPLIDAR running on ROS package rplidar_ros. SDK Version:%s", SDK_VERSION)
         try:
@@ -296,6 +320,8 @@ class RplidarNode:
         self.log.info("RPLIDAR S/N: %s", info.serialnum.hex().upper())
         self.log.info("Firmware Ver: %d.%02d", info.firmware_version >> 8, info.firmware_version & 0xFF)
         self.log.info("Hardware Rev: %d", info.hardware_version)
+        if self.initial_reset and not self._reset_device():
+            return 1
         try:
             health = self.dev.health()
         except (TimeoutError, rp.RplidarError) as exc:
@@ -319,6 +345,7 @@ class RplidarNode:
         except (TimeoutError, rp.RplidarError) as exc:
             self.log.error("Error, cannot get the scan modes of the lidar: %s", exc)
             return 1
+        by_id = {m.id: m for m in modes}
         if self.scan_mode_name:
             chosen = [m for m in modes if m.name == self.scan_mode_name]
             if not chosen:
@@ -332,10 +359,18 @@ class RplidarNode:
                         m.max_distance,
                         1000.0 / m.us_per_sample,
                     )
-                return 1
-            self.mode = chosen[0]
-        else:
-            by_id = {m.id: m for m in modes}
+                # rplidar_ros stays up without a scan (RESULT_OPERATION_FAIL); its start_motor service
+                # then starts the typical mode, which is kept ready here
+                self.log.error("Can not start scan: %08x!", RESULT_OPERATION_FAIL)
+                try:
+                    typical = typical_mode_id(self.dev, info)
+                except (TimeoutError, rp.RplidarError) as exc:
+                    self.log.error("Error, cannot get the scan modes of the lidar: %s", exc)
+                    return 1
+                self.stopped = True
+            else:
+                self.mode = chosen[0]
+        if self.mode is None:
             # the typical mode (legacy: Express when the device has it, else Standard)
             self.mode = by_id.get(typical if typical is not None else -1, modes[-1])
         if self.mode.ans_type not in DECODERS:
@@ -472,6 +507,14 @@ def main(argv: list[str] | None = None) -> int:
     """``rosrun rplidar_ros rplidarNode``."""
 
     def build(node: Any) -> int:
+        channel = str(node.get_param("~channel_type", "serial"))
+        if channel != "serial":  # rplidar_ros 2.x: S-series lidars on Ethernet
+            node.log.error(
+                "Error, channel_type %s is not supported here: this rplidarNode speaks to the lidar on a "
+                "serial port only (channel_type serial, serial_port, serial_baudrate)",
+                channel,
+            )
+            return 1
         path = str(node.get_param("~serial_port", "/dev/ttyUSB0"))
         baud = int(node.get_param("~serial_baudrate", 115200))
         try:
@@ -500,4 +543,5 @@ def main(argv: list[str] | None = None) -> int:
             port.close()
         return 0
 
-    return run_node("rplidarNode", argv, build)
+    # ros::init's name in rplidar_ros (the launch files name the node rplidarNode)
+    return run_node("rplidar_node", argv, build)

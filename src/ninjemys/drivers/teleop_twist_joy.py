@@ -8,7 +8,9 @@ Parameters (private, as teleop_twist_joy reads them): ``~enable_button`` (0),
 ``~enable_turbo_button`` (-1: none); ``~axis_linear`` either an int (the ``x`` axis, default 1) with
 ``~scale_linear`` (0.5) and ``~scale_linear_turbo`` (1.0), or a map ``{x, y, z: axis}`` with maps of
 scales; ``~axis_angular`` an int (``yaw``, default 0) with ``~scale_angular`` (0.5) and
-``~scale_angular_turbo`` (defaults to the normal scale), or a map ``{yaw, pitch, roll: axis}``. An axis
+``~scale_angular_turbo`` (defaults to the normal scale), or a map ``{yaw, pitch, roll: axis}``. ``~require_enable_button`` (true) is the ROS 2 port's switch,
+read so that its config files work: false drives with the normal scales without holding a button
+(ROS 1's node has no such parameter and always requires the button). An axis
 or button beyond the message's arrays reads as 0 / not pressed.
 """
 
@@ -38,12 +40,14 @@ class TeleopConfig:
     scale_linear: dict[str, dict[str, float]] | None = None  # "normal"/"turbo" -> field -> scale
     axis_angular: dict[str, int] | None = None
     scale_angular: dict[str, dict[str, float]] | None = None
+    require_enable_button: bool = True
 
 
 def read_config(get: Any) -> TeleopConfig:
     """The configuration from ``get(name, default)`` (private parameters), as the C++ node reads it."""
     missing = object()
     config = TeleopConfig(int(get("~enable_button", 0)), int(get("~enable_turbo_button", -1)))
+    config.require_enable_button = bool(get("~require_enable_button", True))
     axis = get("~axis_linear", missing)
     if isinstance(axis, dict):
         config.axis_linear = {str(k): int(v) for k, v in axis.items()}
@@ -94,7 +98,7 @@ class Teleop:
         c = self.config
         if c.enable_turbo_button >= 0 and self._held(buttons, c.enable_turbo_button):
             return self._twist(axes, "turbo")
-        if self._held(buttons, c.enable_button):
+        if not c.require_enable_button or self._held(buttons, c.enable_button):
             return self._twist(axes, "normal")
         if not self.sent_disable:
             self.sent_disable = True

@@ -12,11 +12,13 @@ import inspect
 import sys
 from collections.abc import Mapping
 
+from ninjemys.commands import answer_sigint
 from ninjemys.packages.shipped import shipped_executable
 
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
+    answer_sigint()
     if len(argv) < 2:
         print(
             "ERROR: usage: python -m ninjemys.packages.run_shipped PACKAGE EXECUTABLE [args...]",

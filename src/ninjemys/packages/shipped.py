@@ -138,12 +138,20 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
         "joy": {"joy_node": ("ninjemys.drivers.joy_node:main", ())},
         "teleop_twist_joy": {"teleop_node": ("ninjemys.drivers.teleop_twist_joy:main", ())},
         "realsense2_camera": {"realsense2_camera_node": ("ninjemys.drivers.realsense_node:main", ())},
-        "rosserial_python": {"serial_node.py": ("ninjemys.drivers.rosserial_node:main", ())},
+        "rosserial_python": {
+            "serial_node.py": ("ninjemys.drivers.rosserial_node:main", ()),
+            "message_info_service.py": ("ninjemys.drivers.rosserial_node:message_info_main", ()),
+        },
+        "rosserial_arduino": {"serial_node.py": ("ninjemys.drivers.rosserial_node:arduino_main", ())},
         "rosserial_server": {
-            "serial_node": ("ninjemys.drivers.rosserial_node:main", ()),
+            "serial_node": ("ninjemys.drivers.rosserial_node:server_serial_main", ()),
             "socket_node": ("ninjemys.drivers.rosserial_node:socket_main", ()),
         },
-        "rplidar_ros": {"rplidarNode": ("ninjemys.drivers.rplidar_node:main", ())},
+        "rplidar_ros": {
+            "rplidarNode": ("ninjemys.drivers.rplidar_node:main", ()),
+            "create_udev_rules.sh": ("ninjemys.drivers.udev_rules:create_main", ()),
+            "delete_udev_rules.sh": ("ninjemys.drivers.udev_rules:delete_main", ()),
+        },
         # -- ros_control (docs/sim.md): the manager runs inside the simulator --
         "controller_manager": {
             "spawner": ("ninjemys.sim.ros_control.spawner:main", ()),
