@@ -14,10 +14,11 @@
    ``sched_setaffinity``: the issue's "on one core"), and the subscribers and the master run on
    the other cores (``--readers-anywhere``: anywhere, as before); its speed is measured from outside, by the
    subscriber process: the odometry stamps' advance over the wall time they took to arrive (the
-   real-time factor a student's node sees), next to the simulator's own exit summary (simulated s
-   per CPU s, which a shared machine disturbs less). One row has image readers that lag (50 ms per
-   image, queue_size 1): the simulation must not wait for them (ROS 1 drops what a subscriber
-   cannot take).
+   real-time factor a student's node sees), next to simulated s per CPU s of the simulator process
+   over the same window (its threads' schedstat: a shared machine disturbs it less; the simulator's
+   exit summary also counts its unsubscribed start and end, several times faster). One row has image
+   readers that lag (50 ms per image, queue_size 1): the simulation must not wait for them (ROS 1
+   drops what a subscriber cannot take); one reads scan and odometry only (everything but the camera).
 
 3. The camera alone: CPU time of one frame (colour + depth, 320x240) of the URDF PuzzleBot's camera
    turning and driving in the office world, rendered in a child process by the older tree and by this
@@ -30,7 +31,11 @@
    ``time.thread_time_ns`` around each stage, in a child process pinned to CPU 0, by the older tree
    and by this tree, alternating (the sends are left out: they depend on the subscribers).
 
-Run alone: ``.venv/bin/python bench/sim_gazebo.py [--quick] [--before REV] [--only launch|ab|camera|stages]``.
+5. The split of the simulator's wall time (``--only split``): over the subscriber's window, each of
+   its threads' CPU, its wait for the CPU (schedstat run_delay: another process had the core) and its
+   voluntary and involuntary context switches; the rest of the wall time the process slept.
+
+Run alone: ``.venv/bin/python bench/sim_gazebo.py [--quick] [--before REV] [--only launch|ab|camera|stages|split]``.
 """
 
 from __future__ import annotations
