@@ -294,7 +294,7 @@ def bench_ab(before: str, duration: float, rounds: int) -> None:
     print(
         f"the simulator pinned to CPU {SIM_CORE}, office world, as fast as possible, {duration:.0f} s runs; "
         "real-time factor measured from outside (/odom stamps over wall time, medians), and simulated s "
-        "per CPU s from the simulator's summary"
+        "per CPU s of the simulator process over the same window"
     )
     print(
         "| robot | subscribers | before: outside / per CPU s | after: outside / per CPU s | after / before (outside) |"
