@@ -34,6 +34,12 @@ ROS1_DEBS += ros-actionlib-msgs
 ROS1_DEBS += python3-interactive-markers
 # catkin_add_nosetests: Debian's nose, which Debian's catkin_make run_tests runs (the reference for ours)
 ROS1_DEBS += python3-nose
+# tf's C++ library (the navigation tutorials' robot_setup_tf/odometry_publisher, turtle_tf): C++ nodes on tf build
+ROS1_DEBS += libtf-dev
+# image_geometry's camera models (vision course code): Debian's, the reference for ours (tests/image_geometry)
+ROS1_DEBS += python3-image-geometry
+# diagnostic_updater (drivers' and nodes' /diagnostics): Debian's, the reference for ours (tests/diagnostic_updater)
+ROS1_DEBS += python3-diagnostic-updater
 BROWSER_DEBS := chromium chromium-driver fonts-dejavu-core
 # multi-host tests: network namespaces (iproute2), roslaunch <machine> over ssh (openssh-server)
 NET_DEBS     := iproute2 openssh-server openssh-client

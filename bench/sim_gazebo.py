@@ -14,10 +14,11 @@
    ``sched_setaffinity``: the issue's "on one core"), and the subscribers and the master run on
    the other cores (``--readers-anywhere``: anywhere, as before); its speed is measured from outside, by the
    subscriber process: the odometry stamps' advance over the wall time they took to arrive (the
-   real-time factor a student's node sees), next to the simulator's own exit summary (simulated s
-   per CPU s, which a shared machine disturbs less). One row has image readers that lag (50 ms per
-   image, queue_size 1): the simulation must not wait for them (ROS 1 drops what a subscriber
-   cannot take).
+   real-time factor a student's node sees), next to simulated s per CPU s of the simulator process
+   over the same window (its threads' schedstat: a shared machine disturbs it less; the simulator's
+   exit summary also counts its unsubscribed start and end, several times faster). One row has image
+   readers that lag (50 ms per image, queue_size 1): the simulation must not wait for them (ROS 1
+   drops what a subscriber cannot take); one reads scan and odometry only (everything but the camera).
 
 3. The camera alone: CPU time of one frame (colour + depth, 320x240) of the URDF PuzzleBot's camera
    turning and driving in the office world, rendered in a child process by the older tree and by this
@@ -30,7 +31,11 @@
    ``time.thread_time_ns`` around each stage, in a child process pinned to CPU 0, by the older tree
    and by this tree, alternating (the sends are left out: they depend on the subscribers).
 
-Run alone: ``.venv/bin/python bench/sim_gazebo.py [--quick] [--before REV] [--only launch|ab|camera|stages]``.
+5. The split of the simulator's wall time (``--only split``): over the subscriber's window, each of
+   its threads' CPU, its wait for the CPU (schedstat run_delay: another process had the core) and its
+   voluntary and involuntary context switches; the rest of the wall time the process slept.
+
+Run alone: ``.venv/bin/python bench/sim_gazebo.py [--quick] [--before REV] [--only launch|ab|camera|stages|split]``.
 """
 
 from __future__ import annotations
@@ -44,6 +49,8 @@ import sys
 import tempfile
 import threading
 import time
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 from ninjemys.testing import ninjemys_bin, run_master
@@ -139,14 +146,62 @@ def keep_readers_off_the_sim_core() -> bool:
     return True
 
 
+@dataclass
+class TaskStat:
+    """One thread of the simulator, from /proc: CPU and waiting-for-CPU ns (schedstat), switches."""
+
+    cpu_ns: int
+    run_delay_ns: int
+    voluntary: int
+    involuntary: int
+
+
+def task_stats(pid: int) -> dict[int, TaskStat]:
+    """Every thread of ``pid`` now (a thread that ended between the listing and the read is left out)."""
+    out: dict[int, TaskStat] = {}
+    for task in Path(f"/proc/{pid}/task").iterdir():
+        try:
+            cpu, delay, _ = (int(v) for v in (task / "schedstat").read_text().split())
+            status = (task / "status").read_text()
+        except (OSError, ValueError):
+            continue
+        switches = dict(re.findall(r"^(\w+_ctxt_switches):\s+(\d+)", status, re.M))
+        out[int(task.name)] = TaskStat(
+            cpu, delay, int(switches["voluntary_ctxt_switches"]), int(switches["nonvoluntary_ctxt_switches"])
+        )
+    return out
+
+
+@dataclass
+class SimRun:
+    """What one run of the simulator measured, over the window the subscriber watched."""
+
+    outside: float  #: real-time factor seen by the subscriber (odometry stamps over arrival times)
+    per_cpu: float  #: simulated s per CPU s of the simulator process, in the window
+    on_cpu: float  #: share of the window's wall time the process' threads ran (all threads summed)
+    waiting: float  #: share its threads were runnable but another process had the core
+    summary: float  #: the simulator's own exit figure (simulated s per CPU s over its whole run)
+
+
 def sim_run(
-    src: Path | None, subscribe: bool, duration: float, model: Path | None = None, slow: float = 0.0
-) -> tuple[float, float]:
-    """(real-time factor seen from outside, simulated s per CPU s) of one headless run, the simulator
-    pinned to one core (``src``: that tree on PYTHONPATH; None: this tree). From outside: the advance
-    of ``/odom``'s stamps over the wall time between their arrivals here, after a 1 s warm-up.
+    src: Path | None,
+    subscribe: bool,
+    duration: float,
+    model: Path | None = None,
+    slow: float = 0.0,
+    window: Callable[[int], None] | None = None,
+    camera: bool = True,
+) -> SimRun:
+    """One headless run, the simulator pinned to one core (``src``: that tree on PYTHONPATH; None:
+    this tree). From outside: the advance of ``/odom``'s stamps over the wall time between their
+    arrivals here, after a 1 s warm-up; per CPU s: that advance over the simulator process' CPU time
+    in the same window (its threads' schedstat), not over the whole run: the simulator runs from
+    its start until the subscribers connect, and after they leave, with nothing to render, several
+    times faster (its exit summary counts those seconds, see :class:`SimRun`). ``camera`` False:
+    ``subscribe`` reads the scan only (everything but the camera).
     ``slow``: the image subscribers take that long per image, with queue_size 1 (a reader that lags:
-    ROS 1 drops what it cannot take, the simulation must not wait for it)."""
+    ROS 1 drops what it cannot take, the simulation must not wait for it). ``window``: called with
+    the simulator's pid at the start and at the end of the measured window."""
     from ninjemys.idl.loader import get_message_class
     from ninjemys.node import Node
 
@@ -187,7 +242,7 @@ def sim_run(
                 ("/scan", "sensor_msgs/LaserScan"),
                 ("/camera/color/image_raw", "sensor_msgs/Image"),
                 ("/camera/depth/image_rect_raw", "sensor_msgs/Image"),
-            ):
+            )[: 3 if camera else 1]:
                 lagging = slow > 0 and kind == "sensor_msgs/Image"
                 node.subscriber(
                     topic,
@@ -202,19 +257,32 @@ def sim_run(
         node.publisher("/cmd_vel", twist_cls, queue_size=1, latch=True).publish(twist)
         time.sleep(1.0)  # warm-up: connections made, first frames out
         start = len(odom)
+        if window is not None:
+            window(proc.pid)
+        t0, before = time.monotonic(), task_stats(proc.pid)
         time.sleep(duration)
         seen = odom[start:]
+        t1, after = time.monotonic(), task_stats(proc.pid)
+        if window is not None:
+            window(proc.pid)
         node.shutdown("bench over")
         proc.terminate()
         proc.wait(15)
         drain.join(5)
     if len(seen) < 2 or seen[-1][0] <= seen[0][0]:
         raise RuntimeError("too few /odom messages to measure:\n" + "".join(lines[-10:]))
-    outside = (seen[-1][1] - seen[0][1]) / (seen[-1][0] - seen[0][0])
+    simulated = seen[-1][1] - seen[0][1]
+    outside = simulated / (seen[-1][0] - seen[0][0])
+    zero = TaskStat(0, 0, 0, 0)
+    cpu = sum(end.cpu_ns - before.get(tid, zero).cpu_ns for tid, end in after.items()) / 1e9
+    waited = sum(end.run_delay_ns - before.get(tid, zero).run_delay_ns for tid, end in after.items()) / 1e9
     for line in lines:
         m = re.search(r"\(([\d.]+) simulated s per CPU s\)", line)
         if m:
-            return outside, float(m.group(1))
+            wall = t1 - t0
+            return SimRun(
+                outside, outside * wall / max(cpu, 1e-9), cpu / wall, waited / wall, float(m.group(1))
+            )
     raise RuntimeError("no summary from the simulator:\n" + "".join(lines[-10:]))
 
 
@@ -226,7 +294,7 @@ def bench_ab(before: str, duration: float, rounds: int) -> None:
     print(
         f"the simulator pinned to CPU {SIM_CORE}, office world, as fast as possible, {duration:.0f} s runs; "
         "real-time factor measured from outside (/odom stamps over wall time, medians), and simulated s "
-        "per CPU s from the simulator's summary"
+        "per CPU s of the simulator process over the same window"
     )
     print(
         "| robot | subscribers | before: outside / per CPU s | after: outside / per CPU s | after / before (outside) |"
@@ -234,21 +302,85 @@ def bench_ab(before: str, duration: float, rounds: int) -> None:
     print("|---|---|---:|---:|---:|")
     with tempfile.TemporaryDirectory() as tmp:
         old = extract_tree(before, Path(tmp))
-        for model, subscribe, slow, robot, label in (
-            (None, True, 0.0, "PuzzleBot (YAML)", "scan + camera + odom"),
-            (URDF_MODEL, True, 0.0, "PuzzleBot from its URDF", "scan + camera + odom"),
-            (URDF_MODEL, True, 0.05, "PuzzleBot from its URDF", "the same, images read in 50 ms (lagging)"),
-            (None, False, 0.0, "PuzzleBot (YAML)", "/odom only (nothing rendered)"),
+        for model, subscribe, slow, robot, label, camera in (
+            (None, True, 0.0, "PuzzleBot (YAML)", "scan + camera + odom", True),
+            (URDF_MODEL, True, 0.0, "PuzzleBot from its URDF", "scan + camera + odom", True),
+            (
+                URDF_MODEL,
+                True,
+                0.05,
+                "PuzzleBot from its URDF",
+                "the same, images read in 50 ms (lagging)",
+                True,
+            ),
+            (
+                URDF_MODEL,
+                True,
+                0.0,
+                "PuzzleBot from its URDF",
+                "scan + odom (everything but the camera)",
+                False,
+            ),
+            (None, False, 0.0, "PuzzleBot (YAML)", "/odom only (nothing rendered)", True),
         ):
-            a: list[tuple[float, float]] = []
-            b: list[tuple[float, float]] = []
+            a: list[SimRun] = []
+            b: list[SimRun] = []
             for _ in range(rounds):
-                a.append(sim_run(old, subscribe, duration, model, slow))
-                b.append(sim_run(None, subscribe, duration, model, slow))
-            ao, ac = (statistics.median(v[i] for v in a) for i in (0, 1))
-            bo, bc = (statistics.median(v[i] for v in b) for i in (0, 1))
+                a.append(sim_run(old, subscribe, duration, model, slow, camera=camera))
+                b.append(sim_run(None, subscribe, duration, model, slow, camera=camera))
+            ao, ac = statistics.median(v.outside for v in a), statistics.median(v.per_cpu for v in a)
+            bo, bc = statistics.median(v.outside for v in b), statistics.median(v.per_cpu for v in b)
             print(f"| {robot} | {label} | {ao:.1f}x / {ac:.1f}x | {bo:.1f}x / {bc:.1f}x | {bo / ao:.2f} |")
             print(f"load average: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
+
+
+def bench_split(duration: float, rounds: int) -> None:
+    """Where the simulator's wall time goes: on the CPU, waiting for the CPU (another process had its
+    core), or asleep (blocked: a lock, a wait, a send the kernel made wait)."""
+    print("\n## the simulator's wall time: on CPU / runnable but not running / asleep, per thread")
+    print(
+        f"URDF PuzzleBot, scan + camera + odom subscribed, pinned to CPU {SIM_CORE}, {duration:.0f} s "
+        "windows; per wall second of the window: thread CPU, its wait for the CPU (schedstat run_delay), "
+        "voluntary / involuntary context switches"
+    )
+    for i in range(2 * rounds):
+        slow = 0.05 if i % 2 else 0.0  # every other run: image readers that lag (the publisher may yield)
+        marks: list[tuple[float, dict[int, TaskStat]]] = []
+        run = sim_run(
+            None,
+            True,
+            duration,
+            URDF_MODEL,
+            slow,
+            window=lambda pid, marks=marks: marks.append((time.monotonic(), task_stats(pid))),
+        )
+        (t0, a), (t1, b) = marks
+        wall = t1 - t0
+        rows = []
+        for tid, end in b.items():
+            beg = a.get(tid, TaskStat(0, 0, 0, 0))
+            rows.append(
+                (
+                    (end.cpu_ns - beg.cpu_ns) / 1e9 / wall,
+                    (end.run_delay_ns - beg.run_delay_ns) / 1e9 / wall,
+                    (end.voluntary - beg.voluntary) / wall,
+                    (end.involuntary - beg.involuntary) / wall,
+                    tid,
+                )
+            )
+        rows.sort(reverse=True)
+        print("images read in 50 ms (lagging readers):" if slow else "readers keeping up:")
+        print(
+            f"{run.outside:.1f}x real time from outside; {run.per_cpu:.1f} simulated s per CPU s in the window "
+            f"({run.summary:.1f} by the simulator's summary of its whole run); the process on CPU "
+            f"{run.on_cpu:.1%} of the window, runnable but off its core {run.waiting:.1%}, asleep "
+            f"{max(0.0, 1.0 - run.on_cpu - run.waiting):.1%}; load {' '.join(f'{v:.2f}' for v in os.getloadavg())}"
+        )
+        print("| thread | on CPU | waiting for CPU | voluntary switches/s | involuntary/s |")
+        print("|---|---:|---:|---:|---:|")
+        for share, delay, vol, invol, tid in rows:
+            if share > 0.001 or vol > 10:
+                print(f"| {tid} | {share:.1%} | {delay:.1%} | {vol:.0f} | {invol:.0f} |")
 
 
 CAMERA_FRAMES = """
@@ -413,7 +545,7 @@ def main() -> int:
         action="store_true",
         help="let the subscribers run on the simulator's core too (the figures before 2026-11-29 16:00)",
     )
-    p.add_argument("--only", choices=("launch", "ab", "camera", "stages"), help="run one part")
+    p.add_argument("--only", choices=("launch", "ab", "camera", "stages", "split"), help="run one part")
     args = p.parse_args()
     print(f"load average: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
     if not args.readers_anywhere and keep_readers_off_the_sim_core():
@@ -424,6 +556,8 @@ def main() -> int:
         bench_ab(args.before or default_before(), 5.0 if args.quick else 10.0, 1 if args.quick else 2)
     if args.only in (None, "camera"):
         bench_camera(args.before or default_before(), 3 if args.quick else 5)
+    if args.only in (None, "split"):
+        bench_split(5.0 if args.quick else 10.0, 1 if args.quick else 2)
     if args.only in (None, "stages"):
         bench_stages(args.before or default_before(), 3 if args.quick else 5, 10.0 if args.quick else 20.0)
     print(f"load average: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")

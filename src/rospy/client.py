@@ -19,6 +19,7 @@ from ninjemys import interrupt
 from ninjemys.errors import MasterError, MasterUnreachable, NameError_, NinjemysError, ParameterError
 from ninjemys.interrupt import wait_event
 from ninjemys.node.log import INFO
+from rospy._numpy_compat import restore_numpy_aliases
 from rospy.core import _process, is_shutdown, signal_shutdown, warn_illegal_name
 from rospy.exceptions import ROSException, ROSInitException, ROSInterruptException, mapped, translate
 
@@ -103,6 +104,7 @@ def init_node(
         ):
             _install_signal_handlers()
         _install_process_hooks()
+        restore_numpy_aliases()
         node = _start_node(full, args, log_level or INFO, not disable_rostime, not disable_rosout)
         _process.node = node
         _process.init_args = key

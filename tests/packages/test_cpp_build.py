@@ -274,27 +274,29 @@ def test_message_definitions_missing_for_cpp_generation_get_one_hint(tmp_path: P
 
 @needs_toolchain
 def test_a_dependency_without_its_cpp_side_leaves_the_python_side_built(tmp_path: Path) -> None:
-    """A course package with a Python node and a C++ node on tf's C++ library, which this machine
-    lacks (ninjemys provides tf for Python, and only tf's messages for C++): the build succeeds, the
-    Python node is ready, and the C++ target is named as not built, saying which package's C++ side
-    is missing."""
+    """A course package with a Python node and a C++ node on ros_control's controller_manager
+    library, which this machine lacks (ninjemys provides controller_manager's messages for C++, not its
+    library; Debian has none): the build succeeds, the Python node is ready, and the C++ target is
+    named as not built, saying which package's C++ side is missing. (tf was the example until
+    `make test` installed Debian's libtf-dev.)"""
     pkg = tmp_path / "src" / "aruco_follow"
     (pkg / "src").mkdir(parents=True)
     (pkg / "scripts").mkdir()
     (pkg / "package.xml").write_text(
         PACKAGE_XML.replace("cpp_chat", "aruco_follow").replace(
-            "<depend>std_msgs</depend>", "<depend>std_msgs</depend>\n  <depend>tf</depend>"
+            "<depend>std_msgs</depend>",
+            "<depend>std_msgs</depend>\n  <depend>controller_manager_msgs</depend>",
         )
     )
     (pkg / "CMakeLists.txt").write_text(
         "cmake_minimum_required(VERSION 3.0.2)\nproject(aruco_follow)\n"
-        "find_package(catkin REQUIRED COMPONENTS roscpp rospy tf)\ncatkin_package()\n"
+        "find_package(catkin REQUIRED COMPONENTS roscpp rospy controller_manager_msgs)\ncatkin_package()\n"
         "include_directories(${catkin_INCLUDE_DIRS})\nadd_executable(follow_node src/follow.cpp)\n"
         "target_link_libraries(follow_node ${catkin_LIBRARIES})\n"
         "catkin_install_python(PROGRAMS scripts/follow.py DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})\n"
     )
     (pkg / "src" / "follow.cpp").write_text(
-        "#include <ros/ros.h>\n#include <tf/transform_listener.h>\nint main() { return 0; }\n"
+        "#include <ros/ros.h>\n#include <controller_manager/controller_manager.h>\nint main() { return 0; }\n"
     )
     (pkg / "scripts" / "follow.py").write_text(
         "#!/usr/bin/env python3\nfrom fiducial_msgs.msg import Fiducial\n"
@@ -326,10 +328,10 @@ def test_a_dependency_without_its_cpp_side_leaves_the_python_side_built(tmp_path
     )
     out = result.stdout + result.stderr
     if "C++ program(s) built by catkin's CMake: follow_node" in out:
-        pytest.skip("tf's C++ side is installed here")
+        pytest.skip("controller_manager's C++ side is installed here")
     assert result.returncode == 0, out
     assert "aruco_follow: 1 C++ target(s) not built" in out
-    assert "[the C++ side of 'tf' is not installed" in out
+    assert "[the C++ side of 'controller_manager' is not installed" in out
     assert (tmp_path / "devel" / "lib" / "aruco_follow" / "follow.py").is_file()
     assert "plain_node: C++ program(s) built by catkin's CMake: plain" in out
     assert (tmp_path / "devel" / "lib" / "plain_node" / "plain").is_file()

@@ -10,7 +10,18 @@ from typing import Any
 import numpy as np
 
 from ninjemys.sim.camera import FLOOR_RGB, SKY_RGB
+from ninjemys.sim.lighting import Lighting
 from ninjemys.sim.simcore import Simulation
+
+
+def lit(colour: Any, normal: tuple[float, float, float], lighting: Lighting) -> np.ndarray:
+    """Gazebo's rule, written out for one pixel: colour x (ambient + sum of diffuse x max(0, n . -d))."""
+    factor = np.array(lighting.ambient, dtype=float)
+    for sun in lighting.suns:
+        d = np.array(sun.direction, dtype=float)
+        factor = factor + np.array(sun.diffuse) * max(0.0, float(np.dot(normal, -d / np.linalg.norm(d))))
+    value = np.array(colour, dtype=float) * factor
+    return np.clip(np.floor(value + 0.5), 0, 255).astype(np.uint8)
 
 
 def ray_hits(x: float, y: float, angle: float, segs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -33,8 +44,9 @@ def reference_render(sim: Simulation, r: Any) -> tuple[np.ndarray, np.ndarray]:
     nearest point where the pixel's ray meets one: a side (between base and top where the ray
     enters the outline), the lid (a shape lower than the camera, seen from above) or the underside
     (a shape held above the camera); else floor below the horizon, else sky. Colour: the obstacle's,
-    flat, darker with the depth of the side the ray crosses in that column (for a lid or an
-    underside: the side where the ray leaves the outline). Only sides within the depth range count."""
+    lit by the world's lights (:func:`lit`) on the normal of what the ray meets: a side's, turned
+    toward the camera (a round shape's from its axis; a sphere's tilted by the height it is met at),
+    a lid's up, an underside's down; the floor's up. Only sides within the depth range count."""
     cam = r.camera
     spec = r.model.camera
     x, y = sim.sensor_pose(r, spec.pose.xyz)
@@ -42,53 +54,84 @@ def reference_render(sim: Simulation, r: Any) -> tuple[np.ndarray, np.ndarray]:
     far = cam.depth_max / float(cam.col_cos.min())
     rgb = np.zeros((cam.height, cam.width, 3), dtype=np.uint8)
     depth = np.zeros((cam.height, cam.width), dtype=np.uint16)
-    pieces: list[tuple[Any, np.ndarray]] = [(ob, ob.segments()) for ob in sim.world.obstacles]
+    look = sim.world.look
+    lighting = look.lighting
+    pieces: list[tuple[Any, np.ndarray]] = []
+    for i, ob in enumerate(sim.world.obstacles):
+        centre = look.round_centres[i]
+        ball = (look.sphere_z[i], look.sphere_r[i]) if not np.isnan(look.sphere_r[i]) else None
+        pieces.append((SimpleNamespace(ob=ob, centre=centre, ball=ball), ob.segments()))
     for i, m in enumerate(sim.world.moving):  # moving obstacles (people) where they are now
+        mover = SimpleNamespace(base=0.0, height=m.height, color=m.color)
         pieces.append(
             (
-                SimpleNamespace(base=0.0, height=m.height, color=m.color),
+                SimpleNamespace(ob=mover, centre=np.array([np.nan, np.nan]), ball=None),
                 sim._mover_outline(i, *m.position(sim.world_time)),
             )
         )
+    floor_rgb = lit(lighting.floor if lighting.floor is not None else FLOOR_RGB, (0.0, 0.0, 1.0), lighting)
+    sky_rgb = np.array(lighting.sky if lighting.sky is not None else SKY_RGB).astype(np.uint8)
     for u in range(cam.width):
         angle = yaw + cam.col_angles[u]
-        spans = []  # (entry depth, exit depth, obstacle)
-        for ob, segs in pieces:
-            dists, _ = ray_hits(x, y, angle, segs)
-            depths = dists[dists <= far] * cam.col_cos[u]
+        spans = []  # (entry depth, exit depth, piece, the side entered by)
+        for piece, segs in pieces:
+            dists, which = ray_hits(x, y, angle, segs)
+            near = dists <= far
+            depths, which = dists[near] * cam.col_cos[u], which[near]
             if len(segs) == 1:  # a thin wall: no inside
-                spans += [(d, d, ob) for d in depths]
+                spans += [(d, d, piece, segs[0]) for d in depths]
             else:  # a closed outline: entering and leaving in turn
-                spans += [(depths[i], depths[i + 1], ob) for i in range(0, len(depths) - 1, 2)]
+                spans += [
+                    (depths[i], depths[i + 1], piece, segs[which[i]]) for i in range(0, len(depths) - 1, 2)
+                ]
         for v in range(cam.height):
             slope = cam.row_slope[v]
-            best: tuple[float, float, Any] | None = None  # (hit depth, shading depth, obstacle)
-            for d_in, d_out, ob in spans:
+            best: tuple[float, str, Any, Any] | None = None  # (hit depth, what is met, piece, side)
+            for d_in, d_out, piece, side in spans:
+                ob = piece.ob
                 z_in = cam.cam_z + slope * d_in
                 hit = None
                 if ob.base - 1e-12 <= z_in <= ob.height + 1e-12 and d_in <= cam.depth_max:
-                    hit = (d_in, d_in)
+                    hit = (d_in, "side")
                 elif z_in > ob.height and slope < 0 and d_out <= cam.depth_max:
                     d = (ob.height - cam.cam_z) / slope
-                    hit = (d, d_out) if d <= d_out else None
+                    hit = (d, "lid") if d <= d_out else None
                 elif z_in < ob.base and slope > 0 and d_out <= cam.depth_max:
                     d = (ob.base - cam.cam_z) / slope
-                    hit = (d, d_out) if d <= d_out else None
+                    hit = (d, "under") if d <= d_out else None
                 if hit is not None and (best is None or hit[0] < best[0]):
-                    best = (hit[0], hit[1], ob)
+                    best = (hit[0], hit[1], piece, side)
             if best is not None:
-                d, shade_d, ob = best
-                light = min(max(1.1 - shade_d / 15.0, 0.45), 1.0)
-                rgb[v, u] = (np.array(ob.color, dtype=np.float32) * light).astype(np.uint8)
+                d, what, piece, side = best
+                if what == "lid":
+                    normal = (0.0, 0.0, 1.0)
+                elif what == "under":
+                    normal = (0.0, 0.0, -1.0)
+                else:
+                    reach = d / cam.col_cos[u]
+                    hx, hy = x + reach * math.cos(angle), y + reach * math.sin(angle)
+                    if np.isnan(piece.centre[0]):  # a flat side: its normal on the camera's side
+                        nx, ny = side[3] - side[1], side[0] - side[2]
+                        if nx * (x - side[0]) + ny * (y - side[1]) < 0:
+                            nx, ny = -nx, -ny
+                    else:  # a round one: from its axis
+                        nx, ny = hx - piece.centre[0], hy - piece.centre[1]
+                    norm = math.hypot(nx, ny)
+                    nx, ny = nx / norm, ny / norm
+                    t = 0.0
+                    if piece.ball is not None:  # a sphere: the normal tilts with the height met
+                        t = min(max((cam.cam_z + slope * d - piece.ball[0]) / piece.ball[1], -1.0), 1.0)
+                    across = math.sqrt(1.0 - t * t)
+                    normal = (nx * across, ny * across, t)
+                rgb[v, u] = lit(piece.ob.color, normal, lighting)
                 depth[v, u] = round(d * 1000.0)
             elif slope < -1e-9:
                 floor = cam.cam_z / -slope
                 floor = floor if floor <= cam.depth_max else 0.0  # beyond the depth range: no data
-                shade = min(max(1.15 - floor / 12.0, 0.55), 1.0)
-                rgb[v, u] = (shade * FLOOR_RGB).astype(np.uint8)
+                rgb[v, u] = floor_rgb
                 depth[v, u] = round(floor * 1000.0)
             else:
-                rgb[v, u] = SKY_RGB.astype(np.uint8)
+                rgb[v, u] = sky_rgb
     return rgb, depth
 
 

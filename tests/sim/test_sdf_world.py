@@ -313,12 +313,12 @@ def test_the_camera_sees_models_at_their_heights_and_colours(tmp_path):
     near, far = 1.3 - cam_x, 5.9 - cam_x
     rows = [row_at(0.25, near), row_at(0.05, near), row_at(0.4, near), row_at(1.5, far), row_at(2.3, far)]
     assert all(0 <= v < cam.height for v in rows) and len(set(rows)) == 5
-    for v in (row_at(0.25, near), row_at(0.05, near)):  # the crate
+    for v in (row_at(0.25, near), row_at(0.05, near)):  # the crate (its side in the shade: 0.4 x 255)
         r_, g, b = rgb[v, u]
-        assert r_ > 200 and g < 30 and b < 30 and depth[v, u] == round(near * 1000), (v, rgb[v, u])
+        assert r_ > 80 and g < 30 and b < 30 and depth[v, u] == round(near * 1000), (v, rgb[v, u])
     for v in (row_at(0.4, near), row_at(1.5, far)):  # above the crate: the wall behind it
         r_, g, b = rgb[v, u]
-        assert g > 150 and r_ < 30 and b < 30 and depth[v, u] == round(far * 1000), (v, rgb[v, u])
+        assert g > 80 and r_ < 30 and b < 30 and depth[v, u] == round(far * 1000), (v, rgb[v, u])
     v = row_at(2.3, far)  # above the wall: sky, no depth
     assert depth[v, u] == 0 and tuple(rgb[v, u]) not in {(255, 0, 0), (0, 255, 0)}
 

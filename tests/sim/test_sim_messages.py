@@ -99,6 +99,24 @@ def test_odometry_refreshed_in_place_is_a_fresh_message() -> None:
         assert b"".join(kept.frame_parts()[1]) == b"".join(fresh.frame_parts()[1])
 
 
+def test_transform_and_joint_states_refreshed_in_place_are_fresh_messages() -> None:
+    """The odom -> base transform and the wheels' joint_states are built once per robot and refreshed
+    per sample: the bytes are those of messages built for that sample."""
+    from ninjemys.rostime import Time
+    from ninjemys.tf2.math import quaternion_from_yaw
+
+    tf = messages.transform(Time(0, 0), "odom", "base_footprint", (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
+    js = messages.joint_state(Time(0, 0), ["left", "right"], [0.0, 0.0], [0.0, 0.0])
+    for secs, x, y, yaw in ((1, 1.0, 2.0, 0.3), (2, -1.5, 0.25, -3.1)):
+        q = quaternion_from_yaw(yaw)
+        fresh = messages.transform(Time(secs, 7), "odom", "base_footprint", (x, y, 0.0), q)
+        assert messages.transform_into(tf, Time(secs, 7), (x, y, 0.0), q) is tf
+        assert b"".join(tf.frame_parts()[1]) == b"".join(fresh.frame_parts()[1])
+        fresh_js = messages.joint_state(Time(secs, 7), ["left", "right"], [x, y], [yaw, -yaw])
+        assert messages.joint_state_into(js, Time(secs, 7), [x, y], [yaw, -yaw]) is js
+        assert b"".join(js.frame_parts()[1]) == b"".join(fresh_js.frame_parts()[1])
+
+
 def test_camera_messages() -> None:
     model = load_robot_model("puzzlebot")
     rgb = np.zeros((4, 6, 3), dtype=np.uint8)

@@ -273,6 +273,58 @@ def test_a_step_alone_in_open_space_moves_as_the_checked_step():
     assert calls["full"] >= 1000  # the checked run did check its moving steps
 
 
+@pytest.mark.parametrize("world", ["office", "walker"])
+def test_a_step_with_movers_out_of_reach_moves_as_the_checked_step(world, tmp_path):
+    """A robot alone, in its free disk, with no moving obstacle within reach, builds no collision
+    geometry at all; it moves, meets the walker crossing its path (or the office's person and walls)
+    exactly as when every step goes through the full broad phase."""
+
+    def build(fast: bool) -> tuple[Simulation, list[int]]:
+        if world == "office":
+            sim = Simulation(load_world(world_path("office")), 0.01, 3)
+            sim.add_robot("pb", load_robot_model("puzzlebot"), 3.0, 0.0, 0.0)  # in the person's way
+        else:  # the walker paces across the robot's path, back and forth
+            sim = walker_world(tmp_path, "[[1.2, -2.5], [1.2, 2.5], [1.2, -2.5], [1.2, 2.5]]")
+            sim.add_robot("pb", load_robot_model("puzzlebot"), 0.0, 0.0, 0.0)
+        built: list[int] = []
+        geometry = sim._collision_geometry
+
+        def counted(*args, **kwargs):
+            built.append(1)
+            return geometry(*args, **kwargs)
+
+        sim._collision_geometry = counted  # type: ignore[method-assign]
+        if not fast:
+            sim._any_mover_near = lambda *_a: True  # type: ignore[method-assign]
+        return sim, built
+
+    (fast, fast_built), (checked, checked_built) = build(True), build(False)
+    a, b = _drive(fast, "pb", 3000), _drive(checked, "pb", 3000)
+    assert a == b
+    person = [m.position(s.world_time) for s in (fast, checked) for m in s.world.moving]
+    assert person[0] == person[1]
+    met = {w for *_, c, w in a if c}
+    assert met, "the drive must meet the person, the walker or a wall"
+    if world == "walker":
+        assert met == {"walker"}
+    assert len(checked_built) >= 1000 and len(fast_built) < len(checked_built) // 2
+
+
+def test_rays_in_order_and_shuffled_meet_the_same():
+    """segment_pairs skips its sort when the rays come in order (a lidar's beams): each ray's hit is
+    bit for bit the one it gets from the same rays shuffled (which are sorted first)."""
+    sim = Simulation(load_world(world_path("office")), 0.01, 0)
+    scene = sim.scene()
+    rng = np.random.default_rng(5)
+    for x, y, yaw in valid_poses(sim, 10, 7):
+        angles = yaw - math.pi + (2.0 * math.pi / 360) * np.arange(360)
+        perm = rng.permutation(360)
+        in_order = cast_segments(x, y, angles, scene.segments, 12.0, scene.facing)
+        shuffled = cast_segments(x, y, angles[perm], scene.segments, 12.0, scene.facing)
+        for ordered, mixed in zip(in_order, shuffled, strict=True):
+            assert np.array_equal(ordered[perm], mixed)
+
+
 #: a red board 1.5 m ahead with no collision (an ArUco tag): the camera sees it, the lidar does not
 VISUAL_BOARD_WORLD = (
     '<sdf version="1.6"><world name="w"><model name="aruco"><static>true</static>'

@@ -140,6 +140,31 @@ def test_errors_name_the_file_and_the_package(workspace, tmp_path: Path) -> None
     assert result.returncode != 0 and "nope" in result.stderr and "undefined.xacro" in result.stderr
 
 
+def test_a_missing_package_and_a_missing_file_read_as_noetics_xacro(workspace, tmp_path: Path) -> None:
+    """A description including a package this machine lacks (husky's accessories need Clearpath's
+    mount packages) says ``resource not found: pkg`` and lists the ROS paths, as Noetic's xacro
+    does; a model path given relative to the wrong directory (urdf_tutorial's ``model:=urdf/...``
+    outside the package) is one error line and exit 2, never a traceback."""
+    pkg, env = workspace
+    parent = tmp_path / "parent.urdf.xacro"
+    parent.write_text(
+        '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
+        '  <xacro:include filename="$(find mount_description_not_here)/urdf/lockmount.urdf.xacro"/>\n</robot>\n'
+    )
+    result = _expand([str(parent)], env)
+    assert result.returncode == 2
+    assert "resource not found: mount_description_not_here\n" in result.stderr
+    assert f"ROS path [0]={tmp_path / 'src'}" in result.stderr
+    assert "when processing file: " + str(parent) in result.stderr
+    assert "Traceback" not in result.stderr and "PackageNotFoundError" not in result.stderr
+    result = subprocess.run(
+        [str(BIN / "xacro"), "urdf/01-myfirst.urdf"], cwd=tmp_path, env=env, capture_output=True, text=True
+    )
+    assert result.returncode == 2
+    assert "No such file or directory" in result.stderr and "01-myfirst.urdf" in result.stderr
+    assert "Traceback" not in result.stderr and "AttributeError" not in result.stderr
+
+
 SUBST = """<?xml version="1.0"?>
 <robot name="subst" xmlns:xacro="http://www.ros.org/wiki/xacro">
   <xacro:arg name="scale" default="2"/>

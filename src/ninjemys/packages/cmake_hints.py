@@ -39,6 +39,10 @@ class CMakeHints:
     nosetests: tuple[tuple[str, str | None, int], ...] = ()
     #: the CMakeLists.txt line of each ``catkin_install_python`` program, for error messages
     program_lines: tuple[tuple[str, int], ...] = ()
+    #: ``roslint_cpp(files)`` / ``roslint_python(files)``: ("cpp" or "python", files as written, line)
+    lint: tuple[tuple[str, tuple[str, ...], int], ...] = ()
+    #: ``set(ROSLINT_CPP_OPTS ...)`` / ``set(ROSLINT_PYTHON_OPTS ...)``: ("cpp" or "python", options)
+    lint_opts: tuple[tuple[str, tuple[str, ...]], ...] = ()
 
     @property
     def programs(self) -> tuple[str, ...]:
@@ -64,6 +68,8 @@ def read_cmake_hints(package_dir: Path) -> CMakeHints:
     rostests: list[str] = []
     nosetests: list[tuple[str, str | None, int]] = []
     program_lines: list[tuple[str, int]] = []
+    lint: list[tuple[str, tuple[str, ...], int]] = []
+    lint_opts: dict[str, tuple[str, ...]] = {}
     for match in _CALL.finditer(text):
         command = match.group(1).lower()
         args = [a.strip("\"'") for a in match.group(2).split()]
@@ -82,6 +88,11 @@ def read_cmake_hints(package_dir: Path) -> CMakeHints:
             required.extend(_requirements(args, line))
         elif command == "add_rostest" and args and "${" not in args[0]:
             rostests.append(args[0])
+        elif command in ("roslint_cpp", "roslint_python"):
+            lint.append((command.removeprefix("roslint_"), tuple(args), line))
+        elif command == "set" and args and args[0] in ("ROSLINT_CPP_OPTS", "ROSLINT_PYTHON_OPTS"):
+            options = [o for a in args[1:] for o in a.split(";") if o]
+            lint_opts[args[0].split("_")[1].lower()] = tuple(options)
         elif command == "catkin_add_nosetests" and args:
             workdir = args[args.index("WORKING_DIRECTORY") + 1] if "WORKING_DIRECTORY" in args[:-1] else None
             nosetests.append((args[0], workdir, line))
@@ -92,6 +103,8 @@ def read_cmake_hints(package_dir: Path) -> CMakeHints:
         rostests=tuple(rostests),
         nosetests=tuple(nosetests),
         program_lines=tuple(program_lines),
+        lint=tuple(lint),
+        lint_opts=tuple(lint_opts.items()),
     )
 
 

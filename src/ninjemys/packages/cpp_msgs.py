@@ -16,12 +16,17 @@ package config with genmsg's ``-msg-paths.cmake``, and a ``.catkin`` marker so c
 treats the prefix as a workspace it overlays. The C++ build puts the prefix on CMAKE_PREFIX_PATH
 and its ``include`` on every target's include path, as a ROS install does. Files are rewritten only
 when their content changes, so a rebuild recompiles nothing.
+
+The same prefix carries the shipped packages whose C++ side is only CMake functions (roslint's
+``roslint_cpp()`` & co, :func:`cmake_only_packages`), so ``find_package(catkin REQUIRED COMPONENTS
+roscpp roslint)`` configures as on a ROS 1 install.
 """
 
 from __future__ import annotations
 
 import os
 import re
+import sys
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -90,12 +95,25 @@ def shipped_interface_packages() -> list[str]:
     return sorted(p.name for p in root.iterdir() if (p / "package.xml").is_file())
 
 
+def cmake_only_packages() -> dict[str, Path]:
+    """Shipped packages whose whole C++ side is CMake code of ours (roslint's functions): each has
+    ``cmake/<name>Config.cmake`` in its directory under ``ninjemys/packages/share``; by name."""
+    root = Path(__file__).resolve().parent / "share"
+    return {
+        p.name: p
+        for p in sorted(root.iterdir())
+        if (p / "cmake" / f"{p.name}Config.cmake").is_file() and (p / "package.xml").is_file()
+    }
+
+
 def packages_without_cpp_side(env: Mapping[str, str], exclude: Iterable[str] = ()) -> list[str]:
-    """The shipped interface packages that need ninjemys' C++ side on this machine: those no prefix
-    provides, except the ones in ``exclude`` (packages of the workspace being built)."""
+    """The shipped interface packages (and CMake-only packages, :func:`cmake_only_packages`) that
+    need ninjemys' C++ side on this machine: those no prefix provides, except the ones in
+    ``exclude`` (packages of the workspace being built)."""
     prefixes = installed_prefixes(env)
     skip = set(exclude) | _NEVER
-    return [p for p in shipped_interface_packages() if p not in skip and not has_cpp_side(p, prefixes)]
+    names = [*shipped_interface_packages(), *cmake_only_packages()]
+    return [p for p in names if p not in skip and not has_cpp_side(p, prefixes)]
 
 
 class _Files:
@@ -237,6 +255,16 @@ def _write_package(package: str, files: _Files, root: Path) -> None:
     )
 
 
+def _copy_cmake_package(source: Path, files: _Files, root: Path) -> None:
+    """A CMake-only package into the prefix: its package.xml and cmake files, with the Python that
+    runs ninjemys written in (the commands its functions add run ninjemys' modules)."""
+    share = root / "share" / source.name
+    files.write(share / "package.xml", (source / "package.xml").read_text(encoding="utf-8"))
+    for path in sorted((source / "cmake").glob("*.cmake")):
+        text = path.read_text(encoding="utf-8").replace("@NINJEMYS_PYTHON@", sys.executable)
+        files.write(share / "cmake" / path.name, text)
+
+
 def write_prefix(root: Path, packages: Iterable[str]) -> CppPrefix:
     """Write (or bring up to date) the prefix for ``packages``; files of packages no longer asked
     for are removed. Raises DefinitionError / TypeNotFoundError for a broken shipped definition."""
@@ -246,8 +274,12 @@ def write_prefix(root: Path, packages: Iterable[str]) -> CppPrefix:
     files.write(
         root / "ninjemys_cpp_msgs.txt", f"generator {GENERATOR_VERSION}\n" + "\n".join(prefix.packages) + "\n"
     )
+    cmake_only = cmake_only_packages()
     for package in prefix.packages:
-        _write_package(package, files, root)
+        if package in cmake_only:
+            _copy_cmake_package(cmake_only[package], files, root)
+        else:
+            _write_package(package, files, root)
     for directory in (root / "include", root / "share"):
         if not directory.is_dir():
             continue
@@ -262,6 +294,7 @@ def write_prefix(root: Path, packages: Iterable[str]) -> CppPrefix:
 __all__ = [
     "CppPrefix",
     "GENERATOR_VERSION",
+    "cmake_only_packages",
     "has_cpp_side",
     "installed_prefixes",
     "packages_without_cpp_side",

@@ -162,6 +162,11 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
             "xacro": ("ninjemys.tools.xacro:main", ()),
             "xacro.py": ("ninjemys.tools.xacro:main", ()),
         },
+        # -- roslint (REAL4): the linters roslint_cpp()/roslint_python() run, ROS style rules --
+        "roslint": {
+            "cpplint": ("ninjemys.tools.roslint:main", ("cpplint",)),
+            "pep8": ("ninjemys.tools.roslint:main", ("pep8",)),
+        },
         "rosbag": {
             sub: ("ninjemys.tools.rosbag:main", (sub,))
             for sub in (

@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from ninjemys.sim.lighting import DEFAULT_LIGHTING, Lighting, SceneLook
 from ninjemys.sim.raycast import circle_pairs, column_pairs
 from ninjemys.sim.sensors import FloorPaint, Scene
 
@@ -40,8 +41,14 @@ _EMPTY_RGB = np.zeros((0, 0, 3), dtype=np.uint8)
 _EMPTY_DEPTH = np.zeros((0, 0), dtype=np.uint16)
 #: an RGB pixel as one 3-byte item (see Camera._colour_cells)
 _PIXEL = np.dtype("V3")
+#: the floor's own colour (lit by the world's lights: see :mod:`ninjemys.sim.lighting`) and the sky's,
+#: where the world does not give them (an SDF world gives Gazebo's grey ground and background)
 FLOOR_RGB = np.array([176, 170, 160], dtype=np.float32)
 SKY_RGB = np.array([206, 220, 235], dtype=np.float32)
+#: a scene that says nothing of its lights: Gazebo's default sun, every side flat
+_DEFAULT_LOOK = SceneLook()
+_UP = (0.0, 0.0, 1.0)
+_DOWN = (0.0, 0.0, -1.0)
 
 
 class Camera:
@@ -68,9 +75,7 @@ class Camera:
         floor_depth[below] = cam_z / -self.row_slope[below]
         floor_depth[floor_depth > depth_max] = 0.0
         self.floor_depth_mm = np.rint(floor_depth * 1000).astype(np.uint16)
-        # static background: floor shaded with distance, sky above the horizon
-        shade = np.clip(1.15 - floor_depth / 12.0, 0.55, 1.0)[:, None] * FLOOR_RGB[None, :]
-        bg = np.where(below[:, None], shade, SKY_RGB[None, :]).astype(np.uint8)
+        self._below = below
         # the rows that see the floor within range: the last ones, from the first such row down
         # (the floor's depth shrinks row by row below the horizon)
         self._floor_first = int(np.flatnonzero(floor_depth > 0)[0]) if (floor_depth > 0).any() else height
@@ -86,7 +91,15 @@ class Camera:
         # subtraction and one comparison per pixel, (v - top) mod 2^bits < bottom - top
         self._row_type = np.uint8 if height <= 255 else np.uint16
         self._rows = np.arange(height, dtype=self._row_type)[:, None]
-        self._background = np.ascontiguousarray(np.broadcast_to(bg[:, None, :], (height, width, 3)))
+        #: the floor (one colour: a directional light does not fade with distance) below the horizon
+        #: and the sky above, for the lights of :attr:`_lit_by` (see :meth:`_light`)
+        self._lit_by: Lighting | None = None
+        self._background = np.zeros((height, width, 3), dtype=np.uint8)
+        self._lit_palette: tuple[np.ndarray, Lighting, np.ndarray] | None = None
+        #: the segments' colours lit on each side, for the last scene seen (see _Palette), and the
+        #: arrays of the last scene drawn without one
+        self._palette: _Palette | None = None
+        self._last_scene: tuple[Any, ...] | None = None
         self._floor_depth_image = np.ascontiguousarray(
             np.broadcast_to(self.floor_depth_mm[:, None], (height, width))
         )
@@ -137,13 +150,21 @@ class Camera:
     ) -> tuple[np.ndarray, np.ndarray]:
         if not (want_rgb or want_depth):
             return _EMPTY_RGB, _EMPTY_DEPTH
+        look = scene.look or _DEFAULT_LOOK
+        if want_rgb:
+            self._light(look.lighting)
         seen = self._crossings(scene, x, y, yaw)
         wall = (
             np.zeros((self.height, self.width), dtype=bool) if want_rgb and scene.floor is not None else None
         )
         ranks = seen.ranks() if seen is not None else None
+        if seen is not None and want_rgb:
+            self._shade(seen, scene, look, x, y, yaw)
         if seen is not None and seen.plane is None and ranks == [None]:
             rgb, depth_mm = self._paint_one_layer(seen, want_rgb, want_depth, wall)
+            if seen.round_pixels is not None:
+                _, rows, cols, colours = seen.round_pixels
+                rgb[rows, cols] = colours
         else:
             rgb = self._background.copy() if want_rgb else _EMPTY_RGB
             depth_mm = self._floor_depth_image.copy() if want_depth else _EMPTY_DEPTH
@@ -152,8 +173,158 @@ class Camera:
                 self._paint_crossings(seen, ranks, rgb, depth_mm, wall)
         if wall is not None:
             assert scene.floor is not None
-            self._paint_floor(rgb, wall, scene.floor, x, y, yaw)
+            self._paint_floor(rgb, wall, scene.floor, x, y, yaw, look.lighting)
         return rgb, depth_mm
+
+    def _light(self, lighting: Lighting) -> None:
+        """Draw the background for ``lighting`` (when it changed): the floor lit as a surface facing
+        up (the same colour at every distance), the sky above the horizon."""
+        if lighting is self._lit_by:
+            return
+        floor = np.asarray(lighting.floor if lighting.floor is not None else FLOOR_RGB, dtype=np.float32)
+        sky = np.asarray(lighting.sky if lighting.sky is not None else SKY_RGB, dtype=np.float32)
+        row = np.where(self._below[:, None], lighting.shade_flat(floor, _UP)[None, :], sky.astype(np.uint8))
+        self._background[...] = row[:, None, :]
+        self._lit_by = lighting
+
+    def _shade(self, seen: _Seen, scene: Scene, look: SceneLook, x: float, y: float, yaw: float) -> None:
+        """Each crossing's colour (``seen.rgb``), lit by the world's lights on its face's normal: a
+        side's horizontal normal on the camera's side of it (one of the two colours of each segment,
+        lit once per world: :class:`_Palette`), a round shape's from its axis to where the ray meets
+        it, a lid's up, an underside's down; and the pixels of the sides of spheres, lit row by row
+        on the sphere's normal at that height (``seen.round_pixels``)."""
+        pal = self._palette_for(scene, look)
+        item = seen.item
+        n = pal.n
+        seen.round_pixels = None
+        if n == len(scene.segments) + len(scene.circles) or _ALL(item < n):
+            rgb = pal.seen_from(x, y).take(item, axis=0)
+            if pal.any_round:
+                round_ = np.flatnonzero(pal.is_round.take(item))
+                if len(round_):
+                    self._shade_round(
+                        seen, look, rgb, round_, pal.centres.take(item.take(round_), axis=0), pal, x, y, yaw
+                    )
+        else:  # crossings of moving obstacles' sides and of other robots' round bodies
+            rgb = np.empty((len(item), 3), dtype=np.uint8)
+            known = np.flatnonzero(item < n)
+            rgb[known] = pal.seen_from(x, y).take(item.take(known), axis=0)
+            n_seg = len(scene.segments)
+            moved = np.flatnonzero((item >= n) & (item < n_seg))
+            if len(moved):
+                rgb[moved] = _flat_colours(scene, look.lighting, item.take(moved), x, y)
+            round_ = np.flatnonzero(item >= n_seg)
+            centres = scene.circles[item.take(round_) - n_seg]
+            if pal.any_round:
+                also = known[pal.is_round.take(item.take(known))]
+                round_ = np.concatenate([also, round_])
+                centres = np.concatenate([pal.centres.take(item.take(also), axis=0), centres])
+            if len(round_):
+                self._shade_round(seen, look, rgb, round_, centres, pal, x, y, yaw)
+        if seen.plane is not None:
+            flat = np.flatnonzero(~np.isnan(seen.plane))
+            lid = (seen.plane.take(flat) < self.cam_z)[:, None]
+            under = item.take(flat)
+            if _ALL(under < n):
+                rgb[flat] = np.where(lid, pal.lid.take(under, axis=0), pal.under.take(under, axis=0))
+            else:  # a moving obstacle's lid
+                colours = seen.colors.take(under, axis=0)
+                lighting = look.lighting
+                rgb[flat] = np.where(
+                    lid, lighting.shade_flat(colours, _UP), lighting.shade_flat(colours, _DOWN)
+                )
+        seen.rgb = rgb
+
+    def _palette_for(self, scene: Scene, look: SceneLook) -> _Palette:
+        """The palette of the scene's segments: the last one if the scene has the same arrays, or
+        starts with the same segments (the world's, before the moving obstacles' that change every
+        step); else a new one over the segments the scene shares with the last scene drawn."""
+        pal = self._palette
+        if pal is not None and (pal.fits(scene, look) or pal.prefix_of(scene, look)):
+            return pal
+        n = len(scene.segments)
+        last = self._last_scene
+        if last is not None and last[3] is look:
+            n = _common_rows(n, (last[0], scene.segments), (last[1], scene.colors), (last[2], scene.owners))
+        self._last_scene = _arrays_of(scene, look)
+        pal = self._palette = _Palette(scene, look, n)
+        return pal
+
+    def _shade_round(
+        self,
+        seen: _Seen,
+        look: SceneLook,
+        rgb: np.ndarray,
+        k: np.ndarray,
+        centres: np.ndarray,
+        pal: _Palette,
+        x: float,
+        y: float,
+        yaw: float,
+    ) -> None:
+        """The colours (into ``rgb``) of crossings ``k``, sides of round shapes (the world's
+        cylinders and spheres, other robots' bodies) with axes at ``centres``: lit on the normal from
+        the axis to where the ray meets the side; spheres' pixels row by row (``_sphere_pixels``)."""
+        d = seen.depth.take(k)
+        slope = self.col_slopes.take(seen.col.take(k))
+        c, s = math.cos(yaw), math.sin(yaw)
+        nx = x + d * (c - s * slope) - centres[:, 0]
+        ny = y + d * (s + c * slope) - centres[:, 1]
+        length = np.hypot(nx, ny)
+        length[length == 0.0] = 1.0
+        normals = np.zeros((len(k), 3))
+        normals[:, 0], normals[:, 1] = nx / length, ny / length
+        colours = seen.colors.take(seen.item.take(k), axis=0)
+        rgb[k] = look.lighting.shade(colours, normals)
+        if pal.any_sphere:
+            self._sphere_pixels(seen, look, pal, k, normals, colours)
+
+    def _sphere_pixels(
+        self,
+        seen: _Seen,
+        look: SceneLook,
+        pal: _Palette,
+        k: np.ndarray,
+        normals: np.ndarray,
+        colours: np.ndarray,
+    ) -> None:
+        """The pixels of the sides of spheres (seen directly, not through a lid), each lit on the
+        sphere's normal at the height its ray meets the side: tilted up toward the top (a white
+        ball's upper part saturates, as in Gazebo), down toward the bottom. ``k``: the crossings of
+        round shapes, with their horizontal ``normals`` and ``colours``."""
+        item = seen.item.take(k)
+        ball = item < pal.n
+        ball[ball] = ~np.isnan(pal.sphere_r.take(item[ball]))
+        if seen.plane is not None:
+            ball &= np.isnan(seen.plane.take(k))
+        if not _ANY(ball):
+            return
+        pick = np.flatnonzero(ball)
+        kk, ball_item = k[pick], item[pick]
+        r, cz = pal.sphere_r.take(ball_item), pal.sphere_z.take(ball_item)
+        top, bottom = seen.top.take(kk).astype(np.intp), seen.bottom.take(kk).astype(np.intp)
+        lengths = bottom - top
+        keep = lengths > 0
+        if not _ALL(keep):
+            pick, kk, r, cz, top, lengths = (a[keep] for a in (pick, kk, r, cz, top, lengths))
+        if not len(kk):
+            return
+        which = np.repeat(np.arange(len(kk)), lengths)
+        starts = np.repeat(np.cumsum(lengths) - lengths, lengths)
+        rows = np.arange(len(which)) - starts + top[which]
+        height = self.cam_z + self.row_slope[rows] * seen.depth[kk][which]
+        t = np.clip((height - cz[which]) / r[which], -1.0, 1.0)
+        across = np.sqrt(1.0 - t * t)
+        n = np.empty((len(which), 3))
+        n[:, 0] = normals[pick[which], 0] * across
+        n[:, 1] = normals[pick[which], 1] * across
+        n[:, 2] = t
+        seen.round_pixels = (
+            kk[which],
+            rows,
+            seen.col[kk][which],
+            look.lighting.shade(colours[pick[which]], n),
+        )
 
     def _crossings(self, scene: Scene, x: float, y: float, yaw: float) -> _Seen | None:
         """The crossings that show in the image, each with its rows cut to what the nearer strips
@@ -337,8 +508,7 @@ class Camera:
         cv2 = _opencv()
         rgb, depth_mm = _EMPTY_RGB, _EMPTY_DEPTH
         if want_rgb:
-            light = np.clip(1.1 - seen.depth / 15.0, 0.45, 1.0)
-            shaded = (seen.colors.take(seen.item, axis=0) * light[:, None]).astype(np.uint8)
+            shaded = seen.rgb
             if full:
                 colour_row = shaded
             else:
@@ -387,17 +557,23 @@ class Camera:
         depth_mm: np.ndarray,
         wall: np.ndarray | None,
     ) -> None:
-        """Fill each crossing's rows with its colour (flat, darker with distance) and depth: one
-        masked copy per rank within the column, the farthest first, over the band of rows that rank
-        spans (a nearer strip in the air is painted over what it hides). A lid's or an underside's
-        rows (a far side seen through them) get, in the depth image, the depth where each row's ray
-        meets that plane: (plane - cam_z) / slope_v."""
+        """Fill each crossing's rows with its colour (lit, flat; a sphere's side row by row) and depth:
+        one masked copy per rank within the column, the farthest first, over the band of rows that
+        rank spans (a nearer strip in the air is painted over what it hides). A lid's or an
+        underside's rows (a far side seen through them) get, in the depth image, the depth where each
+        row's ray meets that plane: (plane - cam_z) / slope_v."""
         if rgb.size:
-            light = np.clip(1.1 - seen.depth / 15.0, 0.45, 1.0)
-            shaded = (seen.colors.take(seen.item, axis=0) * light[:, None]).astype(np.uint8)
+            shaded = seen.rgb
+            spheres = seen.round_pixels
+            if spheres is not None:
+                pass_of = np.zeros(len(seen.col), dtype=np.intp)
+                for p, sel in enumerate(ranks):
+                    if sel is not None:
+                        pass_of[sel] = p
+                sphere_pass = pass_of[spheres[0]]
         if depth_mm.size:
             mm = np.rint(seen.depth * 1000.0).astype(np.uint16)
-        for sel in ranks:
+        for p, sel in enumerate(ranks):
             cols = seen.col if sel is None else seen.col.take(sel)
             top = seen.top if sel is None else seen.top.take(sel)
             bottom = seen.bottom if sel is None else seen.bottom.take(sel)
@@ -410,6 +586,9 @@ class Camera:
                 cells = shaded.view(_PIXEL).reshape(-1)
                 self._colour_cells[cols] = cells if sel is None else cells.take(sel)
                 self._paint(rgb[r0:r1], self._colour_row, mask)
+                if spheres is not None:
+                    here = sphere_pass == p
+                    rgb[spheres[1][here], spheres[2][here]] = spheres[3][here]
             if depth_mm.size:
                 self._depth_row[cols] = mm if sel is None else mm.take(sel)
                 self._paint(depth_mm[r0:r1], self._depth_row, mask)
@@ -481,41 +660,59 @@ class Camera:
         cv2.copyTo(full, mask, image)
 
     def _paint_floor(
-        self, rgb: np.ndarray, wall: np.ndarray, paint: FloorPaint, x: float, y: float, yaw: float
+        self,
+        rgb: np.ndarray,
+        wall: np.ndarray,
+        paint: FloorPaint,
+        x: float,
+        y: float,
+        yaw: float,
+        lighting: Lighting = DEFAULT_LIGHTING,
     ) -> None:
-        """Draw the floor markings (the course's 1 m square) where floor pixels see them: each floor
-        pixel's point on the floor looked up in the markings' texture."""
+        """Draw the floor markings (the course's 1 m square) where floor pixels see them, lit as the
+        floor. The floor is a plane: the image rows that see it map onto the markings' texture by one
+        homography, so the texture is looked up for every floor pixel by one perspective warp
+        (OpenCV, nearest texel, 0 outside the texture) rather than a dozen numpy passes over the
+        floor's rows; the wall pixels are then cleared of ink."""
         first = self._floor_first
-        forward, lateral = self._floor_points
-        c, s = np.float32(math.cos(yaw) / paint.resolution), np.float32(math.sin(yaw) / paint.resolution)
-        # ``forward`` is one value per row: its products are taken per row and broadcast along it
-        # (the same float32 operations, element by element, as over the whole block)
-        east = c * forward
-        east = east - s * lateral
-        east += np.float32((x - paint.origin_x) / paint.resolution)
-        north = s * forward
-        north = north + c * lateral
-        north += np.float32((y - paint.origin_y) / paint.resolution)
-        col, row = east.astype(np.int32), north.astype(np.int32)
-        th, tw = paint.texture.shape
-        # 0 <= i < n as one unsigned comparison (a negative index wraps to above any size)
-        inside = col.view(np.uint32) < tw
-        inside &= row.view(np.uint32) < th
-        np.greater(inside, wall[first:], out=inside)  # and not a wall pixel
-        # every floor pixel looks its texel up (a few passes over whole rows, no index lists), an
-        # index outside it clipped to some texel and its ink cleared: left are the inked pixels,
-        # a few hundred, rather than index lists of the tens of thousands inside the texture
-        index = row
-        index *= tw
-        index += col
-        ink = paint.texture.reshape(-1).take(index, mode="clip")
-        np.multiply(ink, inside, out=ink)
+        if first >= self.height:
+            return
+        res = paint.resolution
+        c, s = math.cos(yaw), math.sin(yaw)
+        fx, cx = self.fx, self.cx
+        # one over the distance ahead of row first + r is g2 r + g3; the floor point seen by pixel
+        # (u, first + r) at texel (X, Y) = (a . (u, r, 1), b . (u, r, 1)) / (g2 r + g3), less half a
+        # texel so that the warp's rounding to the nearest texel takes the texel the point lies in
+        g2 = 1.0 / (self.cam_z * self.fy)
+        g3 = (first - self.cy) * g2
+        ex, ny = (x - paint.origin_x) / res - 0.5, (y - paint.origin_y) / res - 0.5
+        warp = np.array(
+            [
+                [s / (fx * res), ex * g2, ex * g3 + (c - s * cx / fx) / res],
+                [-c / (fx * res), ny * g2, ny * g3 + (s + c * cx / fx) / res],
+                [0.0, g2, g3],
+            ]
+        )
+        cv2 = _opencv()
+        ink = cv2.warpPerspective(
+            paint.texture,
+            warp,
+            (self.width, self.height - first),
+            flags=cv2.INTER_NEAREST | cv2.WARP_INVERSE_MAP,
+            borderMode=cv2.BORDER_CONSTANT,
+            borderValue=0,
+        )
+        np.copyto(ink, 0, where=wall[first:])  # a wall stands there
         painted = np.flatnonzero(ink)
         if not len(painted):
             return
         cells = rgb.view(_PIXEL).reshape(-1)
+        kept = self._lit_palette
+        if kept is None or kept[0] is not paint.palette or kept[1] is not lighting:
+            kept = (paint.palette, lighting, np.ascontiguousarray(lighting.shade_flat(paint.palette, _UP)))
+            self._lit_palette = kept
         cells[painted + first * self.width] = (
-            paint.palette.view(_PIXEL).reshape(-1).take(ink.reshape(-1).take(painted) - 1)
+            kept[2].view(_PIXEL).reshape(-1).take(ink.reshape(-1).take(painted) - 1)
         )
 
     def intrinsics(self) -> tuple[float, float, float, float]:
@@ -544,6 +741,10 @@ class _Seen:
         #: per crossing: the height of the lid or underside it is seen through (NaN: a side seen
         #: directly); None when no crossing is
         self.plane = plane
+        #: per crossing: its colour as lit (see Camera._shade), set when a colour image is drawn
+        self.rgb: np.ndarray = _EMPTY_RGB
+        #: the sides of spheres, pixel by pixel: (crossing, row, column, colour) arrays; None: none
+        self.round_pixels: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
 
     def ranks(self) -> list[np.ndarray | None]:
         """The crossings of each paint pass: each column's crossings from its farthest to its
@@ -562,15 +763,133 @@ class _Seen:
         return [np.flatnonzero(from_far == p) for p in range(passes)]
 
 
+class _Palette:
+    """The first ``n`` segments of a scene (the world's; a scene's moving obstacles' come after
+    them) with their colours lit once, each on both of its sides (``front`` seen from the side of
+    its normal (``nx``, ``ny``), ``back`` from the other), and per segment the centre of a round
+    obstacle and a sphere's centre height and radius (NaN: not round, not a sphere)."""
+
+    def __init__(self, scene: Scene, look: SceneLook, n: int) -> None:
+        self.scene_arrays = _arrays_of(scene, look)
+        self.look = look
+        self.n = n
+        seg = self.segments = scene.segments[:n]
+        self.colors = scene.colors[:n]
+        self.owners = None if scene.owners is None else scene.owners[:n]
+        self.centres = np.full((n, 2), np.nan)
+        self.sphere_z = np.full(n, np.nan)
+        self.sphere_r = np.full(n, np.nan)
+        self.any_round = self.any_sphere = False
+        if self.owners is not None and look.any_round:
+            owner = self.owners
+            known = (owner >= 0) & (owner < len(look.round_centres))
+            self.centres[known] = look.round_centres[owner[known]]
+            self.sphere_z[known] = look.sphere_z[owner[known]]
+            self.sphere_r[known] = look.sphere_r[owner[known]]
+            self.any_round = not bool(np.isnan(self.centres[:, 0]).all())
+            self.any_sphere = not bool(np.isnan(self.sphere_r).all())
+        #: per segment: a side of a round obstacle
+        self.is_round = ~np.isnan(self.centres[:, 0])
+        nx = seg[:, 3] - seg[:, 1]
+        ny = seg[:, 0] - seg[:, 2]
+        length = np.hypot(nx, ny)
+        length[length == 0.0] = 1.0
+        self.nx, self.ny = nx / length, ny / length
+        self.c0 = self.nx * seg[:, 0] + self.ny * seg[:, 1]
+        normals = np.zeros((2 * n, 3))
+        normals[0::2, 0], normals[0::2, 1] = self.nx, self.ny
+        normals[1::2, 0], normals[1::2, 1] = -self.nx, -self.ny
+        table = look.lighting.shade(np.repeat(self.colors, 2, axis=0), normals)
+        #: each segment's colour seen from the side of its normal, and from the other
+        self.front, self.back = table[0::2], table[1::2]
+        #: each segment's colour on a lid (seen from above) and on an underside
+        self.lid = look.lighting.shade_flat(self.colors, _UP)
+        self.under = look.lighting.shade_flat(self.colors, _DOWN)
+        self._seen_at: tuple[tuple[float, float], np.ndarray] | None = None
+
+    def seen_from(self, x: float, y: float) -> np.ndarray:
+        """(n, 3): each segment's colour on the side a camera at (x, y) is on (n . (camera - p0) < 0:
+        its back); a few passes over the segments, cheaper than per crossing for a few hundred."""
+        if self._seen_at is not None and self._seen_at[0] == (x, y):
+            return self._seen_at[1]
+        side = self.nx * x
+        side += self.ny * y
+        back = np.less(side, self.c0)[:, None]
+        colours = np.where(back, self.back, self.front)
+        self._seen_at = ((x, y), colours)
+        return colours
+
+    def fits(self, scene: Scene, look: SceneLook) -> bool:
+        """Built from these very arrays and lights."""
+        return all(a is b for a, b in zip(self.scene_arrays, _arrays_of(scene, look), strict=True))
+
+    def prefix_of(self, scene: Scene, look: SceneLook) -> bool:
+        """The scene starts with this palette's segments, colours and owners (a scene of the same
+        world whose moving obstacles moved)."""
+        n = self.n
+        if (
+            look is not self.look
+            or len(scene.segments) < n
+            or (scene.owners is None) != (self.owners is None)
+        ):
+            return False
+        if (
+            not np.equal(scene.segments[:n], self.segments).all()
+            or not np.equal(scene.colors[:n], self.colors).all()
+        ):
+            return False
+        owners = scene.owners
+        return owners is None or self.owners is None or bool(np.equal(owners[:n], self.owners).all())
+
+
+def _common_rows(n: int, *pairs: tuple[np.ndarray | None, np.ndarray | None]) -> int:
+    """How many first rows (at most ``n``) every pair of arrays has equal."""
+    for a, b in pairs:
+        if a is None or b is None:
+            if a is not b:
+                return 0
+            continue
+        m = min(n, len(a), len(b))
+        same = np.equal(a[:m], b[:m])
+        if same.ndim > 1:
+            same = same.all(axis=1)
+        n = m if same.all() else int(np.argmin(same))
+    return n
+
+
+def _flat_colours(scene: Scene, lighting: Lighting, it: np.ndarray, x: float, y: float) -> np.ndarray:
+    """(len(it), 3): the colours of segments ``it`` lit on the side a camera at (x, y) is on,
+    computed for these crossings alone (the moving obstacles' sides)."""
+    seg = scene.segments.take(it, axis=0)
+    ex = seg[:, 2] - seg[:, 0]
+    ey = seg[:, 3] - seg[:, 1]
+    toward = ey * (x - seg[:, 0])
+    toward -= ex * (y - seg[:, 1])
+    length = np.hypot(ex, ey)
+    length[length == 0.0] = 1.0
+    flip = np.where(toward < 0.0, -1.0, 1.0)
+    flip /= length
+    normals = np.zeros((len(it), 3))
+    normals[:, 0] = ey * flip
+    normals[:, 1] = -ex * flip
+    return lighting.shade(scene.colors.take(it, axis=0), normals)
+
+
+def _arrays_of(scene: Scene, look: SceneLook) -> tuple[Any, ...]:
+    """What a palette is built from (compared by identity)."""
+    return (scene.segments, scene.colors, scene.owners, look)
+
+
 class _SceneCopy:
     """What a scene held, to tell whether the next one is the same (a still camera's frame is reused)."""
 
     def __init__(self, scene: Scene) -> None:
         self.arrays = [None if a is None else a.copy() for a in _scene_arrays(scene)]
         self.floor = scene.floor
+        self.look = scene.look
 
     def same(self, scene: Scene) -> bool:
-        if scene.floor is not self.floor:
+        if scene.floor is not self.floor or scene.look is not self.look:
             return False
         for kept, now in zip(self.arrays, _scene_arrays(scene), strict=True):
             if kept is None or now is None:

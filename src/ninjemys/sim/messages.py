@@ -55,6 +55,19 @@ def transform(
     return t
 
 
+def transform_into(
+    t: Any, stamp: Time, xyz: tuple[float, float, float], quaternion: tuple[float, float, float, float]
+) -> Any:
+    """``t`` (made by :func:`transform`, same frames) at a new stamp and pose: the odometry's
+    transform goes out at 100 Hz, its nested message is refreshed in place (see :func:`odometry_into`)."""
+    t.header.stamp = stamp
+    tr = t.transform.translation
+    tr.x, tr.y, tr.z = xyz
+    q = t.transform.rotation
+    q.x, q.y, q.z, q.w = quaternion
+    return t
+
+
 def static_transforms(model: RobotModel, prefix: str, stamp: Time) -> list[Any]:
     """base frame -> each sensor's frame, and the camera's link -> the optical frames its images name."""
     base = model.drive.base_frame
@@ -127,6 +140,14 @@ def joint_state(stamp: Time, names: list[str], positions: list[float], velocitie
     js = JointState()
     js.header.stamp = stamp
     js.name = names
+    js.position = positions
+    js.velocity = velocities
+    return js
+
+
+def joint_state_into(js: Any, stamp: Time, positions: list[float], velocities: list[float]) -> Any:
+    """``js`` (made by :func:`joint_state`, same joints) at a new stamp, positions and velocities."""
+    js.header.stamp = stamp
     js.position = positions
     js.velocity = velocities
     return js

@@ -130,6 +130,13 @@ class RobotIO:
     #: a p3d plugin's ground truth and a bumper plugin's contacts, at their own rates (None: not asked for)
     truth_due: Due | None = None
     bumper_due: Due | None = None
+    #: the drive's odometry and base frames under the robot's prefix (fixed at spawn: not rebuilt per step)
+    odom_frame_id: str = ""
+    base_frame_id: str = ""
+    #: the odom -> base transform and the wheels' joint_states, built at the first sample and
+    #: refreshed in place after that (as ``odom_msg``)
+    odom_tf: Any = None
+    joints_msg: Any = None
 
     def frame(self, name: str) -> str:
         return scoped(self.frame_prefix, name)
@@ -315,6 +322,7 @@ class SimNode:
             Due(_period(imu.rate, 100.0, dt), now) if imu else None,
             topics=topics,
         )
+        io.odom_frame_id, io.base_frame_id = io.frame(drive.odom_frame), io.frame(drive.base_frame)
         gt = model.ground_truth
         if gt is not None and gt.rate is not None:  # a p3d plugin's own rate (ours: with the odometry)
             io.truth_due = Due(_period(gt.rate, 0.0, dt), now)
@@ -480,46 +488,58 @@ class SimNode:
                 io.control.step_robot(io.robot, sim.time, sim.dt)
         touched = sim.step()
         now = sim.time
-        stamp = self._stamp()
+        secs, nsecs = divmod(sim.time_ns, 1_000_000_000)
+        stamp = Time._raw(secs, nsecs)  # _stamp() inlined (every step)
         if self.clock_pub.get_num_connections() and self._clock_due(now):  # nobody listening: nothing
             # rosgraph_msgs/Clock is two uint32s: its frame is packed here, with no message object
-            self.clock_pub.publish_framed(_CLOCK_FRAME(8, stamp.secs, stamp.nsecs))
+            self.clock_pub.publish_framed(_CLOCK_FRAME(8, secs, nsecs))
         for r in touched:
             self.log.warn(
                 "robot [%s] hit '%s' at (%.3f, %.3f): stopped at contact", r.name, r.contact_with, r.x, r.y
             )
         tfs: list[Any] | None = [] if self.tf_pub.get_num_connections() else None
         view = self.view  # one read: the browser view attaches while the simulation runs
+        timeout = self.cmd_timeout
         for io in self.io.values():
             r = io.robot
             last = io.last_cmd
-            if self.cmd_timeout > 0 and last is not None and not 0.0 <= now - last <= self.cmd_timeout:
+            if timeout > 0 and last is not None and not 0.0 <= now - last <= timeout:
                 io.last_cmd = None  # a driver that went quiet (or starved) does not drive on blind
                 r.command(0.0, 0.0)
-            self._publish_contact(io)
+            if io.last_contact != r.contact:
+                self._publish_contact(io)
             pubs = io.pubs
-            if io.odom_due is not None and io.odom_due.fire(now):
+            due = io.odom_due
+            if due is not None and due.fire(now):
                 self._odometry(io, stamp, tfs)
-            if io.truth_due is not None and io.truth_due.fire(now):
+            due = io.truth_due
+            if due is not None and due.fire(now):
                 self._ground_truth(io, stamp)
-            if io.bumper_due is not None and io.bumper_due.fire(now):
+            due = io.bumper_due
+            if due is not None and due.fire(now):
                 self._bumper(io, stamp)
-            imu, imu_spec = pubs.get("imu"), r.model.imu
-            if io.imu_due is not None and io.imu_due.fire(now) and imu is not None and imu_spec is not None:
-                if imu.get_num_connections():
+            due = io.imu_due
+            if due is not None and due.fire(now):
+                imu, imu_spec = pubs.get("imu"), r.model.imu
+                if imu is not None and imu_spec is not None and imu.get_num_connections():
                     imu.publish(messages.imu(stamp, io.frame(imu_spec.pose.frame), imu_spec, sim.imu(r)))
-            laser = r.model.laser
-            if io.scan_due is not None and laser is not None:
-                scan = pubs["scan"]
-                subscribed = scan.get_num_connections()
-                if not subscribed and not (view is not None and view.wants_scans()):
-                    io.scan_due.next = now  # idle: a new subscriber's first scan goes out at once
-                elif io.scan_due.fire(now):
-                    ranges = sim.scan(r, scene=self._scene(r, solid_only=True))
-                    io.last_scan = ranges
-                    if subscribed:
-                        scan.publish(messages.laser_scan(stamp, io.frame(laser.pose.frame), laser, ranges))
-            if io.camera_due is not None and io.camera_due.fire(now):
+            due = io.scan_due
+            if due is not None:
+                laser = r.model.laser
+                if laser is not None:
+                    scan = pubs["scan"]
+                    subscribed = scan.get_num_connections()
+                    if not subscribed and not (view is not None and view.wants_scans()):
+                        due.next = now  # idle: a new subscriber's first scan goes out at once
+                    elif due.fire(now):
+                        ranges = sim.scan(r, scene=self._scene(r, solid_only=True))
+                        io.last_scan = ranges
+                        if subscribed:
+                            scan.publish(
+                                messages.laser_scan(stamp, io.frame(laser.pose.frame), laser, ranges)
+                            )
+            due = io.camera_due
+            if due is not None and due.fire(now):
                 want = any(
                     pubs[k].get_num_connections()
                     for k in ("image", "image_compressed", "depth", "color_info", "depth_info")
@@ -552,12 +572,11 @@ class SimNode:
         r = io.robot
         pubs = io.pubs
         drive = r.model.drive
-        driven = drive.kind != "none"
         if drive.odometry_source == "world":
             pose = (r.x, r.y, r.yaw)  # gazebo_ros_diff_drive's odometrySource world: the true pose
         else:
             pose = self.sim.odometry(r)
-        odom_frame, base_frame = io.frame(drive.odom_frame), io.frame(drive.base_frame)
+        odom_frame, base_frame = io.odom_frame_id, io.base_frame_id
         odom = pubs.get("odom")
         if odom is not None and odom.get_num_connections():
             if io.odom_msg is None:
@@ -576,22 +595,22 @@ class SimNode:
             wr.publish(Float32(data=r.wr))
         js = pubs.get("joint_states")
         if js is not None and js.get_num_connections():
-            js.publish(
-                messages.joint_state(
-                    stamp,
-                    [r.model.left_joint, r.model.right_joint],
-                    [r.left_angle, r.right_angle],
-                    [r.wl, r.wr],
-                )
-            )
-        if tfs is None or not driven:
+            positions, speeds = [r.left_angle, r.right_angle], [r.wl, r.wr]
+            if io.joints_msg is None:
+                joints = [r.model.left_joint, r.model.right_joint]
+                io.joints_msg = messages.joint_state(stamp, joints, positions, speeds)
+            else:
+                messages.joint_state_into(io.joints_msg, stamp, positions, speeds)
+            js.publish(io.joints_msg)
+        if tfs is None or drive.kind == "none":
             return
         if drive.publish_odom_tf:
-            tfs.append(
-                messages.transform(
-                    stamp, odom_frame, base_frame, (pose[0], pose[1], 0.0), quaternion_from_yaw(pose[2])
-                )
-            )
+            xyz, q = (pose[0], pose[1], 0.0), quaternion_from_yaw(pose[2])
+            if io.odom_tf is None:
+                io.odom_tf = messages.transform(stamp, odom_frame, base_frame, xyz, q)
+            else:
+                messages.transform_into(io.odom_tf, stamp, xyz, q)
+            tfs.append(io.odom_tf)
         # gazebo_ros_diff_drive's publishWheelTF: each wheel link in its parent's frame, turned by its angle
         for joint, angle in zip(r.model.wheel_tf_joints, (r.left_angle, r.right_angle), strict=False):
             x, y, z, qx, qy, qz, qw = joint.transform(angle)

@@ -24,6 +24,7 @@ import numpy as np
 #: reductions called as ufunc methods: ``a.any()`` and ``a.min()`` go through numpy's Python-level
 #: wrappers, a few microseconds a call that the camera's per-frame code feels
 _ANY = np.logical_or.reduce
+_ALL = np.logical_and.reduce
 
 
 def cast_segments(
@@ -103,15 +104,21 @@ def segment_pairs(
         keep = np.flatnonzero(near)
         if not len(keep):
             return none
-        px, py, ex, ey, qx, qy = px[keep], py[keep], ex[keep], ey[keep], qx[keep], qy[keep]
+        # gathers by ``take`` (the same elements as fancy indexing, a few times cheaper at this size)
+        px, py, ex, ey = px.take(keep), py.take(keep), ex.take(keep), ey.take(keep)
+        qx, qy = qx.take(keep), qy.take(keep)
     else:
         keep = None
     k = len(px)
     two_pi = 2.0 * math.pi
     a0 = float(angles.min())
     rel = (angles - a0) % two_pi
-    order = np.argsort(rel, kind="stable")
-    rel_sorted = rel[order]
+    if n < 2 or _ALL(rel[1:] >= rel[:-1]):
+        # already in order (a lidar's evenly spaced beams): the stable sort would be the identity
+        order, rel_sorted = None, rel
+    else:
+        order = np.argsort(rel, kind="stable")
+        rel_sorted = rel[order]
     ends = (np.arctan2(np.concatenate([py, qy]), np.concatenate([px, qx])) - a0) % two_pi
     r1, r2 = ends[:k], ends[k:]
     lo, hi = np.minimum(r1, r2), np.maximum(r1, r2)
@@ -130,15 +137,17 @@ def segment_pairs(
         return none
     seg_of = np.repeat(seg_ids, counts)
     shift = np.repeat(starts - (np.cumsum(counts) - counts), counts)
-    ray_of = order[np.arange(total) + shift]
-    dx, dy = np.cos(angles)[ray_of], np.sin(angles)[ray_of]
-    sx, sy, gx, gy = px[seg_of], py[seg_of], ex[seg_of], ey[seg_of]
+    ray_of = np.arange(total) + shift
+    if order is not None:
+        ray_of = order.take(ray_of)
+    dx, dy = np.cos(angles).take(ray_of), np.sin(angles).take(ray_of)
+    sx, sy, gx, gy = px.take(seg_of), py.take(seg_of), ex.take(seg_of), ey.take(seg_of)
     denom = dx * gy - dy * gx
     with np.errstate(divide="ignore", invalid="ignore"):
         t = (sx * gy - sy * gx) / denom
         u = (sx * dy - sy * dx) / denom
     t[~((u >= -1e-9) & (u <= 1 + 1e-9) & (t >= 0) & (t <= max_range))] = np.inf  # NaN fails too
-    return ray_of, (seg_of if keep is None else keep[seg_of]), t
+    return ray_of, (seg_of if keep is None else keep.take(seg_of)), t
 
 
 def grid_edges(occupied: np.ndarray, resolution: float, origin_x: float, origin_y: float) -> np.ndarray:

@@ -47,6 +47,7 @@ from ninjemys.errors import PackageError
 from ninjemys.maps.mapfile import MapFileError
 from ninjemys.packages.discovery import crawl, find_package
 from ninjemys.sim.gazebo_materials import STOCK, TEXTURED, material_block, script_colour, stock_colour
+from ninjemys.sim.lighting import GAZEBO_AMBIENT, GAZEBO_BACKGROUND, GAZEBO_SUN, Lighting, Sun
 from ninjemys.sim.meshes import load_mesh
 from ninjemys.sim.world2d import FloorImage, Obstacle, World
 
@@ -281,6 +282,8 @@ class _Context:
     origins: dict[str, tuple[float, float, float]] = field(default_factory=dict)
     #: each top-level model's pose height, before it settles
     heights: dict[str, float] = field(default_factory=dict)
+    #: the world's ``<light>``s, its own and its includes' (``model://sun``), for the camera
+    lights: list[Element] = field(default_factory=list)
 
     def missing(self, uri: str, el: Element, exc: SdfError | None = None) -> None:
         """SdfError, or in a world a note that ``uri`` is left out (Gazebo's behaviour)."""
@@ -917,7 +920,8 @@ def _include(
     model = root.find("model")
     if model is None:
         if root.find("light") is not None:
-            return  # a light (Gazebo's sun is one): nothing solid
+            ctx.lights += root.findall("light")  # a light (Gazebo's sun is one): nothing solid
+            return
         raise root.error(f"{uri}: no <model> in {path}")
     name = el.value("name")
     if name:
@@ -981,8 +985,48 @@ def parse_sdf_world(
     world.dynamic_models = list(drops)  # models with physics: a set_model_state re-drops them
     world.placed_heights = {name: ctx.heights[name] for name in drops if name in ctx.heights}
     world.floor_images = ctx.floor_images
+    world.lighting = _lighting(world_el, ctx)
     _report(ctx, source, warn)
     return world
+
+
+def _colour_of(el: Element | None, default: tuple[float, float, float]) -> tuple[float, float, float]:
+    """An SDF colour element's red, green and blue (alpha optional), each 0-1 (SdfError otherwise)."""
+    if el is None:
+        return default
+    words = el.text.split()
+    values = _numbers(el, len(words) if len(words) in (3, 4) else 4, "r g b a")
+    if not all(0.0 <= v <= 1.0 for v in values):
+        raise el.error(f"colour components are 0-1, got {el.text.strip()!r}")
+    return (values[0], values[1], values[2])
+
+
+def _lighting(world_el: Element, ctx: _Context) -> Lighting:
+    """The camera's lights for a world: its ``<scene>``'s ambient and background (Gazebo's 0.4 and
+    0.7 grey by default), its directional ``<light>``s (Gazebo's sun comes from ``model://sun``),
+    the floor Gazebo's grey ground plane. A world with no directional light is lit by Gazebo's
+    default sun (Gazebo would light it by the ambient alone, a dim grey picture: such a world is a
+    fragment written without the usual ``model://sun``, not a night scene). Point and spot lights
+    are not drawn (see :mod:`ninjemys.sim.lighting`)."""
+    scene = world_el.find("scene")
+    ambient = _colour_of(scene.find("ambient") if scene is not None else None, GAZEBO_AMBIENT)
+    grey = GAZEBO_BACKGROUND[0] / 255.0
+    background = _colour_of(scene.find("background") if scene is not None else None, (grey, grey, grey))
+    suns = []
+    for light in ctx.lights:
+        if light.attrib.get("type", "point") != "directional":
+            continue
+        direction_el = light.find("direction")
+        direction = (0.0, 0.0, -1.0) if direction_el is None else tuple(_numbers(direction_el, 3, "x y z"))
+        if not any(direction):
+            raise (direction_el or light).error("a directional light's <direction> must not be 0 0 0")
+        suns.append(Sun(_colour_of(light.find("diffuse"), (1.0, 1.0, 1.0)), direction))  # type: ignore[arg-type]
+    return Lighting(
+        ambient,
+        tuple(suns) if suns else (GAZEBO_SUN,),
+        sky=(round(background[0] * 255), round(background[1] * 255), round(background[2] * 255)),
+        floor=stock_colour("Gazebo/Grey"),
+    )
 
 
 def sdf_model_obstacles(
@@ -1034,6 +1078,8 @@ def _world_solids(world_el: Element, ctx: _Context) -> list[_Solid]:
             _include(child, np.eye(4), ctx, solids, [], 1, saved)
         elif child.tag == "plugin":
             ctx.skip(f"world plugin {child.attrib.get('filename', '?')}", child)
+        elif child.tag == "light":
+            ctx.lights.append(child)
         elif child.tag != "state" and child.tag not in _QUIET_WORLD:
             ctx.skip(f"<{child.tag}>", child)
     return solids

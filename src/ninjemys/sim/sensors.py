@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ninjemys.sim.lighting import SceneLook
 from ninjemys.sim.raycast import cast_circles, cast_segments
 
 
@@ -34,6 +35,9 @@ class Scene:
     #: per segment: which obstacle's outline it belongs to (-1: none known); the camera pairs the
     #: side a ray enters a shape by with the side it leaves by (a lid seen between them)
     owners: np.ndarray | None = None
+    #: the world's lights and round obstacles, for the camera (None: Gazebo's default sun, every
+    #: side flat); see :mod:`ninjemys.sim.lighting`
+    look: SceneLook | None = None
 
 
 @dataclass

@@ -163,6 +163,7 @@ class Simulation:
         self.static_names: list[str] = []
         self._movers_at: tuple[float, tuple] | None = None
         self._mover_fixed: tuple | None = None
+        self._mover_joined: tuple[np.ndarray, np.ndarray, list[str]] | None = None
         self._floor = floor_paint(world)
         for name, (x, y, yaw) in world.model_poses.items():  # an SDF world's models: their own poses
             self.obstacle_origin[name] = (x, y)
@@ -225,6 +226,7 @@ class Simulation:
         for r in self.robots.values():
             r.free = None  # the static world changed
         st = self._static
+        self._scene_cache: dict[tuple[bool, int], tuple] = {}  # see _scene_parts
         self._static_lo = np.minimum(st[:, :2], st[:, 2:])  # bounding boxes for the collision broad phase
         self._static_hi = np.maximum(st[:, :2], st[:, 2:])
         self._movers_at = None
@@ -274,14 +276,12 @@ class Simulation:
         movers = self.world.moving
         if not movers:
             return np.zeros((0, 4)), np.zeros(0), np.zeros((0, 3), dtype=np.uint8), []
-        heights, colours, names, _, _ = self._mover_shapes()
+        if self._mover_joined is None:  # what does not move, joined once
+            heights, colours, names, _, _ = self._mover_shapes()
+            self._mover_joined = (np.concatenate(heights), np.vstack(colours), [n for g in names for n in g])
+        joined_heights, joined_colours, joined_names = self._mover_joined
         segs = [self._mover_outline(i, *m.position(self.world_time)) for i, m in enumerate(movers)]
-        return (
-            np.vstack(segs),
-            np.concatenate(heights),
-            np.vstack(colours),
-            [n for group in names for n in group],
-        )
+        return np.vstack(segs), joined_heights, joined_colours, joined_names
 
     def _movers_near(self, x: float, y: float, reach: float) -> tuple[np.ndarray, list[str]]:
         """Outline segments and names of the moving obstacles that come within ``reach`` of (x, y)
@@ -300,6 +300,20 @@ class Simulation:
                 near_names += names[i]
         return (np.vstack(segs) if segs else self._static[:0]), near_names
 
+    def _any_mover_near(self, x: float, y: float, reach: float) -> bool:
+        """Whether some moving obstacle comes within ``reach`` of (x, y) now: the test
+        :meth:`_movers_near` makes, without building any outline."""
+        moving = self.world.moving
+        if not moving:
+            return False
+        bounds = self._mover_shapes()[4]
+        t = self.world_time
+        for i, m in enumerate(moving):
+            mx, my, _ = m.position(t)
+            if math.hypot(mx - x, my - y) <= reach + bounds[i]:
+                return True
+        return False
+
     @property
     def has_visuals(self) -> bool:
         """Some static piece is only drawn, not solid (an ArUco board): a lidar's scene then differs
@@ -310,21 +324,10 @@ class Simulation:
         """Everything seen now by robot ``exclude`` (its own body left out): by a camera, or with
         ``solid_only`` by a lidar (visuals without collision left out)."""
         ms, mh, mc, _ = self._mover_segments()
-        static, s_height, s_color = self._static, self._static_height, self._static_color
-        s_base, s_facing, s_owner = self._static_base, self._static_facing, self._static_owner
-        if solid_only and self._any_visual:
-            keep = self._static_solid
-            static, s_height, s_color = static[keep], s_height[keep], s_color[keep]
-            s_base, s_facing, s_owner = s_base[keep], s_facing[keep], s_owner[keep]
+        static, heights, colours, bases, facing, owners = self._scene_parts(
+            solid_only and self._any_visual, mh, mc
+        )
         segs = np.vstack([static, ms]) if len(ms) else static
-        heights = np.concatenate([s_height, mh]) if len(ms) else s_height
-        colours = np.vstack([s_color, mc]) if len(ms) else s_color
-        bases = None
-        if self._any_base:
-            bases = np.concatenate([s_base, np.zeros(len(ms))]) if len(ms) else s_base
-        # a moving obstacle may walk over a robot (the camera inside it sees its inside): both sides
-        facing = np.concatenate([s_facing, np.zeros(len(ms), dtype=np.int8)]) if len(ms) else s_facing
-        owners = np.concatenate([s_owner, np.full(len(ms), -1)]) if len(ms) else s_owner
         others = [r for r in self.robots.values() if r.name != exclude]
         if others:
             circles = (
@@ -344,7 +347,35 @@ class Simulation:
             facing,
             bases,
             owners,
+            self.world.look,
         )
+
+    def _scene_parts(self, solid: bool, mh: np.ndarray, mc: np.ndarray) -> tuple:
+        """What a scene holds besides the moving obstacles' segments, which alone change from step to
+        step: the static segments (``solid``: the solid ones only) and every segment's height,
+        colour, base, facing and owner, the movers' included. Built once per static world and kind
+        of scene (a scene is only read), not at each of the 40 scenes a simulated second."""
+        key = (solid, len(mh))
+        parts = self._scene_cache.get(key)
+        if parts is not None:
+            return parts
+        static, s_height, s_color = self._static, self._static_height, self._static_color
+        s_base, s_facing, s_owner = self._static_base, self._static_facing, self._static_owner
+        if solid:
+            keep = self._static_solid
+            static, s_height, s_color = static[keep], s_height[keep], s_color[keep]
+            s_base, s_facing, s_owner = s_base[keep], s_facing[keep], s_owner[keep]
+        n = len(mh)
+        heights = np.concatenate([s_height, mh]) if n else s_height
+        colours = np.vstack([s_color, mc]) if n else s_color
+        bases = None
+        if self._any_base:
+            bases = np.concatenate([s_base, np.zeros(n)]) if n else s_base
+        # a moving obstacle may walk over a robot (the camera inside it sees its inside): both sides
+        facing = np.concatenate([s_facing, np.zeros(n, dtype=np.int8)]) if n else s_facing
+        owners = np.concatenate([s_owner, np.full(n, -1)]) if n else s_owner
+        parts = self._scene_cache[key] = (static, heights, colours, bases, facing, owners)
+        return parts
 
     def clearance(
         self, x: float, y: float, exclude: str | None = None, height: float = math.inf, above: float = 0.0
@@ -750,8 +781,15 @@ class Simulation:
         if travel > 0:
             radius = m.body_radius
             static = not self._static_free(r, nx, ny)
-            geometry = self._collision_geometry(r.x, r.y, travel + radius + 0.05, r.name, static)
-            if len(geometry[0]) or len(geometry[2]):
+            reach = travel + radius + 0.05
+            geometry: tuple | None
+            if not static and len(self.robots) == 1 and not self._any_mover_near(r.x, r.y, reach):
+                # alone, inside its free disk, no moving obstacle within reach (the common step):
+                # what _collision_geometry would find is nothing, so nothing is built
+                geometry = None
+            else:
+                geometry = self._collision_geometry(r.x, r.y, reach, r.name, static)
+            if geometry is not None and (len(geometry[0]) or len(geometry[2])):
                 pieces = max(1, math.ceil(travel / (radius * 0.5)))
                 f = np.arange(0, pieces + 1) / pieces
                 dist, who = self._clearances(r.x + f * ddx, r.y + f * ddy, r.name, geometry)
@@ -761,6 +799,7 @@ class Simulation:
                 # cheapest: no samples along the move are made at all)
                 blocked = _NONE_BLOCKED
             if len(blocked):
+                assert geometry is not None  # something was in reach
                 k = int(blocked[0]) + 1
                 lo, hi = f[k - 1], f[k]
                 for _ in range(12):  # contact point to travel/pieces/4096

@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ninjemys.maps.mapfile import Fields, GridMap, MapFileError, load_map, text_byte, yaml_lines
+from ninjemys.sim.lighting import DEFAULT_LIGHTING, Lighting, SceneLook, scene_look
 
 CYLINDER_SIDES = 24
 DEFAULT_WALL_HEIGHT = 1.0
@@ -232,9 +233,23 @@ class World:
     #: counts the rebuilds: a view that drew the obstacles redraws them when it changes (a model
     #: spawned, moved or deleted)
     revision: int = 0
+    #: the lights the camera sees the world by (an SDF world's ``<light>``s and ``<scene>``; Gazebo's
+    #: default sun and ambient otherwise): see :mod:`ninjemys.sim.lighting`
+    lighting: Lighting = DEFAULT_LIGHTING
 
     def __post_init__(self) -> None:
+        self._look: tuple[int, Lighting, SceneLook] | None = None
         self.rebuild()
+
+    @property
+    def look(self) -> SceneLook:
+        """The lights and the round obstacles' centres, for the camera (built again after a rebuild
+        or a change of lights)."""
+        kept = self._look
+        if kept is None or kept[0] != self.revision or kept[1] is not self.lighting:
+            kept = (self.revision, self.lighting, scene_look(self.lighting, self.obstacles))
+            self._look = kept
+        return kept[2]
 
     def rebuild(self) -> None:
         """Recompute the flat segment arrays after obstacles were added or removed."""

@@ -23,6 +23,7 @@ from ninjemys.packages.cpp_build import install_cpp
 from ninjemys.packages.install_space import install_workspace
 from ninjemys.packages.workspace import Workspace
 from ninjemys.rostest.junit import CaseResult, SuiteResult, write_xml
+from ninjemys.tools.catkin_roslint import is_lint_target, run_lint_target
 from ninjemys.tools.cli import entry
 
 
@@ -45,7 +46,8 @@ def _parser() -> argparse.ArgumentParser:
         "targets",
         nargs="*",
         help="make targets: 'clean' removes build/ and devel/; 'install' also writes the install space; "
-        "'run_tests' runs the add_rostest() files with rostest and the catkin_add_nosetests() tests",
+        "'run_tests' runs the add_rostest() files with rostest and the catkin_add_nosetests() tests; "
+        "'roslint' / 'roslint_<pkg>' run the linters of roslint_cpp() and roslint_python()",
     )
     return p
 
@@ -81,6 +83,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"-- {len(report.cpp_skipped)} C++ target(s) not built (see above): {names}")
     if "install" in args.targets:
         _install(ws, prefix, report.cpp_build)
+    for target in (t for t in args.targets if is_lint_target(t)):
+        if run_lint_target(ws, target) != 0:
+            return 1
     if "run_tests" in args.targets:
         if _testing_enabled(passthrough):
             _run_tests(ws, _results_dir(ws, passthrough))

@@ -153,8 +153,22 @@ function loadState(state) {
 ros.subscribe(VIEW_CHANNEL, (m) => (m.kind === "state" ? loadState(m) : applyUpdate(m)));
 ros.on("close", () => { statusLine.textContent = "disconnected (retrying)"; statusLine.className = "error"; });
 
-// camera images: the selected robot's colour (rgb8) and depth (16UC1, mm) topics, drawn as they come
+// camera images: the selected robot's colour (rgb8) and depth (16UC1, mm) topics. Only the newest image of
+// each is drawn, once per animation frame: a simulator running faster than real time sends more frames than a
+// page can convert, and drawing every one kept the page busy enough to miss clicks on a loaded machine.
 let cameraSubs = [];
+const newestImages = new Map(); // canvas -> the newest image not drawn yet
+let imagesQueued = false;
+function showImage(target, msg) {
+  newestImages.set(target, msg);
+  if (imagesQueued) return;
+  imagesQueued = true;
+  requestAnimationFrame(() => {
+    imagesQueued = false;
+    for (const [canvasOf, newest] of newestImages) drawImage(canvasOf, newest);
+    newestImages.clear();
+  });
+}
 let cameraRobot = null;
 function drawImage(target, msg) {
   const { width, height } = msg;
@@ -186,8 +200,8 @@ function followCameras() {
   cameraRobot = name;
   if (!r || !name) return;
   cameraSubs = [
-    ros.subscribe(r.topics.color, (msg) => drawImage(colorCanvas, msg), { type: "sensor_msgs/Image" }),
-    ros.subscribe(r.topics.depth, (msg) => drawImage(depthCanvas, msg), { type: "sensor_msgs/Image" }),
+    ros.subscribe(r.topics.color, (msg) => showImage(colorCanvas, msg), { type: "sensor_msgs/Image" }),
+    ros.subscribe(r.topics.depth, (msg) => showImage(depthCanvas, msg), { type: "sensor_msgs/Image" }),
   ];
 }
 setInterval(followCameras, 200);
