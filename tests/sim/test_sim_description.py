@@ -271,12 +271,56 @@ def test_malformed_xml_and_geometry():
         DescriptionError, match=r"bot\.urdf:\d+: <cylinder>: radius='big' is not 1 finite number"
     ):
         model_from_description(bad, "bot.urdf")
-    with pytest.raises(DescriptionError, match="ros_control robot needs two wheel joints"):
+    with pytest.raises(DescriptionError, match="joint .left_joint. is not in the robot"):
         model_from_description(
-            '<robot name="b"><link name="a"/><gazebo><plugin name="d" filename="libgazebo_ros_control.so">'
+            '<robot name="b"><link name="a"/><gazebo><plugin name="d" filename="libgazebo_ros_diff_drive.so">'
             "</plugin></gazebo></robot>",
             "bot.urdf",
         )
+
+
+_ARM = """<robot name="arm">
+  <link name="world"/>
+  <joint name="fixed" type="fixed"><parent link="world"/><child link="base"/></joint>
+  <link name="base"><collision><origin xyz="0 0 0.5"/><geometry><box size="0.1 0.1 1"/></geometry></collision></link>
+  <joint name="shoulder" type="continuous"><parent link="base"/><child link="upper"/>
+    <origin xyz="0 0.1 0.95"/><axis xyz="0 1 0"/></joint>
+  <link name="upper"><collision><origin xyz="0 0 0.45"/><geometry><box size="0.1 0.1 1"/></geometry></collision></link>
+  <joint name="elbow" type="continuous"><parent link="upper"/><child link="fore"/>
+    <origin xyz="0 0.1 0.9"/><axis xyz="0 1 0"/></joint>
+  <link name="fore"><collision><origin xyz="0 0 0.45"/><geometry><box size="0.1 0.1 1"/></geometry></collision></link>
+  <transmission name="t1"><type>transmission_interface/SimpleTransmission</type>
+    <joint name="shoulder"><hardwareInterface>hardware_interface/EffortJointInterface</hardwareInterface></joint>
+    <actuator name="m1"/></transmission>
+  <transmission name="t2"><type>transmission_interface/SimpleTransmission</type>
+    <joint name="elbow"><hardwareInterface>hardware_interface/EffortJointInterface</hardwareInterface></joint>
+    <actuator name="m2"/></transmission>
+  <gazebo><plugin name="gazebo_ros_control" filename="libgazebo_ros_control.so"/></gazebo>
+</robot>"""
+
+
+def test_an_arm_under_ros_control_spawns_without_wheels():
+    """RRBot's pattern (gazebo_ros_demos): continuous arm joints with box links under gazebo_ros_control.
+    Gazebo spawns it; its joints are no wheels (only a round collision rolls), so the base stays put and
+    ros_control exposes the joints without a side, with one warning saying so."""
+    m = model_from_description(_ARM, "arm.urdf")
+    assert m.drive.kind == "ros_control"
+    assert (m.left_joint, m.right_joint) == ("", "")
+    assert m.control_joints == {"shoulder": "", "elbow": ""}
+    assert any("no two continuous joints with a cylinder or sphere collision" in w for w in m.warnings)
+    # a wheeled ros_control robot still finds its round wheels among other continuous joints
+    wheeled = _ARM.replace(
+        '<link name="fore"><collision><origin xyz="0 0 0.45"/><geometry><box size="0.1 0.1 1"/>',
+        '<link name="fore"><collision><origin xyz="0 0 0.45"/><geometry><cylinder radius="0.05" length="0.02"/>',
+    ).replace(
+        "</robot>",
+        '<joint name="right" type="continuous"><parent link="base"/><child link="rw"/>'
+        '<origin xyz="0 -0.1 0.05"/><axis xyz="0 1 0"/></joint>'
+        '<link name="rw"><collision><geometry><cylinder radius="0.05" length="0.02"/></geometry></collision></link>'
+        "</robot>",
+    )
+    w = model_from_description(wheeled, "wheeled.urdf")
+    assert {w.left_joint, w.right_joint} == {"elbow", "right"} and w.wheel_radius == 0.05
 
 
 def test_mutated_descriptions_give_description_errors_and_nothing_else():

@@ -42,7 +42,7 @@ def model_from_description(text: str, source: str, *, robot_namespace: str | Non
     doc = parse(text, source)
     geo = read_geometry(doc)
     cfg = read_gazebo(doc, geo, robot_namespace)
-    warnings = list(cfg.warnings)
+    warnings: list[str] = []
     drive = cfg.drive
     if drive is None:
         drive = DriveSpec(
@@ -59,6 +59,7 @@ def model_from_description(text: str, source: str, *, robot_namespace: str | Non
             " the robot is passive"
         )
     left, right = _wheels(doc, geo, cfg, drive)
+    warnings = [*cfg.warnings, *warnings]  # the configuration's, with those choosing the wheels
     radius = _wheel_radius(doc, left, right, drive)
     separation = abs(left.pose[1][1] - right.pose[1][1]) if left is not right else 0.0
     if separation == 0.0:
@@ -154,7 +155,7 @@ def _control_joints(doc: Document, geo: Geometry, left: Wheel, right: Wheel) -> 
     named = [j.get("name", "") for t in doc.root.findall("transmission") for j in t.findall("joint")]
     mid = (left.pose[1][1] + right.pose[1][1]) / 2.0
     sides: dict[str, str] = {left.joint: "left", right.joint: "right"} if left is not right else {}
-    wheel_joints = {w.joint: w for w in geo.wheels}
+    wheel_joints = {w.joint: w for w in geo.wheels} if left is not right else {}
     for name in named:
         if name not in geo.joints:
             for t in doc.root.findall("transmission"):
@@ -183,6 +184,10 @@ def _wheels(doc: Document, geo: Geometry, cfg: GazeboConfig, drive: DriveSpec) -
             found.append(Wheel(name, j.child, compose(geo.pose_of(j.parent), (j.rotation, j.xyz)), None))
         return found[0], found[1]
     wheels = geo.wheels
+    if drive.kind == "ros_control" and not drive.wheel_radius:
+        # gazebo_ros_control drives whatever joints the controllers name: the continuous joints of an
+        # arm (RRBot's) are no wheels, and only a joint with a round collision can roll
+        wheels = [w for w in wheels if w.radius]
     if len(wheels) >= 2:
         pair = sorted(wheels, key=lambda w: -w.pose[1][1])
         if len(wheels) > 2 and drive.kind != "none":
@@ -191,7 +196,13 @@ def _wheels(doc: Document, geo: Geometry, cfg: GazeboConfig, drive: DriveSpec) -
                 " are taken as the left and right wheels"
             )
         return pair[0], pair[-1]
-    if drive.kind in ("diff_drive", "skid_steer", "ros_control"):
+    if drive.kind == "ros_control":
+        # Gazebo spawns an arm or any other model without wheels under ros_control as well
+        cfg.warnings.append(
+            f"{doc.source}: no two continuous joints with a cylinder or sphere collision to roll on:"
+            " the base stays where it is spawned"
+        )
+    elif drive.kind in ("diff_drive", "skid_steer"):
         raise doc.error(
             doc.root,
             f"a {drive.kind} robot needs two wheel joints (continuous), found {len(wheels)}",
@@ -202,6 +213,8 @@ def _wheels(doc: Document, geo: Geometry, cfg: GazeboConfig, drive: DriveSpec) -
 
 
 def _wheel_radius(doc: Document, left: Wheel, right: Wheel, drive: DriveSpec) -> float:
+    if left is right:  # no wheels (a passive or wheel-less model): the radius is never used
+        return drive.wheel_radius or 0.05
     for w in (left, right):
         if w.radius:
             return w.radius
