@@ -250,3 +250,57 @@ def test_speed_limiter_and_odometry_arithmetic():
     assert o.x == pytest.approx(r * math.sin(o.heading)) and o.y == pytest.approx(
         r * (1 - math.cos(o.heading))
     )
+
+
+def test_an_arms_position_controllers_move_its_joints_and_report_state():
+    """RRBot's pattern: effort_controllers/JointPositionController (follows the command, at most at the
+    URDF's velocity limit, state on <name>/state) and position_controllers/JointPositionController (set at
+    once) on joints that are no wheels, moved by the control loop itself; the base does not move."""
+    from types import SimpleNamespace
+
+    from ninjemys.idl.loader import get_message_class
+    from ninjemys.sim.ros_control.hardware import ControlLoop
+
+    params = {
+        "arm": {
+            "shoulder_controller": {
+                "type": "effort_controllers/JointPositionController",
+                "joint": "shoulder",
+                "pid": {"p": 100.0, "i": 0.01, "d": 10.0},
+            },
+            "elbow_controller": {"type": "position_controllers/JointPositionController", "joint": "elbow"},
+            "joint_state_controller": JSC,
+        }
+    }
+    node = FakeNode(params)
+    model = SimpleNamespace(
+        left_joint="",
+        right_joint="",
+        control_joints={"shoulder": "", "elbow": ""},
+        joint_velocity_limits={"shoulder": 1.0},
+        wheel_separation=0.34,
+        wheel_radius=0.05,
+        drive=SimpleNamespace(controller_namespace="/arm"),
+    )
+    loop = ControlLoop(node, model)  # type: ignore[arg-type]
+    cm = loop.manager
+    for name in ("shoulder_controller", "elbow_controller", "joint_state_controller"):
+        assert cm.load(name), node.log.lines
+    assert cm.switch(["shoulder_controller", "elbow_controller", "joint_state_controller"], [], STRICT)
+    robot = SimpleNamespace(left_angle=0.0, right_angle=0.0, wl=0.0, wr=0.0, target=(9.0, 9.0))
+    command = get_message_class("std_msgs/Float64")
+    node.subs["/arm/shoulder_controller/command"](command(data=0.5))
+    node.subs["/arm/elbow_controller/command"](command(data=-0.3))
+    positions = []
+    for i in range(100):  # 1 s at 100 Hz
+        loop.step_robot(robot, i * 0.01, 0.01)
+        positions.append(loop.free["shoulder"].position)
+    assert robot.target == (0.0, 0.0)  # no wheels: the base stays
+    assert loop.free["elbow"].position == pytest.approx(-0.3)  # the position interface sets it
+    # the effort controller's joint never exceeds the 1 rad/s limit and settles on the command
+    assert all(b - a <= 0.01 + 1e-12 for a, b in zip(positions, positions[1:], strict=False))
+    assert positions[4] < 0.05 + 1e-9 and positions[-1] == pytest.approx(0.5, abs=1e-3)
+    state = node.pubs["/arm/shoulder_controller/state"].sent[-1]
+    assert state.set_point == 0.5 and state.process_value == pytest.approx(0.5, abs=1e-3)
+    last = node.pubs["/arm/joint_states"].sent[-1]
+    assert last.name == ["shoulder", "elbow"] and list(last.position) == pytest.approx([0.5, -0.3], abs=1e-3)

@@ -147,6 +147,8 @@ class RobotModel:
     # ros_control: the joints with a <transmission> and their side ("left", "right"; "" for a joint that
     # is not a wheel): every wheel of a side turns as that side's wheel of the simulated body
     control_joints: dict[str, str] = field(default_factory=dict)
+    #: the URDF's <limit velocity> of the joints ros_control exposes, where one is given (rad/s)
+    joint_velocity_limits: dict[str, float] = field(default_factory=dict)
     #: what apply_body_wrench pushes: the body's mass (kg) and moment of inertia about the vertical
     #: (kg m^2), from a URDF's <inertial>s; None: a torque turns it as it would a 1 kg m^2 body
     mass: float = 1.0

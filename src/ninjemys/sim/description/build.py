@@ -75,6 +75,7 @@ def model_from_description(text: str, source: str, *, robot_namespace: str | Non
     max_accel = accel / radius if accel else UNLIMITED_ACCEL
     limit = _velocity_limit(doc, left.joint) if left.joint else None
     mass, inertia_z = _body_mass(doc, geo)
+    control_joints = _control_joints(doc, geo, left, right) if drive.kind == "ros_control" else {}
     return RobotModel(
         name=geo.name or "robot",
         wheel_radius=radius,
@@ -97,7 +98,8 @@ def model_from_description(text: str, source: str, *, robot_namespace: str | Non
         ignored_plugins=list(dict.fromkeys(cfg.ignored)),
         warnings=warnings,
         sensor_tf=False,
-        control_joints=_control_joints(doc, geo, left, right) if drive.kind == "ros_control" else {},
+        control_joints=control_joints,
+        joint_velocity_limits={j: v for j in control_joints if (v := _velocity_limit(doc, j)) is not None},
         mass=mass,
         inertia_z=inertia_z,
         rest_z=-geo.ground_z() + 0.0,

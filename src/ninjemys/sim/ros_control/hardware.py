@@ -41,10 +41,18 @@ class SimRobotHW:
     URDF when its own parameters are absent.
     """
 
-    def __init__(self, joints: Iterable[str], wheel_separation: float, wheel_radius: float) -> None:
+    def __init__(
+        self,
+        joints: Iterable[str],
+        wheel_separation: float,
+        wheel_radius: float,
+        velocity_limits: Mapping[str, float] | None = None,
+    ) -> None:
         self.joints = {name: JointHandle(name) for name in joints}
         self.wheel_separation = wheel_separation
         self.wheel_radius = wheel_radius
+        #: the URDF's <limit velocity> per joint (rad/s), where it gives one
+        self.velocity_limits = dict(velocity_limits or {})
         self.lock = threading.Lock()
 
     def read(self, states: Mapping[str, tuple[float, float]]) -> None:
@@ -66,10 +74,12 @@ class ControlLoop:
 
         named = [j for j in (model.left_joint, model.right_joint) if j]
         joints = list(dict.fromkeys(named + list(model.control_joints)))
-        self.hw = SimRobotHW(joints, model.wheel_separation, model.wheel_radius)
+        self.hw = SimRobotHW(joints, model.wheel_separation, model.wheel_radius, model.joint_velocity_limits)
         sides = dict(model.control_joints) or {model.left_joint: "left", model.right_joint: "right"}
         self.left = [j for j, side in sides.items() if side == "left"]
         self.right = [j for j, side in sides.items() if side == "right"]
+        #: joints that are no wheel (an arm's): moved here, kinematically, at their commanded speed
+        self.free = {j: JointHandle(j) for j, side in sides.items() if not side and j}
         ns = namespace if namespace is not None else model.drive.controller_namespace
         self.manager = ControllerManager(node, self.hw, ns)
 
@@ -84,7 +94,11 @@ class ControlLoop:
         target is the mean of its commanded joints (0 when no running controller commands them)."""
         states = {j: (robot.left_angle, robot.wl) for j in self.left}
         states.update({j: (robot.right_angle, robot.wr) for j in self.right})
+        states.update({j: (h.position, h.velocity) for j, h in self.free.items()})
         commands = self.step(now, period, states)
+        for j, h in self.free.items():
+            h.velocity = commands.get(j, 0.0)
+            h.position += h.velocity * period
         left = [commands[j] for j in self.left if j in commands]
         right = [commands[j] for j in self.right if j in commands]
         robot.target = (sum(left) / len(left) if left else 0.0, sum(right) / len(right) if right else 0.0)

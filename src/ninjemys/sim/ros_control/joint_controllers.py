@@ -1,5 +1,6 @@
-"""One-joint velocity controllers: ``effort_controllers/JointVelocityController`` and
-``velocity_controllers/JointVelocityController``.
+"""One-joint controllers: ``effort_controllers/JointVelocityController`` and
+``velocity_controllers/JointVelocityController`` for wheels, ``effort_controllers/JointPositionController``
+and ``position_controllers/JointPositionController`` for an arm's joints (RRBot in gazebo_ros_demos).
 
 The maker's Gazebo PuzzleBot (puzzlebot_control's ``puzzlebot_diff_control.yaml``) drives each
 wheel with an effort_controllers/JointVelocityController: a wheel speed in rad/s on
@@ -13,6 +14,13 @@ state message reports (``command``: the effort it would ask for). The state is p
 updates of a 1 kHz Gazebo loop (100 Hz): here at 100 Hz of simulated time.
 
 velocity_controllers/JointVelocityController forwards ``<name>/command`` to the joint as is.
+
+The simulator has no link dynamics for an arm: a position-controlled joint is moved kinematically.
+effort_controllers/JointPositionController's joint closes the position error with a time constant of
+:data:`POSITION_TIME_CONSTANT` (a well-damped PID in Gazebo settles in a few tenths of a second), at most
+at the joint's URDF velocity limit; position_controllers/JointPositionController's joint is set to the
+command at the next step, as Gazebo's position interface sets it. Every command reaching the simulator
+is a joint velocity in rad/s.
 """
 
 from __future__ import annotations
@@ -26,8 +34,11 @@ from ninjemys.sim.ros_control.controllers import Controller, ControllerError, _j
 from ninjemys.sim.ros_control.hardware import VELOCITY_INTERFACE, SimRobotHW
 
 EFFORT_INTERFACE = "hardware_interface::EffortJointInterface"
+POSITION_INTERFACE = "hardware_interface::PositionJointInterface"
 #: JointControllerState is published this often (s of simulated time): Gazebo's 1 kHz loop / 10
 STATE_PERIOD = 0.01
+#: how fast an effort-controlled arm joint closes its position error (s)
+POSITION_TIME_CONSTANT = 0.1
 
 
 def _joint(params: dict, ns: str, hw: SimRobotHW, interface: str) -> str:
@@ -165,7 +176,92 @@ class EffortJointVelocityController(_JointVelocity):
         self.state_pub.unregister()
 
 
+class _JointPosition(_JointVelocity):
+    """A joint angle (rad) on ``<ns>/<name>/command``; the joint is moved to it."""
+
+    def starting(self, now: float) -> None:
+        with self._lock:  # ros_control's position controllers hold the joint where it is on start
+            self._command = self.hw.joints[self.joint].position
+
+    def stopping(self, now: float) -> None:
+        self.hw.joints[self.joint].command = 0.0
+
+    def speed_to(self, target: float, period: float) -> float:
+        """The joint velocity that moves it toward ``target`` this step."""
+        handle = self.hw.joints[self.joint]
+        if not math.isfinite(target) or period <= 0:
+            return 0.0
+        return (target - handle.position) / period
+
+    def update(self, now: float, period: float) -> None:
+        self.hw.joints[self.joint].command = self.speed_to(self.command(), period)
+
+
+class PositionJointPositionController(_JointPosition):
+    """position_controllers/JointPositionController: the joint is set to the command."""
+
+    type_name = "position_controllers/JointPositionController"
+    interface = POSITION_INTERFACE
+
+
+class EffortJointPositionController(_JointPosition):
+    """effort_controllers/JointPositionController: the joint follows the command, its state published."""
+
+    type_name = "effort_controllers/JointPositionController"
+    interface = EFFORT_INTERFACE
+
+    def __init__(self, name: str, node: Any, hw: SimRobotHW, root_ns: str, params: dict) -> None:
+        pid = _Pid(params.get("pid"), _join(root_ns, name))  # before subscribing: nothing to undo
+        super().__init__(name, node, hw, root_ns, params)
+        self.pid = pid
+        self._state: Any = get_message_class("control_msgs/JointControllerState")
+        self.state_pub = node.publisher(_join(self.ns, "state"), self._state, queue_size=1)
+        self.last_state: float | None = None
+        self.limit = hw.velocity_limits.get(self.joint)
+
+    def starting(self, now: float) -> None:
+        super().starting(now)
+        self.pid.reset()
+        self.last_state = None
+
+    def speed_to(self, target: float, period: float) -> float:
+        handle = self.hw.joints[self.joint]
+        if not math.isfinite(target):
+            return 0.0
+        speed = (target - handle.position) / max(POSITION_TIME_CONSTANT, period)
+        if self.limit:
+            speed = max(-self.limit, min(self.limit, speed))
+        return speed
+
+    def update(self, now: float, period: float) -> None:
+        target = self.command()
+        handle = self.hw.joints[self.joint]
+        handle.command = self.speed_to(target, period)
+        error = target - handle.position
+        effort = self.pid.compute(error, period)
+        if self.last_state is not None and now < self.last_state + STATE_PERIOD - 1e-9:
+            return
+        self.last_state = now
+        msg = self._state()
+        msg.header.stamp = _stamp(now)
+        msg.set_point = target
+        msg.process_value = handle.position
+        msg.process_value_dot = handle.velocity
+        msg.error = error
+        msg.time_step = period
+        msg.command = effort
+        msg.p, msg.i, msg.d, msg.i_clamp = self.pid.p, self.pid.i, self.pid.d, self.pid.i_clamp
+        msg.antiwindup = self.pid.antiwindup
+        self.state_pub.publish(msg)
+
+    def close(self) -> None:
+        super().close()
+        self.state_pub.unregister()
+
+
 JOINT_CONTROLLER_TYPES: dict[str, type[Controller]] = {
+    EffortJointPositionController.type_name: EffortJointPositionController,
+    PositionJointPositionController.type_name: PositionJointPositionController,
     EffortJointVelocityController.type_name: EffortJointVelocityController,
     VelocityJointVelocityController.type_name: VelocityJointVelocityController,
 }
