@@ -86,6 +86,46 @@ class _Pid:
         return self.p * error + self.i * self.integral + self.d * derivative
 
 
+class _StateReport:
+    """An effort controller's PID and its ``control_msgs/JointControllerState`` on ``<name>/state``, sent
+    every :data:`STATE_PERIOD` of simulated time (what both effort controllers publish)."""
+
+    def __init__(self, node: Any, ns: str, pid: _Pid) -> None:
+        self.pid = pid
+        self._msg: Any = get_message_class("control_msgs/JointControllerState")
+        self.pub = node.publisher(_join(ns, "state"), self._msg, queue_size=1)
+        self.last: float | None = None
+
+    def reset(self) -> None:
+        self.pid.reset()
+        self.last = None
+
+    def update(
+        self, now: float, period: float, set_point: float, value: float, value_dot: float | None
+    ) -> None:
+        """Run the PID on ``set_point - value``; publish the state when it is due."""
+        error = set_point - value
+        effort = self.pid.compute(error, period)
+        if self.last is not None and now < self.last + STATE_PERIOD - 1e-9:
+            return
+        self.last = now
+        msg = self._msg()
+        msg.header.stamp = _stamp(now)
+        msg.set_point = set_point
+        msg.process_value = value
+        if value_dot is not None:
+            msg.process_value_dot = value_dot
+        msg.error = error
+        msg.time_step = period
+        msg.command = effort
+        msg.p, msg.i, msg.d, msg.i_clamp = self.pid.p, self.pid.i, self.pid.d, self.pid.i_clamp
+        msg.antiwindup = self.pid.antiwindup
+        self.pub.publish(msg)
+
+    def close(self) -> None:
+        self.pub.unregister()
+
+
 class _JointVelocity(Controller):
     """A wheel speed (rad/s) on ``<ns>/<name>/command``; the joint is driven at it."""
 
@@ -141,39 +181,20 @@ class EffortJointVelocityController(_JointVelocity):
     def __init__(self, name: str, node: Any, hw: SimRobotHW, root_ns: str, params: dict) -> None:
         pid = _Pid(params.get("pid"), _join(root_ns, name))  # before subscribing: nothing to undo
         super().__init__(name, node, hw, root_ns, params)
-        self.pid = pid
-        self._state: Any = get_message_class("control_msgs/JointControllerState")
-        self.state_pub = node.publisher(_join(self.ns, "state"), self._state, queue_size=1)
-        self.last_state: float | None = None
+        self.report = _StateReport(node, self.ns, pid)
 
     def starting(self, now: float) -> None:
         super().starting(now)
-        self.pid.reset()
-        self.last_state = None
+        self.report.reset()
 
     def update(self, now: float, period: float) -> None:
         super().update(now, period)
         handle = self.hw.joints[self.joint]
-        target = handle.command
-        error = target - handle.velocity
-        effort = self.pid.compute(error, period)
-        if self.last_state is not None and now < self.last_state + STATE_PERIOD - 1e-9:
-            return
-        self.last_state = now
-        msg = self._state()
-        msg.header.stamp = _stamp(now)
-        msg.set_point = target
-        msg.process_value = handle.velocity
-        msg.error = error
-        msg.time_step = period
-        msg.command = effort
-        msg.p, msg.i, msg.d, msg.i_clamp = self.pid.p, self.pid.i, self.pid.d, self.pid.i_clamp
-        msg.antiwindup = self.pid.antiwindup
-        self.state_pub.publish(msg)
+        self.report.update(now, period, handle.command, handle.velocity, None)
 
     def close(self) -> None:
         super().close()
-        self.state_pub.unregister()
+        self.report.close()
 
 
 class _JointPosition(_JointVelocity):
@@ -213,16 +234,12 @@ class EffortJointPositionController(_JointPosition):
     def __init__(self, name: str, node: Any, hw: SimRobotHW, root_ns: str, params: dict) -> None:
         pid = _Pid(params.get("pid"), _join(root_ns, name))  # before subscribing: nothing to undo
         super().__init__(name, node, hw, root_ns, params)
-        self.pid = pid
-        self._state: Any = get_message_class("control_msgs/JointControllerState")
-        self.state_pub = node.publisher(_join(self.ns, "state"), self._state, queue_size=1)
-        self.last_state: float | None = None
+        self.report = _StateReport(node, self.ns, pid)
         self.limit = hw.velocity_limits.get(self.joint)
 
     def starting(self, now: float) -> None:
         super().starting(now)
-        self.pid.reset()
-        self.last_state = None
+        self.report.reset()
 
     def speed_to(self, target: float, period: float) -> float:
         handle = self.hw.joints[self.joint]
@@ -237,26 +254,11 @@ class EffortJointPositionController(_JointPosition):
         target = self.command()
         handle = self.hw.joints[self.joint]
         handle.command = self.speed_to(target, period)
-        error = target - handle.position
-        effort = self.pid.compute(error, period)
-        if self.last_state is not None and now < self.last_state + STATE_PERIOD - 1e-9:
-            return
-        self.last_state = now
-        msg = self._state()
-        msg.header.stamp = _stamp(now)
-        msg.set_point = target
-        msg.process_value = handle.position
-        msg.process_value_dot = handle.velocity
-        msg.error = error
-        msg.time_step = period
-        msg.command = effort
-        msg.p, msg.i, msg.d, msg.i_clamp = self.pid.p, self.pid.i, self.pid.d, self.pid.i_clamp
-        msg.antiwindup = self.pid.antiwindup
-        self.state_pub.publish(msg)
+        self.report.update(now, period, target, handle.position, handle.velocity)
 
     def close(self) -> None:
         super().close()
-        self.state_pub.unregister()
+        self.report.close()
 
 
 JOINT_CONTROLLER_TYPES: dict[str, type[Controller]] = {
