@@ -34,6 +34,9 @@ start = x()
 right = rospy.Publisher("/right_wheel_velocity_controller/command", Float64, queue_size=1)
 left = rospy.Publisher("/left_wheel_velocity_controller/command", Float64, queue_size=1)
 deadline = rospy.get_time() + 30.0
+# a wheel whose command link comes up first would turn alone for a while: wait for both, as a user would
+while min(right.get_num_connections(), left.get_num_connections()) == 0 and rospy.get_time() < deadline:
+    rospy.sleep(0.05)
 while rospy.get_time() < deadline and x().x - start.x < 1.5:
     right.publish(Float64(6.0)); left.publish(Float64(6.0)); rospy.sleep(0.05)
 right.publish(Float64(0.0)); left.publish(Float64(0.0))
