@@ -364,7 +364,9 @@ def test_a_real_rospy_controller_drives_a_square_checked_against_model_states(ga
     SetPhysicsProperties = get_service_class("gazebo_msgs/SetPhysicsProperties")
     state = SetModelState._request_class().model_state
     state.model_name, state.pose.orientation.w = "puzzlebot", 1.0
-    if "puzzlebot" not in gazebo.model_states():  # run alone: spawn it (the first test does otherwise)
+    GetWorldProperties = get_service_class("gazebo_msgs/GetWorldProperties")
+    # run alone: spawn it (the first test does otherwise); asked by service, which answers while paused
+    if "puzzlebot" not in gazebo.call("/gazebo/get_world_properties", GetWorldProperties).model_names:
         gazebo.client.set_param("/robot_description", URDF)
         out = gazebo.spawn_model("-urdf", "-param", "robot_description", "-model", "puzzlebot", "-unpause")
         assert out.returncode == 0, out.stdout + out.stderr
