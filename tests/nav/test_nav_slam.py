@@ -118,8 +118,12 @@ def test_a_small_start_map_grows_to_what_the_laser_sees(laser):
     assert all(12.8 <= abs(b) <= 13.0 for b in bounds), bounds
     assert all(abs((b - 1) / params.delta - round((b - 1) / params.delta)) < 1e-6 for b in bounds)
     grid = mapper.occupancy()
-    size = (round((params.ymax - params.ymin) / params.delta), round((params.xmax - params.xmin) / params.delta))
+    size = (
+        round((params.ymax - params.ymin) / params.delta),
+        round((params.xmax - params.xmin) / params.delta),
+    )
     assert grid.shape == (mapper.height, mapper.width) == size
+
     def cell(v: float, low: float) -> int:
         return int((v - low) / params.delta)
 

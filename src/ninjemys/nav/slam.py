@@ -394,7 +394,9 @@ class ParticleMapper:
         q.visits.ravel()[flat] += 1
         q.hits.ravel()[flat] += 1
 
-    def _grow_to(self, laser_pose: tuple[float, float, float], ranges: np.ndarray, angles: np.ndarray) -> None:
+    def _grow_to(
+        self, laser_pose: tuple[float, float, float], ranges: np.ndarray, angles: np.ndarray
+    ) -> None:
         """Enlarge every particle's map (and move the bounds) so that the cells this scan writes from
         each particle's pose are on it: GMapping's computeActiveArea, which resizes by enlargeStep."""
         p = self.params
