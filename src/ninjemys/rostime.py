@@ -165,7 +165,10 @@ class TVal:
 class Time(TVal):
     """A point in time (seconds since the epoch, or since simulation start). Never negative."""
 
-    __slots__ = ()
+    # genpy's Time and Duration name their fields in their own __slots__, and code that walks a
+    # message through ``type(value).__slots__`` (rosbag-to-CSV exporters) reaches a stamp's secs and
+    # nsecs that way; an empty tuple here made stamps vanish from its output
+    __slots__ = ("secs", "nsecs")
 
     def __init__(self, secs: int | float = 0, nsecs: int = 0) -> None:
         super().__init__(secs, nsecs)
@@ -211,7 +214,7 @@ class Time(TVal):
 class Duration(TVal):
     """A signed span of time."""
 
-    __slots__ = ()
+    __slots__ = ("secs", "nsecs")  # as genpy's (see Time)
 
     def __repr__(self) -> str:
         return f"rospy.Duration[{self.to_nsec()}]"
