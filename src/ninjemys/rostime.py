@@ -165,10 +165,7 @@ class TVal:
 class Time(TVal):
     """A point in time (seconds since the epoch, or since simulation start). Never negative."""
 
-    # genpy's Time and Duration name their fields in their own __slots__, and code that walks a
-    # message through ``type(value).__slots__`` (rosbag-to-CSV exporters) reaches a stamp's secs and
-    # nsecs that way; an empty tuple here made stamps vanish from its output
-    __slots__ = ("secs", "nsecs")
+    __slots__ = ()  # TVal's layout; the visible __slots__ is set below the classes
 
     def __init__(self, secs: int | float = 0, nsecs: int = 0) -> None:
         super().__init__(secs, nsecs)
@@ -214,7 +211,7 @@ class Time(TVal):
 class Duration(TVal):
     """A signed span of time."""
 
-    __slots__ = ("secs", "nsecs")  # as genpy's (see Time)
+    __slots__ = ()  # TVal's layout; the visible __slots__ is set below the classes
 
     def __repr__(self) -> str:
         return f"rospy.Duration[{self.to_nsec()}]"
@@ -285,3 +282,10 @@ class Duration(TVal):
             return NotImplemented
         q, r = divmod(self.to_nsec(), val.to_nsec())
         return q, Duration._raw(0, r)
+
+
+# genpy's Time and Duration name their fields in their own __slots__, and code that walks a message
+# through ``type(value).__slots__`` (rosbag-to-CSV exporters) reaches a stamp's secs and nsecs that
+# way: with an empty tuple, stamps vanished from its output. Set after the classes are made, so that
+# the instances keep TVal's layout (no second pair of slots: 48 bytes a stamp, not 64).
+Time.__slots__ = Duration.__slots__ = TVal.__slots__  # type: ignore[assignment]
