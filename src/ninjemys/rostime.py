@@ -183,6 +183,10 @@ class Time(TVal):
         """rospy's alias of :meth:`from_sec`."""
         return cls.from_sec(float_secs)
 
+    def to_time(self) -> float:
+        """genpy's alias of :meth:`to_sec` (``time.time()``'s format; rosbag scripts call it)."""
+        return self.to_sec()
+
     def __repr__(self) -> str:
         return f"rospy.Time[{self.to_nsec()}]"
 

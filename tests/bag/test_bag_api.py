@@ -239,10 +239,17 @@ def test_garbage_message_bytes_and_bad_definitions_are_format_errors(tmp_path):
 def test_a_csv_export_script_reads_what_real_rosbag_gives(tmp_path):
     """The bag-to-CSV scripts of course and lab repositories walk a message through
     ``type(value).__slots__`` (a stamp's secs and nsecs included: genpy's Time and Duration list
-    them) and print the bag with ``str(bag)`` (each topic's rate, as rosbag computes it when the
-    index is read): the same text from Debian's rosbag and ours."""
+    them; a float32[] is a tuple, written whole), stamp rows with ``t.to_time()``, and print the bag
+    with ``str(bag)`` (each topic's rate, as rosbag computes it when the index is read): the same
+    text from Debian's rosbag and ours."""
+    from sensor_msgs.msg import LaserScan
+
     path = tmp_path / "a.bag"
     sample(path)
+    with rosbag.Bag(str(path), "a") as bag:
+        bag.write(
+            "/scan", LaserScan(ranges=[1.0, 2.5, float("inf")], angle_increment=0.5), Time(1_700_000_001)
+        )
     code = """
 import sys, rosbag
 
@@ -252,8 +259,8 @@ def flat(value, prefix=""):
     return [(prefix[:-1], str(value))]
 
 bag = rosbag.Bag(sys.argv[1])
-for topic, msg, t in bag.read_messages(topics=["/pose"]):
-    print(topic, t.to_nsec(), flat(msg))
+for topic, msg, t in bag.read_messages(topics=["/pose", "/scan"]):
+    print(topic, t.to_time(), flat(msg))
 print(str(bag).split("topics:")[1])
 print(rosbag.Bag(sys.argv[1], skip_index=True))
 """
