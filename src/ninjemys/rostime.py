@@ -165,7 +165,7 @@ class TVal:
 class Time(TVal):
     """A point in time (seconds since the epoch, or since simulation start). Never negative."""
 
-    __slots__ = ()
+    __slots__ = ()  # TVal's layout; the visible __slots__ is set below the classes
 
     def __init__(self, secs: int | float = 0, nsecs: int = 0) -> None:
         super().__init__(secs, nsecs)
@@ -182,6 +182,10 @@ class Time(TVal):
     def from_seconds(cls, float_secs: float) -> Time:
         """rospy's alias of :meth:`from_sec`."""
         return cls.from_sec(float_secs)
+
+    def to_time(self) -> float:
+        """genpy's alias of :meth:`to_sec` (``time.time()``'s format; rosbag scripts call it)."""
+        return self.to_sec()
 
     def __repr__(self) -> str:
         return f"rospy.Time[{self.to_nsec()}]"
@@ -211,7 +215,7 @@ class Time(TVal):
 class Duration(TVal):
     """A signed span of time."""
 
-    __slots__ = ()
+    __slots__ = ()  # TVal's layout; the visible __slots__ is set below the classes
 
     def __repr__(self) -> str:
         return f"rospy.Duration[{self.to_nsec()}]"
@@ -282,3 +286,10 @@ class Duration(TVal):
             return NotImplemented
         q, r = divmod(self.to_nsec(), val.to_nsec())
         return q, Duration._raw(0, r)
+
+
+# genpy's Time and Duration name their fields in their own __slots__, and code that walks a message
+# through ``type(value).__slots__`` (rosbag-to-CSV exporters) reaches a stamp's secs and nsecs that
+# way: with an empty tuple, stamps vanished from its output. Set after the classes are made, so that
+# the instances keep TVal's layout (no second pair of slots: 48 bytes a stamp, not 64).
+Time.__slots__ = Duration.__slots__ = TVal.__slots__  # type: ignore[assignment]

@@ -98,3 +98,40 @@ def test_parameters_out_of_range_are_named_and_ignored():
     assert "must be > 0, got 0.0; using 0.05" in rejected[0][1]
     assert p.delta == 0.05 and p.particles == 30 and p.srr == 0.05 and p.lskip == 0
     assert (p.xmin, p.xmax) == (-15.0, 15.0)
+
+
+def test_a_small_start_map_grows_to_what_the_laser_sees(laser):
+    """turtlebot's gmapping launch file and its copies (ROS By Example, the ros_exploring book) start
+    with ``xmin -1 .. xmax 1``: GMapping enlarges the map 10 m past any cell a scan writes outside it,
+    and slam_gmapping publishes the grown map with its new origin. Ours stayed a 2 x 2 m map."""
+    from ninjemys.maps.mapfile import GridMap
+
+    from .conftest import room_map
+
+    angles, cast = laser
+    room = GridMap(room_map().data, 0.05, (-3.0, -3.0, 0.0))  # 6 x 6 m, the robot in its middle
+    params = SlamParams(xmin=-1, ymin=-1, xmax=1, ymax=1, maxUrange=4.5, maxRange=5.0, particles=4)
+    mapper = ParticleMapper(params)
+    mapper.process((0.0, 0.0, 0.0), cast(room, (0.0, 0.0, 0.0), angles, 5.0), angles, range_max=5.0)
+    # 10 m past the walls' returns (about 2.9 m out) on every side, on the start map's cell grid
+    bounds = (params.xmin, params.ymin, params.xmax, params.ymax)
+    assert all(12.8 <= abs(b) <= 13.0 for b in bounds), bounds
+    assert all(abs((b - 1) / params.delta - round((b - 1) / params.delta)) < 1e-6 for b in bounds)
+    grid = mapper.occupancy()
+    size = (
+        round((params.ymax - params.ymin) / params.delta),
+        round((params.xmax - params.xmin) / params.delta),
+    )
+    assert grid.shape == (mapper.height, mapper.width) == size
+
+    def cell(v: float, low: float) -> int:
+        return int((v - low) / params.delta)
+
+    # along +x and -y from the robot: free from the start map's edge out to the wall, then the wall
+    row = grid[cell(0.0, params.ymin), cell(1.0, params.xmin) : cell(3.0, params.xmin)]
+    col = grid[cell(-3.0, params.ymin) : cell(-1.0, params.ymin), cell(0.0, params.xmin)][::-1]
+    for line in (row, col):
+        assert (line[: cell(2.85, 1.0)] == 0).all() and 100 in line[cell(2.85, 1.0) :], line
+    # a second scan from the same place grows nothing: the bounds stay
+    mapper.process((0.6, 0.0, 0.0), cast(room, (0.6, 0.0, 0.0), angles, 5.0), angles, range_max=5.0)
+    assert (params.xmin, params.ymin, params.xmax, params.ymax) == bounds and grid.shape == size

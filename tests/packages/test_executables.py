@@ -82,6 +82,22 @@ def test_shipped_executable_resolves_through_package_index() -> None:
     assert exe.command(["__name:=t"])[-3:] == ["turtlesim", "turtlesim_node", "__name:=t"]
 
 
+def test_turtlesims_multisim_launch_is_shipped(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``roslaunch turtlesim multisim.launch`` (turtlesim's own launch file, used by the tutorials) starts
+    two simulators, one per namespace, as on ROS 1; it was "neither a launch file in package [turtlesim]"."""
+    from ninjemys.launch.xml import load_launch
+    from ninjemys.tools import roslaunch
+
+    monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
+    assert roslaunch.main(["--nodes", "turtlesim", "multisim.launch"]) == 0
+    assert capsys.readouterr().out.split() == ["/turtlesim1/sim", "/turtlesim2/sim"]
+    launch = PackageIndex.from_environment({}).find("turtlesim").path / "launch" / "multisim.launch"
+    nodes = load_launch([launch], env={}).nodes
+    assert {(n.package, n.type) for n in nodes} == {("turtlesim", "turtlesim_node")}
+
+
 def test_missing_shipped_module_is_one_clear_error(monkeypatch: pytest.MonkeyPatch) -> None:
     from ninjemys.packages import shipped
 

@@ -97,7 +97,8 @@ def test_a_course_control_package_naming_ros_control_builds(
     tmp_path: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """The course's puzzlebot_control asks catkin for ros_control's packages (a Python node beside
-    them): they are known, so catkin_make builds it, as on a machine with Gazebo and ros_control."""
+    them): they are known, so catkin_make builds it, as on a machine with Gazebo and ros_control.
+    A book's description package (ros_exploring's mrobot_gazebo) also names gazebo_plugins."""
     from pathlib import Path
 
     from ninjemys.packages.discovery import find_package
@@ -108,6 +109,7 @@ def test_a_course_control_package_naming_ros_control_builds(
     names = (
         "controller_manager", "diff_drive_controller", "hardware_interface", "transmission_interface",
         "effort_controllers", "velocity_controllers", "joint_state_controller", "gazebo_ros_control",
+        "gazebo_plugins", "gazebo_ros",
     )  # fmt: skip
     for name in names:
         assert (find_package(name, {}) / "package.xml").is_file(), name

@@ -133,6 +133,9 @@ class Bag:
         self._writer: BagWriter | None = None
         self._decoders = _Decoders()
         self._unindexed = False
+        # rosbag's str(bag) gives each topic's rate when it has read the connection indexes (the
+        # default; `rosbag info` opens with skip_index unless --freq): our reader always has them
+        self._skip_index = skip_index
         try:
             if mode == "r":
                 self._reader = BagReader(f)
@@ -414,7 +417,7 @@ class Bag:
         )
 
     def __str__(self) -> str:
-        return info_text(self._require_reader(), self._filename)
+        return info_text(self._require_reader(), self._filename, freq=not self._skip_index)
 
     def _get_yaml_info(self, key: str | None = None) -> str | None:
         text = info_yaml(self._require_reader(), self._filename)

@@ -156,3 +156,19 @@ class NumericArray(Sequence):
 
     def __deepcopy__(self, memo: dict) -> list[Any]:
         return self.tolist()
+
+
+class _NoSlotsHere:
+    """Makes ``__slots__`` unreadable on :class:`NumericArray` (its layout is unchanged).
+
+    genpy gives a variable-length numeric array as a tuple, which has no ``__slots__``; code that walks
+    a message through ``type(value).__slots__`` (rosbag_to_csv and its copies) recurses into whatever
+    has them and writes ``str(value)`` for the rest. Our array's own slots (``_raw``, ``_fmt``, ...)
+    would be walked instead of the values being written, so reading the name fails here as on a tuple.
+    """
+
+    def __get__(self, obj: object, owner: type | None = None) -> Any:
+        raise AttributeError("__slots__")
+
+
+NumericArray.__slots__ = _NoSlotsHere()  # type: ignore[assignment]

@@ -20,6 +20,11 @@ rule), and then, for every particle:
    cell a visit and a hit; beams end at ``maxUrange`` for mapping (longer readings clear free space
    up to there but mark nothing), readings at or beyond ``maxRange`` carry no hit.
 
+The map grows as gmapping's does: when the cells a scan writes (the sensor and its beam ends, cut at
+``maxUrange``) fall outside ``xmin..xmax`` / ``ymin..ymax``, the map is enlarged on that side to 10 m
+past them (GMapping's ``enlargeStep``) and the bounds move with it, as slam_gmapping's ``xmin_``.. do;
+a launch file's small start map (``xmin -1 .. xmax 1``, turtlebot's and its copies) maps the world.
+
 When the weights degenerate (effective sample size below ``resampleThreshold`` times the particle
 count) the particles are resampled (low variance), and a drawn particle takes a copy of its parent's
 map. The published map is the best particle's: a cell is occupied (100) when hits / visits >
@@ -118,6 +123,8 @@ class ParticleMapper:
 
     #: beams used for scoring a pose (spread evenly over the scan); the map update uses them all
     MATCH_BEAMS = 90
+    #: metres a map grows past the cells that overflowed it (GMapping ScanMatcher's m_enlargeStep)
+    ENLARGE_STEP = 10.0
 
     def __init__(self, params: SlamParams | None = None, seed: int = 0) -> None:
         self.params = p = params or SlamParams()
@@ -232,6 +239,7 @@ class ParticleMapper:
                 q.logw += log_eta
             self._normalize_and_resample()
         self._give_own_maps()
+        self._grow_to(laser_pose, ranges, angles)
         for q in self.particles:
             self._integrate(q, se2_compose(q.pose, laser_pose), ranges, angles, hit)
         self.odom = odom_pose
@@ -385,6 +393,42 @@ class ParticleMapper:
         flat = self._flat(sensor[0] + cosw[hit] * reach, sensor[1] + sinw[hit] * reach, sensor)
         q.visits.ravel()[flat] += 1
         q.hits.ravel()[flat] += 1
+
+    def _grow_to(
+        self, laser_pose: tuple[float, float, float], ranges: np.ndarray, angles: np.ndarray
+    ) -> None:
+        """Enlarge every particle's map (and move the bounds) so that the cells this scan writes from
+        each particle's pose are on it: GMapping's computeActiveArea, which resizes by enlargeStep."""
+        p = self.params
+        reach = np.minimum(ranges, p.maxUrange)
+        lo, hi = [math.inf, math.inf], [-math.inf, -math.inf]
+        for q in self.particles:
+            sx, sy, sth = se2_compose(q.pose, laser_pose)
+            xs = np.append(sx + reach * np.cos(sth + angles), sx)
+            ys = np.append(sy + reach * np.sin(sth + angles), sy)
+            lo = [min(lo[0], float(xs.min())), min(lo[1], float(ys.min()))]
+            hi = [max(hi[0], float(xs.max())), max(hi[1], float(ys.max()))]
+        # cells to add on each side (low x, low y, high x, high y); the grid keeps its alignment
+        step = self.ENLARGE_STEP
+        add = [
+            math.ceil((p.xmin - (lo[0] - step)) / p.delta) if lo[0] < p.xmin else 0,
+            math.ceil((p.ymin - (lo[1] - step)) / p.delta) if lo[1] < p.ymin else 0,
+            math.ceil((hi[0] + step - p.xmax) / p.delta) if hi[0] >= p.xmax else 0,
+            math.ceil((hi[1] + step - p.ymax) / p.delta) if hi[1] >= p.ymax else 0,
+        ]
+        if not any(add):
+            return
+        pad = ((add[1], add[3]), (add[0], add[2]))
+        grown: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        for q in self.particles:
+            if id(q.hits) not in grown:  # maps shared after a resample stay shared
+                grown[id(q.hits)] = (np.pad(q.hits, pad), np.pad(q.visits, pad))
+            q.hits, q.visits = grown[id(q.hits)]
+        p.xmin -= add[0] * p.delta
+        p.ymin -= add[1] * p.delta
+        p.xmax += add[2] * p.delta
+        p.ymax += add[3] * p.delta
+        self.height, self.width = self.particles[0].hits.shape
 
     def _flat(self, x: np.ndarray, y: np.ndarray, sensor: tuple[float, float, float]) -> np.ndarray:
         """Flat cell indices of points within ``maxUrange`` of ``sensor``, those off the map left out."""
