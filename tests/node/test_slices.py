@@ -39,10 +39,11 @@ def test_shorten_takes_a_quarter_of_this_thread_only() -> None:
     before = _in_thread(_own_slice)
     if before is None or not sys.platform.startswith("linux"):
         pytest.skip("no EEVDF slice to read on this kernel")
-    done, after = _in_thread(lambda: (slices.shorten(), _own_slice()))
+    done, after, spawned = _in_thread(lambda: (slices.shorten(), _own_slice(), _in_thread(_own_slice)))
     if not done:
         pytest.skip("this kernel does not take a custom slice (older than 6.12)")
     assert after == max(100_000, before // 4)
+    assert spawned == before  # a thread the worker starts (a callback's) gets the default again
     assert _own_slice() == before  # the calling (main) thread keeps its own
 
 

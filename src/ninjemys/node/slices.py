@@ -18,8 +18,9 @@ processes counted.
 The cost: a worker that runs a long callback while the CPU is contended is switched out every
 quarter slice instead of every slice (the same share of the CPU, in shorter turns). Python offers no
 ``sched_setattr``, so ``ctypes`` calls it (imported by the worker on its first start, ~2 ms).
-Elsewhere (another OS, an unknown architecture, an older kernel that ignores the field, a thread
-not of the normal policy) nothing changes. ``NINJEMYS_WORKER_SLICE=0`` turns it off.
+Threads and processes a callback starts do not inherit it (``SCHED_FLAG_RESET_ON_FORK``). Elsewhere
+(another OS, an unknown architecture, an older kernel that ignores the field, a thread not of the
+normal policy) nothing changes. ``NINJEMYS_WORKER_SLICE=0`` turns it off.
 """
 
 from __future__ import annotations
@@ -44,7 +45,8 @@ _SYSCALLS = {
 #: priority, runtime, deadline, period
 _ATTR = struct.Struct("=IIQiIQQQ")
 _SCHED_OTHER = 0
-#: the only flag passed back as read (the utilization-clamp flags would need the longer struct)
+#: the flag set with the slice: threads and processes a callback starts get the default slice back
+#: (and, as the kernel does it, nice 0 for a negative nice), not the worker's
 _RESET_ON_FORK = 0x01
 #: the kernel's smallest custom slice (ns); a shorter request is raised to it anyway
 _MIN_SLICE = 100_000
@@ -75,14 +77,14 @@ def shorten() -> bool:
         buf = ctypes.create_string_buffer(_ATTR.size)
         if syscall(numbers[1], 0, buf, _ATTR.size, 0) != 0:
             raise OSError(ctypes.get_errno(), "sched_getattr")
-        _, policy, flags, nice, priority, slice_ns, _, _ = _ATTR.unpack(buf.raw)
+        _, policy, _, nice, priority, slice_ns, _, _ = _ATTR.unpack(buf.raw)
         if policy != _SCHED_OTHER or not slice_ns:
             return False  # a real-time or batch thread (or a kernel that reports no slice): as it is
         wanted = max(_MIN_SLICE, slice_ns // _FRACTION)
         if wanted >= slice_ns:
             return False
         attr = ctypes.create_string_buffer(
-            _ATTR.pack(_ATTR.size, policy, flags & _RESET_ON_FORK, nice, priority, wanted, 0, 0), _ATTR.size
+            _ATTR.pack(_ATTR.size, policy, _RESET_ON_FORK, nice, priority, wanted, 0, 0), _ATTR.size
         )
         if syscall(numbers[0], 0, attr, 0) != 0:
             raise OSError(ctypes.get_errno(), "sched_setattr")
