@@ -45,7 +45,7 @@ from collections.abc import Callable, Mapping
 
 from ninjemys.errors import NinjemysError, ProtocolError
 from ninjemys.net import auth, xmlrpc_client
-from ninjemys.node import intraprocess, transport
+from ninjemys.node import intraprocess, slices, transport
 from ninjemys.node.intraprocess import Handoff
 from ninjemys.node.log import ERROR
 from ninjemys.node.topics import connection_ids
@@ -883,6 +883,7 @@ class Subscriber:
     # -- the worker thread -----------------------------------------------------------------------
 
     def _work(self) -> None:
+        slices.shorten()  # a callback that wakes a thread keeps the CPU until it sleeps (see slices)
         try:
             while not (self._closed and self._retire()):
                 busy = False
