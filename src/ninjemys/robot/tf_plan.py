@@ -147,11 +147,15 @@ class TfPlan:
             first = struct.pack("<II", struct.calcsize("".join(fmt)), self.count)
             fmt[1], args[0] = f"{len(first)}s", repr(first)
         self.stamps = [struct.calcsize("".join(fmt[:i])) + 4 for i in stamps]
-        packs = [f"{src.constant(struct.Struct(''.join(f)).pack)}({', '.join(a)})" for f, a in _groups(fmt, args)]
+        packs = [
+            f"{src.constant(struct.Struct(''.join(f)).pack)}({', '.join(a)})" for f, a in _groups(fmt, args)
+        ]
         # the functions as defaults: local names, cheaper than globals on every use
         defaults = ", ".join(f"{name}={name}" for name in src.names if name != "__builtins__")
         lines = [f"def message(p, stamp, {defaults}):", *(f"    {line}" for line in body)]
-        lines.append(f"    return {packs[0]}" if len(packs) == 1 else f"    return b''.join(({', '.join(packs)}))")
+        lines.append(
+            f"    return {packs[0]}" if len(packs) == 1 else f"    return b''.join(({', '.join(packs)}))"
+        )
         return src.function("\n".join(lines), "message")
 
     def segments(self, message: bytes) -> list[bytes]:
@@ -168,14 +172,14 @@ def _groups(fmt: list[str], args: list[str]) -> list[tuple[list[str], list[str]]
     about 30 arguments is compiled into a list built one append at a time, made a tuple and called
     the slow way (``CALL_FUNCTION_EX``); ~10 % of a plan's instructions for a 20-joint robot."""
     groups: list[tuple[list[str], list[str]]] = []
-    items, given = fmt[:1], []
+    items, given = fmt[:1], list[str]()
     rest = iter(args)
     for item in re.findall(r"\d*[a-zA-Z?]", "".join(fmt[1:])):
         code, repeat = item[-1], int(item[:-1] or 1)
         count = 0 if code == "x" else 1 if code in "sp" else repeat
         if len(given) + count > _MAX_ARGS:
             groups.append((items, given))
-            items, given = fmt[:1], []
+            items, given = fmt[:1], list[str]()
         items.append(item)
         given += [next(rest) for _ in range(count)]
     groups.append((items, given))
