@@ -5,6 +5,7 @@ joints, a mimic joint, prismatic joints, a clock that moves backwards and malfor
 
 from __future__ import annotations
 
+import ast
 import io
 import math
 import struct
@@ -280,3 +281,35 @@ def test_positions_that_do_not_match_the_plan_are_reported_even_inside_the_throt
         for ta, tb in zip(_transforms(ours), _transforms(theirs), strict=True):
             assert ta[:4] == tb[:4]
             assert max(abs(x - y) for x, y in zip(ta[4], tb[4], strict=True)) < 1e-12
+
+
+def test_a_long_chain_is_packed_in_short_calls_with_the_general_paths_bytes() -> None:
+    """A plan of 30 joints packs its message in calls of at most 28 arguments (a longer call is built
+    as a list, one append per argument), joined: the same bytes as the general path's message."""
+    count = 30
+    urdf = (
+        '<robot name="r"><link name="l0"/>'
+        + "".join(
+            f'<link name="l{i + 1}"/><joint name="j{i}" type="{"prismatic" if i % 4 == 3 else "revolute"}">'
+            f'<parent link="l{i}"/><child link="l{i + 1}"/><origin xyz="0.{i % 7} 0.1 0.2" rpy="0.{i % 5} -0.3 1"/>'
+            f'<axis xyz="0 {i % 2} 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>'
+            for i in range(count)
+        )
+        + "</robot>"
+    )
+    model = parse_urdf(urdf)
+    names = [f"j{i}" for i in range(count)]
+    general = StatePublisher(_Node({}), model, print)
+    plan = TfPlan(names, model.joints, {}, lambda joint: general.encoded[joint.name].frames)
+    calls = [node for node in ast.walk(ast.parse(plan.source.text)) if isinstance(node, ast.Call)]
+    assert max(len(call.args) for call in calls) <= 28
+    assert sum(len(call.args) for call in calls) > 2 * 28  # several packs
+    for k in range(5):
+        positions = [0.7 * k - 0.3 * i for i in range(count)]
+        stamp = Time(10 + k, 5)
+        general.on_joint_state(tuple(names), tuple(positions), stamp.secs, stamp.nsecs)
+        ours = _transforms(plan.message(positions, struct.pack("<II", stamp.secs, stamp.nsecs)))
+        theirs = _transforms(general.tf.sent[-1])
+        assert [t[:4] for t in ours] == [t[:4] for t in theirs]
+        for ta, tb in zip(ours, theirs, strict=True):
+            assert max(abs(x - y) for x, y in zip(ta[4], tb[4], strict=True)) < 1e-12, ta[1]

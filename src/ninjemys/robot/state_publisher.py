@@ -100,17 +100,21 @@ class StatePublisher:
             secs, nsecs, frame_len = _STAMP_FRAME.unpack_from(data, 4)
             start = 16 + frame_len
             entry = self.last_entry
-            if entry is None or not data.startswith(entry.key, start):
+            # the names and the position count, as in the last message: one comparison of bytes
+            if entry is None or not data.startswith(entry.head, start):
                 key, count = self._names_section(data, start)
                 entry = self.plans.get(key)
                 if entry is None:
                     self._general(data, secs, nsecs, key, count, start + len(key))
                     return
                 self.last_entry = entry
+                if _COUNT.unpack_from(data, start + entry.size)[0] != entry.count:
+                    self._general(data, secs, nsecs, key, count, start + entry.size)  # says what is wrong
+                    return
             offset = start + entry.size  # the position count, then the positions
             # checked, not unpacked: a message the throttle drops (a third of a stream stamped at
             # publish_frequency with jitter) never has its positions made into floats
-            if len(data) < offset + entry.span or _COUNT.unpack_from(data, offset)[0] != entry.count:
+            if len(data) < offset + entry.span:
                 self._general(data, secs, nsecs, entry.key, entry.count, offset)  # says what is wrong
                 return
         except (struct.error, UnicodeDecodeError, IndexError, ValueError):
@@ -286,6 +290,7 @@ class _Entry:
     __slots__ = (
         "count",
         "frame",
+        "head",
         "key",
         "known",
         "plan",
@@ -299,6 +304,8 @@ class _Entry:
 
     def __init__(self, key: bytes, count: int, plan: TfPlan) -> None:
         self.key, self.size, self.count, self.plan = key, len(key), count, plan
+        #: the names and then the position count, as a message that matches the plan has them
+        self.head = key + _COUNT.pack(count)
         self.known = plan.known
         self.zeros = [0] * len(self.known)
         self.positions = struct.Struct(f"<I{count}d")
