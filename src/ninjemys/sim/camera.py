@@ -773,6 +773,8 @@ class _Palette:
         self.scene_arrays = _arrays_of(scene, look)
         self.look = look
         self.n = n
+        #: the scene's static segments when this palette covers no more than them (see prefix_of)
+        self.prefix = scene.prefix if scene.prefix is not None and n <= len(scene.prefix) else None
         seg = self.segments = scene.segments[:n]
         self.colors = scene.colors[:n]
         self.owners = None if scene.owners is None else scene.owners[:n]
@@ -833,6 +835,12 @@ class _Palette:
             or (scene.owners is None) != (self.owners is None)
         ):
             return False
+        if self.prefix is not None and scene.prefix is self.prefix:
+            # the same world's static segments (the simulator's one array): only the moving
+            # obstacles after them changed; colours and owners are the same arrays too
+            _, colors, owners, _ = self.scene_arrays
+            if scene.colors is colors and scene.owners is owners:
+                return True
         if (
             not np.equal(scene.segments[:n], self.segments).all()
             or not np.equal(scene.colors[:n], self.colors).all()
