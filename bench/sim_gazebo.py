@@ -543,7 +543,7 @@ def sim_instructions(src: Path | None, camera: bool, secs: float = 4 * math.pi) 
     in the office with scan + camera + odometry subscribed (``camera`` False: scan + odometry).
     Collection is switched on and off from outside (``callgrind_control``) at those /odom stamps.
     Deterministic where CPU time is not, but memcpy counts about one instruction per byte."""
-    from ninjemys.idl.loader import get_message_class
+    from ninjemys.idl.loader import get_message_class, get_service_class
     from ninjemys.node import Node
 
     env = dict(os.environ, PYTHONHASHSEED="0")
@@ -554,7 +554,9 @@ def sim_instructions(src: Path | None, camera: bool, secs: float = 4 * math.pi) 
         env["ROS_MASTER_URI"] = master
         cmd = ["valgrind", "--tool=callgrind", "--instr-atstart=no", f"--callgrind-out-file={out}"]
         cmd += [sys.executable, "-m", "ninjemys.packages.run_shipped", "puzzlebot_sim", "sim_node"]
-        cmd += ["_world:=office", "_rate:=0", "_gui:=false", f"_model:={URDF_MODEL}"]
+        # paused until every subscriber and the drive command are connected: both trees then
+        # simulate the very same run, the robot driving from the first step on
+        cmd += ["_world:=office", "_rate:=0", "_gui:=false", f"_model:={URDF_MODEL}", "_paused:=true"]
         proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         node = Node("bench_callgrind", anonymous=True, master_uri=master)
         stamp = [0.0]
@@ -564,13 +566,22 @@ def sim_instructions(src: Path | None, camera: bool, secs: float = 4 * math.pi) 
         )
         topics = (("/scan", "sensor_msgs/LaserScan"), ("/camera/color/image_raw", "sensor_msgs/Image"))
         topics += (("/camera/depth/image_rect_raw", "sensor_msgs/Image"),)
+        subs = [node.subscriber("/odom", odom, lambda _m: None, queue_size=1)]
         for topic, kind in topics[: 3 if camera else 1]:
-            node.subscriber(topic, get_message_class(kind), lambda _m: None, queue_size=100, raw=True)
+            subs.append(
+                node.subscriber(topic, get_message_class(kind), lambda _m: None, queue_size=100, raw=True)
+            )
         twist_cls = get_message_class("geometry_msgs/Twist")
         twist = twist_cls()
         twist.linear.x, twist.angular.z = 0.05, 0.5
-        node.publisher("/cmd_vel", twist_cls, queue_size=1, latch=True).publish(twist)
+        drive = node.publisher("/cmd_vel", twist_cls, queue_size=1, latch=True)
+        drive.publish(twist)
         try:
+            while not (drive.get_num_connections() and all(s.get_num_connections() for s in subs)):
+                time.sleep(0.05)
+            time.sleep(1.0)  # the latched command taken in
+            node.wait_for_service("/gazebo/unpause_physics", 120)
+            node.service_proxy("/gazebo/unpause_physics", get_service_class("std_srvs/Empty")).call()
             while stamp[0] < 2.0:
                 time.sleep(0.005)
             control = ["callgrind_control", "-i"]
@@ -584,7 +595,9 @@ def sim_instructions(src: Path | None, camera: bool, secs: float = 4 * math.pi) 
             node.shutdown("bench over")
             proc.terminate()
             proc.wait(60)
-        found = re.search(r"^(?:totals|summary):\s*(\d+)", out.read_text(errors="replace"), re.M)
+        text = out.read_text(errors="replace")
+        # "totals" (what was collected); "summary" is 0 when collection started switched off
+        found = re.search(r"^totals:\s*(\d+)", text, re.M) or re.search(r"^summary:\s*(\d+)", text, re.M)
     if found is None:
         raise RuntimeError("callgrind wrote no totals")
     return int(found.group(1)) / (t1 - t0)
