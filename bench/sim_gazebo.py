@@ -35,12 +35,19 @@
    its threads' CPU, its wait for the CPU (schedstat run_delay: another process had the core) and its
    voluntary and involuntary context switches; the rest of the wall time the process slept.
 
-Run alone: ``.venv/bin/python bench/sim_gazebo.py [--quick] [--before REV] [--only launch|ab|camera|stages|split]``.
+6. Instructions per simulated second (``--only callgrind``, asked for by name: minutes under valgrind):
+   the whole simulator process under callgrind over one circle of the robot's drive, collection
+   switched on and off from outside at /odom stamps, by the older tree and by this one; scan + camera
+   + odometry subscribed and scan + odometry. Deterministic where CPU time is not (memcpy counts
+   about one instruction per byte, so copies weigh more than their time).
+
+Run alone: ``.venv/bin/python bench/sim_gazebo.py [--quick] [--before REV] [--only launch|ab|camera|stages|split|callgrind]``.
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import re
 import statistics
@@ -529,6 +536,88 @@ def bench_stages(before: str, rounds: int, secs: float) -> None:
     print(f"load average: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
 
 
+def sim_instructions(src: Path | None, camera: bool, secs: float = 4 * math.pi) -> float:
+    """Instructions (callgrind, every thread of the simulator process) per simulated second, over
+    ``secs`` simulated seconds from the second simulated second on (default: one full circle of the
+    robot's 0.05 m/s, 0.5 rad/s drive, so that both trees see the same views), the URDF PuzzleBot
+    in the office with scan + camera + odometry subscribed (``camera`` False: scan + odometry).
+    Collection is switched on and off from outside (``callgrind_control``) at those /odom stamps.
+    Deterministic where CPU time is not, but memcpy counts about one instruction per byte."""
+    from ninjemys.idl.loader import get_message_class, get_service_class
+    from ninjemys.node import Node
+
+    env = dict(os.environ, PYTHONHASHSEED="0")
+    if src is not None:
+        env["PYTHONPATH"] = str(src)
+    with tempfile.TemporaryDirectory() as tmp, run_master() as master:
+        out = Path(tmp) / "callgrind.out"
+        env["ROS_MASTER_URI"] = master
+        cmd = ["valgrind", "--tool=callgrind", "--instr-atstart=no", f"--callgrind-out-file={out}"]
+        cmd += [sys.executable, "-m", "ninjemys.packages.run_shipped", "puzzlebot_sim", "sim_node"]
+        # paused until every subscriber and the drive command are connected: both trees then
+        # simulate the very same run, the robot driving from the first step on
+        cmd += ["_world:=office", "_rate:=0", "_gui:=false", f"_model:={URDF_MODEL}", "_paused:=true"]
+        proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        node = Node("bench_callgrind", anonymous=True, master_uri=master)
+        stamp = [0.0]
+        odom = get_message_class("nav_msgs/Odometry")
+        node.subscriber(
+            "/odom", odom, lambda m: stamp.__setitem__(0, m.header.stamp.to_sec()), queue_size=100
+        )
+        topics = (("/scan", "sensor_msgs/LaserScan"), ("/camera/color/image_raw", "sensor_msgs/Image"))
+        topics += (("/camera/depth/image_rect_raw", "sensor_msgs/Image"),)
+        subs = [node.subscriber("/odom", odom, lambda _m: None, queue_size=1)]
+        for topic, kind in topics[: 3 if camera else 1]:
+            subs.append(
+                node.subscriber(topic, get_message_class(kind), lambda _m: None, queue_size=100, raw=True)
+            )
+        twist_cls = get_message_class("geometry_msgs/Twist")
+        twist = twist_cls()
+        twist.linear.x, twist.angular.z = 0.05, 0.5
+        drive = node.publisher("/cmd_vel", twist_cls, queue_size=1, latch=True)
+        drive.publish(twist)
+        try:
+            while not (drive.get_num_connections() and all(s.get_num_connections() for s in subs)):
+                time.sleep(0.05)
+            time.sleep(1.0)  # the latched command taken in
+            node.wait_for_service("/gazebo/unpause_physics", 120)
+            node.service_proxy("/gazebo/unpause_physics", get_service_class("std_srvs/Empty")).call()
+            while stamp[0] < 2.0:
+                time.sleep(0.005)
+            control = ["callgrind_control", "-i"]
+            subprocess.run([*control, "on", str(proc.pid)], capture_output=True, check=True)
+            t0 = stamp[0]
+            while stamp[0] < t0 + secs:
+                time.sleep(0.005)
+            subprocess.run([*control, "off", str(proc.pid)], capture_output=True, check=True)
+            t1 = stamp[0]
+        finally:
+            node.shutdown("bench over")
+            proc.terminate()
+            proc.wait(60)
+        text = out.read_text(errors="replace")
+        # "totals" (what was collected); "summary" is 0 when collection started switched off
+        found = re.search(r"^totals:\s*(\d+)", text, re.M) or re.search(r"^summary:\s*(\d+)", text, re.M)
+    if found is None:
+        raise RuntimeError("callgrind wrote no totals")
+    return int(found.group(1)) / (t1 - t0)
+
+
+def bench_callgrind(before: str) -> None:
+    rev = subprocess.run(
+        ["git", "-C", str(ROOT), "rev-parse", "--short", before], capture_output=True, text=True, check=True
+    ).stdout.strip()
+    print(f"\n## instructions per simulated second (callgrind), {rev} (before) and this tree (after)")
+    print("URDF PuzzleBot, office, one circle of its drive (12.6 simulated s), the whole simulator process")
+    print("| subscribers | before | after | after / before |")
+    print("|---|---:|---:|---:|")
+    with tempfile.TemporaryDirectory() as tmp:
+        old = extract_tree(before, Path(tmp))
+        for camera, label in ((True, "scan + camera + odom"), (False, "scan + odom")):
+            a, b = sim_instructions(old, camera), sim_instructions(None, camera)
+            print(f"| {label} | {a / 1e6:.1f} M | {b / 1e6:.1f} M | {b / a:.3f} |")
+
+
 def default_before() -> str:
     out = subprocess.run(
         ["git", "-C", str(ROOT), "merge-base", "HEAD", "main"], capture_output=True, text=True
@@ -545,7 +634,9 @@ def main() -> int:
         action="store_true",
         help="let the subscribers run on the simulator's core too (the figures before 2026-11-29 16:00)",
     )
-    p.add_argument("--only", choices=("launch", "ab", "camera", "stages", "split"), help="run one part")
+    p.add_argument(
+        "--only", choices=("launch", "ab", "camera", "stages", "split", "callgrind"), help="run one part"
+    )
     args = p.parse_args()
     print(f"load average: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
     if not args.readers_anywhere and keep_readers_off_the_sim_core():
@@ -558,6 +649,8 @@ def main() -> int:
         bench_camera(args.before or default_before(), 3 if args.quick else 5)
     if args.only in (None, "split"):
         bench_split(5.0 if args.quick else 10.0, 1 if args.quick else 2)
+    if args.only == "callgrind":  # minutes under valgrind: asked for by name only
+        bench_callgrind(args.before or default_before())
     if args.only in (None, "stages"):
         bench_stages(args.before or default_before(), 3 if args.quick else 5, 10.0 if args.quick else 20.0)
     print(f"load average: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")

@@ -115,6 +115,10 @@ class Camera:
         self._depth_row = np.zeros(width, dtype=np.uint16)
         #: the last frame's pose and images, and a copy of its scene once the camera stood still
         self._last: tuple[tuple[float, float, float, bool, bool], tuple[np.ndarray, np.ndarray]] | None = None
+        #: what row bounds are made of (see _rises) for the last heights and bases seen, and the
+        #: offsets of the two bounds (cy for a top row, cy + 1 for the row past a base)
+        self._rise: tuple[np.ndarray, np.ndarray | None, np.ndarray] | None = None
+        self._row_offsets = np.array([[self.cy], [self.cy + 1.0]])
         self._still: _SceneCopy | None = None
 
     def render(
@@ -387,20 +391,12 @@ class Camera:
         h = self.height
         # rows v whose ray meets the strip between its base and its top: base <= cam_z + slope_v d <= top,
         # slope_v = (cy - v) / fy; the bound is one row past the base's row (exclusive)
-        per_m = self.fy / d
-        top = heights.take(item)
-        top -= self.cam_z
-        top *= per_m
-        np.subtract(self.cy, top, out=top)
+        # (both bounds at once: cy + (cam_z - top) fy / d and cy + 1 + (cam_z - base) fy / d)
+        rows = self._rises(heights, bases).take(item, axis=1)
+        rows *= self.fy / d
+        rows += self._row_offsets
+        top, bottom = rows
         np.ceil(top, out=top)
-        if bases is None:
-            bottom = per_m * self.cam_z
-        else:
-            bottom = bases.take(item)
-            bottom -= self.cam_z
-            bottom *= per_m
-            np.negative(bottom, out=bottom)
-        bottom += self.cy + 1.0
         np.floor(bottom, out=bottom)
         plane: np.ndarray | None = None
         if plane_of is not None:
@@ -427,7 +423,8 @@ class Camera:
             pick = shows.nonzero()[0]
             if not len(pick):
                 return None
-            col, item, d, top, bottom = (a.take(pick) for a in (col, item, d, top, bottom))
+            col, item, d = col.take(pick), item.take(pick), d.take(pick)
+            rows = rows.take(pick, axis=1)
             if plane is not None:
                 plane = plane.take(pick)
         if plane is not None and np.isnan(plane).all():
@@ -436,13 +433,25 @@ class Camera:
             col,
             item,
             d,
-            top,
-            bottom,
+            rows,
             colors,
             plane,
             self.width,
             self._row_type,
         )
+
+    def _rises(self, heights: np.ndarray, bases: np.ndarray | None) -> np.ndarray:
+        """(2, N): per segment, the camera's height less its top and less its base (0: on the floor),
+        what the image rows of its crossings follow from; kept for the last arrays seen (a world's
+        scenes share them from step to step)."""
+        kept = self._rise
+        if kept is not None and kept[0] is heights and kept[1] is bases:
+            return kept[2]
+        rise = np.empty((2, len(heights)))
+        np.subtract(self.cam_z, heights, out=rise[0])
+        np.subtract(self.cam_z, 0.0 if bases is None else bases, out=rise[1])
+        self._rise = (heights, bases, rise)
+        return rise
 
     def _through_planes(
         self,
@@ -721,23 +730,22 @@ class Camera:
 
 class _Seen:
     """The crossings that show, sorted by column and, within a column, nearest first: column, obstacle
-    (``item``, into ``colors``), optical-axis depth and the rows they may fill (``top <= v < bottom``)."""
+    (``item``, into ``colors``), optical-axis depth and the rows they may fill (``top <= v < bottom``,
+    given as the two rows of ``rows``)."""
 
     def __init__(
         self,
         col: np.ndarray,
         item: np.ndarray,
         depth: np.ndarray,
-        top: np.ndarray,
-        bottom: np.ndarray,
+        rows: np.ndarray,
         colors: np.ndarray,
         plane: np.ndarray | None,
         width: int,
         row_type: type,
     ) -> None:
         self.col, self.item, self.depth, self.colors, self.width = col, item, depth, colors, width
-        self.top: np.ndarray = top.astype(row_type)
-        self.bottom: np.ndarray = bottom.astype(row_type)
+        self.top, self.bottom = rows.astype(row_type)
         #: per crossing: the height of the lid or underside it is seen through (NaN: a side seen
         #: directly); None when no crossing is
         self.plane = plane
@@ -773,6 +781,8 @@ class _Palette:
         self.scene_arrays = _arrays_of(scene, look)
         self.look = look
         self.n = n
+        #: the scene's static segments when this palette covers no more than them (see prefix_of)
+        self.prefix = scene.prefix if scene.prefix is not None and n <= len(scene.prefix) else None
         seg = self.segments = scene.segments[:n]
         self.colors = scene.colors[:n]
         self.owners = None if scene.owners is None else scene.owners[:n]
@@ -833,6 +843,12 @@ class _Palette:
             or (scene.owners is None) != (self.owners is None)
         ):
             return False
+        if self.prefix is not None and scene.prefix is self.prefix:
+            # the same world's static segments (the simulator's one array): only the moving
+            # obstacles after them changed; colours and owners are the same arrays too
+            _, colors, owners, _ = self.scene_arrays
+            if scene.colors is colors and scene.owners is owners:
+                return True
         if (
             not np.equal(scene.segments[:n], self.segments).all()
             or not np.equal(scene.colors[:n], self.colors).all()

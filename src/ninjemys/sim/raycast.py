@@ -25,6 +25,8 @@ import numpy as np
 #: wrappers, a few microseconds a call that the camera's per-frame code feels
 _ANY = np.logical_or.reduce
 _ALL = np.logical_and.reduce
+#: the sign of the side an end behind the camera stands for, for the first end and the second
+_AWAY = np.array([-1.0, 1.0])
 
 
 def cast_segments(
@@ -334,26 +336,24 @@ def column_pairs(
         return none
     if m < len(num):
         ends, ex, ey, num = ends[:, idx], ex[idx], ey[idx], num[idx]
-    # each end point's bearing, left positive, in two rows: the smaller, the larger
-    bearing = np.arctan2(ends[1::2], ends[0::2])
-    bearing.sort(axis=0)
-    lim = math.atan(float(slopes[0])) + 1e-9
-    wrap = bearing[1] - bearing[0] > math.pi
-    if _ANY(wrap):
-        # a segment passing behind the camera subtends [hi, pi] + [-pi, lo] (its short arc): of those
-        # two pieces only one can meet a field of view narrower than 180 degrees
-        lo, hi = bearing
-        left = wrap & (hi <= lim)  # the piece [hi, pi] reaches into the view
-        bearing = np.array(
-            [np.where(wrap, np.where(left, hi, -lim), lo), np.where(wrap, np.where(left, lim, lo), hi)]
-        )
-    np.maximum(bearing, -lim, out=bearing)
-    np.minimum(bearing, lim, out=bearing)
-    # column u looks along atan(slopes[u]), slopes evenly spaced (a pinhole camera's): the columns
-    # within [lo, hi] run from u(hi) to u(lo), u(a) = (slopes[0] - tan a) / (slopes[0] - slopes[1])
+    # each end point's slope (lateral over ahead, left positive), in two rows: the smaller, the
+    # larger; the columns follow from slopes (a pinhole camera's columns are evenly spaced in
+    # slope), so no angle is computed. An end behind the camera (or beside it) is replaced by the
+    # side the segment leaves the view by: the side its short arc turns to from its end ahead,
+    # left (+inf) when counterclockwise, that is when cross(end ahead, end behind) > 0, which is
+    # ``num`` for the second end behind and ``-num`` for the first
+    xs = ends[0::2]
+    ahead = xs > 0.0
+    at = np.outer(_AWAY, np.copysign(np.inf, num))
+    np.divide(ends[1::2], xs, out=at, where=ahead)
+    at.sort(axis=0)
     k0 = float(slopes[0])
+    lim = math.tan(math.atan(k0) + 1e-9)
+    np.maximum(at, -lim, out=at)
+    np.minimum(at, lim, out=at)
+    # column u looks along slopes[u], slopes evenly spaced (a pinhole camera's): the columns
+    # within [lo, hi] run from u(hi) to u(lo), u(k) = (slopes[0] - k) / (slopes[0] - slopes[1])
     scale = (n - 1) / (k0 - float(slopes[-1])) if n > 1 else 0.0
-    at = np.tan(bearing)
     np.subtract(k0, at, out=at)
     at *= scale
     first = np.ceil(at[1] - 1e-9)

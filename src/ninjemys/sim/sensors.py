@@ -38,6 +38,10 @@ class Scene:
     #: the world's lights and round obstacles, for the camera (None: Gazebo's default sun, every
     #: side flat); see :mod:`ninjemys.sim.lighting`
     look: SceneLook | None = None
+    #: the array whose rows ``segments`` starts with (the world's static segments, the same object at
+    #: every step; the moving obstacles' follow), or None: lets the camera tell that the world's part
+    #: of the scene is unchanged without comparing it value by value at every frame
+    prefix: np.ndarray | None = None
 
 
 @dataclass

@@ -327,7 +327,7 @@ class Simulation:
         static, heights, colours, bases, facing, owners = self._scene_parts(
             solid_only and self._any_visual, mh, mc
         )
-        segs = np.vstack([static, ms]) if len(ms) else static
+        segs = np.concatenate([static, ms]) if len(ms) else static
         others = [r for r in self.robots.values() if r.name != exclude]
         if others:
             circles = (
@@ -348,6 +348,7 @@ class Simulation:
             bases,
             owners,
             self.world.look,
+            static,
         )
 
     def _scene_parts(self, solid: bool, mh: np.ndarray, mc: np.ndarray) -> tuple:

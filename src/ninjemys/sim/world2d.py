@@ -165,6 +165,9 @@ class MovingObstacle:
             for a, b in zip(path[:-1], path[1:], strict=True)
         ]
         self._total = sum(leg[4] for leg in self._legs)
+        #: the last pose :meth:`route_pose` gave and for how far along: the step's collision
+        #: checks and the sensors' scenes ask for the same one several times a step
+        self._pose_at: tuple[float, tuple[float, float, float]] | None = None
 
     def position(self, t: float) -> tuple[float, float, float]:
         """Pose (x, y, heading) at time ``t`` seconds after the start; for a mover that gives way,
@@ -176,6 +179,14 @@ class MovingObstacle:
 
     def route_pose(self, travelled: float) -> tuple[float, float, float]:
         """Pose (x, y, heading) on the route after ``travelled`` metres from the first waypoint."""
+        last = self._pose_at
+        if last is not None and last[0] == travelled:
+            return last[1]
+        pose = self._route_pose(travelled)
+        self._pose_at = (travelled, pose)
+        return pose
+
+    def _route_pose(self, travelled: float) -> tuple[float, float, float]:
         x0, y0 = float(self.waypoints[0, 0]), float(self.waypoints[0, 1])
         if self.speed <= 0 or self._total <= 0:
             return x0, y0, 0.0
