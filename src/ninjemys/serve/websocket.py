@@ -115,7 +115,7 @@ class WebSocket:
             self._pong.clear()
             await self._pong.wait()
 
-    def _confirm(self, payload: bytes) -> None:
+    def _confirm(self, payload: bytes | bytearray | memoryview) -> None:
         """A pong: the client read the stream up to the position its ping carried (other pongs,
         unsolicited or of another form, are ignored)."""
         try:
