@@ -145,6 +145,17 @@ def test_rosbridge_client_is_told_about_its_drops(make_gateway: Callable[..., Ga
 
 
 WINDOW = 256 * 1024
+FRAME = Image(height=100, width=1000, encoding="rgb8", step=3000, data=bytes(300_000))
+
+
+def _subscribed(gateway: Gateway, node: Node, topic: str, ws: Any) -> Any:
+    """An image publisher on ``topic`` whose channel Foxglove client ``ws`` subscribed (id 1)."""
+    images = node.publisher(topic, Image, queue_size=None)
+    wait_until(lambda: topic in {c["topic"] for c in gateway.catalog.channels.values()}, what="channel")
+    channel = next(c["id"] for c in gateway.catalog.channels.values() if c["topic"] == topic)
+    ws.send(json.dumps({"op": "subscribe", "subscriptions": [{"id": 1, "channelId": channel}]}))
+    wait_until(lambda: images.get_num_connections(), what="the tap")
+    return images
 
 
 def test_a_stalled_client_has_at_most_a_window_in_flight(
@@ -154,28 +165,17 @@ def test_a_stalled_client_has_at_most_a_window_in_flight(
     in the sockets' buffers (where it would reach the client late): past ``client_window`` bytes
     unconfirmed by its pongs the gateway sends no more."""
     gateway = make_gateway(client_window=WINDOW)
-    images = node.publisher("/camera/stall", Image, queue_size=None)
-    wait_until(
-        lambda: "/camera/stall" in {c["topic"] for c in gateway.catalog.channels.values()}, what="channel"
-    )
-    channel = next(c["id"] for c in gateway.catalog.channels.values() if c["topic"] == "/camera/stall")
-    frame = Image(height=100, width=1000, encoding="rgb8", step=3000, data=bytes(300_000))
-    with connect(
-        f"ws://127.0.0.1:{gateway.port}/",
-        subprotocols=["foxglove.websocket.v1"],
-        max_queue=1,
-        close_timeout=0.5,
-    ) as stalled:
-        stalled.send(json.dumps({"op": "subscribe", "subscriptions": [{"id": 1, "channelId": channel}]}))
-        wait_until(lambda: images.get_num_connections(), what="the tap")
+    url = f"ws://127.0.0.1:{gateway.port}/"
+    with connect(url, subprotocols=["foxglove.websocket.v1"], max_queue=1, close_timeout=0.5) as stalled:
+        images = _subscribed(gateway, node, "/camera/stall", stalled)
         for _ in range(40):  # 12 MB, while the client reads nothing
-            images.publish(frame)
+            images.publish(FRAME)
         wait_until(
             lambda: gateway.status()["clients"][0]["dropped"].get("/camera/stall", 0) >= 20, what="drops"
         )
         client = gateway.status()["clients"][0]
     # one batch and one frame may go out past the window before the sender stops
-    assert client["unconfirmed_bytes"] <= WINDOW + 64 * 1024 + 2 * len(frame.data), client
+    assert client["unconfirmed_bytes"] <= WINDOW + 64 * 1024 + 2 * len(FRAME.data), client
 
 
 def test_a_client_that_reads_gets_everything_through_the_window(
@@ -184,19 +184,12 @@ def test_a_client_that_reads_gets_everything_through_the_window(
     """The window only paces: a client that keeps reading (its library answers the pings) gets every
     message of a burst many windows long."""
     gateway = make_gateway(client_window=WINDOW, queue_length=100)
-    images = node.publisher("/camera/paced", Image, queue_size=None)
-    wait_until(
-        lambda: "/camera/paced" in {c["topic"] for c in gateway.catalog.channels.values()}, what="channel"
-    )
-    channel = next(c["id"] for c in gateway.catalog.channels.values() if c["topic"] == "/camera/paced")
-    frame = Image(height=100, width=1000, encoding="rgb8", step=3000, data=bytes(300_000))
     with connect(
         f"ws://127.0.0.1:{gateway.port}/", subprotocols=["foxglove.websocket.v1"], close_timeout=0.5
     ) as ws:
-        ws.send(json.dumps({"op": "subscribe", "subscriptions": [{"id": 1, "channelId": channel}]}))
-        wait_until(lambda: images.get_num_connections(), what="the tap")
+        images = _subscribed(gateway, node, "/camera/paced", ws)
         for _ in range(30):  # 9 MB: about 35 windows
-            images.publish(frame)
+            images.publish(FRAME)
         got = 0
         while got < 30:
             data = ws.recv(timeout=30)
