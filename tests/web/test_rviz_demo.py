@@ -100,6 +100,7 @@ def test_a_goal_clicked_in_rviz_is_reached(tmp_path: Path, browser_page: Any) ->
         page.wait_for_function(
             "document.querySelector('.rv-display[data-name=\"Global Plan\"] .rv-status').innerText"
             ".includes('poses')",
+            polling=100,  # on a timer, not on animation frames (which a CPU-starved page is short of)
             timeout=30000,
         )
         demo.send_signal(signal.SIGINT)
