@@ -142,3 +142,57 @@ def test_rosbridge_client_is_told_about_its_drops(make_gateway: Callable[..., Ga
             if msg.get("op") == "status":
                 break
         assert msg["level"] == "warning" and "dropped" in msg["msg"] and "/camera/small" in msg["msg"]
+
+
+WINDOW = 256 * 1024
+FRAME = Image(height=100, width=1000, encoding="rgb8", step=3000, data=bytes(300_000))
+
+
+def _subscribed(gateway: Gateway, node: Node, topic: str, ws: Any) -> Any:
+    """An image publisher on ``topic`` whose channel Foxglove client ``ws`` subscribed (id 1)."""
+    images = node.publisher(topic, Image, queue_size=None)
+    wait_until(lambda: topic in {c["topic"] for c in gateway.catalog.channels.values()}, what="channel")
+    channel = next(c["id"] for c in gateway.catalog.channels.values() if c["topic"] == topic)
+    ws.send(json.dumps({"op": "subscribe", "subscriptions": [{"id": 1, "channelId": channel}]}))
+    wait_until(lambda: images.get_num_connections(), what="the tap")
+    return images
+
+
+def test_a_stalled_client_has_at_most_a_window_in_flight(
+    make_gateway: Callable[..., Gateway], node: Node
+) -> None:
+    """What a client has not read stays in the gateway's outbox (where the oldest is dropped), not
+    in the sockets' buffers (where it would reach the client late): past ``client_window`` bytes
+    unconfirmed by its pongs the gateway sends no more."""
+    gateway = make_gateway(client_window=WINDOW)
+    url = f"ws://127.0.0.1:{gateway.port}/"
+    with connect(url, subprotocols=["foxglove.websocket.v1"], max_queue=1, close_timeout=0.5) as stalled:
+        images = _subscribed(gateway, node, "/camera/stall", stalled)
+        for _ in range(40):  # 12 MB, while the client reads nothing
+            images.publish(FRAME)
+        wait_until(
+            lambda: gateway.status()["clients"][0]["dropped"].get("/camera/stall", 0) >= 20, what="drops"
+        )
+        client = gateway.status()["clients"][0]
+    # one batch and one frame may go out past the window before the sender stops
+    assert client["unconfirmed_bytes"] <= WINDOW + 64 * 1024 + 2 * len(FRAME.data), client
+
+
+def test_a_client_that_reads_gets_everything_through_the_window(
+    make_gateway: Callable[..., Gateway], node: Node
+) -> None:
+    """The window only paces: a client that keeps reading (its library answers the pings) gets every
+    message of a burst many windows long."""
+    gateway = make_gateway(client_window=WINDOW, queue_length=100)
+    with connect(
+        f"ws://127.0.0.1:{gateway.port}/", subprotocols=["foxglove.websocket.v1"], close_timeout=0.5
+    ) as ws:
+        images = _subscribed(gateway, node, "/camera/paced", ws)
+        for _ in range(30):  # 9 MB: about 35 windows
+            images.publish(FRAME)
+        got = 0
+        while got < 30:
+            data = ws.recv(timeout=30)
+            if isinstance(data, bytes) and data[0] == 0x01:
+                got += 1
+        assert gateway.status()["clients"][0]["dropped"] == {}

@@ -73,6 +73,10 @@ class GatewayOptions:
     max_client_bytes: int = 8 * 1024 * 1024
     #: Foxglove lanes: messages kept per client and channel
     queue_length: int = 10
+    #: bytes sent to a client and not yet confirmed read (WebSocket ping/pong) before the gateway waits
+    #: for it, so that a slow client's backlog stays in its outbox, where the oldest data is dropped,
+    #: instead of in the sockets' buffers, where it is only late (0: no limit; see WebSocket.pace)
+    client_window: int = 1024 * 1024
     #: how often the topic and service lists are refreshed (s)
     update_period: float = 1.0
     node_name: str = "rosbridge_websocket"
@@ -636,6 +640,7 @@ class Gateway:
     async def _sender(self, client: _Client) -> None:
         ws, outbox = client.ws, client.outbox
         limit = self.options.max_client_bytes
+        window = self.options.client_window
         try:
             while not ws.closed:
                 await client.wake.wait()
@@ -654,10 +659,14 @@ class Gateway:
                         pending = 0
                         if ws.buffered > WRITE_HIGH_WATER:
                             await ws.drain()
+                        if window:
+                            await ws.pace(window)  # what comes meanwhile waits (and drops) in the outbox
                     if outbox.bytes > 4 * limit:  # replies pile up: the client is not reading at all
                         ws.close(1008, "client too slow: its replies exceed the memory budget")
                         return
                 ws.flush()
+                if window:
+                    await ws.pace(window)
         except (ConnectionError, asyncio.CancelledError):
             return
 
@@ -685,7 +694,8 @@ class Gateway:
                         client.session.status("warning", text)
 
     def status(self) -> dict[str, Any]:
-        """Per client: protocol, queued bytes and drops per topic (GET /api/bridge/status)."""
+        """Per client: protocol, queued bytes, bytes sent but not yet confirmed read (in the sockets'
+        buffers or the client's) and drops per topic (GET /api/bridge/status)."""
         return {
             "clients": [
                 {
@@ -693,6 +703,7 @@ class Gateway:
                     "protocol": c.ws.subprotocol or "rosbridge",
                     "peer": c.ws.peer,
                     "queued_bytes": c.outbox.bytes,
+                    "unconfirmed_bytes": c.ws.sent - c.ws.confirmed,
                     "dropped": {
                         k.split("#", 1)[0]: v for k, v in c.outbox.dropped.items() if not k.startswith("\0")
                     },
