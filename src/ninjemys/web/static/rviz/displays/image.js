@@ -3,6 +3,8 @@
 import { $, state } from "/static/rviz/context.js";
 import { Display } from "/static/rviz/display.js";
 
+const RAW_ENCODINGS = new Set(["rgb8", "bgr8", "rgba8", "bgra8", "mono8", "8uc1", "16uc1", "mono16", "32fc1"]);
+
 export class ImageDisplay extends Display {
   constructor(cfg) {
     super(cfg);
@@ -21,7 +23,7 @@ export class ImageDisplay extends Display {
     const t = this.cfg.topic;
     return t && this.compressed && !/\/compressed$/.test(t) ? `${t}/compressed` : t;
   }
-  start() { this.pending = null; this.decoding = false; super.start(); this.figure.style.display = this.cfg.enabled ? "" : "none"; this.caption.textContent = `${this.cfg.name}: ${this.subscribedTopic()}`; }
+  start() { this.pending = null; this.pendingRaw = null; this.decoding = false; super.start(); this.figure.style.display = this.cfg.enabled ? "" : "none"; this.caption.textContent = `${this.cfg.name}: ${this.subscribedTopic()}`; }
   destroy() { super.destroy(); this.figure.remove(); }
   onMessage(m, info) {
     if (info?.type === "sensor_msgs/CompressedImage" || m.format !== undefined) { this.onCompressed(m); return; }
@@ -55,10 +57,29 @@ export class ImageDisplay extends Display {
     };
     next();
   }
+  /** Checked at once (a bad image's status names it), drawn at the next rendered frame: only the newest
+   *  image is converted, so a camera faster than the page (a simulator ahead of real time) costs one
+   *  conversion a frame, not one a message, and a starved page still takes input. */
   onRaw(m) {
     const { width: w, height: h, encoding, step, data } = m;
     if (!w || !h) throw new Error("empty image");
     if (step * h > data.length) throw new Error(`image data holds ${data.length} bytes; ${h} rows of ${step} need ${step * h}`);
+    if (!RAW_ENCODINGS.has(encoding.toLowerCase())) throw new Error(`image encoding ${encoding} is not shown`);
+    this.pendingRaw = m;
+  }
+  update() {
+    super.update();
+    const m = this.pendingRaw;
+    if (!m) return;
+    this.pendingRaw = null;
+    try {
+      this.drawRaw(m);
+    } catch (err) {
+      this.setStatus("Message", "error", `${this.subscribedTopic()}: ${err.message}`);
+    }
+  }
+  drawRaw(m) {
+    const { width: w, height: h, encoding, step, data } = m;
     if (this.canvas.width !== w || this.canvas.height !== h) { this.canvas.width = w; this.canvas.height = h; }
     const ctx = this.canvas.getContext("2d");
     const img = ctx.createImageData(w, h);
