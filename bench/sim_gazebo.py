@@ -118,6 +118,13 @@ def bench_launch(repeat: int) -> None:
     print("target: at most 1 s (Gazebo's gzserver alone needs several seconds to load a world)")
 
 
+def short_rev(rev: str) -> str:
+    """The abbreviated commit of ``rev``, for the tables' headings."""
+    return subprocess.run(
+        ["git", "-C", str(ROOT), "rev-parse", "--short", rev], capture_output=True, text=True, check=True
+    ).stdout.strip()
+
+
 def extract_tree(rev: str, dest: Path) -> Path:
     """``src/`` of ``rev`` (git archive), for running the simulator as it was."""
     data = subprocess.run(
@@ -294,9 +301,7 @@ def sim_run(
 
 
 def bench_ab(before: str, duration: float, rounds: int) -> None:
-    rev = subprocess.run(
-        ["git", "-C", str(ROOT), "rev-parse", "--short", before], capture_output=True, text=True, check=True
-    ).stdout.strip()
+    rev = short_rev(before)
     print(f"\n## the simulator, A/B: {rev} (before) and this tree (after), alternating")
     print(
         f"the simulator pinned to CPU {SIM_CORE}, office world, as fast as possible, {duration:.0f} s runs; "
@@ -428,9 +433,7 @@ def camera_frame_ms(src: Path | None, world: str = "office") -> float:
 
 
 def bench_camera(before: str, rounds: int) -> None:
-    rev = subprocess.run(
-        ["git", "-C", str(ROOT), "rev-parse", "--short", before], capture_output=True, text=True, check=True
-    ).stdout.strip()
+    rev = short_rev(before)
     print(f"\n## the camera alone, A/B: {rev} (before) and this tree (after), alternating")
     print("CPU time of a frame (colour + depth, 320x240, URDF PuzzleBot turning and driving), median")
     print("| world | before | after | after / before |")
@@ -510,9 +513,7 @@ def stage_ms(src: Path | None, secs: float) -> dict[str, float]:
 
 
 def bench_stages(before: str, rounds: int, secs: float) -> None:
-    rev = subprocess.run(
-        ["git", "-C", str(ROOT), "rev-parse", "--short", before], capture_output=True, text=True, check=True
-    ).stdout.strip()
+    rev = short_rev(before)
     print(
         f"\n## one simulated second, stage by stage, A/B: {rev} (before) and this tree (after), alternating"
     )
@@ -604,9 +605,7 @@ def sim_instructions(src: Path | None, camera: bool, secs: float = 4 * math.pi) 
 
 
 def bench_callgrind(before: str) -> None:
-    rev = subprocess.run(
-        ["git", "-C", str(ROOT), "rev-parse", "--short", before], capture_output=True, text=True, check=True
-    ).stdout.strip()
+    rev = short_rev(before)
     print(f"\n## instructions per simulated second (callgrind), {rev} (before) and this tree (after)")
     print("URDF PuzzleBot, office, one circle of its drive (12.6 simulated s), the whole simulator process")
     print("| subscribers | before | after | after / before |")
