@@ -125,6 +125,12 @@ def short_rev(rev: str) -> str:
     ).stdout.strip()
 
 
+def print_ab_head(first: str) -> None:
+    """The head of a before/after table whose rows are named in column ``first``."""
+    print(f"| {first} | before | after | after / before |")
+    print("|---|---:|---:|---:|")
+
+
 def extract_tree(rev: str, dest: Path) -> Path:
     """``src/`` of ``rev`` (git archive), for running the simulator as it was."""
     data = subprocess.run(
@@ -436,8 +442,7 @@ def bench_camera(before: str, rounds: int) -> None:
     rev = short_rev(before)
     print(f"\n## the camera alone, A/B: {rev} (before) and this tree (after), alternating")
     print("CPU time of a frame (colour + depth, 320x240, URDF PuzzleBot turning and driving), median")
-    print("| world | before | after | after / before |")
-    print("|---|---:|---:|---:|")
+    print_ab_head("world")
     with tempfile.TemporaryDirectory() as tmp:
         old = extract_tree(before, Path(tmp))
         # office: walls and furniture; square: the course's floor markings looked up per floor pixel
@@ -521,8 +526,7 @@ def bench_stages(before: str, rounds: int, secs: float) -> None:
         f"URDF PuzzleBot, office world, {secs:.0f} simulated s per run, thread CPU ms per simulated s "
         f"(median of {rounds}), pinned to CPU {SIM_CORE}; sends not included"
     )
-    print("| stage | before | after | after / before |")
-    print("|---|---:|---:|---:|")
+    print_ab_head("stage")
     with tempfile.TemporaryDirectory() as tmp:
         old = extract_tree(before, Path(tmp))
         a: list[dict[str, float]] = []
@@ -608,8 +612,7 @@ def bench_callgrind(before: str) -> None:
     rev = short_rev(before)
     print(f"\n## instructions per simulated second (callgrind), {rev} (before) and this tree (after)")
     print("URDF PuzzleBot, office, one circle of its drive (12.6 simulated s), the whole simulator process")
-    print("| subscribers | before | after | after / before |")
-    print("|---|---:|---:|---:|")
+    print_ab_head("subscribers")
     with tempfile.TemporaryDirectory() as tmp:
         old = extract_tree(before, Path(tmp))
         for camera, label in ((True, "scan + camera + odom"), (False, "scan + odom")):
