@@ -303,3 +303,26 @@ def test_foxglove_channel_for_a_type_only_the_publisher_knows(gateway: Gateway, 
             assert data[13:] == sample.serialize_to_bytes()
     finally:
         stop.set()
+
+
+def test_foxglove_subscriptions_end_with_their_channel(gateway: Gateway, node: Node) -> None:
+    """A channel unadvertised (its last publisher gone) takes the client's subscriptions on it along,
+    as Foxglove's own server does: the gateway stops taking the topic for an id nobody reads."""
+    pub = node.publisher("/ephemeral", String)
+    channel = wait_until(
+        lambda: next((c for c in gateway.catalog.channels.values() if c["topic"] == "/ephemeral"), None),
+        what="a channel for /ephemeral",
+    )
+    with connect(f"ws://127.0.0.1:{gateway.port}/", subprotocols=["foxglove.websocket.v1"]) as ws:
+        ws.send(json.dumps({"op": "subscribe", "subscriptions": [{"id": 7, "channelId": channel["id"]}]}))
+        first(ws, lambda m: isinstance(m, bytes) and m[0] == 1, lambda: pub.publish(String(data="x")))
+        assert "/ephemeral" in gateway.taps.topics()
+        pub.unregister()
+        gone = first(ws, lambda m: isinstance(m, dict) and m.get("op") == "unadvertise")
+        assert channel["id"] in gone["channelIds"]  # type: ignore[index]
+        wait_until(lambda: "/ephemeral" not in gateway.taps.topics(), what="the tap on /ephemeral dropped")
+        # the client's later unsubscribe of the ended subscription is harmless
+        ws.send(json.dumps({"op": "unsubscribe", "subscriptionIds": [7]}))
+        ws.send(json.dumps({"op": "subscribe", "subscriptions": [{"id": 7, "channelId": channel["id"]}]}))
+        status = first(ws, lambda m: isinstance(m, dict) and m.get("op") == "status")
+        assert f"unknown channel {channel['id']}" in status["message"]  # type: ignore[index]

@@ -38,7 +38,9 @@ class FoxgloveSession:
         self.gateway = gateway
         self.client_id = client_id
         self.outbox = outbox
-        self._subs: dict[int, int] = {}  # subscription id -> channel id
+        #: subscription id -> (channel id, topic): the topic kept, as a removed channel is no longer in
+        #: the catalog when its subscriptions are dropped
+        self._subs: dict[int, tuple[int, str]] = {}
         self._client_channels: dict[int, tuple[str, Any]] = {}  # client channel id -> (topic, publisher)
         self._param_names: set[str] = set()
         self.graph_subscribed = False
@@ -162,12 +164,12 @@ class FoxgloveSession:
             if channel is None:
                 self.status(1, f"subscribe: unknown channel {channel_id}")
                 continue
+            topic = channel["topic"]
             with self._lock:
                 if sub_id in self._subs:
                     self.status(1, f"subscribe: subscription id {sub_id} is already in use")
                     continue
-                self._subs[sub_id] = channel_id
-            topic = channel["topic"]
+                self._subs[sub_id] = (channel_id, topic)
             app = self.gateway.catalog.app.get(channel_id)
             if app is not None:  # a channel of this process's own app (a simulator's view)
                 app.add((self, sub_id), self._sink(sub_id, topic))
@@ -187,20 +189,36 @@ class FoxgloveSession:
                 raise
 
     def op_unsubscribe(self, msg: dict[str, Any]) -> None:
-        for sub_id in msg["subscriptionIds"]:
-            with self._lock:
-                channel_id = self._subs.pop(int(sub_id), None)
-            channel = self.gateway.catalog.channel(channel_id) if channel_id is not None else None
-            if channel is not None:
-                self._drop(int(sub_id), channel)
-                self.outbox.discard(f"{channel['topic']}#{sub_id}")
+        self._unsubscribe([int(sub_id) for sub_id in msg["subscriptionIds"]])
 
-    def _drop(self, sub_id: int, channel: dict[str, Any]) -> None:
-        app = self.gateway.catalog.app.get(channel["id"])
+    def channels_removed(self, channel_ids: list[int]) -> None:
+        """The gateway unadvertised these channels: their subscriptions end with them, as in Foxglove's
+        own server (a client subscribes again under the new channel when the topic comes back; the
+        old subscription would otherwise go on taking the topic for an id nobody reads)."""
+        gone = set(channel_ids)
+
+        def drop() -> None:
+            with self._lock:
+                ended = [sub_id for sub_id, (channel_id, _) in self._subs.items() if channel_id in gone]
+            self._unsubscribe(ended)
+
+        if not self._closed:
+            self._worker.submit(drop)
+
+    def _unsubscribe(self, sub_ids: list[int]) -> None:
+        for sub_id in sub_ids:
+            with self._lock:
+                entry = self._subs.pop(sub_id, None)
+            if entry is not None:
+                self._drop(sub_id, *entry)
+                self.outbox.discard(f"{entry[1]}#{sub_id}")
+
+    def _drop(self, sub_id: int, channel_id: int, topic: str) -> None:
+        app = self.gateway.catalog.app.get(channel_id)
         if app is not None:
             app.remove((self, sub_id))
         else:
-            self.gateway.taps.remove(channel["topic"], (self, sub_id))
+            self.gateway.taps.remove(topic, (self, sub_id))
 
     def _sink(self, sub_id: int, topic: str) -> Callable[[Delivery], None]:
         lane = f"{topic}#{sub_id}"
@@ -355,10 +373,8 @@ class FoxgloveSession:
         self._closed = True
 
         def cleanup() -> None:
-            for sub_id, channel_id in list(self._subs.items()):
-                channel = self.gateway.catalog.channel(channel_id)
-                if channel is not None:
-                    self._drop(sub_id, channel)
+            for sub_id, (channel_id, topic) in list(self._subs.items()):
+                self._drop(sub_id, channel_id, topic)
             self._subs.clear()
             for channel_id, (topic, _pub) in list(self._client_channels.items()):
                 self.gateway.publishers.unadvertise(topic, (self, channel_id))

@@ -497,6 +497,7 @@ class Gateway:
                 fox.master_status(None)
         for fox in foxes:
             if diff["removed_channels"]:
+                fox.channels_removed(diff["removed_channels"])
                 fox.send({"op": "unadvertise", "channelIds": diff["removed_channels"]})
             if diff["channels"]:
                 fox.send({"op": "advertise", "channels": diff["channels"]})
