@@ -71,7 +71,9 @@ THREADS: tuple[Thread, ...] = (
         "node.subscriber.Subscriber (one per Subscriber handle)",
         "the topic's reader (first handle): reads its publisher sockets, cuts frames; every handle: "
         "its queue, deserialization and its callback (a direct=True handle's callback also runs on an "
-        "in-process publisher's thread, inside publish, when the handle is idle)",
+        "in-process publisher's thread, inside publish, when the handle is idle); on Linux 6.12+ it runs "
+        "with a quarter of the scheduler slice (node.slices), so a callback that wakes another thread "
+        "keeps the CPU until its next read",
         "subscriber callbacks",
     ),
     Thread(
