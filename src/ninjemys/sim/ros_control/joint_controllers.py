@@ -172,11 +172,9 @@ class VelocityJointVelocityController(_JointVelocity):
     interface = VELOCITY_INTERFACE
 
 
-class EffortJointVelocityController(_JointVelocity):
-    """effort_controllers/JointVelocityController: a PID around the joint's speed, its state published."""
-
-    type_name = "effort_controllers/JointVelocityController"
-    interface = EFFORT_INTERFACE
+class _Reported(_JointVelocity):
+    """An effort controller's PID gains and its JointControllerState on ``<name>/state``: read,
+    reset at start and closed with the controller (the subclass's ``update`` reports)."""
 
     def __init__(self, name: str, node: Any, hw: SimRobotHW, root_ns: str, params: dict) -> None:
         pid = _Pid(params.get("pid"), _join(root_ns, name))  # before subscribing: nothing to undo
@@ -187,14 +185,21 @@ class EffortJointVelocityController(_JointVelocity):
         super().starting(now)
         self.report.reset()
 
+    def close(self) -> None:
+        super().close()
+        self.report.close()
+
+
+class EffortJointVelocityController(_Reported):
+    """effort_controllers/JointVelocityController: a PID around the joint's speed, its state published."""
+
+    type_name = "effort_controllers/JointVelocityController"
+    interface = EFFORT_INTERFACE
+
     def update(self, now: float, period: float) -> None:
         super().update(now, period)
         handle = self.hw.joints[self.joint]
         self.report.update(now, period, handle.command, handle.velocity, None)
-
-    def close(self) -> None:
-        super().close()
-        self.report.close()
 
 
 class _JointPosition(_JointVelocity):
@@ -203,9 +208,6 @@ class _JointPosition(_JointVelocity):
     def starting(self, now: float) -> None:
         with self._lock:  # ros_control's position controllers hold the joint where it is on start
             self._command = self.hw.joints[self.joint].position
-
-    def stopping(self, now: float) -> None:
-        self.hw.joints[self.joint].command = 0.0
 
     def speed_to(self, target: float, period: float) -> float:
         """The joint velocity that moves it toward ``target`` this step."""
@@ -225,21 +227,15 @@ class PositionJointPositionController(_JointPosition):
     interface = POSITION_INTERFACE
 
 
-class EffortJointPositionController(_JointPosition):
+class EffortJointPositionController(_Reported, _JointPosition):
     """effort_controllers/JointPositionController: the joint follows the command, its state published."""
 
     type_name = "effort_controllers/JointPositionController"
     interface = EFFORT_INTERFACE
 
     def __init__(self, name: str, node: Any, hw: SimRobotHW, root_ns: str, params: dict) -> None:
-        pid = _Pid(params.get("pid"), _join(root_ns, name))  # before subscribing: nothing to undo
         super().__init__(name, node, hw, root_ns, params)
-        self.report = _StateReport(node, self.ns, pid)
         self.limit = hw.velocity_limits.get(self.joint)
-
-    def starting(self, now: float) -> None:
-        super().starting(now)
-        self.report.reset()
 
     def speed_to(self, target: float, period: float) -> float:
         handle = self.hw.joints[self.joint]
@@ -255,10 +251,6 @@ class EffortJointPositionController(_JointPosition):
         handle = self.hw.joints[self.joint]
         handle.command = self.speed_to(target, period)
         self.report.update(now, period, target, handle.position, handle.velocity)
-
-    def close(self) -> None:
-        super().close()
-        self.report.close()
 
 
 JOINT_CONTROLLER_TYPES: dict[str, type[Controller]] = {
