@@ -63,6 +63,21 @@ class _Record:
         return (type(self), self._values())
 
 
+class _Named(_Record):
+    """A record named ``pkg/Type`` (a message, service or action type): its package and short name."""
+
+    __slots__ = ()
+    full_name: str
+
+    @property
+    def package(self) -> str:
+        return self.full_name.split("/", 1)[0]
+
+    @property
+    def short_name(self) -> str:
+        return self.full_name.split("/", 1)[1]
+
+
 class FieldType(_Record):
     """A field's type: ``base`` is a builtin name or a resolved ``pkg/Type``; arrays carry their length."""
 
@@ -126,7 +141,7 @@ class Constant(_Record):
         _set(self, "value_text", value_text)
 
 
-class MsgSpec(_Record):
+class MsgSpec(_Named):
     """One message type."""
 
     __slots__ = ("full_name", "fields", "constants", "text", "path")
@@ -154,14 +169,6 @@ class MsgSpec(_Record):
         _set(self, "path", path)
 
     @property
-    def package(self) -> str:
-        return self.full_name.split("/", 1)[0]
-
-    @property
-    def short_name(self) -> str:
-        return self.full_name.split("/", 1)[1]
-
-    @property
     def has_header(self) -> bool:
         """ROS 1 rule: the first field is ``Header header`` (std_msgs/Header)."""
         return (
@@ -180,7 +187,7 @@ class MsgSpec(_Record):
         return tuple(seen)
 
 
-class SrvSpec(_Record):
+class SrvSpec(_Named):
     """A service: request and response are ordinary message specs named ``pkg/TypeRequest`` / ``...Response``."""
 
     __slots__ = ("full_name", "request", "response", "text", "path")
@@ -200,16 +207,8 @@ class SrvSpec(_Record):
         _set(self, "text", text)
         _set(self, "path", path)
 
-    @property
-    def package(self) -> str:
-        return self.full_name.split("/", 1)[0]
 
-    @property
-    def short_name(self) -> str:
-        return self.full_name.split("/", 1)[1]
-
-
-class ActionSpec(_Record):
+class ActionSpec(_Named):
     """An action (.action: goal --- result --- feedback) and the 7 messages actionlib generates from it."""
 
     __slots__ = ("full_name", "goal", "result", "feedback", "generated", "text", "path")
@@ -240,11 +239,3 @@ class ActionSpec(_Record):
         _set(self, "generated", generated)
         _set(self, "text", text)
         _set(self, "path", path)
-
-    @property
-    def package(self) -> str:
-        return self.full_name.split("/", 1)[0]
-
-    @property
-    def short_name(self) -> str:
-        return self.full_name.split("/", 1)[1]
