@@ -64,6 +64,7 @@ def test_lidar_turned_by_pi_with_its_beams_angles_and_names():
     assert laser.beams == 360 and (laser.angle_min, laser.angle_max) == (-3.14159, 3.14159)
     assert (laser.range_min, laser.range_max, laser.range_resolution, laser.noise) == (0.12, 12.0, 0.01, 0.01)
     assert laser.rate == 10.0 and laser.topic == "/scan" and laser.pose.frame == "laser_frame"
+    assert laser.gazebo_fields  # libgazebo_ros_laser.so's scan_time 0 and intensities
     assert laser.pose.rpy[2] == pytest.approx(math.pi)
     # base_link is 0.05 above the ground (wheel radius), the lidar 0.11 above base_link
     assert laser.pose.xyz == pytest.approx((-0.03, 0.0, 0.16))
@@ -191,6 +192,7 @@ def test_skid_steer_gpu_laser_kinect_and_imu_model_plugin():
     laser = m.laser
     assert laser.beams == 720 and laser.topic == "/front/scan" and laser.pose.frame == "front_laser"
     assert laser.rate == 40.0 and laser.range_max == 30.0
+    assert laser.gazebo_fields  # scan_time 0 and an intensity per ray, as gazebo_ros_gpu_laser publishes
     assert laser.pose.xyz == pytest.approx(
         (0.1, 0.0, 0.2)
     )  # base_link is at the ground (wheels r=0.07 at 0.07)

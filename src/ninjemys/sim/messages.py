@@ -161,12 +161,12 @@ def laser_scan(stamp: Time, frame: str, spec: LaserSpec, ranges: np.ndarray) -> 
     msg.angle_min = amin
     msg.angle_max = amax
     msg.angle_increment = inc
-    msg.time_increment = 0.0
-    msg.scan_time = 1.0 / spec.rate
+    msg.time_increment = 0.0  # every ray at once, as Gazebo's instantaneous scan
+    msg.scan_time = 0.0 if spec.gazebo_fields else 1.0 / spec.rate
     msg.range_min = spec.range_min
     msg.range_max = spec.range_max
     msg.ranges = ranges
-    msg.intensities = []
+    msg.intensities = np.zeros(len(ranges), np.float32) if spec.gazebo_fields else []
     return msg
 
 

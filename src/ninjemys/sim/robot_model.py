@@ -42,6 +42,10 @@ class LaserSpec:
     angle_min: float = -math.pi
     angle_max: float | None = None
     range_resolution: float = 0.0  # ranges rounded to this step (Gazebo's <range><resolution>); 0: none
+    # Gazebo's laser plugins (gazebo_ros_laser, gpu_laser) publish scan_time 0 and one intensity per
+    # ray (the ray sensor's retro value: 0 on surfaces without one); a spinning lidar's driver gives
+    # the revolution's period and no intensities. True: the plugin's fields.
+    gazebo_fields: bool = False
 
 
 @dataclass

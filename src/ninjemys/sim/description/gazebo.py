@@ -321,6 +321,7 @@ def _sensor(
             lo,
             hi,
             range_resolution=s.number("ray/range/resolution", 0.0, minimum=0),
+            gazebo_fields=True,
         )
         if cfg.laser is None:
             cfg.laser = laser
