@@ -18,7 +18,7 @@ from pathlib import Path
 import yaml
 
 from ninjemys.maps.mapfile import Fields, MapFileError, yaml_lines
-from ninjemys.robot.kinematics import Joint
+from ninjemys.robot.kinematics import Joint, URDFError, parse_urdf
 from ninjemys.sim.worlds import ROBOTS_DIR
 
 
@@ -339,6 +339,10 @@ def model_from_urdf(
         raise MapFileError(f"{source}:{line}: invalid URDF XML: {exc}") from None
     if root.tag != "robot":
         raise MapFileError(f"{source}: URDF root element is <{root.tag}>, expected <robot>")
+    try:
+        parse_urdf(text, source)  # what urdfdom refuses (a joint naming a missing link), Gazebo does not load
+    except URDFError as exc:
+        raise MapFileError(str(exc)) from None
     doc = _default_doc()
     doc["name"] = root.get("name", "robot")
     links = {link.get("name"): link for link in root.findall("link")}
