@@ -183,7 +183,8 @@ def test_skid_steer_gpu_laser_kinect_and_imu_model_plugin():
              <plugin name="k" filename="libgazebo_ros_openni_kinect.so"><cameraName>kinect</cameraName>
              <imageTopicName>rgb/image_raw</imageTopicName><cameraInfoTopicName>rgb/camera_info</cameraInfoTopicName>
              <depthImageTopicName>depth/image_raw</depthImageTopicName>
-             <frameName>kinect_optical</frameName><pointCloudCutoffMax>4.0</pointCloudCutoffMax></plugin></sensor></gazebo>"""
+             <frameName>kinect_optical</frameName><pointCloudCutoffMax>4.0</pointCloudCutoffMax>
+             <hackBaseline>0.07</hackBaseline></plugin></sensor></gazebo>"""
     m = model_from_description(_urdf(g), "bot.urdf")
     d = m.drive
     assert d.kind == "skid_steer" and d.command_topic == "/husky/cmd_vel" and d.odom_topic == "/husky/odom"
@@ -198,6 +199,7 @@ def test_skid_steer_gpu_laser_kinect_and_imu_model_plugin():
     )  # base_link is at the ground (wheels r=0.07 at 0.07)
     cam = m.camera
     assert (cam.width, cam.height, cam.depth_max) == (160, 120, 4.0)
+    assert cam.hack_baseline == 0.07  # CameraInfo P[3] = -fx * 0.07, as gazebo_ros_camera_utils
     assert cam.image_topic == "/kinect/rgb/image_raw" and cam.depth_topic == "/kinect/depth/image_raw"
     assert cam.depth_info_topic == "/kinect/depth/camera_info" and cam.frame == "kinect_optical"
     assert m.imu.topic == "/imu/data" and m.imu.rate == 50.0 and m.imu.gyro_noise == 0.02

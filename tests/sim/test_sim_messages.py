@@ -142,6 +142,11 @@ def test_camera_messages() -> None:
     assert depth.encoding == "16UC1" and bytes(depth.data[:2]) == (1500).to_bytes(2, "little")
     info = messages.camera_info(messages.stamp_of(0, 0.01), "cam", model.camera, (100.0, 100.0, 160.0, 120.0))
     assert info.K[0] == 100.0 and info.width == model.camera.width
+    assert info.P[3] == 0.0
+    # gazebo_ros_camera's <hackBaseline> 0.07 (the Gazebo tutorials' camera, a stereo pair's right eye)
+    model.camera.hack_baseline = 0.07
+    info = messages.camera_info(messages.stamp_of(0, 0.01), "cam", model.camera, (100.0, 100.0, 160.0, 120.0))
+    assert info.P[3] == pytest.approx(-7.0) and info.P[:3] == [100.0, 0.0, 160.0]
 
 
 def test_configure_model_from_parameters() -> None:

@@ -224,5 +224,5 @@ def camera_info(
     info.D = [0.0, 0.0, 0.0, 0.0, 0.0]
     info.K = [fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0]
     info.R = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
-    info.P = [fx, 0.0, cx, 0.0, 0.0, fy, cy, 0.0, 0.0, 0.0, 1.0, 0.0]
+    info.P = [fx, 0.0, cx, -fx * spec.hack_baseline, 0.0, fy, cy, 0.0, 0.0, 0.0, 1.0, 0.0]
     return info

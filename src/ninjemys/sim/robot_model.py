@@ -63,6 +63,8 @@ class CameraSpec:
     depth_topic: str | None = "camera/depth/image_rect_raw"
     depth_info_topic: str | None = "camera/depth/camera_info"
     depth_frame: str = "camera_depth_optical_frame"
+    #: gazebo_ros_camera's <hackBaseline> (m): CameraInfo's P[3] = -fx * baseline (a stereo pair's right camera)
+    hack_baseline: float = 0.0
 
 
 @dataclass

@@ -364,6 +364,7 @@ def _sensor(
             f"{cam_ns}/{p.text('depthImageTopicName', 'depth/image_raw')}" if depth else None,
             f"{cam_ns}/{p.text('depthImageCameraInfoTopicName', 'depth/camera_info')}" if depth else None,
             frame_id,
+            hack_baseline=p.number("hackBaseline", 0.0),
         )
         if cfg.camera is None:
             cfg.camera = camera
