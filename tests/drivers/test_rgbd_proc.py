@@ -133,28 +133,19 @@ def test_image_proc_and_point_cloud_xyzrgb_nodes_give_the_registered_cloud(tmp_p
 
     with run_master() as uri:
         env = dict(os.environ, ROS_MASTER_URI=uri, ROS_HOME=str(tmp_path), ROS_LOG_DIR=str(tmp_path))
+        remaps = [
+            "__ns:=/camera",
+            "rgb/image_rect_color:=color/image_rect_color",
+            "rgb/camera_info:=color/camera_info",
+            "depth_registered/image_rect:=aligned_depth_to_color/image_raw",
+        ]
+        commands = [
+            shipped_executable("image_proc", "image_proc").command(["__ns:=/camera/color"]),
+            shipped_executable("depth_image_proc", "point_cloud_xyzrgb").command(remaps),
+        ]
+        out = subprocess.PIPE
         procs = [
-            subprocess.Popen(
-                shipped_executable("image_proc", "image_proc").command(["__ns:=/camera/color"]),
-                env=env,
-                stdout=subprocess.PIPE,
-                stderr=subprocess.STDOUT,
-                text=True,
-            ),
-            subprocess.Popen(
-                shipped_executable("depth_image_proc", "point_cloud_xyzrgb").command(
-                    [
-                        "__ns:=/camera",
-                        "rgb/image_rect_color:=color/image_rect_color",
-                        "rgb/camera_info:=color/camera_info",
-                        "depth_registered/image_rect:=aligned_depth_to_color/image_raw",
-                    ]
-                ),
-                env=env,
-                stdout=subprocess.PIPE,
-                stderr=subprocess.STDOUT,
-                text=True,
-            ),
+            subprocess.Popen(c, env=env, stdout=out, stderr=subprocess.STDOUT, text=True) for c in commands
         ]
         node = Node("rgbd_test", master_uri=uri)
         try:
