@@ -153,6 +153,9 @@ class RobotModel:
     # ros_control: the joints with a <transmission> and their side ("left", "right"; "" for a joint that
     # is not a wheel): every wheel of a side turns as that side's wheel of the simulated body
     control_joints: dict[str, str] = field(default_factory=dict)
+    #: gazebo_ros_control beside a plugin drive: its controller_manager (namespace, period) over
+    #: ``control_joints``; the plugin keeps driving unless a running controller commands the wheels
+    control_beside: DriveSpec | None = None
     #: the URDF's <limit velocity> of the joints ros_control exposes, where one is given (rad/s)
     joint_velocity_limits: dict[str, float] = field(default_factory=dict)
     #: what apply_body_wrench pushes: the body's mass (kg) and moment of inertia about the vertical
