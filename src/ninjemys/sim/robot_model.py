@@ -126,6 +126,19 @@ class DriveSpec:
     controller_namespace: str = "/"
     robot_param: str = "robot_description"
 
+    @classmethod
+    def silent(cls, kind: str, **fields: object) -> DriveSpec:
+        """A drive that subscribes and publishes nothing itself (ros_control's, or none at all)."""
+        quiet: dict[str, object] = {
+            "command_topic": "",
+            "odom_topic": "",
+            "publish_odom": False,
+            "publish_odom_tf": False,
+            "publish_wheel_joint_state": False,
+            "publish_wheel_speeds": False,
+        }
+        return cls(kind=kind, **{**quiet, **fields})  # type: ignore[arg-type]
+
 
 @dataclass
 class RobotModel:

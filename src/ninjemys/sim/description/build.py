@@ -45,15 +45,7 @@ def model_from_description(text: str, source: str, *, robot_namespace: str | Non
     warnings: list[str] = []
     drive = cfg.drive
     if drive is None:
-        drive = DriveSpec(
-            kind="none",
-            command_topic="",
-            odom_topic="",
-            publish_odom=False,
-            publish_odom_tf=False,
-            publish_wheel_joint_state=False,
-            publish_wheel_speeds=False,
-        )
+        drive = DriveSpec.silent("none")
         warnings.append(
             f"{source}: no drive plugin ({DIFF_DRIVE}, {SKID_STEER} or {ROS_CONTROL}) in a <gazebo> block:"
             " the robot is passive"

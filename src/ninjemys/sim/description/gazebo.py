@@ -122,14 +122,8 @@ def _ros_control(r: Reader, label: str, cfg: GazeboConfig, ns_override: str | No
     sim_type = r.text("robotSimType", "gazebo_ros_control/DefaultRobotHWSim")
     if sim_type != "gazebo_ros_control/DefaultRobotHWSim":
         cfg.warnings.append(f"{label}: robotSimType {sim_type}: simulated as DefaultRobotHWSim")
-    return DriveSpec(
-        kind="ros_control",
-        command_topic="",
-        odom_topic="",
-        publish_odom=False,
-        publish_odom_tf=False,
-        publish_wheel_joint_state=False,
-        publish_wheel_speeds=False,
+    return DriveSpec.silent(
+        "ros_control",
         update_rate=(1.0 / period) if period else None,
         controller_namespace=topic(ns, "").rstrip("/") or "/",
         robot_param=r.text("robotParam", "robot_description"),
