@@ -151,3 +151,5 @@ def test_a_missing_command_names_it_as_roslaunch_does(tmp_path: Path) -> None:
         "Invalid <param> tag: Cannot load command parameter [robot_description]: no such command "
         "[['/nonexistent/xacro.py', '/tmp/x/my bot.xacro']]"
     ), text
+    text = error(tmp_path, '<param name="robot_description" command="/bin/sh -c \'exit 3\'"/>')
+    assert text.endswith("command [['/bin/sh', '-c', 'exit 3']] returned with code [3]"), text

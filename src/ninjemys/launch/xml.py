@@ -424,7 +424,7 @@ class _Loader:
                 ) from None
             if proc.returncode != 0:
                 raise LaunchError(
-                    f"Cannot load command parameter [{name}]: command [{command}] returned with code [{proc.returncode}]"
+                    f"Cannot load command parameter [{name}]: command [{argv!r}] returned with code [{proc.returncode}]"
                 )
             return convert_value(proc.stdout.decode("utf-8", errors="replace"), ptype)
         except LaunchError as exc:
