@@ -62,11 +62,29 @@ def answer_sigint() -> None:
         signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
+def _terminated(_signum: int, _frame: object) -> None:
+    raise KeyboardInterrupt
+
+
+def answer_sigterm() -> None:
+    """SIGTERM (``kill``, ``timeout 10 rostopic hz ...``) stops a tool as Ctrl-C does: its node
+    unregisters from the master on the way out. rospy's tools do (rospy handles SIGTERM and shuts
+    down); with the default action the process vanished and left its node registered. A tool that
+    handles SIGTERM itself (roscore, roslaunch, a node's ``run_node``) sets its own handler later."""
+    if (
+        threading.current_thread() is threading.main_thread()
+        and signal.getsignal(signal.SIGTERM) is signal.SIG_DFL
+    ):
+        signal.signal(signal.SIGTERM, _terminated)
+
+
 def entry(main: Callable[[list[str] | None], int]) -> Callable[[], None]:
-    """Wrap ``main`` for a console script: map our errors and Ctrl-C to exit codes, never a traceback."""
+    """Wrap ``main`` for a console script: map our errors, Ctrl-C and SIGTERM to exit codes, never a
+    traceback."""
 
     def console_main() -> None:
         answer_sigint()
+        answer_sigterm()
         try:
             code = main(sys.argv[1:])
         except KeyboardInterrupt:

@@ -270,3 +270,38 @@ print(rosbag.Bag(sys.argv[1], skip_index=True))
     ours = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True, text=True)
     assert ours.returncode == 0, ours.stderr
     assert ours.stdout == theirs.stdout
+
+
+RAW_READ = """
+import sys, rosbag, genpy
+from std_msgs.msg import String, UInt8MultiArray
+if sys.argv[2] == "write":
+    with rosbag.Bag(sys.argv[1], "w", compression=sys.argv[3]) as b:
+        for i in range(3):
+            b.write("/chatter", String(data="hi %d" % i), genpy.Time(1, i))
+            b.write("/u8", UInt8MultiArray(data=bytes([i, 255])), genpy.Time(1, i))
+    sys.exit(0)
+with rosbag.Bag(sys.argv[1]) as b:
+    for topic, raw, t in b.read_messages(raw=True):
+        dt, data, md5, pos, pytype = raw
+        print(topic, len(raw), dt, type(data).__name__, data.hex(), md5, pos, pytype._type, pytype._md5sum, t)
+"""
+
+
+@pytest.mark.parametrize("compression", ["none", "bz2", "lz4"])
+def test_a_raw_read_gives_real_rosbags_tuple(tmp_path, compression):
+    """``read_messages(raw=True)``: (datatype, data bytes, md5sum, (chunk_pos, offset in the chunk),
+    pytype), the position as rosbag gives it (ours gave the chunk's position alone)."""
+    from ninjemys.testing import have_ros1
+
+    if not have_ros1():
+        pytest.skip("Debian's ROS 1 is not installed")
+    path = tmp_path / "raw.bag"
+    made = ros1_run(RAW_READ, str(path), "write", compression)
+    assert made.returncode == 0, made.stderr
+    theirs = ros1_run(RAW_READ, str(path), "read")
+    assert theirs.returncode == 0, theirs.stderr
+    assert "(4117, 167)" in theirs.stdout  # the first message record, after its connection record
+    ours = subprocess.run([sys.executable, "-c", RAW_READ, str(path), "read"], capture_output=True, text=True)
+    assert ours.returncode == 0, ours.stderr
+    assert ours.stdout == theirs.stdout

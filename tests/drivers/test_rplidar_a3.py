@@ -177,3 +177,30 @@ def test_an_hq_mode_and_a_garbled_mode_list_are_one_clear_line_each(rig: Rig) ->
         "Error, cannot get the scan modes of the lidar: GET_LIDAR_CONF asked for entry 0x70 "
         "and was answered 0x71"
     ) in out, out
+
+
+def test_rplidar_ros_2_scan_frequency_sizes_the_compensated_scan(rig: Rig) -> None:
+    """rplidar_ros 2.x's ``scan_frequency`` (Hz, default 10): the angle-compensated scan has the bins a
+    turn at that rate fills (Sensitivity's 16K samples/s at 5 Hz: 8 a degree, 2880 beams, where 1.x's
+    fixed 10 Hz gave 4); a frequency that is not a positive number is one clear line."""
+    assert (compensate_multiple(62.0), compensate_multiple(62.0, 5.0), compensate_multiple(62.0, 40.0)) == (
+        4,
+        8,
+        1,
+    )
+    a3 = rig.device(EmulatedA3())
+    node = rig.node("rplidar_scan_frequency")
+    scans = rig.collect(node, "/scan", LaserScan)
+    proc = rplidar(
+        rig,
+        f"_serial_port:={a3.path}",
+        "_angle_compensate:=true",
+        "_scan_mode:=Sensitivity",
+        "_scan_frequency:=5.0",
+    )
+    scans.wait_count(3, timeout=30)
+    check_room(scans.items[-1], a3.mode_samples(ULTRA), 8)
+    out = rig.stop(proc)
+    assert "angle_compensate: 8" in out and "Traceback" not in out, out
+    out = rig.exit_output(rplidar(rig, f"_serial_port:={a3.path}", "_scan_frequency:=0"))
+    assert "Error, scan_frequency must be a number of Hz above 0 (and below 100), got 0" in out, out

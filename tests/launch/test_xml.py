@@ -139,3 +139,17 @@ def test_an_illegal_node_name_warns_with_ros1s_lines_and_keeps_the_node(tmp_path
         "t.launch:2] illegal <node> name 'fake_scan.py'.\nhttp://ros.org/wiki/Names\n"
         "This will likely cause problems with other ROS tools."
     )
+
+
+def test_a_missing_command_names_it_as_roslaunch_does(tmp_path: Path) -> None:
+    # the mybot tutorial's `$(find xacro)/xacro.py` (Noetic's xacro has no xacro.py): roslaunch prints
+    # the split command, "no such command [['/opt/ros/noetic/share/xacro/xacro.py', '.../mybot.xacro']]"
+    text = error(
+        tmp_path, '<param name="robot_description" command="/nonexistent/xacro.py \'/tmp/x/my bot.xacro\'"/>'
+    )
+    assert text.endswith(
+        "Invalid <param> tag: Cannot load command parameter [robot_description]: no such command "
+        "[['/nonexistent/xacro.py', '/tmp/x/my bot.xacro']]"
+    ), text
+    text = error(tmp_path, '<param name="robot_description" command="/bin/sh -c \'exit 3\'"/>')
+    assert text.endswith("command [['/bin/sh', '-c', 'exit 3']] returned with code [3]"), text

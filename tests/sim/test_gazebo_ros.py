@@ -255,6 +255,21 @@ def test_spawn_model_bad_input_gives_gazebo_ros_texts(gazebo: Gazebo) -> None:
     bad.write_text("<robot name='x'><link name='a'>")
     out = gazebo.spawn_model("-urdf", "-file", str(bad), "-model", "x")
     assert out.returncode == 1 and "Invalid XML: " in out.stdout + out.stderr
+    # a joint naming a link that is not there (a xacro's unexpanded macro): urdfdom refuses the URDF,
+    # and with it Gazebo; ours said nothing and spawned a plain box
+    missing = gazebo.tmp / "missing_link.urdf"
+    missing.write_text(
+        "<robot name='m'><link name='base_link'><collision><geometry><box size='0.2 0.2 0.1'/></geometry>"
+        "</collision></link><mrobot_body/><joint name='rplidar_joint' type='fixed'>"
+        "<parent link='plate_2_link'/><child link='base_link'/></joint></robot>"
+    )
+    out = gazebo.spawn_model("-urdf", "-file", str(missing), "-model", "mrobot")
+    assert out.returncode == 1, out.stdout + out.stderr
+    assert (
+        "Spawn status: SpawnModel: Failure - model_xml: Failed to build tree: parent link [plate_2_link] of"
+        " joint [rplidar_joint] not found.  This is not valid according to the URDF spec." in out.stdout
+    )
+    assert "mrobot" not in gazebo.model_states()
     out = gazebo.spawn_model("-urdf", "-param", "robot_description", "-model", "puzzlebot")
     assert out.returncode == 1
     assert "Spawn status: SpawnModel: Failure - entity already exists." in out.stdout

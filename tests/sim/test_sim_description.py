@@ -64,6 +64,7 @@ def test_lidar_turned_by_pi_with_its_beams_angles_and_names():
     assert laser.beams == 360 and (laser.angle_min, laser.angle_max) == (-3.14159, 3.14159)
     assert (laser.range_min, laser.range_max, laser.range_resolution, laser.noise) == (0.12, 12.0, 0.01, 0.01)
     assert laser.rate == 10.0 and laser.topic == "/scan" and laser.pose.frame == "laser_frame"
+    assert laser.gazebo_fields  # libgazebo_ros_laser.so's scan_time 0 and intensities
     assert laser.pose.rpy[2] == pytest.approx(math.pi)
     # base_link is 0.05 above the ground (wheel radius), the lidar 0.11 above base_link
     assert laser.pose.xyz == pytest.approx((-0.03, 0.0, 0.16))
@@ -182,7 +183,8 @@ def test_skid_steer_gpu_laser_kinect_and_imu_model_plugin():
              <plugin name="k" filename="libgazebo_ros_openni_kinect.so"><cameraName>kinect</cameraName>
              <imageTopicName>rgb/image_raw</imageTopicName><cameraInfoTopicName>rgb/camera_info</cameraInfoTopicName>
              <depthImageTopicName>depth/image_raw</depthImageTopicName>
-             <frameName>kinect_optical</frameName><pointCloudCutoffMax>4.0</pointCloudCutoffMax></plugin></sensor></gazebo>"""
+             <frameName>kinect_optical</frameName><pointCloudCutoffMax>4.0</pointCloudCutoffMax>
+             <hackBaseline>0.07</hackBaseline></plugin></sensor></gazebo>"""
     m = model_from_description(_urdf(g), "bot.urdf")
     d = m.drive
     assert d.kind == "skid_steer" and d.command_topic == "/husky/cmd_vel" and d.odom_topic == "/husky/odom"
@@ -191,11 +193,13 @@ def test_skid_steer_gpu_laser_kinect_and_imu_model_plugin():
     laser = m.laser
     assert laser.beams == 720 and laser.topic == "/front/scan" and laser.pose.frame == "front_laser"
     assert laser.rate == 40.0 and laser.range_max == 30.0
+    assert laser.gazebo_fields  # scan_time 0 and an intensity per ray, as gazebo_ros_gpu_laser publishes
     assert laser.pose.xyz == pytest.approx(
         (0.1, 0.0, 0.2)
     )  # base_link is at the ground (wheels r=0.07 at 0.07)
     cam = m.camera
     assert (cam.width, cam.height, cam.depth_max) == (160, 120, 4.0)
+    assert cam.hack_baseline == 0.07  # CameraInfo P[3] = -fx * 0.07, as gazebo_ros_camera_utils
     assert cam.image_topic == "/kinect/rgb/image_raw" and cam.depth_topic == "/kinect/depth/image_raw"
     assert cam.depth_info_topic == "/kinect/depth/camera_info" and cam.frame == "kinect_optical"
     assert m.imu.topic == "/imu/data" and m.imu.rate == 50.0 and m.imu.gyro_noise == 0.02

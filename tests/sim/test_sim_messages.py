@@ -47,6 +47,22 @@ def test_laser_scan_message_uses_the_spec() -> None:
     assert len(msg.ranges) == 1147
 
 
+def test_a_gazebo_laser_scan_has_the_plugins_timing_and_intensity_fields() -> None:
+    # gazebo_ros_laser / gpu_laser: time_increment 0 and scan_time 0 (an instantaneous simulated scan),
+    # one intensity per ray (the ray sensor's retro value, 0 here); a driver-like laser keeps its period
+    ranges = np.full(360, 2.0, dtype=np.float32)
+    spec = laser(360)
+    spec.rate = 5.0
+    driver = messages.laser_scan(messages.stamp_of(0, 0.01), "laser", spec, ranges)
+    assert (driver.time_increment, driver.scan_time, len(driver.intensities)) == (0.0, pytest.approx(0.2), 0)
+    spec.gazebo_fields = True
+    gz = messages.laser_scan(messages.stamp_of(0, 0.01), "laser", spec, ranges)
+    assert (gz.time_increment, gz.scan_time) == (0.0, 0.0)
+    assert list(gz.intensities) == [0.0] * 360
+    back = type(gz)().deserialize(gz.serialize_to_bytes())  # the wire form carries the intensities
+    assert back.scan_time == 0.0 and len(back.intensities) == 360
+
+
 def test_scan_of_a_half_turn_laser_sees_what_is_ahead_only() -> None:
     """Beams from -pi/2 to pi/2: a box behind the robot is invisible, one ahead is seen."""
     model = load_robot_model("puzzlebot")
@@ -126,6 +142,11 @@ def test_camera_messages() -> None:
     assert depth.encoding == "16UC1" and bytes(depth.data[:2]) == (1500).to_bytes(2, "little")
     info = messages.camera_info(messages.stamp_of(0, 0.01), "cam", model.camera, (100.0, 100.0, 160.0, 120.0))
     assert info.K[0] == 100.0 and info.width == model.camera.width
+    assert info.P[3] == 0.0
+    # gazebo_ros_camera's <hackBaseline> 0.07 (the Gazebo tutorials' camera, a stereo pair's right eye)
+    model.camera.hack_baseline = 0.07
+    info = messages.camera_info(messages.stamp_of(0, 0.01), "cam", model.camera, (100.0, 100.0, 160.0, 120.0))
+    assert info.P[3] == pytest.approx(-7.0) and info.P[:3] == [100.0, 0.0, 160.0]
 
 
 def test_configure_model_from_parameters() -> None:

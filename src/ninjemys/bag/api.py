@@ -324,7 +324,7 @@ class Bag:
         per_conn: dict[int, Any] = {}
         cls: Any  # None only for a raw read of a type that cannot be loaded (never deserialized)
         try:
-            for conn, ns, data, chunk_pos in source:
+            for conn, ns, data, chunk_pos, offset in source:
                 cached = per_conn.get(conn.id)
                 if cached is None:
                     cls = _pytype_or_none(decoders, conn) if raw else decoders.get(conn)
@@ -333,7 +333,7 @@ class Bag:
                 secs, nsecs = divmod(ns, NSEC)
                 stamp = make_time(secs, nsecs)
                 if raw:
-                    message: Any = (conn.datatype, bytes(data), conn.md5sum, chunk_pos, cls)
+                    message: Any = (conn.datatype, bytes(data), conn.md5sum, (chunk_pos, offset), cls)
                 else:
                     message = _deserialize(cls, data, conn)
                 if with_header:

@@ -56,6 +56,8 @@ class RawMessage(NamedTuple):
     time: int
     data: memoryview
     chunk_pos: int
+    #: the message record's offset in the decompressed chunk (rosbag's position is (chunk_pos, offset))
+    offset: int = 0
 
 
 class _Encrypted(BagError):
@@ -514,7 +516,7 @@ class BagReader:
                 ) from None
             if end > size:
                 raise BagError(f"{self.path}: chunk at {pos}: message at offset {off} overruns the chunk")
-            yield make(connections[conn], ns, view[start:end], pos)
+            yield make(connections[conn], ns, view[start:end], pos, off)
 
     def _pop(
         self, pending: list[tuple[int, int, int, int, bytes]], connections: dict[int, Connection]
@@ -522,7 +524,11 @@ class BagReader:
         ns, chunk_pos, off, conn, data = heapq.heappop(pending)
         view = memoryview(data)
         return RawMessage(
-            connections[conn], ns, self._slice(view, len(data), off, chunk_pos, U32.unpack_from), chunk_pos
+            connections[conn],
+            ns,
+            self._slice(view, len(data), off, chunk_pos, U32.unpack_from),
+            chunk_pos,
+            off,
         )
 
     def _slice(self, view: memoryview, size: int, off: int, chunk_pos: int, unpack: Callable) -> memoryview:

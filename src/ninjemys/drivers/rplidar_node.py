@@ -1,7 +1,8 @@
 """``rosrun rplidar_ros rplidarNode``: a Slamtec RPLIDAR on ``sensor_msgs/LaserScan``, as rplidar_ros 1.10.
 
 Parameters (private): ``serial_port`` (/dev/ttyUSB0), ``serial_baudrate`` (115200; A3: 256000),
-``frame_id`` (laser_frame), ``inverted`` (false), ``angle_compensate`` (false; the launch files set
+``frame_id`` (laser_frame), ``inverted`` (false), ``scan_frequency`` (rplidar_ros 2.x: 10 Hz, the turn rate the
+compensation bins are sized for), ``angle_compensate`` (false; the launch files set
 true), ``scan_mode`` ("" = the device's typical mode; before firmware 1.24: Express when the firmware has it,
 else Standard).
 Publishes ``scan`` (queue 1000, as rplidar_ros); services ``stop_motor`` and ``start_motor``
@@ -269,6 +270,9 @@ class RplidarNode:
         self.angle_compensate = bool(node.get_param("~angle_compensate", False))
         self.scan_mode_name = str(node.get_param("~scan_mode", ""))
         self.initial_reset = bool(node.get_param("~initial_reset", False))  # rplidar_ros 2.x
+        # rplidar_ros 2.x: the turn rate the compensation bins are sized for (an A-series motor still
+        # runs at its PWM default; 2.x sets the rate itself only on S/T-series lidars)
+        self.scan_frequency: Any = node.get_param("~scan_frequency", 10.0)
         self.pub = node.publisher("scan", self.LaserScan, queue_size=1000)
         self.actions: queue.Queue[tuple[str, threading.Event]] = queue.Queue()
         self.scanning = False
@@ -309,6 +313,13 @@ class RplidarNode:
 
     def setup(self) -> int:
         self.log.info("RPLIDAR running on ROS package rplidar_ros. SDK Version:%s", SDK_VERSION)
+        freq = self.scan_frequency
+        if isinstance(freq, bool) or not isinstance(freq, int | float) or not 0 < freq < 100:
+            self.log.error(
+                "Error, scan_frequency must be a number of Hz above 0 (and below 100), got %r", freq
+            )
+            return 1
+        self.scan_frequency = float(freq)
         try:
             info = self.dev.device_info()
         except TimeoutError:
@@ -381,7 +392,7 @@ class RplidarNode:
                 self.mode.ans_type,
             )
             return 1
-        self.multiple = compensate_multiple(self.mode.us_per_sample)
+        self.multiple = compensate_multiple(self.mode.us_per_sample, self.scan_frequency)
         return 0
 
     def _start_scan(self, quiet: bool) -> bool:

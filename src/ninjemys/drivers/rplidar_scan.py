@@ -94,8 +94,10 @@ def ascend(rev: np.ndarray) -> np.ndarray | None:
     return rev[np.argsort(rev[:, 0], kind="stable")]
 
 
-def compensate_multiple(us_per_sample: float) -> int:
-    return max(1, int(1000 * 1000 / us_per_sample / 10.0 / 360.0))
+def compensate_multiple(us_per_sample: float, scan_frequency: float = 10.0) -> int:
+    """Bins per degree of an angle-compensated scan: the samples of one turn at ``scan_frequency``
+    (Hz; rplidar_ros 1.x assumed 10, 2.x reads its ``scan_frequency`` parameter) over 360, at least 1."""
+    return max(1, int(1000 * 1000 / us_per_sample / scan_frequency / 360.0))
 
 
 def compensated(rev: np.ndarray, multiple: int) -> np.ndarray:

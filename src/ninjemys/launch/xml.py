@@ -405,9 +405,10 @@ class _Loader:
                 except OSError as exc:
                     raise LaunchError(f"cannot read binfile [{binfile}]: {exc.strerror}") from None
             assert command is not None
+            argv = shlex.split(command)
             try:
                 proc = subprocess.run(
-                    shlex.split(command),
+                    argv,
                     stdout=subprocess.PIPE,
                     check=False,
                     timeout=60,
@@ -415,7 +416,7 @@ class _Loader:
                 )
             except FileNotFoundError:
                 raise LaunchError(
-                    f"Cannot load command parameter [{name}]: no such command [{command}]"
+                    f"Cannot load command parameter [{name}]: no such command [{argv!r}]"
                 ) from None
             except subprocess.TimeoutExpired:
                 raise LaunchError(
@@ -423,7 +424,7 @@ class _Loader:
                 ) from None
             if proc.returncode != 0:
                 raise LaunchError(
-                    f"Cannot load command parameter [{name}]: command [{command}] returned with code [{proc.returncode}]"
+                    f"Cannot load command parameter [{name}]: command [{argv!r}] returned with code [{proc.returncode}]"
                 )
             return convert_value(proc.stdout.decode("utf-8", errors="replace"), ptype)
         except LaunchError as exc:

@@ -138,6 +138,10 @@ def _table() -> dict[str, dict[str, ShippedExecutable]]:
         "joy": {"joy_node": ("ninjemys.drivers.joy_node:main", ())},
         "teleop_twist_joy": {"teleop_node": ("ninjemys.drivers.teleop_twist_joy:main", ())},
         "realsense2_camera": {"realsense2_camera_node": ("ninjemys.drivers.realsense_node:main", ())},
+        "image_proc": {"image_proc": ("ninjemys.drivers.rgbd_proc:image_proc_main", ())},
+        "depth_image_proc": {
+            "point_cloud_xyzrgb": ("ninjemys.drivers.rgbd_proc:point_cloud_xyzrgb_main", ())
+        },
         "rosserial_python": {
             "serial_node.py": ("ninjemys.drivers.rosserial_node:main", ()),
             "message_info_service.py": ("ninjemys.drivers.rosserial_node:message_info_main", ()),

@@ -146,18 +146,32 @@ def parse_urdf(text: str, source: str = "robot_description") -> RobotModel:
         joint = _joint(el, source)
         if joint.name in joints:
             raise URDFError(f"{source}: joint '{joint.name}' is not unique")
-        for link in (joint.parent, joint.child):
-            if link not in links:
-                raise URDFError(
-                    f"{source}: joint '{joint.name}' names link '{link}', which is not in the robot"
-                )
         joints[joint.name] = joint
+    _check_links(joints, set(links), source)
     for joint in joints.values():
         if joint.mimic and joint.mimic.joint not in joints:
             raise URDFError(
                 f"{source}: joint '{joint.name}' mimics '{joint.mimic.joint}', which is not in the robot"
             )
     return RobotModel(name=root.get("name", ""), links=links, joints=joints)
+
+
+def _check_links(joints: dict[str, Joint], links: set[str], source: str) -> None:
+    """urdfdom's tree check, in its words (robot_state_publisher, check_urdf and Gazebo's URDF import
+    print them): joints in name order, a joint's child link before its parent."""
+    for name in sorted(joints):
+        joint = joints[name]
+        if joint.child not in links:
+            raise URDFError(
+                f"{source}: Failed to build tree: child link [{joint.child}] of joint [{name}] not found"
+            )
+        if joint.parent not in links:
+            raise URDFError(
+                f"{source}: Failed to build tree: parent link [{joint.parent}] of joint [{name}] not found.  This is"
+                " not valid according to the URDF spec. Every link you refer to from a joint needs to be explicitly"
+                f" defined in the robot description. To fix this problem you can either remove this joint [{name}]"
+                f' from your urdf file, or add "<link name="{joint.parent}" />" to your urdf file.'
+            )
 
 
 def _joint(el: ET.Element, source: str) -> Joint:

@@ -30,6 +30,7 @@ import numpy as np
 
 from ninjemys.idl.loader import get_message_class, get_service_class
 from ninjemys.maps.mapfile import MapFileError
+from ninjemys.robot.kinematics import URDFError, parse_urdf
 from ninjemys.rostime import Time
 from ninjemys.sim.gazebo_materials import stock_colour
 from ninjemys.sim.robot_model import load_robot_model, model_from_urdf
@@ -794,6 +795,11 @@ def parse_model_xml(
         root = ET.fromstring(body)
     except ET.ParseError as exc:
         raise SpawnError(f"model_xml is not valid XML: {exc}") from None
+    if root.tag == "robot":
+        try:  # Gazebo's URDF import goes through urdfdom: what it refuses is never spawned
+            parse_urdf(body, "model_xml")
+        except URDFError as exc:
+            raise SpawnError(str(exc)) from None
     if root.tag == "sdf":
         # SdfError (a MapFileError) names the element and the reason
         return "sdf", sdf_model_obstacles(body, z=z, drops=drops, supports=supports, models=models)

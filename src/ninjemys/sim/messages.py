@@ -161,12 +161,12 @@ def laser_scan(stamp: Time, frame: str, spec: LaserSpec, ranges: np.ndarray) -> 
     msg.angle_min = amin
     msg.angle_max = amax
     msg.angle_increment = inc
-    msg.time_increment = 0.0
-    msg.scan_time = 1.0 / spec.rate
+    msg.time_increment = 0.0  # every ray at once, as Gazebo's instantaneous scan
+    msg.scan_time = 0.0 if spec.gazebo_fields else 1.0 / spec.rate
     msg.range_min = spec.range_min
     msg.range_max = spec.range_max
     msg.ranges = ranges
-    msg.intensities = []
+    msg.intensities = np.zeros(len(ranges), np.float32) if spec.gazebo_fields else []
     return msg
 
 
@@ -224,5 +224,5 @@ def camera_info(
     info.D = [0.0, 0.0, 0.0, 0.0, 0.0]
     info.K = [fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0]
     info.R = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
-    info.P = [fx, 0.0, cx, 0.0, 0.0, fy, cy, 0.0, 0.0, 0.0, 1.0, 0.0]
+    info.P = [fx, 0.0, cx, -fx * spec.hack_baseline, 0.0, fy, cy, 0.0, 0.0, 0.0, 1.0, 0.0]
     return info

@@ -233,7 +233,7 @@ class SimNode:
             else:
                 prefix = frame_prefix = f"{name}/" if namespaced else ""
             io = self._endpoints(robot, prefix, frame_prefix)
-            if model.drive.kind == "ros_control":
+            if model.drive.kind == "ros_control" or model.control_beside is not None:
                 # the controllers drive the wheels; their manager's services live in the robot's namespace
                 io.control = ControlLoop(self.node, model, namespace or None)
             self.io[name] = io

@@ -18,7 +18,7 @@ from pathlib import Path
 import yaml
 
 from ninjemys.maps.mapfile import Fields, MapFileError, yaml_lines
-from ninjemys.robot.kinematics import Joint
+from ninjemys.robot.kinematics import Joint, URDFError, parse_urdf
 from ninjemys.sim.worlds import ROBOTS_DIR
 
 
@@ -42,6 +42,10 @@ class LaserSpec:
     angle_min: float = -math.pi
     angle_max: float | None = None
     range_resolution: float = 0.0  # ranges rounded to this step (Gazebo's <range><resolution>); 0: none
+    # Gazebo's laser plugins (gazebo_ros_laser, gpu_laser) publish scan_time 0 and one intensity per
+    # ray (the ray sensor's retro value: 0 on surfaces without one); a spinning lidar's driver gives
+    # the revolution's period and no intensities. True: the plugin's fields.
+    gazebo_fields: bool = False
 
 
 @dataclass
@@ -59,6 +63,8 @@ class CameraSpec:
     depth_topic: str | None = "camera/depth/image_rect_raw"
     depth_info_topic: str | None = "camera/depth/camera_info"
     depth_frame: str = "camera_depth_optical_frame"
+    #: gazebo_ros_camera's <hackBaseline> (m): CameraInfo's P[3] = -fx * baseline (a stereo pair's right camera)
+    hack_baseline: float = 0.0
 
 
 @dataclass
@@ -120,6 +126,19 @@ class DriveSpec:
     controller_namespace: str = "/"
     robot_param: str = "robot_description"
 
+    @classmethod
+    def silent(cls, kind: str, **fields: object) -> DriveSpec:
+        """A drive that subscribes and publishes nothing itself (ros_control's, or none at all)."""
+        quiet: dict[str, object] = {
+            "command_topic": "",
+            "odom_topic": "",
+            "publish_odom": False,
+            "publish_odom_tf": False,
+            "publish_wheel_joint_state": False,
+            "publish_wheel_speeds": False,
+        }
+        return cls(kind=kind, **{**quiet, **fields})  # type: ignore[arg-type]
+
 
 @dataclass
 class RobotModel:
@@ -147,6 +166,9 @@ class RobotModel:
     # ros_control: the joints with a <transmission> and their side ("left", "right"; "" for a joint that
     # is not a wheel): every wheel of a side turns as that side's wheel of the simulated body
     control_joints: dict[str, str] = field(default_factory=dict)
+    #: gazebo_ros_control beside a plugin drive: its controller_manager (namespace, period) over
+    #: ``control_joints``; the plugin keeps driving unless a running controller commands the wheels
+    control_beside: DriveSpec | None = None
     #: the URDF's <limit velocity> of the joints ros_control exposes, where one is given (rad/s)
     joint_velocity_limits: dict[str, float] = field(default_factory=dict)
     #: what apply_body_wrench pushes: the body's mass (kg) and moment of inertia about the vertical
@@ -335,6 +357,10 @@ def model_from_urdf(
         raise MapFileError(f"{source}:{line}: invalid URDF XML: {exc}") from None
     if root.tag != "robot":
         raise MapFileError(f"{source}: URDF root element is <{root.tag}>, expected <robot>")
+    try:
+        parse_urdf(text, source)  # what urdfdom refuses (a joint naming a missing link), Gazebo does not load
+    except URDFError as exc:
+        raise MapFileError(str(exc)) from None
     doc = _default_doc()
     doc["name"] = root.get("name", "robot")
     links = {link.get("name"): link for link in root.findall("link")}

@@ -58,6 +58,10 @@ class EchoPrinter:
             from ninjemys.rostime import Time
 
             offset = Time.now()
+        if isinstance(value, bytes | bytearray | memoryview):
+            # a uint8[] field echoed alone (`rostopic echo /t/data`): numbers, as rostopic means to
+            # print it (ros_comm #243; Noetic's Python 3 rostopic stops there on ord() of an int)
+            value = list(value)
         body = strify_message(value, time_offset=offset, field_filter=self.filter)
         return f"{self.prefix}{body}\n---\n"
 

@@ -45,15 +45,7 @@ def model_from_description(text: str, source: str, *, robot_namespace: str | Non
     warnings: list[str] = []
     drive = cfg.drive
     if drive is None:
-        drive = DriveSpec(
-            kind="none",
-            command_topic="",
-            odom_topic="",
-            publish_odom=False,
-            publish_odom_tf=False,
-            publish_wheel_joint_state=False,
-            publish_wheel_speeds=False,
-        )
+        drive = DriveSpec.silent("none")
         warnings.append(
             f"{source}: no drive plugin ({DIFF_DRIVE}, {SKID_STEER} or {ROS_CONTROL}) in a <gazebo> block:"
             " the robot is passive"
@@ -75,7 +67,8 @@ def model_from_description(text: str, source: str, *, robot_namespace: str | Non
     max_accel = accel / radius if accel else UNLIMITED_ACCEL
     limit = _velocity_limit(doc, left.joint) if left.joint else None
     mass, inertia_z = _body_mass(doc, geo)
-    control_joints = _control_joints(doc, geo, left, right) if drive.kind == "ros_control" else {}
+    managed = drive.kind == "ros_control" or cfg.control is not None
+    control_joints = _control_joints(doc, geo, left, right) if managed else {}
     return RobotModel(
         name=geo.name or "robot",
         wheel_radius=radius,
@@ -99,6 +92,7 @@ def model_from_description(text: str, source: str, *, robot_namespace: str | Non
         warnings=warnings,
         sensor_tf=False,
         control_joints=control_joints,
+        control_beside=cfg.control,
         joint_velocity_limits={j: v for j in control_joints if (v := _velocity_limit(doc, j)) is not None},
         mass=mass,
         inertia_z=inertia_z,

@@ -56,6 +56,9 @@ class GazeboConfig:
     imu: ImuSpec | None = None
     ground_truth: GroundTruthSpec | None = None  # a p3d plugin's (Gazebo publishes none without one)
     bumper: BumperSpec | None = None  # a contact sensor's bumper plugin
+    #: gazebo_ros_control beside a plugin drive (the ROSbot's skid steer): its controller_manager runs
+    #: over the transmissions' joints all the same, so joint_state_controller publishes the wheels
+    control: DriveSpec | None = None
     materials: dict[str, tuple[int, int, int]] = field(default_factory=dict)
     ignored: list[str] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
@@ -112,6 +115,21 @@ def read_gazebo(doc: Document, geo: Geometry, robot_namespace: str | None = None
     return cfg
 
 
+def _ros_control(r: Reader, label: str, cfg: GazeboConfig, ns_override: str | None) -> DriveSpec:
+    """gazebo_ros_control's plugin: its controller_manager's namespace, period and robot parameter."""
+    ns = _namespace(r, ns_override)
+    period = r.number("controlPeriod", 0.0, minimum=0)
+    sim_type = r.text("robotSimType", "gazebo_ros_control/DefaultRobotHWSim")
+    if sim_type != "gazebo_ros_control/DefaultRobotHWSim":
+        cfg.warnings.append(f"{label}: robotSimType {sim_type}: simulated as DefaultRobotHWSim")
+    return DriveSpec.silent(
+        "ros_control",
+        update_rate=(1.0 / period) if period else None,
+        controller_namespace=topic(ns, "").rstrip("/") or "/",
+        robot_param=r.text("robotParam", "robot_description"),
+    )
+
+
 def _model_plugin(
     doc: Document, plugin: ET.Element, geo: Geometry, cfg: GazeboConfig, ns_override: str | None
 ) -> None:
@@ -119,10 +137,18 @@ def _model_plugin(
     label = f"plugin {plugin.get('name', '')} ({filename})"
     r = Reader(doc, plugin, label)
     if filename in DRIVES and cfg.drive is not None:
-        cfg.warnings.append(
-            f"{label}: a second drive plugin; the first one ({cfg.drive.kind}) drives the robot"
-        )
-        return
+        if cfg.control is None and (filename == ROS_CONTROL) != (cfg.drive.kind == "ros_control"):
+            # a plugin drive and gazebo_ros_control, in either order: the plugin drives the wheels,
+            # the controller_manager runs beside it
+            if filename == ROS_CONTROL:
+                cfg.control = _ros_control(r, label, cfg, ns_override)
+                return
+            cfg.control, cfg.drive = cfg.drive, None  # the plugin drive is read below
+        else:
+            cfg.warnings.append(
+                f"{label}: a second drive plugin; the first one ({cfg.drive.kind}) drives the robot"
+            )
+            return
     if filename == DIFF_DRIVE:
         ns = _namespace(r, ns_override)
         cfg.drive = DriveSpec(
@@ -172,23 +198,7 @@ def _model_plugin(
         _joint(r, geo, "leftRearJoint", "left_rear_joint")
         _joint(r, geo, "rightRearJoint", "right_rear_joint")
     elif filename == ROS_CONTROL:
-        ns = _namespace(r, ns_override)
-        period = r.number("controlPeriod", 0.0, minimum=0)
-        sim_type = r.text("robotSimType", "gazebo_ros_control/DefaultRobotHWSim")
-        if sim_type != "gazebo_ros_control/DefaultRobotHWSim":
-            cfg.warnings.append(f"{label}: robotSimType {sim_type}: simulated as DefaultRobotHWSim")
-        cfg.drive = DriveSpec(
-            kind="ros_control",
-            command_topic="",
-            odom_topic="",
-            publish_odom=False,
-            publish_odom_tf=False,
-            publish_wheel_joint_state=False,
-            publish_wheel_speeds=False,
-            update_rate=(1.0 / period) if period else None,
-            controller_namespace=topic(ns, "").rstrip("/") or "/",
-            robot_param=r.text("robotParam", "robot_description"),
-        )
+        cfg.drive = _ros_control(r, label, cfg, ns_override)
     elif filename == IMU_MODEL:
         body = r.text("bodyName", "")
         if not body:
@@ -321,6 +331,7 @@ def _sensor(
             lo,
             hi,
             range_resolution=s.number("ray/range/resolution", 0.0, minimum=0),
+            gazebo_fields=True,
         )
         if cfg.laser is None:
             cfg.laser = laser
@@ -363,6 +374,7 @@ def _sensor(
             f"{cam_ns}/{p.text('depthImageTopicName', 'depth/image_raw')}" if depth else None,
             f"{cam_ns}/{p.text('depthImageCameraInfoTopicName', 'depth/camera_info')}" if depth else None,
             frame_id,
+            hack_baseline=p.number("hackBaseline", 0.0),
         )
         if cfg.camera is None:
             cfg.camera = camera

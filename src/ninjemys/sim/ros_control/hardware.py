@@ -80,7 +80,11 @@ class ControlLoop:
         self.right = [j for j, side in sides.items() if side == "right"]
         #: joints that are no wheel (an arm's): moved here, kinematically, at their commanded speed
         self.free = {j: JointHandle(j) for j, side in sides.items() if not side and j}
-        ns = namespace if namespace is not None else model.drive.controller_namespace
+        #: beside a plugin drive: the wheels keep the plugin's targets unless a controller commands them
+        beside = getattr(model, "control_beside", None)  # (a stand-in model may not have one)
+        self.beside = beside is not None
+        spec = beside or model.drive
+        ns = namespace if namespace is not None else spec.controller_namespace
         self.manager = ControllerManager(node, self.hw, ns)
 
     def step(self, now: float, period: float, joints: Mapping[str, tuple[float, float]]) -> dict[str, float]:
@@ -101,6 +105,8 @@ class ControlLoop:
             h.position += h.velocity * period
         left = [commands[j] for j in self.left if j in commands]
         right = [commands[j] for j in self.right if j in commands]
+        if self.beside and not (left or right):
+            return
         robot.target = (sum(left) / len(left) if left else 0.0, sum(right) / len(right) if right else 0.0)
 
     def close(self) -> None:
