@@ -122,15 +122,23 @@ def odometry(
     return msg
 
 
-def odometry_into(msg: Any, stamp: Time, pose: tuple[float, float, float], twist: tuple[float, float]) -> Any:
-    """``msg`` (made by :func:`odometry`, same frames and covariance) at a new stamp, pose and twist.
+def odometry_into(
+    msg: Any,
+    stamp: Time,
+    pose: tuple[float, float, float],
+    twist: tuple[float, float],
+    quaternion: tuple[float, float, float, float] | None = None,
+) -> Any:
+    """``msg`` (made by :func:`odometry`, same frames and covariance) at a new stamp, pose and twist
+    (``quaternion``: the pose's yaw as a quaternion, when the caller has it already for /tf).
 
     A robot's odometry goes out at 100 Hz: its nested message (ten objects) is built once and
     refreshed in place, which publishing allows (a message is serialized when published)."""
     msg.header.stamp = stamp
     p = msg.pose.pose
     p.position.x, p.position.y = pose[0], pose[1]
-    p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w = quaternion_from_yaw(pose[2])
+    o = p.orientation
+    o.x, o.y, o.z, o.w = quaternion_from_yaw(pose[2]) if quaternion is None else quaternion
     msg.twist.twist.linear.x = twist[0]
     msg.twist.twist.angular.z = twist[1]
     return msg

@@ -61,8 +61,12 @@ def scan_angles(spec: LaserSpec) -> tuple[float, float, float]:
     return spec.angle_min, spec.angle_max, inc
 
 
+_PI = math.pi
+_TWO_PI = 2.0 * math.pi
+
+
 def wrap_angle(a: float) -> float:
-    return (a + math.pi) % (2.0 * math.pi) - math.pi
+    return (a + _PI) % _TWO_PI - _PI
 
 
 def point_segment_distance(px: np.ndarray, py: np.ndarray, segs: np.ndarray) -> np.ndarray:
@@ -183,6 +187,14 @@ class Simulation:
         """Simulated time in whole nanoseconds (message stamps), exact over any number of steps."""
         steps0, ns0 = self._since
         return ns0 + round((self.steps - steps0) * self.dt * 1e9)
+
+    def clock(self) -> tuple[float, int]:
+        """(:attr:`time`, :attr:`time_ns`) in one call (the node reads both every step)."""
+        steps0, ns0 = self._since
+        if not ns0:
+            return self.steps * self.dt, round(self.steps * self.dt * 1e9)
+        since = (self.steps - steps0) * self.dt
+        return ns0 / 1e9 + since, ns0 + round(since * 1e9)
 
     def set_time_step(self, dt: float) -> None:
         """Step ``dt`` seconds from now on (Gazebo's ``set_physics_properties`` time_step); time
@@ -820,7 +832,7 @@ class Simulation:
             elif r.contact:
                 r.contact, r.contact_with = False, ""
         r.x, r.y = nx, ny
-        r.yaw = wrap_angle(r.yaw + th)
+        r.yaw = (r.yaw + th + _PI) % _TWO_PI - _PI  # wrap_angle inlined (every step)
         if r.elevation > 0.0:
             self._drop_if_unsupported(r)
         if not r.trail or math.hypot(r.x - r.trail[-1][0], r.y - r.trail[-1][1]) > 0.02:
@@ -864,7 +876,8 @@ class Simulation:
         ax, ay = m.aside
         want = (0.0, 0.0)  # back onto the route unless a robot is in the way
         nearest = math.inf
-        for r in self.robots.values():
+        robots = self.robots.values()
+        for r in robots:
             keep = radius + r.model.body_radius + PERSONAL_SPACE + 0.1  # how far across it passes
             dx, dy = r.x - x, r.y - y
             along, lateral = dx * ux + dy * uy, dx * -uy + dy * ux
@@ -893,7 +906,10 @@ class Simulation:
             nx, ny = nx + ax + side[0], ny + ay + side[1]
             if side != (0.0, 0.0) and not self._room_for(np.array([nx]), np.array([ny]), radius):
                 continue
-            if all(self._keeps_clear(r, x, y, nx, ny, radius) for r in self.robots.values()):
+            for r in robots:
+                if not self._keeps_clear(r, x, y, nx, ny, radius):
+                    break
+            else:  # clear of every robot
                 m.walked += walk
                 m.aside = (ax + side[0], ay + side[1])
                 return
@@ -926,11 +942,12 @@ class Simulation:
         px, py, pyaw = r.odom_ref
         dx, dy = r.x - px, r.y - py
         trans = math.hypot(dx, dy)
-        rot1 = wrap_angle(math.atan2(dy, dx) - pyaw) if trans > 1e-6 else 0.0
+        # wrap_angle inlined here and below (every step)
+        rot1 = (math.atan2(dy, dx) - pyaw + _PI) % _TWO_PI - _PI if trans > 1e-6 else 0.0
         if abs(rot1) > math.pi / 2 and trans > 1e-6:  # reversing: measure rot1 against the backward heading
             rot1 = wrap_angle(rot1 + math.pi)
             trans = -trans
-        rot2 = wrap_angle(r.yaw - pyaw - rot1)
+        rot2 = (r.yaw - pyaw - rot1 + _PI) % _TWO_PI - _PI
         if a1 or a2 or a3 or a4:
             rot1_n = min(abs(rot1), abs(wrap_angle(rot1 - math.pi)))
             rot2_n = min(abs(rot2), abs(wrap_angle(rot2 - math.pi)))
@@ -940,7 +957,7 @@ class Simulation:
         ox, oy, oyaw = r.odom
         ox += trans * math.cos(oyaw + rot1)
         oy += trans * math.sin(oyaw + rot1)
-        oyaw = wrap_angle(oyaw + rot1 + rot2)
+        oyaw = (oyaw + rot1 + rot2 + _PI) % _TWO_PI - _PI
         r.odom = [ox, oy, oyaw]
         r.odom_ref = (r.x, r.y, r.yaw)
         return ox, oy, oyaw
