@@ -536,25 +536,26 @@ class SimNode:
             due = io.truth_due
             if due is not None and due.next <= soon and due.fire(now):
                 self._ground_truth(io, stamp)
+            pubs = io.pubs
             due = io.bumper_due
             if due is not None and due.next <= soon and due.fire(now):
                 self._bumper(io, stamp)
             due = io.imu_due
             if due is not None and due.next <= soon and due.fire(now):
-                self._imu(io, stamp)
+                imu = pubs.get("imu")
+                if imu is not None and (imu.publication.connections or imu.publication.intra):
+                    self._imu(io, imu, stamp)
             due = io.scan_due  # idle (nobody reads it) or due: see _scan
-            if due is not None and (due.next <= soon or not _listened(io.pubs["scan"])):
+            if due is not None and (due.next <= soon or not _listened(pubs["scan"])):
                 self._scan(io, stamp, now, view)
             due = io.camera_due
             if due is not None and due.next <= soon and due.fire(now):
-                pubs = io.pubs
-                want = any(
-                    pubs[k].get_num_connections()
-                    for k in ("image", "image_compressed", "depth", "color_info", "depth_info")
-                    if k in pubs
-                )
-                if want:  # a browser view watches the cameras as ROS topics too (through its gateway)
-                    self._camera(io, stamp)
+                for key in ("image", "image_compressed", "depth", "color_info", "depth_info"):
+                    pub = pubs.get(key)
+                    if pub is not None and pub.get_num_connections():
+                        # a browser view watches the cameras as ROS topics too (through its gateway)
+                        self._camera(io, stamp)
+                        break
             for extra in io.extras:
                 if extra.due.fire(now):
                     self._extra_sensor(io, extra, stamp)
@@ -566,9 +567,9 @@ class SimNode:
         if view is not None:
             view.publish(now)
 
-    def _imu(self, io: RobotIO, stamp: Time) -> None:
-        imu, spec = io.pubs.get("imu"), io.robot.model.imu
-        if imu is not None and spec is not None and _listened(imu):
+    def _imu(self, io: RobotIO, imu: Any, stamp: Time) -> None:
+        spec = io.robot.model.imu
+        if spec is not None:
             imu.publish(messages.imu(stamp, io.frame(spec.pose.frame), spec, self.sim.imu(io.robot)))
 
     def _scan(self, io: RobotIO, stamp: Time, now: float, view: Any) -> None:
@@ -618,15 +619,16 @@ class SimNode:
             else:
                 messages.odometry_into(io.odom_msg, stamp, pose, (r.v, r.w), q)
             odom.publish(io.odom_msg)
-        if io.truth_due is None:
+        truth = pubs.get("ground_truth")
+        if truth is not None and io.truth_due is None and _listened(truth):
             self._ground_truth(io, stamp)
         wl, wr = pubs.get("wl"), pubs.get("wr")
-        if wl is not None and _listened(wl):
+        if wl is not None and (wl.publication.connections or wl.publication.intra):
             wl.publish(Float32(data=r.wl))
-        if wr is not None and _listened(wr):
+        if wr is not None and (wr.publication.connections or wr.publication.intra):
             wr.publish(Float32(data=r.wr))
         js = pubs.get("joint_states")
-        if js is not None and _listened(js):
+        if js is not None and (js.publication.connections or js.publication.intra):
             positions, speeds = [r.left_angle, r.right_angle], [r.wl, r.wr]
             if io.joints_msg is None:
                 joints = [r.model.left_joint, r.model.right_joint]

@@ -768,27 +768,33 @@ class Simulation:
         return touched
 
     def _move(self, r: Robot, dt: float) -> bool:
+        # the state read into locals once (every step of every robot): the same arithmetic, fewer lookups
         m = r.model
         step = m.max_wheel_accel * dt
         target_wl, target_wr = r.target
-        r.wl += min(max(target_wl - r.wl, -step), step)
-        r.wr += min(max(target_wr - r.wr, -step), step)
-        v = m.wheel_radius * (r.wr + r.wl) / 2.0
-        w = m.wheel_radius * (r.wr - r.wl) / m.wheel_separation
+        wl, wr = r.wl, r.wr
+        dl, dr = target_wl - wl, target_wr - wr  # each change clamped to +-step (as min(max(d, -step), step))
+        wl += -step if dl < -step else (step if dl > step else dl)
+        wr += -step if dr < -step else (step if dr > step else dr)
+        r.wl, r.wr = wl, wr
+        radius_w = m.wheel_radius
+        v = radius_w * (wr + wl) / 2.0
+        w = radius_w * (wr - wl) / m.wheel_separation
         r.v_prev = r.v
         r.v, r.w = v, w
-        r.left_angle += r.wl * dt
-        r.right_angle += r.wr * dt
+        r.left_angle += wl * dt
+        r.right_angle += wr * dt
         if v == 0.0 and w == 0.0:
             return False
         th = w * dt
+        x, y, yaw = r.x, r.y, r.yaw
         if abs(th) > 1e-9:
-            nx = r.x + v / w * (math.sin(r.yaw + th) - math.sin(r.yaw))
-            ny = r.y - v / w * (math.cos(r.yaw + th) - math.cos(r.yaw))
+            nx = x + v / w * (math.sin(yaw + th) - math.sin(yaw))
+            ny = y - v / w * (math.cos(yaw + th) - math.cos(yaw))
         else:
-            nx = r.x + v * dt * math.cos(r.yaw)
-            ny = r.y + v * dt * math.sin(r.yaw)
-        ddx, ddy = nx - r.x, ny - r.y
+            nx = x + v * dt * math.cos(yaw)
+            ny = y + v * dt * math.sin(yaw)
+        ddx, ddy = nx - x, ny - y
         travel = math.hypot(ddx, ddy)
         new_contact = False
         if travel > 0:
@@ -796,7 +802,7 @@ class Simulation:
             static = not self._static_free(r, nx, ny)
             reach = travel + radius + 0.05
             geometry: tuple | None
-            if not static and len(self.robots) == 1 and not self._any_mover_near(r.x, r.y, reach):
+            if not static and len(self.robots) == 1 and not self._any_mover_near(x, y, reach):
                 # alone, inside its free disk, no moving obstacle within reach (the common step):
                 # what _collision_geometry would find is nothing, so nothing is built
                 geometry = None
@@ -832,11 +838,12 @@ class Simulation:
             elif r.contact:
                 r.contact, r.contact_with = False, ""
         r.x, r.y = nx, ny
-        r.yaw = (r.yaw + th + _PI) % _TWO_PI - _PI  # wrap_angle inlined (every step)
+        r.yaw = (yaw + th + _PI) % _TWO_PI - _PI  # wrap_angle inlined (every step)
         if r.elevation > 0.0:
-            self._drop_if_unsupported(r)
-        if not r.trail or math.hypot(r.x - r.trail[-1][0], r.y - r.trail[-1][1]) > 0.02:
-            r.trail.append((round(r.x, 3), round(r.y, 3)))
+            self._drop_if_unsupported(r)  # a fall changes the level, not x and y
+        trail = r.trail
+        if not trail or math.hypot(nx - trail[-1][0], ny - trail[-1][1]) > 0.02:
+            trail.append((round(nx, 3), round(ny, 3)))
             r.trail_count += 1
         return new_contact
 
@@ -897,9 +904,17 @@ class Simulation:
         reach = m.speed * dt
         gx, gy = want[0] - ax, want[1] - ay
         g = math.hypot(gx, gy)
-        step_aside = (gx * min(1.0, reach / g), gy * min(1.0, reach / g)) if g > 1e-9 else (0.0, 0.0)
-        # forward and aside, aside only, forward only: the first that keeps clear of every robot
-        for walk, side in ((reach, step_aside), (0.0, step_aside), (reach, (0.0, 0.0))):
+        if g > 1e-9:
+            step_aside = (gx * min(1.0, reach / g), gy * min(1.0, reach / g))
+            # forward and aside, aside only, forward only: the first that keeps clear of every robot
+            candidates: tuple[tuple[float, tuple[float, float]], ...] = (
+                (reach, step_aside),
+                (0.0, step_aside),
+                (reach, (0.0, 0.0)),
+            )
+        else:  # no step aside (the common step): forward is the one candidate the three come to
+            candidates = ((reach, (0.0, 0.0)),)
+        for walk, side in candidates:
             if walk == 0.0 and side == (0.0, 0.0):
                 continue
             nx, ny, _ = m.route_pose(m.walked + walk)
