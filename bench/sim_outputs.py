@@ -28,9 +28,8 @@ import time
 import xmlrpc.client
 from pathlib import Path
 
-from sim_gazebo import URDF_MODEL, default_before, extract_tree, short_rev
-
 from ninjemys.testing import run_master
+from sim_gazebo import URDF_MODEL, default_before, extract_tree, short_rev
 
 #: the simulator's node name (the shipped launch's default)
 SIM_NODE = "/puzzlebot_sim"
@@ -39,7 +38,9 @@ SIM_NODE = "/puzzlebot_sim"
 STAMP_AT = {"/clock": 0, "/tf": 8}
 
 
-def record(src: Path | None, secs: float, rate: float, only: set[str] | None = None) -> tuple[dict[str, list[bytes]], set[str]]:
+def record(
+    src: Path | None, secs: float, rate: float, only: set[str] | None = None
+) -> tuple[dict[str, list[bytes]], set[str]]:
     """Every topic's payloads, in order, the stamped ones over the first ``secs`` simulated seconds,
     and which topics are stamped (``src``: that tree's ``src`` on PYTHONPATH; None: this tree;
     ``only``: subscribe to these topics alone, /clock always: what nobody reads is not computed)."""
