@@ -727,8 +727,10 @@ class GazeboApi:
                 self.sn.log.warn("robot [%s] pushed into an obstacle: stopped", name)
 
     def after_step(self, stamp: Time) -> None:
-        """Publish /gazebo/model_states and /gazebo/link_states to whoever listens."""
-        if self.model_states_pub.get_num_connections():
+        """Publish /gazebo/model_states and /gazebo/link_states to whoever listens (every step: who
+        listens is read from the publications' connection tuples, without a call)."""
+        model_pub, link_pub = self.model_states_pub.publication, self.link_states_pub.publication
+        if model_pub.connections or model_pub.intra:
             names = self.model_names()
             poses = [self.model_pose(n) for n in names]
             self.model_states_pub.publish(
@@ -738,7 +740,7 @@ class GazeboApi:
                     twist=[_twist_msg(*self.model_twist(n)) for n in names],
                 )
             )
-        if self.link_states_pub.get_num_connections():
+        if link_pub.connections or link_pub.intra:
             names, poses, twists = [], [], []
             for model in self.model_names():
                 links = self.links(model) or {}

@@ -18,7 +18,11 @@ from ninjemys.idl.loader import get_message_class
 from ninjemys.rostime import Time
 from ninjemys.sim.robot_model import CameraSpec, ImuSpec, LaserSpec, RobotModel
 from ninjemys.sim.simcore import scan_angles
-from ninjemys.tf2.math import quaternion_from_rpy, quaternion_from_yaw
+from ninjemys.tf2.math import Quaternion, quaternion_from_rpy, quaternion_from_yaw
+
+#: a planar pose (x, y, yaw) and a planar twist (v, w)
+Pose2D = tuple[float, float, float]
+Twist2D = tuple[float, float]
 
 TransformStamped: Any = get_message_class("geometry_msgs/TransformStamped")
 JointState: Any = get_message_class("sensor_msgs/JointState")
@@ -105,14 +109,9 @@ def odometry(
     """nav_msgs/Odometry at (x, y, yaw) moving at (v, w); ``alpha`` (amcl's noise) sets the
     covariance of an odometry estimate, None gives ground truth (no covariance)."""
     msg = Odometry()
-    msg.header.stamp = stamp
     msg.header.frame_id = frame
     msg.child_frame_id = child
-    p = msg.pose.pose
-    p.position.x, p.position.y = pose[0], pose[1]
-    p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w = quaternion_from_yaw(pose[2])
-    msg.twist.twist.linear.x = twist[0]
-    msg.twist.twist.angular.z = twist[1]
+    odometry_into(msg, stamp, pose, twist)
     if alpha is not None:
         a1, _a2, a3, _a4 = alpha
         var_xy = 1e-4 + a3 * 0.01
@@ -122,15 +121,19 @@ def odometry(
     return msg
 
 
-def odometry_into(msg: Any, stamp: Time, pose: tuple[float, float, float], twist: tuple[float, float]) -> Any:
-    """``msg`` (made by :func:`odometry`, same frames and covariance) at a new stamp, pose and twist.
+def odometry_into(
+    msg: Any, stamp: Time, pose: Pose2D, twist: Twist2D, quaternion: Quaternion | None = None
+) -> Any:
+    """``msg`` (made by :func:`odometry`, same frames and covariance) at a new stamp, pose and twist
+    (``quaternion``: the pose's yaw as a quaternion, when the caller has it already for /tf).
 
     A robot's odometry goes out at 100 Hz: its nested message (ten objects) is built once and
     refreshed in place, which publishing allows (a message is serialized when published)."""
     msg.header.stamp = stamp
     p = msg.pose.pose
     p.position.x, p.position.y = pose[0], pose[1]
-    p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w = quaternion_from_yaw(pose[2])
+    o = p.orientation
+    o.x, o.y, o.z, o.w = quaternion_from_yaw(pose[2]) if quaternion is None else quaternion
     msg.twist.twist.linear.x = twist[0]
     msg.twist.twist.angular.z = twist[1]
     return msg

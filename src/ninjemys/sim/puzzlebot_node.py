@@ -137,6 +137,8 @@ class RobotIO:
     #: refreshed in place after that (as ``odom_msg``)
     odom_tf: Any = None
     joints_msg: Any = None
+    #: the ground truth's nav_msgs/Odometry, refreshed in place (as ``odom_msg``)
+    truth_msg: Any = None
 
     def frame(self, name: str) -> str:
         return scoped(self.frame_prefix, name)
@@ -162,6 +164,13 @@ def scoped(prefix: str, name: str) -> str:
         return name
     inner = name.lstrip("/")
     return name if inner.startswith(prefix) else prefix + inner
+
+
+def _listened(pub: Any) -> bool:
+    """Whether someone subscribes to ``pub`` now: its publication's connection tuples (replaced
+    whole when a subscriber comes or goes), read without the calls of ``get_num_connections``."""
+    publication = pub.publication
+    return bool(publication.connections or publication.intra)
 
 
 def _period(rate: float | None, default: float, dt: float) -> float:
@@ -195,6 +204,7 @@ class SimNode:
         self.view: Any = None
         self.clock_pub = node.publisher("/clock", Clock, queue_size=10)
         self.tf_pub = node.publisher("/tf", TFMessage, queue_size=100)
+        self._tf_msg = TFMessage()  # each step's /tf: its transforms replaced, the message kept
         #: advertised with the first static transform (a Gazebo description's come from robot_state_publisher)
         self.tf_static_pub: Any = None
         self.gazebo = GazeboApi(self)
@@ -391,11 +401,16 @@ class SimNode:
     def _ground_truth(self, io: RobotIO, stamp: Time) -> None:
         """The true pose: ours in ``map`` (Stage's way), a p3d plugin's in its frameName, for its bodyName."""
         pub, spec, r = io.pubs.get("ground_truth"), io.robot.model.ground_truth, io.robot
-        if pub is None or spec is None or not pub.get_num_connections():
+        if pub is None or spec is None or not _listened(pub):
             return
-        own = r.model.sensor_tf  # our own description: frames under the robot's prefix
-        frame, body = (WORLD_FRAME, io.frame(spec.body)) if own else (spec.frame, spec.body)
-        pub.publish(messages.odometry(stamp, frame, body, (r.x, r.y, r.yaw), (r.v, r.w)))
+        pose, twist = (r.x, r.y, r.yaw), (r.v, r.w)
+        if io.truth_msg is None:
+            own = r.model.sensor_tf  # our own description: frames under the robot's prefix
+            frame, body = (WORLD_FRAME, io.frame(spec.body)) if own else (spec.frame, spec.body)
+            io.truth_msg = messages.odometry(stamp, frame, body, pose, twist)
+        else:
+            messages.odometry_into(io.truth_msg, stamp, pose, twist)
+        pub.publish(io.truth_msg)
 
     def _bumper(self, io: RobotIO, stamp: Time) -> None:
         """gazebo_ros_bumper: every update, the contacts of the watched collision (none: an empty list)."""
@@ -478,29 +493,36 @@ class SimNode:
         try:
             self._publish_step()
         finally:
-            self._scenes.clear()  # the world moves on: no scene outlives its step
+            if self._scenes:
+                self._scenes.clear()  # the world moves on: no scene outlives its step
 
     def _publish_step(self) -> None:
-        sim = self.sim
-        self.gazebo.before_step()
-        for io in self.io.values():
+        sim, gazebo = self.sim, self.gazebo
+        if gazebo.pushes:
+            gazebo.before_step()
+        ios = self.io.values()
+        for io in ios:
             if io.control is not None:
                 io.control.step_robot(io.robot, sim.time, sim.dt)
         touched = sim.step()
-        now = sim.time
-        secs, nsecs = divmod(sim.time_ns, 1_000_000_000)
+        now, ns = sim.clock()
+        secs, nsecs = divmod(ns, 1_000_000_000)
         stamp = Time._raw(secs, nsecs)  # _stamp() inlined (every step)
-        if self.clock_pub.get_num_connections() and self._clock_due(now):  # nobody listening: nothing
+        # who listens is read from each publication's connection tuples, without a call (every step)
+        clock = self.clock_pub.publication
+        if (clock.connections or clock.intra) and self._clock_due(now):  # nobody listening: nothing
             # rosgraph_msgs/Clock is two uint32s: its frame is packed here, with no message object
             self.clock_pub.publish_framed(_CLOCK_FRAME(8, secs, nsecs))
         for r in touched:
             self.log.warn(
                 "robot [%s] hit '%s' at (%.3f, %.3f): stopped at contact", r.name, r.contact_with, r.x, r.y
             )
-        tfs: list[Any] | None = [] if self.tf_pub.get_num_connections() else None
+        tf = self.tf_pub.publication
+        tfs: list[Any] | None = [] if tf.connections or tf.intra else None
         view = self.view  # one read: the browser view attaches while the simulation runs
         timeout = self.cmd_timeout
-        for io in self.io.values():
+        soon = now + 1e-9  # Due.fire's test, made here first: most outputs are not due at most steps
+        for io in ios:
             r = io.robot
             last = io.last_cmd
             if timeout > 0 and last is not None and not 0.0 <= now - last <= timeout:
@@ -508,53 +530,63 @@ class SimNode:
                 r.command(0.0, 0.0)
             if io.last_contact != r.contact:
                 self._publish_contact(io)
-            pubs = io.pubs
             due = io.odom_due
-            if due is not None and due.fire(now):
+            if due is not None and due.next <= soon and due.fire(now):
                 self._odometry(io, stamp, tfs)
             due = io.truth_due
-            if due is not None and due.fire(now):
+            if due is not None and due.next <= soon and due.fire(now):
                 self._ground_truth(io, stamp)
+            pubs = io.pubs
             due = io.bumper_due
-            if due is not None and due.fire(now):
+            if due is not None and due.next <= soon and due.fire(now):
                 self._bumper(io, stamp)
             due = io.imu_due
-            if due is not None and due.fire(now):
-                imu, imu_spec = pubs.get("imu"), r.model.imu
-                if imu is not None and imu_spec is not None and imu.get_num_connections():
-                    imu.publish(messages.imu(stamp, io.frame(imu_spec.pose.frame), imu_spec, sim.imu(r)))
-            due = io.scan_due
-            if due is not None:
-                laser = r.model.laser
-                if laser is not None:
-                    scan = pubs["scan"]
-                    subscribed = scan.get_num_connections()
-                    if not subscribed and not (view is not None and view.wants_scans()):
-                        due.next = now  # idle: a new subscriber's first scan goes out at once
-                    elif due.fire(now):
-                        ranges = sim.scan(r, scene=self._scene(r, solid_only=True))
-                        io.last_scan = ranges
-                        if subscribed:
-                            scan.publish(
-                                messages.laser_scan(stamp, io.frame(laser.pose.frame), laser, ranges)
-                            )
+            if due is not None and due.next <= soon and due.fire(now):
+                imu = pubs.get("imu")
+                if imu is not None and (imu.publication.connections or imu.publication.intra):
+                    self._imu(io, imu, stamp)
+            due = io.scan_due  # idle (nobody reads it) or due: see _scan
+            if due is not None and (due.next <= soon or not _listened(pubs["scan"])):
+                self._scan(io, stamp, now, view)
             due = io.camera_due
-            if due is not None and due.fire(now):
-                want = any(
-                    pubs[k].get_num_connections()
-                    for k in ("image", "image_compressed", "depth", "color_info", "depth_info")
-                    if k in pubs
-                )
-                if want:  # a browser view watches the cameras as ROS topics too (through its gateway)
-                    self._camera(io, stamp)
+            if due is not None and due.next <= soon and due.fire(now):
+                for key in ("image", "image_compressed", "depth", "color_info", "depth_info"):
+                    pub = pubs.get(key)
+                    if pub is not None and pub.get_num_connections():
+                        # a browser view watches the cameras as ROS topics too (through its gateway)
+                        self._camera(io, stamp)
+                        break
             for extra in io.extras:
                 if extra.due.fire(now):
                     self._extra_sensor(io, extra, stamp)
         if tfs:
-            self.tf_pub.publish(TFMessage(transforms=tfs))
-        self.gazebo.after_step(stamp)
+            tf_msg = self._tf_msg  # one message, its list of transforms replaced each step
+            tf_msg.transforms = tfs
+            self.tf_pub.publish(tf_msg)
+        gazebo.after_step(stamp)
         if view is not None:
             view.publish(now)
+
+    def _imu(self, io: RobotIO, imu: Any, stamp: Time) -> None:
+        spec = io.robot.model.imu
+        if spec is not None:
+            imu.publish(messages.imu(stamp, io.frame(spec.pose.frame), spec, self.sim.imu(io.robot)))
+
+    def _scan(self, io: RobotIO, stamp: Time, now: float, view: Any) -> None:
+        """The lidar's scan when due, to its subscribers and the browser view (nobody: not cast)."""
+        r, due = io.robot, io.scan_due
+        laser = r.model.laser
+        if laser is None or due is None:
+            return
+        scan = io.pubs["scan"]
+        subscribed = _listened(scan)
+        if not subscribed and not (view is not None and view.wants_scans()):
+            due.next = now  # idle: a new subscriber's first scan goes out at once
+        elif due.fire(now):
+            ranges = self.sim.scan(r, scene=self._scene(r, solid_only=True))
+            io.last_scan = ranges
+            if subscribed:
+                scan.publish(messages.laser_scan(stamp, io.frame(laser.pose.frame), laser, ranges))
 
     def _clock_due(self, now: float) -> bool:
         """Whether /clock goes out this step: every step, or with ``clock_period`` set, once that much
@@ -575,26 +607,28 @@ class SimNode:
         if drive.odometry_source == "world":
             pose = (r.x, r.y, r.yaw)  # gazebo_ros_diff_drive's odometrySource world: the true pose
         else:
-            pose = self.sim.odometry(r)
-        odom_frame, base_frame = io.odom_frame_id, io.base_frame_id
+            pose = self.sim.odometry(r)  # advanced whoever listens: its noise draws are the same
+        q = None
         odom = pubs.get("odom")
-        if odom is not None and odom.get_num_connections():
+        if odom is not None and (odom.publication.connections or odom.publication.intra):
+            q = quaternion_from_yaw(pose[2])
             if io.odom_msg is None:
                 io.odom_msg = messages.odometry(
-                    stamp, odom_frame, base_frame, pose, (r.v, r.w), r.model.odom_alpha
+                    stamp, io.odom_frame_id, io.base_frame_id, pose, (r.v, r.w), r.model.odom_alpha
                 )
             else:
-                messages.odometry_into(io.odom_msg, stamp, pose, (r.v, r.w))
+                messages.odometry_into(io.odom_msg, stamp, pose, (r.v, r.w), q)
             odom.publish(io.odom_msg)
-        if io.truth_due is None:
+        truth = pubs.get("ground_truth")
+        if truth is not None and io.truth_due is None and _listened(truth):
             self._ground_truth(io, stamp)
         wl, wr = pubs.get("wl"), pubs.get("wr")
-        if wl is not None and wl.get_num_connections():
+        if wl is not None and (wl.publication.connections or wl.publication.intra):
             wl.publish(Float32(data=r.wl))
-        if wr is not None and wr.get_num_connections():
+        if wr is not None and (wr.publication.connections or wr.publication.intra):
             wr.publish(Float32(data=r.wr))
         js = pubs.get("joint_states")
-        if js is not None and js.get_num_connections():
+        if js is not None and (js.publication.connections or js.publication.intra):
             positions, speeds = [r.left_angle, r.right_angle], [r.wl, r.wr]
             if io.joints_msg is None:
                 joints = [r.model.left_joint, r.model.right_joint]
@@ -605,9 +639,11 @@ class SimNode:
         if tfs is None or drive.kind == "none":
             return
         if drive.publish_odom_tf:
-            xyz, q = (pose[0], pose[1], 0.0), quaternion_from_yaw(pose[2])
+            xyz = (pose[0], pose[1], 0.0)
+            if q is None:
+                q = quaternion_from_yaw(pose[2])
             if io.odom_tf is None:
-                io.odom_tf = messages.transform(stamp, odom_frame, base_frame, xyz, q)
+                io.odom_tf = messages.transform(stamp, io.odom_frame_id, io.base_frame_id, xyz, q)
             else:
                 messages.transform_into(io.odom_tf, stamp, xyz, q)
             tfs.append(io.odom_tf)

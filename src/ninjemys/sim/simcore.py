@@ -61,8 +61,12 @@ def scan_angles(spec: LaserSpec) -> tuple[float, float, float]:
     return spec.angle_min, spec.angle_max, inc
 
 
+_PI = math.pi
+_TWO_PI = 2.0 * math.pi
+
+
 def wrap_angle(a: float) -> float:
-    return (a + math.pi) % (2.0 * math.pi) - math.pi
+    return (a + _PI) % _TWO_PI - _PI
 
 
 def point_segment_distance(px: np.ndarray, py: np.ndarray, segs: np.ndarray) -> np.ndarray:
@@ -183,6 +187,14 @@ class Simulation:
         """Simulated time in whole nanoseconds (message stamps), exact over any number of steps."""
         steps0, ns0 = self._since
         return ns0 + round((self.steps - steps0) * self.dt * 1e9)
+
+    def clock(self) -> tuple[float, int]:
+        """(:attr:`time`, :attr:`time_ns`) in one call (the node reads both every step)."""
+        steps0, ns0 = self._since
+        if not ns0:
+            return self.steps * self.dt, round(self.steps * self.dt * 1e9)
+        since = (self.steps - steps0) * self.dt
+        return ns0 / 1e9 + since, ns0 + round(since * 1e9)
 
     def set_time_step(self, dt: float) -> None:
         """Step ``dt`` seconds from now on (Gazebo's ``set_physics_properties`` time_step); time
@@ -756,27 +768,33 @@ class Simulation:
         return touched
 
     def _move(self, r: Robot, dt: float) -> bool:
+        # the state read into locals once (every step of every robot): the same arithmetic, fewer lookups
         m = r.model
         step = m.max_wheel_accel * dt
         target_wl, target_wr = r.target
-        r.wl += min(max(target_wl - r.wl, -step), step)
-        r.wr += min(max(target_wr - r.wr, -step), step)
-        v = m.wheel_radius * (r.wr + r.wl) / 2.0
-        w = m.wheel_radius * (r.wr - r.wl) / m.wheel_separation
+        wl, wr = r.wl, r.wr
+        dl, dr = target_wl - wl, target_wr - wr  # each change clamped to +-step (as min(max(d, -step), step))
+        wl += -step if dl < -step else (step if dl > step else dl)
+        wr += -step if dr < -step else (step if dr > step else dr)
+        r.wl, r.wr = wl, wr
+        radius_w = m.wheel_radius
+        v = radius_w * (wr + wl) / 2.0
+        w = radius_w * (wr - wl) / m.wheel_separation
         r.v_prev = r.v
         r.v, r.w = v, w
-        r.left_angle += r.wl * dt
-        r.right_angle += r.wr * dt
+        r.left_angle += wl * dt
+        r.right_angle += wr * dt
         if v == 0.0 and w == 0.0:
             return False
         th = w * dt
+        x, y, yaw = r.x, r.y, r.yaw
         if abs(th) > 1e-9:
-            nx = r.x + v / w * (math.sin(r.yaw + th) - math.sin(r.yaw))
-            ny = r.y - v / w * (math.cos(r.yaw + th) - math.cos(r.yaw))
+            nx = x + v / w * (math.sin(yaw + th) - math.sin(yaw))
+            ny = y - v / w * (math.cos(yaw + th) - math.cos(yaw))
         else:
-            nx = r.x + v * dt * math.cos(r.yaw)
-            ny = r.y + v * dt * math.sin(r.yaw)
-        ddx, ddy = nx - r.x, ny - r.y
+            nx = x + v * dt * math.cos(yaw)
+            ny = y + v * dt * math.sin(yaw)
+        ddx, ddy = nx - x, ny - y
         travel = math.hypot(ddx, ddy)
         new_contact = False
         if travel > 0:
@@ -784,7 +802,7 @@ class Simulation:
             static = not self._static_free(r, nx, ny)
             reach = travel + radius + 0.05
             geometry: tuple | None
-            if not static and len(self.robots) == 1 and not self._any_mover_near(r.x, r.y, reach):
+            if not static and len(self.robots) == 1 and not self._any_mover_near(x, y, reach):
                 # alone, inside its free disk, no moving obstacle within reach (the common step):
                 # what _collision_geometry would find is nothing, so nothing is built
                 geometry = None
@@ -820,11 +838,12 @@ class Simulation:
             elif r.contact:
                 r.contact, r.contact_with = False, ""
         r.x, r.y = nx, ny
-        r.yaw = wrap_angle(r.yaw + th)
+        r.yaw = (yaw + th + _PI) % _TWO_PI - _PI  # wrap_angle inlined (every step)
         if r.elevation > 0.0:
-            self._drop_if_unsupported(r)
-        if not r.trail or math.hypot(r.x - r.trail[-1][0], r.y - r.trail[-1][1]) > 0.02:
-            r.trail.append((round(r.x, 3), round(r.y, 3)))
+            self._drop_if_unsupported(r)  # a fall changes the level, not x and y
+        trail = r.trail
+        if not trail or math.hypot(nx - trail[-1][0], ny - trail[-1][1]) > 0.02:
+            trail.append((round(nx, 3), round(ny, 3)))
             r.trail_count += 1
         return new_contact
 
@@ -864,7 +883,8 @@ class Simulation:
         ax, ay = m.aside
         want = (0.0, 0.0)  # back onto the route unless a robot is in the way
         nearest = math.inf
-        for r in self.robots.values():
+        robots = self.robots.values()
+        for r in robots:
             keep = radius + r.model.body_radius + PERSONAL_SPACE + 0.1  # how far across it passes
             dx, dy = r.x - x, r.y - y
             along, lateral = dx * ux + dy * uy, dx * -uy + dy * ux
@@ -884,16 +904,27 @@ class Simulation:
         reach = m.speed * dt
         gx, gy = want[0] - ax, want[1] - ay
         g = math.hypot(gx, gy)
-        step_aside = (gx * min(1.0, reach / g), gy * min(1.0, reach / g)) if g > 1e-9 else (0.0, 0.0)
-        # forward and aside, aside only, forward only: the first that keeps clear of every robot
-        for walk, side in ((reach, step_aside), (0.0, step_aside), (reach, (0.0, 0.0))):
+        if g > 1e-9:
+            step_aside = (gx * min(1.0, reach / g), gy * min(1.0, reach / g))
+            # forward and aside, aside only, forward only: the first that keeps clear of every robot
+            candidates: tuple[tuple[float, tuple[float, float]], ...] = (
+                (reach, step_aside),
+                (0.0, step_aside),
+                (reach, (0.0, 0.0)),
+            )
+        else:  # no step aside (the common step): forward is the one candidate the three come to
+            candidates = ((reach, (0.0, 0.0)),)
+        for walk, side in candidates:
             if walk == 0.0 and side == (0.0, 0.0):
                 continue
             nx, ny, _ = m.route_pose(m.walked + walk)
             nx, ny = nx + ax + side[0], ny + ay + side[1]
             if side != (0.0, 0.0) and not self._room_for(np.array([nx]), np.array([ny]), radius):
                 continue
-            if all(self._keeps_clear(r, x, y, nx, ny, radius) for r in self.robots.values()):
+            for r in robots:
+                if not self._keeps_clear(r, x, y, nx, ny, radius):
+                    break
+            else:  # clear of every robot
                 m.walked += walk
                 m.aside = (ax + side[0], ay + side[1])
                 return
@@ -926,11 +957,12 @@ class Simulation:
         px, py, pyaw = r.odom_ref
         dx, dy = r.x - px, r.y - py
         trans = math.hypot(dx, dy)
-        rot1 = wrap_angle(math.atan2(dy, dx) - pyaw) if trans > 1e-6 else 0.0
+        # wrap_angle inlined here and below (every step)
+        rot1 = (math.atan2(dy, dx) - pyaw + _PI) % _TWO_PI - _PI if trans > 1e-6 else 0.0
         if abs(rot1) > math.pi / 2 and trans > 1e-6:  # reversing: measure rot1 against the backward heading
             rot1 = wrap_angle(rot1 + math.pi)
             trans = -trans
-        rot2 = wrap_angle(r.yaw - pyaw - rot1)
+        rot2 = (r.yaw - pyaw - rot1 + _PI) % _TWO_PI - _PI
         if a1 or a2 or a3 or a4:
             rot1_n = min(abs(rot1), abs(wrap_angle(rot1 - math.pi)))
             rot2_n = min(abs(rot2), abs(wrap_angle(rot2 - math.pi)))
@@ -940,7 +972,7 @@ class Simulation:
         ox, oy, oyaw = r.odom
         ox += trans * math.cos(oyaw + rot1)
         oy += trans * math.sin(oyaw + rot1)
-        oyaw = wrap_angle(oyaw + rot1 + rot2)
+        oyaw = (oyaw + rot1 + rot2 + _PI) % _TWO_PI - _PI
         r.odom = [ox, oy, oyaw]
         r.odom_ref = (r.x, r.y, r.yaw)
         return ox, oy, oyaw

@@ -155,25 +155,27 @@ class Stepper:
         self._started = (time.monotonic(), time.process_time())
         wall0 = time.monotonic()
         sim0 = self._sim_time()
-        while not self._stop.is_set():
-            with self.lock.stepping:
-                paused = self.paused
+        stepping, stopped, step = self.lock.stepping, self._stop.is_set, self._step
+        while not stopped():
+            try:
+                # the pause flag is read under the same hold of the lock as the step (one hold a step)
+                with stepping:
+                    paused = self.paused
+                    if not paused:
+                        if self._rebase or self._sim_time() < sim0:  # a new rate, or reset_simulation
+                            self._rebase = False
+                            wall0, sim0 = time.monotonic(), self._sim_time()
+                        step()
+                        self.stepped += self.dt
+            except ShutdownError:
+                return  # the node shut down under the stepping thread
+            except Exception as exc:  # a bug in one step must not freeze the simulation for good
+                self._on_error(exc)
             if paused:
                 self._wake.wait(0.5)
                 self._wake.clear()
                 wall0, sim0 = time.monotonic(), self._sim_time()
                 continue
-            try:
-                with self.lock.stepping:
-                    if self._rebase or self._sim_time() < sim0:  # a new rate, or reset_simulation
-                        self._rebase = False
-                        wall0, sim0 = time.monotonic(), self._sim_time()
-                    self._step()
-                    self.stepped += self.dt
-            except ShutdownError:
-                return  # the node shut down under the stepping thread
-            except Exception as exc:  # a bug in one step must not freeze the simulation for good
-                self._on_error(exc)
             if self.rate <= 0:
                 self.lock.give_way(0.5)  # as fast as possible, yet services and the view get the lock
             else:

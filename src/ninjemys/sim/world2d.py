@@ -165,6 +165,7 @@ class MovingObstacle:
             for a, b in zip(path[:-1], path[1:], strict=True)
         ]
         self._total = sum(leg[4] for leg in self._legs)
+        self._first = pts[0] if pts else (0.0, 0.0)  # the first waypoint, as floats
         #: the last pose :meth:`route_pose` gave and for how far along: the step's collision
         #: checks and the sensors' scenes ask for the same one several times a step
         self._pose_at: tuple[float, tuple[float, float, float]] | None = None
@@ -187,7 +188,7 @@ class MovingObstacle:
         return pose
 
     def _route_pose(self, travelled: float) -> tuple[float, float, float]:
-        x0, y0 = float(self.waypoints[0, 0]), float(self.waypoints[0, 1])
+        x0, y0 = self._first
         if self.speed <= 0 or self._total <= 0:
             return x0, y0, 0.0
         s = travelled % self._total
