@@ -21,8 +21,10 @@ A camera that has not moved in an unchanged scene returns the images it drew las
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import math
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -120,6 +122,8 @@ class Camera:
         self._rise: tuple[np.ndarray, np.ndarray | None, np.ndarray] | None = None
         self._row_offsets = np.array([[self.cy], [self.cy + 1.0]])
         self._still: _SceneCopy | None = None
+        #: the arrays the next frames are drawn into (see drawing_into)
+        self._into: tuple[np.ndarray | None, np.ndarray | None] = (None, None)
 
     def render(
         self,
@@ -135,22 +139,60 @@ class Camera:
         ``colour=False`` or ``depth=False`` leaves that image out (an empty array in its place):
         a camera whose depth stream nobody reads (or that has none) does not draw it. The arrays
         returned are not changed afterwards (a camera that stood still returns the same ones again).
+        Inside :meth:`drawing_into` the images are drawn into (and returned as) the arrays given there.
         """
         key = (x, y, yaw, colour, depth)
+        into = self._into
+        out = (into[0] if colour else None, into[1] if depth else None)
         last = self._last
         if last is not None and last[0] == key:
             # the camera stood still: the scene is compared with a copy taken at the previous frame
             if self._still is not None and self._still.same(scene):
-                return last[1]
+                if out[0] is None and out[1] is None:
+                    return last[1]
+                images = _copied_into(last[1], out)
+                self._last = (key, images)
+                return images
             self._still = _SceneCopy(scene)
         else:
             self._still = None
-        images = self._render(scene, x, y, yaw, colour, depth)
+        images = self._render(scene, x, y, yaw, colour, depth, out)
         self._last = (key, images)
         return images
 
+    @contextlib.contextmanager
+    def drawing_into(self, rgb: np.ndarray | None, depth: np.ndarray | None) -> Iterator[None]:
+        """Draw the frames rendered inside the block into ``rgb`` (C-contiguous (H, W, 3) uint8) and
+        ``depth`` ((H, W) uint16); None: into new arrays, as outside. Why: a publisher's loan is a
+        shared-memory slot that its subscriber reads, so an image drawn there is never copied. The
+        arrays are kept as the frame's images (a camera that stands still copies them into the next
+        frame's), so the caller must not change them afterwards either. A wrong array raises
+        ValueError naming it."""
+        for name, array, shape, dtype in (
+            ("colour", rgb, (self.height, self.width, 3), np.uint8),
+            ("depth", depth, (self.height, self.width), np.uint16),
+        ):
+            if array is not None and not _fits(array, shape, dtype):
+                raise ValueError(
+                    f"camera {self.width}x{self.height}: the {name} image must be drawn into a "
+                    f"writable C-contiguous {np.dtype(dtype).name} array of shape {shape}, got "
+                    f"{array.dtype} {array.shape}{'' if array.flags.writeable else ' read-only'}"
+                )
+        self._into = (rgb, depth)
+        try:
+            yield
+        finally:
+            self._into = (None, None)
+
     def _render(
-        self, scene: Scene, x: float, y: float, yaw: float, want_rgb: bool, want_depth: bool
+        self,
+        scene: Scene,
+        x: float,
+        y: float,
+        yaw: float,
+        want_rgb: bool,
+        want_depth: bool,
+        out: tuple[np.ndarray | None, np.ndarray | None] = (None, None),
     ) -> tuple[np.ndarray, np.ndarray]:
         if not (want_rgb or want_depth):
             return _EMPTY_RGB, _EMPTY_DEPTH
@@ -165,13 +207,13 @@ class Camera:
         if seen is not None and want_rgb:
             self._shade(seen, scene, look, x, y, yaw)
         if seen is not None and seen.plane is None and ranks == [None]:
-            rgb, depth_mm = self._paint_one_layer(seen, want_rgb, want_depth, wall)
+            rgb, depth_mm = self._paint_one_layer(seen, want_rgb, want_depth, wall, out)
             if seen.round_pixels is not None:
                 _, rows, cols, colours = seen.round_pixels
                 rgb[rows, cols] = colours
         else:
-            rgb = self._background.copy() if want_rgb else _EMPTY_RGB
-            depth_mm = self._floor_depth_image.copy() if want_depth else _EMPTY_DEPTH
+            rgb = _filled(out[0], self._background) if want_rgb else _EMPTY_RGB
+            depth_mm = _filled(out[1], self._floor_depth_image) if want_depth else _EMPTY_DEPTH
             if seen is not None:
                 assert ranks is not None
                 self._paint_crossings(seen, ranks, rgb, depth_mm, wall)
@@ -497,7 +539,12 @@ class Camera:
         top[inner] = np.where(lid, top[inner], np.floor(self.cy + edge) + 1.0)
 
     def _paint_one_layer(
-        self, seen: _Seen, want_rgb: bool, want_depth: bool, wall: np.ndarray | None
+        self,
+        seen: _Seen,
+        want_rgb: bool,
+        want_depth: bool,
+        wall: np.ndarray | None,
+        out: tuple[np.ndarray | None, np.ndarray | None],
     ) -> tuple[np.ndarray, np.ndarray]:
         """The images when each column shows at most one crossing and no lid or underside (the common
         case), the same pixels as :meth:`_paint_crossings` in fewer passes: each output pixel is
@@ -523,7 +570,7 @@ class Camera:
             else:
                 colour_row = self._colour_row
                 self._colour_cells[cols] = shaded.view(_PIXEL).reshape(-1)
-            rgb = np.empty((h, w, 3), dtype=np.uint8)
+            rgb = np.empty((h, w, 3), dtype=np.uint8) if out[0] is None else out[0]
             rgb[:r0] = self._background[:r0]
             rgb[r1:] = self._background[r1:]
             if c0 < c1:
@@ -535,7 +582,7 @@ class Camera:
             else:
                 depth_row = self._depth_row
                 depth_row[cols] = mm
-            depth_mm = np.empty((h, w), dtype=np.uint16)
+            depth_mm = np.empty((h, w), dtype=np.uint16) if out[1] is None else out[1]
             depth_mm[:r0] = self._floor_depth_image[:r0]
             depth_mm[r1:] = self._floor_depth_image[r1:]
             if c0 < c1:
@@ -871,6 +918,29 @@ def _common_rows(n: int, *pairs: tuple[np.ndarray | None, np.ndarray | None]) ->
             same = same.all(axis=1)
         n = m if same.all() else int(np.argmin(same))
     return n
+
+
+def _fits(array: np.ndarray, shape: tuple[int, ...], dtype: type) -> bool:
+    flags = array.flags
+    return array.shape == shape and array.dtype == dtype and flags.c_contiguous and flags.writeable
+
+
+def _filled(out: np.ndarray | None, image: np.ndarray) -> np.ndarray:
+    """``image`` copied into ``out``, or a new copy of it."""
+    if out is None:
+        return image.copy()
+    np.copyto(out, image)
+    return out
+
+
+def _copied_into(
+    images: tuple[np.ndarray, np.ndarray], out: tuple[np.ndarray | None, np.ndarray | None]
+) -> tuple[np.ndarray, np.ndarray]:
+    """A still camera's last ``images`` again, each copied into its ``out`` array if it has one."""
+    return (
+        images[0] if out[0] is None else _filled(out[0], images[0]),
+        images[1] if out[1] is None else _filled(out[1], images[1]),
+    )
 
 
 def _flat_colours(scene: Scene, lighting: Lighting, it: np.ndarray, x: float, y: float) -> np.ndarray:
