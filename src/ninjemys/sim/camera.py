@@ -121,6 +121,8 @@ class Camera:
         #: offsets of the two bounds (cy for a top row, cy + 1 for the row past a base)
         self._rise: tuple[np.ndarray, np.ndarray | None, np.ndarray] | None = None
         self._row_offsets = np.array([[self.cy], [self.cy + 1.0]])
+        #: the sides to cast and the planes seen through them for the last arrays seen (_cast_sides)
+        self._sides: tuple[Any, ...] | None = None
         self._still: _SceneCopy | None = None
         #: the arrays the next frames are drawn into (see drawing_into)
         self._into: tuple[np.ndarray | None, np.ndarray | None] = (None, None)
@@ -246,20 +248,20 @@ class Camera:
         if n == len(scene.segments) + len(scene.circles) or _ALL(item < n):
             rgb = pal.seen_from(x, y).take(item, axis=0)
             if pal.any_round:
-                round_ = np.flatnonzero(pal.is_round.take(item))
+                round_ = pal.is_round.take(item).nonzero()[0]
                 if len(round_):
                     self._shade_round(
                         seen, look, rgb, round_, pal.centres.take(item.take(round_), axis=0), pal, x, y, yaw
                     )
         else:  # crossings of moving obstacles' sides and of other robots' round bodies
             rgb = np.empty((len(item), 3), dtype=np.uint8)
-            known = np.flatnonzero(item < n)
+            known = (item < n).nonzero()[0]
             rgb[known] = pal.seen_from(x, y).take(item.take(known), axis=0)
             n_seg = len(scene.segments)
-            moved = np.flatnonzero((item >= n) & (item < n_seg))
+            moved = ((item >= n) & (item < n_seg)).nonzero()[0]
             if len(moved):
                 rgb[moved] = _flat_colours(scene, look.lighting, item.take(moved), x, y)
-            round_ = np.flatnonzero(item >= n_seg)
+            round_ = (item >= n_seg).nonzero()[0]
             centres = scene.circles[item.take(round_) - n_seg]
             if pal.any_round:
                 also = known[pal.is_round.take(item.take(known))]
@@ -268,7 +270,7 @@ class Camera:
             if len(round_):
                 self._shade_round(seen, look, rgb, round_, centres, pal, x, y, yaw)
         if seen.plane is not None:
-            flat = np.flatnonzero(~np.isnan(seen.plane))
+            flat = (~np.isnan(seen.plane)).nonzero()[0]
             lid = (seen.plane.take(flat) < self.cam_z)[:, None]
             under = item.take(flat)
             if _ALL(under < n):
@@ -345,7 +347,7 @@ class Camera:
             ball &= np.isnan(seen.plane.take(k))
         if not _ANY(ball):
             return
-        pick = np.flatnonzero(ball)
+        pick = ball.nonzero()[0]
         kk, ball_item = k[pick], item[pick]
         r, cz = pal.sphere_r.take(ball_item), pal.sphere_z.take(ball_item)
         top, bottom = seen.top.take(kk).astype(np.intp), seen.bottom.take(kk).astype(np.intp)
@@ -380,18 +382,9 @@ class Camera:
         lower than the camera, seen from above) or its underside (a shape held above the camera): it
         is cast only for those shapes, and its visible rows are the lid's or the underside's, drawn
         at the depth where each row's ray meets that plane (see :meth:`_paint_crossings`)."""
-        heights, bases, colors, facing = scene.heights, scene.bases, scene.colors, scene.facing
+        heights, bases, colors = scene.heights, scene.bases, scene.colors
         segments = scene.segments
-        inner_plane: np.ndarray | None = None  # per segment: the lid's or underside's height, or NaN
-        if facing is not None and len(segments):
-            straddles = heights >= self.cam_z
-            if bases is not None:
-                straddles &= bases <= self.cam_z
-            if not _ALL(straddles):
-                # sides facing away are cast for shapes the camera sees from above or below
-                level = np.where(heights < self.cam_z, heights, bases if bases is not None else 0.0)
-                inner_plane = np.where(straddles | (facing == 0), np.nan, level)
-                facing = np.where(straddles, facing, 0).astype(np.int8)
+        facing, inner_plane = self._cast_sides(heights, bases, scene.facing)
         col, item, d = column_pairs(x, y, yaw, self.col_slopes, segments, self.depth_max, facing)
         plane_of: np.ndarray | None = None
         if inner_plane is not None and len(item):
@@ -482,6 +475,30 @@ class Camera:
             self._row_type,
         )
 
+    def _cast_sides(
+        self, heights: np.ndarray, bases: np.ndarray | None, facing: np.ndarray | None
+    ) -> tuple[np.ndarray | None, np.ndarray | None]:
+        """Which sides to cast (``facing`` for the cast: the far sides of the shapes the camera sees
+        from above or below are cast too, as 0) and per segment the height of the lid or underside
+        they are seen through (NaN: none; None: no segment is); kept for the last arrays seen, as a
+        world's scenes share them from step to step."""
+        kept = self._sides
+        if kept is not None and kept[0] is heights and kept[1] is bases and kept[2] is facing:
+            return kept[3]
+        inner_plane: np.ndarray | None = None
+        cast = facing
+        if facing is not None and len(heights):
+            straddles = heights >= self.cam_z
+            if bases is not None:
+                straddles &= bases <= self.cam_z
+            if not _ALL(straddles):
+                # sides facing away are cast for shapes the camera sees from above or below
+                level = np.where(heights < self.cam_z, heights, bases if bases is not None else 0.0)
+                inner_plane = np.where(straddles | (facing == 0), np.nan, level)
+                cast = np.where(straddles, facing, 0).astype(np.int8)
+        self._sides = (heights, bases, facing, (cast, inner_plane))
+        return cast, inner_plane
+
     def _rises(self, heights: np.ndarray, bases: np.ndarray | None) -> np.ndarray:
         """(2, N): per segment, the camera's height less its top and less its base (0: on the floor),
         what the image rows of its crossings follow from; kept for the last arrays seen (a world's
@@ -516,10 +533,10 @@ class Camera:
         n = len(scene.segments)
         if scene.owners is not None:
             # crossings of other robots (items from n on, round bodies) belong to no outline
-            shape = np.flatnonzero(item < n)
+            shape = (item < n).nonzero()[0]
             shape = shape[scene.owners.take(item.take(shape)) >= 0]
         else:
-            shape = np.flatnonzero(~np.isnan(plane))
+            shape = (~np.isnan(plane)).nonzero()[0]
             shape = shape[item[shape] < n]
         owner = scene.owners[item[shape]] if scene.owners is not None else np.zeros(len(shape), np.intp)
         by_shape = shape[np.lexsort((d[shape], owner, col[shape]))]
@@ -528,7 +545,7 @@ class Camera:
         same = (col[prev] == col[cur]) & (np.isnan(plane[prev])) & (~np.isnan(plane[cur]))
         if scene.owners is not None:
             same &= scene.owners[item[prev]] == scene.owners[item[cur]]
-        inner = np.flatnonzero(~np.isnan(plane))
+        inner = (~np.isnan(plane)).nonzero()[0]
         d_in = np.zeros(len(d))
         d_in[cur[same]] = d[prev[same]]
         rise = plane[inner] - self.cam_z
@@ -589,10 +606,13 @@ class Camera:
                 cv2.repeat(depth_row[None], c1 - c0, 1, dst=depth_mm[c0:c1])
         if wall is not None and c0 < c1:
             wall[c0:c1] = True
+        spans: tuple[np.ndarray, np.ndarray] | None = None  # the columns' rows, for both fringes
         for a, b in ((r0, c0), (c1, r1)):
             if a >= b:
                 continue
-            mask = self._column_mask(cols, top, bottom, a, b)
+            if spans is None:
+                spans = (bottom - top, top) if full else self._column_spans(cols, top, bottom)
+            mask = self._band_mask(*spans, a, b)
             if want_rgb:
                 rgb_band = rgb[a:b]
                 rgb_band[...] = self._background[a:b]
@@ -655,22 +675,26 @@ class Camera:
         self, cols: np.ndarray, top: np.ndarray, bottom: np.ndarray, r0: int, r1: int
     ) -> np.ndarray:
         """uint8 (r1 - r0, width): 1 at the rows top <= v < bottom of columns ``cols`` (each once,
-        top < bottom), 0 in the other columns; see :meth:`_span_mask`."""
+        top < bottom), 0 in the other columns; see :meth:`_band_mask`."""
+        return self._band_mask(*self._column_spans(cols, top, bottom), r0, r1)
+
+    def _column_spans(
+        self, cols: np.ndarray, top: np.ndarray, bottom: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Per image column: how many rows columns ``cols`` cover from ``top`` (0 elsewhere), and
+        that top row (scratch rows: the values of other columns do not matter)."""
         span, start = self._span_row, self._top_row
         span.fill(0)
         span[cols] = bottom - top
         start[cols] = top
-        offset, mask = self._offset[: r1 - r0], self._mask[: r1 - r0]
-        np.subtract(self._rows[r0:r1], start, out=offset)
-        np.less(offset, span, out=mask)
-        return mask.view(np.uint8)
+        return span, start
 
     def _paint_planes(self, seen: _Seen, sel: np.ndarray | None, depth_mm: np.ndarray) -> None:
         """The depth of the lids and undersides among one pass's crossings (their columns' rows, at
         the depth where each row's ray meets the plane), over what the pass painted there."""
         assert seen.plane is not None
         plane = seen.plane if sel is None else seen.plane[sel]
-        lid = np.flatnonzero(~np.isnan(plane))
+        lid = (~np.isnan(plane)).nonzero()[0]
         if not len(lid):
             return
         pick = lid if sel is None else sel[lid]
@@ -694,10 +718,15 @@ class Camera:
 
     def _span_mask(self, top: np.ndarray, bottom: np.ndarray, r0: int, r1: int) -> np.ndarray:
         """uint8 (r1 - r0, width): 1 at the rows v in [r0, r1) of each column u with
-        top[u] <= v < bottom[u] (none where bottom <= top), as (v - top) mod 2^bits < bottom - top:
-        a row above top wraps around to at least 2^bits - top, more than any span below ``height``."""
+        top[u] <= v < bottom[u] (none where bottom <= top)."""
         span = np.subtract(bottom, top, dtype=self._row_type)
         span[bottom <= top] = 0
+        return self._band_mask(span, top, r0, r1)
+
+    def _band_mask(self, span: np.ndarray, top: np.ndarray, r0: int, r1: int) -> np.ndarray:
+        """uint8 (r1 - r0, width): 1 at the rows v in [r0, r1) of each column u with
+        top[u] <= v < top[u] + span[u], as (v - top) mod 2^bits < span: a row above top wraps
+        around to at least 2^bits - top, more than any span below ``height``."""
         offset, mask = self._offset[: r1 - r0], self._mask[: r1 - r0]
         np.subtract(self._rows[r0:r1], top, out=offset)
         np.less(offset, span, out=mask)
@@ -759,7 +788,7 @@ class Camera:
             borderValue=0,
         )
         np.copyto(ink, 0, where=wall[first:])  # a wall stands there
-        painted = np.flatnonzero(ink)
+        painted = ink.reshape(-1).nonzero()[0]
         if not len(painted):
             return
         cells = rgb.view(_PIXEL).reshape(-1)
@@ -810,12 +839,16 @@ class _Seen:
         if not _ANY(repeated):
             return [None]
         n = len(col)
-        starts = np.flatnonzero(np.concatenate([[True], ~repeated]))
-        lengths = np.diff(np.append(starts, n))
-        from_far = np.repeat(starts + lengths, lengths)  # each crossing's column's end
+        # where each column's crossings start, and the end of the last column
+        bounds = np.ones(n + 1, dtype=bool)
+        np.logical_not(repeated, out=bounds[1:n])
+        edges = bounds.nonzero()[0]
+        ends = edges[1:]
+        lengths = ends - edges[:-1]
+        from_far = ends.repeat(lengths)  # each crossing's column's end
         from_far -= np.arange(1, n + 1)
-        passes = int(lengths.max())
-        return [np.flatnonzero(from_far == p) for p in range(passes)]
+        passes = int(_MAX(lengths))
+        return [(from_far == p).nonzero()[0] for p in range(passes)]
 
 
 class _Palette:
