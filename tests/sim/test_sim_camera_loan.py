@@ -52,16 +52,16 @@ def sim(monkeypatch: pytest.MonkeyPatch) -> Iterator[tuple[SimNode, list[tuple[b
             )
             sn.add_robot("puzzlebot", load_robot_model("puzzlebot"), 0.0, 0.0, 0.0, False)
             rendered: list[tuple[bytes, bytes]] = []
-            real = sn.sim.render
+            camera = sn.sim.robots["puzzlebot"].camera
+            assert camera is not None
+            draw = camera.render
 
-            def recorded(
-                r: Any, scene: Any = None, colour: bool = True, depth: bool = True, extra: Any = None
-            ) -> Any:
-                rgb, depth_mm = real(r, scene, colour, depth, extra)
-                rendered.append((rgb.tobytes(), depth_mm.tobytes()))
-                return rgb, depth_mm
+            def recorded(*args: Any, **kwargs: Any) -> tuple[np.ndarray, np.ndarray]:
+                images = draw(*args, **kwargs)
+                rendered.append((images[0].tobytes(), images[1].tobytes()))
+                return images
 
-            sn.sim.render = recorded  # type: ignore[method-assign]
+            camera.render = recorded  # type: ignore[method-assign]
             yield sn, rendered, client
         finally:
             for node in reversed(nodes):
