@@ -612,17 +612,17 @@ class Camera:
                 continue
             if spans is None:
                 spans = (bottom - top, top) if full else self._column_spans(cols, top, bottom)
-            mask = self._band_mask(*spans, a, b)
+            # the band is the columns' values repeated down, then the background copied back where
+            # no crossing covers it: each pixel written at most twice and no band-sized temporary
+            bare = self._band_mask(*spans, a, b, inside=False)
             if want_rgb:
-                rgb_band = rgb[a:b]
-                rgb_band[...] = self._background[a:b]
-                cv2.copyTo(cv2.repeat(colour_row[None], b - a, 1), mask, rgb_band)
+                cv2.repeat(colour_row[None], b - a, 1, dst=rgb[a:b])
+                cv2.copyTo(self._background[a:b], bare, rgb[a:b])
             if want_depth:
-                depth_band = depth_mm[a:b]
-                depth_band[...] = self._floor_depth_image[a:b]
-                cv2.copyTo(cv2.repeat(depth_row[None], b - a, 1), mask, depth_band)
+                cv2.repeat(depth_row[None], b - a, 1, dst=depth_mm[a:b])
+                cv2.copyTo(self._floor_depth_image[a:b], bare, depth_mm[a:b])
             if wall is not None:
-                wall[a:b] |= mask.view(bool)
+                wall[a:b] |= ~bare.view(bool)
         return rgb, depth_mm
 
     def _paint_crossings(
@@ -723,13 +723,16 @@ class Camera:
         span[bottom <= top] = 0
         return self._band_mask(span, top, r0, r1)
 
-    def _band_mask(self, span: np.ndarray, top: np.ndarray, r0: int, r1: int) -> np.ndarray:
+    def _band_mask(
+        self, span: np.ndarray, top: np.ndarray, r0: int, r1: int, inside: bool = True
+    ) -> np.ndarray:
         """uint8 (r1 - r0, width): 1 at the rows v in [r0, r1) of each column u with
         top[u] <= v < top[u] + span[u], as (v - top) mod 2^bits < span: a row above top wraps
-        around to at least 2^bits - top, more than any span below ``height``."""
+        around to at least 2^bits - top, more than any span below ``height``; ``inside=False``:
+        1 at the other rows."""
         offset, mask = self._offset[: r1 - r0], self._mask[: r1 - r0]
         np.subtract(self._rows[r0:r1], top, out=offset)
-        np.less(offset, span, out=mask)
+        (np.less if inside else np.greater_equal)(offset, span, out=mask)
         return mask.view(np.uint8)
 
     def _paint(
