@@ -213,12 +213,14 @@ class Camera:
             if seen.round_pixels is not None:
                 _, rows, cols, colours = seen.round_pixels
                 rgb[rows, cols] = colours
-        else:
+        elif seen is None:
             rgb = _filled(out[0], self._background) if want_rgb else _EMPTY_RGB
             depth_mm = _filled(out[1], self._floor_depth_image) if want_depth else _EMPTY_DEPTH
-            if seen is not None:
-                assert ranks is not None
-                self._paint_crossings(seen, ranks, rgb, depth_mm, wall)
+        else:  # the background drawn by the first pass, around and under its crossings
+            assert ranks is not None
+            rgb = _new_image(out[0], self._background) if want_rgb else _EMPTY_RGB
+            depth_mm = _new_image(out[1], self._floor_depth_image) if want_depth else _EMPTY_DEPTH
+            self._paint_crossings(seen, ranks, rgb, depth_mm, wall)
         if wall is not None:
             assert scene.floor is not None
             self._paint_floor(rgb, wall, scene.floor, x, y, yaw, look.lighting)
@@ -616,11 +618,9 @@ class Camera:
             # no crossing covers it: each pixel written at most twice and no band-sized temporary
             bare = self._band_mask(*spans, a, b, inside=False)
             if want_rgb:
-                cv2.repeat(colour_row[None], b - a, 1, dst=rgb[a:b])
-                cv2.copyTo(self._background[a:b], bare, rgb[a:b])
+                _columns_over(rgb[a:b], colour_row, self._background[a:b], bare)
             if want_depth:
-                cv2.repeat(depth_row[None], b - a, 1, dst=depth_mm[a:b])
-                cv2.copyTo(self._floor_depth_image[a:b], bare, depth_mm[a:b])
+                _columns_over(depth_mm[a:b], depth_row, self._floor_depth_image[a:b], bare)
             if wall is not None:
                 wall[a:b] |= ~bare.view(bool)
         return rgb, depth_mm
@@ -637,7 +637,8 @@ class Camera:
         one masked copy per rank within the column, the farthest first, over the band of rows that
         rank spans (a nearer strip in the air is painted over what it hides). A lid's or an
         underside's rows (a far side seen through them) get, in the depth image, the depth where each
-        row's ray meets that plane: (plane - cam_z) / slope_v."""
+        row's ray meets that plane: (plane - cam_z) / slope_v. The images come undrawn: the first
+        pass draws the background around its band and where its crossings do not cover the band."""
         if rgb.size:
             shaded = seen.rgb
             spheres = seen.round_pixels
@@ -654,29 +655,32 @@ class Camera:
             top = seen.top if sel is None else seen.top.take(sel)
             bottom = seen.bottom if sel is None else seen.bottom.take(sel)
             r0, r1 = int(_MIN(top)), int(_MAX(bottom))
-            mask = self._column_mask(cols, top, bottom, r0, r1)
+            # the first pass's mask is where its band shows the background, the others' where
+            # their crossings cover it
+            mask = self._band_mask(*self._column_spans(cols, top, bottom), r0, r1, inside=p > 0)
             if wall is not None:
-                wall[r0:r1] |= mask.view(bool)
+                wall[r0:r1] |= mask.view(bool) if p else ~mask.view(bool)
             # the values of columns outside the mask do not matter: the scratch rows are not cleared
             if rgb.size:
                 cells = shaded.view(_PIXEL).reshape(-1)
                 self._colour_cells[cols] = cells if sel is None else cells.take(sel)
-                self._paint(rgb[r0:r1], self._colour_row, mask)
+                if p:
+                    self._paint(rgb[r0:r1], self._colour_row, mask)
+                else:
+                    _background_around(rgb, self._background, r0, r1)
+                    _columns_over(rgb[r0:r1], self._colour_row, self._background[r0:r1], mask)
                 if spheres is not None:
                     here = sphere_pass == p
                     rgb[spheres[1][here], spheres[2][here]] = spheres[3][here]
             if depth_mm.size:
                 self._depth_row[cols] = mm if sel is None else mm.take(sel)
-                self._paint(depth_mm[r0:r1], self._depth_row, mask)
+                if p:
+                    self._paint(depth_mm[r0:r1], self._depth_row, mask)
+                else:
+                    _background_around(depth_mm, self._floor_depth_image, r0, r1)
+                    _columns_over(depth_mm[r0:r1], self._depth_row, self._floor_depth_image[r0:r1], mask)
                 if seen.plane is not None:
                     self._paint_planes(seen, sel, depth_mm)
-
-    def _column_mask(
-        self, cols: np.ndarray, top: np.ndarray, bottom: np.ndarray, r0: int, r1: int
-    ) -> np.ndarray:
-        """uint8 (r1 - r0, width): 1 at the rows top <= v < bottom of columns ``cols`` (each once,
-        top < bottom), 0 in the other columns; see :meth:`_band_mask`."""
-        return self._band_mask(*self._column_spans(cols, top, bottom), r0, r1)
 
     def _column_spans(
         self, cols: np.ndarray, top: np.ndarray, bottom: np.ndarray
@@ -959,6 +963,26 @@ def _common_rows(n: int, *pairs: tuple[np.ndarray | None, np.ndarray | None]) ->
 def _fits(array: np.ndarray, shape: tuple[int, ...], dtype: type) -> bool:
     flags = array.flags
     return array.shape == shape and array.dtype == dtype and flags.c_contiguous and flags.writeable
+
+
+def _columns_over(band: np.ndarray, per_column: np.ndarray, background: np.ndarray, bare: np.ndarray) -> None:
+    """Draw ``band``: each column's value (``per_column``) repeated down its rows, and ``background``
+    copied back where ``bare`` (uint8) is set; each pixel written at most twice (OpenCV), with no
+    band-sized temporary."""
+    cv2 = _opencv()
+    cv2.repeat(per_column[None], band.shape[0], 1, dst=band)
+    cv2.copyTo(background, bare, band)
+
+
+def _background_around(image: np.ndarray, background: np.ndarray, r0: int, r1: int) -> None:
+    """``background``'s rows above ``r0`` and from ``r1`` on, copied into ``image``."""
+    image[:r0] = background[:r0]
+    image[r1:] = background[r1:]
+
+
+def _new_image(out: np.ndarray | None, like: np.ndarray) -> np.ndarray:
+    """``out``, or a new array shaped as ``like``, to be drawn in full."""
+    return np.empty_like(like) if out is None else out
 
 
 def _filled(out: np.ndarray | None, image: np.ndarray) -> np.ndarray:
