@@ -21,8 +21,10 @@ A camera that has not moved in an unchanged scene returns the images it drew las
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import math
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -119,7 +121,11 @@ class Camera:
         #: offsets of the two bounds (cy for a top row, cy + 1 for the row past a base)
         self._rise: tuple[np.ndarray, np.ndarray | None, np.ndarray] | None = None
         self._row_offsets = np.array([[self.cy], [self.cy + 1.0]])
+        #: the sides to cast and the planes seen through them for the last arrays seen (_cast_sides)
+        self._sides: tuple[Any, ...] | None = None
         self._still: _SceneCopy | None = None
+        #: the arrays the next frames are drawn into (see drawing_into)
+        self._into: tuple[np.ndarray | None, np.ndarray | None] = (None, None)
 
     def render(
         self,
@@ -135,22 +141,60 @@ class Camera:
         ``colour=False`` or ``depth=False`` leaves that image out (an empty array in its place):
         a camera whose depth stream nobody reads (or that has none) does not draw it. The arrays
         returned are not changed afterwards (a camera that stood still returns the same ones again).
+        Inside :meth:`drawing_into` the images are drawn into (and returned as) the arrays given there.
         """
         key = (x, y, yaw, colour, depth)
+        into = self._into
+        out = (into[0] if colour else None, into[1] if depth else None)
         last = self._last
         if last is not None and last[0] == key:
             # the camera stood still: the scene is compared with a copy taken at the previous frame
             if self._still is not None and self._still.same(scene):
-                return last[1]
+                if out[0] is None and out[1] is None:
+                    return last[1]
+                images = _copied_into(last[1], out)
+                self._last = (key, images)
+                return images
             self._still = _SceneCopy(scene)
         else:
             self._still = None
-        images = self._render(scene, x, y, yaw, colour, depth)
+        images = self._render(scene, x, y, yaw, colour, depth, out)
         self._last = (key, images)
         return images
 
+    @contextlib.contextmanager
+    def drawing_into(self, rgb: np.ndarray | None, depth: np.ndarray | None) -> Iterator[None]:
+        """Draw the frames rendered inside the block into ``rgb`` (C-contiguous (H, W, 3) uint8) and
+        ``depth`` ((H, W) uint16); None: into new arrays, as outside. Why: a publisher's loan is a
+        shared-memory slot that its subscriber reads, so an image drawn there is never copied. The
+        arrays are kept as the frame's images (a camera that stands still copies them into the next
+        frame's), so the caller must not change them afterwards either. A wrong array raises
+        ValueError naming it."""
+        for name, array, shape, dtype in (
+            ("colour", rgb, (self.height, self.width, 3), np.uint8),
+            ("depth", depth, (self.height, self.width), np.uint16),
+        ):
+            if array is not None and not _fits(array, shape, dtype):
+                raise ValueError(
+                    f"camera {self.width}x{self.height}: the {name} image must be drawn into a "
+                    f"writable C-contiguous {np.dtype(dtype).name} array of shape {shape}, got "
+                    f"{array.dtype} {array.shape}{'' if array.flags.writeable else ' read-only'}"
+                )
+        self._into = (rgb, depth)
+        try:
+            yield
+        finally:
+            self._into = (None, None)
+
     def _render(
-        self, scene: Scene, x: float, y: float, yaw: float, want_rgb: bool, want_depth: bool
+        self,
+        scene: Scene,
+        x: float,
+        y: float,
+        yaw: float,
+        want_rgb: bool,
+        want_depth: bool,
+        out: tuple[np.ndarray | None, np.ndarray | None] = (None, None),
     ) -> tuple[np.ndarray, np.ndarray]:
         if not (want_rgb or want_depth):
             return _EMPTY_RGB, _EMPTY_DEPTH
@@ -165,16 +209,18 @@ class Camera:
         if seen is not None and want_rgb:
             self._shade(seen, scene, look, x, y, yaw)
         if seen is not None and seen.plane is None and ranks == [None]:
-            rgb, depth_mm = self._paint_one_layer(seen, want_rgb, want_depth, wall)
+            rgb, depth_mm = self._paint_one_layer(seen, want_rgb, want_depth, wall, out)
             if seen.round_pixels is not None:
                 _, rows, cols, colours = seen.round_pixels
                 rgb[rows, cols] = colours
-        else:
-            rgb = self._background.copy() if want_rgb else _EMPTY_RGB
-            depth_mm = self._floor_depth_image.copy() if want_depth else _EMPTY_DEPTH
-            if seen is not None:
-                assert ranks is not None
-                self._paint_crossings(seen, ranks, rgb, depth_mm, wall)
+        elif seen is None:
+            rgb = _filled(out[0], self._background) if want_rgb else _EMPTY_RGB
+            depth_mm = _filled(out[1], self._floor_depth_image) if want_depth else _EMPTY_DEPTH
+        else:  # the background drawn by the first pass, around and under its crossings
+            assert ranks is not None
+            rgb = _new_image(out[0], self._background) if want_rgb else _EMPTY_RGB
+            depth_mm = _new_image(out[1], self._floor_depth_image) if want_depth else _EMPTY_DEPTH
+            self._paint_crossings(seen, ranks, rgb, depth_mm, wall)
         if wall is not None:
             assert scene.floor is not None
             self._paint_floor(rgb, wall, scene.floor, x, y, yaw, look.lighting)
@@ -204,20 +250,20 @@ class Camera:
         if n == len(scene.segments) + len(scene.circles) or _ALL(item < n):
             rgb = pal.seen_from(x, y).take(item, axis=0)
             if pal.any_round:
-                round_ = np.flatnonzero(pal.is_round.take(item))
+                round_ = pal.is_round.take(item).nonzero()[0]
                 if len(round_):
                     self._shade_round(
                         seen, look, rgb, round_, pal.centres.take(item.take(round_), axis=0), pal, x, y, yaw
                     )
         else:  # crossings of moving obstacles' sides and of other robots' round bodies
             rgb = np.empty((len(item), 3), dtype=np.uint8)
-            known = np.flatnonzero(item < n)
+            known = (item < n).nonzero()[0]
             rgb[known] = pal.seen_from(x, y).take(item.take(known), axis=0)
             n_seg = len(scene.segments)
-            moved = np.flatnonzero((item >= n) & (item < n_seg))
+            moved = ((item >= n) & (item < n_seg)).nonzero()[0]
             if len(moved):
                 rgb[moved] = _flat_colours(scene, look.lighting, item.take(moved), x, y)
-            round_ = np.flatnonzero(item >= n_seg)
+            round_ = (item >= n_seg).nonzero()[0]
             centres = scene.circles[item.take(round_) - n_seg]
             if pal.any_round:
                 also = known[pal.is_round.take(item.take(known))]
@@ -226,7 +272,7 @@ class Camera:
             if len(round_):
                 self._shade_round(seen, look, rgb, round_, centres, pal, x, y, yaw)
         if seen.plane is not None:
-            flat = np.flatnonzero(~np.isnan(seen.plane))
+            flat = (~np.isnan(seen.plane)).nonzero()[0]
             lid = (seen.plane.take(flat) < self.cam_z)[:, None]
             under = item.take(flat)
             if _ALL(under < n):
@@ -303,7 +349,7 @@ class Camera:
             ball &= np.isnan(seen.plane.take(k))
         if not _ANY(ball):
             return
-        pick = np.flatnonzero(ball)
+        pick = ball.nonzero()[0]
         kk, ball_item = k[pick], item[pick]
         r, cz = pal.sphere_r.take(ball_item), pal.sphere_z.take(ball_item)
         top, bottom = seen.top.take(kk).astype(np.intp), seen.bottom.take(kk).astype(np.intp)
@@ -338,18 +384,9 @@ class Camera:
         lower than the camera, seen from above) or its underside (a shape held above the camera): it
         is cast only for those shapes, and its visible rows are the lid's or the underside's, drawn
         at the depth where each row's ray meets that plane (see :meth:`_paint_crossings`)."""
-        heights, bases, colors, facing = scene.heights, scene.bases, scene.colors, scene.facing
+        heights, bases, colors = scene.heights, scene.bases, scene.colors
         segments = scene.segments
-        inner_plane: np.ndarray | None = None  # per segment: the lid's or underside's height, or NaN
-        if facing is not None and len(segments):
-            straddles = heights >= self.cam_z
-            if bases is not None:
-                straddles &= bases <= self.cam_z
-            if not _ALL(straddles):
-                # sides facing away are cast for shapes the camera sees from above or below
-                level = np.where(heights < self.cam_z, heights, bases if bases is not None else 0.0)
-                inner_plane = np.where(straddles | (facing == 0), np.nan, level)
-                facing = np.where(straddles, facing, 0).astype(np.int8)
+        facing, inner_plane = self._cast_sides(heights, bases, scene.facing)
         col, item, d = column_pairs(x, y, yaw, self.col_slopes, segments, self.depth_max, facing)
         plane_of: np.ndarray | None = None
         if inner_plane is not None and len(item):
@@ -440,6 +477,30 @@ class Camera:
             self._row_type,
         )
 
+    def _cast_sides(
+        self, heights: np.ndarray, bases: np.ndarray | None, facing: np.ndarray | None
+    ) -> tuple[np.ndarray | None, np.ndarray | None]:
+        """Which sides to cast (``facing`` for the cast: the far sides of the shapes the camera sees
+        from above or below are cast too, as 0) and per segment the height of the lid or underside
+        they are seen through (NaN: none; None: no segment is); kept for the last arrays seen, as a
+        world's scenes share them from step to step."""
+        kept = self._sides
+        if kept is not None and kept[0] is heights and kept[1] is bases and kept[2] is facing:
+            return kept[3]
+        inner_plane: np.ndarray | None = None
+        cast = facing
+        if facing is not None and len(heights):
+            straddles = heights >= self.cam_z
+            if bases is not None:
+                straddles &= bases <= self.cam_z
+            if not _ALL(straddles):
+                # sides facing away are cast for shapes the camera sees from above or below
+                level = np.where(heights < self.cam_z, heights, bases if bases is not None else 0.0)
+                inner_plane = np.where(straddles | (facing == 0), np.nan, level)
+                cast = np.where(straddles, facing, 0).astype(np.int8)
+        self._sides = (heights, bases, facing, (cast, inner_plane))
+        return cast, inner_plane
+
     def _rises(self, heights: np.ndarray, bases: np.ndarray | None) -> np.ndarray:
         """(2, N): per segment, the camera's height less its top and less its base (0: on the floor),
         what the image rows of its crossings follow from; kept for the last arrays seen (a world's
@@ -474,10 +535,10 @@ class Camera:
         n = len(scene.segments)
         if scene.owners is not None:
             # crossings of other robots (items from n on, round bodies) belong to no outline
-            shape = np.flatnonzero(item < n)
+            shape = (item < n).nonzero()[0]
             shape = shape[scene.owners.take(item.take(shape)) >= 0]
         else:
-            shape = np.flatnonzero(~np.isnan(plane))
+            shape = (~np.isnan(plane)).nonzero()[0]
             shape = shape[item[shape] < n]
         owner = scene.owners[item[shape]] if scene.owners is not None else np.zeros(len(shape), np.intp)
         by_shape = shape[np.lexsort((d[shape], owner, col[shape]))]
@@ -486,7 +547,7 @@ class Camera:
         same = (col[prev] == col[cur]) & (np.isnan(plane[prev])) & (~np.isnan(plane[cur]))
         if scene.owners is not None:
             same &= scene.owners[item[prev]] == scene.owners[item[cur]]
-        inner = np.flatnonzero(~np.isnan(plane))
+        inner = (~np.isnan(plane)).nonzero()[0]
         d_in = np.zeros(len(d))
         d_in[cur[same]] = d[prev[same]]
         rise = plane[inner] - self.cam_z
@@ -497,7 +558,12 @@ class Camera:
         top[inner] = np.where(lid, top[inner], np.floor(self.cy + edge) + 1.0)
 
     def _paint_one_layer(
-        self, seen: _Seen, want_rgb: bool, want_depth: bool, wall: np.ndarray | None
+        self,
+        seen: _Seen,
+        want_rgb: bool,
+        want_depth: bool,
+        wall: np.ndarray | None,
+        out: tuple[np.ndarray | None, np.ndarray | None],
     ) -> tuple[np.ndarray, np.ndarray]:
         """The images when each column shows at most one crossing and no lid or underside (the common
         case), the same pixels as :meth:`_paint_crossings` in fewer passes: each output pixel is
@@ -523,7 +589,7 @@ class Camera:
             else:
                 colour_row = self._colour_row
                 self._colour_cells[cols] = shaded.view(_PIXEL).reshape(-1)
-            rgb = np.empty((h, w, 3), dtype=np.uint8)
+            rgb = np.empty((h, w, 3), dtype=np.uint8) if out[0] is None else out[0]
             rgb[:r0] = self._background[:r0]
             rgb[r1:] = self._background[r1:]
             if c0 < c1:
@@ -535,27 +601,28 @@ class Camera:
             else:
                 depth_row = self._depth_row
                 depth_row[cols] = mm
-            depth_mm = np.empty((h, w), dtype=np.uint16)
+            depth_mm = np.empty((h, w), dtype=np.uint16) if out[1] is None else out[1]
             depth_mm[:r0] = self._floor_depth_image[:r0]
             depth_mm[r1:] = self._floor_depth_image[r1:]
             if c0 < c1:
                 cv2.repeat(depth_row[None], c1 - c0, 1, dst=depth_mm[c0:c1])
         if wall is not None and c0 < c1:
             wall[c0:c1] = True
+        spans: tuple[np.ndarray, np.ndarray] | None = None  # the columns' rows, for both fringes
         for a, b in ((r0, c0), (c1, r1)):
             if a >= b:
                 continue
-            mask = self._column_mask(cols, top, bottom, a, b)
+            if spans is None:
+                spans = (bottom - top, top) if full else self._column_spans(cols, top, bottom)
+            # the band is the columns' values repeated down, then the background copied back where
+            # no crossing covers it: each pixel written at most twice and no band-sized temporary
+            bare = self._band_mask(*spans, a, b, inside=False)
             if want_rgb:
-                rgb_band = rgb[a:b]
-                rgb_band[...] = self._background[a:b]
-                cv2.copyTo(cv2.repeat(colour_row[None], b - a, 1), mask, rgb_band)
+                _columns_over(rgb[a:b], colour_row, self._background[a:b], bare)
             if want_depth:
-                depth_band = depth_mm[a:b]
-                depth_band[...] = self._floor_depth_image[a:b]
-                cv2.copyTo(cv2.repeat(depth_row[None], b - a, 1), mask, depth_band)
+                _columns_over(depth_mm[a:b], depth_row, self._floor_depth_image[a:b], bare)
             if wall is not None:
-                wall[a:b] |= mask.view(bool)
+                wall[a:b] |= ~bare.view(bool)
         return rgb, depth_mm
 
     def _paint_crossings(
@@ -570,7 +637,8 @@ class Camera:
         one masked copy per rank within the column, the farthest first, over the band of rows that
         rank spans (a nearer strip in the air is painted over what it hides). A lid's or an
         underside's rows (a far side seen through them) get, in the depth image, the depth where each
-        row's ray meets that plane: (plane - cam_z) / slope_v."""
+        row's ray meets that plane: (plane - cam_z) / slope_v. The images come undrawn: the first
+        pass draws the background around its band and where its crossings do not cover the band."""
         if rgb.size:
             shaded = seen.rgb
             spheres = seen.round_pixels
@@ -587,43 +655,50 @@ class Camera:
             top = seen.top if sel is None else seen.top.take(sel)
             bottom = seen.bottom if sel is None else seen.bottom.take(sel)
             r0, r1 = int(_MIN(top)), int(_MAX(bottom))
-            mask = self._column_mask(cols, top, bottom, r0, r1)
+            # the first pass's mask is where its band shows the background, the others' where
+            # their crossings cover it
+            mask = self._band_mask(*self._column_spans(cols, top, bottom), r0, r1, inside=p > 0)
             if wall is not None:
-                wall[r0:r1] |= mask.view(bool)
+                wall[r0:r1] |= mask.view(bool) if p else ~mask.view(bool)
             # the values of columns outside the mask do not matter: the scratch rows are not cleared
             if rgb.size:
                 cells = shaded.view(_PIXEL).reshape(-1)
                 self._colour_cells[cols] = cells if sel is None else cells.take(sel)
-                self._paint(rgb[r0:r1], self._colour_row, mask)
+                if p:
+                    self._paint(rgb[r0:r1], self._colour_row, mask)
+                else:
+                    _background_around(rgb, self._background, r0, r1)
+                    _columns_over(rgb[r0:r1], self._colour_row, self._background[r0:r1], mask)
                 if spheres is not None:
                     here = sphere_pass == p
                     rgb[spheres[1][here], spheres[2][here]] = spheres[3][here]
             if depth_mm.size:
                 self._depth_row[cols] = mm if sel is None else mm.take(sel)
-                self._paint(depth_mm[r0:r1], self._depth_row, mask)
+                if p:
+                    self._paint(depth_mm[r0:r1], self._depth_row, mask)
+                else:
+                    _background_around(depth_mm, self._floor_depth_image, r0, r1)
+                    _columns_over(depth_mm[r0:r1], self._depth_row, self._floor_depth_image[r0:r1], mask)
                 if seen.plane is not None:
                     self._paint_planes(seen, sel, depth_mm)
 
-    def _column_mask(
-        self, cols: np.ndarray, top: np.ndarray, bottom: np.ndarray, r0: int, r1: int
-    ) -> np.ndarray:
-        """uint8 (r1 - r0, width): 1 at the rows top <= v < bottom of columns ``cols`` (each once,
-        top < bottom), 0 in the other columns; see :meth:`_span_mask`."""
+    def _column_spans(
+        self, cols: np.ndarray, top: np.ndarray, bottom: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Per image column: how many rows columns ``cols`` cover from ``top`` (0 elsewhere), and
+        that top row (scratch rows: the values of other columns do not matter)."""
         span, start = self._span_row, self._top_row
         span.fill(0)
         span[cols] = bottom - top
         start[cols] = top
-        offset, mask = self._offset[: r1 - r0], self._mask[: r1 - r0]
-        np.subtract(self._rows[r0:r1], start, out=offset)
-        np.less(offset, span, out=mask)
-        return mask.view(np.uint8)
+        return span, start
 
     def _paint_planes(self, seen: _Seen, sel: np.ndarray | None, depth_mm: np.ndarray) -> None:
         """The depth of the lids and undersides among one pass's crossings (their columns' rows, at
         the depth where each row's ray meets the plane), over what the pass painted there."""
         assert seen.plane is not None
         plane = seen.plane if sel is None else seen.plane[sel]
-        lid = np.flatnonzero(~np.isnan(plane))
+        lid = (~np.isnan(plane)).nonzero()[0]
         if not len(lid):
             return
         pick = lid if sel is None else sel[lid]
@@ -647,13 +722,21 @@ class Camera:
 
     def _span_mask(self, top: np.ndarray, bottom: np.ndarray, r0: int, r1: int) -> np.ndarray:
         """uint8 (r1 - r0, width): 1 at the rows v in [r0, r1) of each column u with
-        top[u] <= v < bottom[u] (none where bottom <= top), as (v - top) mod 2^bits < bottom - top:
-        a row above top wraps around to at least 2^bits - top, more than any span below ``height``."""
+        top[u] <= v < bottom[u] (none where bottom <= top)."""
         span = np.subtract(bottom, top, dtype=self._row_type)
         span[bottom <= top] = 0
+        return self._band_mask(span, top, r0, r1)
+
+    def _band_mask(
+        self, span: np.ndarray, top: np.ndarray, r0: int, r1: int, inside: bool = True
+    ) -> np.ndarray:
+        """uint8 (r1 - r0, width): 1 at the rows v in [r0, r1) of each column u with
+        top[u] <= v < top[u] + span[u], as (v - top) mod 2^bits < span: a row above top wraps
+        around to at least 2^bits - top, more than any span below ``height``; ``inside=False``:
+        1 at the other rows."""
         offset, mask = self._offset[: r1 - r0], self._mask[: r1 - r0]
         np.subtract(self._rows[r0:r1], top, out=offset)
-        np.less(offset, span, out=mask)
+        (np.less if inside else np.greater_equal)(offset, span, out=mask)
         return mask.view(np.uint8)
 
     def _paint(
@@ -712,7 +795,7 @@ class Camera:
             borderValue=0,
         )
         np.copyto(ink, 0, where=wall[first:])  # a wall stands there
-        painted = np.flatnonzero(ink)
+        painted = ink.reshape(-1).nonzero()[0]
         if not len(painted):
             return
         cells = rgb.view(_PIXEL).reshape(-1)
@@ -763,12 +846,16 @@ class _Seen:
         if not _ANY(repeated):
             return [None]
         n = len(col)
-        starts = np.flatnonzero(np.concatenate([[True], ~repeated]))
-        lengths = np.diff(np.append(starts, n))
-        from_far = np.repeat(starts + lengths, lengths)  # each crossing's column's end
+        # where each column's crossings start, and the end of the last column
+        bounds = np.ones(n + 1, dtype=bool)
+        np.logical_not(repeated, out=bounds[1:n])
+        edges = bounds.nonzero()[0]
+        ends = edges[1:]
+        lengths = ends - edges[:-1]
+        from_far = ends.repeat(lengths)  # each crossing's column's end
         from_far -= np.arange(1, n + 1)
-        passes = int(lengths.max())
-        return [np.flatnonzero(from_far == p) for p in range(passes)]
+        passes = int(_MAX(lengths))
+        return [(from_far == p).nonzero()[0] for p in range(passes)]
 
 
 class _Palette:
@@ -871,6 +958,49 @@ def _common_rows(n: int, *pairs: tuple[np.ndarray | None, np.ndarray | None]) ->
             same = same.all(axis=1)
         n = m if same.all() else int(np.argmin(same))
     return n
+
+
+def _fits(array: np.ndarray, shape: tuple[int, ...], dtype: type) -> bool:
+    flags = array.flags
+    return array.shape == shape and array.dtype == dtype and flags.c_contiguous and flags.writeable
+
+
+def _columns_over(band: np.ndarray, per_column: np.ndarray, background: np.ndarray, bare: np.ndarray) -> None:
+    """Draw ``band``: each column's value (``per_column``) repeated down its rows, and ``background``
+    copied back where ``bare`` (uint8) is set; each pixel written at most twice (OpenCV), with no
+    band-sized temporary."""
+    cv2 = _opencv()
+    cv2.repeat(per_column[None], band.shape[0], 1, dst=band)
+    cv2.copyTo(background, bare, band)
+
+
+def _background_around(image: np.ndarray, background: np.ndarray, r0: int, r1: int) -> None:
+    """``background``'s rows above ``r0`` and from ``r1`` on, copied into ``image``."""
+    image[:r0] = background[:r0]
+    image[r1:] = background[r1:]
+
+
+def _new_image(out: np.ndarray | None, like: np.ndarray) -> np.ndarray:
+    """``out``, or a new array shaped as ``like``, to be drawn in full."""
+    return np.empty_like(like) if out is None else out
+
+
+def _filled(out: np.ndarray | None, image: np.ndarray) -> np.ndarray:
+    """``image`` copied into ``out``, or a new copy of it."""
+    if out is None:
+        return image.copy()
+    np.copyto(out, image)
+    return out
+
+
+def _copied_into(
+    images: tuple[np.ndarray, np.ndarray], out: tuple[np.ndarray | None, np.ndarray | None]
+) -> tuple[np.ndarray, np.ndarray]:
+    """A still camera's last ``images`` again, each copied into its ``out`` array if it has one."""
+    return (
+        images[0] if out[0] is None else _filled(out[0], images[0]),
+        images[1] if out[1] is None else _filled(out[1], images[1]),
+    )
 
 
 def _flat_colours(scene: Scene, lighting: Lighting, it: np.ndarray, x: float, y: float) -> np.ndarray:

@@ -190,8 +190,10 @@ def imu(stamp: Time, frame: str, spec: ImuSpec, reading: tuple[float, float, flo
     return msg
 
 
-def rgb_image(stamp: Time, frame: str, rgb: np.ndarray) -> Any:
-    img = Image()
+def rgb_image(stamp: Time, frame: str, rgb: np.ndarray, img: Any = None) -> Any:
+    """rgb8; ``img``: the Image to fill (a publisher's loan, whose data ``rgb`` was drawn into)."""
+    if img is None:
+        img = Image()
     img.header.stamp = stamp
     img.header.frame_id = frame
     img.height, img.width = rgb.shape[0], rgb.shape[1]
@@ -202,9 +204,11 @@ def rgb_image(stamp: Time, frame: str, rgb: np.ndarray) -> Any:
     return img
 
 
-def depth_image(stamp: Time, frame: str, depth: np.ndarray) -> Any:
-    """16UC1 in millimetres, as RGB-D drivers publish ``depth/image_rect_raw``."""
-    d = Image()
+def depth_image(stamp: Time, frame: str, depth: np.ndarray, d: Any = None) -> Any:
+    """16UC1 in millimetres, as RGB-D drivers publish ``depth/image_rect_raw``; ``d``: the Image to
+    fill (a publisher's loan, whose data ``depth`` was drawn into)."""
+    if d is None:
+        d = Image()
     d.header.stamp = stamp
     d.header.frame_id = frame
     d.height, d.width = depth.shape[0], depth.shape[1]

@@ -696,16 +696,32 @@ class SimNode:
         want_colour = bool(want_raw or pubs["image_compressed"].get_num_connections())
         want_depth = bool("depth" in pubs and pubs["depth"].get_num_connections())
         if want_colour or want_depth:
-            rgb, depth = self.sim.render(
-                r, scene=self._scene(r), colour=want_colour, depth=want_depth, extra=extra
-            )
-            if want_colour:
-                img = messages.rgb_image(stamp, frame, rgb)
-                if want_raw:
-                    pubs["image"].publish(img)
-                pubs["image_compressed"].publish(img)
-            if want_depth:
-                pubs["depth"].publish(messages.depth_image(stamp, depth_frame, depth))
+            # the images are drawn straight into the publishers' loans: in a shared-memory slot of
+            # an SHMROS subscriber's ring, publish then copies nothing (else a heap array, as before)
+            h, w = camera.height, camera.width
+            colour_loan = pubs["image"].loan(h * w * 3) if want_raw else None
+            depth_loan = pubs["depth"].loan(h * w * 2) if want_depth else None
+            try:
+                with camera.drawing_into(
+                    None if colour_loan is None else colour_loan.msg.data.reshape(h, w, 3),
+                    None if depth_loan is None else depth_loan.msg.data.view("<u2").reshape(h, w),
+                ):
+                    rgb, depth = self.sim.render(
+                        r, scene=self._scene(r), colour=want_colour, depth=want_depth, extra=extra
+                    )
+                if want_colour:
+                    img = messages.rgb_image(
+                        stamp, frame, rgb, None if colour_loan is None else colour_loan.msg
+                    )
+                    if want_raw:
+                        pubs["image"].publish(img)
+                    pubs["image_compressed"].publish(img)
+                if depth_loan is not None:
+                    pubs["depth"].publish(messages.depth_image(stamp, depth_frame, depth, depth_loan.msg))
+            finally:
+                for loan in (colour_loan, depth_loan):
+                    if loan is not None:
+                        loan.release()
         intrinsics = camera.intrinsics()
         for key, frame_id in (("color_info", frame), ("depth_info", depth_frame)):
             if key in pubs and pubs[key].get_num_connections():

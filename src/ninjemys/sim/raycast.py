@@ -318,13 +318,17 @@ def column_pairs(
     if not n or not len(segments):
         return none
     c, s = math.cos(yaw), math.sin(yaw)
-    # both end points of every segment in the camera frame in one product: rows x0, y0, x1, y1
+    # per segment, one row each: both end points in the camera frame (x0, y0, x1, y1, from one
+    # product), the edge (ex, ey) and cross(p, e) (the same in any frame), so that culling and the
+    # gathers per crossing below are one call each for all of them
     turn = np.array([[c, -s, 0.0, 0.0], [s, c, 0.0, 0.0], [0.0, 0.0, c, -s], [0.0, 0.0, s, c]])
-    ends = turn.T @ (segments - (ox, oy, ox, oy)).T
-    x0, y0, x1, y1 = ends
-    ex, ey = x1 - x0, y1 - y0
-    num = x0 * ey
-    num -= y0 * ex  # cross(p, e): the same in any frame
+    rows = np.empty((7, len(segments)))
+    np.matmul(turn.T, (segments - (ox, oy, ox, oy)).T, out=rows[:4])
+    x0, y0, x1, y1, ex, ey, num = rows
+    np.subtract(x1, x0, out=ex)
+    np.subtract(y1, y0, out=ey)
+    np.multiply(x0, ey, out=num)
+    num -= y0 * ex
     # some point ahead of the camera and some point within the depth range (a point's depth is its x)
     keep = np.maximum(x0, x1) > 0.0
     keep &= np.minimum(x0, x1) <= depth_max
@@ -335,7 +339,8 @@ def column_pairs(
     if not m:
         return none
     if m < len(num):
-        ends, ex, ey, num = ends[:, idx], ex[idx], ey[idx], num[idx]
+        rows = rows.take(idx, axis=1)
+    ends, num = rows[:4], rows[6]
     # each end point's slope (lateral over ahead, left positive), in two rows: the smaller, the
     # larger; the columns follow from slopes (a pinhole camera's columns are evenly spaced in
     # slope), so no angle is computed. An end behind the camera (or beside it) is replaced by the
@@ -344,7 +349,7 @@ def column_pairs(
     # ``num`` for the second end behind and ``-num`` for the first
     xs = ends[0::2]
     ahead = xs > 0.0
-    at = np.outer(_AWAY, np.copysign(np.inf, num))
+    at = np.multiply.outer(_AWAY, np.copysign(np.inf, num))
     np.divide(ends[1::2], xs, out=at, where=ahead)
     at.sort(axis=0)
     k0 = float(slopes[0])
@@ -372,7 +377,8 @@ def column_pairs(
     col_of += (first.astype(np.intp) - (counts.cumsum() - counts)).repeat(counts)
     with np.errstate(divide="ignore", invalid="ignore"):
         # gathers by ``take``: a few times cheaper than fancy indexing at a thousand crossings
-        depth = num.take(seg_of) / (ey.take(seg_of) - slopes.take(col_of) * ex.take(seg_of))
+        ex, ey, num = rows[4:].take(seg_of, axis=1)
+        depth = num / (ey - slopes.take(col_of) * ex)
     ok = depth > 1e-9  # NaN (seen edge-on) fails too
     ok &= depth <= depth_max
     ok = ok.nonzero()[0]
