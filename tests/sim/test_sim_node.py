@@ -180,6 +180,20 @@ def test_services_pause_reset_spawn_delete(sims, client):
     sim = sims("_world:=office", "_rate:=5.0")
     clock = Latest(client, "/clock", Clock)
     clock.wait()
+    # the reset is judged in the callback, on every /clock message in order: time past the pause's,
+    # then under it again. At 5x real time the clock climbs back past the pause's time within a
+    # fraction of a second, which a poll of the latest message missed under load (20 s of "time back
+    # near 0" timed out at load 12)
+    paused_at: list[float] = []
+    ran_on, back = threading.Event(), threading.Event()
+
+    def on_clock(msg) -> None:  # type: ignore[no-untyped-def]
+        if paused_at and msg.clock.to_sec() > paused_at[0]:
+            ran_on.set()
+        elif ran_on.is_set() and msg.clock.to_sec() < paused_at[0]:
+            back.set()
+
+    client.subscriber("/clock", Clock, on_clock, queue_size=1000)
 
     def call(name, cls, **fields):  # type: ignore[no-untyped-def]
         client.wait_for_service(name, 10)
@@ -195,9 +209,11 @@ def test_services_pause_reset_spawn_delete(sims, client):
     time.sleep(0.5)
     assert clock.msg.clock.to_sec() == t_paused
     call("/gazebo/unpause_physics", Empty)
+    paused_at.append(t_paused)
     wait_until(lambda: clock.msg.clock.to_sec() > t_paused, what="time running again")
+    assert ran_on.wait(20.0), "the reset watcher saw no /clock after the pause's"
     call("/gazebo/reset_simulation", Empty)
-    wait_until(lambda: clock.msg.clock.to_sec() < t_paused, what="time back near 0")
+    assert back.wait(20.0), "no /clock back below the pause's time after reset_simulation"
 
     req = SpawnModel._request_class()
     req.model_name = "intruder"
