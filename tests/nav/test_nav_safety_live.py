@@ -316,7 +316,9 @@ def test_safety_live_teleop_over_navigation_and_the_watchdog_on_sim_time(rig):
     said = re.compile(r"navigation \(/nav/cmd_vel\) last came ([0-9.]+) s ago")
     assert rig.wait_real(lambda: said.search(rig.log()) is not None), rig.log()
     age = float(said.findall(rig.log())[-1])
-    assert 0.5 < age <= 0.5 + 0.1 + 0.1, age  # within a cycle or two (the scan watchdog's bound)
+    # not before its time (0.5 on the 10 ms /clock grid is stale in float: 0.5000000000000009, printed
+    # 0.500), then within a cycle or two (the scan watchdog's bound)
+    assert 0.5 <= age <= 0.5 + 0.1 + 0.1, age
     rig.settle(2.0)
     after = rig.cmds_from(last + 1e-6)
     first_zero = next(t for t, v, w in after if v == 0.0 and w == 0.0)
@@ -324,8 +326,9 @@ def test_safety_live_teleop_over_navigation_and_the_watchdog_on_sim_time(rig):
     zeros = [t for t, v, w in after if t >= first_zero]
     assert all(v == 0.0 and w == 0.0 for t, v, w in after if t >= first_zero)
     # zero twists for one second, then silence (as twist_mux, no stream of stops forever): one a
-    # cycle of its clock, 21 at most (a starved cycle is skipped, not made up: half of them at least)
-    assert 10 <= len(zeros) <= 21, zeros
+    # cycle of its clock, 21 in a second; its Rate makes up a late cycle or two (22, 23 seen at load
+    # 22) and skips starved ones
+    assert 10 <= len(zeros) <= 21 + 3, zeros
     rig.stream("teleop", 0.05, 0.0)
     assert rig.output() == pytest.approx((0.05, 0.0))  # a fresh command passes again
 
