@@ -321,10 +321,12 @@ def test_safety_live_teleop_over_navigation_and_the_watchdog_on_sim_time(rig):
     assert 0.5 <= age <= 0.5 + 0.1 + 0.1, age
     rig.settle(2.0)
     after = rig.cmds_from(last + 1e-6)
-    first_zero = next(t for t, v, w in after if v == 0.0 and w == 0.0)
-    assert all((v, w) == pytest.approx((0.2, 0.1)) for t, v, w in after if t < first_zero)
-    zeros = [t for t, v, w in after if t >= first_zero]
-    assert all(v == 0.0 and w == 0.0 for t, v, w in after if t >= first_zero)
+    # split in the order received, not by stamp: a loaded rig takes the last twists passed and the
+    # first stop in one step of its clock, with one stamp
+    cut = next(i for i, (t, v, w) in enumerate(after) if v == 0.0 and w == 0.0)
+    assert all((v, w) == pytest.approx((0.2, 0.1)) for t, v, w in after[:cut])
+    zeros = after[cut:]
+    assert all(v == 0.0 and w == 0.0 for t, v, w in zeros), after
     # zero twists for one second, then silence (as twist_mux, no stream of stops forever): one a
     # cycle of its clock, 21 in a second; its Rate makes up a late cycle or two (22, 23 seen at load
     # 22) and skips starved ones
