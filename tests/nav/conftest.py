@@ -16,6 +16,8 @@ import pytest
 
 from ninjemys.maps.mapfile import GridMap
 
+RUN = 16  # samples per beam and pass in cast(): 0.2 m at 5 cm cells
+
 
 def room_map(size: float = 6.0, res: float = 0.05) -> GridMap:
     """A square room with walls and two boxes (the shapes break the symmetry for localization)."""
@@ -29,20 +31,32 @@ def room_map(size: float = 6.0, res: float = 0.05) -> GridMap:
 
 
 def cast(grid: GridMap, pose: tuple[float, float, float], angles: np.ndarray, max_range: float) -> np.ndarray:
-    """Ranges from ``pose`` along ``angles`` (robot frame) to the first occupied cell, or inf."""
+    """Ranges from ``pose`` along ``angles`` (robot frame) to the first occupied cell, or inf.
+
+    Sampled every quarter cell, RUN samples at a time for the beams that have hit nothing yet: the
+    same samples and arithmetic as all of them at once, without the 360 x 400 arrays (a corner of the
+    maze closed-loop test cast 800 scans; at once they were 1.4 million page faults and 4 of its 6 s)."""
     step = grid.resolution / 4
     t = np.arange(0.0, max_range, step)
     world = pose[2] + angles
-    xs = pose[0] + np.cos(world)[:, None] * t[None, :]
-    ys = pose[1] + np.sin(world)[:, None] * t[None, :]
-    ix = np.floor((xs - grid.origin[0]) / grid.resolution).astype(int)
-    iy = np.floor((ys - grid.origin[1]) / grid.resolution).astype(int)
-    inside = (ix >= 0) & (ix < grid.width) & (iy >= 0) & (iy < grid.height)
-    occ = np.ones(xs.shape, dtype=bool)
-    occ[inside] = grid.data[iy[inside], ix[inside]] >= 50
-    first = np.argmax(occ, axis=1)
-    hit = occ.any(axis=1)
-    return np.where(hit, t[first], np.inf)
+    cos, sin = np.cos(world), np.sin(world)
+    ranges = np.full(len(angles), np.inf)
+    live = np.arange(len(angles))
+    for lo in range(0, len(t), RUN):
+        ts = t[lo : lo + RUN]
+        xs = pose[0] + cos[live, None] * ts[None, :]
+        ys = pose[1] + sin[live, None] * ts[None, :]
+        ix = np.floor((xs - grid.origin[0]) / grid.resolution).astype(int)
+        iy = np.floor((ys - grid.origin[1]) / grid.resolution).astype(int)
+        inside = (ix >= 0) & (ix < grid.width) & (iy >= 0) & (iy < grid.height)
+        occ = np.ones(xs.shape, dtype=bool)
+        occ[inside] = grid.data[iy[inside], ix[inside]] >= 50
+        hit = occ.any(axis=1)
+        ranges[live[hit]] = ts[np.argmax(occ[hit], axis=1)]
+        live = live[~hit]
+        if not live.size:
+            break
+    return ranges
 
 
 @pytest.fixture

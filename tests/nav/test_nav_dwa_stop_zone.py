@@ -81,8 +81,11 @@ class Maze:
         ok = np.isfinite(r)
         return np.column_stack([r[ok] * np.cos(ANGLES[ok]), r[ok] * np.sin(ANGLES[ok])])
 
-    def command(self, dwa: DWAPlanner, pose: tuple, vel: tuple[float, float]):
-        dwa.stop_points = self.scan(pose)
+    def command(
+        self, dwa: DWAPlanner, pose: tuple, vel: tuple[float, float], points: np.ndarray | None = None
+    ):
+        """DWA's command at ``pose``, its stop zone against ``points`` (default: the laser there)."""
+        dwa.stop_points = self.scan(pose) if points is None else points
         self.local.update_origin(pose[0], pose[1])
         self.local.update()
         return dwa.compute(pose, vel, self.local)
@@ -139,8 +142,9 @@ def test_corner_is_passed_with_no_command_refused(maze):
     for i in range(400):  # 20 s
         if i % 20 == 0:  # planner_frequency 1 Hz
             dwa.set_plan(maze.plan((x, y, th), goal))
-        cmd = maze.command(dwa, (x, y, th), (v, w))
-        if refused(zone, maze.scan((x, y, th)), cmd.v, cmd.w, v):
+        points = maze.scan((x, y, th))  # one scan a cycle, for the planner and the monitor
+        cmd = maze.command(dwa, (x, y, th), (v, w), points)
+        if refused(zone, points, cmd.v, cmd.w, v):
             vetoes += 1
             cmd.v = 0.0
         v, w = cmd.v, cmd.w

@@ -222,7 +222,13 @@ def test_spawn_and_delete_sdf_and_urdf_models_refused_inside_a_wall(gazebo: Gaze
 
 
 def test_apply_body_wrench_pushes_the_robot(gazebo: Gazebo) -> None:
+    GetWorldProperties = get_service_class("gazebo_msgs/GetWorldProperties")
+
+    def sim_time() -> float:
+        return float(gazebo.call("/gazebo/get_world_properties", GetWorldProperties).sim_time)
+
     x0, y0, _ = gazebo.model_states()["puzzlebot"]
+    start = sim_time()
     req = ApplyBodyWrench._request_class()
     req.wrench.force.y = 4.0
     req.duration.secs = 1
@@ -232,9 +238,12 @@ def test_apply_body_wrench_pushes_the_robot(gazebo: Gazebo) -> None:
     )  # fmt: skip
     assert resp.success, resp.status_message
     wait_until(lambda: gazebo.model_states()["puzzlebot"][1] > y0 + 0.5, 20, "pushed along +y")
-    time.sleep(0.5)
+    # the push lasts a second of sim time: waited for on sim time (a loaded simulator runs slower than
+    # the wall clock, and half a second of it could end before the push did)
+    wait_until(lambda: sim_time() > start + 1.0 + 0.5, 60, "the push's second of sim time over")
     y1 = gazebo.model_states()["puzzlebot"][1]
-    time.sleep(0.5)
+    then = sim_time()
+    wait_until(lambda: sim_time() > then + 0.5, 60, "half a second more of sim time")
     assert gazebo.model_states()["puzzlebot"][1] == pytest.approx(y1, abs=1e-3)  # the push ended: it stopped
     resp = gazebo.call("/gazebo/apply_body_wrench", ApplyBodyWrench, body_name="nobody::link")
     assert (resp.success, resp.status_message) == (False, "ApplyBodyWrench: body does not exist")

@@ -173,13 +173,26 @@ def test_sim_time_factor_and_rospy_rate_follow_it(sims, master, tmp_path, client
 
 
 def test_services_pause_reset_spawn_delete(sims, client):
-    from gazebo_msgs.srv import DeleteModel, SpawnModel
+    from gazebo_msgs.srv import DeleteModel, GetWorldProperties, SpawnModel
     from rosgraph_msgs.msg import Clock
     from std_srvs.srv import Empty
 
     sim = sims("_world:=office", "_rate:=5.0")
-    clock = Latest(client, "/clock", Clock)
-    clock.wait()
+    # /clock is judged in its callback, on every message in order, not by polling the latest: at 5x
+    # real time the clock climbed back past the pause's time after the reset before a loaded poll
+    # looked (20 s of "time back near 0" timed out at load 12); and the pause's time is the world's,
+    # not the newest /clock received 0.3 s later (a loaded machine may still be delivering older ones)
+    paused_at: list[float] = []
+    newest, ran_on, back = [0.0], threading.Event(), threading.Event()
+
+    def on_clock(msg) -> None:  # type: ignore[no-untyped-def]
+        newest[0] = t = msg.clock.to_sec()
+        if paused_at and t > paused_at[0] + 1e-6:  # (the world's float time vs. /clock's nanoseconds)
+            ran_on.set()
+        elif ran_on.is_set() and t < paused_at[0]:
+            back.set()
+
+    client.subscriber("/clock", Clock, on_clock, queue_size=1000)
 
     def call(name, cls, **fields):  # type: ignore[no-untyped-def]
         client.wait_for_service(name, 10)
@@ -189,15 +202,17 @@ def test_services_pause_reset_spawn_delete(sims, client):
             setattr(req, k, v)
         return proxy(req)
 
+    wait_until(lambda: newest[0] > 0.0, what="/clock in the test's callback")
     call("/gazebo/pause_physics", Empty)
-    time.sleep(0.3)
-    t_paused = clock.msg.clock.to_sec()
-    time.sleep(0.5)
-    assert clock.msg.clock.to_sec() == t_paused
+    t_paused = call("/gazebo/get_world_properties", GetWorldProperties).sim_time
+    time.sleep(0.5)  # paused: nothing moves meanwhile
+    assert call("/gazebo/get_world_properties", GetWorldProperties).sim_time == t_paused
+    assert newest[0] <= t_paused + 1e-6
+    paused_at.append(t_paused)
     call("/gazebo/unpause_physics", Empty)
-    wait_until(lambda: clock.msg.clock.to_sec() > t_paused, what="time running again")
+    assert ran_on.wait(20.0), "no /clock past the pause's time after unpause_physics"
     call("/gazebo/reset_simulation", Empty)
-    wait_until(lambda: clock.msg.clock.to_sec() < t_paused, what="time back near 0")
+    assert back.wait(20.0), "no /clock back below the pause's time after reset_simulation"
 
     req = SpawnModel._request_class()
     req.model_name = "intruder"

@@ -7,7 +7,7 @@ inputs below their priority while true or silent past their timeout). Every ``1 
 the fresh, unmasked input of highest priority goes out on ``cmd_vel``, after these guards:
 
 - watchdog: an input older than its timeout does not count; with none left the robot is stopped
-  (zero twists for one second, then silence);
+  (zero twists for one second, then silence; the stop is logged once with the last command's age);
 - stop zone: the linear velocity is cut to zero when driving the commanded arc for ``~reaction_time``
   and then braking (``~max_decel``) would bring the footprint (``~robot_radius`` or ``~footprint``)
   within ``~safety_margin`` (+ ``~obstacle_speed`` x that time, for people walking in) of a point of
@@ -327,6 +327,7 @@ class SafetyMonitor:
                 self.active = None
                 if self.stale_since is None:
                     self.stale_since = now
+                    self._report_timeout(now)
                 return 0.0, 0.0, now - self.stale_since <= 1.0
             self.stale_since = None
             self.active = inp.name
@@ -343,6 +344,23 @@ class SafetyMonitor:
             if self.blocked or self.scan_stale:
                 v = 0.0
             return v, w, True
+
+    def _report_timeout(self, now: float) -> None:
+        """Say once why the robot stops when every input went silent, with the newest command's age on
+        this node's clock (the watchdog's own measure, as the scan watchdog's line: a command that
+        reached a loaded node late is timed from its arrival, as in twist_mux). A stop by a lock, or
+        before any command came, is not the watchdog's and says nothing."""
+        heard = [inp for inp in self.mux.inputs if inp.last_time != NEVER]
+        if not heard or any(inp.fresh(now) for inp in heard):
+            return
+        last = max(heard, key=lambda inp: inp.last_time)
+        self.node.log.info(
+            "safety_monitor: no fresh command: %s (%s) last came %.3f s ago (timeout %.2f s); stopping",
+            last.name,
+            self.node.resolve_name(last.topic),
+            now - last.last_time,
+            last.timeout,
+        )
 
     def _time_moved_backwards(self, now: float) -> None:
         """A simulation reset or a looping bag: every age measured before is meaningless now, and a
