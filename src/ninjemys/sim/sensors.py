@@ -68,8 +68,9 @@ class LidarCache:
 
     def __init__(self) -> None:
         self._offsets: dict[tuple[float, int], np.ndarray] = {}
-        #: per lidar height: the arrays it was made from (by identity) and the prepared segments
-        self._static: dict[float, tuple[tuple[object, ...], SegmentSet]] = {}
+        #: per lidar height: the arrays it was made from (by identity), the prepared segments and
+        #: which moving ones it sees (None: all)
+        self._static: dict[float, tuple[tuple[object, ...], SegmentSet, np.ndarray | None]] = {}
 
     def offsets(self, increment: float, beams: int) -> np.ndarray:
         """``increment * arange(beams)``: each beam's angle from the first (never written to)."""
@@ -100,16 +101,15 @@ class LidarCache:
                 None if facing is None else facing[:k],
                 z,
             )
-            found = self._static[z] = (made, seen)
+            # the moving segments (after the prefix) it sees: their heights and bases do not move
+            tall = scene.heights[k:] >= z
+            if bases is not None:
+                tall &= bases[k:] <= z
+            found = self._static[z] = (made, seen, None if _ALL(tall) else tall)
         moving = scene.segments[k:]
         if not len(moving):
             return found[1], None
-        tall = scene.heights[k:] >= z
-        if scene.bases is not None:
-            tall &= scene.bases[k:] <= z
-        if not _ALL(tall):
-            moving = moving[tall]
-        return found[1], moving
+        return found[1], (moving if found[2] is None else moving[found[2]])
 
 
 def _seen(
