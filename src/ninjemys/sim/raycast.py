@@ -142,7 +142,8 @@ def segment_pairs(
     ray_of, seg_of = _spans(near, rel, a0)
     if not len(ray_of):
         return _NO_PAIRS
-    ray_of = order.take(ray_of, mode="wrap") if order is not None else ray_of % n
+    if order is not None:
+        ray_of = order.take(ray_of)
     t = _meet(near, ray_directions(angles), ray_of, seg_of, max_range)
     return ray_of, (seg_of if keep is None else keep.take(seg_of)), t
 
@@ -171,17 +172,12 @@ def cast_beams(
         return dist
     a0, rel, order = _sorted_rays(angles, in_order)
     ray_of, seg_of = _spans(near, rel, a0)
-    if not len(ray_of):
-        return dist
-    dirs = ray_directions(angles) if directions is None else directions
-    if order is not None:
-        ray_of = order.take(ray_of, mode="wrap")
+    if len(ray_of):
+        if order is not None:
+            ray_of = order.take(ray_of)
+        dirs = ray_directions(angles) if directions is None else directions
         np.minimum.at(dist, ray_of, _meet(near, dirs, ray_of, seg_of, max_range))
-        return dist
-    # positions past the last beam are the first ones again: folded after the minimum
-    turns = np.full(2 * n, np.inf)
-    np.minimum.at(turns, ray_of, _meet(near, dirs, ray_of, seg_of, max_range))
-    return np.minimum(turns[:n], turns[n:])
+    return dist
 
 
 def _sorted_rays(angles: np.ndarray, in_order: bool) -> tuple[float, np.ndarray, np.ndarray | None]:
@@ -266,12 +262,11 @@ def _near(
 
 def _spans(near: np.ndarray, rel: np.ndarray, a0: float) -> tuple[np.ndarray, np.ndarray]:
     """(ray position, segment) of every ray inside the angle a segment subtends, rays given by
-    their angles from ``a0`` (``rel``: sorted, in [0, 2 pi)): by segment, then by ray; positions
-    n and on are the rays 0 and on again (a take with ``mode="wrap"`` reads them).
+    their angles from ``a0`` (``rel``: sorted, in [0, 2 pi)): by segment, then by ray.
 
     A segment's end points' angles from ``a0`` bound its rays, found by ``searchsorted`` (with
     1e-12 rad of slack); one whose short arc crosses ``a0`` takes the rays from its larger angle
-    to the last and on from the first to its smaller one, as positions past the last."""
+    to the last and on from the first to its smaller one, as positions past n brought back."""
     n = len(rel)
     two_pi = 2.0 * math.pi
     at = np.arctan2(near[1::4], near[0::4])  # rows: the first end's angle, the second's
@@ -292,6 +287,7 @@ def _spans(near: np.ndarray, rel: np.ndarray, a0: float) -> tuple[np.ndarray, np
     seg_of = np.arange(len(counts)).repeat(counts)
     ray_of = np.arange(total)
     ray_of += (stop - counts.cumsum()).repeat(counts)
+    np.subtract(ray_of, n, out=ray_of, where=ray_of >= n)
     return ray_of, seg_of
 
 
@@ -303,7 +299,7 @@ def _meet(
 
     The crossing p + u e = t d: t = cross(p, e) / cross(d, e), u = cross(p, d) / cross(d, e),
     each product made for two rows at once."""
-    d = dirs.take(ray_of, axis=1, mode="wrap")  # dx, dy (positions past the last: see _spans)
+    d = dirs.take(ray_of, axis=1)  # dx, dy
     s = near[:4].take(seg_of, axis=1)  # px, py, ex, ey
     p, e_swapped = s[0:2], s[3:1:-1]
     pe = p * e_swapped  # px ey, py ex
