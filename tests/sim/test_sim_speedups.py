@@ -16,9 +16,9 @@ from camera_reference import assert_matches_reference
 from ninjemys.idl.loader import get_message_class
 from ninjemys.sim import camera as sim_camera
 from ninjemys.sim.puzzlebot_node import keep_freed_memory
-from ninjemys.sim.raycast import cast_segments
+from ninjemys.sim.raycast import cast_beams, cast_segments, prepare_segments
 from ninjemys.sim.robot_model import load_robot_model
-from ninjemys.sim.sensors import Scene
+from ninjemys.sim.sensors import LidarCache, Scene, lidar_ranges
 from ninjemys.sim.simcore import Simulation
 from ninjemys.sim.stepper import StepLock
 from ninjemys.sim.world2d import load_world
@@ -175,6 +175,70 @@ def test_cast_segments_equals_brute_force(seed):
             seen = np.isfinite(dist)
             assert np.allclose(dist[seen], expected[seen], rtol=0, atol=1e-9)
             assert (hit[seen] >= 0).all() and (hit[~seen] == -1).all()
+
+
+def random_lidar_scene(rng: np.random.Generator, moving: int, facing: bool) -> Scene:
+    """300 random segments (some lower than a lidar, some held above it, with ``facing`` some
+    said to face a way, as if sides of outlines), the last ``moving`` of them after the scene's
+    static prefix, as a moving obstacle's are."""
+    k = 300
+    start = rng.uniform(-15, 15, (k, 2))
+    segments = np.hstack([start, start + rng.uniform(-3, 3, (k, 2))])
+    heights = rng.choice([0.1, 0.5, 1.2], k)
+    bases = np.where(rng.random(k) < 0.1, 0.3, 0.0)
+    facing = rng.choice(np.array([-1, 0, 1], dtype=np.int8), k) * np.int8(facing)
+    facing[k - moving :] = 0
+    empty = np.zeros((0, 2))
+    return Scene(
+        segments, heights, np.zeros((k, 3), np.uint8), empty, np.zeros(0), np.zeros(0),
+        np.zeros((0, 3), np.uint8), facing=facing, bases=bases, prefix=segments[: k - moving],
+    )  # fmt: skip
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_lidar_ranges_equal_brute_force(seed):
+    """A lidar's scan (its static segments prepared once and kept in a cache, the moving ones cast
+    with them) against every beam x every segment it can see: a full turn from the back, a full
+    turn whose last beam is its first again (Gazebo's -pi..pi), a narrow fan; then the same scans
+    from a fresh cache, bit for bit."""
+    rng = np.random.default_rng(seed)
+    scene = random_lidar_scene(rng, moving=24, facing=False)
+    seen = (scene.heights >= 0.17) & (scene.bases <= 0.17)
+    cache = LidarCache()
+    fans = ((-math.pi, 2 * math.pi / 360, 360), (-math.pi, 2 * math.pi / 359, 360), (-0.4, 0.01, 81))
+    scans = []
+    for _ in range(3):
+        x, y, yaw = *rng.uniform(-5, 5, 2), rng.uniform(-10, 10)
+        for angle_min, inc, beams in fans:
+            for max_range in (12.0, 3.0):
+                ranges = lidar_ranges(
+                    scene, x, y, 0.17, yaw, angle_min, inc, beams, 0.0, max_range, 0.0, rng, cache
+                )
+                angles = yaw + angle_min + inc * np.arange(beams)
+                expected = brute_force_cast(x, y, angles, scene.segments[seen], max_range).astype(np.float32)
+                assert np.array_equal(np.isinf(ranges), np.isinf(expected))
+                assert np.allclose(ranges[np.isfinite(ranges)], expected[np.isfinite(expected)], rtol=1e-6)
+                scans.append((x, y, yaw, angle_min, inc, beams, max_range, ranges))
+    for x, y, yaw, angle_min, inc, beams, max_range, ranges in scans:
+        again = lidar_ranges(scene, x, y, 0.17, yaw, angle_min, inc, beams, 0.0, max_range, 0.0, rng)
+        assert np.array_equal(again, ranges)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_cast_beams_equals_cast_segments(seed):
+    """The lidar's cast (prepared segments, beams in order, moving segments apart) meets what
+    cast_segments meets from the same segments, bit for bit: the same pairs, the same sums."""
+    rng = np.random.default_rng(seed)
+    scene = random_lidar_scene(rng, moving=24, facing=True)
+    k = len(scene.prefix)
+    prepared = prepare_segments(scene.prefix, scene.facing[:k])
+    for _ in range(5):
+        x, y = rng.uniform(-5, 5, 2)
+        angles = rng.uniform(-10, 10) + (2 * math.pi / 360) * np.arange(360)
+        for max_range in (12.0, 3.0):
+            dist = cast_beams(x, y, angles, prepared, max_range, extra=scene.segments[k:], in_order=True)
+            expected, _ = cast_segments(x, y, angles, scene.segments, max_range, scene.facing)
+            assert np.array_equal(dist, expected)
 
 
 def valid_poses(sim: Simulation, count: int, seed: int) -> list[tuple[float, float, float]]:

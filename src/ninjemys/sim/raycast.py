@@ -18,6 +18,7 @@ hit within ``max_range``) and, for segments and circles, which one was hit.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -27,6 +28,50 @@ _ANY = np.logical_or.reduce
 _ALL = np.logical_and.reduce
 #: the sign of the side an end behind the camera stands for, for the first end and the second
 _AWAY = np.array([-1.0, 1.0])
+
+
+@dataclass(frozen=True, eq=False)
+class SegmentSet:
+    """Segments as the casts use them, with what depends on the segments alone worked out once
+    (:func:`prepare_segments`): a lidar keeps the static world's between scans, which then differ
+    only in where the eye stands and which way it looks."""
+
+    #: (6, k): x0, y0, ex, ey, x0, y0 (e = second end - first): less the eye's (x, y, 0, 0, x, y)
+    #: they are p, e, p (p: the first end seen from the eye), and one add makes the second p into q
+    rows: np.ndarray
+    #: (2, k): facing * ex and -(facing * ey), or None when no side is known to face a way: the
+    #: sides whose outer face looks at the eye are those with py face[0] + px face[1] >= 0
+    face: np.ndarray | None
+    #: (2, k): x0 + x1, y0 + y1 (twice the middle); (k,): the lengths (the broad phase by range)
+    middle: np.ndarray
+    length: np.ndarray
+    #: (x_lo, y_lo, x_hi, y_hi) of every end point: an eye whose farthest corner is within range
+    #: reaches all of them, and the broad phase by range is skipped
+    box: tuple[float, float, float, float]
+
+
+def prepare_segments(segments: np.ndarray, facing: np.ndarray | None = None) -> SegmentSet:
+    """``segments`` (k, 4) and their ``facing`` (see :func:`segment_pairs`) made ready to cast against."""
+    k = len(segments)
+    ends = np.asarray(segments, dtype=np.float64).T  # x0, y0, x1, y1
+    rows = np.empty((6, k))
+    rows[0:2] = ends[0:2]
+    np.subtract(ends[2:4], ends[0:2], out=rows[2:4])
+    rows[4:6] = ends[0:2]
+    face = None
+    if facing is not None and _ANY(facing != 0):
+        face = rows[2:4] * np.asarray(facing, dtype=np.float64)
+        np.negative(face[1], out=face[1])  # multiplying by +-1 and negating are exact: same signs
+    box = (0.0, 0.0, 0.0, 0.0)
+    if k:
+        lo, hi = np.minimum(ends[0:2], ends[2:4]).min(axis=1), np.maximum(ends[0:2], ends[2:4]).max(axis=1)
+        box = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
+    return SegmentSet(rows, face, ends[0:2] + ends[2:4], np.hypot(rows[2], rows[3]), box)
+
+
+#: the lower bounds of a crossing's (t, u): ahead of the eye, on the segment (ends included, and
+#: a hair beyond them, so that a ray through a shared corner meets one side or the other)
+_LOW = np.array([[0.0], [-1e-9]])
 
 
 def cast_segments(
@@ -40,7 +85,7 @@ def cast_segments(
     """Distance to the first segment along each ray (inf if none within ``max_range``) and its index (-1).
 
     ``angles`` are the rays' world angles in any order. The candidate pairs come from
-    :func:`segment_pairs`; the nearest per ray wins (on an exact tie, the pair listed last).
+    :func:`segment_pairs`; the nearest per ray wins (on an exact tie, the segment listed last).
     """
     n = len(angles)
     ray_of, seg_of, t = segment_pairs(ox, oy, angles, segments, max_range, facing)
@@ -72,14 +117,14 @@ def segment_pairs(
     facing: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Every (ray, segment) pair that can meet, and where: ``(ray_of, seg_of, t)`` with ``t`` the
-    distance along the ray to the segment, ``inf`` where they do not meet within ``max_range``.
+    distance along the ray to the segment, ``inf`` where they do not meet within ``max_range``;
+    by segment (ascending), then by ray position from the rays' smallest angle on.
 
     Each segment is paired only with the rays inside the angle it subtends from the origin (found
     with one ``searchsorted`` over the sorted rays), so the work grows with what is visible, not
-    with rays x segments. Every step is done for all segments at once (both end points in one
-    ``arctan2``, all span ends in two ``searchsorted``): at a few hundred segments the cost is the
-    number of numpy calls. The lidar takes the nearest pair per ray (:func:`nearest_hits`); the
-    camera also looks behind it for taller obstacles, from the same pairs.
+    with rays x segments. Every step is done for all segments at once: at a few hundred segments
+    the cost is the number of numpy calls. The lidar takes the nearest pair per ray
+    (:func:`cast_beams`, its segments prepared once); :func:`cast_segments` also says which one.
 
     ``facing`` (per segment: +1 or -1 for a side of a convex outline going counter-clockwise or
     clockwise, 0 otherwise) leaves out the sides whose outer face looks away from the origin: a
@@ -88,68 +133,190 @@ def segment_pairs(
     """
     angles = np.asarray(angles, dtype=np.float64)
     n = len(angles)
-    none = (np.zeros(0, np.intp), np.zeros(0, np.intp), np.zeros(0))
     if not n or not len(segments):
-        return none
-    # first end point relative to the origin (p), edge vector (e), second end point (q = p + e)
-    px, py = segments[:, 0] - ox, segments[:, 1] - oy
-    ex, ey = segments[:, 2] - segments[:, 0], segments[:, 3] - segments[:, 1]
-    qx, qy = px + ex, py + ey
-    # broad phase: a segment whose middle is farther than max_range plus half its length cannot be
-    # hit within range (a superset of the segments that come within range: same answers)
-    near = np.hypot(px + qx, py + qy) - np.hypot(ex, ey) <= 2.0 * max_range + 1e-9
-    if facing is not None:
-        # the origin on a side's outer side: (origin - p) . outward normal >= 0, the outward normal
-        # being (ey, -ex) for a counter-clockwise outline and its opposite for a clockwise one
-        near &= facing * (py * ex - px * ey) >= 0
-    if not near.all():
-        keep = np.flatnonzero(near)
-        if not len(keep):
-            return none
-        # gathers by ``take`` (the same elements as fancy indexing, a few times cheaper at this size)
-        px, py, ex, ey = px.take(keep), py.take(keep), ex.take(keep), ey.take(keep)
-        qx, qy = qx.take(keep), qy.take(keep)
-    else:
-        keep = None
-    k = len(px)
-    two_pi = 2.0 * math.pi
-    a0 = float(angles.min())
-    rel = (angles - a0) % two_pi
-    if n < 2 or _ALL(rel[1:] >= rel[:-1]):
-        # already in order (a lidar's evenly spaced beams): the stable sort would be the identity
-        order, rel_sorted = None, rel
-    else:
-        order = np.argsort(rel, kind="stable")
-        rel_sorted = rel[order]
-    ends = (np.arctan2(np.concatenate([py, qy]), np.concatenate([px, qx])) - a0) % two_pi
-    r1, r2 = ends[:k], ends[k:]
-    lo, hi = np.minimum(r1, r2), np.maximum(r1, r2)
-    wrap = (hi - lo) > math.pi
-    left = np.searchsorted(rel_sorted, np.concatenate([lo, hi]) - 1e-12, "left")
-    right = np.searchsorted(rel_sorted, np.concatenate([hi, lo]) + 1e-12, "right")
-    # spans of sorted ray positions: [lo, hi] or, for a segment whose short arc crosses the first
-    # ray, [hi, end) and then [0, lo] (the wrapping ones get a second span, after all the first ones)
-    w = np.flatnonzero(wrap)
-    starts = np.concatenate([np.where(wrap, left[k:], left[:k]), np.zeros(len(w), np.intp)])
-    stops = np.concatenate([np.where(wrap, n, right[:k]), right[k:][w]])
-    seg_ids = np.concatenate([np.arange(k), w])
-    counts = np.maximum(stops - starts, 0)
-    total = int(counts.sum())
-    if not total:
-        return none
-    seg_of = np.repeat(seg_ids, counts)
-    shift = np.repeat(starts - (np.cumsum(counts) - counts), counts)
-    ray_of = np.arange(total) + shift
+        return _NO_PAIRS
+    a0, rel, order = _sorted_rays(angles, False)
+    near, keep = _near(ox, oy, prepare_segments(segments, facing), max_range)
+    if near is None:
+        return _NO_PAIRS
+    ray_of, seg_of = _spans(near, rel, a0)
+    if not len(ray_of):
+        return _NO_PAIRS
     if order is not None:
         ray_of = order.take(ray_of)
-    dx, dy = np.cos(angles).take(ray_of), np.sin(angles).take(ray_of)
-    sx, sy, gx, gy = px.take(seg_of), py.take(seg_of), ex.take(seg_of), ey.take(seg_of)
-    denom = dx * gy - dy * gx
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t = (sx * gy - sy * gx) / denom
-        u = (sx * dy - sy * dx) / denom
-    t[~((u >= -1e-9) & (u <= 1 + 1e-9) & (t >= 0) & (t <= max_range))] = np.inf  # NaN fails too
+    t = _meet(near, ray_directions(angles), ray_of, seg_of, max_range)
     return ray_of, (seg_of if keep is None else keep.take(seg_of)), t
+
+
+def cast_beams(
+    ox: float,
+    oy: float,
+    angles: np.ndarray,
+    segments: SegmentSet,
+    max_range: float,
+    directions: np.ndarray | None = None,
+    extra: np.ndarray | None = None,
+    in_order: bool = False,
+) -> np.ndarray:
+    """A lidar's :func:`cast_segments` distances, bit for bit (from the same pairs): its
+    ``segments`` prepared once (:func:`prepare_segments`) and ``extra`` ones (k, 4), which move,
+    cast with them; ``directions``: the beams' (cos, sin) (:func:`ray_directions`) if known;
+    ``in_order``: the angles increase (a lidar's evenly spaced beams), not checked.
+    """
+    n = len(angles)
+    dist = np.full(n, np.inf)
+    if not n:
+        return dist
+    near, _ = _near(ox, oy, segments, max_range, extra)
+    if near is None:
+        return dist
+    a0, rel, order = _sorted_rays(angles, in_order)
+    ray_of, seg_of = _spans(near, rel, a0)
+    if len(ray_of):
+        if order is not None:
+            ray_of = order.take(ray_of)
+        dirs = ray_directions(angles) if directions is None else directions
+        np.minimum.at(dist, ray_of, _meet(near, dirs, ray_of, seg_of, max_range))
+    return dist
+
+
+def _sorted_rays(angles: np.ndarray, in_order: bool) -> tuple[float, np.ndarray, np.ndarray | None]:
+    """The rays' smallest angle a0, their angles from it in [0, 2 pi) sorted, and the sort's order
+    (None: they came in order). ``in_order``: they increase, from a0 = the first, and when they
+    span less than a turn nothing else is done."""
+    two_pi = 2.0 * math.pi
+    if in_order:
+        a0 = float(angles[0])
+        rel = angles - a0
+        if rel[-1] < two_pi:
+            return a0, rel, None
+    else:
+        a0 = float(angles.min())
+        rel = angles - a0
+    rel %= two_pi
+    if len(rel) < 2 or _ALL(rel[1:] >= rel[:-1]):
+        # already in order (a lidar's evenly spaced beams): the stable sort would be the identity
+        return a0, rel, None
+    order = np.argsort(rel, kind="stable")
+    return a0, rel.take(order), order
+
+
+def ray_directions(angles: np.ndarray) -> np.ndarray:
+    """(2, n): the rays' cos and sin (a lidar's circles and segments cast along the same)."""
+    dirs = np.empty((2, len(angles)))
+    np.cos(angles, out=dirs[0])
+    np.sin(angles, out=dirs[1])
+    return dirs
+
+
+def _near(
+    ox: float, oy: float, segs: SegmentSet, max_range: float, extra: np.ndarray | None = None
+) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """The segments seen from (ox, oy) that can be met within ``max_range`` (a superset of them):
+    their (6, k) p, e, q (rows as in :attr:`SegmentSet.rows`), and their indices (None: all of
+    them; ``extra``'s numbered after ``segs``' and never left out); (None, None) if none.
+
+    Two broad phases, both answer-neutral: the sides facing away (see :func:`segment_pairs`), and
+    the segments out of range, the latter only when the world reaches beyond twice the range (an
+    office's few far segments cost less to cast than to cull)."""
+    k = segs.rows.shape[1]
+    m = 0 if extra is None else len(extra)
+    eye = np.array([[ox], [oy], [0.0], [0.0], [ox], [oy]])
+    if not m:
+        near = segs.rows - eye
+    else:
+        assert extra is not None
+        near = np.empty((6, k + m))
+        np.subtract(segs.rows, eye, out=near[:, :k])
+        ends = extra.T
+        np.subtract(ends[0:2], eye[0:2], out=near[0:2, k:])
+        np.subtract(ends[2:4], ends[0:2], out=near[2:4, k:])
+        near[4:6, k:] = near[0:2, k:]
+    near[4:6] += near[2:4]
+    x_lo, y_lo, x_hi, y_hi = segs.box
+    ranged = math.hypot(max(ox - x_lo, x_hi - ox), max(oy - y_lo, y_hi - oy)) > 2.0 * max_range
+    if not k or (segs.face is None and not ranged):
+        return (near if k + m else None), None
+    if segs.face is not None:
+        # the eye on a side's outer side: (eye - p) . outward normal >= 0, the outward normal being
+        # (ey, -ex) for a counter-clockwise outline and its opposite for a clockwise one
+        turned = near[1::-1, :k] * segs.face
+        keep = turned[0] + turned[1] >= 0.0
+    else:
+        keep = np.ones(k, dtype=bool)
+    if ranged:
+        # a segment whose middle is farther than max_range plus half its length cannot be met
+        # within range (with a hair of slack for rounding: a superset, the same answers)
+        away = np.hypot(segs.middle[0] - 2.0 * ox, segs.middle[1] - 2.0 * oy)
+        away -= segs.length
+        keep &= away <= 2.0 * max_range + 1e-9
+    idx = keep.nonzero()[0]
+    if m:
+        idx = np.concatenate([idx, np.arange(k, k + m)])
+    if len(idx) == k + m:
+        return near, None
+    if not len(idx):
+        return None, None
+    return near.take(idx, axis=1), idx
+
+
+def _spans(near: np.ndarray, rel: np.ndarray, a0: float) -> tuple[np.ndarray, np.ndarray]:
+    """(ray position, segment) of every ray inside the angle a segment subtends, rays given by
+    their angles from ``a0`` (``rel``: sorted, in [0, 2 pi)): by segment, then by ray.
+
+    A segment's end points' angles from ``a0`` bound its rays, found by ``searchsorted`` (with
+    1e-12 rad of slack); one whose short arc crosses ``a0`` takes the rays from its larger angle
+    to the last and on from the first to its smaller one, as positions past n brought back."""
+    n = len(rel)
+    two_pi = 2.0 * math.pi
+    at = np.arctan2(near[1::4], near[0::4])  # rows: the first end's angle, the second's
+    at -= a0
+    at %= two_pi
+    ends = np.empty_like(at)  # rows: the smaller, the larger (a sort along axis 0 costs more)
+    np.minimum(at[0], at[1], out=ends[0])
+    np.maximum(at[0], at[1], out=ends[1])
+    wrap = ends[1] - ends[0] > math.pi
+    ends = np.where(wrap, ends[::-1], ends)  # rows: where the rays start, where they stop
+    start = rel.searchsorted(ends[0] - 1e-12, "left")
+    stop = rel.searchsorted(ends[1] + 1e-12, "right")
+    np.add(stop, n, out=stop, where=wrap)
+    counts = stop - start
+    total = int(np.add.reduce(counts))
+    if not total:
+        return _NO_PAIRS[0], _NO_PAIRS[1]
+    seg_of = np.arange(len(counts)).repeat(counts)
+    ray_of = np.arange(total)
+    ray_of += (stop - counts.cumsum()).repeat(counts)
+    np.subtract(ray_of, n, out=ray_of, where=ray_of >= n)
+    return ray_of, seg_of
+
+
+def _meet(
+    near: np.ndarray, dirs: np.ndarray, ray_of: np.ndarray, seg_of: np.ndarray, max_range: float
+) -> np.ndarray:
+    """Distance along each ray ``ray_of`` (``dirs``: (2, n) cos, sin) to segment ``seg_of`` (of
+    ``near``, as :func:`_near` gives it), inf where they do not meet within ``max_range``.
+
+    The crossing p + u e = t d: t = cross(p, e) / cross(d, e), u = cross(p, d) / cross(d, e),
+    each product made for two rows at once."""
+    d = dirs.take(ray_of, axis=1)  # dx, dy
+    s = near[:4].take(seg_of, axis=1)  # px, py, ex, ey
+    p, e_swapped = s[0:2], s[3:1:-1]
+    pe = p * e_swapped  # px ey, py ex
+    de = d * e_swapped  # dx ey, dy ex
+    pd = p * d[::-1]  # px dy, py dx
+    num = np.empty_like(pd)
+    np.subtract(pe[0], pe[1], out=num[0])
+    np.subtract(pd[0], pd[1], out=num[1])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tu = num / (de[0] - de[1])  # rows t, u
+    ok = tu >= _LOW
+    ok &= tu <= np.array([[max_range], [1 + 1e-9]])  # NaN (parallel) fails both
+    return np.where(ok[0] & ok[1], tu[0], np.inf)
+
+
+#: the answer when no pair can meet (shared, never written to)
+_NO_PAIRS = (np.zeros(0, np.intp), np.zeros(0, np.intp), np.zeros(0))
 
 
 def grid_edges(occupied: np.ndarray, resolution: float, origin_x: float, origin_y: float) -> np.ndarray:
@@ -183,14 +350,21 @@ def grid_edges(occupied: np.ndarray, resolution: float, origin_x: float, origin_
 
 
 def cast_circles(
-    ox: float, oy: float, angles: np.ndarray, centers: np.ndarray, radii: np.ndarray, max_range: float
+    ox: float,
+    oy: float,
+    angles: np.ndarray,
+    centers: np.ndarray,
+    radii: np.ndarray,
+    max_range: float,
+    directions: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Distance to the first circle along each ray (inf if none) and its index (-1); rays starting
-    inside a circle do not see it (a robot's own body)."""
+    inside a circle do not see it (a robot's own body). ``directions``: the rays' (cos, sin) if
+    known (:func:`ray_directions`)."""
     n = len(angles)
     if not len(centers):
         return np.full(n, np.inf), np.full(n, -1, dtype=np.intp)
-    dx, dy = np.cos(angles), np.sin(angles)
+    dx, dy = ray_directions(angles) if directions is None else directions
     cx = centers[:, 0] - ox
     cy = centers[:, 1] - oy
     b = dx[:, None] * cx + dy[:, None] * cy  # projection of the centre on the ray

@@ -11,7 +11,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ninjemys.sim.lighting import SceneLook
-from ninjemys.sim.raycast import cast_circles, cast_segments
+from ninjemys.sim.raycast import SegmentSet, cast_beams, cast_circles, prepare_segments, ray_directions
+
+_ALL = np.logical_and.reduce  # ``a.all()`` without numpy's Python-level wrapper
 
 
 @dataclass
@@ -55,6 +57,75 @@ class FloorPaint:
     resolution: float
 
 
+class LidarCache:
+    """What a simulation's lidar scans share from one scan to the next (kept by the simulation, one
+    for all its lidars): the beams' angles from the first and, per lidar height, the static world's
+    segments that lidar sees (:attr:`Scene.prefix`, as tall as the lidar and standing on the floor
+    below it) made ready to cast against; a scan then costs what depends on where the lidar is."""
+
+    #: the most lidar heights kept (robots standing on table tops carry theirs higher)
+    HEIGHTS = 8
+
+    def __init__(self) -> None:
+        self._offsets: dict[tuple[float, int], np.ndarray] = {}
+        #: per lidar height: the arrays it was made from (by identity), the prepared segments and
+        #: which moving ones it sees (None: all)
+        self._static: dict[float, tuple[tuple[object, ...], SegmentSet, np.ndarray | None]] = {}
+
+    def offsets(self, increment: float, beams: int) -> np.ndarray:
+        """``increment * arange(beams)``: each beam's angle from the first (never written to)."""
+        key = (increment, beams)
+        found = self._offsets.get(key)
+        if found is None:
+            found = self._offsets[key] = increment * np.arange(beams)
+        return found
+
+    def segments(self, scene: Scene, z: float) -> tuple[SegmentSet, np.ndarray | None]:
+        """What a lidar at height ``z`` casts against in ``scene``: the static segments it sees,
+        prepared (kept while the scene's static world is the same arrays), and the moving ones it
+        sees after them (None if there are none), as (k, 4)."""
+        prefix = scene.prefix
+        if prefix is None:  # no static world named: all of it, prepared for this scan only
+            return _seen(scene.segments, scene.heights, scene.bases, scene.facing, z), None
+        k = len(prefix)
+        made = (prefix, scene.heights, scene.bases, scene.facing)
+        found = self._static.get(z)
+        if found is None or any(a is not b for a, b in zip(found[0], made, strict=True)):
+            if len(self._static) >= self.HEIGHTS:
+                self._static.clear()
+            heights, bases, facing = scene.heights[:k], scene.bases, scene.facing
+            seen = _seen(
+                prefix,
+                heights,
+                None if bases is None else bases[:k],
+                None if facing is None else facing[:k],
+                z,
+            )
+            # the moving segments (after the prefix) it sees: their heights and bases do not move
+            tall = scene.heights[k:] >= z
+            if bases is not None:
+                tall &= bases[k:] <= z
+            found = self._static[z] = (made, seen, None if _ALL(tall) else tall)
+        moving = scene.segments[k:]
+        if not len(moving):
+            return found[1], None
+        return found[1], (moving if found[2] is None else moving[found[2]])
+
+
+def _seen(
+    segments: np.ndarray, heights: np.ndarray, bases: np.ndarray | None, facing: np.ndarray | None, z: float
+) -> SegmentSet:
+    """The segments a planar lidar at height ``z`` sees, prepared: as tall as it, and of those
+    held above the floor only the ones reaching down to it."""
+    tall = heights >= z
+    if bases is not None:
+        tall &= bases <= z
+    if not _ALL(tall):
+        segments = segments[tall]
+        facing = facing[tall] if facing is not None else None
+    return prepare_segments(segments, facing)
+
+
 def lidar_ranges(
     scene: Scene,
     x: float,
@@ -68,24 +139,23 @@ def lidar_ranges(
     range_max: float,
     noise: float,
     rng: np.random.Generator,
+    cache: LidarCache | None = None,
 ) -> np.ndarray:
     """float32 ranges (REP 117: +inf no return within range_max, -inf closer than range_min).
 
     Only obstacles at least as tall as the lidar (``z``) are seen, as with a real planar lidar, and
-    of those held above the floor (``scene.bases``) only the ones reaching down to it.
+    of those held above the floor (``scene.bases``) only the ones reaching down to it. ``cache``:
+    what the caller's earlier scans left to reuse (a scan with none makes its own).
     """
-    angles = yaw + angle_min + increment * np.arange(beams)
-    tall = scene.heights >= z
-    if scene.bases is not None:
-        tall &= scene.bases <= z
-    segments, facing = scene.segments, scene.facing
-    if not tall.all():
-        segments = segments[tall]
-        facing = facing[tall] if facing is not None else None
-    dist, _ = cast_segments(x, y, angles, segments, range_max, facing)
+    if cache is None:
+        cache = LidarCache()
+    angles = yaw + angle_min + cache.offsets(increment, beams)
+    static, moving = cache.segments(scene, z)
+    dirs = ray_directions(angles)
+    dist = cast_beams(x, y, angles, static, range_max, dirs, moving, increment > 0)
     if len(scene.circles):
         tall_c = scene.circle_heights >= z
-        cd, _ = cast_circles(x, y, angles, scene.circles[tall_c], scene.radii[tall_c], range_max)
+        cd, _ = cast_circles(x, y, angles, scene.circles[tall_c], scene.radii[tall_c], range_max, dirs)
         dist = np.minimum(dist, cd)
     if noise > 0:
         dist = dist + rng.normal(0.0, noise, beams)

@@ -24,7 +24,7 @@ from ninjemys.errors import NinjemysError
 from ninjemys.sim.camera import Camera
 from ninjemys.sim.raycast import grid_edges
 from ninjemys.sim.robot_model import CameraSpec, LaserSpec, RobotModel
-from ninjemys.sim.sensors import FloorPaint, Scene, imu_reading, lidar_ranges
+from ninjemys.sim.sensors import FloorPaint, LidarCache, Scene, imu_reading, lidar_ranges
 from ninjemys.sim.world2d import MovingObstacle, Obstacle, World, box_outline, circle_outline
 
 TRAIL_LENGTH = 2000
@@ -169,6 +169,8 @@ class Simulation:
         self._mover_fixed: tuple | None = None
         self._mover_joined: tuple[np.ndarray, np.ndarray, list[str]] | None = None
         self._floor = floor_paint(world)
+        #: what the lidars' scans reuse from one to the next (the static world prepared per height)
+        self._lidar = LidarCache()
         for name, (x, y, yaw) in world.model_poses.items():  # an SDF world's models: their own poses
             self.obstacle_origin[name] = (x, y)
             self.obstacle_yaw[name] = yaw
@@ -1001,6 +1003,7 @@ class Simulation:
             spec.range_max,
             spec.noise,
             r.rng,
+            self._lidar,
         )
 
     def render(
