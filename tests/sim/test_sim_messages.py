@@ -4,6 +4,7 @@ the node's sensor parameters, and Gazebo's frame arithmetic."""
 from __future__ import annotations
 
 import math
+import os
 import threading
 import time
 
@@ -208,6 +209,42 @@ def test_stepper_pauses_and_counts() -> None:
     assert len(steps) >= 50 and stepper.stepped == pytest.approx(0.01 * len(steps))
     assert "simulated" in stepper.summary() and not errors
     assert not any(t.name == "test-stepper" for t in threading.enumerate())
+
+
+def test_a_paced_stepper_behind_its_rate_lets_a_waiter_in_at_the_next_step() -> None:
+    """A simulator paced at real time whose steps take longer than they simulate (a loaded
+    machine) steps back to back: a service waiting for the lock gets it after the step under way,
+    not whenever the stepping thread happens to lose the race for it (both threads on one CPU,
+    where the stepping thread used to win it step after step)."""
+    lock = StepLock()
+    count = {"n": 0}
+
+    def step() -> None:  # 20 ms of CPU for 10 ms of simulated time
+        count["n"] += 1
+        end = time.thread_time() + 0.02
+        while time.thread_time() < end:
+            pass
+
+    errors: list[Exception] = []
+    cpu = min(os.sched_getaffinity(0))
+    before = os.sched_getaffinity(0)
+    os.sched_setaffinity(0, {cpu})  # this thread, and the threads it starts, on one CPU
+    try:
+        stepper = Stepper(step, lambda: count["n"] * 0.01, 0.01, 1.0, lock, errors.append)
+        stepper.start()
+        try:
+            waits = []
+            for _ in range(10):
+                time.sleep(0.03)
+                asked = count["n"]
+                with lock:
+                    waits.append(count["n"] - asked)
+        finally:
+            stepper.stop()
+    finally:
+        os.sched_setaffinity(0, before)
+    assert not errors and count["n"] >= 10
+    assert max(waits) <= 1, waits  # the step under way finishes, then the waiter is in
 
 
 def test_a_failing_step_is_reported_and_stepping_goes_on() -> None:

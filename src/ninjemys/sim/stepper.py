@@ -184,5 +184,10 @@ class Stepper:
                 if delay > 0:
                     self._wake.wait(delay)
                     self._wake.clear()
-                elif delay < -0.25:  # far behind (machine busy): run on from now, no burst to catch up
+                    continue
+                if delay < -0.25:  # far behind (machine busy): run on from now, no burst to catch up
                     wall0, sim0 = time.monotonic(), self._sim_time()
+                # behind its rate it steps back to back, as fast as possible: give way as then (a
+                # loaded machine had a paced simulator take its lock straight back, and Gazebo's
+                # services and spawns waited for it for a minute)
+                self.lock.give_way(0.5)
