@@ -182,16 +182,21 @@ def test_a_client_that_reads_gets_everything_through_the_window(
     make_gateway: Callable[..., Gateway], node: Node
 ) -> None:
     """The window only paces: a client that keeps reading (its library answers the pings) gets every
-    message of a burst many windows long."""
-    gateway = make_gateway(client_window=WINDOW, queue_length=100)
+    message of a burst many windows long. The burst fits the client's outbox twice over: on a loaded
+    machine the whole of it can reach the gateway before its sender has written a window, and past
+    ``max_client_bytes`` the outbox drops the oldest (what the slow-client tests want, not this one)."""
+    burst = 30  # 9 MB: about 35 windows
+    gateway = make_gateway(
+        client_window=WINDOW, queue_length=100, max_client_bytes=2 * burst * len(FRAME.data)
+    )
     with connect(
         f"ws://127.0.0.1:{gateway.port}/", subprotocols=["foxglove.websocket.v1"], close_timeout=0.5
     ) as ws:
         images = _subscribed(gateway, node, "/camera/paced", ws)
-        for _ in range(30):  # 9 MB: about 35 windows
+        for _ in range(burst):
             images.publish(FRAME)
         got = 0
-        while got < 30:
+        while got < burst:
             data = ws.recv(timeout=30)
             if isinstance(data, bytes) and data[0] == 0x01:
                 got += 1
