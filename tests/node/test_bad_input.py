@@ -166,3 +166,24 @@ def test_misbehaving_publisher_is_dropped(pair, caplog, fake_publisher: FakePubl
     assert wait_until(lambda: _logged(caplog, expected)), [r.getMessage() for r in caplog.records]
     assert len(_logged(caplog, expected)) == 1
     _still_works(pub, got, expected)
+
+
+def test_a_subscriber_gone_before_its_hello_leaves_the_node_working(pair) -> None:
+    """A subscriber that hangs up between its header and the publisher's answer: the hello's write
+    fails while the publication's lock is held, and the connection's end is reported after it (it
+    was reported inline, on the I/O thread, waiting for that same lock: the thread hung and with it
+    every later call of the process)."""
+    talker, _listener, pub, got = pair
+    publication = talker._publications["/chatter"]
+    ours, theirs = socket.socketpair()
+    theirs.close()  # gone: the publisher's first write fails (EPIPE)
+    ours.setblocking(False)
+    header = {
+        "callerid": "/gone",
+        "topic": "/chatter",
+        "type": String._type,
+        "md5sum": String._md5sum,
+    }
+    talker.runtime.run(publication.accept(ours, header), timeout=5)
+    assert wait_until(lambda: pub.get_num_connections() == 1)  # the dead one removed, the listener kept
+    _still_works(pub, got, "after a subscriber that hung up")

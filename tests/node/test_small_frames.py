@@ -19,6 +19,9 @@ class _Loop:
     def call_soon(self, fn: Any, *args: Any) -> None:
         self.calls.append(fn)
 
+    def defer(self, fn: Any, *args: Any) -> None:
+        self.calls.append(fn)
+
     def call_later(self, delay: float, fn: Any, *args: Any) -> None:
         self.calls.append(fn)
 

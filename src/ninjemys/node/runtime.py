@@ -67,6 +67,16 @@ class Runtime:
         except RuntimeError:
             _log.debug("I/O loop already closed; dropped %r", fn)
 
+    def defer(self, fn: Callable[..., Any], *args: Any) -> None:
+        """Run ``fn(*args)`` at the loop's next turn, even when called on the loop itself: for a call
+        that takes a lock its caller may hold (a connection that fails while its publication's lock
+        is held reports its end this way; run inline, the report waited for that lock on the I/O
+        thread, and every later operation of the process waited for the I/O thread)."""
+        try:
+            self.loop.call_soon_threadsafe(fn, *args)
+        except RuntimeError:
+            _log.debug("I/O loop already closed; dropped %r", fn)
+
     def spawn(self, coro: Coroutine[Any, Any, T]) -> ThreadFuture:
         """Schedule ``coro`` on the loop and return a future usable from any thread."""
         try:

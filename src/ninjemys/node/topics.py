@@ -466,7 +466,9 @@ class PubConnection:
         self._queued_bytes = 0
         self._partial = None
         self.node.runtime.call_soon(self._release_socket)
-        self.node.runtime.call_soon(self.node.connection_closed, self)
+        # deferred: a connection fails under locks (accept sends its hello holding the publication's
+        # lock, which connection_closed takes)
+        self.node.runtime.defer(self.node.connection_closed, self)
 
     def _release_socket(self) -> None:
         loop = self.node.runtime.loop
@@ -540,6 +542,8 @@ class Publication:
             reply = headers.encode_header(auth.sign_fields(self.reply_header(extra)))
             frames = [f for f in (h.latched_frame() for h in self.handles if h.latch) if f is not None]
             conn.send_hello(reply, frames)
+            if conn.closed:  # the subscriber hung up before its answer went out (logged by _fail)
+                return
             conn.num_sent = 1 if frames else 0
             self.connections = (*self.connections, conn)
         conn.watch()
