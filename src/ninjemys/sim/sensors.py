@@ -102,9 +102,7 @@ class LidarCache:
                 z,
             )
             # the moving segments (after the prefix) it sees: their heights and bases do not move
-            tall = scene.heights[k:] >= z
-            if bases is not None:
-                tall &= bases[k:] <= z
+            tall = _tall(scene.heights[k:], None if bases is None else bases[k:], z)
             found = self._static[z] = (made, seen, None if _ALL(tall) else tall)
         moving = scene.segments[k:]
         if not len(moving):
@@ -112,14 +110,21 @@ class LidarCache:
         return found[1], (moving if found[2] is None else moving[found[2]])
 
 
+def _tall(heights: np.ndarray, bases: np.ndarray | None, z: float) -> np.ndarray:
+    """Which segments a planar lidar at height ``z`` sees: as tall as it and, if held above the
+    floor, reaching down to it."""
+    tall = heights >= z
+    if bases is not None:
+        tall &= bases <= z
+    return tall
+
+
 def _seen(
     segments: np.ndarray, heights: np.ndarray, bases: np.ndarray | None, facing: np.ndarray | None, z: float
 ) -> SegmentSet:
     """The segments a planar lidar at height ``z`` sees, prepared: as tall as it, and of those
     held above the floor only the ones reaching down to it."""
-    tall = heights >= z
-    if bases is not None:
-        tall &= bases <= z
+    tall = _tall(heights, bases, z)
     if not _ALL(tall):
         segments = segments[tall]
         facing = facing[tall] if facing is not None else None
